@@ -1,0 +1,5 @@
+import sys
+
+from netplc.cli import main
+
+sys.exit(main())

@@ -1,0 +1,257 @@
+"""The NetPlc engine: one scan every NetSyncTime tick (DESIGN sections 1 and 4).
+
+Only the engine thread mutates memory. Everything else (network results, operator writes, Modbus
+server writes) is queued with `post`/`write_*` and applied at the start of the next scan, and
+readers use the immutable snapshot published after each scan. The program is compiled once into
+generated Python (netplc/compiler.py); netplc/interpreter.py is the plain reference kept beside it.
+"""
+
+from __future__ import annotations
+
+import time
+from collections import deque
+from collections.abc import Callable
+from dataclasses import dataclass
+from enum import Enum
+
+from netplc.address import (
+    ALWAYS_ONE,
+    EMERGENCY_STOP,
+    FERR1,
+    TIMEBASE_HI,
+    TIMEBASE_LO,
+    BitRef,
+    fmt_octal,
+)
+from netplc.functions.registry import Fon, FunctionSpec, NetLink, lookup
+from netplc.memory import Memory, Snapshot
+from netplc.program import Program
+from netplc.records import NullSink, Record, RecordSink
+from netplc.rtc import Rtc
+from netplc.timers import run_ctr, run_tim, update_generators
+
+WATCHDOG_STEPS = 1_000_000  # instructions (reference) or blocks (compiled) per scan before faulting
+
+
+class RunState(str, Enum):
+    RUNNING = "running"
+    HALTED = "halted"  # by HLT
+    STOPPED = "stopped"  # by the emergency-stop bit 03770 (code 11), the operator, or the watchdog
+
+
+@dataclass
+class ScanStats:
+    count: int = 0
+    last_ms: float = 0.0
+    max_ms: float = 0.0
+    mean_ms: float = 0.0
+    overruns: int = 0  # scans that took longer than the tick
+
+    def add(self, ms: float, tick_ms: float) -> None:
+        self.count += 1
+        self.last_ms = ms
+        self.max_ms = max(self.max_ms, ms)
+        self.mean_ms += (ms - self.mean_ms) / self.count
+        if ms > tick_ms:
+            self.overruns += 1
+
+
+class FakeClock:
+    """A clock that moves only when told to: for tests and `python -m netplc run`."""
+
+    def __init__(self, start: float = 0.0) -> None:
+        self.t = start
+
+    def __call__(self) -> float:
+        return self.t
+
+    def advance(self, seconds: float) -> None:
+        self.t += seconds
+
+
+class Engine:
+    def __init__(
+        self,
+        program: Program,
+        *,
+        clock: Callable[[], float] = time.monotonic,
+        wallclock: Callable[[], float] = time.time,
+        sink: RecordSink | None = None,
+        exchange: NetLink | None = None,
+        tick: float = 0.1,
+        memory: Memory | None = None,
+        compiled: bool = True,
+    ) -> None:
+        self.mem = memory or Memory()
+        self.clock = clock
+        self.wallclock = wallclock
+        self.sink: RecordSink = sink or NullSink()
+        self.exchange = exchange
+        self.tick = tick
+        self.compiled = compiled
+        self.node = 0
+        self.scan_counter = 0
+        self.now = clock()
+        self.dt = 0.0
+        self._start = self.now
+        self.state = RunState.RUNNING
+        self.stop_code = 0
+        self.stats = ScanStats()
+        self.tim_ticks: dict[int, float] = {}  # TIM current values by coil address C
+        self.ctr_values: dict[int, int] = {}  # CTR current values by coil address C
+        self.rtc = Rtc()
+        self.listeners: list[Callable[[Snapshot], None]] = []
+        self._queue: deque[Callable[[Memory], None]] = deque()
+        self._faulted: set[int] = set()
+        self.mem.bits[TIMEBASE_LO] = 1  # 0.1 s time base after start, as on a CPU-165
+        self.mem.bits[TIMEBASE_HI] = 0
+        self.snapshot: Snapshot = self._publish()
+        self.load(program)
+
+    # --- program -------------------------------------------------------------------------------
+
+    def load(self, program: Program) -> None:
+        """Install a program (memory, timer and counter values are kept)."""
+        from netplc.compiler import compile_program
+        from netplc.interpreter import Interpreter
+
+        self.program = program
+        self.fons: dict[int, tuple[Fon, FunctionSpec | None]] = {}
+        for index, ins in enumerate(program.instrs):
+            if ins.op == "FON":
+                fon = Fon(ins.c or 0, ins.n or 0, ins.s, ins.d, ins.r, index, ins.line)
+                self.fons[index] = (fon, lookup(fon.f))
+        self._run = compile_program(program, self) if self.compiled else Interpreter(program, self).run
+
+    # --- what the program calls ----------------------------------------------------------------
+
+    def wall_time(self) -> float:
+        return self.wallclock()
+
+    def tim(self, c: int, n: int, res: int) -> None:
+        run_tim(self.mem.bits, self.tim_ticks, c, n, res, self.dt)
+
+    def ctr(self, c: int, n: int, res: int) -> None:
+        run_ctr(self.mem.bits, self.ctr_values, c, n, res)
+
+    def fon(self, index: int, res: int) -> None:
+        """Bit C = RES; while RES is 1 the function runs every scan (level semantics)."""
+        fon, spec = self.fons[index]
+        self.mem.bits[fon.c] = res
+        if not res:
+            return
+        if spec is None:
+            self.mem.bits[FERR1] = 1
+            return
+        try:
+            spec.run(self, fon)
+        except (ValueError, IndexError) as e:  # AddressError is a ValueError: a bad computed address
+            self.mem.bits[FERR1] = 1
+            self._fault_once(index, f"{spec.mnemonic} at line {fon.line}: {e}")
+        except Exception as e:  # noqa: BLE001 - a function bug must not stop the plant
+            self.mem.bits[FERR1] = 1
+            self._fault_once(index, f"{spec.mnemonic} at line {fon.line} failed: {e!r}")
+
+    def _fault_once(self, index: int, text: str) -> None:
+        if index not in self._faulted:
+            self._faulted.add(index)
+            self.sink.put(Record(self.wall_time(), "system", source="netplc", text=text))
+
+    # --- queued writes -------------------------------------------------------------------------
+
+    def post(self, fn: Callable[[Memory], None]) -> None:
+        """Run `fn(memory)` at the start of the next scan (thread-safe)."""
+        self._queue.append(fn)
+
+    def write_bit(self, addr: int | BitRef, value: int, *, user: str = "operator") -> None:
+        """Queue an operator write of an HMI bit address (journaled when applied)."""
+        hmi = addr.hmi if isinstance(addr, BitRef) else addr
+
+        def apply(mem: Memory) -> None:
+            old = mem.get_hmi_bit(hmi)
+            mem.set_hmi_bit(hmi, value)
+            self._journal(user, fmt_octal(hmi, 6 if hmi >= 0o40000 else 5), old, 1 if value else 0, hmi)
+
+        self.post(apply)
+
+    def write_word(self, addr: int, value: int, *, user: str = "operator") -> None:
+        def apply(mem: Memory) -> None:
+            old = mem.get_word(addr)
+            mem.set_word(addr, value)
+            self._journal(user, fmt_octal(addr), old, value & 0xFFFF, addr)
+
+        self.post(apply)
+
+    def write_bytes(self, addr: int, payload: bytes, *, user: str = "operator") -> None:
+        def apply(mem: Memory) -> None:
+            old = mem.read(addr, len(payload))
+            mem.write(addr, payload)
+            self._journal(user, f"{fmt_octal(addr)}:{len(payload)}", old.hex(" "), payload.hex(" "), addr)
+
+        self.post(apply)
+
+    def _journal(self, user: str, where: str, old: object, new: object, addr: int) -> None:
+        value = float(new) if isinstance(new, int) else None
+        self.sink.put(
+            Record(self.wall_time(), "operator", source=user, number=addr, value=value,
+                   text=f"write {where}: {old} -> {new}")
+        )
+
+    # --- run control ---------------------------------------------------------------------------
+
+    def start(self) -> None:
+        """Leave HALTED/STOPPED: clears the emergency-stop bit, as an operator's restart does."""
+        self.mem.bits[EMERGENCY_STOP] = 0
+        self.state = RunState.RUNNING
+        self.stop_code = 0
+
+    def stop(self, code: int = 0) -> None:
+        self.state = RunState.STOPPED
+        self.stop_code = code
+
+    @property
+    def state_text(self) -> str:
+        if self.state is RunState.STOPPED and self.stop_code:
+            return f"stopped, code {self.stop_code}"
+        return self.state.value
+
+    # --- the scan ------------------------------------------------------------------------------
+
+    def scan(self) -> Snapshot:
+        t0 = time.perf_counter()
+        now = self.clock()
+        self.dt = max(0.0, now - self.now)
+        self.now = now
+        mem = self.mem
+        queue = self._queue
+        while queue:
+            fn = queue.popleft()
+            try:
+                fn(mem)
+            except ValueError as e:  # a queued write to an address that does not exist
+                self.sink.put(Record(self.wall_time(), "system", source="netplc", text=f"write refused: {e}"))
+        bits = mem.bits
+        bits[ALWAYS_ONE] = 1
+        update_generators(bits, now - self._start)
+        self.rtc.update(mem, self.wall_time())
+        if bits[EMERGENCY_STOP] and self.state is RunState.RUNNING:
+            self.stop(11)
+        if self.state is RunState.RUNNING:
+            outcome = self._run()
+            if outcome == "halt":
+                self.state = RunState.HALTED
+            elif outcome == "watchdog":
+                self.stop(0)
+                self.sink.put(Record(self.wall_time(), "system", source="netplc",
+                                     text="watchdog: the scan did not reach its end (endless jump loop)"))
+            if bits[EMERGENCY_STOP]:
+                self.stop(11)
+        self.scan_counter += 1
+        self.snapshot = self._publish()
+        self.stats.add((time.perf_counter() - t0) * 1000.0, self.tick * 1000.0)
+        for listener in self.listeners:
+            listener(self.snapshot)
+        return self.snapshot
+
+    def _publish(self) -> Snapshot:
+        return self.mem.snapshot(self.scan_counter, self.now, self.wall_time(), self.state_text)

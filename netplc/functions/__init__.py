@@ -1,0 +1,1 @@
+"""FON functions, one module per group of the manual's section 3; see registry.py."""

@@ -1,0 +1,87 @@
+"""The reference interpreter: the instruction semantics of DESIGN section 4, written plainly.
+
+The compiled engine must leave memory exactly as this does (tests/netplc/test_compiled_equivalence.py).
+"""
+
+from __future__ import annotations
+
+from typing import TYPE_CHECKING
+
+from netplc.program import Program
+
+if TYPE_CHECKING:
+    from netplc.engine import Engine
+
+TERMINATORS = frozenset({"YON", "SON", "SOF", "SKP", "JMY", "JMN", "TIM", "CTR", "FON"})
+
+
+class Interpreter:
+    def __init__(self, program: Program, engine: Engine) -> None:
+        self.instrs = program.instrs
+        self.engine = engine
+
+    def run(self) -> str | None:
+        """One scan; returns None at the end, "halt" on HLT, "watchdog" on an endless loop."""
+        from netplc.engine import WATCHDOG_STEPS
+
+        eng = self.engine
+        bits = eng.mem.bits
+        instrs = self.instrs
+        acc, sm = 1, 0
+        pc = 0
+        steps = 0
+        while pc < len(instrs):
+            steps += 1
+            if steps > WATCHDOG_STEPS:
+                return "watchdog"
+            ins = instrs[pc]
+            op = ins.op
+            pc += 1
+            if op == "TNA":
+                acc &= bits[ins.c]
+            elif op == "TFA":
+                acc &= bits[ins.c] ^ 1
+            elif op == "TNO":
+                acc |= bits[ins.c]
+            elif op == "TFO":
+                acc |= bits[ins.c] ^ 1
+            elif op == "TNE":
+                sm |= acc
+                acc = bits[ins.c]
+            elif op == "TFE":
+                sm |= acc
+                acc = bits[ins.c] ^ 1
+            elif op == "NOP":
+                continue
+            elif op == "HLT":
+                return "halt"
+            elif op == "JMP":
+                if ins.target is None:
+                    return None
+                pc = ins.target
+                acc, sm = 1, 0
+            else:
+                res = sm | acc
+                acc, sm = 1, 0
+                if op == "YON":
+                    bits[ins.c] = res
+                elif op == "SON":
+                    if res:
+                        bits[ins.c] = 1
+                elif op == "SOF":
+                    if res:
+                        bits[ins.c] = 0
+                elif op == "SKP":
+                    if not res:
+                        pc += 1
+                elif op == "TIM":
+                    eng.tim(ins.c, ins.n, res)
+                elif op == "CTR":
+                    eng.ctr(ins.c, ins.n, res)
+                elif op == "FON":
+                    eng.fon(pc - 1, res)
+                elif (op == "JMY" and res) or (op == "JMN" and not res):
+                    if ins.target is None:
+                        return None
+                    pc = ins.target
+        return None

@@ -1,0 +1,400 @@
+"""STL program text -> a validated list of instructions (DESIGN section 5).
+
+An engineer's typo must come back as `file:line:col: message`, all of them at once, never as a
+traceback, so the parser collects diagnostics and raises one ProgramError at the end.
+"""
+
+from __future__ import annotations
+
+import csv
+import re
+from dataclasses import dataclass, field
+from pathlib import Path
+
+from netplc.address import IO_BITS, AddressError, check_operand, fmt_octal, parse_octal
+from netplc.functions.registry import DEFINED_CODES, FunctionSpec, lookup
+
+PROGRAM_WORDS = 0o20000  # 8 K words of program memory
+
+# mnemonic -> (parameter keys it takes, size in words)
+LOGIC = {
+    "NOP": ((), 1), "TNA": (("C",), 1), "TFA": (("C",), 1), "TNO": (("C",), 1),
+    "TFO": (("C",), 1), "TNE": (("C",), 1), "TFE": (("C",), 1), "SKP": ((), 1),
+    "SON": (("C",), 1), "SOF": (("C",), 1), "YON": (("C",), 1), "HLT": ((), 1),
+    "FON": (("C", "N", "S", "D", "R"), 5), "TIM": (("C", "N"), 2), "CTR": (("C", "N"), 2),
+    "JMY": (("L",), 1), "JMN": (("L",), 1), "JMP": (("L",), 1),
+}
+CONTACTS = frozenset({"TNA", "TFA", "TNO", "TFO", "TNE", "TFE"})
+JUMPS = frozenset({"JMY", "JMN", "JMP"})
+# bits used by a coil-like instruction at C: C..C+n-1 must be I/O bits
+COIL_BITS = {"SON": 1, "SOF": 1, "YON": 1, "TIM": 2, "CTR": 3, "FON": 4}
+
+_NAME = r"[^\W\d][\w.\[\]]*"
+_LINE_NO = re.compile(r"\s*\d+\.\d+\s+")
+_LABEL = re.compile(rf"\s*({_NAME})\s*:(?![^\s;])")
+_SYMDEF = re.compile(rf"\s*({_NAME})\s*=\s*(\S+)\s*$")
+_MNEMONIC = re.compile(r"\s*([A-Za-z]+)\b")
+_PARAM = re.compile(r"\s*(?:([A-Za-z])\s*:\s*)?([^\s;:]+)\s*;?")
+
+
+@dataclass(frozen=True, slots=True)
+class Diagnostic:
+    file: str
+    line: int
+    col: int
+    message: str
+
+    def __str__(self) -> str:
+        return f"{self.file}:{self.line}:{self.col}: {self.message}"
+
+
+class ProgramError(Exception):
+    """All problems found in a program (or symbols file), each with its position."""
+
+    def __init__(self, errors: list[Diagnostic]) -> None:
+        self.errors = errors
+        super().__init__("\n".join(str(e) for e in errors))
+
+
+@dataclass(frozen=True, slots=True)
+class Instr:
+    op: str
+    c: int | None = None
+    n: int | None = None  # TIM/CTR preset, FON function number
+    s: int | None = None
+    d: int | None = None
+    r: int | None = None
+    target: int | None = None  # jump: instruction index, or None for "end of scan" (JMP 0)
+    addr: int = 0  # word address in program memory
+    line: int = 0
+    text: str = ""
+
+
+@dataclass
+class Program:
+    instrs: list[Instr]
+    symbols: dict[str, int] = field(default_factory=dict)
+    source: str = "<program>"
+    words: int = 0
+
+    def functions(self) -> list[tuple[Instr, FunctionSpec | None]]:
+        return [(i, lookup(i.n or 0)) for i in self.instrs if i.op == "FON"]
+
+
+def load_symbols(path: str | Path) -> dict[str, int]:
+    """Read `symbols.csv` (name,address,comment); ProgramError names the file and line."""
+    path = Path(path)
+    errors: list[Diagnostic] = []
+    symbols: dict[str, int] = {}
+    try:
+        text = path.read_text(encoding="utf-8-sig")
+    except OSError as e:
+        raise ProgramError([Diagnostic(str(path), 0, 0, f"cannot read symbols: {e.strerror}")]) from None
+    for lineno, row in enumerate(csv.reader(text.splitlines()), start=1):
+        if not row or not row[0].strip() or row[0].lstrip().startswith(("#", ";")):
+            continue
+        if lineno == 1 and row[0].strip().lower() == "name":
+            continue
+        name = row[0].strip()
+        if len(row) < 2:
+            errors.append(Diagnostic(str(path), lineno, 1, f"symbol {name!r} has no address"))
+            continue
+        try:
+            addr = parse_octal(row[1])
+        except ValueError as e:
+            errors.append(Diagnostic(str(path), lineno, len(row[0]) + 2, str(e)))
+            continue
+        if not re.fullmatch(_NAME, name):
+            errors.append(Diagnostic(str(path), lineno, 1, f"{name!r} is not a valid symbol name"))
+        elif name in symbols:
+            errors.append(Diagnostic(str(path), lineno, 1, f"symbol {name!r} defined twice"))
+        else:
+            symbols[name] = addr
+    if errors:
+        raise ProgramError(errors)
+    return symbols
+
+
+def parse_file(path: str | Path, symbols: dict[str, int] | None = None) -> Program:
+    path = Path(path)
+    try:
+        text = path.read_text(encoding="utf-8-sig")
+    except (OSError, UnicodeDecodeError) as e:
+        raise ProgramError([Diagnostic(str(path), 0, 0, f"cannot read program: {e}")]) from None
+    return parse(text, source=str(path), symbols=symbols)
+
+
+@dataclass
+class _Raw:
+    line: int
+    col: int
+    op: str
+    params: dict[str, tuple[str, int]]  # key -> (token, col)
+    text: str
+
+
+def parse(text: str, source: str = "<program>", symbols: dict[str, int] | None = None) -> Program:
+    """Parse STL text; raise ProgramError listing every problem."""
+    p = _Parser(source, dict(symbols or {}))
+    return p.run(text)
+
+
+class _Parser:
+    def __init__(self, source: str, symbols: dict[str, int]) -> None:
+        self.source = source
+        self.symbols = symbols
+        self.errors: list[Diagnostic] = []
+
+    def err(self, line: int, col: int, msg: str) -> None:
+        self.errors.append(Diagnostic(self.source, line, col, msg))
+
+    def run(self, text: str) -> Program:
+        raws: list[_Raw] = []
+        labels: dict[str, int] = {}  # label -> instruction index
+        for lineno, line in enumerate(text.splitlines(), start=1):
+            self._scan_line(lineno, line, raws, labels)
+        instrs: list[Instr] = []
+        words = 0
+        addr_of: list[int] = []
+        for raw in raws:
+            addr_of.append(words)
+            words += LOGIC[raw.op][1]
+        by_addr = {a: i for i, a in enumerate(addr_of)}
+        for index, raw in enumerate(raws):
+            ins = self._build(raw, index, addr_of[index], labels, by_addr)
+            if ins is not None:
+                instrs.append(ins)
+        if words > PROGRAM_WORDS:
+            self.err(raws[-1].line, 1, f"program needs {words} words; program memory holds {PROGRAM_WORDS}")
+        if self.errors:
+            self.errors.sort(key=lambda d: (d.line, d.col))
+            raise ProgramError(self.errors)
+        return Program(instrs, self.symbols, self.source, words)
+
+    def _scan_line(self, lineno: int, line: str, raws: list[_Raw], labels: dict[str, int]) -> None:
+        stripped = line.strip()
+        if not stripped or stripped.startswith((";", "#", "//")):
+            return
+        m = _SYMDEF.match(line)
+        if m:
+            name, value = m.group(1), m.group(2)
+            try:
+                addr = parse_octal(value)
+            except ValueError:
+                self.err(lineno, m.start(2) + 1, f"symbol {name!r}: {value!r} is not a $octal address")
+                return
+            if name in self.symbols:
+                self.err(lineno, m.start(1) + 1, f"symbol {name!r} defined twice")
+            self.symbols[name] = addr
+            return
+        pos = 0
+        m = _LINE_NO.match(line, pos)
+        if m:
+            pos = m.end()
+        m = _LABEL.match(line, pos)
+        if m:
+            label = m.group(1)
+            if label in labels:
+                self.err(lineno, m.start(1) + 1, f"label {label!r} defined twice")
+            else:
+                labels[label] = len(raws)
+            pos = m.end()
+            if not line[pos:].strip() or line[pos:].strip().startswith((";", "#")):
+                return  # a label alone on its line names the next instruction
+        m = _MNEMONIC.match(line, pos)
+        if not m:
+            self.err(lineno, pos + 1 + len(line[pos:]) - len(line[pos:].lstrip()), "expected an instruction")
+            return
+        op = m.group(1).upper()
+        if op not in LOGIC:
+            self.err(lineno, m.start(1) + 1, f"unknown instruction {m.group(1)!r}")
+            return
+        keys = LOGIC[op][0]
+        pos = m.end()
+        params: dict[str, tuple[str, int]] = {}
+        rest = line[pos:]
+        # a trailing comment after two spaces and ';;' or '#'
+        for marker in (" #", ";;", " //"):
+            cut = rest.find(marker)
+            if cut >= 0:
+                rest = rest[:cut]
+        ok = True
+        i = 0
+        while i < len(rest):
+            if rest[i] in " \t;":
+                i += 1
+                continue
+            pm = _PARAM.match(rest, i)
+            if not pm or pm.end() == i:
+                self.err(lineno, pos + i + 1, f"cannot read parameter at {rest[i:].strip()!r}")
+                ok = False
+                break
+            key = (pm.group(1) or "").upper()
+            token = pm.group(2)
+            col = pos + pm.start(2) + 1
+            if not key:
+                # a positional parameter: the first one the instruction takes that is not given yet
+                free = [k for k in keys if k not in params]
+                if not free:
+                    self.err(lineno, col, f"{op} takes no more parameters (extra {token!r})")
+                    ok = False
+                    break
+                key = free[0]
+            if key not in keys:
+                self.err(lineno, col, f"{op} has no parameter {key}:" if keys else f"{op} takes no parameters")
+                ok = False
+            elif key in params:
+                self.err(lineno, col, f"parameter {key}: given twice")
+                ok = False
+            else:
+                params[key] = (token, col)
+            i = pm.end()
+        if ok:
+            raws.append(_Raw(lineno, m.start(1) + 1, op, params, stripped))
+
+    # --- values ------------------------------------------------------------------------------
+
+    def _address(self, raw: _Raw, key: str, nbytes: int = 1) -> int | None:
+        token, col = raw.params[key]
+        if token.startswith("$") or token[0].isdigit():
+            try:
+                addr = parse_octal(token)
+            except ValueError:
+                self.err(raw.line, col, f"{key}: {token!r} is not an octal address")
+                return None
+        elif token in self.symbols:
+            addr = self.symbols[token]
+        else:
+            self.err(raw.line, col, f"{key}: unknown symbol {token!r}")
+            return None
+        try:
+            check_operand(addr, nbytes)
+        except AddressError as e:
+            self.err(raw.line, col, f"{key}: {e}")
+            return None
+        return addr
+
+    def _coil(self, raw: _Raw, nbits: int) -> int | None:
+        if "C" not in raw.params:
+            self.err(raw.line, raw.col, f"{raw.op} needs C: (a bit address)")
+            return None
+        token, col = raw.params["C"]
+        addr = self._address(raw, "C")
+        if addr is None:
+            return None
+        if addr >= IO_BITS or addr + nbits > IO_BITS:
+            what = "an I/O bit" if nbits == 1 else f"{nbits} I/O bits"
+            self.err(raw.line, col, f"C: {fmt_octal(addr)} is not {what} (00000-03777)")
+            return None
+        return addr
+
+    def _const(self, raw: _Raw, key: str, kind: str, lo: int = 0, hi: int = 0xFFFF) -> int | None:
+        token, col = raw.params[key]
+        if token.startswith("$") or token in self.symbols:
+            self.err(raw.line, col, f"{key}: a constant is needed here, not the address {token!r}")
+            return None
+        if kind == "B":
+            if not token.isdigit() or len(token) > 4:
+                self.err(raw.line, col, f"{key}: {token!r} is not a BCD constant (up to 4 decimal digits)")
+                return None
+            return int(token, 16)
+        radix, name = (8, "octal") if kind == "O" else (10, "decimal")
+        try:
+            value = int(token, radix)
+        except ValueError:
+            self.err(raw.line, col, f"{key}: {token!r} is not a {name} number")
+            return None
+        if not lo <= value <= hi:
+            self.err(raw.line, col, f"{key}: {token} is outside {lo}-{hi}")
+            return None
+        return value
+
+    def _build(
+        self, raw: _Raw, index: int, addr: int, labels: dict[str, int], by_addr: dict[int, int]
+    ) -> Instr | None:
+        op = raw.op
+        common = {"addr": addr, "line": raw.line, "text": raw.text}
+        if op in CONTACTS:
+            c = self._coil(raw, 1)
+            return None if c is None else Instr(op, c=c, **common)
+        if op in ("SON", "SOF", "YON"):
+            c = self._coil(raw, 1)
+            return None if c is None else Instr(op, c=c, **common)
+        if op in ("NOP", "SKP", "HLT"):
+            return Instr(op, **common)
+        if op in JUMPS:
+            if "L" not in raw.params:
+                self.err(raw.line, raw.col, f"{op} needs a label")
+                return None
+            token, col = raw.params["L"]
+            if token.isdigit():
+                value = int(token, 8)
+                if value == 0:
+                    return Instr(op, target=None, **common)
+                if value not in by_addr:
+                    self.err(raw.line, col, f"L: program address {token} is not the start of an instruction")
+                    return None
+                return Instr(op, target=by_addr[value], **common)
+            if token not in labels:
+                self.err(raw.line, col, f"L: undefined label {token!r}")
+                return None
+            return Instr(op, target=labels[token], **common)
+        if op in ("TIM", "CTR"):
+            c = self._coil(raw, COIL_BITS[op])
+            if "N" not in raw.params:
+                self.err(raw.line, raw.col, f"{op} needs N: (preset 0-255)")
+                return None
+            n = self._const(raw, "N", "D", 0, 255)
+            if c is None or n is None:
+                return None
+            return Instr(op, c=c, n=n, **common)
+        return self._build_fon(raw, common)
+
+    def _build_fon(self, raw: _Raw, common: dict) -> Instr | None:
+        c = self._coil(raw, COIL_BITS["FON"])
+        if "N" not in raw.params:
+            self.err(raw.line, raw.col, "FON needs N: (function number or mnemonic)")
+            return None
+        token, col = raw.params["N"]
+        spec: FunctionSpec | None = None
+        if token.isdigit():
+            number = int(token)
+            if number not in DEFINED_CODES:
+                self.err(raw.line, col, f"N: function {number} does not exist")
+                return None
+            spec = lookup(number)
+        else:
+            spec = lookup(token)
+            if spec is None:
+                self.err(raw.line, col, f"N: unknown function {token!r}")
+                return None
+            number = spec.number
+        values: dict[str, int | None] = {"S": None, "D": None, "R": None}
+        ok = c is not None
+        if spec is not None:
+            for key, kind in spec.kinds().items():
+                if kind is None:
+                    if key in raw.params:
+                        self.err(raw.line, raw.params[key][1], f"{spec.mnemonic} takes no {key}: parameter")
+                        ok = False
+                    continue
+                if key not in raw.params:
+                    self.err(raw.line, raw.col, f"{spec.mnemonic} needs {key}: ({_KIND_NAMES[kind]})")
+                    ok = False
+                    continue
+                v = self._address(raw, key) if kind == "M" else self._const(raw, key, kind)
+                ok = ok and v is not None
+                values[key] = v
+        else:  # a defined code not implemented on this build: keep raw octal values, FErr1 at run time
+            for key in ("S", "D", "R"):
+                if key in raw.params:
+                    try:
+                        values[key] = parse_octal(raw.params[key][0])
+                    except ValueError:
+                        values[key] = None
+        if not ok:
+            return None
+        return Instr("FON", c=c, n=number, s=values["S"], d=values["D"], r=values["R"], **common)
+
+
+_KIND_NAMES = {"M": "an address", "O": "an octal constant", "D": "a decimal constant", "B": "a BCD constant"}

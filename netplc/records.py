@@ -1,0 +1,43 @@
+"""Records the engine and its helpers hand to the registrar.
+
+The registrar owns storage; NetPlc only needs somewhere to put records, so the sink is a protocol
+and tests use ListSink. Columns mirror the archive table (DESIGN section 8).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from typing import Literal, Protocol
+
+Kind = Literal["data", "message", "operator", "system"]
+
+
+@dataclass(frozen=True, slots=True)
+class Record:
+    ts: float  # wall clock, seconds since the epoch (UTC)
+    kind: Kind
+    grp: int | None = None
+    type: int | None = None
+    source: str | None = None  # octal address, element name, user@peer...
+    number: int | None = None  # message number for NMSG
+    value: float | None = None
+    text: str | None = None  # None for NMSG: the registrar resolves it from the catalog
+
+
+class RecordSink(Protocol):
+    def put(self, record: Record) -> None: ...
+
+
+class ListSink:
+    """Keeps records in a list: for tests and for `python -m netplc run`."""
+
+    def __init__(self) -> None:
+        self.records: list[Record] = []
+
+    def put(self, record: Record) -> None:
+        self.records.append(record)
+
+
+class NullSink:
+    def put(self, record: Record) -> None:
+        pass

@@ -1,0 +1,55 @@
+"""The CPU-165 real-time clock in data bytes 077700-077707 (BCD).
+
+The program sets the clock by the documented sequence: write non-zero to 077700, write the new
+time to 077701-077707, write 0 to 077700. NetPlc never touches the PC's clock: it keeps the
+difference as an offset and shows wall time plus offset from then on.
+"""
+
+from __future__ import annotations
+
+import datetime as dt
+
+from netplc.address import RTC_CONTROL, RTC_FIRST, data_index
+from netplc.memory import Memory
+
+_CTRL = data_index(RTC_CONTROL)
+_FIRST = data_index(RTC_FIRST)
+
+
+def to_bcd(v: int) -> int:
+    return ((v // 10) << 4) | (v % 10)
+
+
+def from_bcd(b: int) -> int:
+    return (b >> 4) * 10 + (b & 0x0F)
+
+
+class Rtc:
+    def __init__(self) -> None:
+        self.offset = 0.0  # seconds added to the wall clock
+        self._setting = False
+
+    def update(self, mem: Memory, wall: float) -> None:
+        """Called once per scan before the program runs."""
+        data = mem.data
+        if data[_CTRL]:
+            self._setting = True
+            return
+        if self._setting:
+            self._setting = False
+            self._take_setting(data, wall)
+        t = dt.datetime.fromtimestamp(wall + self.offset)
+        fields = (t.second, t.minute, t.hour, t.day, t.month, t.year % 100, (t.weekday() + 1) % 7)
+        for i, v in enumerate(fields):
+            data[_FIRST + i] = to_bcd(v)
+
+    def now(self, wall: float) -> dt.datetime:
+        return dt.datetime.fromtimestamp(wall + self.offset)
+
+    def _take_setting(self, data: bytearray, wall: float) -> None:
+        s, mi, h, d, mo, y = (from_bcd(data[_FIRST + i]) for i in range(6))
+        try:
+            wanted = dt.datetime(2000 + y, mo, d, h, mi, s)
+        except ValueError:
+            return  # an impossible date: keep the clock as it was
+        self.offset = wanted.timestamp() - wall
