@@ -1,0 +1,217 @@
+"""Shared machinery of the FON functions: build-once operand accessors, BCD, error flags.
+
+A function runs inside the scan on every scan its rung is true, so the work that depends only on
+the instruction's S/D/R (validating operands, locating them in the data array) is done once per
+instruction and memory: each function is written as a *builder* that returns the closure the scan
+calls. An operand that cannot be read or written (a word on the last byte of a bank, a block running
+past its bank) makes the builder raise AddressError; the function then only sets FErr1, every scan
+it runs, and writes nothing - the same as a bad indirect address at run time.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable
+
+from netplc.address import FERR1, IO_BITS, AddressError, check_operand, data_index, fmt_octal
+from netplc.functions.registry import Fon, FonContext, Run
+from netplc.memory import Memory
+
+Step = Callable[[FonContext], None]
+Builder = Callable[[Memory, Fon], Step]
+
+def fail(ctx: FonContext) -> None:
+    """Raise FErr1 (sticky: only the program clears it)."""
+    ctx.mem.bits[FERR1] = 1
+
+
+def built(build: Builder) -> Run:
+    """Turn a builder into a FON run function that builds once per instruction and memory."""
+
+    def run(ctx: FonContext, fon: Fon) -> None:
+        mem = ctx.mem
+        cached = fon.state.get("_step")
+        if cached is None or cached[0] is not mem:
+            try:
+                step = build(mem, fon)
+            except AddressError:
+                step = fail
+            cached = fon.state["_step"] = (mem, step)
+        cached[1](ctx)
+
+    run.__doc__ = build.__doc__
+    run.__name__ = build.__name__
+    return run
+
+
+# --- operand accessors: closures bound to one memory and one operand address -------------------
+
+
+def word_get(mem: Memory, addr: int | None) -> Callable[[], int]:
+    """Reader of the 16-bit word at operand `addr` (data bytes, or 16 I/O bits below 04000)."""
+    a = _operand(addr, 2)
+    if a >= IO_BITS:
+        d = mem.data
+        i = data_index(a)
+        j = i + 1
+        return lambda: d[i] | d[j] << 8
+    b = mem.bits
+    return lambda: sum(b[a + k] << k for k in range(16))
+
+
+def word_set(mem: Memory, addr: int | None) -> Callable[[int], None]:
+    a = _operand(addr, 2)
+    if a >= IO_BITS:
+        d = mem.data
+        i = data_index(a)
+        j = i + 1
+
+        def set_data(v: int) -> None:
+            d[i] = v & 0xFF
+            d[j] = (v >> 8) & 0xFF
+
+        return set_data
+    b = mem.bits
+
+    def set_bits(v: int) -> None:
+        for k in range(16):
+            b[a + k] = (v >> k) & 1
+
+    return set_bits
+
+
+def byte_get(mem: Memory, addr: int | None) -> Callable[[], int]:
+    a = _operand(addr, 1)
+    if a >= IO_BITS:
+        d = mem.data
+        i = data_index(a)
+        return lambda: d[i]
+    b = mem.bits
+    return lambda: sum(b[a + k] << k for k in range(8))
+
+
+def byte_set(mem: Memory, addr: int | None) -> Callable[[int], None]:
+    a = _operand(addr, 1)
+    if a >= IO_BITS:
+        d = mem.data
+        i = data_index(a)
+
+        def set_data(v: int) -> None:
+            d[i] = v & 0xFF
+
+        return set_data
+    b = mem.bits
+
+    def set_bits(v: int) -> None:
+        for k in range(8):
+            b[a + k] = (v >> k) & 1
+
+    return set_bits
+
+
+def block_get(mem: Memory, addr: int | None, n: int) -> Callable[[], bytes]:
+    """Reader of `n` bytes at operand `addr` (n > 0)."""
+    a = _operand(addr, n)
+    if a >= IO_BITS:
+        d = mem.data
+        i = data_index(a)
+        j = i + n
+        return lambda: d[i:j]
+    return lambda: mem.read(a, n)
+
+
+def block_set(mem: Memory, addr: int | None, n: int) -> Callable[[bytes | bytearray], None]:
+    a = _operand(addr, n)
+    if a >= IO_BITS:
+        d = mem.data
+        i = data_index(a)
+        j = i + n
+
+        def set_data(v: bytes | bytearray) -> None:
+            d[i:j] = v
+
+        return set_data
+    return lambda v: mem.write(a, v)
+
+
+def bit_get(mem: Memory, addr: int) -> Callable[[], int]:
+    """Reader of bit k of an operand: an I/O bit (addr < 04000) or bit addr&7 of data byte addr>>3.
+
+    Used with `addr = operand + k` for I/O operands and `operand * 8 + k` for data operands; see
+    `operand_bit`.
+    """
+    if addr < IO_BITS:
+        b = mem.bits
+        return lambda: b[addr]
+    d = mem.data
+    i = data_index(addr >> 3)
+    mask = 1 << (addr & 7)
+    return lambda: 1 if d[i] & mask else 0
+
+
+def operand_bit(base: int, k: int) -> int:
+    """Bit k of the bit string at operand `base`, as a `bit_get` address (bit k = bit k%8 of byte k//8)."""
+    if base < IO_BITS:
+        if base + k >= IO_BITS:
+            raise AddressError(f"bit {k} of {fmt_octal(base)} runs past bit 03777")
+        return base + k
+    check_operand(base + k // 8, 1)
+    return (base + k // 8) * 8 + k % 8
+
+
+def at(addr: int | None, k: int) -> int:
+    """Operand address k bytes after `addr` (8*k bits further in the I/O area)."""
+    a = addr or 0
+    return a + 8 * k if a < IO_BITS else a + k
+
+
+def span(first: int | None, last: int | None) -> int:
+    """Bytes from operand `first` to operand `last` inclusive (0 or less when last < first).
+
+    In the I/O area a byte is 8 bits, so bits 00100..00170 are 8 bytes; an area that mixes the
+    I/O bits and data memory, or ends inside a byte of bits, is invalid (AddressError).
+    """
+    a, b = first or 0, last or 0
+    if a < IO_BITS and b < IO_BITS:
+        if (b - a) % 8:
+            raise AddressError(f"{fmt_octal(a)}..{fmt_octal(b)} is not a whole number of bytes")
+        return (b - a) // 8 + 1
+    if (a < IO_BITS) != (b < IO_BITS):
+        raise AddressError(f"{fmt_octal(a)}..{fmt_octal(b)} mixes I/O bits and data memory")
+    return b - a + 1
+
+
+def valid_block(addr: int, n: int) -> bool:
+    """Whether `n` bytes at `addr` are all addressable (n = 0 is an empty, valid block)."""
+    if n == 0:
+        return addr >= 0
+    try:
+        check_operand(addr, n)
+    except AddressError:
+        return False
+    return True
+
+
+def _operand(addr: int | None, n: int) -> int:
+    if addr is None:
+        raise AddressError("missing operand")
+    check_operand(addr, n)
+    return addr
+
+
+# --- BCD -----------------------------------------------------------------------------------------
+
+
+def bcd_to_bin(w: int) -> int | None:
+    """Value of a 4-digit BCD word, or None if a nibble is above 9."""
+    value = 0
+    for shift in (12, 8, 4, 0):
+        digit = (w >> shift) & 0xF
+        if digit > 9:
+            return None
+        value = value * 10 + digit
+    return value
+
+
+def bin_to_bcd(v: int) -> int:
+    """4-digit BCD word of 0 <= v <= 9999."""
+    return (v // 1000) << 12 | (v // 100 % 10) << 8 | (v // 10 % 10) << 4 | v % 10

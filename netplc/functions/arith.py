@@ -1,0 +1,239 @@
+"""Arithmetic (manual group 3.4): ADDBCD SUBBCD CMP ROR ROL SCALE MATH ADD SUB MUL DIV.
+
+Words are unsigned 16-bit. Output flags at C+1.. are written (1 or 0) every time the function
+executes; an error sets FErr1 and leaves memory and flags as they were.
+"""
+
+from __future__ import annotations
+
+from netplc.address import FERR2
+from netplc.functions._util import (
+    Step,
+    at,
+    bcd_to_bin,
+    bin_to_bcd,
+    built,
+    byte_get,
+    byte_set,
+    fail,
+    word_get,
+    word_set,
+)
+from netplc.functions.registry import Fon, FonContext, register
+from netplc.memory import Memory
+
+
+@register(10, "ADDBCD", "M", "M", "M")
+@built
+def addbcd(mem: Memory, fon: Fon) -> Step:
+    """word[R] = low 4 BCD digits of S + D; C+1 carry (sum > 9999); C+2 Z (stored value 0).
+
+    FErr1 and nothing done when an addend is not valid BCD.
+    """
+    gs, gd, put = word_get(mem, fon.s), word_get(mem, fon.d), word_set(mem, fon.r)
+    b, c1, c2 = mem.bits, fon.c + 1, fon.c + 2
+
+    def step(ctx: FonContext) -> None:
+        x, y = bcd_to_bin(gs()), bcd_to_bin(gd())
+        if x is None or y is None:
+            fail(ctx)
+            return
+        total = x + y
+        value = total % 10000
+        put(bin_to_bcd(value))
+        b[c1] = 1 if total > 9999 else 0
+        b[c2] = 1 if value == 0 else 0
+
+    return step
+
+
+@register(11, "SUBBCD", "M", "M", "M")
+@built
+def subbcd(mem: Memory, fon: Fon) -> Step:
+    """word[R] = S - D in BCD; C+1 borrow (S < D); C+2 Z.
+
+    The manual does not say what is stored on a negative result; decided: the 10000's complement
+    (1234 - 5555 stores 5679 with the borrow set), as a 4-digit BCD subtractor leaves it. An operand
+    that is not valid BCD raises FErr1 and nothing is done, as in ADDBCD.
+    """
+    gs, gd, put = word_get(mem, fon.s), word_get(mem, fon.d), word_set(mem, fon.r)
+    b, c1, c2 = mem.bits, fon.c + 1, fon.c + 2
+
+    def step(ctx: FonContext) -> None:
+        x, y = bcd_to_bin(gs()), bcd_to_bin(gd())
+        if x is None or y is None:
+            fail(ctx)
+            return
+        value = (x - y) % 10000
+        put(bin_to_bcd(value))
+        b[c1] = 1 if x < y else 0
+        b[c2] = 1 if value == 0 else 0
+
+    return step
+
+
+@register(12, "CMP", "M", "M")
+@built
+def cmp(mem: Memory, fon: Fon) -> Step:
+    """C+1 = S > D, C+2 = S == D, C+3 = S < D (unsigned 16-bit; the table and values, not the prose)."""
+    gs, gd = word_get(mem, fon.s), word_get(mem, fon.d)
+    b, c1, c2, c3 = mem.bits, fon.c + 1, fon.c + 2, fon.c + 3
+
+    def step(ctx: FonContext) -> None:
+        x, y = gs(), gd()
+        b[c1] = 1 if x > y else 0
+        b[c2] = 1 if x == y else 0
+        b[c3] = 1 if x < y else 0
+
+    return step
+
+
+@register(36, "ROR", "M")
+@built
+def ror(mem: Memory, fon: Fon) -> Step:
+    """Rotate word[S] right: bit 15 <- input C+1; C+2 <- old bit 0; C+3 <- old bit 8."""
+    get, put = word_get(mem, fon.s), word_set(mem, fon.s)
+    b, c1, c2, c3 = mem.bits, fon.c + 1, fon.c + 2, fon.c + 3
+
+    def step(ctx: FonContext) -> None:
+        w = get()
+        put((w >> 1) | (b[c1] << 15))
+        b[c2] = w & 1
+        b[c3] = (w >> 8) & 1
+
+    return step
+
+
+@register(37, "ROL", "M")
+@built
+def rol(mem: Memory, fon: Fon) -> Step:
+    """Rotate word[S] left: bit 0 <- input C+1; C+2 <- old bit 15; C+3 <- old bit 7 (the dump wins)."""
+    get, put = word_get(mem, fon.s), word_set(mem, fon.s)
+    b, c1, c2, c3 = mem.bits, fon.c + 1, fon.c + 2, fon.c + 3
+
+    def step(ctx: FonContext) -> None:
+        w = get()
+        put(((w << 1) & 0xFFFF) | b[c1])
+        b[c2] = w >> 15
+        b[c3] = (w >> 7) & 1
+
+    return step
+
+
+@register(54, "SCALE", "M", "M", "O")
+@built
+def scale(mem: Memory, fon: Fon) -> Step:
+    """Y = (A/B)*X + s*C with X = word[S], Y = word[D], A, B, C = words D+2, D+4, D+6; R 0: s=+1, 1: s=-1.
+
+    Decided where the manual is silent: evaluated as floor(A*X / B) with an exact intermediate, so
+    A/B < 1 keeps its precision; B = 0 or R other than 0/1 raises FErr1 and writes nothing; a result
+    outside 0..65535 is saturated to the nearest end and raises FErr2 (the output stays usable, the
+    program can see the overflow).
+    """
+    d = fon.d or 0
+    gx, put = word_get(mem, fon.s), word_set(mem, d)
+    ga, gb, gc = word_get(mem, at(d, 2)), word_get(mem, at(d, 4)), word_get(mem, at(d, 6))
+    if fon.r not in (0, 1):
+        return fail
+    sign = -1 if fon.r else 1
+    b = mem.bits
+
+    def step(ctx: FonContext) -> None:
+        div = gb()
+        if div == 0:
+            fail(ctx)
+            return
+        y = ga() * gx() // div + sign * gc()
+        if not 0 <= y <= 0xFFFF:
+            y = 0 if y < 0 else 0xFFFF
+            b[FERR2] = 1
+        put(y)
+
+    return step
+
+
+@register(55, "MATH", "M", "M", "D")
+@built
+def math(mem: Memory, fon: Fon) -> Step:
+    """Special math functions: the manual lists only the parameters and the outputs < = >.
+
+    Decided: with no operation defined anywhere, any computation would be a guess that a ported
+    CPU-165 program would silently rely on; MATH loads (so such programs run) and raises FErr1 each
+    time it executes, touching nothing else, so the program can detect it.
+    """
+    return fail
+
+
+@register(92, "ADD", "M", "M", "M")
+@built
+def add(mem: Memory, fon: Fon) -> Step:
+    """word[R] = S + D (16 bits); C+1 carry out of 16 bits; C+2 Z."""
+    gs, gd, put = word_get(mem, fon.s), word_get(mem, fon.d), word_set(mem, fon.r)
+    b, c1, c2 = mem.bits, fon.c + 1, fon.c + 2
+
+    def step(ctx: FonContext) -> None:
+        total = gs() + gd()
+        value = total & 0xFFFF
+        put(value)
+        b[c1] = total >> 16
+        b[c2] = 1 if value == 0 else 0
+
+    return step
+
+
+@register(93, "SUB", "M", "M", "M")
+@built
+def sub(mem: Memory, fon: Fon) -> Step:
+    """word[R] = S - D (16 bits, wrapping); C+1 borrow (S < D); C+2 Z."""
+    gs, gd, put = word_get(mem, fon.s), word_get(mem, fon.d), word_set(mem, fon.r)
+    b, c1, c2 = mem.bits, fon.c + 1, fon.c + 2
+
+    def step(ctx: FonContext) -> None:
+        x, y = gs(), gd()
+        value = (x - y) & 0xFFFF
+        put(value)
+        b[c1] = 1 if x < y else 0
+        b[c2] = 1 if value == 0 else 0
+
+    return step
+
+
+@register(94, "MUL", "M", "M", "M")
+@built
+def mul(mem: Memory, fon: Fon) -> Step:
+    """32-bit product of the unsigned words S and D: low word at R, high word at R+2."""
+    r = fon.r or 0
+    gs, gd = word_get(mem, fon.s), word_get(mem, fon.d)
+    lo, hi = word_set(mem, r), word_set(mem, at(r, 2))
+
+    def step(ctx: FonContext) -> None:
+        p = gs() * gd()
+        lo(p)
+        hi(p >> 16)
+
+    return step
+
+
+@register(95, "DIV", "M", "M", "M")
+@built
+def div(mem: Memory, fon: Fon) -> Step:
+    """word[S] / byte[D]: 16-bit quotient at R, 8-bit remainder in byte R+2 (the "24-bit result").
+
+    The manual gives the divisor as "8-bit data" and the result as 24 bits, which fits exactly a
+    16-bit quotient and a remainder below 256; so the divisor is the byte at D (the low byte of the
+    word) and exactly three bytes are written. A zero divisor raises FErr1 and writes nothing.
+    """
+    r = fon.r or 0
+    gs, gd = word_get(mem, fon.s), byte_get(mem, fon.d)
+    quot, rem = word_set(mem, r), byte_set(mem, at(r, 2))
+
+    def step(ctx: FonContext) -> None:
+        divisor = gd()
+        if divisor == 0:
+            fail(ctx)
+            return
+        q, m = divmod(gs(), divisor)
+        quot(q)
+        rem(m)
+
+    return step
