@@ -1,0 +1,219 @@
+"""Analog elements (manual 2.4.3): a word converted to a physical value, and the operator's setpoint.
+
+Conversion is linear between the hardware range AppMin..AppMax and the physical range
+PhyMin..PhyMax, taken from a named Device of the form or from the element's own four properties
+(DESIGN section 9). Decisions where the manual is silent:
+- PhyLow/PhyHigh split the value into zones low/normal/high; a zone is left only when the value is
+  back by Hysteresis (physical units, default 0), so a noisy value at a limit does not flood the
+  journal. RegMessages records each zone change (kind "message": NormalMessage with type 0,
+  LowMessage/HighMessage with type 2 = alarm, which the operator must acknowledge); a value
+  already outside the limits at start is reported too.
+- RegData records the value whenever its displayed text (Precision decimals) changes.
+- KeepMaxValue keeps the largest physical value seen until `reset_max` (the widget: double-click).
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field
+from typing import Any
+
+from hmi_forms.elements import props as p
+from hmi_forms.elements.base import Element
+from hmi_forms.elements.trend import Trend
+from netplc.memory import Snapshot
+
+APPEARANCES = ("digital", "hbar", "dial", "semidial", "graph")
+ZONE_TYPES = {"low": 2, "normal": 0, "high": 2}
+
+
+@dataclass(eq=False)
+class Scaled(Element):
+    """The conversion and number format shared by the analog input and output."""
+
+    Device: str | None = field(default=None, metadata=p.prop(p.text))
+    AppMin: float | None = field(default=None, metadata=p.prop(p.number))
+    AppMax: float | None = field(default=None, metadata=p.prop(p.number))
+    PhyMin: float | None = field(default=None, metadata=p.prop(p.number))
+    PhyMax: float | None = field(default=None, metadata=p.prop(p.number))
+    Precision: int = field(default=1, metadata=p.prop(p.integer(0, 6)))
+    Units: str = field(default="", metadata=p.prop(p.text))
+
+    scaling: p.Scaling = field(default=p.Scaling(0, 1, 0, 1), init=False)
+
+    def check(self, ctx: p.Context) -> list[tuple[str, str]]:
+        inline = {k: getattr(self, k) for k in ("AppMin", "AppMax", "PhyMin", "PhyMax")}
+        given = [k for k, v in inline.items() if v is not None]
+        if self.Device is not None:
+            if given:
+                return [(given[0], "give either Device or AppMin/AppMax/PhyMin/PhyMax, not both")]
+            if self.Device not in ctx.devices:
+                known = ", ".join(sorted(ctx.devices)) or "the form has no devices"
+                return [("Device", f'unknown device "{self.Device}" ({known})')]
+            self.scaling = ctx.devices[self.Device]
+            return []
+        missing = [k for k, v in inline.items() if v is None]
+        if len(missing) == 4:
+            return [("Device", "missing: give a Device or AppMin, AppMax, PhyMin and PhyMax")]
+        if missing:
+            return [(k, "missing (needed with the other range properties)") for k in missing]
+        problems = scaling_problems(inline)
+        if not problems:
+            self.scaling = p.Scaling(**inline)
+        return problems
+
+    def format(self, phy: float) -> str:
+        return f"{phy:.{self.Precision}f}"
+
+
+def scaling_problems(ranges: dict[str, Any]) -> list[tuple[str, str]]:
+    """Ranges that would divide by zero; shared by elements and the form's Devices table."""
+    problems = []
+    if ranges["AppMax"] == ranges["AppMin"]:
+        problems.append(("AppMax", f"equals AppMin ({ranges['AppMin']:g}): the conversion is undefined"))
+    if ranges["PhyMax"] == ranges["PhyMin"]:
+        problems.append(("PhyMax", f"equals PhyMin ({ranges['PhyMin']:g}): the conversion is undefined"))
+    return problems
+
+
+@dataclass(eq=False)
+class AnalogBase(Scaled):
+    TYPE = "AnalogBase"
+
+    InAddr: int | None = field(default=None, metadata=p.prop(p.word, required=True, alias="Address"))
+    KeepMaxValue: bool = field(default=False, metadata=p.prop(p.boolean))
+    PhyLow: float | None = field(default=None, metadata=p.prop(p.number))
+    PhyHigh: float | None = field(default=None, metadata=p.prop(p.number))
+    Hysteresis: float = field(default=0.0, metadata=p.prop(p.number))
+    LowMessage: str = field(default="", metadata=p.prop(p.text))
+    NormalMessage: str = field(default="", metadata=p.prop(p.text))
+    HighMessage: str = field(default="", metadata=p.prop(p.text))
+    Appearance: str = field(default="digital", metadata=p.prop(p.choice(*APPEARANCES), alias="Arreragance"))
+    Elements: int = field(default=200, metadata=p.prop(p.integer(2, 100_000)))
+    Colors: p.Color | None = field(default=None, metadata=p.prop(p.color))
+    LineWidth: int = field(default=1, metadata=p.prop(p.integer(1, 10)))
+    LabelInt: int = field(default=50, metadata=p.prop(p.integer(1, 100_000)))
+
+    hw: int | None = field(default=None, init=False)
+    phy: float = field(default=math.nan, init=False)
+    text: str = field(default="", init=False)
+    maximum: float | None = field(default=None, init=False)
+    zone: str | None = field(default=None, init=False)
+    trend: Trend | None = field(default=None, init=False, repr=False)
+    last_scan: int = field(default=-1, init=False)
+
+    def check(self, ctx: p.Context) -> list[tuple[str, str]]:
+        problems = super().check(ctx)
+        if self.PhyLow is not None and self.PhyHigh is not None and self.PhyLow >= self.PhyHigh:
+            problems.append(("PhyHigh", f"{self.PhyHigh:g} must be above PhyLow {self.PhyLow:g}"))
+        if self.Hysteresis < 0:
+            problems.append(("Hysteresis", "must not be negative"))
+        return problems
+
+    def __post_init__(self) -> None:
+        if self.Appearance == "graph":
+            self.trend = Trend(self.Elements)
+
+    def zone_of(self, phy: float) -> str:
+        """Zone with hysteresis: leaving the current zone needs the value to be Hysteresis inside."""
+        lo, hi, hy = self.PhyLow, self.PhyHigh, self.Hysteresis
+        if self.zone == "low" and lo is not None and phy < lo + hy:
+            return "low"
+        if self.zone == "high" and hi is not None and phy > hi - hy:
+            return "high"
+        if lo is not None and phy < lo:
+            return "low"
+        if hi is not None and phy > hi:
+            return "high"
+        return "normal"
+
+    @property
+    def message(self) -> str:
+        return {"low": self.LowMessage, "high": self.HighMessage, "normal": self.NormalMessage}.get(
+            self.zone or "", "")
+
+    def refresh(self, snap: Snapshot) -> bool:
+        assert self.InAddr is not None
+        hw = snap.get_word(self.InAddr)
+        sampled = self._sample(snap, hw)
+        if hw == self.hw:
+            return sampled
+        self.hw = hw
+        phy = self.scaling.to_phy(hw)
+        self.phy = phy
+        text = self.format(phy)
+        if self.RegData and text != self.text:
+            self.record(snap, "data", value=phy)
+        self.text = text
+        if self.KeepMaxValue and (self.maximum is None or phy > self.maximum):
+            self.maximum = phy
+        if self.PhyLow is not None or self.PhyHigh is not None:
+            zone = self.zone_of(phy)
+            report = zone != self.zone and self.RegMessages and (self.zone is not None or zone != "normal")
+            self.zone = zone
+            if report:
+                text = self.message or f"{zone}: {text}"
+                self.record(snap, "message", type=ZONE_TYPES[zone], value=phy, text=text)
+        return True
+
+    def refresh_stale(self, snap: Snapshot) -> bool:
+        return self._sample(snap, None)
+
+    def _sample(self, snap: Snapshot, hw: int | None) -> bool:
+        """One trend sample per scan (NaN while stale, drawn as a gap)."""
+        if self.trend is None or snap.scan == self.last_scan:
+            return False
+        self.last_scan = snap.scan
+        self.trend.add(math.nan if hw is None else self.scaling.to_phy(hw))
+        return True
+
+    def reset_max(self) -> None:
+        self.maximum = None if math.isnan(self.phy) else self.phy
+
+    @property
+    def fraction(self) -> float:
+        return 0.0 if math.isnan(self.phy) else self.scaling.fraction(self.phy)
+
+
+@dataclass(eq=False)
+class AnalogOutput(Scaled):
+    """The operator enters a physical value; it is checked, converted, clamped and written."""
+
+    TYPE = "AnalogOutput"
+
+    OutAddr: int | None = field(default=None, metadata=p.prop(p.word, required=True))
+    InAddr: int | None = field(default=None, metadata=p.prop(p.word, alias="Address"))
+    Enabled: bool = field(default=True, metadata=p.prop(p.boolean))
+
+    hw: int | None = field(default=None, init=False)
+    text: str = field(default="", init=False)
+
+    def refresh(self, snap: Snapshot) -> bool:
+        addr = self.InAddr if self.InAddr is not None else self.OutAddr
+        assert addr is not None
+        hw = snap.get_word(addr)
+        if hw == self.hw:
+            return False
+        self.hw = hw
+        self.text = self.format(self.scaling.to_phy(hw))
+        return True
+
+    def submit(self, entry: str) -> tuple[bool, str]:
+        """Validate the operator's entry and write it; returns (accepted, message to show)."""
+        lo, hi = self.scaling.phy_range
+        units = f" {self.Units}" if self.Units else ""
+        if not self.Enabled:
+            return False, "Input is disabled for this element"
+        try:
+            phy = float(entry.strip().replace(",", "."))
+        except ValueError:
+            return False, f'"{entry.strip()}" is not a number'
+        if not math.isfinite(phy):
+            return False, f'"{entry.strip()}" is not a number'
+        if not lo <= phy <= hi:
+            return False, f"{entry.strip()} is out of range {self.format(lo)} … {self.format(hi)}{units}"
+        hw = self.scaling.to_hw(phy)
+        assert self.OutAddr is not None
+        if self.target is not None:
+            self.target.write_word(self.OutAddr, hw, user=self.user)
+        return True, f"Set to {self.format(self.scaling.to_phy(hw))}{units}"

@@ -1,0 +1,79 @@
+"""What every HMI element shares: geometry, the UObject look, SyncType gating and data quality.
+
+An element model reads snapshots and keeps what its widget must draw; `update` says whether that
+changed, so the form repaints only those widgets. Gating and quality are decided here once:
+- SyncType 0 updates every tick; otherwise only while that bit is 1 (the manual's level sync).
+- QualityAddr (an extension) names a bit such as an NREAD link output: while it is 0 the element
+  keeps its last value and marks it stale, so frozen data never looks live.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+from typing import Any, ClassVar
+
+from hmi_forms.elements import props as p
+from hmi_forms.elements.target import Target
+from netplc.address import BitRef
+from netplc.memory import Snapshot
+from netplc.records import Kind, Record
+
+BORDER_STYLES = ("None", "FixedSingle", "Fixed3D")
+CURSORS = ("Default", "Hand", "Cross", "IBeam", "No")
+
+
+@dataclass(eq=False)
+class Element:
+    TYPE: ClassVar[str] = ""
+
+    Name: str = field(default="", metadata=p.prop(p.text, required=True))
+    x: int = field(default=0, metadata=p.prop(p.integer(0, 10000), required=True))
+    y: int = field(default=0, metadata=p.prop(p.integer(0, 10000), required=True))
+    w: int = field(default=1, metadata=p.prop(p.integer(1, 10000), required=True))
+    h: int = field(default=1, metadata=p.prop(p.integer(1, 10000), required=True))
+    SyncType: BitRef | None = field(default=None, metadata=p.prop(p.sync_type))
+    QualityAddr: BitRef | None = field(default=None, metadata=p.prop(p.bit))
+    RegData: bool = field(default=False, metadata=p.prop(p.boolean))
+    RegMessages: bool = field(default=False, metadata=p.prop(p.boolean))
+    BackColor: p.Color | None = field(default=None, metadata=p.prop(p.color))
+    ForeColor: p.Color | None = field(default=None, metadata=p.prop(p.color))
+    BorderStyle: str = field(default="None", metadata=p.prop(p.choice(*BORDER_STYLES)))
+    TextAlign: str = field(default="MiddleCenter", metadata=p.prop(p.alignment))
+    Font: p.Font | None = field(default=None, metadata=p.prop(p.font))
+    Cursor: str = field(default="Default", metadata=p.prop(p.choice(*CURSORS)))
+    BackgroundImage: Any = field(default=None, metadata=p.prop(p.image_file))
+    ImageAlign: str = field(default="MiddleCenter", metadata=p.prop(p.alignment))
+
+    stale: bool = field(default=False, init=False)
+    target: Target | None = field(default=None, init=False, repr=False)
+    user: str = field(default="operator", init=False)
+
+    def check(self, ctx: p.Context) -> list[tuple[str, str]]:
+        """Problems between properties, as (property, problem); resolves references to the context."""
+        return []
+
+    def bind(self, target: Target, user: str = "operator") -> None:
+        self.target = target
+        self.user = user
+
+    def update(self, snap: Snapshot) -> bool:
+        """Read one snapshot; True when what the widget shows has changed."""
+        if self.SyncType is not None and not snap.get_hmi_bit(self.SyncType):
+            return False
+        stale = self.QualityAddr is not None and not snap.get_hmi_bit(self.QualityAddr)
+        changed = stale != self.stale
+        self.stale = stale
+        if stale:
+            return self.refresh_stale(snap) or changed
+        return self.refresh(snap) or changed
+
+    def refresh(self, snap: Snapshot) -> bool:
+        return False
+
+    def refresh_stale(self, snap: Snapshot) -> bool:
+        """Called instead of `refresh` while the data are stale: by default everything is kept."""
+        return False
+
+    def record(self, snap: Snapshot, kind: Kind, **fields: Any) -> None:
+        if self.target is not None:
+            self.target.put(Record(snap.wall, kind, source=self.Name, **fields))

@@ -1,0 +1,227 @@
+"""Property parsers for .hmi files: one function per kind of value the manual's properties take.
+
+Each parser takes the JSON value and the load context and returns the typed value or raises
+PropError with a message an engineer can act on. Element models declare their properties as
+dataclass fields carrying a parser in their metadata (see `prop`), so the schema of every element
+type lives next to the model that uses it and the loader needs no per-type code.
+"""
+
+from __future__ import annotations
+
+import math
+import re
+from collections.abc import Callable
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any
+
+from netplc.address import AddressError, BitRef, check_operand, parse_hmi_bit, parse_octal
+
+Color = tuple[int, int, int, int]  # r, g, b, alpha
+
+
+class PropError(ValueError):
+    """A property value the loader refuses; the message is the `problem` part of the report."""
+
+
+@dataclass(frozen=True, slots=True)
+class Scaling:
+    """Linear hardware <-> physical conversion (DESIGN section 9)."""
+
+    AppMin: float
+    AppMax: float
+    PhyMin: float
+    PhyMax: float
+
+    def to_phy(self, hw: float) -> float:
+        return self.PhyMin + (hw - self.AppMin) * (self.PhyMax - self.PhyMin) / (self.AppMax - self.AppMin)
+
+    def to_hw(self, phy: float) -> int:
+        """The inverse, rounded and clamped to the hardware range (and to an unsigned word)."""
+        hw = self.AppMin + (phy - self.PhyMin) * (self.AppMax - self.AppMin) / (self.PhyMax - self.PhyMin)
+        lo, hi = sorted((self.AppMin, self.AppMax))
+        hw = min(max(hw, lo), hi)
+        return min(max(round(hw), 0), 0xFFFF)
+
+    @property
+    def phy_range(self) -> tuple[float, float]:
+        lo, hi = sorted((self.PhyMin, self.PhyMax))
+        return lo, hi
+
+    def fraction(self, phy: float) -> float:
+        """Position of `phy` on the scale PhyMin..PhyMax, clamped to 0..1 (for pointers and bars)."""
+        f = (phy - self.PhyMin) / (self.PhyMax - self.PhyMin)
+        return min(max(f, 0.0), 1.0)
+
+
+@dataclass(frozen=True, slots=True)
+class Font:
+    Family: str = "DejaVu Sans"
+    Size: float = 10.0
+    Bold: bool = False
+    Italic: bool = False
+
+
+@dataclass
+class Context:
+    """What a property value may refer to: symbols, the form's folder, devices and image list."""
+
+    symbols: dict[str, int]
+    folder: Path
+    devices: dict[str, Scaling] = field(default_factory=dict)
+    images: list[Path] = field(default_factory=list)
+
+
+Parser = Callable[[Any, Context], Any]
+
+
+def prop(parser: Parser, *, required: bool = False, alias: str | None = None) -> dict[str, Any]:
+    """Field metadata marking a dataclass field as an .hmi property."""
+    return {"parser": parser, "required": required, "alias": alias}
+
+
+def _show(value: Any) -> str:
+    text = repr(value) if not isinstance(value, str) else f'"{value}"'
+    return text if len(text) <= 40 else text[:37] + "..."
+
+
+def text(value: Any, _ctx: Context) -> str:
+    if not isinstance(value, str):
+        raise PropError(f"expected text, got {_show(value)}")
+    return value
+
+
+def boolean(value: Any, _ctx: Context) -> bool:
+    if not isinstance(value, bool):
+        raise PropError(f"expected true or false, got {_show(value)}")
+    return value
+
+
+def integer(lo: int, hi: int) -> Parser:
+    def parse(value: Any, _ctx: Context) -> int:
+        if isinstance(value, bool) or not isinstance(value, int):
+            raise PropError(f"expected an integer from {lo} to {hi}, got {_show(value)}")
+        if not lo <= value <= hi:
+            raise PropError(f"{value} is out of range {lo}..{hi}")
+        return value
+
+    return parse
+
+
+def number(value: Any, _ctx: Context) -> float:
+    if isinstance(value, bool) or not isinstance(value, int | float) or not math.isfinite(value):
+        raise PropError(f"expected a number, got {_show(value)}")
+    return float(value)
+
+
+def choice(*options: str) -> Parser:
+    def parse(value: Any, _ctx: Context) -> str:
+        if value not in options:
+            raise PropError(f"{_show(value)} is not one of {', '.join(options)}")
+        return value
+
+    return parse
+
+
+def _address(value: Any, ctx: Context) -> int:
+    """Octal text (`"02000"`), a symbol, or `symbol.k` (bit k of the byte a symbol names)."""
+    if not isinstance(value, str):
+        raise PropError(f'addresses are octal text such as "02000" or a symbol, got {_show(value)}')
+    name, _, bit = value.partition(".")
+    if name in ctx.symbols:
+        addr = ctx.symbols[name]
+        if not bit:
+            return addr
+        if bit not in tuple("01234567"):
+            raise PropError(f'bit number after "{name}." must be 0-7, got "{bit}"')
+        return addr * 8 + int(bit)
+    if re.fullmatch(r"[A-Za-z_]\w*(\.\d+)?", value):
+        raise PropError(f'unknown symbol "{name}"')
+    try:
+        return parse_octal(value)
+    except ValueError:
+        raise PropError(f'"{value}" is not an octal address or a symbol') from None
+
+
+def bit(value: Any, ctx: Context) -> BitRef:
+    """An HMI bit: an I/O bit below 04000, or byte*8+bit at 040000 and above."""
+    try:
+        return parse_hmi_bit(_address(value, ctx))
+    except AddressError as e:
+        raise PropError(str(e)) from None
+
+
+def word(value: Any, ctx: Context) -> int:
+    """The byte address of a 2-byte analog value."""
+    addr = _address(value, ctx)
+    try:
+        check_operand(addr, 2)
+    except AddressError as e:
+        raise PropError(str(e)) from None
+    return addr
+
+
+def sync_type(value: Any, ctx: Context) -> BitRef | None:
+    """0 = every tick, else the bit whose level 1 lets the element update."""
+    if value in (0, "0"):
+        return None
+    return bit(value, ctx)
+
+
+_NAMED_COLORS = {
+    "black": "#000000", "white": "#ffffff", "red": "#d32f2f", "green": "#2e7d32", "blue": "#1565c0",
+    "yellow": "#f2c400", "orange": "#ef8a00", "gray": "#808080", "grey": "#808080",
+    "lightgray": "#d3d3d3", "darkgray": "#505050", "transparent": "#00000000",
+}
+
+
+def color(value: Any, _ctx: Context) -> Color:
+    """`#RRGGBB`, `#AARRGGBB` (as Qt and .NET write them) or one of a few names."""
+    if not isinstance(value, str):
+        raise PropError(f'expected a colour such as "#1a2b3c", got {_show(value)}')
+    v = _NAMED_COLORS.get(value.lower(), value)
+    if re.fullmatch(r"#[0-9a-fA-F]{6}", v):
+        return int(v[1:3], 16), int(v[3:5], 16), int(v[5:7], 16), 255
+    if re.fullmatch(r"#[0-9a-fA-F]{8}", v):
+        return int(v[3:5], 16), int(v[5:7], 16), int(v[7:9], 16), int(v[1:3], 16)
+    raise PropError(f'"{value}" is not a colour (#RRGGBB, #AARRGGBB or {", ".join(sorted(_NAMED_COLORS))})')
+
+
+def font(value: Any, ctx: Context) -> Font:
+    if not isinstance(value, dict):
+        raise PropError(f'expected {{"Family": ..., "Size": ..., "Bold": ...}}, got {_show(value)}')
+    unknown = sorted(set(value) - {"Family", "Size", "Bold", "Italic"})
+    if unknown:
+        raise PropError(f"unknown font field {', '.join(unknown)} (Family, Size, Bold, Italic)")
+    size = number(value.get("Size", 10), ctx)
+    if not 4 <= size <= 200:
+        raise PropError(f"font size {size:g} is out of range 4..200")
+    return Font(
+        text(value.get("Family", Font.Family), ctx),
+        size,
+        boolean(value.get("Bold", False), ctx),
+        boolean(value.get("Italic", False), ctx),
+    )
+
+
+def image_file(value: Any, ctx: Context) -> Path:
+    """A picture file relative to the form's folder (forms travel with their images)."""
+    name = text(value, ctx)
+    path = (ctx.folder / name).resolve()
+    if not path.is_file():
+        raise PropError(f'image file "{name}" not found in {ctx.folder}')
+    return path
+
+
+def image_index(value: Any, ctx: Context) -> int:
+    """An index into the form's "images" list; -1 = no image."""
+    n = len(ctx.images)
+    if isinstance(value, bool) or not isinstance(value, int):
+        raise PropError(f"expected an image index (-1 for none), got {_show(value)}")
+    if not -1 <= value < n:
+        raise PropError(f"image index {value} is out of range: the form has {n} images (-1 = none)")
+    return value
+
+
+ALIGNMENTS = tuple(f"{v}{h}" for v in ("Top", "Middle", "Bottom") for h in ("Left", "Center", "Right"))
+alignment = choice(*ALIGNMENTS)

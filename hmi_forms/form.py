@@ -1,0 +1,248 @@
+"""Load and validate `.hmi` forms (DESIGN section 9).
+
+A form file is JSON:
+
+    {"form": {"title": ..., "width": ..., "height": ..., "BackColor": ..., "ForeColor": ..., "Font": ...},
+     "devices": [{"Name": ..., "AppMin": ..., "AppMax": ..., "PhyMin": ..., "PhyMax": ...}],
+     "images": ["pump0.png", ...],
+     "elements": [{"type": ..., "Name": ..., "x": ..., "y": ..., "w": ..., "h": ..., <properties>}]}
+
+Every problem of a file is collected and reported at once as `file: element "Name": property:
+problem`, because an engineer fixing a form wants the whole list, not one error per attempt.
+`load_forms` loads a folder so that one broken form does not stop the others from opening.
+"""
+
+from __future__ import annotations
+
+import difflib
+import json
+from dataclasses import dataclass, field, fields
+from pathlib import Path
+from typing import Any
+
+from hmi_forms.elements import ELEMENT_TYPES, Element
+from hmi_forms.elements import props as p
+from hmi_forms.elements.analog import scaling_problems
+
+FORM_BACK = (0xDD, 0xE1, 0xE6, 255)
+FORM_FORE = (0x1A, 0x1A, 0x1A, 255)
+
+
+class FormError(Exception):
+    def __init__(self, problems: list[str]) -> None:
+        super().__init__("\n".join(problems))
+        self.problems = problems
+
+
+@dataclass
+class Form:
+    path: Path
+    title: str
+    width: int
+    height: int
+    BackColor: p.Color = FORM_BACK
+    ForeColor: p.Color = FORM_FORE
+    Font: p.Font = field(default_factory=p.Font)
+    BackgroundImage: Path | None = None
+    devices: dict[str, p.Scaling] = field(default_factory=dict)
+    images: list[Path] = field(default_factory=list)
+    elements: list[Element] = field(default_factory=list)
+
+
+FORM_PROPS: dict[str, p.Parser] = {
+    "title": p.text,
+    "width": p.integer(1, 10000),
+    "height": p.integer(1, 10000),
+    "BackColor": p.color,
+    "ForeColor": p.color,
+    "Font": p.font,
+    "BackgroundImage": p.image_file,
+}
+DEVICE_PROPS = ("Name", "AppMin", "AppMax", "PhyMin", "PhyMax")
+
+
+def _unknown(name: str, known: list[str]) -> str:
+    close = difflib.get_close_matches(name, known, n=1)
+    return f'unknown property; did you mean "{close[0]}"?' if close else "unknown property"
+
+
+class _Loader:
+    def __init__(self, path: Path, symbols: dict[str, int]) -> None:
+        self.path = path
+        self.problems: list[str] = []
+        self.ctx = p.Context(symbols, path.parent)
+
+    def problem(self, where: str, prop: str | None, text: str) -> None:
+        head = f"{self.path}: {where}: {prop}" if prop else f"{self.path}: {where}"
+        self.problems.append(f"{head}: {text}")
+
+    def load(self) -> Form:
+        try:
+            raw = self.path.read_text(encoding="utf-8-sig")
+        except (OSError, UnicodeDecodeError) as e:
+            raise FormError([f"{self.path}: cannot read the form: {e}"]) from None
+        try:
+            doc = json.loads(raw)
+        except json.JSONDecodeError as e:
+            raise FormError([f"{self.path}:{e.lineno}:{e.colno}: bad JSON: {e.msg}"]) from None
+        if not isinstance(doc, dict):
+            raise FormError([f"{self.path}: the form must be a JSON object with form, devices, elements"])
+        for key in sorted(set(doc) - {"form", "devices", "images", "elements"}):
+            self.problem("file", key, "unknown section (form, devices, images, elements)")
+        form = self.form_settings(doc.get("form"))
+        form.devices = self.ctx.devices = self.devices(doc.get("devices", []))
+        form.images = self.ctx.images = self.images(doc.get("images", []))
+        form.elements = self.elements(doc.get("elements"))
+        for el in form.elements:
+            if el.x + el.w > form.width or el.y + el.h > form.height:
+                self.problem(f'element "{el.Name}"', "w" if el.x + el.w > form.width else "h",
+                             f"the element ({el.x},{el.y} {el.w}x{el.h}) extends past the form "
+                             f"({form.width}x{form.height})")
+        if self.problems:
+            raise FormError(self.problems)
+        return form
+
+    def form_settings(self, raw: Any) -> Form:
+        form = Form(self.path, self.path.stem, 800, 600)
+        if not isinstance(raw, dict):
+            self.problem("form", None, 'missing or not an object {"title": ..., "width": ..., "height": ...}')
+            return form
+        for key, value in raw.items():
+            parser = FORM_PROPS.get(key)
+            if parser is None:
+                self.problem("form", key, _unknown(key, list(FORM_PROPS)))
+                continue
+            try:
+                setattr(form, key, parser(value, self.ctx))
+            except p.PropError as e:
+                self.problem("form", key, str(e))
+        for key in ("width", "height"):
+            if key not in raw:
+                self.problem("form", key, "missing required property")
+        return form
+
+    def devices(self, raw: Any) -> dict[str, p.Scaling]:
+        out: dict[str, p.Scaling] = {}
+        if not isinstance(raw, list):
+            self.problem("devices", None, "must be a list of {Name, AppMin, AppMax, PhyMin, PhyMax}")
+            return out
+        for i, dev in enumerate(raw):
+            named = isinstance(dev, dict) and isinstance(dev.get("Name"), str)
+            where = f'device "{dev["Name"]}"' if named else f"device #{i + 1}"
+            if not isinstance(dev, dict):
+                self.problem(where, None, "must be an object {Name, AppMin, AppMax, PhyMin, PhyMax}")
+                continue
+            values: dict[str, Any] = {}
+            for key, value in dev.items():
+                if key not in DEVICE_PROPS:
+                    self.problem(where, key, _unknown(key, list(DEVICE_PROPS)))
+                    continue
+                try:
+                    values[key] = (p.text if key == "Name" else p.number)(value, self.ctx)
+                except p.PropError as e:
+                    self.problem(where, key, str(e))
+            missing = [k for k in DEVICE_PROPS if k not in dev]
+            for key in missing:
+                self.problem(where, key, "missing required property")
+            if len(values) < len(DEVICE_PROPS):
+                continue
+            name = values.pop("Name")
+            bad = scaling_problems(values)
+            for key, text in bad:
+                self.problem(where, key, text)
+            if name in out:
+                self.problem(where, "Name", "duplicate device name")
+            elif not bad:
+                out[name] = p.Scaling(**values)
+        return out
+
+    def images(self, raw: Any) -> list[Path]:
+        if not isinstance(raw, list):
+            self.problem("images", None, "must be a list of image files")
+            return []
+        out = []
+        for i, name in enumerate(raw):
+            try:
+                out.append(p.image_file(name, self.ctx))
+            except p.PropError as e:
+                self.problem(f"image #{i}", None, str(e))
+                out.append(self.path.parent / str(name))  # keep the indices of later images
+        return out
+
+    def elements(self, raw: Any) -> list[Element]:
+        if not isinstance(raw, list):
+            self.problem("elements", None, "missing or not a list of elements")
+            return []
+        out: list[Element] = []
+        names: set[str] = set()
+        for i, el in enumerate(raw):
+            name = el.get("Name") if isinstance(el, dict) else None
+            where = f'element "{name}"' if isinstance(name, str) else f"element #{i + 1}"
+            if not isinstance(el, dict):
+                self.problem(where, None, "must be an object with type, Name, x, y, w, h")
+                continue
+            if isinstance(name, str):
+                if name in names:
+                    self.problem(where, "Name", "duplicate element name")
+                names.add(name)
+            element = self.element(where, el)
+            if element is not None:
+                out.append(element)
+        return out
+
+    def element(self, where: str, raw: dict[str, Any]) -> Element | None:
+        kind = raw.get("type")
+        cls = ELEMENT_TYPES.get(kind) if isinstance(kind, str) else None
+        if cls is None:
+            hint = f"; did you mean \"{m[0]}\"?" if isinstance(kind, str) and (
+                m := difflib.get_close_matches(kind, list(ELEMENT_TYPES), n=1)) else ""
+            text = "missing" if kind is None else f"unknown element type {kind!r}{hint}"
+            self.problem(where, "type", f"{text} (types: {', '.join(ELEMENT_TYPES)})")
+            return None
+        schema = {f.name: f for f in fields(cls) if "parser" in f.metadata}
+        aliases = {f.metadata["alias"]: f.name for f in schema.values() if f.metadata["alias"]}
+        values: dict[str, Any] = {}
+        seen: dict[str, str] = {}
+        before = len(self.problems)
+        for key, value in raw.items():
+            if key == "type":
+                continue
+            target = aliases.get(key, key)
+            f = schema.get(target)
+            if f is None:
+                self.problem(where, key, _unknown(key, list(schema)))
+                continue
+            if target in seen:
+                self.problem(where, key, f"given twice (as {seen[target]} and {key})")
+                continue
+            seen[target] = key
+            try:
+                values[target] = f.metadata["parser"](value, self.ctx)
+            except p.PropError as e:
+                self.problem(where, key, str(e))
+        for f in schema.values():
+            if f.metadata["required"] and f.name not in raw and f.metadata["alias"] not in raw:
+                self.problem(where, f.name, "missing required property")
+        if len(self.problems) > before:
+            return None
+        element = cls(**values)
+        for key, text in element.check(self.ctx):
+            self.problem(where, key, text)
+        return element
+
+
+def load_form(path: str | Path, symbols: dict[str, int] | None = None) -> Form:
+    """Load one form; FormError lists every problem of the file."""
+    return _Loader(Path(path), symbols or {}).load()
+
+
+def load_forms(folder: str | Path, symbols: dict[str, int] | None = None) -> tuple[list[Form], list[str]]:
+    """Load every `*.hmi` of a folder (sorted by name): the good forms, and the problems of the rest."""
+    forms: list[Form] = []
+    problems: list[str] = []
+    for path in sorted(Path(folder).glob("*.hmi")):
+        try:
+            forms.append(load_form(path, symbols))
+        except FormError as e:
+            problems.extend(e.problems)
+    return forms, problems

@@ -1,0 +1,56 @@
+"""Shared builders for the HMI form tests: snapshots with chosen contents, and elements from dicts."""
+
+from __future__ import annotations
+
+import json
+from pathlib import Path
+from typing import Any
+
+from hmi_forms.elements import Element
+from hmi_forms.form import load_form
+from netplc.memory import Memory, Snapshot
+from netplc.records import Record
+
+
+def snap(bits: dict[int, int] | None = None, words: dict[int, int] | None = None, scan: int = 0,
+         time: float = 0.0, wall: float = 0.0) -> Snapshot:
+    mem = Memory()
+    for addr, v in (bits or {}).items():
+        mem.set_hmi_bit(addr, v)
+    for addr, v in (words or {}).items():
+        mem.set_word(addr, v)
+    return mem.snapshot(scan, time, wall)
+
+
+class ListTarget:
+    """Collects what elements write, as the engine would receive it."""
+
+    def __init__(self) -> None:
+        self.writes: list[tuple[str, int, int, str | None]] = []
+        self.records: list[Record] = []
+
+    def write_bit(self, addr: int, value: int, *, user: str) -> None:
+        self.writes.append(("bit", addr, value, user))
+
+    def write_word(self, addr: int, value: int, *, user: str) -> None:
+        self.writes.append(("word", addr, value, user))
+
+    def set_bit(self, addr: int, value: int) -> None:
+        self.writes.append(("set", addr, value, None))
+
+    def put(self, record: Record) -> None:
+        self.records.append(record)
+
+
+def write_form(folder: Path, elements: list[dict[str, Any]], name: str = "t.hmi", **extra: Any) -> Path:
+    doc = {"form": {"title": "Test", "width": 800, "height": 600}, "elements": elements, **extra}
+    path = folder / name
+    path.write_text(json.dumps(doc, ensure_ascii=False, indent=1), encoding="utf-8")
+    return path
+
+
+def element(tmp_path: Path, type_: str, **props: Any) -> Element:
+    """One element loaded through the real loader (so the tests cover the property parsers too)."""
+    extra = {k: props.pop(k) for k in ("devices", "images") if k in props}
+    raw = {"type": type_, "Name": props.pop("Name", "e1"), "x": 10, "y": 10, "w": 200, "h": 120, **props}
+    return load_form(write_form(tmp_path, [raw], **extra)).elements[0]
