@@ -1,0 +1,254 @@
+"""The read side of the archive: the operator's journal, the offline viewer, CSV export.
+
+The file is opened read-only, and in WAL mode a reader sees the last committed state without ever
+blocking the writer. Every statement is fetched completely before returning, so no read
+transaction stays open to hold back the writer's checkpoints.
+
+Pages are read in id order (newest first by default) and filtered as they are scanned: the first
+page of a common filter needs only the newest rows, and a filter that matches nothing scans one
+day once. Series use the (kind, grp, type, source) index, whose rows come out in id order.
+"""
+
+from __future__ import annotations
+
+import csv
+import datetime as dt
+import sqlite3
+from dataclasses import dataclass
+from pathlib import Path
+from typing import NamedTuple
+from urllib.parse import quote
+
+import numpy as np
+
+from registrar.schema import COLUMNS, DAY_GLOB, parse_table_name, quoted, table_name
+
+EXPORT_CHUNK = 10_000
+SCAN_ABOVE = 0.125  # a series holding more than this share of its day is read by a table scan
+
+
+@dataclass(frozen=True)
+class Filter:
+    kinds: set[str] | frozenset[str] | None = None
+    grp: int | None = None
+    type: int | None = None
+    min_type: int | None = None  # e.g. 2: alarms and worse
+    source: str | None = None
+    text: str | None = None  # contains
+    since: float | None = None  # seconds since the epoch, inclusive
+    until: float | None = None  # seconds since the epoch, exclusive
+
+
+@dataclass(frozen=True, slots=True)
+class Row:
+    id: int
+    ts: float  # seconds since the epoch
+    kind: str
+    grp: int | None
+    type: int | None
+    source: str | None
+    number: int | None
+    value: float | None
+    text: str | None
+
+    @property
+    def time(self) -> dt.datetime:
+        """Local time of the record."""
+        return dt.datetime.fromtimestamp(self.ts)
+
+
+class SeriesKey(NamedTuple):
+    kind: str
+    grp: int | None
+    type: int | None
+    source: str | None
+
+
+_SELECT = "SELECT " + ", ".join(COLUMNS)
+
+
+class Archive:
+    def __init__(self, path: str | Path) -> None:
+        self.path = Path(path)
+        if not self.path.is_file():
+            raise FileNotFoundError(f"{self.path}: no such archive")
+        self._con = self._connect()
+
+    def _connect(self) -> sqlite3.Connection:
+        uri = f"file:{quote(str(self.path.resolve()))}"
+        try:
+            con = sqlite3.connect(f"{uri}?mode=ro", uri=True, isolation_level=None,
+                                  check_same_thread=False)
+            con.execute("SELECT count(*) FROM sqlite_master").fetchone()
+        except sqlite3.OperationalError:
+            # A WAL archive on read-only media (no -shm can be made): nobody writes it there.
+            con = sqlite3.connect(f"{uri}?mode=ro&immutable=1", uri=True, isolation_level=None,
+                                  check_same_thread=False)
+            con.execute("SELECT count(*) FROM sqlite_master").fetchone()
+        con.execute("PRAGMA query_only=1")
+        return con
+
+    def close(self) -> None:
+        self._con.close()
+
+    def __enter__(self) -> Archive:
+        return self
+
+    def __exit__(self, *exc: object) -> None:
+        self.close()
+
+    # --- days and catalogues -------------------------------------------------------------------
+
+    def days(self) -> list[dt.date]:
+        names = self._con.execute(
+            "SELECT name FROM sqlite_master WHERE type = 'table' AND name GLOB ?", (DAY_GLOB,)).fetchall()
+        return sorted((d for (n,) in names if (d := parse_table_name(n)) is not None), reverse=True)
+
+    def meta(self) -> dict[str, str]:
+        return dict(self._con.execute("SELECT key, value FROM meta").fetchall())
+
+    def message_texts(self) -> dict[int, str]:
+        """The catalog as it was copied into the archive."""
+        return dict(self._con.execute("SELECT number, text FROM messages").fetchall())
+
+    def series_keys(self, day: dt.date) -> list[SeriesKey]:
+        rows = self._con.execute(
+            "SELECT kind, grp, type, source FROM series WHERE day = ? ORDER BY kind, grp, type, source",
+            (table_name(day),)).fetchall()
+        return [SeriesKey(*r) for r in rows]
+
+    # --- records -------------------------------------------------------------------------------
+
+    def records(self, day: dt.date, flt: Filter | None = None, offset: int = 0, limit: int = 200,
+                newest_first: bool = True) -> list[Row]:
+        if not self._has(day):
+            return []
+        where, args = _where(flt or Filter())
+        order = "DESC" if newest_first else "ASC"
+        sql = (f"{_SELECT} FROM {quoted(day)} NOT INDEXED{where} "
+               f"ORDER BY id {order} LIMIT ? OFFSET ?")
+        rows = self._con.execute(sql, [*args, limit, offset]).fetchall()
+        return [_row(r) for r in rows]
+
+    def count(self, day: dt.date, flt: Filter | None = None) -> int:
+        if not self._has(day):
+            return 0
+        where, args = _where(flt or Filter())
+        return self._con.execute(f"SELECT count(*) FROM {quoted(day)}{where}", args).fetchone()[0]
+
+    def export_csv(self, path: str | Path, day: dt.date, flt: Filter | None = None) -> int:
+        """Write the selection oldest first; UTF-8 with a BOM so spreadsheets read Cyrillic."""
+        n = 0
+        with open(path, "w", newline="", encoding="utf-8-sig") as f:
+            out = csv.writer(f)
+            out.writerow(["id", "time", *COLUMNS[1:]])
+            if not self._has(day):
+                return 0
+            where, args = _where(flt or Filter())
+            cur = self._con.execute(f"{_SELECT} FROM {quoted(day)} NOT INDEXED{where} ORDER BY id", args)
+            try:
+                while chunk := cur.fetchmany(EXPORT_CHUNK):
+                    for r in chunk:
+                        local = dt.datetime.fromtimestamp(r[1] / 1000).isoformat(timespec="milliseconds")
+                        out.writerow([r[0], local, *r[1:]])
+                    n += len(chunk)
+            finally:
+                cur.close()
+        return n
+
+    # --- series --------------------------------------------------------------------------------
+
+    def series(self, day: dt.date, *, grp: int | None = None, type: int | None = None,
+               source: str | None = None, points: int = 1000) -> tuple[np.ndarray, np.ndarray]:
+        """Times (s) and values of the day's data records, reduced to about `points` points.
+
+        Above `points` the day is cut into points/2 equal time buckets and each keeps its minimum
+        and its maximum at their own times, so peaks survive the reduction.
+        """
+        empty = (np.empty(0), np.empty(0))
+        if not self._has(day):
+            return empty
+        conds = ["kind = 'data'", "value IS NOT NULL"]
+        args: list[object] = []
+        for col, val in (("grp", grp), ("type", type), ("source", source)):
+            if val is not None:
+                conds.append(f"{col} = ?")
+                args.append(val)
+        where = " WHERE " + " AND ".join(conds)
+        table = quoted(day)
+        n = self._con.execute(f"SELECT count(*) FROM {table}{where}", args).fetchone()[0]
+        if n == 0:
+            return empty
+        total = self._con.execute(f"SELECT max(id) FROM {table}").fetchone()[0] or 0
+        hint = " NOT INDEXED" if n > SCAN_ABOVE * total else ""
+        cur = self._con.execute(f"SELECT ts, value FROM {table}{hint}{where} ORDER BY id", args)
+        data = np.fromiter(cur, dtype=[("ts", "i8"), ("value", "f8")], count=n)
+        ts = data["ts"]
+        if len(ts) > 1 and np.any(ts[1:] < ts[:-1]):  # the wall clock was set back
+            data = data[np.argsort(ts, kind="stable")]
+        ts, values = data["ts"] / 1000.0, data["value"]
+        if len(ts) <= points:
+            return ts, values
+        return _min_max(ts, values, max(1, points // 2))
+
+    # --- helpers -------------------------------------------------------------------------------
+
+    def _has(self, day: dt.date) -> bool:
+        return self._con.execute("SELECT 1 FROM sqlite_master WHERE type = 'table' AND name = ?",
+                                 (table_name(day),)).fetchone() is not None
+
+
+def _row(r: tuple) -> Row:
+    return Row(r[0], r[1] / 1000.0, *r[2:])
+
+
+def _where(flt: Filter) -> tuple[str, list[object]]:
+    conds: list[str] = []
+    args: list[object] = []
+    if flt.kinds is not None:
+        kinds = sorted(flt.kinds)
+        conds.append(f"kind IN ({', '.join('?' * len(kinds))})" if kinds else "0")
+        args.extend(kinds)
+    for col, val in (("grp", flt.grp), ("type", flt.type), ("source", flt.source)):
+        if val is not None:
+            conds.append(f"{col} = ?")
+            args.append(val)
+    if flt.min_type is not None:
+        conds.append("type >= ?")
+        args.append(flt.min_type)
+    if flt.since is not None:
+        conds.append("ts >= ?")
+        args.append(round(flt.since * 1000))
+    if flt.until is not None:
+        conds.append("ts < ?")
+        args.append(round(flt.until * 1000))
+    if flt.text:
+        # SQLite folds case for ASCII only; the usual spellings of a Cyrillic word are tried too.
+        variants = sorted({flt.text, flt.text.lower(), flt.text.upper(), flt.text.capitalize()})
+        conds.append("(" + " OR ".join("text LIKE ? ESCAPE '\\'" for _ in variants) + ")")
+        args.extend(f"%{_escape_like(v)}%" for v in variants)
+    return (" WHERE " + " AND ".join(conds)) if conds else "", args
+
+
+def _escape_like(text: str) -> str:
+    return text.replace("\\", "\\\\").replace("%", "\\%").replace("_", "\\_")
+
+
+def _min_max(ts: np.ndarray, values: np.ndarray, buckets: int) -> tuple[np.ndarray, np.ndarray]:
+    """Per equal-time bucket, the minimum and the maximum in the order they occurred."""
+    edges = np.linspace(ts[0], ts[-1], buckets + 1)
+    idx = np.clip(np.searchsorted(edges, ts, side="right") - 1, 0, buckets - 1)
+    starts = np.flatnonzero(np.r_[True, idx[1:] != idx[:-1]])
+    lo = _arg_reduce(values, starts, np.minimum)
+    hi = _arg_reduce(values, starts, np.maximum)
+    keep = np.unique(np.concatenate([lo, hi]))
+    return ts[keep], values[keep]
+
+
+def _arg_reduce(values: np.ndarray, starts: np.ndarray, op: np.ufunc) -> np.ndarray:
+    """Index of the first element equal to each segment's reduction (segments begin at `starts`)."""
+    best = op.reduceat(values, starts)
+    seg = np.repeat(np.arange(len(starts)), np.diff(np.r_[starts, len(values)]))
+    hits = np.flatnonzero(values == best[seg])
+    first = np.r_[True, seg[hits][1:] != seg[hits][:-1]]
+    return hits[first]

@@ -1,0 +1,66 @@
+"""The archive's layout, shared by the writer (store.py) and the readers (query.py).
+
+One table per local day named "DD_MM_YYYY" (the original registrar wrote one DD_MM_YYYY file a
+day), so retention drops a whole table and a day's queries never touch other days.
+"""
+
+from __future__ import annotations
+
+import datetime as dt
+
+SCHEMA_VERSION = "1"
+COLUMNS = ("id", "ts", "kind", "grp", "type", "source", "number", "value", "text")
+DAY_GLOB = "[0-3][0-9]_[01][0-9]_[0-9][0-9][0-9][0-9]"
+
+# ts is milliseconds since the epoch (UTC) so that sorting and ranges are integer comparisons.
+DAY_COLUMNS_SQL = """(
+    id     INTEGER PRIMARY KEY,
+    ts     INTEGER NOT NULL,
+    kind   TEXT    NOT NULL,
+    grp    INTEGER,
+    type   INTEGER,
+    source TEXT,
+    number INTEGER,
+    value  REAL,
+    text   TEXT
+)"""
+
+# The only index: low-cardinality keys receive rows in id order, so each insert lands on the last
+# page of its key range and the index costs little while writing. It serves series (all four
+# keys fixed: rows come out in id order) and counts; pages are read in id order (see query.py).
+KEY_INDEX_COLUMNS = "(kind, grp, type, source)"
+
+META_SQL = "CREATE TABLE IF NOT EXISTS meta (key TEXT PRIMARY KEY, value TEXT)"
+MESSAGES_SQL = ("CREATE TABLE IF NOT EXISTS messages "
+                "(number INTEGER PRIMARY KEY, grp INTEGER, type INTEGER, text TEXT)")
+# The distinct data series of each day, kept by the writer so the viewer's picker is instant.
+SERIES_SQL = ("CREATE TABLE IF NOT EXISTS series (day TEXT NOT NULL, kind TEXT NOT NULL, grp INTEGER, "
+              "type INTEGER, source TEXT, UNIQUE (day, kind, grp, type, source))")
+
+
+def table_name(day: dt.date) -> str:
+    return f"{day.day:02d}_{day.month:02d}_{day.year:04d}"
+
+
+def parse_table_name(name: str) -> dt.date | None:
+    try:
+        d, m, y = name.split("_")
+        if len(d) != 2 or len(m) != 2 or len(y) != 4:
+            return None
+        return dt.date(int(y), int(m), int(d))
+    except ValueError:
+        return None
+
+
+def quoted(day: dt.date) -> str:
+    """The table name quoted for SQL (it starts with a digit)."""
+    return f'"{table_name(day)}"'
+
+
+def local_day_bounds(ts: float) -> tuple[dt.date, float, float]:
+    """The local date of `ts` and the epoch seconds of its local midnight and the next one."""
+    day = dt.date.fromtimestamp(ts)
+    start = dt.datetime(day.year, day.month, day.day).timestamp()
+    nxt = day + dt.timedelta(days=1)
+    end = dt.datetime(nxt.year, nxt.month, nxt.day).timestamp()
+    return day, start, end

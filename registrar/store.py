@@ -1,0 +1,324 @@
+"""The archive writer: records from the engine and the station go to daily SQLite tables.
+
+`put` is called from the scan thread, so it only appends to a bounded deque; a writer thread of
+its own commits what has queued at least every `flush_interval` seconds, one transaction per batch
+(the transaction, not the insert, is what costs in SQLite). WAL with synchronous=NORMAL keeps
+every committed batch through a crash of the process; a crash loses at most the batch being
+written. When the disk fails the batch is kept and retried, and when the queue is full records are
+dropped and counted; both are reported in 'system' records and in `stats`, never silently.
+"""
+
+from __future__ import annotations
+
+import contextlib
+import datetime as dt
+import sqlite3
+import threading
+import time
+from collections import deque
+from collections.abc import Callable
+from dataclasses import dataclass, replace
+from pathlib import Path
+
+from netplc.records import Record
+from registrar.catalog import Catalog
+from registrar.schema import (
+    DAY_COLUMNS_SQL,
+    DAY_GLOB,
+    KEY_INDEX_COLUMNS,
+    MESSAGES_SQL,
+    META_SQL,
+    SCHEMA_VERSION,
+    SERIES_SQL,
+    local_day_bounds,
+    parse_table_name,
+    table_name,
+)
+
+SOURCE = "registrar"
+BATCH_MAX = 50_000  # records per transaction: bounds the time one commit holds the writer
+RETRY_MAX = 5.0  # seconds between attempts while the disk keeps failing
+BUSY_TIMEOUT_MS = 1000
+
+Row = tuple[int, str, int | None, int | None, str | None, int | None, float | None, str | None]
+
+
+@dataclass(frozen=True)
+class StoreStats:
+    queued: int = 0  # records waiting in the queue
+    committed: int = 0  # records known to be on disk
+    batches: int = 0  # transactions committed
+    overflows: int = 0  # times the queue filled up
+    dropped: int = 0  # records lost because the queue was full
+    last_error: str = ""  # the last write failure ("" once writing works again)
+    db_path: str = ""
+
+
+class Store:
+    def __init__(
+        self,
+        path: str | Path,
+        *,
+        catalog: Catalog | None = None,
+        keep_days: int = 0,
+        wallclock: Callable[[], float] = time.time,
+        queue_size: int = 100_000,
+        flush_interval: float = 1.0,
+        on_commit: Callable[[int], None] | None = None,
+    ) -> None:
+        self.path = Path(path)
+        self.catalog = catalog or Catalog()
+        self.keep_days = keep_days
+        self.wallclock = wallclock
+        self.queue_size = queue_size
+        self.flush_interval = flush_interval
+        self.on_commit = on_commit  # called in the writer thread with the committed total
+        self._queue: deque[Record] = deque()
+        self._wake = threading.Event()
+        self._stopping = threading.Event()
+        self._thread: threading.Thread | None = None
+        self._lock = threading.Lock()  # guards the overflow counters (put runs in several threads)
+        self._overflowing = False
+        self._stats = StoreStats(db_path=str(self.path))
+        self._con: sqlite3.Connection | None = None
+        self._known: dict[str, set[tuple]] = {}  # day table -> data series keys already listed
+        self._day: tuple[float, float, str] = (0.0, 0.0, "")  # [start, end) of the cached local day
+        self._reported_drops = 0
+        self._failing_since: float | None = None
+        self._new_day = False  # a day table was opened: run retention after the commit
+
+    # --- producer side (any thread) ------------------------------------------------------------
+
+    def put(self, record: Record) -> None:
+        """Queue a record; never blocks. A full queue drops the record and counts it."""
+        queue = self._queue
+        if len(queue) >= self.queue_size:
+            with self._lock:
+                if not self._overflowing:
+                    self._overflowing = True
+                    self._stats = replace(self._stats, overflows=self._stats.overflows + 1)
+                self._stats = replace(self._stats, dropped=self._stats.dropped + 1)
+            self._wake.set()
+            return
+        queue.append(record)
+        if len(queue) >= BATCH_MAX:
+            self._wake.set()
+
+    @property
+    def stats(self) -> StoreStats:
+        return replace(self._stats, queued=len(self._queue))
+
+    @property
+    def committed(self) -> int:
+        return self._stats.committed
+
+    # --- lifecycle -----------------------------------------------------------------------------
+
+    def start(self) -> None:
+        self.path.parent.mkdir(parents=True, exist_ok=True)
+        self._con = self._open()
+        self._thread = threading.Thread(target=self._run, name="registrar-writer", daemon=True)
+        self._thread.start()
+
+    def close(self, timeout: float = 30.0) -> None:
+        """Write everything queued, then stop the writer and close the file."""
+        self._stopping.set()
+        self._wake.set()
+        if self._thread is not None:
+            self._thread.join(timeout)
+            self._thread = None
+
+    # --- writer thread -------------------------------------------------------------------------
+
+    def _open(self) -> sqlite3.Connection:
+        con = sqlite3.connect(self.path, isolation_level=None, check_same_thread=False)
+        con.execute(f"PRAGMA busy_timeout={BUSY_TIMEOUT_MS}")
+        con.execute("PRAGMA journal_mode=WAL")
+        con.execute("PRAGMA synchronous=NORMAL")
+        con.execute("BEGIN IMMEDIATE")
+        con.execute(META_SQL)
+        con.execute(MESSAGES_SQL)
+        con.execute(SERIES_SQL)
+        meta = {
+            "schema_version": SCHEMA_VERSION,
+            "ts_unit": "milliseconds since 1970-01-01 UTC",
+            "day_tables": "one per local day, named DD_MM_YYYY",
+            "timezone": time.strftime("%Z %z"),
+            "message_types": "0 info, 1 warning, 2 alarm, 3 critical",
+        }
+        con.execute("INSERT OR IGNORE INTO meta VALUES ('created', ?)",
+                    (dt.datetime.fromtimestamp(self.wallclock()).isoformat(timespec="seconds"),))
+        con.executemany("INSERT OR REPLACE INTO meta VALUES (?, ?)", meta.items())
+        if len(self.catalog):
+            con.execute("DELETE FROM messages")
+            con.executemany("INSERT INTO messages VALUES (?, ?, ?, ?)",
+                            [(m.number, m.grp, m.type, m.text) for m in self.catalog])
+        con.execute("COMMIT")
+        self._retain(con)
+        return con
+
+    def _run(self) -> None:
+        pending: list[Record] = []
+        wait = self.flush_interval
+        while True:
+            self._wake.wait(wait)
+            self._wake.clear()
+            stopping = self._stopping.is_set()
+            pending = self._drain(pending)
+            if pending:  # the disk fails: back off, keep the batch
+                if stopping:
+                    break  # nothing more can be kept; stats.last_error says why
+                wait = min(RETRY_MAX, max(wait * 2, self.flush_interval))
+            elif stopping:
+                if not self._queue:
+                    break
+                wait = 0.0
+            else:
+                wait = self.flush_interval
+                if self._new_day:
+                    self._new_day = False
+                    self._retain(self._con)
+        assert self._con is not None
+        self._con.close()
+
+    def _drain(self, pending: list[Record]) -> list[Record]:
+        """Write until the queue is empty; return the batch that failed, if any."""
+        while True:
+            if not pending:
+                pending = self._take()
+                if not pending:
+                    return []
+            if not self._write(pending):
+                return pending
+            pending = []
+
+    def _take(self) -> list[Record]:
+        queue = self._queue
+        n = min(len(queue), BATCH_MAX)
+        batch = [queue.popleft() for _ in range(n)]
+        with self._lock:
+            dropped = self._stats.dropped
+            if self._overflowing and len(queue) < self.queue_size:
+                self._overflowing = False
+        if dropped > self._reported_drops:
+            lost = dropped - self._reported_drops
+            self._reported_drops = dropped
+            batch.append(Record(self.wallclock(), "system", source=SOURCE,
+                                text=f"archive queue full: {lost} record(s) lost "
+                                     f"(the disk did not keep up; queue size {self.queue_size})"))
+        return batch
+
+    def _write(self, batch: list[Record]) -> bool:
+        """One transaction for the batch; on failure keep it for a retry and say so once."""
+        con = self._con
+        assert con is not None
+        try:
+            tables = self._rows_by_table(batch)
+            con.execute("BEGIN IMMEDIATE")
+            for table, rows in tables.items():
+                self._ensure_table(con, table, rows)
+                con.executemany(
+                    f'INSERT INTO "{table}" (ts, kind, grp, type, source, number, value, text) '
+                    "VALUES (?, ?, ?, ?, ?, ?, ?, ?)", rows)
+            con.execute("COMMIT")
+        except (sqlite3.Error, OSError) as e:
+            self._failed(con, e)
+            return False
+        committed = self._stats.committed + len(batch)
+        self._stats = replace(self._stats, committed=committed, batches=self._stats.batches + 1,
+                              last_error="")
+        if self._failing_since is not None:
+            seconds = self.wallclock() - self._failing_since
+            self._failing_since = None
+            self._queue.appendleft(Record(self.wallclock(), "system", source=SOURCE,
+                                          text=f"archive writing resumed after {seconds:.0f} s; "
+                                               "no records were lost"))
+            self._wake.set()
+        if self.on_commit is not None:
+            try:
+                self.on_commit(committed)
+            except Exception as e:  # a listener's bug must not stop the archive
+                self.on_commit = None
+                self._queue.append(Record(self.wallclock(), "system", source=SOURCE,
+                                          text=f"archive commit listener failed and was removed: {e!r}"))
+        return True
+
+    def _failed(self, con: sqlite3.Connection, error: Exception) -> None:
+        if con.in_transaction:
+            with contextlib.suppress(sqlite3.Error):  # if it fails, SQLite has rolled back already
+                con.execute("ROLLBACK")
+        self._known.clear()  # tables created in the failed transaction are gone
+        text = f"archive write failed: {error}"
+        self._stats = replace(self._stats, last_error=text)
+        if self._failing_since is None:
+            self._failing_since = self.wallclock()
+            self._queue.append(Record(self.wallclock(), "system", source=SOURCE,
+                                      text=f"{text}; records are kept in memory and retried"))
+
+    def _rows_by_table(self, batch: list[Record]) -> dict[str, list[Row]]:
+        tables: dict[str, list[Row]] = {}
+        start, end, name = self._day
+        rows = tables.setdefault(name, []) if name else []
+        text_for = self.catalog.text_for
+        get = self.catalog.get
+        for r in batch:
+            ts = r.ts
+            if not start <= ts < end:
+                day, start, end = local_day_bounds(ts)
+                name = table_name(day)
+                rows = tables.setdefault(name, [])
+            text = r.text
+            grp, kind_type = r.grp, r.type
+            if r.kind == "message" and r.number is not None:
+                if text is None:
+                    text = text_for(r.number)
+                if grp is None or kind_type is None:
+                    message = get(r.number)
+                    if message is not None:
+                        grp = message.grp if grp is None else grp
+                        kind_type = message.type if kind_type is None else kind_type
+            rows.append((round(ts * 1000), r.kind, grp, kind_type, r.source, r.number, r.value, text))
+        self._day = (start, end, name)
+        return {t: rows for t, rows in tables.items() if rows}
+
+    def _ensure_table(self, con: sqlite3.Connection, table: str, rows: list[Row]) -> None:
+        known = self._known.get(table)
+        if known is None:
+            con.execute(f'CREATE TABLE IF NOT EXISTS "{table}" {DAY_COLUMNS_SQL}')
+            con.execute(f'CREATE INDEX IF NOT EXISTS "{table}_key" ON "{table}" {KEY_INDEX_COLUMNS}')
+            known = {tuple(k) for k in con.execute(
+                "SELECT kind, grp, type, source FROM series WHERE day = ?", (table,))}
+            self._known[table] = known
+            self._new_day = True
+        new = {(k, g, t, s) for _, k, g, t, s, _, _, _ in rows if k == "data"} - known
+        if new:
+            con.executemany("INSERT OR IGNORE INTO series VALUES (?, ?, ?, ?, ?)",
+                            [(table, *key) for key in new])
+            known |= new
+
+    def _retain(self, con: sqlite3.Connection | None) -> None:
+        """Retention, run after a commit that opened a day table (and at start); never VACUUM."""
+        if self.keep_days <= 0 or con is None:
+            return
+        try:
+            self._drop_old_days(con)
+        except sqlite3.Error as e:
+            if con.in_transaction:
+                con.execute("ROLLBACK")
+            self._stats = replace(self._stats, last_error=f"dropping old days failed: {e}")
+
+    def _drop_old_days(self, con: sqlite3.Connection) -> None:
+        """Whole day tables older than keep_days go; their pages are reused by later days."""
+        today = dt.date.fromtimestamp(self.wallclock())
+        oldest = today - dt.timedelta(days=self.keep_days - 1)
+        names = [n for (n,) in con.execute(
+            "SELECT name FROM sqlite_master WHERE type = 'table' AND name GLOB ?", (DAY_GLOB,))]
+        old = [n for n in names if (d := parse_table_name(n)) is not None and d < oldest]
+        if not old:
+            return
+        con.execute("BEGIN IMMEDIATE")
+        for name in old:
+            con.execute(f'DROP TABLE "{name}"')
+            con.execute("DELETE FROM series WHERE day = ?", (name,))
+            self._known.pop(name, None)
+        con.execute("COMMIT")
