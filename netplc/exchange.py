@@ -1,0 +1,373 @@
+"""Exchange with the PLC network: NODE / NREAD / NWRITE block requests over Modbus (DESIGN 1 and 7).
+
+The scan never waits for the network. NREAD/NWRITE hand a block request to the node's asyncio task
+(on the exchange's own event-loop thread) and return at once with the node's link state; while a
+request of an instruction is in flight, the instruction asks for nothing more. The task's result
+comes back through `engine.post`, so it is applied to memory at the start of a later scan, by the
+engine thread, like every other write. Link-state changes reach the presence list 077740-077777
+the same way.
+
+Each node has its own task, connection, timeout, retries and reconnect back-off, so a dead or slow
+node only ever delays its own requests. While a node is backing off, its requests fail at once
+(the instruction's output shows the link is down) and the first request after the back-off tries
+to reconnect.
+"""
+
+from __future__ import annotations
+
+import asyncio
+import time
+from collections.abc import Iterable
+from dataclasses import dataclass, field
+from typing import TYPE_CHECKING
+
+from netplc.address import PRESENCE_LIST, PRESENCE_NODES, AddressError, check_operand
+from netplc.memory import Memory
+from netplc.modbus_driver import (
+    DeviceError,
+    Endpoint,
+    LinkError,
+    LoopThread,
+    ModbusClient,
+    parse_endpoint,
+)
+from netplc.modbus_map import PROFILES, TABLES, WRITABLE_TABLES, Block, MapError, describe, locate
+from netplc.program import Diagnostic, Program
+from netplc.records import NullSink, Record, RecordSink
+
+if TYPE_CHECKING:
+    from netplc.engine import Engine
+    from netplc.program import Instr
+
+NODE, NREAD, NWRITE = 300, 301, 302
+
+
+@dataclass
+class NodeConfig:
+    """One remote node of station.toml: where it is and how to talk to it."""
+
+    node: int
+    endpoint: str
+    unit: int = 1
+    profile: str = "cpu165"
+    timeout: float = 1.0  # seconds per attempt
+    retries: int = 1  # further attempts after a failed one
+    table: str = "holding"  # profile "modbus": holding, input, coils or discrete
+    backoff: float = 0.2  # first reconnect delay after the link went down, seconds
+    backoff_max: float = 5.0  # the delay doubles up to this
+
+    def __post_init__(self) -> None:
+        self.parsed: Endpoint = self.validate()
+
+    def validate(self) -> Endpoint:
+        """The parsed endpoint; ValueError names the node and what is wrong."""
+        where = f"node {self.node}"
+        if not isinstance(self.node, int) or not 0 <= self.node <= 255:
+            raise ValueError(f"{where}: the node number must be 0-255")
+        try:
+            endpoint = parse_endpoint(self.endpoint)
+        except ValueError as e:
+            raise ValueError(f"{where}: {e}") from None
+        if not 0 <= self.unit <= 255:
+            raise ValueError(f"{where}: unit {self.unit} is not 0-255")
+        if self.profile not in PROFILES:
+            raise ValueError(f"{where}: profile {self.profile!r} is not one of {', '.join(PROFILES)}")
+        if self.table not in TABLES:
+            raise ValueError(f"{where}: table {self.table!r} is not one of {', '.join(TABLES)}")
+        if not self.timeout > 0:
+            raise ValueError(f"{where}: timeout {self.timeout} must be more than 0 s")
+        if self.retries < 0:
+            raise ValueError(f"{where}: retries {self.retries} must be 0 or more")
+        if not 0 < self.backoff <= self.backoff_max:
+            raise ValueError(f"{where}: backoff {self.backoff} must be more than 0 and at most "
+                             f"backoff_max {self.backoff_max}")
+        return endpoint
+
+    @classmethod
+    def parse(cls, node: int, values: dict) -> NodeConfig:
+        """Build from a config table (station.toml `[nodes.N]`); ValueError names the bad key."""
+        known = {"endpoint", "unit", "profile", "timeout", "retries", "table", "backoff", "backoff_max"}
+        unknown = sorted(set(values) - known)
+        if unknown:
+            raise ValueError(f"node {node}: unknown setting(s) {', '.join(unknown)} "
+                             f"(known: {', '.join(sorted(known))})")
+        if "endpoint" not in values:
+            raise ValueError(f"node {node}: endpoint is missing")
+        kinds = {"endpoint": str, "unit": int, "profile": str, "timeout": (int, float),
+                 "retries": int, "table": str, "backoff": (int, float), "backoff_max": (int, float)}
+        for key, value in values.items():
+            if not isinstance(value, kinds[key]) or isinstance(value, bool):
+                raise ValueError(f"node {node}: {key} = {value!r} has the wrong type")
+        return cls(node=node, **values)
+
+
+@dataclass
+class NodeStats:
+    """What the status bar shows of a node."""
+
+    node: int
+    endpoint: str
+    up: bool = False
+    reads: int = 0  # completed block reads
+    writes: int = 0  # completed block writes
+    errors: int = 0  # failed block requests
+    last_error: str = ""
+    changed: float = 0.0  # monotonic time of the last link-state change
+
+
+@dataclass
+class _Request:
+    key: int  # the FON instruction index
+    remote: int
+    local: int = 0
+    length: int = 0
+    payload: bytes | None = None  # None: a read
+    issued: float = field(default_factory=time.monotonic)
+
+
+class _Node:
+    """A node's task state: lives on the exchange loop, except `stats.up`, read by the scan."""
+
+    def __init__(self, config: NodeConfig, exchange: Exchange, stats: NodeStats) -> None:
+        self.config = config
+        self.exchange = exchange
+        self.stats = stats
+        self.client = ModbusClient(config.parsed, config.unit, config.timeout)
+        self.queue: asyncio.Queue[_Request] = asyncio.Queue()
+        self.delay = config.backoff
+        self.retry_at = 0.0  # monotonic time before which requests fail without trying
+
+    async def run(self) -> None:
+        try:
+            while True:
+                req = await self.queue.get()
+                try:
+                    data, error = await self.serve(req)
+                except Exception as e:  # a bug must not end the node's task: report, go on
+                    self.client.close()
+                    data, error = None, f"internal error: {e!r}"
+                self.exchange.complete(self, req, data, error)
+        finally:
+            self.client.close()
+
+    async def serve(self, req: _Request) -> tuple[bytes | None, str]:
+        now = time.monotonic()
+        if now < self.retry_at:
+            return None, self.stats.last_error or "link down"
+        where = describe(self.config.profile, req.remote)
+        try:
+            block = locate(self.config.profile, self.config.table,
+                           req.remote, req.length if req.payload is None else len(req.payload))
+        except MapError as e:
+            return None, f"{where}: {e}"
+        try:
+            data = await self.attempts(block, req.payload)
+        except (MapError, DeviceError) as e:  # the device answered: the link is up
+            self.link(True, "")
+            return None, f"{where}: {e}"
+        except LinkError as e:
+            self.client.close()
+            self.retry_at = time.monotonic() + self.delay
+            self.delay = min(2 * self.delay, self.config.backoff_max)
+            self.link(False, str(e))
+            return None, str(e)
+        self.delay = self.config.backoff
+        self.link(True, "")
+        return data, ""
+
+    async def attempts(self, block: Block, payload: bytes | None) -> bytes:
+        for attempt in range(self.config.retries + 1):
+            try:
+                if not self.client.connected:
+                    await self.client.connect()
+                if payload is None:
+                    return await self.read(block)
+                await self.write(block, payload)
+                return b""
+            except LinkError:
+                self.client.close()
+                if attempt == self.config.retries:
+                    raise
+        raise AssertionError("unreachable")
+
+    async def read(self, block: Block) -> bytes:
+        values: list[int] = []
+        for address, count in block.spans(write=False):
+            values += await self.client.read(block.table, address, count)
+        return block.decode(values)
+
+    async def write(self, block: Block, payload: bytes) -> None:
+        if block.table not in WRITABLE_TABLES:
+            raise MapError(f"{block.table} is a read-only table")
+        first = last = 0
+        if block.skip:  # odd edges: keep the neighbouring bytes of the edge registers
+            first = (await self.client.read(block.table, block.address, 1))[0]
+        if block.odd_end:
+            last = (await self.client.read(block.table, block.address + block.count - 1, 1))[0]
+        values = block.encode(payload, first, last)
+        offset = 0
+        for address, count in block.spans(write=True):
+            await self.client.write(block.table, address, values[offset : offset + count])
+            offset += count
+
+    def link(self, up: bool, error: str) -> None:
+        stats = self.stats
+        if error:
+            stats.last_error = error
+        if stats.up == up:
+            return
+        stats.up = up
+        stats.changed = time.monotonic()
+        self.exchange.link_changed(self, up, error)
+
+
+class Exchange:
+    """Implements `NetLink` for the engine: block requests to configured nodes over Modbus."""
+
+    def __init__(self, nodes: list[NodeConfig], sink: RecordSink | None = None) -> None:
+        self.configs: dict[int, NodeConfig] = {}
+        for cfg in nodes:
+            if cfg.node in self.configs:
+                raise ValueError(f"node {cfg.node} is configured twice")
+            self.configs[cfg.node] = cfg
+        self.sink: RecordSink = sink or NullSink()
+        self.engine: Engine | None = None
+        self.stats: dict[int, NodeStats] = {
+            n: NodeStats(n, str(cfg.parsed)) for n, cfg in self.configs.items()
+        }
+        self._nodes: dict[int, _Node] = {}
+        self._inflight: set[int] = set()  # instruction keys; touched by the engine thread only
+        self._thread = LoopThread("netplc-exchange")
+
+    # --- wiring ----------------------------------------------------------------------------------
+
+    def attach(self, engine: Engine) -> None:
+        """Results and presence-list changes go to `engine.post`; the engine's NREAD/NWRITE call us."""
+        self.engine = engine
+        engine.exchange = self
+
+    def start(self) -> None:
+        if self.engine is None:
+            raise RuntimeError("Exchange.attach(engine) must come before start()")
+        inflight = self._inflight
+        self.engine.post(lambda mem: inflight.clear())  # requests of an earlier run never complete
+        self._thread.start()
+        self._thread.run(self._spawn())
+
+    async def _spawn(self) -> None:
+        for n, cfg in self.configs.items():
+            node = _Node(cfg, self, self.stats[n])
+            self._nodes[n] = node
+            asyncio.get_running_loop().create_task(node.run(), name=f"node {n}")
+
+    def stop(self) -> None:
+        self._thread.stop()
+        self._nodes.clear()
+
+    # --- NetLink (called by NREAD/NWRITE on the engine thread) -----------------------------------
+
+    def link_up(self, node: int) -> bool:
+        stats = self.stats.get(node)
+        return stats is not None and stats.up
+
+    def request_read(self, key: int, node: int, remote: int, local: int, length: int) -> bool:
+        return self._request(node, _Request(key, remote, local, length))
+
+    def request_write(self, key: int, node: int, remote: int, payload: bytes) -> bool:
+        return self._request(node, _Request(key, remote, payload=bytes(payload)))
+
+    def _request(self, node: int, req: _Request) -> bool:
+        target = self._nodes.get(node)
+        if target is None:
+            return False
+        if req.key not in self._inflight:
+            self._inflight.add(req.key)
+            self._thread.call(target.queue.put_nowait, req)
+        return target.stats.up
+
+    # --- back on the engine thread ---------------------------------------------------------------
+
+    def complete(self, node: _Node, req: _Request, data: bytes | None, error: str) -> None:
+        """A request is done (exchange loop): count it and apply its result at the next scan."""
+        stats = node.stats
+        if error:
+            stats.errors += 1
+        elif req.payload is None:
+            stats.reads += 1
+        else:
+            stats.writes += 1
+        inflight = self._inflight
+
+        def apply(mem: Memory) -> None:
+            inflight.discard(req.key)
+            if data:
+                mem.write(req.local, data)
+
+        self.engine.post(apply)
+
+    def link_changed(self, node: _Node, up: bool, error: str) -> None:
+        n = node.config.node
+        text = f"node {n} ({node.stats.endpoint}): link {'up' if up else 'down'}"
+        self.sink.put(Record(time.time(), "system", source=f"node {n}", number=n,
+                             value=1.0 if up else 0.0, text=f"{text}: {error}" if error else text))
+        if n < PRESENCE_NODES:
+            byte = 0xFF if up else 0x00
+            self.engine.post(lambda mem: mem.set_byte(PRESENCE_LIST + n, byte))
+
+
+def _fon_nodes(program: Program) -> Iterable[tuple[int, Instr, int | None]]:
+    """(function, instruction, node it talks to): the nearest NODE above it in the text; node 0
+    when the program has no NODE; None above the first NODE (the last NODE of the previous scan)."""
+    has_node = any(i.op == "FON" and i.n == NODE for i in program.instrs)
+    current: int | None = None if has_node else 0
+    for ins in program.instrs:
+        if ins.op != "FON":
+            continue
+        if ins.n == NODE:
+            current = ins.s
+        elif ins.n in (NREAD, NWRITE):
+            yield ins.n, ins, current
+
+
+def check_program_nodes(program: Program, nodes: list[NodeConfig]) -> list[Diagnostic]:
+    """Load-time check of the program's network instructions against the configured nodes.
+
+    Every NODE must name a configured node; an NREAD/NWRITE before any NODE talks to node 0 (the
+    engine's initial node), which must then be configured. The remote block is checked against
+    the profile of the node selected by the nearest NODE above it, and the local block against
+    NetPlc memory.
+    """
+    configs = {c.node: c for c in nodes}
+    have = ", ".join(str(n) for n in sorted(configs)) or "none"
+    out: list[Diagnostic] = []
+
+    def err(ins: Instr, text: str) -> None:
+        out.append(Diagnostic(program.source, ins.line, 1, text))
+
+    for ins in program.instrs:
+        if ins.op == "FON" and ins.n == NODE and ins.s not in configs:
+            err(ins, f"NODE S:{ins.s}: node {ins.s} is not configured (configured nodes: {have})")
+    for fn, ins, node in _fon_nodes(program):
+        name = "NREAD" if fn == NREAD else "NWRITE"
+        remote, local = (ins.s, ins.d) if fn == NREAD else (ins.d, ins.s)
+        length = ins.r or 0
+        try:
+            check_operand(local, length)
+        except AddressError as e:
+            err(ins, f"{name}: local block of {length} bytes: {e}")
+        if node is None:
+            continue
+        cfg = configs.get(node)
+        if cfg is None:
+            if not any(i.op == "FON" and i.n == NODE for i in program.instrs):
+                err(ins, f"{name} with no NODE in the program talks to node 0, which is not configured "
+                         f"(configured nodes: {have})")
+            continue  # otherwise its NODE is reported above
+        try:
+            block = locate(cfg.profile, cfg.table, remote, length)
+        except MapError as e:
+            err(ins, f"{name}: node {node}: {e}")
+            continue
+        if fn == NWRITE and block.table not in WRITABLE_TABLES:
+            err(ins, f"NWRITE: node {node}: table {block.table} is read-only")
+    return out

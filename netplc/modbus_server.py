@@ -1,0 +1,98 @@
+"""NetPlc memory served over Modbus TCP with the cpu165 profile (DESIGN 1 and 7).
+
+Other SCADAs and debugging tools read what the HMI reads: the snapshot published after the last
+scan, never the live memory. Writes are accepted only inside the configured ranges (exception 2
+outside, like an address that does not exist), go through the engine's queue to be applied at the
+start of the next scan, and are journaled by the engine as 'operator' records whose source is the
+peer's address.
+"""
+
+from __future__ import annotations
+
+from netplc.address import IO_BITS, fmt_octal
+from netplc.engine import Engine
+from netplc.modbus_driver import LoopThread, TcpServer
+from netplc.modbus_map import (
+    BIT_TABLES,
+    MapError,
+    Table,
+    bits_target,
+    bytes_from_bits,
+    bytes_from_words,
+    read_bits,
+    read_registers,
+    registers_target,
+)
+
+ALL_MEMORY: list[tuple[int, int]] = [(0, 0o77777)]  # every I/O bit and every data byte
+
+
+class ModbusServer:
+    """`start()` binds `host:port` (port 0: an ephemeral port, see `.port`) on a thread of its own.
+
+    `writable` lists inclusive NetPlc address ranges a client may write: I/O bit addresses for
+    coils, data byte addresses for registers (the two never overlap). None: read-only.
+    `unit` None answers every unit id; otherwise other unit ids get exception 0x0B.
+    """
+
+    def __init__(self, engine: Engine, host: str = "127.0.0.1", port: int = 0,
+                 writable: list[tuple[int, int]] | None = None, unit: int | None = None) -> None:
+        self.engine = engine
+        self.host = host
+        self.requested_port = port
+        self.writable = list(writable or [])
+        for lo, hi in self.writable:
+            if not 0 <= lo <= hi <= 0o77777:
+                raise ValueError(f"writable range {fmt_octal(lo)}-{fmt_octal(hi)} is not within 00000-077777")
+        self.unit = unit
+        self._server = TcpServer(self, unit)
+        self._thread = LoopThread(f"modbus-server-{host}:{port}")
+
+    @property
+    def port(self) -> int:
+        return self._server.port
+
+    def start(self) -> None:
+        self._thread.start()
+        try:
+            self._thread.run(self._server.listen(self.host, self.requested_port))
+        except BaseException:
+            self._thread.stop()
+            raise
+
+    def stop(self) -> None:
+        if self._thread.loop is not None:
+            self._thread.run(self._server.close())
+        self._thread.stop()
+
+    # --- ServeHandler (on the server's loop) ------------------------------------------------------
+
+    def read(self, table: Table, address: int, count: int) -> list[int]:
+        snap = self.engine.snapshot
+        if table in BIT_TABLES:
+            return read_bits(snap, address, count)
+        return read_registers(snap, address, count)
+
+    def write(self, table: Table, address: int, values: list[int], peer: str) -> None:
+        user = f"modbus {peer}"
+        engine = self.engine
+        if table == "coils":
+            first = bits_target(address, len(values))
+            self._check(first, first + len(values) - 1)
+            if len(values) % 8 == 0:  # whole bytes of bits: one journal record
+                engine.write_bytes(first, bytes_from_bits(values), user=user)
+            else:
+                for i, v in enumerate(values):
+                    engine.write_bit(first + i, v, user=user)
+            return
+        first = registers_target(address, len(values))
+        self._check(first, first + 2 * len(values) - 1)
+        if len(values) == 1:
+            engine.write_word(first, values[0], user=user)
+        else:
+            engine.write_bytes(first, bytes_from_words(values), user=user)
+
+    def _check(self, lo: int, hi: int) -> None:
+        if not any(a <= lo and hi <= b for a, b in self.writable):
+            what = "bits" if lo < IO_BITS else "bytes"
+            raise MapError(f"{what} {fmt_octal(lo)}-{fmt_octal(hi)} are not writable over Modbus")

@@ -1,0 +1,95 @@
+"""A simulated CPU-165 node: the NetPlc engine running a CPU-165 program on its tick, served over
+Modbus TCP with the cpu165 profile and all of its memory writable (DESIGN section 1).
+
+It is what a user points NetPlc at before the plant exists, what the demo station embeds, and
+what the exchange tests and benchmark talk to. It has no exchange of its own: a CPU-165 answers
+the network, it does not ask it.
+
+    python main.py simulate PROGRAM.stl [--symbols F] [--host H] [--port P] [--unit U] [--tick MS]
+    python -m netplc.simulator PROGRAM.stl ...
+"""
+
+from __future__ import annotations
+
+import argparse
+import sys
+import threading
+
+from netplc.engine import Engine
+from netplc.modbus_server import ALL_MEMORY, ModbusServer
+from netplc.program import Program, ProgramError, load_symbols, parse_file
+from netplc.records import RecordSink
+from netplc.scheduler import ScanThread
+
+
+class Simulator:
+    def __init__(self, program: Program, host: str = "127.0.0.1", port: int = 0, unit: int | None = 1,
+                 tick: float = 0.1, sink: RecordSink | None = None) -> None:
+        self.engine = Engine(program, tick=tick, sink=sink)
+        self.scan = ScanThread(self.engine, tick, name="cpu165-sim-scan")
+        self.server = ModbusServer(self.engine, host, port, writable=ALL_MEMORY, unit=unit)
+
+    @property
+    def port(self) -> int:
+        return self.server.port
+
+    def start(self) -> None:
+        self.scan.start()
+        try:
+            self.server.start()
+        except BaseException:
+            self.scan.stop()
+            raise
+
+    def stop(self) -> None:
+        self.server.stop()
+        self.scan.stop()
+
+
+def build_parser() -> argparse.ArgumentParser:
+    p = argparse.ArgumentParser(prog="simulate", description="run a simulated CPU-165 node over Modbus TCP")
+    p.add_argument("program", help="CPU-165 program (.stl)")
+    p.add_argument("--symbols", help="symbols.csv (name,address,comment)")
+    p.add_argument("--host", default="127.0.0.1", help="address to bind (default 127.0.0.1)")
+    p.add_argument("--port", type=int, default=502, help="TCP port (default 502; 0 = any free port)")
+    p.add_argument("--unit", type=int, default=1, help="Modbus unit id to answer (default 1)")
+    p.add_argument("--tick", type=int, default=100, help="scan tick in ms (default 100)")
+    return p
+
+
+def main(argv: list[str] | None = None) -> int:
+    args = build_parser().parse_args(argv)
+    if not 1 <= args.tick <= 60_000:
+        print(f"simulate: --tick {args.tick}: expected 1-60000 ms", file=sys.stderr)
+        return 2
+    if not 0 <= args.unit <= 255 or not 0 <= args.port <= 65535:
+        print("simulate: --unit takes 0-255 and --port 0-65535", file=sys.stderr)
+        return 2
+    try:
+        symbols = load_symbols(args.symbols) if args.symbols else {}
+        program = parse_file(args.program, symbols)
+    except ProgramError as e:
+        print(e, file=sys.stderr)
+        return 2
+    except OSError as e:
+        print(f"simulate: {e}", file=sys.stderr)
+        return 2
+    sim = Simulator(program, args.host, args.port, args.unit, args.tick / 1000.0)
+    try:
+        sim.start()
+    except OSError as e:
+        print(f"simulate: cannot listen on {args.host}:{args.port}: {e}", file=sys.stderr)
+        return 1
+    print(f"simulated CPU-165 node: {args.program} every {args.tick} ms, "
+          f"Modbus TCP on {args.host}:{sim.port} unit {args.unit} (Ctrl-C stops)", flush=True)
+    try:
+        threading.Event().wait()
+    except KeyboardInterrupt:
+        pass
+    finally:
+        sim.stop()
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
