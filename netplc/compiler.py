@@ -1,9 +1,12 @@
 """Compile an STL program once into generated Python, so that a scan is a few function calls.
 
 The program is cut into basic blocks at jump targets; each block becomes one straight-line
-function over local variables `a` (ACC) and `s` (SUM) and the bit array `b`, returning the index
-of the next block (None ends the scan, -1 halts). Contacts and coils become single indexing
-statements; TIM, CTR and FON call the engine's shared implementations.
+function of the chain state `a` (ACC) and `s` (SUM) on entry, returning the index of the next
+block (None ends the scan, HALT halts) and the state on exit. Inside a block the chain state is
+kept symbolically: a chain of contacts becomes one short-circuit expression (contacts have no side
+effects, so `and`/`or` give the same RES as the bitwise model of DESIGN section 4), evaluated
+once by its terminator. TIM, CTR and FON call per-instruction closures the engine builds, the same
+ones the reference interpreter reaches, so only contacts and jumps are compiled twice.
 """
 
 from __future__ import annotations
@@ -17,6 +20,8 @@ if TYPE_CHECKING:
     from netplc.engine import Engine
 
 HALT = -1
+_MAX_DEPTH = 24  # nested and/or groups before the state is stored in a and s (parser limits)
+_MAX_TERMS = 200  # contacts in one expression before the same
 
 
 def _block_starts(instrs: list[Instr]) -> list[int]:
@@ -27,7 +32,7 @@ def _block_starts(instrs: list[Instr]) -> list[int]:
                 starts.add(ins.target)
             starts.add(i + 1)
     # the instruction after SKP must sit in SKP's block, unless it starts one: then the skip
-    # jumps to the block after it
+    # jumps to the block after it (in index order, so a start added here is seen by a later SKP)
     for i, ins in enumerate(instrs):
         if ins.op == "SKP" and i + 1 in starts:
             starts.add(i + 2)
@@ -38,96 +43,180 @@ def _target(t: int | None, n: int) -> str:
     return "None" if t is None or t >= n else str(t)
 
 
-def _code(ins: Instr, index: int, n: int) -> list[str]:
-    """Python lines for one instruction (without the chain reset of terminators)."""
-    op, c = ins.op, ins.c
-    if op == "TNA":
-        return [f"a &= b[{c}]"]
-    if op == "TFA":
-        return [f"a &= b[{c}] ^ 1"]
-    if op == "TNO":
-        return [f"a |= b[{c}]"]
-    if op == "TFO":
-        return [f"a |= b[{c}] ^ 1"]
-    if op == "TNE":
-        return ["s |= a", f"a = b[{c}]"]
-    if op == "TFE":
-        return ["s |= a", f"a = b[{c}] ^ 1"]
-    if op == "NOP":
-        return []
-    if op == "YON":
-        return [f"b[{c}] = s | a", "a = 1; s = 0"]
-    if op == "SON":
-        return [f"if s | a: b[{c}] = 1", "a = 1; s = 0"]
-    if op == "SOF":
-        return [f"if s | a: b[{c}] = 0", "a = 1; s = 0"]
-    if op == "TIM":
-        return [f"tim({c}, {ins.n}, s | a)", "a = 1; s = 0"]
-    if op == "CTR":
-        return [f"ctr({c}, {ins.n}, s | a)", "a = 1; s = 0"]
-    if op == "FON":
-        return [f"fon({index}, s | a)", "a = 1; s = 0"]
-    if op == "HLT":
-        return [f"return {HALT}, a, s"]
-    if op == "JMP":
-        return [f"return {_target(ins.target, n)}, 1, 0"]
-    if op == "JMY":
-        return [f"if s | a: return {_target(ins.target, n)}, 1, 0", "a = 1; s = 0"]
-    if op == "JMN":
-        return [f"if not (s | a): return {_target(ins.target, n)}, 1, 0", "a = 1; s = 0"]
-    raise AssertionError(op)
+class _Expr:
+    """A boolean expression over the bit array, with its precedence and nesting for the parser."""
+
+    __slots__ = ("depth", "kind", "terms", "text")
+
+    def __init__(self, text: str, kind: str = "atom", depth: int = 0, terms: int = 1) -> None:
+        self.text, self.kind, self.depth, self.terms = text, kind, depth, terms
+
+    def join(self, op: str, other: _Expr) -> _Expr:
+        """self <op> other, op being 'and' or 'or'; constants fold (contacts have no effects)."""
+        absorbing, neutral = ("0", "1") if op == "and" else ("1", "0")
+        if self.text == absorbing or other.text == neutral:
+            return self
+        if self.text == neutral or other.text == absorbing:
+            return other
+        left, depth = self.text, self.depth
+        if self.kind not in ("atom", op) and not (op == "or" and self.kind == "and"):
+            left, depth = f"({left})", depth + 1
+        right = other.text if other.kind == "atom" else f"({other.text})"
+        depth = max(depth, other.depth + (other.kind != "atom"))
+        return _Expr(f"{left} {op} {right}", op, depth, self.terms + other.terms)
+
+    def heavy(self) -> bool:
+        return self.depth > _MAX_DEPTH or self.terms > _MAX_TERMS
+
+
+ONE, ZERO = _Expr("1"), _Expr("0")
+
+
+def _contact(ins: Instr) -> _Expr:
+    negated = ins.op in ("TFA", "TFO", "TFE")
+    return _Expr(f"(not b[{ins.c}])" if negated else f"b[{ins.c}]")
+
+
+class _Block:
+    """Code of one basic block, generated with the chain state (acc, sm) tracked symbolically."""
+
+    def __init__(self, n: int) -> None:
+        self.n = n
+        self.lines: list[str] = []
+        self.acc, self.sm = _Expr("a"), _Expr("s")
+        self.ended = False  # the last line returns
+
+    def res(self) -> str:
+        return self.sm.join("or", self.acc).text
+
+    def store(self) -> None:
+        """Put the symbolic state into the variables (both at once: each may read the other)."""
+        self.lines.append(f"s, a = {self.sm.text}, {self.acc.text}")
+        self.acc, self.sm = _Expr("a"), _Expr("s")
+
+    def chain_end(self) -> None:
+        self.acc, self.sm = ONE, ZERO
+
+    def emit(self, ins: Instr, index: int) -> None:
+        op, c, lines = ins.op, ins.c, self.lines
+        if op in ("TNA", "TFA"):
+            self.acc = self.acc.join("and", _contact(ins))
+        elif op in ("TNO", "TFO"):
+            self.acc = self.acc.join("or", _contact(ins))
+        elif op in ("TNE", "TFE"):
+            self.sm = self.sm.join("or", self.acc)
+            self.acc = _contact(ins)
+        elif op == "NOP":
+            return
+        elif op == "YON":
+            lines.append(f"b[{c}] = {self.res()}")
+            self.chain_end()
+        elif op in ("SON", "SOF"):
+            res = self.res()
+            if res != "0":
+                lines.append(f"b[{c}] = {int(op == 'SON')}" if res == "1" else
+                             f"if {res}: b[{c}] = {int(op == 'SON')}")
+            self.chain_end()
+        elif op in ("TIM", "CTR", "FON"):
+            lines.append(f"{op.lower()}{index}({self.res()})")
+            self.chain_end()
+        elif op == "HLT":
+            lines.append(f"return {HALT}, 1, 0")
+            self.ended = True
+        elif op == "JMP":
+            lines.append(f"return {_target(ins.target, self.n)}, 1, 0")
+            self.ended = True
+        elif op in ("JMY", "JMN"):
+            cond = self.res() if op == "JMY" else f"not ({self.res()})"
+            lines.append(f"if {cond}: return {_target(ins.target, self.n)}, 1, 0")
+            self.chain_end()
+        else:
+            raise AssertionError(op)
+        if self.acc.heavy() or self.sm.heavy():
+            self.store()
+
+    def skip(self, nxt: Instr | None, index: int, block_end: int) -> None:
+        """SKP at `index`: when RES is 0, skip instruction index+1 (`nxt`, None if past the block)."""
+        self.lines.append(f"r = {self.res()}")
+        self.chain_end()
+        if nxt is None:  # the skipped instruction starts the next block: go past it
+            self.lines.append(f"if not r: return {_target(index + 2, self.n)}, 1, 0")
+            return
+        if nxt.op in ("SKP", "NOP"):  # a SKP reached right after a terminator sees RES = 1: no-op
+            return
+        inner = _Block(self.n)
+        inner.acc, inner.sm = ONE, ZERO
+        inner.emit(nxt, index + 1)
+        contact = inner.acc is not ONE or inner.sm is not ZERO
+        if contact:
+            inner.store()
+        if not inner.lines:  # e.g. TNO: with ACC = 1 it changes nothing
+            return
+        self.lines.append("if r:")
+        self.lines += ["    " + line for line in inner.lines]
+        if contact:  # the two paths leave different chain states: keep it in a and s
+            self.lines += ["else:", "    s, a = 0, 1"]
+            self.acc, self.sm = _Expr("a"), _Expr("s")
+
+    def finish(self, end: int) -> None:
+        if not self.ended:
+            self.lines.append(f"return {_target(end, self.n)}, {self.acc.text}, {self.sm.text}")
 
 
 def generate_source(program: Program) -> str:
+    """Python source of `_make(b, calls)`, returning {block start: block function}."""
     instrs = program.instrs
     n = len(instrs)
     starts = _block_starts(instrs)
-    lines = ["def _make(b, tim, ctr, fon):"]
+    names = [f"{ins.op.lower()}{i}" for i, ins in enumerate(instrs) if ins.op in ("TIM", "CTR", "FON")]
+    out = ["def _make(b, calls):"]
+    out += [f"    {name} = calls[{name!r}]" for name in names]
     for k, start in enumerate(starts):
+        if start >= n:
+            continue
         end = starts[k + 1] if k + 1 < len(starts) else n
-        lines.append(f"    def _b{start}(a, s):")
-        body: list[str] = []
+        block = _Block(n)
         i = start
-        while i < end:
+        while i < end and not block.ended:
             ins = instrs[i]
             if ins.op == "SKP":
-                body += ["r = s | a", "a = 1; s = 0"]
-                if i + 1 >= end:  # nothing in this block to skip: the skipped one starts the next
-                    body.append(f"if not r: return {_target(i + 2, n)}, 1, 0")
-                elif i + 1 < n:
-                    skipped = _code(instrs[i + 1], i + 1, n)
-                    body.append("if r:")
-                    body += ["    " + line for line in skipped] or ["    pass"]
-                    i += 1
+                block.skip(instrs[i + 1] if i + 1 < end else None, i, end)
+                i += 1  # past the skipped instruction too (if it was in this block)
             else:
-                body += _code(ins, i, n)
+                block.emit(ins, i)
             i += 1
-            if body and body[-1].startswith("return"):
-                break
-        if not body or not body[-1].startswith("return"):
-            body.append(f"return {_target(end, n)}, a, s")
-        lines += ["        " + line for line in body]
-    lines.append("    return {" + ", ".join(f"{s}: _b{s}" for s in starts if s < n) + "}")
-    return "\n".join(lines) + "\n"
+        block.finish(end)
+        out.append(f"    def _b{start}(a, s, b=b):")
+        out += ["        " + line for line in block.lines]
+    out.append("    return {" + ", ".join(f"{s}: _b{s}" for s in starts if s < n) + "}")
+    return "\n".join(out) + "\n"
 
 
 def compile_program(program: Program, engine: Engine) -> Callable[[], str | None]:
+    """One scan of `program` on `engine`: returns None at the end, "halt" or "watchdog"."""
     from netplc.engine import WATCHDOG_STEPS
 
+    instrs = program.instrs
+    calls: dict[str, Callable[[int], None]] = {}
+    for i, ins in enumerate(instrs):
+        if ins.op in ("TIM", "CTR", "FON"):
+            calls[f"{ins.op.lower()}{i}"] = engine.instruction_call(i)
     namespace: dict = {}
     exec(compile(generate_source(program), f"<compiled {program.source}>", "exec"), namespace)
-    blocks = namespace["_make"](engine.mem.bits, engine.tim, engine.ctr, engine.fon)
+    blocks = namespace["_make"](engine.mem.bits, calls)
+    starts = sorted(blocks)
+    sizes = {s: (starts[k + 1] if k + 1 < len(starts) else len(instrs)) - s for k, s in enumerate(starts)}
     first = blocks.get(0)
 
     def run() -> str | None:
         if first is None:
             return None
         nxt, a, s = first(1, 0)
-        steps = 0
+        steps = sizes[0]
         while nxt is not None:
             if nxt == HALT:
                 return "halt"
-            steps += 1
+            steps += sizes[nxt]
             if steps > WATCHDOG_STEPS:
                 return "watchdog"
             nxt, a, s = blocks[nxt](a, s)

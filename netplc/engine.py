@@ -12,7 +12,7 @@ import time
 from collections import deque
 from collections.abc import Callable
 from dataclasses import dataclass
-from enum import Enum
+from enum import StrEnum
 
 from netplc.address import (
     ALWAYS_ONE,
@@ -28,12 +28,12 @@ from netplc.memory import Memory, Snapshot
 from netplc.program import Program
 from netplc.records import NullSink, Record, RecordSink
 from netplc.rtc import Rtc
-from netplc.timers import run_ctr, run_tim, update_generators
+from netplc.timers import make_ctr, make_tim, update_generators
 
-WATCHDOG_STEPS = 1_000_000  # instructions (reference) or blocks (compiled) per scan before faulting
+WATCHDOG_STEPS = 1_000_000  # instructions per scan before the scan is abandoned (endless jump loop)
 
 
-class RunState(str, Enum):
+class RunState(StrEnum):
     RUNNING = "running"
     HALTED = "halted"  # by HLT
     STOPPED = "stopped"  # by the emergency-stop bit 03770 (code 11), the operator, or the watchdog
@@ -116,11 +116,19 @@ class Engine:
         from netplc.interpreter import Interpreter
 
         self.program = program
+        self._faulted.clear()
         self.fons: dict[int, tuple[Fon, FunctionSpec | None]] = {}
+        self._calls: dict[int, Callable[[int], None]] = {}
+        bits = self.mem.bits
         for index, ins in enumerate(program.instrs):
-            if ins.op == "FON":
+            if ins.op == "TIM":
+                self._calls[index] = make_tim(bits, self.tim_ticks, ins.c or 0, ins.n or 0, self)
+            elif ins.op == "CTR":
+                self._calls[index] = make_ctr(bits, self.ctr_values, ins.c or 0, ins.n or 0)
+            elif ins.op == "FON":
                 fon = Fon(ins.c or 0, ins.n or 0, ins.s, ins.d, ins.r, index, ins.line)
                 self.fons[index] = (fon, lookup(fon.f))
+                self._calls[index] = self._make_fon(index)
         self._run = compile_program(program, self) if self.compiled else Interpreter(program, self).run
 
     # --- what the program calls ----------------------------------------------------------------
@@ -128,29 +136,45 @@ class Engine:
     def wall_time(self) -> float:
         return self.wallclock()
 
-    def tim(self, c: int, n: int, res: int) -> None:
-        run_tim(self.mem.bits, self.tim_ticks, c, n, res, self.dt)
+    def instruction_call(self, index: int) -> Callable[[int], None]:
+        """The closure that runs the TIM, CTR or FON at `index` with its chain result RES.
 
-    def ctr(self, c: int, n: int, res: int) -> None:
-        run_ctr(self.mem.bits, self.ctr_values, c, n, res)
+        Both the compiled program and the reference interpreter call these, so timers, counters
+        and functions behave identically under both.
+        """
+        return self._calls[index]
 
-    def fon(self, index: int, res: int) -> None:
-        """Bit C = RES; while RES is 1 the function runs every scan (level semantics)."""
+    def _make_fon(self, index: int) -> Callable[[int], None]:
+        """Bit C = RES; while RES is 1 the function runs every scan (level semantics).
+
+        A function this build lacks, or a CPU-165 module function, only sets FErr1. A function
+        that raises sets FErr1 too and is reported once as a system record: a bug in one function
+        must not stop the plant, and the operator must still learn of it.
+        """
         fon, spec = self.fons[index]
-        self.mem.bits[fon.c] = res
-        if not res:
-            return
-        if spec is None:
-            self.mem.bits[FERR1] = 1
-            return
-        try:
-            spec.run(self, fon)
-        except (ValueError, IndexError) as e:  # AddressError is a ValueError: a bad computed address
-            self.mem.bits[FERR1] = 1
-            self._fault_once(index, f"{spec.mnemonic} at line {fon.line}: {e}")
-        except Exception as e:  # noqa: BLE001 - a function bug must not stop the plant
-            self.mem.bits[FERR1] = 1
-            self._fault_once(index, f"{spec.mnemonic} at line {fon.line} failed: {e!r}")
+        bits = self.mem.bits
+        c = fon.c
+        if spec is None or spec.hardware:
+
+            def unavailable(res: int) -> None:
+                bits[c] = 1 if res else 0
+                if res:
+                    bits[FERR1] = 1
+
+            return unavailable
+        run = spec.run
+
+        def call(res: int) -> None:
+            bits[c] = 1 if res else 0
+            if res:
+                try:
+                    run(self, fon)
+                except Exception as e:
+                    bits[FERR1] = 1
+                    where = f"FON {spec.mnemonic} at line {fon.line}"
+                    self._fault_once(index, f"{where}: {type(e).__name__}: {e}")
+
+        return call
 
     def _fault_once(self, index: int, text: str) -> None:
         if index not in self._faulted:
@@ -230,6 +254,7 @@ class Engine:
                 fn(mem)
             except ValueError as e:  # a queued write to an address that does not exist
                 self.sink.put(Record(self.wall_time(), "system", source="netplc", text=f"write refused: {e}"))
+            self.rtc.watch(mem)
         bits = mem.bits
         bits[ALWAYS_ONE] = 1
         update_generators(bits, now - self._start)
@@ -246,6 +271,7 @@ class Engine:
                                      text="watchdog: the scan did not reach its end (endless jump loop)"))
             if bits[EMERGENCY_STOP]:
                 self.stop(11)
+            self.rtc.watch(mem)
         self.scan_counter += 1
         self.snapshot = self._publish()
         self.stats.add((time.perf_counter() - t0) * 1000.0, self.tick * 1000.0)

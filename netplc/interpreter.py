@@ -74,12 +74,8 @@ class Interpreter:
                 elif op == "SKP":
                     if not res:
                         pc += 1
-                elif op == "TIM":
-                    eng.tim(ins.c, ins.n, res)
-                elif op == "CTR":
-                    eng.ctr(ins.c, ins.n, res)
-                elif op == "FON":
-                    eng.fon(pc - 1, res)
+                elif op in ("TIM", "CTR", "FON"):
+                    eng.instruction_call(pc - 1)(res)
                 elif (op == "JMY" and res) or (op == "JMN" and not res):
                     if ins.target is None:
                         return None

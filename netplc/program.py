@@ -33,8 +33,12 @@ _NAME = r"[^\W\d][\w.\[\]]*"
 _LINE_NO = re.compile(r"\s*\d+\.\d+\s+")
 _LABEL = re.compile(rf"\s*({_NAME})\s*:(?![^\s;])")
 _SYMDEF = re.compile(rf"\s*({_NAME})\s*=\s*(\S+)\s*$")
-_MNEMONIC = re.compile(r"\s*([A-Za-z]+)\b")
-_PARAM = re.compile(r"\s*(?:([A-Za-z])\s*:\s*)?([^\s;:]+)\s*;?")
+_MNEMONIC = re.compile(r"\s*([^\W\d]\w*)")
+_PARAM = re.compile(r"\s*(?:([A-Za-z])\s*:\s*)?([^\s;:]*)\s*;?")
+_OFFSET = re.compile(rf"({_NAME}?)\[([0-9]+)\]")  # TA[2]: the bit two after symbol TA (manual's notation)
+_DECIMAL = re.compile(r"-?[0-9]+")  # str.isdigit() also accepts '²', which int() refuses
+_OCTAL = re.compile(r"[0-7]+")
+_COMMENT = re.compile(r"\s[;#]|;;|\s//")
 
 
 @dataclass(frozen=True, slots=True)
@@ -207,17 +211,20 @@ class _Parser:
             return
         op = m.group(1).upper()
         if op not in LOGIC:
-            self.err(lineno, m.start(1) + 1, f"unknown instruction {m.group(1)!r}")
+            hint = ""
+            after = _MNEMONIC.match(line, m.end())
+            if after and after.group(1).upper() in LOGIC:
+                hint = f" (a label needs a colon: '{m.group(1)}:')"
+            self.err(lineno, m.start(1) + 1, f"unknown instruction {m.group(1)!r}{hint}")
             return
         keys = LOGIC[op][0]
         pos = m.end()
         params: dict[str, tuple[str, int]] = {}
         rest = line[pos:]
-        # a trailing comment after two spaces and ';;' or '#'
-        for marker in (" #", ";;", " //"):
-            cut = rest.find(marker)
-            if cut >= 0:
-                rest = rest[:cut]
+        # a trailing comment: ';' or '#' after white space, or ';;' ('C:$03000;N:56;' separates)
+        cut = _COMMENT.search(rest)
+        if cut:
+            rest = rest[: cut.start()]
         ok = True
         i = 0
         while i < len(rest):
@@ -232,6 +239,10 @@ class _Parser:
             key = (pm.group(1) or "").upper()
             token = pm.group(2)
             col = pos + pm.start(2) + 1
+            if not token:
+                self.err(lineno, pos + pm.start(1) + 1, f"{key}: has no value")
+                ok = False
+                break
             if not key:
                 # a positional parameter: the first one the instruction takes that is not given yet
                 free = [k for k in keys if k not in params]
@@ -241,7 +252,8 @@ class _Parser:
                     break
                 key = free[0]
             if key not in keys:
-                self.err(lineno, col, f"{op} has no parameter {key}:" if keys else f"{op} takes no parameters")
+                problem = f"has no parameter {key}:" if keys else "takes no parameters"
+                self.err(lineno, col, f"{op} {problem}")
                 ok = False
             elif key in params:
                 self.err(lineno, col, f"parameter {key}: given twice")
@@ -254,37 +266,50 @@ class _Parser:
 
     # --- values ------------------------------------------------------------------------------
 
-    def _address(self, raw: _Raw, key: str, nbytes: int = 1) -> int | None:
+    def _resolve(self, raw: _Raw, key: str) -> int | None:
+        """An address parameter: `$octal`, bare octal digits, a symbol, or `symbol[k]` (k bits on)."""
         token, col = raw.params[key]
-        if token.startswith("$") or token[0].isdigit():
+        if token[0] == "$" or token[0] in "0123456789":
             try:
-                addr = parse_octal(token)
+                return parse_octal(token)
             except ValueError:
                 self.err(raw.line, col, f"{key}: {token!r} is not an octal address")
                 return None
-        elif token in self.symbols:
-            addr = self.symbols[token]
-        else:
-            self.err(raw.line, col, f"{key}: unknown symbol {token!r}")
+        if token in self.symbols:
+            return self.symbols[token]
+        m = _OFFSET.fullmatch(token)
+        if m and m.group(1) in self.symbols:
+            return self.symbols[m.group(1)] + int(m.group(2))
+        self.err(raw.line, col, f"{key}: unknown symbol {token!r}")
+        return None
+
+    def _address(self, raw: _Raw, key: str, nbytes: int = 1) -> int | None:
+        """A function operand of `nbytes` bytes (below 04000: 8*nbytes I/O bits)."""
+        addr = self._resolve(raw, key)
+        if addr is None:
             return None
         try:
             check_operand(addr, nbytes)
         except AddressError as e:
-            self.err(raw.line, col, f"{key}: {e}")
+            self.err(raw.line, raw.params[key][1], f"{key}: {e}")
             return None
         return addr
 
     def _coil(self, raw: _Raw, nbits: int) -> int | None:
+        """The C parameter: `nbits` consecutive I/O bits (a contact or a coil uses one)."""
         if "C" not in raw.params:
             self.err(raw.line, raw.col, f"{raw.op} needs C: (a bit address)")
             return None
-        token, col = raw.params["C"]
-        addr = self._address(raw, "C")
+        addr = self._resolve(raw, "C")
         if addr is None:
             return None
-        if addr >= IO_BITS or addr + nbits > IO_BITS:
-            what = "an I/O bit" if nbits == 1 else f"{nbits} I/O bits"
-            self.err(raw.line, col, f"C: {fmt_octal(addr)} is not {what} (00000-03777)")
+        col = raw.params["C"][1]
+        if addr >= IO_BITS:
+            self.err(raw.line, col, f"C: {fmt_octal(addr)} is not an I/O bit (00000-03777)")
+            return None
+        if addr + nbits > IO_BITS:
+            last = fmt_octal(addr + nbits - 1)
+            self.err(raw.line, col, f"C: {raw.op} uses bits {fmt_octal(addr)}-{last}, past I/O bit 03777")
             return None
         return addr
 
@@ -294,16 +319,15 @@ class _Parser:
             self.err(raw.line, col, f"{key}: a constant is needed here, not the address {token!r}")
             return None
         if kind == "B":
-            if not token.isdigit() or len(token) > 4:
+            if not re.fullmatch(r"[0-9]{1,4}", token):
                 self.err(raw.line, col, f"{key}: {token!r} is not a BCD constant (up to 4 decimal digits)")
                 return None
             return int(token, 16)
-        radix, name = (8, "octal") if kind == "O" else (10, "decimal")
-        try:
-            value = int(token, radix)
-        except ValueError:
+        pattern, radix, name = (_OCTAL, 8, "octal") if kind == "O" else (_DECIMAL, 10, "decimal")
+        if not pattern.fullmatch(token):
             self.err(raw.line, col, f"{key}: {token!r} is not a {name} number")
             return None
+        value = int(token, radix)
         if not lo <= value <= hi:
             self.err(raw.line, col, f"{key}: {token} is outside {lo}-{hi}")
             return None
@@ -327,8 +351,12 @@ class _Parser:
                 self.err(raw.line, raw.col, f"{op} needs a label")
                 return None
             token, col = raw.params["L"]
-            if token.isdigit():
-                value = int(token, 8)
+            if token[0] == "$" or token[0] in "0123456789":
+                try:
+                    value = parse_octal(token)
+                except ValueError:
+                    self.err(raw.line, col, f"L: {token!r} is not an octal program address")
+                    return None
                 if value == 0:
                     return Instr(op, target=None, **common)
                 if value not in by_addr:
@@ -357,7 +385,10 @@ class _Parser:
             return None
         token, col = raw.params["N"]
         spec: FunctionSpec | None = None
-        if token.isdigit():
+        if token[0] in "0123456789":
+            if not _DECIMAL.fullmatch(token):
+                self.err(raw.line, col, f"N: {token!r} is not a function number")
+                return None
             number = int(token)
             if number not in DEFINED_CODES:
                 self.err(raw.line, col, f"N: function {number} does not exist")
@@ -385,13 +416,11 @@ class _Parser:
                 v = self._address(raw, key) if kind == "M" else self._const(raw, key, kind)
                 ok = ok and v is not None
                 values[key] = v
-        else:  # a defined code not implemented on this build: keep raw octal values, FErr1 at run time
+        else:  # a defined code not implemented on this build: keep the values, FErr1 at run time
             for key in ("S", "D", "R"):
                 if key in raw.params:
-                    try:
-                        values[key] = parse_octal(raw.params[key][0])
-                    except ValueError:
-                        values[key] = None
+                    values[key] = self._resolve(raw, key)
+                    ok = ok and values[key] is not None
         if not ok:
             return None
         return Instr("FON", c=c, n=number, s=values["S"], d=values["D"], r=values["R"], **common)

@@ -2,7 +2,10 @@
 
 The program sets the clock by the documented sequence: write non-zero to 077700, write the new
 time to 077701-077707, write 0 to 077700. NetPlc never touches the PC's clock: it keeps the
-difference as an offset and shows wall time plus offset from then on.
+difference as an offset and shows wall time plus offset from then on. The control byte is watched
+after each queued operator write and after the program, so the sequence may be spread over scans
+or sent as one batch of operator writes; the new time is taken at the start of the scan after the
+control byte returns to 0.
 """
 
 from __future__ import annotations
@@ -42,6 +45,11 @@ class Rtc:
         fields = (t.second, t.minute, t.hour, t.day, t.month, t.year % 100, (t.weekday() + 1) % 7)
         for i, v in enumerate(fields):
             data[_FIRST + i] = to_bcd(v)
+
+    def watch(self, mem: Memory) -> None:
+        """Note a setting in progress (control byte non-zero) between the points update() runs."""
+        if mem.data[_CTRL]:
+            self._setting = True
 
     def now(self, wall: float) -> dt.datetime:
         return dt.datetime.fromtimestamp(wall + self.offset)

@@ -42,7 +42,7 @@ class ScanThread:
             try:
                 with self.lock:
                     self.engine.scan()
-            except BaseException as e:  # noqa: BLE001 - reported, and the thread goes on
+            except BaseException as e:  # reported, and the thread goes on
                 if self._on_error:
                     self._on_error(e)
             deadline += self.tick
