@@ -222,7 +222,7 @@ class Store:
                     "VALUES (?, ?, ?, ?, ?, ?, ?, ?)", rows)
             con.execute("COMMIT")
         except (sqlite3.Error, OSError) as e:
-            self._failed(con, e)
+            self._failed(con, e, batch)
             return False
         committed = self._stats.committed + len(batch)
         self._stats = replace(self._stats, committed=committed, batches=self._stats.batches + 1,
@@ -243,7 +243,7 @@ class Store:
                                           text=f"archive commit listener failed and was removed: {e!r}"))
         return True
 
-    def _failed(self, con: sqlite3.Connection, error: Exception) -> None:
+    def _failed(self, con: sqlite3.Connection, error: Exception, batch: list[Record]) -> None:
         if con.in_transaction:
             with contextlib.suppress(sqlite3.Error):  # if it fails, SQLite has rolled back already
                 con.execute("ROLLBACK")
@@ -252,8 +252,8 @@ class Store:
         self._stats = replace(self._stats, last_error=text)
         if self._failing_since is None:
             self._failing_since = self.wallclock()
-            self._queue.append(Record(self.wallclock(), "system", source=SOURCE,
-                                      text=f"{text}; records are kept in memory and retried"))
+            batch.append(Record(self.wallclock(), "system", source=SOURCE,
+                                text=f"{text}; records are kept in memory and retried"))
 
     def _rows_by_table(self, batch: list[Record]) -> dict[str, list[Row]]:
         tables: dict[str, list[Row]] = {}

@@ -1,0 +1,190 @@
+"""Retentive memory: what a CPU-165 keeps through a power cut, kept here through a restart.
+
+That is all data memory, the I/O bits 03000-03477, and the timer and counter current values
+(DESIGN section 3). A save is written to a temporary file, fsynced and renamed over the current
+one, whose last good version is kept as the previous save; a crash at any moment leaves at least
+one complete save. Each save carries a CRC, so a damaged file is recognised and the previous one
+used instead. Saves read the snapshot the engine publishes after each scan, never live memory.
+"""
+
+from __future__ import annotations
+
+import json
+import os
+import struct
+import threading
+import zlib
+from dataclasses import dataclass
+from pathlib import Path
+
+from netplc.address import DATA_SIZE, RETAIN_BITS
+from netplc.engine import Engine
+from netplc.records import Record, RecordSink
+
+MAGIC = b"NPLCRETN"
+VERSION = 1
+HEADER = struct.Struct("<8sHII")  # magic, version, crc32 of the payload, payload length
+SOURCE = "retain"
+BITS = slice(RETAIN_BITS.start, RETAIN_BITS.stop)
+
+
+class SaveError(ValueError):
+    """A save file that cannot be used (missing, truncated, damaged, another format)."""
+
+
+@dataclass(frozen=True)
+class Saved:
+    """The retentive state as read back from a save."""
+
+    bits: bytes  # I/O bits 03000-03477, one per byte
+    data: bytes  # all data memory
+    tim: dict[int, float]
+    ctr: dict[int, int]
+    wall: float  # wall clock of the scan that was saved
+
+
+class Retainer:
+    def __init__(self, path: str | Path, engine: Engine, sink: RecordSink | None = None) -> None:
+        self.path = Path(path)
+        self.previous = self.path.with_name(self.path.name + ".prev")
+        self._tmp = self.path.with_name(self.path.name + ".tmp")
+        self.engine = engine
+        self.sink = sink if sink is not None else engine.sink
+        self.saves = 0
+        self.last_error = ""
+        self._current_good = False  # the current file is ours and complete: it may become .prev
+        self._lock = threading.Lock()
+        self._stop = threading.Event()
+        self._thread: threading.Thread | None = None
+
+    # --- restore -------------------------------------------------------------------------------
+
+    def restore(self) -> str:
+        """Load the newest good save into the engine; call it before the scan thread starts.
+
+        Returns "current", "previous" or "zeroes" and journals which, and why, as a 'system' record.
+        """
+        problems: list[str] = []
+        for used, path in (("current", self.path), ("previous", self.previous)):
+            try:
+                saved = read_save(path)
+            except SaveError as e:
+                problems.append(f"{used} save {e}")
+                continue
+            self._apply(saved)
+            self._current_good = used == "current"
+            why = f" ({'; '.join(problems)})" if problems else ""
+            self._journal(f"retentive memory restored from the {used} save {path.name}{why}")
+            return used
+        self._apply(Saved(bytes(len(RETAIN_BITS)), bytes(DATA_SIZE), {}, {}, 0.0))
+        self._journal(f"retentive memory starts from zeroes ({'; '.join(problems)})")
+        return "zeroes"
+
+    def _apply(self, saved: Saved) -> None:
+        engine = self.engine
+        mem = engine.mem
+        mem.bits[BITS] = saved.bits
+        mem.data[:] = saved.data
+        engine.tim_ticks.clear()
+        engine.tim_ticks.update(saved.tim)
+        engine.ctr_values.clear()
+        engine.ctr_values.update(saved.ctr)
+        # Publish at once, so that a save before the first scan keeps what was restored.
+        engine.snapshot = mem.snapshot(engine.scan_counter, engine.now, engine.wall_time(), engine.state_text)
+
+    def _journal(self, text: str) -> None:
+        self.sink.put(Record(self.engine.wall_time(), "system", source=SOURCE, text=text))
+
+    # --- save ----------------------------------------------------------------------------------
+
+    def save(self) -> None:
+        """Write the state of the last published scan; OSError if the disk refuses."""
+        engine = self.engine
+        snap = engine.snapshot
+        tim, ctr = dict(engine.tim_ticks), dict(engine.ctr_values)
+        meta = json.dumps({"tim": {str(k): v for k, v in tim.items()},
+                           "ctr": {str(k): v for k, v in ctr.items()},
+                           "wall": snap.wall, "scan": snap.scan}).encode()
+        payload = snap.bits[BITS] + snap.data + meta
+        blob = HEADER.pack(MAGIC, VERSION, zlib.crc32(payload), len(payload)) + payload
+        with self._lock:
+            self.path.parent.mkdir(parents=True, exist_ok=True)
+            with open(self._tmp, "wb") as f:
+                f.write(blob)
+                f.flush()
+                os.fsync(f.fileno())
+            if self._current_good and self.path.exists():
+                os.replace(self.path, self.previous)
+            os.replace(self._tmp, self.path)
+            _fsync_dir(self.path.parent)
+            self._current_good = True
+            self.saves += 1
+
+    def _save_reporting(self) -> None:
+        try:
+            self.save()
+        except OSError as e:
+            if not self.last_error:
+                self._journal(f"retentive memory could not be saved: {e}")
+            self.last_error = str(e)
+        else:
+            if self.last_error:
+                self.last_error = ""
+                self._journal("retentive memory is being saved again")
+
+    # --- background ----------------------------------------------------------------------------
+
+    def start(self, interval: float = 1.0) -> None:
+        self._stop.clear()
+        self._thread = threading.Thread(target=self._loop, args=(interval,), name="retain", daemon=True)
+        self._thread.start()
+
+    def stop(self) -> None:
+        """Stop the periodic saves and save once more (call it after the scan thread stopped)."""
+        self._stop.set()
+        if self._thread is not None:
+            self._thread.join()
+            self._thread = None
+        self._save_reporting()
+
+    def _loop(self, interval: float) -> None:
+        while not self._stop.wait(interval):
+            self._save_reporting()
+
+
+def read_save(path: Path) -> Saved:
+    try:
+        blob = path.read_bytes()
+    except FileNotFoundError:
+        raise SaveError("is missing") from None
+    except OSError as e:
+        raise SaveError(f"cannot be read: {e.strerror}") from None
+    if len(blob) < HEADER.size:
+        raise SaveError("is truncated")
+    magic, version, crc, length = HEADER.unpack_from(blob)
+    if magic != MAGIC or version != VERSION:
+        raise SaveError("is not a retentive memory save of this version")
+    payload = blob[HEADER.size:]
+    if len(payload) != length or zlib.crc32(payload) != crc:
+        raise SaveError("is damaged (length or checksum wrong)")
+    nbits = len(RETAIN_BITS)
+    try:
+        meta = json.loads(payload[nbits + DATA_SIZE:])
+        tim = {int(k): float(v) for k, v in meta["tim"].items()}
+        ctr = {int(k): int(v) for k, v in meta["ctr"].items()}
+        wall = float(meta["wall"])
+    except (ValueError, KeyError, TypeError, AttributeError) as e:
+        raise SaveError(f"has unreadable timer and counter values: {e}") from None
+    return Saved(payload[:nbits], payload[nbits:nbits + DATA_SIZE], tim, ctr, wall)
+
+
+def _fsync_dir(directory: Path) -> None:
+    """Make the renames themselves durable (POSIX); not possible on every platform."""
+    flags = getattr(os, "O_DIRECTORY", None)
+    if flags is None:
+        return
+    fd = os.open(directory, os.O_RDONLY | flags)
+    try:
+        os.fsync(fd)
+    finally:
+        os.close(fd)

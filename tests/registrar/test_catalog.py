@@ -1,0 +1,55 @@
+from pathlib import Path
+
+import pytest
+
+from registrar.catalog import Catalog, CatalogError, Message
+
+EXAMPLE = Path(__file__).parents[2] / "resources" / "example" / "messages.csv"
+
+
+def write(tmp_path: Path, text: str) -> Path:
+    path = tmp_path / "messages.csv"
+    path.write_text(text, encoding="utf-8")
+    return path
+
+
+def test_demo_catalog_loads_with_cyrillic_texts():
+    catalog = Catalog.load(EXAMPLE)
+    assert catalog.get(3) == Message(3, 1, 2, "Уровень выше 90 %")
+    assert catalog.text_for(1) == "Пуск нажат"
+    assert len(catalog) >= 4
+
+
+def test_header_is_optional_and_commas_stay_in_the_text(tmp_path):
+    catalog = Catalog.load(write(tmp_path, '7,2,1,Насос 1, перегрев\n8,2,3,"Авария, стоп"\n\n# note\n'))
+    assert catalog.text_for(7) == "Насос 1, перегрев"
+    assert catalog.get(8) == Message(8, 2, 3, "Авария, стоп")
+
+
+def test_unknown_number_has_a_text_saying_so():
+    text = Catalog().text_for(42)
+    assert "42" in text and "unknown" in text
+    assert Catalog().get(42) is None
+
+
+def test_errors_name_file_and_line(tmp_path):
+    path = write(tmp_path, "number,group,type,text\n1,1,0,ok\nx,1,0,bad number\n2,1,7,bad type\n"
+                           "1,1,0,again\n3,1\n4,1,0,\n")
+    with pytest.raises(CatalogError) as info:
+        Catalog.load(path)
+    problems = info.value.problems
+    assert [p.split(": ", 1)[0] for p in problems] == [f"{path}:{n}" for n in (3, 4, 5, 6, 7)]
+    assert "'x'" in problems[0]
+    assert "type 7" in problems[1]
+    assert "line 2" in problems[2]
+    assert "4 field" not in problems[3] and "2 field" in problems[3]
+    assert "no text" in problems[4]
+
+
+def test_missing_or_undecodable_file_is_a_catalog_error(tmp_path):
+    with pytest.raises(CatalogError, match="cannot read"):
+        Catalog.load(tmp_path / "none.csv")
+    bad = tmp_path / "cp1251.csv"
+    bad.write_bytes("1,1,0,Пуск\n".encode("cp1251"))
+    with pytest.raises(CatalogError, match=r"cp1251\.csv:0"):
+        Catalog.load(bad)

@@ -1,0 +1,174 @@
+import csv
+import datetime as dt
+import shutil
+import threading
+
+import numpy as np
+import pytest
+
+from netplc.records import Record
+from registrar.catalog import Catalog, Message
+from registrar.query import Archive, Filter, SeriesKey
+from registrar.store import Store
+
+from .conftest import wait_for
+
+DAY = dt.date(2026, 3, 5)
+T0 = dt.datetime(2026, 3, 5, 8, 0).timestamp()
+CATALOG = Catalog({1: Message(1, 1, 0, "Пуск нажат"), 3: Message(3, 1, 2, "Уровень выше 90 %"),
+                   4: Message(4, 2, 1, "Связь с узлом 0 потеряна")})
+
+
+def write(db, records):
+    store = Store(db, catalog=CATALOG, wallclock=lambda: T0)
+    for r in records:
+        store.put(r)
+    store.start()
+    store.close()
+
+
+@pytest.fixture
+def archive(db):
+    records = []
+    for i in range(300):
+        records.append(Record(T0 + i, "data", 1, 1, "04010", value=float(i)))
+        if i % 10 == 0:
+            records.append(Record(T0 + i, "message", 1 if i % 20 else 2, 2 if i % 30 == 0 else 0,
+                                  number=3 if i % 30 == 0 else 1))
+    records.append(Record(T0 + 400, "operator", source="ivanov", number=0o4030, value=7.0,
+                          text="write 04030: 0 -> 7"))
+    records.append(Record(T0 - 86400, "system", source="app", text="station started"))
+    write(db, records)
+    with Archive(db) as a:
+        yield a
+
+
+def test_days_newest_first(archive):
+    assert archive.days() == [DAY, DAY - dt.timedelta(days=1)]
+
+
+def test_pages_newest_first_with_offset(archive):
+    first = archive.records(DAY, limit=5)
+    assert [r.kind for r in first] == ["operator", "data", "data", "data", "data"]
+    assert first[0].ts == T0 + 400 and first[0].source == "ivanov" and first[0].value == 7.0
+    assert first[0].time == dt.datetime(2026, 3, 5, 8, 6, 40)
+    second = archive.records(DAY, offset=5, limit=5)
+    assert second[0].id == first[-1].id - 1
+    oldest = archive.records(DAY, limit=2, newest_first=False)
+    assert [(r.kind, r.value) for r in oldest] == [("data", 0.0), ("message", None)]
+
+
+def test_filters_and_counts_agree(archive):
+    cases = [
+        (Filter(kinds={"message"}), 30),
+        (Filter(kinds={"message"}, min_type=2), 10),
+        (Filter(kinds={"message", "operator"}), 31),
+        (Filter(kinds={"message"}, grp=2), 15),
+        (Filter(kinds={"message"}, type=0), 20),
+        (Filter(source="04010"), 300),
+        (Filter(text="уровень"), 10),
+        (Filter(text="ПУСК"), 20),
+        (Filter(text="90 %"), 10),
+        (Filter(text="100%"), 0),
+        (Filter(kinds={"data"}, since=T0 + 100, until=T0 + 110), 10),
+        (Filter(kinds=set()), 0),
+        (Filter(), 331),
+    ]
+    for flt, n in cases:
+        assert archive.count(DAY, flt) == n, flt
+        got = archive.records(DAY, flt, limit=1000)
+        assert len(got) == n, flt
+    alarms = archive.records(DAY, Filter(kinds={"message"}, min_type=2))
+    assert {(r.number, r.type, r.text) for r in alarms} == {(3, 2, "Уровень выше 90 %")}
+
+
+
+def test_a_missing_day_is_empty(archive):
+    other = dt.date(2020, 1, 1)
+    assert archive.records(other) == []
+    assert archive.count(other) == 0
+    ts, values = archive.series(other, grp=1)
+    assert len(ts) == len(values) == 0
+
+
+def test_series_keys_and_small_series(archive):
+    assert archive.series_keys(DAY) == [SeriesKey("data", 1, 1, "04010")]
+    assert archive.series_keys(DAY - dt.timedelta(days=1)) == []
+    ts, values = archive.series(DAY, grp=1, type=1, source="04010")
+    assert np.array_equal(ts, T0 + np.arange(300)) and np.array_equal(values, np.arange(300.0))
+
+
+def test_downsampling_keeps_peaks(db):
+    n = 20_000
+    values = np.sin(np.arange(n) / 500.0) * 100.0
+    values[12_345] = 1000.0
+    values[777] = -1000.0
+    write(db, [Record(T0 + i * 0.1, "data", 3, 4, "04020", value=float(v)) for i, v in enumerate(values)])
+    with Archive(db) as a:
+        ts, got = a.series(DAY, grp=3, type=4, points=200)
+        _, full = a.series(DAY, grp=3, type=4, points=n)
+    assert 100 <= len(ts) <= 200
+    assert np.all(np.diff(ts) > 0)
+    assert got.max() == 1000.0 and got.min() == -1000.0
+    assert ts[np.argmax(got)] == pytest.approx(T0 + 1234.5)
+    assert ts[np.argmin(got)] == pytest.approx(T0 + 77.7)
+    assert len(full) == n and np.array_equal(full, values)
+
+
+def test_export_csv(archive, tmp_path):
+    out = tmp_path / "alarms.csv"
+    assert archive.export_csv(out, DAY, Filter(kinds={"message"}, min_type=2)) == 10
+    with open(out, encoding="utf-8-sig", newline="") as f:
+        table = list(csv.reader(f))
+    assert table[0] == ["id", "time", "ts", "kind", "grp", "type", "source", "number", "value", "text"]
+    assert table[1][1] == "2026-03-05T08:00:00.000" and table[1][-1] == "Уровень выше 90 %"
+    assert len(table) == 11
+    assert out.read_bytes().startswith(b"\xef\xbb\xbf")
+
+
+def test_catalog_and_meta_travel_with_a_copied_archive(archive, db, tmp_path):
+    copy = tmp_path / "elsewhere" / "copy.sqlite"
+    copy.parent.mkdir()
+    shutil.copyfile(db, copy)
+    with Archive(copy) as a:
+        assert a.days()[0] == DAY
+        assert a.count(DAY) == 331
+        assert a.message_texts()[3] == "Уровень выше 90 %"
+        assert a.meta()["ts_unit"].startswith("milliseconds")
+
+
+def test_a_missing_file_is_not_created(tmp_path):
+    with pytest.raises(FileNotFoundError):
+        Archive(tmp_path / "none.sqlite")
+    assert not (tmp_path / "none.sqlite").exists()
+
+
+def test_reading_while_the_writer_writes(db):
+    store = Store(db, flush_interval=0.01, wallclock=lambda: T0)
+    store.start()
+    store.put(Record(T0, "data", 1, 1, "04000", value=0.0))
+    wait_for(lambda: store.committed == 1)
+    stop = threading.Event()
+
+    def produce() -> None:
+        i = 0
+        while not stop.is_set():
+            store.put(Record(T0 + i / 1000, "data", 1, 1, "04000", value=float(i)))
+            i += 1
+            if i % 500 == 0:
+                stop.wait(0.001)
+
+    producer = threading.Thread(target=produce)
+    producer.start()
+    counts = []
+    with Archive(db) as a:
+        while len(counts) < 50 or counts[-1] == counts[0]:
+            counts.append(a.count(DAY))
+            a.records(DAY, Filter(kinds={"data"}), limit=50)
+            a.series(DAY, grp=1, type=1, source="04000", points=100)
+        stop.set()
+        producer.join()
+        store.close()
+        assert counts == sorted(counts)
+        assert a.count(DAY) == store.committed
+    assert store.stats.last_error == ""

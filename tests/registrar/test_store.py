@@ -1,0 +1,181 @@
+import datetime as dt
+import sqlite3
+import threading
+
+from netplc.records import Record
+from registrar.catalog import Catalog, Message
+from registrar.schema import table_name
+from registrar.store import Store
+
+from .conftest import rows, wait_for
+
+CATALOG = Catalog({3: Message(3, 1, 2, "Уровень выше 90 %")})
+
+
+def local_midnight(day: dt.date) -> float:
+    return dt.datetime(day.year, day.month, day.day).timestamp()
+
+
+def tables(path) -> list[str]:
+    con = sqlite3.connect(path)
+    try:
+        return sorted(n for (n,) in con.execute("SELECT name FROM sqlite_master WHERE type = 'table'"))
+    finally:
+        con.close()
+
+
+def test_a_batch_spanning_midnight_lands_in_two_day_tables(db):
+    midnight = local_midnight(dt.date(2026, 3, 5))
+    store = Store(db, wallclock=lambda: midnight)
+    store.put(Record(midnight - 0.5, "data", 1, 2, "04000", value=10.0))
+    store.put(Record(midnight + 0.5, "data", 1, 2, "04000", value=11.0))
+    store.put(Record(midnight - 0.001, "system", source="x", text="late"))
+    store.start()
+    store.close()
+    assert {"04_03_2026", "05_03_2026"} <= set(tables(db))
+    before = rows(db, "04_03_2026", "ts, kind, value, text")
+    after = rows(db, "05_03_2026", "ts, kind, value, text")
+    assert before == [(round((midnight - 0.5) * 1000), "data", 10.0, None),
+                      (round((midnight - 0.001) * 1000), "system", None, "late")]
+    assert after == [(round((midnight + 0.5) * 1000), "data", 11.0, None)]
+    assert store.stats.committed == 3 and store.stats.batches == 1
+
+
+def test_messages_get_their_catalog_text_and_unknown_numbers_are_kept(db):
+    store = Store(db, catalog=CATALOG)
+    now = 1_790_000_000.25
+    store.start()
+    store.put(Record(now, "message", grp=1, type=2, number=3))
+    store.put(Record(now, "message", grp=5, type=0, number=99))
+    store.put(Record(now, "message", number=3))  # group and type from the catalog
+    store.close()
+    day = table_name(dt.date.fromtimestamp(now))
+    assert rows(db, day, "ts, kind, grp, type, number, text") == [
+        (1_790_000_000_250, "message", 1, 2, 3, "Уровень выше 90 %"),
+        (1_790_000_000_250, "message", 5, 0, 99, "unknown message 99 (not in the catalog)"),
+        (1_790_000_000_250, "message", 1, 2, 3, "Уровень выше 90 %"),
+    ]
+
+
+def test_schema_reads_sensibly_with_the_catalog_copied_in(db):
+    store = Store(db, catalog=CATALOG)
+    store.start()
+    store.put(Record(1_790_000_000.0, "operator", source="ivanov", number=0o4030, value=5.0, text="write"))
+    store.close()
+    con = sqlite3.connect(db)
+    day = table_name(dt.date.fromtimestamp(1_790_000_000.0))
+    columns = [(c[1], c[2]) for c in con.execute(f'PRAGMA table_info("{day}")')]
+    assert columns == [("id", "INTEGER"), ("ts", "INTEGER"), ("kind", "TEXT"), ("grp", "INTEGER"),
+                       ("type", "INTEGER"), ("source", "TEXT"), ("number", "INTEGER"), ("value", "REAL"),
+                       ("text", "TEXT")]
+    assert con.execute("SELECT * FROM messages").fetchall() == [(3, 1, 2, "Уровень выше 90 %")]
+    meta = dict(con.execute("SELECT key, value FROM meta"))
+    assert meta["ts_unit"].startswith("milliseconds") and meta["schema_version"] == "1"
+    assert con.execute("PRAGMA journal_mode").fetchone() == ("wal",)
+
+
+def test_close_flushes_everything_and_reports_commits(db):
+    seen: list[int] = []
+    store = Store(db, flush_interval=60.0, on_commit=seen.append)
+    store.start()
+    for i in range(20_000):
+        store.put(Record(1_790_000_000.0 + i / 1000, "data", 1, 1, "04000", value=float(i)))
+    store.close()
+    assert store.committed == 20_000 and seen[-1] == 20_000
+    day = table_name(dt.date.fromtimestamp(1_790_000_000.0))
+    assert rows(db, day, "count(*), sum(value)") == [(20_000, sum(range(20_000)))]
+
+
+def test_commits_at_least_every_flush_interval(db):
+    store = Store(db, flush_interval=0.05)
+    store.start()
+    store.put(Record(1_790_000_000.0, "system", text="one"))
+    wait_for(lambda: store.committed == 1, timeout=2.0)
+    store.close()
+
+
+def test_a_full_queue_drops_counts_and_reports(db):
+    store = Store(db, queue_size=10, wallclock=lambda: 1_790_000_100.0)
+    for i in range(25):
+        store.put(Record(1_790_000_000.0, "data", 1, 1, "04000", value=float(i)))
+    assert store.stats.queued == 10 and store.stats.dropped == 15 and store.stats.overflows == 1
+    store.start()
+    store.close()
+    day = table_name(dt.date.fromtimestamp(1_790_000_000.0))
+    got = rows(db, day, "kind, value, text")
+    assert [v for k, v, _ in got if k == "data"] == [float(i) for i in range(10)]
+    assert [t for k, _, t in got if k == "system"] == [
+        "archive queue full: 15 record(s) lost (the disk did not keep up; queue size 10)"]
+
+
+def test_a_locked_database_is_retried_and_nothing_is_lost(db):
+    store = Store(db, flush_interval=0.05, wallclock=lambda: 1_790_000_002.0)
+    store.start()
+    store.put(Record(1_790_000_000.0, "data", 1, 1, "04000", value=1.0))
+    wait_for(lambda: store.committed == 1)
+    other = sqlite3.connect(db, isolation_level=None)
+    other.execute("BEGIN EXCLUSIVE")
+    store.put(Record(1_790_000_001.0, "data", 1, 1, "04000", value=2.0))
+    wait_for(lambda: store.stats.last_error != "")
+    assert "locked" in store.stats.last_error
+    other.execute("ROLLBACK")
+    other.close()
+    wait_for(lambda: store.stats.last_error == "" and store.stats.queued == 0)
+    store.close()
+    day = table_name(dt.date.fromtimestamp(1_790_000_000.0))
+    got = rows(db, day, "kind, value, text")
+    assert [v for k, v, _ in got if k == "data"] == [1.0, 2.0]
+    texts = [t for k, _, t in got if k == "system"]
+    assert texts[0].startswith("archive write failed: database is locked")
+    assert texts[1].startswith("archive writing resumed")
+
+
+def test_keep_days_drops_whole_old_day_tables(db):
+    today = dt.date(2026, 3, 10)
+    noon = local_midnight(today) + 12 * 3600
+    store = Store(db, wallclock=lambda: noon - 5 * 86400)
+    for days_ago in (5, 2, 1, 0):
+        store.put(Record(noon - days_ago * 86400, "data", 1, 1, "04000", value=float(days_ago)))
+    store.start()
+    store.close()
+    assert {"05_03_2026", "08_03_2026", "09_03_2026", "10_03_2026"} <= set(tables(db))
+    store = Store(db, keep_days=2, wallclock=lambda: noon)
+    store.start()
+    store.close()
+    left = [t for t in tables(db) if t[2] == "_"]
+    assert left == ["09_03_2026", "10_03_2026"]
+    con = sqlite3.connect(db)
+    assert sorted(d for (d,) in con.execute("SELECT day FROM series")) == ["09_03_2026", "10_03_2026"]
+
+
+def test_put_from_many_threads_loses_nothing(db):
+    store = Store(db, flush_interval=0.01)
+    store.start()
+
+    def produce(k: int) -> None:
+        for i in range(2000):
+            store.put(Record(1_790_000_000.0, "data", k, 1, "04000", value=float(i)))
+
+    threads = [threading.Thread(target=produce, args=(k,)) for k in range(4)]
+    for t in threads:
+        t.start()
+    for t in threads:
+        t.join()
+    store.close()
+    day = table_name(dt.date.fromtimestamp(1_790_000_000.0))
+    con = sqlite3.connect(db)
+    counts = dict(con.execute(f'SELECT grp, count(*) FROM "{day}" GROUP BY grp'))
+    assert counts == {0: 2000, 1: 2000, 2: 2000, 3: 2000}
+
+
+def test_a_failing_commit_listener_is_removed_and_journaled(db):
+    def listener(total: int) -> None:
+        raise RuntimeError("widget gone")
+
+    store = Store(db, on_commit=listener, wallclock=lambda: 1_790_000_001.0)
+    store.start()
+    store.put(Record(1_790_000_000.0, "data", 1, 1, "04000", value=1.0))
+    store.close()
+    day = table_name(dt.date.fromtimestamp(1_790_000_000.0))
+    texts = [t for (t,) in rows(db, day, "text") if t]
+    assert len(texts) == 1 and "widget gone" in texts[0]
