@@ -236,7 +236,10 @@ class Exchange:
             n: NodeStats(n, str(cfg.parsed)) for n, cfg in self.configs.items()
         }
         self._nodes: dict[int, _Node] = {}
-        self._inflight: set[int] = set()  # instruction keys; touched by the engine thread only
+        # Touched by the engine thread only: instruction keys with a request in flight, and the
+        # nodes whose link is up as of this scan (changes arrive with the presence-list update).
+        self._inflight: set[int] = set()
+        self._present: set[int] = set()
         self._thread = LoopThread("netplc-exchange")
 
     # --- wiring ----------------------------------------------------------------------------------
@@ -249,8 +252,7 @@ class Exchange:
     def start(self) -> None:
         if self.engine is None:
             raise RuntimeError("Exchange.attach(engine) must come before start()")
-        inflight = self._inflight
-        self.engine.post(lambda mem: inflight.clear())  # requests of an earlier run never complete
+        self._post_reset()
         self._thread.start()
         self._thread.run(self._spawn())
 
@@ -263,6 +265,23 @@ class Exchange:
     def stop(self) -> None:
         self._thread.stop()
         self._nodes.clear()
+        for stats in self.stats.values():
+            stats.up = False
+        if self.engine is not None:
+            self._post_reset()
+
+    def _post_reset(self) -> None:
+        """No link and nothing in flight as of the next scan (requests of a stopped run never complete)."""
+        inflight, present, nodes = self._inflight, self._present, list(self.configs)
+
+        def reset(mem: Memory) -> None:
+            inflight.clear()
+            present.clear()
+            for n in nodes:
+                if n < PRESENCE_NODES:
+                    mem.set_byte(PRESENCE_LIST + n, 0)
+
+        self.engine.post(reset)
 
     # --- NetLink (called by NREAD/NWRITE on the engine thread) -----------------------------------
 
@@ -283,7 +302,7 @@ class Exchange:
         if req.key not in self._inflight:
             self._inflight.add(req.key)
             self._thread.call(target.queue.put_nowait, req)
-        return target.stats.up
+        return node in self._present
 
     # --- back on the engine thread ---------------------------------------------------------------
 
@@ -310,9 +329,17 @@ class Exchange:
         text = f"node {n} ({node.stats.endpoint}): link {'up' if up else 'down'}"
         self.sink.put(Record(time.time(), "system", source=f"node {n}", number=n,
                              value=1.0 if up else 0.0, text=f"{text}: {error}" if error else text))
-        if n < PRESENCE_NODES:
-            byte = 0xFF if up else 0x00
-            self.engine.post(lambda mem: mem.set_byte(PRESENCE_LIST + n, byte))
+        present = self._present
+
+        def apply(mem: Memory) -> None:
+            if up:
+                present.add(n)
+            else:
+                present.discard(n)
+            if n < PRESENCE_NODES:
+                mem.set_byte(PRESENCE_LIST + n, 0xFF if up else 0x00)
+
+        self.engine.post(apply)
 
 
 def _fon_nodes(program: Program) -> Iterable[tuple[int, Instr, int | None]]:

@@ -375,10 +375,15 @@ class LoopThread:
             return
 
         async def cancel_all() -> None:
-            tasks = [t for t in asyncio.all_tasks() if t is not asyncio.current_task()]
-            for t in tasks:
-                t.cancel()
-            await asyncio.gather(*tasks, return_exceptions=True)
+            # Cancel again while anything is left: on Python 3.11 asyncio.wait_for (used inside
+            # pymodbus) swallows a cancellation that arrives as its inner future completes.
+            for _ in range(20):
+                tasks = [t for t in asyncio.all_tasks() if t is not asyncio.current_task() and not t.done()]
+                if not tasks:
+                    return
+                for t in tasks:
+                    t.cancel()
+                await asyncio.wait(tasks, timeout=0.1)
 
         try:
             asyncio.run_coroutine_threadsafe(cancel_all(), loop).result(timeout)
