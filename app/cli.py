@@ -1,15 +1,140 @@
-"""Command line of the station (placeholder until the application issue lands: a window saying so)."""
+"""The station's command line: the workstation, the headless runtime, the viewer, check, simulate.
+
+`python main.py [STATION]` must keep working as the manual's "open the server with its forms", so
+the station is an optional positional argument of the top level and the other commands are
+recognised by their first word instead of argparse sub-commands (which cannot share a level with
+an optional positional).
+"""
 
 from __future__ import annotations
 
+import argparse
+import signal
 import sys
+import threading
+import time
+from pathlib import Path
+
+DEMO_STATION = Path(__file__).resolve().parent.parent / "resources" / "example"
+COMMANDS = ("view", "check", "simulate")
+
+
+def _main_parser() -> argparse.ArgumentParser:
+    p = argparse.ArgumentParser(
+        prog="python main.py",
+        description="NetPlc Station: runs a station (NetPlc program, exchange with PLC nodes, archive) "
+                    "and shows its HMI forms.",
+        epilog="other commands: view [ARCHIVE] (offline journal viewer), check STATION (validate a "
+               "station), simulate PROGRAM.stl (a simulated CPU-165 node); each takes --help.",
+    )
+    p.add_argument("station", nargs="?", default=str(DEMO_STATION),
+                   help="station folder or its station.toml (default: the demo station)")
+    p.add_argument("--no-gui", action="store_true", help="run headless, printing a status line")
+    p.add_argument("--duration", type=float, metavar="S",
+                   help="with --no-gui: stop after S seconds (default: until SIGINT/SIGTERM)")
+    p.add_argument("--status-every", type=float, default=5.0, metavar="S",
+                   help="with --no-gui: seconds between status lines (default 5)")
+    return p
+
+
+def _view_parser() -> argparse.ArgumentParser:
+    p = argparse.ArgumentParser(prog="python main.py view",
+                                description="Open an archive read-only: records by day, filters, "
+                                            "series plots, CSV export. No station needs to run.")
+    p.add_argument("archive", nargs="?",
+                   help="archive file (journal.sqlite) or a station folder (default: the demo station's)")
+    return p
+
+
+def _check_parser() -> argparse.ArgumentParser:
+    p = argparse.ArgumentParser(prog="python main.py check",
+                                description="Validate a station: station.toml, NetPlc program, symbols, "
+                                            "simulator programs, messages and every form. Prints all "
+                                            "problems; exit status 1 if there are any.")
+    p.add_argument("station", help="station folder or its station.toml")
+    return p
 
 
 def main(argv: list[str] | None = None) -> int:
-    from PySide6.QtWidgets import QApplication, QLabel
+    args = list(sys.argv[1:] if argv is None else argv)
+    if args and args[0] in COMMANDS:
+        command, rest = args[0], args[1:]
+        if command == "simulate":
+            from netplc.simulator import main as simulate
 
-    app = QApplication(sys.argv if argv is None else ["netplc-station", *argv])
-    label = QLabel("NetPlc Station: the operator workstation is not built yet (application issue).")
-    label.resize(520, 80)
-    label.show()
-    return app.exec()
+            return simulate(rest)
+        if command == "check":
+            return run_check(_check_parser().parse_args(rest).station)
+        return run_viewer(_view_parser().parse_args(rest).archive)
+    ns = _main_parser().parse_args(args)
+    if ns.duration is not None and not ns.no_gui:
+        _main_parser().error("--duration needs --no-gui")
+    if ns.no_gui:
+        return run_headless(ns.station, ns.duration, ns.status_every)
+    return run_gui(ns.station)
+
+
+def run_check(station: str) -> int:
+    from app.check import check_station
+
+    report = check_station(station)
+    for problem in report.problems:
+        print(problem)
+    if report.ok:
+        for note in report.notes:
+            print(f"ok: {note}")
+        return 0
+    print(f"{len(report.problems)} problem(s) found", file=sys.stderr)
+    return 1
+
+
+def _open_runtime(station: str):  # -> Runtime | None (typed lazily: the runtime imports the parts)
+    from app.config import ConfigError, load_station
+    from app.runtime import Runtime, StartError
+
+    try:
+        return Runtime(load_station(station))
+    except (ConfigError, StartError) as e:
+        for problem in e.problems:
+            print(problem, file=sys.stderr)
+        return None
+
+
+def run_headless(station: str, duration: float | None, every: float) -> int:
+    runtime = _open_runtime(station)
+    if runtime is None:
+        return 2
+    done = threading.Event()
+
+    def on_signal(signum: int, _frame: object) -> None:
+        print(f"{signal.Signals(signum).name}: stopping", flush=True)
+        done.set()
+
+    previous = {s: signal.signal(s, on_signal) for s in (signal.SIGINT, signal.SIGTERM)}
+    try:
+        runtime.start()
+        print(f"station {runtime.station.name} started: {runtime.station.path}", flush=True)
+        started = time.monotonic()
+        while not done.is_set():
+            left = every if duration is None else min(every, started + duration - time.monotonic())
+            if left <= 0 or done.wait(left):
+                break
+            print(runtime.status().line(), flush=True)
+    finally:
+        runtime.stop()
+        for s, handler in previous.items():
+            signal.signal(s, handler)
+    print(f"station stopped: {runtime.status().line()}", flush=True)
+    return 0
+
+
+def run_gui(station: str) -> int:
+    from app.gui.main_window import run_workstation
+
+    return run_workstation(station)
+
+
+def run_viewer(archive: str | None) -> int:
+    from app.gui.viewer import run_viewer as viewer
+
+    return viewer(archive)

@@ -155,18 +155,28 @@ def _kind_name(kind: type | tuple[type, ...]) -> str:
 
 def load_station(path: str | Path) -> Station:
     """Read and validate a station; ConfigError lists every problem."""
+    station, problems = read_station(path)
+    if problems or station is None:
+        raise ConfigError(problems)
+    return station
+
+
+def read_station(path: str | Path) -> tuple[Station | None, list[str]]:
+    """The station as far as it can be read, and its problems (for `check`, which goes on to
+    check the program and forms even when a setting is wrong). Files that do not exist are None
+    in the returned station; None instead of a station when the file is not TOML at all."""
     file = station_file(path)
     fname = str(file)
     try:
         data = tomllib.loads(file.read_text(encoding="utf-8"))
     except FileNotFoundError:
-        raise ConfigError([f"{fname}: no station file here"]) from None
+        return None, [f"{fname}: no station file here"]
     except OSError as e:
-        raise ConfigError([f"{fname}: cannot read: {e.strerror}"]) from None
+        return None, [f"{fname}: cannot read: {e.strerror}"]
     except UnicodeDecodeError as e:
-        raise ConfigError([f"{fname}: not UTF-8 text: {e.reason}"]) from None
+        return None, [f"{fname}: not UTF-8 text: {e.reason}"]
     except tomllib.TOMLDecodeError as e:
-        raise ConfigError([f"{fname}: not valid TOML: {e}"]) from None
+        return None, [f"{fname}: not valid TOML: {e}"]
     problems: list[str] = []
     base = file.parent.resolve()
     top = _Reader(problems, fname, data)
@@ -186,23 +196,33 @@ def load_station(path: str | Path) -> Station:
     users = _users(problems, fname, top.get("operator", dict, {}))
     top.finish()
     nodes = _with_simulated_nodes(problems, fname, nodes, simulators)
-    for key, p, must_be_dir in (("NetPlcProgram", program, False), ("Symbols", symbols, False),
-                                ("HMIload", hmi, True), ("Messages", messages, False)):
-        if p is not None and not (p.is_dir() if must_be_dir else p.is_file()):
-            top.bad(key, f"{'folder' if must_be_dir else 'file'} {p} does not exist")
+    program, symbols, hmi, messages = (
+        _existing(top, key, p, must_be_dir)
+        for key, p, must_be_dir in (("NetPlcProgram", program, False), ("Symbols", symbols, False),
+                                    ("HMIload", hmi, True), ("Messages", messages, False)))
+    runnable: list[SimulatorSettings] = []
     for i, sim in enumerate(simulators):
-        for key, p in (("program", sim.program), ("symbols", sim.symbols)):
-            if p is not None and not p.is_file():
-                problems.append(f"{fname}: simulators[{i}].{key}: file {p} does not exist")
-    if problems:
-        raise ConfigError(problems)
-    assert archive is not None
-    return Station(
-        path=file.resolve(), name=name, NetPlcLoad=load, NetPlcProgram=program, Symbols=symbols,
-        HMIload=hmi, NetSyncTime=sync, Archive=archive, Messages=messages, keep_days=keep_days,
-        Retain=retain or archive.with_name("retain.bin"), modbus_server=server, nodes=tuple(nodes),
-        simulators=tuple(simulators), users=users,
+        missing = [(key, p) for key, p in (("program", sim.program), ("symbols", sim.symbols))
+                   if p is not None and not p.is_file()]
+        for key, p in missing:
+            problems.append(f"{fname}: simulators[{i}].{key}: file {p} does not exist")
+        if not missing:
+            runnable.append(sim)
+    archive = archive or base / "archive" / "journal.sqlite"
+    station = Station(
+        path=file.resolve(), name=name or base.name, NetPlcLoad=bool(load), NetPlcProgram=program,
+        Symbols=symbols, HMIload=hmi, NetSyncTime=sync, Archive=archive, Messages=messages,
+        keep_days=keep_days, Retain=retain or archive.with_name("retain.bin"), modbus_server=server,
+        nodes=tuple(nodes), simulators=tuple(runnable), users=users,
     )
+    return station, problems
+
+
+def _existing(r: _Reader, key: str, path: Path | None, must_be_dir: bool) -> Path | None:
+    if path is not None and not (path.is_dir() if must_be_dir else path.is_file()):
+        r.bad(key, f"{'folder' if must_be_dir else 'file'} {path} does not exist")
+        return None
+    return path
 
 
 def _modbus_server(problems: list[str], fname: str, table: dict[str, Any]) -> ModbusServerSettings:

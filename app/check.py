@@ -1,0 +1,83 @@
+"""`python main.py check STATION`: every problem of a station before it is started on a plant.
+
+Each part is checked even when an earlier one failed (a broken program does not hide a broken
+form), so an engineer gets the whole list at once, each line naming its file and place.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+from pathlib import Path
+
+from app.config import Station, read_station
+from app.runtime import load_simulated_program
+from hmi_forms.form import load_forms
+from netplc.exchange import NodeConfig, check_program_nodes
+from netplc.program import Program, ProgramError, load_symbols, parse_file
+from registrar.catalog import Catalog, CatalogError
+
+
+@dataclass
+class CheckReport:
+    problems: list[str] = field(default_factory=list)
+    notes: list[str] = field(default_factory=list)  # what was found good, for the summary
+
+    @property
+    def ok(self) -> bool:
+        return not self.problems
+
+
+def check_station(path: str | Path) -> CheckReport:
+    report = CheckReport()
+    station, problems = read_station(path)
+    report.problems += problems
+    if station is None:
+        return report
+    report.notes.append(f"station {station.path}")
+    symbols = _symbols(station.Symbols, report)
+    program = _program(station, symbols, report)
+    if program is not None:
+        nodes = [NodeConfig(n.node, n.endpoint or "tcp://127.0.0.1:1", unit=n.unit, profile=n.profile,
+                            timeout=n.timeout, retries=n.retries, table=n.table) for n in station.nodes]
+        report.problems += [str(d) for d in check_program_nodes(program, nodes)]
+    for sim in station.simulators:
+        try:
+            p = load_simulated_program(sim.program, sim.symbols)
+            report.notes.append(f"node {sim.node} simulator program {sim.program.name}: "
+                                    f"{len(p.instrs)} instructions")
+        except ProgramError as e:
+            report.problems += [str(d) for d in e.errors]
+    if station.Messages is not None:
+        try:
+            catalog = Catalog.load(station.Messages)
+            report.notes.append(f"messages {station.Messages.name}: {len(catalog)} texts")
+        except CatalogError as e:
+            report.problems += list(e.problems)
+    if station.HMIload is not None:
+        forms, problems = load_forms(station.HMIload, symbols)
+        report.problems += [str(p) for p in problems]
+        report.notes.append(f"forms in {station.HMIload}: {len(forms)} loaded")
+    return report
+
+
+def _symbols(path: Path | None, report: CheckReport) -> dict[str, int]:
+    if path is None:
+        return {}
+    try:
+        return load_symbols(path)
+    except ProgramError as e:
+        report.problems += [str(d) for d in e.errors]
+        return {}
+
+
+def _program(station: Station, symbols: dict[str, int], report: CheckReport) -> Program | None:
+    if not station.NetPlcLoad or station.NetPlcProgram is None:
+        return None
+    try:
+        program = parse_file(station.NetPlcProgram, symbols)
+    except ProgramError as e:
+        report.problems += [str(d) for d in e.errors]
+        return None
+    report.notes.append(f"program {station.NetPlcProgram.name}: {len(program.instrs)} instructions, "
+                        f"{program.words} words")
+    return program

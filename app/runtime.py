@@ -1,0 +1,302 @@
+"""The station runtime ("FregatServer" without a window): registrar, retentive memory, simulated
+nodes, exchange, Modbus server and the NetPlc scan on the NetSyncTime tick.
+
+It imports no Qt, so `--no-gui` is this module alone and the workstation only attaches to it.
+Start and stop run in opposite orders: the registrar is the first thing up and the last thing
+down, so every record produced while the rest starts or stops (link lost, final retentive save,
+'stop') is written; memory is saved only after the scan thread has ended, so the save is of a
+finished scan.
+"""
+
+from __future__ import annotations
+
+import threading
+import time
+from collections.abc import Callable
+from dataclasses import dataclass, field
+from pathlib import Path
+
+from app.config import NodeSettings, Station
+from netplc.engine import Engine
+from netplc.exchange import Exchange, NodeConfig
+from netplc.modbus_server import ModbusServer
+from netplc.program import Program, ProgramError, load_symbols, parse, parse_file
+from netplc.records import Record
+from netplc.scheduler import ScanThread
+from netplc.simulator import Simulator
+from registrar.catalog import Catalog, CatalogError
+from registrar.retain import Retainer
+from registrar.store import Store, StoreStats
+
+RecordObserver = Callable[[Record], None]
+
+
+class StartError(Exception):
+    """The station cannot start: every problem found (program, symbols, messages, addresses)."""
+
+    def __init__(self, problems: list[str]) -> None:
+        self.problems = problems
+        super().__init__("\n".join(problems))
+
+
+@dataclass(frozen=True)
+class NodeStatus:
+    node: int
+    endpoint: str
+    up: bool
+
+
+@dataclass(frozen=True)
+class RuntimeStatus:
+    """One consistent look at the station for the status line and the status bar."""
+
+    running: bool  # the runtime is started
+    state: str  # NetPlc state text: running / halted / stopped, code 11
+    scans: int
+    scan_last_ms: float
+    scan_max_ms: float
+    scan_mean_ms: float
+    overruns: int
+    tick_ms: int
+    nodes: tuple[NodeStatus, ...]
+    records_written: int
+    records_pending: int
+    records_lost: int
+    modbus_port: int | None
+    problems: tuple[str, ...] = field(default=())  # what an operator must see (disk, server, ...)
+
+    @property
+    def nodes_up(self) -> int:
+        return sum(n.up for n in self.nodes)
+
+    def line(self) -> str:
+        """The one-line status of `--no-gui`."""
+        nodes = ", ".join(f"{n.node}:{'up' if n.up else 'DOWN'}" for n in self.nodes) or "none"
+        text = (f"NetPlc {self.state} | scan {self.scan_last_ms:.2f} ms (max {self.scan_max_ms:.2f}, "
+                f"tick {self.tick_ms} ms, {self.overruns} overruns, {self.scans} scans) | "
+                f"nodes {self.nodes_up}/{len(self.nodes)} up [{nodes}] | records {self.records_written}")
+        if self.problems:
+            text += " | " + "; ".join(self.problems)
+        return text
+
+
+def load_program(station: Station) -> Program:
+    """The station's NetPlc program (an empty one when NetPlcLoad is false); ProgramError if broken."""
+    if not station.NetPlcLoad or station.NetPlcProgram is None:
+        return parse("", source="<no program>")
+    symbols = load_symbols(station.Symbols) if station.Symbols else {}
+    return parse_file(station.NetPlcProgram, symbols)
+
+
+def load_simulated_program(path: Path, symbols: Path | None) -> Program:
+    return parse_file(path, load_symbols(symbols) if symbols else {})
+
+
+class Runtime:
+    """The running station. `start()`, then `status()` as often as wanted, then `stop()`."""
+
+    def __init__(self, station: Station, *, wallclock: Callable[[], float] = time.time) -> None:
+        self.station = station
+        self.wallclock = wallclock
+        self.catalog, self.program = self._load()
+        self.store: Store | None = None
+        self.engine: Engine | None = None
+        self.retainer: Retainer | None = None
+        self.simulators: list[Simulator] = []
+        self.exchange: Exchange | None = None
+        self.modbus: ModbusServer | None = None
+        self.scan_thread: ScanThread | None = None
+        self.nodes: list[NodeSettings] = list(station.nodes)
+        self.restored = ""  # which retentive save was used: current / previous / zeroes
+        self._observers: list[RecordObserver] = []
+        self._problems: list[str] = []
+        self._lock = threading.Lock()
+        self._final_store: StoreStats | None = None  # the archive's figures after stop
+        self.started = False
+
+    # --- records -------------------------------------------------------------------------------
+
+    def put(self, record: Record) -> None:
+        """The sink every part writes to: the registrar, then whoever watches (alarm banner)."""
+        if self.store is not None:
+            self.store.put(record)
+        for observer in list(self._observers):
+            observer(record)
+
+    def subscribe(self, observer: RecordObserver) -> None:
+        """Call `observer(record)` for every record, from the thread that produced it."""
+        self._observers.append(observer)
+
+    def unsubscribe(self, observer: RecordObserver) -> None:
+        if observer in self._observers:
+            self._observers.remove(observer)
+
+    def system(self, text: str) -> None:
+        self.put(Record(self.wallclock(), "system", source="station", text=text))
+
+    def message_text(self, record: Record) -> str:
+        """An NMSG record's text as the archive will show it (the catalog resolves it)."""
+        if record.text:
+            return record.text
+        return self.catalog.text_for(record.number) if record.number is not None else ""
+
+    def acknowledge(self, record: Record, user: str) -> None:
+        """An operator acknowledges an alarm: an 'operator' record naming the user and the message."""
+        self.put(Record(self.wallclock(), "operator", grp=record.grp, type=record.type, source=user,
+                        number=record.number, text=f"acknowledged: {self.message_text(record)}"))
+
+    # --- start and stop ------------------------------------------------------------------------
+
+    def _load(self) -> tuple[Catalog, Program]:
+        """Message texts and the program, both checked before anything starts."""
+        problems: list[str] = []
+        catalog = Catalog()
+        program = parse("", source="<none>")
+        try:
+            if self.station.Messages is not None:
+                catalog = Catalog.load(self.station.Messages)
+        except CatalogError as e:
+            problems += e.problems
+        try:
+            program = load_program(self.station)
+        except ProgramError as e:
+            problems += [str(d) for d in e.errors]
+        if problems:
+            raise StartError(problems)
+        return catalog, program
+
+    def start(self) -> None:
+        st = self.station
+        st.Archive.parent.mkdir(parents=True, exist_ok=True)
+        self.store = Store(st.Archive, catalog=self.catalog, keep_days=st.keep_days, wallclock=self.wallclock)
+        self.store.start()
+        try:
+            self._start_parts()
+        except BaseException:
+            self.stop()
+            raise
+
+    def _start_parts(self) -> None:
+        st = self.station
+        self.system(f"station starting: {st.path}")
+        self.engine = Engine(self.program, sink=self, tick=st.tick, wallclock=self.wallclock)
+        if not st.NetPlcLoad:
+            self.engine.stop()
+        self.retainer = Retainer(st.Retain, self.engine, self)
+        self.restored = self.retainer.restore()
+        for sim in st.simulators:
+            program = load_simulated_program(sim.program, sim.symbols)
+            simulator = Simulator(program, host=sim.host, port=sim.port, unit=sim.unit,
+                                  tick=sim.tick_ms / 1000)
+            simulator.start()
+            self.simulators.append(simulator)
+            self._fill_endpoint(sim.node, f"tcp://{sim.host}:{simulator.port}")
+        configs = [NodeConfig(n.node, n.endpoint, unit=n.unit, profile=n.profile, timeout=n.timeout,
+                              retries=n.retries, table=n.table) for n in self.nodes]
+        self.exchange = Exchange(configs, self)
+        self.exchange.attach(self.engine)
+        self.exchange.start()
+        server = st.modbus_server
+        if server.enabled:
+            modbus = ModbusServer(self.engine, host=server.host, port=server.port,
+                                  writable=list(server.writable))
+            try:
+                modbus.start()
+                self.modbus = modbus
+            except OSError as e:
+                self._problem(f"Modbus server not started: {server.host}:{server.port}: {e.strerror or e}")
+        self.system(f"program loaded: {self.program.source} ({len(self.program.instrs)} instructions, "
+                    f"{self.program.words} words)")
+        self.scan_thread = ScanThread(self.engine, st.tick, on_error=self._scan_error)
+        self.scan_thread.start()
+        self.retainer.start()
+        self.started = True
+        self.system(f"station started: NetSyncTime {st.NetSyncTime} ms, "
+                    f"retentive memory from {self.restored}")
+
+    def _fill_endpoint(self, node: int, endpoint: str) -> None:
+        self.nodes = [NodeSettings(n.node, endpoint, n.unit, n.profile, n.timeout, n.retries, n.table)
+                      if n.node == node and not n.endpoint else n for n in self.nodes]
+
+    def _scan_error(self, error: BaseException) -> None:
+        self._problem(f"scan failed: {error!r}")
+
+    def _problem(self, text: str) -> None:
+        with self._lock:
+            if text in self._problems:
+                return
+            self._problems.append(text)
+        self.system(text)
+
+    def stop(self) -> None:
+        """Stop everything in the reverse order of start; safe to call twice or after a failed start."""
+        if self.scan_thread is not None:
+            self.scan_thread.stop()
+            self.scan_thread = None
+        if self.retainer is not None:
+            self.retainer.stop()  # the final save, of the last finished scan
+            self.retainer = None
+        if self.modbus is not None:
+            self.modbus.stop()
+            self.modbus = None
+        if self.exchange is not None:
+            self.exchange.stop()
+            self.exchange = None
+        for simulator in reversed(self.simulators):
+            simulator.stop()
+        self.simulators.clear()
+        if self.store is not None:
+            if self.started:
+                self.system("station stopped")
+            store, self.store = self.store, None
+            store.close()  # flushes every queued record
+            self._final_store = store.stats
+        self.started = False
+
+    # --- NetPlc run control (the workstation's menu) -------------------------------------------
+
+    def run_program(self) -> None:
+        engine = self.engine
+        if engine is not None:
+            engine.post(lambda _m: engine.start())
+            self.system("NetPlc started by the operator")
+
+    def stop_program(self) -> None:
+        engine = self.engine
+        if engine is not None:
+            engine.post(lambda _m: engine.stop())
+            self.system("NetPlc stopped by the operator")
+
+    # --- status --------------------------------------------------------------------------------
+
+    def status(self) -> RuntimeStatus:
+        engine = self.engine
+        stats = engine.stats if engine else None
+        exchange = self.exchange
+        nodes = tuple(NodeStatus(n.node, n.endpoint, bool(exchange and exchange.link_up(n.node)))
+                      for n in self.nodes)
+        problems = list(self._problems)
+        written = pending = lost = 0
+        s = self.store.stats if self.store is not None else self._final_store
+        if s is not None:
+            written, pending, lost = s.committed, s.queued, s.dropped
+            if s.last_error:
+                problems.append(f"archive: {s.last_error}")
+            if s.dropped:
+                problems.append(f"archive: {s.dropped} records lost (disk too slow or full)")
+        return RuntimeStatus(
+            running=self.started,
+            state=engine.state_text if engine else "not started",
+            scans=stats.count if stats else 0,
+            scan_last_ms=stats.last_ms if stats else 0.0,
+            scan_max_ms=stats.max_ms if stats else 0.0,
+            scan_mean_ms=stats.mean_ms if stats else 0.0,
+            overruns=stats.overruns if stats else 0,
+            tick_ms=self.station.NetSyncTime,
+            nodes=nodes,
+            records_written=written,
+            records_pending=pending,
+            records_lost=lost,
+            modbus_port=self.modbus.port if self.modbus else None,
+            problems=tuple(problems),
+        )

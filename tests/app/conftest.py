@@ -1,0 +1,47 @@
+"""Stations for the application tests: copies of the demo station and small hand-made ones."""
+
+from __future__ import annotations
+
+import shutil
+from pathlib import Path
+
+import pytest
+
+REPO = Path(__file__).resolve().parents[2]
+DEMO = REPO / "resources" / "example"
+
+
+def copy_demo(dest: Path) -> Path:
+    """The demo station copied to `dest`, its archive there too, its Modbus server on a free port."""
+    shutil.copytree(DEMO, dest, ignore=shutil.ignore_patterns("archive", "__pycache__"))
+    toml = dest / "station.toml"
+    text = toml.read_text(encoding="utf-8")
+    assert "\nport = 1502\n" in text
+    toml.write_text(text.replace("\nport = 1502\n", "\nport = 0\n"), encoding="utf-8")
+    return dest
+
+
+def write_station(folder: Path, toml: str, files: dict[str, str] | None = None) -> Path:
+    folder.mkdir(parents=True, exist_ok=True)
+    (folder / "station.toml").write_text(toml, encoding="utf-8")
+    for name, text in (files or {}).items():
+        (folder / name).write_text(text, encoding="utf-8")
+    return folder
+
+
+@pytest.fixture
+def demo_copy(tmp_path: Path) -> Path:
+    return copy_demo(tmp_path / "station")
+
+
+@pytest.fixture(scope="session")
+def headless_archive(tmp_path_factory: pytest.TempPathFactory) -> tuple[Path, str]:
+    """The demo station run headless for 5 s (once per session): its archive and its output."""
+    import subprocess
+    import sys
+
+    station = copy_demo(tmp_path_factory.mktemp("headless") / "station")
+    r = subprocess.run([sys.executable, "main.py", "--no-gui", str(station), "--duration", "5",
+                        "--status-every", "1"], cwd=REPO, capture_output=True, text=True, timeout=60)
+    assert r.returncode == 0, r.stderr
+    return station / "archive" / "journal.sqlite", r.stdout

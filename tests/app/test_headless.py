@@ -1,0 +1,93 @@
+"""`python main.py --no-gui`: the whole station in a subprocess, over real TCP into a real archive."""
+
+from __future__ import annotations
+
+import datetime as dt
+import signal
+import sqlite3
+import subprocess
+import sys
+import time
+from pathlib import Path
+
+from tests.app.conftest import REPO
+
+
+def day_table() -> str:
+    return dt.date.today().strftime("%d_%m_%Y")
+
+
+def kinds(archive: Path) -> dict[str, list[tuple]]:
+    con = sqlite3.connect(f"file:{archive}?mode=ro", uri=True)
+    try:
+        rows = con.execute(f'SELECT kind, grp, type, source, number, value, text FROM "{day_table()}"'
+                           " ORDER BY id").fetchall()
+    finally:
+        con.close()
+    out: dict[str, list[tuple]] = {}
+    for r in rows:
+        out.setdefault(r[0], []).append(r)
+    return out
+
+
+def check_archive(archive: Path) -> dict[str, list[tuple]]:
+    by_kind = kinds(archive)
+    data = by_kind["data"]
+    assert {(r[1], r[2]) for r in data} >= {(1, 1), (1, 2), (1, 3), (1, 4), (1, 5)}  # NSTORE group/type
+    level = [r[5] for r in data if (r[1], r[2]) == (1, 1)]
+    assert level == sorted(level) and level[-1] > level[0]  # the node's level rises after start
+    messages = {(r[4], r[6]) for r in by_kind["message"]}
+    assert (5, "NetPlc запущен") in messages
+    assert (6, "Связь с узлом 0 установлена") in messages
+    system = [r[6] for r in by_kind["system"]]
+    assert any(t.startswith("station started") for t in system)
+    assert system[-1] == "station stopped"  # the last record written: everything before it is flushed
+    assert any("link up" in t for t in system)
+    return by_kind
+
+
+def test_headless_run_for_a_duration(headless_archive: tuple[Path, str]) -> None:
+    archive, out = headless_archive
+    check_archive(archive)
+    lines = out.splitlines()
+    assert lines[0].startswith("station Demo station started")
+    status = [line for line in lines if line.startswith("NetPlc running")]
+    assert status and "nodes 1/1 up" in status[-1] and "records" in status[-1]
+    assert lines[-1].startswith("station stopped")
+
+
+def test_sigterm_mid_run_exits_0_with_everything_flushed(demo_copy: Path) -> None:
+    proc = subprocess.Popen([sys.executable, "main.py", "--no-gui", str(demo_copy), "--status-every", "0.5"],
+                            cwd=REPO, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+    try:
+        assert proc.stdout is not None
+        deadline = time.monotonic() + 20
+        while time.monotonic() < deadline:
+            if "nodes 1/1 up" in proc.stdout.readline():
+                break
+        time.sleep(1.5)  # at least one NSTORE second after the link is up
+        proc.send_signal(signal.SIGTERM)
+        out, err = proc.communicate(timeout=20)
+    finally:
+        if proc.poll() is None:
+            proc.kill()
+    assert proc.returncode == 0, err
+    assert "SIGTERM: stopping" in out
+    check_archive(demo_copy / "archive" / "journal.sqlite")
+
+
+def test_bad_station_exits_2_naming_the_problem(tmp_path: Path) -> None:
+    (tmp_path / "station.toml").write_text('NetPlcProgram = "p.stl"\n', encoding="utf-8")
+    (tmp_path / "p.stl").write_text("TNA $09000\nJMP 0\n", encoding="utf-8")
+    r = subprocess.run([sys.executable, "main.py", "--no-gui", str(tmp_path), "--duration", "1"],
+                       cwd=REPO, capture_output=True, text=True, timeout=30)
+    assert r.returncode == 2
+    assert f"{tmp_path / 'p.stl'}:1:5:" in r.stderr
+
+
+def test_help_everywhere() -> None:
+    for args in ([], ["view"], ["check"], ["simulate"]):
+        r = subprocess.run([sys.executable, "main.py", *args, "--help"], cwd=REPO, capture_output=True,
+                           text=True, timeout=30)
+        assert r.returncode == 0, (args, r.stderr)
+        assert "usage:" in r.stdout
