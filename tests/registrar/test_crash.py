@@ -1,0 +1,102 @@
+"""Processes killed with SIGKILL: the archive stays intact and retentive memory is not lost."""
+
+from __future__ import annotations
+
+import os
+import signal
+import sqlite3
+import subprocess
+import sys
+from pathlib import Path
+
+import pytest
+
+from registrar.schema import DAY_GLOB
+
+HERE = Path(__file__).parent
+ROOT = HERE.parents[1]
+
+pytestmark = pytest.mark.skipif(not hasattr(signal, "SIGKILL"), reason="needs POSIX signals")
+
+
+def spawn(script: str, *args: str) -> subprocess.Popen[str]:
+    env = {**os.environ, "PYTHONPATH": str(ROOT)}
+    return subprocess.Popen([sys.executable, str(HERE / script), *args], stdout=subprocess.PIPE,
+                            stderr=subprocess.PIPE, text=True, env=env)
+
+
+def read_until(child: subprocess.Popen[str], done) -> list[str]:
+    """Lines the child prints until `done(line)` (the test's timeout guards a stuck child)."""
+    assert child.stdout is not None
+    lines = []
+    for line in child.stdout:
+        lines.append(line.split())
+        if done(lines[-1]):
+            return lines
+    raise AssertionError(f"child ended early: {child.stderr.read() if child.stderr else ''}")
+
+
+def kill(child: subprocess.Popen[str]) -> list[list[str]]:
+    child.send_signal(signal.SIGKILL)
+    out, _ = child.communicate(timeout=10)
+    return [line.split() for line in out.splitlines()]
+
+
+def test_sigkill_during_writes_keeps_every_committed_record(tmp_path):
+    db = tmp_path / "journal.sqlite"
+    child = spawn("writer_child.py", str(db))
+    try:
+        lines = read_until(child, lambda line: int(line[0]) >= 30_000)
+        lines += kill(child)
+    finally:
+        if child.poll() is None:
+            child.kill()
+    committed = int(lines[-1][0])
+    assert committed >= 30_000
+    con = sqlite3.connect(db)
+    assert con.execute("PRAGMA integrity_check").fetchone() == ("ok",)
+    tables = [n for (n,) in con.execute(
+        "SELECT name FROM sqlite_master WHERE type = 'table' AND name GLOB ?", (DAY_GLOB,))]
+    numbers = set()
+    for table in tables:
+        numbers.update(n for (n,) in con.execute(f'SELECT number FROM "{table}"'))
+    assert set(range(committed)) <= numbers
+
+
+def test_retentive_counting_continues_after_clean_stop_and_sigkill(tmp_path):
+    save = tmp_path / "retain.bin"
+
+    child = spawn("retain_child.py", str(save))
+    first = read_until(child, lambda line: line[0] == "count" and int(line[1]) >= 30)
+    assert first[0][:2] == ["restored", "zeroes"]
+    child.send_signal(signal.SIGTERM)
+    out, err = child.communicate(timeout=10)
+    assert child.returncode == 0, err
+    stopped = out.split()
+    assert stopped[0] == "stopped"
+    word, counter = int(stopped[1]), int(stopped[2])
+    assert word >= 30 and counter > 0
+
+    child = spawn("retain_child.py", str(save))
+    try:
+        lines = read_until(child, lambda line: line[0] == "count" and int(line[1]) >= word + 90)
+        assert lines[0] == ["restored", "current", str(word), str(counter)]
+        lines += kill(child)
+    finally:
+        if child.poll() is None:
+            child.kill()
+    last = [line for line in lines if line[0] == "count"][-1]
+    killed_word, killed_counter = int(last[1]), int(last[2])
+
+    child = spawn("retain_child.py", str(save))
+    try:
+        (restored,) = read_until(child, lambda line: line[0] == "restored")
+    finally:
+        child.kill()
+        child.communicate(timeout=10)
+    assert restored[1] == "current"
+    word_after, counter_after = int(restored[2]), int(restored[3])
+    per_second = 1 / 0.02  # the word counts once a scan
+    assert killed_word - per_second - 5 <= word_after <= killed_word + 5
+    assert word_after > word
+    assert killed_counter - 10 - 2 <= counter_after <= killed_counter + 2

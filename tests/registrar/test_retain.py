@@ -1,0 +1,94 @@
+from netplc.engine import Engine, FakeClock
+from netplc.program import parse
+from netplc.records import ListSink
+from registrar.retain import Retainer, read_save
+
+PROGRAM = "TNA $02000\nCTR C:$03000 N:100\nJMP 0\n"
+
+
+def engine() -> Engine:
+    return Engine(parse(PROGRAM), clock=FakeClock(), wallclock=lambda: 1_790_000_000.0, sink=ListSink())
+
+
+def filled(value: int) -> Engine:
+    e = engine()
+    e.mem.set_word(0o4000, value)
+    e.mem.set_word(0o77776, value + 1)  # the last word of the last bank
+    e.mem.set_bit(0o3000 + 5, 1)
+    e.mem.set_bit(0o3477, 1)
+    e.mem.set_bit(0o2001, 1)  # not retentive
+    e.tim_ticks[0o2200] = 12.5
+    e.ctr_values[0o3000] = value % 100
+    e.scan()
+    return e
+
+
+def texts(e: Engine) -> list[str]:
+    return [r.text or "" for r in e.sink.records if r.kind == "system"]
+
+
+def test_save_and_restore_the_current_save(tmp_path):
+    path = tmp_path / "retain.bin"
+    Retainer(path, filled(1234)).save()
+    e = engine()
+    assert Retainer(path, e).restore() == "current"
+    assert e.mem.get_word(0o4000) == 1234 and e.mem.get_word(0o77776) == 1235
+    assert e.mem.get_bit(0o3005) == 1 and e.mem.get_bit(0o3477) == 1
+    assert e.mem.get_bit(0o2001) == 0
+    assert e.tim_ticks == {0o2200: 12.5}
+    assert e.ctr_values[0o3000] == 34
+    assert e.snapshot.get_word(0o4000) == 1234  # published before the first scan
+    assert texts(e) == ["retentive memory restored from the current save retain.bin"]
+
+
+def test_a_damaged_current_save_falls_back_to_the_previous(tmp_path):
+    path = tmp_path / "retain.bin"
+    r = Retainer(path, filled(1))
+    r.save()
+    r.engine.mem.set_word(0o4000, 2)
+    r.engine.scan()
+    r.save()
+    assert read_save(r.previous).data[0] == 1 and read_save(path).data[0] == 2
+    blob = bytearray(path.read_bytes())
+    blob[100] ^= 0xFF
+    path.write_bytes(bytes(blob))
+    e = engine()
+    restored = Retainer(path, e)
+    assert restored.restore() == "previous"
+    assert e.mem.get_word(0o4000) == 1
+    assert "damaged" in texts(e)[0] and "previous save" in texts(e)[0]
+    restored.save()  # the damaged current file must not push the good previous one out
+    assert read_save(restored.previous).data[0] == 1 and read_save(path).data[0] == 1
+
+
+def test_a_truncated_save_and_a_missing_previous_give_zeroes(tmp_path):
+    path = tmp_path / "retain.bin"
+    Retainer(path, filled(7)).save()
+    path.write_bytes(path.read_bytes()[:1000])
+    e = engine()
+    e.mem.set_word(0o4000, 99)
+    assert Retainer(path, e).restore() == "zeroes"
+    assert e.mem.get_word(0o4000) == 0 and e.ctr_values == {}
+    assert texts(e) == ["retentive memory starts from zeroes "
+                        "(current save is damaged (length or checksum wrong); previous save is missing)"]
+
+
+def test_first_start_without_any_save(tmp_path):
+    e = engine()
+    assert Retainer(tmp_path / "none" / "retain.bin", e).restore() == "zeroes"
+    assert "current save is missing" in texts(e)[0]
+
+
+def test_stop_makes_a_final_save_and_failures_are_journaled(tmp_path):
+    e = filled(55)
+    r = Retainer(tmp_path / "retain.bin", e)
+    r.start(interval=60.0)
+    r.stop()
+    assert r.saves == 1 and read_save(r.path).data[0] == 55
+    blocked = tmp_path / "file"
+    blocked.write_text("not a directory")
+    bad = Retainer(blocked / "retain.bin", e)
+    bad.stop()
+    bad.stop()
+    assert bad.last_error and texts(e).count(texts(e)[-1]) == 1
+    assert texts(e)[-1].startswith("retentive memory could not be saved")
