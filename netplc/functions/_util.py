@@ -201,15 +201,16 @@ def _operand(addr: int | None, n: int) -> int:
 # --- BCD -----------------------------------------------------------------------------------------
 
 
+# value 0-99 of a BCD byte, or -1 if a nibble is above 9: BCDW and ADDBCD run in the scan
+_BCD_BYTE = [(b >> 4) * 10 + (b & 0xF) if b >> 4 < 10 and b & 0xF < 10 else -1 for b in range(256)]
+
+
 def bcd_to_bin(w: int) -> int | None:
     """Value of a 4-digit BCD word, or None if a nibble is above 9."""
-    value = 0
-    for shift in (12, 8, 4, 0):
-        digit = (w >> shift) & 0xF
-        if digit > 9:
-            return None
-        value = value * 10 + digit
-    return value
+    hi, lo = _BCD_BYTE[w >> 8], _BCD_BYTE[w & 0xFF]
+    if hi < 0 or lo < 0:
+        return None
+    return hi * 100 + lo
 
 
 def bin_to_bcd(v: int) -> int:

@@ -1,0 +1,47 @@
+"""The README's function tutorial is true: each `$ python -m netplc run ...` line in its console
+blocks is run as a subprocess from the repository root, and its output must be the one shown."""
+
+from __future__ import annotations
+
+import shlex
+import subprocess
+import sys
+from pathlib import Path
+
+import pytest
+
+ROOT = Path(__file__).resolve().parents[2]
+PROMPT = "$ python -m netplc run "
+
+
+def tutorial_commands() -> list[tuple[str, list[str]]]:
+    """(command line, expected output lines) for every command of the `## Function tutorial` section."""
+    text = (ROOT / "README.md").read_text(encoding="utf-8")
+    section = text.split("\n## Function tutorial\n", 1)[1].split("\n## ", 1)[0]
+    commands: list[tuple[str, list[str]]] = []
+    in_console = False
+    for line in section.splitlines():
+        if line.startswith("```"):
+            in_console = line == "```console"
+        elif in_console and line.startswith(PROMPT):
+            commands.append((line[2:], []))
+        elif in_console and commands:
+            commands[-1][1].append(line)
+    return commands
+
+
+COMMANDS = tutorial_commands()
+
+
+def test_the_tutorial_covers_the_required_examples() -> None:
+    programs = [shlex.split(cmd)[4] for cmd, _ in COMMANDS]
+    for name, times in (("mov", 1), ("bcdw", 1), ("addbcd", 2), ("cmp", 2)):
+        assert programs.count(f"tests/vectors/tutorial/{name}.stl") == times
+
+
+@pytest.mark.parametrize(("command", "expected"), COMMANDS, ids=[c for c, _ in COMMANDS])
+def test_tutorial_command_prints_what_the_readme_shows(command: str, expected: list[str]) -> None:
+    argv = [sys.executable, *shlex.split(command)[1:]]
+    done = subprocess.run(argv, cwd=ROOT, capture_output=True, text=True, timeout=60)
+    assert (done.stdout + done.stderr).splitlines() == expected
+    assert done.returncode == (2 if "bad.stl" in command else 0)
