@@ -6,6 +6,7 @@ form), so an engineer gets the whole list at once, each line naming its file and
 
 from __future__ import annotations
 
+import tempfile
 from dataclasses import dataclass, field
 from pathlib import Path
 
@@ -13,8 +14,10 @@ from app.config import Station, read_station
 from app.runtime import load_simulated_program
 from hmi_forms.form import load_forms
 from netplc.exchange import NodeConfig, check_program_nodes
-from netplc.program import Program, ProgramError, load_symbols, parse_file
+from netplc.program import Program, ProgramError, load_symbols, parse, parse_file
 from registrar.catalog import Catalog, CatalogError
+
+RECOVERY_ROUNDS = 5
 
 
 @dataclass
@@ -61,23 +64,50 @@ def check_station(path: str | Path) -> CheckReport:
 
 
 def _symbols(path: Path | None, report: CheckReport) -> dict[str, int]:
+    """The symbols; with errors, those of the good lines, so the program is checked against them."""
     if path is None:
         return {}
     try:
         return load_symbols(path)
     except ProgramError as e:
         report.problems += [str(d) for d in e.errors]
-        return {}
+        bad = {d.line for d in e.errors}
+    with tempfile.TemporaryDirectory() as tmp:
+        good = Path(tmp) / path.name
+        good.write_text(_blank_lines(path, bad), encoding="utf-8")
+        try:
+            return load_symbols(good)
+        except ProgramError:
+            return {}
 
 
 def _program(station: Station, symbols: dict[str, int], report: CheckReport) -> Program | None:
-    if not station.NetPlcLoad or station.NetPlcProgram is None:
+    """The program; with errors, the program without its bad lines (line numbers kept), so the
+    checks that need a whole program (nodes of NREAD/NWRITE) still run on the rest."""
+    path = station.NetPlcProgram
+    if not station.NetPlcLoad or path is None:
         return None
     try:
-        program = parse_file(station.NetPlcProgram, symbols)
+        program = parse_file(path, symbols)
     except ProgramError as e:
         report.problems += [str(d) for d in e.errors]
-        return None
-    report.notes.append(f"program {station.NetPlcProgram.name}: {len(program.instrs)} instructions, "
-                        f"{program.words} words")
+        return _recovered(path, symbols, {d.line for d in e.errors})
+    report.notes.append(f"program {path.name}: {len(program.instrs)} instructions, {program.words} words")
     return program
+
+
+def _recovered(path: Path, symbols: dict[str, int], bad: set[int]) -> Program | None:
+    for _ in range(RECOVERY_ROUNDS):  # removing a line can break another (a label it defined)
+        try:
+            return parse(_blank_lines(path, bad), source=str(path), symbols=symbols)
+        except ProgramError as e:
+            more = {d.line for d in e.errors} - bad
+            if not more:
+                return None
+            bad |= more
+    return None
+
+
+def _blank_lines(path: Path, lines: set[int]) -> str:
+    text = path.read_text(encoding="utf-8-sig").splitlines()
+    return "\n".join("" if i in lines else line for i, line in enumerate(text, start=1))

@@ -1,0 +1,74 @@
+"""`python main.py check`: every error planted in a broken copy of the demo station is reported."""
+
+from __future__ import annotations
+
+import json
+import subprocess
+import sys
+from pathlib import Path
+
+from tests.app.conftest import REPO, copy_demo
+
+
+def run_check(station: Path) -> subprocess.CompletedProcess[str]:
+    return subprocess.run([sys.executable, "main.py", "check", str(station)], cwd=REPO, capture_output=True,
+                          text=True, timeout=60)
+
+
+def test_the_demo_station_is_clean() -> None:
+    r = run_check(REPO / "resources" / "example")
+    assert r.returncode == 0, r.stdout + r.stderr
+    assert "ok: program netplc.stl" in r.stdout
+
+
+def plant(path: Path, old: str, new: str) -> None:
+    text = path.read_text(encoding="utf-8")
+    assert old in text, (path, old)
+    path.write_text(text.replace(old, new, 1), encoding="utf-8")
+
+
+def test_every_planted_error_is_found(tmp_path: Path) -> None:
+    st = copy_demo(tmp_path / "broken")
+    plant(st / "station.toml", "NetSyncTime = 100", 'NetSyncTime = "fast"\nColour = "red"')
+    plant(st / "station.toml", "timeout = 0.5", 'timeout = 0.5\nendpoint = "tcp://plc"')
+    plant(st / "netplc.stl", "TNA ON\nFON C:$02140 N:NODE S:0", "TNX ON\nFON C:$02140 N:NODE S:0")
+    plant(st / "netplc.stl", "FON C:NRD N:NREAD S:4000 D:TRIG_IN R:2",
+          "FON C:NRD N:NREAD S:4000 D:NO_SUCH R:2")
+    plant(st / "netplc.stl", "TNA ON\nFON C:$02134 N:NWRITE", "TNA ON\nFON C:$02500 N:NODE S:7\n"
+          "TNA ON\nFON C:$02134 N:NWRITE")
+    plant(st / "symbols.csv", "PUMP,02120", "PUMP,02190")
+    plant(st / "node0.stl", "CTR TB N:2", "CTR TB N:999")
+    plant(st / "messages.csv", "3,1,2,", "3,1,alarm,")
+    forms = sorted((st / "forms").glob("*.hmi"))
+    form = json.loads(forms[0].read_text(encoding="utf-8")) if forms else {
+        "form": {"title": "t", "width": 100, "height": 100}, "elements": []}
+    form["elements"].append({"type": "DiscreteBase", "Name": "Broken", "x": 0, "y": 0, "w": 10, "h": 10,
+                             "InAddr": "09999"})
+    form["elements"].append({"type": "NoSuchElement", "Name": "Alien", "x": 0, "y": 0, "w": 10, "h": 10})
+    (st / "forms" / "zz_broken.hmi").write_text(json.dumps(form, ensure_ascii=False), encoding="utf-8")
+
+    r = run_check(st)
+    assert r.returncode == 1
+    out = r.stdout
+    lines = (st / "netplc.stl").read_text(encoding="utf-8").splitlines()
+    tnx = lines.index("TNX ON") + 1
+    nosuch = next(i for i, line in enumerate(lines, 1) if "NO_SUCH" in line)
+    node7 = lines.index("FON C:$02500 N:NODE S:7") + 1
+    node_lines = (st / "node0.stl").read_text(encoding="utf-8").splitlines()
+    ctr = node_lines.index("CTR TB N:999") + 1
+    expected = [
+        f"{st / 'station.toml'}: NetSyncTime: expected an integer",
+        f"{st / 'station.toml'}: Colour: unknown setting",
+        f"{st / 'station.toml'}: nodes[0].endpoint: 'tcp://plc'",
+        f"{st / 'netplc.stl'}:{tnx}:1: unknown instruction 'TNX'",
+        f"{st / 'netplc.stl'}:{nosuch}:",
+        f"{st / 'netplc.stl'}:{node7}:1: NODE S:7: node 7 is not configured",  # found past other errors
+        f"{st / 'symbols.csv'}:",
+        f"{st / 'node0.stl'}:{ctr}:",
+        "messages.csv:",
+        'zz_broken.hmi: element "Broken": InAddr',
+        'zz_broken.hmi: element "Alien"',
+    ]
+    for e in expected:
+        assert e in out, f"{e!r} not in:\n{out}"
+    assert f"{len(out.splitlines())} problem(s) found" in r.stderr
