@@ -115,13 +115,6 @@ def test_t_trigger_end_to_end(node0: Simulator) -> None:
         st.stop()
 
 
-def test_without_exchange_the_link_output_is_0() -> None:
-    engine = Engine(parse(NETPLC_PROGRAM))
-    engine.scan()
-    assert engine.snapshot.get_bit(0o2110) == 1  # the coil follows the rung
-    assert engine.snapshot.get_bit(0o2111) == 0 and engine.snapshot.get_bit(0o2105) == 0
-
-
 def test_an_instruction_never_has_two_requests_in_flight() -> None:
     """A node that accepts the connection but never answers: 200 scans send exactly one request."""
     with socket.create_server(("127.0.0.1", 0)) as listener:
