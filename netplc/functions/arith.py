@@ -8,6 +8,7 @@ from __future__ import annotations
 
 from netplc.address import FERR2
 from netplc.functions._util import (
+    Builder,
     Step,
     at,
     bcd_to_bin,
@@ -23,53 +24,37 @@ from netplc.functions.registry import Fon, FonContext, register
 from netplc.memory import Memory
 
 
-@register(10, "ADDBCD", "M", "M", "M")
-@built
-def addbcd(mem: Memory, fon: Fon) -> Step:
-    """word[R] = low 4 BCD digits of S + D; C+1 carry (sum > 9999); C+2 Z (stored value 0).
+def _bcd_arith(subtract: bool) -> Builder:
+    """word[R] = S + D or S - D on 4-digit BCD words; C+1 carry/borrow; C+2 Z (stored value 0).
 
-    FErr1 and nothing done when an addend is not valid BCD.
+    FErr1 and nothing done when an operand is not valid BCD (stated for ADDBCD; decided for SUBBCD
+    the same way). Z follows the stored 4 digits (5000 + 5000 stores 0000: carry 1, Z 1). The
+    manual does not say what SUBBCD stores on a negative result; decided: the 10000's complement
+    (1234 - 5555 stores 5679 with the borrow set), as a 4-digit BCD subtractor leaves it.
     """
-    gs, gd, put = word_get(mem, fon.s), word_get(mem, fon.d), word_set(mem, fon.r)
-    b, c1, c2 = mem.bits, fon.c + 1, fon.c + 2
 
-    def step(ctx: FonContext) -> None:
-        x, y = bcd_to_bin(gs()), bcd_to_bin(gd())
-        if x is None or y is None:
-            fail(ctx)
-            return
-        total = x + y
-        value = total % 10000
-        put(bin_to_bcd(value))
-        b[c1] = 1 if total > 9999 else 0
-        b[c2] = 1 if value == 0 else 0
+    def build(mem: Memory, fon: Fon) -> Step:
+        gs, gd, put = word_get(mem, fon.s), word_get(mem, fon.d), word_set(mem, fon.r)
+        b, c1, c2 = mem.bits, fon.c + 1, fon.c + 2
 
-    return step
+        def step(ctx: FonContext) -> None:
+            x, y = bcd_to_bin(gs()), bcd_to_bin(gd())
+            if x is None or y is None:
+                fail(ctx)
+                return
+            total = x - y if subtract else x + y
+            value = total % 10000
+            put(bin_to_bcd(value))
+            b[c1] = 1 if total < 0 or total > 9999 else 0
+            b[c2] = 1 if value == 0 else 0
+
+        return step
+
+    return build
 
 
-@register(11, "SUBBCD", "M", "M", "M")
-@built
-def subbcd(mem: Memory, fon: Fon) -> Step:
-    """word[R] = S - D in BCD; C+1 borrow (S < D); C+2 Z.
-
-    The manual does not say what is stored on a negative result; decided: the 10000's complement
-    (1234 - 5555 stores 5679 with the borrow set), as a 4-digit BCD subtractor leaves it. An operand
-    that is not valid BCD raises FErr1 and nothing is done, as in ADDBCD.
-    """
-    gs, gd, put = word_get(mem, fon.s), word_get(mem, fon.d), word_set(mem, fon.r)
-    b, c1, c2 = mem.bits, fon.c + 1, fon.c + 2
-
-    def step(ctx: FonContext) -> None:
-        x, y = bcd_to_bin(gs()), bcd_to_bin(gd())
-        if x is None or y is None:
-            fail(ctx)
-            return
-        value = (x - y) % 10000
-        put(bin_to_bcd(value))
-        b[c1] = 1 if x < y else 0
-        b[c2] = 1 if value == 0 else 0
-
-    return step
+register(10, "ADDBCD", "M", "M", "M")(built(_bcd_arith(subtract=False)))
+register(11, "SUBBCD", "M", "M", "M")(built(_bcd_arith(subtract=True)))
 
 
 @register(12, "CMP", "M", "M")
@@ -88,36 +73,31 @@ def cmp(mem: Memory, fon: Fon) -> Step:
     return step
 
 
-@register(36, "ROR", "M")
-@built
-def ror(mem: Memory, fon: Fon) -> Step:
-    """Rotate word[S] right: bit 15 <- input C+1; C+2 <- old bit 0; C+3 <- old bit 8."""
-    get, put = word_get(mem, fon.s), word_set(mem, fon.s)
-    b, c1, c2, c3 = mem.bits, fon.c + 1, fon.c + 2, fon.c + 3
+def _rotate(left: bool) -> Builder:
+    """Rotate word[S] by one through the input bit C+1, reporting two bits of the old word.
 
-    def step(ctx: FonContext) -> None:
-        w = get()
-        put((w >> 1) | (b[c1] << 15))
-        b[c2] = w & 1
-        b[c3] = (w >> 8) & 1
+    ROR: bit 15 <- C+1; C+2 <- old bit 0; C+3 <- old bit 8 (the table and example, not the prose).
+    ROL: bit 0 <- C+1; C+2 <- old bit 15; C+3 <- old bit 7 (the dump 0080 -> 0101, not the prose).
+    """
+    out_bit, mid_bit = (15, 7) if left else (0, 8)
 
-    return step
+    def build(mem: Memory, fon: Fon) -> Step:
+        get, put = word_get(mem, fon.s), word_set(mem, fon.s)
+        b, c1, c2, c3 = mem.bits, fon.c + 1, fon.c + 2, fon.c + 3
+
+        def step(ctx: FonContext) -> None:
+            w = get()
+            put(((w << 1) & 0xFFFF) | b[c1] if left else (w >> 1) | (b[c1] << 15))
+            b[c2] = (w >> out_bit) & 1
+            b[c3] = (w >> mid_bit) & 1
+
+        return step
+
+    return build
 
 
-@register(37, "ROL", "M")
-@built
-def rol(mem: Memory, fon: Fon) -> Step:
-    """Rotate word[S] left: bit 0 <- input C+1; C+2 <- old bit 15; C+3 <- old bit 7 (the dump wins)."""
-    get, put = word_get(mem, fon.s), word_set(mem, fon.s)
-    b, c1, c2, c3 = mem.bits, fon.c + 1, fon.c + 2, fon.c + 3
-
-    def step(ctx: FonContext) -> None:
-        w = get()
-        put(((w << 1) & 0xFFFF) | b[c1])
-        b[c2] = w >> 15
-        b[c3] = (w >> 7) & 1
-
-    return step
+register(36, "ROR", "M")(built(_rotate(left=False)))
+register(37, "ROL", "M")(built(_rotate(left=True)))
 
 
 @register(54, "SCALE", "M", "M", "O")
@@ -164,38 +144,27 @@ def math(mem: Memory, fon: Fon) -> Step:
     return fail
 
 
-@register(92, "ADD", "M", "M", "M")
-@built
-def add(mem: Memory, fon: Fon) -> Step:
-    """word[R] = S + D (16 bits); C+1 carry out of 16 bits; C+2 Z."""
-    gs, gd, put = word_get(mem, fon.s), word_get(mem, fon.d), word_set(mem, fon.r)
-    b, c1, c2 = mem.bits, fon.c + 1, fon.c + 2
+def _bin_arith(subtract: bool) -> Builder:
+    """word[R] = S + D or S - D (16 bits, wrapping); C+1 carry out of 16 bits / borrow (S < D); C+2 Z."""
 
-    def step(ctx: FonContext) -> None:
-        total = gs() + gd()
-        value = total & 0xFFFF
-        put(value)
-        b[c1] = total >> 16
-        b[c2] = 1 if value == 0 else 0
+    def build(mem: Memory, fon: Fon) -> Step:
+        gs, gd, put = word_get(mem, fon.s), word_get(mem, fon.d), word_set(mem, fon.r)
+        b, c1, c2 = mem.bits, fon.c + 1, fon.c + 2
 
-    return step
+        def step(ctx: FonContext) -> None:
+            total = gs() - gd() if subtract else gs() + gd()
+            value = total & 0xFFFF
+            put(value)
+            b[c1] = 1 if total != value else 0
+            b[c2] = 1 if value == 0 else 0
+
+        return step
+
+    return build
 
 
-@register(93, "SUB", "M", "M", "M")
-@built
-def sub(mem: Memory, fon: Fon) -> Step:
-    """word[R] = S - D (16 bits, wrapping); C+1 borrow (S < D); C+2 Z."""
-    gs, gd, put = word_get(mem, fon.s), word_get(mem, fon.d), word_set(mem, fon.r)
-    b, c1, c2 = mem.bits, fon.c + 1, fon.c + 2
-
-    def step(ctx: FonContext) -> None:
-        x, y = gs(), gd()
-        value = (x - y) & 0xFFFF
-        put(value)
-        b[c1] = 1 if x < y else 0
-        b[c2] = 1 if value == 0 else 0
-
-    return step
+register(92, "ADD", "M", "M", "M")(built(_bin_arith(subtract=False)))
+register(93, "SUB", "M", "M", "M")(built(_bin_arith(subtract=True)))
 
 
 @register(94, "MUL", "M", "M", "M")

@@ -9,6 +9,7 @@ from __future__ import annotations
 
 from netplc.address import is_valid_operand
 from netplc.functions._util import (
+    Builder,
     Step,
     block_get,
     block_set,
@@ -161,52 +162,32 @@ def mvmblk(mem: Memory, fon: Fon) -> Step:
     return step
 
 
-@register(74, "STM", "M", "M")
-@built
-def stm(mem: Memory, fon: Fon) -> Step:
-    """word[word[D]] = word[S]."""
-    get, ptr = word_get(mem, fon.s), word_get(mem, fon.d)
+def _indirect(src_pointer: bool, dst_pointer: bool) -> Builder:
+    """Word move where S and/or D hold the address to use (read from memory on every execution).
 
-    def step(ctx: FonContext) -> None:
-        d = ptr()
-        if is_valid_operand(d, 2):
-            ctx.mem.set_word(d, get())
-        else:
-            fail(ctx)
+    A computed address that is not a valid word raises FErr1 and nothing is written.
+    """
 
-    return step
+    def build(mem: Memory, fon: Fon) -> Step:
+        src, dst = word_get(mem, fon.s), word_get(mem, fon.d)
+        s, d = fon.s or 0, fon.d or 0
 
+        def step(ctx: FonContext) -> None:
+            a = src() if src_pointer else s
+            b = dst() if dst_pointer else d
+            if is_valid_operand(a, 2) and is_valid_operand(b, 2):
+                ctx.mem.set_word(b, ctx.mem.get_word(a))
+            else:
+                fail(ctx)
 
-@register(75, "LDM", "M", "M")
-@built
-def ldm(mem: Memory, fon: Fon) -> Step:
-    """word[D] = word[word[S]]."""
-    ptr, put = word_get(mem, fon.s), word_set(mem, fon.d)
+        return step
 
-    def step(ctx: FonContext) -> None:
-        s = ptr()
-        if is_valid_operand(s, 2):
-            put(ctx.mem.get_word(s))
-        else:
-            fail(ctx)
-
-    return step
+    return build
 
 
-@register(76, "MVM", "M", "M")
-@built
-def mvm(mem: Memory, fon: Fon) -> Step:
-    """word[word[D]] = word[word[S]]."""
-    src, dst = word_get(mem, fon.s), word_get(mem, fon.d)
-
-    def step(ctx: FonContext) -> None:
-        s, d = src(), dst()
-        if is_valid_operand(s, 2) and is_valid_operand(d, 2):
-            ctx.mem.set_word(d, ctx.mem.get_word(s))
-        else:
-            fail(ctx)
-
-    return step
+register(74, "STM", "M", "M")(built(_indirect(src_pointer=False, dst_pointer=True)))  # [[D]] = [S]
+register(75, "LDM", "M", "M")(built(_indirect(src_pointer=True, dst_pointer=False)))  # [D] = [[S]]
+register(76, "MVM", "M", "M")(built(_indirect(src_pointer=True, dst_pointer=True)))  # [[D]] = [[S]]
 
 
 @register(91, "SHFTBLK", "M", "M")
