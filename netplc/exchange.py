@@ -18,7 +18,7 @@ from __future__ import annotations
 import asyncio
 import time
 from collections.abc import Iterable
-from dataclasses import dataclass, field
+from dataclasses import dataclass
 from typing import TYPE_CHECKING
 
 from netplc.address import PRESENCE_LIST, PRESENCE_NODES, AddressError, check_operand
@@ -113,6 +113,8 @@ class NodeStats:
     errors: int = 0  # failed block requests
     last_error: str = ""
     changed: float = 0.0  # monotonic time of the last link-state change
+    age: int = 0  # scans from the request of the last completed read to its data in memory
+    age_max: int = 0
 
 
 @dataclass
@@ -122,7 +124,7 @@ class _Request:
     local: int = 0
     length: int = 0
     payload: bytes | None = None  # None: a read
-    issued: float = field(default_factory=time.monotonic)
+    scan: int = 0  # the scan that asked
 
 
 class _Node:
@@ -301,6 +303,7 @@ class Exchange:
             return False
         if req.key not in self._inflight:
             self._inflight.add(req.key)
+            req.scan = self.engine.scan_counter if self.engine is not None else 0
             self._thread.call(target.queue.put_nowait, req)
         return node in self._present
 
@@ -315,11 +318,13 @@ class Exchange:
             stats.reads += 1
         else:
             stats.writes += 1
-        inflight = self._inflight
+        inflight, engine = self._inflight, self.engine
 
         def apply(mem: Memory) -> None:
             inflight.discard(req.key)
             if data:
+                stats.age = engine.scan_counter - req.scan
+                stats.age_max = max(stats.age_max, stats.age)
                 mem.write(req.local, data)
 
         self.engine.post(apply)
