@@ -6,6 +6,7 @@ of today should be re-read; the widget runs the queries through `registrar.query
 
 from __future__ import annotations
 
+import datetime as dt
 from dataclasses import dataclass, field
 from typing import Any
 
@@ -44,7 +45,7 @@ class MessageJournal(Element):
     Rows: int = field(default=500, metadata=p.prop(p.integer(10, 100_000)))
     RefreshTicks: int = field(default=10, metadata=p.prop(p.integer(1, 100_000)))
 
-    day: str | None = field(default=None, init=False)  # None = today, else a "DD_MM_YYYY" table
+    day: dt.date | None = field(default=None, init=False)  # None = today (follows midnight)
     kinds: tuple[str, ...] = field(default=(), init=False)
     group: int | None = field(default=None, init=False)
     min_type: int | None = field(default=None, init=False)

@@ -1,0 +1,161 @@
+"""The base of every element widget: geometry from the model, UObject frame, and the stale mark.
+
+Widgets only draw what their model computed. The stale mark (grey wash, hatching and a "?" badge)
+is a child widget kept above everything else, so it also covers plots and input fields, and it is
+drawn identically for all element types: an operator learns it once.
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+from PySide6.QtCore import QPointF, QRectF, Qt
+from PySide6.QtGui import QBrush, QColor, QPainter, QPaintEvent, QPen, QPixmap
+from PySide6.QtWidgets import QWidget
+
+from hmi_forms.elements import Element
+from hmi_forms.widgets import theme
+
+CURSORS = {"Hand": Qt.CursorShape.PointingHandCursor, "Cross": Qt.CursorShape.CrossCursor,
+           "IBeam": Qt.CursorShape.IBeamCursor, "No": Qt.CursorShape.ForbiddenCursor}
+
+
+class Images:
+    """The pictures of one form, loaded once and shared by its widgets."""
+
+    def __init__(self, files: list[Path]) -> None:
+        self.files = files
+        self._cache: dict[Path, QPixmap] = {}
+
+    def get(self, path: Path) -> QPixmap:
+        pix = self._cache.get(path)
+        if pix is None:
+            pix = self._cache[path] = QPixmap(str(path))
+        return pix
+
+    def index(self, i: int) -> QPixmap | None:
+        return self.get(self.files[i]) if 0 <= i < len(self.files) else None
+
+
+def draw_pixmap(p: QPainter, pix: QPixmap, rect: QRectF, mode: str = "Zoom",
+                align: Qt.AlignmentFlag = Qt.AlignmentFlag.AlignCenter) -> None:
+    if pix.isNull() or rect.width() <= 0 or rect.height() <= 0:
+        return
+    w, h = pix.width(), pix.height()
+    if mode == "Stretch":
+        p.drawPixmap(rect.toRect(), pix)
+        return
+    if mode == "Zoom":
+        k = min(rect.width() / w, rect.height() / h)
+        w, h = w * k, h * k
+    x = rect.left() + (rect.width() - w) * (0 if align & Qt.AlignmentFlag.AlignLeft else
+                                            1 if align & Qt.AlignmentFlag.AlignRight else 0.5)
+    y = rect.top() + (rect.height() - h) * (0 if align & Qt.AlignmentFlag.AlignTop else
+                                            1 if align & Qt.AlignmentFlag.AlignBottom else 0.5)
+    p.drawPixmap(QRectF(x, y, w, h), pix, QRectF(0, 0, pix.width(), pix.height()))
+
+
+class StaleMark(QWidget):
+    """Covers an element while its data are stale: greyed, hatched, with a "?" badge."""
+
+    def __init__(self, parent: QWidget) -> None:
+        super().__init__(parent)
+        self.setAttribute(Qt.WidgetAttribute.WA_TransparentForMouseEvents)
+        self.setToolTip("Stale: the data source of this element is not answering; the last value is shown")
+        self.hide()
+
+    def paintEvent(self, event: QPaintEvent) -> None:
+        p = QPainter(self)
+        r = QRectF(self.rect())
+        p.fillRect(r, QColor(221, 225, 230, 150))
+        p.fillRect(r, QBrush(QColor(90, 96, 106, 110), Qt.BrushStyle.BDiagPattern))
+        p.setRenderHint(QPainter.RenderHint.Antialiasing)
+        d = max(12.0, min(22.0, min(r.width(), r.height()) * 0.35))
+        badge = QRectF(r.right() - d - 2, r.top() + 2, d, d)
+        p.setPen(QPen(QColor("#ffffff"), 1.5))
+        p.setBrush(theme.STALE)
+        p.drawEllipse(badge)
+        p.setFont(theme.sized_font(d * 0.75, bold=True))
+        p.drawText(badge, Qt.AlignmentFlag.AlignCenter, "?")
+
+
+class ElementWidget(QWidget):
+    """Draws background, frame and content; `sync` is called when the model reports a change."""
+
+    default_back: QColor | None = theme.PANEL  # None = transparent
+
+    def __init__(self, model: Element, images: Images, parent: QWidget | None = None) -> None:
+        super().__init__(parent)
+        self.model = model
+        self.images = images
+        self.setGeometry(model.x, model.y, model.w, model.h)
+        if model.Cursor in CURSORS:
+            self.setCursor(CURSORS[model.Cursor])
+        self.stale_mark = StaleMark(self)
+        self.stale_mark.setGeometry(self.rect())
+        self._stale = False
+        back = self.back_color()
+        if back is not None and back.alpha() == 255:
+            self.setAttribute(Qt.WidgetAttribute.WA_OpaquePaintEvent)
+
+    def back_color(self) -> QColor | None:
+        if self.model.BackColor is not None:
+            return QColor(*self.model.BackColor)
+        return self.default_back
+
+    def fore_color(self) -> QColor:
+        return theme.qcolor(self.model.ForeColor, theme.TEXT)
+
+    def sync(self) -> None:
+        """The model changed: show the stale mark as needed and schedule a repaint."""
+        if self.model.stale != self._stale:
+            self._stale = self.model.stale
+            self.stale_mark.setVisible(self._stale)
+            self.stale_mark.raise_()
+        self.update()
+
+    def flush(self) -> None:
+        """Bring throttled parts (plots, queries) up to date; plain painted widgets have none."""
+
+    def paintEvent(self, event: QPaintEvent) -> None:
+        p = QPainter(self)
+        try:  # a painter left active after an error would crash Qt
+            self.paint(p)
+        finally:
+            p.end()
+
+    def paint(self, p: QPainter) -> None:
+        p.setRenderHint(QPainter.RenderHint.Antialiasing)
+        r = QRectF(self.rect())
+        back = self.back_color()
+        if back is not None:
+            p.fillRect(r, back)
+        if self.model.BackgroundImage is not None:
+            draw_pixmap(p, self.images.get(self.model.BackgroundImage), r, "Zoom",
+                        theme.alignment(self.model.ImageAlign))
+        self.paint_content(p, r)
+        self.paint_border(p, r)
+
+    def paint_content(self, p: QPainter, r: QRectF) -> None:
+        """Draw the element itself inside `r`."""
+
+    def paint_border(self, p: QPainter, r: QRectF) -> None:
+        style = self.model.BorderStyle
+        if style == "FixedSingle":
+            p.setPen(QPen(theme.qcolor(self.model.ForeColor, theme.BORDER), 1))
+            p.setBrush(Qt.BrushStyle.NoBrush)
+            p.drawRect(r.adjusted(0.5, 0.5, -0.5, -0.5))
+        elif style == "Fixed3D":
+            bevel(p, r, sunken=True)
+
+
+def bevel(p: QPainter, r: QRectF, sunken: bool) -> None:
+    """A 3D edge: light top-left and dark bottom-right (swapped when sunken)."""
+    light, dark = QColor("#ffffff"), QColor("#7d848e")
+    if sunken:
+        light, dark = dark, light
+    r = r.adjusted(0.5, 0.5, -0.5, -0.5)
+    p.setPen(QPen(light, 1))
+    p.drawPolyline([QPointF(r.left(), r.bottom()), r.topLeft(), QPointF(r.right(), r.top())])
+    p.setPen(QPen(dark, 1))
+    p.drawPolyline([QPointF(r.right(), r.top()), r.bottomRight(), QPointF(r.left(), r.bottom())])

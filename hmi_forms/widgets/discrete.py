@@ -1,0 +1,103 @@
+"""Widgets of the discrete elements: an indicator, or a button when the element is Enabled.
+
+An Enabled element is drawn raised (a button) and a disabled one flat, so the operator can tell
+what a click will do before clicking. A base element without state colours gets a lamp on its
+left: its state must be visible even when TextFalse and TextTrue are empty.
+"""
+
+from __future__ import annotations
+
+from PySide6.QtCore import QRectF, Qt
+from PySide6.QtGui import QColor, QLinearGradient, QMouseEvent, QPainter, QPen
+from PySide6.QtWidgets import QWidget
+
+from hmi_forms.elements.discrete import DiscreteBase, DiscreteColorLabel
+from hmi_forms.widgets import theme
+from hmi_forms.widgets.base import ElementWidget, Images, draw_pixmap
+
+
+class DiscreteWidget(ElementWidget):
+    model: DiscreteBase
+
+    def __init__(self, model: DiscreteBase, images: Images, parent: QWidget | None = None) -> None:
+        super().__init__(model, images, parent)
+        self._pressed = False
+        has_images = model.ImageFalse >= 0 or model.ImageTrue >= 0
+        self.has_lamp = not isinstance(model, DiscreteColorLabel) and not has_images
+        if model.Enabled:
+            self.setAttribute(Qt.WidgetAttribute.WA_OpaquePaintEvent, False)
+            if model.Cursor == "Default":
+                self.setCursor(Qt.CursorShape.PointingHandCursor)
+        self.setToolTip(f"{model.Name}: {model.InAddr}" + (" (click to toggle)" if model.Enabled else ""))
+
+    def back_color(self) -> QColor | None:
+        if isinstance(self.model, DiscreteColorLabel):
+            return theme.qcolor(self.model.back_color, theme.PANEL)
+        return super().back_color()
+
+    def fore_color(self) -> QColor:
+        if isinstance(self.model, DiscreteColorLabel):
+            return theme.qcolor(self.model.fore_color, theme.TEXT)
+        return super().fore_color()
+
+    def paint(self, p: QPainter) -> None:
+        if not self.model.Enabled:
+            super().paint(p)
+            return
+        p.setRenderHint(QPainter.RenderHint.Antialiasing)
+        r = QRectF(self.rect()).adjusted(1, 1, -1, -1)
+        base = self.back_color() or theme.PANEL
+        if self._pressed:
+            top, bottom = base.darker(112), base.darker(104)
+        else:
+            top, bottom = base.lighter(108), base.darker(108)
+        grad = QLinearGradient(r.topLeft(), r.bottomLeft())
+        grad.setColorAt(0, top)
+        grad.setColorAt(1, bottom)
+        p.setPen(QPen(theme.BORDER.darker(115) if self.model.clickable else theme.BORDER, 1))
+        p.setBrush(grad)
+        p.drawRoundedRect(r, 4, 4)
+        if not self._pressed:
+            p.setPen(QPen(QColor(255, 255, 255, 160), 1))
+            p.drawLine(r.left() + 4, r.top() + 1.5, r.right() - 4, r.top() + 1.5)
+        self.paint_content(p, r.adjusted(3, 2, -3, -2).translated(0, 1 if self._pressed else 0))
+
+    def paint_content(self, p: QPainter, r: QRectF) -> None:
+        m = self.model
+        if self.has_lamp:
+            d = min(r.height() * 0.55, 18.0)
+            lamp = QRectF(r.left() + 6, r.center().y() - d / 2, d, d)
+            on = bool(m.value) and m.indicating
+            p.setPen(QPen(theme.ON.darker(140) if on else theme.BORDER, 1))
+            p.setBrush(theme.ON if on else theme.OFF.lighter(125))
+            p.drawEllipse(lamp)
+            if on:
+                p.setPen(Qt.PenStyle.NoPen)
+                p.setBrush(QColor(255, 255, 255, 110))
+                p.drawEllipse(QRectF(lamp.left() + d * 0.22, lamp.top() + d * 0.15, d * 0.35, d * 0.3))
+            r = r.adjusted(d + 12, 0, 0, 0)
+        pix = self.images.index(m.image)
+        text = m.text
+        if pix is not None:
+            box = QRectF(r.left(), r.top(), r.height(), r.height()) if text else r
+            draw_pixmap(p, pix, box.adjusted(1, 1, -1, -1), "Zoom")
+            if text:
+                r = r.adjusted(r.height() + 4, 0, 0, 0)
+        if text:
+            p.setFont(theme.qfont(m.Font, bold=m.Enabled))
+            p.setPen(self.fore_color() if m.value is not None else theme.TEXT_DIM)
+            p.drawText(r.adjusted(4, 0, -4, 0), theme.alignment(m.TextAlign) | theme.WRAP,
+                       text)
+
+    def mousePressEvent(self, event: QMouseEvent) -> None:
+        if event.button() == Qt.MouseButton.LeftButton and self.model.clickable:
+            self._pressed = True
+            self.update()
+
+    def mouseReleaseEvent(self, event: QMouseEvent) -> None:
+        if not self._pressed:
+            return
+        self._pressed = False
+        self.update()
+        if self.rect().contains(event.position().toPoint()):
+            self.model.click()

@@ -1,0 +1,124 @@
+"""A whole HMI form as one widget: element widgets placed as in the file, refreshed once per tick.
+
+The workstation calls `refresh(engine.snapshot)` from a QTimer. Every model reads the snapshot;
+only widgets whose model reports a change are scheduled for repainting, and Qt paints them all in
+one pass. Trend plots are redrawn in staggered turns (a few per tick, each about four times a
+second) so fifty plots never land in the same tick. A model that raises is reported once, marked
+stale and skipped; the rest of the form keeps running.
+"""
+
+from __future__ import annotations
+
+import time
+from pathlib import Path
+
+from PySide6.QtCore import QRectF, QSize, Qt
+from PySide6.QtGui import QColor, QPainter, QPaintEvent
+from PySide6.QtWidgets import QWidget
+
+from hmi_forms.elements import Element
+from hmi_forms.elements.analog import AnalogBase, AnalogOutput
+from hmi_forms.elements.discrete import DiscreteBase
+from hmi_forms.elements.graph import Graph
+from hmi_forms.elements.journal import MessageJournal
+from hmi_forms.elements.static import DateTime, StaticPicture, StaticText
+from hmi_forms.elements.sync import SyncGenerator
+from hmi_forms.elements.target import Target
+from hmi_forms.form import Form
+from hmi_forms.widgets.analog_output import AnalogOutputWidget
+from hmi_forms.widgets.base import ElementWidget, Images, draw_pixmap
+from hmi_forms.widgets.discrete import DiscreteWidget
+from hmi_forms.widgets.gauges import GaugeWidget
+from hmi_forms.widgets.journal import JournalWidget
+from hmi_forms.widgets.static import DateTimeWidget, StaticPictureWidget, StaticTextWidget, SyncWidget
+from hmi_forms.widgets.trend import REDRAW_INTERVAL, TrendWidget
+from netplc.memory import Snapshot
+
+
+class FormView(QWidget):
+    def __init__(self, form: Form, target: Target, *, archive_path: str | Path | None = None,
+                 user: str = "operator", started: float | None = None, parent: QWidget | None = None) -> None:
+        """`started` is the engine-clock time the station started (for DateTime's time since start)."""
+        super().__init__(parent)
+        self.form = form
+        self.setFixedSize(QSize(form.width, form.height))
+        self.setWindowTitle(form.title)
+        self.setAttribute(Qt.WidgetAttribute.WA_OpaquePaintEvent)
+        self.images = Images(form.images)
+        self.pairs: list[tuple[Element, ElementWidget]] = []
+        self.trends: list[TrendWidget] = []
+        self.errors: list[str] = []
+        self._last: Snapshot | None = None
+        archive = Path(archive_path) if archive_path is not None else None
+        for model in form.elements:
+            model.bind(target, user)
+            if isinstance(model, DateTime) and started is not None:
+                model.started = started
+            widget = self._widget(model, archive)
+            widget.setParent(self)
+            self.pairs.append((model, widget))
+            if isinstance(widget, TrendWidget):
+                self.trends.append(widget)
+        start = time.monotonic()
+        for i, w in enumerate(self.trends):  # stagger the redraw turns over one interval
+            w.next_flush = start + REDRAW_INTERVAL * i / max(len(self.trends), 1)
+
+    def _widget(self, model: Element, archive: Path | None) -> ElementWidget:
+        images = self.images
+        if isinstance(model, DiscreteBase):
+            return DiscreteWidget(model, images)
+        if isinstance(model, AnalogBase):
+            return TrendWidget(model, images) if model.Appearance == "graph" else GaugeWidget(model, images)
+        if isinstance(model, Graph):
+            return TrendWidget(model, images)
+        if isinstance(model, AnalogOutput):
+            return AnalogOutputWidget(model, images)
+        if isinstance(model, MessageJournal):
+            return JournalWidget(model, images, archive)
+        if isinstance(model, SyncGenerator):
+            return SyncWidget(model, images)
+        if isinstance(model, DateTime):
+            return DateTimeWidget(model, images)
+        if isinstance(model, StaticText):
+            return StaticTextWidget(model, images)
+        if isinstance(model, StaticPicture):
+            return StaticPictureWidget(model, images)
+        raise TypeError(f"no widget for element type {model.TYPE}")
+
+    def refresh(self, snapshot: Snapshot) -> None:
+        """Update every element from one snapshot; repaint only what changed."""
+        if snapshot is self._last:
+            return
+        self._last = snapshot
+        for model, widget in self.pairs:
+            try:
+                changed = model.update(snapshot)
+            except Exception as e:
+                self._fault(model, e)
+                changed = True
+            if changed:
+                widget.sync()
+        now = time.monotonic()
+        for trend in self.trends:
+            trend.flush_due(now)
+
+    def _fault(self, model: Element, error: Exception) -> None:
+        text = f'{self.form.path}: element "{model.Name}": update failed: {error!r}'
+        if text not in self.errors:
+            self.errors.append(text)
+        model.stale = True
+
+    def flush(self) -> None:
+        """Bring every throttled part up to date (before a screenshot)."""
+        for _, widget in self.pairs:
+            widget.flush()
+
+    def save_png(self, path: str | Path) -> bool:
+        self.flush()
+        return self.grab().save(str(path))
+
+    def paintEvent(self, event: QPaintEvent) -> None:
+        p = QPainter(self)
+        p.fillRect(event.rect(), QColor(*self.form.BackColor))
+        if self.form.BackgroundImage is not None:
+            draw_pixmap(p, self.images.get(self.form.BackgroundImage), QRectF(self.rect()), "Stretch")

@@ -1,0 +1,312 @@
+"""AnalogBase gauges painted with QPainter: digital readout, horizontal bar, dial and semicircular dial.
+
+The scale (face, zone bands, ticks, labels, name) does not change while the form runs, so it is
+painted once per size into a pixmap; a tick then only draws the pointer and the readout. That
+keeps a form of a hundred dials well inside the update budget. Sizes of text and strokes follow
+the element's size, so a gauge stays legible from a 90-pixel tile to a full panel.
+"""
+
+from __future__ import annotations
+
+import math
+
+from PySide6.QtCore import QPointF, QRectF, Qt
+from PySide6.QtGui import QColor, QMouseEvent, QPainter, QPainterPath, QPen, QPixmap, QPolygonF
+from PySide6.QtWidgets import QWidget
+
+from hmi_forms.elements.analog import AnalogBase
+from hmi_forms.widgets import theme
+from hmi_forms.widgets.base import ElementWidget, Images
+
+
+def nice_step(span: float, max_ticks: int) -> float:
+    raw = abs(span) / max(max_ticks, 1)
+    mag = 10 ** math.floor(math.log10(raw)) if raw > 0 else 1.0
+    for m in (1, 2, 2.5, 5, 10):
+        if m * mag >= raw * 0.999:
+            return m * mag
+    return 10 * mag
+
+
+def scale_ticks(lo: float, hi: float, max_major: int) -> tuple[list[float], list[float], int]:
+    """Major and minor tick values in lo..hi, and the decimals their labels need."""
+    step = nice_step(hi - lo, max_major)
+    minor = step / (4 if str(step / 10 ** math.floor(math.log10(step)))[0] == "2" else 5)
+    first = math.ceil(lo / step - 1e-9) * step
+    majors = [first + i * step for i in range(int((hi - first) / step + 1e-9) + 1)]
+    first_minor = math.ceil(lo / minor - 1e-9) * minor
+    minors = [first_minor + i * minor for i in range(int((hi - first_minor) / minor + 1e-9) + 1)]
+    decimals = max(0, -math.floor(math.log10(step) + 1e-9)) if step < 1 else 0
+    if step == 2.5 * 10 ** math.floor(math.log10(step)) and step < 10:
+        decimals += 1
+    return majors, minors, decimals
+
+
+class GaugeWidget(ElementWidget):
+    """AnalogBase with Appearance digital, hbar, dial or semidial."""
+
+    model: AnalogBase
+
+    def __init__(self, model: AnalogBase, images: Images, parent: QWidget | None = None) -> None:
+        super().__init__(model, images, parent)
+        self._static: QPixmap | None = None
+        units = f" {model.Units}" if model.Units else ""
+        lo, hi = model.scaling.phy_range
+        self.setToolTip(f"{model.Name}: word {oct(model.InAddr or 0)[2:].rjust(5, '0')}, "
+                        f"{model.format(lo)} … {model.format(hi)}{units}"
+                        + ("; double-click resets the maximum" if model.KeepMaxValue else ""))
+
+    # --- geometry shared by the static layer and the pointer ----------------------------------
+
+    def _name_height(self) -> float:
+        return max(11.0, min(18.0, self.height() * 0.11)) if self.model.Name else 0.0
+
+    def _dial_geometry(self) -> tuple[QPointF, float, float, float]:
+        """Centre, radius, start angle and sweep (degrees, counter-clockwise from 3 o'clock)."""
+        w, h = self.width(), self.height()
+        top = self._name_height() + 4
+        if self.model.Appearance == "semidial":
+            readout = max(14.0, h * 0.16)
+            r = max(10.0, min(w / 2 - 8, h - top - readout - 8))
+            return QPointF(w / 2, top + r + 2), r, 180.0, -180.0
+        r = max(10.0, min(w, h - top) / 2 - 4)
+        return QPointF(w / 2, top + (h - top) / 2), r, 225.0, -270.0
+
+    @staticmethod
+    def _at(c: QPointF, r: float, deg: float) -> QPointF:
+        a = math.radians(deg)
+        return QPointF(c.x() + r * math.cos(a), c.y() - r * math.sin(a))
+
+    def _bar_geometry(self) -> QRectF:
+        h = self.height()
+        top = max(self._name_height(), h * 0.28) + 6
+        track_h = max(6.0, min(22.0, (h - top) * 0.35))
+        inset = max(14.0, min(24.0, self.height() * 0.2))  # room for the end labels
+        return QRectF(inset, top, self.width() - 2 * inset, track_h)
+
+    # --- painting ------------------------------------------------------------------------------
+
+    def resizeEvent(self, event) -> None:
+        self._static = None
+        super().resizeEvent(event)
+
+    def paint_content(self, p: QPainter, r: QRectF) -> None:
+        if self.model.Appearance == "digital":
+            self._paint_digital(p, r)
+            return
+        if self._static is None or self._static.size() != self.size() * self.devicePixelRatioF():
+            self._static = self._render_static()
+        p.drawPixmap(0, 0, self._static)
+        if self.model.Appearance == "hbar":
+            self._paint_bar_value(p)
+        else:
+            self._paint_needle(p)
+
+    def _render_static(self) -> QPixmap:
+        dpr = self.devicePixelRatioF()
+        pix = QPixmap(self.size() * dpr)
+        pix.setDevicePixelRatio(dpr)
+        pix.fill(Qt.GlobalColor.transparent)
+        p = QPainter(pix)
+        try:  # a painter left open on a pixmap crashes Qt when the pixmap goes
+            p.setRenderHint(QPainter.RenderHint.Antialiasing)
+            p.setRenderHint(QPainter.RenderHint.TextAntialiasing)
+            self._paint_name(p)
+            if self.model.Appearance == "hbar":
+                self._paint_bar_scale(p)
+            else:
+                self._paint_dial_scale(p)
+        finally:
+            p.end()
+        return pix
+
+    def _paint_name(self, p: QPainter) -> None:
+        nh = self._name_height()
+        if not nh:
+            return
+        p.setFont(theme.sized_font(nh * 0.78, bold=True))
+        p.setPen(theme.TEXT_DIM)
+        align = theme.LEFT if self.model.Appearance == "hbar" else Qt.AlignmentFlag.AlignCenter
+        p.drawText(QRectF(6, 2, self.width() - 12, nh + 2), align,
+                   self.model.Name)
+
+    def _zones(self) -> list[tuple[float, float, QColor]]:
+        m = self.model
+        lo, hi = m.scaling.PhyMin, m.scaling.PhyMax
+        zones = []
+        if m.PhyLow is not None:
+            zones.append((m.scaling.fraction(lo), m.scaling.fraction(m.PhyLow), theme.WARN))
+        if m.PhyHigh is not None:
+            zones.append((m.scaling.fraction(m.PhyHigh), m.scaling.fraction(hi), theme.ALARM))
+        return [(min(a, b), max(a, b), c) for a, b, c in zones]
+
+    def _paint_dial_scale(self, p: QPainter) -> None:
+        m = self.model
+        c, r, start, sweep = self._dial_geometry()
+        face = QRectF(c.x() - r, c.y() - r, 2 * r, 2 * r)
+        p.setPen(QPen(theme.BORDER, max(1.0, r * 0.02)))
+        p.setBrush(QColor("#fbfbfc"))
+        if sweep == -180.0:
+            path = QPainterPath()
+            path.moveTo(c.x() - r, c.y() + r * 0.06)
+            path.arcTo(face, 180, -180)
+            path.lineTo(c.x() + r, c.y() + r * 0.06)
+            path.closeSubpath()
+            p.drawPath(path)
+        else:
+            p.drawEllipse(face)
+        band = r * 0.07
+        for f0, f1, color in self._zones():
+            rr = r * 0.925
+            p.setPen(QPen(color, band, Qt.PenStyle.SolidLine, Qt.PenCapStyle.FlatCap))
+            p.setBrush(Qt.BrushStyle.NoBrush)
+            p.drawArc(QRectF(c.x() - rr, c.y() - rr, 2 * rr, 2 * rr), round((start + sweep * f0) * 16),
+                      round(sweep * (f1 - f0) * 16))
+        lo, hi = m.scaling.phy_range
+        max_major = 4 if r < 45 else 6 if r < 90 else 10
+        if sweep != -270.0:
+            max_major = max(3, max_major - 1)
+        majors, minors, decimals = scale_ticks(lo, hi, max_major)
+        p.setPen(QPen(theme.TEXT, max(1.0, r * 0.012)))
+        for v in minors:
+            a = start + sweep * m.scaling.fraction(v)
+            p.drawLine(self._at(c, r * 0.88, a), self._at(c, r * 0.81, a))
+        p.setPen(QPen(theme.TEXT, max(1.3, r * 0.025), Qt.PenStyle.SolidLine, Qt.PenCapStyle.FlatCap))
+        font = theme.sized_font(max(8.0, r * 0.14))
+        p.setFont(font)
+        for v in majors:
+            a = start + sweep * m.scaling.fraction(v)
+            p.drawLine(self._at(c, r * 0.88, a), self._at(c, r * 0.74, a))
+            label_at = self._at(c, r * 0.58, a)
+            box = QRectF(label_at.x() - r * 0.3, label_at.y() - r * 0.1, r * 0.6, r * 0.2)
+            p.drawText(box, Qt.AlignmentFlag.AlignCenter, f"{v:.{decimals}f}")
+        if m.Units:
+            p.setPen(theme.TEXT_DIM)
+            p.setFont(theme.sized_font(max(8.0, r * 0.13)))
+            uy = c.y() + r * 0.25 if sweep == -270.0 else c.y() - r * 0.3
+            p.drawText(QRectF(c.x() - r * 0.5, uy - r * 0.09, r, r * 0.18), Qt.AlignmentFlag.AlignCenter,
+                       m.Units)
+
+    def _readout(self, p: QPainter, box: QRectF, size: float) -> None:
+        """The value in a sunken box; coloured when the value is outside PhyLow..PhyHigh."""
+        m = self.model
+        zone_color = theme.ZONE_COLORS.get(m.zone or "")
+        p.setPen(QPen(theme.BORDER, 1))
+        p.setBrush(zone_color if zone_color is not None else QColor("#ffffff"))
+        p.drawRoundedRect(box, 3, 3)
+        p.setFont(theme.sized_font(size, bold=True, family=theme.MONO))
+        p.setPen(QColor("#ffffff") if zone_color == theme.ALARM else theme.TEXT)
+        p.drawText(box, Qt.AlignmentFlag.AlignCenter, m.text or "---")
+
+    def _paint_needle(self, p: QPainter) -> None:
+        m = self.model
+        c, r, start, sweep = self._dial_geometry()
+        if m.maximum is not None:
+            a = start + sweep * m.scaling.fraction(m.maximum)
+            tip, left, right = self._at(c, r * 0.9, a), self._at(c, r, a + 4), self._at(c, r, a - 4)
+            p.setPen(Qt.PenStyle.NoPen)
+            p.setBrush(theme.ALARM)
+            p.drawPolygon(QPolygonF([tip, left, right]))
+        size = max(9.0, r * 0.2)
+        if sweep == -270.0:
+            box = QRectF(c.x() - r * 0.45, c.y() + r * 0.42, r * 0.9, size * 1.5)
+        else:  # below the centre, in the strip the layout keeps free
+            top = c.y() + max(6.0, r * 0.1)
+            height = min(size * 1.5, self.height() - top - 4)
+            size = height / 1.5
+            box = QRectF(c.x() - r * 0.45, top, r * 0.9, height)
+        self._readout(p, box, size)
+        if m.hw is None:
+            return
+        a = start + sweep * m.fraction
+        tip, tail = self._at(c, r * 0.8, a), self._at(c, r * 0.12, a + 180)
+        side1, side2 = self._at(c, r * 0.045, a + 90), self._at(c, r * 0.045, a - 90)
+        p.setPen(QPen(theme.ACCENT.darker(130), 1))
+        p.setBrush(theme.ACCENT)
+        p.drawPolygon(QPolygonF([tip, side1, tail, side2]))
+        p.setBrush(QColor("#33393f"))
+        hub = r * 0.07
+        p.drawEllipse(c, hub, hub)
+
+    def _paint_bar_scale(self, p: QPainter) -> None:
+        m = self.model
+        track = self._bar_geometry()
+        p.setPen(QPen(theme.BORDER, 1))
+        p.setBrush(QColor("#ffffff"))
+        p.drawRect(track)
+        for f0, f1, color in self._zones():
+            x0, x1 = track.left() + f0 * track.width(), track.left() + f1 * track.width()
+            p.fillRect(QRectF(x0, track.bottom() + 1, x1 - x0, 3), color)
+        lo, hi = m.scaling.phy_range
+        majors, minors, decimals = scale_ticks(lo, hi, max(2, int(track.width() / 55)))
+        y = track.bottom() + 4
+        tick_len = max(4.0, min(8.0, self.height() * 0.08))
+        p.setPen(QPen(theme.TEXT, 1))
+        for v in minors:
+            x = track.left() + m.scaling.fraction(v) * track.width()
+            p.drawLine(QPointF(x, y), QPointF(x, y + tick_len * 0.55))
+        font_px = max(8.0, min(14.0, self.height() * 0.16))
+        p.setFont(theme.sized_font(font_px))
+        for v in majors:
+            x = track.left() + m.scaling.fraction(v) * track.width()
+            p.drawLine(QPointF(x, y), QPointF(x, y + tick_len))
+            p.drawText(QRectF(x - 30, y + tick_len, 60, font_px * 1.4), Qt.AlignmentFlag.AlignHCenter,
+                       f"{v:.{decimals}f}")
+
+    def _paint_bar_value(self, p: QPainter) -> None:
+        m = self.model
+        track = self._bar_geometry()
+        if m.hw is not None:
+            f = m.fraction
+            zone_color = theme.ZONE_COLORS.get(m.zone or "")
+            p.fillRect(QRectF(track.left() + 1, track.top() + 1, (track.width() - 1) * f, track.height() - 1),
+                       zone_color or theme.ACCENT)
+        if m.maximum is not None:
+            x = track.left() + m.scaling.fraction(m.maximum) * track.width()
+            p.setPen(QPen(theme.ALARM, 2))
+            p.drawLine(QPointF(x, track.top() - 3), QPointF(x, track.bottom()))
+        nh = max(self._name_height(), self.height() * 0.28)
+        size = max(10.0, nh * 0.8)
+        units = f" {m.Units}" if m.Units else ""
+        p.setFont(theme.sized_font(size, bold=True, family=theme.MONO))
+        zone_color = theme.ZONE_COLORS.get(m.zone or "")
+        p.setPen(zone_color.darker(115) if zone_color is not None else theme.TEXT)
+        p.drawText(QRectF(6, 2, self.width() - 12, nh + 2), theme.RIGHT,
+                   (m.text or "---") + units)
+
+    def _paint_digital(self, p: QPainter, r: QRectF) -> None:
+        m = self.model
+        nh = self._name_height() if r.height() >= 40 else 0.0
+        if nh:
+            p.setFont(theme.sized_font(nh * 0.78, bold=True))
+            p.setPen(theme.TEXT_DIM)
+            p.drawText(QRectF(6, 2, r.width() - 12, nh + 2), theme.LEFT,
+                       m.Name)
+        box = QRectF(4, nh + 4, r.width() - 8, r.height() - nh - 8)
+        zone_color = theme.ZONE_COLORS.get(m.zone or "")
+        p.setPen(QPen(theme.BORDER, 1))
+        p.setBrush(zone_color if zone_color is not None else QColor("#ffffff"))
+        p.drawRoundedRect(box, 3, 3)
+        fg = QColor("#ffffff") if zone_color == theme.ALARM else theme.TEXT
+        size = max(9.0, min(box.height() * 0.62, box.width() / max(4, len(m.text or "---") + 2) * 1.5))
+        units_w = 0.0
+        if m.Units:
+            p.setFont(theme.sized_font(size * 0.55))
+            units_w = p.fontMetrics().horizontalAdvance(m.Units) + 8
+            p.setPen(fg if zone_color is not None else theme.TEXT_DIM)
+            p.drawText(box.adjusted(0, 0, -6, -box.height() * 0.12),
+                       int(Qt.AlignmentFlag.AlignRight | Qt.AlignmentFlag.AlignBottom), m.Units)
+        p.setFont(theme.sized_font(size, bold=True, family=theme.MONO))
+        p.setPen(fg)
+        p.drawText(box.adjusted(6, 0, -6 - units_w, 0), theme.RIGHT,
+                   m.text or "---")
+        if m.maximum is not None and box.height() > 30:
+            p.setFont(theme.sized_font(max(8.0, size * 0.38)))
+            p.setPen(fg if zone_color is not None else theme.ALARM)
+            p.drawText(box.adjusted(6, 2, 0, 0), int(Qt.AlignmentFlag.AlignLeft | Qt.AlignmentFlag.AlignTop),
+                       f"max {m.format(m.maximum)}")
+
+    def mouseDoubleClickEvent(self, event: QMouseEvent) -> None:
+        if self.model.KeepMaxValue:
+            self.model.reset_max()
+            self.update()
