@@ -67,6 +67,9 @@ def data_unchanged(engine: Engine, before: bytes) -> bool:
         ("N:NSYNC S:0 D:0", {}),
         ("N:PID S:1 D:5", {}),  # formula above 4
         ("N:ERCODE S:$04000 D:$02000", {0o4000: 3}),  # indicator must be an external bit
+        ("N:NMOVW S:$07700 D:$04000 R:100", {}),  # 200 bytes run past the end of bank 0
+        ("N:NMOVB S:$04000 D:$03770 R:2", {}),  # 16 bits from 03770 run past bit 03777
+        ("N:NAVG S:$04000 D:$07776", {0o4000: 7}),  # the count word D+2 is outside the bank
     ],
 )
 def test_error_sets_ferr1_and_writes_nothing(fon: str, words: dict[int, int]) -> None:
@@ -78,6 +81,13 @@ def test_error_sets_ferr1_and_writes_nothing(fon: str, words: dict[int, int]) ->
     assert e.mem.bits[FERR1] == 1
     assert data_unchanged(e, before)
     assert not any(e.mem.bits[C + 1 : C + 4])
+
+
+def test_nstore_of_an_invalid_word_sets_ferr1_and_records_nothing() -> None:
+    e = engine_for("N:NSTORE S:$07777 D:1 R:0")
+    scan(e)
+    assert e.mem.bits[FERR1] == 1
+    assert e.sink.records == []  # type: ignore[attr-defined]
 
 
 def test_ferr1_is_sticky_until_the_program_clears_it() -> None:
