@@ -28,7 +28,7 @@ from netplc.modbus_driver import (
     Endpoint,
     LinkError,
     LoopThread,
-    ModbusClient,
+    open_client,
     parse_endpoint,
 )
 from netplc.modbus_map import PROFILES, TABLES, WRITABLE_TABLES, Block, MapError, describe, locate
@@ -134,7 +134,7 @@ class _Node:
         self.config = config
         self.exchange = exchange
         self.stats = stats
-        self.client = ModbusClient(config.parsed, config.unit, config.timeout)
+        self.client = open_client(config.parsed, config.unit, config.timeout, exchange.lean)
         self.queue: asyncio.Queue[_Request] = asyncio.Queue()
         self.delay = config.backoff
         self.retry_at = 0.0  # monotonic time before which requests fail without trying
@@ -226,7 +226,8 @@ class _Node:
 class Exchange:
     """Implements `NetLink` for the engine: block requests to configured nodes over Modbus."""
 
-    def __init__(self, nodes: list[NodeConfig], sink: RecordSink | None = None) -> None:
+    def __init__(self, nodes: list[NodeConfig], sink: RecordSink | None = None, *, lean: bool = True) -> None:
+        self.lean = lean  # our lean Modbus TCP client; False: pymodbus's (bench/exchange.py compares)
         self.configs: dict[int, NodeConfig] = {}
         for cfg in nodes:
             if cfg.node in self.configs:

@@ -117,11 +117,39 @@ def parse_endpoint(text: str) -> Endpoint:
     raise ValueError(f"endpoint {text!r}: unknown scheme {url.scheme!r} ({forms})")
 
 
-# --- client --------------------------------------------------------------------------------------
+# --- clients -------------------------------------------------------------------------------------
+
+_MBAP = struct.Struct(">HHHB")  # Modbus TCP header: transaction, protocol 0, length, unit
+_READ_CODES: dict[str, int] = {"coils": 1, "discrete": 2, "holding": 3, "input": 4}
 
 
-class ModbusClient:
-    """One node's connection through pymodbus: connect, read and write a table, close."""
+class ModbusClient(Protocol):
+    """One node's connection: connect, read and write a table, close."""
+
+    endpoint: Endpoint
+
+    @property
+    def connected(self) -> bool: ...
+
+    async def connect(self) -> None: ...
+
+    def close(self) -> None: ...
+
+    async def read(self, table: Table, address: int, count: int) -> list[int]: ...
+
+    async def write(self, table: Table, address: int, values: list[int]) -> None: ...
+
+
+def open_client(endpoint: Endpoint, unit: int, timeout: float, lean: bool = True) -> ModbusClient:
+    """The client for a node: serial RTU through pymodbus's serial framer; TCP through our lean
+    client (`lean=False`: pymodbus's, which bench/exchange.py compares it with)."""
+    if endpoint.scheme == "tcp" and lean:
+        return LeanTcpClient(endpoint, unit, timeout)
+    return PymodbusClient(endpoint, unit, timeout)
+
+
+class PymodbusClient:
+    """A node's connection through pymodbus (TCP or RTU)."""
 
     def __init__(self, endpoint: Endpoint, unit: int, timeout: float) -> None:
         self.endpoint = endpoint
@@ -197,6 +225,120 @@ class ModbusClient:
             raise MapError(f"{table} is a read-only table")
 
 
+class _Answers(asyncio.Protocol):
+    """Collects Modbus TCP answers on a client connection and hands the awaited one over."""
+
+    def __init__(self) -> None:
+        self.buf = bytearray()
+        self.transport: asyncio.Transport | None = None
+        self.waiter: asyncio.Future[bytes] | None = None
+        self.tid = 0  # the transaction awaited; late answers to abandoned ones are dropped
+
+    def connection_made(self, transport: asyncio.BaseTransport) -> None:
+        assert isinstance(transport, asyncio.Transport)
+        self.transport = transport
+
+    def data_received(self, data: bytes) -> None:
+        buf = self.buf
+        buf += data
+        while len(buf) >= 8:
+            tid, proto, length, _ = _MBAP.unpack_from(buf)
+            if proto != 0 or length < 2:  # not Modbus TCP: the next request reconnects
+                assert self.transport is not None
+                self.transport.abort()
+                return
+            if len(buf) < 6 + length:
+                return
+            pdu = bytes(buf[7 : 6 + length])
+            del buf[: 6 + length]
+            waiter = self.waiter
+            if tid == self.tid and waiter is not None and not waiter.done():
+                waiter.set_result(pdu)
+
+    def connection_lost(self, exc: Exception | None) -> None:
+        self.transport = None
+        waiter = self.waiter
+        if waiter is not None and not waiter.done():
+            waiter.set_exception(LinkError(f"connection lost{f': {exc}' if exc else ''}"))
+
+
+class LeanTcpClient:
+    """A Modbus TCP client of our own for the exchange's hot path: one request at a time per
+    connection, an MBAP frame in and out, no per-request objects beyond the bytes. pymodbus's
+    client spends most of NetPlc's CPU at a few thousand block reads per second (bench/exchange.py
+    shows both); this one also fails a request the moment its connection drops."""
+
+    def __init__(self, endpoint: Endpoint, unit: int, timeout: float) -> None:
+        self.endpoint = endpoint
+        self.unit = unit
+        self.timeout = timeout
+        self._proto: _Answers | None = None
+        self._tid = 0
+
+    @property
+    def connected(self) -> bool:
+        return self._proto is not None and self._proto.transport is not None
+
+    async def connect(self) -> None:
+        self.close()
+        loop = asyncio.get_running_loop()
+        try:
+            _, proto = await asyncio.wait_for(
+                loop.create_connection(_Answers, self.endpoint.host, self.endpoint.port), self.timeout)
+        except (OSError, TimeoutError) as e:
+            raise LinkError(f"cannot connect to {self.endpoint}: {e or 'timed out'}") from None
+        self._proto = proto
+
+    def close(self) -> None:
+        proto, self._proto = self._proto, None
+        if proto is not None and proto.transport is not None:
+            proto.transport.abort()
+
+    async def _transact(self, pdu: bytes, what: str) -> bytes:
+        proto = self._proto
+        if proto is None or proto.transport is None:
+            raise LinkError(f"{what}: not connected to {self.endpoint}")
+        self._tid = tid = self._tid % 0xFFFF + 1
+        waiter = asyncio.get_running_loop().create_future()
+        proto.tid, proto.waiter = tid, waiter
+        proto.transport.write(_MBAP.pack(tid, 0, len(pdu) + 1, self.unit) + pdu)
+        try:
+            reply = await asyncio.wait_for(waiter, self.timeout)
+        except TimeoutError:
+            raise LinkError(f"{what}: no answer within {self.timeout:g} s") from None
+        finally:
+            proto.waiter = None
+        if reply[0] == pdu[0] | 0x80 and len(reply) == 2:
+            raise DeviceError(reply[1], what)
+        if reply[0] != pdu[0]:
+            raise LinkError(f"{what}: answer with function {reply[0]}")
+        return reply
+
+    async def read(self, table: Table, address: int, count: int) -> list[int]:
+        what = f"read {table} {address}+{count}"
+        fc = _READ_CODES[table]
+        reply = await self._transact(struct.pack(">BHH", fc, address, count), what)
+        data = reply[2:]
+        if table in BIT_TABLES:
+            if len(data) != reply[1] or len(data) != (count + 7) // 8:
+                raise LinkError(f"{what}: {len(data)} bytes of coils in the answer")
+            return bits_from_bytes(data)[:count]
+        if len(data) != reply[1] or len(data) != 2 * count:
+            raise LinkError(f"{what}: {len(data) // 2} registers in the answer")
+        return list(struct.unpack(f">{count}H", data))
+
+    async def write(self, table: Table, address: int, values: list[int]) -> None:
+        what = f"write {table} {address}+{len(values)}"
+        n = len(values)
+        if table == "coils":
+            data = bytes_from_bits(values)
+            await self._transact(struct.pack(">BHHB", 15, address, n, len(data)) + data, what)
+        elif table == "holding":
+            await self._transact(struct.pack(f">BHHB{n}H", 16, address, n, 2 * n, *values), what)
+        else:
+            raise MapError(f"{table} is a read-only table")
+
+
 # --- server --------------------------------------------------------------------------------------
 
 
@@ -209,7 +351,6 @@ class ServeHandler(Protocol):
 
 
 _READ_TABLES: dict[int, Table] = {1: "coils", 2: "discrete", 3: "holding", 4: "input"}
-_MBAP = struct.Struct(">HHHB")
 
 
 class _Refuse(Exception):
