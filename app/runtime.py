@@ -107,7 +107,8 @@ class Runtime:
         self.modbus: ModbusServer | None = None
         self.scan_thread: ScanThread | None = None
         self.nodes: list[NodeSettings] = list(station.nodes)
-        self.restored = ""  # which retentive save was used: current / previous / zeroes
+        self.restored = ""
+        self.started_clock: float | None = None  # which retentive save was used: current / previous / zeroes
         self._observers: list[RecordObserver] = []
         self._problems: list[str] = []
         self._lock = threading.Lock()
@@ -180,6 +181,7 @@ class Runtime:
         st = self.station
         self.system(f"station starting: {st.path}")
         self.engine = Engine(self.program, sink=self, tick=st.tick, wallclock=self.wallclock)
+        self.started_clock = self.engine.now  # engine-clock time of the start (DateTime elements)
         if not st.NetPlcLoad:
             self.engine.stop()
         self.retainer = Retainer(st.Retain, self.engine, self)

@@ -1,0 +1,122 @@
+"""The alarm banner: unacknowledged messages of type >= 2 (alarm, critical), newest first.
+
+An alarm stays on the banner until an operator acknowledges it, even after its condition has
+gone, because the operator must know it happened. Acknowledging is journaled with the user's name
+by the runtime; the banner only collects and shows.
+"""
+
+from __future__ import annotations
+
+import time
+from dataclasses import dataclass
+
+from PySide6.QtCore import Qt, QTimer, Signal
+from PySide6.QtWidgets import QFrame, QHBoxLayout, QLabel, QPushButton, QWidget
+
+from netplc.records import Record
+
+ALARM_TYPE = 2  # DESIGN section 8: 0 info, 1 warning, 2 alarm, 3 critical
+TYPE_NAMES = {0: "info", 1: "warning", 2: "ALARM", 3: "CRITICAL"}
+
+
+@dataclass(frozen=True)
+class Alarm:
+    record: Record
+    text: str
+
+
+class AlarmBanner(QFrame):
+    """A red strip with the newest unacknowledged alarm, the count, and Acknowledge / Acknowledge all."""
+
+    acknowledged = Signal(object)  # Alarm
+
+    def __init__(self, parent: QWidget | None = None) -> None:
+        super().__init__(parent)
+        self.setObjectName("alarmBanner")
+        self.alarms: list[Alarm] = []
+        self._blink = False
+        lay = QHBoxLayout(self)
+        lay.setContentsMargins(12, 6, 8, 6)
+        self.icon = QLabel("\u26a0")
+        self.icon.setObjectName("alarmIcon")
+        self.text = QLabel()
+        self.text.setObjectName("alarmText")
+        self.count = QLabel()
+        self.count.setObjectName("alarmCount")
+        self.ack = QPushButton("Acknowledge")
+        self.ack.setObjectName("alarmAck")
+        self.ack_all = QPushButton("Acknowledge all")
+        self.ack_all.setObjectName("alarmAck")
+        lay.addWidget(self.icon)
+        lay.addWidget(self.text, 1)
+        lay.addWidget(self.count)
+        lay.addWidget(self.ack)
+        lay.addWidget(self.ack_all)
+        self.ack.clicked.connect(self.acknowledge_newest)
+        self.ack_all.clicked.connect(self.acknowledge_all)
+        self._timer = QTimer(self)
+        self._timer.setInterval(500)
+        self._timer.timeout.connect(self._toggle_blink)
+        self._show()
+
+    def add(self, record: Record, text: str) -> None:
+        if record.kind != "message" or (record.type or 0) < ALARM_TYPE:
+            return
+        self.alarms.insert(0, Alarm(record, text))
+        self._show()
+
+    def acknowledge_newest(self) -> None:
+        if self.alarms:
+            self.acknowledged.emit(self.alarms.pop(0))
+            self._show()
+
+    def acknowledge_all(self) -> None:
+        while self.alarms:
+            self.acknowledged.emit(self.alarms.pop(0))
+        self._show()
+
+    def _show(self) -> None:
+        if not self.alarms:
+            self.setVisible(False)
+            self._timer.stop()
+            return
+        newest = self.alarms[0]
+        when = time.strftime("%H:%M:%S", time.localtime(newest.record.ts))
+        kind = TYPE_NAMES.get(newest.record.type or 0, "ALARM")
+        self.text.setText(f"{when}   {kind}   {newest.text}")
+        self.count.setText(f"{len(self.alarms)} unacknowledged" if len(self.alarms) > 1 else "")
+        self.ack_all.setVisible(len(self.alarms) > 1)
+        self.setVisible(True)
+        if not self._timer.isActive():
+            self._timer.start()
+
+    def _toggle_blink(self) -> None:
+        self._blink = not self._blink
+        self.setProperty("blink", self._blink)
+        self.style().unpolish(self)
+        self.style().polish(self)
+
+    def sizeHint(self):
+        hint = super().sizeHint()
+        hint.setHeight(max(hint.height(), 40))
+        return hint
+
+
+class HealthStrip(QFrame):
+    """A yellow strip listing what is wrong with the station itself: program stopped, node down,
+    archive failing. Shown only while something is wrong."""
+
+    def __init__(self, parent: QWidget | None = None) -> None:
+        super().__init__(parent)
+        self.setObjectName("healthStrip")
+        lay = QHBoxLayout(self)
+        lay.setContentsMargins(12, 4, 12, 4)
+        self.label = QLabel()
+        self.label.setObjectName("healthText")
+        self.label.setTextInteractionFlags(Qt.TextInteractionFlag.TextSelectableByMouse)
+        lay.addWidget(self.label, 1)
+        self.setVisible(False)
+
+    def show_problems(self, problems: list[str]) -> None:
+        self.label.setText("   \u2022   ".join(problems))
+        self.setVisible(bool(problems))

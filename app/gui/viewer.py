@@ -1,0 +1,361 @@
+"""The offline journal viewer: an archive opened read-only, without a running station.
+
+It needs only the archive file (the message texts are stored in it), so an archive copied from a
+plant PC opens on any machine. Records are paged from SQLite rather than loaded whole, so a day
+of a million records opens as fast as a day of ten.
+"""
+
+from __future__ import annotations
+
+import datetime as dt
+import sqlite3
+import sys
+from pathlib import Path
+
+import numpy as np
+import pyqtgraph as pg
+from PySide6.QtCore import Qt
+from PySide6.QtGui import QAction, QColor, QKeySequence
+from PySide6.QtWidgets import (
+    QApplication,
+    QComboBox,
+    QFileDialog,
+    QFormLayout,
+    QHBoxLayout,
+    QLabel,
+    QLineEdit,
+    QListWidget,
+    QListWidgetItem,
+    QMainWindow,
+    QMessageBox,
+    QPushButton,
+    QSpinBox,
+    QSplitter,
+    QTabWidget,
+    QTimeEdit,
+    QVBoxLayout,
+    QWidget,
+)
+
+from app.config import ConfigError, load_station, station_file
+from app.gui.journal import make_table
+from app.gui.records import RecordsModel
+from app.gui.style import apply_style
+from registrar.query import Archive, Filter, SeriesKey
+
+PAGE = 500
+SERIES_POINTS = 4000
+KINDS = ("all", "data", "message", "operator", "system")
+TYPES = ("any", "0 info", "1 warning", "2 alarm", "3 critical")
+PALETTE = ("#1f77b4", "#d62728", "#2ca02c", "#ff7f0e", "#9467bd", "#17becf", "#8c564b", "#e377c2")
+
+
+def series_label(key: SeriesKey) -> str:
+    parts = [f"group {key.grp}" if key.grp is not None else "",
+             f"type {key.type}" if key.type is not None else "", key.source or ""]
+    return " / ".join(p for p in parts if p) or key.kind
+
+
+class ViewerWindow(QMainWindow):
+    def __init__(self, archive_path: Path | None = None, parent: QWidget | None = None) -> None:
+        super().__init__(parent)
+        self.setWindowTitle("NetPlc Station — journal viewer")
+        self.archive: Archive | None = None
+        self.archive_path: Path | None = None
+        self.offset = 0
+        self.total = 0
+        self.curves: dict[SeriesKey, pg.PlotDataItem] = {}
+        self._build()
+        self.resize(1280, 820)
+        if archive_path is not None:
+            self.open_archive(archive_path)
+
+    # --- building ------------------------------------------------------------------------------
+
+    def _build(self) -> None:
+        menu = self.menuBar().addMenu("&Archive")
+        open_ = QAction("&Open…", self)
+        open_.setShortcut(QKeySequence.StandardKey.Open)
+        open_.triggered.connect(self._choose_archive)
+        self.act_export = QAction("&Export selection to CSV…", self)
+        self.act_export.setShortcut(QKeySequence("Ctrl+E"))
+        self.act_export.triggered.connect(self._choose_export)
+        reload_ = QAction("&Reload", self)
+        reload_.setShortcut(QKeySequence.StandardKey.Refresh)
+        reload_.triggered.connect(self.reload)
+        close = QAction("&Close", self)
+        close.setShortcut(QKeySequence.StandardKey.Close)
+        close.triggered.connect(self.close)
+        for a in (open_, self.act_export, reload_):
+            menu.addAction(a)
+        menu.addSeparator()
+        menu.addAction(close)
+
+        side = QWidget()
+        side.setObjectName("viewerSide")
+        side_lay = QVBoxLayout(side)
+        self.path_label = QLabel("no archive")
+        self.path_label.setWordWrap(True)
+        side_lay.addWidget(QLabel("<b>Days</b>"))
+        self.days = QListWidget()
+        self.days.currentRowChanged.connect(self._day_changed)
+        side_lay.addWidget(self.days, 1)
+        side_lay.addWidget(QLabel("<b>Filter</b>"))
+        form = QFormLayout()
+        self.kind = QComboBox()
+        self.kind.addItems(KINDS)
+        self.group = QSpinBox()
+        self.group.setRange(-1, 65535)
+        self.group.setSpecialValueText("any")
+        self.group.setValue(-1)
+        self.type = QComboBox()
+        self.type.addItems(TYPES)
+        self.source = QLineEdit()
+        self.source.setPlaceholderText("exact source")
+        self.text = QLineEdit()
+        self.text.setPlaceholderText("text contains")
+        self.since = QTimeEdit()
+        self.since.setDisplayFormat("HH:mm:ss")
+        self.until = QTimeEdit()
+        self.until.setDisplayFormat("HH:mm:ss")
+        self.until.setTime(self.until.maximumTime())
+        for label, w in (("Kind", self.kind), ("Group", self.group), ("Type", self.type),
+                         ("Source", self.source), ("Text", self.text), ("From", self.since),
+                         ("To", self.until)):
+            form.addRow(label, w)
+        side_lay.addLayout(form)
+        apply = QPushButton("Apply filter")
+        apply.clicked.connect(self.apply_filter)
+        self.source.returnPressed.connect(self.apply_filter)
+        self.text.returnPressed.connect(self.apply_filter)
+        export = QPushButton("Export CSV…")
+        export.clicked.connect(self._choose_export)
+        side_lay.addWidget(apply)
+        side_lay.addWidget(export)
+        side_lay.addWidget(self.path_label)
+
+        self.tabs = QTabWidget()
+        records = QWidget()
+        rec_lay = QVBoxLayout(records)
+        self.model = RecordsModel(self)
+        self.table = make_table(self.model)
+        rec_lay.addWidget(self.table, 1)
+        pager = QHBoxLayout()
+        self.first = QPushButton("\u23ee First")
+        self.prev = QPushButton("\u25c0 Previous")
+        self.next = QPushButton("Next \u25b6")
+        self.page_label = QLabel()
+        for b, step in ((self.first, None), (self.prev, -PAGE), (self.next, PAGE)):
+            b.clicked.connect(lambda _=False, s=step: self.page(s))
+            pager.addWidget(b)
+        pager.addStretch(1)
+        pager.addWidget(self.page_label)
+        rec_lay.addLayout(pager)
+        self.tabs.addTab(records, "Records")
+
+        plots = QSplitter(Qt.Orientation.Horizontal)
+        self.series_list = QListWidget()
+        self.series_list.itemChanged.connect(self._series_toggled)
+        self.plot = pg.PlotWidget(axisItems={"bottom": pg.DateAxisItem()})
+        self.plot.setBackground("w")
+        self.plot.showGrid(x=True, y=True, alpha=0.25)
+        self.plot.addLegend(offset=(10, 10))
+        self.plot.setLabel("left", "value")
+        plots.addWidget(self.series_list)
+        plots.addWidget(self.plot)
+        plots.setSizes([260, 1000])
+        self.tabs.addTab(plots, "Series")
+
+        split = QSplitter(Qt.Orientation.Horizontal)
+        split.addWidget(side)
+        split.addWidget(self.tabs)
+        split.setSizes([280, 1000])
+        self.setCentralWidget(split)
+
+    # --- archive and day -----------------------------------------------------------------------
+
+    def open_archive(self, path: Path) -> bool:
+        try:
+            archive = Archive(path)
+            days = archive.days()
+        except (sqlite3.Error, OSError) as e:
+            QMessageBox.warning(self, "Journal viewer", f"Cannot open {path}:\n{e}")
+            return False
+        if self.archive is not None:
+            self.archive.close()
+        self.archive, self.archive_path = archive, Path(path)
+        self.path_label.setText(f"<small>{path}</small>")
+        self.days.blockSignals(True)
+        self.days.clear()
+        for day in days:
+            item = QListWidgetItem(day.strftime("%d.%m.%Y  (%a)"))
+            item.setData(Qt.ItemDataRole.UserRole, day)
+            self.days.addItem(item)
+        self.days.blockSignals(False)
+        if days:
+            self.days.setCurrentRow(0)
+        return True
+
+    @property
+    def day(self) -> dt.date | None:
+        item = self.days.currentItem()
+        return item.data(Qt.ItemDataRole.UserRole) if item else None
+
+    def reload(self) -> None:
+        if self.archive_path is not None:
+            day = self.day
+            self.open_archive(self.archive_path)
+            for i in range(self.days.count()):
+                if self.days.item(i).data(Qt.ItemDataRole.UserRole) == day:
+                    self.days.setCurrentRow(i)
+
+    def _day_changed(self, _row: int) -> None:
+        self.apply_filter()
+        self._load_series_keys()
+
+    # --- records -------------------------------------------------------------------------------
+
+    def current_filter(self) -> Filter:
+        kind = self.kind.currentText()
+        day = self.day or dt.date.today()
+        since = dt.datetime.combine(day, self.since.time().toPython()).timestamp()
+        until = dt.datetime.combine(day, self.until.time().toPython()).timestamp() + 1
+        return Filter(
+            kinds=None if kind == "all" else {kind},
+            grp=None if self.group.value() < 0 else self.group.value(),
+            type=None if self.type.currentIndex() == 0 else self.type.currentIndex() - 1,
+            source=self.source.text().strip() or None,
+            text=self.text.text().strip() or None,
+            since=since,
+            until=until,
+        )
+
+    def apply_filter(self) -> None:
+        self.offset = 0
+        self._load_page()
+
+    def page(self, step: int | None) -> None:
+        if step is None:
+            self.offset = 0
+        else:
+            self.offset = min(max(0, self.offset + step), max(0, self.total - 1) // PAGE * PAGE)
+        self._load_page()
+
+    def _load_page(self) -> None:
+        day = self.day
+        if self.archive is None or day is None:
+            self.model.set_rows([])
+            self.page_label.setText("no records")
+            return
+        flt = self.current_filter()
+        self.total = self.archive.count(day, flt)
+        rows = self.archive.records(day, flt, self.offset, PAGE, newest_first=False)
+        self.model.set_rows(rows)
+        last = self.offset + len(rows)
+        self.page_label.setText(f"records {self.offset + 1 if rows else 0}–{last} of {self.total}")
+        self.prev.setEnabled(self.offset > 0)
+        self.first.setEnabled(self.offset > 0)
+        self.next.setEnabled(last < self.total)
+
+    def export_csv(self, path: Path) -> int:
+        day = self.day
+        if self.archive is None or day is None:
+            return 0
+        return self.archive.export_csv(path, day, self.current_filter())
+
+    def _choose_export(self) -> None:
+        day = self.day
+        if day is None:
+            return
+        name, _ = QFileDialog.getSaveFileName(self, "Export selection", f"journal_{day:%d_%m_%Y}.csv",
+                                              "CSV files (*.csv)")
+        if name:
+            n = self.export_csv(Path(name))
+            self.statusBar().showMessage(f"{n} records exported to {name}", 8000)
+
+    def _choose_archive(self) -> None:
+        name, _ = QFileDialog.getOpenFileName(self, "Open archive", "",
+                                              "Archives (*.sqlite *.db);;All files (*)")
+        if name:
+            self.open_archive(Path(name))
+
+    # --- series --------------------------------------------------------------------------------
+
+    def _load_series_keys(self) -> None:
+        for curve in self.curves.values():
+            self.plot.removeItem(curve)
+        self.curves.clear()
+        self.series_list.blockSignals(True)
+        self.series_list.clear()
+        day = self.day
+        if self.archive is not None and day is not None:
+            for key in self.archive.series_keys(day):
+                if key.kind != "data":
+                    continue
+                item = QListWidgetItem(series_label(key))
+                item.setData(Qt.ItemDataRole.UserRole, key)
+                item.setFlags(item.flags() | Qt.ItemFlag.ItemIsUserCheckable)
+                item.setCheckState(Qt.CheckState.Unchecked)
+                self.series_list.addItem(item)
+        self.series_list.blockSignals(False)
+
+    def _series_toggled(self, item: QListWidgetItem) -> None:
+        key = item.data(Qt.ItemDataRole.UserRole)
+        self.show_series(key, item.checkState() == Qt.CheckState.Checked)
+
+    def show_series(self, key: SeriesKey, shown: bool = True) -> pg.PlotDataItem | None:
+        """Plot (or remove) one series of the current day, downsampled to SERIES_POINTS."""
+        if not shown:
+            curve = self.curves.pop(key, None)
+            if curve is not None:
+                self.plot.removeItem(curve)
+            return None
+        day = self.day
+        if self.archive is None or day is None:
+            return None
+        ts, values = self.archive.series(day, grp=key.grp, type=key.type, source=key.source,
+                                         points=SERIES_POINTS)
+        color = QColor(PALETTE[len(self.curves) % len(PALETTE)])
+        curve = self.plot.plot(np.asarray(ts, dtype=np.float64), np.asarray(values, dtype=np.float64),
+                               pen=pg.mkPen(color, width=1.5), name=series_label(key), connect="finite")
+        self.curves[key] = curve
+        self.plot.enableAutoRange()
+        return curve
+
+    def check_series(self, row: int) -> None:
+        """Tick a series in the list (what a click does), for scripts and tests."""
+        self.series_list.item(row).setCheckState(Qt.CheckState.Checked)
+
+    def closeEvent(self, event) -> None:
+        if self.archive is not None:
+            self.archive.close()
+            self.archive = None
+        super().closeEvent(event)
+
+
+def archive_of(target: str | None) -> Path:
+    """The archive named on the command line: a file, a station folder, or the demo station's."""
+    from app.cli import DEMO_STATION
+
+    if target is None:
+        return load_station(DEMO_STATION).Archive
+    p = Path(target)
+    if p.is_dir() or p.suffix == ".toml":
+        return load_station(station_file(p)).Archive
+    return p
+
+
+def run_viewer(target: str | None) -> int:
+    try:
+        path = archive_of(target)
+    except ConfigError as e:
+        print("\n".join(e.problems), file=sys.stderr)
+        return 2
+    if not path.is_file():
+        print(f"{path}: no archive here (run the station first, or name an archive file)", file=sys.stderr)
+        return 2
+    app = QApplication.instance() or QApplication(sys.argv[:1])
+    apply_style(app)
+    window = ViewerWindow(path)
+    window.show()
+    return app.exec()

@@ -1,0 +1,58 @@
+"""The offline viewer on an archive made by the headless run, copied elsewhere as from another PC."""
+
+from __future__ import annotations
+
+import csv
+import datetime as dt
+import shutil
+from pathlib import Path
+
+from PySide6.QtCore import Qt
+
+from app.gui.viewer import ViewerWindow, archive_of
+
+
+def test_viewer_shows_rows_plots_and_exports(qtbot, headless_archive: tuple[Path, str],
+                                             tmp_path: Path) -> None:
+    source, _ = headless_archive
+    copy = tmp_path / "copied" / "journal.sqlite"
+    copy.parent.mkdir()
+    shutil.copy(source, copy)  # a clean stop leaves no WAL behind: the file alone is the archive
+    viewer = ViewerWindow(copy)
+    qtbot.addWidget(viewer)
+    viewer.show()
+
+    assert viewer.day == dt.date.today()
+    assert viewer.model.rowCount() > 20
+    kinds = {viewer.model.index(r, 1).data() for r in range(viewer.model.rowCount())}
+    assert kinds >= {"data", "message", "system"}
+    texts = [viewer.model.index(r, 7).data() for r in range(viewer.model.rowCount())]
+    assert "NetPlc запущен" in texts and texts[-1] == "station stopped"  # oldest first
+
+    viewer.kind.setCurrentText("message")
+    viewer.apply_filter()
+    assert {viewer.model.index(r, 1).data() for r in range(viewer.model.rowCount())} == {"message"}
+    assert viewer.page_label.text().startswith("records 1–")
+
+    labels = [viewer.series_list.item(i).text() for i in range(viewer.series_list.count())]
+    level = labels.index("group 1 / type 1 / 04010")
+    viewer.check_series(level)
+    viewer.check_series(labels.index("group 1 / type 2 / 04012"))
+    assert len(viewer.curves) == 2
+    xs, ys = next(iter(viewer.curves.values())).getData()
+    assert len(xs) >= 3 and ys[-1] > ys[0]  # the level rises after a start
+    viewer.series_list.item(level).setCheckState(Qt.CheckState.Unchecked)
+    assert len(viewer.curves) == 1
+
+    out = tmp_path / "messages.csv"
+    n = viewer.export_csv(out)
+    with open(out, encoding="utf-8-sig", newline="") as f:
+        rows = list(csv.DictReader(f))
+    assert n == len(rows) == viewer.total
+    assert {r["kind"] for r in rows} == {"message"}
+    assert "NetPlc запущен" in {r["text"] for r in rows}
+
+
+def test_archive_argument(tmp_path: Path) -> None:
+    assert archive_of(str(tmp_path / "a.sqlite")) == tmp_path / "a.sqlite"
+    assert archive_of(None).name == "journal.sqlite"

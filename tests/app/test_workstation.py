@@ -1,0 +1,122 @@
+"""The operator workstation on the demo station: real runtime, real TCP, real archive, offscreen Qt."""
+
+from __future__ import annotations
+
+import datetime as dt
+import itertools
+import math
+import sqlite3
+from collections.abc import Iterator
+from pathlib import Path
+
+import pytest
+from PySide6.QtCore import Qt
+
+from app.config import load_station
+from app.gui.main_window import MainWindow
+from app.runtime import Runtime
+from hmi_forms.elements import Element
+from hmi_forms.widgets.base import ElementWidget
+
+START_BIT = 0o40042
+LEVEL = 0o4010
+
+
+@pytest.fixture
+def workstation(qtbot, demo_copy: Path) -> Iterator[MainWindow]:
+    runtime = Runtime(load_station(demo_copy))
+    runtime.start()
+    window = MainWindow(runtime)
+    qtbot.addWidget(window)
+    window.show()
+    try:
+        yield window
+    finally:
+        window.close()
+        runtime.stop()
+
+
+def element(window: MainWindow, name: str) -> tuple[Element, ElementWidget]:
+    for view in window.views:
+        for model, widget in view.pairs:
+            if model.Name == name:
+                return model, widget
+    raise AssertionError(f"no element {name!r} in the demo forms")
+
+
+def transitions(values: list[float]) -> int:
+    live = [v for v in values if not math.isnan(v)]
+    return sum(a != b for a, b in itertools.pairwise(live))
+
+
+def archive_rows(runtime: Runtime, kind: str) -> list[tuple]:
+    con = sqlite3.connect(f"file:{runtime.station.Archive}?mode=ro", uri=True)
+    try:
+        return con.execute(f'SELECT source, number, text FROM "{dt.date.today():%d_%m_%Y}" WHERE kind = ?',
+                           (kind,)).fetchall()
+    finally:
+        con.close()
+
+
+def test_start_twice_changes_the_trigger_output_once(qtbot, workstation: MainWindow) -> None:
+    runtime = workstation.runtime
+    engine = runtime.engine
+    assert engine is not None
+    graph, _ = element(workstation, "TA[2]: выход триггера")
+    _, button = element(workstation, "Пуск")
+    qtbot.waitUntil(lambda: runtime.status().nodes_up == 1 and graph.trend.count > 3, timeout=10_000)
+    qtbot.waitUntil(lambda: not math.isnan(graph.trend.last), timeout=5000)
+    assert graph.trend.last == 0.0
+    before = graph.trend.count
+
+    qtbot.mouseClick(button, Qt.MouseButton.LeftButton)
+    qtbot.waitUntil(lambda: engine.snapshot.get_hmi_bit(START_BIT) == 1, timeout=3000)
+    qtbot.wait(400)
+    qtbot.mouseClick(button, Qt.MouseButton.LeftButton)
+    qtbot.waitUntil(lambda: engine.snapshot.get_hmi_bit(START_BIT) == 0, timeout=3000)
+    qtbot.waitUntil(lambda: graph.trend.last == 1.0, timeout=5000)
+    qtbot.wait(600)  # the output must stay: the second click (a falling edge) does not count
+
+    shown = list(graph.trend.values())[-(graph.trend.count - before):]
+    assert transitions(shown) == 1
+    assert graph.trend.last == 1.0
+    workstation.refresh_status()
+    assert workstation.status.state.text() == "NetPlc: running"
+
+
+def test_an_alarm_is_shown_and_its_acknowledgement_journaled(qtbot, workstation: MainWindow) -> None:
+    runtime = workstation.runtime
+    qtbot.waitUntil(lambda: runtime.status().nodes_up == 1, timeout=10_000)
+    workstation.header.user.setCurrentText("engineer")
+    # the plant: node 0's level jumps close to the top; its program keeps it rising past 90 %
+    runtime.simulators[0].engine.write_word(LEVEL, 3700)
+    high = "Уровень выше 90 %"
+    qtbot.waitUntil(lambda: any(a.text == high for a in workstation.alarms.alarms), timeout=5000)
+    assert workstation.alarms.isVisible()
+    assert high in workstation.alarms.text.text()  # the newest alarm is in front
+    assert workstation.alarms.grab().toImage().pixelColor(4, 4).red() > 150  # a red banner
+
+    banner = workstation.alarms
+    button = banner.ack_all if len(banner.alarms) > 1 else banner.ack
+    qtbot.mouseClick(button, Qt.MouseButton.LeftButton)
+    assert not banner.alarms and not banner.isVisible()
+    runtime.stop()  # flushes the archive
+    operator = archive_rows(runtime, "operator")
+    assert ("engineer", 3, "acknowledged: Уровень выше 90 %") in operator
+    messages = archive_rows(runtime, "message")
+    assert (None, 3, "Уровень выше 90 %") in messages
+
+
+def test_a_dead_node_and_a_stopped_program_show_in_the_window(qtbot, workstation: MainWindow) -> None:
+    runtime = workstation.runtime
+    qtbot.waitUntil(lambda: runtime.status().nodes_up == 1, timeout=10_000)
+    qtbot.waitUntil(lambda: runtime.status().scans > 35, timeout=10_000)  # past the start-up grace
+    runtime.simulators[0].stop()
+    qtbot.waitUntil(lambda: runtime.status().nodes_up == 0, timeout=10_000)
+    runtime.stop_program()  # after the link is seen down: a stopped program sends no more requests
+    text = workstation.health.label.text
+    qtbot.waitUntil(lambda: "NetPlc program stopped" in text() and "no link to node 0" in text(),
+                    timeout=3000)
+    assert workstation.health.isVisible()
+    assert workstation.status.state.property("level") == "bad"
+    assert workstation.status.nodes.property("level") == "bad"
