@@ -42,6 +42,10 @@ def table_name(day: dt.date) -> str:
     return f"{day.day:02d}_{day.month:02d}_{day.year:04d}"
 
 
+def key_index(table: str) -> str:
+    return f"{table}_key"
+
+
 def parse_table_name(name: str) -> dt.date | None:
     try:
         d, m, y = name.split("_")

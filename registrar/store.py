@@ -12,12 +12,13 @@ from __future__ import annotations
 
 import contextlib
 import datetime as dt
+import operator
 import sqlite3
 import threading
 import time
 from collections import deque
 from collections.abc import Callable
-from dataclasses import dataclass, replace
+from dataclasses import dataclass
 from pathlib import Path
 
 from netplc.records import Record
@@ -30,6 +31,7 @@ from registrar.schema import (
     META_SQL,
     SCHEMA_VERSION,
     SERIES_SQL,
+    key_index,
     local_day_bounds,
     parse_table_name,
     table_name,
@@ -40,7 +42,18 @@ BATCH_MAX = 50_000  # records per transaction: bounds the time one commit holds 
 RETRY_MAX = 5.0  # seconds between attempts while the disk keeps failing
 BUSY_TIMEOUT_MS = 1000
 
-Row = tuple[int, str, int | None, int | None, str | None, int | None, float | None, str | None]
+# A record as inserted: ts is still seconds (float); the INSERT rounds it to milliseconds.
+Row = tuple[float, str, int | None, int | None, str | None, int | None, float | None, str | None]
+_FIELDS = operator.attrgetter("ts", "kind", "grp", "type", "source", "number", "value", "text")
+_TS, _KIND, _KEY = operator.itemgetter(0), operator.itemgetter(1), operator.itemgetter(1, 2, 3, 4)
+HALF_MS = 0.0005  # a record rounding up to the next midnight belongs to the next day
+
+
+def _day_of(ts: float) -> tuple[float, float, str]:
+    """The [start, end) seconds of the local day whose table gets a record at `ts`, and its name."""
+    day, start, end = local_day_bounds(ts + HALF_MS)
+    return start - HALF_MS, end - HALF_MS, table_name(day)
+
 
 
 @dataclass(frozen=True)
@@ -79,7 +92,10 @@ class Store:
         self._thread: threading.Thread | None = None
         self._lock = threading.Lock()  # guards the overflow counters (put runs in several threads)
         self._overflowing = False
-        self._stats = StoreStats(db_path=str(self.path))
+        # Counters: committed, batches and last_error are written by the writer thread only;
+        # overflows and dropped by producers, under the lock.
+        self._committed = self._batches = self._overflows = self._dropped = 0
+        self._last_error = ""
         self._con: sqlite3.Connection | None = None
         self._known: dict[str, set[tuple]] = {}  # day table -> data series keys already listed
         self._day: tuple[float, float, str] = (0.0, 0.0, "")  # [start, end) of the cached local day
@@ -96,8 +112,8 @@ class Store:
             with self._lock:
                 if not self._overflowing:
                     self._overflowing = True
-                    self._stats = replace(self._stats, overflows=self._stats.overflows + 1)
-                self._stats = replace(self._stats, dropped=self._stats.dropped + 1)
+                    self._overflows += 1
+                self._dropped += 1
             self._wake.set()
             return
         queue.append(record)
@@ -106,17 +122,22 @@ class Store:
 
     @property
     def stats(self) -> StoreStats:
-        return replace(self._stats, queued=len(self._queue))
+        return StoreStats(len(self._queue), self._committed, self._batches, self._overflows,
+                          self._dropped, self._last_error, str(self.path))
 
     @property
     def committed(self) -> int:
-        return self._stats.committed
+        return self._committed
 
     # --- lifecycle -----------------------------------------------------------------------------
 
     def start(self) -> None:
+        """Open (or create) the archive and start the writer; sqlite3.Error names the file."""
         self.path.parent.mkdir(parents=True, exist_ok=True)
-        self._con = self._open()
+        try:
+            self._con = self._open()
+        except sqlite3.Error as e:
+            raise type(e)(f"{self.path}: cannot open the archive: {e}") from e
         self._thread = threading.Thread(target=self._run, name="registrar-writer", daemon=True)
         self._thread.start()
 
@@ -132,6 +153,16 @@ class Store:
 
     def _open(self) -> sqlite3.Connection:
         con = sqlite3.connect(self.path, isolation_level=None, check_same_thread=False)
+        try:
+            self._prepare(con)
+        except BaseException:
+            con.close()
+            raise
+        self._retain(con)
+        return con
+
+    def _prepare(self, con: sqlite3.Connection) -> None:
+        """WAL, the shared tables, and the catalog copied in so the file explains itself."""
         con.execute(f"PRAGMA busy_timeout={BUSY_TIMEOUT_MS}")
         con.execute("PRAGMA journal_mode=WAL")
         con.execute("PRAGMA synchronous=NORMAL")
@@ -154,8 +185,6 @@ class Store:
             con.executemany("INSERT INTO messages VALUES (?, ?, ?, ?)",
                             [(m.number, m.grp, m.type, m.text) for m in self.catalog])
         con.execute("COMMIT")
-        self._retain(con)
-        return con
 
     def _run(self) -> None:
         pending: list[Record] = []
@@ -197,7 +226,7 @@ class Store:
         n = min(len(queue), BATCH_MAX)
         batch = [queue.popleft() for _ in range(n)]
         with self._lock:
-            dropped = self._stats.dropped
+            dropped = self._dropped
             if self._overflowing and len(queue) < self.queue_size:
                 self._overflowing = False
         if dropped > self._reported_drops:
@@ -219,14 +248,15 @@ class Store:
                 self._ensure_table(con, table, rows)
                 con.executemany(
                     f'INSERT INTO "{table}" (ts, kind, grp, type, source, number, value, text) '
-                    "VALUES (?, ?, ?, ?, ?, ?, ?, ?)", rows)
+                    "VALUES (CAST(round(? * 1000) AS INTEGER), ?, ?, ?, ?, ?, ?, ?)", rows)
             con.execute("COMMIT")
         except (sqlite3.Error, OSError) as e:
             self._failed(con, e, batch)
             return False
-        committed = self._stats.committed + len(batch)
-        self._stats = replace(self._stats, committed=committed, batches=self._stats.batches + 1,
-                              last_error="")
+        self._committed += len(batch)
+        self._batches += 1
+        self._last_error = ""
+        committed = self._committed
         if self._failing_since is not None:
             seconds = self.wallclock() - self._failing_since
             self._failing_since = None
@@ -249,48 +279,58 @@ class Store:
                 con.execute("ROLLBACK")
         self._known.clear()  # tables created in the failed transaction are gone
         text = f"archive write failed: {error}"
-        self._stats = replace(self._stats, last_error=text)
+        self._last_error = text
         if self._failing_since is None:
             self._failing_since = self.wallclock()
             batch.append(Record(self.wallclock(), "system", source=SOURCE,
                                 text=f"{text}; records are kept in memory and retried"))
 
     def _rows_by_table(self, batch: list[Record]) -> dict[str, list[Row]]:
-        tables: dict[str, list[Row]] = {}
+        """Rows for each day table; the common batch lies in one day and is built in C loops."""
+        rows = list(map(_FIELDS, batch))
+        kinds = list(map(_KIND, rows))
+        i = 0
+        with contextlib.suppress(ValueError):  # raised when no message is left
+            while True:
+                i = kinds.index("message", i)
+                rows[i] = self._resolve(rows[i])
+                i += 1
+        stamps = list(map(_TS, rows))
         start, end, name = self._day
-        rows = tables.setdefault(name, []) if name else []
-        text_for = self.catalog.text_for
-        get = self.catalog.get
-        for r in batch:
-            ts = r.ts
+        if name and start <= min(stamps) and max(stamps) < end:
+            return {name: rows}
+        tables: dict[str, list[Row]] = {}
+        for row, ts in zip(rows, stamps):
             if not start <= ts < end:
-                day, start, end = local_day_bounds(ts)
-                name = table_name(day)
-                rows = tables.setdefault(name, [])
-            text = r.text
-            grp, kind_type = r.grp, r.type
-            if r.kind == "message" and r.number is not None:
-                if text is None:
-                    text = text_for(r.number)
-                if grp is None or kind_type is None:
-                    message = get(r.number)
-                    if message is not None:
-                        grp = message.grp if grp is None else grp
-                        kind_type = message.type if kind_type is None else kind_type
-            rows.append((round(ts * 1000), r.kind, grp, kind_type, r.source, r.number, r.value, text))
-        self._day = (start, end, name)
-        return {t: rows for t, rows in tables.items() if rows}
+                start, end, name = _day_of(ts)
+                self._day = (start, end, name)
+            tables.setdefault(name, []).append(row)
+        return tables
+
+    def _resolve(self, row: Row) -> Row:
+        """An NMSG record gets its catalog text (and group and type if it named none)."""
+        ts, kind, grp, typ, source, number, value, text = row
+        if number is None:
+            return row
+        if text is None:
+            text = self.catalog.text_for(number)
+        if grp is None or typ is None:
+            message = self.catalog.get(number)
+            if message is not None:
+                grp = message.grp if grp is None else grp
+                typ = message.type if typ is None else typ
+        return (ts, kind, grp, typ, source, number, value, text)
 
     def _ensure_table(self, con: sqlite3.Connection, table: str, rows: list[Row]) -> None:
         known = self._known.get(table)
         if known is None:
             con.execute(f'CREATE TABLE IF NOT EXISTS "{table}" {DAY_COLUMNS_SQL}')
-            con.execute(f'CREATE INDEX IF NOT EXISTS "{table}_key" ON "{table}" {KEY_INDEX_COLUMNS}')
+            con.execute(f'CREATE INDEX IF NOT EXISTS "{key_index(table)}" ON "{table}" {KEY_INDEX_COLUMNS}')
             known = {tuple(k) for k in con.execute(
                 "SELECT kind, grp, type, source FROM series WHERE day = ?", (table,))}
             self._known[table] = known
             self._new_day = True
-        new = {(k, g, t, s) for _, k, g, t, s, _, _, _ in rows if k == "data"} - known
+        new = {key for key in set(map(_KEY, rows)) if key[0] == "data"} - known
         if new:
             con.executemany("INSERT OR IGNORE INTO series VALUES (?, ?, ?, ?, ?)",
                             [(table, *key) for key in new])
@@ -305,7 +345,7 @@ class Store:
         except sqlite3.Error as e:
             if con.in_transaction:
                 con.execute("ROLLBACK")
-            self._stats = replace(self._stats, last_error=f"dropping old days failed: {e}")
+            self._last_error = f"dropping old days failed: {e}"
 
     def _drop_old_days(self, con: sqlite3.Connection) -> None:
         """Whole day tables older than keep_days go; their pages are reused by later days."""

@@ -172,3 +172,48 @@ def test_reading_while_the_writer_writes(db):
         assert counts == sorted(counts)
         assert a.count(DAY) == store.committed
     assert store.stats.last_error == ""
+
+
+def test_every_page_strategy_gives_the_reference_answer(db, monkeypatch):
+    """Small probe and index limits force all three ways of finding a page on a modest day."""
+    import random
+
+    import registrar.query as query
+
+    monkeypatch.setattr(query, "PROBE_ROWS", 50)
+    monkeypatch.setattr(query, "INDEX_ROWS", 100)
+    rnd = random.Random(5)
+    records = []
+    for i in range(3000):
+        if i < 40 or rnd.random() < 0.01:
+            number = rnd.choice((1, 3, 4))
+            records.append(Record(T0 + i, "message", rnd.randrange(3), rnd.randrange(4), number=number))
+        elif i % 500 == 0:
+            records.append(Record(T0 + i, "system", source="app", text="station started"))
+        else:
+            records.append(Record(T0 + i, "data", 1 + i % 2, 1, "04010", value=float(i)))
+    write(db, records)
+    filters = [
+        Filter(kinds={"message"}), Filter(kinds={"message", "system"}), Filter(kinds={"message"}, grp=2),
+        Filter(grp=0), Filter(grp=2, type=3), Filter(kinds={"data"}, grp=1), Filter(text="связь"),
+        Filter(kinds={"message"}, min_type=2), Filter(kinds={"data"}, until=T0 + 100), Filter(grp=9),
+    ]
+    with Archive(db) as a:
+        everything = a.records(DAY, limit=10_000, newest_first=False)
+        assert len(everything) == 3000
+        for flt in filters:
+            expected = [r for r in everything if _matches(r, flt)]
+            assert a.count(DAY, flt) == len(expected), flt
+            for newest_first in (True, False):
+                ordered = expected[::-1] if newest_first else expected
+                for offset, limit in ((0, 10), (5, 30), (len(expected) - 3, 10)):
+                    got = a.records(DAY, flt, offset=max(offset, 0), limit=limit, newest_first=newest_first)
+                    assert got == ordered[max(offset, 0):max(offset, 0) + limit], (flt, newest_first, offset)
+
+
+def _matches(r, flt: Filter) -> bool:
+    return ((flt.kinds is None or r.kind in flt.kinds) and (flt.grp is None or r.grp == flt.grp)
+            and (flt.type is None or r.type == flt.type)
+            and (flt.min_type is None or (r.type is not None and r.type >= flt.min_type))
+            and (flt.until is None or r.ts < flt.until)
+            and (flt.text is None or (r.text is not None and flt.text.lower() in r.text.lower())))

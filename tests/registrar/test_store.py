@@ -2,6 +2,8 @@ import datetime as dt
 import sqlite3
 import threading
 
+import pytest
+
 from netplc.records import Record
 from registrar.catalog import Catalog, Message
 from registrar.schema import table_name
@@ -179,3 +181,22 @@ def test_a_failing_commit_listener_is_removed_and_journaled(db):
     day = table_name(dt.date.fromtimestamp(1_790_000_000.0))
     texts = [t for (t,) in rows(db, day, "text") if t]
     assert len(texts) == 1 and "widget gone" in texts[0]
+
+
+def test_a_file_that_is_no_database_is_named_in_the_error(tmp_path):
+    path = tmp_path / "journal.sqlite"
+    path.write_bytes(b"this is not an SQLite file at all, just text" * 100)
+    store = Store(path)
+    with pytest.raises(sqlite3.DatabaseError, match=r"journal\.sqlite: cannot open the archive"):
+        store.start()
+
+
+def test_records_are_split_where_their_milliseconds_fall(db):
+    midnight = local_midnight(dt.date(2026, 3, 5))
+    store = Store(db, wallclock=lambda: midnight)
+    store.put(Record(midnight - 0.0004, "data", 1, 1, "04000", value=1.0))  # rounds to 00:00:00.000
+    store.put(Record(midnight - 0.0006, "data", 1, 1, "04000", value=2.0))
+    store.start()
+    store.close()
+    assert rows(db, "05_03_2026", "ts, value") == [(round(midnight * 1000), 1.0)]
+    assert rows(db, "04_03_2026", "ts, value") == [(round(midnight * 1000) - 1, 2.0)]
