@@ -17,6 +17,7 @@ from __future__ import annotations
 
 import asyncio
 import time
+from collections import deque
 from collections.abc import Iterable
 from dataclasses import dataclass
 from typing import TYPE_CHECKING
@@ -243,6 +244,8 @@ class Exchange:
         # nodes whose link is up as of this scan (changes arrive with the presence-list update).
         self._inflight: set[int] = set()
         self._present: set[int] = set()
+        self._outbox: deque[tuple[_Node, _Request]] = deque()  # engine thread -> exchange loop
+        self._wake = False
         self._thread = LoopThread("netplc-exchange")
 
     # --- wiring ----------------------------------------------------------------------------------
@@ -277,6 +280,9 @@ class Exchange:
         """No link and nothing in flight as of the next scan (requests of a stopped run never complete)."""
         inflight, present, nodes = self._inflight, self._present, list(self.configs)
 
+        self._outbox.clear()
+        self._wake = False
+
         def reset(mem: Memory) -> None:
             inflight.clear()
             present.clear()
@@ -305,8 +311,19 @@ class Exchange:
         if req.key not in self._inflight:
             self._inflight.add(req.key)
             req.scan = self.engine.scan_counter if self.engine is not None else 0
-            self._thread.call(target.queue.put_nowait, req)
+            self._outbox.append((target, req))
+            if not self._wake:  # one wake-up of the loop per batch, not one per request
+                self._wake = True
+                self._thread.call(self._dispatch)
         return node in self._present
+
+    def _dispatch(self) -> None:
+        """Exchange loop: hand the requests of the scan(s) since the last wake-up to their nodes."""
+        self._wake = False  # first: a request appended from now on schedules another wake-up
+        outbox = self._outbox
+        while outbox:
+            target, req = outbox.popleft()
+            target.queue.put_nowait(req)
 
     # --- back on the engine thread ---------------------------------------------------------------
 
