@@ -79,18 +79,16 @@ class Archive:
         self._con = self._connect()
 
     def _connect(self) -> sqlite3.Connection:
-        uri = f"file:{quote(str(self.path.resolve()))}"
+        uri = f"file:{quote(str(self.path.resolve()))}?mode=ro"
         try:
-            con = sqlite3.connect(f"{uri}?mode=ro", uri=True, isolation_level=None,
-                                  check_same_thread=False)
-            con.execute("SELECT count(*) FROM sqlite_master").fetchone()
-        except sqlite3.OperationalError:
-            # A WAL archive on read-only media (no -shm can be made): nobody writes it there.
-            con = sqlite3.connect(f"{uri}?mode=ro&immutable=1", uri=True, isolation_level=None,
-                                  check_same_thread=False)
-            con.execute("SELECT count(*) FROM sqlite_master").fetchone()
-        con.execute("PRAGMA query_only=1")
-        return con
+            return _open_ro(uri)
+        except sqlite3.Error:
+            pass  # e.g. a WAL archive on read-only media, where no -shm file can be made
+        try:
+            # Nobody can be writing there: read the file as it is (a live WAL would be ignored).
+            return _open_ro(uri + "&immutable=1")
+        except sqlite3.Error as e:
+            raise type(e)(f"{self.path}: cannot open the archive: {e}") from e
 
     def close(self) -> None:
         self._con.close()
@@ -247,6 +245,17 @@ class Archive:
     def _has(self, day: dt.date) -> bool:
         return self._con.execute("SELECT 1 FROM sqlite_master WHERE type = 'table' AND name = ?",
                                  (table_name(day),)).fetchone() is not None
+
+
+def _open_ro(uri: str) -> sqlite3.Connection:
+    con = sqlite3.connect(uri, uri=True, isolation_level=None, check_same_thread=False)
+    try:
+        con.execute("SELECT count(*) FROM sqlite_master").fetchone()
+        con.execute("PRAGMA query_only=1")
+    except sqlite3.Error:
+        con.close()
+        raise
+    return con
 
 
 def _row(r: tuple) -> Row:

@@ -11,6 +11,7 @@ from pathlib import Path
 
 import pytest
 
+from registrar.query import Archive
 from registrar.schema import DAY_GLOB
 
 HERE = Path(__file__).parent
@@ -61,6 +62,8 @@ def test_sigkill_during_writes_keeps_every_committed_record(tmp_path):
     for table in tables:
         numbers.update(n for (n,) in con.execute(f'SELECT number FROM "{table}"'))
     assert set(range(committed)) <= numbers
+    with Archive(db) as archive:  # the read side sees the same, straight after the crash
+        assert sum(archive.count(day) for day in archive.days()) == len(numbers)
 
 
 def test_retentive_counting_continues_after_clean_stop_and_sigkill(tmp_path):

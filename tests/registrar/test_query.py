@@ -1,6 +1,7 @@
 import csv
 import datetime as dt
 import shutil
+import sqlite3
 import threading
 
 import numpy as np
@@ -217,3 +218,10 @@ def _matches(r, flt: Filter) -> bool:
             and (flt.min_type is None or (r.type is not None and r.type >= flt.min_type))
             and (flt.until is None or r.ts < flt.until)
             and (flt.text is None or (r.text is not None and flt.text.lower() in r.text.lower())))
+
+
+def test_a_file_that_is_no_archive_is_named_in_the_error(tmp_path):
+    path = tmp_path / "notes.sqlite"
+    path.write_bytes(b"plain text, not SQLite " * 100)
+    with pytest.raises(sqlite3.DatabaseError, match=r"notes\.sqlite: cannot open the archive"):
+        Archive(path)
