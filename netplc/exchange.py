@@ -128,14 +128,33 @@ class _Request:
     scan: int = 0  # the scan that asked
 
 
+class _Line:
+    """One connection: a TCP node's own, or a serial RS-485 line shared by the nodes on it, whose
+    transactions the lock keeps one at a time (a silent slave holds its line for the timeout, as it
+    would on the wire, but never another line)."""
+
+    def __init__(self, endpoint: Endpoint, timeout: float, lean: bool) -> None:
+        self.client = open_client(endpoint, timeout, lean)
+        self.serial = endpoint.scheme == "rtu"
+        self.lock = asyncio.Lock()
+
+    def failed(self) -> None:
+        """After a transport failure: a TCP connection is dropped and made again for the next
+        attempt; a serial port stays open (a timeout is the slave's, not the port's) unless the
+        port itself went away."""
+        if not self.serial or not self.client.connected:
+            self.client.close()
+
+
 class _Node:
     """A node's task state: lives on the exchange loop, except `stats.up`, read by the scan."""
 
-    def __init__(self, config: NodeConfig, exchange: Exchange, stats: NodeStats) -> None:
+    def __init__(self, config: NodeConfig, exchange: Exchange, stats: NodeStats, line: _Line) -> None:
         self.config = config
         self.exchange = exchange
         self.stats = stats
-        self.client = open_client(config.parsed, config.unit, config.timeout, exchange.lean)
+        self.line = line
+        self.client = line.client
         self.queue: asyncio.Queue[_Request] = asyncio.Queue()
         self.delay = config.backoff
         self.retry_at = 0.0  # monotonic time before which requests fail without trying
@@ -147,7 +166,7 @@ class _Node:
                 try:
                     data, error = await self.serve(req)
                 except Exception as e:  # a bug must not end the node's task: report, go on
-                    self.client.close()
+                    self.line.failed()
                     data, error = None, f"internal error: {e!r}"
                 self.exchange.complete(self, req, data, error)
         finally:
@@ -169,7 +188,6 @@ class _Node:
             self.link(True, "")
             return None, f"{where}: {e}"
         except LinkError as e:
-            self.client.close()
             self.retry_at = time.monotonic() + self.delay
             self.delay = min(2 * self.delay, self.config.backoff_max)
             self.link(False, str(e))
@@ -181,14 +199,15 @@ class _Node:
     async def attempts(self, block: Block, payload: bytes | None) -> bytes:
         for attempt in range(self.config.retries + 1):
             try:
-                if not self.client.connected:
-                    await self.client.connect()
-                if payload is None:
-                    return await self.read(block)
-                await self.write(block, payload)
-                return b""
+                async with self.line.lock:
+                    if not self.client.connected:
+                        await self.client.connect()
+                    if payload is None:
+                        return await self.read(block)
+                    await self.write(block, payload)
+                    return b""
             except LinkError:
-                self.client.close()
+                self.line.failed()
                 if attempt == self.config.retries:
                     raise
         raise AssertionError("unreachable")
@@ -196,21 +215,22 @@ class _Node:
     async def read(self, block: Block) -> bytes:
         values: list[int] = []
         for address, count in block.spans(write=False):
-            values += await self.client.read(block.table, address, count)
+            values += await self.client.read(self.config.unit, block.table, address, count)
         return block.decode(values)
 
     async def write(self, block: Block, payload: bytes) -> None:
         if block.table not in WRITABLE_TABLES:
             raise MapError(f"{block.table} is a read-only table")
         first = last = 0
+        unit, table = self.config.unit, block.table
         if block.skip:  # odd edges: keep the neighbouring bytes of the edge registers
-            first = (await self.client.read(block.table, block.address, 1))[0]
+            first = (await self.client.read(unit, table, block.address, 1))[0]
         if block.odd_end:
-            last = (await self.client.read(block.table, block.address + block.count - 1, 1))[0]
+            last = (await self.client.read(unit, table, block.address + block.count - 1, 1))[0]
         values = block.encode(payload, first, last)
         offset = 0
         for address, count in block.spans(write=True):
-            await self.client.write(block.table, address, values[offset : offset + count])
+            await self.client.write(self.config.unit, block.table, address, values[offset : offset + count])
             offset += count
 
     def link(self, up: bool, error: str) -> None:
@@ -230,10 +250,16 @@ class Exchange:
     def __init__(self, nodes: list[NodeConfig], sink: RecordSink | None = None, *, lean: bool = True) -> None:
         self.lean = lean  # our lean Modbus TCP client; False: pymodbus's (bench/exchange.py compares)
         self.configs: dict[int, NodeConfig] = {}
+        serial: dict[str, NodeConfig] = {}
         for cfg in nodes:
             if cfg.node in self.configs:
                 raise ValueError(f"node {cfg.node} is configured twice")
             self.configs[cfg.node] = cfg
+            ep = cfg.parsed
+            other = serial.setdefault(ep.device, cfg) if ep.scheme == "rtu" else cfg
+            if other.parsed != ep:
+                raise ValueError(f"node {cfg.node}: {ep} and node {other.node}: {other.parsed} share "
+                                 f"{ep.device} with different line settings")
         self.sink: RecordSink = sink or NullSink()
         self.engine: Engine | None = None
         self.stats: dict[int, NodeStats] = {
@@ -263,8 +289,17 @@ class Exchange:
         self._thread.run(self._spawn())
 
     async def _spawn(self) -> None:
+        lines: dict[str, _Line] = {}
         for n, cfg in self.configs.items():
-            node = _Node(cfg, self, self.stats[n])
+            ep = cfg.parsed
+            if ep.scheme == "rtu":  # the nodes of one serial port share its line
+                if ep.device not in lines:
+                    timeout = max(c.timeout for c in self.configs.values() if c.parsed.device == ep.device)
+                    lines[ep.device] = _Line(ep, timeout, self.lean)
+                line = lines[ep.device]
+            else:
+                line = _Line(ep, cfg.timeout, self.lean)
+            node = _Node(cfg, self, self.stats[n], line)
             self._nodes[n] = node
             asyncio.get_running_loop().create_task(node.run(), name=f"node {n}")
 

@@ -135,25 +135,25 @@ class ModbusClient(Protocol):
 
     def close(self) -> None: ...
 
-    async def read(self, table: Table, address: int, count: int) -> list[int]: ...
+    async def read(self, unit: int, table: Table, address: int, count: int) -> list[int]: ...
 
-    async def write(self, table: Table, address: int, values: list[int]) -> None: ...
+    async def write(self, unit: int, table: Table, address: int, values: list[int]) -> None: ...
 
 
-def open_client(endpoint: Endpoint, unit: int, timeout: float, lean: bool = True) -> ModbusClient:
-    """The client for a node: serial RTU through pymodbus's serial framer; TCP through our lean
-    client (`lean=False`: pymodbus's, which bench/exchange.py compares it with)."""
+def open_client(endpoint: Endpoint, timeout: float, lean: bool = True) -> ModbusClient:
+    """The client for an endpoint: serial RTU through pymodbus's serial framer; TCP through our
+    lean client (`lean=False`: pymodbus's, which bench/exchange.py compares it with). The unit id
+    goes with each request, so the nodes of one RS-485 line can share one client."""
     if endpoint.scheme == "tcp" and lean:
-        return LeanTcpClient(endpoint, unit, timeout)
-    return PymodbusClient(endpoint, unit, timeout)
+        return LeanTcpClient(endpoint, timeout)
+    return PymodbusClient(endpoint, timeout)
 
 
 class PymodbusClient:
     """A node's connection through pymodbus (TCP or RTU)."""
 
-    def __init__(self, endpoint: Endpoint, unit: int, timeout: float) -> None:
+    def __init__(self, endpoint: Endpoint, timeout: float) -> None:
         self.endpoint = endpoint
-        self.unit = unit
         self.timeout = timeout
         self._client: AsyncModbusTcpClient | AsyncModbusSerialClient | None = None
 
@@ -191,13 +191,12 @@ class PymodbusClient:
             raise DeviceError(getattr(response, "exception_code", 4), what)
         return response
 
-    async def read(self, table: Table, address: int, count: int) -> list[int]:
-        """`count` registers or bits of `table` from `address`."""
+    async def read(self, unit: int, table: Table, address: int, count: int) -> list[int]:
+        """`count` registers or bits of `table` from `address` of device `unit`."""
         c = self._client
         if c is None:
             raise LinkError(f"not connected to {self.endpoint}")
         what = f"read {table} {address}+{count}"
-        unit = self.unit
         if table == "coils":
             rr = await self._call(what, c.read_coils(address, count=count, device_id=unit))
         elif table == "discrete":
@@ -212,15 +211,15 @@ class PymodbusClient:
             raise LinkError(f"{what}: {len(rr.registers)} registers in the answer")
         return list(rr.registers)
 
-    async def write(self, table: Table, address: int, values: list[int]) -> None:
+    async def write(self, unit: int, table: Table, address: int, values: list[int]) -> None:
         c = self._client
         if c is None:
             raise LinkError(f"not connected to {self.endpoint}")
         what = f"write {table} {address}+{len(values)}"
         if table == "coils":
-            await self._call(what, c.write_coils(address, [bool(v) for v in values], device_id=self.unit))
+            await self._call(what, c.write_coils(address, [bool(v) for v in values], device_id=unit))
         elif table == "holding":
-            await self._call(what, c.write_registers(address, values, device_id=self.unit))
+            await self._call(what, c.write_registers(address, values, device_id=unit))
         else:
             raise MapError(f"{table} is a read-only table")
 
@@ -268,9 +267,8 @@ class LeanTcpClient:
     client spends most of NetPlc's CPU at a few thousand block reads per second (bench/exchange.py
     shows both); this one also fails a request the moment its connection drops."""
 
-    def __init__(self, endpoint: Endpoint, unit: int, timeout: float) -> None:
+    def __init__(self, endpoint: Endpoint, timeout: float) -> None:
         self.endpoint = endpoint
-        self.unit = unit
         self.timeout = timeout
         self._proto: _Answers | None = None
         self._tid = 0
@@ -294,14 +292,14 @@ class LeanTcpClient:
         if proto is not None and proto.transport is not None:
             proto.transport.abort()
 
-    async def _transact(self, pdu: bytes, what: str) -> bytes:
+    async def _transact(self, unit: int, pdu: bytes, what: str) -> bytes:
         proto = self._proto
         if proto is None or proto.transport is None:
             raise LinkError(f"{what}: not connected to {self.endpoint}")
         self._tid = tid = self._tid % 0xFFFF + 1
         waiter = asyncio.get_running_loop().create_future()
         proto.tid, proto.waiter = tid, waiter
-        proto.transport.write(_MBAP.pack(tid, 0, len(pdu) + 1, self.unit) + pdu)
+        proto.transport.write(_MBAP.pack(tid, 0, len(pdu) + 1, unit) + pdu)
         try:
             reply = await asyncio.wait_for(waiter, self.timeout)
         except TimeoutError:
@@ -314,10 +312,10 @@ class LeanTcpClient:
             raise LinkError(f"{what}: answer with function {reply[0]}")
         return reply
 
-    async def read(self, table: Table, address: int, count: int) -> list[int]:
+    async def read(self, unit: int, table: Table, address: int, count: int) -> list[int]:
         what = f"read {table} {address}+{count}"
         fc = _READ_CODES[table]
-        reply = await self._transact(struct.pack(">BHH", fc, address, count), what)
+        reply = await self._transact(unit, struct.pack(">BHH", fc, address, count), what)
         data = reply[2:]
         if table in BIT_TABLES:
             if len(data) != reply[1] or len(data) != (count + 7) // 8:
@@ -327,14 +325,14 @@ class LeanTcpClient:
             raise LinkError(f"{what}: {len(data) // 2} registers in the answer")
         return list(struct.unpack(f">{count}H", data))
 
-    async def write(self, table: Table, address: int, values: list[int]) -> None:
+    async def write(self, unit: int, table: Table, address: int, values: list[int]) -> None:
         what = f"write {table} {address}+{len(values)}"
         n = len(values)
         if table == "coils":
             data = bytes_from_bits(values)
-            await self._transact(struct.pack(">BHHB", 15, address, n, len(data)) + data, what)
+            await self._transact(unit, struct.pack(">BHHB", 15, address, n, len(data)) + data, what)
         elif table == "holding":
-            await self._transact(struct.pack(f">BHHB{n}H", 16, address, n, 2 * n, *values), what)
+            await self._transact(unit, struct.pack(f">BHHB{n}H", 16, address, n, 2 * n, *values), what)
         else:
             raise MapError(f"{table} is a read-only table")
 

@@ -120,15 +120,33 @@ def test_nread_and_odd_edged_nwrite_over_rtu(rtu_node: RtuNode) -> None:
         st.stop()
 
 
-def test_wrong_unit_on_the_line_times_out_and_reports_the_link_down(rtu_node: RtuNode) -> None:
-    program = "TNA $03760\nFON C:$02104 N:NREAD S:4000 D:$04000 R:2\nJMP 0\n"
-    cfg = NodeConfig(0, f"rtu://{rtu_node.port}", unit=UNIT + 1, timeout=0.2, retries=0)
-    st = Station(program, [cfg])
+def test_two_nodes_share_the_line_and_a_silent_one_only_fails_itself(rtu_node: RtuNode) -> None:
+    program = (
+        "TNA $03760\n"
+        "FON C:$02100 N:NODE S:1\n"
+        "FON C:$02104 N:NREAD S:4000 D:$04000 R:2\n"
+        "FON C:$02110 N:NODE S:2\n"
+        "FON C:$02114 N:NREAD S:4000 D:$04010 R:2\n"
+        "JMP 0\n"
+    )
+    line = f"rtu://{rtu_node.port}?baudrate=19200"
+    nodes = [NodeConfig(1, line, unit=UNIT, timeout=0.2, retries=0),
+             NodeConfig(2, line, unit=UNIT + 1, timeout=0.2, retries=0)]  # nobody answers unit 6
+    st = Station(program, nodes)
     st.start()
     try:
-        wait_until(lambda: st.exchange.stats[0].errors >= 1)
-        assert st.engine.snapshot.get_bit(0o2105) == 0
-        assert st.engine.snapshot.get_word(0o4000) == 0
-        assert rtu_node.frames >= 1
+        snap = lambda: st.engine.snapshot  # noqa: E731
+        wait_until(lambda: st.exchange.stats[2].errors >= 2)
+        wait_until(lambda: snap().get_word(0o4000) == 0x5AA5 and snap().get_bit(0o2105) == 1)
+        assert snap().get_bit(0o2115) == 0 and snap().get_word(0o4010) == 0
+        assert snap().read(0o77741, 2) == b"\xff\x00"
+        assert st.exchange.stats[1].errors == 0 and st.exchange.stats[1].reads >= 1
+        assert "no answer" in st.exchange.stats[2].last_error or "retries" in st.exchange.stats[2].last_error
     finally:
         st.stop()
+
+
+def test_nodes_on_one_port_need_the_same_line_settings() -> None:
+    with pytest.raises(ValueError, match=r"node 2: .* share /dev/ttyS7 with different line settings"):
+        Station("JMP 0\n", [NodeConfig(1, "rtu:///dev/ttyS7?baudrate=9600"),
+                            NodeConfig(2, "rtu:///dev/ttyS7?baudrate=19200")])
