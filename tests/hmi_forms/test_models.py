@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import datetime as dt
 import math
 
 import pytest
@@ -271,5 +272,5 @@ def test_journal_refreshes_today_every_refresh_ticks(tmp_path) -> None:
     j = element(tmp_path, "MessageJournal", RefreshTicks=3, Kinds=["message"], MinType=2)
     assert [j.update(snap()) for _ in range(6)] == [False, False, True, False, False, True]
     assert j.kinds == ("message",) and j.min_type == 2
-    j.day = "01_01_2026"
+    j.day = dt.date(2026, 1, 1)
     assert not any(j.update(snap()) for _ in range(6))

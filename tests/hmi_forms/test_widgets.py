@@ -1,0 +1,233 @@
+"""Widgets really rendered (offscreen), operator input through a real Engine, and the demo forms."""
+
+from __future__ import annotations
+
+import shutil
+import time
+from pathlib import Path
+
+import pytest
+from PySide6.QtCore import Qt
+from PySide6.QtGui import QImage
+
+from hmi_forms.elements import ELEMENT_TYPES
+from hmi_forms.elements.target import EngineTarget
+from hmi_forms.form import Form, load_form, load_forms
+from hmi_forms.widgets.form_view import FormView
+from netplc.engine import Engine, FakeClock
+from netplc.program import load_symbols, parse
+from netplc.records import ListSink, Record
+from registrar.store import Store
+from tests.hmi_forms.helpers import snap, write_form
+
+EXAMPLE = Path(__file__).resolve().parents[2] / "resources" / "example"
+Q = "02101"  # quality bit used where an element has no state of its own
+LEVEL = [{"Name": "Level", "AppMin": 0, "AppMax": 4095, "PhyMin": 0, "PhyMax": 100}]
+
+
+def engine() -> tuple[Engine, ListSink]:
+    sink = ListSink()
+    return Engine(parse(""), clock=FakeClock(), wallclock=lambda: 1_800_000_000.0, sink=sink), sink
+
+
+def image(view: FormView, qtbot) -> QImage:
+    view.flush()
+    return view.grab().toImage()
+
+
+def differs(a: QImage, b: QImage) -> int:
+    """Number of differing pixels (sampled every 2 px)."""
+    assert a.size() == b.size()
+    points = ((x, y) for x in range(0, a.width(), 2) for y in range(0, a.height(), 2))
+    return sum(a.pixel(x, y) != b.pixel(x, y) for x, y in points)
+
+
+def one(tmp_path: Path, type_: str, w: int = 220, h: int = 140, **props) -> Form:
+    extra = {k: props.pop(k) for k in ("devices", "images") if k in props}
+    raw = {"type": type_, "Name": "E", "x": 0, "y": 0, "w": w, "h": h, **props}
+    doc = write_form(tmp_path, [raw], **extra)
+    form = load_form(doc)
+    form.width, form.height = w, h
+    return form
+
+
+def pump_images(tmp_path: Path) -> list[str]:
+    for name in ("pump_off.png", "pump_on_0.png", "pump_on_1.png", "tank.png"):
+        shutil.copy(EXAMPLE / "forms" / "images" / name, tmp_path / name)
+    return ["pump_off.png", "pump_on_0.png", "pump_on_1.png"]
+
+
+CASES = {
+    "SyncGenerator": ({"OutAddr": "02001", "InAddr": "02000", "Period0": 5, "Period1": 10, "Phase1": 1},
+                      {0o2000: 0}, {0o2000: 1}),
+    "SyncTimer": ({"OutAddr": "02001", "Ainput": "02002", "Period0": 1}, {0o2002: 1}, {0o2002: 0}),
+    "DiscreteBase": ({"InAddr": "02120", "TextFalse": "Стоп", "TextTrue": "Работа"},
+                     {0o2120: 0}, {0o2120: 1}),
+    "DiscreteColorLabel": ({"InAddr": "02120", "TextTrue": "ON", "BackColorTrue": "#2e7d32"},
+                           {0o2120: 0}, {0o2120: 1}),
+    "DiscreteControlledEnable": ({"InAddr": "02120", "EnableAddr": "02121", "TextTrue": "ON",
+                                  "BackColorTrue": "#2e7d32"},
+                                 {0o2120: 1, 0o2121: 0}, {0o2120: 1, 0o2121: 1}),
+    "DiscreteAnimation": ({"InAddr": "02120", "EnableAddr": "03760", "ImageFalse": 0, "ImageFirst": 1,
+                           "ImageLast": 2}, {0o2120: 0, 0o3760: 1}, {0o2120: 1, 0o3760: 1}),
+    "StaticPicture": ({"Image": "tank.png", "QualityAddr": Q}, {0o2101: 1}, {0o2101: 0}),
+    "StaticText": ({"Text": "Узел 0", "QualityAddr": Q}, {0o2101: 1}, {0o2101: 0}),
+    "Graph": ({"Address": "040005", "Elements": 20}, {0o40005: 0}, {0o40005: 1}),
+    "DateTime": ({"QualityAddr": Q}, {0o2101: 1}, {0o2101: 0}),
+}
+
+
+@pytest.mark.parametrize("type_", list(CASES))
+def test_each_element_type_renders_its_state(qtbot, tmp_path, type_: str) -> None:
+    props, state_a, state_b = CASES[type_]
+    images = pump_images(tmp_path)
+    form = one(tmp_path, type_, images=images, **props)
+    view = FormView(form, EngineTarget(engine()[0]))
+    qtbot.addWidget(view)
+    pictures = []
+    for scan, bits in enumerate((state_a, state_b)):
+        for k in range(12):  # several scans: graphs fill, animations step
+            view.refresh(snap(bits=bits, scan=scan * 100 + k, time=k, wall=1_800_000_000.0 + k))
+        pictures.append(image(view, qtbot))
+    assert differs(*pictures) > 20, type_
+
+
+@pytest.mark.parametrize("appearance", ["digital", "hbar", "dial", "semidial", "graph"])
+def test_analog_appearances_render_the_value(qtbot, tmp_path, appearance: str) -> None:
+    form = one(tmp_path, "AnalogBase", w=240, h=200, InAddr="04010", Device="Level", Units="%",
+               Appearance=appearance, PhyHigh=90, devices=LEVEL)
+    view = FormView(form, EngineTarget(engine()[0]))
+    qtbot.addWidget(view)
+    pictures = []
+    for base, hw in ((0, 400), (100, 4000)):
+        for k in range(5):
+            view.refresh(snap(words={0o4010: hw}, scan=base + k))
+        pictures.append(image(view, qtbot))
+    assert differs(*pictures) > 50
+    model = form.elements[0]
+    assert model.text == "97.7" and model.zone == "high"
+    for small in ((90, 70), (400, 320)):  # legible at small and large sizes: nothing raises
+        view.pairs[0][1].resize(*small)
+        view.pairs[0][1].grab()
+
+
+def test_stale_mark_covers_the_last_value(qtbot, tmp_path) -> None:
+    form = one(tmp_path, "AnalogBase", InAddr="04010", Device="Level", Appearance="digital", QualityAddr=Q,
+               devices=LEVEL)
+    view = FormView(form, EngineTarget(engine()[0]))
+    qtbot.addWidget(view)
+    view.refresh(snap(words={0o4010: 2048}, bits={0o2101: 1}))
+    live = image(view, qtbot)
+    view.refresh(snap(words={0o4010: 0}, bits={0o2101: 0}))
+    stale = image(view, qtbot)
+    widget = view.pairs[0][1]
+    assert widget.stale_mark.isVisibleTo(view) and form.elements[0].text == "50.0"
+    assert differs(live, stale) > 100
+
+
+def test_click_on_an_enabled_discrete_toggles_the_bit_through_the_scan(qtbot, tmp_path) -> None:
+    eng, sink = engine()
+    form = load_form(write_form(tmp_path, [
+        {"type": "DiscreteBase", "Name": "Пуск", "x": 0, "y": 0, "w": 120, "h": 40, "InAddr": "040042",
+         "Enabled": True},
+        {"type": "DiscreteBase", "Name": "Lamp", "x": 0, "y": 50, "w": 120, "h": 40, "InAddr": "02120"},
+    ]))
+    view = FormView(form, EngineTarget(eng), user="ivanov")
+    qtbot.addWidget(view)
+    view.refresh(eng.snapshot)
+    button, lamp = (w for _, w in view.pairs)
+    qtbot.mouseClick(button, Qt.MouseButton.LeftButton)
+    assert eng.snapshot.get_hmi_bit(0o40042) == 0  # queued, not yet applied
+    view.refresh(eng.scan())
+    assert eng.snapshot.get_hmi_bit(0o40042) == 1 and eng.snapshot.get_byte(0o4004) == 0b100
+    qtbot.mouseClick(button, Qt.MouseButton.LeftButton)
+    view.refresh(eng.scan())
+    assert eng.snapshot.get_hmi_bit(0o40042) == 0
+    assert [(r.kind, r.source, r.text) for r in sink.records] == [
+        ("operator", "ivanov", "write 040042: 0 -> 1"), ("operator", "ivanov", "write 040042: 1 -> 0")]
+    qtbot.mouseClick(lamp, Qt.MouseButton.LeftButton)
+    view.refresh(eng.scan())
+    assert eng.snapshot.get_hmi_bit(0o2120) == 0 and len(sink.records) == 2
+
+
+def test_analog_output_rejects_text_and_out_of_range_values_visibly(qtbot, tmp_path) -> None:
+    eng, sink = engine()
+    form = one(tmp_path, "AnalogOutput", w=280, h=110, OutAddr="04030", AppMin=0, AppMax=4095, PhyMin=-50,
+               PhyMax=150, Units="°C")
+    view = FormView(form, EngineTarget(eng))
+    qtbot.addWidget(view)
+    view.show()
+    widget = view.pairs[0][1]
+    before = image(view, qtbot)
+    for entry, message in (("abc", '"abc" is not a number'), ("200", "200 is out of range -50.0 … 150.0 °C")):
+        widget.edit.setText("")
+        qtbot.keyClicks(widget.edit, entry)
+        qtbot.keyClick(widget.edit, Qt.Key.Key_Return)
+        assert widget.message.text() == message and widget.message.isVisible()
+        assert "color: #d32f2f" in widget.message.styleSheet() and widget.edit.text() == entry
+    rejected = image(view, qtbot)
+    assert differs(before, rejected) > 20
+    view.refresh(eng.scan())
+    assert eng.snapshot.get_word(0o4030) == 0 and sink.records == []
+    widget.edit.setText("50")
+    qtbot.mouseClick(widget.button, Qt.MouseButton.LeftButton)
+    view.refresh(eng.scan())
+    assert eng.snapshot.get_word(0o4030) == 2048 and widget.message.text() == "Set to 50.0 °C"
+    assert widget.current.text() == "50.0 °C" and sink.records[0].kind == "operator"
+
+
+def test_sync_generator_drives_netplc_memory_through_the_engine(qtbot, tmp_path) -> None:
+    eng, sink = engine()
+    form = one(tmp_path, "SyncGenerator", InAddr="02000", OutAddr="02001", Period0=5, Phase0=0, Period1=10,
+               Phase1=1)
+    view = FormView(form, EngineTarget(eng))
+    qtbot.addWidget(view)
+    seen = []
+    for scan in range(32):
+        if scan == 12:
+            eng.write_bit(0o2000, 1, user="test")
+        view.refresh(eng.snapshot)
+        seen.append(eng.scan().get_bit(0o2001))
+    assert [i for i, v in enumerate(seen) if v] == [0, 5, 10, 21, 31]
+    assert [r.kind for r in sink.records] == ["operator"]  # generator writes are not journaled
+
+
+def test_message_journal_shows_the_archive(qtbot, tmp_path) -> None:
+    archive = tmp_path / "archive" / "journal.sqlite"
+    form = one(tmp_path, "MessageJournal", w=700, h=240, RefreshTicks=1)
+    view = FormView(form, EngineTarget(engine()[0]), archive_path=archive)
+    qtbot.addWidget(view)
+    widget = view.pairs[0][1]
+    empty = image(view, qtbot)
+    assert widget.status.text() == "no archive yet"
+    store = Store(archive)
+    store.start()
+    now = time.time()
+    store.put(Record(now, "message", grp=1, type=2, source="LT1", text="Уровень выше 90 %"))
+    store.put(Record(now, "message", grp=1, type=0, source="LT1", text="Уровень в норме"))
+    store.put(Record(now, "data", source="LT1", value=5.0))
+    store.close()
+    view.refresh(snap(scan=1))
+    assert [r.text for r in widget.table.rows] == ["Уровень в норме", "Уровень выше 90 %"]
+    assert differs(empty, image(view, qtbot)) > 100
+    widget.min_type.setCurrentIndex(2)  # alarms and worse
+    assert [r.type for r in widget.table.rows] == [2] and widget.status.text().startswith("1 records")
+    widget.close_archive()
+
+
+def test_demo_forms_load_and_use_every_element_type(qtbot) -> None:
+    symbols = load_symbols(EXAMPLE / "symbols.csv")
+    forms, found = load_forms(EXAMPLE / "forms", symbols)
+    assert found == [] and len(forms) >= 3
+    used = {el.TYPE for f in forms for el in f.elements}
+    assert used == set(ELEMENT_TYPES)
+    trigger = next(f for f in forms if any(el.Name == "Пуск" for el in f.elements))
+    start = next(el for el in trigger.elements if el.Name == "Пуск")
+    assert start.TYPE == "DiscreteBase" and start.InAddr.hmi == 0o40042 and start.Enabled
+    assert sorted(el.Address.hmi for el in trigger.elements if el.TYPE == "Graph") == [0o40003, 0o40005]
+    eng = engine()[0]
+    for form in forms:
+        view = FormView(form, EngineTarget(eng))
+        qtbot.addWidget(view)
+        view.refresh(eng.snapshot)
+        assert not view.grab().isNull() and view.errors == []
