@@ -158,6 +158,7 @@ class _Node:
         self.queue: asyncio.Queue[_Request] = asyncio.Queue()
         self.delay = config.backoff
         self.retry_at = 0.0  # monotonic time before which requests fail without trying
+        self.reported = False
 
     async def run(self) -> None:
         try:
@@ -237,8 +238,9 @@ class _Node:
         stats = self.stats
         if error:
             stats.last_error = error
-        if stats.up == up:
+        if stats.up == up and self.reported:
             return
+        self.reported = True  # the first outcome is reported either way: a node down from the start too
         stats.up = up
         stats.changed = time.monotonic()
         self.exchange.link_changed(self, up, error)

@@ -93,6 +93,10 @@ def test_silent_node_times_out_and_the_scan_does_not_wait() -> None:
             wait_until(lambda: st.exchange.stats[1].errors >= 1, timeout=3)
             assert snap().get_bit(0o2105) == 0
             assert "read holding 1024+1" in st.exchange.stats[1].last_error
+            # down from the start is reported too, not only a change after an up
+            texts = [r.text for r in st.sink.records if r.kind == "system" and r.source == "node 1"]
+            assert texts[0] == (f"node 1 (tcp://127.0.0.1:{port}): link down: "
+                                f"read holding 1024+1: no answer within {TIMEOUT:g} s")
             assert st.exchange.stats[2].reads > 50
             assert st.engine.stats.max_ms < 1000 * TIMEOUT / 3
         finally:
