@@ -120,7 +120,9 @@ def main() -> None:
             "alarms (kind message, type >= 2)": Filter(kinds={"message"}, min_type=2),
             "messages of group 3": Filter(kinds={"message"}, grp=3),
             "text contains 'авария'": Filter(text="авария"),
-            "no match (group 99): whole day scanned": Filter(grp=99),
+            "group 99 (no match, key index)": Filter(grp=99),
+            "operator records (none among 1,000,000)": Filter(kinds={"operator"}),
+            "text matching nothing (the whole day scanned)": Filter(text="нет такого"),
         }
         for label, flt in cases.items():
             ms, n = first_page(path, flt)

@@ -42,18 +42,16 @@ BATCH_MAX = 50_000  # records per transaction: bounds the time one commit holds 
 RETRY_MAX = 5.0  # seconds between attempts while the disk keeps failing
 BUSY_TIMEOUT_MS = 1000
 
-# A record as inserted: ts is still seconds (float); the INSERT rounds it to milliseconds.
-Row = tuple[float, str, int | None, int | None, str | None, int | None, float | None, str | None]
-_FIELDS = operator.attrgetter("ts", "kind", "grp", "type", "source", "number", "value", "text")
-_TS, _KIND, _KEY = operator.itemgetter(0), operator.itemgetter(1), operator.itemgetter(1, 2, 3, 4)
-HALF_MS = 0.0005  # a record rounding up to the next midnight belongs to the next day
+Row = tuple[int, str, int | None, int | None, str | None, int | None, float | None, str | None]
+_TS = operator.attrgetter("ts")
+_REST = operator.attrgetter("kind", "grp", "type", "source", "number", "value", "text")
+_KIND, _KEY = operator.itemgetter(1), operator.itemgetter(1, 2, 3, 4)
 
 
-def _day_of(ts: float) -> tuple[float, float, str]:
-    """The [start, end) seconds of the local day whose table gets a record at `ts`, and its name."""
-    day, start, end = local_day_bounds(ts + HALF_MS)
-    return start - HALF_MS, end - HALF_MS, table_name(day)
-
+def _day_of(ms: int) -> tuple[int, int, str]:
+    """The [start, end) milliseconds of the local day holding `ms`, and its table's name."""
+    day, start, end = local_day_bounds(ms / 1000)
+    return round(start * 1000), round(end * 1000), table_name(day)
 
 
 @dataclass(frozen=True)
@@ -98,7 +96,7 @@ class Store:
         self._last_error = ""
         self._con: sqlite3.Connection | None = None
         self._known: dict[str, set[tuple]] = {}  # day table -> data series keys already listed
-        self._day: tuple[float, float, str] = (0.0, 0.0, "")  # [start, end) of the cached local day
+        self._day: tuple[int, int, str] = (0, 0, "")  # [start, end) ms of the last local day seen
         self._reported_drops = 0
         self._failing_since: float | None = None
         self._new_day = False  # a day table was opened: run retention after the commit
@@ -248,7 +246,7 @@ class Store:
                 self._ensure_table(con, table, rows)
                 con.executemany(
                     f'INSERT INTO "{table}" (ts, kind, grp, type, source, number, value, text) '
-                    "VALUES (CAST(round(? * 1000) AS INTEGER), ?, ?, ?, ?, ?, ?, ?)", rows)
+                    "VALUES (?, ?, ?, ?, ?, ?, ?, ?)", rows)
             con.execute("COMMIT")
         except (sqlite3.Error, OSError) as e:
             self._failed(con, e, batch)
@@ -286,8 +284,9 @@ class Store:
                                 text=f"{text}; records are kept in memory and retried"))
 
     def _rows_by_table(self, batch: list[Record]) -> dict[str, list[Row]]:
-        """Rows for each day table; the common batch lies in one day and is built in C loops."""
-        rows = list(map(_FIELDS, batch))
+        """Rows for each day table, built in C loops where it counts (a batch is mostly one day)."""
+        stamps = [round(ts * 1000) for ts in map(_TS, batch)]
+        rows = list(map(operator.add, zip(stamps), map(_REST, batch)))
         kinds = list(map(_KIND, rows))
         i = 0
         with contextlib.suppress(ValueError):  # raised when no message is left
@@ -295,31 +294,29 @@ class Store:
                 i = kinds.index("message", i)
                 rows[i] = self._resolve(rows[i])
                 i += 1
-        stamps = list(map(_TS, rows))
         start, end, name = self._day
         if name and start <= min(stamps) and max(stamps) < end:
             return {name: rows}
         tables: dict[str, list[Row]] = {}
-        for row, ts in zip(rows, stamps):
-            if not start <= ts < end:
-                start, end, name = _day_of(ts)
-                self._day = (start, end, name)
+        for row in rows:
+            if not start <= row[0] < end:
+                start, end, name = _day_of(row[0])
             tables.setdefault(name, []).append(row)
+        self._day = (start, end, name)
         return tables
 
     def _resolve(self, row: Row) -> Row:
         """An NMSG record gets its catalog text (and group and type if it named none)."""
-        ts, kind, grp, typ, source, number, value, text = row
+        ms, kind, grp, typ, source, number, value, text = row
         if number is None:
             return row
         if text is None:
             text = self.catalog.text_for(number)
-        if grp is None or typ is None:
-            message = self.catalog.get(number)
-            if message is not None:
-                grp = message.grp if grp is None else grp
-                typ = message.type if typ is None else typ
-        return (ts, kind, grp, typ, source, number, value, text)
+        message = self.catalog.get(number)
+        if message is not None:
+            grp = message.grp if grp is None else grp
+            typ = message.type if typ is None else typ
+        return (ms, kind, grp, typ, source, number, value, text)
 
     def _ensure_table(self, con: sqlite3.Connection, table: str, rows: list[Row]) -> None:
         known = self._known.get(table)
