@@ -122,7 +122,7 @@ def main() -> None:
             "text contains 'авария'": Filter(text="авария"),
             "group 99 (no match, key index)": Filter(grp=99),
             "operator records (none among 1,000,000)": Filter(kinds={"operator"}),
-            "text matching nothing (the whole day scanned)": Filter(text="нет такого"),
+            "text matching nothing (every text of the day read)": Filter(text="нет такого"),
         }
         for label, flt in cases.items():
             ms, n = first_page(path, flt)

@@ -23,7 +23,15 @@ from urllib.parse import quote
 
 import numpy as np
 
-from registrar.schema import COLUMNS, DAY_GLOB, key_index, parse_table_name, quoted, table_name
+from registrar.schema import (
+    COLUMNS,
+    DAY_GLOB,
+    key_index,
+    parse_table_name,
+    quoted,
+    table_name,
+    text_index,
+)
 
 EXPORT_CHUNK = 10_000
 PROBE_ROWS = 20_000  # newest rows tried first for a page (a couple of milliseconds)
@@ -151,9 +159,13 @@ class Archive:
             index = f'"{key_index(table_name(day))}"'
             return [_row(r) for r in self._con.execute(
                 f"{_SELECT} FROM {table} INDEXED BY {index}{where} {page}", [*args, limit, offset])]
-        # 3. Everything else: one scan of the day in id order, stopping at the page.
+        # 3. Everything else: one pass in id order, stopping at the page; a text search passes
+        #    over the rows that have a text only.
+        source = "NOT INDEXED"
+        if flt.text and self._has_index(text_index(table_name(day))):
+            source = f'INDEXED BY "{text_index(table_name(day))}"'
         return [_row(r) for r in self._con.execute(
-            f"{_SELECT} FROM {table} NOT INDEXED{where} {page}", [*args, limit, offset])]
+            f"{_SELECT} FROM {table} {source}{where} {page}", [*args, limit, offset])]
 
     def _keyed(self, day: dt.date, flt: Filter) -> Filter | None:
         """The filter with its kinds spelt out, if the key index narrows it to few rows."""
@@ -242,6 +254,10 @@ class Archive:
 
     # --- helpers -------------------------------------------------------------------------------
 
+    def _has_index(self, name: str) -> bool:
+        return self._con.execute("SELECT 1 FROM sqlite_master WHERE type = 'index' AND name = ?",
+                                 (name,)).fetchone() is not None
+
     def _has(self, day: dt.date) -> bool:
         return self._con.execute("SELECT 1 FROM sqlite_master WHERE type = 'table' AND name = ?",
                                  (table_name(day),)).fetchone() is not None
@@ -285,7 +301,8 @@ def _where(flt: Filter) -> tuple[str, list[object]]:
     if flt.text:
         # SQLite folds case for ASCII only; the usual spellings of a Cyrillic word are tried too.
         variants = sorted({flt.text, flt.text.lower(), flt.text.upper(), flt.text.capitalize()})
-        conds.append("(" + " OR ".join("text LIKE ? ESCAPE '\\'" for _ in variants) + ")")
+        likes = " OR ".join("text LIKE ? ESCAPE '\\'" for _ in variants)
+        conds.append(f"text IS NOT NULL AND ({likes})")
         args.extend(f"%{_escape_like(v)}%" for v in variants)
     return (" WHERE " + " AND ".join(conds)) if conds else "", args
 

@@ -25,10 +25,27 @@ DAY_COLUMNS_SQL = """(
     text   TEXT
 )"""
 
-# The only index: low-cardinality keys receive rows in id order, so each insert lands on the last
-# page of its key range and the index costs little while writing. It serves series (all four
-# keys fixed: rows come out in id order) and counts; pages are read in id order (see query.py).
+# Two indexes, both cheap while writing. The key index: its low-cardinality keys receive rows in
+# id order, so each insert lands on the last page of its key range. It serves series (all four
+# keys fixed: rows come out in id order), counts, and pages of rare kinds. The text index holds
+# only rows with a text (messages, operator and system records, not NSTORE data), in id order
+# with the text beside it, so a text search reads those alone and never the table's data rows.
 KEY_INDEX_COLUMNS = "(kind, grp, type, source)"
+
+
+def key_index(table: str) -> str:
+    return f"{table}_key"
+
+
+def text_index(table: str) -> str:
+    return f"{table}_text"
+
+
+def index_sql(table: str) -> list[str]:
+    return [f'CREATE INDEX IF NOT EXISTS "{key_index(table)}" ON "{table}" {KEY_INDEX_COLUMNS}',
+            f'CREATE INDEX IF NOT EXISTS "{text_index(table)}" ON "{table}" (id, text) '
+            "WHERE text IS NOT NULL"]
+
 
 META_SQL = "CREATE TABLE IF NOT EXISTS meta (key TEXT PRIMARY KEY, value TEXT)"
 MESSAGES_SQL = ("CREATE TABLE IF NOT EXISTS messages "
@@ -40,10 +57,6 @@ SERIES_SQL = ("CREATE TABLE IF NOT EXISTS series (day TEXT NOT NULL, kind TEXT N
 
 def table_name(day: dt.date) -> str:
     return f"{day.day:02d}_{day.month:02d}_{day.year:04d}"
-
-
-def key_index(table: str) -> str:
-    return f"{table}_key"
 
 
 def parse_table_name(name: str) -> dt.date | None:

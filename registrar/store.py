@@ -26,12 +26,11 @@ from registrar.catalog import Catalog
 from registrar.schema import (
     DAY_COLUMNS_SQL,
     DAY_GLOB,
-    KEY_INDEX_COLUMNS,
     MESSAGES_SQL,
     META_SQL,
     SCHEMA_VERSION,
     SERIES_SQL,
-    key_index,
+    index_sql,
     local_day_bounds,
     parse_table_name,
     table_name,
@@ -322,7 +321,8 @@ class Store:
         known = self._known.get(table)
         if known is None:
             con.execute(f'CREATE TABLE IF NOT EXISTS "{table}" {DAY_COLUMNS_SQL}')
-            con.execute(f'CREATE INDEX IF NOT EXISTS "{key_index(table)}" ON "{table}" {KEY_INDEX_COLUMNS}')
+            for sql in index_sql(table):
+                con.execute(sql)
             known = {tuple(k) for k in con.execute(
                 "SELECT kind, grp, type, source FROM series WHERE day = ?", (table,))}
             self._known[table] = known
