@@ -12,6 +12,7 @@ from __future__ import annotations
 
 import contextlib
 import datetime as dt
+import math
 import operator
 import sqlite3
 import threading
@@ -45,6 +46,27 @@ Row = tuple[int, str, int | None, int | None, str | None, int | None, float | No
 _TS = operator.attrgetter("ts")
 _REST = operator.attrgetter("kind", "grp", "type", "source", "number", "value", "text")
 _KIND, _KEY = operator.itemgetter(1), operator.itemgetter(1, 2, 3, 4)
+
+
+# What a record that breaks the Record contract raises while its row is built or bound.
+_MALFORMED = (TypeError, ValueError, OverflowError, AttributeError, sqlite3.InterfaceError,
+              sqlite3.ProgrammingError)
+_INT64 = range(-(2**63), 2**63)
+
+
+def _well_formed(r: object) -> bool:
+    return (isinstance(r, Record) and isinstance(r.ts, int | float) and math.isfinite(r.ts)
+            and abs(r.ts) < 1e12 and isinstance(r.kind, str)
+            and all(v is None or (isinstance(v, int) and v in _INT64) for v in (r.grp, r.type, r.number))
+            and all(v is None or isinstance(v, str) for v in (r.source, r.text))
+            and (r.value is None or isinstance(r.value, float)
+                 or (isinstance(r.value, int) and r.value in _INT64)))
+
+
+def _rollback(con: sqlite3.Connection) -> None:
+    if con.in_transaction:
+        with contextlib.suppress(sqlite3.Error):  # if it fails, SQLite has rolled back already
+            con.execute("ROLLBACK")
 
 
 def _day_of(ms: int) -> tuple[int, int, str]:
@@ -239,14 +261,12 @@ class Store:
         con = self._con
         assert con is not None
         try:
-            tables = self._rows_by_table(batch)
-            con.execute("BEGIN IMMEDIATE")
-            for table, rows in tables.items():
-                self._ensure_table(con, table, rows)
-                con.executemany(
-                    f'INSERT INTO "{table}" (ts, kind, grp, type, source, number, value, text) '
-                    "VALUES (?, ?, ?, ?, ?, ?, ?, ?)", rows)
-            con.execute("COMMIT")
+            try:
+                self._insert(con, batch)
+            except _MALFORMED:
+                _rollback(con)
+                batch[:] = self._valid(batch)
+                self._insert(con, batch)
         except (sqlite3.Error, OSError) as e:
             self._failed(con, e, batch)
             return False
@@ -270,10 +290,28 @@ class Store:
                                           text=f"archive commit listener failed and was removed: {e!r}"))
         return True
 
+    def _insert(self, con: sqlite3.Connection, batch: list[Record]) -> None:
+        tables = self._rows_by_table(batch)
+        con.execute("BEGIN IMMEDIATE")
+        for table, rows in tables.items():
+            self._ensure_table(con, table, rows)
+            con.executemany(
+                f'INSERT INTO "{table}" (ts, kind, grp, type, source, number, value, text) '
+                "VALUES (?, ?, ?, ?, ?, ?, ?, ?)", rows)
+        con.execute("COMMIT")
+
+    def _valid(self, batch: list[Record]) -> list[Record]:
+        """The well-formed records, and a 'system' record naming what was refused."""
+        good = [r for r in batch if _well_formed(r)]
+        if len(good) < len(batch):
+            bad = [r for r in batch if not _well_formed(r)]
+            good.append(Record(self.wallclock(), "system", source=SOURCE,
+                               text=f"archive refused {len(bad)} malformed record(s), "
+                                    f"the first: {bad[0]!r:.300}"))
+        return good
+
     def _failed(self, con: sqlite3.Connection, error: Exception, batch: list[Record]) -> None:
-        if con.in_transaction:
-            with contextlib.suppress(sqlite3.Error):  # if it fails, SQLite has rolled back already
-                con.execute("ROLLBACK")
+        _rollback(con)
         self._known.clear()  # tables created in the failed transaction are gone
         text = f"archive write failed: {error}"
         self._last_error = text

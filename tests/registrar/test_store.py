@@ -200,3 +200,20 @@ def test_records_are_split_where_their_milliseconds_fall(db):
     store.close()
     assert rows(db, "05_03_2026", "ts, value") == [(round(midnight * 1000), 1.0)]
     assert rows(db, "04_03_2026", "ts, value") == [(round(midnight * 1000) - 1, 2.0)]
+
+
+def test_malformed_records_are_refused_and_the_rest_is_kept(db):
+    store = Store(db, wallclock=lambda: 1_790_000_000.0)
+    store.put(Record(1_790_000_000.0, "data", 1, 1, "04000", value=1.0))
+    store.put(Record(float("nan"), "data", 1, 1, "04000", value=2.0))
+    store.put(Record(1_790_000_000.0, "data", 1, 1, "04000", value=[3]))  # type: ignore[arg-type]
+    store.put("not a record")  # type: ignore[arg-type]
+    store.put(Record(1_790_000_000.5, "data", 1, 1, "04000", value=4.0))
+    store.start()
+    store.close()
+    day = table_name(dt.date.fromtimestamp(1_790_000_000.0))
+    got = rows(db, day, "kind, value, text")
+    assert [v for k, v, _ in got if k == "data"] == [1.0, 4.0]
+    (text,) = [t for k, _, t in got if k == "system"]
+    assert text.startswith("archive refused 3 malformed record(s), the first: Record(ts=nan")
+    assert store.stats.last_error == ""
