@@ -378,8 +378,7 @@ class Store:
         try:
             self._drop_old_days(con)
         except sqlite3.Error as e:
-            if con.in_transaction:
-                con.execute("ROLLBACK")
+            _rollback(con)
             self._last_error = f"dropping old days failed: {e}"
 
     def _drop_old_days(self, con: sqlite3.Connection) -> None:
