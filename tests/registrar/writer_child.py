@@ -14,7 +14,7 @@ def main(path: str) -> None:
     def committed(total: int) -> None:
         print(total, flush=True)
 
-    store = Store(path, flush_interval=0.02, on_commit=committed)
+    store = Store(path, flush_interval=0.02, queue_size=10_000_000, on_commit=committed)  # never drops
     store.start()
     i = 0
     while True:
