@@ -40,7 +40,7 @@ def make_table(model: RecordsModel) -> QTableView:
     table.verticalHeader().setDefaultSectionSize(22)
     header = table.horizontalHeader()
     header.setStretchLastSection(True)
-    for col, width in enumerate((96, 70, 52, 64, 120, 44, 70)):
+    for col, width in enumerate((96, 70, 52, 64, 120, 64, 70)):
         header.resizeSection(col, width)
     header.setSectionResizeMode(QHeaderView.ResizeMode.Interactive)
     return table
@@ -56,7 +56,8 @@ class JournalDock(QDockWidget):
         lay = QVBoxLayout(body)
         lay.setContentsMargins(4, 4, 4, 4)
         bar = QHBoxLayout()
-        self.messages_only = QCheckBox("Messages and operator actions only")
+        self.messages_only = QCheckBox("Events only (messages, operator actions, system)")
+        self.messages_only.setChecked(True)  # data records are for the viewer's plots
         self.messages_only.toggled.connect(self._filter_changed)
         self.summary = QLabel()
         bar.addWidget(self.messages_only)

@@ -11,7 +11,7 @@ from __future__ import annotations
 import sys
 import time
 
-from PySide6.QtCore import Qt, QTimer
+from PySide6.QtCore import QSize, Qt, QTimer
 from PySide6.QtGui import QAction, QCloseEvent, QKeySequence
 from PySide6.QtWidgets import (
     QApplication,
@@ -42,6 +42,9 @@ from netplc.program import ProgramError, load_symbols
 from netplc.records import Record
 
 STATUS_MS = 500
+FRAME_HEIGHT = 380  # menu, header, banner, tabs, journal dock and status bar around a form
+MIN_SIZE = (1024, 720)
+JOURNAL_HEIGHT = 190
 
 
 class MainWindow(QMainWindow):
@@ -86,7 +89,7 @@ class MainWindow(QMainWindow):
         self._timer.timeout.connect(self.refresh_status)
         self._timer.start()
         self.refresh_status()
-        self.resize(1280, 860)
+        self._fit_to_forms()
 
     @property
     def user(self) -> str:
@@ -138,7 +141,7 @@ class MainWindow(QMainWindow):
             self.views.append(view)
             scroll = QScrollArea()
             scroll.setWidget(view)
-            scroll.setAlignment(Qt.AlignmentFlag.AlignCenter)
+            scroll.setAlignment(Qt.AlignmentFlag.AlignHCenter | Qt.AlignmentFlag.AlignTop)
             scroll.setFrameShape(QFrame.Shape.NoFrame)
             self.tabs.addTab(scroll, form.title)
         if problems:
@@ -148,6 +151,20 @@ class MainWindow(QMainWindow):
             self.tabs.addTab(_placeholder(f"No .hmi forms in {station.HMIload}."), "No forms")
         self.header.user.currentTextChanged.connect(self._user_changed)
         return problems
+
+    def preferred_size(self) -> QSize:
+        """Large enough to show the biggest form above the journal."""
+        width = max((v.width() for v in self.views), default=900) + 40
+        height = max((v.height() for v in self.views), default=500) + FRAME_HEIGHT
+        return QSize(max(width, MIN_SIZE[0]), max(height, MIN_SIZE[1]))
+
+    def _fit_to_forms(self) -> None:
+        size = self.preferred_size()
+        screen = self.screen()
+        if screen is not None:
+            size = size.boundedTo(screen.availableGeometry().size())
+        self.resize(size)
+        self.resizeDocks([self.journal], [JOURNAL_HEIGHT], Qt.Orientation.Vertical)
 
     # --- live updates --------------------------------------------------------------------------
 

@@ -11,6 +11,7 @@ import time
 from PySide6.QtCore import QAbstractTableModel, QModelIndex, QPersistentModelIndex, Qt
 from PySide6.QtGui import QBrush, QColor
 
+from netplc.address import fmt_octal
 from registrar.query import Row
 
 COLUMNS = ("Time", "Kind", "Group", "Type", "Source", "No.", "Value", "Text")
@@ -85,7 +86,10 @@ class RecordsModel(QAbstractTableModel):
         if col == 4:
             return row.source or ""
         if col == 5:
-            return "" if row.number is None else str(row.number)
+            if row.number is None:
+                return ""
+            # an operator write names the address it wrote: octal, as everywhere else
+            return fmt_octal(row.number) if row.kind == "operator" else str(row.number)
         if col == 6:
             return format_value(row.value)
         return row.text or ""

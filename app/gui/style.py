@@ -50,6 +50,10 @@ QHeaderView::section { background: #e6e9ee; color: #263445; border: none;
 
 
 def apply_style(app: QApplication) -> None:
+    """Idempotent: replacing the QStyle of a running application deletes the one its widgets use."""
+    if app.property("netplc_styled"):
+        return
+    app.setProperty("netplc_styled", True)
     app.setStyle("Fusion")
     font = QFont("DejaVu Sans", 9)
     app.setFont(font)

@@ -1,0 +1,130 @@
+"""`python -m app.screenshots DIR`: the workstation and the viewer on the demo station, as PNGs.
+
+The demo station runs for real (a copy in a temporary folder, the embedded node over TCP, its own
+archive) while a short script plays the operator: Пуск pressed a few times, a setpoint entered,
+the pump switched on, and the level driven over its alarm limit, so that the pictures show what an
+operator sees on a working plant, not empty widgets.
+"""
+
+from __future__ import annotations
+
+import argparse
+import re
+import shutil
+import sys
+import tempfile
+import time
+from collections.abc import Callable
+from pathlib import Path
+from typing import TYPE_CHECKING
+
+from app.config import load_station
+
+if TYPE_CHECKING:
+    from PySide6.QtCore import QCoreApplication
+
+    from app.runtime import Runtime
+
+DEMO = Path(__file__).resolve().parent.parent / "resources" / "example"
+SIZE = (1400, 900)  # the viewer's
+RUN_SECONDS = 24.0
+START_BIT = 0o40042
+PUMP, PUMP_IND = 0o2120, 0o2121
+SETPOINT = 0o4030
+LEVEL = 0o4010
+
+
+def copy_station(dest: Path) -> Path:
+    shutil.copytree(DEMO, dest, ignore=shutil.ignore_patterns("archive", "__pycache__"))
+    toml = dest / "station.toml"
+    toml.write_text(re.sub(r"(?m)^port = 1502$", "port = 0", toml.read_text(encoding="utf-8")),
+                    encoding="utf-8")
+    return dest
+
+
+def slug(text: str) -> str:
+    return re.sub(r"[^0-9a-z]+", "-", text.lower()).strip("-") or "form"
+
+
+def main(argv: list[str] | None = None) -> int:
+    ap = argparse.ArgumentParser(prog="python -m app.screenshots",
+                                 description="Render the workstation and the viewer on the demo station.")
+    ap.add_argument("out", type=Path, help="folder for the PNGs (docs/screenshots)")
+    ap.add_argument("--seconds", type=float, default=RUN_SECONDS, help="how long the station runs first")
+    args = ap.parse_args(argv)
+
+    from PySide6.QtWidgets import QApplication
+
+    from app.gui.main_window import MainWindow
+    from app.gui.style import apply_style
+    from app.gui.viewer import ViewerWindow
+    from app.runtime import Runtime
+
+    app = QApplication.instance() or QApplication(sys.argv[:1])
+    apply_style(app)
+    args.out.mkdir(parents=True, exist_ok=True)
+    written: list[Path] = []
+    with tempfile.TemporaryDirectory() as tmp:
+        runtime = Runtime(load_station(copy_station(Path(tmp) / "station")))
+        runtime.start()
+        window = MainWindow(runtime)
+        window.resize(window.preferred_size())
+        window.show()
+        try:
+            _play_operator(runtime, lambda s: _pump_events(app, s), args.seconds)
+            for i, view in enumerate(window.views):
+                window.tabs.setCurrentIndex(i)
+                _pump_events(app, 0.3)
+                view.flush()
+                path = args.out / f"workstation-{slug(view.form.path.stem)}.png"
+                window.grab().save(str(path))
+                written.append(path)
+        finally:
+            window.close()
+            runtime.stop()
+        viewer = ViewerWindow(runtime.station.Archive)
+        viewer.resize(*SIZE)
+        viewer.show()
+        _pump_events(app, 0.3)
+        path = args.out / "viewer-records.png"
+        viewer.grab().save(str(path))
+        written.append(path)
+        for row in range(min(3, viewer.series_list.count())):
+            viewer.check_series(row)
+        viewer.tabs.setCurrentIndex(1)
+        _pump_events(app, 0.5)
+        path = args.out / "viewer-series.png"
+        viewer.grab().save(str(path))
+        written.append(path)
+        viewer.close()
+    for path in written:
+        print(path)
+    return 0
+
+
+def _play_operator(runtime: Runtime, wait: Callable[[float], None], seconds: float) -> None:
+    """A few minutes of a shift, compressed: what makes the forms and the journal worth looking at."""
+    engine = runtime.engine
+    node = runtime.simulators[0].engine
+    engine.write_word(SETPOINT, 2867, user="operator")  # 70 %: the temperature starts to follow
+    engine.write_bit(PUMP_IND, 1, user="operator")
+    wait(1.0)
+    engine.write_bit(PUMP, 1, user="operator")
+    node.write_word(LEVEL, 3300)  # the tank is nearly full: the level alarm comes during the run
+    start = time.monotonic()
+    pressed = 0
+    while time.monotonic() - start < seconds:
+        engine.write_bit(START_BIT, 1 - pressed % 2, user="operator")
+        pressed += 1
+        wait(1.2)
+
+
+def _pump_events(app: QCoreApplication, seconds: float) -> None:
+    end = time.monotonic() + seconds
+    while time.monotonic() < end:
+        app.processEvents()
+        time.sleep(0.01)
+
+
+if __name__ == "__main__":
+    sys.exit(main())
