@@ -225,3 +225,12 @@ def test_a_file_that_is_no_archive_is_named_in_the_error(tmp_path):
     path.write_bytes(b"plain text, not SQLite " * 100)
     with pytest.raises(sqlite3.DatabaseError, match=r"notes\.sqlite: cannot open the archive"):
         Archive(path)
+
+
+def test_a_series_stays_in_time_order_when_the_clock_was_set_back(db):
+    stamps = [T0 + 10, T0 + 11, T0 + 5, T0 + 12]  # the wall clock jumped back after the second
+    write(db, [Record(t, "data", 1, 1, "04000", value=float(i)) for i, t in enumerate(stamps)])
+    with Archive(db) as a:
+        ts, values = a.series(DAY, grp=1, type=1, source="04000")
+        assert list(ts) == sorted(stamps) and list(values) == [2.0, 0.0, 1.0, 3.0]
+        assert [r.value for r in a.records(DAY, newest_first=False)] == [0.0, 1.0, 2.0, 3.0]
