@@ -2,13 +2,15 @@
 
 The file is opened read-only, and in WAL mode a reader sees the last committed state without ever
 blocking the writer. Every statement is fetched completely before returning, so no read
-transaction stays open to hold back the writer's checkpoints.
+transaction stays open to hold back the writer's checkpoints. A copy on read-only media, where
+SQLite cannot make its -shm file, is opened as immutable.
 
 Pages are in id order (newest first by default) and are found in three steps: the newest 20,000
-rows are filtered first (the first page of a common filter is there); a filter naming kinds (and
-a group, type, source) whose matches are few takes them from the key index and sorts them (the
-journal's messages among a day of NSTORE data); anything else scans the day once in id order,
-stopping at the page. Series use the key index too, whose rows for one key come out in id order.
+rows are filtered first (the first page of a common filter is there); a filter naming kinds or a
+group whose matches are few takes them from the key index and sorts them (the journal's messages
+among a day of NSTORE data); anything else passes over the day once in id order, stopping at the
+page (a text search over the text index: rows with a text only). Series use the key index too,
+whose rows for one key come out in id order.
 """
 
 from __future__ import annotations
