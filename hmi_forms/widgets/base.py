@@ -1,5 +1,10 @@
 """The base of every element widget: geometry from the model, UObject frame, and the stale mark.
 
+Painting is split in two: a layer (background, frame and everything that depends only on a few
+states, such as a discrete element's text or a gauge's scale) rendered once per state into a
+pixmap, and a dynamic part (a pointer, a value) drawn over it. A form of hundreds of elements then
+costs one pixmap copy per element and tick plus the few strokes that really change.
+
 Widgets only draw what their model computed. The stale mark (grey wash, hatching and a "?" badge)
 is a child widget kept above everything else, so it also covers plots and input fields, and it is
 drawn identically for all element types: an operator learns it once.
@@ -7,15 +12,17 @@ drawn identically for all element types: an operator learns it once.
 
 from __future__ import annotations
 
+from collections.abc import Hashable
 from pathlib import Path
 
 from PySide6.QtCore import QPointF, QRectF, Qt
-from PySide6.QtGui import QBrush, QColor, QPainter, QPaintEvent, QPen, QPixmap
+from PySide6.QtGui import QBrush, QColor, QPainter, QPaintEvent, QPen, QPixmap, QResizeEvent
 from PySide6.QtWidgets import QWidget
 
 from hmi_forms.elements import Element
 from hmi_forms.widgets import theme
 
+MAX_LAYERS = 6  # cached layers per widget: enough for every state of a discrete element
 CURSORS = {"Hand": Qt.CursorShape.PointingHandCursor, "Cross": Qt.CursorShape.CrossCursor,
            "IBeam": Qt.CursorShape.IBeamCursor, "No": Qt.CursorShape.ForbiddenCursor}
 
@@ -94,6 +101,7 @@ class ElementWidget(QWidget):
         self.stale_mark = StaleMark(self)
         self.stale_mark.setGeometry(self.rect())
         self._stale = False
+        self._layers: dict[Hashable, QPixmap] = {}
         back = self.back_color()
         if back is not None and back.alpha() == 255:
             self.setAttribute(Qt.WidgetAttribute.WA_OpaquePaintEvent)
@@ -117,27 +125,60 @@ class ElementWidget(QWidget):
     def flush(self) -> None:
         """Bring throttled parts (plots, queries) up to date; plain painted widgets have none."""
 
+    def layer_key(self) -> Hashable:
+        """What the cached layer (background, frame, `paint_static`) depends on."""
+        return ()
+
     def paintEvent(self, event: QPaintEvent) -> None:
+        key = self.layer_key()
+        layer = self._layers.get(key)
+        if layer is None:
+            layer = self._layers[key] = self._render_layer()
+            if len(self._layers) > MAX_LAYERS:
+                del self._layers[next(iter(self._layers))]
         p = QPainter(self)
         try:  # a painter left active after an error would crash Qt
-            self.paint(p)
+            p.drawPixmap(0, 0, layer)
+            p.setRenderHint(QPainter.RenderHint.Antialiasing)
+            self.paint_dynamic(p, QRectF(self.rect()))
         finally:
             p.end()
 
-    def paint(self, p: QPainter) -> None:
-        p.setRenderHint(QPainter.RenderHint.Antialiasing)
-        r = QRectF(self.rect())
+    def _render_layer(self) -> QPixmap:
+        dpr = self.devicePixelRatioF()
+        pix = QPixmap(self.size() * dpr)
+        pix.setDevicePixelRatio(dpr)
+        back = self.back_color()
+        opaque = back is not None and back.alpha() == 255
+        pix.fill(back if opaque else Qt.GlobalColor.transparent)  # opaque layers copy without blending
+        p = QPainter(pix)
+        try:  # a painter left open on a pixmap crashes Qt when the pixmap goes
+            p.setRenderHint(QPainter.RenderHint.Antialiasing)
+            self.paint_layer(p, QRectF(self.rect()))
+        finally:
+            p.end()
+        return pix
+
+    def paint_layer(self, p: QPainter, r: QRectF) -> None:
         back = self.back_color()
         if back is not None:
             p.fillRect(r, back)
         if self.model.BackgroundImage is not None:
             draw_pixmap(p, self.images.get(self.model.BackgroundImage), r, "Zoom",
                         theme.alignment(self.model.ImageAlign))
-        self.paint_content(p, r)
+        self.paint_static(p, r)
         self.paint_border(p, r)
 
-    def paint_content(self, p: QPainter, r: QRectF) -> None:
-        """Draw the element itself inside `r`."""
+    def paint_static(self, p: QPainter, r: QRectF) -> None:
+        """Draw what changes rarely (it is cached per `layer_key`)."""
+
+    def paint_dynamic(self, p: QPainter, r: QRectF) -> None:
+        """Draw what changes every tick, over the cached layer."""
+
+    def resizeEvent(self, event: QResizeEvent) -> None:
+        self._layers.clear()
+        self.stale_mark.setGeometry(self.rect())
+        super().resizeEvent(event)
 
     def paint_border(self, p: QPainter, r: QRectF) -> None:
         style = self.model.BorderStyle

@@ -7,6 +7,8 @@ left: its state must be visible even when TextFalse and TextTrue are empty.
 
 from __future__ import annotations
 
+from collections.abc import Hashable
+
 from PySide6.QtCore import QRectF, Qt
 from PySide6.QtGui import QColor, QLinearGradient, QMouseEvent, QPainter, QPen
 from PySide6.QtWidgets import QWidget
@@ -40,12 +42,15 @@ class DiscreteWidget(ElementWidget):
             return theme.qcolor(self.model.fore_color, theme.TEXT)
         return super().fore_color()
 
-    def paint(self, p: QPainter) -> None:
+    def layer_key(self) -> Hashable:
+        m = self.model
+        return m.value, m.indicating, m.image, m.text, m.clickable, self._pressed
+
+    def paint_layer(self, p: QPainter, r: QRectF) -> None:
         if not self.model.Enabled:
-            super().paint(p)
+            super().paint_layer(p, r)
             return
-        p.setRenderHint(QPainter.RenderHint.Antialiasing)
-        r = QRectF(self.rect()).adjusted(1, 1, -1, -1)
+        r = r.adjusted(1, 1, -1, -1)
         base = self.back_color() or theme.PANEL
         if self._pressed:
             top, bottom = base.darker(112), base.darker(104)
@@ -60,9 +65,9 @@ class DiscreteWidget(ElementWidget):
         if not self._pressed:
             p.setPen(QPen(QColor(255, 255, 255, 160), 1))
             p.drawLine(r.left() + 4, r.top() + 1.5, r.right() - 4, r.top() + 1.5)
-        self.paint_content(p, r.adjusted(3, 2, -3, -2).translated(0, 1 if self._pressed else 0))
+        self.paint_static(p, r.adjusted(3, 2, -3, -2).translated(0, 1 if self._pressed else 0))
 
-    def paint_content(self, p: QPainter, r: QRectF) -> None:
+    def paint_static(self, p: QPainter, r: QRectF) -> None:
         m = self.model
         if self.has_lamp:
             d = min(r.height() * 0.55, 18.0)

@@ -2,14 +2,15 @@
 
 The workstation calls `refresh(engine.snapshot)` from a QTimer. Every model reads the snapshot;
 only widgets whose model reports a change are scheduled for repainting, and Qt paints them all in
-one pass. Trend plots are redrawn in staggered turns (a few per tick, each about four times a
-second) so fifty plots never land in the same tick. A model that raises is reported once, marked
+one pass. Trend plots are redrawn in staggered turns (a few per tick, each once a second, as PyDM
+does by default) so fifty plots never land in the same tick. A model that raises is reported once, marked
 stale and skipped; the rest of the form keeps running.
 """
 
 from __future__ import annotations
 
 import time
+from collections.abc import Callable
 from pathlib import Path
 
 from PySide6.QtCore import QRectF, QSize, Qt
@@ -37,8 +38,11 @@ from netplc.memory import Snapshot
 
 class FormView(QWidget):
     def __init__(self, form: Form, target: Target, *, archive_path: str | Path | None = None,
-                 user: str = "operator", started: float | None = None, parent: QWidget | None = None) -> None:
-        """`started` is the engine-clock time the station started (for DateTime's time since start)."""
+                 user: str = "operator", started: float | None = None,
+                 clock: Callable[[], float] = time.monotonic,
+                 parent: QWidget | None = None) -> None:
+        """`started` is the engine-clock time the station started (for DateTime's time since start);
+        `clock` paces the plot redraws (a benchmark replays ticks faster than real time)."""
         super().__init__(parent)
         self.form = form
         self.setFixedSize(QSize(form.width, form.height))
@@ -49,6 +53,7 @@ class FormView(QWidget):
         self.trends: list[TrendWidget] = []
         self.errors: list[str] = []
         self._last: Snapshot | None = None
+        self.clock = clock
         archive = Path(archive_path) if archive_path is not None else None
         for model in form.elements:
             model.bind(target, user)
@@ -59,7 +64,7 @@ class FormView(QWidget):
             self.pairs.append((model, widget))
             if isinstance(widget, TrendWidget):
                 self.trends.append(widget)
-        start = time.monotonic()
+        start = clock()
         for i, w in enumerate(self.trends):  # stagger the redraw turns over one interval
             w.next_flush = start + REDRAW_INTERVAL * i / max(len(self.trends), 1)
 
@@ -98,7 +103,7 @@ class FormView(QWidget):
                 changed = True
             if changed:
                 widget.sync()
-        now = time.monotonic()
+        now = self.clock()
         for trend in self.trends:
             trend.flush_due(now)
 

@@ -9,9 +9,10 @@ the element's size, so a gauge stays legible from a 90-pixel tile to a full pane
 from __future__ import annotations
 
 import math
+from collections.abc import Hashable
 
-from PySide6.QtCore import QPointF, QRectF, Qt
-from PySide6.QtGui import QColor, QMouseEvent, QPainter, QPainterPath, QPen, QPixmap, QPolygonF
+from PySide6.QtCore import QPointF, QRectF, QSize, Qt
+from PySide6.QtGui import QColor, QFontMetricsF, QMouseEvent, QPainter, QPainterPath, QPen, QPolygonF
 from PySide6.QtWidgets import QWidget
 
 from hmi_forms.elements.analog import AnalogBase
@@ -42,6 +43,11 @@ def scale_ticks(lo: float, hi: float, max_major: int) -> tuple[list[float], list
     return majors, minors, decimals
 
 
+NEEDLE_PEN = QPen(theme.ACCENT.darker(130), 1)
+HUB = QColor("#33393f")
+WHITE = QColor("#ffffff")
+
+
 class GaugeWidget(ElementWidget):
     """AnalogBase with Appearance digital, hbar, dial or semidial."""
 
@@ -49,7 +55,9 @@ class GaugeWidget(ElementWidget):
 
     def __init__(self, model: AnalogBase, images: Images, parent: QWidget | None = None) -> None:
         super().__init__(model, images, parent)
-        self._static: QPixmap | None = None
+        lo, hi = model.scaling.phy_range
+        self.digits = max(len(model.format(lo)), len(model.format(hi)))
+        self._geometry: tuple[QSize, tuple[QPointF, float, float, float]] | None = None
         units = f" {model.Units}" if model.Units else ""
         lo, hi = model.scaling.phy_range
         self.setToolTip(f"{model.Name}: word {oct(model.InAddr or 0)[2:].rjust(5, '0')}, "
@@ -63,6 +71,11 @@ class GaugeWidget(ElementWidget):
 
     def _dial_geometry(self) -> tuple[QPointF, float, float, float]:
         """Centre, radius, start angle and sweep (degrees, counter-clockwise from 3 o'clock)."""
+        if self._geometry is None or self._geometry[0] != self.size():
+            self._geometry = (self.size(), self._compute_dial_geometry())
+        return self._geometry[1]
+
+    def _compute_dial_geometry(self) -> tuple[QPointF, float, float, float]:
         w, h = self.width(), self.height()
         top = self._name_height() + 4
         if self.model.Appearance == "semidial":
@@ -84,41 +97,36 @@ class GaugeWidget(ElementWidget):
         inset = max(14.0, min(24.0, self.height() * 0.2))  # room for the end labels
         return QRectF(inset, top, self.width() - 2 * inset, track_h)
 
-    # --- painting ------------------------------------------------------------------------------
+    # --- painting: the layer (name, scale, readout box) and the dynamic part --------------------
 
-    def resizeEvent(self, event) -> None:
-        self._static = None
-        super().resizeEvent(event)
+    def layer_key(self) -> Hashable:
+        return self.model.zone  # the readout box is coloured by zone
 
-    def paint_content(self, p: QPainter, r: QRectF) -> None:
-        if self.model.Appearance == "digital":
-            self._paint_digital(p, r)
+    def paint_static(self, p: QPainter, r: QRectF) -> None:
+        p.setRenderHint(QPainter.RenderHint.TextAntialiasing)
+        appearance = self.model.Appearance
+        if appearance == "digital":
+            self._paint_digital_box(p, r)
             return
-        if self._static is None or self._static.size() != self.size() * self.devicePixelRatioF():
-            self._static = self._render_static()
-        p.drawPixmap(0, 0, self._static)
-        if self.model.Appearance == "hbar":
+        self._paint_name(p)
+        if appearance == "hbar":
+            self._paint_bar_scale(p)
+        else:
+            self._paint_dial_scale(p)
+            box, _ = self._readout_box()
+            zone_color = theme.ZONE_COLORS.get(self.model.zone or "")
+            p.setPen(QPen(theme.BORDER, 1))
+            p.setBrush(zone_color if zone_color is not None else QColor("#ffffff"))
+            p.drawRoundedRect(box, 3, 3)
+
+    def paint_dynamic(self, p: QPainter, r: QRectF) -> None:
+        appearance = self.model.Appearance
+        if appearance == "digital":
+            self._paint_digital_value(p)
+        elif appearance == "hbar":
             self._paint_bar_value(p)
         else:
             self._paint_needle(p)
-
-    def _render_static(self) -> QPixmap:
-        dpr = self.devicePixelRatioF()
-        pix = QPixmap(self.size() * dpr)
-        pix.setDevicePixelRatio(dpr)
-        pix.fill(Qt.GlobalColor.transparent)
-        p = QPainter(pix)
-        try:  # a painter left open on a pixmap crashes Qt when the pixmap goes
-            p.setRenderHint(QPainter.RenderHint.Antialiasing)
-            p.setRenderHint(QPainter.RenderHint.TextAntialiasing)
-            self._paint_name(p)
-            if self.model.Appearance == "hbar":
-                self._paint_bar_scale(p)
-            else:
-                self._paint_dial_scale(p)
-        finally:
-            p.end()
-        return pix
 
     def _paint_name(self, p: QPainter) -> None:
         nh = self._name_height()
@@ -187,47 +195,6 @@ class GaugeWidget(ElementWidget):
             p.drawText(QRectF(c.x() - r * 0.5, uy - r * 0.09, r, r * 0.18), Qt.AlignmentFlag.AlignCenter,
                        m.Units)
 
-    def _readout(self, p: QPainter, box: QRectF, size: float) -> None:
-        """The value in a sunken box; coloured when the value is outside PhyLow..PhyHigh."""
-        m = self.model
-        zone_color = theme.ZONE_COLORS.get(m.zone or "")
-        p.setPen(QPen(theme.BORDER, 1))
-        p.setBrush(zone_color if zone_color is not None else QColor("#ffffff"))
-        p.drawRoundedRect(box, 3, 3)
-        p.setFont(theme.sized_font(size, bold=True, family=theme.MONO))
-        p.setPen(QColor("#ffffff") if zone_color == theme.ALARM else theme.TEXT)
-        p.drawText(box, Qt.AlignmentFlag.AlignCenter, m.text or "---")
-
-    def _paint_needle(self, p: QPainter) -> None:
-        m = self.model
-        c, r, start, sweep = self._dial_geometry()
-        if m.maximum is not None:
-            a = start + sweep * m.scaling.fraction(m.maximum)
-            tip, left, right = self._at(c, r * 0.9, a), self._at(c, r, a + 4), self._at(c, r, a - 4)
-            p.setPen(Qt.PenStyle.NoPen)
-            p.setBrush(theme.ALARM)
-            p.drawPolygon(QPolygonF([tip, left, right]))
-        size = max(9.0, r * 0.2)
-        if sweep == -270.0:
-            box = QRectF(c.x() - r * 0.45, c.y() + r * 0.42, r * 0.9, size * 1.5)
-        else:  # below the centre, in the strip the layout keeps free
-            top = c.y() + max(6.0, r * 0.1)
-            height = min(size * 1.5, self.height() - top - 4)
-            size = height / 1.5
-            box = QRectF(c.x() - r * 0.45, top, r * 0.9, height)
-        self._readout(p, box, size)
-        if m.hw is None:
-            return
-        a = start + sweep * m.fraction
-        tip, tail = self._at(c, r * 0.8, a), self._at(c, r * 0.12, a + 180)
-        side1, side2 = self._at(c, r * 0.045, a + 90), self._at(c, r * 0.045, a - 90)
-        p.setPen(QPen(theme.ACCENT.darker(130), 1))
-        p.setBrush(theme.ACCENT)
-        p.drawPolygon(QPolygonF([tip, side1, tail, side2]))
-        p.setBrush(QColor("#33393f"))
-        hub = r * 0.07
-        p.drawEllipse(c, hub, hub)
-
     def _paint_bar_scale(self, p: QPainter) -> None:
         m = self.model
         track = self._bar_geometry()
@@ -253,57 +220,101 @@ class GaugeWidget(ElementWidget):
             p.drawText(QRectF(x - 30, y + tick_len, 60, font_px * 1.4), Qt.AlignmentFlag.AlignHCenter,
                        f"{v:.{decimals}f}")
 
+    def _readout_box(self) -> tuple[QRectF, float]:
+        c, r, _, sweep = self._dial_geometry()
+        size = max(9.0, r * 0.2)
+        if sweep == -270.0:
+            return QRectF(c.x() - r * 0.45, c.y() + r * 0.42, r * 0.9, size * 1.5), size
+        top = c.y() + max(6.0, r * 0.1)  # below the centre, in the strip the layout keeps free
+        height = min(size * 1.5, self.height() - top - 4)
+        return QRectF(c.x() - r * 0.45, top, r * 0.9, height), height / 1.5
+
+    def _paint_needle(self, p: QPainter) -> None:
+        m = self.model
+        c, r, start, sweep = self._dial_geometry()
+        if m.maximum is not None:
+            a = start + sweep * m.scaling.fraction(m.maximum)
+            tip, left, right = self._at(c, r * 0.9, a), self._at(c, r, a + 4), self._at(c, r, a - 4)
+            p.setPen(Qt.PenStyle.NoPen)
+            p.setBrush(theme.ALARM)
+            p.drawPolygon(QPolygonF([tip, left, right]))
+        box, size = self._readout_box()
+        p.setFont(theme.sized_font(size, bold=True, family=theme.MONO))
+        p.setPen(WHITE if m.zone == "high" else theme.TEXT)
+        p.drawText(box, Qt.AlignmentFlag.AlignCenter, m.text or "---")
+        if m.hw is None:
+            return
+        a = math.radians(start + sweep * m.fraction)
+        dx, dy = math.cos(a) * r, -math.sin(a) * r
+        cx, cy = c.x(), c.y()
+        p.setPen(NEEDLE_PEN)
+        p.setBrush(theme.ACCENT)
+        p.drawPolygon(QPolygonF([
+            QPointF(cx + 0.8 * dx, cy + 0.8 * dy), QPointF(cx - 0.045 * dy, cy + 0.045 * dx),
+            QPointF(cx - 0.12 * dx, cy - 0.12 * dy), QPointF(cx + 0.045 * dy, cy - 0.045 * dx)]))
+        p.setBrush(HUB)
+        hub = r * 0.07
+        p.drawEllipse(c, hub, hub)
+
     def _paint_bar_value(self, p: QPainter) -> None:
         m = self.model
         track = self._bar_geometry()
+        zone_color = theme.ZONE_COLORS.get(m.zone or "")
         if m.hw is not None:
-            f = m.fraction
-            zone_color = theme.ZONE_COLORS.get(m.zone or "")
-            p.fillRect(QRectF(track.left() + 1, track.top() + 1, (track.width() - 1) * f, track.height() - 1),
+            width = (track.width() - 1) * m.fraction
+            p.fillRect(QRectF(track.left() + 1, track.top() + 1, width, track.height() - 1),
                        zone_color or theme.ACCENT)
         if m.maximum is not None:
             x = track.left() + m.scaling.fraction(m.maximum) * track.width()
             p.setPen(QPen(theme.ALARM, 2))
             p.drawLine(QPointF(x, track.top() - 3), QPointF(x, track.bottom()))
         nh = max(self._name_height(), self.height() * 0.28)
-        size = max(10.0, nh * 0.8)
         units = f" {m.Units}" if m.Units else ""
-        p.setFont(theme.sized_font(size, bold=True, family=theme.MONO))
-        zone_color = theme.ZONE_COLORS.get(m.zone or "")
+        p.setFont(theme.sized_font(max(10.0, nh * 0.8), bold=True, family=theme.MONO))
         p.setPen(zone_color.darker(115) if zone_color is not None else theme.TEXT)
-        p.drawText(QRectF(6, 2, self.width() - 12, nh + 2), theme.RIGHT,
-                   (m.text or "---") + units)
+        p.drawText(QRectF(6, 2, self.width() - 12, nh + 2), theme.RIGHT, (m.text or "---") + units)
 
-    def _paint_digital(self, p: QPainter, r: QRectF) -> None:
+    def _digital_geometry(self) -> tuple[QRectF, float, float]:
+        """Readout box, value font size (fixed by the widest value of the range) and units width."""
+        h = self.height()
+        nh = self._name_height() if h >= 40 else 0.0
+        box = QRectF(4, nh + 4, self.width() - 8, h - nh - 8)
+        size = max(9.0, min(box.height() * 0.62, box.width() / (self.digits + 2) * 1.5))
+        units_w = 0.0
+        if self.model.Units:
+            metrics = QFontMetricsF(theme.sized_font(size * 0.55))
+            units_w = metrics.horizontalAdvance(self.model.Units) + 8
+        return box, size, units_w
+
+    def _paint_digital_box(self, p: QPainter, r: QRectF) -> None:
         m = self.model
         nh = self._name_height() if r.height() >= 40 else 0.0
         if nh:
             p.setFont(theme.sized_font(nh * 0.78, bold=True))
             p.setPen(theme.TEXT_DIM)
-            p.drawText(QRectF(6, 2, r.width() - 12, nh + 2), theme.LEFT,
-                       m.Name)
-        box = QRectF(4, nh + 4, r.width() - 8, r.height() - nh - 8)
+            p.drawText(QRectF(6, 2, r.width() - 12, nh + 2), theme.LEFT, m.Name)
+        box, size, _ = self._digital_geometry()
         zone_color = theme.ZONE_COLORS.get(m.zone or "")
         p.setPen(QPen(theme.BORDER, 1))
         p.setBrush(zone_color if zone_color is not None else QColor("#ffffff"))
         p.drawRoundedRect(box, 3, 3)
-        fg = QColor("#ffffff") if zone_color == theme.ALARM else theme.TEXT
-        size = max(9.0, min(box.height() * 0.62, box.width() / max(4, len(m.text or "---") + 2) * 1.5))
-        units_w = 0.0
         if m.Units:
             p.setFont(theme.sized_font(size * 0.55))
-            units_w = p.fontMetrics().horizontalAdvance(m.Units) + 8
-            p.setPen(fg if zone_color is not None else theme.TEXT_DIM)
+            p.setPen(QColor("#ffffff") if m.zone == "high" else theme.TEXT if zone_color else theme.TEXT_DIM)
             p.drawText(box.adjusted(0, 0, -6, -box.height() * 0.12),
-                       int(Qt.AlignmentFlag.AlignRight | Qt.AlignmentFlag.AlignBottom), m.Units)
+                       Qt.AlignmentFlag.AlignRight | Qt.AlignmentFlag.AlignBottom, m.Units)
+
+    def _paint_digital_value(self, p: QPainter) -> None:
+        m = self.model
+        box, size, units_w = self._digital_geometry()
+        fg = QColor("#ffffff") if m.zone == "high" else theme.TEXT
         p.setFont(theme.sized_font(size, bold=True, family=theme.MONO))
         p.setPen(fg)
-        p.drawText(box.adjusted(6, 0, -6 - units_w, 0), theme.RIGHT,
-                   m.text or "---")
+        p.drawText(box.adjusted(6, 0, -6 - units_w, 0), theme.RIGHT, m.text or "---")
         if m.maximum is not None and box.height() > 30:
             p.setFont(theme.sized_font(max(8.0, size * 0.38)))
-            p.setPen(fg if zone_color is not None else theme.ALARM)
-            p.drawText(box.adjusted(6, 2, 0, 0), int(Qt.AlignmentFlag.AlignLeft | Qt.AlignmentFlag.AlignTop),
+            p.setPen(fg if m.zone else theme.ALARM)
+            p.drawText(box.adjusted(6, 2, 0, 0), Qt.AlignmentFlag.AlignLeft | Qt.AlignmentFlag.AlignTop,
                        f"max {m.format(m.maximum)}")
 
     def mouseDoubleClickEvent(self, event: QMouseEvent) -> None:

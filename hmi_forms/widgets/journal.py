@@ -115,7 +115,7 @@ class JournalWidget(ElementWidget):
         self.kind.addItem("all kinds", KINDS)
         for k in KINDS:
             self.kind.addItem(k, (k,))
-        self.kind.addItem("form default", model.Kinds)
+        self.kind.addItem("as configured", model.Kinds)
         self.kind.setCurrentIndex(self.kind.count() - 1)
         self.kind.currentIndexChanged.connect(self._filter_changed)
         self.min_type = QComboBox()

@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+from collections.abc import Hashable
+
 from PySide6.QtCore import QRectF, Qt
 from PySide6.QtGui import QColor, QPainter, QPen
 
@@ -15,7 +17,7 @@ class StaticTextWidget(ElementWidget):
     model: StaticText
     default_back = None
 
-    def paint_content(self, p: QPainter, r: QRectF) -> None:
+    def paint_static(self, p: QPainter, r: QRectF) -> None:
         p.setFont(theme.qfont(self.model.Font, 11))
         p.setPen(self.fore_color())
         p.drawText(r.adjusted(4, 2, -4, -2), theme.alignment(self.model.TextAlign) | theme.WRAP,
@@ -26,7 +28,7 @@ class StaticPictureWidget(ElementWidget):
     model: StaticPicture
     default_back = None
 
-    def paint_content(self, p: QPainter, r: QRectF) -> None:
+    def paint_static(self, p: QPainter, r: QRectF) -> None:
         if self.model.Image is not None:
             p.setRenderHint(QPainter.RenderHint.SmoothPixmapTransform)
             draw_pixmap(p, self.images.get(self.model.Image), r, self.model.SizeMode,
@@ -36,7 +38,7 @@ class StaticPictureWidget(ElementWidget):
 class DateTimeWidget(ElementWidget):
     model: DateTime
 
-    def paint_content(self, p: QPainter, r: QRectF) -> None:
+    def paint_dynamic(self, p: QPainter, r: QRectF) -> None:
         m = self.model
         lines = 1 + m.ShowDate + m.ShowUptime
         big = min(r.height() / (lines * 0.75 + 0.6), r.width() / 5.2)
@@ -63,7 +65,10 @@ class SyncWidget(ElementWidget):
 
     model: SyncGenerator
 
-    def paint_content(self, p: QPainter, r: QRectF) -> None:
+    def layer_key(self) -> Hashable:
+        return self.model.pair, self.model.output, self.model.enabled
+
+    def paint_static(self, p: QPainter, r: QRectF) -> None:
         m = self.model
         h = min(r.height() / 3, 22.0)
         p.setFont(theme.sized_font(h * 0.62, bold=True))

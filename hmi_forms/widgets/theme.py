@@ -7,6 +7,8 @@ BackColor/ForeColor in the form override the defaults.
 
 from __future__ import annotations
 
+import functools
+
 from PySide6.QtCore import Qt
 from PySide6.QtGui import QColor, QFont
 
@@ -49,8 +51,9 @@ def qfont(font: Font | None, default_size: float = 10.0, bold: bool = False) -> 
     return f
 
 
+@functools.lru_cache(maxsize=512)
 def sized_font(size_px: float, bold: bool = False, family: str = FAMILY) -> QFont:
-    """A font sized in pixels, for gauges whose text scales with the element."""
+    """A font sized in pixels, for gauges whose text scales with the element (shared: do not modify)."""
     f = QFont(family)
     f.setPixelSize(max(7, round(size_px)))
     f.setBold(bold)

@@ -9,6 +9,8 @@ destroyed while the form lives (the PySide6 PlotItem leak).
 
 from __future__ import annotations
 
+from collections.abc import Hashable
+
 import pyqtgraph as pg
 from PySide6.QtCore import QRectF, Qt
 from PySide6.QtGui import QColor, QPainter, QPen
@@ -21,7 +23,7 @@ from hmi_forms.elements.trend import Trend
 from hmi_forms.widgets import theme
 from hmi_forms.widgets.base import ElementWidget, Images
 
-REDRAW_INTERVAL = 0.25  # seconds between redraws of one plot
+REDRAW_INTERVAL = 1.0  # seconds between redraws of one plot (samples are kept every scan)
 
 
 def _pen_color(color: Color | None) -> QColor:
@@ -92,28 +94,31 @@ class TrendWidget(ElementWidget):
             self.flush()
             self.next_flush = max(self.next_flush + REDRAW_INTERVAL, now)
 
-    def paint_content(self, p: QPainter, r: QRectF) -> None:
+    def layer_key(self) -> Hashable:
+        m = self.model
+        return self.trend.last == 1 if isinstance(m, Graph) else m.zone
+
+    def paint_static(self, p: QPainter, r: QRectF) -> None:
         m = self.model
         hr = QRectF(6, 0, r.width() - 12, self.header)
         p.setFont(theme.sized_font(self.header * 0.62, bold=True))
         p.setPen(theme.TEXT_DIM)
         p.drawText(hr, theme.LEFT, m.Name)
         if isinstance(m, Graph):
-            last = self.trend.last
-            on = last == 1
             d = self.header * 0.5
             lamp = QRectF(hr.right() - d, hr.center().y() - d / 2, d, d)
             p.setPen(QPen(theme.BORDER, 1))
-            p.setBrush(_pen_color(m.Colors) if on else theme.OFF.lighter(125))
+            p.setBrush(_pen_color(m.Colors) if self.trend.last == 1 else theme.OFF.lighter(125))
             p.drawEllipse(lamp)
             p.setPen(theme.TEXT_DIM)
             p.setFont(theme.sized_font(self.header * 0.55))
-            p.drawText(hr.adjusted(0, 0, -d - 6, 0), theme.RIGHT,
-                       str(m.Address))
-        else:
+            p.drawText(hr.adjusted(0, 0, -d - 6, 0), theme.RIGHT, str(m.Address))
+
+    def paint_dynamic(self, p: QPainter, r: QRectF) -> None:
+        m = self.model
+        if isinstance(m, AnalogBase):
             units = f" {m.Units}" if m.Units else ""
             color = theme.ZONE_COLORS.get(m.zone or "")
             p.setPen(color.darker(115) if color is not None else theme.TEXT)
             p.setFont(theme.sized_font(self.header * 0.66, bold=True, family=theme.MONO))
-            p.drawText(hr, theme.RIGHT, (m.text or "---") + units)
-
+            p.drawText(QRectF(6, 0, r.width() - 12, self.header), theme.RIGHT, (m.text or "---") + units)
