@@ -8,6 +8,7 @@ the window, not only logged, because the operator is the one who must act on it.
 
 from __future__ import annotations
 
+import signal
 import sys
 import time
 
@@ -282,8 +283,19 @@ def run_workstation(station_path: str) -> int:
         return 2
     window = MainWindow(runtime)
     window.show()
+    _quit_on_signals(app)
     try:
         return app.exec()
     finally:
         runtime.stop()
+
+
+def _quit_on_signals(app: QApplication) -> None:
+    """Ctrl+C or SIGTERM close the window like Quit does, so the archive is flushed. Python runs
+    signal handlers only between bytecodes, so a timer lets the interpreter in while Qt waits."""
+    for sig in (signal.SIGINT, signal.SIGTERM):
+        signal.signal(sig, lambda *_: app.closeAllWindows())
+    timer = QTimer(app)
+    timer.timeout.connect(lambda: None)
+    timer.start(250)
 

@@ -14,7 +14,8 @@ from PySide6.QtCore import Qt
 
 from app.config import load_station
 from app.gui.main_window import MainWindow
-from app.runtime import Runtime
+from app.gui.status import StationStatusBar, station_problems
+from app.runtime import NodeStatus, Runtime, RuntimeStatus
 from hmi_forms.elements import Element
 from hmi_forms.widgets.base import ElementWidget
 
@@ -120,3 +121,17 @@ def test_a_dead_node_and_a_stopped_program_show_in_the_window(qtbot, workstation
     assert workstation.health.isVisible()
     assert workstation.status.state.property("level") == "bad"
     assert workstation.status.nodes.property("level") == "bad"
+
+
+def test_a_failing_archive_shows_in_the_status_bar(qtbot) -> None:
+    status = RuntimeStatus(
+        running=True, state="running", scans=100, scan_last_ms=0.3, scan_max_ms=1.0, scan_mean_ms=0.4,
+        overruns=0, tick_ms=100, nodes=(NodeStatus(0, "tcp://127.0.0.1:1", True),), records_written=10,
+        records_pending=5, records_lost=7, modbus_port=None,
+        problems=("archive: database or disk is full", "archive: 7 records lost (disk too slow or full)"))
+    bar = StationStatusBar()
+    qtbot.addWidget(bar)
+    bar.show_status(status)
+    assert bar.records.property("level") == "bad"
+    assert bar.state.property("level") == "ok"
+    assert station_problems(status) == list(status.problems)
