@@ -18,6 +18,7 @@ from collections.abc import Callable
 from pathlib import Path
 from typing import TYPE_CHECKING
 
+from app.cli import DEMO_STATION
 from app.config import load_station
 
 if TYPE_CHECKING:
@@ -25,7 +26,6 @@ if TYPE_CHECKING:
 
     from app.runtime import Runtime
 
-DEMO = Path(__file__).resolve().parent.parent / "resources" / "example"
 SIZE = (1400, 900)  # the viewer's
 RUN_SECONDS = 24.0
 START_BIT = 0o40042
@@ -35,7 +35,7 @@ LEVEL = 0o4010
 
 
 def copy_station(dest: Path) -> Path:
-    shutil.copytree(DEMO, dest, ignore=shutil.ignore_patterns("archive", "__pycache__"))
+    shutil.copytree(DEMO_STATION, dest, ignore=shutil.ignore_patterns("archive", "__pycache__"))
     toml = dest / "station.toml"
     toml.write_text(re.sub(r"(?m)^port = 1502$", "port = 0", toml.read_text(encoding="utf-8")),
                     encoding="utf-8")

@@ -2,10 +2,11 @@
 
 from __future__ import annotations
 
-import shutil
 from pathlib import Path
 
 import pytest
+
+from app.screenshots import copy_station
 
 REPO = Path(__file__).resolve().parents[2]
 DEMO = REPO / "resources" / "example"
@@ -13,11 +14,8 @@ DEMO = REPO / "resources" / "example"
 
 def copy_demo(dest: Path) -> Path:
     """The demo station copied to `dest`, its archive there too, its Modbus server on a free port."""
-    shutil.copytree(DEMO, dest, ignore=shutil.ignore_patterns("archive", "__pycache__"))
-    toml = dest / "station.toml"
-    text = toml.read_text(encoding="utf-8")
-    assert "\nport = 1502\n" in text
-    toml.write_text(text.replace("\nport = 1502\n", "\nport = 0\n"), encoding="utf-8")
+    copy_station(dest)
+    assert "\nport = 0\n" in (dest / "station.toml").read_text(encoding="utf-8")
     return dest
 
 
