@@ -16,10 +16,11 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass, field
+from functools import cached_property
 from typing import Any
 
 from hmi_forms.elements import props as p
-from hmi_forms.elements.base import Element
+from hmi_forms.elements.base import Element, Reader, word_reader
 from hmi_forms.elements.trend import Trend
 from netplc.memory import Snapshot
 
@@ -114,6 +115,11 @@ class AnalogBase(Scaled):
         if self.Appearance == "graph":
             self.trend = Trend(self.Elements)
 
+    @cached_property
+    def _in(self) -> Reader:
+        assert self.InAddr is not None
+        return word_reader(self.InAddr)
+
     def zone_of(self, phy: float) -> str:
         """Zone with hysteresis: leaving the current zone needs the value to be Hysteresis inside."""
         lo, hi, hy = self.PhyLow, self.PhyHigh, self.Hysteresis
@@ -133,8 +139,7 @@ class AnalogBase(Scaled):
             self.zone or "", "")
 
     def refresh(self, snap: Snapshot) -> bool:
-        assert self.InAddr is not None
-        hw = snap.get_word(self.InAddr)
+        hw = self._in(snap)
         sampled = self._sample(snap, hw)
         if hw == self.hw:
             return sampled

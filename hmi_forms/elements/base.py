@@ -9,14 +9,36 @@ changed, so the form repaints only those widgets. Gating and quality are decided
 
 from __future__ import annotations
 
+from collections.abc import Callable
 from dataclasses import dataclass, field
+from functools import cached_property
 from typing import Any, ClassVar
 
 from hmi_forms.elements import props as p
 from hmi_forms.elements.target import Target
-from netplc.address import BitRef
+from netplc.address import IO_BITS, BitRef, data_index
 from netplc.memory import Snapshot
 from netplc.records import Kind, Record
+
+Reader = Callable[[Snapshot], int]
+
+
+def bit_reader(ref: BitRef) -> Reader:
+    """A reader of one bit, with the address decoded once (a form reads hundreds per tick)."""
+    hmi = ref.hmi
+    if hmi < IO_BITS:
+        return lambda s: s.bits[hmi]
+    i, k = data_index(hmi >> 3), hmi & 7
+    return lambda s: (s.data[i] >> k) & 1
+
+
+def word_reader(addr: int) -> Reader:
+    """A reader of the little-endian word at byte address `addr` (validated by the loader)."""
+    if addr < IO_BITS:
+        return lambda s: s.get_word(addr)
+    i = data_index(addr)
+    return lambda s: s.data[i] | s.data[i + 1] << 8
+
 
 BORDER_STYLES = ("None", "FixedSingle", "Fixed3D")
 CURSORS = ("Default", "Hand", "Cross", "IBeam", "No")
@@ -58,14 +80,20 @@ class Element:
 
     def update(self, snap: Snapshot) -> bool:
         """Read one snapshot; True when what the widget shows has changed."""
-        if self.SyncType is not None and not snap.get_hmi_bit(self.SyncType):
+        sync, quality = self._gates
+        if sync is not None and not sync(snap):
             return False
-        stale = self.QualityAddr is not None and not snap.get_hmi_bit(self.QualityAddr)
+        stale = quality is not None and not quality(snap)
         changed = stale != self.stale
         self.stale = stale
         if stale:
             return self.refresh_stale(snap) or changed
         return self.refresh(snap) or changed
+
+    @cached_property
+    def _gates(self) -> tuple[Reader | None, Reader | None]:
+        return (bit_reader(self.SyncType) if self.SyncType is not None else None,
+                bit_reader(self.QualityAddr) if self.QualityAddr is not None else None)
 
     def refresh(self, snap: Snapshot) -> bool:
         return False

@@ -12,9 +12,10 @@ Each type extends the previous one, as in the manual: base -> colour label -> co
 from __future__ import annotations
 
 from dataclasses import dataclass, field
+from functools import cached_property
 
 from hmi_forms.elements import props as p
-from hmi_forms.elements.base import Element
+from hmi_forms.elements.base import Element, Reader, bit_reader
 from netplc.address import BitRef
 from netplc.memory import Snapshot
 
@@ -33,6 +34,11 @@ class DiscreteBase(Element):
 
     value: int | None = field(default=None, init=False)
 
+    @cached_property
+    def _in(self) -> Reader:
+        assert self.InAddr is not None
+        return bit_reader(self.InAddr)
+
     @property
     def text(self) -> str:
         return self.TextTrue if self.value else self.TextFalse
@@ -50,8 +56,7 @@ class DiscreteBase(Element):
         return self.Enabled and self.value is not None and not self.stale and self.indicating
 
     def refresh(self, snap: Snapshot) -> bool:
-        assert self.InAddr is not None
-        v = snap.get_hmi_bit(self.InAddr)
+        v = self._in(snap)
         if v == self.value:
             return False
         first = self.value is None

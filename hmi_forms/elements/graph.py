@@ -8,9 +8,10 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass, field
+from functools import cached_property
 
 from hmi_forms.elements import props as p
-from hmi_forms.elements.base import Element
+from hmi_forms.elements.base import Element, Reader, bit_reader
 from hmi_forms.elements.trend import Trend
 from netplc.address import BitRef
 from netplc.memory import Snapshot
@@ -33,8 +34,12 @@ class Graph(Element):
         self.trend = Trend(self.Elements)
 
     def refresh(self, snap: Snapshot) -> bool:
+        return self._sample(snap, float(self._bit(snap)))
+
+    @cached_property
+    def _bit(self) -> Reader:
         assert self.Address is not None
-        return self._sample(snap, float(snap.get_hmi_bit(self.Address)))
+        return bit_reader(self.Address)
 
     def refresh_stale(self, snap: Snapshot) -> bool:
         return self._sample(snap, math.nan)

@@ -14,19 +14,18 @@ from PySide6.QtWidgets import QHBoxLayout, QLabel, QLineEdit, QPushButton, QVBox
 
 from hmi_forms.elements.analog import AnalogOutput
 from hmi_forms.widgets import theme
-from hmi_forms.widgets.base import ElementWidget, Images
+from hmi_forms.widgets.base import Images, SelfPainted
 
 OK_STYLE = f"color: {theme.ON.name()};"
 BAD_STYLE = f"color: {theme.ALARM.name()}; font-weight: bold;"
 EDIT_BAD = f"QLineEdit {{ border: 2px solid {theme.ALARM.name()}; background: #fdecea; }}"
 
 
-class AnalogOutputWidget(ElementWidget):
+class AnalogOutputWidget(SelfPainted):
     model: AnalogOutput
 
     def __init__(self, model: AnalogOutput, images: Images, parent: QWidget | None = None) -> None:
         super().__init__(model, images, parent)
-        self.setAttribute(Qt.WidgetAttribute.WA_OpaquePaintEvent, False)
         lo, hi = model.scaling.phy_range
         units = f" {model.Units}" if model.Units else ""
         layout = QVBoxLayout(self)

@@ -15,7 +15,7 @@ from __future__ import annotations
 from collections.abc import Hashable
 from pathlib import Path
 
-from PySide6.QtCore import QPointF, QRectF, Qt
+from PySide6.QtCore import QPointF, QRect, QRectF, Qt
 from PySide6.QtGui import QBrush, QColor, QPainter, QPaintEvent, QPen, QPixmap, QResizeEvent
 from PySide6.QtWidgets import QWidget
 
@@ -62,32 +62,48 @@ def draw_pixmap(p: QPainter, pix: QPixmap, rect: QRectF, mode: str = "Zoom",
     p.drawPixmap(QRectF(x, y, w, h), pix, QRectF(0, 0, pix.width(), pix.height()))
 
 
+STALE_TIP = "Stale: the data source of this element is not answering; the last value is shown"
+
+
+def paint_stale(p: QPainter, r: QRectF) -> None:
+    """Greyed, hatched, with a "?" badge: the same mark on every element type."""
+    p.fillRect(r, QColor(221, 225, 230, 150))
+    p.fillRect(r, QBrush(QColor(90, 96, 106, 110), Qt.BrushStyle.BDiagPattern))
+    p.setRenderHint(QPainter.RenderHint.Antialiasing)
+    d = max(12.0, min(22.0, min(r.width(), r.height()) * 0.35))
+    badge = QRectF(r.right() - d - 2, r.top() + 2, d, d)
+    p.setPen(QPen(QColor("#ffffff"), 1.5))
+    p.setBrush(theme.STALE)
+    p.drawEllipse(badge)
+    p.setFont(theme.sized_font(d * 0.75, bold=True))
+    p.drawText(badge, Qt.AlignmentFlag.AlignCenter, "?")
+
+
 class StaleMark(QWidget):
-    """Covers an element while its data are stale: greyed, hatched, with a "?" badge."""
+    """The stale mark as a child on top of elements made of child widgets (plots, input fields)."""
 
     def __init__(self, parent: QWidget) -> None:
         super().__init__(parent)
         self.setAttribute(Qt.WidgetAttribute.WA_TransparentForMouseEvents)
-        self.setToolTip("Stale: the data source of this element is not answering; the last value is shown")
+        self.setToolTip(STALE_TIP)
         self.hide()
 
     def paintEvent(self, event: QPaintEvent) -> None:
         p = QPainter(self)
-        r = QRectF(self.rect())
-        p.fillRect(r, QColor(221, 225, 230, 150))
-        p.fillRect(r, QBrush(QColor(90, 96, 106, 110), Qt.BrushStyle.BDiagPattern))
-        p.setRenderHint(QPainter.RenderHint.Antialiasing)
-        d = max(12.0, min(22.0, min(r.width(), r.height()) * 0.35))
-        badge = QRectF(r.right() - d - 2, r.top() + 2, d, d)
-        p.setPen(QPen(QColor("#ffffff"), 1.5))
-        p.setBrush(theme.STALE)
-        p.drawEllipse(badge)
-        p.setFont(theme.sized_font(d * 0.75, bold=True))
-        p.drawText(badge, Qt.AlignmentFlag.AlignCenter, "?")
+        try:
+            paint_stale(p, QRectF(self.rect()))
+        finally:
+            p.end()
 
 
 class ElementWidget(QWidget):
-    """Draws background, frame and content; `sync` is called when the model reports a change."""
+    """An element on a form: its geometry, input and tooltip, and the code that draws it.
+
+    Elements drawn only with QPainter are painted by the form itself, in one pass with one painter
+    (`render`), and their widget stays an invisible proxy for the mouse, cursor and tooltip: a
+    QPainter per widget per tick costs more than drawing a whole gauge. Elements made of child
+    widgets (`SelfPainted`) paint themselves and carry a StaleMark child instead.
+    """
 
     default_back: QColor | None = theme.PANEL  # None = transparent
 
@@ -98,13 +114,9 @@ class ElementWidget(QWidget):
         self.setGeometry(model.x, model.y, model.w, model.h)
         if model.Cursor in CURSORS:
             self.setCursor(CURSORS[model.Cursor])
-        self.stale_mark = StaleMark(self)
-        self.stale_mark.setGeometry(self.rect())
-        self._stale = False
         self._layers: dict[Hashable, QPixmap] = {}
-        back = self.back_color()
-        if back is not None and back.alpha() == 255:
-            self.setAttribute(Qt.WidgetAttribute.WA_OpaquePaintEvent)
+        self._stale = False
+        self._tip = ""
 
     def back_color(self) -> QColor | None:
         if self.model.BackColor is not None:
@@ -115,12 +127,15 @@ class ElementWidget(QWidget):
         return theme.qcolor(self.model.ForeColor, theme.TEXT)
 
     def sync(self) -> None:
-        """The model changed: show the stale mark as needed and schedule a repaint."""
+        """The model changed: have the form repaint this element's rectangle."""
+        parent = self.parentWidget()
+        if parent is not None:
+            parent.update(self.geometry())
         if self.model.stale != self._stale:
             self._stale = self.model.stale
-            self.stale_mark.setVisible(self._stale)
-            self.stale_mark.raise_()
-        self.update()
+            if self._stale:
+                self._tip = self.toolTip()
+            self.setToolTip(STALE_TIP if self._stale else self._tip)
 
     def flush(self) -> None:
         """Bring throttled parts (plots, queries) up to date; plain painted widgets have none."""
@@ -129,20 +144,22 @@ class ElementWidget(QWidget):
         """What the cached layer (background, frame, `paint_static`) depends on."""
         return ()
 
-    def paintEvent(self, event: QPaintEvent) -> None:
+    def render(self, p: QPainter) -> None:  # type: ignore[override]
+        """Draw the element with its top-left corner at the painter's origin."""
+        p.drawPixmap(0, 0, self.layer())
+        r = QRectF(0, 0, self.width(), self.height())
+        self.paint_dynamic(p, r)
+        if self.model.stale:
+            paint_stale(p, r)
+
+    def layer(self) -> QPixmap:
         key = self.layer_key()
         layer = self._layers.get(key)
         if layer is None:
             layer = self._layers[key] = self._render_layer()
             if len(self._layers) > MAX_LAYERS:
                 del self._layers[next(iter(self._layers))]
-        p = QPainter(self)
-        try:  # a painter left active after an error would crash Qt
-            p.drawPixmap(0, 0, layer)
-            p.setRenderHint(QPainter.RenderHint.Antialiasing)
-            self.paint_dynamic(p, QRectF(self.rect()))
-        finally:
-            p.end()
+        return layer
 
     def _render_layer(self) -> QPixmap:
         dpr = self.devicePixelRatioF()
@@ -177,7 +194,6 @@ class ElementWidget(QWidget):
 
     def resizeEvent(self, event: QResizeEvent) -> None:
         self._layers.clear()
-        self.stale_mark.setGeometry(self.rect())
         super().resizeEvent(event)
 
     def paint_border(self, p: QPainter, r: QRectF) -> None:
@@ -188,6 +204,41 @@ class ElementWidget(QWidget):
             p.drawRect(r.adjusted(0.5, 0.5, -0.5, -0.5))
         elif style == "Fixed3D":
             bevel(p, r, sunken=True)
+
+
+class SelfPainted(ElementWidget):
+    """An element made of child widgets: it paints its own background and frame under them."""
+
+    def __init__(self, model: Element, images: Images, parent: QWidget | None = None) -> None:
+        super().__init__(model, images, parent)
+        self.stale_mark = StaleMark(self)
+        self.stale_mark.setGeometry(self.rect())
+        back = self.back_color()
+        if back is not None and back.alpha() == 255:  # the form need not repaint what is beneath
+            self.setAttribute(Qt.WidgetAttribute.WA_OpaquePaintEvent)
+
+    def sync(self) -> None:
+        if self.model.stale != self.stale_mark.isVisibleTo(self):
+            self.stale_mark.setVisible(self.model.stale)
+            self.stale_mark.raise_()
+        self.update(self.changed_rect())
+
+    def changed_rect(self) -> QRect:
+        """The part to repaint after a change (children repaint themselves)."""
+        return self.rect()
+
+    def paintEvent(self, event: QPaintEvent) -> None:
+        p = QPainter(self)
+        try:  # a painter left active after an error would crash Qt
+            p.drawPixmap(0, 0, self.layer())
+            p.setRenderHint(QPainter.RenderHint.Antialiasing)
+            self.paint_dynamic(p, QRectF(self.rect()))
+        finally:
+            p.end()
+
+    def resizeEvent(self, event: QResizeEvent) -> None:
+        self.stale_mark.setGeometry(self.rect())
+        super().resizeEvent(event)
 
 
 def bevel(p: QPainter, r: QRectF, sunken: bool) -> None:

@@ -26,10 +26,8 @@ class DiscreteWidget(ElementWidget):
         self._pressed = False
         has_images = model.ImageFalse >= 0 or model.ImageTrue >= 0
         self.has_lamp = not isinstance(model, DiscreteColorLabel) and not has_images
-        if model.Enabled:
-            self.setAttribute(Qt.WidgetAttribute.WA_OpaquePaintEvent, False)
-            if model.Cursor == "Default":
-                self.setCursor(Qt.CursorShape.PointingHandCursor)
+        if model.Enabled and model.Cursor == "Default":
+            self.setCursor(Qt.CursorShape.PointingHandCursor)
         self.setToolTip(f"{model.Name}: {model.InAddr}" + (" (click to toggle)" if model.Enabled else ""))
 
     def back_color(self) -> QColor | None:
@@ -97,12 +95,12 @@ class DiscreteWidget(ElementWidget):
     def mousePressEvent(self, event: QMouseEvent) -> None:
         if event.button() == Qt.MouseButton.LeftButton and self.model.clickable:
             self._pressed = True
-            self.update()
+            self.sync()
 
     def mouseReleaseEvent(self, event: QMouseEvent) -> None:
         if not self._pressed:
             return
         self._pressed = False
-        self.update()
+        self.sync()
         if self.rect().contains(event.position().toPoint()):
             self.model.click()

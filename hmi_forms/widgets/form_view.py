@@ -14,7 +14,7 @@ from collections.abc import Callable
 from pathlib import Path
 
 from PySide6.QtCore import QRectF, QSize, Qt
-from PySide6.QtGui import QColor, QPainter, QPaintEvent
+from PySide6.QtGui import QColor, QPainter, QPaintEvent, QTransform
 from PySide6.QtWidgets import QWidget
 
 from hmi_forms.elements import Element
@@ -27,7 +27,7 @@ from hmi_forms.elements.sync import SyncGenerator
 from hmi_forms.elements.target import Target
 from hmi_forms.form import Form
 from hmi_forms.widgets.analog_output import AnalogOutputWidget
-from hmi_forms.widgets.base import ElementWidget, Images, draw_pixmap
+from hmi_forms.widgets.base import ElementWidget, Images, SelfPainted, draw_pixmap
 from hmi_forms.widgets.discrete import DiscreteWidget
 from hmi_forms.widgets.gauges import GaugeWidget
 from hmi_forms.widgets.journal import JournalWidget
@@ -48,9 +48,11 @@ class FormView(QWidget):
         self.setFixedSize(QSize(form.width, form.height))
         self.setWindowTitle(form.title)
         self.setAttribute(Qt.WidgetAttribute.WA_OpaquePaintEvent)
+        self._back = QColor(*form.BackColor)
         self.images = Images(form.images)
         self.pairs: list[tuple[Element, ElementWidget]] = []
         self.trends: list[TrendWidget] = []
+        self.painted: list[ElementWidget] = []  # drawn by this widget's paintEvent, in file order
         self.errors: list[str] = []
         self._last: Snapshot | None = None
         self.clock = clock
@@ -64,6 +66,8 @@ class FormView(QWidget):
             self.pairs.append((model, widget))
             if isinstance(widget, TrendWidget):
                 self.trends.append(widget)
+            if not isinstance(widget, SelfPainted):
+                self.painted.append(widget)
         start = clock()
         for i, w in enumerate(self.trends):  # stagger the redraw turns over one interval
             w.next_flush = start + REDRAW_INTERVAL * i / max(len(self.trends), 1)
@@ -123,7 +127,23 @@ class FormView(QWidget):
         return self.grab().save(str(path))
 
     def paintEvent(self, event: QPaintEvent) -> None:
+        """The background, and every QPainter-drawn element in the repainted region, with one painter."""
         p = QPainter(self)
-        p.fillRect(event.rect(), QColor(*self.form.BackColor))
-        if self.form.BackgroundImage is not None:
-            draw_pixmap(p, self.images.get(self.form.BackgroundImage), QRectF(self.rect()), "Stretch")
+        try:  # a painter left active after an error would crash Qt
+            p.fillRect(event.rect(), self._back)
+            if self.form.BackgroundImage is not None:
+                draw_pixmap(p, self.images.get(self.form.BackgroundImage), QRectF(self.rect()), "Stretch")
+            region = event.region()
+            p.setRenderHint(QPainter.RenderHint.Antialiasing)
+            for widget in self.painted:  # each render sets the pens, brushes and fonts it uses
+                geometry = widget.geometry()
+                if not region.intersects(geometry):
+                    continue
+                p.setTransform(QTransform.fromTranslate(geometry.x(), geometry.y()))
+                p.setClipRect(0, 0, geometry.width(), geometry.height())
+                try:
+                    widget.render(p)
+                except Exception as e:
+                    self._fault(widget.model, e)
+        finally:
+            p.end()

@@ -57,7 +57,9 @@ class GaugeWidget(ElementWidget):
         super().__init__(model, images, parent)
         lo, hi = model.scaling.phy_range
         self.digits = max(len(model.format(lo)), len(model.format(hi)))
-        self._geometry: tuple[QSize, tuple[QPointF, float, float, float]] | None = None
+        self._laid_out: QSize | None = None  # the size the cached dial layout below is for
+        self._dial: tuple[QPointF, float, float, float] = (QPointF(), 0.0, 0.0, 0.0)
+        self._box: tuple[QRectF, float] = (QRectF(), 0.0)
         units = f" {model.Units}" if model.Units else ""
         lo, hi = model.scaling.phy_range
         self.setToolTip(f"{model.Name}: word {oct(model.InAddr or 0)[2:].rjust(5, '0')}, "
@@ -69,11 +71,16 @@ class GaugeWidget(ElementWidget):
     def _name_height(self) -> float:
         return max(11.0, min(18.0, self.height() * 0.11)) if self.model.Name else 0.0
 
+    def _layout(self) -> None:
+        if self._laid_out != self.size():
+            self._laid_out = self.size()
+            self._dial = self._compute_dial_geometry()
+            self._box = self._compute_readout_box()
+
     def _dial_geometry(self) -> tuple[QPointF, float, float, float]:
         """Centre, radius, start angle and sweep (degrees, counter-clockwise from 3 o'clock)."""
-        if self._geometry is None or self._geometry[0] != self.size():
-            self._geometry = (self.size(), self._compute_dial_geometry())
-        return self._geometry[1]
+        self._layout()
+        return self._dial
 
     def _compute_dial_geometry(self) -> tuple[QPointF, float, float, float]:
         w, h = self.width(), self.height()
@@ -221,7 +228,11 @@ class GaugeWidget(ElementWidget):
                        f"{v:.{decimals}f}")
 
     def _readout_box(self) -> tuple[QRectF, float]:
-        c, r, _, sweep = self._dial_geometry()
+        self._layout()
+        return self._box
+
+    def _compute_readout_box(self) -> tuple[QRectF, float]:
+        c, r, _, sweep = self._dial
         size = max(9.0, r * 0.2)
         if sweep == -270.0:
             return QRectF(c.x() - r * 0.45, c.y() + r * 0.42, r * 0.9, size * 1.5), size
@@ -320,4 +331,4 @@ class GaugeWidget(ElementWidget):
     def mouseDoubleClickEvent(self, event: QMouseEvent) -> None:
         if self.model.KeepMaxValue:
             self.model.reset_max()
-            self.update()
+            self.sync()

@@ -30,7 +30,7 @@ from PySide6.QtWidgets import (
 
 from hmi_forms.elements.journal import KINDS, MessageJournal
 from hmi_forms.widgets import theme
-from hmi_forms.widgets.base import ElementWidget, Images
+from hmi_forms.widgets.base import Images, SelfPainted
 from registrar.query import Archive, Filter, Row
 
 COLUMNS = ("Time", "Kind", "Group", "Type", "Source", "Text", "Value")
@@ -92,13 +92,12 @@ class JournalTable(QAbstractTableModel):
         return "" if row.value is None else f"{row.value:g}"
 
 
-class JournalWidget(ElementWidget):
+class JournalWidget(SelfPainted):
     model: MessageJournal
 
     def __init__(self, model: MessageJournal, images: Images, archive_path: Path | None,
                  parent: QWidget | None = None) -> None:
         super().__init__(model, images, parent)
-        self.setAttribute(Qt.WidgetAttribute.WA_OpaquePaintEvent, False)
         self.archive_path = archive_path
         self.archive: Archive | None = None
         layout = QVBoxLayout(self)

@@ -12,7 +12,7 @@ from __future__ import annotations
 from collections.abc import Hashable
 
 import pyqtgraph as pg
-from PySide6.QtCore import QRectF, Qt
+from PySide6.QtCore import QRect, QRectF, Qt
 from PySide6.QtGui import QColor, QPainter, QPen
 from PySide6.QtWidgets import QWidget
 
@@ -21,7 +21,7 @@ from hmi_forms.elements.graph import Graph
 from hmi_forms.elements.props import Color
 from hmi_forms.elements.trend import Trend
 from hmi_forms.widgets import theme
-from hmi_forms.widgets.base import ElementWidget, Images
+from hmi_forms.widgets.base import Images, SelfPainted
 
 REDRAW_INTERVAL = 1.0  # seconds between redraws of one plot (samples are kept every scan)
 
@@ -30,7 +30,7 @@ def _pen_color(color: Color | None) -> QColor:
     return theme.qcolor(color, theme.ACCENT)
 
 
-class TrendWidget(ElementWidget):
+class TrendWidget(SelfPainted):
     model: Graph | AnalogBase
 
     def __init__(self, model: Graph | AnalogBase, images: Images, parent: QWidget | None = None) -> None:
@@ -74,10 +74,18 @@ class TrendWidget(ElementWidget):
         self.dirty = False
         self.shown = -1  # trend.count when last drawn
         self.next_flush = 0.0
+        self._header_shown: tuple[object, ...] = ()
 
     def sync(self) -> None:
+        """A new sample: the plot waits for its turn; the header is repainted only if it changed."""
         self.dirty = True
-        super().sync()
+        shown = (self.layer_key(), getattr(self.model, "text", None), self.model.stale)
+        if shown != self._header_shown:
+            self._header_shown = shown
+            super().sync()
+
+    def changed_rect(self) -> QRect:
+        return QRect(0, 0, self.width(), self.header)  # the plot is redrawn by flush_due
 
     def flush(self) -> None:
         if self.trend.count == self.shown:
