@@ -123,6 +123,21 @@ _MBAP = struct.Struct(">HHHB")  # Modbus TCP header: transaction, protocol 0, le
 _READ_CODES: dict[str, int] = {"coils": 1, "discrete": 2, "holding": 3, "input": 4}
 
 
+def take_frames(buf: bytearray) -> list[tuple[int, int, bytes]] | None:
+    """Remove the complete Modbus TCP frames from the front of `buf`: (transaction, unit, PDU)
+    each; a partial frame stays for the next data. None: the bytes are not Modbus TCP."""
+    frames = []
+    while len(buf) >= 8:
+        tid, proto, length, unit = _MBAP.unpack_from(buf)
+        if proto != 0 or not 2 <= length <= 254:
+            return None
+        if len(buf) < 6 + length:
+            break
+        frames.append((tid, unit, bytes(buf[7 : 6 + length])))
+        del buf[: 6 + length]
+    return frames
+
+
 class ModbusClient(Protocol):
     """One node's connection: connect, read and write a table, close."""
 
@@ -238,18 +253,13 @@ class _Answers(asyncio.Protocol):
         self.transport = transport
 
     def data_received(self, data: bytes) -> None:
-        buf = self.buf
-        buf += data
-        while len(buf) >= 8:
-            tid, proto, length, _ = _MBAP.unpack_from(buf)
-            if proto != 0 or length < 2:  # not Modbus TCP: the next request reconnects
-                assert self.transport is not None
-                self.transport.abort()
-                return
-            if len(buf) < 6 + length:
-                return
-            pdu = bytes(buf[7 : 6 + length])
-            del buf[: 6 + length]
+        self.buf += data
+        frames = take_frames(self.buf)
+        if frames is None:  # not Modbus TCP: the next request reconnects
+            assert self.transport is not None
+            self.transport.abort()
+            return
+        for tid, _, pdu in frames:
             waiter = self.waiter
             if tid == self.tid and waiter is not None and not waiter.done():
                 waiter.set_result(pdu)
@@ -423,19 +433,14 @@ class _Connection(asyncio.Protocol):
         self.server.connections.discard(self)
 
     def data_received(self, data: bytes) -> None:
-        buf = self.buf
-        buf += data
+        self.buf += data
+        frames = take_frames(self.buf)
+        if frames is None:  # not Modbus TCP: drop the peer, as devices do
+            assert self.transport is not None
+            self.transport.close()
+            return
         out = bytearray()
-        while len(buf) >= 8:
-            tid, proto, length, unit = _MBAP.unpack_from(buf)
-            if proto != 0 or not 2 <= length <= 254:  # not Modbus TCP: drop the peer, as devices do
-                assert self.transport is not None
-                self.transport.close()
-                return
-            if len(buf) < 6 + length:
-                break
-            pdu = bytes(buf[7 : 6 + length])
-            del buf[: 6 + length]
+        for tid, unit, pdu in frames:
             if self.server.unit is not None and unit != self.server.unit:
                 response = bytes((pdu[0] | 0x80, 0x0B))  # gateway: target device failed to respond
             else:
