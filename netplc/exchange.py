@@ -369,6 +369,7 @@ class Exchange:
         stats = node.stats
         if error:
             stats.errors += 1
+            stats.last_error = error
         elif req.payload is None:
             stats.reads += 1
         else:

@@ -193,3 +193,24 @@ def test_check_program_nodes_names_the_program_line() -> None:
         "p.stl:2:1: NREAD with no NODE in the program talks to node 0, which is not configured "
         "(configured nodes: 1)"]
     assert check_program_nodes(parse(NETPLC_PROGRAM), [NodeConfig(0, "tcp://h:1")]) == []
+
+
+def test_modbus_profile_and_device_exceptions(node0: Simulator) -> None:
+    """A `modbus` node addresses registers by number; a Modbus exception leaves the link up."""
+    node0.engine.write_word(0o4010, 0xCAFE)
+    program = (
+        "TNA $03760\n"
+        "FON C:$02100 N:NREAD S:2004 D:$04020 R:2\n"  # register 02004 (1028) = the node's word 04010
+        "FON C:$02104 N:NREAD S:0 D:$04030 R:2\n"  # register 0: exception 2 from a CPU-165
+        "JMP 0\n"
+    )
+    st = Station(program, [NodeConfig(0, f"tcp://127.0.0.1:{node0.port}", profile="modbus",
+                                      table="input", timeout=0.5)])
+    st.start()
+    try:
+        snap = lambda: st.engine.snapshot  # noqa: E731
+        wait_until(lambda: snap().get_word(0o4020) == 0xCAFE and st.exchange.stats[0].errors >= 1)
+        assert snap().get_bit(0o2105) == 1 and snap().get_bit(0o2101) == 1  # the device answered
+        assert st.exchange.stats[0].last_error == "0: read input 0+1: Modbus exception 2"
+    finally:
+        st.stop()
