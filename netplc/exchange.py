@@ -8,7 +8,8 @@ engine thread, like every other write. Link-state changes reach the presence lis
 the same way.
 
 Each node has its own task, connection, timeout, retries and reconnect back-off, so a dead or slow
-node only ever delays its own requests. While a node is backing off, its requests fail at once
+node only ever delays its own requests (the nodes of one RS-485 line share its connection, one
+transaction at a time, as they share the wire). While a node is backing off, its requests fail at once
 (the instruction's output shows the link is down) and the first request after the back-off tries
 to reconnect.
 """
@@ -316,7 +317,6 @@ class Exchange:
     def _post_reset(self) -> None:
         """No link and nothing in flight as of the next scan (requests of a stopped run never complete)."""
         inflight, present, nodes = self._inflight, self._present, list(self.configs)
-
         self._outbox.clear()
         self._wake = False
 
