@@ -11,9 +11,9 @@ from dataclasses import dataclass, field
 from pathlib import Path
 
 from app.config import Station, read_station
-from app.runtime import load_simulated_program
+from app.runtime import load_simulated_program, node_configs
 from hmi_forms.form import load_forms
-from netplc.exchange import NodeConfig, check_program_nodes
+from netplc.exchange import check_program_nodes
 from netplc.program import Program, ProgramError, load_symbols, parse, parse_file
 from registrar.catalog import Catalog, CatalogError
 
@@ -40,9 +40,7 @@ def check_station(path: str | Path) -> CheckReport:
     symbols = _symbols(station.Symbols, report)
     program = _program(station, symbols, report)
     if program is not None:
-        nodes = [NodeConfig(n.node, n.endpoint or "tcp://127.0.0.1:1", unit=n.unit, profile=n.profile,
-                            timeout=n.timeout, retries=n.retries, table=n.table) for n in station.nodes]
-        report.problems += [str(d) for d in check_program_nodes(program, nodes)]
+        report.problems += [str(d) for d in check_program_nodes(program, node_configs(station.nodes))]
     for sim in station.simulators:
         try:
             p = load_simulated_program(sim.program, sim.symbols)

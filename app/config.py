@@ -9,16 +9,17 @@ engineer fixes a broken station in one pass instead of one error per start.
 from __future__ import annotations
 
 import tomllib
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from pathlib import Path
 from typing import Any
-from urllib.parse import urlsplit
 
 from netplc.address import fmt_octal, is_data_byte, is_io_bit, parse_octal
+from netplc.modbus_driver import parse_endpoint
 
 STATION_FILE = "station.toml"
 PROFILES = ("cpu165", "modbus")
 TABLES = ("holding", "input", "coils", "discrete")
+BAD_ENDPOINT = "?"  # an endpoint already reported as wrong: not "missing" as well
 DEFAULT_WRITABLE = ((0o2000, 0o3777), (0o4000, 0o7777))
 
 
@@ -263,24 +264,6 @@ def _ranges(r: _Reader, ranges: list[Any]) -> tuple[tuple[int, int], ...]:
     return tuple(out)
 
 
-def check_endpoint(endpoint: str) -> str | None:
-    """The problem with an endpoint string, or None when it is usable."""
-    parts = urlsplit(endpoint)
-    if parts.scheme == "tcp":
-        try:
-            port = parts.port
-        except ValueError:
-            return f"{endpoint!r}: the port is not a number 0-65535"
-        if not parts.hostname or port is None:
-            return f"{endpoint!r}: expected tcp://host:port"
-        return None
-    if parts.scheme == "rtu":
-        if not parts.path or parts.path == "/":
-            return f"{endpoint!r}: expected rtu:///dev/ttyX?baudrate=19200&parity=N"
-        return None
-    return f"{endpoint!r}: expected tcp://host:port or rtu:///dev/ttyX?baudrate=..&parity=.."
-
-
 def _nodes(problems: list[str], fname: str, items: list[Any]) -> list[NodeSettings]:
     nodes: list[NodeSettings] = []
     seen: set[int] = set()
@@ -297,8 +280,12 @@ def _nodes(problems: list[str], fname: str, items: list[Any]) -> list[NodeSettin
         retries = r.number("retries", 1, 0, 10)
         table_name = r.get("table", str, "holding")
         r.finish()
-        if endpoint and (why := check_endpoint(endpoint)):
-            r.bad("endpoint", why)
+        if endpoint:
+            try:
+                parse_endpoint(endpoint)
+            except ValueError as e:
+                r.bad("endpoint", str(e))
+                endpoint = BAD_ENDPOINT
         if profile not in PROFILES:
             r.bad("profile", f"{profile!r} is not one of {', '.join(PROFILES)}")
         if table_name not in TABLES:
@@ -354,10 +341,11 @@ def _with_simulated_nodes(problems: list[str], fname: str, nodes: list[NodeSetti
         endpoint = f"tcp://{sim.host}:{sim.port}" if sim.port else ""
         if node is None:
             by_node[sim.node] = NodeSettings(sim.node, endpoint, unit=sim.unit)
-        elif node.endpoint and sim.port and node.endpoint != endpoint:
+        elif node.endpoint not in ("", BAD_ENDPOINT) and sim.port and node.endpoint != endpoint:
             problems.append(f"{fname}: simulators[{i}].port: node {sim.node} has endpoint "
                             f"{node.endpoint}, but its simulator listens on {endpoint}")
     for n in by_node.values():
         if not n.endpoint and not any(s.node == n.node for s in sims):
             problems.append(f"{fname}: nodes: node {n.node} has no endpoint and no simulator")
-    return sorted(by_node.values(), key=lambda n: n.node)
+    return sorted((replace(n, endpoint="") if n.endpoint == BAD_ENDPOINT else n for n in by_node.values()),
+                  key=lambda n: n.node)

@@ -12,13 +12,13 @@ from __future__ import annotations
 
 import threading
 import time
-from collections.abc import Callable
+from collections.abc import Callable, Iterable
 from dataclasses import dataclass, field
 from pathlib import Path
 
 from app.config import NodeSettings, Station
 from netplc.engine import Engine
-from netplc.exchange import Exchange, NodeConfig
+from netplc.exchange import Exchange, NodeConfig, check_program_nodes
 from netplc.modbus_server import ModbusServer
 from netplc.program import Program, ProgramError, load_symbols, parse, parse_file
 from netplc.records import Record
@@ -29,6 +29,7 @@ from registrar.retain import Retainer
 from registrar.store import Store, StoreStats
 
 RecordObserver = Callable[[Record], None]
+UNSTARTED = "tcp://127.0.0.1:1"  # endpoint of a simulated node whose simulator has not started
 
 
 class StartError(Exception):
@@ -92,13 +93,20 @@ def load_simulated_program(path: Path, symbols: Path | None) -> Program:
     return parse_file(path, load_symbols(symbols) if symbols else {})
 
 
+def node_configs(nodes: Iterable[NodeSettings]) -> list[NodeConfig]:
+    """The exchange's view of the station's nodes. A simulated node has no endpoint before its
+    simulator has a port; a placeholder stands in so the program can be checked against it."""
+    return [NodeConfig(n.node, n.endpoint or UNSTARTED, unit=n.unit, profile=n.profile, timeout=n.timeout,
+                       retries=n.retries, table=n.table) for n in nodes]
+
+
 class Runtime:
     """The running station. `start()`, then `status()` as often as wanted, then `stop()`."""
 
     def __init__(self, station: Station, *, wallclock: Callable[[], float] = time.time) -> None:
         self.station = station
         self.wallclock = wallclock
-        self.catalog, self.program = self._load()
+        self.catalog, self.program, self.node_programs = self._load()
         self.store: Store | None = None
         self.engine: Engine | None = None
         self.retainer: Retainer | None = None
@@ -107,8 +115,8 @@ class Runtime:
         self.modbus: ModbusServer | None = None
         self.scan_thread: ScanThread | None = None
         self.nodes: list[NodeSettings] = list(station.nodes)
-        self.restored = ""
-        self.started_clock: float | None = None  # which retentive save was used: current / previous / zeroes
+        self.restored = ""  # which retentive save was used: current / previous / zeroes
+        self.started_clock: float | None = None
         self._observers: list[RecordObserver] = []
         self._problems: list[str] = []
         self._lock = threading.Lock()
@@ -148,23 +156,32 @@ class Runtime:
 
     # --- start and stop ------------------------------------------------------------------------
 
-    def _load(self) -> tuple[Catalog, Program]:
-        """Message texts and the program, both checked before anything starts."""
+    def _load(self) -> tuple[Catalog, Program, list[Program]]:
+        """Message texts, the program and the simulated nodes' programs, all checked before
+        anything starts; a NREAD/NWRITE to a node the station does not configure is an error."""
+        st = self.station
         problems: list[str] = []
         catalog = Catalog()
         program = parse("", source="<none>")
+        node_programs: list[Program] = []
         try:
-            if self.station.Messages is not None:
-                catalog = Catalog.load(self.station.Messages)
+            if st.Messages is not None:
+                catalog = Catalog.load(st.Messages)
         except CatalogError as e:
             problems += e.problems
         try:
-            program = load_program(self.station)
+            program = load_program(st)
+            problems += [str(d) for d in check_program_nodes(program, node_configs(st.nodes))]
         except ProgramError as e:
             problems += [str(d) for d in e.errors]
+        for sim in st.simulators:
+            try:
+                node_programs.append(load_simulated_program(sim.program, sim.symbols))
+            except ProgramError as e:
+                problems += [str(d) for d in e.errors]
         if problems:
             raise StartError(problems)
-        return catalog, program
+        return catalog, program, node_programs
 
     def start(self) -> None:
         st = self.station
@@ -186,16 +203,13 @@ class Runtime:
             self.engine.stop()
         self.retainer = Retainer(st.Retain, self.engine, self)
         self.restored = self.retainer.restore()
-        for sim in st.simulators:
-            program = load_simulated_program(sim.program, sim.symbols)
+        for sim, program in zip(st.simulators, self.node_programs, strict=True):
             simulator = Simulator(program, host=sim.host, port=sim.port, unit=sim.unit,
                                   tick=sim.tick_ms / 1000)
             simulator.start()
             self.simulators.append(simulator)
             self._fill_endpoint(sim.node, f"tcp://{sim.host}:{simulator.port}")
-        configs = [NodeConfig(n.node, n.endpoint, unit=n.unit, profile=n.profile, timeout=n.timeout,
-                              retries=n.retries, table=n.table) for n in self.nodes]
-        self.exchange = Exchange(configs, self)
+        self.exchange = Exchange(node_configs(self.nodes), self)
         self.exchange.attach(self.engine)
         self.exchange.start()
         server = st.modbus_server

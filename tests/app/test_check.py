@@ -30,7 +30,7 @@ def plant(path: Path, old: str, new: str) -> None:
 def test_every_planted_error_is_found(tmp_path: Path) -> None:
     st = copy_demo(tmp_path / "broken")
     plant(st / "station.toml", "NetSyncTime = 100", 'NetSyncTime = "fast"\nColour = "red"')
-    plant(st / "station.toml", "timeout = 0.5", 'timeout = 0.5\nendpoint = "tcp://plc"')
+    plant(st / "station.toml", "timeout = 0.5", 'timeout = 0.5\nendpoint = "tcp://plc:99999"')
     plant(st / "netplc.stl", "TNA ON\nFON C:$02140 N:NODE S:0", "TNX ON\nFON C:$02140 N:NODE S:0")
     plant(st / "netplc.stl", "FON C:NRD N:NREAD S:4000 D:TRIG_IN R:2",
           "FON C:NRD N:NREAD S:4000 D:NO_SUCH R:2")
@@ -59,7 +59,7 @@ def test_every_planted_error_is_found(tmp_path: Path) -> None:
     expected = [
         f"{st / 'station.toml'}: NetSyncTime: expected an integer",
         f"{st / 'station.toml'}: Colour: unknown setting",
-        f"{st / 'station.toml'}: nodes[0].endpoint: 'tcp://plc'",
+        f"{st / 'station.toml'}: nodes[0].endpoint: endpoint 'tcp://plc:99999'",
         f"{st / 'netplc.stl'}:{tnx}:1: unknown instruction 'TNX'",
         f"{st / 'netplc.stl'}:{nosuch}:",
         f"{st / 'netplc.stl'}:{node7}:1: NODE S:7: node 7 is not configured",  # found past other errors

@@ -45,7 +45,7 @@ port = 70000
 writable = [["04000"], ["09000", "04777"], ["04777", "04000"], ["02000", "04000"]]
 [[nodes]]
 node = 3
-endpoint = "tcp://plc"
+endpoint = "tcp://plc:99999"
 profile = "s7"
 [[nodes]]
 node = 3
@@ -66,8 +66,9 @@ users = []
         "Colour: unknown setting", "modbus_server.port: 70000 is outside", "modbus_server.writable[0]",
         "modbus_server.writable[1]: '09000' is not an octal number",
         "modbus_server.writable[2]: 04777 is above",
-        "modbus_server.writable[3]: a range must lie within", "nodes[0].endpoint: 'tcp://plc'",
-        "nodes[0].profile: 's7'", "nodes[1].node: node 3 is configured twice", "nodes[1].endpoint: 'com1'",
+        "modbus_server.writable[3]: a range must lie within", "nodes[0].endpoint: endpoint 'tcp://plc:99999'",
+        "nodes[0].profile: 's7'", "nodes[1].node: node 3 is configured twice",
+        "nodes[1].endpoint: endpoint 'com1'",
         "node 5 has no endpoint and no simulator", "simulators[0].program: file", "operator.users",
     ):
         assert expected in text, expected
