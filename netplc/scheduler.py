@@ -19,6 +19,7 @@ class ScanThread:
                  on_error: Callable[[BaseException], None] | None = None) -> None:
         self.engine = engine
         self.tick = tick if tick is not None else engine.tick
+        engine.tick = self.tick  # overruns are counted against the tick the scans really run on
         self._stop = threading.Event()
         self._thread = threading.Thread(target=self._loop, name=name, daemon=True)
         self._on_error = on_error

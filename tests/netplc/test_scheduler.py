@@ -1,0 +1,73 @@
+"""ScanThread: scans on its tick in a thread of its own, survives a failing scan, stops cleanly.
+
+These tests use the real monotonic clock (that is what the thread schedules on) but wait on
+events with generous timeouts instead of sleeping for fixed times.
+"""
+
+from __future__ import annotations
+
+import threading
+
+from netplc.engine import Engine
+from netplc.program import parse
+from netplc.scheduler import ScanThread
+
+
+def engine_for(text: str) -> Engine:
+    return Engine(parse(text), tick=0.1)
+
+
+def test_scans_run_on_the_tick_and_stop():
+    engine = engine_for("TNA $03760\nCTR $03000 N:255")
+    done = threading.Event()
+    engine.listeners.append(lambda snap: snap.scan >= 5 and done.set())
+    thread = ScanThread(engine, tick=0.005)
+    assert engine.tick == 0.005  # overruns are counted against the thread's tick
+    thread.start()
+    try:
+        assert done.wait(10)
+        assert thread.running
+    finally:
+        thread.stop()
+    assert not thread.running
+    count = engine.scan_counter
+    assert count >= 5 and engine.stats.count == count
+    assert engine.ctr_values[0o3000] == 1  # the program ran: 03760 rose once, counted
+    assert engine.snapshot.scan == count
+
+
+def test_a_failing_scan_is_reported_and_the_thread_goes_on():
+    engine = engine_for("NOP")
+    errors: list[BaseException] = []
+    recovered = threading.Event()
+
+    def listener(snap):
+        if snap.scan == 2:
+            raise RuntimeError("listener bug")
+        if snap.scan >= 4:
+            recovered.set()
+
+    engine.listeners.append(listener)
+    thread = ScanThread(engine, tick=0.005, on_error=errors.append)
+    thread.start()
+    try:
+        assert recovered.wait(10)
+    finally:
+        thread.stop()
+    assert [str(e) for e in errors] == ["listener bug"]
+
+
+def test_lock_holds_the_scans_off():
+    engine = engine_for("NOP")
+    thread = ScanThread(engine, tick=0.002)
+    scanned = threading.Event()
+    engine.listeners.append(lambda snap: scanned.set())
+    with thread.lock:
+        thread.start()
+        before = engine.scan_counter
+        assert not scanned.wait(0.05)  # no scan while the lock is held
+        assert engine.scan_counter == before
+    try:
+        assert scanned.wait(10)
+    finally:
+        thread.stop()
