@@ -135,6 +135,7 @@ class _Raw:
     op: str
     params: dict[str, tuple[str, int]]  # key -> (token, col)
     text: str
+    extra: list[tuple[str, int]] = field(default_factory=list)  # FON positional S/D/R, by function
 
 
 def parse(text: str, source: str = "<program>", symbols: dict[str, int] | None = None) -> Program:
@@ -220,6 +221,7 @@ class _Parser:
         keys = LOGIC[op][0]
         pos = m.end()
         params: dict[str, tuple[str, int]] = {}
+        extra: list[tuple[str, int]] = []
         rest = line[pos:]
         # a trailing comment: ';' or '#' after white space, or ';;' ('C:$03000;N:56;' separates)
         cut = _COMMENT.search(rest)
@@ -246,6 +248,10 @@ class _Parser:
             if not key:
                 # a positional parameter: the first one the instruction takes that is not given yet
                 free = [k for k in keys if k not in params]
+                if op == "FON" and free and free[0] in "SDR":
+                    extra.append((token, col))  # which of S, D, R depends on the function
+                    i = pm.end()
+                    continue
                 if not free:
                     self.err(lineno, col, f"{op} takes no more parameters (extra {token!r})")
                     ok = False
@@ -262,7 +268,7 @@ class _Parser:
                 params[key] = (token, col)
             i = pm.end()
         if ok:
-            raws.append(_Raw(lineno, m.start(1) + 1, op, params, stripped))
+            raws.append(_Raw(lineno, m.start(1) + 1, op, params, stripped, extra))
 
     # --- values ------------------------------------------------------------------------------
 
@@ -400,6 +406,16 @@ class _Parser:
                 self.err(raw.line, col, f"N: unknown function {token!r}")
                 return None
             number = spec.number
+        # positional operands fill the parameters this function takes, in S, D, R order
+        takes = [k for k, kind in spec.kinds().items() if kind] if spec else ["S", "D", "R"]
+        free = [k for k in takes if k not in raw.params]
+        for key, (token, col) in zip(free, raw.extra):
+            raw.params[key] = (token, col)
+        if len(raw.extra) > len(free):
+            token, col = raw.extra[len(free)]
+            self.err(raw.line, col, f"FON {spec.mnemonic if spec else number} takes no more parameters "
+                                    f"(extra {token!r})")
+            return None
         values: dict[str, int | None] = {"S": None, "D": None, "R": None}
         ok = c is not None
         if spec is not None:

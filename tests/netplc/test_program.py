@@ -81,6 +81,18 @@ def test_fon_takes_a_function_number_or_its_mnemonic(monkeypatch):
     assert p.words == 10
 
 
+def test_positional_fon_operands_fill_the_parameters_the_function_takes(monkeypatch):
+    spec = FunctionSpec(4249, "DONLY", None, "M", "D", lambda ctx, fon: None)
+    monkeypatch.setitem(REGISTRY, 4249, spec)
+    monkeypatch.setitem(BY_NAME, "DONLY", spec)
+    ins = parse("FON $03000 N:DONLY $04010 12").instrs[0]
+    assert (ins.s, ins.d, ins.r) == (None, 0o4010, 12)
+    ins = parse("FON $03000 N:DONLY R:5 $04010").instrs[0]
+    assert (ins.d, ins.r) == (0o4010, 5)
+    assert one_error("FON $03000 N:DONLY $04010 12 $04000") == (
+        "p.stl:1:30: FON DONLY takes no more parameters (extra '$04000')")
+
+
 def test_parse_file_names_the_file(tmp_path):
     f = tmp_path / "prog.stl"
     f.write_text("TNA $02042\nXYZ\n", encoding="utf-8")
