@@ -32,7 +32,7 @@ COIL_BITS = {"SON": 1, "SOF": 1, "YON": 1, "TIM": 2, "CTR": 3, "FON": 4}
 _NAME = r"[^\W\d][\w.\[\]]*"
 _LINE_NO = re.compile(r"\s*\d+\.\d+\s+")
 _LABEL = re.compile(rf"\s*({_NAME})\s*:(?![^\s;])")
-_SYMDEF = re.compile(rf"\s*({_NAME})\s*=\s*(\S+)\s*$")
+_SYMDEF = re.compile(rf"\s*({_NAME})\s*=\s*([^\s;#]+)\s*(?:[;#].*)?$")
 _MNEMONIC = re.compile(r"\s*([^\W\d]\w*)")
 _PARAM = re.compile(r"\s*(?:([A-Za-z])\s*:\s*)?([^\s;:]*)\s*;?")
 _OFFSET = re.compile(rf"({_NAME}?)\[([0-9]+)\]")  # TA[2]: the bit two after symbol TA (manual's notation)

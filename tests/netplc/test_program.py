@@ -29,7 +29,7 @@ def one_error(text: str, **kw) -> str:
 def test_instructions_labels_symbols_and_comments():
     text = """; a comment line
 # another
-START = $02042
+START = $02042   ; start button
 0.0   TNA   C:START;
 0.1   TFA $00001
 lab1: TNO C:$03760
