@@ -43,6 +43,7 @@ def scale_ticks(lo: float, hi: float, max_major: int) -> tuple[list[float], list
     return majors, minors, decimals
 
 
+SMALL_DIAL = 45.0  # radius in px below which a dial drops its labels and enlarges the readout
 NEEDLE_PEN = QPen(theme.ACCENT.darker(130), 1)
 HUB = QColor("#33393f")
 WHITE = QColor("#ffffff")
@@ -178,12 +179,13 @@ class GaugeWidget(ElementWidget):
             p.drawArc(QRectF(c.x() - rr, c.y() - rr, 2 * rr, 2 * rr), round((start + sweep * f0) * 16),
                       round(sweep * (f1 - f0) * 16))
         lo, hi = m.scaling.phy_range
+        small = r < SMALL_DIAL  # a tile: ticks only, the readout carries the number
         max_major = 4 if r < 45 else 6 if r < 90 else 10
         if sweep != -270.0:
             max_major = max(3, max_major - 1)
         majors, minors, decimals = scale_ticks(lo, hi, max_major)
         p.setPen(QPen(theme.TEXT, max(1.0, r * 0.012)))
-        for v in minors:
+        for v in [] if small else minors:
             a = start + sweep * m.scaling.fraction(v)
             p.drawLine(self._at(c, r * 0.88, a), self._at(c, r * 0.81, a))
         p.setPen(QPen(theme.TEXT, max(1.3, r * 0.025), Qt.PenStyle.SolidLine, Qt.PenCapStyle.FlatCap))
@@ -192,10 +194,12 @@ class GaugeWidget(ElementWidget):
         for v in majors:
             a = start + sweep * m.scaling.fraction(v)
             p.drawLine(self._at(c, r * 0.88, a), self._at(c, r * 0.74, a))
+            if small:
+                continue
             label_at = self._at(c, r * 0.58, a)
             box = QRectF(label_at.x() - r * 0.3, label_at.y() - r * 0.1, r * 0.6, r * 0.2)
             p.drawText(box, Qt.AlignmentFlag.AlignCenter, f"{v:.{decimals}f}")
-        if m.Units:
+        if m.Units and not small:
             p.setPen(theme.TEXT_DIM)
             p.setFont(theme.sized_font(max(8.0, r * 0.13)))
             uy = c.y() + r * 0.25 if sweep == -270.0 else c.y() - r * 0.3
@@ -233,6 +237,9 @@ class GaugeWidget(ElementWidget):
 
     def _compute_readout_box(self) -> tuple[QRectF, float]:
         c, r, _, sweep = self._dial
+        if r < SMALL_DIAL:  # the number matters more than the face: a wide readout over the gap
+            size = max(9.0, r * 0.36)
+            return QRectF(c.x() - r * 0.8, c.y() + r * 0.38, r * 1.6, size * 1.35), size
         size = max(9.0, r * 0.2)
         if sweep == -270.0:
             return QRectF(c.x() - r * 0.45, c.y() + r * 0.42, r * 0.9, size * 1.5), size
