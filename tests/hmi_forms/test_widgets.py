@@ -232,3 +232,37 @@ def test_demo_forms_load_and_use_every_element_type(qtbot) -> None:
         qtbot.addWidget(view)
         view.refresh(eng.snapshot)
         assert not view.grab().isNull() and view.errors == []
+
+
+def test_element_records_reach_the_sink_through_the_engine_thread(qtbot, tmp_path) -> None:
+    eng, sink = engine()
+    form = one(tmp_path, "DiscreteBase", InAddr="02120", TextFalse="Насос остановлен",
+               TextTrue="Насос работает", RegMessages=True)
+    view = FormView(form, EngineTarget(eng))
+    qtbot.addWidget(view)
+    view.refresh(eng.snapshot)
+    eng.write_bit(0o2120, 1, user="test")
+    view.refresh(eng.scan())
+    assert [r.kind for r in sink.records] == ["operator"]  # the element's record waits for the next scan
+    eng.scan()
+    assert [(r.kind, r.source, r.text, r.type) for r in sink.records[1:]] == [
+        ("message", "E", "Насос работает", 0)]
+
+
+def test_a_failing_element_is_reported_and_the_others_go_on(qtbot, tmp_path) -> None:
+    form = load_form(write_form(tmp_path, [
+        {"type": "DiscreteBase", "Name": "A", "x": 0, "y": 0, "w": 100, "h": 30, "InAddr": "02120"},
+        {"type": "DiscreteBase", "Name": "B", "x": 0, "y": 40, "w": 100, "h": 30, "InAddr": "02121"},
+    ]))
+    view = FormView(form, EngineTarget(engine()[0]))
+    qtbot.addWidget(view)
+
+    def broken(snapshot) -> bool:
+        raise RuntimeError("boom")
+
+    form.elements[0].refresh = broken
+    view.refresh(snap(bits={0o2121: 1}))
+    view.refresh(snap(bits={0o2121: 0}, scan=1))
+    assert len(view.errors) == 1 and 'element "A": update failed' in view.errors[0]
+    assert form.elements[0].stale and form.elements[1].value == 0
+    assert not view.grab().isNull()
