@@ -12,9 +12,6 @@ from netplc.program import Program
 if TYPE_CHECKING:
     from netplc.engine import Engine
 
-TERMINATORS = frozenset({"YON", "SON", "SOF", "SKP", "JMY", "JMN", "TIM", "CTR", "FON"})
-
-
 class Interpreter:
     def __init__(self, program: Program, engine: Engine) -> None:
         self.instrs = program.instrs

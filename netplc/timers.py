@@ -22,10 +22,6 @@ class ScanClock(Protocol):
     dt: float  # seconds since the previous scan
 
 
-def time_base(bits: bytearray) -> float:
-    return TIME_BASES[(bits[TIMEBASE_HI] << 1) | bits[TIMEBASE_LO]]
-
-
 def make_tim(
     bits: bytearray, ticks: dict[int, float], c: int, n: int, clock: ScanClock
 ) -> Callable[[int], None]:
