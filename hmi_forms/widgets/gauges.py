@@ -241,8 +241,8 @@ class GaugeWidget(ElementWidget):
             size = max(9.0, r * 0.36)
             return QRectF(c.x() - r * 0.8, c.y() + r * 0.38, r * 1.6, size * 1.35), size
         size = max(9.0, r * 0.2)
-        if sweep == -270.0:
-            return QRectF(c.x() - r * 0.45, c.y() + r * 0.42, r * 0.9, size * 1.5), size
+        if sweep == -270.0:  # in the gap at the bottom, clear of the end labels
+            return QRectF(c.x() - r * 0.36, c.y() + r * 0.54, r * 0.72, size * 1.45), size
         top = c.y() + max(6.0, r * 0.1)  # below the centre, in the strip the layout keeps free
         height = min(size * 1.5, self.height() - top - 4)
         return QRectF(c.x() - r * 0.45, top, r * 0.9, height), height / 1.5
