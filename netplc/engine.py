@@ -254,6 +254,9 @@ class Engine:
                 fn(mem)
             except ValueError as e:  # a queued write to an address that does not exist
                 self.sink.put(Record(self.wall_time(), "system", source="netplc", text=f"write refused: {e}"))
+            except Exception as e:  # a faulty producer must not cost the scan or the writes after it
+                text = f"queued write failed: {type(e).__name__}: {e}"
+                self.sink.put(Record(self.wall_time(), "system", source="netplc", text=text))
             self.rtc.watch(mem)
         bits = mem.bits
         bits[ALWAYS_ONE] = 1

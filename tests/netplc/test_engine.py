@@ -392,6 +392,15 @@ def test_a_queued_write_to_a_gap_is_refused_and_the_scan_goes_on(compiled):
     assert any("write refused" in (r.text or "") for r in rig.sink.records)
 
 
+def test_a_failing_queued_write_costs_neither_the_scan_nor_later_writes():
+    rig = Rig("YON $02000")
+    rig.engine.post(lambda mem: 1 / 0)
+    rig.engine.write_word(0o4000, 5)
+    rig.step()
+    assert rig.bit(0o2000) == 1 and rig.engine.mem.get_word(0o4000) == 5
+    assert any("ZeroDivisionError" in (r.text or "") for r in rig.sink.records)
+
+
 @engines
 def test_snapshot_is_published_after_each_scan_to_listeners(compiled):
     rig = Rig("TNA $0\nYON $02000", compiled)
