@@ -9,7 +9,7 @@ from dataclasses import dataclass
 from netplc.address import IO_BITS, AddressError, check_operand, fmt_octal, parse_octal
 from netplc.engine import Engine, FakeClock
 from netplc.memory import Memory
-from netplc.program import ProgramError, load_symbols, parse_file
+from netplc.program import ProgramError, load_program
 from netplc.records import ListSink
 
 
@@ -93,8 +93,7 @@ def build_parser() -> argparse.ArgumentParser:
 
 def run(args: argparse.Namespace) -> int:
     try:
-        symbols = load_symbols(args.symbols) if args.symbols else {}
-        program = parse_file(args.program, symbols)
+        program = load_program(args.program, args.symbols)
     except ProgramError as e:
         print(e, file=sys.stderr)
         return 2

@@ -128,6 +128,12 @@ def parse_file(path: str | Path, symbols: dict[str, int] | None = None) -> Progr
     return parse(text, source=str(path), symbols=symbols)
 
 
+def load_program(path: str | Path, symbols_path: str | Path | None = None) -> Program:
+    """Read the symbols file (if any) and parse the program with it: what every front end does."""
+    symbols = load_symbols(symbols_path) if symbols_path else {}
+    return parse_file(path, symbols)
+
+
 @dataclass
 class _Raw:
     line: int
@@ -329,13 +335,15 @@ class _Parser:
                 self.err(raw.line, col, f"{key}: {token!r} is not a BCD constant (up to 4 decimal digits)")
                 return None
             return int(token, 16)
-        pattern, radix, name = (_OCTAL, 8, "octal") if kind == "O" else (_DECIMAL, 10, "decimal")
+        octal = kind == "O"
+        pattern, radix, name = (_OCTAL, 8, "an octal") if octal else (_DECIMAL, 10, "a decimal")
         if not pattern.fullmatch(token):
-            self.err(raw.line, col, f"{key}: {token!r} is not a {name} number")
+            self.err(raw.line, col, f"{key}: {token!r} is not {name} number")
             return None
         value = int(token, radix)
         if not lo <= value <= hi:
-            self.err(raw.line, col, f"{key}: {token} is outside {lo}-{hi}")
+            bounds = f"{lo:o}-{hi:o}" if octal else f"{lo}-{hi}"  # in the radix the constant is written in
+            self.err(raw.line, col, f"{key}: {token} is outside {bounds}")
             return None
         return value
 

@@ -17,7 +17,7 @@ import threading
 
 from netplc.engine import Engine
 from netplc.modbus_server import ALL_MEMORY, ModbusServer
-from netplc.program import Program, ProgramError, load_symbols, parse_file
+from netplc.program import Program, ProgramError, load_program
 from netplc.records import RecordSink
 from netplc.scheduler import ScanThread
 
@@ -66,8 +66,7 @@ def main(argv: list[str] | None = None) -> int:
         print("simulate: --unit takes 0-255 and --port 0-65535", file=sys.stderr)
         return 2
     try:
-        symbols = load_symbols(args.symbols) if args.symbols else {}
-        program = parse_file(args.program, symbols)
+        program = load_program(args.program, args.symbols)
     except ProgramError as e:
         print(e, file=sys.stderr)
         return 2
