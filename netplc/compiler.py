@@ -5,8 +5,11 @@ function of the chain state `a` (ACC) and `s` (SUM) on entry, returning the inde
 block (None ends the scan, HALT halts) and the state on exit. Inside a block the chain state is
 kept symbolically: a chain of contacts becomes one short-circuit expression (contacts have no side
 effects, so `and`/`or` give the same RES as the bitwise model of DESIGN section 4), evaluated
-once by its terminator. TIM, CTR and FON call per-instruction closures the engine builds, the same
-ones the reference interpreter reaches, so only contacts and jumps are compiled twice.
+once by its terminator. TIM and CTR are written out from the source lines netplc/timers.py keeps
+beside its closures; a FON runs its function's inline source lines (FunctionSpec.inline, for simple
+functions on data operands) or calls the step the engine binds once per instruction. The reference
+interpreter reaches the same timers and functions through the engine's closures, and the equivalence
+tests hold the two to identical memory.
 """
 
 from __future__ import annotations
@@ -15,6 +18,7 @@ from collections.abc import Callable
 from typing import TYPE_CHECKING
 
 from netplc.program import Instr, Program
+from netplc.timers import TIME_BASES, ctr_lines, tim_lines
 
 if TYPE_CHECKING:
     from netplc.engine import Engine
@@ -77,11 +81,24 @@ def _contact(ins: Instr) -> _Expr:
     return _Expr(f"(not b[{ins.c}])" if negated else f"b[{ins.c}]")
 
 
+def _branch(res: str, on: list[str], off: list[str]) -> list[str]:
+    """Lines running `on` when the expression `res` is true, else `off`."""
+    if res == "1":
+        return on
+    if res == "0":
+        return off
+    out = [f"if {res}:", *("    " + line for line in on or ["pass"])]
+    if off:
+        out += ["else:", *("    " + line for line in off)]
+    return out
+
+
 class _Block:
     """Code of one basic block, generated with the chain state (acc, sm) tracked symbolically."""
 
-    def __init__(self, n: int) -> None:
+    def __init__(self, n: int, inline: dict[int, list[str]]) -> None:
         self.n = n
+        self.inline = inline  # FON index -> the function's source lines
         self.lines: list[str] = []
         self.acc, self.sm = _Expr("a"), _Expr("s")
         self.ended = False  # the last line returns
@@ -117,8 +134,18 @@ class _Block:
                 lines.append(f"b[{c}] = {int(op == 'SON')}" if res == "1" else
                              f"if {res}: b[{c}] = {int(op == 'SON')}")
             self.chain_end()
-        elif op in ("TIM", "CTR", "FON"):
-            lines.append(f"{op.lower()}{index}({self.res()})")
+        elif op == "TIM":
+            lines += _branch(self.res(), *tim_lines(c or 0, ins.n or 0))
+            self.chain_end()
+        elif op == "CTR":
+            on, off, after = ctr_lines(c or 0, ins.n or 0)
+            lines += _branch(self.res(), on, off) + after
+            self.chain_end()
+        elif op == "FON":
+            body = self.inline.get(index)
+            if body is None:
+                body = ["try:", f"    fon{index}(eng)", "except Exception as _e:", f"    failed({index}, _e)"]
+            lines += _branch(self.res(), [f"b[{c}] = 1", *body], [f"b[{c}] = 0"])
             self.chain_end()
         elif op == "HLT":
             lines.append(f"return {HALT}, 1, 0")
@@ -144,7 +171,7 @@ class _Block:
             return
         if nxt.op in ("SKP", "NOP"):  # a SKP reached right after a terminator sees RES = 1: no-op
             return
-        inner = _Block(self.n)
+        inner = _Block(self.n, self.inline)
         inner.acc, inner.sm = ONE, ZERO
         inner.emit(nxt, index + 1)
         contact = inner.acc is not ONE or inner.sm is not ZERO
@@ -163,19 +190,25 @@ class _Block:
             self.lines.append(f"return {_target(end, self.n)}, {self.acc.text}, {self.sm.text}")
 
 
-def generate_source(program: Program) -> str:
-    """Python source of `_make(b, calls)`, returning {block start: block function}."""
+_ARGS = "b, d, eng, tk, cv, TB, failed"  # bits, data, engine, TIM and CTR values, time bases
+
+
+def generate_source(program: Program, inline: dict[int, list[str]] | None = None) -> str:
+    """Python source of `_make(steps, {_ARGS})`, returning {block start: block function}.
+
+    `inline` maps a FON's index to its function's source lines; any other FON calls steps[index].
+    """
+    inline = inline or {}
     instrs = program.instrs
     n = len(instrs)
     starts = _block_starts(instrs)
-    names = [f"{ins.op.lower()}{i}" for i, ins in enumerate(instrs) if ins.op in ("TIM", "CTR", "FON")]
-    out = ["def _make(b, calls):"]
-    out += [f"    {name} = calls[{name!r}]" for name in names]
+    out = [f"def _make(steps, {_ARGS}):"]
+    out += [f"    fon{i} = steps[{i}]" for i, ins in enumerate(instrs) if ins.op == "FON" and i not in inline]
     for k, start in enumerate(starts):
         if start >= n:
             continue
         end = starts[k + 1] if k + 1 < len(starts) else n
-        block = _Block(n)
+        block = _Block(n, inline)
         i = start
         while i < end and not block.ended:
             ins = instrs[i]
@@ -186,7 +219,7 @@ def generate_source(program: Program) -> str:
                 block.emit(ins, i)
             i += 1
         block.finish(end)
-        out.append(f"    def _b{start}(a, s, b=b):")
+        out.append(f"    def _b{start}(a, s, {', '.join(f'{v}={v}' for v in _ARGS.split(', '))}):")
         out += ["        " + line for line in block.lines]
     out.append("    return {" + ", ".join(f"{s}: _b{s}" for s in starts if s < n) + "}")
     return "\n".join(out) + "\n"
@@ -197,13 +230,18 @@ def compile_program(program: Program, engine: Engine) -> Callable[[], str | None
     from netplc.engine import WATCHDOG_STEPS
 
     instrs = program.instrs
-    calls: dict[str, Callable[[int], None]] = {}
-    for i, ins in enumerate(instrs):
-        if ins.op in ("TIM", "CTR", "FON"):
-            calls[f"{ins.op.lower()}{i}"] = engine.instruction_call(i)
+    inline: dict[int, list[str]] = {}
+    steps = {}
+    for i, (fon, spec) in engine.fons.items():
+        lines = spec.inline(fon) if spec is not None and spec.inline and not spec.hardware else None
+        if lines is None:
+            steps[i] = engine.fon_step(i)
+        else:
+            inline[i] = lines
     namespace: dict = {}
-    exec(compile(generate_source(program), f"<compiled {program.source}>", "exec"), namespace)
-    blocks = namespace["_make"](engine.mem.bits, calls)
+    exec(compile(generate_source(program, inline), f"<compiled {program.source}>", "exec"), namespace)
+    blocks = namespace["_make"](steps, engine.mem.bits, engine.mem.data, engine, engine.tim_ticks,
+                                engine.ctr_values, TIME_BASES, engine.fon_failed)
     starts = sorted(blocks)
     sizes = {s: (starts[k + 1] if k + 1 < len(starts) else len(instrs)) - s for k, s in enumerate(starts)}
     first = blocks.get(0)

@@ -23,6 +23,7 @@ from netplc.address import (
     BitRef,
     fmt_octal,
 )
+from netplc.functions._util import Step, bind, fail
 from netplc.functions.registry import Fon, FunctionSpec, NetLink, lookup
 from netplc.memory import Memory, Snapshot
 from netplc.program import Program
@@ -139,10 +140,24 @@ class Engine:
     def instruction_call(self, index: int) -> Callable[[int], None]:
         """The closure that runs the TIM, CTR or FON at `index` with its chain result RES.
 
-        Both the compiled program and the reference interpreter call these, so timers, counters
-        and functions behave identically under both.
+        The reference interpreter calls these; the compiled program writes TIM and CTR out and
+        calls `fon_step` (or the function's inline source) itself, with the same effects.
         """
         return self._calls[index]
+
+    def fon_step(self, index: int) -> Step:
+        """The function of the FON at `index`, bound to its operands once, for the compiled program
+        to call while RES is 1 (after setting bit C), reporting an exception to `fon_failed`."""
+        fon, spec = self.fons[index]
+        if spec is None or spec.hardware:
+            return fail
+        return bind(spec.run, self.mem, fon)
+
+    def fon_failed(self, index: int, e: Exception) -> None:
+        fon, spec = self.fons[index]
+        self.mem.bits[FERR1] = 1
+        name = spec.mnemonic if spec else fon.f
+        self._fault_once(index, f"FON {name} at line {fon.line}: {type(e).__name__}: {e}")
 
     def _make_fon(self, index: int) -> Callable[[int], None]:
         """Bit C = RES; while RES is 1 the function runs every scan (level semantics).
@@ -170,9 +185,7 @@ class Engine:
                 try:
                     run(self, fon)
                 except Exception as e:
-                    bits[FERR1] = 1
-                    where = f"FON {spec.mnemonic} at line {fon.line}"
-                    self._fault_once(index, f"{where}: {type(e).__name__}: {e}")
+                    self.fon_failed(index, e)
 
         return call
 

@@ -69,6 +69,41 @@ def make_ctr(bits: bytearray, values: dict[int, int], c: int, n: int) -> Callabl
     return ctr
 
 
+# The same two instructions as source lines for the compiled program (netplc/compiler.py), which
+# runs the first list when RES is 1 and the second when it is 0. They see the bit array as `b`, the
+# current values as `tk` and `cv`, the engine (dt) as `eng`, TIME_BASES as `TB`, locals _t _x _v.
+
+
+def tim_lines(c: int, n: int) -> tuple[list[str], list[str]]:
+    """`make_tim`'s timer, written out (same float operations in the same order)."""
+    c1 = c + 1
+    on = [f"if b[{c}]:",
+          f"    _t = tk.get({c}, 0.0) + eng.dt / TB[(b[{TIMEBASE_HI}] << 1) | b[{TIMEBASE_LO}]]",
+          f"    if _t > {n}:",
+          f"        _t = {float(n)!r}",
+          "else:",
+          "    _t = 0.0",
+          f"tk[{c}] = _t",
+          f"b[{c1}] = _t >= {n - _EPS!r}",
+          f"b[{c}] = 1"]
+    return on, [f"tk[{c}] = 0.0", f"b[{c}] = 0", f"b[{c1}] = 0"]
+
+
+def ctr_lines(c: int, n: int) -> tuple[list[str], list[str], list[str]]:
+    """`make_ctr`'s counter, written out: RES 1 lines, RES 0 lines, then lines for both."""
+    c1, c2 = c + 1, c + 2
+    after = [f"if b[{c1}]:",
+             f"    cv[{c}] = 0",
+             f"    b[{c2}] = 0",
+             "else:",
+             f"    _v = cv.get({c}, 0)",
+             f"    if _x and _v < {n}:",
+             "        _v += 1",
+             f"        cv[{c}] = _v",
+             f"    b[{c2}] = _v >= {n}"]
+    return [f"_x = not b[{c}]", f"b[{c}] = 1"], ["_x = 0", f"b[{c}] = 0"], after
+
+
 def update_generators(bits: bytearray, elapsed: float) -> None:
     """03750-03757: square waves of period 0.1 s * 2**k, 50 % duty, from the engine clock."""
     halves = int(elapsed * 20 + _EPS)  # number of 0.05 s half-periods of the fastest generator

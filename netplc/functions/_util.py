@@ -12,7 +12,15 @@ from __future__ import annotations
 
 from collections.abc import Callable
 
-from netplc.address import FERR1, IO_BITS, AddressError, check_operand, data_index, fmt_octal
+from netplc.address import (
+    FERR1,
+    IO_BITS,
+    AddressError,
+    check_operand,
+    data_index,
+    fmt_octal,
+    is_valid_operand,
+)
 from netplc.functions.registry import Fon, FonContext, Run
 from netplc.memory import Memory
 
@@ -24,23 +32,43 @@ def fail(ctx: FonContext) -> None:
     ctx.mem.bits[FERR1] = 1
 
 
-def built(build: Builder) -> Run:
-    """Turn a builder into a FON run function that builds once per instruction and memory."""
+class Built:
+    """A FON run function made from a builder: builds once per instruction and memory.
 
-    def run(ctx: FonContext, fon: Fon) -> None:
+    The reference interpreter calls it like any run function; the compiled engine takes `build`
+    and binds the step itself, once at load time (`bind`), so a scan skips this layer.
+    """
+
+    def __init__(self, build: Builder) -> None:
+        self.build = build
+        self.__doc__ = build.__doc__
+        self.__name__ = build.__name__
+
+    def __call__(self, ctx: FonContext, fon: Fon) -> None:
         mem = ctx.mem
         cached = fon.state.get("_step")
         if cached is None or cached[0] is not mem:
-            try:
-                step = build(mem, fon)
-            except AddressError:
-                step = fail
-            cached = fon.state["_step"] = (mem, step)
+            cached = fon.state["_step"] = (mem, _build(self.build, mem, fon))
         cached[1](ctx)
 
-    run.__doc__ = build.__doc__
-    run.__name__ = build.__name__
-    return run
+
+def built(build: Builder) -> Run:
+    """Turn a builder into a FON run function that builds once per instruction and memory."""
+    return Built(build)
+
+
+def bind(run: Run, mem: Memory, fon: Fon) -> Step:
+    """The step that runs `fon` on `mem`: the built step itself, or a call of a plain run function."""
+    if isinstance(run, Built):
+        return _build(run.build, mem, fon)
+    return lambda ctx: run(ctx, fon)
+
+
+def _build(build: Builder, mem: Memory, fon: Fon) -> Step:
+    try:
+        return build(mem, fon)
+    except AddressError:
+        return fail
 
 
 # --- operand accessors: closures bound to one memory and one operand address -------------------
@@ -196,6 +224,50 @@ def _operand(addr: int | None, n: int) -> int:
         raise AddressError("missing operand")
     check_operand(addr, n)
     return addr
+
+
+# --- inline source (FunctionSpec.inline): data operands only, resolved when the program compiles --
+
+
+def data_at(addr: int | None, n: int) -> int | None:
+    """Index in the data array of the `n`-byte operand `addr`; None for I/O-bit or invalid operands
+    (the function is then called, and does what it does with them)."""
+    if addr is None or addr < IO_BITS or not is_valid_operand(addr, n):
+        return None
+    return data_index(addr)
+
+
+def word_src(i: int) -> str:
+    """Expression reading the data word at index `i`."""
+    return f"(d[{i}] | d[{i + 1}] << 8)"
+
+
+def word_store(i: int, v: str) -> list[str]:
+    """Lines storing `v` (0..65535) as the data word at index `i`, low byte first as `word_set` does."""
+    return [f"d[{i}] = {v} & 255", f"d[{i + 1}] = {v} >> 8"]
+
+
+def copy_inline(s: int | None, d: int | None, n: int) -> list[str] | None:
+    """Lines copying n data bytes from operand s to d (n > 0): byte by byte, or as one slice (read
+    whole before writing, as `block_get`/`block_set` do) when the areas overlap or are long."""
+    i, k = data_at(s, n), data_at(d, n)
+    if i is None or k is None:
+        return None
+    if abs(i - k) < n or n > 4:
+        return [f"d[{k}:{k + n}] = d[{i}:{i + n}]"]
+    return [f"d[{k + j}] = d[{i + j}]" for j in range(n)]
+
+
+def constant_inline(d: int | None, value: int) -> list[str] | None:
+    """Lines storing the constant word `value` at operand d."""
+    k = data_at(d, 2)
+    return None if k is None else [f"d[{k}] = {value & 0xFF}", f"d[{k + 1}] = {value >> 8 & 0xFF}"]
+
+
+def flag_bits(fon: Fon, count: int) -> list[int] | None:
+    """The output bits C+1..C+count, or None when one is past the I/O bits."""
+    bits = [fon.c + k for k in range(1, count + 1)]
+    return bits if bits[-1] < IO_BITS else None
 
 
 # --- BCD -----------------------------------------------------------------------------------------

@@ -16,11 +16,15 @@ from netplc.functions._util import (
     built,
     byte_get,
     byte_set,
+    data_at,
     fail,
+    flag_bits,
     word_get,
     word_set,
+    word_src,
+    word_store,
 )
-from netplc.functions.registry import Fon, FonContext, register
+from netplc.functions.registry import Fon, FonContext, Inline, register
 from netplc.memory import Memory
 
 
@@ -57,7 +61,16 @@ register(10, "ADDBCD", "M", "M", "M")(built(_bcd_arith(subtract=False)))
 register(11, "SUBBCD", "M", "M", "M")(built(_bcd_arith(subtract=True)))
 
 
-@register(12, "CMP", "M", "M")
+def _cmp_inline(fon: Fon) -> list[str] | None:
+    i, j, flags = data_at(fon.s, 2), data_at(fon.d, 2), flag_bits(fon, 3)
+    if i is None or j is None or flags is None:
+        return None
+    c1, c2, c3 = flags
+    return [f"_x = {word_src(i)}", f"_y = {word_src(j)}",
+            f"b[{c1}] = _x > _y", f"b[{c2}] = _x == _y", f"b[{c3}] = _x < _y"]
+
+
+@register(12, "CMP", "M", "M", inline=_cmp_inline)
 @built
 def cmp(mem: Memory, fon: Fon) -> Step:
     """C+1 = S > D, C+2 = S == D, C+3 = S < D (unsigned 16-bit; the table and values, not the prose)."""
@@ -163,8 +176,20 @@ def _bin_arith(subtract: bool) -> Builder:
     return build
 
 
-register(92, "ADD", "M", "M", "M")(built(_bin_arith(subtract=False)))
-register(93, "SUB", "M", "M", "M")(built(_bin_arith(subtract=True)))
+def _bin_arith_inline(subtract: bool) -> Inline:
+    def inline(fon: Fon) -> list[str] | None:
+        i, j, k, flags = data_at(fon.s, 2), data_at(fon.d, 2), data_at(fon.r, 2), flag_bits(fon, 2)
+        if i is None or j is None or k is None or flags is None:
+            return None
+        c1, c2 = flags
+        return [f"_t = {word_src(i)} {'-' if subtract else '+'} {word_src(j)}", "_v = _t & 65535",
+                *word_store(k, "_v"), f"b[{c1}] = _t != _v", f"b[{c2}] = _v == 0"]
+
+    return inline
+
+
+for _number, _name, _subtract in ((92, "ADD", False), (93, "SUB", True)):
+    register(_number, _name, "M", "M", "M", inline=_bin_arith_inline(_subtract))(built(_bin_arith(_subtract)))
 
 
 @register(94, "MUL", "M", "M", "M")

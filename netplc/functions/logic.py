@@ -5,12 +5,30 @@ from __future__ import annotations
 import operator
 from collections.abc import Callable
 
-from netplc.functions._util import Builder, Step, built, byte_get, byte_set, fail, word_get, word_set
-from netplc.functions.registry import Fon, FonContext, register
+from netplc.functions._util import (
+    Builder,
+    Step,
+    built,
+    byte_get,
+    byte_set,
+    data_at,
+    fail,
+    flag_bits,
+    word_get,
+    word_set,
+)
+from netplc.functions.registry import Fon, FonContext, Inline, register
 from netplc.memory import Memory
 
 
-@register(9, "NEG", "M", "M")
+def _neg_inline(fon: Fon) -> list[str] | None:
+    i, k, flags = data_at(fon.s, 1), data_at(fon.d, 1), flag_bits(fon, 1)
+    if i is None or k is None or flags is None:
+        return None
+    return [f"_v = ~d[{i}] & 255", f"d[{k}] = _v", f"b[{flags[0]}] = _v == 0"]
+
+
+@register(9, "NEG", "M", "M", inline=_neg_inline)
 @built
 def neg(mem: Memory, fon: Fon) -> Step:
     """byte[D] = ~byte[S]; C+1 Z (result 0)."""
@@ -42,9 +60,19 @@ def _byte_logic(op: Callable[[int, int], int]) -> Builder:
     return build
 
 
-register(13, "AND", "M", "M", "M")(built(_byte_logic(operator.and_)))
-register(14, "OR", "M", "M", "M")(built(_byte_logic(operator.or_)))
-register(18, "XOR", "M", "M", "M")(built(_byte_logic(operator.xor)))
+def _byte_logic_inline(symbol: str) -> Inline:
+    def inline(fon: Fon) -> list[str] | None:
+        i, j, k, flags = data_at(fon.s, 1), data_at(fon.d, 1), data_at(fon.r, 1), flag_bits(fon, 1)
+        if i is None or j is None or k is None or flags is None:
+            return None
+        return [f"_v = d[{i}] {symbol} d[{j}]", f"d[{k}] = _v", f"b[{flags[0]}] = _v == 0"]
+
+    return inline
+
+
+register(13, "AND", "M", "M", "M", inline=_byte_logic_inline("&"))(built(_byte_logic(operator.and_)))
+register(14, "OR", "M", "M", "M", inline=_byte_logic_inline("|"))(built(_byte_logic(operator.or_)))
+register(18, "XOR", "M", "M", "M", inline=_byte_logic_inline("^"))(built(_byte_logic(operator.xor)))
 
 
 @register(38, "BMASK", "M", "O", "O")

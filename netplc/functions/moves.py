@@ -16,6 +16,8 @@ from netplc.functions._util import (
     built,
     byte_get,
     byte_set,
+    constant_inline,
+    copy_inline,
     fail,
     span,
     valid_block,
@@ -29,7 +31,7 @@ STACK_MAX = 64  # PUSH/POP/SHFTBLK area limit in bytes
 BLOCK_MAX = 256  # MOVBLK/MVMBLK length limit in bytes
 
 
-@register(0, "MOV", "M", "M")
+@register(0, "MOV", "M", "M", inline=lambda fon: copy_inline(fon.s, fon.d, 2))
 @built
 def mov(mem: Memory, fon: Fon) -> Step:
     """word[D] = word[S]."""
@@ -44,9 +46,13 @@ def _store_constant(mem: Memory, fon: Fon) -> Step:
 
 # The parser has already turned the constant into the word to store (BCD digits as nibbles for
 # MVIBCD, decimal for MVID, octal for MVIO), so the three differ only in how S is written.
-register(1, "MVIBCD", "B", "M")(built(_store_constant))
-register(7, "MVID", "D", "M")(built(_store_constant))
-register(8, "MVIO", "O", "M")(built(_store_constant))
+def _store_constant_inline(fon: Fon) -> list[str] | None:
+    return constant_inline(fon.d, fon.s or 0)
+
+
+register(1, "MVIBCD", "B", "M", inline=_store_constant_inline)(built(_store_constant))
+register(7, "MVID", "D", "M", inline=_store_constant_inline)(built(_store_constant))
+register(8, "MVIO", "O", "M", inline=_store_constant_inline)(built(_store_constant))
 
 
 @register(2, "XCG", "M", "M")
@@ -64,7 +70,7 @@ def xcg(mem: Memory, fon: Fon) -> Step:
     return step
 
 
-@register(90, "MOVB", "M", "M")
+@register(90, "MOVB", "M", "M", inline=lambda fon: copy_inline(fon.s, fon.d, 1))
 @built
 def movb(mem: Memory, fon: Fon) -> Step:
     """byte[D] = byte[S]."""

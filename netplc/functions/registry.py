@@ -66,6 +66,10 @@ class Fon:
 
 
 Run = Callable[[FonContext, Fon], None]
+# Python source lines doing what `run` does for this instruction, for the compiled engine to put in
+# line (netplc/compiler.py): they see the bit array as `b` and the data array as `d`, may use the
+# locals _t _v _x _y, and run only when RES is 1 (after bit C is set). None: call `run` instead.
+Inline = Callable[[Fon], list[str] | None]
 
 
 @dataclass(frozen=True, slots=True)
@@ -77,6 +81,7 @@ class FunctionSpec:
     r: ParamKind | None
     run: Run
     hardware: bool = False  # a CPU-165 module function: sets FErr1 on this platform
+    inline: Inline | None = None
 
     def kinds(self) -> dict[str, ParamKind | None]:
         return {"S": self.s, "D": self.d, "R": self.r}
@@ -94,13 +99,14 @@ def register(
     r: ParamKind | None = None,
     *,
     hardware: bool = False,
+    inline: Inline | None = None,
 ) -> Callable[[Run], Run]:
     """Decorator: register `run` as function `number` / `mnemonic` with its parameter kinds."""
 
     def deco(run: Run) -> Run:
         if number in REGISTRY or mnemonic in BY_NAME:
             raise RuntimeError(f"function {number} {mnemonic} registered twice")
-        spec = FunctionSpec(number, mnemonic, s, d, r, run, hardware)
+        spec = FunctionSpec(number, mnemonic, s, d, r, run, hardware, inline)
         REGISTRY[number] = spec
         BY_NAME[mnemonic] = spec
         return run

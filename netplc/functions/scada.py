@@ -18,11 +18,16 @@ from netplc.functions._util import (
     block_get,
     block_set,
     built,
+    constant_inline,
+    copy_inline,
+    data_at,
     fail,
+    flag_bits,
     word_get,
     word_set,
+    word_src,
 )
-from netplc.functions.registry import Fon, FonContext, register
+from netplc.functions.registry import Fon, FonContext, Inline, register
 from netplc.memory import Memory
 from netplc.records import Record
 
@@ -96,11 +101,28 @@ def _compare(op: str, immediate: bool) -> Builder:
     return build
 
 
-register(306, "NGREAT", "M", "M")(built(_compare(">", immediate=False)))
-register(307, "NLESS", "M", "M")(built(_compare("<", immediate=False)))
-register(308, "NEQUAL", "M", "M")(built(_compare("=", immediate=False)))
-register(315, "NLESSI", "M", "D")(built(_compare("<", immediate=True)))
-register(316, "NGREATI", "M", "D")(built(_compare(">", immediate=True)))
+def _compare_inline(op: str, immediate: bool) -> Inline:
+    symbol = "==" if op == "=" else op
+
+    def inline(fon: Fon) -> list[str] | None:
+        i, flags = data_at(fon.s, 2), flag_bits(fon, 1)
+        j = None if immediate else data_at(fon.d, 2)
+        if i is None or flags is None or (j is None and not immediate):
+            return None
+        other = str(fon.d or 0) if j is None else word_src(j)
+        return [f"b[{flags[0]}] = {word_src(i)} {symbol} {other}"]
+
+    return inline
+
+
+for _number, _name, _d, _op, _imm in (
+    (306, "NGREAT", "M", ">", False),
+    (307, "NLESS", "M", "<", False),
+    (308, "NEQUAL", "M", "=", False),
+    (315, "NLESSI", "D", "<", True),
+    (316, "NGREATI", "D", ">", True),
+):
+    register(_number, _name, "M", _d, inline=_compare_inline(_op, _imm))(built(_compare(_op, _imm)))
 
 
 @register(309, "NMEM", "M")
@@ -148,7 +170,7 @@ def navg(mem: Memory, fon: Fon) -> Step:
     return step
 
 
-@register(311, "NSETDI", "M", "D")
+@register(311, "NSETDI", "M", "D", inline=lambda fon: constant_inline(fon.s, fon.d or 0))
 @built
 def nsetdi(mem: Memory, fon: Fon) -> Step:
     """word[S] = the decimal constant D (S is the destination here)."""
@@ -172,8 +194,16 @@ def _move(unit: int) -> Builder:
     return build
 
 
-register(312, "NMOVB", "M", "M", "D")(built(_move(1)))
-register(313, "NMOVW", "M", "M", "D")(built(_move(2)))
+def _move_inline(unit: int) -> Inline:
+    def inline(fon: Fon) -> list[str] | None:
+        n = (fon.r or 0) * unit
+        return [] if n == 0 else copy_inline(fon.s, fon.d, n)
+
+    return inline
+
+
+register(312, "NMOVB", "M", "M", "D", inline=_move_inline(1))(built(_move(1)))
+register(313, "NMOVW", "M", "M", "D", inline=_move_inline(2))(built(_move(2)))
 
 
 @register(314, "NMAX", "M", "M")

@@ -9,7 +9,20 @@ is the same for a group executed every scan (the manual's recommended use, e.g. 
 
 from __future__ import annotations
 
-from netplc.functions._util import Step, at, bit_get, built, fail, operand_bit, word_get, word_set
+from netplc.functions._util import (
+    Step,
+    at,
+    bit_get,
+    built,
+    data_at,
+    fail,
+    flag_bits,
+    operand_bit,
+    word_get,
+    word_set,
+    word_src,
+    word_store,
+)
 from netplc.functions.registry import Fon, FonContext, register
 from netplc.memory import Memory
 
@@ -78,7 +91,16 @@ def timfix(mem: Memory, fon: Fon) -> Step:
     return step
 
 
-@register(63, "INCW", "M", "M")
+def _incw_inline(fon: Fon) -> list[str] | None:
+    i, k, flags = data_at(fon.s, 2), data_at(fon.d, 2), flag_bits(fon, 2)
+    if i is None or k is None or flags is None:
+        return None
+    c1, c2 = flags  # the setpoint is read after the store, as the step reads it
+    return [f"_v = {word_src(k)} + 1 & 65535", *word_store(k, "_v"),
+            f"b[{c1}] = _v == 0", f"b[{c2}] = _v == {word_src(i)}"]
+
+
+@register(63, "INCW", "M", "M", inline=_incw_inline)
 @built
 def incw(mem: Memory, fon: Fon) -> Step:
     """Counter: word[D] += 1 (wrapping); C+1 ">" = it wrapped past FFFF; C+2 "=" = word[D] == word[S].
@@ -99,7 +121,16 @@ def incw(mem: Memory, fon: Fon) -> Step:
     return step
 
 
-@register(64, "DECW", "M")
+def _decw_inline(fon: Fon) -> list[str] | None:
+    k, flags = data_at(fon.s, 2), flag_bits(fon, 2)
+    if k is None or flags is None:
+        return None
+    c1, c2 = flags
+    return [f"_x = {word_src(k)}", "_v = _x - 1 & 65535", *word_store(k, "_v"),
+            f"b[{c1}] = _x == 0", f"b[{c2}] = _v == 0"]
+
+
+@register(64, "DECW", "M", inline=_decw_inline)
 @built
 def decw(mem: Memory, fon: Fon) -> Step:
     """word[S] -= 1 (wrapping); C+1 "<" = it passed through 0000; C+2 Z = the new value is 0."""
