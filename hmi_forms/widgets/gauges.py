@@ -44,7 +44,6 @@ def scale_ticks(lo: float, hi: float, max_major: int) -> tuple[list[float], list
 
 
 SMALL_DIAL = 45.0  # radius in px below which a dial drops its labels and enlarges the readout
-NEEDLE_PEN = QPen(theme.ACCENT.darker(130), 1)
 HUB = QColor("#33393f")
 WHITE = QColor("#ffffff")
 
@@ -265,7 +264,7 @@ class GaugeWidget(ElementWidget):
         a = math.radians(start + sweep * m.fraction)
         dx, dy = math.cos(a) * r, -math.sin(a) * r
         cx, cy = c.x(), c.y()
-        p.setPen(NEEDLE_PEN)
+        p.setPen(Qt.PenStyle.NoPen)  # filled only: a stroke would double the rasterising
         p.setBrush(theme.ACCENT)
         p.drawPolygon(QPolygonF([
             QPointF(cx + 0.8 * dx, cy + 0.8 * dy), QPointF(cx - 0.045 * dy, cy + 0.045 * dx),
