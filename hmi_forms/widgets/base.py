@@ -100,7 +100,7 @@ class ElementWidget(QWidget):
     """An element on a form: its geometry, input and tooltip, and the code that draws it.
 
     Elements drawn only with QPainter are painted by the form itself, in one pass with one painter
-    (`render`), and their widget stays an invisible proxy for the mouse, cursor and tooltip: a
+    (`draw`), and their widget stays an invisible proxy for the mouse, cursor and tooltip: a
     QPainter per widget per tick costs more than drawing a whole gauge. Elements made of child
     widgets (`SelfPainted`) paint themselves and carry a StaleMark child instead.
     """
@@ -144,7 +144,7 @@ class ElementWidget(QWidget):
         """What the cached layer (background, frame, `paint_static`) depends on."""
         return ()
 
-    def render(self, p: QPainter) -> None:  # type: ignore[override]
+    def draw(self, p: QPainter) -> None:
         """Draw the element with its top-left corner at the painter's origin."""
         p.drawPixmap(0, 0, self.layer())
         r = QRectF(0, 0, self.width(), self.height())

@@ -103,7 +103,7 @@ class FormView(QWidget):
             try:
                 changed = model.update(snapshot)
             except Exception as e:
-                self._fault(model, e)
+                self._fault(model, e, "update")
                 changed = True
             if changed:
                 widget.sync()
@@ -111,8 +111,8 @@ class FormView(QWidget):
         for trend in self.trends:
             trend.flush_due(now)
 
-    def _fault(self, model: Element, error: Exception) -> None:
-        text = f'{self.form.path}: element "{model.Name}": update failed: {error!r}'
+    def _fault(self, model: Element, error: Exception, what: str) -> None:
+        text = f'{self.form.path}: element "{model.Name}": {what} failed: {error!r}'
         if text not in self.errors:
             self.errors.append(text)
         model.stale = True
@@ -142,8 +142,8 @@ class FormView(QWidget):
                 p.setTransform(QTransform.fromTranslate(geometry.x(), geometry.y()))
                 p.setClipRect(0, 0, geometry.width(), geometry.height())
                 try:
-                    widget.render(p)
+                    widget.draw(p)
                 except Exception as e:
-                    self._fault(widget.model, e)
+                    self._fault(widget.model, e, "drawing")
         finally:
             p.end()

@@ -185,6 +185,10 @@ class JournalWidget(SelfPainted):
             return
         m = self.model
         day = m.day or dt.date.today()
+        if m.day is None and self.date.date() != QDate(day.year, day.month, day.day):
+            self.date.blockSignals(True)  # today moved on past midnight: follow it
+            self.date.setDate(QDate(day.year, day.month, day.day))
+            self.date.blockSignals(False)
         flt = Filter(kinds=frozenset(m.kinds), grp=m.group, min_type=m.min_type)
         try:
             rows = archive.records(day, flt, limit=m.Rows)
