@@ -18,7 +18,7 @@ from collections.abc import Callable
 from typing import TYPE_CHECKING
 
 from netplc.program import Instr, Program
-from netplc.timers import TIME_BASES, ctr_lines, tim_lines
+from netplc.timers import QUOTIENT, TIME_BASE_BITS, TIME_BASES, ctr_lines, tim_lines
 
 if TYPE_CHECKING:
     from netplc.engine import Engine
@@ -26,6 +26,10 @@ if TYPE_CHECKING:
 HALT = -1
 _MAX_DEPTH = 24  # nested and/or groups before the state is stored in a and s (parser limits)
 _MAX_TERMS = 200  # contacts in one expression before the same
+# A long block is cut into functions of about this many lines, between instructions where no chain
+# state is pending: CPython runs a long function's code noticeably slower (its constants and jumps
+# outgrow one-byte arguments), and a call per chunk costs less than that.
+_CHUNK_LINES = 60
 
 
 def _block_starts(instrs: list[Instr]) -> list[int]:
@@ -99,6 +103,8 @@ class _Block:
     def __init__(self, n: int, inline: dict[int, list[str]]) -> None:
         self.n = n
         self.inline = inline  # FON index -> the function's source lines
+        self.quotient = False  # _q holds the TIM time-base quotient (see netplc/timers.py)
+        self.cuts = [0]  # line indices where chunks start
         self.lines: list[str] = []
         self.acc, self.sm = _Expr("a"), _Expr("s")
         self.ended = False  # the last line returns
@@ -128,25 +134,35 @@ class _Block:
         elif op == "YON":
             lines.append(f"b[{c}] = {self.res()}")
             self.chain_end()
+            self.wrote(c, 1)
         elif op in ("SON", "SOF"):
             res = self.res()
             if res != "0":
                 lines.append(f"b[{c}] = {int(op == 'SON')}" if res == "1" else
                              f"if {res}: b[{c}] = {int(op == 'SON')}")
             self.chain_end()
+            self.wrote(c, 1)
         elif op == "TIM":
+            if not self.quotient:
+                lines.append(QUOTIENT)
+                self.quotient = True
             lines += _branch(self.res(), *tim_lines(c or 0, ins.n or 0))
             self.chain_end()
+            self.wrote(c, 2)
         elif op == "CTR":
-            on, off, after = ctr_lines(c or 0, ins.n or 0)
-            lines += _branch(self.res(), on, off) + after
+            lines += _branch(self.res(), *ctr_lines(c or 0, ins.n or 0))
             self.chain_end()
+            self.wrote(c, 3)
         elif op == "FON":
             body = self.inline.get(index)
             if body is None:
                 body = ["try:", f"    fon{index}(eng)", "except Exception as _e:", f"    failed({index}, _e)"]
+                self.quotient = False  # the function may write any bit
+            elif any(f"b[{bit}]" in line for bit in TIME_BASE_BITS for line in body):
+                self.quotient = False
             lines += _branch(self.res(), [f"b[{c}] = 1", *body], [f"b[{c}] = 0"])
             self.chain_end()
+            self.wrote(c, 1)
         elif op == "HLT":
             lines.append(f"return {HALT}, 1, 0")
             self.ended = True
@@ -162,6 +178,18 @@ class _Block:
         if self.acc.heavy() or self.sm.heavy():
             self.store()
 
+    def maybe_cut(self) -> None:
+        """Start a new chunk here if the current one is long and no chain state is pending."""
+        if (self.acc is ONE and self.sm is ZERO and not self.ended
+                and len(self.lines) - self.cuts[-1] >= _CHUNK_LINES):
+            self.cuts.append(len(self.lines))
+            self.quotient = False  # _q is local to a chunk
+
+    def wrote(self, c: int | None, count: int) -> None:
+        """Bits C..C+count-1 were (maybe) written: a time-base bit among them voids _q."""
+        if c is not None and any(c <= bit < c + count for bit in TIME_BASE_BITS):
+            self.quotient = False
+
     def skip(self, nxt: Instr | None, index: int, block_end: int) -> None:
         """SKP at `index`: when RES is 0, skip instruction index+1 (`nxt`, None if past the block)."""
         self.lines.append(f"r = {self.res()}")
@@ -173,7 +201,9 @@ class _Block:
             return
         inner = _Block(self.n, self.inline)
         inner.acc, inner.sm = ONE, ZERO
+        inner.quotient = self.quotient
         inner.emit(nxt, index + 1)
+        self.quotient = self.quotient and inner.quotient  # _q set only on one path is not set
         contact = inner.acc is not ONE or inner.sm is not ZERO
         if contact:
             inner.store()
@@ -190,7 +220,7 @@ class _Block:
             self.lines.append(f"return {_target(end, self.n)}, {self.acc.text}, {self.sm.text}")
 
 
-_ARGS = "b, d, eng, tk, cv, TB, failed"  # bits, data, engine, TIM and CTR values, time bases
+_ARGS = "b, d, w, eng, tk, cv, TB, failed"  # bits, data bytes and words, engine, TIM/CTR values, time bases
 
 
 def generate_source(program: Program, inline: dict[int, list[str]] | None = None) -> str:
@@ -217,12 +247,29 @@ def generate_source(program: Program, inline: dict[int, list[str]] | None = None
                 i += 1  # past the skipped instruction too (if it was in this block)
             else:
                 block.emit(ins, i)
+            block.maybe_cut()
             i += 1
         block.finish(end)
-        out.append(f"    def _b{start}(a, s, {', '.join(f'{v}={v}' for v in _ARGS.split(', '))}):")
-        out += ["        " + line for line in block.lines]
+        out += ["    " + line for line in _chunked(f"_b{start}", block)]
     out.append("    return {" + ", ".join(f"{s}: _b{s}" for s in starts if s < n) + "}")
     return "\n".join(out) + "\n"
+
+
+def _chunked(name: str, block: _Block) -> list[str]:
+    """The block's function, its middle chunks as functions it calls (a jump out of one returns)."""
+    defaults = ", ".join(f"{v}={v}" for v in _ARGS.split(", "))
+    cuts = [*block.cuts, len(block.lines)]
+    chunks = [block.lines[cuts[j]:cuts[j + 1]] for j in range(len(cuts) - 1)]
+    out: list[str] = []
+    calls: list[str] = []
+    for j, chunk in enumerate(chunks[1:-1], start=1):
+        out += [f"def {name}_{j}({defaults}):", *("    " + line for line in chunk)]
+        if any("return " in line for line in chunk):
+            calls += [f"_r = {name}_{j}()", "if _r is not None:", "    return _r"]
+        else:
+            calls.append(f"{name}_{j}()")
+    body = chunks[0] + calls + (chunks[-1] if len(chunks) > 1 else [])
+    return [*out, f"def {name}(a, s, {defaults}):", *("    " + line for line in body)]
 
 
 def compile_program(program: Program, engine: Engine) -> Callable[[], str | None]:
@@ -240,8 +287,9 @@ def compile_program(program: Program, engine: Engine) -> Callable[[], str | None
             inline[i] = lines
     namespace: dict = {}
     exec(compile(generate_source(program, inline), f"<compiled {program.source}>", "exec"), namespace)
-    blocks = namespace["_make"](steps, engine.mem.bits, engine.mem.data, engine, engine.tim_ticks,
-                                engine.ctr_values, TIME_BASES, engine.fon_failed)
+    data = engine.mem.data
+    blocks = namespace["_make"](steps, engine.mem.bits, data, memoryview(data).cast("H"), engine,
+                                engine.tim_ticks, engine.ctr_values, TIME_BASES, engine.fon_failed)
     starts = sorted(blocks)
     sizes = {s: (starts[k + 1] if k + 1 < len(starts) else len(instrs)) - s for k, s in enumerate(starts)}
     first = blocks.get(0)

@@ -71,14 +71,19 @@ def make_ctr(bits: bytearray, values: dict[int, int], c: int, n: int) -> Callabl
 
 # The same two instructions as source lines for the compiled program (netplc/compiler.py), which
 # runs the first list when RES is 1 and the second when it is 0. They see the bit array as `b`, the
-# current values as `tk` and `cv`, the engine (dt) as `eng`, TIME_BASES as `TB`, locals _t _x _v.
+# current values as `tk` and `cv`, the engine (dt) as `eng`, TIME_BASES as `TB`, locals _t _v _q.
+# A TIM's elapsed ticks `_q` are computed by QUOTIENT, which the compiler places before the TIM and
+# reuses for later TIMs until something may have written a TIME_BASE_BITS bit (or called out).
+
+TIME_BASE_BITS = (TIMEBASE_LO, TIMEBASE_HI)
+QUOTIENT = f"_q = eng.dt / TB[(b[{TIMEBASE_HI}] << 1) | b[{TIMEBASE_LO}]]"
 
 
 def tim_lines(c: int, n: int) -> tuple[list[str], list[str]]:
-    """`make_tim`'s timer, written out (same float operations in the same order)."""
+    """`make_tim`'s timer, written out (the same float operations: dt / base, then the sum)."""
     c1 = c + 1
     on = [f"if b[{c}]:",
-          f"    _t = tk.get({c}, 0.0) + eng.dt / TB[(b[{TIMEBASE_HI}] << 1) | b[{TIMEBASE_LO}]]",
+          f"    _t = tk.get({c}, 0.0) + _q",
           f"    if _t > {n}:",
           f"        _t = {float(n)!r}",
           "else:",
@@ -89,19 +94,23 @@ def tim_lines(c: int, n: int) -> tuple[list[str], list[str]]:
     return on, [f"tk[{c}] = 0.0", f"b[{c}] = 0", f"b[{c1}] = 0"]
 
 
-def ctr_lines(c: int, n: int) -> tuple[list[str], list[str], list[str]]:
-    """`make_ctr`'s counter, written out: RES 1 lines, RES 0 lines, then lines for both."""
+def ctr_lines(c: int, n: int) -> tuple[list[str], list[str]]:
+    """`make_ctr`'s counter, written out (a rising edge is RES 1 while bit C was 0)."""
     c1, c2 = c + 1, c + 2
-    after = [f"if b[{c1}]:",
-             f"    cv[{c}] = 0",
-             f"    b[{c2}] = 0",
-             "else:",
-             f"    _v = cv.get({c}, 0)",
-             f"    if _x and _v < {n}:",
-             "        _v += 1",
-             f"        cv[{c}] = _v",
-             f"    b[{c2}] = _v >= {n}"]
-    return [f"_x = not b[{c}]", f"b[{c}] = 1"], ["_x = 0", f"b[{c}] = 0"], after
+    reset = [f"if b[{c1}]:", f"    cv[{c}] = 0", f"    b[{c2}] = 0", "else:"]
+    on = [f"if b[{c}]:",
+          f"    b[{c}] = 1",  # no edge
+          *("    " + line for line in reset),
+          f"        b[{c2}] = cv.get({c}, 0) >= {n}",
+          "else:",
+          f"    b[{c}] = 1",
+          *("    " + line for line in reset),
+          f"        _v = cv.get({c}, 0)",
+          f"        if _v < {n}:",
+          "            _v += 1",
+          f"            cv[{c}] = _v",
+          f"        b[{c2}] = _v >= {n}"]
+    return on, [f"b[{c}] = 0", *reset, f"    b[{c2}] = cv.get({c}, 0) >= {n}"]
 
 
 def update_generators(bits: bytearray, elapsed: float) -> None:

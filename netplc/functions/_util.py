@@ -10,6 +10,7 @@ it runs, and writes nothing - the same as a bad indirect address at run time.
 
 from __future__ import annotations
 
+import sys
 from collections.abc import Callable
 
 from netplc.address import (
@@ -237,13 +238,20 @@ def data_at(addr: int | None, n: int) -> int | None:
     return data_index(addr)
 
 
+# The compiled program also sees the data array as native 16-bit words `w` (w[k] = bytes 2k, 2k+1):
+# one subscript instead of two for a word at an even index, on a little-endian machine.
+_WORDS = sys.byteorder == "little"
+
+
 def word_src(i: int) -> str:
-    """Expression reading the data word at index `i`."""
-    return f"(d[{i}] | d[{i + 1}] << 8)"
+    """Expression reading the (little-endian) data word at index `i`."""
+    return f"w[{i >> 1}]" if _WORDS and i % 2 == 0 else f"(d[{i}] | d[{i + 1}] << 8)"
 
 
 def word_store(i: int, v: str) -> list[str]:
-    """Lines storing `v` (0..65535) as the data word at index `i`, low byte first as `word_set` does."""
+    """Lines storing `v` (0..65535) as the data word at index `i`, as `word_set` does."""
+    if _WORDS and i % 2 == 0:
+        return [f"w[{i >> 1}] = {v}"]
     return [f"d[{i}] = {v} & 255", f"d[{i + 1}] = {v} >> 8"]
 
 
@@ -253,6 +261,8 @@ def copy_inline(s: int | None, d: int | None, n: int) -> list[str] | None:
     i, k = data_at(s, n), data_at(d, n)
     if i is None or k is None:
         return None
+    if n == 2 and i != k:
+        return word_store(k, word_src(i))  # read whole before the store, so an overlap is fine
     if abs(i - k) < n or n > 4:
         return [f"d[{k}:{k + n}] = d[{i}:{i + n}]"]
     return [f"d[{k + j}] = d[{i + j}]" for j in range(n)]
@@ -261,7 +271,7 @@ def copy_inline(s: int | None, d: int | None, n: int) -> list[str] | None:
 def constant_inline(d: int | None, value: int) -> list[str] | None:
     """Lines storing the constant word `value` at operand d."""
     k = data_at(d, 2)
-    return None if k is None else [f"d[{k}] = {value & 0xFF}", f"d[{k + 1}] = {value >> 8 & 0xFF}"]
+    return None if k is None else word_store(k, str(value & 0xFFFF))
 
 
 def flag_bits(fon: Fon, count: int) -> list[int] | None:
