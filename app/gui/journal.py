@@ -11,39 +11,13 @@ import sqlite3
 from pathlib import Path
 
 from PySide6.QtCore import Qt, QTimer
-from PySide6.QtWidgets import (
-    QAbstractItemView,
-    QCheckBox,
-    QDockWidget,
-    QHBoxLayout,
-    QHeaderView,
-    QLabel,
-    QTableView,
-    QVBoxLayout,
-    QWidget,
-)
+from PySide6.QtWidgets import QCheckBox, QDockWidget, QHBoxLayout, QLabel, QVBoxLayout, QWidget
 
-from app.gui.records import RecordsModel
+from hmi_forms.widgets.records import EVENT_KINDS, RecordsModel, records_view
 from registrar.query import Archive, Filter
 
 JOURNAL_ROWS = 500
 REFRESH_MS = 1500
-
-
-def make_table(model: RecordsModel) -> QTableView:
-    table = QTableView()
-    table.setModel(model)
-    table.setAlternatingRowColors(True)
-    table.setSelectionBehavior(QAbstractItemView.SelectionBehavior.SelectRows)
-    table.setEditTriggers(QAbstractItemView.EditTrigger.NoEditTriggers)
-    table.verticalHeader().setVisible(False)
-    table.verticalHeader().setDefaultSectionSize(22)
-    header = table.horizontalHeader()
-    header.setStretchLastSection(True)
-    for col, width in enumerate((96, 70, 52, 64, 120, 64, 70)):
-        header.resizeSection(col, width)
-    header.setSectionResizeMode(QHeaderView.ResizeMode.Interactive)
-    return table
 
 
 class JournalDock(QDockWidget):
@@ -64,8 +38,8 @@ class JournalDock(QDockWidget):
         bar.addStretch(1)
         bar.addWidget(self.summary)
         lay.addLayout(bar)
-        self.model = RecordsModel(self)
-        self.table = make_table(self.model)
+        self.model = RecordsModel(parent=self)
+        self.table = records_view(self.model, row_height=22)
         lay.addWidget(self.table)
         self.setWidget(body)
         self.setAllowedAreas(Qt.DockWidgetArea.BottomDockWidgetArea | Qt.DockWidgetArea.RightDockWidgetArea)
@@ -80,7 +54,7 @@ class JournalDock(QDockWidget):
         if archive is None:
             self.summary.setText("no archive yet")
             return
-        flt = Filter(kinds={"message", "operator", "system"}) if self.messages_only.isChecked() else None
+        flt = Filter(kinds=EVENT_KINDS) if self.messages_only.isChecked() else None
         today = dt.date.today()
         try:
             total = archive.count(today, flt)

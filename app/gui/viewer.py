@@ -38,9 +38,8 @@ from PySide6.QtWidgets import (
 )
 
 from app.config import ConfigError, load_station, station_file
-from app.gui.journal import make_table
-from app.gui.records import RecordsModel
 from app.gui.style import apply_style
+from hmi_forms.widgets.records import RecordsModel, records_view
 from registrar.query import Archive, Filter, SeriesKey
 
 PAGE = 500
@@ -137,8 +136,8 @@ class ViewerWindow(QMainWindow):
         self.tabs = QTabWidget()
         records = QWidget()
         rec_lay = QVBoxLayout(records)
-        self.model = RecordsModel(self)
-        self.table = make_table(self.model)
+        self.model = RecordsModel(parent=self)
+        self.table = records_view(self.model, row_height=22)
         rec_lay.addWidget(self.table, 1)
         pager = QHBoxLayout()
         self.first = QPushButton("\u00ab First")

@@ -10,20 +10,16 @@ from __future__ import annotations
 
 import datetime as dt
 from pathlib import Path
-from typing import Any
 
-from PySide6.QtCore import QAbstractTableModel, QDate, QModelIndex, QPersistentModelIndex, Qt
+from PySide6.QtCore import QDate
 from PySide6.QtGui import QColor
 from PySide6.QtWidgets import (
-    QAbstractItemView,
     QComboBox,
     QDateEdit,
     QHBoxLayout,
-    QHeaderView,
     QLabel,
     QPushButton,
     QSpinBox,
-    QTableView,
     QVBoxLayout,
     QWidget,
 )
@@ -31,65 +27,12 @@ from PySide6.QtWidgets import (
 from hmi_forms.elements.journal import KINDS, MessageJournal
 from hmi_forms.widgets import theme
 from hmi_forms.widgets.base import Images, SelfPainted
-from registrar.query import Archive, Filter, Row
+from hmi_forms.widgets.records import JOURNAL_COLUMNS, Palette, RecordsModel, records_view
+from registrar.query import Archive, Filter
 
-COLUMNS = ("Time", "Kind", "Group", "Type", "Source", "Text", "Value")
-TYPE_NAMES = {0: "info", 1: "warning", 2: "alarm", 3: "critical"}
-TYPE_BACK = {1: QColor("#fff4d6"), 2: QColor("#fde0dc"), 3: theme.ALARM}
-TYPE_FORE = {2: QColor("#8e1b1b"), 3: QColor("#ffffff")}
 MIN_TYPES = (("all types", None), ("warnings and worse", 1), ("alarms and worse", 2), ("critical", 3))
-ModelIndex = QModelIndex | QPersistentModelIndex
-
-
-class JournalTable(QAbstractTableModel):
-    def __init__(self) -> None:
-        super().__init__()
-        self.rows: list[Row] = []
-
-    def set_rows(self, rows: list[Row]) -> None:
-        if [r.id for r in rows] == [r.id for r in self.rows]:
-            return
-        self.beginResetModel()
-        self.rows = rows
-        self.endResetModel()
-
-    def rowCount(self, parent: ModelIndex = QModelIndex()) -> int:  # noqa: B008 - Qt API
-        return 0 if parent.isValid() else len(self.rows)
-
-    def columnCount(self, parent: ModelIndex = QModelIndex()) -> int:  # noqa: B008 - Qt API
-        return 0 if parent.isValid() else len(COLUMNS)
-
-    def headerData(self, section: int, orientation: Qt.Orientation,
-                   role: int = Qt.ItemDataRole.DisplayRole) -> Any:
-        if role == Qt.ItemDataRole.DisplayRole and orientation == Qt.Orientation.Horizontal:
-            return COLUMNS[section]
-        return None
-
-    def data(self, index: ModelIndex, role: int = Qt.ItemDataRole.DisplayRole) -> Any:
-        row = self.rows[index.row()]
-        if role == Qt.ItemDataRole.DisplayRole:
-            return self.cell(row, index.column())
-        if role == Qt.ItemDataRole.BackgroundRole:
-            return TYPE_BACK.get(row.type) if row.kind == "message" else None
-        if role == Qt.ItemDataRole.ForegroundRole:
-            return TYPE_FORE.get(row.type) if row.kind == "message" else None
-        return None
-
-    @staticmethod
-    def cell(row: Row, column: int) -> str:
-        if column == 0:
-            return row.time.strftime("%H.%M.%S")
-        if column == 1:
-            return row.kind
-        if column == 2:
-            return "" if row.grp is None else str(row.grp)
-        if column == 3:
-            return "" if row.type is None else TYPE_NAMES.get(row.type, str(row.type))
-        if column == 4:
-            return row.source or ""
-        if column == 5:
-            return row.text or ("" if row.number is None else f"message {row.number}")
-        return "" if row.value is None else f"{row.value:g}"
+PALETTE = Palette(back={1: QColor("#fff4d6"), 2: QColor("#fde0dc"), 3: theme.ALARM},
+                  fore={2: QColor("#8e1b1b"), 3: QColor("#ffffff")})
 
 
 class JournalWidget(SelfPainted):
@@ -135,19 +78,8 @@ class JournalWidget(SelfPainted):
         bar.addStretch(1)
         bar.addWidget(self.status)
         layout.addLayout(bar)
-        self.table = JournalTable()
-        self.view = QTableView()
-        self.view.setModel(self.table)
-        self.view.setSelectionBehavior(QAbstractItemView.SelectionBehavior.SelectRows)
-        self.view.setEditTriggers(QAbstractItemView.EditTrigger.NoEditTriggers)
-        self.view.verticalHeader().setVisible(False)
-        self.view.verticalHeader().setDefaultSectionSize(20)
-        self.view.setAlternatingRowColors(True)
-        header = self.view.horizontalHeader()
-        for col, width in enumerate((70, 70, 50, 64, 110, 0, 60)):
-            if width:
-                header.resizeSection(col, width)
-        header.setSectionResizeMode(5, QHeaderView.ResizeMode.Stretch)
+        self.table = RecordsModel(JOURNAL_COLUMNS, PALETTE)
+        self.view = records_view(self.table, row_height=20)
         layout.addWidget(self.view, 1)
         self.stale_mark.raise_()
         self.reload()
