@@ -62,8 +62,8 @@ class DiscreteBase(Element):
         first = self.value is None
         self.value = v
         if not first:
-            if self.RegMessages:
-                self.record(snap, "message", type=0, text=self.text)
+            if self.RegMessages:  # the state, also while its indication is switched off
+                self.record(snap, "message", type=0, text=self.TextTrue if v else self.TextFalse)
             if self.RegData:
                 self.record(snap, "data", value=float(v))
         return True

@@ -221,6 +221,16 @@ def test_discrete_transitions_record_text_and_value(tmp_path) -> None:
     ]
 
 
+def test_a_hidden_state_is_still_journaled_by_its_text(tmp_path) -> None:
+    d = element(tmp_path, "DiscreteControlledEnable", InAddr="02120", EnableAddr="02121",
+                TextFalse="Насос остановлен", TextTrue="Насос работает", RegMessages=True)
+    t = ListTarget()
+    d.bind(t)
+    d.update(snap(bits={0o2120: 0, 0o2121: 0}))
+    d.update(snap(bits={0o2120: 1, 0o2121: 0}))
+    assert d.text == "" and [r.text for r in t.records] == ["Насос работает"]
+
+
 def test_color_label_and_controlled_enable(tmp_path) -> None:
     d = element(tmp_path, "DiscreteControlledEnable", InAddr="02120", EnableAddr="02121", Enabled=True,
                 BackColor="#c0c0c0", BackColorFalse="#808080", BackColorTrue="#00ff00", TextTrue="ON")
