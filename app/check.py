@@ -11,7 +11,7 @@ from dataclasses import dataclass, field
 from pathlib import Path
 
 from app.config import Station, read_station
-from app.runtime import load_simulated_program, node_configs
+from app.runtime import load_simulated_program, node_configs, unresolved_hosts
 from hmi_forms.form import load_forms
 from netplc.exchange import check_program_nodes
 from netplc.program import Program, ProgramError, load_symbols, parse, parse_file
@@ -37,6 +37,7 @@ def check_station(path: str | Path) -> CheckReport:
     if station is None:
         return report
     report.notes.append(f"station {station.path}")
+    report.problems += unresolved_hosts(station)
     symbols = _symbols(station.Symbols, report)
     program = _program(station, symbols, report)
     if program is not None:

@@ -14,7 +14,7 @@ from pathlib import Path
 from typing import Any
 
 from netplc.address import fmt_octal, is_data_byte, is_io_bit, parse_octal
-from netplc.modbus_driver import parse_endpoint
+from netplc.modbus_driver import Endpoint, parse_endpoint
 
 STATION_FILE = "station.toml"
 PROFILES = ("cpu165", "modbus")
@@ -40,6 +40,9 @@ class NodeSettings:
     timeout: float = 1.0
     retries: int = 1
     table: str = "holding"
+    backoff: float = 0.2  # s, the first reconnect delay after the link went down
+    backoff_max: float = 5.0  # s, the delay doubles up to this
+    key: str = "nodes"  # where it is set in station.toml (nodes[2], simulators[0]), for messages
 
 
 @dataclass(frozen=True)
@@ -59,6 +62,7 @@ class ModbusServerSettings:
     host: str = "127.0.0.1"
     port: int = 1502
     writable: tuple[tuple[int, int], ...] = DEFAULT_WRITABLE
+    unit: int | None = None  # the unit id answered; None: every unit id
 
 
 @dataclass(frozen=True)
@@ -125,7 +129,7 @@ class _Reader:
             return default
         return value
 
-    def number(self, key: str, default: int, lo: int, hi: int, required: bool = False) -> int:
+    def number(self, key: str, default: int | None, lo: int, hi: int, required: bool = False) -> Any:
         value = self.get(key, int, default, required)
         if value is not None and not lo <= value <= hi:
             self.bad(key, f"{value} is outside {lo}-{hi}")
@@ -232,9 +236,10 @@ def _modbus_server(problems: list[str], fname: str, table: dict[str, Any]) -> Mo
     host = r.get("host", str, "127.0.0.1")
     port = r.number("port", 1502, 0, 65535)
     ranges = r.get("writable", list, None)
+    unit = r.number("unit", None, 1, 247)
     r.finish()
     writable = DEFAULT_WRITABLE if ranges is None else _ranges(r, ranges)
-    return ModbusServerSettings(enabled, host, port, writable)
+    return ModbusServerSettings(enabled, host, port, writable, unit)
 
 
 def _ranges(r: _Reader, ranges: list[Any]) -> tuple[tuple[int, int], ...]:
@@ -267,6 +272,7 @@ def _ranges(r: _Reader, ranges: list[Any]) -> tuple[tuple[int, int], ...]:
 def _nodes(problems: list[str], fname: str, items: list[Any]) -> list[NodeSettings]:
     nodes: list[NodeSettings] = []
     seen: set[int] = set()
+    lines: dict[str, tuple[int, Endpoint]] = {}  # serial device -> the first node on it
     for i, table in enumerate(items):
         if not isinstance(table, dict):
             problems.append(f"{fname}: nodes[{i}]: expected a [[nodes]] table")
@@ -276,28 +282,45 @@ def _nodes(problems: list[str], fname: str, items: list[Any]) -> list[NodeSettin
         endpoint = r.get("endpoint", str, "")
         unit = r.number("unit", 1, 0, 247)
         profile = r.get("profile", str, "cpu165")
-        timeout = r.get("timeout", float, 1.0)
+        timeout = _seconds(r, "timeout", 1.0, 0.01, 60)
         retries = r.number("retries", 1, 0, 10)
         table_name = r.get("table", str, "holding")
+        backoff = _seconds(r, "backoff", 0.2, 0.01, 600)
+        backoff_max = _seconds(r, "backoff_max", 5.0, 0.01, 3600)
         r.finish()
+        if backoff > backoff_max:
+            r.bad("backoff", f"{backoff:g} s is more than backoff_max {backoff_max:g} s")
+            backoff = min(0.2, backoff_max)
         if endpoint:
             try:
-                parse_endpoint(endpoint)
+                ep = parse_endpoint(endpoint)
             except ValueError as e:
                 r.bad("endpoint", str(e))
                 endpoint = BAD_ENDPOINT
+            else:
+                first, line = lines.setdefault(ep.device, (node, ep)) if ep.scheme == "rtu" else (node, ep)
+                if line != ep:
+                    r.bad("endpoint", f"{ep} and node {first}'s {line} share {ep.device} with "
+                                      "different line settings")
         if profile not in PROFILES:
             r.bad("profile", f"{profile!r} is not one of {', '.join(PROFILES)}")
         if table_name not in TABLES:
             r.bad("table", f"{table_name!r} is not one of {', '.join(TABLES)}")
-        if timeout is not None and not 0.01 <= timeout <= 60:
-            r.bad("timeout", f"{timeout} s is outside 0.01-60 s")
         if node in seen:
             r.bad("node", f"node {node} is configured twice")
         if node >= 0:
             seen.add(node)
-            nodes.append(NodeSettings(node, endpoint, unit, profile, timeout or 1.0, retries, table_name))
+            nodes.append(NodeSettings(node, endpoint, unit, profile, timeout, retries, table_name,
+                                      backoff, backoff_max, key=f"nodes[{i}]"))
     return nodes
+
+
+def _seconds(r: _Reader, key: str, default: float, lo: float, hi: float) -> float:
+    value = r.get(key, float, default)
+    if not lo <= value <= hi:
+        r.bad(key, f"{value:g} s is outside {lo:g}-{hi:g} s")
+        return default
+    return value
 
 
 def _simulators(problems: list[str], fname: str, items: list[Any], base: Path) -> list[SimulatorSettings]:
@@ -340,7 +363,7 @@ def _with_simulated_nodes(problems: list[str], fname: str, nodes: list[NodeSetti
         node = by_node.get(sim.node)
         endpoint = f"tcp://{sim.host}:{sim.port}" if sim.port else ""
         if node is None:
-            by_node[sim.node] = NodeSettings(sim.node, endpoint, unit=sim.unit)
+            by_node[sim.node] = NodeSettings(sim.node, endpoint, unit=sim.unit, key=f"simulators[{i}]")
         elif node.endpoint not in ("", BAD_ENDPOINT) and sim.port and node.endpoint != endpoint:
             problems.append(f"{fname}: simulators[{i}].port: node {sim.node} has endpoint "
                             f"{node.endpoint}, but its simulator listens on {endpoint}")

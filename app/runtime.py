@@ -10,15 +10,20 @@ finished scan.
 
 from __future__ import annotations
 
+import os
+import socket
+import sqlite3
 import threading
 import time
 from collections.abc import Callable, Iterable
-from dataclasses import dataclass, field
+from concurrent.futures import ThreadPoolExecutor, wait
+from dataclasses import dataclass, field, replace
 from pathlib import Path
 
 from app.config import NodeSettings, Station
 from netplc.engine import Engine
 from netplc.exchange import Exchange, NodeConfig, check_program_nodes
+from netplc.modbus_driver import parse_endpoint
 from netplc.modbus_server import ModbusServer
 from netplc.program import Program, ProgramError, load_symbols, parse, parse_file
 from netplc.records import Record
@@ -30,6 +35,7 @@ from registrar.store import Store, StoreStats
 
 RecordObserver = Callable[[Record], None]
 UNSTARTED = "tcp://127.0.0.1:1"  # endpoint of a simulated node whose simulator has not started
+RESOLVE_TIMEOUT = 5.0  # seconds for the host names of all TCP nodes to resolve
 
 
 class StartError(Exception):
@@ -97,7 +103,35 @@ def node_configs(nodes: Iterable[NodeSettings]) -> list[NodeConfig]:
     """The exchange's view of the station's nodes. A simulated node has no endpoint before its
     simulator has a port; a placeholder stands in so the program can be checked against it."""
     return [NodeConfig(n.node, n.endpoint or UNSTARTED, unit=n.unit, profile=n.profile, timeout=n.timeout,
-                       retries=n.retries, table=n.table) for n in nodes]
+                       retries=n.retries, table=n.table, backoff=n.backoff, backoff_max=n.backoff_max)
+            for n in nodes]
+
+
+def unresolved_hosts(station: Station) -> list[str]:
+    """The TCP nodes whose host name does not resolve, each naming its key. A typo in a host name
+    would otherwise be a node that is silently down forever; the names are looked up together,
+    so a dead name server costs RESOLVE_TIMEOUT once, not once per node."""
+    hosts: dict[str, list[str]] = {}
+    for n in station.nodes:
+        ep = parse_endpoint(n.endpoint) if n.endpoint else None
+        if ep is not None and ep.scheme == "tcp":
+            hosts.setdefault(ep.host, []).append(f"{n.key}.endpoint")
+    if not hosts:
+        return []
+    pool = ThreadPoolExecutor(len(hosts), thread_name_prefix="resolve")
+    lookups = {pool.submit(socket.getaddrinfo, host, None, type=socket.SOCK_STREAM): host for host in hosts}
+    wait(lookups, RESOLVE_TIMEOUT)
+    pool.shutdown(wait=False, cancel_futures=True)
+    problems = []
+    for lookup, host in lookups.items():
+        if not lookup.done():
+            why = f"did not resolve within {RESOLVE_TIMEOUT:g} s"
+        elif isinstance(error := lookup.exception(), OSError):
+            why = f"does not resolve: {error.strerror or error}"
+        else:
+            continue
+        problems += [f"{station.path}: {key}: host {host!r} {why}" for key in hosts[host]]
+    return problems
 
 
 class Runtime:
@@ -179,17 +213,28 @@ class Runtime:
                 node_programs.append(load_simulated_program(sim.program, sim.symbols))
             except ProgramError as e:
                 problems += [str(d) for d in e.errors]
+        problems += unresolved_hosts(st)
         if problems:
             raise StartError(problems)
         return catalog, program, node_programs
 
     def start(self) -> None:
+        """Start every part; StartError names the key of what could not start (the archive, a
+        simulator's port, the nodes), after what did start is stopped again."""
         st = self.station
-        st.Archive.parent.mkdir(parents=True, exist_ok=True)
-        self.store = Store(st.Archive, catalog=self.catalog, keep_days=st.keep_days, wallclock=self.wallclock)
-        self.store.start()
+        store = Store(st.Archive, catalog=self.catalog, keep_days=st.keep_days, wallclock=self.wallclock)
+        try:
+            store.start()
+        except (OSError, sqlite3.Error) as e:
+            raise StartError([f"{st.path}: Archive: {e}"]) from None
+        self.store = store
         try:
             self._start_parts()
+        except StartError as e:
+            for problem in e.problems:
+                self.system(f"station cannot start: {problem}")
+            self.stop()
+            raise
         except BaseException:
             self.stop()
             raise
@@ -203,10 +248,15 @@ class Runtime:
             self.engine.stop()
         self.retainer = Retainer(st.Retain, self.engine, self)
         self.restored = self.retainer.restore()
-        for sim, program in zip(st.simulators, self.node_programs, strict=True):
+        for i, (sim, program) in enumerate(zip(st.simulators, self.node_programs, strict=True)):
             simulator = Simulator(program, host=sim.host, port=sim.port, unit=sim.unit,
                                   tick=sim.tick_ms / 1000)
-            simulator.start()
+            try:
+                simulator.start()
+            except OSError as e:
+                why = os.strerror(e.errno) if e.errno else str(e)
+                raise StartError([f"{st.path}: simulators[{i}].port: cannot listen on "
+                                  f"{sim.host}:{sim.port}: {why}"]) from None
             self.simulators.append(simulator)
             self._fill_endpoint(sim.node, f"tcp://{sim.host}:{simulator.port}")
         self.exchange = Exchange(node_configs(self.nodes), self)
@@ -215,7 +265,7 @@ class Runtime:
         server = st.modbus_server
         if server.enabled:
             modbus = ModbusServer(self.engine, host=server.host, port=server.port,
-                                  writable=list(server.writable))
+                                  writable=list(server.writable), unit=server.unit)
             try:
                 modbus.start()
                 self.modbus = modbus
@@ -231,8 +281,8 @@ class Runtime:
                     f"retentive memory from {self.restored}")
 
     def _fill_endpoint(self, node: int, endpoint: str) -> None:
-        self.nodes = [NodeSettings(n.node, endpoint, n.unit, n.profile, n.timeout, n.retries, n.table)
-                      if n.node == node and not n.endpoint else n for n in self.nodes]
+        self.nodes = [replace(n, endpoint=endpoint) if n.node == node and not n.endpoint else n
+                      for n in self.nodes]
 
     def _scan_error(self, error: BaseException) -> None:
         self._problem(f"scan failed: {error!r}")

@@ -12,6 +12,13 @@ node only ever delays its own requests (the nodes of one RS-485 line share its c
 transaction at a time, as they share the wire). While a node is backing off, its requests fail at once
 (the instruction's output shows the link is down) and the first request after the back-off tries
 to reconnect.
+
+A link state is only as fresh as the last transaction, and NetPlc may ask a node nothing for a long
+time (the program stopped, a rung that is rarely on). So a node without a request for
+max(timeout, PROBE_IDLE) gets a liveness probe, a one-register read through the same attempts,
+back-off and link-state path: the presence list, `link_up()` and the link up/down records never
+show a dead node as up (nor, after its back-off, a live one as down) for longer than that plus the
+timeouts of the probe. A Modbus exception in answer to the probe is an answer: the link is up.
 """
 
 from __future__ import annotations
@@ -19,9 +26,9 @@ from __future__ import annotations
 import asyncio
 import time
 from collections import deque
-from collections.abc import Iterable
+from collections.abc import Awaitable, Callable, Iterable
 from dataclasses import dataclass
-from typing import TYPE_CHECKING
+from typing import TYPE_CHECKING, TypeVar
 
 from netplc.address import PRESENCE_LIST, PRESENCE_NODES, AddressError, check_operand
 from netplc.memory import Memory
@@ -42,6 +49,8 @@ if TYPE_CHECKING:
     from netplc.program import Instr
 
 NODE, NREAD, NWRITE = 300, 301, 302
+PROBE_IDLE = 1.0  # seconds without a request before a node's link is probed
+T = TypeVar("T")
 
 
 @dataclass
@@ -114,6 +123,7 @@ class NodeStats:
     writes: int = 0  # completed block writes
     errors: int = 0  # failed block requests
     last_error: str = ""
+    probes: int = 0  # liveness probes sent while NetPlc asked the node nothing
     changed: float = 0.0  # monotonic time of the last link-state change
     age: int = 0  # scans from the request of the last completed read to its data in memory
     age_max: int = 0
@@ -127,6 +137,9 @@ class _Request:
     length: int = 0
     payload: bytes | None = None  # None: a read
     scan: int = 0  # the scan that asked
+
+
+PROBE = _Request(key=-1, remote=0)  # the queue item of a liveness probe
 
 
 class _Line:
@@ -160,19 +173,45 @@ class _Node:
         self.delay = config.backoff
         self.retry_at = 0.0  # monotonic time before which requests fail without trying
         self.reported = False
+        self.idle = max(config.timeout, PROBE_IDLE)
+        self.active = time.monotonic()  # when the last request or probe ended
+        self.busy = False  # a request or probe is being served
 
     async def run(self) -> None:
+        watch = asyncio.get_running_loop().create_task(self.watch(), name=f"node {self.config.node} probe")
         try:
             while True:
                 req = await self.queue.get()
+                self.busy = True
                 try:
-                    data, error = await self.serve(req)
+                    data, error = await (self.probe() if req is PROBE else self.serve(req))
                 except Exception as e:  # a bug must not end the node's task: report, go on
                     self.line.failed()
                     data, error = None, f"internal error: {e!r}"
-                self.exchange.complete(self, req, data, error)
+                self.active, self.busy = time.monotonic(), False
+                if req is not PROBE:
+                    self.exchange.complete(self, req, data, error)
         finally:
+            watch.cancel()
             self.client.close()
+
+    async def watch(self) -> None:
+        """Queue a probe once the node has been idle for `idle` (and its back-off has run out)."""
+        while True:
+            due = max(self.active + self.idle, self.retry_at)
+            now = time.monotonic()
+            if self.busy or not self.queue.empty():  # the link state comes with the requests
+                await asyncio.sleep(self.idle)
+            elif now < due:
+                await asyncio.sleep(due - now)
+            else:
+                self.active = now
+                self.queue.put_nowait(PROBE)
+
+    async def probe(self) -> tuple[None, str]:
+        self.stats.probes += 1
+        cfg = self.config
+        return None, await self.transact(lambda: self.client.read(cfg.unit, cfg.table, 0, 1), "probe")
 
     async def serve(self, req: _Request) -> tuple[bytes | None, str]:
         now = time.monotonic()
@@ -184,8 +223,18 @@ class _Node:
                            req.remote, req.length if req.payload is None else len(req.payload))
         except MapError as e:
             return None, f"{where}: {e}"
+        if req.payload is None:
+            data, error = await self.transact(lambda: self.read(block), where)
+        else:
+            payload = req.payload
+            data, error = await self.transact(lambda: self.write(block, payload), where)
+        return data, error
+
+    async def transact(self, call: Callable[[], Awaitable[T]], where: str) -> tuple[T | None, str]:
+        """`call()` with the node's retries; its outcome sets the link state and the back-off.
+        Returns (result, "") or (None, what went wrong)."""
         try:
-            data = await self.attempts(block, req.payload)
+            result = await self.attempts(call)
         except (MapError, DeviceError) as e:  # the device answered: the link is up
             self.link(True, "")
             return None, f"{where}: {e}"
@@ -196,18 +245,15 @@ class _Node:
             return None, str(e)
         self.delay = self.config.backoff
         self.link(True, "")
-        return data, ""
+        return result, ""
 
-    async def attempts(self, block: Block, payload: bytes | None) -> bytes:
+    async def attempts(self, call: Callable[[], Awaitable[T]]) -> T:
         for attempt in range(self.config.retries + 1):
             try:
                 async with self.line.lock:
                     if not self.client.connected:
                         await self.client.connect()
-                    if payload is None:
-                        return await self.read(block)
-                    await self.write(block, payload)
-                    return b""
+                    return await call()
             except LinkError:
                 self.line.failed()
                 if attempt == self.config.retries:
@@ -220,7 +266,7 @@ class _Node:
             values += await self.client.read(self.config.unit, block.table, address, count)
         return block.decode(values)
 
-    async def write(self, block: Block, payload: bytes) -> None:
+    async def write(self, block: Block, payload: bytes) -> bytes:
         if block.table not in WRITABLE_TABLES:
             raise MapError(f"{block.table} is a read-only table")
         first = last = 0
@@ -234,6 +280,7 @@ class _Node:
         for address, count in block.spans(write=True):
             await self.client.write(self.config.unit, block.table, address, values[offset : offset + count])
             offset += count
+        return b""
 
     def link(self, up: bool, error: str) -> None:
         stats = self.stats

@@ -96,6 +96,10 @@ def parse_endpoint(text: str) -> Endpoint:
             raise ValueError(f"endpoint {text!r}: no host ({forms})")
         if url.path not in ("", "/") or url.query:
             raise ValueError(f"endpoint {text!r}: a tcp endpoint has no path or options ({forms})")
+        try:
+            url.hostname.encode("idna")
+        except UnicodeError:
+            raise ValueError(f"endpoint {text!r}: {url.hostname!r} is not a valid host name") from None
         return Endpoint("tcp", host=url.hostname, port=port if port is not None else 502)
     if url.scheme == "rtu":
         if url.netloc or not url.path:

@@ -94,3 +94,66 @@ port = 5020
     st = load_station(tmp_path)
     assert st.nodes[0].endpoint == "tcp://127.0.0.1:5020"
     assert st.NetPlcProgram is None
+
+
+def test_node_back_off_and_server_unit_pass_through(tmp_path: Path) -> None:
+    write_station(tmp_path, """
+NetPlcLoad = false
+[modbus_server]
+unit = 5
+[[nodes]]
+node = 1
+endpoint = "tcp://127.0.0.1:5020"
+backoff = 0.5
+backoff_max = 2
+""")
+    from app.runtime import node_configs
+
+    st = load_station(tmp_path)
+    assert (st.nodes[0].backoff, st.nodes[0].backoff_max, st.nodes[0].key) == (0.5, 2.0, "nodes[0]")
+    cfg = node_configs(st.nodes)[0]
+    assert (cfg.backoff, cfg.backoff_max) == (0.5, 2.0)
+    assert st.modbus_server.unit == 5
+    write_station(tmp_path, "NetPlcLoad = false\n")
+    assert load_station(tmp_path).modbus_server.unit is None  # every unit id is answered
+
+
+def test_node_timing_and_line_problems_are_named_by_key(tmp_path: Path) -> None:
+    write_station(tmp_path, """
+NetPlcLoad = false
+[modbus_server]
+unit = 300
+[[nodes]]
+node = 1
+endpoint = "tcp://127.0.0.1:5020"
+backoff = "fast"
+backoff_max = 0
+timeout = true
+[[nodes]]
+node = 2
+endpoint = "tcp://127.0.0.1:5021"
+backoff = 3
+backoff_max = 1
+[[nodes]]
+node = 3
+endpoint = "tcp://bad..name:502"
+[[nodes]]
+node = 4
+endpoint = "rtu:///dev/ttyX?baudrate=9600"
+[[nodes]]
+node = 5
+endpoint = "rtu:///dev/ttyX?baudrate=19200"
+""")
+    with pytest.raises(ConfigError) as e:
+        load_station(tmp_path)
+    problems = [p.removeprefix(f"{tmp_path / 'station.toml'}: ") for p in e.value.problems]
+    assert problems == [
+        "modbus_server.unit: 300 is outside 1-247",
+        "nodes[0].timeout: expected a number, got True",
+        "nodes[0].backoff: expected a number, got 'fast'",
+        "nodes[0].backoff_max: 0 s is outside 0.01-3600 s",
+        "nodes[1].backoff: 3 s is more than backoff_max 1 s",
+        "nodes[2].endpoint: endpoint 'tcp://bad..name:502': 'bad..name' is not a valid host name",
+        "nodes[4].endpoint: rtu:///dev/ttyX?baudrate=19200&parity=N and node 4's "
+        "rtu:///dev/ttyX?baudrate=9600&parity=N share /dev/ttyX with different line settings",
+    ]

@@ -1,0 +1,126 @@
+"""What cannot start is named by its key or file: in Runtime, in `check`, and from `--no-gui`."""
+
+from __future__ import annotations
+
+import asyncio
+import socket
+import sqlite3
+import subprocess
+import sys
+from pathlib import Path
+
+import pytest
+
+from app.check import check_station
+from app.config import load_station
+from app.runtime import Runtime, StartError
+from netplc.modbus_driver import DeviceError, LeanTcpClient, parse_endpoint
+from tests.app.conftest import REPO, write_station
+
+SIMULATED = """
+NetPlcLoad = false
+[modbus_server]
+port = 0
+unit = 5
+[[simulators]]
+node = 0
+program = "node.stl"
+port = {port}
+"""
+UNRESOLVABLE = """
+NetPlcLoad = false
+[modbus_server]
+enabled = false
+[[nodes]]
+node = 1
+endpoint = "tcp://127.0.0.1:5020"
+[[nodes]]
+node = 2
+endpoint = "tcp://nohost.invalid:502"
+"""
+
+
+def headless(station: Path) -> subprocess.CompletedProcess[str]:
+    return subprocess.run([sys.executable, "main.py", "--no-gui", str(station), "--duration", "0.5"],
+                          cwd=REPO, capture_output=True, text=True, timeout=60)
+
+
+def system_texts(archive: Path) -> list[str]:
+    con = sqlite3.connect(f"file:{archive}?mode=ro", uri=True)
+    try:
+        tables = [r[0] for r in con.execute("SELECT name FROM sqlite_master WHERE type='table'")
+                  if r[0][:2].isdigit()]
+        query = 'SELECT text FROM "{}" WHERE kind = \'system\''
+        return [r[0] for t in tables for r in con.execute(query.format(t))]
+    finally:
+        con.close()
+
+
+def test_the_modbus_server_answers_the_configured_unit_only(tmp_path: Path) -> None:
+    write_station(tmp_path, SIMULATED.format(port=0), {"node.stl": "JMP 0\n"})
+    runtime = Runtime(load_station(tmp_path))
+    runtime.start()
+    try:
+        assert runtime.modbus is not None and runtime.modbus.unit == 5
+
+        async def read(unit: int) -> list[int]:
+            client = LeanTcpClient(parse_endpoint(f"tcp://127.0.0.1:{runtime.modbus.port}"), 2.0)
+            await client.connect()
+            try:
+                return await client.read(unit, "holding", 0o2000, 1)
+            finally:
+                client.close()
+
+        assert asyncio.run(read(5)) == [0]
+        with pytest.raises(DeviceError, match="Modbus exception 11"):
+            asyncio.run(read(1))
+    finally:
+        runtime.stop()
+
+
+def test_a_simulator_port_in_use_names_the_key_and_starts_nothing(tmp_path: Path) -> None:
+    with socket.create_server(("127.0.0.1", 0)) as taken:
+        port = taken.getsockname()[1]
+        write_station(tmp_path, SIMULATED.format(port=port), {"node.stl": "JMP 0\n"})
+        runtime = Runtime(load_station(tmp_path))
+        with pytest.raises(StartError) as e:
+            runtime.start()
+    problem = (f"{tmp_path / 'station.toml'}: simulators[0].port: cannot listen on 127.0.0.1:{port}: "
+               "Address already in use")
+    assert e.value.problems == [problem]
+    assert runtime.simulators == [] and runtime.exchange is None and runtime.modbus is None
+    assert not runtime.started
+    texts = system_texts(tmp_path / "archive" / "journal.sqlite")
+    assert f"station cannot start: {problem}" in texts and "station stopped" not in texts
+    runtime.stop()  # a second stop after a failed start does nothing
+
+
+def test_a_node_host_that_does_not_resolve_is_named_by_its_key(tmp_path: Path) -> None:
+    write_station(tmp_path, UNRESOLVABLE)
+    where = f"{tmp_path / 'station.toml'}: nodes[1].endpoint: host 'nohost.invalid' d"  # does / did not
+    with pytest.raises(StartError) as e:
+        Runtime(load_station(tmp_path))
+    assert len(e.value.problems) == 1 and e.value.problems[0].startswith(where)
+    report = check_station(tmp_path)
+    assert [p for p in report.problems if "endpoint" in p] == e.value.problems
+    r = headless(tmp_path)
+    assert r.returncode == 2 and r.stderr.startswith(where) and "Traceback" not in r.stderr
+
+
+def test_a_missing_program_file_exits_2_naming_the_key(tmp_path: Path) -> None:
+    write_station(tmp_path, 'NetPlcProgram = "gone.stl"\n')
+    r = headless(tmp_path)
+    assert r.returncode == 2 and "Traceback" not in r.stderr
+    assert r.stderr.strip() == (f"{tmp_path / 'station.toml'}: NetPlcProgram: file {tmp_path / 'gone.stl'} "
+                                "does not exist")
+
+
+@pytest.mark.xfail(strict=True, reason="app/cli.py run_headless must catch StartError from "
+                                       "Runtime.start() (asked of the lead); remove this mark then")
+def test_headless_with_a_simulator_port_in_use_exits_2_naming_the_key(tmp_path: Path) -> None:
+    with socket.create_server(("127.0.0.1", 0)) as taken:
+        port = taken.getsockname()[1]
+        write_station(tmp_path, SIMULATED.format(port=port), {"node.stl": "JMP 0\n"})
+        r = headless(tmp_path)
+    assert r.returncode == 2 and "Traceback" not in r.stderr
+    assert f"simulators[0].port: cannot listen on 127.0.0.1:{port}" in r.stderr
