@@ -261,8 +261,9 @@ def copy_inline(s: int | None, d: int | None, n: int) -> list[str] | None:
     i, k = data_at(s, n), data_at(d, n)
     if i is None or k is None:
         return None
-    if n == 2 and i != k:
-        return word_store(k, word_src(i))  # read whole before the store, so an overlap is fine
+    if n == 2 and i != k:  # the word is read whole before it is stored, so an overlap is fine
+        store = word_store(k, word_src(i))
+        return store if len(store) == 1 else [f"_v = {word_src(i)}", *word_store(k, "_v")]
     if abs(i - k) < n or n > 4:
         return [f"d[{k}:{k + n}] = d[{i}:{i + n}]"]
     return [f"d[{k + j}] = d[{i + j}]" for j in range(n)]

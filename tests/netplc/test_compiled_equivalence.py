@@ -4,15 +4,22 @@ the reference interpreter does (DESIGN section 5), for random valid programs ove
 Programs are generated as nested structures so that every jump terminates: forward jumps to a
 label after a nested body, and backward loops guarded by a loop bit the body never writes (each
 loop runs its body twice per entry). SKP may precede any instruction, a jump, or a label.
+
+FON draws every function the compiler puts in line (and some it calls), with operands that are
+data words at even and odd addresses, I/O bits (the coils the program reads), or a word that runs
+off its bank (FErr1), on random initial data; the compiled side is run both with its usual chunk
+size and with tiny chunks, so that chunk boundaries fall everywhere.
 """
 
 from __future__ import annotations
 
 import itertools
+from unittest import mock
 
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
+from netplc import compiler
 from netplc.engine import Engine, FakeClock
 from netplc.functions.registry import lookup
 from netplc.program import parse
@@ -27,11 +34,18 @@ COUNTERS = [0o3100 + 3 * k for k in range(4)]  # C, C+1 (reset), C+2
 LOOP_BITS = [0o3200 + k for k in range(32)]  # written only by loop control
 SCRATCH = 0o3277  # ends the loop body's chain; never read
 DATA = [0o4000 + 2 * k for k in range(8)]
+INITIAL = range(0o4000, 0o4022)  # data bytes given random values before the first scan
+OPERANDS = [*DATA, 0o4001, 0o4003, 0o4011, 0o2000, 0o2010, 0o7777]  # odd, I/O bits, off the bank
 
-# functions with plain memory semantics (no exchange, no records, no module state)
-CANDIDATES = ("MOV", "ADD", "SUB", "MOVB", "AND", "OR", "XOR", "CMP", "INCW", "DECW", "NEG")
+# functions with plain memory semantics (no exchange, no records, no module state): those the
+# compiler puts in line, and a few it calls
+CANDIDATES = ("MOV", "MVIBCD", "MVID", "MVIO", "MOVB", "ADD", "SUB", "INCW", "DECW", "NSETDI", "NMOVW",
+              "NMOVB", "AND", "OR", "XOR", "NEG", "NGREAT", "NLESS", "NEQUAL", "NGREATI", "NLESSI", "CMP",
+              "XCG", "WMASK", "MUL")
 FUNCTIONS = [s for name in CANDIDATES if (s := lookup(name)) is not None and not s.hardware]
 UNREGISTERED = next((n for n in (9, 3, 4, 12) if lookup(n) is None), None)
+CONSTANTS = {"D": st.integers(0, 65535).map(str), "O": st.integers(0, 0o177777).map(lambda v: f"{v:o}"),
+             "B": st.integers(0, 9999).map(str)}
 
 
 def _fon(draw) -> str:
@@ -44,9 +58,9 @@ def _fon(draw) -> str:
     params = []
     for key, kind in spec.kinds().items():
         if kind == "M":
-            params.append(f"{key}:$0{draw(st.sampled_from(DATA)):o}")
-        elif kind is not None:
-            params.append(f"{key}:{draw(st.integers(0, 7))}")
+            params.append(f"{key}:$0{draw(st.sampled_from(OPERANDS)):o}")
+        elif kind is not None:  # a count (NMOVB/NMOVW R) is mostly small, sometimes off the bank
+            params.append(f"{key}:{draw(st.one_of(st.integers(0, 5).map(str), CONSTANTS[kind]))}")
     return f"FON C:$0{c:o} N:{spec.mnemonic} " + " ".join(params)
 
 
@@ -115,20 +129,26 @@ def state(engine: Engine) -> tuple:
             dict(engine.ctr_values), engine.state_text, engine.scan_counter)
 
 
-def run_both(text: str, inputs: list[list[int]], dts: list[float]) -> None:
+def run_both(text: str, inputs: list[list[int]], dts: list[float], data: bytes = b"") -> None:
+    """Scan `text` in the reference interpreter and in the compiled engine (usual and tiny chunks)."""
     program = parse(text, source="random.stl")
     engines = []
-    for compiled in (True, False):
+    for compiled, chunk in ((False, 0), (True, compiler._CHUNK_LINES), (True, 3)):
         clock = FakeClock()
-        engines.append((Engine(program, clock=clock, wallclock=lambda: 0.0, compiled=compiled), clock))
+        with mock.patch.object(compiler, "_CHUNK_LINES", chunk):
+            engine = Engine(program, clock=clock, wallclock=lambda: 0.0, compiled=compiled)
+        if data:
+            engine.mem.write(INITIAL[0], data)
+        engines.append((engine, clock))
     for scan_inputs, dt in zip(inputs, dts):
         for eng, clock in engines:
             for addr, v in zip(INPUTS, scan_inputs):
                 eng.mem.bits[addr] = v
             clock.advance(dt)
             eng.scan()
-        (a, _), (b, _) = engines
-        assert state(a) == state(b), text
+        reference = state(engines[0][0])
+        for eng, _ in engines[1:]:
+            assert state(eng) == reference, text
 
 
 @settings(max_examples=300, deadline=None, suppress_health_check=[HealthCheck.too_slow])
@@ -136,9 +156,10 @@ def run_both(text: str, inputs: list[list[int]], dts: list[float]) -> None:
     programs(),
     st.lists(st.lists(st.integers(0, 1), min_size=len(INPUTS), max_size=len(INPUTS)), min_size=4, max_size=6),
     st.lists(st.sampled_from([0.01, 0.05, 0.1, 0.35, 1.0]), min_size=6, max_size=6),
+    st.binary(min_size=len(INITIAL), max_size=len(INITIAL)),
 )
-def test_random_programs_leave_identical_state(text, inputs, dts):
-    run_both(text, inputs, dts)
+def test_random_programs_leave_identical_state(text, inputs, dts, data):
+    run_both(text, inputs, dts, data)
 
 
 def test_long_chains_are_split_before_the_parser_chokes():
