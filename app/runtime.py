@@ -134,6 +134,11 @@ def unresolved_hosts(station: Station) -> list[str]:
     return problems
 
 
+def _reason(e: OSError) -> str:
+    """The OS's words for a socket error (asyncio wraps them in a sentence of its own)."""
+    return os.strerror(e.errno) if e.errno else str(e)
+
+
 class Runtime:
     """The running station. `start()`, then `status()` as often as wanted, then `stop()`."""
 
@@ -254,9 +259,8 @@ class Runtime:
             try:
                 simulator.start()
             except OSError as e:
-                why = os.strerror(e.errno) if e.errno else str(e)
                 raise StartError([f"{st.path}: simulators[{i}].port: cannot listen on "
-                                  f"{sim.host}:{sim.port}: {why}"]) from None
+                                  f"{sim.host}:{sim.port}: {_reason(e)}"]) from None
             self.simulators.append(simulator)
             self._fill_endpoint(sim.node, f"tcp://{sim.host}:{simulator.port}")
         self.exchange = Exchange(node_configs(self.nodes), self)
@@ -269,8 +273,9 @@ class Runtime:
             try:
                 modbus.start()
                 self.modbus = modbus
-            except OSError as e:
-                self._problem(f"Modbus server not started: {server.host}:{server.port}: {e.strerror or e}")
+            except OSError as e:  # the station runs on without it; the operator sees why
+                self._problem(f"Modbus server not started: {st.path}: modbus_server.port: cannot listen on "
+                              f"{server.host}:{server.port}: {_reason(e)}")
         self.system(f"program loaded: {self.program.source} ({len(self.program.instrs)} instructions, "
                     f"{self.program.words} words)")
         self.scan_thread = ScanThread(self.engine, st.tick, on_error=self._scan_error)

@@ -124,3 +124,31 @@ def test_headless_with_a_simulator_port_in_use_exits_2_naming_the_key(tmp_path: 
         r = headless(tmp_path)
     assert r.returncode == 2 and "Traceback" not in r.stderr
     assert f"simulators[0].port: cannot listen on 127.0.0.1:{port}" in r.stderr
+
+
+def test_the_modbus_server_port_in_use_is_a_problem_shown_not_a_stop(tmp_path: Path) -> None:
+    with socket.create_server(("127.0.0.1", 0)) as taken:
+        port = taken.getsockname()[1]
+        write_station(tmp_path, SIMULATED.format(port=0).replace("port = 0\nunit = 5", f"port = {port}"),
+                      {"node.stl": "JMP 0\n"})
+        runtime = Runtime(load_station(tmp_path))
+        runtime.start()
+        try:
+            status = runtime.status()
+            assert status.running and status.modbus_port is None
+            assert status.problems == (f"Modbus server not started: {tmp_path / 'station.toml'}: "
+                                       f"modbus_server.port: cannot listen on 127.0.0.1:{port}: "
+                                       "Address already in use",)
+        finally:
+            runtime.stop()
+
+
+def test_an_archive_that_cannot_be_made_names_the_key(tmp_path: Path) -> None:
+    write_station(tmp_path, 'NetPlcLoad = false\nArchive = "blocker/journal.sqlite"\n')
+    (tmp_path / "blocker").write_text("a file where the archive folder should be", encoding="utf-8")
+    runtime = Runtime(load_station(tmp_path))
+    with pytest.raises(StartError) as e:
+        runtime.start()
+    [problem] = e.value.problems
+    assert problem.startswith(f"{tmp_path / 'station.toml'}: Archive: ") and "blocker" in problem
+    assert runtime.store is None and not runtime.started
