@@ -201,6 +201,7 @@ def read_station(path: str | Path) -> tuple[Station | None, list[str]]:
     users = _users(problems, fname, top.get("operator", dict, {}))
     top.finish()
     nodes = _with_simulated_nodes(problems, fname, nodes, simulators)
+    _ports_in_common(problems, fname, server, simulators)
     program, symbols, hmi, messages = (
         _existing(top, key, p, must_be_dir)
         for key, p, must_be_dir in (("NetPlcProgram", program, False), ("Symbols", symbols, False),
@@ -351,6 +352,19 @@ def _users(problems: list[str], fname: str, table: dict[str, Any]) -> tuple[str,
         r.bad("users", "expected a non-empty list of user names")
         return ("operator",)
     return tuple(users)
+
+
+def _ports_in_common(problems: list[str], fname: str, server: ModbusServerSettings,
+                     sims: list[SimulatorSettings]) -> None:
+    """Fixed ports that the station itself would listen on twice (port 0 is always a free one)."""
+    taken: dict[tuple[str, int], str] = {}
+    if server.enabled and server.port:
+        taken[server.host, server.port] = "modbus_server.port"
+    for i, sim in enumerate(sims):
+        if sim.port:
+            first = taken.setdefault((sim.host, sim.port), f"simulators[{i}].port")
+            if first != f"simulators[{i}].port":
+                problems.append(f"{fname}: simulators[{i}].port: {sim.host}:{sim.port} is also {first}")
 
 
 def _with_simulated_nodes(problems: list[str], fname: str, nodes: list[NodeSettings],

@@ -157,3 +157,29 @@ endpoint = "rtu:///dev/ttyX?baudrate=19200"
         "nodes[4].endpoint: rtu:///dev/ttyX?baudrate=19200&parity=N and node 4's "
         "rtu:///dev/ttyX?baudrate=9600&parity=N share /dev/ttyX with different line settings",
     ]
+
+
+def test_ports_the_station_would_listen_on_twice(tmp_path: Path) -> None:
+    write_station(tmp_path, """
+NetPlcLoad = false
+[modbus_server]
+port = 5020
+[[simulators]]
+node = 1
+program = "n.stl"
+port = 5020
+[[simulators]]
+node = 2
+program = "n.stl"
+port = 5021
+[[simulators]]
+node = 3
+program = "n.stl"
+port = 5021
+""", {"n.stl": "JMP 0\n"})
+    with pytest.raises(ConfigError) as e:
+        load_station(tmp_path)
+    assert [p.split(": ", 1)[1] for p in e.value.problems] == [
+        "simulators[0].port: 127.0.0.1:5020 is also modbus_server.port",
+        "simulators[2].port: 127.0.0.1:5021 is also simulators[1].port",
+    ]
