@@ -11,8 +11,17 @@ from __future__ import annotations
 import math
 from collections.abc import Hashable
 
-from PySide6.QtCore import QPointF, QRectF, QSize, Qt
-from PySide6.QtGui import QColor, QFontMetricsF, QMouseEvent, QPainter, QPainterPath, QPen, QPolygonF
+from PySide6.QtCore import QPointF, QRectF, Qt
+from PySide6.QtGui import (
+    QColor,
+    QFontMetricsF,
+    QMouseEvent,
+    QPainter,
+    QPainterPath,
+    QPen,
+    QPolygonF,
+    QResizeEvent,
+)
 from PySide6.QtWidgets import QWidget
 
 from hmi_forms.elements.analog import AnalogBase
@@ -57,9 +66,12 @@ class GaugeWidget(ElementWidget):
         super().__init__(model, images, parent)
         lo, hi = model.scaling.phy_range
         self.digits = max(len(model.format(lo)), len(model.format(hi)))
-        self._laid_out: QSize | None = None  # the size the cached dial layout below is for
+        self._laid_out = False  # the geometry below is for the current size (reset on resize)
         self._dial: tuple[QPointF, float, float, float] = (QPointF(), 0.0, 0.0, 0.0)
         self._box: tuple[QRectF, float] = (QRectF(), 0.0)
+        self._digital: tuple[QRectF, float, float] = (QRectF(), 0.0, 0.0)
+        self._travel = 0.0  # pixels the pointer (needle tip, bar end) travels over the whole scale
+        self._shown: tuple[object, ...] | None = None
         units = f" {model.Units}" if model.Units else ""
         lo, hi = model.scaling.phy_range
         self.setToolTip(f"{model.Name}: word {oct(model.InAddr or 0)[2:].rjust(5, '0')}, "
@@ -72,10 +84,43 @@ class GaugeWidget(ElementWidget):
         return max(11.0, min(18.0, self.height() * 0.11)) if self.model.Name else 0.0
 
     def _layout(self) -> None:
-        if self._laid_out != self.size():
-            self._laid_out = self.size()
+        if not self._laid_out:
+            self._laid_out = True
             self._dial = self._compute_dial_geometry()
             self._box = self._compute_readout_box()
+            self._digital = self._compute_digital_geometry()
+            appearance = self.model.Appearance
+            if appearance == "hbar":
+                self._travel = self._bar_geometry().width()
+            elif appearance != "digital":
+                _, r, _, sweep = self._dial
+                self._travel = abs(math.radians(sweep)) * r  # the maximum mark's outer corner
+
+    def resizeEvent(self, event: QResizeEvent) -> None:
+        self._laid_out = False
+        super().resizeEvent(event)
+
+    def shown(self) -> tuple[object, ...]:
+        """What the operator can see change: the texts, and the pointers to the nearest pixel."""
+        self._layout()
+        m = self.model
+        travel = self._travel
+        pointer = None if m.hw is None else round(m.fraction * travel)
+        if m.maximum is None:
+            peak: object = None
+        elif travel:
+            peak = round(m.scaling.fraction(m.maximum) * travel)
+        else:
+            peak = m.format(m.maximum)
+        return m.text, pointer, peak, m.zone, m.stale
+
+    def sync(self) -> None:
+        """Repaint only when something moved by a pixel or a text changed (a value that creeps
+        below a pixel per tick costs no paint until it has moved one)."""
+        shown = self.shown()
+        if shown != self._shown:
+            self._shown = shown
+            super().sync()
 
     def _dial_geometry(self) -> tuple[QPointF, float, float, float]:
         """Centre, radius, start angle and sweep (degrees, counter-clockwise from 3 o'clock)."""
@@ -255,7 +300,7 @@ class GaugeWidget(ElementWidget):
             p.setPen(Qt.PenStyle.NoPen)
             p.setBrush(theme.ALARM)
             p.drawPolygon(QPolygonF([tip, left, right]))
-        box, size = self._readout_box()
+        box, size = self._box
         p.setFont(theme.sized_font(size, bold=True, family=theme.MONO))
         p.setPen(WHITE if m.zone == "high" else theme.TEXT)
         p.drawText(box, Qt.AlignmentFlag.AlignCenter, m.text or "---")
@@ -292,6 +337,10 @@ class GaugeWidget(ElementWidget):
         p.drawText(QRectF(6, 2, self.width() - 12, nh + 2), theme.RIGHT, (m.text or "---") + units)
 
     def _digital_geometry(self) -> tuple[QRectF, float, float]:
+        self._layout()
+        return self._digital
+
+    def _compute_digital_geometry(self) -> tuple[QRectF, float, float]:
         """Readout box, value font size (fixed by the widest value of the range) and units width."""
         h = self.height()
         nh = self._name_height() if h >= 40 else 0.0

@@ -1,10 +1,11 @@
 """Trends with pyqtgraph: the Graph element (a bit) and AnalogBase with Appearance "graph".
 
 Following anchors.md section 4: the plot and its curve are created once per widget and fed with
-`setData`; the axes have fixed ranges (no autorange per frame); mouse interaction, menus and
-buttons are off (an operator panel, not an analysis tool); and redraws are throttled: the model
-samples every scan, the plot is redrawn when `flush_due` says its turn has come. Plots are never
-destroyed while the form lives (the PySide6 PlotItem leak).
+`setData` (a bare PlotCurveItem: PlotDataItem's per-call bookkeeping cost five times the data
+itself); the axes have fixed ranges (no autorange per frame) and are cached as pixmaps; mouse
+interaction, menus and buttons are off (an operator panel, not an analysis tool); and redraws are
+throttled: the model samples every scan, the plot is redrawn when `flush_due` says its turn has
+come. Plots are never destroyed while the form lives (the PySide6 PlotItem leak).
 """
 
 from __future__ import annotations
@@ -14,7 +15,7 @@ from collections.abc import Hashable
 import pyqtgraph as pg
 from PySide6.QtCore import QRect, QRectF, Qt
 from PySide6.QtGui import QColor, QPainter, QPen
-from PySide6.QtWidgets import QWidget
+from PySide6.QtWidgets import QGraphicsItem, QWidget
 
 from hmi_forms.elements.analog import AnalogBase
 from hmi_forms.elements.graph import Graph
@@ -59,7 +60,7 @@ class TrendWidget(SelfPainted):
             item.setYRange(-0.15, 1.15, padding=0)
             item.getAxis("left").setTicks([[(0, "0"), (1, "1")]])
             item.getAxis("left").setWidth(18)
-            self.curve = item.plot(pen=pen, stepMode="left", connect="finite")
+            self.curve = pg.PlotCurveItem(pen=pen, stepMode="left", connect="finite")
         else:
             lo, hi = model.scaling.phy_range
             item.setYRange(lo, hi, padding=0.04)
@@ -68,7 +69,10 @@ class TrendWidget(SelfPainted):
                 if limit is not None:
                     pen_limit = pg.mkPen(color, style=Qt.PenStyle.DashLine)
                     item.addItem(pg.InfiniteLine(limit, angle=0, pen=pen_limit))
-            self.curve = item.plot(pen=pen, connect="finite")
+            self.curve = pg.PlotCurveItem(pen=pen, connect="finite")
+        item.addItem(self.curve)
+        for name in ("left", "bottom"):  # fixed ranges: axes and grid are blitted, not re-stroked
+            item.getAxis(name).setCacheMode(QGraphicsItem.CacheMode.DeviceCoordinateCache)
         self.plot = plot
         self.stale_mark.raise_()
         self.dirty = False
@@ -92,7 +96,7 @@ class TrendWidget(SelfPainted):
             return
         y = self.trend.values()
         n = len(y)
-        self.curve.setData(self.trend.x[:n] - (n - 1), y, skipFiniteCheck=False)
+        self.curve.setData(self.trend.x[:n] - (n - 1), y)
         self.shown = self.trend.count
         self.dirty = False
 
