@@ -80,17 +80,21 @@ QUOTIENT = f"_q = eng.dt / TB[(b[{TIMEBASE_HI}] << 1) | b[{TIMEBASE_LO}]]"
 
 
 def tim_lines(c: int, n: int) -> tuple[list[str], list[str]]:
-    """`make_tim`'s timer, written out (the same float operations: dt / base, then the sum)."""
+    """`make_tim`'s timer, written out (the same float operations: dt / base, then the sum).
+
+    Bits hold 0 or 1, so where bit C is found 1 it is not stored again.
+    """
     c1 = c + 1
     on = [f"if b[{c}]:",
           f"    _t = tk.get({c}, 0.0) + _q",
           f"    if _t > {n}:",
           f"        _t = {float(n)!r}",
-          "else:",
-          "    _t = 0.0",
-          f"tk[{c}] = _t",
-          f"b[{c1}] = _t >= {n - _EPS!r}",
-          f"b[{c}] = 1"]
+          f"    tk[{c}] = _t",
+          f"    b[{c1}] = _t >= {n - _EPS!r}",
+          "else:",  # the timer starts on this scan
+          f"    tk[{c}] = 0.0",
+          f"    b[{c1}] = {int(n - _EPS <= 0.0)}",
+          f"    b[{c}] = 1"]
     return on, [f"tk[{c}] = 0.0", f"b[{c}] = 0", f"b[{c1}] = 0"]
 
 
@@ -98,8 +102,7 @@ def ctr_lines(c: int, n: int) -> tuple[list[str], list[str]]:
     """`make_ctr`'s counter, written out (a rising edge is RES 1 while bit C was 0)."""
     c1, c2 = c + 1, c + 2
     reset = [f"if b[{c1}]:", f"    cv[{c}] = 0", f"    b[{c2}] = 0", "else:"]
-    on = [f"if b[{c}]:",
-          f"    b[{c}] = 1",  # no edge
+    on = [f"if b[{c}]:",  # no edge (bits hold 0 or 1: bit C stays 1)
           *("    " + line for line in reset),
           f"        b[{c2}] = cv.get({c}, 0) >= {n}",
           "else:",

@@ -275,6 +275,9 @@ def constant_inline(d: int | None, value: int) -> list[str] | None:
     return None if k is None else word_store(k, str(value & 0xFFFF))
 
 
+FAIL_LINE = f"b[{FERR1}] = 1"  # what `fail` does, as a line
+
+
 def flag_bits(fon: Fon, count: int) -> list[int] | None:
     """The output bits C+1..C+count, or None when one is past the I/O bits."""
     bits = [fon.c + k for k in range(1, count + 1)]

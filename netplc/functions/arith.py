@@ -8,6 +8,7 @@ from __future__ import annotations
 
 from netplc.address import FERR2
 from netplc.functions._util import (
+    FAIL_LINE,
     Builder,
     Step,
     at,
@@ -192,7 +193,16 @@ for _number, _name, _subtract in ((92, "ADD", False), (93, "SUB", True)):
     register(_number, _name, "M", "M", "M", inline=_bin_arith_inline(_subtract))(built(_bin_arith(_subtract)))
 
 
-@register(94, "MUL", "M", "M", "M")
+def _mul_inline(fon: Fon) -> list[str] | None:
+    i, j = data_at(fon.s, 2), data_at(fon.d, 2)
+    lo, hi = data_at(fon.r, 2), data_at(at(fon.r, 2), 2)
+    if i is None or j is None or lo is None or hi is None:
+        return None
+    return [f"_t = {word_src(i)} * {word_src(j)}", "_v = _t & 65535", *word_store(lo, "_v"),
+            "_v = _t >> 16", *word_store(hi, "_v")]
+
+
+@register(94, "MUL", "M", "M", "M", inline=_mul_inline)
 @built
 def mul(mem: Memory, fon: Fon) -> Step:
     """32-bit product of the unsigned words S and D: low word at R, high word at R+2."""
@@ -208,7 +218,17 @@ def mul(mem: Memory, fon: Fon) -> Step:
     return step
 
 
-@register(95, "DIV", "M", "M", "M")
+def _div_inline(fon: Fon) -> list[str] | None:
+    i, j = data_at(fon.s, 2), data_at(fon.d, 1)
+    q, m = data_at(fon.r, 2), data_at(at(fon.r, 2), 1)
+    if i is None or j is None or q is None or m is None:
+        return None
+    return [f"_y = d[{j}]", "if _y:", f"    _x = {word_src(i)}", "    _v = _x // _y",
+            *("    " + line for line in word_store(q, "_v")), f"    d[{m}] = _x % _y", "else:",
+            f"    {FAIL_LINE}"]
+
+
+@register(95, "DIV", "M", "M", "M", inline=_div_inline)
 @built
 def div(mem: Memory, fon: Fon) -> Step:
     """word[S] / byte[D]: 16-bit quotient at R, 8-bit remainder in byte R+2 (the "24-bit result").

@@ -16,6 +16,8 @@ from netplc.functions._util import (
     flag_bits,
     word_get,
     word_set,
+    word_src,
+    word_store,
 )
 from netplc.functions.registry import Fon, FonContext, Inline, register
 from netplc.memory import Memory
@@ -86,7 +88,14 @@ def bmask(mem: Memory, fon: Fon) -> Step:
     return lambda ctx: put((get() & ~and_mask) | or_mask)
 
 
-@register(39, "WMASK", "M", "O", "O")
+def _wmask_inline(fon: Fon) -> list[str] | None:
+    i = data_at(fon.s, 2)
+    if i is None:
+        return None
+    return [f"_v = {word_src(i)} & {~(fon.d or 0) & 0xFFFF} | {fon.r or 0}", *word_store(i, "_v")]
+
+
+@register(39, "WMASK", "M", "O", "O", inline=_wmask_inline)
 @built
 def wmask(mem: Memory, fon: Fon) -> Step:
     """word[S] = (word[S] & ~D) | R, in place."""

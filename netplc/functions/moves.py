@@ -18,11 +18,14 @@ from netplc.functions._util import (
     byte_set,
     constant_inline,
     copy_inline,
+    data_at,
     fail,
     span,
     valid_block,
     word_get,
     word_set,
+    word_src,
+    word_store,
 )
 from netplc.functions.registry import Fon, FonContext, register
 from netplc.memory import Memory
@@ -55,7 +58,14 @@ register(7, "MVID", "D", "M", inline=_store_constant_inline)(built(_store_consta
 register(8, "MVIO", "O", "M", inline=_store_constant_inline)(built(_store_constant))
 
 
-@register(2, "XCG", "M", "M")
+def _xcg_inline(fon: Fon) -> list[str] | None:
+    i, k = data_at(fon.s, 2), data_at(fon.d, 2)
+    if i is None or k is None:
+        return None
+    return [f"_x = {word_src(i)}", f"_y = {word_src(k)}", *word_store(i, "_y"), *word_store(k, "_x")]
+
+
+@register(2, "XCG", "M", "M", inline=_xcg_inline)
 @built
 def xcg(mem: Memory, fon: Fon) -> Step:
     """Swap word[S] and word[D]."""

@@ -68,8 +68,8 @@ class Fon:
 Run = Callable[[FonContext, Fon], None]
 # Python source lines doing what `run` does for this instruction, for the compiled engine to put in
 # line (netplc/compiler.py): they see the bit array as `b`, the data array as `d` and as 16-bit words
-# `w`, may use the locals _t _v _x _y, and run only when RES is 1 (after bit C is set). None: call
-# `run` instead.
+# `w`, the engine as `eng`, may use the locals _t _v _x _y, and run only when RES is 1 (after bit C
+# is set). None: call `run` instead.
 Inline = Callable[[Fon], list[str] | None]
 
 

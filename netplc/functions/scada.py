@@ -12,6 +12,7 @@ from __future__ import annotations
 
 from netplc.address import DATA_SIZE, fmt_octal
 from netplc.functions._util import (
+    FAIL_LINE,
     Builder,
     Step,
     at,
@@ -26,6 +27,7 @@ from netplc.functions._util import (
     word_get,
     word_set,
     word_src,
+    word_store,
 )
 from netplc.functions.registry import Fon, FonContext, Inline, register
 from netplc.memory import Memory
@@ -57,7 +59,16 @@ def nstore(mem: Memory, fon: Fon) -> Step:
     return step
 
 
-@register(305, "NSYNC", "D", "D")
+def _nsync_inline(fon: Fon) -> list[str] | None:
+    flags = flag_bits(fon, 1)
+    if flags is None:
+        return None
+    if not fon.s:
+        return [f"b[{flags[0]}] = 0", FAIL_LINE]
+    return [f"b[{flags[0]}] = eng.scan_counter % {fon.s} == {fon.d or 0}"]
+
+
+@register(305, "NSYNC", "D", "D", inline=_nsync_inline)
 @built
 def nsync(mem: Memory, fon: Fon) -> Step:
     """C+1 = 1 on the scans whose number modulo the period S equals the phase D (else 0).
@@ -206,7 +217,16 @@ register(312, "NMOVB", "M", "M", "D", inline=_move_inline(1))(built(_move(1)))
 register(313, "NMOVW", "M", "M", "D", inline=_move_inline(2))(built(_move(2)))
 
 
-@register(314, "NMAX", "M", "M")
+def _nmax_inline(fon: Fon) -> list[str] | None:
+    i, k, flags = data_at(fon.s, 2), data_at(fon.d, 2), flag_bits(fon, 1)
+    if i is None or k is None or flags is None:
+        return None
+    return [f"if b[{flags[0]}]:", f"    _x = {word_src(i)}", f"    if _x > {word_src(k)}:",
+            *("        " + line for line in word_store(k, "_x")), "else:",
+            *("    " + line for line in word_store(k, "0"))]
+
+
+@register(314, "NMAX", "M", "M", inline=_nmax_inline)
 @built
 def nmax(mem: Memory, fon: Fon) -> Step:
     """Input C+1 = 0: word[D] = 0 ("reset by 0"); C+1 = 1: word[D] = max(word[D], word[S])."""
