@@ -114,7 +114,22 @@ register(36, "ROR", "M")(built(_rotate(left=False)))
 register(37, "ROL", "M")(built(_rotate(left=True)))
 
 
-@register(54, "SCALE", "M", "M", "O")
+def _scale_inline(fon: Fon) -> list[str] | None:
+    d = fon.d or 0
+    x, y = data_at(fon.s, 2), data_at(d, 2)
+    a, b, c = (data_at(at(d, k), 2) for k in (2, 4, 6))
+    if x is None or y is None or a is None or b is None or c is None:
+        return None
+    if fon.r not in (0, 1):
+        return [FAIL_LINE]
+    return [f"_y = {word_src(b)}", "if _y:",
+            f"    _t = {word_src(a)} * {word_src(x)} // _y {'-' if fon.r else '+'} {word_src(c)}",
+            "    if _t < 0:", "        _t = 0", f"        b[{FERR2}] = 1",
+            "    elif _t > 65535:", "        _t = 65535", f"        b[{FERR2}] = 1",
+            *("    " + line for line in word_store(y, "_t")), "else:", f"    {FAIL_LINE}"]
+
+
+@register(54, "SCALE", "M", "M", "O", inline=_scale_inline)
 @built
 def scale(mem: Memory, fon: Fon) -> Step:
     """Y = (A/B)*X + s*C with X = word[S], Y = word[D], A, B, C = words D+2, D+4, D+6; R 0: s=+1, 1: s=-1.

@@ -21,7 +21,7 @@ from netplc.program import parse
 lookup(0)  # imports every function module
 INLINED = sorted((s for s in REGISTRY.values() if s.inline is not None), key=lambda s: s.number)
 ADDRESSES = [0o4000, 0o4001, 0o4002, 0o4003, 0o7776, 0o7777, 0o2000]  # 07777: a word runs off bank 0
-CONSTANTS = {"D": ["0", "1", "3", "255", "256", "40000", "65535"], "O": ["0", "17", "177777"],
+CONSTANTS = {"D": ["0", "1", "3", "255", "256", "40000", "65535"], "O": ["0", "1", "17", "177777"],
              "B": ["0", "1234", "9999"]}
 RUNG = 0o2400
 
