@@ -101,6 +101,8 @@ def _open_runtime(station: str):  # -> Runtime | None (typed lazily: the runtime
 
 
 def run_headless(station: str, duration: float | None, every: float) -> int:
+    from app.runtime import StartError
+
     runtime = _open_runtime(station)
     if runtime is None:
         return 2
@@ -112,7 +114,12 @@ def run_headless(station: str, duration: float | None, every: float) -> int:
 
     previous = {s: signal.signal(s, on_signal) for s in (signal.SIGINT, signal.SIGTERM)}
     try:
-        runtime.start()
+        try:
+            runtime.start()
+        except StartError as e:
+            for problem in e.problems:
+                print(problem, file=sys.stderr)
+            return 2
         print(f"station {runtime.station.name} started: {runtime.station.path}", flush=True)
         started = time.monotonic()
         while not done.is_set():

@@ -37,7 +37,7 @@ def test_numbers_and_mnemonics_take_the_documented_parameter_kinds() -> None:
     ("line", "message"),
     [
         ("FON C:$02100 N:NREAD S:$04000 D:$04000 R:2", "S: a constant is needed here"),
-        ("FON C:$02100 N:NWRITE S:$04000 D:4009 R:2", "D: '4009' is not a octal number"),
+        ("FON C:$02100 N:NWRITE S:$04000 D:4009 R:2", "D: '4009' is not an octal number"),
         ("FON C:$02100 N:NODE S:x", "S: 'x' is not a decimal number"),
         ("FON C:$02100 N:NODE S:1 D:2", "NODE takes no D: parameter"),
     ],
