@@ -144,10 +144,9 @@ class ElementWidget(QWidget):
         """What the cached layer (background, frame, `paint_static`) depends on."""
         return ()
 
-    def draw(self, p: QPainter) -> None:
-        """Draw the element with its top-left corner at the painter's origin."""
+    def draw(self, p: QPainter, r: QRectF) -> None:
+        """Draw the element into `r`, its own rectangle, with its top-left corner at the origin."""
         p.drawPixmap(0, 0, self.layer())
-        r = QRectF(0, 0, self.width(), self.height())
         self.paint_dynamic(p, r)
         if self.model.stale:
             paint_stale(p, r)

@@ -68,6 +68,9 @@ class FormView(QWidget):
                 self.trends.append(widget)
             if not isinstance(widget, SelfPainted):
                 self.painted.append(widget)
+        # where each painted element goes, worked out once: the paint loop runs 200 times a tick
+        self._slots = [(w, w.geometry(), QTransform.fromTranslate(w.x(), w.y()), QRectF(w.rect()))
+                       for w in self.painted]
         start = clock()
         for i, w in enumerate(self.trends):  # stagger the redraw turns over one interval
             w.next_flush = start + REDRAW_INTERVAL * i / max(len(self.trends), 1)
@@ -135,14 +138,13 @@ class FormView(QWidget):
                 draw_pixmap(p, self.images.get(self.form.BackgroundImage), QRectF(self.rect()), "Stretch")
             region = event.region()
             p.setRenderHint(QPainter.RenderHint.Antialiasing)
-            for widget in self.painted:  # each render sets the pens, brushes and fonts it uses
-                geometry = widget.geometry()
+            for widget, geometry, at, rect in self._slots:  # each sets the pens, fonts... it uses
                 if not region.intersects(geometry):
                     continue
-                p.setTransform(QTransform.fromTranslate(geometry.x(), geometry.y()))
-                p.setClipRect(0, 0, geometry.width(), geometry.height())
+                p.setTransform(at)
+                p.setClipRect(rect)
                 try:
-                    widget.draw(p)
+                    widget.draw(p, rect)
                 except Exception as e:
                     self._fault(widget.model, e, "drawing")
         finally:

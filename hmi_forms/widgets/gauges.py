@@ -70,6 +70,7 @@ class GaugeWidget(ElementWidget):
         self._dial: tuple[QPointF, float, float, float] = (QPointF(), 0.0, 0.0, 0.0)
         self._box: tuple[QRectF, float] = (QRectF(), 0.0)
         self._digital: tuple[QRectF, float, float] = (QRectF(), 0.0, 0.0)
+        self._needle = QPolygonF()  # pointing at 3 o'clock from the centre; the painter turns it
         self._travel = 0.0  # pixels the pointer (needle tip, bar end) travels over the whole scale
         self._shown: tuple[object, ...] | None = None
         units = f" {model.Units}" if model.Units else ""
@@ -95,6 +96,8 @@ class GaugeWidget(ElementWidget):
             elif appearance != "digital":
                 _, r, _, sweep = self._dial
                 self._travel = abs(math.radians(sweep)) * r  # the maximum mark's outer corner
+                self._needle = QPolygonF([QPointF(0.8 * r, 0), QPointF(0, 0.045 * r),
+                                          QPointF(-0.12 * r, 0), QPointF(0, -0.045 * r)])
 
     def resizeEvent(self, event: QResizeEvent) -> None:
         self._laid_out = False
@@ -306,14 +309,13 @@ class GaugeWidget(ElementWidget):
         p.drawText(box, Qt.AlignmentFlag.AlignCenter, m.text or "---")
         if m.hw is None:
             return
-        a = math.radians(start + sweep * m.fraction)
-        dx, dy = math.cos(a) * r, -math.sin(a) * r
-        cx, cy = c.x(), c.y()
+        at = p.transform()
+        p.translate(c)
+        p.rotate(-(start + sweep * m.fraction))  # the needle is laid out pointing at 3 o'clock
         p.setPen(Qt.PenStyle.NoPen)  # filled only: a stroke would double the rasterising
         p.setBrush(theme.ACCENT)
-        p.drawPolygon(QPolygonF([
-            QPointF(cx + 0.8 * dx, cy + 0.8 * dy), QPointF(cx - 0.045 * dy, cy + 0.045 * dx),
-            QPointF(cx - 0.12 * dx, cy - 0.12 * dy), QPointF(cx + 0.045 * dy, cy - 0.045 * dx)]))
+        p.drawPolygon(self._needle)
+        p.setTransform(at)
         p.setBrush(HUB)
         hub = r * 0.07
         p.drawEllipse(c, hub, hub)

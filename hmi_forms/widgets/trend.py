@@ -31,6 +31,24 @@ def _pen_color(color: Color | None) -> QColor:
     return theme.qcolor(color, theme.ACCENT)
 
 
+def extent(points: int, lo: float, hi: float) -> QRectF:
+    """The data rectangle of a trend of `points` samples ending at x = 0, with room for the pen."""
+    pad_x, pad_y = points * 0.05, (hi - lo) * 0.05
+    return QRectF(-(points - 1) - pad_x, lo - pad_y, points - 1 + 2 * pad_x, hi - lo + 2 * pad_y)
+
+
+class FixedCurve(pg.PlotCurveItem):
+    """A curve whose extent is the plot's fixed range: pyqtgraph would otherwise measure the data
+    (with pixel padding) after every setData, for nothing, since the view never rescales to it."""
+
+    def __init__(self, extent: QRectF, **opts: object) -> None:
+        super().__init__(**opts)
+        self.extent = extent
+
+    def boundingRect(self) -> QRectF:
+        return self.extent
+
+
 class TrendWidget(SelfPainted):
     model: Graph | AnalogBase
 
@@ -57,10 +75,11 @@ class TrendWidget(SelfPainted):
         item.getAxis("bottom").setTickSpacing(major=model.LabelInt, minor=max(1, model.LabelInt / 5))
         pen = pg.mkPen(_pen_color(model.Colors), width=model.LineWidth)
         if isinstance(model, Graph):
-            item.setYRange(-0.15, 1.15, padding=0)
+            lo, hi = -0.15, 1.15
+            item.setYRange(lo, hi, padding=0)
             item.getAxis("left").setTicks([[(0, "0"), (1, "1")]])
             item.getAxis("left").setWidth(18)
-            self.curve = pg.PlotCurveItem(pen=pen, stepMode="left", connect="finite")
+            self.curve = FixedCurve(extent(n, lo, hi), pen=pen, stepMode="left", connect="finite")
         else:
             lo, hi = model.scaling.phy_range
             item.setYRange(lo, hi, padding=0.04)
@@ -69,7 +88,7 @@ class TrendWidget(SelfPainted):
                 if limit is not None:
                     pen_limit = pg.mkPen(color, style=Qt.PenStyle.DashLine)
                     item.addItem(pg.InfiniteLine(limit, angle=0, pen=pen_limit))
-            self.curve = pg.PlotCurveItem(pen=pen, connect="finite")
+            self.curve = FixedCurve(extent(n, lo, hi), pen=pen, connect="finite")
         item.addItem(self.curve)
         for name in ("left", "bottom"):  # fixed ranges: axes and grid are blitted, not re-stroked
             item.getAxis(name).setCacheMode(QGraphicsItem.CacheMode.DeviceCoordinateCache)
