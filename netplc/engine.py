@@ -151,7 +151,15 @@ class Engine:
         fon, spec = self.fons[index]
         if spec is None or spec.hardware:
             return fail
-        return bind(spec.run, self.mem, fon)
+        try:
+            return bind(spec.run, self.mem, fon)
+        except Exception as e:  # a builder bug: fail when the function runs, as the interpreter does
+            error = e
+
+            def broken(ctx: object) -> None:
+                raise error
+
+            return broken
 
     def fon_failed(self, index: int, e: Exception) -> None:
         fon, spec = self.fons[index]

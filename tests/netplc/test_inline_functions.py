@@ -13,10 +13,13 @@ import random
 
 import pytest
 
+from netplc.address import FERR1
 from netplc.compiler import generate_source
 from netplc.engine import Engine, FakeClock
-from netplc.functions.registry import REGISTRY, lookup
+from netplc.functions._util import built
+from netplc.functions.registry import BY_NAME, REGISTRY, FunctionSpec, lookup
 from netplc.program import parse
+from netplc.records import ListSink
 
 lookup(0)  # imports every function module
 INLINED = sorted((s for s in REGISTRY.values() if s.inline is not None), key=lambda s: s.number)
@@ -76,3 +79,23 @@ def test_data_operands_are_inlined_and_io_operands_called():
     assert list(inline) == [1]  # the one on I/O bits 02000-02017 is called
     source = generate_source(program, inline)
     assert "fon3 = steps[3]" in source and "fon1" not in source
+
+
+@pytest.mark.parametrize("compiled", [True, False], ids=["compiled", "reference"])
+def test_a_builder_that_raises_fails_when_its_fon_runs(compiled, monkeypatch):
+    def build(mem, fon):
+        raise RuntimeError("bad table")
+
+    spec = FunctionSpec(4247, "BROKEN", "M", None, None, built(build))
+    monkeypatch.setitem(REGISTRY, 4247, spec)
+    monkeypatch.setitem(BY_NAME, "BROKEN", spec)
+    program = parse("TNA $02000\nFON C:$03000 N:BROKEN S:$04000\n")
+    sink = ListSink()
+    engine = Engine(program, clock=FakeClock(), wallclock=lambda: 0.0, sink=sink, compiled=compiled)
+    engine.scan()
+    assert engine.mem.bits[FERR1] == 0 and not sink.records  # loading does not run it
+    engine.mem.bits[0o2000] = 1
+    engine.scan()
+    engine.scan()
+    assert engine.mem.bits[FERR1] == 1 and engine.mem.bits[0o3000] == 1
+    assert [r.text for r in sink.records] == ["FON BROKEN at line 2: RuntimeError: bad table"]
