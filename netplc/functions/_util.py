@@ -33,35 +33,34 @@ def fail(ctx: FonContext) -> None:
     ctx.mem.bits[FERR1] = 1
 
 
-class Built:
-    """A FON run function made from a builder: builds once per instruction and memory.
-
-    The reference interpreter calls it like any run function; the compiled engine takes `build`
-    and binds the step itself, once at load time (`bind`), so a scan skips this layer.
-    """
-
-    def __init__(self, build: Builder) -> None:
-        self.build = build
-        self.__doc__ = build.__doc__
-        self.__name__ = build.__name__
-
-    def __call__(self, ctx: FonContext, fon: Fon) -> None:
-        mem = ctx.mem
-        cached = fon.state.get("_step")
-        if cached is None or cached[0] is not mem:
-            cached = fon.state["_step"] = (mem, _build(self.build, mem, fon))
-        cached[1](ctx)
+_BUILDERS: dict[Run, Builder] = {}  # run function -> the builder it was made from, for `bind`
 
 
 def built(build: Builder) -> Run:
-    """Turn a builder into a FON run function that builds once per instruction and memory."""
-    return Built(build)
+    """Turn a builder into a FON run function that builds once per instruction and memory.
+
+    The reference interpreter calls that function; the compiled engine binds the step itself, once
+    at load time (`bind`), so a scan skips this layer.
+    """
+
+    def run(ctx: FonContext, fon: Fon) -> None:
+        mem = ctx.mem
+        cached = fon.state.get("_step")
+        if cached is None or cached[0] is not mem:
+            cached = fon.state["_step"] = (mem, _build(build, mem, fon))
+        cached[1](ctx)
+
+    run.__doc__ = build.__doc__
+    run.__name__ = build.__name__
+    _BUILDERS[run] = build
+    return run
 
 
 def bind(run: Run, mem: Memory, fon: Fon) -> Step:
     """The step that runs `fon` on `mem`: the built step itself, or a call of a plain run function."""
-    if isinstance(run, Built):
-        return _build(run.build, mem, fon)
+    build = _BUILDERS.get(run)
+    if build is not None:
+        return _build(build, mem, fon)
     return lambda ctx: run(ctx, fon)
 
 
