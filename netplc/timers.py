@@ -1,8 +1,9 @@
 """TIM and CTR semantics, the timer time base and the square-wave generators (DESIGN section 4).
 
-Each TIM/CTR instruction gets one closure bound to its coil address and preset; the compiled
-program calls it directly and the reference interpreter reaches the same closure through the
-engine, so the two can differ only in how they evaluate contacts and jumps. Current values are
+Each TIM/CTR instruction gets one closure bound to its coil address and preset, which the reference
+interpreter calls through the engine; the compiled program runs the same semantics written out as
+source lines (`tim_lines`, `ctr_lines`, kept here beside the closures), and the equivalence tests
+hold the two to identical memory and current values. Current values are
 hidden state keyed by the coil address C (the manual exposes them nowhere), so they survive a
 program reload and can be made retentive.
 """
