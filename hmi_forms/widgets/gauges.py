@@ -238,14 +238,22 @@ class GaugeWidget(ElementWidget):
         p.setPen(QPen(theme.TEXT, max(1.3, r * 0.025), Qt.PenStyle.SolidLine, Qt.PenCapStyle.FlatCap))
         font = theme.sized_font(max(8.0, r * 0.14))
         p.setFont(font)
+        metrics = QFontMetricsF(font)
         for v in majors:
             a = start + sweep * m.scaling.fraction(v)
             p.drawLine(self._at(c, r * 0.88, a), self._at(c, r * 0.74, a))
             if small:
                 continue
-            label_at = self._at(c, r * 0.58, a)
-            box = QRectF(label_at.x() - r * 0.3, label_at.y() - r * 0.1, r * 0.6, r * 0.2)
-            p.drawText(box, Qt.AlignmentFlag.AlignCenter, f"{v:.{decimals}f}")
+            # each label keeps the same gap to its tick whatever its width: a wide "-50" or "100"
+            # at the ends of the scale moves inwards instead of running into the tick and the band
+            text = f"{v:.{decimals}f}"
+            w, h = metrics.horizontalAdvance(text), metrics.capHeight()
+            rad = math.radians(a)
+            reach = abs(math.cos(rad)) * w / 2 + abs(math.sin(rad)) * h / 2
+            label_at = self._at(c, r * 0.68 - reach, a)
+            lh = metrics.height()
+            box = QRectF(label_at.x() - w / 2 - 2, label_at.y() - lh / 2, w + 4, lh)
+            p.drawText(box, Qt.AlignmentFlag.AlignCenter, text)
         if m.Units and not small:
             p.setPen(theme.TEXT_DIM)
             p.setFont(theme.sized_font(max(8.0, r * 0.13)))
@@ -289,7 +297,7 @@ class GaugeWidget(ElementWidget):
             return QRectF(c.x() - r * 0.8, c.y() + r * 0.38, r * 1.6, size * 1.35), size
         size = max(9.0, r * 0.2)
         if sweep == -270.0:  # in the gap at the bottom, clear of the end labels
-            return QRectF(c.x() - r * 0.36, c.y() + r * 0.54, r * 0.72, size * 1.45), size
+            return QRectF(c.x() - r * 0.36, c.y() + r * 0.6, r * 0.72, size * 1.45), size
         top = c.y() + max(6.0, r * 0.1)  # below the centre, in the strip the layout keeps free
         height = min(size * 1.5, self.height() - top - 4)
         return QRectF(c.x() - r * 0.45, top, r * 0.9, height), height / 1.5
