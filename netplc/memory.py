@@ -1,7 +1,10 @@
 """NetPlc memory: 2048 I/O bits and 16 KB of data in eight banks, plus immutable snapshots.
 
-I/O bits are kept one per byte (0 or 1) because contacts and coils are by far the most frequent
-operations and the compiled program then touches them with a plain index. Byte and word operands
+I/O bits are kept one per element of a Python list because contacts and coils are by far the most
+frequent operations: the compiled program touches them with a plain index, and indexing a list
+costs about half what indexing a bytearray does in CPython 3.11. An element is 0/1 or False/True
+(the compiled program stores comparison results as they are); the read API and snapshots always
+give 0 or 1. Byte and word operands
 below 04000 are assembled from 8 or 16 consecutive bits (bit A+k is bit k of the value).
 Words are little-endian; 32-bit values are low word first (DESIGN section 3).
 """
@@ -25,13 +28,13 @@ from netplc.address import (
 class MemoryView:
     """Read access shared by the live memory and its snapshots."""
 
-    bits: bytes | bytearray
+    bits: bytes | bytearray | list[int]
     data: bytes | bytearray
 
     def get_bit(self, addr: int) -> int:
         if not 0 <= addr < IO_BITS:
             raise AddressError(f"{fmt_octal(addr)} is not an I/O bit")
-        return self.bits[addr]
+        return 1 if self.bits[addr] else 0  # the compiled program may store True/False
 
     def read(self, addr: int, n: int) -> bytes:
         """`n` bytes starting at operand address `addr` (I/O bits or data)."""
@@ -68,7 +71,7 @@ class MemoryView:
     def get_hmi_bit(self, ref: BitRef | int) -> int:
         hmi = ref.hmi if isinstance(ref, BitRef) else ref
         if hmi < IO_BITS:
-            return self.bits[hmi]
+            return 1 if self.bits[hmi] else 0
         if hmi < HMI_DATA_BIT_BASE:
             raise AddressError(f"{fmt_octal(hmi)} is not an HMI bit address")
         return (self.data[data_index(hmi >> 3)] >> (hmi & 7)) & 1
@@ -78,7 +81,7 @@ class Memory(MemoryView):
     """The live memory. Only the engine thread writes it (DESIGN section 1)."""
 
     def __init__(self) -> None:
-        self.bits = bytearray(IO_BITS)
+        self.bits: list[int] = [0] * IO_BITS
         self.data = bytearray(DATA_SIZE)
 
     def set_bit(self, addr: int, value: int) -> None:
