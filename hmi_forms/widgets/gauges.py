@@ -1,8 +1,9 @@
 """AnalogBase gauges painted with QPainter: digital readout, horizontal bar, dial and semicircular dial.
 
 The scale (face, zone bands, ticks, labels, name) does not change while the form runs, so it is
-painted once per size into a pixmap; a tick then only draws the pointer and the readout. That
-keeps a form of a hundred dials well inside the update budget. Sizes of text and strokes follow
+painted once per size into a pixmap; a tick then only draws the pointer and the readout, and a
+gauge whose texts are unchanged and whose pointers moved less than a pixel is not repainted at
+all. That keeps a form of a hundred dials well inside the update budget. Sizes of text and strokes follow
 the element's size, so a gauge stays legible from a 90-pixel tile to a full panel.
 """
 

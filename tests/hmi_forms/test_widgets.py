@@ -266,3 +266,21 @@ def test_a_failing_element_is_reported_and_the_others_go_on(qtbot, tmp_path) -> 
     assert len(view.errors) == 1 and 'element "A": update failed' in view.errors[0]
     assert form.elements[0].stale and form.elements[1].value == 0
     assert not view.grab().isNull()
+
+
+def test_a_dial_repaints_when_its_text_changes_or_its_needle_moves_a_pixel(qtbot, tmp_path) -> None:
+    form = one(tmp_path, "AnalogBase", w=140, h=140, InAddr="04010", devices=LEVEL, Device="Level",
+               Appearance="dial", Precision=0)
+    view = FormView(form, EngineTarget(engine()[0]))
+    qtbot.addWidget(view)
+    asked: list[object] = []
+    view.update = lambda *rect: asked.append(rect)  # type: ignore[method-assign]
+    view.refresh(snap(words={0o4010: 2048}))
+    assert len(asked) == 1
+    view.refresh(snap(scan=1, words={0o4010: 2049}))  # 50.0 %: same text, the needle moves < 1 px
+    assert len(asked) == 1
+    view.refresh(snap(scan=2, words={0o4010: 2100}))  # 51 %: the text changes
+    assert len(asked) == 2
+    before = image(view, qtbot)
+    view.refresh(snap(scan=3, words={0o4010: 2048}))
+    assert len(asked) == 3 and differs(before, image(view, qtbot)) > 0
