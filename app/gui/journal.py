@@ -13,7 +13,8 @@ from pathlib import Path
 from PySide6.QtCore import Qt, QTimer
 from PySide6.QtWidgets import QCheckBox, QDockWidget, QHBoxLayout, QLabel, QVBoxLayout, QWidget
 
-from hmi_forms.widgets.records import EVENT_KINDS, RecordsModel, records_view
+from hmi_forms.elements.journal import EVENT_KINDS
+from hmi_forms.widgets.records import RecordsModel, records_view
 from registrar.query import Archive, Filter
 
 JOURNAL_ROWS = 500
@@ -54,7 +55,7 @@ class JournalDock(QDockWidget):
         if archive is None:
             self.summary.setText("no archive yet")
             return
-        flt = Filter(kinds=EVENT_KINDS) if self.messages_only.isChecked() else None
+        flt = Filter(kinds=frozenset(EVENT_KINDS)) if self.messages_only.isChecked() else None
         today = dt.date.today()
         try:
             total = archive.count(today, flt)

@@ -15,6 +15,7 @@ from hmi_forms.elements.base import Element
 from netplc.memory import Snapshot
 
 KINDS = ("message", "operator", "system", "data")
+EVENT_KINDS = ("message", "operator", "system")  # what a journal lists by default; data is for plots
 
 
 def kinds(value: Any, ctx: p.Context) -> tuple[str, ...]:
@@ -39,7 +40,7 @@ def optional_int(lo: int, hi: int) -> p.Parser:
 class MessageJournal(Element):
     TYPE = "MessageJournal"
 
-    Kinds: tuple[str, ...] = field(default=("message", "operator", "system"), metadata=p.prop(kinds))
+    Kinds: tuple[str, ...] = field(default=EVENT_KINDS, metadata=p.prop(kinds))
     Group: int | None = field(default=None, metadata=p.prop(optional_int(0, 65535)))
     MinType: int | None = field(default=None, metadata=p.prop(optional_int(0, 3)))
     Rows: int = field(default=500, metadata=p.prop(p.integer(10, 100_000)))

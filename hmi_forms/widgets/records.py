@@ -22,7 +22,6 @@ from netplc.address import fmt_octal
 from registrar.query import Row
 
 TYPE_NAMES = {0: "info", 1: "warning", 2: "alarm", 3: "critical"}
-EVENT_KINDS = frozenset({"message", "operator", "system"})  # what a journal lists; data is for plots
 Index = QModelIndex | QPersistentModelIndex
 
 
