@@ -208,22 +208,26 @@ class Engine:
         """Run `fn(memory)` at the start of the next scan (thread-safe)."""
         self._queue.append(fn)
 
-    def write_bit(self, addr: int | BitRef, value: int, *, user: str = "operator") -> None:
-        """Queue an operator write of an HMI bit address (journaled when applied)."""
+    def write_bit(
+        self, addr: int | BitRef, value: int, *, user: str = "operator", label: str | None = None
+    ) -> None:
+        """Queue an operator write of an HMI bit address (journaled when applied, naming `label`,
+        e.g. the HMI element, so the log reads "write Пуск (040042)" rather than a bare address)."""
         hmi = addr.hmi if isinstance(addr, BitRef) else addr
 
         def apply(mem: Memory) -> None:
             old = mem.get_hmi_bit(hmi)
             mem.set_hmi_bit(hmi, value)
-            self._journal(user, fmt_octal(hmi, 6 if hmi >= 0o40000 else 5), old, 1 if value else 0, hmi)
+            where = fmt_octal(hmi, 6 if hmi >= 0o40000 else 5)
+            self._journal(user, where, old, 1 if value else 0, hmi, label)
 
         self.post(apply)
 
-    def write_word(self, addr: int, value: int, *, user: str = "operator") -> None:
+    def write_word(self, addr: int, value: int, *, user: str = "operator", label: str | None = None) -> None:
         def apply(mem: Memory) -> None:
             old = mem.get_word(addr)
             mem.set_word(addr, value)
-            self._journal(user, fmt_octal(addr), old, value & 0xFFFF, addr)
+            self._journal(user, fmt_octal(addr), old, value & 0xFFFF, addr, label)
 
         self.post(apply)
 
@@ -235,8 +239,11 @@ class Engine:
 
         self.post(apply)
 
-    def _journal(self, user: str, where: str, old: object, new: object, addr: int) -> None:
+    def _journal(self, user: str, where: str, old: object, new: object, addr: int,
+                 label: str | None = None) -> None:
         value = float(new) if isinstance(new, int) else None
+        if label:
+            where = f"{label} ({where})"
         self.sink.put(
             Record(self.wall_time(), "operator", source=user, number=addr, value=value,
                    text=f"write {where}: {old} -> {new}")

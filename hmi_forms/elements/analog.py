@@ -220,5 +220,5 @@ class AnalogOutput(Scaled):
         hw = self.scaling.to_hw(phy)
         assert self.OutAddr is not None
         if self.target is not None:
-            self.target.write_word(self.OutAddr, hw, user=self.user)
+            self.target.write_word(self.OutAddr, hw, user=self.user, label=self.Name)
         return True, f"Set to {self.format(self.scaling.to_phy(hw))}{units}"

@@ -74,7 +74,7 @@ class DiscreteBase(Element):
             return False
         out = self.OutAddr or self.InAddr
         assert out is not None
-        self.target.write_bit(out.hmi, 0 if self.value else 1, user=self.user)
+        self.target.write_bit(out.hmi, 0 if self.value else 1, user=self.user, label=self.Name)
         return True
 
 

@@ -18,9 +18,9 @@ if TYPE_CHECKING:
 
 
 class Target(Protocol):
-    def write_bit(self, addr: int, value: int, *, user: str) -> None: ...
+    def write_bit(self, addr: int, value: int, *, user: str, label: str | None = None) -> None: ...
 
-    def write_word(self, addr: int, value: int, *, user: str) -> None: ...
+    def write_word(self, addr: int, value: int, *, user: str, label: str | None = None) -> None: ...
 
     def set_bit(self, addr: int, value: int) -> None: ...
 
@@ -35,11 +35,11 @@ class EngineTarget:
         self.engine = engine
         self.sink = sink
 
-    def write_bit(self, addr: int, value: int, *, user: str) -> None:
-        self.engine.write_bit(addr, value, user=user)
+    def write_bit(self, addr: int, value: int, *, user: str, label: str | None = None) -> None:
+        self.engine.write_bit(addr, value, user=user, label=label)
 
-    def write_word(self, addr: int, value: int, *, user: str) -> None:
-        self.engine.write_word(addr, value, user=user)
+    def write_word(self, addr: int, value: int, *, user: str, label: str | None = None) -> None:
+        self.engine.write_word(addr, value, user=user, label=label)
 
     def set_bit(self, addr: int, value: int) -> None:
         def apply(mem: Memory) -> None:
@@ -59,10 +59,10 @@ class EngineTarget:
 class NullTarget:
     """A form shown without a station (the viewer, a screenshot): writes go nowhere."""
 
-    def write_bit(self, addr: int, value: int, *, user: str) -> None:
+    def write_bit(self, addr: int, value: int, *, user: str, label: str | None = None) -> None:
         pass
 
-    def write_word(self, addr: int, value: int, *, user: str) -> None:
+    def write_word(self, addr: int, value: int, *, user: str, label: str | None = None) -> None:
         pass
 
     def set_bit(self, addr: int, value: int) -> None:

@@ -29,10 +29,10 @@ class ListTarget:
         self.writes: list[tuple[str, int, int, str | None]] = []
         self.records: list[Record] = []
 
-    def write_bit(self, addr: int, value: int, *, user: str) -> None:
+    def write_bit(self, addr: int, value: int, *, user: str, label: str | None = None) -> None:
         self.writes.append(("bit", addr, value, user))
 
-    def write_word(self, addr: int, value: int, *, user: str) -> None:
+    def write_word(self, addr: int, value: int, *, user: str, label: str | None = None) -> None:
         self.writes.append(("word", addr, value, user))
 
     def set_bit(self, addr: int, value: int) -> None:

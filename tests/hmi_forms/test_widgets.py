@@ -145,7 +145,9 @@ def test_click_on_an_enabled_discrete_toggles_the_bit_through_the_scan(qtbot, tm
     view.refresh(eng.scan())
     assert eng.snapshot.get_hmi_bit(0o40042) == 0
     assert [(r.kind, r.source, r.text) for r in sink.records] == [
-        ("operator", "ivanov", "write 040042: 0 -> 1"), ("operator", "ivanov", "write 040042: 1 -> 0")]
+        ("operator", "ivanov", "write Пуск (040042): 0 -> 1"),
+        ("operator", "ivanov", "write Пуск (040042): 1 -> 0"),
+    ]
     qtbot.mouseClick(lamp, Qt.MouseButton.LeftButton)
     view.refresh(eng.scan())
     assert eng.snapshot.get_hmi_bit(0o2120) == 0 and len(sink.records) == 2
