@@ -103,18 +103,20 @@ def main(argv: list[str] | None = None) -> int:
 
 
 def _play_operator(runtime: Runtime, wait: Callable[[float], None], seconds: float) -> None:
-    """A few minutes of a shift, compressed: what makes the forms and the journal worth looking at."""
+    """A few minutes of a shift, compressed: what makes the forms and the journal worth looking at.
+    The writes name the form elements an operator would have used, as their clicks do."""
     engine = runtime.engine
     node = runtime.simulators[0].engine
-    engine.write_word(SETPOINT, 2867, user="operator")  # 70 %: the temperature starts to follow
-    engine.write_bit(PUMP_IND, 1, user="operator")
+    # 70 %: the temperature starts to follow
+    engine.write_word(SETPOINT, 2867, user="operator", label="Уставка температуры")
+    engine.write_bit(PUMP_IND, 1, user="operator", label="Индикация насоса")
     wait(1.0)
-    engine.write_bit(PUMP, 1, user="operator")
+    engine.write_bit(PUMP, 1, user="operator", label="Насос")
     node.write_word(LEVEL, 3300)  # the tank is nearly full: the level alarm comes during the run
     start = time.monotonic()
     pressed = 0
     while time.monotonic() - start < seconds:
-        engine.write_bit(START_BIT, 1 - pressed % 2, user="operator")
+        engine.write_bit(START_BIT, 1 - pressed % 2, user="operator", label="Пуск")
         pressed += 1
         wait(1.2)
 
