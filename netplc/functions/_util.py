@@ -237,6 +237,15 @@ def data_at(addr: int | None, n: int) -> int | None:
     return data_index(addr)
 
 
+def sdr_data_at(fon: Fon, n: int, flags: int) -> tuple[int, int, int, list[int]] | None:
+    """Data indexes of the `n`-byte operands S, D and R and the `flags` output bits of a
+    three-operand function (ADD, SUB, AND, OR, XOR), or None when any of them cannot be inlined."""
+    i, j, k, bits = data_at(fon.s, n), data_at(fon.d, n), data_at(fon.r, n), flag_bits(fon, flags)
+    if i is None or j is None or k is None or bits is None:
+        return None
+    return i, j, k, bits
+
+
 # The compiled program also sees the data array as native 16-bit words `w` (w[k] = bytes 2k, 2k+1):
 # one subscript instead of two for a word at an even index, on a little-endian machine.
 _WORDS = sys.byteorder == "little"

@@ -20,6 +20,7 @@ from netplc.functions._util import (
     data_at,
     fail,
     flag_bits,
+    sdr_data_at,
     word_get,
     word_set,
     word_src,
@@ -194,9 +195,10 @@ def _bin_arith(subtract: bool) -> Builder:
 
 def _bin_arith_inline(subtract: bool) -> Inline:
     def inline(fon: Fon) -> list[str] | None:
-        i, j, k, flags = data_at(fon.s, 2), data_at(fon.d, 2), data_at(fon.r, 2), flag_bits(fon, 2)
-        if i is None or j is None or k is None or flags is None:
+        ops = sdr_data_at(fon, 2, 2)
+        if ops is None:
             return None
+        i, j, k, flags = ops
         c1, c2 = flags
         return [f"_t = {word_src(i)} {'-' if subtract else '+'} {word_src(j)}", "_v = _t & 65535",
                 *word_store(k, "_v"), f"b[{c1}] = _t != _v", f"b[{c2}] = _v == 0"]

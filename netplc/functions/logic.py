@@ -14,6 +14,7 @@ from netplc.functions._util import (
     data_at,
     fail,
     flag_bits,
+    sdr_data_at,
     word_get,
     word_set,
     word_src,
@@ -64,9 +65,10 @@ def _byte_logic(op: Callable[[int, int], int]) -> Builder:
 
 def _byte_logic_inline(symbol: str) -> Inline:
     def inline(fon: Fon) -> list[str] | None:
-        i, j, k, flags = data_at(fon.s, 1), data_at(fon.d, 1), data_at(fon.r, 1), flag_bits(fon, 1)
-        if i is None or j is None or k is None or flags is None:
+        ops = sdr_data_at(fon, 1, 1)
+        if ops is None:
             return None
+        i, j, k, flags = ops
         return [f"_v = d[{i}] {symbol} d[{j}]", f"d[{k}] = _v", f"b[{flags[0]}] = _v == 0"]
 
     return inline
