@@ -270,15 +270,23 @@ def _ranges(r: _Reader, ranges: list[Any]) -> tuple[tuple[int, int], ...]:
     return tuple(out)
 
 
+def _array_tables(problems: list[str], fname: str, items: list[Any], key: str) -> list[tuple[int, _Reader]]:
+    """A reader for each table of an array of tables ([[nodes]], [[simulators]]); an item that is
+    not a table is a problem naming its index."""
+    readers = []
+    for i, table in enumerate(items):
+        if isinstance(table, dict):
+            readers.append((i, _Reader(problems, fname, table, f"{key}[{i}].")))
+        else:
+            problems.append(f"{fname}: {key}[{i}]: expected a [[{key}]] table")
+    return readers
+
+
 def _nodes(problems: list[str], fname: str, items: list[Any]) -> list[NodeSettings]:
     nodes: list[NodeSettings] = []
     seen: set[int] = set()
     lines: dict[str, tuple[int, Endpoint]] = {}  # serial device -> the first node on it
-    for i, table in enumerate(items):
-        if not isinstance(table, dict):
-            problems.append(f"{fname}: nodes[{i}]: expected a [[nodes]] table")
-            continue
-        r = _Reader(problems, fname, table, f"nodes[{i}].")
+    for i, r in _array_tables(problems, fname, items, "nodes"):
         node = r.number("node", -1, 0, 255, required=True)
         endpoint = r.get("endpoint", str, "")
         unit = r.number("unit", 1, 0, 247)
@@ -326,11 +334,7 @@ def _seconds(r: _Reader, key: str, default: float, lo: float, hi: float) -> floa
 
 def _simulators(problems: list[str], fname: str, items: list[Any], base: Path) -> list[SimulatorSettings]:
     sims: list[SimulatorSettings] = []
-    for i, table in enumerate(items):
-        if not isinstance(table, dict):
-            problems.append(f"{fname}: simulators[{i}]: expected a [[simulators]] table")
-            continue
-        r = _Reader(problems, fname, table, f"simulators[{i}].")
+    for _i, r in _array_tables(problems, fname, items, "simulators"):
         node = r.number("node", -1, 0, 255, required=True)
         program = r.path("program", base, required=True)
         symbols = r.path("symbols", base)
