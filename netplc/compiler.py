@@ -14,6 +14,7 @@ tests hold the two to identical memory.
 
 from __future__ import annotations
 
+import re
 from collections.abc import Callable
 from typing import TYPE_CHECKING
 
@@ -26,10 +27,11 @@ if TYPE_CHECKING:
 HALT = -1
 _MAX_DEPTH = 24  # nested and/or groups before the state is stored in a and s (parser limits)
 _MAX_TERMS = 200  # contacts in one expression before the same
-# A long block is cut into functions of about this many lines, between instructions where no chain
-# state is pending: CPython runs a long function's code noticeably slower (its constants and jumps
-# outgrow one-byte arguments), and a call per chunk costs less than that.
-_CHUNK_LINES = 60
+# A long block is cut into functions of at most about this many distinct constants, between
+# instructions where no chain state is pending: beyond 256 constants CPython needs an EXTENDED_ARG
+# before every LOAD_CONST of the rest, which costs more than a call per chunk.
+_CHUNK_CONSTS = 200
+_CONST = re.compile(r"(?<![\w.])\d+(?:\.\d*)?(?:e-?\d+)?")
 
 
 def _block_starts(instrs: list[Instr]) -> list[int]:
@@ -105,6 +107,8 @@ class _Block:
         self.inline = inline  # FON index -> the function's source lines
         self.quotient = False  # _q holds the TIM time-base quotient (see netplc/timers.py)
         self.cuts = [0]  # line indices where chunks start
+        self.consts: set[str] = set()  # the constants of the current chunk
+        self.counted = 0  # lines whose constants are in self.consts
         self.lines: list[str] = []
         self.acc, self.sm = _Expr("a"), _Expr("s")
         self.ended = False  # the last line returns
@@ -180,9 +184,13 @@ class _Block:
 
     def maybe_cut(self) -> None:
         """Start a new chunk here if the current one is long and no chain state is pending."""
+        for line in self.lines[self.counted:]:
+            self.consts.update(_CONST.findall(line))
+        self.counted = len(self.lines)
         if (self.acc is ONE and self.sm is ZERO and not self.ended
-                and len(self.lines) - self.cuts[-1] >= _CHUNK_LINES):
+                and len(self.consts) >= _CHUNK_CONSTS):
             self.cuts.append(len(self.lines))
+            self.consts.clear()
             self.quotient = False  # _q is local to a chunk
 
     def wrote(self, c: int | None, count: int) -> None:

@@ -125,17 +125,17 @@ def programs(draw) -> str:
 
 
 def state(engine: Engine) -> tuple:
-    return (bytes(engine.mem.bits), bytes(engine.mem.data), dict(engine.tim_ticks),
-            dict(engine.ctr_values), engine.state_text, engine.scan_counter)
+    return (bytes(engine.mem.bits), bytes(engine.mem.data), engine.held_values(),
+            engine.state_text, engine.scan_counter)
 
 
 def run_both(text: str, inputs: list[list[int]], dts: list[float], data: bytes = b"") -> None:
     """Scan `text` in the reference interpreter and in the compiled engine (usual and tiny chunks)."""
     program = parse(text, source="random.stl")
     engines = []
-    for compiled, chunk in ((False, 0), (True, compiler._CHUNK_LINES), (True, 3)):
+    for compiled, chunk in ((False, 0), (True, compiler._CHUNK_CONSTS), (True, 3)):
         clock = FakeClock()
-        with mock.patch.object(compiler, "_CHUNK_LINES", chunk):
+        with mock.patch.object(compiler, "_CHUNK_CONSTS", chunk):
             engine = Engine(program, clock=clock, wallclock=lambda: 0.0, compiled=compiled)
         if data:
             engine.mem.write(INITIAL[0], data)
