@@ -11,6 +11,7 @@ control byte returns to 0.
 from __future__ import annotations
 
 import datetime as dt
+import math
 
 from netplc.address import RTC_CONTROL, RTC_FIRST, data_index
 from netplc.memory import Memory
@@ -31,6 +32,10 @@ class Rtc:
     def __init__(self) -> None:
         self.offset = 0.0  # seconds added to the wall clock
         self._setting = False
+        # The BCD bytes of the current second: the clock shows seconds, so the calendar is worked
+        # out once a second rather than every scan (it costs more than the rest of the scan set-up).
+        self._second: int | None = None
+        self._bcd = b""
 
     def update(self, mem: Memory, wall: float) -> None:
         """Called once per scan before the program runs."""
@@ -41,10 +46,13 @@ class Rtc:
         if self._setting:
             self._setting = False
             self._take_setting(data, wall)
-        t = dt.datetime.fromtimestamp(wall + self.offset)
-        fields = (t.second, t.minute, t.hour, t.day, t.month, t.year % 100, (t.weekday() + 1) % 7)
-        for i, v in enumerate(fields):
-            data[_FIRST + i] = to_bcd(v)
+        shown = wall + self.offset
+        if math.floor(shown) != self._second:
+            self._second = math.floor(shown)
+            t = dt.datetime.fromtimestamp(shown)
+            fields = (t.second, t.minute, t.hour, t.day, t.month, t.year % 100, (t.weekday() + 1) % 7)
+            self._bcd = bytes(to_bcd(v) for v in fields)
+        data[_FIRST:_FIRST + len(self._bcd)] = self._bcd
 
     def watch(self, mem: Memory) -> None:
         """Note a setting in progress (control byte non-zero) between the points update() runs."""

@@ -34,6 +34,17 @@ def test_rtc_bytes_follow_the_wall_clock_in_bcd(compiled):
     assert rtc(rig)[:3] == bytes([0x01, 0x10, 0x15])
 
 
+def test_rtc_bytes_change_on_the_second_and_a_program_overwrite_lasts_one_scan():
+    rig = Rig("NOP", wall=WALL + 0.5)  # 15:09:26.5
+    rig.step(0.4)
+    assert rtc(rig)[0] == 0x26
+    rig.engine.mem.set_byte(0o77701, 0x99)  # a program or operator scribbling on the seconds
+    rig.step(0.05)  # 15:09:26.95: the same second, the bytes are rewritten all the same
+    assert rtc(rig)[0] == 0x26
+    rig.step(0.1)  # 15:09:27.05
+    assert rtc(rig)[0] == 0x27
+
+
 def test_setting_over_several_scans_as_documented():
     rig = Rig("NOP", wall=WALL)
     mem = rig.engine.mem
