@@ -18,6 +18,7 @@ from netplc.address import (
     ALWAYS_ONE,
     EMERGENCY_STOP,
     FERR1,
+    IO_BITS,
     TIMEBASE_HI,
     TIMEBASE_LO,
     BitRef,
@@ -98,8 +99,10 @@ class Engine:
         self.state = RunState.RUNNING
         self.stop_code = 0
         self.stats = ScanStats()
-        self.tim_ticks: dict[int, float] = {}  # TIM current values by coil address C
-        self.ctr_values: dict[int, int] = {}  # CTR current values by coil address C
+        # TIM and CTR current values, indexed by coil address C (netplc/timers.py). The compiled
+        # program holds these very lists: change them in place, as restore_values does.
+        self.tim_ticks: list[float] = [0.0] * IO_BITS
+        self.ctr_values: list[int] = [0] * IO_BITS
         self.rtc = Rtc()
         self.listeners: list[Callable[[Snapshot], None]] = []
         self._queue: deque[Callable[[Memory], None]] = deque()
@@ -201,6 +204,24 @@ class Engine:
         if index not in self._faulted:
             self._faulted.add(index)
             self.sink.put(Record(self.wall_time(), "system", source="netplc", text=text))
+
+    def held_values(self) -> tuple[dict[int, float], dict[int, int]]:
+        """The timers' and counters' non-zero current values by coil address (for retentive saves)."""
+        return ({c: v for c, v in enumerate(self.tim_ticks) if v},
+                {c: v for c, v in enumerate(self.ctr_values) if v})
+
+    def restore_values(self, tim: dict[int, float], ctr: dict[int, int]) -> None:
+        """Set every timer and counter current value: those given, the others 0; IndexError for a
+        coil address outside the I/O bits."""
+        for c in (*tim, *ctr):
+            if not 0 <= c < IO_BITS:
+                raise IndexError(f"timer or counter address {c} is not an I/O bit")
+        self.tim_ticks[:] = [0.0] * IO_BITS
+        self.ctr_values[:] = [0] * IO_BITS
+        for c, v in tim.items():
+            self.tim_ticks[c] = v
+        for c, v in ctr.items():
+            self.ctr_values[c] = v
 
     # --- queued writes -------------------------------------------------------------------------
 

@@ -3,8 +3,9 @@
 I/O bits are kept one per element of a Python list because contacts and coils are by far the most
 frequent operations: the compiled program touches them with a plain index, and indexing a list
 costs about half what indexing a bytearray does in CPython 3.11. An element is 0/1 or False/True
-(the compiled program stores comparison results as they are); the read API and snapshots always
-give 0 or 1. Byte and word operands
+(the compiled program stores comparison results as they are); the read API always gives 0 or 1.
+A snapshot keeps the bits as a tuple: copying the list into one costs a third of converting it to
+bytes, and the engine publishes a snapshot after every scan. Byte and word operands
 below 04000 are assembled from 8 or 16 consecutive bits (bit A+k is bit k of the value).
 Words are little-endian; 32-bit values are low word first (DESIGN section 3).
 """
@@ -28,7 +29,7 @@ from netplc.address import (
 class MemoryView:
     """Read access shared by the live memory and its snapshots."""
 
-    bits: bytes | bytearray | list[int]
+    bits: tuple[int, ...] | list[int]  # 0/1 or False/True
     data: bytes | bytearray
 
     def get_bit(self, addr: int) -> int:
@@ -133,7 +134,7 @@ class Memory(MemoryView):
         self.data[i] = (self.data[i] | mask) if value else (self.data[i] & ~mask & 0xFF)
 
     def snapshot(self, scan: int = 0, time: float = 0.0, wall: float = 0.0, state: str = "") -> Snapshot:
-        return Snapshot(bytes(self.bits), bytes(self.data), scan, time, wall, state)
+        return Snapshot(tuple(self.bits), bytes(self.data), scan, time, wall, state)
 
     def load(self, view: MemoryView) -> None:
         """Replace the whole contents (used by retentive restore and tests)."""
@@ -145,7 +146,7 @@ class Memory(MemoryView):
 class Snapshot(MemoryView):
     """The memory as it was after one scan: what HMI, registrar and Modbus reads see."""
 
-    bits: bytes
+    bits: tuple[int, ...]  # 0/1 or False/True: read them through get_bit, or by truth
     data: bytes
     scan: int = 0  # scan counter after the scan that produced it
     time: float = 0.0  # engine clock (monotonic seconds)
@@ -154,4 +155,4 @@ class Snapshot(MemoryView):
 
     @classmethod
     def empty(cls) -> Snapshot:
-        return cls(bytes(IO_BITS), bytes(DATA_SIZE))
+        return cls((0,) * IO_BITS, bytes(DATA_SIZE))

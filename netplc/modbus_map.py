@@ -88,7 +88,7 @@ def _check_bits(address: int, count: int) -> None:
 def read_bits(view: MemoryView, address: int, count: int) -> list[int]:
     """Coils / discrete inputs `address`..+count of a NetPlc or CPU-165 memory."""
     _check_bits(address, count)
-    return list(view.bits[address : address + count])
+    return [1 if v else 0 for v in view.bits[address : address + count]]
 
 
 def read_registers(view: MemoryView, address: int, count: int) -> list[int]:

@@ -17,7 +17,7 @@ import zlib
 from dataclasses import dataclass
 from pathlib import Path
 
-from netplc.address import DATA_SIZE, RETAIN_BITS
+from netplc.address import DATA_SIZE, IO_BITS, RETAIN_BITS
 from netplc.engine import Engine
 from netplc.records import Record, RecordSink
 
@@ -85,10 +85,7 @@ class Retainer:
         mem = engine.mem
         mem.bits[BITS] = saved.bits
         mem.data[:] = saved.data
-        engine.tim_ticks.clear()
-        engine.tim_ticks.update(saved.tim)
-        engine.ctr_values.clear()
-        engine.ctr_values.update(saved.ctr)
+        engine.restore_values(saved.tim, saved.ctr)
         # Publish at once, so that a save before the first scan keeps what was restored.
         engine.snapshot = mem.snapshot(engine.scan_counter, engine.now, engine.wall_time(), engine.state_text)
 
@@ -101,11 +98,11 @@ class Retainer:
         """Write the state of the last published scan; OSError if the disk refuses."""
         engine = self.engine
         snap = engine.snapshot
-        tim, ctr = dict(engine.tim_ticks), dict(engine.ctr_values)
+        tim, ctr = engine.held_values()
         meta = json.dumps({"tim": {str(k): v for k, v in tim.items()},
                            "ctr": {str(k): v for k, v in ctr.items()},
                            "wall": snap.wall, "scan": snap.scan}).encode()
-        payload = snap.bits[BITS] + snap.data + meta
+        payload = bytes(snap.bits[BITS]) + snap.data + meta
         blob = HEADER.pack(MAGIC, VERSION, zlib.crc32(payload), len(payload)) + payload
         with self._lock:
             self.path.parent.mkdir(parents=True, exist_ok=True)
@@ -173,6 +170,8 @@ def read_save(path: Path) -> Saved:
         tim = {int(k): float(v) for k, v in meta["tim"].items()}
         ctr = {int(k): int(v) for k, v in meta["ctr"].items()}
         wall = float(meta["wall"])
+        if any(not 0 <= c < IO_BITS for c in (*tim, *ctr)):
+            raise ValueError("a timer or counter address outside the I/O bits")
     except (ValueError, KeyError, TypeError, AttributeError) as e:
         raise SaveError(f"has unreadable timer and counter values: {e}") from None
     return Saved(payload[:nbits], payload[nbits:nbits + DATA_SIZE], tim, ctr, wall)

@@ -27,7 +27,7 @@ def bit_reader(ref: BitRef) -> Reader:
     """A reader of one bit, with the address decoded once (a form reads hundreds per tick)."""
     hmi = ref.hmi
     if hmi < IO_BITS:
-        return lambda s: s.bits[hmi]
+        return lambda s: 1 if s.bits[hmi] else 0
     i, k = data_index(hmi >> 3), hmi & 7
     return lambda s: (s.data[i] >> k) & 1
 

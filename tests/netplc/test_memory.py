@@ -94,7 +94,7 @@ def test_snapshots_are_immutable_copies():
     m.set_bit(0, 1)
     assert snap.get_word(0o4000) == 0x1234 and snap.get_bit(0) == 0
     assert (snap.scan, snap.time, snap.wall, snap.state) == (3, 1.5, 2.0, "running")
-    assert isinstance(snap.bits, bytes) and isinstance(snap.data, bytes)
+    assert isinstance(snap.bits, tuple) and isinstance(snap.data, bytes)
     with pytest.raises(dataclasses.FrozenInstanceError):
         snap.scan = 4
     with pytest.raises(TypeError):

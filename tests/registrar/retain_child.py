@@ -29,7 +29,7 @@ def main(path: str) -> None:
     retainer = Retainer(path, engine)
 
     def state() -> str:
-        return f"{engine.snapshot.get_word(0o4000)} {engine.ctr_values.get(0o3000, 0)}"
+        return f"{engine.snapshot.get_word(0o4000)} {engine.ctr_values[0o3000]}"
 
     used = retainer.restore()
     print("restored", used, state(), flush=True)

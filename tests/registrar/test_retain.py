@@ -1,7 +1,9 @@
+import zlib
+
 from netplc.engine import Engine, FakeClock
 from netplc.program import parse
 from netplc.records import ListSink
-from registrar.retain import Retainer, read_save
+from registrar.retain import HEADER, MAGIC, VERSION, Retainer, read_save
 
 PROGRAM = "TNA $02000\nCTR C:$03000 N:100\nJMP 0\n"
 
@@ -35,7 +37,7 @@ def test_save_and_restore_the_current_save(tmp_path):
     assert e.mem.get_word(0o4000) == 1234 and e.mem.get_word(0o77776) == 1235
     assert e.mem.get_bit(0o3005) == 1 and e.mem.get_bit(0o3477) == 1
     assert e.mem.get_bit(0o2001) == 0
-    assert e.tim_ticks == {0o2200: 12.5}
+    assert e.held_values()[0] == {0o2200: 12.5}
     assert e.ctr_values[0o3000] == 34
     assert e.snapshot.get_word(0o4000) == 1234  # published before the first scan
     assert texts(e) == ["retentive memory restored from the current save retain.bin"]
@@ -68,9 +70,22 @@ def test_a_truncated_save_and_a_missing_previous_give_zeroes(tmp_path):
     e = engine()
     e.mem.set_word(0o4000, 99)
     assert Retainer(path, e).restore() == "zeroes"
-    assert e.mem.get_word(0o4000) == 0 and e.ctr_values == {}
+    assert e.mem.get_word(0o4000) == 0 and e.held_values() == ({}, {})
     assert texts(e) == ["retentive memory starts from zeroes "
                         "(current save is damaged (length or checksum wrong); previous save is missing)"]
+
+
+def test_a_save_naming_a_timer_outside_the_io_bits_falls_back(tmp_path):
+    path = tmp_path / "retain.bin"
+    r = Retainer(path, filled(3))
+    r.save()
+    r.save()  # the same state as the previous save too
+    payload = path.read_bytes()[HEADER.size:].replace(b'"1152": 12.5', b'"4096": 12.5')
+    path.write_bytes(HEADER.pack(MAGIC, VERSION, zlib.crc32(payload), len(payload)) + payload)
+    e = engine()
+    assert Retainer(path, e).restore() == "previous"
+    assert "outside the I/O bits" in texts(e)[0]
+    assert e.held_values() == ({0o2200: 12.5}, {0o3000: 3})
 
 
 def test_first_start_without_any_save(tmp_path):
