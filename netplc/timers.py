@@ -89,7 +89,7 @@ def tim_lines(c: int, n: int) -> tuple[list[str], list[str]]:
     c1 = c + 1
     on = [f"if b[{c}]:",
           f"    _t = tk[{c}] + _q",
-          f"    if _t > {n}:",
+          f"    if _t > {float(n)!r}:",  # float to float: CPython compares these faster
           f"        _t = {float(n)!r}",
           f"    tk[{c}] = _t",
           f"    b[{c1}] = _t >= {n - _EPS!r}",
