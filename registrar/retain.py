@@ -13,6 +13,7 @@ import json
 import os
 import struct
 import threading
+import time
 import zlib
 from dataclasses import dataclass
 from pathlib import Path
@@ -145,8 +146,11 @@ class Retainer:
         self._save_reporting()
 
     def _loop(self, interval: float) -> None:
-        while not self._stop.wait(interval):
+        """Save on a fixed cadence: a slow fsync must not push every later save back as well."""
+        due = time.monotonic() + interval
+        while not self._stop.wait(max(0.0, due - time.monotonic())):
             self._save_reporting()
+            due = max(due + interval, time.monotonic())
 
 
 def read_save(path: Path) -> Saved:

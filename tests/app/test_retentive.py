@@ -70,7 +70,8 @@ def test_counting_continues_after_sigkill(tmp_path: Path) -> None:
     runtime.start()
     try:
         restored = counter(runtime)
-        # the save is at most a second old: 50 scans of 20 ms, plus the scans since the status line
-        assert scans - 50 <= restored <= scans + 50
+        # the save is at most a second old (50 scans of 20 ms) plus the time one save takes to reach
+        # the disk (its fsync: up to a few hundred ms on a disk busy with the fresh .venv's pages)
+        assert scans - 75 <= restored <= scans + 50
     finally:
         runtime.stop()
