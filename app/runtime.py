@@ -218,7 +218,6 @@ class Runtime:
                 node_programs.append(load_simulated_program(sim.program, sim.symbols))
             except ProgramError as e:
                 problems += [str(d) for d in e.errors]
-        problems += unresolved_hosts(st)
         if problems:
             raise StartError(problems)
         return catalog, program, node_programs
@@ -284,6 +283,15 @@ class Runtime:
         self.started = True
         self.system(f"station started: NetSyncTime {st.NetSyncTime} ms, "
                     f"retentive memory from {self.restored}")
+        threading.Thread(target=self._report_unresolved, name="resolve", daemon=True).start()
+
+    def _report_unresolved(self) -> None:
+        """Journal each node host name that does not resolve, by its key. The station starts all the
+        same: the name server may come up after the PC does, and the exchange keeps trying the node
+        (shown down meanwhile); `check` reports the name as a problem, for the typo it may be."""
+        for text in unresolved_hosts(self.station):
+            if self.started:
+                self.system(f"{text}; the node stays down until it does")
 
     def _fill_endpoint(self, node: int, endpoint: str) -> None:
         self.nodes = [replace(n, endpoint=endpoint) if n.node == node and not n.endpoint else n

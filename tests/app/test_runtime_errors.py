@@ -7,6 +7,8 @@ import socket
 import sqlite3
 import subprocess
 import sys
+import threading
+import time
 from pathlib import Path
 
 import pytest
@@ -15,6 +17,8 @@ from app.check import check_station
 from app.config import load_station
 from app.runtime import Runtime, StartError
 from netplc.modbus_driver import DeviceError, LeanTcpClient, parse_endpoint
+from netplc.program import parse
+from netplc.simulator import Simulator
 from tests.app.conftest import REPO, write_station
 
 SIMULATED = """
@@ -36,7 +40,9 @@ node = 1
 endpoint = "tcp://127.0.0.1:5020"
 [[nodes]]
 node = 2
-endpoint = "tcp://nohost.invalid:502"
+endpoint = "tcp://nohost.invalid:{port}"
+backoff = 0.05
+backoff_max = 0.1
 """
 
 
@@ -95,23 +101,48 @@ def test_a_simulator_port_in_use_names_the_key_and_starts_nothing(tmp_path: Path
     runtime.stop()  # a second stop after a failed start does nothing
 
 
-def test_a_node_host_that_does_not_resolve_is_named_by_its_key(tmp_path: Path, monkeypatch) -> None:
-    # The resolver answers "not found" here: a test sends no query beyond this machine.
+def test_a_node_host_that_does_not_resolve_is_journaled_and_the_node_comes_up_once_it_does(
+        tmp_path: Path, monkeypatch) -> None:
+    # The resolver is this test's: "not found" until the name server is "up", then 127.0.0.1, where
+    # a simulated node listens. No query leaves this machine.
     real = socket.getaddrinfo
+    name_server_up = threading.Event()
 
     def resolve(host, *args, **kwargs):
         if host == "nohost.invalid":
-            raise socket.gaierror(socket.EAI_NONAME, "Name or service not known")
+            if not name_server_up.is_set():
+                raise socket.gaierror(socket.EAI_NONAME, "Name or service not known")
+            host = "127.0.0.1"
         return real(host, *args, **kwargs)
 
     monkeypatch.setattr(socket, "getaddrinfo", resolve)
-    write_station(tmp_path, UNRESOLVABLE)
+    node = Simulator(parse("JMP 0\n"))
+    node.start()
+    write_station(tmp_path, UNRESOLVABLE.format(port=node.port))
     where = f"{tmp_path / 'station.toml'}: nodes[1].endpoint: host 'nohost.invalid' does not resolve"
-    with pytest.raises(StartError) as e:
-        Runtime(load_station(tmp_path))
-    assert len(e.value.problems) == 1 and e.value.problems[0].startswith(where)
     report = check_station(tmp_path)
-    assert [p for p in report.problems if "endpoint" in p] == e.value.problems
+    assert next(p for p in report.problems if "endpoint" in p).startswith(where)
+    runtime = Runtime(load_station(tmp_path))
+    texts: list[str] = []
+    runtime.subscribe(lambda r: texts.append(r.text or "") if r.kind == "system" else None)
+    runtime.start()
+    try:
+        assert wait_for(lambda: any(t.startswith(where) for t in texts))
+        assert [n.up for n in runtime.status().nodes] == [False, False]
+        name_server_up.set()
+        assert wait_for(lambda: runtime.status().nodes[1].up)
+    finally:
+        runtime.stop()
+        node.stop()
+
+
+def wait_for(condition, seconds: float = 15.0) -> bool:
+    deadline = time.monotonic() + seconds
+    while not condition():
+        if time.monotonic() > deadline:
+            return False
+        time.sleep(0.02)
+    return True
 
 
 def test_a_missing_program_file_exits_2_naming_the_key(tmp_path: Path) -> None:
