@@ -26,17 +26,15 @@ from array import array
 from pathlib import Path
 
 os.environ.setdefault("QT_QPA_PLATFORM", "offscreen")
-# The script's own folder comes first on sys.path, and bench/registrar.py would shadow the package.
-sys.path[:] = [p for p in sys.path if Path(p or ".").resolve() != Path(__file__).resolve().parent]
 
-from PySide6.QtWidgets import QApplication  # noqa: E402
+from PySide6.QtWidgets import QApplication
 
-from hmi_forms.elements.target import NullTarget  # noqa: E402
-from hmi_forms.form import load_form  # noqa: E402
-from hmi_forms.widgets.form_view import FormView  # noqa: E402
-from hmi_forms.widgets.trend import REDRAW_INTERVAL  # noqa: E402
-from netplc.engine import FakeClock  # noqa: E402
-from netplc.memory import Memory  # noqa: E402
+from hmi_forms.elements.target import NullTarget
+from hmi_forms.form import load_form
+from hmi_forms.widgets.form_view import FormView
+from hmi_forms.widgets.trend import REDRAW_INTERVAL
+from netplc.engine import FakeClock
+from netplc.memory import Memory
 
 COLS = 20
 TILE = 64

@@ -8,7 +8,7 @@ Then, from fresh read-only opens of that file: the first page of filtered querie
 several opens, open included) and a 10,000-point min/max series of the dense source.
 Targets: >= 100,000 records/s sustained; first filtered page of a 1,000,000-record day < 100 ms.
 
-    .venv/bin/python bench/registrar.py [--records N] [--dir PATH]
+    .venv/bin/python bench/archive.py [--records N] [--dir PATH]
 """
 
 from __future__ import annotations
@@ -16,19 +16,15 @@ from __future__ import annotations
 import argparse
 import datetime as dt
 import statistics
-import sys
 import tempfile
 import threading
 import time
 from pathlib import Path
 
-# This file is bench/registrar.py: its own directory, first on sys.path, would shadow the package.
-sys.path = [p for p in sys.path if Path(p or ".").resolve() != Path(__file__).resolve().parent]
-
-from netplc.records import Record  # noqa: E402
-from registrar.catalog import Catalog, Message  # noqa: E402
-from registrar.query import Archive, Filter  # noqa: E402
-from registrar.store import Store  # noqa: E402
+from netplc.records import Record
+from registrar.catalog import Catalog, Message
+from registrar.query import Archive, Filter
+from registrar.store import Store
 
 DAY = dt.date(2026, 3, 5)
 CATALOG = Catalog({n: Message(n, n % 8, 2 if n % 4 == 0 else n % 2,
@@ -121,7 +117,7 @@ def main() -> None:
             "messages of group 3": Filter(kinds={"message"}, grp=3),
             "text contains 'авария'": Filter(text="авария"),
             "group 99 (no match, key index)": Filter(grp=99),
-            "operator records (none among 1,000,000)": Filter(kinds={"operator"}),
+            f"operator records (none among {args.records:,})": Filter(kinds={"operator"}),
             "text matching nothing (every text of the day read)": Filter(text="нет такого"),
         }
         for label, flt in cases.items():
