@@ -92,6 +92,9 @@ def main(argv: list[str] | None = None) -> int:
         for row in range(min(3, viewer.series_list.count())):
             viewer.check_series(row)
         viewer.tabs.setCurrentIndex(1)
+        deadline = time.monotonic() + 30
+        while viewer.loading and time.monotonic() < deadline:  # the series are read in a thread
+            _pump_events(app, 0.05)
         _pump_events(app, 0.5)
         path = args.out / "viewer-series.png"
         viewer.grab().save(str(path))

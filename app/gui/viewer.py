@@ -38,6 +38,7 @@ from PySide6.QtWidgets import (
 )
 
 from app.config import ConfigError, load_station, station_file
+from app.gui.series_loader import SeriesLoader
 from app.gui.style import apply_style
 from hmi_forms.widgets.records import RecordsModel, records_view
 from registrar.query import Archive, Filter, SeriesKey
@@ -64,6 +65,10 @@ class ViewerWindow(QMainWindow):
         self.offset = 0
         self.total = 0
         self.curves: dict[SeriesKey, pg.PlotDataItem] = {}
+        self.loading: dict[SeriesKey, int] = {}  # series asked for and not yet plotted: their token
+        self.loader = SeriesLoader(SERIES_POINTS, self)
+        self.loader.loaded.connect(self._series_loaded)
+        self.loader.failed.connect(self._series_failed)
         self._build()
         self.resize(1280, 820)
         if archive_path is not None:
@@ -285,6 +290,7 @@ class ViewerWindow(QMainWindow):
         for curve in self.curves.values():
             self.plot.removeItem(curve)
         self.curves.clear()
+        self.loading.clear()
         self.series_list.blockSignals(True)
         self.series_list.clear()
         day = self.day
@@ -303,30 +309,42 @@ class ViewerWindow(QMainWindow):
         key = item.data(Qt.ItemDataRole.UserRole)
         self.show_series(key, item.checkState() == Qt.CheckState.Checked)
 
-    def show_series(self, key: SeriesKey, shown: bool = True) -> pg.PlotDataItem | None:
-        """Plot (or remove) one series of the current day, downsampled to SERIES_POINTS."""
-        if not shown:
-            curve = self.curves.pop(key, None)
-            if curve is not None:
-                self.plot.removeItem(curve)
-            return None
+    def show_series(self, key: SeriesKey, shown: bool = True) -> None:
+        """Plot (or remove) one series of the current day, downsampled to SERIES_POINTS. The read
+        runs in the loader's thread; the curve appears when it is done (see `loading`)."""
+        self.loading.pop(key, None)
+        curve = self.curves.pop(key, None)
+        if curve is not None:
+            self.plot.removeItem(curve)
         day = self.day
-        if self.archive is None or day is None:
-            return None
-        ts, values = self.archive.series(day, grp=key.grp, type=key.type, source=key.source,
-                                         points=SERIES_POINTS)
+        if not shown or self.archive_path is None or day is None:
+            return
+        self.loading[key] = self.loader.request(self.archive_path, day, key)
+        self.statusBar().showMessage(f"reading {series_label(key)}…")
+
+    def _series_loaded(self, token: int, key: SeriesKey, ts: np.ndarray, values: np.ndarray) -> None:
+        if self.loading.get(key) != token:
+            return  # unticked, asked for again, or another day chosen since
+        del self.loading[key]
         color = QColor(PALETTE[len(self.curves) % len(PALETTE)])
-        curve = self.plot.plot(np.asarray(ts, dtype=np.float64), np.asarray(values, dtype=np.float64),
-                               pen=pg.mkPen(color, width=1.5), name=series_label(key), connect="finite")
-        self.curves[key] = curve
+        xs, ys = np.asarray(ts, dtype=np.float64), np.asarray(values, dtype=np.float64)
+        self.curves[key] = self.plot.plot(xs, ys, pen=pg.mkPen(color, width=1.5), name=series_label(key),
+                                          connect="finite")
         self.plot.enableAutoRange()
-        return curve
+        if not self.loading:
+            self.statusBar().showMessage(f"{series_label(key)}: {len(ts)} points", 5000)
+
+    def _series_failed(self, token: int, key: SeriesKey, why: str) -> None:
+        if self.loading.get(key) == token:
+            del self.loading[key]
+            self.statusBar().showMessage(f"{series_label(key)} could not be read: {why}", 10000)
 
     def check_series(self, row: int) -> None:
         """Tick a series in the list (what a click does), for scripts and tests."""
         self.series_list.item(row).setCheckState(Qt.CheckState.Checked)
 
     def closeEvent(self, event) -> None:
+        self.loader.close()
         if self.archive is not None:
             self.archive.close()
             self.archive = None

@@ -38,7 +38,9 @@ def test_viewer_shows_rows_plots_and_exports(qtbot, headless_archive: tuple[Path
     level = labels.index("group 1 / type 1 / 04010")
     viewer.check_series(level)
     viewer.check_series(labels.index("group 1 / type 2 / 04012"))
-    assert len(viewer.curves) == 2
+    assert len(viewer.loading) == 2  # read in the loader's thread, plotted when done
+    qtbot.waitUntil(lambda: len(viewer.curves) == 2, timeout=10_000)
+    assert not viewer.loading
     xs, ys = next(iter(viewer.curves.values())).getData()
     assert len(xs) >= 3 and ys[-1] > ys[0]  # the level rises after a start
     viewer.series_list.item(level).setCheckState(Qt.CheckState.Unchecked)
@@ -51,6 +53,28 @@ def test_viewer_shows_rows_plots_and_exports(qtbot, headless_archive: tuple[Path
     assert n == len(rows) == viewer.total
     assert {r["kind"] for r in rows} == {"message"}
     assert "NetPlc запущен" in {r["text"] for r in rows}
+
+
+def test_a_series_unticked_while_it_loads_is_not_plotted_and_a_failed_read_is_said(
+        qtbot, headless_archive: tuple[Path, str], tmp_path: Path) -> None:
+    copy = tmp_path / "journal.sqlite"
+    shutil.copy(headless_archive[0], copy)
+    viewer = ViewerWindow(copy)
+    qtbot.addWidget(viewer)
+    labels = [viewer.series_list.item(i).text() for i in range(viewer.series_list.count())]
+    first, second = labels.index("group 1 / type 1 / 04010"), labels.index("group 1 / type 2 / 04012")
+    viewer.check_series(first)
+    viewer.series_list.item(first).setCheckState(Qt.CheckState.Unchecked)  # before its answer arrives
+    viewer.check_series(second)
+    qtbot.waitUntil(lambda: not viewer.loading, timeout=10_000)  # one worker: first's answer came first
+    assert [curve.name() for curve in viewer.curves.values()] == ["group 1 / type 2 / 04012"]
+
+    viewer.series_list.item(second).setCheckState(Qt.CheckState.Unchecked)
+    copy.write_bytes(b"not an archive" * 100)
+    viewer.check_series(first)
+    qtbot.waitUntil(lambda: not viewer.loading, timeout=10_000)
+    assert not viewer.curves
+    assert viewer.statusBar().currentMessage().startswith("group 1 / type 1 / 04010 could not be read: ")
 
 
 def test_archive_argument(tmp_path: Path) -> None:
