@@ -30,7 +30,7 @@ from netplc.memory import Memory, Snapshot
 from netplc.program import Program
 from netplc.records import NullSink, Record, RecordSink
 from netplc.rtc import Rtc
-from netplc.timers import make_ctr, make_tim, update_generators
+from netplc.timers import held, make_ctr, make_tim, update_generators
 
 WATCHDOG_STEPS = 1_000_000  # instructions per scan before the scan is abandoned (endless jump loop)
 
@@ -207,8 +207,7 @@ class Engine:
 
     def held_values(self) -> tuple[dict[int, float], dict[int, int]]:
         """The timers' and counters' non-zero current values by coil address (for retentive saves)."""
-        return ({c: v for c, v in enumerate(self.tim_ticks) if v},
-                {c: v for c, v in enumerate(self.ctr_values) if v})
+        return held(self.tim_ticks, self.ctr_values)
 
     def restore_values(self, tim: dict[int, float], ctr: dict[int, int]) -> None:
         """Set every timer and counter current value: those given, the others 0; IndexError for a

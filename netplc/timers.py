@@ -118,6 +118,11 @@ def ctr_lines(c: int, n: int) -> tuple[list[str], list[str]]:
     return on, [f"b[{c}] = 0", *reset, f"    b[{c2}] = cv[{c}] >= {n}"]
 
 
+def held(tim: list[float], ctr: list[int]) -> tuple[dict[int, float], dict[int, int]]:
+    """The non-zero timer and counter current values by coil address: what a save needs to keep."""
+    return {c: v for c, v in enumerate(tim) if v}, {c: v for c, v in enumerate(ctr) if v}
+
+
 def update_generators(bits: list[int], elapsed: float) -> None:
     """03750-03757: square waves of period 0.1 s * 2**k, 50 % duty, from the engine clock."""
     halves = int(elapsed * 20 + _EPS)  # number of 0.05 s half-periods of the fastest generator

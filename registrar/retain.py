@@ -4,7 +4,9 @@ That is all data memory, the I/O bits 03000-03477, and the timer and counter cur
 (DESIGN section 3). A save is written to a temporary file, fsynced and renamed over the current
 one, whose last good version is kept as the previous save; a crash at any moment leaves at least
 one complete save. Each save carries a CRC, so a damaged file is recognised and the previous one
-used instead. Saves read the snapshot the engine publishes after each scan, never live memory.
+used instead. While the engine scans, a save's state is taken by the engine thread between two
+scans (a queued job, as writes are), so memory and the hidden timer and counter values are of the
+same moment; once the scan thread has stopped, the memory is read as it was left.
 """
 
 from __future__ import annotations
@@ -20,12 +22,15 @@ from pathlib import Path
 
 from netplc.address import DATA_SIZE, IO_BITS, RETAIN_BITS
 from netplc.engine import Engine
+from netplc.memory import Memory, Snapshot
 from netplc.records import Record, RecordSink
+from netplc.timers import held
 
 MAGIC = b"NPLCRETN"
 VERSION = 1
 HEADER = struct.Struct("<8sHII")  # magic, version, crc32 of the payload, payload length
 SOURCE = "retain"
+CAPTURE_WAIT = 1.0  # seconds a save waits for the engine thread to take the state (3 ticks if longer)
 BITS = slice(RETAIN_BITS.start, RETAIN_BITS.stop)
 
 
@@ -95,11 +100,11 @@ class Retainer:
 
     # --- save ----------------------------------------------------------------------------------
 
-    def save(self) -> None:
-        """Write the state of the last published scan; OSError if the disk refuses."""
+    def save(self, *, live: bool = False) -> None:
+        """Write the retentive state; OSError if the disk refuses. `live` while the scan thread
+        runs (the state is then taken between two scans), else the memory is read as it is."""
         engine = self.engine
-        snap = engine.snapshot
-        tim, ctr = engine.held_values()
+        snap, (tim, ctr) = self._capture() if live else (engine.snapshot, engine.held_values())
         meta = json.dumps({"tim": {str(k): v for k, v in tim.items()},
                            "ctr": {str(k): v for k, v in ctr.items()},
                            "wall": snap.wall, "scan": snap.scan}).encode()
@@ -118,9 +123,27 @@ class Retainer:
             self._current_good = True
             self.saves += 1
 
-    def _save_reporting(self) -> None:
+    def _capture(self) -> tuple[Snapshot, tuple[dict[int, float], dict[int, int]]]:
+        """Memory and timer/counter values of one moment, taken by the engine thread at the start of
+        its next scan; read directly if no scan comes (the scan thread stopped meanwhile)."""
+        engine = self.engine
+        taken: list[tuple[Snapshot, list[float], list[int]]] = []
+        done = threading.Event()
+
+        def take(mem: Memory) -> None:  # copies only: the scan it delays stays short
+            taken.append((mem.snapshot(engine.scan_counter, engine.now, engine.wall_time()),
+                          engine.tim_ticks.copy(), engine.ctr_values.copy()))
+            done.set()
+
+        engine.post(take)
+        if done.wait(max(CAPTURE_WAIT, 3 * engine.tick)):
+            snap, tim, ctr = taken[0]
+            return snap, held(tim, ctr)
+        return engine.snapshot, engine.held_values()
+
+    def _save_reporting(self, live: bool = False) -> None:
         try:
-            self.save()
+            self.save(live=live)
         except OSError as e:
             if not self.last_error:
                 self._journal(f"retentive memory could not be saved: {e}")
@@ -149,7 +172,7 @@ class Retainer:
         """Save on a fixed cadence: a slow fsync must not push every later save back as well."""
         due = time.monotonic() + interval
         while not self._stop.wait(max(0.0, due - time.monotonic())):
-            self._save_reporting()
+            self._save_reporting(live=True)
             due = max(due + interval, time.monotonic())
 
 

@@ -1,3 +1,5 @@
+import sys
+import threading
 import zlib
 
 from netplc.engine import Engine, FakeClock
@@ -107,3 +109,51 @@ def test_stop_makes_a_final_save_and_failures_are_journaled(tmp_path):
     bad.stop()
     assert bad.last_error and texts(e).count(texts(e)[-1]) == 1
     assert texts(e)[-1].startswith("retentive memory could not be saved")
+
+
+# A timer that restarts when done (ticking once a scan: 0.01 s base, 0.01 s scans) beside a word
+# that counts scans: in a consistent save the two agree as they do between any two scans.
+TICKING = ("TFA $03001\nTIM C:$03000 N:7\nTNA $03760\nFON C:$02001 N:INCW S:$04002 D:$04000\n"
+           "JMP 0\n")
+SCANS = 20_000
+
+
+def ticking() -> tuple[Engine, FakeClock]:
+    clock = FakeClock()
+    e = Engine(parse(TICKING), clock=clock, wallclock=lambda: 1_790_000_000.0, sink=ListSink())
+    e.mem.set_bit(0o3773, 0)  # time base 0.01 s
+    return e, clock
+
+
+def test_a_live_save_takes_memory_and_timer_values_of_the_same_moment(tmp_path):
+    reference, clock = ticking()
+    agree = set()
+    for _ in range(SCANS):
+        clock.advance(0.01)
+        reference.scan()
+        agree.add((reference.mem.get_word(0o4000), round(reference.tim_ticks[0o3000], 6)))
+    e, clock = ticking()
+    stop = threading.Event()
+
+    def scanning() -> None:
+        while not stop.is_set():
+            clock.advance(0.01)
+            e.scan()
+
+    thread = threading.Thread(target=scanning)
+    interval = sys.getswitchinterval()
+    sys.setswitchinterval(1e-5)  # threads change hands within scans and within a save's reads
+    thread.start()
+    path = tmp_path / "retain.bin"
+    r = Retainer(path, e)
+    saved = []
+    try:
+        while len(saved) < 30 and e.scan_counter < SCANS - 1_000:
+            r.save(live=True)
+            s = read_save(path)
+            saved.append((int.from_bytes(s.data[:2], "little"), round(s.tim.get(0o3000, 0.0), 6)))
+    finally:
+        stop.set()
+        thread.join()
+        sys.setswitchinterval(interval)
+    assert len(saved) >= 3 and set(saved) <= agree
