@@ -85,7 +85,7 @@ class Endpoint:
 
 def parse_endpoint(text: str) -> Endpoint:
     """Parse an endpoint; ValueError says what is wrong with it and shows the expected form."""
-    forms = "expected tcp://host:port or rtu:///dev/ttyX?baudrate=19200&parity=N"
+    forms = "expected tcp://host:port, rtu:///dev/ttyX?baudrate=19200&parity=N or rtu://COM3?baudrate=..."
     try:
         url = urlsplit(text.strip())
         port = url.port
@@ -102,7 +102,9 @@ def parse_endpoint(text: str) -> Endpoint:
             raise ValueError(f"endpoint {text!r}: {url.hostname!r} is not a valid host name") from None
         return Endpoint("tcp", host=url.hostname, port=port if port is not None else 502)
     if url.scheme == "rtu":
-        if url.netloc or not url.path:
+        # rtu:///dev/ttyS0 names a device path; rtu://COM3 a Windows port (the URL's "host")
+        device = url.path if not url.netloc else url.netloc if not url.path else ""
+        if not device:
             raise ValueError(f"endpoint {text!r}: the serial device must follow rtu:// ({forms})")
         options: dict[str, Any] = {}
         for key, value in parse_qsl(url.query, keep_blank_values=True):
@@ -117,7 +119,7 @@ def parse_endpoint(text: str) -> Endpoint:
             else:
                 raise ValueError(f"endpoint {text!r}: unknown option {key!r} "
                                  "(baudrate, parity, bytesize, stopbits)")
-        return Endpoint("rtu", device=url.path, **options)
+        return Endpoint("rtu", device=device, **options)
     raise ValueError(f"endpoint {text!r}: unknown scheme {url.scheme!r} ({forms})")
 
 

@@ -1,4 +1,5 @@
-"""NetPlc memory served over Modbus TCP with the cpu165 profile (DESIGN 1 and 7).
+"""NetPlc memory served over Modbus TCP, or Modbus RTU on a serial line, with the cpu165 profile
+(DESIGN 1 and 7).
 
 Other SCADAs and debugging tools read what the HMI reads: the snapshot published after the last
 scan, never the live memory. Writes are accepted only inside the configured ranges (exception 2
@@ -11,7 +12,7 @@ from __future__ import annotations
 
 from netplc.address import IO_BITS, fmt_octal
 from netplc.engine import Engine
-from netplc.modbus_driver import LoopThread, TcpServer
+from netplc.modbus_driver import Endpoint, LoopThread, TcpServer
 from netplc.modbus_map import (
     BIT_TABLES,
     MapError,
@@ -23,12 +24,14 @@ from netplc.modbus_map import (
     read_registers,
     registers_target,
 )
+from netplc.modbus_rtu import RtuServer, open_line
 
 ALL_MEMORY: list[tuple[int, int]] = [(0, 0o77777)]  # every I/O bit and every data byte
 
 
 class ModbusServer:
-    """`start()` binds `host:port` (port 0: an ephemeral port, see `.port`) on a thread of its own.
+    """`start()` binds `host:port` (port 0: an ephemeral port, see `.port`) on a thread of its own,
+    or, given `serial` (an rtu:// endpoint), opens that port and answers as an RTU slave.
 
     `writable` lists inclusive NetPlc address ranges a client may write: I/O bit addresses for
     coils, data byte addresses for registers (the two never overlap). None: read-only.
@@ -36,7 +39,8 @@ class ModbusServer:
     """
 
     def __init__(self, engine: Engine, host: str = "127.0.0.1", port: int = 0,
-                 writable: list[tuple[int, int]] | None = None, unit: int | None = None) -> None:
+                 writable: list[tuple[int, int]] | None = None, unit: int | None = None,
+                 serial: Endpoint | None = None) -> None:
         self.engine = engine
         self.host = host
         self.requested_port = port
@@ -45,6 +49,8 @@ class ModbusServer:
             if not 0 <= lo <= hi <= 0o77777:
                 raise ValueError(f"writable range {fmt_octal(lo)}-{fmt_octal(hi)} is not within 00000-077777")
         self.unit = unit
+        self.serial = serial
+        self.rtu: RtuServer | None = None
         self._server = TcpServer(self, unit)
         self._thread = LoopThread(f"modbus-server-{host}:{port}")
 
@@ -53,6 +59,11 @@ class ModbusServer:
         return self._server.port
 
     def start(self) -> None:
+        """OSError if the port cannot be bound or the serial port opened."""
+        if self.serial is not None:
+            self.rtu = RtuServer(self, self.unit, open_line(self.serial), self.serial.device)
+            self.rtu.start()
+            return
         self._thread.start()
         try:
             self._thread.run(self._server.listen(self.host, self.requested_port))
@@ -61,6 +72,9 @@ class ModbusServer:
             raise
 
     def stop(self) -> None:
+        if self.rtu is not None:
+            self.rtu.stop()
+            self.rtu = None
         if self._thread.loop is not None:
             self._thread.run(self._server.close())
         self._thread.stop()

@@ -1,11 +1,13 @@
 """A simulated CPU-165 node: the NetPlc engine running a CPU-165 program on its tick, served over
-Modbus TCP with the cpu165 profile and all of its memory writable (DESIGN section 1).
+Modbus TCP, or Modbus RTU on a serial port, with the cpu165 profile and all of its memory writable
+(DESIGN section 1).
 
 It is what a user points NetPlc at before the plant exists, what the demo station embeds, and
 what the exchange tests and benchmark talk to. It has no exchange of its own: a CPU-165 answers
 the network, it does not ask it.
 
     python main.py simulate PROGRAM.stl [--symbols F] [--host H] [--port P] [--unit U] [--tick MS]
+    python main.py simulate PROGRAM.stl --serial "rtu:///dev/ttyUSB0?baudrate=19200&parity=E" ...
     python -m netplc.simulator PROGRAM.stl ...
 """
 
@@ -16,6 +18,7 @@ import sys
 import threading
 
 from netplc.engine import Engine
+from netplc.modbus_driver import Endpoint, parse_endpoint
 from netplc.modbus_server import ALL_MEMORY, ModbusServer
 from netplc.program import Program, ProgramError, load_program
 from netplc.records import RecordSink
@@ -24,10 +27,10 @@ from netplc.scheduler import ScanThread
 
 class Simulator:
     def __init__(self, program: Program, host: str = "127.0.0.1", port: int = 0, unit: int | None = 1,
-                 tick: float = 0.1, sink: RecordSink | None = None) -> None:
+                 tick: float = 0.1, sink: RecordSink | None = None, serial: Endpoint | None = None) -> None:
         self.engine = Engine(program, tick=tick, sink=sink)
         self.scan = ScanThread(self.engine, tick, name="cpu165-sim-scan")
-        self.server = ModbusServer(self.engine, host, port, writable=ALL_MEMORY, unit=unit)
+        self.server = ModbusServer(self.engine, host, port, writable=ALL_MEMORY, unit=unit, serial=serial)
 
     @property
     def port(self) -> int:
@@ -47,11 +50,15 @@ class Simulator:
 
 
 def build_parser() -> argparse.ArgumentParser:
-    p = argparse.ArgumentParser(prog="simulate", description="run a simulated CPU-165 node over Modbus TCP")
+    p = argparse.ArgumentParser(prog="simulate",
+                                description="run a simulated CPU-165 node over Modbus TCP or RTU")
     p.add_argument("program", help="CPU-165 program (.stl)")
     p.add_argument("--symbols", help="symbols.csv (name,address,comment)")
     p.add_argument("--host", default="127.0.0.1", help="address to bind (default 127.0.0.1)")
     p.add_argument("--port", type=int, default=502, help="TCP port (default 502; 0 = any free port)")
+    p.add_argument("--serial", metavar="ENDPOINT",
+                   help="answer as a Modbus RTU slave on this serial port instead of TCP: "
+                        "rtu:///dev/ttyUSB0?baudrate=19200&parity=N (COM3 on Windows: rtu://COM3)")
     p.add_argument("--unit", type=int, default=1, help="Modbus unit id to answer (default 1)")
     p.add_argument("--tick", type=int, default=100, help="scan tick in ms (default 100)")
     return p
@@ -65,6 +72,16 @@ def main(argv: list[str] | None = None) -> int:
     if not 0 <= args.unit <= 255 or not 0 <= args.port <= 65535:
         print("simulate: --unit takes 0-255 and --port 0-65535", file=sys.stderr)
         return 2
+    serial = None
+    if args.serial is not None:
+        try:
+            serial = parse_endpoint(args.serial)
+        except ValueError as e:
+            print(f"simulate: --serial: {e}", file=sys.stderr)
+            return 2
+        if serial.scheme != "rtu":
+            print(f"simulate: --serial {args.serial!r}: expected an rtu:// endpoint", file=sys.stderr)
+            return 2
     try:
         program = load_program(args.program, args.symbols)
     except ProgramError as e:
@@ -73,14 +90,20 @@ def main(argv: list[str] | None = None) -> int:
     except OSError as e:
         print(f"simulate: {e}", file=sys.stderr)
         return 2
-    sim = Simulator(program, args.host, args.port, args.unit, args.tick / 1000.0)
+    sim = Simulator(program, args.host, args.port, args.unit, args.tick / 1000.0, serial=serial)
+    where = f"{args.host}:{args.port}" if serial is None else serial.device
     try:
         sim.start()
     except OSError as e:
-        print(f"simulate: cannot listen on {args.host}:{args.port}: {e}", file=sys.stderr)
+        print(f"simulate: cannot {'listen on' if serial is None else 'open'} {where}: {e}", file=sys.stderr)
         return 1
-    print(f"simulated CPU-165 node: {args.program} every {args.tick} ms, "
-          f"Modbus TCP on {args.host}:{sim.port} unit {args.unit} (Ctrl-C stops)", flush=True)
+    if serial is None:
+        served = f"Modbus TCP on {args.host}:{sim.port}"
+    else:
+        served = (f"Modbus RTU on {serial.device} ({serial.baudrate} baud, "
+                  f"{serial.bytesize}{serial.parity}{serial.stopbits})")
+    print(f"simulated CPU-165 node: {args.program} every {args.tick} ms, {served} unit {args.unit} "
+          "(Ctrl-C stops)", flush=True)
     try:
         threading.Event().wait()
     except KeyboardInterrupt:

@@ -156,6 +156,9 @@ def test_node_config_reports_bad_endpoints() -> None:
     cfg = NodeConfig(1, "rtu:///dev/ttyUSB0?baudrate=9600&parity=e")
     assert (cfg.parsed.device, cfg.parsed.baudrate, cfg.parsed.parity) == ("/dev/ttyUSB0", 9600, "E")
     assert NodeConfig(2, "tcp://10.0.0.5").parsed.port == 502
+    assert NodeConfig(4, "rtu://COM3?baudrate=9600").parsed.device == "COM3"  # a Windows port
+    with pytest.raises(ValueError, match=r"the serial device must follow rtu://"):
+        NodeConfig(3, "rtu://?baudrate=9600")
 
 
 def test_node_config_parse_from_a_table() -> None:

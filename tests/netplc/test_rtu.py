@@ -1,87 +1,77 @@
-"""The exchange over Modbus RTU (pymodbus serial framer, pyserial) on a pseudo-terminal pair.
+"""Modbus RTU on pseudo-terminal pairs: the exchange (pymodbus serial framer, pyserial) against our
+RTU slave, and the simulator's RTU slave (`main.py simulate --serial`) against raw frames.
 
-NetPlc opens the pty's slave side as its serial port; the test plays the CPU-165 node on the master
-side: it deframes RTU requests (unit, PDU, CRC-16), answers them from a node engine's memory through
-the same cpu165 map the TCP server uses, and frames the answers back.
+For the exchange, NetPlc opens the pty's slave side as its serial port and the simulated CPU-165
+node answers on the master side. For the simulator, it opens the slave side itself and the test
+plays the RTU master on the master side, byte for byte.
 """
 
 from __future__ import annotations
 
 import os
 import select
-import threading
+import subprocess
+import sys
+import time
 from collections.abc import Iterator
+from pathlib import Path
 
 import pytest
 
-from netplc.engine import Engine, FakeClock
+from netplc.engine import Engine
 from netplc.exchange import NodeConfig
-from netplc.modbus_driver import answer
+from netplc.modbus_rtu import RtuServer, crc16, request_length
 from netplc.modbus_server import ALL_MEMORY, ModbusServer
 from netplc.program import parse
+from netplc.scheduler import ScanThread
 from tests.netplc.test_exchange import Station, wait_until
 
 UNIT = 5
+REPO = Path(__file__).resolve().parents[2]
 
 
-def crc16(data: bytes) -> bytes:
-    crc = 0xFFFF
-    for b in data:
-        crc ^= b
-        for _ in range(8):
-            crc = (crc >> 1) ^ 0xA001 if crc & 1 else crc >> 1
-    return crc.to_bytes(2, "little")
+class PtyLine:
+    """The master side of a pty as a serial line: `read` returns at a 5 ms silence."""
 
+    def __init__(self, fd: int) -> None:
+        self.fd = fd
 
-def frame_length(buf: bytes) -> int:
-    """Length of the RTU request at the start of `buf` (0: not enough bytes yet)."""
-    if len(buf) < 7:
-        return 0
-    if buf[1] in (15, 16):
-        return 9 + buf[6]
-    return 8
+    def read(self, size: int) -> bytes:
+        if not select.select([self.fd], [], [], 0.1)[0]:
+            return b""
+        data = os.read(self.fd, size)
+        while len(data) < size and select.select([self.fd], [], [], 0.005)[0]:
+            data += os.read(self.fd, size - len(data))
+        return data
+
+    def write(self, data: bytes) -> int:
+        return os.write(self.fd, data)
+
+    def close(self) -> None:
+        pass  # the pty is the test's to close
 
 
 class RtuNode:
-    """A CPU-165 node on the master side of a pty: its memory served with the cpu165 profile."""
+    """A CPU-165 node (an engine on its scan thread) answering as RTU unit 5 on a pty's master side."""
 
     def __init__(self) -> None:
-        self.engine = Engine(parse("JMP 0\n"), clock=FakeClock())
-        self.handler = ModbusServer(self.engine, writable=ALL_MEMORY)  # used as the map, not started
+        self.engine = Engine(parse("JMP 0\n"), tick=0.01)
+        self.scan = ScanThread(self.engine, 0.01)
         self.master, slave = os.openpty()
         self.port = os.ttyname(slave)
         self._slave = slave
-        self.frames = 0
-        self._stop = threading.Event()
-        self._thread = threading.Thread(target=self._serve, daemon=True)
+        self.server = RtuServer(ModbusServer(self.engine, writable=ALL_MEMORY), UNIT, PtyLine(self.master),
+                                self.port)
 
     def start(self) -> None:
-        self._thread.start()
+        self.scan.start()
+        self.server.start()
 
     def stop(self) -> None:
-        self._stop.set()
-        self._thread.join(2)
+        self.server.stop()
+        self.scan.stop()
         os.close(self.master)
         os.close(self._slave)
-
-    def _serve(self) -> None:
-        buf = b""
-        while not self._stop.is_set():
-            ready, _, _ = select.select([self.master], [], [], 0.05)
-            if not ready:
-                continue
-            buf += os.read(self.master, 512)
-            while (n := frame_length(buf)) and len(buf) >= n:
-                frame, buf = buf[:n], buf[n:]
-                assert crc16(frame[:-2]) == frame[-2:], f"bad CRC in {frame.hex(' ')}"
-                self.frames += 1
-                if frame[0] != UNIT:
-                    continue  # another device on the line: stay silent
-                self.engine.scan()  # the node's scan applies queued writes and publishes memory
-                pdu = answer(self.handler, frame[1:-2], "rtu")
-                reply = bytes([UNIT]) + pdu
-                os.write(self.master, reply + crc16(reply))
-                self.engine.scan()
 
 
 @pytest.fixture
@@ -150,3 +140,90 @@ def test_nodes_on_one_port_need_the_same_line_settings() -> None:
     with pytest.raises(ValueError, match=r"node 2: .* share /dev/ttyS7 with different line settings"):
         Station("JMP 0\n", [NodeConfig(1, "rtu:///dev/ttyS7?baudrate=9600"),
                             NodeConfig(2, "rtu:///dev/ttyS7?baudrate=19200")])
+
+
+# --- the simulator as an RTU slave (`main.py simulate --serial`) ----------------------------------
+
+NODE = "TNA $03760\nFON C:$02000 N:MOV S:$04000 D:$04002\nJMP 0\n"  # copies 04000 to 04002 each scan
+
+
+def frame(unit: int, pdu: bytes) -> bytes:
+    return bytes([unit]) + pdu + crc16(bytes([unit]) + pdu)
+
+
+class Master:
+    """The RTU master on a pty's master side; the simulator process opens the slave side."""
+
+    def __init__(self, fd: int) -> None:
+        self.fd = fd
+
+    def ask(self, request: bytes, wait: float = 2.0) -> bytes:
+        """Send a frame; the reply frame, or b"" if none came within `wait` seconds."""
+        os.write(self.fd, request)
+        reply = b""
+        deadline = time.monotonic() + wait
+        while time.monotonic() < deadline:
+            if select.select([self.fd], [], [], 0.02)[0]:
+                reply += os.read(self.fd, 256)
+            elif reply:
+                return reply
+        return reply
+
+
+@pytest.fixture
+def simulated(tmp_path: Path) -> Iterator[tuple[Master, subprocess.Popen[str]]]:
+    (tmp_path / "node.stl").write_text(NODE)
+    master, slave = os.openpty()
+    serial = f"rtu://{os.ttyname(slave)}?baudrate=19200&parity=E"
+    proc = subprocess.Popen([sys.executable, "main.py", "simulate", str(tmp_path / "node.stl"),
+                             "--tick", "10", "--unit", str(UNIT), "--serial", serial],
+                            cwd=REPO, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+    try:
+        assert proc.stdout is not None
+        banner = proc.stdout.readline()
+        assert "Modbus RTU on /dev/pts/" in banner and "19200 baud, 8E1) unit 5" in banner, banner
+        yield Master(master), proc
+    finally:
+        proc.terminate()
+        proc.wait(10)
+        os.close(master)
+        os.close(slave)
+
+
+def test_the_simulator_answers_as_an_rtu_slave(simulated: tuple[Master, subprocess.Popen[str]]) -> None:
+    master, _ = simulated
+    # FC16 writes 0x1234 to register 1024 (the word at 04000); the program copies it to 04002
+    written = master.ask(frame(UNIT, bytes.fromhex("10 0400 0001 02 1234")))
+    assert written == frame(UNIT, bytes.fromhex("10 0400 0001"))
+    read = frame(UNIT, bytes.fromhex("03 0400 0002"))  # applied at the next scan, then copied by MOV
+    wait_until(lambda: master.ask(read) == frame(UNIT, bytes.fromhex("03 04 1234 1234")))
+    assert master.ask(frame(UNIT, bytes.fromhex("03 0000 0001"))) == frame(UNIT, bytes.fromhex("83 02"))
+
+
+def test_the_rtu_slave_ignores_bad_frames_and_other_units_and_refuses_unknown_codes(
+        simulated: tuple[Master, subprocess.Popen[str]]) -> None:
+    master, _ = simulated
+    read = frame(UNIT, bytes.fromhex("03 0400 0001"))
+    assert master.ask(read[:-1] + bytes([read[-1] ^ 1]), wait=0.5) == b""  # CRC wrong: silence
+    assert master.ask(frame(UNIT + 1, bytes.fromhex("03 0400 0001")), wait=0.5) == b""  # another unit's
+    assert master.ask(frame(UNIT, bytes.fromhex("2b 0e 01 00"))) == frame(UNIT, bytes.fromhex("ab 01"))
+    assert master.ask(frame(0, bytes.fromhex("06 0400 00ff")), wait=0.5) == b""  # broadcast: done, no reply
+    wait_until(lambda: master.ask(read) == frame(UNIT, bytes.fromhex("03 02 00ff")))
+
+
+def test_rtu_request_lengths() -> None:
+    assert request_length(b"\x05") == 0 and request_length(b"\x05\x03") == 8
+    assert request_length(bytes.fromhex("05 10 0000 0002 04")) == 13 and request_length(b"\x05\x10\x00") == 0
+    assert request_length(b"\x05\x2b") is None  # the silence ends it
+
+
+def test_simulate_with_a_serial_port_that_cannot_be_opened(tmp_path: Path) -> None:
+    (tmp_path / "node.stl").write_text(NODE)
+    r = subprocess.run([sys.executable, "main.py", "simulate", str(tmp_path / "node.stl"),
+                        "--serial", "rtu:///dev/no-such-tty"], cwd=REPO, capture_output=True, text=True,
+                       timeout=60)
+    assert r.returncode == 1 and "Traceback" not in r.stderr
+    assert r.stderr.startswith("simulate: cannot open /dev/no-such-tty: ")
+    r = subprocess.run([sys.executable, "main.py", "simulate", str(tmp_path / "node.stl"),
+                        "--serial", "tcp://h:502"], cwd=REPO, capture_output=True, text=True, timeout=60)
+    assert r.returncode == 2 and "expected an rtu:// endpoint" in r.stderr
