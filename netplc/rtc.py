@@ -47,8 +47,9 @@ class Rtc:
             self._setting = False
             self._take_setting(data, wall)
         shown = wall + self.offset
-        if math.floor(shown) != self._second:
-            self._second = math.floor(shown)
+        second = math.floor(shown)
+        if second != self._second:
+            self._second = second
             t = dt.datetime.fromtimestamp(shown)
             fields = (t.second, t.minute, t.hour, t.day, t.month, t.year % 100, (t.weekday() + 1) % 7)
             self._bcd = bytes(to_bcd(v) for v in fields)
