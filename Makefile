@@ -25,7 +25,7 @@ bench: $(STAMP)
 	for b in bench/*.py; do QT_QPA_PLATFORM=offscreen $(PY) $$b || exit 1; done
 
 screenshots: $(STAMP)
-	QT_QPA_PLATFORM=offscreen $(PY) -m app.screenshots docs/screenshots
+	QT_QPA_PLATFORM=offscreen $(PY) -m app.gui.screenshots docs/screenshots
 
 clean:
 	rm -rf $(VENV) build *.egg-info

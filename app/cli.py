@@ -13,9 +13,9 @@ import signal
 import sys
 import threading
 import time
-from pathlib import Path
 
-DEMO_STATION = Path(__file__).resolve().parent.parent / "resources" / "example"
+from app.config import DEMO_STATION
+
 COMMANDS = ("view", "check", "simulate")
 
 

@@ -14,9 +14,10 @@ from pathlib import Path
 from typing import Any
 
 from netplc.address import fmt_octal, is_data_byte, is_io_bit, parse_octal
-from netplc.modbus_driver import Endpoint, parse_endpoint
+from netplc.modbus.driver import Endpoint, parse_endpoint
 
 STATION_FILE = "station.toml"
+DEMO_STATION = Path(__file__).resolve().parent.parent / "resources" / "example"  # the built-in demo
 PROFILES = ("cpu165", "modbus")
 TABLES = ("holding", "input", "coils", "discrete")
 BAD_ENDPOINT = "?"  # an endpoint already reported as wrong: not "missing" as well

@@ -23,8 +23,8 @@ from pathlib import Path
 from app.config import NodeSettings, Station
 from netplc.engine import Engine
 from netplc.exchange import Exchange, NodeConfig, check_program_nodes
-from netplc.modbus_driver import parse_endpoint
-from netplc.modbus_server import ModbusServer
+from netplc.modbus.driver import parse_endpoint
+from netplc.modbus.server import ModbusServer
 from netplc.program import Program, ProgramError, load_symbols, parse, parse_file
 from netplc.records import Record
 from netplc.scheduler import ScanThread

@@ -32,7 +32,7 @@ from typing import TYPE_CHECKING, TypeVar
 
 from netplc.address import PRESENCE_LIST, PRESENCE_NODES, AddressError, check_operand
 from netplc.memory import Memory
-from netplc.modbus_driver import (
+from netplc.modbus.driver import (
     DeviceError,
     Endpoint,
     LinkError,
@@ -40,7 +40,7 @@ from netplc.modbus_driver import (
     open_client,
     parse_endpoint,
 )
-from netplc.modbus_map import PROFILES, TABLES, WRITABLE_TABLES, Block, MapError, describe, locate
+from netplc.modbus.map import PROFILES, TABLES, WRITABLE_TABLES, Block, MapError, describe, locate
 from netplc.program import Diagnostic, Program
 from netplc.records import NullSink, Record, RecordSink
 

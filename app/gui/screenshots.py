@@ -1,4 +1,4 @@
-"""`python -m app.screenshots DIR`: the workstation and the viewer on the demo station, as PNGs.
+"""`python -m app.gui.screenshots DIR`: the workstation and the viewer on the demo station, as PNGs.
 
 The demo station runs for real (a copy in a temporary folder, the embedded node over TCP, its own
 archive) while a short script plays the operator: Пуск pressed a few times, a setpoint entered,
@@ -18,8 +18,7 @@ from collections.abc import Callable
 from pathlib import Path
 from typing import TYPE_CHECKING
 
-from app.cli import DEMO_STATION
-from app.config import load_station
+from app.config import DEMO_STATION, load_station
 
 if TYPE_CHECKING:
     from PySide6.QtCore import QCoreApplication
@@ -47,7 +46,7 @@ def slug(text: str) -> str:
 
 
 def main(argv: list[str] | None = None) -> int:
-    ap = argparse.ArgumentParser(prog="python -m app.screenshots",
+    ap = argparse.ArgumentParser(prog="python -m app.gui.screenshots",
                                  description="Render the workstation and the viewer on the demo station.")
     ap.add_argument("out", type=Path, help="folder for the PNGs (docs/screenshots)")
     ap.add_argument("--seconds", type=float, default=RUN_SECONDS, help="how long the station runs first")

@@ -37,7 +37,7 @@ from PySide6.QtWidgets import (
     QWidget,
 )
 
-from app.config import ConfigError, load_station, station_file
+from app.config import DEMO_STATION, ConfigError, load_station, station_file
 from app.gui.series_loader import SeriesLoader
 from app.gui.style import apply_style
 from hmi_forms.widgets.records import RecordsModel, records_view
@@ -353,7 +353,6 @@ class ViewerWindow(QMainWindow):
 
 def archive_of(target: str | None) -> Path:
     """The archive named on the command line: a file, a station folder, or the demo station's."""
-    from app.cli import DEMO_STATION
 
     if target is None:
         return load_station(DEMO_STATION).Archive

@@ -28,7 +28,7 @@ from pymodbus.client import AsyncModbusSerialClient, AsyncModbusTcpClient
 from pymodbus.exceptions import ModbusException
 from pymodbus.framer import FramerType
 
-from netplc.modbus_map import (
+from netplc.modbus.map import (
     BIT_TABLES,
     MAX_READ_BITS,
     MAX_READ_REGISTERS,

@@ -16,7 +16,7 @@ from typing import Protocol
 
 import serial
 
-from netplc.modbus_driver import Endpoint, ServeHandler, answer
+from netplc.modbus.driver import Endpoint, ServeHandler, answer
 
 BROADCAST = 0
 MAX_FRAME = 256  # an RTU frame's longest: unit, 253 bytes of PDU, CRC

@@ -12,8 +12,8 @@ from __future__ import annotations
 
 from netplc.address import IO_BITS, fmt_octal
 from netplc.engine import Engine
-from netplc.modbus_driver import Endpoint, LoopThread, TcpServer
-from netplc.modbus_map import (
+from netplc.modbus.driver import Endpoint, LoopThread, TcpServer
+from netplc.modbus.map import (
     BIT_TABLES,
     MapError,
     Table,
@@ -24,7 +24,7 @@ from netplc.modbus_map import (
     read_registers,
     registers_target,
 )
-from netplc.modbus_rtu import RtuServer, open_line
+from netplc.modbus.rtu import RtuServer, open_line
 
 ALL_MEMORY: list[tuple[int, int]] = [(0, 0o77777)]  # every I/O bit and every data byte
 

@@ -6,7 +6,7 @@ from pathlib import Path
 
 import pytest
 
-from app.screenshots import copy_station
+from app.gui.screenshots import copy_station
 
 REPO = Path(__file__).resolve().parents[2]
 DEMO = REPO / "resources" / "example"

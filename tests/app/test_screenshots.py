@@ -1,4 +1,4 @@
-"""`python -m app.screenshots`: the README's pictures come from the running demo station."""
+"""`python -m app.gui.screenshots`: the README's pictures come from the running demo station."""
 
 from __future__ import annotations
 
@@ -6,7 +6,7 @@ from pathlib import Path
 
 from PySide6.QtGui import QImage
 
-from app.screenshots import main
+from app.gui.screenshots import main
 
 
 def test_screenshots_of_every_form_and_the_viewer(qtbot, tmp_path: Path) -> None:

@@ -6,7 +6,7 @@ import socket
 import time
 
 from netplc.exchange import NodeConfig
-from netplc.modbus_server import ALL_MEMORY, ModbusServer
+from netplc.modbus.server import ALL_MEMORY, ModbusServer
 from netplc.program import parse
 from netplc.simulator import Simulator
 from tests.netplc.test_exchange import Station, wait_until

@@ -7,7 +7,7 @@ from collections.abc import Iterator
 import pytest
 
 from netplc.exchange import PROBE_IDLE, NodeConfig
-from netplc.modbus_server import ALL_MEMORY, ModbusServer
+from netplc.modbus.server import ALL_MEMORY, ModbusServer
 from netplc.program import parse
 from netplc.simulator import Simulator
 from tests.netplc.test_exchange import NETPLC_PROGRAM, NODE_PROGRAM, Station, wait_until

@@ -5,7 +5,7 @@ from __future__ import annotations
 import pytest
 
 from netplc.memory import Memory
-from netplc.modbus_map import (
+from netplc.modbus.map import (
     MapError,
     bits_from_bytes,
     bits_target,

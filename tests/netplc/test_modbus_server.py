@@ -11,7 +11,7 @@ import pytest
 from pymodbus.client import ModbusTcpClient
 
 from netplc.engine import Engine, FakeClock
-from netplc.modbus_server import ModbusServer
+from netplc.modbus.server import ModbusServer
 from netplc.program import parse
 from netplc.records import ListSink
 

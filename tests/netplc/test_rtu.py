@@ -20,8 +20,8 @@ import pytest
 
 from netplc.engine import Engine
 from netplc.exchange import NodeConfig
-from netplc.modbus_rtu import RtuServer, crc16, request_length
-from netplc.modbus_server import ALL_MEMORY, ModbusServer
+from netplc.modbus.rtu import RtuServer, crc16, request_length
+from netplc.modbus.server import ALL_MEMORY, ModbusServer
 from netplc.program import parse
 from netplc.scheduler import ScanThread
 from tests.netplc.test_exchange import Station, wait_until

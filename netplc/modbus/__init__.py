@@ -1,0 +1,7 @@
+"""The Modbus stack: endpoints, the lean TCP client and the pymodbus one, our Modbus TCP server,
+RTU framing, and the CPU-165 Modbus map (how NetPlc memory looks as coils and registers).
+
+It is the wire and nothing more: what NODE/NREAD/NWRITE mean is `netplc/exchange.py`, what a
+simulated CPU-165 node is is `netplc/simulator.py`; both reach the wire through this package.
+Only this package imports pymodbus, whose API changes at every minor release.
+"""
