@@ -8,7 +8,7 @@ import itertools
 
 import pytest
 
-from netplc import engine as engine_mod
+from netplc import backend
 from netplc.address import EMERGENCY_STOP, FERR1, GEN_BASE, TIMEBASE_HI, TIMEBASE_LO
 from netplc.engine import RunState
 from netplc.functions.registry import REGISTRY, FunctionSpec
@@ -208,7 +208,7 @@ def test_emergency_stop_set_from_outside_stops_before_the_program(compiled):
 
 @engines
 def test_watchdog_stops_an_endless_loop(compiled, monkeypatch):
-    monkeypatch.setattr(engine_mod, "WATCHDOG_STEPS", 1000)
+    monkeypatch.setattr(backend, "WATCHDOG_STEPS", 1000)
     rig = Rig("YON $02000\nl: NOP\nJMP l", compiled)
     rig.step()
     assert rig.engine.state is RunState.STOPPED
