@@ -18,8 +18,7 @@ import sys
 import threading
 
 from netplc.engine import Engine
-from netplc.modbus.driver import Endpoint, parse_endpoint
-from netplc.modbus.server import ALL_MEMORY, ModbusServer
+from netplc.modbus import ALL_MEMORY, Endpoint, ModbusServer, parse_endpoint
 from netplc.program import Program, ProgramError, load_program
 from netplc.records import RecordSink
 from netplc.scheduler import ScanThread
