@@ -20,7 +20,10 @@ from netplc.problems import Problems
 
 STATION_FILE = "station.toml"
 DEMO_STATION = Path(__file__).resolve().parent.parent / "resources" / "example"  # the built-in demo
-DEFAULT_WRITABLE = ((0o2000, 0o3777), (0o4000, 0o7777))
+# What Modbus clients may write when station.toml names nothing: the internal bits and the first
+# data bank, but not the special bits 03700-03777 (03770 stops NetPlc, 03771/03772 are the error
+# flags, 03773/03774 the time base): a range that names them explicitly still opens them.
+DEFAULT_WRITABLE = ((0o2000, 0o3677), (0o4000, 0o7777))
 
 
 class ConfigError(Problems):
@@ -83,11 +86,13 @@ def station_file(path: str | Path) -> Path:
 class _Reader:
     """Typed access to one TOML table that records problems instead of raising at the first."""
 
-    def __init__(self, problems: list[str], fname: str, table: dict[str, Any], prefix: str = "") -> None:
+    def __init__(self, problems: list[str], fname: str, table: dict[str, Any], prefix: str = "",
+                 allow_outside: bool = False) -> None:
         self.problems = problems
         self.fname = fname
         self.table = table
         self.prefix = prefix
+        self.allow_outside = allow_outside  # may paths leave the station folder?
         self.known: set[str] = set()
 
     def bad(self, key: str, problem: str) -> None:
@@ -125,7 +130,11 @@ class _Reader:
         if not value.strip():
             self.bad(key, "empty path")
             return None
-        return (base / value).resolve() if not Path(value).is_absolute() else Path(value)
+        path = (base / value).resolve()
+        if not self.allow_outside and not path.is_relative_to(base):
+            self.bad(key, f"{path} is outside the station folder {base} (allow_outside = true permits it)")
+            return None
+        return path
 
     def finish(self) -> None:
         for key in self.table:
@@ -167,6 +176,7 @@ def read_station(path: str | Path) -> tuple[Station | None, list[str]]:
     problems: list[str] = []
     base = file.parent.resolve()
     top = _Reader(problems, fname, data)
+    top.allow_outside = bool(top.get("allow_outside", bool, False))
     name = top.get("name", str, base.name)
     load = top.get("NetPlcLoad", bool, True)
     program = top.path("NetPlcProgram", base, required=bool(load))
@@ -179,7 +189,7 @@ def read_station(path: str | Path) -> tuple[Station | None, list[str]]:
     retain = top.path("Retain", base)
     server = _modbus_server(problems, fname, top.get("modbus_server", dict, {}))
     nodes = _nodes(problems, fname, top.get("nodes", list, []))
-    simulators = _simulators(problems, fname, top.get("simulators", list, []), base)
+    simulators = _simulators(problems, fname, top.get("simulators", list, []), base, top.allow_outside)
     users = _users(problems, fname, top.get("operator", dict, {}))
     top.finish()
     nodes = _with_simulated_nodes(problems, fname, nodes, simulators)
@@ -197,13 +207,35 @@ def read_station(path: str | Path) -> tuple[Station | None, list[str]]:
         if not missing:
             runnable.append(sim)
     archive = archive or base / "archive" / "journal.sqlite"
+    retain = retain or archive.with_name("retain.bin")
+    _outputs_apart(top, file.resolve(), archive, retain, program, symbols, messages, hmi, simulators)
     station = Station(
         path=file.resolve(), name=name or base.name, NetPlcLoad=bool(load), NetPlcProgram=program,
         Symbols=symbols, HMIload=hmi, NetSyncTime=sync, Archive=archive, Messages=messages,
-        keep_days=keep_days, Retain=retain or archive.with_name("retain.bin"), modbus_server=server,
+        keep_days=keep_days, Retain=retain, modbus_server=server,
         nodes=tuple(nodes), simulators=tuple(runnable), users=users,
     )
     return station, problems
+
+
+def _outputs_apart(r: _Reader, file: Path, archive: Path, retain: Path, program: Path | None,
+                   symbols: Path | None, messages: Path | None, hmi: Path | None,
+                   sims: list[SimulatorSettings]) -> None:
+    """The station writes Archive and Retain: neither may be one of its input files (the first save
+    would overwrite the program or station.toml), a form, or the other one."""
+    inputs = {p: key for key, p in (("station.toml", file), ("NetPlcProgram", program), ("Symbols", symbols),
+                                    ("Messages", messages)) if p is not None}
+    for i, sim in enumerate(sims):
+        inputs.update({p: f"simulators[{i}].{key}" for key, p in (("program", sim.program),
+                                                                  ("symbols", sim.symbols)) if p})
+    for key, path in (("Archive", archive), ("Retain", retain)):
+        what = inputs.get(path)
+        if what is None and hmi is not None and path.parent == hmi and path.suffix == ".hmi":
+            what = "a form of HMIload"
+        if what is not None:
+            r.bad(key, f"{path} is a station input ({what}): writing there would overwrite it")
+    if retain == archive:
+        r.bad("Retain", f"{retain} is the Archive as well")
 
 
 def _existing(r: _Reader, key: str, path: Path | None, must_be_dir: bool) -> Path | None:
@@ -323,9 +355,11 @@ def _seconds(r: _Reader, key: str, default: float, lo: float, hi: float) -> floa
     return value
 
 
-def _simulators(problems: list[str], fname: str, items: list[Any], base: Path) -> list[SimulatorSettings]:
+def _simulators(problems: list[str], fname: str, items: list[Any], base: Path,
+                allow_outside: bool) -> list[SimulatorSettings]:
     sims: list[SimulatorSettings] = []
     for _i, r in _array_tables(problems, fname, items, "simulators"):
+        r.allow_outside = allow_outside
         node = r.number("node", -1, 0, 255, required=True)
         program = r.path("program", base, required=True)
         symbols = r.path("symbols", base)

@@ -158,6 +158,9 @@ endpoint = "rtu:///dev/ttyX?baudrate=19200"
     ]
 
 
+WHY = "(0 is broadcast, which never answers; 248-255 are reserved)"
+
+
 def test_node_unit_ranges_are_the_models_per_scheme(tmp_path: Path) -> None:
     write_station(tmp_path, """
 NetPlcLoad = false
@@ -181,9 +184,8 @@ unit = 256
     station, problems = read_station(tmp_path)
     problems = [p.removeprefix(f"{tmp_path / 'station.toml'}: ") for p in problems]
     assert problems == [
-        "nodes[1].unit: unit 0 is not 1-247 on rtu (0 is broadcast, which never answers; 248-255 are reserved)",
-        "nodes[2].unit: unit 248 is not 1-247 on rtu (0 is broadcast, which never answers; 248-255 are "
-        "reserved)",
+        f"nodes[1].unit: unit 0 is not 1-247 on rtu {WHY}",
+        f"nodes[2].unit: unit 248 is not 1-247 on rtu {WHY}",
         "nodes[3].unit: 256 is outside 0-255",
     ]
     assert station is not None and station.nodes[0].unit == 255

@@ -4,6 +4,7 @@ sync pulses, scan for scan, and the same element records, once each, even when t
 from __future__ import annotations
 
 import datetime as dt
+import itertools
 import socket
 import sqlite3
 import subprocess
@@ -55,7 +56,7 @@ def check_every_scan(scans: Scans) -> int:
     with scans.lock:
         snaps = list(scans.snapshots)
     pulses = 0
-    for before, after in zip(snaps, snaps[1:], strict=False):
+    for before, after in itertools.pairwise(snaps):
         assert after.scan == before.scan + 1  # the listener saw every scan
         assert (after.get_bit(OUT), after.get_bit(TIMER_OUT)) == expected_pulses(before), before.scan
         pulses += after.get_bit(OUT) + after.get_bit(TIMER_OUT)
@@ -147,9 +148,9 @@ def test_no_gui_process_pulses_and_journals_what_a_modbus_client_switches(demo_c
 
     port = free_port()
     toml = demo_copy / "station.toml"
-    toml.write_text(toml.read_text(encoding="utf-8").replace(
-        '[modbus_server]\nhost = "127.0.0.1"\nport = 0', f'[modbus_server]\nhost = "127.0.0.1"\nport = {port}'),
-        encoding="utf-8")
+    server = '[modbus_server]\nhost = "127.0.0.1"\nport = '
+    text = toml.read_text(encoding="utf-8").replace(server + "0", server + str(port))
+    toml.write_text(text, encoding="utf-8")
     assert f"port = {port}" in toml.read_text(encoding="utf-8")
     proc = subprocess.Popen([sys.executable, "main.py", "--no-gui", str(demo_copy), "--duration", "6"],
                             cwd=REPO, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
@@ -163,7 +164,7 @@ def test_no_gui_process_pulses_and_journals_what_a_modbus_client_switches(demo_c
             outputs.add(client.read_coils(OUT, count=1).bits[0])
             time.sleep(0.01)
         client.close()
-        out, err = proc.communicate(timeout=30)
+        _, err = proc.communicate(timeout=30)
     finally:
         if proc.poll() is None:
             proc.kill()
