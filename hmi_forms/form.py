@@ -1,4 +1,4 @@
-"""Load and validate `.hmi` forms (DESIGN section 9).
+"""Load and validate `.hmi` forms (docs/architecture.md section 9).
 
 A form file is JSON:
 

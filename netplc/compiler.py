@@ -4,7 +4,7 @@ The program is cut into basic blocks at jump targets; each block becomes one str
 function of the chain state `a` (ACC) and `s` (SUM) on entry, returning the index of the next
 block (None ends the scan, HALT halts) and the state on exit. Inside a block the chain state is
 kept symbolically: a chain of contacts becomes one short-circuit expression (contacts have no side
-effects, so `and`/`or` give the same RES as the bitwise model of DESIGN section 4), evaluated
+effects, so `and`/`or` give the same RES as the bitwise model of docs/architecture.md section 4), evaluated
 once by its terminator. TIM and CTR are written out from the source lines netplc/timers.py keeps
 beside its closures; a FON runs its function's inline source lines (FunctionSpec.inline, for simple
 functions on data operands) or calls the step the engine binds once per instruction. The reference

@@ -1,4 +1,4 @@
-"""The NetPlc engine: one scan every NetSyncTime tick (DESIGN sections 1 and 4).
+"""The NetPlc engine: one scan every NetSyncTime tick (docs/architecture.md sections 1 and 4).
 
 Only the engine thread mutates memory. Everything else (network results, operator writes, Modbus
 server writes) is queued with `post`/`write_*` and applied at the start of the next scan, and

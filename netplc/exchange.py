@@ -1,4 +1,5 @@
-"""Exchange with the PLC network: NODE / NREAD / NWRITE block requests over Modbus (DESIGN 1 and 7).
+"""Exchange with the PLC network: NODE / NREAD / NWRITE block requests over Modbus
+(docs/architecture.md sections 1 and 7).
 
 The scan never waits for the network. NREAD/NWRITE hand a block request to the node's asyncio task
 (on the exchange's own event-loop thread) and return at once with the node's link state; while a

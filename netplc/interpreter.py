@@ -1,4 +1,4 @@
-"""The reference interpreter: the instruction semantics of DESIGN section 4, written plainly.
+"""The reference interpreter: the instruction semantics of docs/architecture.md section 4, written plainly.
 
 The compiled engine must leave memory exactly as this does (tests/netplc/test_compiled_equivalence.py).
 """

@@ -1,4 +1,4 @@
-"""STL program text -> a validated list of instructions (DESIGN section 5).
+"""STL program text -> a validated list of instructions (docs/architecture.md section 5).
 
 An engineer's typo must come back as `file:line:col: message`, all of them at once, never as a
 traceback, so the parser collects diagnostics and raises one ProgramError at the end.

@@ -13,7 +13,7 @@ from pathlib import Path
 
 from netplc.problems import Problems
 
-MESSAGE_TYPES = {0: "info", 1: "warning", 2: "alarm", 3: "critical"}  # DESIGN section 8
+MESSAGE_TYPES = {0: "info", 1: "warning", 2: "alarm", 3: "critical"}  # docs/architecture.md section 8
 
 
 class CatalogError(Problems):

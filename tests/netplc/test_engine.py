@@ -1,6 +1,6 @@
-"""The engine: logic instructions (DESIGN section 4), jumps, run states, special bits, FON dispatch,
-queued writes and scan statistics; every behaviour under both the compiled engine and the
-reference interpreter."""
+"""The engine: logic instructions (docs/architecture.md section 4), jumps, run states, special bits,
+FON dispatch, queued writes and scan statistics; every behaviour under both the compiled engine and
+the reference interpreter."""
 
 from __future__ import annotations
 
@@ -38,7 +38,7 @@ def test_figure_chains_over_every_input_combination(compiled, figure):
 
 @engines
 def test_series_of_parallel_branches_with_tne(compiled):
-    # a*b + c*d: TNE closes the branch a*b and starts c*d (DESIGN section 4)
+    # a*b + c*d: TNE closes the branch a*b and starts c*d (docs/architecture.md section 4)
     rig = Rig("TNA $0\nTNA $1\nTNE $2\nTNA $3\nYON $02000", compiled)
     for a, b, c, d in itertools.product((0, 1), repeat=4):
         rig.step(b0=a, b1=b, b2=c, b3=d)
