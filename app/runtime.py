@@ -321,7 +321,7 @@ class Runtime:
         exchange = self.exchange
         nodes = tuple(NodeStatus(n.node, n.endpoint, bool(exchange and exchange.link_up(n.node)))
                       for n in self.nodes)
-        problems = list(self._problems)
+        problems = list(self._problems) + [f"form problem: {p}" for p in self.form_problems[:3]]
         written = pending = lost = 0
         s = self.store.stats if self.store is not None else self._final_store
         if s is not None:

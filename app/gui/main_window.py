@@ -186,7 +186,7 @@ class MainWindow(QMainWindow):
     def refresh_status(self) -> None:
         status = self.runtime.status()
         self.status.show_status(status)
-        problems = station_problems(status) + [f"form problem: {p}" for p in self.form_problems[:3]]
+        problems = station_problems(status)
         self.health.show_problems(problems)
         running = status.state == "running"
         self.act_run.setEnabled(not running)

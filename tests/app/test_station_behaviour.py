@@ -177,3 +177,33 @@ def test_no_gui_process_pulses_and_journals_what_a_modbus_client_switches(demo_c
     finally:
         con.close()
     assert rows.count(PUMP_ON) == 1
+
+
+def test_a_form_that_does_not_load_is_a_problem_the_station_runs_with(tmp_path: Path) -> None:
+    from tests.app.conftest import write_station
+
+    forms = tmp_path / "forms"
+    forms.mkdir(parents=True)
+    (forms / "bad.hmi").write_text("{", encoding="utf-8")
+    (forms / "good.hmi").write_text(
+        '{"form": {"width": 200, "height": 100}, "elements": [{"type": "SyncGenerator", "Name": "G", '
+        '"x": 0, "y": 0, "w": 100, "h": 50, "OutAddr": "02001", "Period0": 2}]}', encoding="utf-8")
+    write_station(tmp_path, 'NetPlcProgram = "p.stl"\nHMIload = "forms"\n[modbus_server]\nenabled = false\n',
+                  {"p.stl": "TNA $02001\nYON $02002\n"})
+    rt = Runtime(load_station(tmp_path))
+    scans = Scans()
+    rt.start()
+    try:
+        assert rt.engine is not None
+        rt.engine.listeners.append(scans)
+        poll(lambda: scans.count() > 6)
+        status = rt.status()
+    finally:
+        rt.stop()
+    assert status.problems == (f"form problem: {forms / 'bad.hmi'}:1:2: bad JSON: Expecting property name "
+                               "enclosed in double quotes",)
+    assert "NetPlc running" in status.line() and "form problem" in status.line()
+    with scans.lock:
+        snaps = list(scans.snapshots)
+    for before, after in itertools.pairwise(snaps):  # the good form's generator, seen by the program
+        assert after.get_bit(0o2002) == after.get_bit(OUT) == int(before.scan % 2 == 0)
