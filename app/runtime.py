@@ -213,7 +213,11 @@ class Runtime:
             self.engine.stop()
         self.retainer = Retainer(st.Retain, self.engine, self)
         self.restored = self.retainer.restore()
-        FormBehaviour(self.forms, self.engine.mem, self, self._problem).attach(self.engine)
+        behaviour = FormBehaviour(self.forms, self.engine.mem, self, self._problem)
+        behaviour.attach(self.engine)
+        if self.forms:
+            self.system(f"forms loaded: {len(self.forms)}, of their elements {len(behaviour.elements)} act "
+                        "on the station (sync generators, RegData/RegMessages), with or without a window")
         for i, (sim, program) in enumerate(zip(st.simulators, self.node_programs, strict=True)):
             simulator = Simulator(program, host=sim.host, port=sim.port, unit=sim.unit,
                                   tick=sim.tick_ms / 1000)

@@ -110,6 +110,13 @@ def test_headless_runtime_pulses_every_scan_and_journals_the_forms_records(runti
     runtime.stop()  # flushes the archive
     found = messages(runtime)
     assert found.count(PUMP_ON) == 1 and found.count(TEMP_HIGH) == 1
+    con = sqlite3.connect(f"file:{runtime.station.Archive}?mode=ro", uri=True)
+    try:
+        system = [t for (t,) in con.execute(f'SELECT text FROM "{dt.date.today():%d_%m_%Y}" WHERE kind = ?',
+                                            ("system",))]
+    finally:
+        con.close()
+    assert any(t.startswith("forms loaded: 3, of their elements 4 act on the station") for t in system)
 
 
 def test_the_workstation_changes_nothing_even_when_its_window_lags(qtbot, runtime: Runtime) -> None:
