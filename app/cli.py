@@ -89,12 +89,13 @@ def run_check(station: str) -> int:
 
 
 def _open_runtime(station: str):  # -> Runtime | None (typed lazily: the runtime imports the parts)
-    from app.config import ConfigError, load_station
-    from app.runtime import Runtime, StartError
+    from app.config import load_station
+    from app.runtime import Runtime
+    from netplc.problems import Problems
 
     try:
         return Runtime(load_station(station))
-    except (ConfigError, StartError) as e:
+    except Problems as e:
         for problem in e.problems:
             print(problem, file=sys.stderr)
         return None

@@ -9,41 +9,25 @@ engineer fixes a broken station in one pass instead of one error per start.
 from __future__ import annotations
 
 import tomllib
-from dataclasses import dataclass, replace
+from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
 from netplc.address import fmt_octal, is_data_byte, is_io_bit, parse_octal
-from netplc.modbus.driver import Endpoint, parse_endpoint
+from netplc.exchange import LIMITS, NODE_NUMBERS, UNITS, NodeConfig, unit_problem
+from netplc.modbus import PROFILES, TABLES, Endpoint, parse_endpoint
+from netplc.problems import Problems
 
 STATION_FILE = "station.toml"
 DEMO_STATION = Path(__file__).resolve().parent.parent / "resources" / "example"  # the built-in demo
-PROFILES = ("cpu165", "modbus")
-TABLES = ("holding", "input", "coils", "discrete")
-BAD_ENDPOINT = "?"  # an endpoint already reported as wrong: not "missing" as well
-DEFAULT_WRITABLE = ((0o2000, 0o3777), (0o4000, 0o7777))
+# What Modbus clients may write when station.toml names nothing: the internal bits and the first
+# data bank, but not the special bits 03700-03777 (03770 stops NetPlc, 03771/03772 are the error
+# flags, 03773/03774 the time base): a range that names them explicitly still opens them.
+DEFAULT_WRITABLE = ((0o2000, 0o3677), (0o4000, 0o7777))
 
 
-class ConfigError(Exception):
+class ConfigError(Problems):
     """Every problem of a station file, each naming the key."""
-
-    def __init__(self, problems: list[str]) -> None:
-        self.problems = problems
-        super().__init__("\n".join(problems))
-
-
-@dataclass(frozen=True)
-class NodeSettings:
-    node: int
-    endpoint: str  # tcp://host:port or rtu:///dev/ttyX?baudrate=..&parity=..; "" until a simulator fills it
-    unit: int = 1
-    profile: str = "cpu165"
-    timeout: float = 1.0
-    retries: int = 1
-    table: str = "holding"
-    backoff: float = 0.2  # s, the first reconnect delay after the link went down
-    backoff_max: float = 5.0  # s, the delay doubles up to this
-    key: str = "nodes"  # where it is set in station.toml (nodes[2], simulators[0]), for messages
 
 
 @dataclass(frozen=True)
@@ -80,7 +64,7 @@ class Station:
     keep_days: int
     Retain: Path
     modbus_server: ModbusServerSettings
-    nodes: tuple[NodeSettings, ...] = ()
+    nodes: tuple[NodeConfig, ...] = ()
     simulators: tuple[SimulatorSettings, ...] = ()
     users: tuple[str, ...] = ("operator",)
 
@@ -102,11 +86,13 @@ def station_file(path: str | Path) -> Path:
 class _Reader:
     """Typed access to one TOML table that records problems instead of raising at the first."""
 
-    def __init__(self, problems: list[str], fname: str, table: dict[str, Any], prefix: str = "") -> None:
+    def __init__(self, problems: list[str], fname: str, table: dict[str, Any], prefix: str = "",
+                 allow_outside: bool = False) -> None:
         self.problems = problems
         self.fname = fname
         self.table = table
         self.prefix = prefix
+        self.allow_outside = allow_outside  # may paths leave the station folder?
         self.known: set[str] = set()
 
     def bad(self, key: str, problem: str) -> None:
@@ -144,7 +130,11 @@ class _Reader:
         if not value.strip():
             self.bad(key, "empty path")
             return None
-        return (base / value).resolve() if not Path(value).is_absolute() else Path(value)
+        path = (base / value).resolve()
+        if not self.allow_outside and not path.is_relative_to(base):
+            self.bad(key, f"{path} is outside the station folder {base} (allow_outside = true permits it)")
+            return None
+        return path
 
     def finish(self) -> None:
         for key in self.table:
@@ -186,6 +176,7 @@ def read_station(path: str | Path) -> tuple[Station | None, list[str]]:
     problems: list[str] = []
     base = file.parent.resolve()
     top = _Reader(problems, fname, data)
+    top.allow_outside = bool(top.get("allow_outside", bool, False))
     name = top.get("name", str, base.name)
     load = top.get("NetPlcLoad", bool, True)
     program = top.path("NetPlcProgram", base, required=bool(load))
@@ -198,7 +189,7 @@ def read_station(path: str | Path) -> tuple[Station | None, list[str]]:
     retain = top.path("Retain", base)
     server = _modbus_server(problems, fname, top.get("modbus_server", dict, {}))
     nodes = _nodes(problems, fname, top.get("nodes", list, []))
-    simulators = _simulators(problems, fname, top.get("simulators", list, []), base)
+    simulators = _simulators(problems, fname, top.get("simulators", list, []), base, top.allow_outside)
     users = _users(problems, fname, top.get("operator", dict, {}))
     top.finish()
     nodes = _with_simulated_nodes(problems, fname, nodes, simulators)
@@ -216,13 +207,35 @@ def read_station(path: str | Path) -> tuple[Station | None, list[str]]:
         if not missing:
             runnable.append(sim)
     archive = archive or base / "archive" / "journal.sqlite"
+    retain = retain or archive.with_name("retain.bin")
+    _outputs_apart(top, file.resolve(), archive, retain, program, symbols, messages, hmi, simulators)
     station = Station(
         path=file.resolve(), name=name or base.name, NetPlcLoad=bool(load), NetPlcProgram=program,
         Symbols=symbols, HMIload=hmi, NetSyncTime=sync, Archive=archive, Messages=messages,
-        keep_days=keep_days, Retain=retain or archive.with_name("retain.bin"), modbus_server=server,
+        keep_days=keep_days, Retain=retain, modbus_server=server,
         nodes=tuple(nodes), simulators=tuple(runnable), users=users,
     )
     return station, problems
+
+
+def _outputs_apart(r: _Reader, file: Path, archive: Path, retain: Path, program: Path | None,
+                   symbols: Path | None, messages: Path | None, hmi: Path | None,
+                   sims: list[SimulatorSettings]) -> None:
+    """The station writes Archive and Retain: neither may be one of its input files (the first save
+    would overwrite the program or station.toml), a form, or the other one."""
+    inputs = {p: key for key, p in (("station.toml", file), ("NetPlcProgram", program), ("Symbols", symbols),
+                                    ("Messages", messages)) if p is not None}
+    for i, sim in enumerate(sims):
+        inputs.update({p: f"simulators[{i}].{key}" for key, p in (("program", sim.program),
+                                                                  ("symbols", sim.symbols)) if p})
+    for key, path in (("Archive", archive), ("Retain", retain)):
+        what = inputs.get(path)
+        if what is None and hmi is not None and path.parent == hmi and path.suffix == ".hmi":
+            what = "a form of HMIload"
+        if what is not None:
+            r.bad(key, f"{path} is a station input ({what}): writing there would overwrite it")
+    if retain == archive:
+        r.bad("Retain", f"{retain} is the Archive as well")
 
 
 def _existing(r: _Reader, key: str, path: Path | None, must_be_dir: bool) -> Path | None:
@@ -283,45 +296,54 @@ def _array_tables(problems: list[str], fname: str, items: list[Any], key: str) -
     return readers
 
 
-def _nodes(problems: list[str], fname: str, items: list[Any]) -> list[NodeSettings]:
-    nodes: list[NodeSettings] = []
+def _nodes(problems: list[str], fname: str, items: list[Any]) -> list[NodeConfig]:
+    """The [[nodes]] tables as NodeConfig, with every problem named by its key; the limits are the
+    model's own (netplc/exchange.py), so a node station.toml accepts is one the exchange runs."""
+    nodes: list[NodeConfig] = []
     seen: set[int] = set()
     lines: dict[str, tuple[int, Endpoint]] = {}  # serial device -> the first node on it
+    d = NodeConfig
     for i, r in _array_tables(problems, fname, items, "nodes"):
-        node = r.number("node", -1, 0, 255, required=True)
+        node = r.number("node", -1, *NODE_NUMBERS, required=True)
         endpoint = r.get("endpoint", str, "")
-        unit = r.number("unit", 1, 0, 247)
-        profile = r.get("profile", str, "cpu165")
-        timeout = _seconds(r, "timeout", 1.0, 0.01, 60)
-        retries = r.number("retries", 1, 0, 10)
-        table_name = r.get("table", str, "holding")
-        backoff = _seconds(r, "backoff", 0.2, 0.01, 600)
-        backoff_max = _seconds(r, "backoff_max", 5.0, 0.01, 3600)
+        unit = r.number("unit", d.unit, min(lo for lo, _ in UNITS.values()),
+                        max(hi for _, hi in UNITS.values()))
+        profile = r.get("profile", str, d.profile)
+        timeout = _seconds(r, "timeout", d.timeout, *LIMITS["timeout"])
+        retries = r.number("retries", d.retries, *map(int, LIMITS["retries"]))
+        table_name = r.get("table", str, d.table)
+        backoff = _seconds(r, "backoff", d.backoff, *LIMITS["backoff"])
+        backoff_max = _seconds(r, "backoff_max", d.backoff_max, *LIMITS["backoff_max"])
         r.finish()
         if backoff > backoff_max:
             r.bad("backoff", f"{backoff:g} s is more than backoff_max {backoff_max:g} s")
-            backoff = min(0.2, backoff_max)
+            backoff = min(d.backoff, backoff_max)
         if endpoint:
             try:
                 ep = parse_endpoint(endpoint)
             except ValueError as e:
                 r.bad("endpoint", str(e))
-                endpoint = BAD_ENDPOINT
+                endpoint = ""
             else:
                 first, line = lines.setdefault(ep.device, (node, ep)) if ep.scheme == "rtu" else (node, ep)
                 if line != ep:
                     r.bad("endpoint", f"{ep} and node {first}'s {line} share {ep.device} with "
                                       "different line settings")
+                if problem := unit_problem(ep.scheme, unit):
+                    r.bad("unit", problem)
+                    unit = d.unit
         if profile not in PROFILES:
             r.bad("profile", f"{profile!r} is not one of {', '.join(PROFILES)}")
+            profile = d.profile
         if table_name not in TABLES:
             r.bad("table", f"{table_name!r} is not one of {', '.join(TABLES)}")
+            table_name = d.table
         if node in seen:
             r.bad("node", f"node {node} is configured twice")
         if node >= 0:
             seen.add(node)
-            nodes.append(NodeSettings(node, endpoint, unit, profile, timeout, retries, table_name,
-                                      backoff, backoff_max, key=f"nodes[{i}]"))
+            nodes.append(NodeConfig(node, endpoint, unit, profile, timeout, retries, table_name,
+                                    backoff, backoff_max, key=f"nodes[{i}]"))
     return nodes
 
 
@@ -333,9 +355,11 @@ def _seconds(r: _Reader, key: str, default: float, lo: float, hi: float) -> floa
     return value
 
 
-def _simulators(problems: list[str], fname: str, items: list[Any], base: Path) -> list[SimulatorSettings]:
+def _simulators(problems: list[str], fname: str, items: list[Any], base: Path,
+                allow_outside: bool) -> list[SimulatorSettings]:
     sims: list[SimulatorSettings] = []
     for _i, r in _array_tables(problems, fname, items, "simulators"):
+        r.allow_outside = allow_outside
         node = r.number("node", -1, 0, 255, required=True)
         program = r.path("program", base, required=True)
         symbols = r.path("symbols", base)
@@ -372,8 +396,8 @@ def _ports_in_common(problems: list[str], fname: str, server: ModbusServerSettin
                 problems.append(f"{fname}: simulators[{i}].port: {sim.host}:{sim.port} is also {first}")
 
 
-def _with_simulated_nodes(problems: list[str], fname: str, nodes: list[NodeSettings],
-                          sims: list[SimulatorSettings]) -> list[NodeSettings]:
+def _with_simulated_nodes(problems: list[str], fname: str, nodes: list[NodeConfig],
+                          sims: list[SimulatorSettings]) -> list[NodeConfig]:
     """A simulator serves its node: its endpoint is the simulator's address (filled at start if port 0)."""
     by_node = {n.node: n for n in nodes}
     for i, sim in enumerate(sims):
@@ -382,12 +406,12 @@ def _with_simulated_nodes(problems: list[str], fname: str, nodes: list[NodeSetti
         node = by_node.get(sim.node)
         endpoint = f"tcp://{sim.host}:{sim.port}" if sim.port else ""
         if node is None:
-            by_node[sim.node] = NodeSettings(sim.node, endpoint, unit=sim.unit, key=f"simulators[{i}]")
-        elif node.endpoint not in ("", BAD_ENDPOINT) and sim.port and node.endpoint != endpoint:
+            by_node[sim.node] = NodeConfig(sim.node, endpoint, unit=sim.unit, key=f"simulators[{i}]")
+        elif node.endpoint and sim.port and node.endpoint != endpoint:
             problems.append(f"{fname}: simulators[{i}].port: node {sim.node} has endpoint "
                             f"{node.endpoint}, but its simulator listens on {endpoint}")
     for n in by_node.values():
-        if not n.endpoint and not any(s.node == n.node for s in sims):
+        reported = any(p.startswith(f"{fname}: {n.key}.endpoint: ") for p in problems)
+        if not n.endpoint and not reported and not any(s.node == n.node for s in sims):
             problems.append(f"{fname}: nodes: node {n.node} has no endpoint and no simulator")
-    return sorted((replace(n, endpoint="") if n.endpoint == BAD_ENDPOINT else n for n in by_node.values()),
-                  key=lambda n: n.node)
+    return sorted(by_node.values(), key=lambda n: n.node)

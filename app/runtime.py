@@ -1,11 +1,16 @@
 """The station runtime ("FregatServer" without a window): registrar, retentive memory, simulated
-nodes, exchange, Modbus server and the NetPlc scan on the NetSyncTime tick.
+nodes, exchange, Modbus server, the NetPlc scan on the NetSyncTime tick, and what the forms do.
 
 It imports no Qt, so `--no-gui` is this module alone and the workstation only attaches to it.
 Start and stop run in opposite orders: the registrar is the first thing up and the last thing
 down, so every record produced while the rest starts or stops (link lost, final retentive save,
 'stop') is written; memory is saved only after the scan thread has ended, so the save is of a
 finished scan.
+
+Whatever the station does, it does here, with or without a window: the forms' models are loaded
+headless and their behaviour (sync generators, RegData/RegMessages and limit records) is evaluated
+from every scan's snapshot on the engine thread (`hmi_forms/behaviour.py`). Later per-scan
+consumers (tags and quality, alarms) attach the same way, as engine listeners beside it.
 """
 
 from __future__ import annotations
@@ -15,35 +20,30 @@ import socket
 import sqlite3
 import threading
 import time
-from collections.abc import Callable, Iterable
+from collections.abc import Callable
 from concurrent.futures import ThreadPoolExecutor, wait
 from dataclasses import dataclass, field, replace
-from pathlib import Path
 
-from app.config import NodeSettings, Station
+from app.config import Station
+from app.load import load, load_station_forms
+from hmi_forms.behaviour import FormBehaviour
+from hmi_forms.form import Form
 from netplc.engine import Engine
-from netplc.exchange import Exchange, NodeConfig, check_program_nodes
-from netplc.modbus.driver import parse_endpoint
-from netplc.modbus.server import ModbusServer
-from netplc.program import Program, ProgramError, load_symbols, parse, parse_file
+from netplc.exchange import Exchange, NodeConfig
+from netplc.modbus import ModbusServer, parse_endpoint
+from netplc.problems import Problems
 from netplc.records import Record
 from netplc.scheduler import ScanThread
 from netplc.simulator import Simulator
-from registrar.catalog import Catalog, CatalogError
 from registrar.retain import Retainer
 from registrar.store import Store, StoreStats
 
 RecordObserver = Callable[[Record], None]
-UNSTARTED = "tcp://127.0.0.1:1"  # endpoint of a simulated node whose simulator has not started
 RESOLVE_TIMEOUT = 5.0  # seconds for the host names of all TCP nodes to resolve
 
 
-class StartError(Exception):
+class StartError(Problems):
     """The station cannot start: every problem found (program, symbols, messages, addresses)."""
-
-    def __init__(self, problems: list[str]) -> None:
-        self.problems = problems
-        super().__init__("\n".join(problems))
 
 
 @dataclass(frozen=True)
@@ -87,26 +87,6 @@ class RuntimeStatus:
         return text
 
 
-def load_program(station: Station) -> Program:
-    """The station's NetPlc program (an empty one when NetPlcLoad is false); ProgramError if broken."""
-    if not station.NetPlcLoad or station.NetPlcProgram is None:
-        return parse("", source="<no program>")
-    symbols = load_symbols(station.Symbols) if station.Symbols else {}
-    return parse_file(station.NetPlcProgram, symbols)
-
-
-def load_simulated_program(path: Path, symbols: Path | None) -> Program:
-    return parse_file(path, load_symbols(symbols) if symbols else {})
-
-
-def node_configs(nodes: Iterable[NodeSettings]) -> list[NodeConfig]:
-    """The exchange's view of the station's nodes. A simulated node has no endpoint before its
-    simulator has a port; a placeholder stands in so the program can be checked against it."""
-    return [NodeConfig(n.node, n.endpoint or UNSTARTED, unit=n.unit, profile=n.profile, timeout=n.timeout,
-                       retries=n.retries, table=n.table, backoff=n.backoff, backoff_max=n.backoff_max)
-            for n in nodes]
-
-
 def unresolved_hosts(station: Station) -> list[str]:
     """The TCP nodes whose host name does not resolve, each naming its key. A typo in a host name
     would otherwise be a node that is silently down forever; the names are looked up together,
@@ -145,7 +125,13 @@ class Runtime:
     def __init__(self, station: Station, *, wallclock: Callable[[], float] = time.time) -> None:
         self.station = station
         self.wallclock = wallclock
-        self.catalog, self.program, self.node_programs = self._load()
+        loaded = load(station)
+        if loaded.problems:
+            raise StartError(loaded.problems)
+        self.symbols, self.catalog, self.program = loaded.symbols, loaded.catalog, loaded.program
+        self.node_programs = loaded.node_programs
+        self.forms: list[Form] = loaded.forms  # the runtime's own models: evaluated, never shown
+        self.form_problems = loaded.form_problems
         self.store: Store | None = None
         self.engine: Engine | None = None
         self.retainer: Retainer | None = None
@@ -153,7 +139,7 @@ class Runtime:
         self.exchange: Exchange | None = None
         self.modbus: ModbusServer | None = None
         self.scan_thread: ScanThread | None = None
-        self.nodes: list[NodeSettings] = list(station.nodes)
+        self.nodes: list[NodeConfig] = list(station.nodes)
         self.restored = ""  # which retentive save was used: current / previous / zeroes
         self.started_clock: float | None = None
         self._observers: list[RecordObserver] = []
@@ -195,33 +181,6 @@ class Runtime:
 
     # --- start and stop ------------------------------------------------------------------------
 
-    def _load(self) -> tuple[Catalog, Program, list[Program]]:
-        """Message texts, the program and the simulated nodes' programs, all checked before
-        anything starts; a NREAD/NWRITE to a node the station does not configure is an error."""
-        st = self.station
-        problems: list[str] = []
-        catalog = Catalog()
-        program = parse("", source="<none>")
-        node_programs: list[Program] = []
-        try:
-            if st.Messages is not None:
-                catalog = Catalog.load(st.Messages)
-        except CatalogError as e:
-            problems += e.problems
-        try:
-            program = load_program(st)
-            problems += [str(d) for d in check_program_nodes(program, node_configs(st.nodes))]
-        except ProgramError as e:
-            problems += [str(d) for d in e.errors]
-        for sim in st.simulators:
-            try:
-                node_programs.append(load_simulated_program(sim.program, sim.symbols))
-            except ProgramError as e:
-                problems += [str(d) for d in e.errors]
-        if problems:
-            raise StartError(problems)
-        return catalog, program, node_programs
-
     def start(self) -> None:
         """Start every part; StartError names the key of what could not start (the archive, a
         simulator's port, the nodes), after what did start is stopped again."""
@@ -248,10 +207,17 @@ class Runtime:
         self.system(f"station starting: {st.path}")
         self.engine = Engine(self.program, sink=self, tick=st.tick, wallclock=self.wallclock)
         self.started_clock = self.engine.now  # engine-clock time of the start (DateTime elements)
+        for problem in self.form_problems:
+            self.system(f"form not loaded: {problem}")
         if not st.NetPlcLoad:
             self.engine.stop()
         self.retainer = Retainer(st.Retain, self.engine, self)
         self.restored = self.retainer.restore()
+        behaviour = FormBehaviour(self.forms, self.engine.mem, self, self._problem)
+        behaviour.attach(self.engine)
+        if self.forms:
+            self.system(f"forms loaded: {len(self.forms)}, of their elements {len(behaviour.elements)} act "
+                        "on the station (sync generators, RegData/RegMessages), with or without a window")
         for i, (sim, program) in enumerate(zip(st.simulators, self.node_programs, strict=True)):
             simulator = Simulator(program, host=sim.host, port=sim.port, unit=sim.unit,
                                   tick=sim.tick_ms / 1000)
@@ -262,7 +228,7 @@ class Runtime:
                                   f"{sim.host}:{sim.port}: {_reason(e)}"]) from None
             self.simulators.append(simulator)
             self._fill_endpoint(sim.node, f"tcp://{sim.host}:{simulator.port}")
-        self.exchange = Exchange(node_configs(self.nodes), self)
+        self.exchange = Exchange(self.nodes, self)
         self.exchange.attach(self.engine)
         self.exchange.start()
         server = st.modbus_server
@@ -292,6 +258,11 @@ class Runtime:
         for text in unresolved_hosts(self.station):
             if self.started:
                 self.system(f"{text}; the node stays down until it does")
+
+    def open_forms(self) -> tuple[list[Form], list[str]]:
+        """Fresh models of the station's forms for a view, which only shows them (the runtime
+        evaluates its own); and the problems of the forms that did not load."""
+        return load_station_forms(self.station, self.symbols)
 
     def _fill_endpoint(self, node: int, endpoint: str) -> None:
         self.nodes = [replace(n, endpoint=endpoint) if n.node == node and not n.endpoint else n
@@ -354,7 +325,7 @@ class Runtime:
         exchange = self.exchange
         nodes = tuple(NodeStatus(n.node, n.endpoint, bool(exchange and exchange.link_up(n.node)))
                       for n in self.nodes)
-        problems = list(self._problems)
+        problems = list(self._problems) + [f"form problem: {p}" for p in self.form_problems[:3]]
         written = pending = lost = 0
         s = self.store.stats if self.store is not None else self._final_store
         if s is not None:

@@ -1,4 +1,4 @@
-"""Load and validate `.hmi` forms (DESIGN section 9).
+"""Load and validate `.hmi` forms (docs/architecture.md section 9).
 
 A form file is JSON:
 
@@ -23,15 +23,14 @@ from typing import Any
 from hmi_forms.elements import ELEMENT_TYPES, Element
 from hmi_forms.elements import props as p
 from hmi_forms.elements.analog import scaling_problems
+from netplc.problems import Problems
 
 FORM_BACK = (0xDD, 0xE1, 0xE6, 255)
 FORM_FORE = (0x1A, 0x1A, 0x1A, 255)
 
 
-class FormError(Exception):
-    def __init__(self, problems: list[str]) -> None:
-        super().__init__("\n".join(problems))
-        self.problems = problems
+class FormError(Problems):
+    """Every problem of one form file, each naming the element and property."""
 
 
 @dataclass

@@ -16,7 +16,7 @@ DATA_SIZE = BANKS * BANK_SIZE  # 16 KB
 MAX_ADDRESS = 0o77777
 HMI_DATA_BIT_BASE = 0o40000  # HMI bit address >= this is byte*8 + bit
 
-# Special I/O bits (DESIGN section 3).
+# Special I/O bits (docs/architecture.md section 3).
 GEN_BASE = 0o3750  # 03750-03757 square-wave generators, 0.1 s * 2**k
 ALWAYS_ONE = 0o3760
 EMERGENCY_STOP = 0o3770

@@ -4,7 +4,7 @@ The program is cut into basic blocks at jump targets; each block becomes one str
 function of the chain state `a` (ACC) and `s` (SUM) on entry, returning the index of the next
 block (None ends the scan, HALT halts) and the state on exit. Inside a block the chain state is
 kept symbolically: a chain of contacts becomes one short-circuit expression (contacts have no side
-effects, so `and`/`or` give the same RES as the bitwise model of DESIGN section 4), evaluated
+effects, so `and`/`or` give the same RES as the bitwise model of docs/architecture.md section 4), evaluated
 once by its terminator. TIM and CTR are written out from the source lines netplc/timers.py keeps
 beside its closures; a FON runs its function's inline source lines (FunctionSpec.inline, for simple
 functions on data operands) or calls the step the engine binds once per instruction. The reference
@@ -15,14 +15,11 @@ tests hold the two to identical memory.
 from __future__ import annotations
 
 import re
-from collections.abc import Callable
-from typing import TYPE_CHECKING
 
+from netplc import backend
+from netplc.backend import Backend, Outcome, ScanHost
 from netplc.program import Instr, Program
 from netplc.timers import QUOTIENT, TIME_BASE_BITS, TIME_BASES, ctr_lines, tim_lines
-
-if TYPE_CHECKING:
-    from netplc.engine import Engine
 
 HALT = -1
 _MAX_DEPTH = 24  # nested and/or groups before the state is stored in a and s (parser limits)
@@ -280,10 +277,8 @@ def _chunked(name: str, block: _Block) -> list[str]:
     return [*out, f"def {name}(a, s, {defaults}):", *("    " + line for line in body)]
 
 
-def compile_program(program: Program, engine: Engine) -> Callable[[], str | None]:
+def compile_program(program: Program, engine: ScanHost) -> Backend:
     """One scan of `program` on `engine`: returns None at the end, "halt" or "watchdog"."""
-    from netplc.engine import WATCHDOG_STEPS
-
     instrs = program.instrs
     inline: dict[int, list[str]] = {}
     steps = {}
@@ -302,16 +297,17 @@ def compile_program(program: Program, engine: Engine) -> Callable[[], str | None
     sizes = {s: (starts[k + 1] if k + 1 < len(starts) else len(instrs)) - s for k, s in enumerate(starts)}
     first = blocks.get(0)
 
-    def run() -> str | None:
+    def run() -> Outcome:
         if first is None:
             return None
         nxt, a, s = first(1, 0)
         steps = sizes[0]
+        limit = backend.WATCHDOG_STEPS
         while nxt is not None:
             if nxt == HALT:
                 return "halt"
             steps += sizes[nxt]
-            if steps > WATCHDOG_STEPS:
+            if steps > limit:
                 return "watchdog"
             nxt, a, s = blocks[nxt](a, s)
         return None

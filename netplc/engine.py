@@ -1,4 +1,4 @@
-"""The NetPlc engine: one scan every NetSyncTime tick (DESIGN sections 1 and 4).
+"""The NetPlc engine: one scan every NetSyncTime tick (docs/architecture.md sections 1 and 4).
 
 Only the engine thread mutates memory. Everything else (network results, operator writes, Modbus
 server writes) is queued with `post`/`write_*` and applied at the start of the next scan, and
@@ -24,15 +24,16 @@ from netplc.address import (
     BitRef,
     fmt_octal,
 )
+from netplc.backend import Backend
+from netplc.compiler import compile_program
 from netplc.functions._util import Step, bind, fail
 from netplc.functions.registry import Fon, FunctionSpec, NetLink, lookup
+from netplc.interpreter import Interpreter
 from netplc.memory import Memory, Snapshot
 from netplc.program import Program
 from netplc.records import NullSink, Record, RecordSink
 from netplc.rtc import Rtc
 from netplc.timers import held, make_ctr, make_tim, update_generators
-
-WATCHDOG_STEPS = 1_000_000  # instructions per scan before the scan is abandoned (endless jump loop)
 
 
 class RunState(StrEnum):
@@ -116,9 +117,6 @@ class Engine:
 
     def load(self, program: Program) -> None:
         """Install a program (memory, timer and counter values are kept)."""
-        from netplc.compiler import compile_program
-        from netplc.interpreter import Interpreter
-
         self.program = program
         self._faulted.clear()
         self.fons: dict[int, tuple[Fon, FunctionSpec | None]] = {}
@@ -133,7 +131,8 @@ class Engine:
                 fon = Fon(ins.c or 0, ins.n or 0, ins.s, ins.d, ins.r, index, ins.line)
                 self.fons[index] = (fon, lookup(fon.f))
                 self._calls[index] = self._make_fon(index)
-        self._run = compile_program(program, self) if self.compiled else Interpreter(program, self).run
+        self._run: Backend = (compile_program(program, self) if self.compiled
+                              else Interpreter(program, self).run)
 
     # --- what the program calls ----------------------------------------------------------------
 

@@ -1,4 +1,5 @@
-"""Exchange with the PLC network: NODE / NREAD / NWRITE block requests over Modbus (DESIGN 1 and 7).
+"""Exchange with the PLC network: NODE / NREAD / NWRITE block requests over Modbus
+(docs/architecture.md sections 1 and 7).
 
 The scan never waits for the network. NREAD/NWRITE hand a block request to the node's asyncio task
 (on the exchange's own event-loop thread) and return at once with the node's link state; while a
@@ -27,20 +28,26 @@ import asyncio
 import time
 from collections import deque
 from collections.abc import Awaitable, Callable, Iterable
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from typing import TYPE_CHECKING, TypeVar
 
 from netplc.address import PRESENCE_LIST, PRESENCE_NODES, AddressError, check_operand
 from netplc.memory import Memory
-from netplc.modbus.driver import (
+from netplc.modbus import (
+    PROFILES,
+    TABLES,
+    WRITABLE_TABLES,
+    Block,
     DeviceError,
     Endpoint,
     LinkError,
     LoopThread,
+    MapError,
+    describe,
+    locate,
     open_client,
     parse_endpoint,
 )
-from netplc.modbus.map import PROFILES, TABLES, WRITABLE_TABLES, Block, MapError, describe, locate
 from netplc.program import Diagnostic, Program
 from netplc.records import NullSink, Record, RecordSink
 
@@ -53,12 +60,30 @@ PROBE_IDLE = 1.0  # seconds without a request before a node's link is probed
 T = TypeVar("T")
 
 
+# What a node's settings may be: station.toml's reader (app/config.py) and the model's own check
+# use these, so the two can never disagree.
+NODE_NUMBERS = (0, 255)  # the manual's node range, as in NODE S:n
+UNITS = {"tcp": (0, 255), "rtu": (1, 247)}  # Modbus unit id per scheme (docs/architecture.md section 7)
+LIMITS: dict[str, tuple[float, float]] = {"timeout": (0.01, 60.0), "retries": (0, 10),
+                                          "backoff": (0.01, 600.0), "backoff_max": (0.01, 3600.0)}
+
+
+def unit_problem(scheme: str, unit: int) -> str | None:
+    """Why `unit` cannot address a device over `scheme` (tcp or rtu), or None."""
+    lo, hi = UNITS[scheme]
+    if lo <= unit <= hi:
+        return None
+    why = "" if scheme == "tcp" else " (0 is broadcast, which never answers; 248-255 are reserved)"
+    return f"unit {unit} is not {lo}-{hi} on {scheme}{why}"
+
+
 @dataclass
 class NodeConfig:
-    """One remote node of station.toml: where it is and how to talk to it."""
+    """One remote node: where it is and how to talk to it. The one model of a node: station.toml's
+    [[nodes]] tables and embedded simulators become these (app/config.py), the exchange runs them."""
 
     node: int
-    endpoint: str
+    endpoint: str  # tcp://host:port or rtu://device?...; "" until a simulator on port 0 fills it in
     unit: int = 1
     profile: str = "cpu165"
     timeout: float = 1.0  # seconds per attempt
@@ -66,50 +91,37 @@ class NodeConfig:
     table: str = "holding"  # profile "modbus": holding, input, coils or discrete
     backoff: float = 0.2  # first reconnect delay after the link went down, seconds
     backoff_max: float = 5.0  # the delay doubles up to this
+    key: str = field(default="nodes", compare=False)  # where station.toml sets it (nodes[2]), for messages
 
     def __post_init__(self) -> None:
-        self.parsed: Endpoint = self.validate()
+        self.parsed: Endpoint | None = self.validate()
 
-    def validate(self) -> Endpoint:
-        """The parsed endpoint; ValueError names the node and what is wrong."""
+    def validate(self) -> Endpoint | None:
+        """The parsed endpoint (None while there is none); ValueError names the node and what is wrong."""
         where = f"node {self.node}"
-        if not isinstance(self.node, int) or not 0 <= self.node <= 255:
-            raise ValueError(f"{where}: the node number must be 0-255")
-        try:
-            endpoint = parse_endpoint(self.endpoint)
-        except ValueError as e:
-            raise ValueError(f"{where}: {e}") from None
-        if not 0 <= self.unit <= 255:
-            raise ValueError(f"{where}: unit {self.unit} is not 0-255")
+        lo, hi = NODE_NUMBERS
+        if not isinstance(self.node, int) or not lo <= self.node <= hi:
+            raise ValueError(f"{where}: the node number must be {lo}-{hi}")
+        endpoint = None
+        if self.endpoint:
+            try:
+                endpoint = parse_endpoint(self.endpoint)
+            except ValueError as e:
+                raise ValueError(f"{where}: {e}") from None
+        problem = unit_problem(endpoint.scheme if endpoint else "tcp", self.unit)
+        if problem:
+            raise ValueError(f"{where}: {problem}")
         if self.profile not in PROFILES:
             raise ValueError(f"{where}: profile {self.profile!r} is not one of {', '.join(PROFILES)}")
         if self.table not in TABLES:
             raise ValueError(f"{where}: table {self.table!r} is not one of {', '.join(TABLES)}")
-        if not self.timeout > 0:
-            raise ValueError(f"{where}: timeout {self.timeout} must be more than 0 s")
-        if self.retries < 0:
-            raise ValueError(f"{where}: retries {self.retries} must be 0 or more")
-        if not 0 < self.backoff <= self.backoff_max:
-            raise ValueError(f"{where}: backoff {self.backoff} must be more than 0 and at most "
-                             f"backoff_max {self.backoff_max}")
+        for key, (lo_, hi_) in LIMITS.items():
+            if not lo_ <= getattr(self, key) <= hi_:
+                raise ValueError(f"{where}: {key} {getattr(self, key):g} is outside {lo_:g}-{hi_:g}")
+        if self.backoff > self.backoff_max:
+            raise ValueError(f"{where}: backoff {self.backoff:g} must be at most "
+                             f"backoff_max {self.backoff_max:g}")
         return endpoint
-
-    @classmethod
-    def parse(cls, node: int, values: dict) -> NodeConfig:
-        """Build from a config table (station.toml `[nodes.N]`); ValueError names the bad key."""
-        known = {"endpoint", "unit", "profile", "timeout", "retries", "table", "backoff", "backoff_max"}
-        unknown = sorted(set(values) - known)
-        if unknown:
-            raise ValueError(f"node {node}: unknown setting(s) {', '.join(unknown)} "
-                             f"(known: {', '.join(sorted(known))})")
-        if "endpoint" not in values:
-            raise ValueError(f"node {node}: endpoint is missing")
-        kinds = {"endpoint": str, "unit": int, "profile": str, "timeout": (int, float),
-                 "retries": int, "table": str, "backoff": (int, float), "backoff_max": (int, float)}
-        for key, value in values.items():
-            if not isinstance(value, kinds[key]) or isinstance(value, bool):
-                raise ValueError(f"node {node}: {key} = {value!r} has the wrong type")
-        return cls(node=node, **values)
 
 
 @dataclass
@@ -306,6 +318,8 @@ class Exchange:
                 raise ValueError(f"node {cfg.node} is configured twice")
             self.configs[cfg.node] = cfg
             ep = cfg.parsed
+            if ep is None:
+                raise ValueError(f"node {cfg.node}: no endpoint")
             other = serial.setdefault(ep.device, cfg) if ep.scheme == "rtu" else cfg
             if other.parsed != ep:
                 raise ValueError(f"node {cfg.node}: {ep} and node {other.node}: {other.parsed} share "

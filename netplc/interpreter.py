@@ -1,35 +1,32 @@
-"""The reference interpreter: the instruction semantics of DESIGN section 4, written plainly.
+"""The reference interpreter: the instruction semantics of docs/architecture.md section 4, written plainly.
 
 The compiled engine must leave memory exactly as this does (tests/netplc/test_compiled_equivalence.py).
 """
 
 from __future__ import annotations
 
-from typing import TYPE_CHECKING
-
+from netplc import backend
+from netplc.backend import Outcome, ScanHost
 from netplc.program import Program
 
-if TYPE_CHECKING:
-    from netplc.engine import Engine
 
 class Interpreter:
-    def __init__(self, program: Program, engine: Engine) -> None:
+    def __init__(self, program: Program, engine: ScanHost) -> None:
         self.instrs = program.instrs
         self.engine = engine
 
-    def run(self) -> str | None:
+    def run(self) -> Outcome:
         """One scan; returns None at the end, "halt" on HLT, "watchdog" on an endless loop."""
-        from netplc.engine import WATCHDOG_STEPS
-
         eng = self.engine
         bits = eng.mem.bits
         instrs = self.instrs
         acc, sm = 1, 0
         pc = 0
         steps = 0
+        limit = backend.WATCHDOG_STEPS
         while pc < len(instrs):
             steps += 1
-            if steps > WATCHDOG_STEPS:
+            if steps > limit:
                 return "watchdog"
             ins = instrs[pc]
             op = ins.op

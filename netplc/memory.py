@@ -7,7 +7,7 @@ costs about half what indexing a bytearray does in CPython 3.11. An element is 0
 A snapshot keeps the bits as a tuple: copying the list into one costs a third of converting it to
 bytes, and the engine publishes a snapshot after every scan. Byte and word operands
 below 04000 are assembled from 8 or 16 consecutive bits (bit A+k is bit k of the value).
-Words are little-endian; 32-bit values are low word first (DESIGN section 3).
+Words are little-endian; 32-bit values are low word first (docs/architecture.md section 3).
 """
 
 from __future__ import annotations
@@ -79,7 +79,7 @@ class MemoryView:
 
 
 class Memory(MemoryView):
-    """The live memory. Only the engine thread writes it (DESIGN section 1)."""
+    """The live memory. Only the engine thread writes it (docs/architecture.md section 1)."""
 
     def __init__(self) -> None:
         self.bits: list[int] = [0] * IO_BITS

@@ -1,4 +1,4 @@
-"""STL program text -> a validated list of instructions (DESIGN section 5).
+"""STL program text -> a validated list of instructions (docs/architecture.md section 5).
 
 An engineer's typo must come back as `file:line:col: message`, all of them at once, never as a
 traceback, so the parser collects diagnostics and raises one ProgramError at the end.
@@ -13,6 +13,7 @@ from pathlib import Path
 
 from netplc.address import IO_BITS, AddressError, check_operand, fmt_octal, parse_octal
 from netplc.functions.registry import DEFINED_CODES, FunctionSpec, lookup
+from netplc.problems import Problems
 
 PROGRAM_WORDS = 0o20000  # 8 K words of program memory
 
@@ -52,12 +53,12 @@ class Diagnostic:
         return f"{self.file}:{self.line}:{self.col}: {self.message}"
 
 
-class ProgramError(Exception):
-    """All problems found in a program (or symbols file), each with its position."""
+class ProgramError(Problems):
+    """All problems found in a program (or symbols file), each with its position in `errors`."""
 
     def __init__(self, errors: list[Diagnostic]) -> None:
         self.errors = errors
-        super().__init__("\n".join(str(e) for e in errors))
+        super().__init__([str(e) for e in errors])
 
 
 @dataclass(frozen=True, slots=True)

@@ -1,7 +1,7 @@
 """Records the engine and its helpers hand to the registrar.
 
 The registrar owns storage; NetPlc only needs somewhere to put records, so the sink is a protocol
-and tests use ListSink. Columns mirror the archive table (DESIGN section 8).
+and tests use ListSink. Columns mirror the archive table (docs/architecture.md section 8).
 """
 
 from __future__ import annotations

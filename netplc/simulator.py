@@ -1,6 +1,6 @@
 """A simulated CPU-165 node: the NetPlc engine running a CPU-165 program on its tick, served over
 Modbus TCP, or Modbus RTU on a serial port, with the cpu165 profile and all of its memory writable
-(DESIGN section 1).
+(docs/architecture.md section 1).
 
 It is what a user points NetPlc at before the plant exists, what the demo station embeds, and
 what the exchange tests and benchmark talk to. It has no exchange of its own: a CPU-165 answers
@@ -18,8 +18,7 @@ import sys
 import threading
 
 from netplc.engine import Engine
-from netplc.modbus.driver import Endpoint, parse_endpoint
-from netplc.modbus.server import ALL_MEMORY, ModbusServer
+from netplc.modbus import ALL_MEMORY, Endpoint, ModbusServer, parse_endpoint
 from netplc.program import Program, ProgramError, load_program
 from netplc.records import RecordSink
 from netplc.scheduler import ScanThread

@@ -1,4 +1,4 @@
-"""TIM and CTR semantics, the timer time base and the square-wave generators (DESIGN section 4).
+"""TIM and CTR semantics, the timer time base and the square-wave generators (docs/architecture.md section 4).
 
 Each TIM/CTR instruction gets one closure bound to its coil address and preset, which the reference
 interpreter calls through the engine; the compiled program runs the same semantics written out as

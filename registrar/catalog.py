@@ -11,15 +11,13 @@ from collections.abc import Iterator
 from dataclasses import dataclass
 from pathlib import Path
 
-MESSAGE_TYPES = {0: "info", 1: "warning", 2: "alarm", 3: "critical"}  # DESIGN section 8
+from netplc.problems import Problems
+
+MESSAGE_TYPES = {0: "info", 1: "warning", 2: "alarm", 3: "critical"}  # docs/architecture.md section 8
 
 
-class CatalogError(Exception):
+class CatalogError(Problems):
     """A catalog that cannot be used; every problem is named `file:line: message`."""
-
-    def __init__(self, problems: list[str]) -> None:
-        super().__init__("\n".join(problems))
-        self.problems = problems
 
 
 @dataclass(frozen=True, slots=True)

@@ -1,7 +1,7 @@
 """Retentive memory: what a CPU-165 keeps through a power cut, kept here through a restart.
 
 That is all data memory, the I/O bits 03000-03477, and the timer and counter current values
-(DESIGN section 3). A save is written to a temporary file, fsynced and renamed over the current
+(docs/architecture.md section 3). A save is written to a temporary file, fsynced and renamed over the current
 one, whose last good version is kept as the previous save; a crash at any moment leaves at least
 one complete save. Each save carries a CRC, so a damaged file is recognised and the previous one
 used instead. While the engine scans, a save's state is taken by the engine thread between two

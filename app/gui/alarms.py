@@ -15,7 +15,7 @@ from PySide6.QtWidgets import QFrame, QHBoxLayout, QLabel, QPushButton, QWidget
 
 from netplc.records import Record
 
-ALARM_TYPE = 2  # DESIGN section 8: 0 info, 1 warning, 2 alarm, 3 critical
+ALARM_TYPE = 2  # docs/architecture.md section 8: 0 info, 1 warning, 2 alarm, 3 critical
 TYPE_NAMES = {0: "info", 1: "warning", 2: "ALARM", 3: "CRITICAL"}
 
 

@@ -3,7 +3,9 @@
 Records and snapshots are produced on the scan and exchange threads; Qt widgets may only be
 touched on the GUI thread. A signal emitted from another thread is delivered through the GUI
 thread's event loop. Snapshots are coalesced: if the GUI falls behind, it skips to the newest
-scan instead of queueing a backlog it can never catch up with.
+scan instead of queueing a backlog it can never catch up with. That is safe because the views
+only show: nothing of the station's behaviour (sync pulses, element records) runs on this path;
+the runtime evaluates it from every snapshot on the engine thread.
 """
 
 from __future__ import annotations

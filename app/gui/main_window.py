@@ -1,7 +1,9 @@
 """The operator workstation: the station's HMI forms as tabs around a running Runtime.
 
-The window never owns plant state: memory comes as snapshots from the scan thread (through the
-bridge), operator actions go to the engine's queued writes, and records go to the runtime's sink.
+The window never owns plant state nor station behaviour: memory comes as snapshots from the scan
+thread (through the bridge, which may skip snapshots when the window lags: only the picture
+skips), operator actions go to the engine's queued writes, and what the forms do by themselves
+(sync generators, element records) the runtime does, window or not.
 What is wrong with the station itself (program stopped, node down, archive failing) is shown in
 the window, not only logged, because the operator is the one who must act on it.
 """
@@ -28,18 +30,17 @@ from PySide6.QtWidgets import (
     QWidget,
 )
 
-from app.config import ConfigError, load_station
+from app.config import load_station
 from app.gui.alarms import Alarm, AlarmBanner, HealthStrip
 from app.gui.bridge import RuntimeBridge
 from app.gui.journal import JournalDock
 from app.gui.status import StationStatusBar, station_problems
 from app.gui.style import apply_style
-from app.runtime import Runtime, StartError
+from app.runtime import Runtime
 from hmi_forms.elements.target import EngineTarget
-from hmi_forms.form import load_forms
 from hmi_forms.widgets.form_view import FormView
 from netplc.memory import Snapshot
-from netplc.program import ProgramError, load_symbols
+from netplc.problems import Problems
 from netplc.records import Record
 
 STATUS_MS = 500
@@ -130,12 +131,8 @@ class MainWindow(QMainWindow):
         if station.HMIload is None:
             self.tabs.addTab(_placeholder("This station has no HMIload folder."), "No forms")
             return []
-        try:
-            symbols = load_symbols(station.Symbols) if station.Symbols else {}
-        except ProgramError:
-            symbols = {}  # the runtime refused to start with broken symbols, so this is not reached
-        forms, problems = load_forms(station.HMIload, symbols)
-        target = EngineTarget(self.runtime.engine, self.runtime)
+        forms, problems = self.runtime.open_forms()  # the views' own models: they only show
+        target = EngineTarget(self.runtime.engine)
         for form in forms:
             view = FormView(form, target, archive_path=station.Archive, user=self.user,
                             started=self.runtime.started_clock)
@@ -189,7 +186,7 @@ class MainWindow(QMainWindow):
     def refresh_status(self) -> None:
         status = self.runtime.status()
         self.status.show_status(status)
-        problems = station_problems(status) + [f"form problem: {p}" for p in self.form_problems[:3]]
+        problems = station_problems(status)
         self.health.show_problems(problems)
         running = status.state == "running"
         self.act_run.setEnabled(not running)
@@ -273,7 +270,7 @@ def run_workstation(station_path: str) -> int:
     try:
         runtime = Runtime(load_station(station_path))
         runtime.start()
-    except (ConfigError, StartError) as e:
+    except Problems as e:
         print("\n".join(e.problems), file=sys.stderr)
         QMessageBox.critical(None, "NetPlc Station", "The station cannot start:\n\n" + "\n".join(e.problems))
         return 2

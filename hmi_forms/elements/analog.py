@@ -2,7 +2,7 @@
 
 Conversion is linear between the hardware range AppMin..AppMax and the physical range
 PhyMin..PhyMax, taken from a named Device of the form or from the element's own four properties
-(DESIGN section 9). Decisions where the manual is silent:
+(docs/architecture.md section 9). Decisions where the manual is silent:
 - PhyLow/PhyHigh split the value into zones low/normal/high; a zone is left only when the value is
   back by Hysteresis (physical units, default 0), so a noisy value at a limit does not flood the
   journal. RegMessages records each zone change (kind "message": NormalMessage with type 0,

@@ -1,7 +1,11 @@
 """What every HMI element shares: geometry, the UObject look, SyncType gating and data quality.
 
 An element model reads snapshots and keeps what its widget must draw; `update` says whether that
-changed, so the form repaints only those widgets. Gating and quality are decided here once:
+changed, so the form repaints only those widgets. The same model, bound to the runtime's
+`Effects`, is what a form does to the station: an element that `acts` (a sync generator, RegData,
+RegMessages) is evaluated by the runtime from every snapshot, and its records and writes go there;
+a view's copy has no effects and only shows (hmi_forms/elements/target.py). Gating and quality are
+decided here once, for both:
 - SyncType 0 updates every tick; otherwise only while that bit is 1 (the manual's level sync).
 - QualityAddr (an extension) names a bit such as an NREAD link output: while it is 0 the element
   keeps its last value and marks it stale, so frozen data never looks live.
@@ -15,7 +19,7 @@ from functools import cached_property
 from typing import Any, ClassVar
 
 from hmi_forms.elements import props as p
-from hmi_forms.elements.target import Target
+from hmi_forms.elements.target import Effects, Target
 from netplc.address import IO_BITS, BitRef, data_index
 from netplc.memory import Snapshot
 from netplc.records import Kind, Record
@@ -67,7 +71,8 @@ class Element:
     ImageAlign: str = field(default="MiddleCenter", metadata=p.prop(p.alignment))
 
     stale: bool = field(default=False, init=False)
-    target: Target | None = field(default=None, init=False, repr=False)
+    target: Target | None = field(default=None, init=False, repr=False)  # the operator's writes
+    effects: Effects | None = field(default=None, init=False, repr=False)  # the runtime's copy only
     user: str = field(default="operator", init=False)
 
     def check(self, ctx: p.Context) -> list[tuple[str, str]]:
@@ -75,8 +80,15 @@ class Element:
         return []
 
     def bind(self, target: Target, user: str = "operator") -> None:
+        """Forward the operator's input (clicks, setpoints) to `target` under `user`."""
         self.target = target
         self.user = user
+
+    @property
+    def acts(self) -> bool:
+        """Whether the element does something to the station by itself (records, writes): the
+        runtime evaluates exactly these, from every snapshot."""
+        return self.RegData or self.RegMessages
 
     def update(self, snap: Snapshot) -> bool:
         """Read one snapshot; True when what the widget shows has changed."""
@@ -103,5 +115,5 @@ class Element:
         return False
 
     def record(self, snap: Snapshot, kind: Kind, **fields: Any) -> None:
-        if self.target is not None:
-            self.target.put(Record(snap.wall, kind, source=self.Name, **fields))
+        if self.effects is not None:
+            self.effects.put(Record(snap.wall, kind, source=self.Name, **fields))

@@ -26,7 +26,7 @@ class PropError(ValueError):
 
 @dataclass(frozen=True, slots=True)
 class Scaling:
-    """Linear hardware <-> physical conversion (DESIGN section 9)."""
+    """Linear hardware <-> physical conversion (docs/architecture.md section 9)."""
 
     AppMin: float
     AppMax: float

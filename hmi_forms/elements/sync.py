@@ -4,8 +4,9 @@ A snapshot carrying scan counter S was published after S scans; the output writt
 at the start of scan number S (counting from 0), so the program of that scan sees
 `S mod Period == Phase`. With pairs (5,0)/(10,1) and select bit 0, the output is 1 in scans
 0, 5, 10, ...; with the select bit 1, in scans 1, 11, 21, ...
-Generators are the only elements that write without an operator, so they use the unjournaled
-`set_bit` of the target, once per new scan (a snapshot seen twice writes nothing more).
+Generators are the only elements that write without an operator: the runtime evaluates them from
+every snapshot on the engine thread and they write through its unjournaled `Effects.set_bit`, once
+per new scan (a snapshot seen twice writes nothing more), so no pulse depends on a view.
 """
 
 from __future__ import annotations
@@ -46,6 +47,10 @@ class SyncGenerator(Element):
     def period_phase(self) -> tuple[int, int]:
         return (self.Period1, self.Phase1) if self.pair else (self.Period0, self.Phase0)
 
+    @property
+    def acts(self) -> bool:
+        return True
+
     def is_enabled(self, snap: Snapshot) -> bool:
         return True
 
@@ -59,8 +64,8 @@ class SyncGenerator(Element):
         self.pair, self.enabled = pair, enabled
         period, phase = self.period_phase
         out = 1 if enabled and snap.scan % period == phase else 0
-        if self.target is not None and self.OutAddr is not None:
-            self.target.set_bit(self.OutAddr.hmi, out)
+        if self.effects is not None and self.OutAddr is not None:
+            self.effects.set_bit(self.OutAddr.hmi, out)
         changed = changed or out != self.output
         self.output = out
         return changed

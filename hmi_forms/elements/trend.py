@@ -1,7 +1,7 @@
 """A fixed-size ring buffer of samples for trend displays (Graph and AnalogBase "graph").
 
 pyqtgraph has no append API, so trends keep a preallocated float64 buffer and hand an ordered
-copy to `setData` only when a redraw is due (anchors.md section 4). NaN marks a sample taken while
+copy to `setData` only when a redraw is due (docs/architecture.md section 9). NaN marks a sample taken while
 the data were stale, which the plot draws as a gap.
 """
 

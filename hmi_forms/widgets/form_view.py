@@ -1,6 +1,9 @@
 """A whole HMI form as one widget: element widgets placed as in the file, refreshed once per tick.
 
-The workstation calls `refresh(engine.snapshot)` from a QTimer. Every model reads the snapshot;
+The workstation calls `refresh(snapshot)` with the snapshots the bridge hands to the GUI thread (it
+skips some when the window lags: a view only shows, and forwards the operator's input; what the
+form does to the station, the runtime does from every snapshot, hmi_forms/behaviour.py). Every
+model reads the snapshot;
 only widgets whose model reports a change are scheduled for repainting, and Qt paints them all in
 one pass. Trend plots are redrawn in staggered turns (a few per tick, each once a second, as PyDM
 does by default) so fifty plots never land in the same tick. A model that raises is reported once, marked

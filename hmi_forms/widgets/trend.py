@@ -1,6 +1,6 @@
 """Trends with pyqtgraph: the Graph element (a bit) and AnalogBase with Appearance "graph".
 
-Following anchors.md section 4: the plot and its curve are created once per widget and fed with
+Following docs/architecture.md section 9: the plot and its curve are created once per widget and fed with
 `setData` (a bare PlotCurveItem: PlotDataItem's per-call bookkeeping cost five times the data
 itself); the axes have fixed ranges (no autorange per frame) and are cached as pixmaps; mouse
 interaction, menus and buttons are off (an operator panel, not an analysis tool); and redraws are

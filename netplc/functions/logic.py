@@ -139,7 +139,7 @@ def _parity_check(odd: bool) -> Builder:
 
 
 # PRTE's description is a copy of PRTO's ("even"), but its example makes the parity odd: the
-# example wins (DESIGN section 6).
+# example wins (docs/architecture.md section 6).
 register(81, "PRTO", "M", "M")(built(_parity_set(odd=False)))
 register(82, "PRTOCH", "M")(built(_parity_check(odd=False)))
 register(83, "PRTE", "M", "M")(built(_parity_set(odd=True)))

@@ -146,7 +146,7 @@ def movblk(mem: Memory, fon: Fon) -> Step:
     """Copy the block S..D (inclusive) to the area starting at R.
 
     The manual gives three readings; its worked example says "the area D = 04000-04007 is copied
-    to the area starting at R = 04010", and the example wins (DESIGN section 6): S is the first
+    to the area starting at R = 04010", and the example wins (docs/architecture.md section 6): S is the first
     source byte, D the last, R the first destination byte. FErr1 when D < S or the block is longer
     than 256 bytes (or runs off its bank).
     """

@@ -1,4 +1,5 @@
-"""NetPlc network functions NODE (300), NREAD (301), NWRITE (302): spec section 4.3, DESIGN 1 and 6.
+"""NetPlc network functions NODE (300), NREAD (301), NWRITE (302): spec section 4.3,
+docs/architecture.md sections 1 and 6.
 
 They only hand block requests to the exchange (netplc/exchange.py) and never wait for the network;
 the data read arrives in memory at the start of a later scan. Output C+1 is the node's link state

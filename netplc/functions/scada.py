@@ -1,4 +1,4 @@
-"""The NetPlc group 303-316 (manual group 3.7, DESIGN section 6): registration and processing.
+"""The NetPlc group 303-316 (manual group 3.7, docs/architecture.md section 6): registration and processing.
 
 NODE, NREAD and NWRITE (300-302) live in net.py with the exchange.
 

@@ -5,3 +5,21 @@ It is the wire and nothing more: what NODE/NREAD/NWRITE mean is `netplc/exchange
 simulated CPU-165 node is is `netplc/simulator.py`; both reach the wire through this package.
 Only this package imports pymodbus, whose API changes at every minor release.
 """
+
+from netplc.modbus.driver import (
+    DeviceError,
+    Endpoint,
+    LinkError,
+    LoopThread,
+    ModbusClient,
+    open_client,
+    parse_endpoint,
+)
+from netplc.modbus.map import PROFILES, TABLES, WRITABLE_TABLES, Block, MapError, Table, describe, locate
+from netplc.modbus.server import ALL_MEMORY, ModbusServer
+
+__all__ = [
+    "ALL_MEMORY", "PROFILES", "TABLES", "WRITABLE_TABLES", "Block", "DeviceError", "Endpoint", "LinkError",
+    "LoopThread", "MapError", "ModbusClient", "ModbusServer", "Table", "describe", "locate", "open_client",
+    "parse_endpoint",
+]

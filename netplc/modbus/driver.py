@@ -1,6 +1,6 @@
 """The Modbus wire: endpoints, one client per node, a Modbus TCP server, and their event-loop thread.
 
-pymodbus changes its API at every minor release (toolchain.md section 5, anchors.md section 3), so
+pymodbus changes its API at every minor release (docs/architecture.md section 7), so
 this is the only module that imports it, and nothing of pymodbus leaks out: callers see
 `LinkError` (the transport failed: refused, timed out, lost) and `DeviceError` (the device answered
 with a Modbus exception). Retries and reconnect back-off belong to the exchange, so the pymodbus

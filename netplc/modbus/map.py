@@ -1,4 +1,5 @@
-"""How NetPlc and CPU-165 memory look in Modbus terms (DESIGN section 7); client and server share it.
+"""How NetPlc and CPU-165 memory look in Modbus terms (docs/architecture.md section 7); client and
+server share it.
 
 Profile `cpu165` (CPU-165 nodes, the simulator, NetPlc's own server): coil n = I/O bit n; holding
 register n = data bytes 2n, 2n+1 as one little-endian word, so byte 04000 is register 1024; the

@@ -1,5 +1,5 @@
 """NetPlc memory served over Modbus TCP, or Modbus RTU on a serial line, with the cpu165 profile
-(DESIGN 1 and 7).
+(docs/architecture.md sections 1 and 7).
 
 Other SCADAs and debugging tools read what the HMI reads: the snapshot published after the last
 scan, never the live memory. Writes are accepted only inside the configured ranges (exception 2

@@ -7,6 +7,8 @@ import subprocess
 import sys
 from pathlib import Path
 
+import pytest
+
 from tests.app.conftest import REPO, copy_demo
 
 
@@ -72,3 +74,18 @@ def test_every_planted_error_is_found(tmp_path: Path) -> None:
     for e in expected:
         assert e in out, f"{e!r} not in:\n{out}"
     assert f"{len(out.splitlines())} problem(s) found" in r.stderr
+
+
+def test_check_reports_exactly_what_a_start_refuses(tmp_path: Path) -> None:
+    from app.check import check_station
+    from app.config import load_station
+    from app.runtime import Runtime, StartError
+
+    st = copy_demo(tmp_path / "broken")
+    plant(st / "netplc.stl", "TNA ON\nFON C:$02140 N:NODE S:0", "TNX ON\nFON C:$02140 N:NODE S:7")
+    plant(st / "node0.stl", "CTR TB N:2", "CTR TB N:999")
+    plant(st / "messages.csv", "3,1,2,", "3,1,alarm,")
+    with pytest.raises(StartError) as refused:
+        Runtime(load_station(st))
+    assert len(refused.value.problems) == 4  # the bad line, NODE 7 further down, the node, the message
+    assert check_station(st).problems == refused.value.problems

@@ -7,6 +7,7 @@ from pathlib import Path
 import pytest
 
 from app.config import ConfigError, load_station, read_station
+from netplc.exchange import NodeConfig
 from tests.app.conftest import DEMO, write_station
 
 
@@ -107,12 +108,10 @@ endpoint = "tcp://127.0.0.1:5020"
 backoff = 0.5
 backoff_max = 2
 """)
-    from app.runtime import node_configs
-
     st = load_station(tmp_path)
-    assert (st.nodes[0].backoff, st.nodes[0].backoff_max, st.nodes[0].key) == (0.5, 2.0, "nodes[0]")
-    cfg = node_configs(st.nodes)[0]
-    assert (cfg.backoff, cfg.backoff_max) == (0.5, 2.0)
+    cfg = st.nodes[0]  # the exchange's own model: nothing is copied field by field
+    assert isinstance(cfg, NodeConfig) and cfg.parsed is not None and cfg.parsed.port == 5020
+    assert (cfg.backoff, cfg.backoff_max, cfg.key) == (0.5, 2.0, "nodes[0]")
     assert st.modbus_server.unit == 5
     write_station(tmp_path, "NetPlcLoad = false\n")
     assert load_station(tmp_path).modbus_server.unit is None  # every unit id is answered
@@ -157,6 +156,39 @@ endpoint = "rtu:///dev/ttyX?baudrate=19200"
         "nodes[4].endpoint: rtu:///dev/ttyX?baudrate=19200&parity=N and node 4's "
         "rtu:///dev/ttyX?baudrate=9600&parity=N share /dev/ttyX with different line settings",
     ]
+
+
+WHY = "(0 is broadcast, which never answers; 248-255 are reserved)"
+
+
+def test_node_unit_ranges_are_the_models_per_scheme(tmp_path: Path) -> None:
+    write_station(tmp_path, """
+NetPlcLoad = false
+[[nodes]]
+node = 1
+endpoint = "tcp://127.0.0.1:5020"
+unit = 255
+[[nodes]]
+node = 2
+endpoint = "rtu:///dev/ttyX?baudrate=9600"
+unit = 0
+[[nodes]]
+node = 3
+endpoint = "rtu:///dev/ttyX?baudrate=9600"
+unit = 248
+[[nodes]]
+node = 4
+endpoint = "tcp://127.0.0.1:5021"
+unit = 256
+""")
+    station, problems = read_station(tmp_path)
+    problems = [p.removeprefix(f"{tmp_path / 'station.toml'}: ") for p in problems]
+    assert problems == [
+        f"nodes[1].unit: unit 0 is not 1-247 on rtu {WHY}",
+        f"nodes[2].unit: unit 248 is not 1-247 on rtu {WHY}",
+        "nodes[3].unit: 256 is outside 0-255",
+    ]
+    assert station is not None and station.nodes[0].unit == 255
 
 
 def test_ports_the_station_would_listen_on_twice(tmp_path: Path) -> None:

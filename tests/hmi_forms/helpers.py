@@ -23,7 +23,8 @@ def snap(bits: dict[int, int] | None = None, words: dict[int, int] | None = None
 
 
 class ListTarget:
-    """Collects what elements write, as the engine would receive it."""
+    """Collects what elements write and record: as a Target, the operator's writes a view forwards;
+    as Effects (the runtime's copy of a model), the generators' bits and the element records."""
 
     def __init__(self) -> None:
         self.writes: list[tuple[str, int, int, str | None]] = []

@@ -66,7 +66,7 @@ def test_low_normal_high_transitions_record_their_messages(tmp_path) -> None:
                 PhyLow=10, PhyHigh=90, Hysteresis=2, LowMessage="Level low", NormalMessage="Level normal",
                 HighMessage="Level high", Name="LT1")
     t = ListTarget()
-    a.bind(t)
+    a.effects = t  # the runtime's copy: it records and writes
 
     def feed(percent: float) -> str | None:
         a.update(snap(words={0o4010: round(percent * 40.95)}, wall=1000.0))
@@ -92,7 +92,7 @@ def test_a_value_outside_the_limits_at_start_is_reported(tmp_path) -> None:
     a = element(tmp_path, "AnalogBase", InAddr="04010", Device="Level", devices=LEVEL, RegMessages=True,
                 PhyHigh=90)
     t = ListTarget()
-    a.bind(t)
+    a.effects = t  # the runtime's copy: it records and writes
     a.update(snap(words={0o4010: 4000}))
     assert [(r.type, r.text) for r in t.records] == [(2, "high: 97.7")]
 
@@ -101,7 +101,7 @@ def test_reg_data_records_each_change_of_the_shown_value(tmp_path) -> None:
     a = element(tmp_path, "AnalogBase", InAddr="04010", Device="Level", devices=LEVEL, RegData=True,
                 Precision=0)
     t = ListTarget()
-    a.bind(t)
+    a.effects = t  # the runtime's copy: it records and writes
     for hw in (0, 1, 2, 41, 41, 4095):
         a.update(snap(words={0o4010: hw}))
     assert [round(r.value) for r in t.records] == [0, 1, 100]  # 1 and 2 still show "0"
@@ -111,7 +111,7 @@ def test_reg_data_records_each_change_of_the_shown_value(tmp_path) -> None:
 def sequence(gen, select: list[int], enable: int = 1) -> list[int]:
     """Run a generator on scans 0..n-1 and collect its output for each scan."""
     t = ListTarget()
-    gen.bind(t)
+    gen.effects = t  # the runtime's copy: it records and writes
     out = []
     for scan, sel in enumerate(select):
         gen.update(snap(bits={0o2000: sel, 0o2002: enable}, scan=scan))
@@ -138,7 +138,7 @@ def test_sync_generator_sequences_of_fig_2_4_3(tmp_path) -> None:
 def test_sync_generator_writes_once_per_scan(tmp_path) -> None:
     gen = element(tmp_path, "SyncGenerator", OutAddr="02001", Period0=2)
     t = ListTarget()
-    gen.bind(t)
+    gen.effects = t  # the runtime's copy: it records and writes
     s = snap(scan=4)
     gen.update(s)
     gen.update(s)
@@ -212,7 +212,7 @@ def test_discrete_transitions_record_text_and_value(tmp_path) -> None:
     d = element(tmp_path, "DiscreteBase", InAddr="02120", TextFalse="Насос остановлен",
                 TextTrue="Насос работает", RegMessages=True, RegData=True, Name="P1")
     t = ListTarget()
-    d.bind(t)
+    d.effects = t  # the runtime's copy: it records and writes
     for v in (0, 1, 1, 0):
         d.update(snap(bits={0o2120: v}))
     assert [(r.kind, r.text, r.value) for r in t.records] == [
@@ -225,7 +225,7 @@ def test_a_hidden_state_is_still_journaled_by_its_text(tmp_path) -> None:
     d = element(tmp_path, "DiscreteControlledEnable", InAddr="02120", EnableAddr="02121",
                 TextFalse="Насос остановлен", TextTrue="Насос работает", RegMessages=True)
     t = ListTarget()
-    d.bind(t)
+    d.effects = t  # the runtime's copy: it records and writes
     d.update(snap(bits={0o2120: 0, 0o2121: 0}))
     d.update(snap(bits={0o2120: 1, 0o2121: 0}))
     assert d.text == "" and [r.text for r in t.records] == ["Насос работает"]

@@ -57,39 +57,68 @@ def pump_images(tmp_path: Path) -> list[str]:
     return ["pump_off.png", "pump_on_0.png", "pump_on_1.png"]
 
 
+# type: (properties, bits of state A, bits of state B, what the model must say in A and in B)
 CASES = {
     "SyncGenerator": ({"OutAddr": "02001", "InAddr": "02000", "Period0": 5, "Period1": 10, "Phase1": 1},
-                      {0o2000: 0}, {0o2000: 1}),
-    "SyncTimer": ({"OutAddr": "02001", "Ainput": "02002", "Period0": 1}, {0o2002: 1}, {0o2002: 0}),
+                      {0o2000: 0}, {0o2000: 1}, lambda m: m.period_phase, (5, 0), (10, 1)),
+    "SyncTimer": ({"OutAddr": "02001", "Ainput": "02002", "Period0": 1}, {0o2002: 1}, {0o2002: 0},
+                  lambda m: m.enabled, True, False),
     "DiscreteBase": ({"InAddr": "02120", "TextFalse": "Стоп", "TextTrue": "Работа"},
-                     {0o2120: 0}, {0o2120: 1}),
+                     {0o2120: 0}, {0o2120: 1}, lambda m: (m.value, m.text), (0, "Стоп"), (1, "Работа")),
     "DiscreteColorLabel": ({"InAddr": "02120", "TextTrue": "ON", "BackColorTrue": "#2e7d32"},
-                           {0o2120: 0}, {0o2120: 1}),
+                           {0o2120: 0}, {0o2120: 1}, lambda m: (m.value, m.back_color),
+                           (0, None), (1, (0x2E, 0x7D, 0x32, 255))),
     "DiscreteControlledEnable": ({"InAddr": "02120", "EnableAddr": "02121", "TextTrue": "ON",
                                   "BackColorTrue": "#2e7d32"},
-                                 {0o2120: 1, 0o2121: 0}, {0o2120: 1, 0o2121: 1}),
+                                 {0o2120: 1, 0o2121: 0}, {0o2120: 1, 0o2121: 1},
+                                 lambda m: (m.indicating, m.text), (False, ""), (True, "ON")),
     "DiscreteAnimation": ({"InAddr": "02120", "EnableAddr": "03760", "ImageFalse": 0, "ImageFirst": 1,
-                           "ImageLast": 2}, {0o2120: 0, 0o3760: 1}, {0o2120: 1, 0o3760: 1}),
-    "StaticPicture": ({"Image": "tank.png", "QualityAddr": Q}, {0o2101: 1}, {0o2101: 0}),
-    "StaticText": ({"Text": "Узел 0", "QualityAddr": Q}, {0o2101: 1}, {0o2101: 0}),
-    "Graph": ({"Address": "040005", "Elements": 20}, {0o40005: 0}, {0o40005: 1}),
-    "DateTime": ({"QualityAddr": Q}, {0o2101: 1}, {0o2101: 0}),
+                           "ImageLast": 2}, {0o2120: 0, 0o3760: 1}, {0o2120: 1, 0o3760: 1},
+                          lambda m: (m.value, m.image in (1, 2)), (0, False), (1, True)),
+    "StaticPicture": ({"Image": "tank.png", "QualityAddr": Q}, {0o2101: 1}, {0o2101: 0},
+                      lambda m: m.stale, False, True),
+    "StaticText": ({"Text": "Узел 0", "QualityAddr": Q}, {0o2101: 1}, {0o2101: 0},
+                   lambda m: m.stale, False, True),
+    "Graph": ({"Address": "040005", "Elements": 20}, {0o40005: 0}, {0o40005: 1},
+              lambda m: (m.trend.last, m.trend.count), (0.0, 12), (1.0, 24)),
+    "DateTime": ({"QualityAddr": Q}, {0o2101: 1}, {0o2101: 0},
+                 lambda m: (m.stale, len(m.clock)), (False, 8), (True, 8)),
 }
 
 
 @pytest.mark.parametrize("type_", list(CASES))
 def test_each_element_type_renders_its_state(qtbot, tmp_path, type_: str) -> None:
-    props, state_a, state_b = CASES[type_]
+    props, state_a, state_b, probe, *expected = CASES[type_]
     images = pump_images(tmp_path)
     form = one(tmp_path, type_, images=images, **props)
     view = FormView(form, EngineTarget(engine()[0]))
     qtbot.addWidget(view)
+    model = form.elements[0]
     pictures = []
-    for scan, bits in enumerate((state_a, state_b)):
+    for scan, (bits, want) in enumerate(zip((state_a, state_b), expected, strict=True)):
         for k in range(12):  # several scans: graphs fill, animations step
             view.refresh(snap(bits=bits, scan=scan * 100 + k, time=k, wall=1_800_000_000.0 + k))
+        assert probe(model) == want, type_
         pictures.append(image(view, qtbot))
+        assert view.errors == [], type_  # a refresh or a drawing that raised would also change pixels
     assert differs(*pictures) > 20, type_
+
+
+def test_an_element_whose_refresh_raises_fails_the_rendering_checks(qtbot, tmp_path) -> None:
+    form = one(tmp_path, "DiscreteBase", InAddr="02120", TextFalse="Стоп", TextTrue="Работа")
+    view = FormView(form, EngineTarget(engine()[0]))
+    qtbot.addWidget(view)
+    model = form.elements[0]
+    view.refresh(snap(bits={0o2120: 0}))
+    before = image(view, qtbot)
+
+    def broken(snapshot) -> bool:
+        raise RuntimeError("boom")
+
+    model.refresh = broken
+    view.refresh(snap(bits={0o2120: 1}, scan=1))
+    assert differs(before, image(view, qtbot)) > 20  # the stale mark alone changes the picture...
+    assert model.value == 0 and view.errors  # ...which is why the model and the errors are checked
 
 
 @pytest.mark.parametrize("appearance", ["digital", "hbar", "dial", "semidial", "graph"])
@@ -179,20 +208,28 @@ def test_analog_output_rejects_text_and_out_of_range_values_visibly(qtbot, tmp_p
     assert widget.current.text() == "50.0 °C" and sink.records[0].kind == "operator"
 
 
-def test_sync_generator_drives_netplc_memory_through_the_engine(qtbot, tmp_path) -> None:
+def test_a_view_only_shows_a_generator_and_journals_nothing(qtbot, tmp_path) -> None:
+    """Sync pulses and element records are the runtime's (hmi_forms/behaviour.py), not the view's:
+    a view that lags or is closed must not change what the station does."""
     eng, sink = engine()
-    form = one(tmp_path, "SyncGenerator", InAddr="02000", OutAddr="02001", Period0=5, Phase0=0, Period1=10,
-               Phase1=1)
+    form = load_form(write_form(tmp_path, [
+        {"type": "SyncGenerator", "Name": "G", "x": 0, "y": 0, "w": 120, "h": 60, "OutAddr": "02001",
+         "Period0": 2},
+        {"type": "DiscreteBase", "Name": "P", "x": 0, "y": 70, "w": 120, "h": 40, "InAddr": "02120",
+         "TextTrue": "Насос работает", "RegMessages": True, "RegData": True},
+    ]))
     view = FormView(form, EngineTarget(eng))
     qtbot.addWidget(view)
-    seen = []
-    for scan in range(32):
-        if scan == 12:
-            eng.write_bit(0o2000, 1, user="test")
+    gen = form.elements[0]
+    outputs = []
+    for k in range(6):
+        if k == 2:
+            eng.write_bit(0o2120, 1, user="test")
         view.refresh(eng.snapshot)
-        seen.append(eng.scan().get_bit(0o2001))
-    assert [i for i, v in enumerate(seen) if v] == [0, 5, 10, 21, 31]
-    assert [r.kind for r in sink.records] == ["operator"]  # generator writes are not journaled
+        outputs.append(gen.output)
+        assert eng.scan().get_bit(0o2001) == 0  # nothing written
+    assert outputs == [1, 0, 1, 0, 1, 0] and form.elements[1].value == 1  # shown all the same
+    assert [r.kind for r in sink.records] == ["operator"] and view.errors == []
 
 
 def test_message_journal_shows_the_archive(qtbot, tmp_path) -> None:
@@ -234,21 +271,6 @@ def test_demo_forms_load_and_use_every_element_type(qtbot) -> None:
         qtbot.addWidget(view)
         view.refresh(eng.snapshot)
         assert not view.grab().isNull() and view.errors == []
-
-
-def test_element_records_reach_the_sink_through_the_engine_thread(qtbot, tmp_path) -> None:
-    eng, sink = engine()
-    form = one(tmp_path, "DiscreteBase", InAddr="02120", TextFalse="Насос остановлен",
-               TextTrue="Насос работает", RegMessages=True)
-    view = FormView(form, EngineTarget(eng))
-    qtbot.addWidget(view)
-    view.refresh(eng.snapshot)
-    eng.write_bit(0o2120, 1, user="test")
-    view.refresh(eng.scan())
-    assert [r.kind for r in sink.records] == ["operator"]  # the element's record waits for the next scan
-    eng.scan()
-    assert [(r.kind, r.source, r.text, r.type) for r in sink.records[1:]] == [
-        ("message", "E", "Насос работает", 0)]
 
 
 def test_a_failing_element_is_reported_and_the_others_go_on(qtbot, tmp_path) -> None:

@@ -1,5 +1,5 @@
 """The compiled engine must leave memory, timer and counter values and the run state exactly as
-the reference interpreter does (DESIGN section 5), for random valid programs over several scans.
+the reference interpreter does (docs/architecture.md section 5), for random valid programs over several scans.
 
 Programs are generated as nested structures so that every jump terminates: forward jumps to a
 label after a nested body, and backward loops guarded by a loop bit the body never writes (each

@@ -1,6 +1,6 @@
-"""The engine: logic instructions (DESIGN section 4), jumps, run states, special bits, FON dispatch,
-queued writes and scan statistics; every behaviour under both the compiled engine and the
-reference interpreter."""
+"""The engine: logic instructions (docs/architecture.md section 4), jumps, run states, special bits,
+FON dispatch, queued writes and scan statistics; every behaviour under both the compiled engine and
+the reference interpreter."""
 
 from __future__ import annotations
 
@@ -8,7 +8,7 @@ import itertools
 
 import pytest
 
-from netplc import engine as engine_mod
+from netplc import backend
 from netplc.address import EMERGENCY_STOP, FERR1, GEN_BASE, TIMEBASE_HI, TIMEBASE_LO
 from netplc.engine import RunState
 from netplc.functions.registry import REGISTRY, FunctionSpec
@@ -38,7 +38,7 @@ def test_figure_chains_over_every_input_combination(compiled, figure):
 
 @engines
 def test_series_of_parallel_branches_with_tne(compiled):
-    # a*b + c*d: TNE closes the branch a*b and starts c*d (DESIGN section 4)
+    # a*b + c*d: TNE closes the branch a*b and starts c*d (docs/architecture.md section 4)
     rig = Rig("TNA $0\nTNA $1\nTNE $2\nTNA $3\nYON $02000", compiled)
     for a, b, c, d in itertools.product((0, 1), repeat=4):
         rig.step(b0=a, b1=b, b2=c, b3=d)
@@ -208,7 +208,7 @@ def test_emergency_stop_set_from_outside_stops_before_the_program(compiled):
 
 @engines
 def test_watchdog_stops_an_endless_loop(compiled, monkeypatch):
-    monkeypatch.setattr(engine_mod, "WATCHDOG_STEPS", 1000)
+    monkeypatch.setattr(backend, "WATCHDOG_STEPS", 1000)
     rig = Rig("YON $02000\nl: NOP\nJMP l", compiled)
     rig.step()
     assert rig.engine.state is RunState.STOPPED

@@ -161,15 +161,17 @@ def test_node_config_reports_bad_endpoints() -> None:
         NodeConfig(3, "rtu://?baudrate=9600")
 
 
-def test_node_config_parse_from_a_table() -> None:
-    cfg = NodeConfig.parse(4, {"endpoint": "tcp://127.0.0.1:1502", "unit": 2, "timeout": 0.5})
-    assert (cfg.node, cfg.unit, cfg.timeout, cfg.profile) == (4, 2, 0.5, "cpu165")
-    with pytest.raises(ValueError, match=r"node 4: unknown setting\(s\) port"):
-        NodeConfig.parse(4, {"endpoint": "tcp://h:1", "port": 1})
-    with pytest.raises(ValueError, match=r"node 4: endpoint is missing"):
-        NodeConfig.parse(4, {})
-    with pytest.raises(ValueError, match=r"node 4: unit = '1' has the wrong type"):
-        NodeConfig.parse(4, {"endpoint": "tcp://h:1", "unit": "1"})
+def test_node_unit_ids_follow_the_modbus_spec_per_scheme() -> None:
+    # TCP: 0-255 (a device reached directly often wants 0 or 255, the spec's recommended 0xFF);
+    # RTU: 1-247 (0 is broadcast and never answers a read, 248-255 are reserved)
+    assert NodeConfig(1, "tcp://h:502", unit=255).unit == 255
+    assert NodeConfig(1, "tcp://h:502", unit=0).unit == 0
+    assert NodeConfig(1, "rtu:///dev/ttyS0", unit=247).unit == 247
+    with pytest.raises(ValueError, match=r"node 1: unit 256 is not 0-255 on tcp"):
+        NodeConfig(1, "tcp://h:502", unit=256)
+    for unit in (0, 248):
+        with pytest.raises(ValueError, match=rf"node 1: unit {unit} is not 1-247 on rtu"):
+            NodeConfig(1, "rtu:///dev/ttyS0", unit=unit)
 
 
 def test_check_program_nodes_names_the_program_line() -> None:

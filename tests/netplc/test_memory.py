@@ -1,5 +1,5 @@
 """NetPlc memory: I/O bits, byte/word operands in the bit area, little-endian data, gaps, HMI bits
-and immutable snapshots (DESIGN section 3)."""
+and immutable snapshots (docs/architecture.md section 3)."""
 
 from __future__ import annotations
 

@@ -1,4 +1,4 @@
-"""The STL parser (DESIGN section 5): what it accepts, and a `file:line:col: message` for every
+"""The STL parser (docs/architecture.md section 5): what it accepts, and a `file:line:col: message` for every
 kind of malformed program, never a traceback."""
 
 from __future__ import annotations

@@ -1,0 +1,122 @@
+"""Everything a station reads before it starts: symbols, the NetPlc program, the simulated nodes'
+programs, the message catalog and the forms. The runtime's start and `check` both call `load`, so
+`check` reports exactly what a start would refuse.
+
+Each part is read even when an earlier one failed, and a broken program or symbols file is read
+again without its bad lines, so the checks that need a whole program (the nodes of NREAD/NWRITE)
+still run on the rest: an engineer gets the whole list at once, each line naming its file and
+place. Forms are apart: a form that does not load is a problem the station runs with (the other
+forms open; its behaviour is missing and said so), never a reason not to start.
+"""
+
+from __future__ import annotations
+
+import tempfile
+from dataclasses import dataclass, field
+from pathlib import Path
+
+from app.config import Station
+from hmi_forms.form import Form, load_forms
+from netplc.exchange import check_program_nodes
+from netplc.program import Program, ProgramError, load_symbols, parse, parse_file
+from registrar.catalog import Catalog, CatalogError
+
+RECOVERY_ROUNDS = 5
+
+
+@dataclass
+class Loaded:
+    symbols: dict[str, int] = field(default_factory=dict)
+    catalog: Catalog = field(default_factory=Catalog)
+    program: Program = field(default_factory=lambda: parse("", source="<no program>"))
+    node_programs: list[Program] = field(default_factory=list)  # one per station.simulators, in order
+    forms: list[Form] = field(default_factory=list)
+    problems: list[str] = field(default_factory=list)  # each one stops a start
+    form_problems: list[str] = field(default_factory=list)  # forms that did not load
+    notes: list[str] = field(default_factory=list)  # what was found good, for check's summary
+
+
+def load(station: Station) -> Loaded:
+    out = Loaded()
+    out.symbols = _symbols(station.Symbols, out)
+    program = _program(station, out)
+    if program is not None:
+        out.problems += [str(d) for d in check_program_nodes(program, station.nodes)]
+    for sim in station.simulators:
+        try:
+            p = parse_file(sim.program, load_symbols(sim.symbols) if sim.symbols else {})
+        except ProgramError as e:
+            out.problems += e.problems
+            continue
+        out.node_programs.append(p)
+        out.notes.append(f"node {sim.node} simulator program {sim.program.name}: "
+                         f"{len(p.instrs)} instructions")
+    if station.Messages is not None:
+        try:
+            out.catalog = Catalog.load(station.Messages)
+            out.notes.append(f"messages {station.Messages.name}: {len(out.catalog)} texts")
+        except CatalogError as e:
+            out.problems += e.problems
+    out.forms, out.form_problems = load_station_forms(station, out.symbols)
+    if station.HMIload is not None:
+        out.notes.append(f"forms in {station.HMIload}: {len(out.forms)} loaded")
+    return out
+
+
+def load_station_forms(station: Station, symbols: dict[str, int]) -> tuple[list[Form], list[str]]:
+    """The forms of HMIload (fresh models each call: the runtime's and each view's are their own),
+    and the problems of those that did not load."""
+    if station.HMIload is None:
+        return [], []
+    return load_forms(station.HMIload, symbols)
+
+
+def _symbols(path: Path | None, out: Loaded) -> dict[str, int]:
+    """The symbols; with errors, those of the good lines, so the program is checked against them."""
+    if path is None:
+        return {}
+    try:
+        return load_symbols(path)
+    except ProgramError as e:
+        out.problems += e.problems
+        bad = {d.line for d in e.errors}
+    with tempfile.TemporaryDirectory() as tmp:
+        good = Path(tmp) / path.name
+        good.write_text(_blank_lines(path, bad), encoding="utf-8")
+        try:
+            return load_symbols(good)
+        except ProgramError:
+            return {}
+
+
+def _program(station: Station, out: Loaded) -> Program | None:
+    """The program (none when NetPlcLoad is false); with errors, the program without its bad lines
+    (line numbers kept) for the checks that need a whole program, and `out.program` stays empty."""
+    path = station.NetPlcProgram
+    if not station.NetPlcLoad or path is None:
+        return None
+    try:
+        program = parse_file(path, out.symbols)
+    except ProgramError as e:
+        out.problems += e.problems
+        return _recovered(path, out.symbols, {d.line for d in e.errors})
+    out.program = program
+    out.notes.append(f"program {path.name}: {len(program.instrs)} instructions, {program.words} words")
+    return program
+
+
+def _recovered(path: Path, symbols: dict[str, int], bad: set[int]) -> Program | None:
+    for _ in range(RECOVERY_ROUNDS):  # removing a line can break another (a label it defined)
+        try:
+            return parse(_blank_lines(path, bad), source=str(path), symbols=symbols)
+        except ProgramError as e:
+            more = {d.line for d in e.errors} - bad
+            if not more:
+                return None
+            bad |= more
+    return None
+
+
+def _blank_lines(path: Path, lines: set[int]) -> str:
+    text = path.read_text(encoding="utf-8-sig").splitlines()
+    return "\n".join("" if i in lines else line for i, line in enumerate(text, start=1))

@@ -1,0 +1,137 @@
+"""The package boundaries of docs/architecture.md, enforced on the source (what import-linter would do).
+
+- The headless parts never import Qt, not even through another module of the project: the soft
+  PLC, the archive, the form models and loader, the runtime, the station configuration.
+- Only the Modbus sub-package imports pymodbus (its API changes at every minor release).
+- No import cycles between modules of the project. Imports under `if TYPE_CHECKING:` are left out:
+  they never run. Imports inside functions count: they run, only later.
+"""
+
+from __future__ import annotations
+
+import ast
+import subprocess
+import sys
+from pathlib import Path
+
+REPO = Path(__file__).resolve().parents[1]
+PACKAGES = ("netplc", "registrar", "hmi_forms", "app")
+QT = ("PySide6", "shiboken6", "pyqtgraph")
+HEADLESS = ("netplc", "registrar", "hmi_forms.elements", "hmi_forms.form", "hmi_forms.behaviour",
+            "app.runtime", "app.config", "app.load", "app.check")
+
+
+def module_name(path: Path) -> str:
+    parts = path.relative_to(REPO).with_suffix("").parts
+    return ".".join(parts[:-1] if parts[-1] == "__init__" else parts)
+
+
+def modules() -> dict[str, Path]:
+    found = {module_name(p): p for pkg in PACKAGES for p in (REPO / pkg).rglob("*.py")}
+    found["main"] = REPO / "main.py"
+    return found
+
+
+def _type_checking(node: ast.If) -> bool:
+    test = node.test
+    return (isinstance(test, ast.Name) and test.id == "TYPE_CHECKING") or (
+        isinstance(test, ast.Attribute) and test.attr == "TYPE_CHECKING")
+
+
+def imports(path: Path, known: set[str]) -> set[str]:
+    """Every module `path` imports when it runs: project modules by name, others by top package."""
+    out: set[str] = set()
+
+    def visit(node: ast.AST) -> None:
+        if isinstance(node, ast.If) and _type_checking(node):
+            for child in node.orelse:
+                visit(child)
+            return
+        if isinstance(node, ast.Import):
+            out.update(alias.name for alias in node.names)
+        elif isinstance(node, ast.ImportFrom) and node.module and not node.level:
+            for alias in node.names:
+                sub = f"{node.module}.{alias.name}"
+                out.add(sub if sub in known else node.module)
+        for child in ast.iter_child_nodes(node):
+            visit(child)
+
+    visit(ast.parse(path.read_text(encoding="utf-8")))
+    return out
+
+
+def graph() -> dict[str, set[str]]:
+    mods = modules()
+    known = set(mods)
+    return {name: imports(path, known) for name, path in mods.items()}
+
+
+def under(name: str, prefixes: tuple[str, ...]) -> bool:
+    return any(name == p or name.startswith(p + ".") for p in prefixes)
+
+
+def test_headless_parts_import_no_qt_even_indirectly() -> None:
+    g = graph()
+    bad = []
+    for start in (m for m in g if under(m, HEADLESS)):
+        seen, todo = {start}, [start]
+        while todo:
+            mod = todo.pop()
+            for dep in g.get(mod, ()):
+                if under(dep, QT):
+                    bad.append(f"{start} imports {dep} (through {mod})")
+                elif dep in g and dep not in seen:
+                    seen.add(dep)
+                    todo.append(dep)
+    assert bad == []
+
+
+def test_headless_parts_run_without_qt_loaded() -> None:
+    code = ("import sys, app.check, app.runtime, hmi_forms.behaviour, netplc.simulator, registrar.query\n"
+            f"print(sorted(m for m in sys.modules if m.split('.')[0] in {QT!r}))")
+    r = subprocess.run([sys.executable, "-c", code], cwd=REPO, capture_output=True, text=True, timeout=60)
+    assert r.returncode == 0, r.stderr
+    assert r.stdout.strip() == "[]"
+
+
+def test_only_the_modbus_subpackage_imports_pymodbus() -> None:
+    users = sorted(m for m, deps in graph().items() if any(under(d, ("pymodbus",)) for d in deps))
+    assert users and all(under(m, ("netplc.modbus",)) for m in users), users
+
+
+def test_the_rest_reaches_the_modbus_stack_through_its_face() -> None:
+    inner = sorted(f"{m} imports {d}" for m, deps in graph().items() if not under(m, ("netplc.modbus",))
+                   for d in deps if d.startswith("netplc.modbus."))
+    assert inner == []
+
+
+def test_no_import_cycles() -> None:
+    g = {m: {d for d in deps if d in modules()} for m, deps in graph().items()}
+    index: dict[str, int] = {}
+    low: dict[str, int] = {}
+    stack: list[str] = []
+    cycles: list[list[str]] = []
+
+    def strongconnect(v: str) -> None:  # Tarjan's strongly connected components
+        index[v] = low[v] = len(index)
+        stack.append(v)
+        for w in g[v]:
+            if w not in index:
+                strongconnect(w)
+                low[v] = min(low[v], low[w])
+            elif w in stack:
+                low[v] = min(low[v], index[w])
+        if low[v] == index[v]:
+            component = []
+            while True:
+                w = stack.pop()
+                component.append(w)
+                if w == v:
+                    break
+            if len(component) > 1 or v in g[v]:
+                cycles.append(sorted(component))
+
+    for v in sorted(g):
+        if v not in index:
+            strongconnect(v)
+    assert cycles == []
