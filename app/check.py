@@ -15,6 +15,7 @@ from app.runtime import load_simulated_program, node_configs, unresolved_hosts
 from hmi_forms.form import load_forms
 from netplc.exchange import check_program_nodes
 from netplc.program import Program, ProgramError, load_symbols, parse, parse_file
+from netplc.tags.table import read_tags
 from registrar.catalog import Catalog, CatalogError
 
 RECOVERY_ROUNDS = 5
@@ -55,6 +56,11 @@ def check_station(path: str | Path) -> CheckReport:
             report.notes.append(f"messages {station.Messages.name}: {len(catalog)} texts")
         except CatalogError as e:
             report.problems += list(e.problems)
+    if station.Tags is not None:
+        tags, problems = read_tags(station.Tags, symbols)
+        report.problems += problems
+        report.notes.append(f"tags {station.Tags.name}: {len(tags.tags)} tags, "
+                            f"{len(tags.alarms)} with alarms")
     if station.HMIload is not None:
         forms, problems = load_forms(station.HMIload, symbols)
         report.problems += [str(p) for p in problems]

@@ -83,6 +83,7 @@ class Station:
     nodes: tuple[NodeSettings, ...] = ()
     simulators: tuple[SimulatorSettings, ...] = ()
     users: tuple[str, ...] = ("operator",)
+    Tags: Path | None = None  # tags.csv: tags and their alarms (netplc/tags/)
 
     @property
     def folder(self) -> Path:
@@ -196,6 +197,7 @@ def read_station(path: str | Path) -> tuple[Station | None, list[str]]:
     messages = top.path("Messages", base)
     keep_days = top.number("keep_days", 0, 0, 36_500)
     retain = top.path("Retain", base)
+    tags = top.path("Tags", base)
     server = _modbus_server(problems, fname, top.get("modbus_server", dict, {}))
     nodes = _nodes(problems, fname, top.get("nodes", list, []))
     simulators = _simulators(problems, fname, top.get("simulators", list, []), base)
@@ -216,11 +218,12 @@ def read_station(path: str | Path) -> tuple[Station | None, list[str]]:
         if not missing:
             runnable.append(sim)
     archive = archive or base / "archive" / "journal.sqlite"
+    tags = _existing(top, "Tags", tags, False)
     station = Station(
         path=file.resolve(), name=name or base.name, NetPlcLoad=bool(load), NetPlcProgram=program,
         Symbols=symbols, HMIload=hmi, NetSyncTime=sync, Archive=archive, Messages=messages,
         keep_days=keep_days, Retain=retain or archive.with_name("retain.bin"), modbus_server=server,
-        nodes=tuple(nodes), simulators=tuple(runnable), users=users,
+        nodes=tuple(nodes), simulators=tuple(runnable), users=users, Tags=tags,
     )
     return station, problems
 
