@@ -12,6 +12,7 @@ import struct
 from collections.abc import Sequence
 from dataclasses import dataclass
 from enum import StrEnum
+from operator import itemgetter
 
 import numpy as np
 
@@ -172,17 +173,25 @@ class Tag:
 class TagReader:
     """The physical values of many tags at once, in a numpy array in the order of `tags`.
 
-    Data-memory words and double words are gathered by numpy; bits and words made of I/O bits
-    (rare) are read one by one. Per scan this costs tens of microseconds for thousands of tags.
+    Data-memory words, double words and bits are gathered by numpy, I/O bits by one C-level
+    itemgetter; only words made of I/O bits (rare) are read one by one. Per scan this costs tens
+    of microseconds for thousands of tags.
     """
 
     def __init__(self, tags: Sequence[Tag]) -> None:
         self.tags = list(tags)
         self._groups: list[tuple[np.ndarray, np.ndarray, TagType]] = []  # positions, byte indexes, type
         self._singles: list[tuple[int, Tag]] = []
+        io_bits: list[tuple[int, int]] = []
+        data_bits: list[tuple[int, int, int]] = []
         by_type: dict[TagType, list[tuple[int, int]]] = {}
         for pos, tag in enumerate(self.tags):
-            if tag.type is TagType.BIT or tag.address < IO_BITS:
+            if tag.type is TagType.BIT:
+                if tag.address < IO_BITS:
+                    io_bits.append((pos, tag.address))
+                else:
+                    data_bits.append((pos, data_index(tag.address >> 3), tag.address & 7))
+            elif tag.address < IO_BITS:
                 self._singles.append((pos, tag))
             else:
                 by_type.setdefault(tag.type, []).append((pos, data_index(tag.address)))
@@ -190,6 +199,11 @@ class TagReader:
             positions = np.array([p for p, _ in items], dtype=np.intp)
             first = np.array([i for _, i in items], dtype=np.intp)
             self._groups.append((positions, first[:, None] + np.arange(SIZES[kind]), kind))
+        self._io_pos = np.array([p for p, _ in io_bits], dtype=np.intp)
+        self._io_get = itemgetter(*(a for _, a in io_bits), 0)  # always a tuple, one item too many
+        self._bit_pos = np.array([p for p, _, _ in data_bits], dtype=np.intp)
+        self._bit_byte = np.array([i for _, i, _ in data_bits], dtype=np.intp)
+        self._bit_shift = np.array([k for _, _, k in data_bits], dtype=np.uint8)
         nan = float("nan")
         scalings = [t.scaling or Scaling(nan, nan, nan, nan) for t in self.tags]
         self._scaled = np.array([t.scaling is not None for t in self.tags], dtype=bool)
@@ -215,6 +229,10 @@ class TagReader:
                 values = nibbles.astype(np.float64) @ np.array([1000.0, 100.0, 10.0, 1.0])
                 values[(nibbles > 9).any(axis=1)] = np.nan
                 out[positions] = values
+        if len(self._bit_pos):
+            out[self._bit_pos] = (data[self._bit_byte] >> self._bit_shift) & 1
+        if len(self._io_pos):
+            out[self._io_pos] = np.array(self._io_get(view.bits)[:-1], dtype=bool)
         for pos, tag in self._singles:
             out[pos] = tag.raw(view)
         return out

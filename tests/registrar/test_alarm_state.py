@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import json
+import sqlite3
 from pathlib import Path
 
 import numpy as np
@@ -27,7 +28,7 @@ class Station:
     def __init__(self, folder: Path, mem: Memory) -> None:
         (folder / "tags.csv").write_text(TAGS, encoding="utf-8")
         self.sink = ListSink()
-        self.file = AlarmStateFile(folder / "archive" / "alarms.json", self.sink)
+        self.file = AlarmStateFile(folder / "archive" / "alarms.sqlite", self.sink)
         saved = self.file.load()
         self.system = AlarmSystem(load_tags(folder / "tags.csv"), sink=self.sink, saved=saved,
                                   on_change=self.file.update)
@@ -40,6 +41,15 @@ class Station:
 
     def stop(self) -> None:
         self.file.close()
+
+
+def stored(path: Path) -> dict[str, dict]:
+    con = sqlite3.connect(path)
+    try:
+        rows = con.execute("SELECT alarm, state FROM alarm_state").fetchall()
+        return {alarm: json.loads(state) for alarm, state in rows}
+    finally:
+        con.close()
 
 
 def plant() -> Memory:
@@ -57,11 +67,11 @@ def test_a_restart_keeps_every_state_and_raises_nothing_twice(tmp_path: Path) ->
     first.system.acknowledge("TEMP.H", "ivanov", T0 + 1)
     first.system.shelve("TRIG.ALARM", "petrov", "sensor check", 600, T0 + 2)
     first.stop()
-    saved = json.loads((tmp_path / "archive" / "alarms.json").read_text())["alarms"]
+    saved = stored(tmp_path / "archive" / "alarms.sqlite")
     assert saved["LEVEL.H"]["acked"] is False and saved["LEVEL.H"]["state"] == "active-unacknowledged"
 
     again = Station(tmp_path, mem)  # conditions still active at the restart
-    assert "alarm states restored from alarms.json: 3 alarm(s)" in again.sink.records[0].text
+    assert "alarm states restored from alarms.sqlite: 3 alarm(s)" in again.sink.records[0].text
     assert again.scan(10) == []
     assert again.system.get("LEVEL.H").state is State.UNACK
     assert again.system.get("TEMP.H").state is State.ACKED
@@ -79,20 +89,21 @@ def test_a_restart_keeps_every_state_and_raises_nothing_twice(tmp_path: Path) ->
 
 def test_a_damaged_file_starts_every_alarm_normal_and_says_so(tmp_path: Path) -> None:
     (tmp_path / "archive").mkdir()
-    (tmp_path / "archive" / "alarms.json").write_text('{"version": 1, "alarms": {"LEV', encoding="utf-8")
+    (tmp_path / "archive" / "alarms.sqlite").write_bytes(b"not a database, a damaged file" * 100)
     station = Station(tmp_path, plant())
     assert station.sink.records[0].kind == "system"
-    assert "alarm states not restored from alarms.json" in station.sink.records[0].text
+    assert "alarm states not restored from alarms.sqlite" in station.sink.records[0].text
+    assert "kept as alarms.sqlite.damaged" in station.sink.records[0].text
     assert len(station.scan(0)) == 3
     station.stop()
-    assert not (tmp_path / "archive" / "alarms.json.tmp").exists()
+    assert set(stored(tmp_path / "archive" / "alarms.sqlite")) == {"LEVEL.H", "TEMP.H", "TRIG.ALARM"}
 
 
 def test_a_save_that_fails_is_journaled_once_and_retried(tmp_path: Path) -> None:
     blocker = tmp_path / "archive"
     blocker.write_text("a file where the folder should be")
     sink = ListSink()
-    file = AlarmStateFile(blocker / "alarms.json", sink)
+    file = AlarmStateFile(blocker / "alarms.sqlite", sink)
     file.update({"A": {"active": True}})
     file.update({"A": {"active": False}})
     assert [r.text for r in sink.records if "could not be saved" in (r.text or "")] != []
@@ -100,4 +111,5 @@ def test_a_save_that_fails_is_journaled_once_and_retried(tmp_path: Path) -> None
     blocker.unlink()
     file.flush()
     assert "being saved again" in sink.records[-1].text
-    assert json.loads((blocker / "alarms.json").read_text())["alarms"] == {"A": {"active": False}}
+    assert stored(blocker / "alarms.sqlite") == {"A": {"active": False}}
+    file.close()
