@@ -466,6 +466,17 @@ class AlarmSystem:
     def shelve(self, alarm_id: str, user: str, reason: str, duration: float,
                now: float | None = None) -> list[Transition]:
         """Shelve an alarm for `duration` seconds; it comes back by itself when they have run out."""
+        i = self.check_shelve(alarm_id, user, reason, duration)
+        when = self.clock() if now is None else now
+        until = when + duration
+        stamp = time.strftime("%Y-%m-%d %H:%M:%S", time.localtime(until))
+        return self._act(lambda out: self._overlay(
+            i, when, out, user, f"shelved for {duration:g} s until {stamp}: {reason}",
+            shelved_until=until, shelved_by=user, reason=reason))
+
+    def check_shelve(self, alarm_id: str, user: str, reason: str, duration: float) -> int:
+        """AlarmError unless the alarm exists and the shelving names its operator, a reason and a
+        duration (what `shelve` checks, for callers that hand the shelving to another thread)."""
         i = self._index(alarm_id)
         if not user.strip():
             raise AlarmError(f"{alarm_id}: shelving needs the operator's name")
@@ -473,12 +484,7 @@ class AlarmSystem:
             raise AlarmError(f"{alarm_id}: shelving needs a reason")
         if not (math.isfinite(duration) and duration > 0):
             raise AlarmError(f"{alarm_id}: shelving needs a duration of more than 0 s")
-        when = self.clock() if now is None else now
-        until = when + duration
-        stamp = time.strftime("%Y-%m-%d %H:%M:%S", time.localtime(until))
-        return self._act(lambda out: self._overlay(
-            i, when, out, user, f"shelved for {duration:g} s until {stamp}: {reason}",
-            shelved_until=until, shelved_by=user, reason=reason))
+        return i
 
     def unshelve(self, alarm_id: str, user: str, now: float | None = None) -> list[Transition]:
         i = self._index(alarm_id)
