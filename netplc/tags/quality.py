@@ -27,7 +27,7 @@ from netplc.address import IO_BITS
 from netplc.exchange import NODE, NREAD, _fon_nodes
 from netplc.memory import MemoryView
 from netplc.program import Program
-from netplc.tags.tag import Tag
+from netplc.tags.tag import Tag, span
 
 STALE_TICKS = 2  # scans of lateness tolerated beyond the normal one-scan answer
 NORMAL_AGE = 1  # scans from a request to its data in memory, normally
@@ -78,8 +78,7 @@ def nread_feeds(program: Program) -> list[Feed]:
     for fn, ins, node in _fon_nodes(program):
         if fn != NREAD:
             continue
-        local, length = ins.d or 0, ins.r or 0
-        first, last = (local, local + 8 * length) if local < IO_BITS else (8 * local, 8 * (local + length))
+        first, last = span(ins.d or 0, ins.r or 0)
         feeds.append(Feed(index[id(ins)], wrap if node is None else node, ins.c or 0, first, last, ins.line))
     return feeds
 
@@ -142,10 +141,29 @@ class QualityMap:
                              dtype=np.int8)
         out = per_group[self._member] if len(self.tags) else np.zeros(0, dtype=np.int8)
         for addr in links.forced:
-            first, last = (addr, addr + 1) if addr < IO_BITS else (8 * addr, 8 * addr + 8)
+            first, last = _forced(addr)
             out[(self._first < last) & (first < self._last)] = Quality.FORCED
         return out
+
+    def at(self, address: int, nbytes: int, view: MemoryView, links: LinkView | None = None) -> Quality:
+        """The quality of any address, tag or not: `nbytes` bytes of operand at an I/O bit or data
+        address, or with `nbytes` 0 the one bit of an HMI bit address (02042, 040005)."""
+        links = links or LinkView()
+        first, last = (address, address + 1) if nbytes == 0 else span(address, nbytes)
+        for addr in links.forced:
+            f_first, f_last = _forced(addr)
+            if f_first < last and first < f_last:
+                return Quality.FORCED
+        scan = getattr(view, "scan", 0)
+        fed = [self.feed_quality(f, view, links, scan) for f in self.feeds
+               if f.first < last and first < f.last]
+        return max(fed, default=Quality.GOOD if links.running else Quality.NOT_RUNNING)
 
     def quality(self, tag: Tag, view: MemoryView, links: LinkView | None = None) -> Quality:
         """One tag's quality (the runtime's per-scan path is `evaluate`)."""
         return Quality(int(self.evaluate(view, links)[self._pos[tag.name]]))
+
+
+def _forced(addr: int) -> tuple[int, int]:
+    """What a forced operand address covers: one I/O bit, or one data byte."""
+    return (addr, addr + 1) if addr < IO_BITS else span(addr, 1)

@@ -77,6 +77,12 @@ LIMITS: dict[TagType, tuple[float, float]] = {
 }
 
 
+def span(addr: int, nbytes: int) -> tuple[int, int]:
+    """[first, last) of an operand of `nbytes` bytes in the HMI bit space (I/O bit n = n, data bit =
+    byte*8+bit): one space in which tags, NREAD blocks and forced addresses can overlap."""
+    return (addr, addr + 8 * nbytes) if addr < IO_BITS else (8 * addr, 8 * (addr + nbytes))
+
+
 def check_address(addr: int, kind: TagType) -> None:
     """AddressError if `addr` cannot hold a value of `kind` (a bit: an HMI bit address)."""
     if kind is TagType.BIT:
@@ -163,11 +169,9 @@ class Tag:
     def footprint(self) -> tuple[int, int]:
         """[first, last) in the HMI bit space (I/O bit n = n, data bit = byte*8+bit) that the tag
         occupies: what `quality.py` overlaps with the blocks NREADs fill."""
-        a = self.address
         if self.type is TagType.BIT:
-            return a, a + 1
-        n = SIZES[self.type]
-        return (a, a + 8 * n) if a < IO_BITS else (8 * a, 8 * (a + n))
+            return self.address, self.address + 1
+        return span(self.address, SIZES[self.type])
 
 
 class TagReader:

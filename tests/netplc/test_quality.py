@@ -95,6 +95,18 @@ def test_not_running_marks_everything_and_forcing_wins() -> None:
 LIVE_PROGRAM = "TNA $03760\nFON C:$02110 N:NREAD S:4000 D:$04000 R:2\nJMP 0\n"
 
 
+def test_the_quality_of_any_address() -> None:
+    qmap = QualityMap(parse(PROGRAM), [])
+    links = LinkView(links={1: False, 2: True}, forced=[0o4100])
+    view = asking().snapshot(10)
+    assert qmap.at(0o4000, 2, view, links) is Quality.COMM_FAIL  # node 1
+    assert qmap.at(0o4004, 1, view, links) is Quality.GOOD  # node 2
+    assert qmap.at(0o4003 * 8 + 7, 0, view, links) is Quality.COMM_FAIL  # bit 7 of 04003: both
+    assert qmap.at(0o2200, 0, view, links) is Quality.GOOD  # bit 02200, node 2
+    assert qmap.at(0o4100, 2, view, links) is Quality.FORCED
+    assert qmap.at(0o4200, 2, view, LinkView(running=False)) is Quality.NOT_RUNNING
+
+
 @pytest.fixture
 def live() -> Iterator[tuple[Station, Simulator]]:
     """NetPlc NREADing 04000 from a real simulated node over Modbus TCP on 127.0.0.1."""
