@@ -20,10 +20,12 @@ from netplc.tags.tag import Scaling, Tag, TagType, check_address
 
 REQUIRED = ("name", "address", "type")
 TAG_COLUMNS = ("unit", "app_min", "app_max", "phy_min", "phy_max", "decimals", "description")
-ALARM_COLUMNS = ("hh", "h", "l", "ll", "deadband", "on_delay", "off_delay", "alarm_when", "priority",
+ALARM_COLUMNS = ("hh", "h", "l", "ll", "deadband", "delay", "on_delay", "off_delay", "alarm_when", "priority",
                  "latching", "suppress_by", "quality_alarm")
 COLUMNS = REQUIRED + TAG_COLUMNS + ALARM_COLUMNS
 LIMITS = ("ll", "l", "h", "hh")  # in the order their values must keep
+TYPES = {t.value for t in TagType}
+ALIASES = {"uint16": "word", "int": "int16", "dint": "int32", "real": "float32"}  # IEC 61131-3 names
 DEFAULT_PRIORITY = 3  # medium
 _NAME = re.compile(r"[^\W\d]\w*")
 _YES = {"1": True, "yes": True, "true": True, "0": False, "no": False, "false": False}
@@ -206,8 +208,9 @@ class _Row:
         elif not _NAME.fullmatch(self.name):
             self.bad(f"{self.name!r} is not a valid tag name (a letter, then letters, digits or _)")
             ok = False
-        type_text = self.cells["type"].lower()
-        kind = TagType(type_text) if type_text in TagType._value2member_map_ else None
+        type_text = self.cells["type"].strip().lower()
+        type_text = ALIASES.get(type_text, type_text)
+        kind = TagType(type_text) if type_text in TYPES else None
         if kind is None:
             self.bad(f"type {self.cells['type']!r} is not one of {', '.join(TagType)}")
             ok = False
@@ -251,8 +254,12 @@ class _Row:
     def alarms(self, kind: TagType | None, scaling: Scaling | None) -> TagAlarms | None:
         limits = {k: self.number(k) for k in LIMITS}
         deadband = self.number("deadband", 0.0)
-        on_delay = self.number("on_delay", 0.0)
-        off_delay = self.number("off_delay", 0.0)
+        delay = self.number("delay", 0.0) or 0.0  # both ways, unless on_delay / off_delay say otherwise
+        if delay < 0:
+            self.bad(f"delay {delay:g} is negative")
+            delay = 0.0
+        on_delay = self.number("on_delay", delay)
+        off_delay = self.number("off_delay", delay)
         when = self.whole("alarm_when", None, 0, 1, " (the bit value that is the alarm)")
         priority = self.whole("priority", DEFAULT_PRIORITY, 1, 4, " (1 critical, 2 high, 3 medium, 4 low)")
         latching = self.flag("latching", False)

@@ -159,6 +159,16 @@ def test_problems_name_the_file_line_and_tag(tmp_path: Path, line: str, problem:
         load_tags(path)
 
 
+def test_iec_type_names_and_one_delay_for_both_ways(tmp_path: Path) -> None:
+    path = write(tmp_path, "name,address,type,h,delay,off_delay\nA,04000,dint,5,2,\nB,04004,real,5,2,0.5\n"
+                           "C,04010,int,-5,,\nD,04012,uint16,,-1,\n")
+    table, problems = read_tags(path)
+    assert [t.type for t in table.tags] == [TagType.INT32, TagType.FLOAT32, TagType.INT16]
+    assert (table.alarms["A"].on_delay, table.alarms["A"].off_delay) == (2, 2)
+    assert (table.alarms["B"].on_delay, table.alarms["B"].off_delay) == (2, 0.5)
+    assert problems == [f"{path}:5: D: delay -1 is negative"]
+
+
 def test_unknown_columns_and_duplicate_names(tmp_path: Path) -> None:
     path = write(tmp_path, "name,address,type,colour\nA,04000,word,red\nA,04002,word,blue\n")
     _, problems = read_tags(path)
