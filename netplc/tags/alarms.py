@@ -31,7 +31,7 @@ from __future__ import annotations
 
 import math
 import time
-from collections.abc import Callable, Iterable, Mapping
+from collections.abc import Callable, Iterable, Mapping, Sequence
 from dataclasses import dataclass, field
 from enum import IntEnum, StrEnum
 from typing import Any, Protocol
@@ -298,9 +298,11 @@ class AlarmSystem:
 
     # --- per scan ------------------------------------------------------------------------------
 
-    def evaluate(self, snapshot: MemoryView, now: float | None = None, quality: np.ndarray | None = None,
+    def evaluate(self, snapshot: MemoryView, now: float | None = None,
+                 quality: np.ndarray | Sequence[int] | Mapping[str, int] | None = None,
                  messages: Iterable[int] = ()) -> list[Transition]:
-        """One scan: `quality` holds each tag's quality code in table order (None: all good),
+        """One scan: `quality` holds each tag's quality code in table order (as
+        `QualityMap.evaluate` gives it) or by tag name (None, or a tag not named: good),
         `messages` the NMSG numbers journaled in the scan. Returns the transitions, which are
         journaled as well."""
         if now is None:
@@ -310,7 +312,9 @@ class AlarmSystem:
         phy = self.reader.convert(raw)
         self._raw, self._phy = raw, phy
         hyst = self._hyst
-        bad = BAD_CODES[quality] if quality is not None else None
+        if isinstance(quality, Mapping):
+            quality = [quality.get(t.name, 0) for t in self.tags]
+        bad = BAD_CODES[np.asarray(quality, dtype=np.intp)] if quality is not None else None
         frozen = self._proc_idx[bad[self._proc_tag]] if bad is not None and bad.any() else None
         keep = hyst[frozen] if frozen is not None else None
         if len(self._lim_idx):

@@ -220,6 +220,12 @@ def test_bad_quality_is_its_own_alarm_and_freezes_the_process_alarms() -> None:
     assert r.state("LEVEL.H") is State.RTNUN
 
 
+def test_quality_may_be_given_by_tag_name() -> None:
+    r = Rig(TagAlarms(h=90, quality_alarm=True))
+    out = r.system.evaluate(r.mem.snapshot(), T0, {"LEVEL": Quality.NOT_RUNNING})
+    assert [(t.alarm, t.new) for t in out] == [("LEVEL.BAD", State.UNACK)]
+
+
 def test_nmsg_alarm_and_critical_messages_are_alarms_with_one_identity() -> None:
     catalog = [Message(1, 1, 0, "Пуск нажат"), Message(3, 1, 2, "Уровень выше 90 %"),
                Message(7, 1, 3, "Авария насоса")]
