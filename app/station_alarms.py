@@ -20,7 +20,7 @@ from netplc.exchange import Exchange
 from netplc.memory import Snapshot
 from netplc.program import Program
 from netplc.records import Record, RecordSink
-from netplc.tags.alarms import AlarmSystem, CatalogMessage, Transition
+from netplc.tags.alarms import AlarmSystem, CatalogMessage
 from netplc.tags.quality import LinkView, QualityMap
 from netplc.tags.table import TagTable, load_tags
 from registrar.alarm_state import AlarmStateFile
@@ -38,10 +38,8 @@ class StationAlarms:
         self.system = AlarmSystem(self.table, messages, sink=sink, saved=self.state.load(),
                                   on_change=self.state.update)
         self.quality = np.zeros(len(self.table.tags), dtype=np.int8)  # of the last scan, by tag
-        self.forced: frozenset[int] = frozenset()  # forced addresses, once forcing exists
         self.engine: Engine | None = None
         self.exchange: Exchange | None = None
-        self.listeners: list[Callable[[list[Transition]], None]] = []  # engine thread, with each scan's
         self._messages: list[int] = []
 
     def attach(self, engine: Engine, exchange: Exchange | None) -> None:
@@ -59,12 +57,10 @@ class StationAlarms:
         ex = self.exchange
         links = LinkView(running=snapshot.state == RunState.RUNNING,
                          links={n: ex.link_up(n) for n in ex.configs} if ex is not None else {},
-                         refreshed=ex.refreshed if ex is not None else {}, forced=self.forced)
+                         refreshed=ex.refreshed if ex is not None else {})
         self.quality = self.quality_map.evaluate(snapshot, links)
         messages, self._messages = self._messages, []
-        out = self.system.evaluate(snapshot, snapshot.wall, self.quality, messages)
-        for listener in self.listeners:
-            listener(out)
+        self.system.evaluate(snapshot, snapshot.wall, self.quality, messages)
 
     def _post(self, action: Callable[[], object]) -> None:
         if self.engine is None:

@@ -284,10 +284,6 @@ class AlarmSystem:
         out["state"] = a.state.word
         return out
 
-    def snapshot_state(self) -> dict[str, dict[str, Any]]:
-        """Every alarm's persisted state."""
-        return {a.id: self.state_of(i) for i, a in enumerate(self.alarms)}
-
     def _flush_changes(self) -> None:
         if self._changed and self.on_change is not None:
             changes = {self.alarms[i].id: self.state_of(i) for i in self._changed}

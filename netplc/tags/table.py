@@ -23,7 +23,7 @@ TAG_COLUMNS = ("unit", "app_min", "app_max", "phy_min", "phy_max", "decimals", "
 ALARM_COLUMNS = ("hh", "h", "l", "ll", "deadband", "delay", "on_delay", "off_delay", "alarm_when", "priority",
                  "latching", "suppress_by", "quality_alarm")
 COLUMNS = REQUIRED + TAG_COLUMNS + ALARM_COLUMNS
-LIMITS = ("ll", "l", "h", "hh")  # in the order their values must keep
+LIMIT_KEYS = ("ll", "l", "h", "hh")  # in the order their values must keep
 TYPES = {t.value for t in TagType}
 ALIASES = {"uint16": "word", "int": "int16", "dint": "int32", "real": "float32"}  # IEC 61131-3 names
 DEFAULT_PRIORITY = 3  # medium
@@ -252,7 +252,7 @@ class _Row:
         return Scaling(app_min, app_max, phy_min, phy_max)  # type: ignore[arg-type]
 
     def alarms(self, kind: TagType | None, scaling: Scaling | None) -> TagAlarms | None:
-        limits = {k: self.number(k) for k in LIMITS}
+        limits = {k: self.number(k) for k in LIMIT_KEYS}
         deadband = self.number("deadband", 0.0)
         delay = self.number("delay", 0.0) or 0.0  # both ways, unless on_delay / off_delay say otherwise
         if delay < 0:

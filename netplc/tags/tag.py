@@ -20,7 +20,6 @@ from netplc.address import (
     IO_BITS,
     check_operand,
     data_index,
-    fmt_octal,
     parse_hmi_bit,
 )
 from netplc.functions._util import bcd_to_bin
@@ -100,10 +99,6 @@ class Tag:
     scaling: Scaling | None = None  # None: the physical value is the hardware value
     decimals: int = 0
     description: str = ""
-
-    @property
-    def where(self) -> str:
-        return fmt_octal(self.address, 6 if self.address >= 0o40000 else 5)
 
     @property
     def limits(self) -> tuple[float, float]:
