@@ -16,7 +16,7 @@ import time
 
 from app.config import DEMO_STATION
 
-COMMANDS = ("view", "check", "simulate")
+COMMANDS = ("view", "check", "simulate", "alarms-report")
 
 
 def _main_parser() -> argparse.ArgumentParser:
@@ -25,7 +25,8 @@ def _main_parser() -> argparse.ArgumentParser:
         description="NetPlc Station: runs a station (NetPlc program, exchange with PLC nodes, archive) "
                     "and shows its HMI forms.",
         epilog="other commands: view [ARCHIVE] (offline journal viewer), check STATION (validate a "
-               "station), simulate PROGRAM.stl (a simulated CPU-165 node); each takes --help.",
+               "station), simulate PROGRAM.stl (a simulated CPU-165 node), alarms-report ARCHIVE --day "
+               "DD_MM_YYYY (alarm-system health); each takes --help.",
     )
     p.add_argument("station", nargs="?", default=str(DEMO_STATION),
                    help="station folder or its station.toml (default: the demo station)")
@@ -55,6 +56,16 @@ def _check_parser() -> argparse.ArgumentParser:
     return p
 
 
+def _alarms_report_parser() -> argparse.ArgumentParser:
+    p = argparse.ArgumentParser(prog="python main.py alarms-report",
+                                description="Alarm-system health of one day as ISA-18.2 measures it: alarms "
+                                            "per 10 minutes and floods, the 10 most frequent alarms, "
+                                            "chattering and stale alarms. Reads the archive read-only.")
+    p.add_argument("archive", help="archive file (journal.sqlite)")
+    p.add_argument("--day", required=True, metavar="DD_MM_YYYY", help="the day, as its table is named")
+    return p
+
+
 def main(argv: list[str] | None = None) -> int:
     args = list(sys.argv[1:] if argv is None else argv)
     if args and args[0] in COMMANDS:
@@ -65,6 +76,9 @@ def main(argv: list[str] | None = None) -> int:
             return simulate(rest)
         if command == "check":
             return run_check(_check_parser().parse_args(rest).station)
+        if command == "alarms-report":
+            ns = _alarms_report_parser().parse_args(rest)
+            return run_alarms_report(ns.archive, ns.day)
         return run_viewer(_view_parser().parse_args(rest).archive)
     ns = _main_parser().parse_args(args)
     if ns.duration is not None and not ns.no_gui:
@@ -86,6 +100,27 @@ def run_check(station: str) -> int:
         return 0
     print(f"{len(report.problems)} problem(s) found", file=sys.stderr)
     return 1
+
+
+def run_alarms_report(archive: str, day: str) -> int:
+    import sqlite3
+
+    from registrar.health import alarm_health
+    from registrar.query import Archive
+    from registrar.schema import parse_table_name
+
+    date = parse_table_name(day)
+    if date is None:
+        print(f"--day: {day!r} is not a day written DD_MM_YYYY (e.g. 05_03_2026)", file=sys.stderr)
+        return 2
+    try:
+        with Archive(archive) as arch:
+            report = alarm_health(arch, date, time.time())
+    except (FileNotFoundError, sqlite3.Error) as e:
+        print(f"{e}", file=sys.stderr)
+        return 2
+    print("\n".join(report.lines()))
+    return 0
 
 
 def _open_runtime(station: str):  # -> Runtime | None (typed lazily: the runtime imports the parts)

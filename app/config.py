@@ -67,6 +67,7 @@ class Station:
     nodes: tuple[NodeConfig, ...] = ()
     simulators: tuple[SimulatorSettings, ...] = ()
     users: tuple[str, ...] = ("operator",)
+    Tags: Path | None = None  # tags.csv: tags and their alarms (netplc/tags/)
 
     @property
     def folder(self) -> Path:
@@ -187,6 +188,7 @@ def read_station(path: str | Path) -> tuple[Station | None, list[str]]:
     messages = top.path("Messages", base)
     keep_days = top.number("keep_days", 0, 0, 36_500)
     retain = top.path("Retain", base)
+    tags = top.path("Tags", base)
     server = _modbus_server(problems, fname, top.get("modbus_server", dict, {}))
     nodes = _nodes(problems, fname, top.get("nodes", list, []))
     simulators = _simulators(problems, fname, top.get("simulators", list, []), base, top.allow_outside)
@@ -194,10 +196,11 @@ def read_station(path: str | Path) -> tuple[Station | None, list[str]]:
     top.finish()
     nodes = _with_simulated_nodes(problems, fname, nodes, simulators)
     _ports_in_common(problems, fname, server, simulators)
-    program, symbols, hmi, messages = (
+    program, symbols, hmi, messages, tags = (
         _existing(top, key, p, must_be_dir)
         for key, p, must_be_dir in (("NetPlcProgram", program, False), ("Symbols", symbols, False),
-                                    ("HMIload", hmi, True), ("Messages", messages, False)))
+                                    ("HMIload", hmi, True), ("Messages", messages, False),
+                                    ("Tags", tags, False)))
     runnable: list[SimulatorSettings] = []
     for i, sim in enumerate(simulators):
         missing = [(key, p) for key, p in (("program", sim.program), ("symbols", sim.symbols))
@@ -208,23 +211,23 @@ def read_station(path: str | Path) -> tuple[Station | None, list[str]]:
             runnable.append(sim)
     archive = archive or base / "archive" / "journal.sqlite"
     retain = retain or archive.with_name("retain.bin")
-    _outputs_apart(top, file.resolve(), archive, retain, program, symbols, messages, hmi, simulators)
+    _outputs_apart(top, file.resolve(), archive, retain, program, symbols, messages, tags, hmi, simulators)
     station = Station(
         path=file.resolve(), name=name or base.name, NetPlcLoad=bool(load), NetPlcProgram=program,
         Symbols=symbols, HMIload=hmi, NetSyncTime=sync, Archive=archive, Messages=messages,
         keep_days=keep_days, Retain=retain, modbus_server=server,
-        nodes=tuple(nodes), simulators=tuple(runnable), users=users,
+        nodes=tuple(nodes), simulators=tuple(runnable), users=users, Tags=tags,
     )
     return station, problems
 
 
 def _outputs_apart(r: _Reader, file: Path, archive: Path, retain: Path, program: Path | None,
-                   symbols: Path | None, messages: Path | None, hmi: Path | None,
+                   symbols: Path | None, messages: Path | None, tags: Path | None, hmi: Path | None,
                    sims: list[SimulatorSettings]) -> None:
     """The station writes Archive and Retain: neither may be one of its input files (the first save
     would overwrite the program or station.toml), a form, or the other one."""
     inputs = {p: key for key, p in (("station.toml", file), ("NetPlcProgram", program), ("Symbols", symbols),
-                                    ("Messages", messages)) if p is not None}
+                                    ("Messages", messages), ("Tags", tags)) if p is not None}
     for i, sim in enumerate(sims):
         inputs.update({p: f"simulators[{i}].{key}" for key, p in (("program", sim.program),
                                                                   ("symbols", sim.symbols)) if p})

@@ -19,6 +19,7 @@ from app.config import Station
 from hmi_forms.form import Form, load_forms
 from netplc.exchange import check_program_nodes
 from netplc.program import Program, ProgramError, load_symbols, parse, parse_file
+from netplc.tags.table import read_tags
 from registrar.catalog import Catalog, CatalogError
 
 RECOVERY_ROUNDS = 5
@@ -57,6 +58,10 @@ def load(station: Station) -> Loaded:
             out.notes.append(f"messages {station.Messages.name}: {len(out.catalog)} texts")
         except CatalogError as e:
             out.problems += e.problems
+    if station.Tags is not None:
+        tags, problems = read_tags(station.Tags, out.symbols)
+        out.problems += problems
+        out.notes.append(f"tags {station.Tags.name}: {len(tags.tags)} tags, {len(tags.alarms)} with alarms")
     out.forms, out.form_problems = load_station_forms(station, out.symbols)
     if station.HMIload is not None:
         out.notes.append(f"forms in {station.HMIload}: {len(out.forms)} loaded")

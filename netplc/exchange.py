@@ -334,6 +334,8 @@ class Exchange:
         # nodes whose link is up as of this scan (changes arrive with the presence-list update).
         self._inflight: set[int] = set()
         self._present: set[int] = set()
+        # NREAD key -> the scan at the start of which its data last landed (data age for quality)
+        self.refreshed: dict[int, int] = {}
         self._outbox: deque[tuple[_Node, _Request]] = deque()  # engine thread -> exchange loop
         self._wake = False
         self._thread = LoopThread("netplc-exchange")
@@ -435,7 +437,7 @@ class Exchange:
             stats.reads += 1
         else:
             stats.writes += 1
-        inflight, engine = self._inflight, self.engine
+        inflight, engine, refreshed = self._inflight, self.engine, self.refreshed
 
         def apply(mem: Memory) -> None:
             inflight.discard(req.key)
@@ -443,6 +445,8 @@ class Exchange:
                 stats.age = engine.scan_counter - req.scan
                 stats.age_max = max(stats.age_max, stats.age)
                 mem.write(req.local, data)
+                if req.payload is None:
+                    refreshed[req.key] = engine.scan_counter
 
         self.engine.post(apply)
 

@@ -9,7 +9,7 @@ from __future__ import annotations
 from dataclasses import dataclass
 from typing import Literal, Protocol
 
-Kind = Literal["data", "message", "operator", "system"]
+Kind = Literal["data", "message", "operator", "system", "alarm"]  # alarm: netplc/tags/alarms.py
 
 
 @dataclass(frozen=True, slots=True)

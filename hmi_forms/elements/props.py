@@ -16,42 +16,13 @@ from pathlib import Path
 from typing import Any
 
 from netplc.address import AddressError, BitRef, check_operand, parse_hmi_bit, parse_octal
+from netplc.tags.tag import Scaling  # the one conversion, shared with tags, journal and viewer
 
 Color = tuple[int, int, int, int]  # r, g, b, alpha
 
 
 class PropError(ValueError):
     """A property value the loader refuses; the message is the `problem` part of the report."""
-
-
-@dataclass(frozen=True, slots=True)
-class Scaling:
-    """Linear hardware <-> physical conversion (docs/architecture.md section 9)."""
-
-    AppMin: float
-    AppMax: float
-    PhyMin: float
-    PhyMax: float
-
-    def to_phy(self, hw: float) -> float:
-        return self.PhyMin + (hw - self.AppMin) * (self.PhyMax - self.PhyMin) / (self.AppMax - self.AppMin)
-
-    def to_hw(self, phy: float) -> int:
-        """The inverse, rounded and clamped to the hardware range (and to an unsigned word)."""
-        hw = self.AppMin + (phy - self.PhyMin) * (self.AppMax - self.AppMin) / (self.PhyMax - self.PhyMin)
-        lo, hi = sorted((self.AppMin, self.AppMax))
-        hw = min(max(hw, lo), hi)
-        return min(max(round(hw), 0), 0xFFFF)
-
-    @property
-    def phy_range(self) -> tuple[float, float]:
-        lo, hi = sorted((self.PhyMin, self.PhyMax))
-        return lo, hi
-
-    def fraction(self, phy: float) -> float:
-        """Position of `phy` on the scale PhyMin..PhyMax, clamped to 0..1 (for pointers and bars)."""
-        f = (phy - self.PhyMin) / (self.PhyMax - self.PhyMin)
-        return min(max(f, 0.0), 1.0)
 
 
 @dataclass(frozen=True, slots=True)

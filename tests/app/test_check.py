@@ -89,3 +89,22 @@ def test_check_reports_exactly_what_a_start_refuses(tmp_path: Path) -> None:
         Runtime(load_station(st))
     assert len(refused.value.problems) == 4  # the bad line, NODE 7 further down, the node, the message
     assert check_station(st).problems == refused.value.problems
+
+
+def test_tags_csv_problems_are_reported_by_check(tmp_path: Path) -> None:
+    st = copy_demo(tmp_path / "tags")
+    plant(st / "tags.csv", "LEVEL,LEVEL,word,%,0,4095,0,100,1,Уровень,95,90,",
+          "LEVEL,LEVEL,word,%,0,4095,0,100,1,Уровень,85,90,")
+    plant(st / "tags.csv", "TEMP,TEMP,word,°C,0,1000,", "TEMP,TEMP,word,°C,7,7,")
+    plant(st / "tags.csv", "TRIGGER,040005,bit,", "TRIGGER,010000,bit,")
+    r = run_check(st)
+    assert r.returncode == 1
+    tags = st / "tags.csv"
+    lines = tags.read_text(encoding="utf-8").splitlines()
+    level = next(i for i, line in enumerate(lines, 1) if line.startswith("LEVEL,"))
+    assert f"{tags}:{level}: LEVEL: HH 85 is below H 90" in r.stdout
+    assert f"{tags}:{level + 1}: TEMP: app_min = app_max = 7" in r.stdout
+    assert f"{tags}:{level + 3}: TRIGGER: address '010000' cannot hold an I/O bit or a data bit" in r.stdout
+    plant(st / "station.toml", 'Tags = "tags.csv"', 'Tags = "no_tags.csv"')
+    r = run_check(st)
+    assert f"{st / 'station.toml'}: Tags: file {st / 'no_tags.csv'} does not exist" in r.stdout

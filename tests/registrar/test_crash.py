@@ -12,6 +12,7 @@ from pathlib import Path
 
 import pytest
 
+from registrar.alarm_state import AlarmStateFile
 from registrar.query import Archive
 from registrar.retain import read_save
 from registrar.schema import DAY_GLOB
@@ -108,3 +109,19 @@ def test_retentive_counting_continues_after_clean_stop_and_sigkill(tmp_path):
     assert word < word_after <= killed_word + 5
     assert killed_word - word_after <= 1.25 / 0.02  # at most about a second of scans behind
     assert counter < counter_after <= killed_counter + 2
+
+
+def test_sigkill_while_alarm_states_are_saved_leaves_one_whole_round(tmp_path):
+    path = tmp_path / "alarms.sqlite"
+    child = spawn("alarm_state_child.py", str(path))
+    try:
+        lines = read_until(child, lambda line: int(line[0]) >= 50)
+        lines += kill(child)
+    finally:
+        if child.poll() is None:
+            child.kill()
+    saved = int(lines[-1][0])
+    states = AlarmStateFile(path).load()
+    rounds = {s["round"] for s in states.values()}
+    assert len(states) == 200 and len(rounds) == 1  # never half of one round and half of another
+    assert rounds.pop() >= saved

@@ -1,0 +1,95 @@
+"""Tags, quality and alarms of a running station, wired the way the runtime needs them.
+
+`StationAlarms` loads `tags.csv`, works out from the program which node fills which tag, takes
+back the alarm states of the last run, and then, attached to the engine, runs once per scan on
+the engine thread: each tag's quality from the exchange's links and data ages and NetPlc's run
+state, then the alarms over that scan's snapshot and the NMSG numbers journaled in it. Operator
+actions are posted to the engine thread, as writes are, so the alarm states have one writer.
+No Qt: the workstation and `--no-gui` share it.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable
+from pathlib import Path
+
+import numpy as np
+
+from netplc.engine import Engine, RunState
+from netplc.exchange import Exchange
+from netplc.memory import Snapshot
+from netplc.program import Program
+from netplc.records import Record, RecordSink
+from netplc.tags.alarms import AlarmSystem, CatalogMessage
+from netplc.tags.quality import LinkView, QualityMap
+from netplc.tags.table import TagTable, load_tags
+from registrar.alarm_state import AlarmStateFile
+
+STATE_FILE = "alarms.sqlite"  # next to the archive
+
+
+class StationAlarms:
+    def __init__(self, tags: Path | None, program: Program, messages: list[CatalogMessage], sink: RecordSink,
+                 state_file: Path, symbols: dict[str, int] | None = None) -> None:
+        """TagError (every problem of tags.csv) if the tags cannot be used."""
+        self.table = load_tags(tags, symbols) if tags is not None else TagTable()
+        self.quality_map = QualityMap(program, self.table.tags)
+        self.state = AlarmStateFile(state_file, sink)
+        self.system = AlarmSystem(self.table, messages, sink=sink, saved=self.state.load(),
+                                  on_change=self.state.update)
+        self.quality = np.zeros(len(self.table.tags), dtype=np.int8)  # of the last scan, by tag
+        self.engine: Engine | None = None
+        self.exchange: Exchange | None = None
+        self._messages: list[int] = []
+
+    def attach(self, engine: Engine, exchange: Exchange | None) -> None:
+        """Evaluate after every scan of `engine`; start saving states."""
+        self.engine, self.exchange = engine, exchange
+        engine.listeners.append(self.on_scan)
+        self.state.start()
+
+    def observe(self, record: Record) -> None:
+        """The runtime's record observer: collects the NMSG numbers of the scan being run."""
+        if record.kind == "message" and record.number is not None:
+            self._messages.append(record.number)
+
+    def on_scan(self, snapshot: Snapshot) -> None:
+        ex = self.exchange
+        links = LinkView(running=snapshot.state == RunState.RUNNING,
+                         links={n: ex.link_up(n) for n in ex.configs} if ex is not None else {},
+                         refreshed=ex.refreshed if ex is not None else {})
+        self.quality = self.quality_map.evaluate(snapshot, links)
+        messages, self._messages = self._messages, []
+        self.system.evaluate(snapshot, snapshot.wall, self.quality, messages)
+
+    def _post(self, action: Callable[[], object]) -> None:
+        if self.engine is None:
+            action()
+        else:
+            self.engine.post(lambda _mem: action())
+
+    # Operator actions: refused at once (AlarmError) for an unknown alarm or a shelving without
+    # its operator, reason or duration; done at the start of the next scan.
+
+    def acknowledge(self, alarm_id: str, user: str) -> None:
+        self.system.get(alarm_id)
+        self._post(lambda: self.system.acknowledge(alarm_id, user))
+
+    def acknowledge_all(self, user: str) -> None:
+        self._post(lambda: self.system.acknowledge_all(user))
+
+    def shelve(self, alarm_id: str, user: str, reason: str, duration: float) -> None:
+        self.system.check_shelve(alarm_id, user, reason, duration)
+        self._post(lambda: self.system.shelve(alarm_id, user, reason, duration))
+
+    def unshelve(self, alarm_id: str, user: str) -> None:
+        self.system.get(alarm_id)
+        self._post(lambda: self.system.unshelve(alarm_id, user))
+
+    def set_out_of_service(self, alarm_id: str, user: str, out_of_service: bool = True) -> None:
+        self.system.get(alarm_id)
+        self._post(lambda: self.system.set_out_of_service(alarm_id, user, out_of_service))
+
+    def close(self) -> None:
+        """After the scan thread has stopped: write the last states."""
+        self.state.close()

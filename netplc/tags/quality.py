@@ -1,0 +1,169 @@
+"""Data quality: whether a value in NetPlc memory can be trusted, derived and never configured.
+
+The program's NREADs say which node fills which bytes (known at load time: the nearest NODE above
+each NREAD, as the exchange itself resolves it). At run time the node's link, the age of the
+block's data in scans, NetPlc's run state and forcing give each address its quality:
+
+- forced: the value is forced by an engineer (it is what it is, but not the plant's);
+- not running: NetPlc is stopped or halted, so nothing in memory changes any more;
+- comm-fail: the node whose NREAD fills the address is down (its answers fail or are malformed);
+- stale: the NREAD asks (its rung is on) but its data has not landed for more than STALE_TICKS
+  scans beyond the one scan an answer normally takes;
+- good: anything else, including what the program computes itself while it runs.
+
+Qualities are ordered so that the worst of several blocks (a tag spanning two NREADs) is the
+highest; an address no NREAD fills is good while NetPlc runs.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Collection, Mapping, Sequence
+from dataclasses import dataclass
+from enum import IntEnum
+
+import numpy as np
+
+from netplc.address import IO_BITS
+from netplc.exchange import NODE, NREAD, _fon_nodes
+from netplc.memory import MemoryView
+from netplc.program import Program
+from netplc.tags.tag import Tag, span
+
+STALE_TICKS = 2  # scans of lateness tolerated beyond the normal one-scan answer
+NORMAL_AGE = 1  # scans from a request to its data in memory, normally
+
+
+class Quality(IntEnum):
+    GOOD = 0
+    STALE = 1
+    COMM_FAIL = 2
+    NOT_RUNNING = 3
+    FORCED = 4
+
+    @property
+    def word(self) -> str:
+        """The word an operator reads in a tooltip or a journal record."""
+        return _WORDS[self]
+
+    @property
+    def bad(self) -> bool:
+        """The value cannot be trusted (forced is shown, but it is not bad: someone chose it)."""
+        return self in (Quality.STALE, Quality.COMM_FAIL, Quality.NOT_RUNNING)
+
+
+_WORDS = {Quality.GOOD: "good", Quality.STALE: "stale", Quality.COMM_FAIL: "comm-fail",
+          Quality.NOT_RUNNING: "not running", Quality.FORCED: "forced"}
+BAD_CODES = np.array([q.bad for q in Quality], dtype=bool)  # indexed by quality code
+
+
+@dataclass(frozen=True, slots=True)
+class Feed:
+    """One NREAD: the node it asks, its coil (1 while the rung asks) and what it fills."""
+
+    key: int  # the FON's instruction index, as the exchange knows the request
+    node: int
+    coil: int
+    first: int  # [first, last) in the HMI bit space (I/O bit n = n, data byte b = bits 8b..8b+7)
+    last: int
+    line: int = 0  # of the program text, for messages
+
+
+def nread_feeds(program: Program) -> list[Feed]:
+    """Every NREAD of the program with the node it talks to. One above the first NODE talks to the
+    node of the last NODE in the text (the one selected when the previous scan ended)."""
+    nodes = [i.s for i in program.instrs if i.op == "FON" and i.n == NODE]
+    wrap = nodes[-1] if nodes else 0
+    index = {id(ins): k for k, ins in enumerate(program.instrs)}
+    feeds = []
+    for fn, ins, node in _fon_nodes(program):
+        if fn != NREAD:
+            continue
+        first, last = span(ins.d or 0, ins.r or 0)
+        feeds.append(Feed(index[id(ins)], wrap if node is None else node, ins.c or 0, first, last, ins.line))
+    return feeds
+
+
+@dataclass(frozen=True)
+class LinkView:
+    """What the quality of a scan depends on besides memory (the runtime fills it per scan)."""
+
+    running: bool = True  # NetPlc runs its program
+    links: Mapping[int, bool] | None = None  # node -> link up; None: every node is up
+    refreshed: Mapping[int, int] | None = None  # NREAD key -> scan its data last landed; None: now
+    forced: Collection[int] = ()  # forced operand addresses: I/O bits and data bytes
+
+
+class QualityMap:
+    """Which NREADs fill each tag, worked out once at load time; per scan, every tag's quality.
+
+    Tags are grouped by the set of blocks they overlap (usually a handful of groups), so a scan
+    computes each block's quality once and each tag's by one numpy gather.
+    """
+
+    def __init__(self, program: Program, tags: Sequence[Tag]) -> None:
+        self.feeds = nread_feeds(program)
+        self.tags = list(tags)
+        groups: dict[tuple[int, ...], int] = {}
+        members = []
+        for tag in self.tags:
+            first, last = tag.footprint()
+            fed = tuple(k for k, f in enumerate(self.feeds) if f.first < last and first < f.last)
+            members.append(groups.setdefault(fed, len(groups)))
+        self.groups = list(groups)  # group -> indexes into self.feeds
+        self._member = np.array(members, dtype=np.intp)
+        spans = np.array([t.footprint() for t in self.tags], dtype=np.int64).reshape(-1, 2)
+        self._first, self._last = spans[:, 0], spans[:, 1]
+        self._pos = {t.name: i for i, t in enumerate(self.tags)}
+
+    def fed_by(self, tag: Tag) -> list[Feed]:
+        """The NREADs whose block overlaps the tag."""
+        return [self.feeds[k] for k in self.groups[self._member[self._pos[tag.name]]]]
+
+    def feed_quality(self, feed: Feed, view: MemoryView, links: LinkView, scan: int) -> Quality:
+        if not links.running:
+            return Quality.NOT_RUNNING
+        if links.links is not None and not links.links.get(feed.node, False):
+            return Quality.COMM_FAIL
+        if links.refreshed is not None and view.get_bit(feed.coil):
+            landed = links.refreshed.get(feed.key)
+            if landed is None or scan - landed > NORMAL_AGE + STALE_TICKS:
+                return Quality.STALE
+        return Quality.GOOD
+
+    def evaluate(self, view: MemoryView, links: LinkView | None = None,
+                 scan: int | None = None) -> np.ndarray:
+        """Every tag's quality code (a `Quality` value) as of this snapshot, in the order of tags."""
+        links = links or LinkView()
+        scan = getattr(view, "scan", 0) if scan is None else scan
+        per_feed = [self.feed_quality(f, view, links, scan) for f in self.feeds]
+        idle = Quality.GOOD if links.running else Quality.NOT_RUNNING
+        per_group = np.array([max((per_feed[k] for k in g), default=idle) for g in self.groups],
+                             dtype=np.int8)
+        out = per_group[self._member] if len(self.tags) else np.zeros(0, dtype=np.int8)
+        for addr in links.forced:
+            first, last = _forced(addr)
+            out[(self._first < last) & (first < self._last)] = Quality.FORCED
+        return out
+
+    def at(self, address: int, nbytes: int, view: MemoryView, links: LinkView | None = None) -> Quality:
+        """The quality of any address, tag or not: `nbytes` bytes of operand at an I/O bit or data
+        address, or with `nbytes` 0 the one bit of an HMI bit address (02042, 040005)."""
+        links = links or LinkView()
+        first, last = (address, address + 1) if nbytes == 0 else span(address, nbytes)
+        for addr in links.forced:
+            f_first, f_last = _forced(addr)
+            if f_first < last and first < f_last:
+                return Quality.FORCED
+        scan = getattr(view, "scan", 0)
+        fed = [self.feed_quality(f, view, links, scan) for f in self.feeds
+               if f.first < last and first < f.last]
+        return max(fed, default=Quality.GOOD if links.running else Quality.NOT_RUNNING)
+
+    def quality(self, tag: Tag, view: MemoryView, links: LinkView | None = None) -> Quality:
+        """One tag's quality (the runtime's per-scan path is `evaluate`)."""
+        return Quality(int(self.evaluate(view, links)[self._pos[tag.name]]))
+
+
+def _forced(addr: int) -> tuple[int, int]:
+    """What a forced operand address covers: one I/O bit, or one data byte."""
+    return (addr, addr + 1) if addr < IO_BITS else span(addr, 1)

@@ -1,0 +1,306 @@
+"""`tags.csv`: the station's tags and their alarms, one per line, checked as a whole.
+
+UTF-8 with or without a BOM, a header line naming the columns (any order; only `name, address,
+type` are required), `#` or `;` comment lines. Every problem is collected and reported as
+`tags.csv:LINE: TAG: problem`, so that `check` and the start name all of them at once; the lines
+that are good still load, so one typo does not take every other tag's alarms away.
+"""
+
+from __future__ import annotations
+
+import csv
+import itertools
+import math
+import re
+from dataclasses import dataclass, field
+from pathlib import Path
+
+from netplc.address import AddressError, parse_hmi_bit, parse_octal
+from netplc.tags.tag import Scaling, Tag, TagType, check_address
+
+REQUIRED = ("name", "address", "type")
+TAG_COLUMNS = ("unit", "app_min", "app_max", "phy_min", "phy_max", "decimals", "description")
+ALARM_COLUMNS = ("hh", "h", "l", "ll", "deadband", "delay", "on_delay", "off_delay", "alarm_when", "priority",
+                 "latching", "suppress_by", "quality_alarm")
+COLUMNS = REQUIRED + TAG_COLUMNS + ALARM_COLUMNS
+LIMIT_KEYS = ("ll", "l", "h", "hh")  # in the order their values must keep
+TYPES = {t.value for t in TagType}
+ALIASES = {"uint16": "word", "int": "int16", "dint": "int32", "real": "float32"}  # IEC 61131-3 names
+DEFAULT_PRIORITY = 3  # medium
+_NAME = re.compile(r"[^\W\d]\w*")
+_YES = {"1": True, "yes": True, "true": True, "0": False, "no": False, "false": False}
+
+
+class TagError(Exception):
+    """A tags file that cannot be used: every problem, each `file:line: ...`."""
+
+    def __init__(self, problems: list[str]) -> None:
+        self.problems = problems
+        super().__init__("\n".join(problems))
+
+
+@dataclass(frozen=True)
+class TagAlarms:
+    """The alarm columns of one tag (physical units, seconds)."""
+
+    hh: float | None = None
+    h: float | None = None
+    l: float | None = None  # noqa: E741 - the ISA-18.2 name
+    ll: float | None = None
+    deadband: float = 0.0
+    on_delay: float = 0.0
+    off_delay: float = 0.0
+    alarm_when: int | None = None  # a bit tag: alarm while the bit has this value
+    priority: int = DEFAULT_PRIORITY  # 1 critical, 2 high, 3 medium, 4 low
+    latching: bool = False
+    suppress_by: int | None = None  # HMI bit address: suppressed by design while it is 1
+    quality_alarm: bool = False  # an alarm of its own class while the tag's quality is bad
+
+    def limits(self) -> list[tuple[str, float]]:
+        """The limits set, as (HH/H/L/LL, value)."""
+        return [(k.upper(), v) for k in ("hh", "h", "l", "ll") if (v := getattr(self, k)) is not None]
+
+    @property
+    def any(self) -> bool:
+        return bool(self.limits()) or self.alarm_when is not None or self.quality_alarm
+
+
+@dataclass
+class TagTable:
+    tags: list[Tag] = field(default_factory=list)
+    alarms: dict[str, TagAlarms] = field(default_factory=dict)  # tag name -> its alarm columns
+    source: str = "tags.csv"
+
+    def __post_init__(self) -> None:
+        self.by_name = {t.name: t for t in self.tags}
+
+    def get(self, name: str) -> Tag | None:
+        return self.by_name.get(name)
+
+
+def load_tags(path: str | Path, symbols: dict[str, int] | None = None) -> TagTable:
+    """The tags of a file; TagError lists every problem."""
+    table, problems = read_tags(path, symbols)
+    if problems:
+        raise TagError(problems)
+    return table
+
+
+def read_tags(path: str | Path, symbols: dict[str, int] | None = None) -> tuple[TagTable, list[str]]:
+    """The good lines' tags and every problem (for `check`, which reports and goes on)."""
+    path = Path(path)
+    fname = str(path)
+    try:
+        text = path.read_text(encoding="utf-8-sig")
+    except (OSError, UnicodeDecodeError) as e:
+        return TagTable(source=fname), [f"{fname}:0: cannot read the tags: {e}"]
+    rows = [(n, row) for n, row in enumerate(csv.reader(text.splitlines()), start=1)
+            if row and "".join(row).strip() and not row[0].lstrip().startswith(("#", ";"))]
+    if not rows:
+        return TagTable(source=fname), []
+    line, header = rows[0]
+    columns = [c.strip().lower() for c in header]
+    problems: list[str] = []
+    missing = [c for c in REQUIRED if c not in columns]
+    if missing:
+        problems.append(f"{fname}:{line}: the header must name the columns {', '.join(REQUIRED)} "
+                        f"(missing: {', '.join(missing)}); known columns: {', '.join(COLUMNS)}")
+        return TagTable(source=fname), problems
+    for c in columns:
+        if c not in COLUMNS:
+            problems.append(f"{fname}:{line}: unknown column {c!r} (known: {', '.join(COLUMNS)})")
+        elif columns.count(c) > 1:
+            problems.append(f"{fname}:{line}: column {c!r} appears twice")
+    tags: list[Tag] = []
+    alarms: dict[str, TagAlarms] = {}
+    first_line: dict[str, int] = {}
+    for lineno, row in rows[1:]:
+        if len(row) > len(columns) and any(v.strip() for v in row[len(columns):]):
+            problems.append(f"{fname}:{lineno}: {len(row)} fields, but the header names {len(columns)}")
+            continue
+        cells = {c: (row[i].strip() if i < len(row) else "") for i, c in enumerate(columns)}
+        parser = _Row(f"{fname}:{lineno}", cells, symbols or {})
+        result = parser.parse()
+        problems += parser.problems
+        if result is None:
+            continue
+        tag, tag_alarms = result
+        if tag.name in first_line:
+            problems.append(f"{fname}:{lineno}: {tag.name}: the name is already used on line "
+                            f"{first_line[tag.name]}")
+            continue
+        first_line[tag.name] = lineno
+        tags.append(tag)
+        if tag_alarms.any:
+            alarms[tag.name] = tag_alarms
+    return TagTable(tags, alarms, fname), problems
+
+
+class _Row:
+    """One line: typed cells, and the problems found in it."""
+
+    def __init__(self, where: str, cells: dict[str, str], symbols: dict[str, int]) -> None:
+        self.where = where
+        self.cells = cells
+        self.symbols = symbols
+        self.name = cells.get("name", "")
+        self.problems: list[str] = []
+
+    def bad(self, problem: str) -> None:
+        self.problems.append(f"{self.where}: {self.name or '(no name)'}: {problem}")
+
+    def number(self, key: str, default: float | None = None) -> float | None:
+        text = self.cells.get(key, "")
+        if not text:
+            return default
+        try:
+            value = float(text.replace(",", "."))
+        except ValueError:
+            self.bad(f"{key} {text!r} is not a number")
+            return default
+        if not math.isfinite(value):
+            self.bad(f"{key} {text!r} is not a finite number")
+            return default
+        return value
+
+    def whole(self, key: str, default: int | None, lo: int, hi: int, meaning: str = "") -> int | None:
+        value = self.number(key)
+        if value is None:
+            return default
+        if value != int(value) or not lo <= value <= hi:
+            self.bad(f"{key} {self.cells[key]!r} is not a whole number {lo}-{hi}{meaning}")
+            return default
+        return int(value)
+
+    def flag(self, key: str, default: bool) -> bool:
+        text = self.cells.get(key, "").lower()
+        if not text:
+            return default
+        if text not in _YES:
+            self.bad(f"{key} {self.cells[key]!r} is not yes/no (or 1/0, true/false)")
+            return default
+        return _YES[text]
+
+    def address(self, kind: TagType | None) -> int | None:
+        text = self.cells["address"]
+        if not text:
+            self.bad("address is missing")
+            return None
+        try:
+            addr = self.symbols[text] if text in self.symbols else parse_octal(text)
+        except ValueError:
+            self.bad(f"address {text!r} is neither an octal address nor a symbol")
+            return None
+        if kind is not None:
+            try:
+                check_address(addr, kind)
+            except AddressError as e:
+                what = "an I/O bit or a data bit (byte*8+bit)" if kind is TagType.BIT else f"a {kind} value"
+                self.bad(f"address {text!r} cannot hold {what}: {e}")
+                return None
+        return addr
+
+    def parse(self) -> tuple[Tag, TagAlarms] | None:
+        ok = True
+        if not self.name:
+            self.bad("name is missing")
+            ok = False
+        elif not _NAME.fullmatch(self.name):
+            self.bad(f"{self.name!r} is not a valid tag name (a letter, then letters, digits or _)")
+            ok = False
+        type_text = self.cells["type"].strip().lower()
+        type_text = ALIASES.get(type_text, type_text)
+        kind = TagType(type_text) if type_text in TYPES else None
+        if kind is None:
+            self.bad(f"type {self.cells['type']!r} is not one of {', '.join(TagType)}")
+            ok = False
+        addr = self.address(kind)
+        scaling = self.scaling(kind)
+        decimals = self.whole("decimals", 0, 0, 10)
+        alarms = self.alarms(kind, scaling)
+        if not ok or addr is None or kind is None or self.problems:
+            return None
+        tag = Tag(self.name, addr, kind, self.cells.get("unit", ""), scaling, decimals or 0,
+                  self.cells.get("description", ""))
+        if alarms is not None:
+            self.fits(tag, alarms)
+        if self.problems or alarms is None:
+            return None
+        return tag, alarms
+
+    def scaling(self, kind: TagType | None) -> Scaling | None:
+        keys = ("app_min", "app_max", "phy_min", "phy_max")
+        values = [self.number(k) for k in keys]
+        given = [k for k, v in zip(keys, values, strict=True) if v is not None]
+        if not given:
+            return None
+        if len(given) < 4:
+            missing = [k for k in keys if k not in given]
+            self.bad(f"give all of app_min, app_max, phy_min, phy_max or none "
+                     f"(missing: {', '.join(missing)})")
+            return None
+        app_min, app_max, phy_min, phy_max = values
+        if kind is TagType.BIT:
+            self.bad("a bit tag has no conversion (app_min..phy_max must be empty)")
+            return None
+        if app_min == app_max:
+            self.bad(f"app_min = app_max = {app_min:g}: the conversion is undefined")
+            return None
+        if phy_min == phy_max:
+            self.bad(f"phy_min = phy_max = {phy_min:g}: the conversion is undefined")
+            return None
+        return Scaling(app_min, app_max, phy_min, phy_max)  # type: ignore[arg-type]
+
+    def alarms(self, kind: TagType | None, scaling: Scaling | None) -> TagAlarms | None:
+        limits = {k: self.number(k) for k in LIMIT_KEYS}
+        deadband = self.number("deadband", 0.0)
+        delay = self.number("delay", 0.0) or 0.0  # both ways, unless on_delay / off_delay say otherwise
+        if delay < 0:
+            self.bad(f"delay {delay:g} is negative")
+            delay = 0.0
+        on_delay = self.number("on_delay", delay)
+        off_delay = self.number("off_delay", delay)
+        when = self.whole("alarm_when", None, 0, 1, " (the bit value that is the alarm)")
+        priority = self.whole("priority", DEFAULT_PRIORITY, 1, 4, " (1 critical, 2 high, 3 medium, 4 low)")
+        latching = self.flag("latching", False)
+        suppress = self.suppress_bit()
+        for key, value in (("deadband", deadband), ("on_delay", on_delay), ("off_delay", off_delay)):
+            if value is not None and value < 0:
+                self.bad(f"{key} {value:g} is negative")
+        given = [(k, v) for k, v in limits.items() if v is not None]
+        for (k1, v1), (k2, v2) in itertools.pairwise(given):
+            if v2 < v1:
+                self.bad(f"{k2.upper()} {v2:g} is below {k1.upper()} {v1:g}: the limits must keep "
+                         "the order LL <= L <= H <= HH")
+        process = bool(given) or when is not None
+        quality = self.flag("quality_alarm", process)
+        if self.problems:
+            return None
+        return TagAlarms(limits["hh"], limits["h"], limits["l"], limits["ll"], deadband or 0.0,
+                         on_delay or 0.0, off_delay or 0.0, when, priority or DEFAULT_PRIORITY, latching,
+                         suppress, quality)
+
+    def suppress_bit(self) -> int | None:
+        text = self.cells.get("suppress_by", "")
+        if not text:
+            return None
+        try:
+            addr = self.symbols[text] if text in self.symbols else parse_octal(text)
+            return parse_hmi_bit(addr).hmi
+        except (ValueError, AddressError) as e:
+            self.bad(f"suppress_by {text!r} is not a bit address or a bit's symbol: {e}")
+            return None
+
+    def fits(self, tag: Tag, alarms: TagAlarms) -> None:
+        """An alarm the tag's type cannot hold: limits on a bit, alarm_when on a value, a limit
+        the tag can never reach."""
+        if tag.type is TagType.BIT:
+            if alarms.limits():
+                self.bad("a bit tag cannot have limit alarms (HH/H/L/LL); give alarm_when 0 or 1")
+            return
+        if alarms.alarm_when is not None:
+            self.bad(f"alarm_when needs a bit tag; {tag.type} takes limit alarms (HH/H/L/LL)")
+        lo, hi = tag.phy_limits
+        for key, value in alarms.limits():
+            if not lo <= value <= hi:
+                self.bad(f"{key} {value:g} is outside what a {tag.type} tag can take here ({lo:g}..{hi:g})")
