@@ -15,6 +15,7 @@ from app.runtime import load_simulated_program, node_configs, unresolved_hosts
 from hmi_forms.form import load_forms
 from netplc.exchange import check_program_nodes
 from netplc.program import Program, ProgramError, load_symbols, parse, parse_file
+from netplc.textfile import TextFileError, read_text
 from registrar.catalog import Catalog, CatalogError
 
 RECOVERY_ROUNDS = 5
@@ -71,9 +72,13 @@ def _symbols(path: Path | None, report: CheckReport) -> dict[str, int]:
     except ProgramError as e:
         report.problems += [str(d) for d in e.errors]
         bad = {d.line for d in e.errors}
+    try:
+        text = _blank_lines(path, bad)
+    except TextFileError:
+        return {}  # already reported
     with tempfile.TemporaryDirectory() as tmp:
         good = Path(tmp) / path.name
-        good.write_text(_blank_lines(path, bad), encoding="utf-8")
+        good.write_text(text, encoding="utf-8")
         try:
             return load_symbols(good)
         except ProgramError:
@@ -99,6 +104,8 @@ def _recovered(path: Path, symbols: dict[str, int], bad: set[int]) -> Program | 
     for _ in range(RECOVERY_ROUNDS):  # removing a line can break another (a label it defined)
         try:
             return parse(_blank_lines(path, bad), source=str(path), symbols=symbols)
+        except TextFileError:
+            return None  # already reported
         except ProgramError as e:
             more = {d.line for d in e.errors} - bad
             if not more:
@@ -108,5 +115,5 @@ def _recovered(path: Path, symbols: dict[str, int], bad: set[int]) -> Program | 
 
 
 def _blank_lines(path: Path, lines: set[int]) -> str:
-    text = path.read_text(encoding="utf-8-sig").splitlines()
+    text = read_text(path).splitlines()
     return "\n".join("" if i in lines else line for i, line in enumerate(text, start=1))

@@ -15,6 +15,7 @@ from typing import Any
 
 from netplc.address import fmt_octal, is_data_byte, is_io_bit, parse_octal
 from netplc.modbus.driver import Endpoint, parse_endpoint
+from netplc.textfile import TextFileError, read_text
 
 STATION_FILE = "station.toml"
 DEMO_STATION = Path(__file__).resolve().parent.parent / "resources" / "example"  # the built-in demo
@@ -121,6 +122,9 @@ class _Reader:
             return default
         value = self.table[key]
         if kind is float and isinstance(value, int) and not isinstance(value, bool):
+            if abs(value) > 1e300:  # float() would overflow
+                self.bad(key, f"a {len(str(abs(value)))}-digit number is too large")
+                return default
             return float(value)
         if isinstance(value, bool) and kind is not bool:
             self.bad(key, f"expected {_kind_name(kind)}, got {value!r}")
@@ -143,6 +147,9 @@ class _Reader:
             return None
         if not value.strip():
             self.bad(key, "empty path")
+            return None
+        if "\0" in value:
+            self.bad(key, "a path cannot hold a NUL character")
             return None
         return (base / value).resolve() if not Path(value).is_absolute() else Path(value)
 
@@ -173,16 +180,16 @@ def read_station(path: str | Path) -> tuple[Station | None, list[str]]:
     in the returned station; None instead of a station when the file is not TOML at all."""
     file = station_file(path)
     fname = str(file)
-    try:
-        data = tomllib.loads(file.read_text(encoding="utf-8"))
-    except FileNotFoundError:
+    if not file.exists():
         return None, [f"{fname}: no station file here"]
-    except OSError as e:
-        return None, [f"{fname}: cannot read: {e.strerror}"]
-    except UnicodeDecodeError as e:
-        return None, [f"{fname}: not UTF-8 text: {e.reason}"]
-    except tomllib.TOMLDecodeError as e:
+    try:
+        data = tomllib.loads(read_text(file, "the station file"))
+    except TextFileError as e:
+        return None, [str(e)]
+    except ValueError as e:  # TOMLDecodeError, or an integer past int()'s 4300 digits
         return None, [f"{fname}: not valid TOML: {e}"]
+    except RecursionError:
+        return None, [f"{fname}: not valid TOML: arrays or tables nested too deeply"]
     problems: list[str] = []
     base = file.parent.resolve()
     top = _Reader(problems, fname, data)

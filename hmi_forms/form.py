@@ -23,9 +23,35 @@ from typing import Any
 from hmi_forms.elements import ELEMENT_TYPES, Element
 from hmi_forms.elements import props as p
 from hmi_forms.elements.analog import scaling_problems
+from netplc.textfile import TextFileError, read_text
 
 FORM_BACK = (0xDD, 0xE1, 0xE6, 255)
 FORM_FORE = (0x1A, 0x1A, 0x1A, 255)
+
+
+MAX_NESTING = 100  # a form too deep for json.loads is reported where it passes this depth
+
+
+def _too_deep(raw: str) -> tuple[int, int]:
+    """Line and column where brackets outside strings first nest deeper than MAX_NESTING."""
+    depth, line, col = 0, 1, 0
+    in_string = escaped = False
+    for ch in raw:
+        col += 1
+        if ch == "\n":
+            line, col = line + 1, 0
+        elif in_string:
+            in_string = escaped or ch != '"'
+            escaped = not escaped and ch == "\\"
+        elif ch == '"':
+            in_string = True
+        elif ch in "[{":
+            depth += 1
+            if depth > MAX_NESTING:
+                return line, col
+        elif ch in "]}":
+            depth -= 1
+    return line, col
 
 
 class FormError(Exception):
@@ -78,13 +104,17 @@ class _Loader:
 
     def load(self) -> Form:
         try:
-            raw = self.path.read_text(encoding="utf-8-sig")
-        except (OSError, UnicodeDecodeError) as e:
-            raise FormError([f"{self.path}: cannot read the form: {e}"]) from None
+            raw = read_text(self.path, "the form")
+        except TextFileError as e:
+            raise FormError([str(e)]) from None
         try:
-            doc = json.loads(raw)
+            doc = json.loads(raw, parse_int=p.json_int)
         except json.JSONDecodeError as e:
             raise FormError([f"{self.path}:{e.lineno}:{e.colno}: bad JSON: {e.msg}"]) from None
+        except RecursionError:
+            line, col = _too_deep(raw)
+            raise FormError([f"{self.path}:{line}:{col}: bad JSON: arrays or objects nested too deeply "
+                             f"(here past {MAX_NESTING} levels)"]) from None
         if not isinstance(doc, dict):
             raise FormError([f"{self.path}: the form must be a JSON object with form, devices, elements"])
         for key in sorted(set(doc) - {"form", "devices", "images", "elements"}):

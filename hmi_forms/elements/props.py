@@ -80,8 +80,27 @@ def prop(parser: Parser, *, required: bool = False, alias: str | None = None) ->
     return {"parser": parser, "required": required, "alias": alias}
 
 
+@dataclass(frozen=True, slots=True)
+class LongNumber:
+    """A JSON integer with more digits than int() converts (Python's limit is 4300): kept as its
+    text, so that every property parser refuses it by name instead of json raising ValueError."""
+
+    text: str
+
+    def __repr__(self) -> str:
+        return f"a {len(self.text.lstrip('-'))}-digit number"
+
+
+def json_int(text: str) -> int | LongNumber:
+    """`parse_int` for json.loads."""
+    return int(text) if len(text) <= 100 else LongNumber(text)
+
+
 def _show(value: Any) -> str:
-    text = repr(value) if not isinstance(value, str) else f'"{value}"'
+    try:
+        text = repr(value) if not isinstance(value, str) else f'"{value}"'
+    except RecursionError:  # json.loads nests deeper than repr can
+        return "a deeply nested value"
     return text if len(text) <= 40 else text[:37] + "..."
 
 
@@ -99,6 +118,8 @@ def boolean(value: Any, _ctx: Context) -> bool:
 
 def integer(lo: int, hi: int) -> Parser:
     def parse(value: Any, _ctx: Context) -> int:
+        if isinstance(value, LongNumber):
+            raise PropError(f"{value!r} is out of range {lo}..{hi}")
         if isinstance(value, bool) or not isinstance(value, int):
             raise PropError(f"expected an integer from {lo} to {hi}, got {_show(value)}")
         if not lo <= value <= hi:
@@ -108,9 +129,17 @@ def integer(lo: int, hi: int) -> Parser:
     return parse
 
 
+MAX_NUMBER = 1e15  # past this a scaled value loses its units digit in a float
+
+
 def number(value: Any, _ctx: Context) -> float:
-    if isinstance(value, bool) or not isinstance(value, int | float) or not math.isfinite(value):
+    if isinstance(value, LongNumber):
+        raise PropError(f"{value!r} is out of range -1e15..1e15")
+    if isinstance(value, bool) or not isinstance(value, int | float) or (
+            isinstance(value, float) and not math.isfinite(value)):
         raise PropError(f"expected a number, got {_show(value)}")
+    if not -MAX_NUMBER <= value <= MAX_NUMBER:  # exact for ints too, which float() may not hold
+        raise PropError(f"{_show(value)} is out of range -1e15..1e15")
     return float(value)
 
 
