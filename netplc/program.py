@@ -442,7 +442,7 @@ class _Parser:
                     self.err(raw.line, raw.col, f"{spec.mnemonic} needs {key}: ({_KIND_NAMES[kind]})")
                     ok = False
                     continue
-                v = self._address(raw, key) if kind == "M" else self._const(raw, key, kind)
+                v = self._address(raw, key) if kind == "M" else self._const(raw, key, kind, *spec.bounds(key))
                 ok = ok and v is not None
                 values[key] = v
         else:  # a defined code not implemented on this build: keep the values, FErr1 at run time
