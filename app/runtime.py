@@ -160,6 +160,7 @@ class Runtime:
         self._problems: list[str] = []
         self._lock = threading.Lock()
         self._final_store: StoreStats | None = None  # the archive's figures after stop
+        self._final_retain_error = ""  # why the final retentive save failed, if it did
         self.started = False
 
     # --- records -------------------------------------------------------------------------------
@@ -314,6 +315,7 @@ class Runtime:
             self.scan_thread = None
         if self.retainer is not None:
             self.retainer.stop()  # the final save, of the last finished scan
+            self._final_retain_error = self.retainer.last_error
             self.retainer = None
         if self.modbus is not None:
             self.modbus.stop()
@@ -355,6 +357,9 @@ class Runtime:
         nodes = tuple(NodeStatus(n.node, n.endpoint, bool(exchange and exchange.link_up(n.node)))
                       for n in self.nodes)
         problems = list(self._problems)
+        retain_error = self.retainer.last_error if self.retainer is not None else self._final_retain_error
+        if retain_error:  # journaled once by the retainer; shown for as long as saves fail
+            problems.append(f"retentive memory not saved: {retain_error}")
         written = pending = lost = 0
         s = self.store.stats if self.store is not None else self._final_store
         if s is not None:
