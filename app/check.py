@@ -57,7 +57,7 @@ def check_station(path: str | Path) -> CheckReport:
         except CatalogError as e:
             report.problems += list(e.problems)
     if station.HMIload is not None:
-        forms, problems = load_forms(station.HMIload, symbols)
+        forms, problems = load_forms(station.HMIload, symbols, station=station.folder)
         report.problems += [str(p) for p in problems]
         report.notes.append(f"forms in {station.HMIload}: {len(forms)} loaded")
     return report

@@ -71,8 +71,9 @@ class Form:
     Font: p.Font = field(default_factory=p.Font)
     BackgroundImage: Path | None = None
     devices: dict[str, p.Scaling] = field(default_factory=dict)
-    images: list[Path] = field(default_factory=list)
+    images: list[Path | None] = field(default_factory=list)  # None: not shown (see props.Outside)
     elements: list[Element] = field(default_factory=list)
+    problems: list[str] = field(default_factory=list)  # of a form that loads all the same
 
 
 FORM_PROPS: dict[str, p.Parser] = {
@@ -93,14 +94,18 @@ def _unknown(name: str, known: list[str]) -> str:
 
 
 class _Loader:
-    def __init__(self, path: Path, symbols: dict[str, int]) -> None:
+    def __init__(self, path: Path, symbols: dict[str, int], station: Path | None,
+                 allow_outside: bool) -> None:
         self.path = path
         self.problems: list[str] = []
-        self.ctx = p.Context(symbols, path.parent)
+        self.fatal = 0  # problems that stop the form from opening (the others only lose a picture)
+        self.ctx = p.Context(symbols, path.parent, roots=(station,) if station else (),
+                             allow_outside=allow_outside)
 
-    def problem(self, where: str, prop: str | None, text: str) -> None:
+    def problem(self, where: str, prop: str | None, text: str, fatal: bool = True) -> None:
         head = f"{self.path}: {where}: {prop}" if prop else f"{self.path}: {where}"
         self.problems.append(f"{head}: {text}")
+        self.fatal += fatal
 
     def load(self) -> Form:
         try:
@@ -128,8 +133,9 @@ class _Loader:
                 self.problem(f'element "{el.Name}"', "w" if el.x + el.w > form.width else "h",
                              f"the element ({el.x},{el.y} {el.w}x{el.h}) extends past the form "
                              f"({form.width}x{form.height})")
-        if self.problems:
+        if self.fatal:
             raise FormError(self.problems)
+        form.problems = self.problems
         return form
 
     def form_settings(self, raw: Any) -> Form:
@@ -145,7 +151,7 @@ class _Loader:
             try:
                 setattr(form, key, parser(value, self.ctx))
             except p.PropError as e:
-                self.problem("form", key, str(e))
+                self.problem("form", key, str(e), fatal=not isinstance(e, p.Outside))
         for key in ("width", "height"):
             if key not in raw:
                 self.problem("form", key, "missing required property")
@@ -186,17 +192,17 @@ class _Loader:
                 out[name] = p.Scaling(**values)
         return out
 
-    def images(self, raw: Any) -> list[Path]:
+    def images(self, raw: Any) -> list[Path | None]:
         if not isinstance(raw, list):
             self.problem("images", None, "must be a list of image files")
             return []
-        out = []
+        out: list[Path | None] = []
         for i, name in enumerate(raw):
             try:
                 out.append(p.image_file(name, self.ctx))
             except p.PropError as e:
-                self.problem(f"image #{i}", None, str(e))
-                out.append(self.path.parent / str(name))  # keep the indices of later images
+                self.problem(f"image #{i}", None, str(e), fatal=not isinstance(e, p.Outside))
+                out.append(None)  # keeps the indices of later images
         return out
 
     def elements(self, raw: Any) -> list[Element]:
@@ -233,7 +239,7 @@ class _Loader:
         aliases = {f.metadata["alias"]: f.name for f in schema.values() if f.metadata["alias"]}
         values: dict[str, Any] = {}
         seen: dict[str, str] = {}
-        before = len(self.problems)
+        before = self.fatal
         for key, value in raw.items():
             if key == "type":
                 continue
@@ -249,11 +255,11 @@ class _Loader:
             try:
                 values[target] = f.metadata["parser"](value, self.ctx)
             except p.PropError as e:
-                self.problem(where, key, str(e))
+                self.problem(where, key, str(e), fatal=not isinstance(e, p.Outside))
         for f in schema.values():
             if f.metadata["required"] and f.name not in raw and f.metadata["alias"] not in raw:
                 self.problem(where, f.name, "missing required property")
-        if len(self.problems) > before:
+        if self.fatal > before:
             return None
         element = cls(**values)
         for key, text in element.check(self.ctx):
@@ -261,18 +267,26 @@ class _Loader:
         return element
 
 
-def load_form(path: str | Path, symbols: dict[str, int] | None = None) -> Form:
-    """Load one form; FormError lists every problem of the file."""
-    return _Loader(Path(path), symbols or {}).load()
+def load_form(path: str | Path, symbols: dict[str, int] | None = None, *, station: Path | None = None,
+              allow_outside: bool = False) -> Form:
+    """Load one form; FormError lists every problem of the file. Files it names must be in its
+    folder or in the `station` folder unless `allow_outside`; one that is not is left out and
+    named in `Form.problems`."""
+    return _Loader(Path(path), symbols or {}, station, allow_outside).load()
 
 
-def load_forms(folder: str | Path, symbols: dict[str, int] | None = None) -> tuple[list[Form], list[str]]:
-    """Load every `*.hmi` of a folder (sorted by name): the good forms, and the problems of the rest."""
+def load_forms(folder: str | Path, symbols: dict[str, int] | None = None, *, station: Path | None = None,
+               allow_outside: bool = False) -> tuple[list[Form], list[str]]:
+    """Load every `*.hmi` of a folder (sorted by name): the forms that open, and every problem
+    (those of the forms that do not open, and the files left out of those that do)."""
     forms: list[Form] = []
     problems: list[str] = []
     for path in sorted(Path(folder).glob("*.hmi")):
         try:
-            forms.append(load_form(path, symbols))
+            form = load_form(path, symbols, station=station, allow_outside=allow_outside)
         except FormError as e:
             problems.extend(e.problems)
+        else:
+            forms.append(form)
+            problems.extend(form.problems)
     return forms, problems

@@ -134,7 +134,7 @@ class MainWindow(QMainWindow):
             symbols = load_symbols(station.Symbols) if station.Symbols else {}
         except ProgramError:
             symbols = {}  # the runtime refused to start with broken symbols, so this is not reached
-        forms, problems = load_forms(station.HMIload, symbols)
+        forms, problems = load_forms(station.HMIload, symbols, station=station.folder)
         target = EngineTarget(self.runtime.engine, self.runtime)
         for form in forms:
             view = FormView(form, target, archive_path=station.Archive, user=self.user,
@@ -146,7 +146,9 @@ class MainWindow(QMainWindow):
             scroll.setFrameShape(QFrame.Shape.NoFrame)
             self.tabs.addTab(scroll, form.title)
         if problems:
-            self.tabs.addTab(_placeholder("Forms that could not be opened:\n\n" + "\n".join(problems)),
+            self.tabs.addTab(_placeholder("Form problems (a form with a wrong property does not open; "
+                                          "one naming a file outside the station opens without it):\n\n"
+                                          + "\n".join(problems)),
                              "Form problems")
         if not forms and not problems:
             self.tabs.addTab(_placeholder(f"No .hmi forms in {station.HMIload}."), "No forms")

@@ -24,6 +24,10 @@ class PropError(ValueError):
     """A property value the loader refuses; the message is the `problem` part of the report."""
 
 
+class Outside(PropError):
+    """A file outside the folders a form may read: reported, and the element shows without it."""
+
+
 @dataclass(frozen=True, slots=True)
 class Scaling:
     """Linear hardware <-> physical conversion (DESIGN section 9)."""
@@ -69,7 +73,9 @@ class Context:
     symbols: dict[str, int]
     folder: Path
     devices: dict[str, Scaling] = field(default_factory=dict)
-    images: list[Path] = field(default_factory=list)
+    images: list[Path | None] = field(default_factory=list)
+    roots: tuple[Path, ...] = ()  # folders files may come from besides `folder` (the station's)
+    allow_outside: bool = False  # the station allows files anywhere
 
 
 Parser = Callable[[Any, Context], Any]
@@ -234,9 +240,17 @@ def font(value: Any, ctx: Context) -> Font:
 
 
 def image_file(value: Any, ctx: Context) -> Path:
-    """A picture file relative to the form's folder (forms travel with their images)."""
+    """A picture file relative to the form's folder (forms travel with their images). It must be
+    inside that folder or the station's (after symbolic links), unless the station allows files
+    anywhere: a form must not make the workstation read /etc/passwd or another station's files."""
     name = text(value, ctx)
+    if "\0" in name:
+        raise PropError(f"image file {_show(name)} has a NUL character")
     path = (ctx.folder / name).resolve()
+    roots = (ctx.folder, *ctx.roots)
+    if not ctx.allow_outside and not any(path.is_relative_to(root.resolve()) for root in roots):
+        raise Outside(f'image file "{name}" is outside the station folder {" and ".join(map(str, roots))} '
+                      "(shown without it; allow_outside = true in station.toml allows it)")
     if not path.is_file():
         raise PropError(f'image file "{name}" not found in {ctx.folder}')
     return path
