@@ -36,6 +36,7 @@ from registrar.store import Store, StoreStats
 RecordObserver = Callable[[Record], None]
 UNSTARTED = "tcp://127.0.0.1:1"  # endpoint of a simulated node whose simulator has not started
 RESOLVE_TIMEOUT = 5.0  # seconds for the host names of all TCP nodes to resolve
+CODE_CACHE = "compiled"  # beside the archive: the compiled program, for a fast next start
 
 
 class StartError(Exception):
@@ -247,7 +248,8 @@ class Runtime:
     def _start_parts(self) -> None:
         st = self.station
         self.system(f"station starting: {st.path}")
-        self.engine = Engine(self.program, sink=self, tick=st.tick, wallclock=self.wallclock)
+        self.engine = Engine(self.program, sink=self, tick=st.tick, wallclock=self.wallclock,
+                             code_cache=st.Archive.parent / CODE_CACHE)
         self.started_clock = self.engine.now  # engine-clock time of the start (DateTime elements)
         if not st.NetPlcLoad:
             self.engine.stop()
