@@ -8,6 +8,7 @@ that the examples reach the checks behind the syntax. Example counts are bounded
 from __future__ import annotations
 
 import json
+from collections.abc import Callable
 from pathlib import Path
 from typing import Any
 
@@ -52,6 +53,17 @@ def encoded(text: str, how: str) -> bytes:
 ENCODINGS = st.sampled_from(["utf-8", "bom", "cp1251"])
 RAW = st.binary(max_size=300)
 
+
+def loaded(path: Path, load: Callable[[Path], Any], error: type[Exception],
+           problems: Callable[[Any], list[str]]) -> Any:
+    """What `load(path)` returns, or None after checking that every problem it raised names the file."""
+    try:
+        return load(path)
+    except error as e:
+        found = problems(e)
+        assert found and all(p.startswith(str(path)) for p in found), found
+        return None
+
 # --- program text ------------------------------------------------------------------------------
 
 PROGRAM_TOKENS = st.one_of(
@@ -71,10 +83,8 @@ def test_program_loads_or_names_its_errors(folder: Path, text: str, how: str, ra
     path.write_bytes(raw if use_raw else encoded(text, how))
     sym = folder / "ok_symbols.csv"
     sym.write_text("A,02000\nW,04000\n", encoding="utf-8")
-    try:
-        load_program(path, sym if symbols else None)
-    except ProgramError as e:
-        assert e.errors and all(str(d).startswith(f"{path}:") for d in e.errors)
+    loaded(path, lambda p: load_program(p, sym if symbols else None), ProgramError,
+           lambda e: [str(d) for d in e.errors])
 
 
 # --- symbols.csv and messages.csv --------------------------------------------------------------
@@ -85,28 +95,14 @@ CSV_TEXT = st.lists(st.lists(CSV_FIELDS, max_size=5).map(",".join), max_size=8).
 
 
 @FUZZ
-@given(text=CSV_TEXT, how=ENCODINGS, raw=RAW, use_raw=st.booleans())
-def test_symbols_load_or_name_their_errors(folder: Path, text: str, how: str, raw: bytes,
-                                           use_raw: bool) -> None:
-    path = folder / "symbols.csv"
+@given(text=CSV_TEXT, how=ENCODINGS, raw=RAW, use_raw=st.booleans(), messages=st.booleans())
+def test_symbols_and_messages_load_or_name_their_errors(folder: Path, text: str, how: str, raw: bytes,
+                                                        use_raw: bool, messages: bool) -> None:
+    path = folder / ("messages.csv" if messages else "symbols.csv")
     path.write_bytes(raw if use_raw else encoded(text, how))
-    try:
-        load_symbols(path)
-    except ProgramError as e:
-        assert e.errors and all(str(d).startswith(f"{path}:") for d in e.errors)
-
-
-@FUZZ
-@given(text=CSV_TEXT, how=ENCODINGS, raw=RAW, use_raw=st.booleans())
-def test_messages_load_or_name_their_errors(folder: Path, text: str, how: str, raw: bytes,
-                                            use_raw: bool) -> None:
-    path = folder / "messages.csv"
-    path.write_bytes(raw if use_raw else encoded(text, how))
-    try:
-        catalog = Catalog.load(path)
-    except CatalogError as e:
-        assert e.problems and all(p.startswith(f"{path}:") for p in e.problems)
-    else:
+    if not messages:
+        loaded(path, load_symbols, ProgramError, lambda e: [str(d) for d in e.errors])
+    elif catalog := loaded(path, Catalog.load, CatalogError, lambda e: e.problems):
         assert all(0 <= m.number < 2**63 and 0 <= m.grp < 2**63 for m in catalog)
 
 
@@ -140,10 +136,7 @@ def test_station_loads_or_names_its_errors(folder: Path, text: str, how: str, ra
     path.write_bytes(raw if use_raw else encoded(text, how))
     _, problems = read_station(station)
     assert all(p.startswith(str(path)) for p in problems)
-    try:
-        load_station(station)
-    except ConfigError as e:
-        assert e.problems == problems
+    assert loaded(station, load_station, ConfigError, lambda e: e.problems) or problems
 
 
 # --- .hmi forms --------------------------------------------------------------------------------
@@ -192,7 +185,5 @@ def test_form_loads_or_names_its_errors(folder: Path, doc: Any, how: str, raw: b
     elif mode == "digits":
         text = text.replace("0", "1" * 5000, 1)
     path.write_bytes(raw if mode == "raw" else encoded(text, how))
-    try:
-        load_form(path, {"A": 0o2000})
-    except FormError as e:
-        assert e.problems and all(p.startswith(str(path)) for p in e.problems)
+    form = loaded(path, lambda p: load_form(p, {"A": 0o2000}), FormError, lambda e: e.problems)
+    assert form is None or all(p.startswith(str(path)) for p in form.problems)

@@ -13,6 +13,7 @@ from pathlib import Path
 from app.config import load_station
 from app.runtime import Runtime
 from tests.app.conftest import REPO, write_station
+from tests.app.test_runtime_errors import wait_for
 
 COUNTER = 0o4000
 # INCW every scan: the word at 04000 counts scans (04002 is the unused setpoint)
@@ -75,15 +76,6 @@ def test_counting_continues_after_sigkill(tmp_path: Path) -> None:
         assert scans - 75 <= restored <= scans + 50
     finally:
         runtime.stop()
-
-
-def wait_for(condition, timeout: float = 10.0) -> bool:
-    deadline = time.monotonic() + timeout
-    while not condition():
-        if time.monotonic() > deadline:
-            return False
-        time.sleep(0.05)
-    return True
 
 
 def test_a_failing_save_is_journaled_once_shown_and_cleared(tmp_path: Path, qtbot) -> None:
