@@ -284,6 +284,19 @@ def _chunked(name: str, block: _Block) -> list[str]:
     return [*out, f"def {name}(a, s, {defaults}):", *("    " + line for line in body)]
 
 
+def fon_code(engine: Engine) -> tuple[dict[int, list[str]], dict[int, Callable]]:
+    """The FONs' code: {index: source lines} of those put in line, {index: bound step} of the rest."""
+    inline: dict[int, list[str]] = {}
+    steps = {}
+    for i, (fon, spec) in engine.fons.items():
+        lines = spec.inline(fon) if spec is not None and spec.inline and not spec.hardware else None
+        if lines is None:
+            steps[i] = engine.fon_step(i)
+        else:
+            inline[i] = lines
+    return inline, steps
+
+
 @functools.cache
 def _compiler_version() -> bytes:
     """What the generated code depends on besides the program: this module and the TIM/CTR lines."""
@@ -304,14 +317,7 @@ def compile_program(program: Program, engine: Engine,
     from netplc.engine import WATCHDOG_STEPS
 
     instrs = program.instrs
-    inline: dict[int, list[str]] = {}
-    steps = {}
-    for i, (fon, spec) in engine.fons.items():
-        lines = spec.inline(fon) if spec is not None and spec.inline and not spec.hardware else None
-        if lines is None:
-            steps[i] = engine.fon_step(i)
-        else:
-            inline[i] = lines
+    inline, steps = fon_code(engine)
     key = program_key(program, inline) if cache is not None else b""
     code = cache.load(key) if cache is not None else None
     if code is None:
