@@ -122,3 +122,26 @@ def test_the_good_forms_still_open_beside_the_broken_ones(tmp_path: Path) -> Non
     assert len(problems) == 3
     for start in expected.values():
         assert any(p.startswith(start) for p in problems), (start, problems)
+
+
+def test_the_workstation_opens_the_demo_forms_beside_the_broken_ones(tmp_path: Path, qtbot) -> None:
+    from app.config import load_station
+    from app.gui.main_window import MainWindow
+    from app.runtime import Runtime
+
+    st = copy_demo(tmp_path / "st")
+    expected = bad_forms(st / "forms")
+    runtime = Runtime(load_station(st))
+    runtime.start()
+    window = MainWindow(runtime)
+    qtbot.addWidget(window)
+    try:
+        titles = [window.tabs.tabText(i) for i in range(window.tabs.count())]
+        assert len(window.views) == len(list((st / "forms").glob("0*.hmi"))) == len(titles) - 1
+        assert titles[-1] == "Form problems"
+        assert all(any(p.startswith(start) for p in window.form_problems) for start in expected.values())
+        window.refresh_status()
+        assert "form problem: " in window.health.label.text()
+    finally:
+        window.close()
+        runtime.stop()
