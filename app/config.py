@@ -8,6 +8,7 @@ engineer fixes a broken station in one pass instead of one error per start.
 
 from __future__ import annotations
 
+import sys
 import tomllib
 from dataclasses import dataclass, replace
 from pathlib import Path
@@ -186,8 +187,10 @@ def read_station(path: str | Path) -> tuple[Station | None, list[str]]:
         data = tomllib.loads(read_text(file, "the station file"))
     except TextFileError as e:
         return None, [str(e)]
-    except ValueError as e:  # TOMLDecodeError, or an integer past int()'s 4300 digits
+    except tomllib.TOMLDecodeError as e:
         return None, [f"{fname}: not valid TOML: {e}"]
+    except ValueError:  # from int(), which tomllib calls without saying where
+        return None, [f"{fname}: not valid TOML: a number of more than {sys.get_int_max_str_digits()} digits"]
     except RecursionError:
         return None, [f"{fname}: not valid TOML: arrays or tables nested too deeply"]
     problems: list[str] = []

@@ -8,6 +8,9 @@ import subprocess
 import sys
 from pathlib import Path
 
+import pytest
+
+from app.config import read_station
 from hmi_forms.form import load_forms
 from registrar.catalog import Catalog
 from tests.app.conftest import REPO, copy_demo
@@ -95,6 +98,24 @@ def test_a_start_with_a_message_number_past_int64_exits_2_naming_the_line(tmp_pa
     r = main("--no-gui", st, "--duration", "1")
     assert r.returncode == 2, r.stdout + r.stderr
     assert "Traceback" not in r.stderr and f"{st / 'messages.csv'}:{line}: number {2**64} is past" in r.stderr
+
+
+@pytest.mark.parametrize(("toml", "problem"), [
+    ("NetSyncTime = " + "1" * 5000, "not valid TOML: a number of more than 4300 digits"),
+    ("NetSyncTime = " + "[" * 5000, "not valid TOML: arrays or tables nested too deeply"),
+    ('NetPlcProgram = "a\\u0000b"', "NetPlcProgram: a path cannot hold a NUL character"),
+    ('NetPlcLoad = false\n[[nodes]]\nnode = 0\nendpoint = "tcp://127.0.0.1:1"\ntimeout = ' + "9" * 400,
+     "nodes[0].timeout: a 400-digit number is too large"),
+])
+def test_station_files_past_the_toml_reader_limits_are_named(tmp_path: Path, toml: str, problem: str) -> None:
+    (tmp_path / "station.toml").write_text(toml, encoding="utf-8")
+    assert read_station(tmp_path)[1] == [f"{tmp_path / 'station.toml'}: {problem}"]
+
+
+def test_a_station_file_in_cp1251_reads(tmp_path: Path) -> None:
+    (tmp_path / "station.toml").write_bytes('name = "Насосная"\nNetPlcLoad = false\n'.encode("cp1251"))
+    station, problems = read_station(tmp_path)
+    assert problems == [] and station is not None and station.name == "Насосная"
 
 
 def test_netplc_run_names_an_unreadable_program_or_symbols_file(tmp_path: Path) -> None:
