@@ -16,6 +16,7 @@ from pathlib import Path
 from typing import Any
 
 from netplc.address import AddressError, BitRef, check_operand, parse_hmi_bit, parse_octal
+from netplc.textfile import MAX_DIGITS
 
 Color = tuple[int, int, int, int]  # r, g, b, alpha
 
@@ -99,7 +100,7 @@ class LongNumber:
 
 def json_int(text: str) -> int | LongNumber:
     """`parse_int` for json.loads."""
-    return int(text) if len(text) <= 100 else LongNumber(text)
+    return int(text) if len(text) <= MAX_DIGITS else LongNumber(text)
 
 
 def _show(value: Any) -> str:
