@@ -8,6 +8,7 @@ engineer fixes a broken station in one pass instead of one error per start.
 
 from __future__ import annotations
 
+import sys
 import tomllib
 from dataclasses import dataclass
 from pathlib import Path
@@ -17,6 +18,7 @@ from netplc.address import fmt_octal, is_data_byte, is_io_bit, parse_octal
 from netplc.exchange import LIMITS, NODE_NUMBERS, UNITS, NodeConfig, unit_problem
 from netplc.modbus import PROFILES, TABLES, Endpoint, parse_endpoint
 from netplc.problems import Problems
+from netplc.textfile import TextFileError, read_text
 
 STATION_FILE = "station.toml"
 DEMO_STATION = Path(__file__).resolve().parent.parent / "resources" / "example"  # the built-in demo
@@ -68,6 +70,7 @@ class Station:
     simulators: tuple[SimulatorSettings, ...] = ()
     users: tuple[str, ...] = ("operator",)
     Tags: Path | None = None  # tags.csv: tags and their alarms (netplc/tags/)
+    allow_outside: bool = False  # may station paths (and form images) leave the station folder?
 
     @property
     def folder(self) -> Path:
@@ -108,6 +111,9 @@ class _Reader:
             return default
         value = self.table[key]
         if kind is float and isinstance(value, int) and not isinstance(value, bool):
+            if abs(value) > 1e300:  # float() would overflow
+                self.bad(key, f"a {len(str(abs(value)))}-digit number is too large")
+                return default
             return float(value)
         if isinstance(value, bool) and kind is not bool:
             self.bad(key, f"expected {_kind_name(kind)}, got {value!r}")
@@ -130,6 +136,9 @@ class _Reader:
             return None
         if not value.strip():
             self.bad(key, "empty path")
+            return None
+        if "\0" in value:
+            self.bad(key, "a path cannot hold a NUL character")
             return None
         path = (base / value).resolve()
         if not self.allow_outside and not path.is_relative_to(base):
@@ -164,16 +173,18 @@ def read_station(path: str | Path) -> tuple[Station | None, list[str]]:
     in the returned station; None instead of a station when the file is not TOML at all."""
     file = station_file(path)
     fname = str(file)
-    try:
-        data = tomllib.loads(file.read_text(encoding="utf-8"))
-    except FileNotFoundError:
+    if not file.exists():
         return None, [f"{fname}: no station file here"]
-    except OSError as e:
-        return None, [f"{fname}: cannot read: {e.strerror}"]
-    except UnicodeDecodeError as e:
-        return None, [f"{fname}: not UTF-8 text: {e.reason}"]
+    try:
+        data = tomllib.loads(read_text(file, "the station file"))
+    except TextFileError as e:
+        return None, [str(e)]
     except tomllib.TOMLDecodeError as e:
         return None, [f"{fname}: not valid TOML: {e}"]
+    except ValueError:  # from int(), which tomllib calls without saying where
+        return None, [f"{fname}: not valid TOML: a number of more than {sys.get_int_max_str_digits()} digits"]
+    except RecursionError:
+        return None, [f"{fname}: not valid TOML: arrays or tables nested too deeply"]
     problems: list[str] = []
     base = file.parent.resolve()
     top = _Reader(problems, fname, data)
@@ -217,6 +228,7 @@ def read_station(path: str | Path) -> tuple[Station | None, list[str]]:
         Symbols=symbols, HMIload=hmi, NetSyncTime=sync, Archive=archive, Messages=messages,
         keep_days=keep_days, Retain=retain, modbus_server=server,
         nodes=tuple(nodes), simulators=tuple(runnable), users=users, Tags=tags,
+        allow_outside=top.allow_outside,
     )
     return station, problems
 

@@ -20,6 +20,7 @@ from hmi_forms.form import Form, load_forms
 from netplc.exchange import check_program_nodes
 from netplc.program import Program, ProgramError, load_symbols, parse, parse_file
 from netplc.tags.table import read_tags
+from netplc.textfile import TextFileError, read_text
 from registrar.catalog import Catalog, CatalogError
 
 RECOVERY_ROUNDS = 5
@@ -73,7 +74,7 @@ def load_station_forms(station: Station, symbols: dict[str, int]) -> tuple[list[
     and the problems of those that did not load."""
     if station.HMIload is None:
         return [], []
-    return load_forms(station.HMIload, symbols)
+    return load_forms(station.HMIload, symbols, station=station.folder, allow_outside=station.allow_outside)
 
 
 def _symbols(path: Path | None, out: Loaded) -> dict[str, int]:
@@ -85,9 +86,13 @@ def _symbols(path: Path | None, out: Loaded) -> dict[str, int]:
     except ProgramError as e:
         out.problems += e.problems
         bad = {d.line for d in e.errors}
+    try:
+        text = _blank_lines(path, bad)
+    except TextFileError:
+        return {}  # already reported
     with tempfile.TemporaryDirectory() as tmp:
         good = Path(tmp) / path.name
-        good.write_text(_blank_lines(path, bad), encoding="utf-8")
+        good.write_text(text, encoding="utf-8")
         try:
             return load_symbols(good)
         except ProgramError:
@@ -114,6 +119,8 @@ def _recovered(path: Path, symbols: dict[str, int], bad: set[int]) -> Program | 
     for _ in range(RECOVERY_ROUNDS):  # removing a line can break another (a label it defined)
         try:
             return parse(_blank_lines(path, bad), source=str(path), symbols=symbols)
+        except TextFileError:
+            return None  # already reported
         except ProgramError as e:
             more = {d.line for d in e.errors} - bad
             if not more:
@@ -123,5 +130,5 @@ def _recovered(path: Path, symbols: dict[str, int], bad: set[int]) -> Program | 
 
 
 def _blank_lines(path: Path, lines: set[int]) -> str:
-    text = path.read_text(encoding="utf-8-sig").splitlines()
+    text = read_text(path).splitlines()
     return "\n".join("" if i in lines else line for i, line in enumerate(text, start=1))

@@ -40,6 +40,7 @@ from registrar.store import Store, StoreStats
 
 RecordObserver = Callable[[Record], None]
 RESOLVE_TIMEOUT = 5.0  # seconds for the host names of all TCP nodes to resolve
+CODE_CACHE = "compiled"  # beside the archive: the compiled program, for a fast next start
 
 
 class StartError(Problems):
@@ -146,6 +147,7 @@ class Runtime:
         self._problems: list[str] = []
         self._lock = threading.Lock()
         self._final_store: StoreStats | None = None  # the archive's figures after stop
+        self._final_retain_error = ""  # why the final retentive save failed, if it did
         self.started = False
 
     # --- records -------------------------------------------------------------------------------
@@ -205,7 +207,8 @@ class Runtime:
     def _start_parts(self) -> None:
         st = self.station
         self.system(f"station starting: {st.path}")
-        self.engine = Engine(self.program, sink=self, tick=st.tick, wallclock=self.wallclock)
+        self.engine = Engine(self.program, sink=self, tick=st.tick, wallclock=self.wallclock,
+                             code_cache=st.Archive.parent / CODE_CACHE)
         self.started_clock = self.engine.now  # engine-clock time of the start (DateTime elements)
         for problem in self.form_problems:
             self.system(f"form not loaded: {problem}")
@@ -285,6 +288,7 @@ class Runtime:
             self.scan_thread = None
         if self.retainer is not None:
             self.retainer.stop()  # the final save, of the last finished scan
+            self._final_retain_error = self.retainer.last_error
             self.retainer = None
         if self.modbus is not None:
             self.modbus.stop()
@@ -326,6 +330,9 @@ class Runtime:
         nodes = tuple(NodeStatus(n.node, n.endpoint, bool(exchange and exchange.link_up(n.node)))
                       for n in self.nodes)
         problems = list(self._problems) + [f"form problem: {p}" for p in self.form_problems[:3]]
+        retain_error = self.retainer.last_error if self.retainer is not None else self._final_retain_error
+        if retain_error:  # journaled once by the retainer; shown for as long as saves fail
+            problems.append(f"retentive memory not saved: {retain_error}")
         written = pending = lost = 0
         s = self.store.stats if self.store is not None else self._final_store
         if s is not None:

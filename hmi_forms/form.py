@@ -24,9 +24,35 @@ from hmi_forms.elements import ELEMENT_TYPES, Element
 from hmi_forms.elements import props as p
 from hmi_forms.elements.analog import scaling_problems
 from netplc.problems import Problems
+from netplc.textfile import TextFileError, read_text
 
 FORM_BACK = (0xDD, 0xE1, 0xE6, 255)
 FORM_FORE = (0x1A, 0x1A, 0x1A, 255)
+
+
+MAX_NESTING = 100  # a form too deep for json.loads is reported where it passes this depth
+
+
+def _too_deep(raw: str) -> tuple[int, int]:
+    """Line and column where brackets outside strings first nest deeper than MAX_NESTING."""
+    depth, line, col = 0, 1, 0
+    in_string = escaped = False
+    for ch in raw:
+        col += 1
+        if ch == "\n":
+            line, col = line + 1, 0
+        elif in_string:
+            in_string = escaped or ch != '"'
+            escaped = not escaped and ch == "\\"
+        elif ch == '"':
+            in_string = True
+        elif ch in "[{":
+            depth += 1
+            if depth > MAX_NESTING:
+                return line, col
+        elif ch in "]}":
+            depth -= 1
+    return line, col
 
 
 class FormError(Problems):
@@ -44,8 +70,9 @@ class Form:
     Font: p.Font = field(default_factory=p.Font)
     BackgroundImage: Path | None = None
     devices: dict[str, p.Scaling] = field(default_factory=dict)
-    images: list[Path] = field(default_factory=list)
+    images: list[Path | None] = field(default_factory=list)  # None: not shown (see props.Outside)
     elements: list[Element] = field(default_factory=list)
+    problems: list[str] = field(default_factory=list)  # of a form that loads all the same
 
 
 FORM_PROPS: dict[str, p.Parser] = {
@@ -66,24 +93,32 @@ def _unknown(name: str, known: list[str]) -> str:
 
 
 class _Loader:
-    def __init__(self, path: Path, symbols: dict[str, int]) -> None:
+    def __init__(self, path: Path, symbols: dict[str, int], station: Path | None,
+                 allow_outside: bool) -> None:
         self.path = path
         self.problems: list[str] = []
-        self.ctx = p.Context(symbols, path.parent)
+        self.fatal = 0  # problems that stop the form from opening (the others only lose a picture)
+        self.ctx = p.Context(symbols, path.parent, roots=(station,) if station else (),
+                             allow_outside=allow_outside)
 
-    def problem(self, where: str, prop: str | None, text: str) -> None:
+    def problem(self, where: str, prop: str | None, text: str, fatal: bool = True) -> None:
         head = f"{self.path}: {where}: {prop}" if prop else f"{self.path}: {where}"
         self.problems.append(f"{head}: {text}")
+        self.fatal += fatal
 
     def load(self) -> Form:
         try:
-            raw = self.path.read_text(encoding="utf-8-sig")
-        except (OSError, UnicodeDecodeError) as e:
-            raise FormError([f"{self.path}: cannot read the form: {e}"]) from None
+            raw = read_text(self.path, "the form")
+        except TextFileError as e:
+            raise FormError([str(e)]) from None
         try:
-            doc = json.loads(raw)
+            doc = json.loads(raw, parse_int=p.json_int)
         except json.JSONDecodeError as e:
             raise FormError([f"{self.path}:{e.lineno}:{e.colno}: bad JSON: {e.msg}"]) from None
+        except RecursionError:
+            line, col = _too_deep(raw)
+            raise FormError([f"{self.path}:{line}:{col}: bad JSON: arrays or objects nested too deeply "
+                             f"(here past {MAX_NESTING} levels)"]) from None
         if not isinstance(doc, dict):
             raise FormError([f"{self.path}: the form must be a JSON object with form, devices, elements"])
         for key in sorted(set(doc) - {"form", "devices", "images", "elements"}):
@@ -97,8 +132,9 @@ class _Loader:
                 self.problem(f'element "{el.Name}"', "w" if el.x + el.w > form.width else "h",
                              f"the element ({el.x},{el.y} {el.w}x{el.h}) extends past the form "
                              f"({form.width}x{form.height})")
-        if self.problems:
+        if self.fatal:
             raise FormError(self.problems)
+        form.problems = self.problems
         return form
 
     def form_settings(self, raw: Any) -> Form:
@@ -114,7 +150,7 @@ class _Loader:
             try:
                 setattr(form, key, parser(value, self.ctx))
             except p.PropError as e:
-                self.problem("form", key, str(e))
+                self.problem("form", key, str(e), fatal=not isinstance(e, p.Outside))
         for key in ("width", "height"):
             if key not in raw:
                 self.problem("form", key, "missing required property")
@@ -155,17 +191,17 @@ class _Loader:
                 out[name] = p.Scaling(**values)
         return out
 
-    def images(self, raw: Any) -> list[Path]:
+    def images(self, raw: Any) -> list[Path | None]:
         if not isinstance(raw, list):
             self.problem("images", None, "must be a list of image files")
             return []
-        out = []
+        out: list[Path | None] = []
         for i, name in enumerate(raw):
             try:
                 out.append(p.image_file(name, self.ctx))
             except p.PropError as e:
-                self.problem(f"image #{i}", None, str(e))
-                out.append(self.path.parent / str(name))  # keep the indices of later images
+                self.problem(f"image #{i}", None, str(e), fatal=not isinstance(e, p.Outside))
+                out.append(None)  # keeps the indices of later images
         return out
 
     def elements(self, raw: Any) -> list[Element]:
@@ -202,7 +238,7 @@ class _Loader:
         aliases = {f.metadata["alias"]: f.name for f in schema.values() if f.metadata["alias"]}
         values: dict[str, Any] = {}
         seen: dict[str, str] = {}
-        before = len(self.problems)
+        before = self.fatal
         for key, value in raw.items():
             if key == "type":
                 continue
@@ -218,11 +254,11 @@ class _Loader:
             try:
                 values[target] = f.metadata["parser"](value, self.ctx)
             except p.PropError as e:
-                self.problem(where, key, str(e))
+                self.problem(where, key, str(e), fatal=not isinstance(e, p.Outside))
         for f in schema.values():
             if f.metadata["required"] and f.name not in raw and f.metadata["alias"] not in raw:
                 self.problem(where, f.name, "missing required property")
-        if len(self.problems) > before:
+        if self.fatal > before:
             return None
         element = cls(**values)
         for key, text in element.check(self.ctx):
@@ -230,18 +266,26 @@ class _Loader:
         return element
 
 
-def load_form(path: str | Path, symbols: dict[str, int] | None = None) -> Form:
-    """Load one form; FormError lists every problem of the file."""
-    return _Loader(Path(path), symbols or {}).load()
+def load_form(path: str | Path, symbols: dict[str, int] | None = None, *, station: Path | None = None,
+              allow_outside: bool = False) -> Form:
+    """Load one form; FormError lists every problem of the file. Files it names must be in its
+    folder or in the `station` folder unless `allow_outside`; one that is not is left out and
+    named in `Form.problems`."""
+    return _Loader(Path(path), symbols or {}, station, allow_outside).load()
 
 
-def load_forms(folder: str | Path, symbols: dict[str, int] | None = None) -> tuple[list[Form], list[str]]:
-    """Load every `*.hmi` of a folder (sorted by name): the good forms, and the problems of the rest."""
+def load_forms(folder: str | Path, symbols: dict[str, int] | None = None, *, station: Path | None = None,
+               allow_outside: bool = False) -> tuple[list[Form], list[str]]:
+    """Load every `*.hmi` of a folder (sorted by name): the forms that open, and every problem
+    (those of the forms that do not open, and the files left out of those that do)."""
     forms: list[Form] = []
     problems: list[str] = []
     for path in sorted(Path(folder).glob("*.hmi")):
         try:
-            forms.append(load_form(path, symbols))
+            form = load_form(path, symbols, station=station, allow_outside=allow_outside)
         except FormError as e:
             problems.extend(e.problems)
+        else:
+            forms.append(form)
+            problems.extend(form.problems)
     return forms, problems

@@ -14,10 +14,14 @@ tests hold the two to identical memory.
 
 from __future__ import annotations
 
+import functools
 import re
+from collections.abc import Callable
+from pathlib import Path
 
-from netplc import backend
+from netplc import backend, timers
 from netplc.backend import Backend, Outcome, ScanHost
+from netplc.codecache import CodeCache, cache_key
 from netplc.program import Instr, Program
 from netplc.timers import QUOTIENT, TIME_BASE_BITS, TIME_BASES, ctr_lines, tim_lines
 
@@ -277,9 +281,8 @@ def _chunked(name: str, block: _Block) -> list[str]:
     return [*out, f"def {name}(a, s, {defaults}):", *("    " + line for line in body)]
 
 
-def compile_program(program: Program, engine: ScanHost) -> Backend:
-    """One scan of `program` on `engine`: returns None at the end, "halt" or "watchdog"."""
-    instrs = program.instrs
+def fon_code(engine: ScanHost) -> tuple[dict[int, list[str]], dict[int, Callable]]:
+    """The FONs' code: {index: source lines} of those put in line, {index: bound step} of the rest."""
     inline: dict[int, list[str]] = {}
     steps = {}
     for i, (fon, spec) in engine.fons.items():
@@ -288,8 +291,35 @@ def compile_program(program: Program, engine: ScanHost) -> Backend:
             steps[i] = engine.fon_step(i)
         else:
             inline[i] = lines
+    return inline, steps
+
+
+@functools.cache
+def _compiler_version() -> bytes:
+    """What the generated code depends on besides the program: this module and the TIM/CTR lines."""
+    return cache_key(Path(__file__).read_bytes(), Path(timers.__file__ or "").read_bytes())
+
+
+def program_key(program: Program, inline: dict[int, list[str]]) -> bytes:
+    """The cache key of the code `generate_source` makes from `program` with these in-line FONs."""
+    instrs = repr([(i.op, i.c, i.n, i.s, i.d, i.r, i.target) for i in program.instrs])
+    return cache_key(_compiler_version(), f"{_CHUNK_CONSTS},{_MAX_DEPTH},{_MAX_TERMS}", program.source,
+                     instrs, repr(sorted(inline.items())))
+
+
+def compile_program(program: Program, engine: ScanHost, cache: CodeCache | None = None) -> Backend:
+    """One scan of `program` on `engine`: returns None at the end, "halt" or "watchdog". With a
+    `cache`, the code object is taken from it when it holds this program's, else stored there."""
+    instrs = program.instrs
+    inline, steps = fon_code(engine)
+    key = program_key(program, inline) if cache is not None else b""
+    code = cache.load(key) if cache is not None else None
+    if code is None:
+        code = compile(generate_source(program, inline), f"<compiled {program.source}>", "exec")
+        if cache is not None:
+            cache.store(key, code)
     namespace: dict = {}
-    exec(compile(generate_source(program, inline), f"<compiled {program.source}>", "exec"), namespace)
+    exec(code, namespace)
     data = engine.mem.data
     blocks = namespace["_make"](steps, engine.mem.bits, data, memoryview(data).cast("H"), engine,
                                 engine.tim_ticks, engine.ctr_values, TIME_BASES, engine.fon_failed)

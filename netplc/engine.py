@@ -13,6 +13,7 @@ from collections import deque
 from collections.abc import Callable
 from dataclasses import dataclass
 from enum import StrEnum
+from pathlib import Path
 
 from netplc.address import (
     ALWAYS_ONE,
@@ -25,6 +26,7 @@ from netplc.address import (
     fmt_octal,
 )
 from netplc.backend import Backend
+from netplc.codecache import CodeCache
 from netplc.compiler import compile_program
 from netplc.functions._util import Step, bind, fail
 from netplc.functions.registry import Fon, FunctionSpec, NetLink, lookup
@@ -84,6 +86,7 @@ class Engine:
         tick: float = 0.1,
         memory: Memory | None = None,
         compiled: bool = True,
+        code_cache: str | Path | None = None,
     ) -> None:
         self.mem = memory or Memory()
         self.clock = clock
@@ -92,6 +95,7 @@ class Engine:
         self.exchange = exchange
         self.tick = tick
         self.compiled = compiled
+        self.code_cache = CodeCache(code_cache) if code_cache is not None else None  # compiled code
         self.node = 0
         self.scan_counter = 0
         self.now = clock()
@@ -131,7 +135,7 @@ class Engine:
                 fon = Fon(ins.c or 0, ins.n or 0, ins.s, ins.d, ins.r, index, ins.line)
                 self.fons[index] = (fon, lookup(fon.f))
                 self._calls[index] = self._make_fon(index)
-        self._run: Backend = (compile_program(program, self) if self.compiled
+        self._run: Backend = (compile_program(program, self, self.code_cache) if self.compiled
                               else Interpreter(program, self).run)
 
     # --- what the program calls ----------------------------------------------------------------

@@ -6,7 +6,6 @@ traceback, so the parser collects diagnostics and raises one ProgramError at the
 
 from __future__ import annotations
 
-import csv
 import re
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -14,6 +13,7 @@ from pathlib import Path
 from netplc.address import IO_BITS, AddressError, check_operand, fmt_octal, parse_octal
 from netplc.functions.registry import DEFINED_CODES, FunctionSpec, lookup
 from netplc.problems import Problems
+from netplc.textfile import MAX_DIGITS, TextFileError, csv_rows, read_text
 
 PROGRAM_WORDS = 0o20000  # 8 K words of program memory
 
@@ -92,10 +92,13 @@ def load_symbols(path: str | Path) -> dict[str, int]:
     errors: list[Diagnostic] = []
     symbols: dict[str, int] = {}
     try:
-        text = path.read_text(encoding="utf-8-sig")
-    except OSError as e:
-        raise ProgramError([Diagnostic(str(path), 0, 0, f"cannot read symbols: {e.strerror}")]) from None
-    for lineno, row in enumerate(csv.reader(text.splitlines()), start=1):
+        text = read_text(path, "symbols")
+    except TextFileError as e:
+        raise ProgramError([Diagnostic(str(path), e.line, 0, e.problem)]) from None
+    for lineno, row in csv_rows(text):
+        if isinstance(row, str):
+            errors.append(Diagnostic(str(path), lineno, 1, row))
+            continue
         if not row or not row[0].strip() or row[0].lstrip().startswith(("#", ";")):
             continue
         if lineno == 1 and row[0].strip().lower() == "name":
@@ -123,9 +126,9 @@ def load_symbols(path: str | Path) -> dict[str, int]:
 def parse_file(path: str | Path, symbols: dict[str, int] | None = None) -> Program:
     path = Path(path)
     try:
-        text = path.read_text(encoding="utf-8-sig")
-    except (OSError, UnicodeDecodeError) as e:
-        raise ProgramError([Diagnostic(str(path), 0, 0, f"cannot read program: {e}")]) from None
+        text = read_text(path, "program")
+    except TextFileError as e:
+        raise ProgramError([Diagnostic(str(path), e.line, 0, e.problem)]) from None
     return parse(text, source=str(path), symbols=symbols)
 
 
@@ -292,6 +295,9 @@ class _Parser:
             return self.symbols[token]
         m = _OFFSET.fullmatch(token)
         if m and m.group(1) in self.symbols:
+            if len(m.group(2)) > MAX_DIGITS:
+                self.err(raw.line, col, f"{key}: bit offset of {m.group(1)!r} is over {MAX_DIGITS} digits")
+                return None
             return self.symbols[m.group(1)] + int(m.group(2))
         self.err(raw.line, col, f"{key}: unknown symbol {token!r}")
         return None
@@ -341,12 +347,11 @@ class _Parser:
         if not pattern.fullmatch(token):
             self.err(raw.line, col, f"{key}: {token!r} is not {name} number")
             return None
-        value = int(token, radix)
-        if not lo <= value <= hi:
+        if len(token) > MAX_DIGITS or not lo <= int(token, radix) <= hi:
             bounds = f"{lo:o}-{hi:o}" if octal else f"{lo}-{hi}"  # in the radix the constant is written in
             self.err(raw.line, col, f"{key}: {token} is outside {bounds}")
             return None
-        return value
+        return int(token, radix)
 
     def _build(
         self, raw: _Raw, index: int, addr: int, labels: dict[str, int], by_addr: dict[int, int]
@@ -404,9 +409,9 @@ class _Parser:
             if not _DECIMAL.fullmatch(token):
                 self.err(raw.line, col, f"N: {token!r} is not a function number")
                 return None
-            number = int(token)
+            number = int(token) if len(token) <= MAX_DIGITS else -1
             if number not in DEFINED_CODES:
-                self.err(raw.line, col, f"N: function {number} does not exist")
+                self.err(raw.line, col, f"N: function {number if number >= 0 else token} does not exist")
                 return None
             spec = lookup(number)
         else:
@@ -438,7 +443,7 @@ class _Parser:
                     self.err(raw.line, raw.col, f"{spec.mnemonic} needs {key}: ({_KIND_NAMES[kind]})")
                     ok = False
                     continue
-                v = self._address(raw, key) if kind == "M" else self._const(raw, key, kind)
+                v = self._address(raw, key) if kind == "M" else self._const(raw, key, kind, *spec.bounds(key))
                 ok = ok and v is not None
                 values[key] = v
         else:  # a defined code not implemented on this build: keep the values, FErr1 at run time

@@ -6,14 +6,15 @@ with it: an archive then stays readable after the catalog changes or on another 
 
 from __future__ import annotations
 
-import csv
 from collections.abc import Iterator
 from dataclasses import dataclass
 from pathlib import Path
 
 from netplc.problems import Problems
+from netplc.textfile import TextFileError, csv_rows, read_text, whole_number
 
 MESSAGE_TYPES = {0: "info", 1: "warning", 2: "alarm", 3: "critical"}  # docs/architecture.md section 8
+INT64_MAX = 2**63 - 1  # the archive's INTEGER columns hold a signed 64-bit value
 
 
 class CatalogError(Problems):
@@ -36,13 +37,16 @@ class Catalog:
     def load(cls, path: str | Path) -> Catalog:
         path = Path(path)
         try:
-            text = path.read_text(encoding="utf-8-sig")
-        except (OSError, UnicodeDecodeError) as e:
-            raise CatalogError([f"{path}:0: cannot read the message catalog: {e}"]) from None
+            text = read_text(path, "the message catalog")
+        except TextFileError as e:
+            raise CatalogError([str(e)]) from None
         problems: list[str] = []
         messages: dict[int, Message] = {}
         lines: dict[int, int] = {}
-        for lineno, row in enumerate(csv.reader(text.splitlines()), start=1):
+        for lineno, row in csv_rows(text):
+            if isinstance(row, str):
+                problems.append(f"{path}:{lineno}: {row}")
+                continue
             if not row or not "".join(row).strip() or row[0].lstrip().startswith(("#", ";")):
                 continue
             if lineno == 1 and not row[0].strip().isdigit():
@@ -91,7 +95,13 @@ def _parse_row(row: list[str]) -> Message:
 
 
 def _integer(field: str, name: str) -> int:
-    value = field.strip()
-    if not value.isdigit():
-        raise ValueError(f"{name} {value!r} is not a non-negative whole number")
-    return int(value)
+    value = whole_number(field)
+    if value is None:
+        raise ValueError(f"{name} {_show(field.strip())} is not a non-negative whole number")
+    if value > INT64_MAX:
+        raise ValueError(f"{name} {value} is past {INT64_MAX}, the largest the archive holds")
+    return value
+
+
+def _show(text: str) -> str:
+    return repr(text) if len(text) <= 40 else repr(text[:37]) + "..."

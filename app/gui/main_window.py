@@ -143,7 +143,9 @@ class MainWindow(QMainWindow):
             scroll.setFrameShape(QFrame.Shape.NoFrame)
             self.tabs.addTab(scroll, form.title)
         if problems:
-            self.tabs.addTab(_placeholder("Forms that could not be opened:\n\n" + "\n".join(problems)),
+            self.tabs.addTab(_placeholder("Form problems (a form with a wrong property does not open; "
+                                          "one naming a file outside the station opens without it):\n\n"
+                                          + "\n".join(problems)),
                              "Form problems")
         if not forms and not problems:
             self.tabs.addTab(_placeholder(f"No .hmi forms in {station.HMIload}."), "No forms")

@@ -17,12 +17,17 @@ from typing import Any
 
 from netplc.address import AddressError, BitRef, check_operand, parse_hmi_bit, parse_octal
 from netplc.tags.tag import Scaling  # the one conversion, shared with tags, journal and viewer
+from netplc.textfile import MAX_DIGITS
 
 Color = tuple[int, int, int, int]  # r, g, b, alpha
 
 
 class PropError(ValueError):
     """A property value the loader refuses; the message is the `problem` part of the report."""
+
+
+class Outside(PropError):
+    """A file outside the folders a form may read: reported, and the element shows without it."""
 
 
 @dataclass(frozen=True, slots=True)
@@ -40,7 +45,9 @@ class Context:
     symbols: dict[str, int]
     folder: Path
     devices: dict[str, Scaling] = field(default_factory=dict)
-    images: list[Path] = field(default_factory=list)
+    images: list[Path | None] = field(default_factory=list)
+    roots: tuple[Path, ...] = ()  # folders files may come from besides `folder` (the station's)
+    allow_outside: bool = False  # the station allows files anywhere
 
 
 Parser = Callable[[Any, Context], Any]
@@ -51,8 +58,27 @@ def prop(parser: Parser, *, required: bool = False, alias: str | None = None) ->
     return {"parser": parser, "required": required, "alias": alias}
 
 
+@dataclass(frozen=True, slots=True)
+class LongNumber:
+    """A JSON integer with more digits than int() converts (Python's limit is 4300): kept as its
+    text, so that every property parser refuses it by name instead of json raising ValueError."""
+
+    text: str
+
+    def __repr__(self) -> str:
+        return f"a {len(self.text.lstrip('-'))}-digit number"
+
+
+def json_int(text: str) -> int | LongNumber:
+    """`parse_int` for json.loads."""
+    return int(text) if len(text) <= MAX_DIGITS else LongNumber(text)
+
+
 def _show(value: Any) -> str:
-    text = repr(value) if not isinstance(value, str) else f'"{value}"'
+    try:
+        text = repr(value) if not isinstance(value, str) else f'"{value}"'
+    except RecursionError:  # json.loads nests deeper than repr can
+        return "a deeply nested value"
     return text if len(text) <= 40 else text[:37] + "..."
 
 
@@ -70,6 +96,8 @@ def boolean(value: Any, _ctx: Context) -> bool:
 
 def integer(lo: int, hi: int) -> Parser:
     def parse(value: Any, _ctx: Context) -> int:
+        if isinstance(value, LongNumber):
+            raise PropError(f"{value!r} is out of range {lo}..{hi}")
         if isinstance(value, bool) or not isinstance(value, int):
             raise PropError(f"expected an integer from {lo} to {hi}, got {_show(value)}")
         if not lo <= value <= hi:
@@ -79,9 +107,17 @@ def integer(lo: int, hi: int) -> Parser:
     return parse
 
 
+MAX_NUMBER = 1e15  # past this a scaled value loses its units digit in a float
+
+
 def number(value: Any, _ctx: Context) -> float:
-    if isinstance(value, bool) or not isinstance(value, int | float) or not math.isfinite(value):
+    if isinstance(value, LongNumber):
+        raise PropError(f"{value!r} is out of range -1e15..1e15")
+    if isinstance(value, bool) or not isinstance(value, int | float) or (
+            isinstance(value, float) and not math.isfinite(value)):
         raise PropError(f"expected a number, got {_show(value)}")
+    if not -MAX_NUMBER <= value <= MAX_NUMBER:  # exact for ints too, which float() may not hold
+        raise PropError(f"{_show(value)} is out of range -1e15..1e15")
     return float(value)
 
 
@@ -176,9 +212,17 @@ def font(value: Any, ctx: Context) -> Font:
 
 
 def image_file(value: Any, ctx: Context) -> Path:
-    """A picture file relative to the form's folder (forms travel with their images)."""
+    """A picture file relative to the form's folder (forms travel with their images). It must be
+    inside that folder or the station's (after symbolic links), unless the station allows files
+    anywhere: a form must not make the workstation read /etc/passwd or another station's files."""
     name = text(value, ctx)
+    if "\0" in name:
+        raise PropError(f"image file {_show(name)} has a NUL character")
     path = (ctx.folder / name).resolve()
+    roots = (ctx.folder, *ctx.roots)
+    if not ctx.allow_outside and not any(path.is_relative_to(root.resolve()) for root in roots):
+        raise Outside(f'image file "{name}" is outside the station folder {" and ".join(map(str, roots))} '
+                      "(shown without it; allow_outside = true in station.toml allows it)")
     if not path.is_file():
         raise PropError(f'image file "{name}" not found in {ctx.folder}')
     return path

@@ -30,7 +30,7 @@ CURSORS = {"Hand": Qt.CursorShape.PointingHandCursor, "Cross": Qt.CursorShape.Cr
 class Images:
     """The pictures of one form, loaded once and shared by its widgets."""
 
-    def __init__(self, files: list[Path]) -> None:
+    def __init__(self, files: list[Path | None]) -> None:
         self.files = files
         self._cache: dict[Path, QPixmap] = {}
 
@@ -41,7 +41,8 @@ class Images:
         return pix
 
     def index(self, i: int) -> QPixmap | None:
-        return self.get(self.files[i]) if 0 <= i < len(self.files) else None
+        path = self.files[i] if 0 <= i < len(self.files) else None  # None: left out by the loader
+        return self.get(path) if path is not None else None
 
 
 def draw_pixmap(p: QPainter, pix: QPixmap, rect: QRectF, mode: str = "Zoom",

@@ -12,9 +12,10 @@ from __future__ import annotations
 from netplc.functions.registry import Fon, FonContext, register
 
 
-@register(300, "NODE", s="D")
+@register(300, "NODE", s="D", limits=(("S", 0, 255),))
 def node(ctx: FonContext, fon: Fon) -> None:
-    """Select the node of the following NREAD/NWRITE (kept until the next NODE, across scans)."""
+    """Select the node of the following NREAD/NWRITE (kept until the next NODE, across scans).
+    Nodes are numbered 0...255 (the manual's range): another number is a load error."""
     ctx.node = fon.s or 0
 
 

@@ -83,9 +83,14 @@ class FunctionSpec:
     run: Run
     hardware: bool = False  # a CPU-165 module function: sets FErr1 on this platform
     inline: Inline | None = None
+    limits: tuple[tuple[str, int, int], ...] = ()  # (key, lo, hi) of a constant narrower than a word
 
     def kinds(self) -> dict[str, ParamKind | None]:
         return {"S": self.s, "D": self.d, "R": self.r}
+
+    def bounds(self, key: str) -> tuple[int, int]:
+        """The range a constant parameter takes (the manual's; a 16-bit word unless it says less)."""
+        return next(((lo, hi) for k, lo, hi in self.limits if k == key), (0, 0xFFFF))
 
 
 REGISTRY: dict[int, FunctionSpec] = {}
@@ -101,13 +106,14 @@ def register(
     *,
     hardware: bool = False,
     inline: Inline | None = None,
+    limits: tuple[tuple[str, int, int], ...] = (),
 ) -> Callable[[Run], Run]:
     """Decorator: register `run` as function `number` / `mnemonic` with its parameter kinds."""
 
     def deco(run: Run) -> Run:
         if number in REGISTRY or mnemonic in BY_NAME:
             raise RuntimeError(f"function {number} {mnemonic} registered twice")
-        spec = FunctionSpec(number, mnemonic, s, d, r, run, hardware, inline)
+        spec = FunctionSpec(number, mnemonic, s, d, r, run, hardware, inline, limits)
         REGISTRY[number] = spec
         BY_NAME[mnemonic] = spec
         return run

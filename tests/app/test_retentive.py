@@ -13,6 +13,7 @@ from pathlib import Path
 from app.config import load_station
 from app.runtime import Runtime
 from tests.app.conftest import REPO, write_station
+from tests.app.test_runtime_errors import wait_for
 
 COUNTER = 0o4000
 # INCW every scan: the word at 04000 counts scans (04002 is the unused setpoint)
@@ -75,3 +76,34 @@ def test_counting_continues_after_sigkill(tmp_path: Path) -> None:
         assert scans - 75 <= restored <= scans + 50
     finally:
         runtime.stop()
+
+
+def test_a_failing_save_is_journaled_once_shown_and_cleared(tmp_path: Path, qtbot) -> None:
+    from app.gui.main_window import MainWindow
+
+    folder = write_station(tmp_path, 'Retain = "blocked/retain.bin"\n' + TOML, {"count.stl": PROGRAM})
+    (folder / "blocked").write_text("a file, not a folder", encoding="utf-8")  # fails as a read-only mount
+    runtime = Runtime(load_station(folder))
+    texts: list[str] = []
+    runtime.subscribe(lambda record: texts.append(record.text or ""))
+    runtime.start()
+    window = MainWindow(runtime)
+    qtbot.addWidget(window)
+    try:
+        assert wait_for(lambda: any("retentive memory not saved" in p for p in runtime.status().problems))
+        time.sleep(2.2)  # two more periodic saves fail: still journaled once
+        assert len([t for t in texts if "could not be saved" in t]) == 1, texts
+        assert "retentive memory not saved: " in runtime.status().line()
+        window.refresh_status()
+        assert not window.health.isHidden() and "retentive memory not saved" in window.health.label.text()
+
+        (folder / "blocked").unlink()  # the disk works again
+        (folder / "blocked").mkdir()
+        assert wait_for(lambda: not any("retentive" in p for p in runtime.status().problems))
+        assert any("being saved again" in t for t in texts)
+        window.refresh_status()
+        assert "retentive" not in window.health.label.text()
+    finally:
+        window.close()
+        runtime.stop()
+    assert (folder / "blocked" / "retain.bin").exists()

@@ -14,6 +14,7 @@ size and with tiny chunks, so that chunk boundaries fall everywhere.
 from __future__ import annotations
 
 import itertools
+import tempfile
 from unittest import mock
 
 from hypothesis import HealthCheck, given, settings
@@ -130,16 +131,22 @@ def state(engine: Engine) -> tuple:
 
 
 def run_both(text: str, inputs: list[list[int]], dts: list[float], data: bytes = b"") -> None:
-    """Scan `text` in the reference interpreter and in the compiled engine (usual and tiny chunks)."""
+    """Scan `text` in the reference interpreter and in the compiled engine (usual and tiny chunks,
+    and the usual code once more as a second start takes it from the compiled-program cache)."""
     program = parse(text, source="random.stl")
     engines = []
-    for compiled, chunk in ((False, 0), (True, compiler._CHUNK_CONSTS), (True, 3)):
-        clock = FakeClock()
-        with mock.patch.object(compiler, "_CHUNK_CONSTS", chunk):
-            engine = Engine(program, clock=clock, wallclock=lambda: 0.0, compiled=compiled)
+    with tempfile.TemporaryDirectory() as cache:
+        Engine(program, clock=FakeClock(), wallclock=lambda: 0.0, code_cache=cache)  # fills the cache
+        usual = compiler._CHUNK_CONSTS
+        kinds = ((False, 0, None), (True, usual, None), (True, 3, None), (True, usual, cache))
+        for compiled, chunk, cached in kinds:
+            clock = FakeClock()
+            with mock.patch.object(compiler, "_CHUNK_CONSTS", chunk):
+                engines.append((Engine(program, clock=clock, wallclock=lambda: 0.0, compiled=compiled,
+                                       code_cache=cached), clock))
+    for engine, _ in engines:
         if data:
             engine.mem.write(INITIAL[0], data)
-        engines.append((engine, clock))
     for scan_inputs, dt in zip(inputs, dts):
         for eng, clock in engines:
             for addr, v in zip(INPUTS, scan_inputs):

@@ -38,6 +38,9 @@ def col(fon: str, token: str) -> int:
         ("FON C:$03000 N:MVIO S:1238 D:$04000", "1238", "S: '1238' is not"),
         ("FON C:$03000 N:MVIO S:200000 D:$04000", "200000", "S: 200000 is outside"),
         ("FON C:$03000 N:MOV S:$10000 D:$04000", "$10000", "S: 010000 is not a valid address"),
+        # NODE: the manual's node range 0...255
+        ("FON C:$03000 N:NODE S:256", "256", "S: 256 is outside 0-255"),
+        ("FON C:$03000 N:300 S:65535", "65535", "S: 65535 is outside 0-255"),
         # functions that do not exist
         ("FON C:$03000 N:17 S:$04000 D:$04000", "17", "N: function 17 does not exist"),
         ("FON C:$03000 N:NOSUCH S:$04000 D:$04000", "NOSUCH", "N: unknown function 'NOSUCH'"),
@@ -95,3 +98,8 @@ def test_every_defined_code_is_registered_except_the_exchange_functions() -> Non
     lookup(0)
     missing = sorted(DEFINED_CODES - set(REGISTRY) - {300, 301, 302})
     assert missing == []
+
+
+def test_node_takes_the_manual_range_0_to_255() -> None:
+    for n in (0, 255):
+        assert parse(f"{PROLOGUE}FON C:$03000 N:NODE S:{n}\n").instrs[1].s == n

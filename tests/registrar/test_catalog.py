@@ -49,7 +49,31 @@ def test_errors_name_file_and_line(tmp_path):
 def test_missing_or_undecodable_file_is_a_catalog_error(tmp_path):
     with pytest.raises(CatalogError, match="cannot read"):
         Catalog.load(tmp_path / "none.csv")
-    bad = tmp_path / "cp1251.csv"
-    bad.write_bytes("1,1,0,Пуск\n".encode("cp1251"))
-    with pytest.raises(CatalogError, match=r"cp1251\.csv:0"):
+    bad = tmp_path / "bad.csv"
+    bad.write_bytes("1,1,0,Пуск\n2,1,0,".encode("cp1251") + b"\x98\n")  # 0x98: not cp1251 either
+    with pytest.raises(CatalogError) as info:
         Catalog.load(bad)
+    assert info.value.problems == [f"{bad}:2: neither UTF-8 nor cp1251 text (byte 0x98)"]
+
+
+def test_utf8_with_or_without_bom_else_cp1251(tmp_path):
+    for name, data in (("utf8.csv", "1,1,0,Пуск\n".encode()), ("bom.csv", "1,1,0,Пуск\n".encode("utf-8-sig")),
+                       ("cp1251.csv", "1,1,0,Пуск\n".encode("cp1251"))):
+        (tmp_path / name).write_bytes(data)
+        assert Catalog.load(tmp_path / name).text_for(1) == "Пуск", name
+
+
+@pytest.mark.parametrize(("line", "problem"), [
+    (f"{2**63},1,0,big", f"number {2**63} is past {2**63 - 1}"),
+    ("-1,1,0,negative", "number '-1' is not a non-negative whole number"),
+    (f"1,{10**30},0,big group", "group 1000000000000000000000000000000 is past"),
+    ("9" * 5000 + ",1,0,huge", "number '99999999999"),
+    ("²,1,0,superscript", "number '²' is not"),
+    ("1,1,0," + "x" * 140_000, "a field is longer than 131072 characters"),
+])
+def test_numbers_the_archive_cannot_hold_and_huge_fields_are_named(tmp_path, line, problem):
+    path = write(tmp_path, f"0,1,0,fine\n{line}\n3,1,0,after\n")
+    with pytest.raises(CatalogError) as info:
+        Catalog.load(path)
+    assert len(info.value.problems) == 1
+    assert info.value.problems[0].startswith(f"{path}:2: {problem}"), info.value.problems

@@ -1,0 +1,168 @@
+"""Broken station files end as named problems (`file:line: ...`), never as tracebacks: `check`
+exits 1 listing them, a start exits 2, and the forms that are fine still open."""
+
+from __future__ import annotations
+
+import json
+import subprocess
+import sys
+from pathlib import Path
+
+import pytest
+
+from app.config import read_station
+from hmi_forms.form import load_forms
+from registrar.catalog import Catalog
+from tests.app.conftest import REPO, copy_demo
+
+NOT_CP1251 = b"\x98"  # a byte that is neither UTF-8 (alone) nor defined in cp1251
+
+
+def main(*args: object) -> subprocess.CompletedProcess[str]:
+    return subprocess.run([sys.executable, "main.py", *map(str, args)], cwd=REPO, capture_output=True,
+                          text=True, timeout=60)
+
+
+def append_line(path: Path, data: bytes) -> int:
+    """Append one line of raw bytes; its line number."""
+    text = path.read_bytes()
+    if not text.endswith(b"\n"):
+        text += b"\n"
+    path.write_bytes(text + data + b"\n")
+    return text.count(b"\n") + 1
+
+
+def form(elements: list[dict], devices: list[dict] | None = None) -> str:
+    return json.dumps({"form": {"title": "t", "width": 200, "height": 200}, "devices": devices or [],
+                       "elements": elements})
+
+
+def bad_forms(folder: Path) -> dict[str, str]:
+    """Three forms that used to crash the loader, and the start of the problem each must give."""
+    analog = {"type": "AnalogBase", "Name": "Level", "x": 0, "y": 0, "w": 10, "h": 10, "InAddr": "04010",
+              "AppMax": 10, "PhyMin": 0, "PhyMax": 1}
+    (folder / "x_deep.hmi").write_text('{"form": {"width": 10, "height": 10},\n"elements": '
+                                       + "[" * 100_000 + "]" * 100_000 + "}", encoding="utf-8")
+    (folder / "x_digits.hmi").write_text(form([]).replace('"width": 200', '"width": ' + "7" * 5000),
+                                         encoding="utf-8")
+    (folder / "x_appmin.hmi").write_text(form([analog]).replace('"AppMax": 10', '"AppMin": ' + "9" * 400
+                                                                + ', "AppMax": 10'), encoding="utf-8")
+    return {
+        "x_deep.hmi": f"{folder / 'x_deep.hmi'}:2:112: bad JSON: arrays or objects nested too deeply",
+        "x_digits.hmi": f"{folder / 'x_digits.hmi'}: form: width: a 5000-digit number is out of range",
+        "x_appmin.hmi": f'{folder / "x_appmin.hmi"}: element "Level": AppMin: a 400-digit number is out of '
+                        "range",
+    }
+
+
+def test_check_lists_every_bad_file_and_exits_1(tmp_path: Path) -> None:
+    st = copy_demo(tmp_path / "st")
+    program_line = append_line(st / "netplc.stl", b"; bad " + NOT_CP1251)
+    symbols_line = append_line(st / "symbols.csv", b"LONG,02000," + b"x" * 140_000)
+    big_line = append_line(st / "messages.csv", f"{2**63},1,0,too big for the archive".encode())
+    expected_forms = bad_forms(st / "forms")
+    r = main("check", st)
+    assert r.returncode == 1, r.stdout + r.stderr
+    assert "Traceback" not in r.stderr
+    out = r.stdout.splitlines()
+    assert f"{st / 'netplc.stl'}:{program_line}:0: neither UTF-8 nor cp1251 text (byte 0x98)" in out
+    assert f"{st / 'symbols.csv'}:{symbols_line}:1: a field is longer than 131072 characters" in out
+    assert (f"{st / 'messages.csv'}:{big_line}: number {2**63} is past {2**63 - 1}, the largest the archive "
+            "holds") in out
+    for start in expected_forms.values():
+        assert any(line.startswith(start) for line in out), (start, out)
+
+
+def test_a_station_written_in_cp1251_checks_clean(tmp_path: Path) -> None:
+    st = copy_demo(tmp_path / "st")
+    for name in ("netplc.stl", "symbols.csv", "messages.csv"):
+        path = st / name
+        path.write_bytes(path.read_text(encoding="utf-8").encode("cp1251"))
+    r = main("check", st)
+    assert r.returncode == 0, r.stdout + r.stderr
+    assert Catalog.load(st / "messages.csv").text_for(1) == "Пуск нажат"
+
+
+def test_a_start_with_an_unreadable_symbols_file_exits_2_naming_it(tmp_path: Path) -> None:
+    st = copy_demo(tmp_path / "st")
+    line = append_line(st / "symbols.csv", b"BAD" + NOT_CP1251 + b",02000")
+    r = main("--no-gui", st, "--duration", "1")
+    assert r.returncode == 2, r.stdout + r.stderr
+    assert "Traceback" not in r.stderr
+    assert f"{st / 'symbols.csv'}:{line}:0: neither UTF-8 nor cp1251 text (byte 0x98)" in r.stderr
+
+
+def test_a_start_with_a_message_number_past_int64_exits_2_naming_the_line(tmp_path: Path) -> None:
+    st = copy_demo(tmp_path / "st")
+    line = append_line(st / "messages.csv", f"{2**64},1,0,too big".encode())
+    r = main("--no-gui", st, "--duration", "1")
+    assert r.returncode == 2, r.stdout + r.stderr
+    assert "Traceback" not in r.stderr and f"{st / 'messages.csv'}:{line}: number {2**64} is past" in r.stderr
+
+
+@pytest.mark.parametrize(("toml", "problem"), [
+    ("NetSyncTime = " + "1" * 5000, "not valid TOML: a number of more than 4300 digits"),
+    ("NetSyncTime = " + "[" * 5000, "not valid TOML: arrays or tables nested too deeply"),
+    ('NetPlcProgram = "a\\u0000b"', "NetPlcProgram: a path cannot hold a NUL character"),
+    ('NetPlcLoad = false\n[[nodes]]\nnode = 0\nendpoint = "tcp://127.0.0.1:1"\ntimeout = ' + "9" * 400,
+     "nodes[0].timeout: a 400-digit number is too large"),
+])
+def test_station_files_past_the_toml_reader_limits_are_named(tmp_path: Path, toml: str, problem: str) -> None:
+    (tmp_path / "station.toml").write_text(toml, encoding="utf-8")
+    assert read_station(tmp_path)[1] == [f"{tmp_path / 'station.toml'}: {problem}"]
+
+
+def test_a_station_file_in_cp1251_reads(tmp_path: Path) -> None:
+    (tmp_path / "station.toml").write_bytes('name = "Насосная"\nNetPlcLoad = false\n'.encode("cp1251"))
+    station, problems = read_station(tmp_path)
+    assert problems == [] and station is not None and station.name == "Насосная"
+
+
+def test_netplc_run_names_an_unreadable_program_or_symbols_file(tmp_path: Path) -> None:
+    program = tmp_path / "p.stl"
+    program.write_bytes(b"TNA $02000 ; \xcf\xf3\xf1\xea\nYON $02001\n")  # a cp1251 comment: fine
+    symbols = tmp_path / "s.csv"
+    symbols.write_bytes(b"A,02000\nB" + NOT_CP1251 + b",02001\n")
+    run = [sys.executable, "-m", "netplc", "run", str(program), "--set", "02000=1", "--print", "02001"]
+    r = subprocess.run(run, cwd=REPO, capture_output=True, text=True, timeout=30)
+    assert r.returncode == 0 and r.stdout == "02001 = 1\n", r.stderr
+    r = subprocess.run([*run, "--symbols", str(symbols)], cwd=REPO, capture_output=True, text=True,
+                       timeout=30)
+    assert r.returncode == 2 and r.stderr == f"{symbols}:2:0: neither UTF-8 nor cp1251 text (byte 0x98)\n"
+    program.write_bytes(b"TNA $02000\n" + NOT_CP1251 + b"\n")
+    r = subprocess.run(run, cwd=REPO, capture_output=True, text=True, timeout=30)
+    assert r.returncode == 2 and r.stderr == f"{program}:2:0: neither UTF-8 nor cp1251 text (byte 0x98)\n"
+
+
+def test_the_good_forms_still_open_beside_the_broken_ones(tmp_path: Path) -> None:
+    (tmp_path / "a_good.hmi").write_text(form([{"type": "StaticText", "Name": "T", "x": 0, "y": 0, "w": 10,
+                                                "h": 10, "Text": "ok"}]), encoding="utf-8")
+    expected = bad_forms(tmp_path)
+    forms, problems = load_forms(tmp_path)
+    assert [f.path.name for f in forms] == ["a_good.hmi"]
+    assert len(problems) == 3
+    for start in expected.values():
+        assert any(p.startswith(start) for p in problems), (start, problems)
+
+
+def test_the_workstation_opens_the_demo_forms_beside_the_broken_ones(tmp_path: Path, qtbot) -> None:
+    from app.config import load_station
+    from app.gui.main_window import MainWindow
+    from app.runtime import Runtime
+
+    st = copy_demo(tmp_path / "st")
+    expected = bad_forms(st / "forms")
+    runtime = Runtime(load_station(st))
+    runtime.start()
+    window = MainWindow(runtime)
+    qtbot.addWidget(window)
+    try:
+        titles = [window.tabs.tabText(i) for i in range(window.tabs.count())]
+        assert len(window.views) == len(list((st / "forms").glob("0*.hmi"))) == len(titles) - 1
+        assert titles[-1] == "Form problems"
+        assert all(any(p.startswith(start) for p in window.form_problems) for start in expected.values())
+        window.refresh_status()
+        assert "form problem: " in window.health.label.text()
+    finally:
+        window.close()
+        runtime.stop()
