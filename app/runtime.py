@@ -26,6 +26,8 @@ from dataclasses import dataclass, field, replace
 
 from app.config import Station
 from app.load import load, load_station_forms
+from app.station_alarms import STATE_FILE as ALARM_STATE_FILE
+from app.station_alarms import StationAlarms
 from hmi_forms.behaviour import FormBehaviour
 from hmi_forms.form import Form
 from netplc.engine import Engine
@@ -139,6 +141,7 @@ class Runtime:
         self.simulators: list[Simulator] = []
         self.exchange: Exchange | None = None
         self.modbus: ModbusServer | None = None
+        self.alarms: StationAlarms | None = None  # tags, quality and alarms, evaluated every scan
         self.scan_thread: ScanThread | None = None
         self.nodes: list[NodeConfig] = list(station.nodes)
         self.restored = ""  # which retentive save was used: current / previous / zeroes
@@ -234,6 +237,10 @@ class Runtime:
         self.exchange = Exchange(self.nodes, self)
         self.exchange.attach(self.engine)
         self.exchange.start()
+        self.alarms = StationAlarms(st.Tags, self.program, list(self.catalog), self,
+                                    st.Archive.with_name(ALARM_STATE_FILE), self.symbols)
+        self.subscribe(self.alarms.observe)
+        self.alarms.attach(self.engine, self.exchange)
         server = st.modbus_server
         if server.enabled:
             modbus = ModbusServer(self.engine, host=server.host, port=server.port,
@@ -286,6 +293,10 @@ class Runtime:
         if self.scan_thread is not None:
             self.scan_thread.stop()
             self.scan_thread = None
+        if self.alarms is not None:
+            self.unsubscribe(self.alarms.observe)
+            self.alarms.close()  # the last alarm states, after the last scan
+            self.alarms = None
         if self.retainer is not None:
             self.retainer.stop()  # the final save, of the last finished scan
             self._final_retain_error = self.retainer.last_error
