@@ -85,6 +85,10 @@ class _Loader:
             doc = json.loads(raw)
         except json.JSONDecodeError as e:
             raise FormError([f"{self.path}:{e.lineno}:{e.colno}: bad JSON: {e.msg}"]) from None
+        return self.build(doc)
+
+    def build(self, doc: Any) -> Form:
+        """The form of a parsed document (the designer checks its unsaved document through this)."""
         if not isinstance(doc, dict):
             raise FormError([f"{self.path}: the form must be a JSON object with form, devices, elements"])
         for key in sorted(set(doc) - {"form", "devices", "images", "elements"}):
