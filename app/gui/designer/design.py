@@ -54,7 +54,7 @@ class FormScene(QGraphicsScene):
     """The form's area: its background colour and image, and the grid."""
 
     def __init__(self, design: Design) -> None:
-        super().__init__()
+        super().__init__(design)
         self.design = design
 
     def drawBackground(self, painter: QPainter, rect: QRectF) -> None:
@@ -79,10 +79,16 @@ class FormScene(QGraphicsScene):
 
 
 class Design(QObject):
-    changed = Signal()  # the document changed (problems, title, properties follow it)
+    """Its signals forward those of its scene and undo stack, so whoever listens is disconnected
+    before those children go (Qt drops a receiver's connections before deleting its children)."""
 
-    def __init__(self, doc: FormDoc, symbols: dict[str, int], archive: Path | None = None) -> None:
-        super().__init__()
+    changed = Signal()  # the document changed (problems, title, properties follow it)
+    selection_changed = Signal()
+    clean_changed = Signal(bool)
+
+    def __init__(self, doc: FormDoc, symbols: dict[str, int], archive: Path | None = None,
+                 parent: QObject | None = None) -> None:
+        super().__init__(parent)
         self.doc = doc
         self.symbols = symbols
         self.archive = archive
@@ -93,6 +99,8 @@ class Design(QObject):
         self.snapshot = Snapshot.empty()
         self.undo = QUndoStack(self)
         self.scene = FormScene(self)
+        self.undo.cleanChanged.connect(self.clean_changed)
+        self.scene.selectionChanged.connect(self.selection_changed)
         self.reader = Reader(doc, symbols)
         self.images = Images(self.reader.ctx.images)
         self.items: dict[int, ElementItem] = {}

@@ -79,13 +79,13 @@ class DesignerWindow(QMainWindow):
     def _design(self, doc: FormDoc) -> Design:
         station = self.context.station
         archive = station.Archive if station is not None and station.Archive.is_file() else None
-        return Design(doc, self.context.names, archive)
+        return Design(doc, self.context.names, archive, self)
 
     def _connect(self) -> None:
         d = self.design
         d.changed.connect(self._changed)
-        d.scene.selectionChanged.connect(self.properties.show_selection)
-        d.undo.cleanChanged.connect(self._title)
+        d.selection_changed.connect(self.properties.show_selection)
+        d.clean_changed.connect(self._title)
         self._title()
 
     def set_document(self, doc: FormDoc) -> None:
@@ -97,8 +97,7 @@ class DesignerWindow(QMainWindow):
         self.problems.set_design(self.design)
         self._rebind_undo()
         self._connect()
-        old.undo.clear()
-        old.scene.clear()
+        old.deleteLater()
         self._update_plan()
 
     def _changed(self) -> None:
