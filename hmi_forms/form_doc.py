@@ -81,17 +81,16 @@ class Reader:
     def __init__(self, doc: FormDoc, symbols: dict[str, int]) -> None:
         self.path = doc.path
         self.symbols = symbols
-        loader = _Loader(doc.path, symbols)
-        loader.ctx.devices = loader.devices(doc.data.get("devices", []))
-        loader.ctx.images = loader.images(doc.data.get("images", []))
-        self.ctx = loader.ctx
+        self.loader = _Loader(doc.path, symbols)
+        self.loader.ctx.devices = self.loader.devices(doc.data.get("devices", []))
+        self.loader.ctx.images = self.loader.images(doc.data.get("images", []))
+        self.ctx = self.loader.ctx
 
     def element(self, raw: dict[str, Any]) -> tuple[Element | None, list[str]]:
         """The model of one element and its problems, as the loader reports them."""
-        loader = _Loader(self.path, self.symbols)
-        loader.ctx = self.ctx
-        model = loader.element(self._where(raw), raw)
-        return model, loader.problems
+        self.loader.problems = []
+        model = self.loader.element(self._where(raw), raw)
+        return model, self.loader.problems
 
     def _where(self, raw: dict[str, Any]) -> str:
         name = raw.get("Name")

@@ -95,7 +95,6 @@ class Design(QObject):
         self.grid = GRID
         self.grid_visible = True
         self.snapping = True
-        self.dragging = False
         self.snapshot = Snapshot.empty()
         self.undo = QUndoStack(self)
         self.scene = FormScene(self)
@@ -230,6 +229,12 @@ class Design(QObject):
         raws = {id(r): r for r in self.doc.elements}
         self.set_props([(raws[k], dict(zip(("x", "y", "w", "h"), g))) for k, g in geometry.items()],
                        text, merge)
+
+    def snap_selection(self) -> None:
+        """While the selection is dragged: each element onto the grid (and not off the form's left
+        or top). Done here rather than in itemChange, which every item would run for every change."""
+        for item in self.scene.selectedItems():
+            item.setPos(self.snap_point(item.pos()))
 
     def commit_moves(self) -> None:
         """After a mouse drag: the moved elements' new places as one step."""

@@ -5,7 +5,7 @@ first comes into view): a widget painted by
 its form is drawn straight into the canvas with `draw`, exactly as the form draws it; a widget made
 of child widgets (plots, input fields, the journal) is rendered once into a pixmap per change. The
 item adds only what a designer needs on top: selection outline and handles, a red outline while
-the element has problems, snapping while it is dragged, and resizing by its handles.
+the element has problems, and resizing by its handles.
 """
 
 from __future__ import annotations
@@ -55,8 +55,7 @@ class ElementItem(QGraphicsItem):
         self._resize: tuple[str, QPointF, QRectF] | None = None  # handle, press point, start rect
         self.resize_rect: QRectF | None = None
         self.setFlags(QGraphicsItem.GraphicsItemFlag.ItemIsSelectable
-                      | QGraphicsItem.GraphicsItemFlag.ItemIsMovable
-                      | QGraphicsItem.GraphicsItemFlag.ItemSendsGeometryChanges)
+                      | QGraphicsItem.GraphicsItemFlag.ItemIsMovable)
         self.setAcceptHoverEvents(True)
         self.rebuild()
 
@@ -155,11 +154,6 @@ class ElementItem(QGraphicsItem):
 
     # --- moving and resizing ---------------------------------------------------------------------
 
-    def itemChange(self, change: QGraphicsItem.GraphicsItemChange, value: Any) -> Any:
-        if change == QGraphicsItem.GraphicsItemChange.ItemPositionChange and self.design.dragging:
-            return self.design.snap_point(value)
-        return super().itemChange(change, value)
-
     def handle_at(self, pos: QPointF) -> str | None:
         if len(self.design.scene.selectedItems()) != 1:
             return None
@@ -182,12 +176,12 @@ class ElementItem(QGraphicsItem):
             self._resize = (handle, event.scenePos(), QRectF(self.pos(), self.rect().size()))
             event.accept()
             return
-        self.design.dragging = True
         super().mousePressEvent(event)
 
     def mouseMoveEvent(self, event: QGraphicsSceneMouseEvent) -> None:
         if self._resize is None:
-            super().mouseMoveEvent(event)
+            super().mouseMoveEvent(event)  # moves the whole selection
+            self.design.snap_selection()
             return
         handle, start, rect = self._resize
         d = event.scenePos() - start
@@ -216,7 +210,6 @@ class ElementItem(QGraphicsItem):
                                                          round(r.height()))}, "Resize")
             return
         super().mouseReleaseEvent(event)
-        self.design.dragging = False
         self.design.commit_moves()
 
 

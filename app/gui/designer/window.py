@@ -62,7 +62,7 @@ class DesignerWindow(QMainWindow):
         self.statusBar().addPermanentWidget(self.preview_label)
         self._build_menus()
         self._connect()
-        self.problems.recheck()
+        self.problems.schedule()  # a moment after the window shows: opening a big form stays quick
         self.properties.show_selection()
         self.resize(SIZE)
         self.resizeDocks([self.palette.parentWidget(), self.properties.parentWidget()], [190, 330],
