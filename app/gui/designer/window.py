@@ -11,7 +11,7 @@ import sys
 from pathlib import Path
 
 from PySide6.QtCore import QMimeData, QSize, Qt
-from PySide6.QtGui import QAction, QCloseEvent, QGuiApplication, QKeySequence
+from PySide6.QtGui import QAction, QCloseEvent, QGuiApplication, QKeySequence, QShowEvent
 from PySide6.QtWidgets import (
     QApplication,
     QDockWidget,
@@ -65,9 +65,7 @@ class DesignerWindow(QMainWindow):
         self.problems.schedule()  # a moment after the window shows: opening a big form stays quick
         self.properties.show_selection()
         self.resize(SIZE)
-        self.resizeDocks([self.palette.parentWidget(), self.properties.parentWidget()], [190, 330],
-                         Qt.Orientation.Horizontal)
-        self.resizeDocks([self.problems_dock], [120], Qt.Orientation.Vertical)
+        self._sized = False
 
     # --- documents ------------------------------------------------------------------------------
 
@@ -290,6 +288,15 @@ class DesignerWindow(QMainWindow):
         if name and self._may_discard():
             self.set_document(new_doc(Path(name)))
 
+    def showEvent(self, event: QShowEvent) -> None:
+        """Give the canvas the room (dock sizes only apply once the window is laid out)."""
+        super().showEvent(event)
+        if not self._sized:
+            self._sized = True
+            self.resizeDocks([self.palette.parentWidget(), self.properties.parentWidget()],  # type: ignore[list-item]
+                             [190, 330], Qt.Orientation.Horizontal)
+            self.resizeDocks([self.problems_dock], [110], Qt.Orientation.Vertical)
+
     def closeEvent(self, event: QCloseEvent) -> None:
         if not self._may_discard():
             event.ignore()
@@ -353,6 +360,7 @@ def run_designer(target: str, screenshot: str | None = None) -> int:
     window.show()
     window.canvas.home()
     if screenshot is not None:
+        window.problems.recheck()
         app.processEvents()
         ok = window.grab().save(screenshot)
         window.design.undo.setClean()
