@@ -9,7 +9,7 @@ import json
 from pathlib import Path
 
 import pytest
-from PySide6.QtCore import QPoint, QPointF, Qt
+from PySide6.QtCore import QPointF, Qt
 from PySide6.QtGui import QDropEvent, QImage, QMouseEvent
 from PySide6.QtWidgets import QApplication
 from pytestqt.qtbot import QtBot
@@ -205,6 +205,20 @@ def test_undo_redo_chain_gives_back_each_state(window: DesignerWindow) -> None:
     assert len(d.items) == len(d.doc.elements)
 
 
+def drag(qtbot: QtBot, window: DesignerWindow, start: QPointF, end: QPointF) -> None:
+    """Press at scene point `start`, move in steps, release at `end` (QTest's mouseMove carries no
+    pressed button, so the moves are sent as events)."""
+    vp = window.canvas.viewport()
+    a, b = window.canvas.mapFromScene(start), window.canvas.mapFromScene(end)
+    qtbot.mousePress(vp, Qt.MouseButton.LeftButton, pos=a)
+    for k in (1, 2, 3):
+        to = a + (b - a) * k / 3
+        move = QMouseEvent(QMouseEvent.Type.MouseMove, QPointF(to), QPointF(vp.mapToGlobal(to)),
+                           Qt.MouseButton.NoButton, Qt.MouseButton.LeftButton, Qt.KeyboardModifier.NoModifier)
+        QApplication.sendEvent(vp, move)
+    qtbot.mouseRelease(vp, Qt.MouseButton.LeftButton, pos=b)
+
+
 def test_move_with_the_mouse_snaps_to_the_grid_and_is_one_step(window: DesignerWindow,
                                                                qtbot: QtBot) -> None:
     window.show()
@@ -212,20 +226,27 @@ def test_move_with_the_mouse_snaps_to_the_grid_and_is_one_step(window: DesignerW
     d = window.design
     raw = named(window, "Время")
     item = d.items[id(raw)]
-    vp = window.canvas.viewport()
-    start = window.canvas.mapFromScene(item.sceneBoundingRect().center())
-    qtbot.mousePress(vp, Qt.MouseButton.LeftButton, pos=start)
-    for dx in (10, 20, 33):
-        to = start + QPoint(-dx, dx)
-        move = QMouseEvent(QMouseEvent.Type.MouseMove, QPointF(to), QPointF(vp.mapToGlobal(to)),
-                           Qt.MouseButton.NoButton, Qt.MouseButton.LeftButton, Qt.KeyboardModifier.NoModifier)
-        QApplication.sendEvent(vp, move)  # QTest's mouseMove carries no pressed button
-    qtbot.mouseRelease(vp, Qt.MouseButton.LeftButton, pos=start + QPoint(-33, 33))
+    centre = item.sceneBoundingRect().center()
+    drag(qtbot, window, centre, centre + QPointF(-33, 33))
     assert (raw["x"], raw["y"]) != (745, 245)
     assert raw["x"] % 8 == 0 and raw["y"] % 8 == 0
     assert d.undo.count() == 1
     d.undo.undo()
     assert (raw["x"], raw["y"]) == (745, 245) and item.pos() == QPointF(745, 245)
+
+
+def test_resize_by_a_handle_and_select_by_rubber_band(window: DesignerWindow, qtbot: QtBot) -> None:
+    window.show()
+    qtbot.waitExposed(window)
+    d = window.design
+    select(window, "Время")
+    raw = named(window, "Время")  # 745, 245, 195 x 100
+    drag(qtbot, window, QPointF(745 + 195, 245 + 100), QPointF(745 + 195 - 50, 245 + 100 + 21))
+    assert (raw["x"], raw["y"], raw["w"], raw["h"]) == (745, 245, 143, 123)  # moved edges snap
+    assert d.undo.count() == 1
+    d.scene.clearSelection()
+    drag(qtbot, window, QPointF(735, 130), QPointF(950, 230))  # from the empty form around two labels
+    assert sorted(r["Name"] for r in d.selected()) == ["Выход триггера", "Связь с узлом 0"]
 
 
 def test_arrow_keys_move_and_resize_the_selection(window: DesignerWindow, qtbot: QtBot) -> None:
