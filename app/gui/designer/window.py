@@ -10,7 +10,7 @@ from __future__ import annotations
 import sys
 from pathlib import Path
 
-from PySide6.QtCore import QMimeData, QSize, Qt
+from PySide6.QtCore import QMimeData, QPointF, QSize, Qt
 from PySide6.QtGui import QAction, QCloseEvent, QGuiApplication, QKeySequence, QShowEvent
 from PySide6.QtWidgets import (
     QApplication,
@@ -50,7 +50,7 @@ class DesignerWindow(QMainWindow):
         self.canvas = Canvas(self.design)
         self.setCentralWidget(self.canvas)
         names = sorted(context.names)
-        self.palette = Palette(lambda kind: self.design.add(kind))
+        self.palette = Palette(self.add)
         self.properties = PropertyPanel(self.design, names)
         self.problems_label = QLabel()
         self.preview_label = QLabel()
@@ -155,7 +155,7 @@ class DesignerWindow(QMainWindow):
         self._action(edit, "Select &all", self.select_all, keys.SelectAll)
         edit.addSeparator()
         add = edit.addMenu("Add &element")
-        self.add_actions = {kind: self._action(add, kind, lambda _=False, k=kind: self.design.add(k))
+        self.add_actions = {kind: self._action(add, kind, lambda _=False, k=kind: self.add(k))
                             for kind in ELEMENT_TYPES}
 
         arrange = bar.addMenu("&Arrange")
@@ -192,6 +192,14 @@ class DesignerWindow(QMainWindow):
         tools.addAction(self.snap_action)
         tools.addAction(self.preview_action)
         self._rebind_undo()
+
+    def add(self, kind: str) -> None:
+        """Edit -> Add element: the new element near the top left of what the canvas shows, each
+        next one a little further down, so a series of adds does not pile up."""
+        seen = self.canvas.mapToScene(self.canvas.viewport().rect()).boundingRect()
+        n = len(self.design.doc.elements) % 10
+        step = 2 * self.design.grid * (n + 1)
+        self.design.add(kind, QPointF(max(seen.left(), 0) + step, max(seen.top(), 0) + step))
 
     def _rebind_undo(self) -> None:
         undo = self.design.undo
