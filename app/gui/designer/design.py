@@ -40,7 +40,6 @@ NEW_PROPS: dict[str, dict[str, Any]] = {
     "AnalogOutput": {"AppMin": 0, "AppMax": 4095, "PhyMin": 0, "PhyMax": 100},
     "DiscreteAnimation": {"ImageFirst": -1, "ImageLast": -1},
 }
-CLIP_MIME = "application/x-netplc-hmi-elements"
 
 
 def _color(value: Any, default: QColor) -> QColor:

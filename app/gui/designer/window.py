@@ -10,7 +10,7 @@ from __future__ import annotations
 import sys
 from pathlib import Path
 
-from PySide6.QtCore import QMimeData, QPointF, QSize, Qt
+from PySide6.QtCore import QPointF, QSize, Qt
 from PySide6.QtGui import QAction, QCloseEvent, QGuiApplication, QKeySequence, QShowEvent
 from PySide6.QtWidgets import (
     QApplication,
@@ -24,7 +24,7 @@ from PySide6.QtWidgets import (
 )
 
 from app.gui.designer.canvas import Canvas
-from app.gui.designer.design import CLIP_MIME, Design
+from app.gui.designer.design import Design
 from app.gui.designer.palette import Palette
 from app.gui.designer.preview import Preview, plan
 from app.gui.designer.problems import ProblemsPane
@@ -224,22 +224,19 @@ class DesignerWindow(QMainWindow):
     # --- clipboard ------------------------------------------------------------------------------
 
     def copy(self) -> None:
+        """The selected elements as JSON text, the way a form file writes them (so they also paste
+        into a text editor, and elements copied from a form file paste here). Plain text rather than
+        a QMimeData of ours: the clipboard would delete that after Python has gone, at exit."""
         raws = self.design.selected()
         if raws:
-            data = QMimeData()
-            text = self.design.copy_text(raws)
-            data.setData(CLIP_MIME, text.encode())
-            data.setText(text)
-            QGuiApplication.clipboard().setMimeData(data)
+            QGuiApplication.clipboard().setText(self.design.copy_text(raws))
 
     def cut(self) -> None:
         self.copy()
         self.design.delete(self.design.selected())
 
     def paste(self) -> None:
-        data = QGuiApplication.clipboard().mimeData()
-        text = bytes(data.data(CLIP_MIME).data()).decode() if data.hasFormat(CLIP_MIME) else data.text()
-        self.design.paste_text(text)
+        self.design.paste_text(QGuiApplication.clipboard().text())
 
     def select_all(self) -> None:
         self.design.select(list(self.design.doc.elements))
