@@ -300,6 +300,13 @@ def test_problems_pane_lists_what_check_reports_and_goes_to_the_element(window: 
         'element "SyncGenerator": OutAddr: missing required property']
     window.problems.go_to(window.problems.item(0))
     assert window.design.selected() == [raw]
+    assert window.design.items[id(raw)].flagged
+    assert window.undo_action.text() == "&Undo Add SyncGenerator"
+    select(window, "Время")
+    window.properties.commit("w", 400)  # now past the form's right edge: a problem of the form
+    found = window.problems.recheck()
+    assert any('element "Время": w: the element (745,245 400x100) extends past the form' in t for t in found)
+    assert window.design.items[id(named(window, "Время"))].flagged
 
 
 def test_save_with_problems_asks_first(window: DesignerWindow) -> None:

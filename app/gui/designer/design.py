@@ -145,6 +145,13 @@ class Design(QObject):
     def image_files(self) -> list[str]:
         return image_files(self.doc.path.parent)
 
+    def flag(self, raws: list[dict[str, Any]]) -> None:
+        """Outline in red the elements the problems pane names (also problems between an element and
+        the form, such as reaching past its edge, which reading the element alone cannot see)."""
+        named = {id(r) for r in raws}
+        for key, item in self.items.items():
+            item.set_flagged(key in named)
+
     def selected(self) -> list[dict[str, Any]]:
         """The selected elements in z-order."""
         chosen = {id(i.raw) for i in self.scene.selectedItems() if isinstance(i, ElementItem)}

@@ -54,6 +54,7 @@ class ElementItem(QGraphicsItem):
         self._size = (1.0, 1.0)
         self._resize: tuple[str, QPointF, QRectF] | None = None  # handle, press point, start rect
         self.resize_rect: QRectF | None = None
+        self.flagged = False  # named by the problems pane
         self.setFlags(QGraphicsItem.GraphicsItemFlag.ItemIsSelectable
                       | QGraphicsItem.GraphicsItemFlag.ItemIsMovable)
         self.setAcceptHoverEvents(True)
@@ -97,6 +98,11 @@ class ElementItem(QGraphicsItem):
             self._pixmap = None
             self.update()
 
+    def set_flagged(self, on: bool) -> None:
+        if on != self.flagged:
+            self.flagged = on
+            self.update()
+
     # --- drawing --------------------------------------------------------------------------------
 
     def boundingRect(self) -> QRectF:
@@ -136,7 +142,7 @@ class ElementItem(QGraphicsItem):
                 widget.draw(p, r)
             finally:
                 p.restore()
-        if self.problems:
+        if self.problems or self.flagged:
             p.setPen(QPen(PROBLEM, 1.5, Qt.PenStyle.DashLine))
             p.setBrush(Qt.BrushStyle.NoBrush)
             p.drawRect(r.adjusted(0.75, 0.75, -0.75, -0.75))

@@ -62,10 +62,14 @@ class ProblemsPane(QListWidget):
             item.setToolTip(text)
             self.addItem(item)
         self.on_count(len(self.problems))
+        self.design.flag([e for e in map(self._element, self.problems) if e is not None])
         return self.problems
 
+    def _element(self, problem: str) -> dict[str, Any] | None:
+        return element_of(problem, self.design.doc.elements)
+
     def go_to(self, item: QListWidgetItem) -> None:
-        raw = element_of(item.data(Qt.ItemDataRole.UserRole), self.design.doc.elements)
+        raw = self._element(item.data(Qt.ItemDataRole.UserRole))
         if raw is None:
             return
         self.design.select([raw])

@@ -202,11 +202,14 @@ class DesignerWindow(QMainWindow):
         self.design.add(kind, QPointF(max(seen.left(), 0) + step, max(seen.top(), 0) + step))
 
     def _rebind_undo(self) -> None:
+        """Undo and Redo follow this form's stack and name the step they would take."""
         undo = self.design.undo
         self.undo_action.setEnabled(undo.canUndo())
         self.redo_action.setEnabled(undo.canRedo())
         undo.canUndoChanged.connect(self.undo_action.setEnabled)
         undo.canRedoChanged.connect(self.redo_action.setEnabled)
+        undo.undoTextChanged.connect(lambda text: self.undo_action.setText(f"&Undo {text}".strip()))
+        undo.redoTextChanged.connect(lambda text: self.redo_action.setText(f"&Redo {text}".strip()))
 
     def _toggle_snap(self, on: bool) -> None:
         self.design.snapping = on
