@@ -393,3 +393,16 @@ def test_a_new_form_is_created_where_it_is_named(qtbot: QtBot, tmp_path: Path) -
     assert w.save()
     assert json.loads(path.read_text(encoding="utf-8"))["elements"][0]["Text"] == "Text"
     assert w.preview_action.isEnabled() is False  # no station beside it
+
+
+def test_a_station_opens_its_first_form_and_offers_the_others(qtbot: QtBot, demo_copy: Path) -> None:
+    w = make_window(qtbot, demo_copy)
+    assert w.design.doc.path.name == "01_trigger.hmi"
+    assert w.preview_action.isEnabled()
+    menu = next(a.menu() for a in w.menuBar().actions() if a.text() == "&File")
+    forms = next(a.menu() for a in menu.actions() if a.text() == "Forms of the station")
+    assert [a.text() for a in forms.actions()] == ["01_trigger.hmi", "02_analog.hmi", "03_sync.hmi"]
+    forms.actions()[2].trigger()
+    assert w.design.doc.path.name == "03_sync.hmi" and w.windowTitle().startswith("03_sync.hmi")
+    w.design.add("DateTime")
+    assert w.undo_action.isEnabled() and w.windowTitle().startswith("03_sync.hmi*")

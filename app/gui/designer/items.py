@@ -98,6 +98,12 @@ class ElementItem(QGraphicsItem):
             self._pixmap = None
             self.update()
 
+    def _placeholder(self, p: QPainter, r: QRectF) -> None:
+        """An element no widget can draw (an unknown type): its type and name on a hatched box."""
+        p.fillRect(r, QBrush(QColor(211, 47, 47, 60), Qt.BrushStyle.BDiagPattern))
+        p.setPen(QColor("#1a1a1a"))
+        p.drawText(r, Qt.AlignmentFlag.AlignCenter, f'{self.raw.get("type")}\n{self.raw.get("Name")}')
+
     def set_flagged(self, on: bool) -> None:
         if on != self.flagged:
             self.flagged = on
@@ -126,22 +132,23 @@ class ElementItem(QGraphicsItem):
         if self.widget is None and self.model is not None:  # made when first seen: opening stays fast
             self.widget = self.design.widget_for(self.model)
         widget = self.widget
-        if widget is None:
-            p.fillRect(r, QBrush(QColor(211, 47, 47, 60), Qt.BrushStyle.BDiagPattern))
-            p.setPen(QColor("#1a1a1a"))
-            p.drawText(r, Qt.AlignmentFlag.AlignCenter, f'{self.raw.get("type")}\n{self.raw.get("Name")}')
-        elif isinstance(widget, SelfPainted):
-            if self._pixmap is None:
-                widget.flush()
-                self._pixmap = widget.grab()
-            p.drawPixmap(0, 0, self._pixmap)
-        else:
-            p.save()
-            p.setClipRect(r)
-            try:
+        p.save()
+        try:
+            if widget is None:
+                self._placeholder(p, r)
+            elif isinstance(widget, SelfPainted):
+                if self._pixmap is None:
+                    widget.flush()
+                    self._pixmap = widget.grab()
+                p.drawPixmap(0, 0, self._pixmap)
+            else:
+                p.setClipRect(r)
                 widget.draw(p, r)
-            finally:
-                p.restore()
+        except Exception as e:  # a widget that cannot draw this model: say so, keep the canvas going
+            self.problems = [*self.problems, f"drawing failed: {e!r}"]
+            self.model = self.widget = None
+        finally:
+            p.restore()
         if self.problems or self.flagged:
             p.setPen(QPen(PROBLEM, 1.5, Qt.PenStyle.DashLine))
             p.setBrush(Qt.BrushStyle.NoBrush)

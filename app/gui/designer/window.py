@@ -138,6 +138,11 @@ class DesignerWindow(QMainWindow):
         file = bar.addMenu("&File")
         self._action(file, "&New form…", self.new_form, keys.New)
         self._action(file, "&Open…", self.open_form, keys.Open)
+        if self.context.forms:
+            station = file.addMenu("Forms of the station")
+            for path in self.context.forms:
+                self._action(station, path.name,
+                             lambda _=False, p=path: self._may_discard() and self.open_path(p))
         self._action(file, "&Save", lambda: self.save(), keys.Save)
         self._action(file, "Save &as…", self.save_as, keys.SaveAs)
         file.addSeparator()
