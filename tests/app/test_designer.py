@@ -406,3 +406,21 @@ def test_a_station_opens_its_first_form_and_offers_the_others(qtbot: QtBot, demo
     assert w.design.doc.path.name == "03_sync.hmi" and w.windowTitle().startswith("03_sync.hmi")
     w.design.add("DateTime")
     assert w.undo_action.isEnabled() and w.windowTitle().startswith("03_sync.hmi*")
+
+
+def test_an_image_of_the_forms_folder_is_taken_into_the_form_in_one_step(qtbot: QtBot,
+                                                                          demo_copy: Path) -> None:
+    w = make_window(qtbot, demo_copy / "forms" / "01_trigger.hmi")  # a form without images
+    select(w, "Пуск")
+    editor = w.properties.editors["ImageTrue"]
+    assert isinstance(editor, ComboEditor)
+    labels = [editor.combo.itemText(i) for i in range(editor.combo.count())]
+    assert "+ images/pump_on_0.png" in labels and "-1: none" in labels
+    editor.combo.activated.emit(labels.index("+ images/pump_on_0.png"))
+    assert w.design.doc.data["images"] == ["images/pump_on_0.png"] and named(w, "Пуск")["ImageTrue"] == 0
+    assert w.design.items[id(named(w, "Пуск"))].problems == []
+    assert w.properties.editors["ImageTrue"].combo.currentText() == "0: images/pump_on_0.png"
+    w.design.undo.undo()
+    assert "images" not in w.design.doc.data and "ImageTrue" not in named(w, "Пуск")
+    picture = w.design.add("StaticPicture")
+    assert picture["Image"] in w.design.image_files()

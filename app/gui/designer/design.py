@@ -94,7 +94,6 @@ class Design(QObject):
         self.grid = GRID
         self.grid_visible = True
         self.snapping = True
-        self.snapshot = Snapshot.empty()
         self.undo = QUndoStack(self)
         self.scene = FormScene(self)
         self.undo.cleanChanged.connect(self.clean_changed)

@@ -33,6 +33,7 @@ from hmi_forms.form_doc import FormDoc, problems
 from hmi_forms.form_writer import element_keys
 
 FORM_SECTIONS = ("devices", "images")  # edited as JSON in the form's properties
+ADD_IMAGE = "add image"  # an image index editor's pick of a picture not yet in the form's list
 
 
 def field_parsers(kind: str) -> dict[str, Any]:
@@ -71,7 +72,7 @@ class PropertyPanel(QWidget):
         self.names = names
         self.targets: list[dict[str, Any]] = []
         self.editors: dict[str, Editor] = {}
-        self._key: tuple[int, ...] | None = None
+        self._key: tuple[object, ...] | None = None
         self.title = QLabel()
         self.title.setWordWrap(True)
         self.title.setStyleSheet("font-weight: bold; padding: 4px;")
@@ -92,14 +93,19 @@ class PropertyPanel(QWidget):
         return not self.targets or self.targets[0] is self.design.doc.settings
 
     def show_selection(self) -> None:
-        """Rebuild the editors when the selection changed; otherwise only refresh their values."""
+        """Rebuild the editors when the selection (or what the editors offer) changed; otherwise
+        only refresh their values."""
         raws = self.design.selected()
-        key = tuple(id(r) for r in raws) + tuple(str(r.get("type")) for r in raws)  # type: ignore[misc]
+        offered = (str(self.design.doc.data.get("images")), str(self.design.doc.data.get("devices")))
+        key = (*(id(r) for r in raws), *(str(r.get("type")) for r in raws), *offered)
         if key == self._key:
             self.refresh()
             return
         self._key = key
         self.targets = raws or [self.design.doc.settings]
+        self._build(raws)
+
+    def _build(self, raws: list[dict[str, Any]]) -> None:
         if raws:
             keys = shown_keys(raws[0])
             for raw in raws[1:]:
@@ -107,14 +113,10 @@ class PropertyPanel(QWidget):
                 keys = [k for k in keys if k in theirs]
             if len(raws) > 1:
                 keys = [k for k in keys if k != "Name"]
-                self.title.setText(f"{len(raws)} elements")
-            else:
-                self.title.setText(f'{raws[0].get("type")} "{raws[0].get("Name")}"')
             parsers = field_parsers(str(raws[0].get("type")))
         else:
             keys = [*FORM_PROPS, *FORM_SECTIONS]
             parsers = dict(FORM_PROPS)
-            self.title.setText(f"Form {self.design.doc.path.name}")
         body = QWidget()
         form = QFormLayout(body)
         form.setFieldGrowthPolicy(QFormLayout.FieldGrowthPolicy.AllNonFixedFieldsGrow)
@@ -146,9 +148,11 @@ class PropertyPanel(QWidget):
             return ComboEditor([(c, c) for c in choices(parser)], check)
         if kind == "image_file":
             return ComboEditor([(f, f) for f in self.design.image_files()], check, editable=True)
-        if kind == "image_index":
+        if kind == "image_index":  # the form's pictures, and those of its folder it may take in
             images = self.design.doc.data.get("images", [])
             options = [("-1: none", -1)] + [(f"{i}: {name}", i) for i, name in enumerate(images)]
+            options += [(f"+ {name}", (ADD_IMAGE, name)) for name in self.design.image_files()
+                        if name not in images]
             return ComboEditor(options, check)
         if kind == "text" and key == "Device":
             return ComboEditor([(d, d) for d in self.design.reader.ctx.devices], check, editable=True)
@@ -156,6 +160,10 @@ class PropertyPanel(QWidget):
 
     def refresh(self) -> None:
         """Show the targets' current values (after an edit, an undo, a move)."""
+        t = self.targets
+        one = f'{t[0].get("type")} "{t[0].get("Name")}"'
+        self.title.setText(f"Form {self.design.doc.path.name}" if self.form_mode else
+                           one if len(t) == 1 else f"{len(t)} elements")
         for key, editor in self.editors.items():
             values = [self._source(t, key).get(key, MISSING) for t in self.targets]
             mixed = any(v != values[0] for v in values[1:])
@@ -167,6 +175,8 @@ class PropertyPanel(QWidget):
     def refusal(self, key: str, value: Any) -> str | None:
         """Why setting `key` to `value` on every target is refused; None: accepted."""
         design = self.design
+        if isinstance(value, tuple):  # (ADD_IMAGE, file): a picture of the form's folder, listed
+            return None
         if self.form_mode:
             return _form_refusal(design.doc, design.symbols, key, value)
         if key == "Name":
@@ -192,7 +202,19 @@ class PropertyPanel(QWidget):
         if reason:
             return
         targets = [self._source(t, key) for t in self.targets]
+        if isinstance(value, tuple):
+            self._add_image(key, value[1], targets)
+            return
         self.design.set_props([(t, {key: value}) for t in targets], f"Set {key}")
+
+    def _add_image(self, key: str, name: str, targets: list[dict[str, Any]]) -> None:
+        """Append a picture to the form's images and point `key` at it, as one undo step."""
+        design = self.design
+        images = list(design.doc.data.get("images", []))
+        design.undo.beginMacro(f"Set {key}")
+        design.set_props([(design.doc.data, {"images": [*images, name]})], "Add image")
+        design.set_props([(t, {key: len(images)}) for t in targets], f"Set {key}")
+        design.undo.endMacro()
 
 
 def _form_refusal(doc: FormDoc, symbols: dict[str, int], key: str, value: Any) -> str | None:
