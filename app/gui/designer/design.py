@@ -34,11 +34,13 @@ GRID_DOT = QColor(0, 0, 0, 60)
 NEW_SIZE = {"SyncGenerator": (195, 72), "SyncTimer": (195, 72), "AnalogBase": (250, 200),
             "AnalogOutput": (280, 110), "StaticPicture": (120, 120), "StaticText": (240, 36),
             "Graph": (500, 160), "MessageJournal": (600, 260), "DateTime": (195, 100)}
+STATES = {"TextFalse": "0", "TextTrue": "1"}
 NEW_PROPS: dict[str, dict[str, Any]] = {
+    "DiscreteBase": STATES, "DiscreteColorLabel": STATES, "DiscreteControlledEnable": STATES,
+    "DiscreteAnimation": {**STATES, "ImageFirst": -1, "ImageLast": -1},
     "StaticText": {"Text": "Text"},
     "AnalogBase": {"AppMin": 0, "AppMax": 4095, "PhyMin": 0, "PhyMax": 100, "Appearance": "digital"},
     "AnalogOutput": {"AppMin": 0, "AppMax": 4095, "PhyMin": 0, "PhyMax": 100},
-    "DiscreteAnimation": {"ImageFirst": -1, "ImageLast": -1},
 }
 
 
