@@ -213,8 +213,14 @@ class DesignerWindow(QMainWindow):
         self.redo_action.setEnabled(undo.canRedo())
         undo.canUndoChanged.connect(self.undo_action.setEnabled)
         undo.canRedoChanged.connect(self.redo_action.setEnabled)
-        undo.undoTextChanged.connect(lambda text: self.undo_action.setText(f"&Undo {text}".strip()))
-        undo.redoTextChanged.connect(lambda text: self.redo_action.setText(f"&Redo {text}".strip()))
+        undo.undoTextChanged.connect(self._undo_text)
+        undo.redoTextChanged.connect(self._redo_text)
+
+    def _undo_text(self, text: str) -> None:
+        self.undo_action.setText(f"&Undo {text}".strip())
+
+    def _redo_text(self, text: str) -> None:
+        self.redo_action.setText(f"&Redo {text}".strip())
 
     def _toggle_snap(self, on: bool) -> None:
         self.design.snapping = on
