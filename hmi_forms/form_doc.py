@@ -62,6 +62,8 @@ def read_doc(path: str | Path) -> FormDoc:
     elements = data.get("elements", [])
     if not isinstance(elements, list) or not all(isinstance(e, dict) for e in elements):
         raise FormError([f"{path}: elements: must be a list of element objects"])
+    if not isinstance(data.get("form", {}), dict):
+        raise FormError([f'{path}: form: must be an object {{"title": ..., "width": ..., "height": ...}}'])
     return FormDoc(path, data)
 
 

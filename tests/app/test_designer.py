@@ -424,3 +424,25 @@ def test_an_image_of_the_forms_folder_is_taken_into_the_form_in_one_step(qtbot: 
     assert "images" not in w.design.doc.data and "ImageTrue" not in named(w, "Пуск")
     picture = w.design.add("StaticPicture")
     assert picture["Image"] in w.design.image_files()
+
+
+def test_a_broken_form_opens_with_its_problems_and_an_uneditable_one_is_refused(
+        qtbot: QtBot, tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    broken = tmp_path / "broken.hmi"
+    broken.write_text(json.dumps({
+        "form": {"title": 3}, "devices": "x", "images": [5],
+        "elements": [{"type": "Nope", "Name": 5, "x": "a"}, {"type": "DiscreteBase"},
+                     {"type": "StaticText", "Name": "T", "x": 0, "y": 0, "w": 99, "h": 30, "Text": "t",
+                      "Font": {"Size": 1000}}]}), encoding="utf-8")
+    w = make_window(qtbot, broken)
+    found = w.problems.recheck()
+    assert 'form: title: expected text, got 3' in "\n".join(found)
+    assert any('element "T": Font: font size 1000 is out of range' in t for t in found)
+    rendered(w)
+    items = [w.design.items[id(r)] for r in w.design.doc.elements]
+    assert items[0].model is None and items[2].model is not None  # drawn from its good properties
+    assert all(i.flagged or i.problems for i in items)
+    w.design.undo.setClean()
+    (tmp_path / "list.hmi").write_text('{"form": [1], "elements": []}', encoding="utf-8")
+    assert main(["design", str(tmp_path / "list.hmi")]) == 2
+    assert "list.hmi: form: must be an object" in capsys.readouterr().err

@@ -149,7 +149,7 @@ class PropertyPanel(QWidget):
         if kind == "image_file":
             return ComboEditor([(f, f) for f in self.design.image_files()], check, editable=True)
         if kind == "image_index":  # the form's pictures, and those of its folder it may take in
-            images = self.design.doc.data.get("images", [])
+            images = self._images()
             options = [("-1: none", -1)] + [(f"{i}: {name}", i) for i, name in enumerate(images)]
             options += [(f"+ {name}", (ADD_IMAGE, name)) for name in self.design.image_files()
                         if name not in images]
@@ -207,10 +207,15 @@ class PropertyPanel(QWidget):
             return
         self.design.set_props([(t, {key: value}) for t in targets], f"Set {key}")
 
+    def _images(self) -> list[Any]:
+        """The form's images list (none while the section is not a list: a problem to fix first)."""
+        images = self.design.doc.data.get("images", [])
+        return list(images) if isinstance(images, list) else []
+
     def _add_image(self, key: str, name: str, targets: list[dict[str, Any]]) -> None:
         """Append a picture to the form's images and point `key` at it, as one undo step."""
         design = self.design
-        images = list(design.doc.data.get("images", []))
+        images = self._images()
         design.undo.beginMacro(f"Set {key}")
         design.set_props([(design.doc.data, {"images": [*images, name]})], "Add image")
         design.set_props([(t, {key: len(images)}) for t in targets], f"Set {key}")
