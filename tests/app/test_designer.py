@@ -9,7 +9,7 @@ import json
 from pathlib import Path
 
 import pytest
-from PySide6.QtCore import QPointF, Qt
+from PySide6.QtCore import QPoint, QPointF, Qt
 from PySide6.QtGui import QDropEvent, QImage, QMouseEvent
 from PySide6.QtWidgets import QApplication
 from pytestqt.qtbot import QtBot
@@ -446,3 +446,27 @@ def test_a_broken_form_opens_with_its_problems_and_an_uneditable_one_is_refused(
     (tmp_path / "list.hmi").write_text('{"form": [1], "elements": []}', encoding="utf-8")
     assert main(["design", str(tmp_path / "list.hmi")]) == 2
     assert "list.hmi: form: must be an object" in capsys.readouterr().err
+
+
+def test_click_and_ctrl_click_select_and_delete_removes(window: DesignerWindow, qtbot: QtBot) -> None:
+    window.show()
+    qtbot.waitExposed(window)
+    d = window.design
+    vp = window.canvas.viewport()
+
+    def at(name: str) -> QPoint:
+        return window.canvas.mapFromScene(d.items[id(named(window, name))].sceneBoundingRect().center())
+
+    qtbot.mouseClick(vp, Qt.MouseButton.LeftButton, pos=at("Пуск"))
+    assert [r["Name"] for r in d.selected()] == ["Пуск"]
+    qtbot.mouseClick(vp, Qt.MouseButton.LeftButton, Qt.KeyboardModifier.ControlModifier, at("Время"))
+    assert sorted(r["Name"] for r in d.selected()) == ["Время", "Пуск"]
+    qtbot.mouseClick(vp, Qt.MouseButton.LeftButton, Qt.KeyboardModifier.ControlModifier, at("Пуск"))
+    assert [r["Name"] for r in d.selected()] == ["Время"]
+    window.activateWindow()
+    qtbot.waitActive(window)
+    window.canvas.setFocus()
+    qtbot.keyClick(window.canvas, Qt.Key.Key_Delete)
+    assert "Время" not in [r["Name"] for r in d.doc.elements]
+    d.undo.undo()
+    assert "Время" in [r["Name"] for r in d.doc.elements]

@@ -35,9 +35,14 @@ class Canvas(QGraphicsView):
         self.verticalScrollBar().setValue(self.verticalScrollBar().minimum())
 
     def keyPressEvent(self, event: QKeyEvent) -> None:
-        """Arrows move the selection by a pixel (Ctrl: by a grid step); Shift+arrows resize it."""
+        """Arrows move the selection by a pixel (Ctrl: by a grid step); Shift+arrows resize it;
+        Delete and Backspace remove it (also where the scene takes Delete before the menu's shortcut)."""
         step = ARROWS.get(Qt.Key(event.key()))
         raws = self.design.selected()
+        if event.key() in (Qt.Key.Key_Delete, Qt.Key.Key_Backspace) and raws:
+            self.design.delete(raws)
+            event.accept()
+            return
         if step is None or not raws:
             super().keyPressEvent(event)
             return
