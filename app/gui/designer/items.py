@@ -52,6 +52,7 @@ class ElementItem(QGraphicsItem):
         self.problems: list[str] = []
         self._pixmap: QPixmap | None = None
         self._size = (1.0, 1.0)
+        self._unread = False
         self._resize: tuple[str, QPointF, QRectF] | None = None  # handle, press point, start rect
         self.resize_rect: QRectF | None = None
         self.flagged = False  # named by the problems pane
@@ -70,8 +71,7 @@ class ElementItem(QGraphicsItem):
             self.widget.deleteLater()
         self.widget = None
         self._pixmap = None
-        if self.model is not None:
-            self.show_snapshot(self.design.snapshot)
+        self._unread = self.model is not None  # reads the design's snapshot when first drawn
         self._size = (float(self.model.w), float(self.model.h)) if self.model is not None else (
             float(_int(self.raw.get("w"), 40)), float(_int(self.raw.get("h"), 20)))
         self.setToolTip(f'{self.raw.get("type")} "{self.raw.get("Name")}"'
@@ -87,6 +87,7 @@ class ElementItem(QGraphicsItem):
         (a missing address drawn from its placeholder) keeps its first look."""
         if self.model is None:
             return
+        self._unread = False
         if self.problems and snap.scan:
             return  # placeholders must not show live values as if they were the element's
         try:
@@ -129,7 +130,9 @@ class ElementItem(QGraphicsItem):
 
     def paint(self, p: QPainter, option: QStyleOptionGraphicsItem, _w: QWidget | None = None) -> None:
         r = self.rect()
-        if self.widget is None and self.model is not None:  # made when first seen: opening stays fast
+        if self._unread:  # read and made when first seen: opening a big form stays fast
+            self.show_snapshot(self.design.snapshot)
+        if self.widget is None and self.model is not None:
             self.widget = self.design.widget_for(self.model)
         widget = self.widget
         p.save()
