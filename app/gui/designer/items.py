@@ -113,8 +113,10 @@ class ElementItem(QGraphicsItem):
     # --- drawing --------------------------------------------------------------------------------
 
     def boundingRect(self) -> QRectF:
+        """The element with room for its handles (and, while resized, for the new outline)."""
         w, h = self._size
-        return QRectF(-HANDLE, -HANDLE, w + 2 * HANDLE, h + 2 * HANDLE)
+        box = QRectF(-HANDLE, -HANDLE, w + 2 * HANDLE, h + 2 * HANDLE)
+        return box if self.resize_rect is None else box.united(self.resize_rect.adjusted(-2, -2, 2, 2))
 
     def rect(self) -> QRectF:
         return QRectF(0, 0, *self._size)
@@ -212,14 +214,14 @@ class ElementItem(QGraphicsItem):
             r.setRight(max(snap(rect.right() + d.x()), rect.left() + 1))
         if bottom:
             r.setBottom(max(snap(rect.bottom() + d.y()), rect.top() + 1))
+        self.prepareGeometryChange()
         self.resize_rect = r.translated(-self.pos())
-        self.update()
 
     def mouseReleaseEvent(self, event: QGraphicsSceneMouseEvent) -> None:
         if self._resize is not None:
             r = self.resize_rect
+            self.prepareGeometryChange()
             self._resize = self.resize_rect = None
-            self.update()
             if r is not None:
                 r = r.translated(self.pos())
                 self.design.set_geometry({id(self.raw): (round(r.x()), round(r.y()), round(r.width()),
