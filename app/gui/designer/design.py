@@ -174,7 +174,7 @@ class Design(QObject):
                     target.pop(key, None)
                 else:
                     target[key] = value
-            if target is self.doc.data or target is self.doc.settings:
+            if target is self.doc.data:  # devices or images: every element may read differently
                 whole = True
             elif id(target) in self.items:
                 item = self.items[id(target)]
@@ -182,7 +182,7 @@ class Design(QObject):
                     item.place()
                 else:
                     item.rebuild()
-        if whole:  # devices, images or the form's size: every element may read differently
+        if whole:
             self.reader = Reader(self.doc, self.symbols)
             self.images = Images(self.reader.ctx.images)
             for item in self.items.values():
