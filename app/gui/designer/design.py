@@ -13,23 +13,20 @@ from pathlib import Path
 from typing import Any
 
 from PySide6.QtCore import QObject, QPointF, QRectF, Signal
-from PySide6.QtGui import QColor, QPainter, QUndoStack
-from PySide6.QtWidgets import QGraphicsScene
+from PySide6.QtGui import QUndoStack
 
+from app.gui.designer.arrange import Z_ORDERS, aligned, box, distributed, number, restacked
 from app.gui.designer.commands import MISSING, NUDGE_ID, Insert, Remove, Reorder, SetProps
 from app.gui.designer.items import ElementItem
+from app.gui.designer.scene import FormScene
 from hmi_forms.elements import ELEMENT_TYPES, Element
-from hmi_forms.elements import props as p
-from hmi_forms.form import FORM_BACK
 from hmi_forms.form_doc import FormDoc, Reader, image_files, problems
 from hmi_forms.form_writer import save_form
-from hmi_forms.widgets.base import ElementWidget, Images, draw_pixmap
+from hmi_forms.widgets.base import ElementWidget, Images
 from hmi_forms.widgets.form_view import FormView
 from netplc.memory import Snapshot
 
 GRID = 8
-OUTSIDE = QColor("#9aa1ab")
-GRID_DOT = QColor(0, 0, 0, 60)
 # the size a new element gets, and the properties it needs that have a sensible default
 NEW_SIZE = {"SyncGenerator": (195, 72), "SyncTimer": (195, 72), "AnalogBase": (250, 200),
             "AnalogOutput": (280, 110), "StaticPicture": (120, 120), "StaticText": (240, 36),
@@ -42,41 +39,6 @@ NEW_PROPS: dict[str, dict[str, Any]] = {
     "AnalogBase": {"AppMin": 0, "AppMax": 4095, "PhyMin": 0, "PhyMax": 100, "Appearance": "digital"},
     "AnalogOutput": {"AppMin": 0, "AppMax": 4095, "PhyMin": 0, "PhyMax": 100},
 }
-
-
-def _color(value: Any, default: QColor) -> QColor:
-    try:
-        return QColor(*p.color(value, None))  # type: ignore[arg-type]
-    except p.PropError:
-        return default
-
-
-class FormScene(QGraphicsScene):
-    """The form's area: its background colour and image, and the grid."""
-
-    def __init__(self, design: Design) -> None:
-        super().__init__(design)
-        self.design = design
-
-    def drawBackground(self, painter: QPainter, rect: QRectF) -> None:
-        painter.fillRect(rect, OUTSIDE)
-        d = self.design
-        form = d.form_rect()
-        settings = d.doc.settings
-        painter.fillRect(form, _color(settings.get("BackColor"), QColor(*FORM_BACK)))
-        image = settings.get("BackgroundImage")
-        if isinstance(image, str) and (d.doc.path.parent / image).is_file():
-            draw_pixmap(painter, d.images.get((d.doc.path.parent / image).resolve()), form, "Stretch")
-        if d.grid_visible and d.grid >= 4:
-            painter.setPen(GRID_DOT)
-            visible = rect.intersected(form)
-            g = d.grid
-            x0 = int(visible.left()) // g * g
-            y0 = int(visible.top()) // g * g
-            points = [QPointF(x, y) for x in range(x0, int(visible.right()) + 1, g)
-                      for y in range(y0, int(visible.bottom()) + 1, g)]
-            if len(points) < 60_000:
-                painter.drawPoints(points)
 
 
 class Design(QObject):
@@ -257,7 +219,7 @@ class Design(QObject):
         """Arrow keys: move (or with dw/dh resize) by a step; repeated presses merge into one undo step."""
         changes = []
         for raw in raws:
-            x, y, w, h = (_num(raw.get(k), d) for k, d in (("x", 0), ("y", 0), ("w", 1), ("h", 1)))
+            x, y, w, h = box(raw)
             changes.append((raw, {"x": max(0, x + dx), "y": max(0, y + dy),
                                   "w": max(1, w + dw), "h": max(1, h + dh)}))
         self.set_props(changes, "Resize" if dw or dh else "Move", NUDGE_ID)
@@ -319,7 +281,7 @@ class Design(QObject):
             raw["Name"] = name = self.unique_name(str(el.get("Name", el["type"])), taken)
             taken.add(name)
             for k in ("x", "y"):
-                raw[k] = _num(el.get(k), 0) + self.grid
+                raw[k] = number(el.get(k), 0) + self.grid
             raws.append(raw)
         if raws:
             self.undo.push(Insert(self, raws, f"Paste {len(raws)} element(s)"))
@@ -327,74 +289,25 @@ class Design(QObject):
         return raws
 
     def align(self, how: str) -> None:
-        """Align the selected elements on the outermost edge of the selection (left, right, top,
-        bottom) or on its middle (hcenter, vcenter)."""
+        """Align the selected elements (arrange.aligned)."""
         raws = self.selected()
-        if len(raws) < 2:
-            return
-        boxes = {id(r): _box(r) for r in raws}
-        xs = [b[0] for b in boxes.values()]
-        ys = [b[1] for b in boxes.values()]
-        rights = [b[0] + b[2] for b in boxes.values()]
-        bottoms = [b[1] + b[3] for b in boxes.values()]
-        geometry = {}
-        for key, (x, y, w, h) in boxes.items():
-            if how == "left":
-                x = min(xs)
-            elif how == "right":
-                x = max(rights) - w
-            elif how == "top":
-                y = min(ys)
-            elif how == "bottom":
-                y = max(bottoms) - h
-            elif how == "hcenter":
-                x = round((min(xs) + max(rights)) / 2 - w / 2)
-            elif how == "vcenter":
-                y = round((min(ys) + max(bottoms)) / 2 - h / 2)
-            geometry[key] = (max(0, x), max(0, y), w, h)
-        self.set_geometry(geometry, f"Align {how}")
+        if len(raws) > 1:
+            boxes = aligned([box(r) for r in raws], how)
+            self.set_geometry({id(r): b for r, b in zip(raws, boxes)}, f"Align {how}")
 
     def distribute(self, axis: str) -> None:
-        """Equal gaps between the selected elements along x ("h") or y ("v"), the outer two fixed."""
+        """Equal gaps between the selected elements (arrange.distributed)."""
         raws = self.selected()
-        if len(raws) < 3:
-            return
-        i = 0 if axis == "h" else 1
-        boxes = sorted(((_box(r), id(r)) for r in raws), key=lambda t: t[0][i])
-        first, last = boxes[0][0], boxes[-1][0]
-        total = sum(b[2 + i] for b, _ in boxes)
-        gap = (last[i] + last[2 + i] - first[i] - total) / (len(boxes) - 1)
-        pos = float(first[i])
-        geometry = {}
-        for b, key in boxes:
-            nb = list(b)
-            nb[i] = round(pos)
-            geometry[key] = tuple(nb)
-            pos += b[2 + i] + gap
-        self.set_geometry(geometry, "Distribute")  # type: ignore[arg-type]
+        if len(raws) > 2:
+            boxes = distributed([box(r) for r in raws], axis)
+            self.set_geometry({id(r): b for r, b in zip(raws, boxes)}, "Distribute")
 
     def z_order(self, how: str) -> None:
-        """front, back, raise (one step up), lower (one step down)."""
-        chosen = self.selected()
-        if not chosen:
-            return
-        ids = {id(r) for r in chosen}
-        order = list(self.doc.elements)
-        rest = [r for r in order if id(r) not in ids]
-        if how == "front":
-            order = rest + chosen
-        elif how == "back":
-            order = chosen + rest
-        else:
-            step = 1 if how == "raise" else -1
-            seq = range(len(order) - 2, -1, -1) if step == 1 else range(1, len(order))
-            for j in seq:
-                k = j + step
-                if id(order[j]) in ids and id(order[k]) not in ids:
-                    order[j], order[k] = order[k], order[j]
+        """front, back, raise (one step up), lower (one step down): arrange.restacked."""
+        ids = {id(r) for r in self.selected()}
+        order = restacked(self.doc.elements, lambda r: id(r) in ids, how)
         if [id(r) for r in order] != [id(r) for r in self.doc.elements]:
-            self.undo.push(Reorder(self, order, {"front": "Bring to front", "back": "Send to back",
-                                                 "raise": "Raise", "lower": "Lower"}[how]))
+            self.undo.push(Reorder(self, order, Z_ORDERS[how]))
 
     def save(self, path: Path | None = None) -> Path:
         if path is not None:
@@ -409,10 +322,3 @@ class Design(QObject):
         for item in self.items.values():
             item.show_snapshot(snap)
 
-
-def _num(value: Any, default: int) -> int:
-    return value if isinstance(value, int) and not isinstance(value, bool) else default
-
-
-def _box(raw: dict[str, Any]) -> tuple[int, int, int, int]:
-    return (_num(raw.get("x"), 0), _num(raw.get("y"), 0), _num(raw.get("w"), 1), _num(raw.get("h"), 1))
