@@ -2,10 +2,10 @@
 
 The document (not the models) is what gets edited and saved, so a value keeps the spelling its
 author chose and an untouched form saves unchanged (`form_writer`). The loader reads it for two
-purposes: `problems` lists exactly what `check` would report for the file, and `element_model`
-gives the model each element's widget draws. An element with a problem is still drawn, from the
-properties that are good (each bad or missing one at its default), so a form being built shows
-what it will show.
+purposes: `problems` lists exactly what `check` would report for the file, and `Reader` gives
+the model each element's widget draws and says why an edit is refused. An element with a problem
+is still drawn, from the properties that are good (each bad or missing one at its default), so a
+form being built shows what it will show.
 """
 
 from __future__ import annotations

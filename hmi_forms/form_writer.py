@@ -1,5 +1,5 @@
 """.hmi forms written in one canonical layout, so a saved form diffs line by line and an untouched
-form saves byte for byte as it was read.
+form in this layout saves byte for byte as it was read (a hand-written one takes the layout once).
 
 The layout: the sections in the order form, devices, images, elements (then any unknown section, kept
 so `check` still reports it); the form settings one per line; a device or an image per line; every
