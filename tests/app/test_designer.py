@@ -31,6 +31,8 @@ from tests.app.conftest import DEMO
 def make_window(qtbot: QtBot, target: Path) -> DesignerWindow:
     window = DesignerWindow(open_target(target))
     window.confirm = lambda question: True  # type: ignore[method-assign]
+    window.warned = []  # type: ignore[attr-defined]
+    window.warn = window.warned.append  # type: ignore[attr-defined,method-assign]
     qtbot.addWidget(window)
     return window
 
@@ -470,3 +472,11 @@ def test_click_and_ctrl_click_select_and_delete_removes(window: DesignerWindow, 
     assert "Время" not in [r["Name"] for r in d.doc.elements]
     d.undo.undo()
     assert "Время" in [r["Name"] for r in d.doc.elements]
+
+
+def test_a_failed_save_says_why_and_keeps_the_form(window: DesignerWindow, tmp_path: Path) -> None:
+    path = window.design.doc.path
+    window.design.add("DateTime")
+    assert window.save(tmp_path / "no" / "such" / "folder" / "f.hmi") is False
+    assert "The form was not saved" in window.warned[0]  # type: ignore[attr-defined]
+    assert window.design.doc.path == path and not window.design.undo.isClean()

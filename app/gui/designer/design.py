@@ -310,11 +310,12 @@ class Design(QObject):
             self.undo.push(Reorder(self, order, Z_ORDERS[how]))
 
     def save(self, path: Path | None = None) -> Path:
-        if path is not None:
-            self.doc.path = Path(path)
-        save_form(self.doc.data, self.doc.path)
+        """Write the form (to `path`: save as); OSError leaves the document as it was."""
+        target = Path(path) if path is not None else self.doc.path
+        save_form(self.doc.data, target)
+        self.doc.path = target
         self.undo.setClean()
-        return self.doc.path
+        return target
 
     def show_snapshot(self, snap: Snapshot) -> None:
         """Live preview: every element reads the station's memory as the workstation would."""

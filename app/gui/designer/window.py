@@ -262,6 +262,11 @@ class DesignerWindow(QMainWindow):
         answer = QMessageBox.question(self, "Form designer", question)
         return answer == QMessageBox.StandardButton.Yes
 
+    def warn(self, text: str) -> None:
+        """Tell the engineer what went wrong (also on stderr, for a designer started from a shell)."""
+        print(text, file=sys.stderr)
+        QMessageBox.warning(self, "Form designer", text)
+
     def save(self, path: Path | None = None) -> bool:
         """Save; the problems are worked out first and, when there are any, shown and confirmed."""
         found = self.problems.recheck()
@@ -271,7 +276,11 @@ class DesignerWindow(QMainWindow):
             if not self.confirm(f"The form has {len(found)} problem(s), listed under Problems; the station "
                                 "will not open it as it is. Save anyway?"):
                 return False
-        saved = self.design.save(path)
+        try:
+            saved = self.design.save(path)
+        except OSError as e:
+            self.warn(f"The form was not saved: {e}")
+            return False
         self._title()
         self.statusBar().showMessage(f"Saved {saved}", 5000)
         return True
@@ -297,7 +306,7 @@ class DesignerWindow(QMainWindow):
         try:
             doc = read_doc(path)
         except FormError as e:
-            QMessageBox.warning(self, "Form designer", "\n".join(e.problems))
+            self.warn("\n".join(e.problems))
             return False
         self.set_document(doc)
         return True
