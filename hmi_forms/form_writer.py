@@ -15,6 +15,7 @@ from __future__ import annotations
 
 import json
 import os
+import sys
 from dataclasses import fields
 from functools import cache
 from pathlib import Path
@@ -22,7 +23,7 @@ from typing import Any
 
 from hmi_forms.elements import ELEMENT_TYPES, Element
 from hmi_forms.elements import props as p
-from hmi_forms.form import DEVICE_PROPS, FORM_PROPS
+from hmi_forms.form import DEVICE_PROPS, FORM_PROPS, FormError
 
 SECTIONS = ("form", "devices", "images", "elements")
 GEOMETRY = ("x", "y", "w", "h")
@@ -108,3 +109,29 @@ def save_form(doc: dict[str, Any], path: str | Path) -> None:
     tmp = path.with_name(path.name + ".tmp")
     tmp.write_text(dump_form(doc), encoding="utf-8", newline="\n")
     os.replace(tmp, path)
+
+
+def main(argv: list[str] | None = None) -> int:
+    """`python -m hmi_forms.form_writer FORM.hmi...`: re-save forms in the canonical layout (what the
+    designer writes), e.g. a form edited in a text editor before it is committed."""
+    from hmi_forms.form_doc import read_doc  # it builds on this module
+
+    paths = sys.argv[1:] if argv is None else argv
+    if not paths:
+        print("usage: python -m hmi_forms.form_writer FORM.hmi...", file=sys.stderr)
+        return 2
+    status = 0
+    for name in paths:
+        try:
+            save_form(read_doc(name).data, name)
+        except FormError as e:
+            print("\n".join(e.problems), file=sys.stderr)
+            status = 1
+        except OSError as e:
+            print(f"{name}: cannot write the form: {e}", file=sys.stderr)
+            status = 1
+    return status
+
+
+if __name__ == "__main__":
+    sys.exit(main())

@@ -118,3 +118,19 @@ def test_reader_refuses_an_edit_that_adds_a_problem_and_draws_a_broken_element()
     assert reader.refusal(raw, dict(raw, PhyLow=95)) == "PhyHigh: 90 must be above PhyLow 95"
     model, found = reader.drawable({"type": "DiscreteBase", "Name": "new", "x": 0, "y": 0, "w": 9, "h": 9})
     assert model is not None and found[0].endswith('element "new": InAddr: missing required property')
+
+
+def test_the_command_line_re_saves_hand_written_forms(tmp_path: Path,
+                                                       capsys: pytest.CaptureFixture[str]) -> None:
+    from hmi_forms.form_writer import main
+
+    hand = tmp_path / "hand.hmi"
+    hand.write_text('{"elements": [{"Name": "a", "type": "StaticText", "Text": "t",'
+                    ' "x": 0, "y": 0, "w": 5, "h": 5}], "form": {"width": 10, "height": 10, "title": "f"}}',
+                    encoding="utf-8")
+    bad = tmp_path / "bad.hmi"
+    bad.write_text("{", encoding="utf-8")
+    assert main([str(hand), str(bad)]) == 1
+    assert "bad.hmi:1:2: bad JSON" in capsys.readouterr().err
+    assert hand.read_text(encoding="utf-8") == dump_form(json.loads(hand.read_text(encoding="utf-8")))
+    assert hand.read_text(encoding="utf-8").startswith('{\n "form": {\n  "title": "f",')
