@@ -16,7 +16,7 @@ import time
 
 from app.config import DEMO_STATION
 
-COMMANDS = ("view", "check", "simulate", "alarms-report")
+COMMANDS = ("view", "check", "simulate", "alarms-report", "design")
 
 
 def _main_parser() -> argparse.ArgumentParser:
@@ -26,7 +26,8 @@ def _main_parser() -> argparse.ArgumentParser:
                     "and shows its HMI forms.",
         epilog="other commands: view [ARCHIVE] (offline journal viewer), check STATION (validate a "
                "station), simulate PROGRAM.stl (a simulated CPU-165 node), alarms-report ARCHIVE --day "
-               "DD_MM_YYYY (alarm-system health); each takes --help.",
+               "DD_MM_YYYY (alarm-system health), design [FORM.hmi | STATION] (the form designer); "
+               "each takes --help.",
     )
     p.add_argument("station", nargs="?", default=str(DEMO_STATION),
                    help="station folder or its station.toml (default: the demo station)")
@@ -66,6 +67,19 @@ def _alarms_report_parser() -> argparse.ArgumentParser:
     return p
 
 
+def _design_parser() -> argparse.ArgumentParser:
+    p = argparse.ArgumentParser(prog="python main.py design",
+                                description="The form designer: place elements, edit their properties, "
+                                            "see the form's problems, preview it live against the running "
+                                            "station, and save the .hmi file.")
+    p.add_argument("target", nargs="?", default=str(DEMO_STATION),
+                   help="a form (FORM.hmi; a new one if it does not exist) or a station folder, whose "
+                        "first form opens (default: the demo station)")
+    p.add_argument("--screenshot", metavar="PNG",
+                   help="render the designer at 1366x768 to PNG and exit")
+    return p
+
+
 def main(argv: list[str] | None = None) -> int:
     args = list(sys.argv[1:] if argv is None else argv)
     if args and args[0] in COMMANDS:
@@ -74,6 +88,9 @@ def main(argv: list[str] | None = None) -> int:
             from netplc.simulator import main as simulate
 
             return simulate(rest)
+        if command == "design":
+            ns = _design_parser().parse_args(rest)
+            return run_designer(ns.target, ns.screenshot)
         if command == "check":
             return run_check(_check_parser().parse_args(rest).station)
         if command == "alarms-report":
@@ -181,3 +198,9 @@ def run_viewer(archive: str | None) -> int:
     from app.gui.viewer import run_viewer as viewer
 
     return viewer(archive)
+
+
+def run_designer(target: str, screenshot: str | None = None) -> int:
+    from app.gui.designer.window import run_designer as designer
+
+    return designer(target, screenshot)

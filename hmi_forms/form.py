@@ -119,6 +119,10 @@ class _Loader:
             line, col = _too_deep(raw)
             raise FormError([f"{self.path}:{line}:{col}: bad JSON: arrays or objects nested too deeply "
                              f"(here past {MAX_NESTING} levels)"]) from None
+        return self.build(doc)
+
+    def build(self, doc: Any) -> Form:
+        """The form of a parsed document (the designer checks its unsaved document through this)."""
         if not isinstance(doc, dict):
             raise FormError([f"{self.path}: the form must be a JSON object with form, devices, elements"])
         for key in sorted(set(doc) - {"form", "devices", "images", "elements"}):

@@ -1,4 +1,4 @@
-"""`python -m app.gui.screenshots DIR`: the workstation and the viewer on the demo station, as PNGs.
+"""`python -m app.gui.screenshots DIR`: the workstation, the viewer and the designer on the demo station.
 
 The demo station runs for real (a copy in a temporary folder, the embedded node over TCP, its own
 archive) while a short script plays the operator: Пуск pressed a few times, a setpoint entered,
@@ -78,6 +78,7 @@ def main(argv: list[str] | None = None) -> int:
                 path = args.out / f"workstation-{slug(view.form.path.stem)}.png"
                 window.grab().save(str(path))
                 written.append(path)
+            written.append(_designer(runtime, args.out, lambda s: _pump_events(app, s)))
         finally:
             window.close()
             runtime.stop()
@@ -102,6 +103,25 @@ def main(argv: list[str] | None = None) -> int:
     for path in written:
         print(path)
     return 0
+
+
+def _designer(runtime: Runtime, out: Path, wait: Callable[[float], None]) -> Path:
+    """The form designer on the analog form, previewing the running station live, a gauge selected."""
+    from app.gui.designer.station import open_target
+    from app.gui.designer.window import DesignerWindow
+
+    window = DesignerWindow(open_target(runtime.station.path.parent / "forms" / "02_analog.hmi"))
+    window.show()
+    window.canvas.home()
+    window.design.select([e for e in window.design.doc.elements if e.get("Name") == "Уровень"])
+    window.start_preview("127.0.0.1", runtime.modbus.port if runtime.modbus is not None else None)
+    wait(2.0)
+    window.problems.recheck()
+    path = out / "designer-02-analog.png"
+    window.grab().save(str(path))
+    window.stop_preview()
+    window.close()
+    return path
 
 
 def _play_operator(runtime: Runtime, wait: Callable[[float], None], seconds: float) -> None:

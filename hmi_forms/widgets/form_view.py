@@ -64,7 +64,7 @@ class FormView(QWidget):
             model.bind(target, user)
             if isinstance(model, DateTime) and started is not None:
                 model.started = started
-            widget = self._widget(model, archive)
+            widget = self.element_widget(model, self.images, archive)
             widget.setParent(self)
             self.pairs.append((model, widget))
             if isinstance(widget, TrendWidget):
@@ -78,8 +78,9 @@ class FormView(QWidget):
         for i, w in enumerate(self.trends):  # stagger the redraw turns over one interval
             w.next_flush = start + REDRAW_INTERVAL * i / max(len(self.trends), 1)
 
-    def _widget(self, model: Element, archive: Path | None) -> ElementWidget:
-        images = self.images
+    @staticmethod
+    def element_widget(model: Element, images: Images, archive: Path | None) -> ElementWidget:
+        """The widget class that draws `model` (the form designer draws its canvas with these too)."""
         if isinstance(model, DiscreteBase):
             return DiscreteWidget(model, images)
         if isinstance(model, AnalogBase):

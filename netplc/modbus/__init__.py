@@ -9,17 +9,31 @@ Only this package imports pymodbus, whose API changes at every minor release.
 from netplc.modbus.driver import (
     DeviceError,
     Endpoint,
+    LeanTcpClient,
     LinkError,
     LoopThread,
     ModbusClient,
     open_client,
     parse_endpoint,
 )
-from netplc.modbus.map import PROFILES, TABLES, WRITABLE_TABLES, Block, MapError, Table, describe, locate
+from netplc.modbus.map import (
+    MAX_READ_BITS,
+    MAX_READ_REGISTERS,
+    PROFILES,
+    TABLES,
+    WRITABLE_TABLES,
+    Block,
+    MapError,
+    Table,
+    bytes_from_words,
+    describe,
+    locate,
+)
 from netplc.modbus.server import ALL_MEMORY, ModbusServer
 
 __all__ = [
-    "ALL_MEMORY", "PROFILES", "TABLES", "WRITABLE_TABLES", "Block", "DeviceError", "Endpoint", "LinkError",
-    "LoopThread", "MapError", "ModbusClient", "ModbusServer", "Table", "describe", "locate", "open_client",
+    "ALL_MEMORY", "MAX_READ_BITS", "MAX_READ_REGISTERS", "PROFILES", "TABLES", "WRITABLE_TABLES",
+    "Block", "DeviceError", "Endpoint", "LeanTcpClient", "LinkError", "LoopThread", "MapError",
+    "ModbusClient", "ModbusServer", "Table", "bytes_from_words", "describe", "locate", "open_client",
     "parse_endpoint",
 ]

@@ -1,0 +1,78 @@
+"""The problems pane: what `check` would report for the form as it stands, a click going to the element.
+
+The list is worked out by the loader itself on the unsaved document (`form_doc.problems`), a
+moment after the last edit (so a burst of arrow-key moves costs one check, not one per step).
+"""
+
+from __future__ import annotations
+
+import re
+from collections.abc import Callable
+from typing import Any
+
+from PySide6.QtCore import Qt, QTimer
+from PySide6.QtWidgets import QListWidget, QListWidgetItem, QWidget
+
+from app.gui.designer.design import Design
+
+ELEMENT = re.compile(r': element (?:"(?P<name>.*?)"|#(?P<index>\d+)): ')
+DELAY_MS = 250
+
+
+def element_of(problem: str, elements: list[dict[str, Any]]) -> dict[str, Any] | None:
+    """The element a problem line names (by Name, or by number when it has none)."""
+    m = ELEMENT.search(problem)
+    if m is None:
+        return None
+    if m["index"] is not None:
+        i = int(m["index"]) - 1
+        return elements[i] if 0 <= i < len(elements) else None
+    return next((e for e in elements if e.get("Name") == m["name"]), None)
+
+
+class ProblemsPane(QListWidget):
+    def __init__(self, design: Design, on_count: Callable[[int], None],
+                 parent: QWidget | None = None) -> None:
+        super().__init__(parent)
+        self.design = design
+        self.on_count = on_count
+        self.problems: list[str] = []
+        self.timer = QTimer(self)
+        self.timer.setSingleShot(True)
+        self.timer.setInterval(DELAY_MS)
+        self.timer.timeout.connect(self.recheck)
+        self.itemClicked.connect(self.go_to)
+        self.itemActivated.connect(self.go_to)
+
+    def set_design(self, design: Design) -> None:
+        self.design = design
+        self.recheck()
+
+    def schedule(self) -> None:
+        self.timer.start()
+
+    def recheck(self) -> list[str]:
+        self.timer.stop()
+        self.problems = self.design.problems()
+        prefix = f"{self.design.doc.path}: "
+        self.clear()
+        for text in self.problems:
+            item = QListWidgetItem(text.removeprefix(prefix))
+            item.setData(Qt.ItemDataRole.UserRole, text)
+            item.setToolTip(text)
+            self.addItem(item)
+        self.on_count(len(self.problems))
+        self.design.flag([e for e in map(self._element, self.problems) if e is not None])
+        return self.problems
+
+    def _element(self, problem: str) -> dict[str, Any] | None:
+        return element_of(problem, self.design.doc.elements)
+
+    def go_to(self, item: QListWidgetItem) -> None:
+        raw = self._element(item.data(Qt.ItemDataRole.UserRole))
+        if raw is None:
+            return
+        self.design.select([raw])
+        target = self.design.items[id(raw)]
+        for view in self.design.scene.views():
+            view.ensureVisible(target)
