@@ -1,6 +1,6 @@
 """A tag: a named piece of NetPlc memory with its type, unit and hardware/physical conversion.
 
-The conversion is the manual's (section 2.4.1, DESIGN section 9), and it is the only one: forms,
+The conversion is the manual's (section 2.4.1, docs/architecture.md section 9), and it is the only one: forms,
 journal, viewer and CSV convert through `Scaling`. `Scaling.to_phy` is written so that it also runs
 element-wise on numpy arrays, which is how `TagReader` converts thousands of tags in one step
 with the very same arithmetic (and so the very same results) as a single tag.
@@ -28,7 +28,7 @@ from netplc.memory import MemoryView
 
 @dataclass(frozen=True, slots=True)
 class Scaling:
-    """Linear hardware <-> physical conversion (DESIGN section 9)."""
+    """Linear hardware <-> physical conversion (docs/architecture.md section 9)."""
 
     AppMin: float
     AppMax: float
@@ -62,7 +62,7 @@ class TagType(StrEnum):
     WORD = "word"  # unsigned 16
     INT16 = "int16"
     BCD = "bcd"  # 4 BCD digits in a word, 0-9999
-    INT32 = "int32"  # two words, low word first (DESIGN section 3)
+    INT32 = "int32"  # two words, low word first (docs/architecture.md section 3)
     FLOAT32 = "float32"  # IEEE single over two words, low word first
 
 
