@@ -67,10 +67,16 @@ class Station:
     nodes: tuple[NodeConfig, ...] = ()
     simulators: tuple[SimulatorSettings, ...] = ()
     users: tuple[str, ...] = ("operator",)
+    RetainForces: bool = False  # forces survive a restart (netplc/forcing.py); off: a restart unforces
 
     @property
     def folder(self) -> Path:
         return self.path.parent
+
+    @property
+    def forces_file(self) -> Path:
+        """Where the forces are kept across a restart when RetainForces is true: beside Retain."""
+        return self.Retain.with_name(self.Retain.stem + ".forces.json")
 
     @property
     def tick(self) -> float:
@@ -187,6 +193,7 @@ def read_station(path: str | Path) -> tuple[Station | None, list[str]]:
     messages = top.path("Messages", base)
     keep_days = top.number("keep_days", 0, 0, 36_500)
     retain = top.path("Retain", base)
+    retain_forces = top.get("RetainForces", bool, False)
     server = _modbus_server(problems, fname, top.get("modbus_server", dict, {}))
     nodes = _nodes(problems, fname, top.get("nodes", list, []))
     simulators = _simulators(problems, fname, top.get("simulators", list, []), base, top.allow_outside)
@@ -213,7 +220,7 @@ def read_station(path: str | Path) -> tuple[Station | None, list[str]]:
         path=file.resolve(), name=name or base.name, NetPlcLoad=bool(load), NetPlcProgram=program,
         Symbols=symbols, HMIload=hmi, NetSyncTime=sync, Archive=archive, Messages=messages,
         keep_days=keep_days, Retain=retain, modbus_server=server,
-        nodes=tuple(nodes), simulators=tuple(runnable), users=users,
+        nodes=tuple(nodes), simulators=tuple(runnable), users=users, RetainForces=bool(retain_forces),
     )
     return station, problems
 

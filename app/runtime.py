@@ -28,8 +28,9 @@ from app.config import Station
 from app.load import load, load_station_forms
 from hmi_forms.behaviour import FormBehaviour
 from hmi_forms.form import Form
-from netplc.engine import Engine
+from netplc.engine import Engine, RunState
 from netplc.exchange import Exchange, NodeConfig
+from netplc.forcing import load_forces, save_forces
 from netplc.modbus import ModbusServer, parse_endpoint
 from netplc.problems import Problems
 from netplc.records import Record
@@ -71,6 +72,7 @@ class RuntimeStatus:
     records_lost: int
     modbus_port: int | None
     problems: tuple[str, ...] = field(default=())  # what an operator must see (disk, server, ...)
+    forced: int = 0  # forces in effect: the always-visible "F: n forced"
 
     @property
     def nodes_up(self) -> int:
@@ -213,6 +215,7 @@ class Runtime:
             self.engine.stop()
         self.retainer = Retainer(st.Retain, self.engine, self)
         self.restored = self.retainer.restore()
+        self._restore_forces()
         behaviour = FormBehaviour(self.forms, self.engine.mem, self, self._problem)
         behaviour.attach(self.engine)
         if self.forms:
@@ -251,6 +254,28 @@ class Runtime:
                     f"retentive memory from {self.restored}")
         threading.Thread(target=self._report_unresolved, name="resolve", daemon=True).start()
 
+    def _restore_forces(self) -> None:
+        """RetainForces = true: the forces of the last run are in effect again from the first scan,
+        each journaled; otherwise a restart starts unforced."""
+        st = self.station
+        if not st.RetainForces or self.engine is None:
+            return
+        forces, problems = load_forces(st.forces_file)
+        for problem in problems:
+            self._problem(f"retained force not restored: {problem}")
+        self.engine.forces.restore(forces, user="station (RetainForces)")
+        if forces:
+            self.system(f"{len(forces)} retained forces restored from {st.forces_file} (RetainForces = true)")
+
+    def _save_forces(self) -> None:
+        st = self.station
+        if not st.RetainForces or self.engine is None:
+            return
+        try:
+            save_forces(st.forces_file, self.engine.forces.listing)
+        except OSError as e:
+            self.system(f"retained forces not saved: {st.forces_file}: {e.strerror or e}")
+
     def _report_unresolved(self) -> None:
         """Journal each node host name that does not resolve, by its key. The station starts all the
         same: the name server may come up after the PC does, and the exchange keeps trying the node
@@ -283,6 +308,7 @@ class Runtime:
         if self.scan_thread is not None:
             self.scan_thread.stop()
             self.scan_thread = None
+            self._save_forces()
         if self.retainer is not None:
             self.retainer.stop()  # the final save, of the last finished scan
             self.retainer = None
@@ -317,6 +343,23 @@ class Runtime:
             engine.post(lambda _m: engine.stop())
             self.system("NetPlc stopped by the operator")
 
+    def step_program(self, user: str) -> bool:
+        """Step one scan while NetPlc is stopped (Engine.step, between two scans of the scan
+        thread); False when NetPlc runs or the station is not started."""
+        engine = self.engine
+        if engine is None or engine.state is RunState.RUNNING:
+            return False
+        thread = self.scan_thread
+        if thread is None:
+            return False
+        with thread.lock:
+            if engine.state is RunState.RUNNING:
+                return False
+            engine.step()
+        self.put(Record(self.wallclock(), "operator", source=user, number=engine.scan_counter,
+                        text=f"step one scan (scan {engine.scan_counter})"))
+        return True
+
     # --- status --------------------------------------------------------------------------------
 
     def status(self) -> RuntimeStatus:
@@ -349,4 +392,5 @@ class Runtime:
             records_lost=lost,
             modbus_port=self.modbus.port if self.modbus else None,
             problems=tuple(problems),
+            forced=engine.forces.count if engine else 0,
         )
