@@ -81,6 +81,7 @@ class ListingView(QAbstractScrollArea):
         self.ascent = fm.ascent() + 1
         self.viewport().setAutoFillBackground(True)
         self.painted_rows = 0  # rows drawn by the last paint (tests and the bench look)
+        self._last_shown: tuple = ()
         self._update_range()
 
     # --- geometry --------------------------------------------------------------------------------
@@ -118,9 +119,23 @@ class ListingView(QAbstractScrollArea):
     # --- live state ------------------------------------------------------------------------------
 
     def show_snapshot(self, snapshot: Snapshot, forced: set[tuple[Kind, int]]) -> None:
+        """Take a new snapshot; repaint only when what the visible lines show has changed."""
         self.snapshot = snapshot
         self.forced = forced
-        self.viewport().update()
+        shown = self._shown(snapshot)
+        if shown != self._last_shown:
+            self._last_shown = shown
+            self.viewport().update()
+
+    def _shown(self, snap: Snapshot) -> tuple:
+        """What the visible lines show (bit, chain result, values), with the scroll position."""
+        instrs = self.listing.program.instrs
+        out: list[object] = [self.verticalScrollBar().value(), self.fmt, frozenset(self.forced)]
+        for i in self.visible_rows():
+            index = self.listing.rows[i].instr
+            if index is not None and instrs[index].c is not None:
+                out += (snap.bits[instrs[index].c], self.listing.chain(snap, index), self._values(index, snap))
+        return tuple(out)
 
     def paintEvent(self, event: QPaintEvent) -> None:
         p = QPainter(self.viewport())
