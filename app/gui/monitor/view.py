@@ -133,8 +133,9 @@ class ListingView(QAbstractScrollArea):
         out: list[object] = [self.verticalScrollBar().value(), self.fmt, frozenset(self.forced)]
         for i in self.visible_rows():
             index = self.listing.rows[i].instr
-            if index is not None and instrs[index].c is not None:
-                out += (snap.bits[instrs[index].c], self.listing.chain(snap, index), self._values(index, snap))
+            c = instrs[index].c if index is not None else None
+            if index is not None and c is not None:
+                out += (snap.bits[c], self.listing.chain(snap, index), self._values(index, snap))
         return tuple(out)
 
     def paintEvent(self, event: QPaintEvent) -> None:
