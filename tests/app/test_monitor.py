@@ -290,3 +290,48 @@ def test_the_monitor_command_target_is_a_station_or_host_port(qtbot, tmp_path: P
         assert dead.state().startswith("link down: cannot connect")
     finally:
         dead.close()
+
+
+# --- the workstation ------------------------------------------------------------------------------------
+
+
+def test_station_menu_opens_the_program_view_and_the_status_bar_counts_forces(qtbot, demo_copy: Path) -> None:
+    from app.gui.main_window import MainWindow
+    from app.gui.monitor.window import ProgramWindow
+
+    runtime = Runtime(load_station(demo_copy))
+    runtime.start()
+    window = MainWindow(runtime)
+    qtbot.addWidget(window)
+    try:
+        menu = window.menuBar().actions()[0].menu()
+        program = next(a for a in menu.actions() if a.text() == "&Program…")
+        assert window.status.forced.text() == "F: 0 forced"
+        program.trigger()
+        opened = [w for w in window.viewers if isinstance(w, ProgramWindow)]
+        assert len(opened) == 1 and opened[0].isVisible()
+        monitor = opened[0].monitor
+        assert len(monitor.listing) > 100
+        monitor.force("bit", 0o2120, 1)
+        wait(qtbot, lambda: runtime.status().forced == 1)
+        window.refresh_status()
+        assert window.status.forced.text() == "F: 1 forced"
+        wait(qtbot, lambda: monitor.forced_pill.text() == "F: 1 forced")
+    finally:
+        window.close()
+        runtime.stop()
+    assert not opened[0].isVisible()
+
+
+def test_main_monitor_command_refuses_a_bad_target_with_a_message() -> None:
+    import os
+    import subprocess
+    import sys
+
+    from tests.app.conftest import REPO
+
+    env = {**os.environ, "QT_QPA_PLATFORM": "offscreen"}
+    r = subprocess.run([sys.executable, "main.py", "monitor", "nowhere"], cwd=REPO, capture_output=True,
+                       text=True, timeout=60, env=env)
+    assert r.returncode == 2 and "nowhere: neither a station folder nor HOST:PORT" in r.stderr
+    assert "Traceback" not in r.stderr
