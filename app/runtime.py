@@ -30,7 +30,7 @@ from hmi_forms.behaviour import FormBehaviour
 from hmi_forms.form import Form
 from netplc.engine import Engine, RunState
 from netplc.exchange import Exchange, NodeConfig
-from netplc.forcing import load_forces, save_forces
+from netplc.forcing import Force, load_forces, save_forces
 from netplc.modbus import ModbusServer, parse_endpoint
 from netplc.problems import Problems
 from netplc.records import Record
@@ -144,6 +144,7 @@ class Runtime:
         self.nodes: list[NodeConfig] = list(station.nodes)
         self.restored = ""  # which retentive save was used: current / previous / zeroes
         self.started_clock: float | None = None
+        self._saved_forces: tuple[Force, ...] | None = None  # the forces as last written (RetainForces)
         self._observers: list[RecordObserver] = []
         self._problems: list[str] = []
         self._lock = threading.Lock()
@@ -266,15 +267,19 @@ class Runtime:
         self.engine.forces.restore(forces, user="station (RetainForces)")
         if forces:
             self.system(f"{len(forces)} retained forces restored from {st.forces_file} (RetainForces = true)")
+        self.engine.listeners.append(self._save_forces)
 
-    def _save_forces(self) -> None:
-        st = self.station
-        if not st.RetainForces or self.engine is None:
+    def _save_forces(self, _snapshot: object) -> None:
+        """An engine listener: the forces are written whenever they changed, so a crash keeps them too."""
+        assert self.engine is not None
+        listing = self.engine.forces.listing
+        if listing is self._saved_forces:
             return
+        self._saved_forces = listing
         try:
-            save_forces(st.forces_file, self.engine.forces.listing)
+            save_forces(self.station.forces_file, listing)
         except OSError as e:
-            self.system(f"retained forces not saved: {st.forces_file}: {e.strerror or e}")
+            self.system(f"retained forces not saved: {self.station.forces_file}: {e.strerror or e}")
 
     def _report_unresolved(self) -> None:
         """Journal each node host name that does not resolve, by its key. The station starts all the
@@ -308,7 +313,6 @@ class Runtime:
         if self.scan_thread is not None:
             self.scan_thread.stop()
             self.scan_thread = None
-            self._save_forces()
         if self.retainer is not None:
             self.retainer.stop()  # the final save, of the last finished scan
             self.retainer = None

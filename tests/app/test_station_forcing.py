@@ -10,6 +10,7 @@ from pathlib import Path
 from app.config import load_station
 from app.runtime import Runtime
 from netplc.engine import RunState
+from netplc.forcing import Force, load_forces
 from netplc.modbus import LoopThread
 from netplc.modbus.driver import LeanTcpClient, parse_endpoint
 from netplc.records import Record
@@ -84,6 +85,9 @@ def test_forces_are_not_retained_by_default_and_are_with_retain_forces(demo_copy
             assert runtime.engine is not None
             runtime.engine.forces.force("bit", 0o2120, 1, user="engineer")
             after_scans(runtime)
+            # with RetainForces the file is written as the forces change, not only at a clean stop
+            expected_file = [Force("bit", 0o2120, 1, "engineer")] if retain else []
+            assert load_forces(station.forces_file)[0] == expected_file
         finally:
             runtime.stop()
         runtime = Runtime(station)
