@@ -360,4 +360,5 @@ class Engine:
             self.clock = clock
 
     def _publish(self) -> Snapshot:
-        return self.mem.snapshot(self.scan_counter, self.now, self.wall_time(), self.state_text)
+        return self.mem.snapshot(self.scan_counter, self.now, self.wall_time(), self.state_text,
+                                 self.forces.listing)

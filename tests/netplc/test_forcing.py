@@ -86,9 +86,11 @@ def test_unforce_restores_live_behaviour_and_unforce_all_is_one_command(compiled
         eng.forces.force(kind, addr, value, user="eng1")
     scans(eng, clock)
     assert eng.forces.count == 3 and len(eng.forces.listing) == 3
+    assert eng.snapshot.forces == eng.forces.listing  # every reader of a snapshot sees what is forced
+    assert [f.where for f in eng.snapshot.forces] == ["02000", "04004:word", "04000:byte"]
     eng.forces.unforce_all(user="eng2")
     scans(eng, clock)
-    assert eng.forces.count == 0
+    assert eng.forces.count == 0 and eng.snapshot.forces == ()
     snap = eng.snapshot
     assert snap.get_bit(0o2000) == 1 and snap.get_word(0o4004) == 7  # the program writes again
     assert snap.get_byte(0o4000) == 0x55  # nothing writes 04000: it keeps the value it was left

@@ -96,7 +96,7 @@ class LocalSource:
         return self.engine.ctr_values[c]
 
     def forces(self) -> tuple[Force, ...]:
-        return self.engine.forces.listing
+        return self.engine.snapshot.forces  # those of the scan shown
 
     def need(self, addrs: Iterable[int]) -> None:
         pass  # the whole snapshot is at hand
