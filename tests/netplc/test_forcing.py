@@ -7,6 +7,7 @@ from pathlib import Path
 
 import pytest
 
+from hmi_forms.elements.target import EngineTarget
 from netplc.engine import Engine, FakeClock, RunState
 from netplc.forcing import Force, ForceError, load_forces, save_forces
 from netplc.program import parse
@@ -66,16 +67,18 @@ def test_operator_modbus_and_exchange_writes_lose_to_the_force(compiled: bool) -
     eng.forces.force("word", 0o4000, 500, user="eng1")
     eng.forces.force("bit", 0o40050, 1, user="eng1")  # byte 04005 bit 0: an HMI data bit
     scans(eng, clock)
-    eng.write_word(0o4000, 1, user="operator")  # an HMI setpoint
+    hmi = EngineTarget(eng)  # what a form's element writes through
+    hmi.write_word(0o4000, 1, user="operator", label="Setpoint")
     eng.write_bytes(0o4000, b"\x02\x00", user="modbus 127.0.0.1:5000")  # the Modbus server's write
     eng.post(lambda mem: mem.set_word(0o4000, 3))  # how the exchange lands an NREAD result
-    eng.write_bit(0o40050, 0, user="operator")
+    hmi.write_bit(0o40050, 0, user="operator", label="Пуск")
     scans(eng, clock)
     snap = eng.snapshot
     assert snap.get_word(0o4000) == 500 and snap.get_word(0o4002) == 500  # the program copied the force
     assert snap.get_hmi_bit(0o40050) == 1
     # the writes were applied and journaled all the same: they just lose
     assert ("modbus 127.0.0.1:5000", "write 04000:2: 01 00 -> 02 00") in texts(sink)
+    assert ("operator", "write Setpoint (04000): 500 -> 1") in texts(sink)
 
 
 @pytest.mark.parametrize("compiled", [True, False])
