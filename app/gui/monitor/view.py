@@ -373,7 +373,7 @@ class ProgramMonitor(QWidget):
 
     def add_watch(self, text: str) -> WatchItem:
         """Watch an address or symbol; ValueError says why it cannot be watched."""
-        item = parse_watch(text, self.listing.program.symbols or self.source.symbols)
+        item = parse_watch(text, {**self.source.symbols, **self.listing.program.symbols})
         r = len(self.watch_items)
         self.watch_items.append(item)
         self.watch.blockSignals(True)
