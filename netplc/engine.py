@@ -308,13 +308,13 @@ class Engine:
                 text = f"queued write failed: {type(e).__name__}: {e}"
                 self.sink.put(Record(self.wall_time(), "system", source="netplc", text=text))
             self.rtc.watch(mem)
-        forces = self.forces
-        if forces.listing:  # force hook 1: over every queued write, and what the program reads
-            forces.apply(mem)
         bits = mem.bits
         bits[ALWAYS_ONE] = 1
         update_generators(bits, now - self._start)
         self.rtc.update(mem, self.wall_time())
+        forces = self.forces
+        if forces.listing:  # force hook 1: over the queued writes, generators and RTC: what the program reads
+            forces.apply(mem)
         if bits[EMERGENCY_STOP] and self.state is RunState.RUNNING:
             self.stop(11)
         if self.state is RunState.RUNNING or self._stepping:

@@ -3,7 +3,8 @@
 is bumpless, always visible and audited).
 
 Priority is force > program > live: the engine applies the forces after the queued writes (the
-exchange's results, operator, HMI and Modbus-server writes) and before the program, so the program
+exchange's results, operator, HMI and Modbus-server writes) and its own generator bits and RTC
+bytes, just before the program, so the program
 reads the forced value, and again after the program, so no snapshot ever shows an unforced value
 (`Forces.apply` at both points, in the compiled engine and the interpreter alike). A force does
 not change the program: a coil the program writes in the middle of its scan is seen by the

@@ -132,6 +132,19 @@ def test_a_force_without_a_value_is_bumpless_and_every_change_is_journaled_with_
     assert all(r.ts == 1000.0 for r in ops)
 
 
+@pytest.mark.parametrize("compiled", [True, False])
+def test_the_program_reads_forced_generators_and_rtc_bytes(compiled: bool) -> None:
+    program = parse("TNA $03750\nYON $02010\nTNA $03760\nFON C:$02100 N:MOV S:$077701 D:$04010\n")
+    sink, clock = ListSink(), FakeClock()
+    eng = Engine(program, clock=clock, sink=sink, compiled=compiled)
+    eng.forces.force("bit", 0o3750, 1, user="eng1")  # the 0.1 s square wave, pinned
+    eng.forces.force("byte", 0o77701, 0x42, user="eng1")  # the RTC's seconds, pinned
+    for _ in range(4):
+        clock.advance(0.05)
+        eng.scan()
+        assert eng.snapshot.get_bit(0o2010) == 1 and eng.snapshot.get_byte(0o4010) == 0x42
+
+
 def test_bad_forces_are_refused_at_once_naming_the_address() -> None:
     eng, _, _ = engine()
     with pytest.raises(ForceError, match="cannot force word 03777"):
