@@ -4,11 +4,11 @@ is bumpless, always visible and audited).
 
 Priority is force > program > live: the engine applies the forces after the queued writes (the
 exchange's results, operator, HMI and Modbus-server writes) and its own generator bits and RTC
-bytes, just before the program, so the program
-reads the forced value, and again after the program, so no snapshot ever shows an unforced value
-(`Forces.apply` at both points, in the compiled engine and the interpreter alike). A force does
-not change the program: a coil the program writes in the middle of its scan is seen by the
-contacts after it within that scan, as on a CPU-165 whose input image is forced.
+bytes, just before the program, so the program reads the forced value, and again after the
+program, so no snapshot ever shows an unforced value (`Forces.apply` at both points, in the
+compiled engine and the interpreter alike). A force does not change the compiled program: a coil
+the program writes in the middle of its scan is seen as written by the contacts after it within
+that scan, and pinned again before anyone outside the engine reads it.
 
 Commands come from any thread (the monitor, the runtime) and are queued to the engine thread like
 writes, so the table changes between two scans only. Bumpless: a force without a value pins what
