@@ -16,7 +16,7 @@ import time
 
 from app.config import DEMO_STATION
 
-COMMANDS = ("view", "check", "simulate", "alarms-report", "design")
+COMMANDS = ("view", "check", "simulate", "alarms-report", "design", "monitor")
 
 
 def _main_parser() -> argparse.ArgumentParser:
@@ -26,8 +26,8 @@ def _main_parser() -> argparse.ArgumentParser:
                     "and shows its HMI forms.",
         epilog="other commands: view [ARCHIVE] (offline journal viewer), check STATION (validate a "
                "station), simulate PROGRAM.stl (a simulated CPU-165 node), alarms-report ARCHIVE --day "
-               "DD_MM_YYYY (alarm-system health), design [FORM.hmi | STATION] (the form designer); "
-               "each takes --help.",
+               "DD_MM_YYYY (alarm-system health), design [FORM.hmi | STATION] (the form designer), "
+               "monitor STATION_OR_HOST:PORT (the program monitor of a running station); each takes --help.",
     )
     p.add_argument("station", nargs="?", default=str(DEMO_STATION),
                    help="station folder or its station.toml (default: the demo station)")
@@ -80,6 +80,18 @@ def _design_parser() -> argparse.ArgumentParser:
     return p
 
 
+def _monitor_parser() -> argparse.ArgumentParser:
+    p = argparse.ArgumentParser(prog="python main.py monitor",
+                                description="The Program view of a running station over its Modbus server: "
+                                            "the listing with live states and a watch table with writes "
+                                            "(journaled by the station with this peer). Forcing and single "
+                                            "scans need the station's own workstation.")
+    p.add_argument("target", help="station folder or station.toml (its program, symbols and Modbus port), "
+                                  "or HOST:PORT of a NetPlc Modbus server")
+    p.add_argument("--user", default="engineer", help="the name shown in this window (default engineer)")
+    return p
+
+
 def main(argv: list[str] | None = None) -> int:
     args = list(sys.argv[1:] if argv is None else argv)
     if args and args[0] in COMMANDS:
@@ -96,6 +108,11 @@ def main(argv: list[str] | None = None) -> int:
         if command == "alarms-report":
             ns = _alarms_report_parser().parse_args(rest)
             return run_alarms_report(ns.archive, ns.day)
+        if command == "monitor":
+            ns = _monitor_parser().parse_args(rest)
+            from app.gui.monitor.window import run_monitor
+
+            return run_monitor(ns.target, ns.user)
         return run_viewer(_view_parser().parse_args(rest).archive)
     ns = _main_parser().parse_args(args)
     if ns.duration is not None and not ns.no_gui:

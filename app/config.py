@@ -71,10 +71,16 @@ class Station:
     users: tuple[str, ...] = ("operator",)
     Tags: Path | None = None  # tags.csv: tags and their alarms (netplc/tags/)
     allow_outside: bool = False  # may station paths (and form images) leave the station folder?
+    RetainForces: bool = False  # forces survive a restart (netplc/forcing.py); off: a restart unforces
 
     @property
     def folder(self) -> Path:
         return self.path.parent
+
+    @property
+    def forces_file(self) -> Path:
+        """Where the forces are kept across a restart when RetainForces is true: beside Retain."""
+        return self.Retain.with_name(self.Retain.stem + ".forces.json")
 
     @property
     def tick(self) -> float:
@@ -200,6 +206,7 @@ def read_station(path: str | Path) -> tuple[Station | None, list[str]]:
     keep_days = top.number("keep_days", 0, 0, 36_500)
     retain = top.path("Retain", base)
     tags = top.path("Tags", base)
+    retain_forces = top.get("RetainForces", bool, False)
     server = _modbus_server(problems, fname, top.get("modbus_server", dict, {}))
     nodes = _nodes(problems, fname, top.get("nodes", list, []))
     simulators = _simulators(problems, fname, top.get("simulators", list, []), base, top.allow_outside)
@@ -228,7 +235,7 @@ def read_station(path: str | Path) -> tuple[Station | None, list[str]]:
         Symbols=symbols, HMIload=hmi, NetSyncTime=sync, Archive=archive, Messages=messages,
         keep_days=keep_days, Retain=retain, modbus_server=server,
         nodes=tuple(nodes), simulators=tuple(runnable), users=users, Tags=tags,
-        allow_outside=top.allow_outside,
+        allow_outside=top.allow_outside, RetainForces=bool(retain_forces),
     )
     return station, problems
 

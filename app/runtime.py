@@ -30,8 +30,9 @@ from app.station_alarms import STATE_FILE as ALARM_STATE_FILE
 from app.station_alarms import StationAlarms
 from hmi_forms.behaviour import FormBehaviour
 from hmi_forms.form import Form
-from netplc.engine import Engine
+from netplc.engine import Engine, RunState
 from netplc.exchange import Exchange, NodeConfig
+from netplc.forcing import Force, load_forces, save_forces
 from netplc.modbus import ModbusServer, parse_endpoint
 from netplc.problems import Problems
 from netplc.records import Record
@@ -74,6 +75,7 @@ class RuntimeStatus:
     records_lost: int
     modbus_port: int | None
     problems: tuple[str, ...] = field(default=())  # what an operator must see (disk, server, ...)
+    forced: int = 0  # forces in effect: the always-visible "F: n forced"
 
     @property
     def nodes_up(self) -> int:
@@ -146,6 +148,7 @@ class Runtime:
         self.nodes: list[NodeConfig] = list(station.nodes)
         self.restored = ""  # which retentive save was used: current / previous / zeroes
         self.started_clock: float | None = None
+        self._saved_forces: tuple[Force, ...] | None = None  # the forces as last written (RetainForces)
         self._observers: list[RecordObserver] = []
         self._problems: list[str] = []
         self._lock = threading.Lock()
@@ -219,6 +222,7 @@ class Runtime:
             self.engine.stop()
         self.retainer = Retainer(st.Retain, self.engine, self)
         self.restored = self.retainer.restore()
+        self._restore_forces()
         behaviour = FormBehaviour(self.forms, self.engine.mem, self, self._problem)
         behaviour.attach(self.engine)
         if self.forms:
@@ -260,6 +264,32 @@ class Runtime:
         self.system(f"station started: NetSyncTime {st.NetSyncTime} ms, "
                     f"retentive memory from {self.restored}")
         threading.Thread(target=self._report_unresolved, name="resolve", daemon=True).start()
+
+    def _restore_forces(self) -> None:
+        """RetainForces = true: the forces of the last run are in effect again from the first scan,
+        each journaled; otherwise a restart starts unforced."""
+        st = self.station
+        if not st.RetainForces or self.engine is None:
+            return
+        forces, problems = load_forces(st.forces_file)
+        for problem in problems:
+            self._problem(f"retained force not restored: {problem}")
+        self.engine.forces.restore(forces, user="station (RetainForces)")
+        if forces:
+            self.system(f"{len(forces)} retained forces restored from {st.forces_file} (RetainForces = true)")
+        self.engine.listeners.append(self._save_forces)
+
+    def _save_forces(self, _snapshot: object) -> None:
+        """An engine listener: the forces are written whenever they changed, so a crash keeps them too."""
+        assert self.engine is not None
+        listing = self.engine.forces.listing
+        if listing is self._saved_forces:
+            return
+        self._saved_forces = listing
+        try:
+            save_forces(self.station.forces_file, listing)
+        except OSError as e:
+            self.system(f"retained forces not saved: {self.station.forces_file}: {e.strerror or e}")
 
     def _report_unresolved(self) -> None:
         """Journal each node host name that does not resolve, by its key. The station starts all the
@@ -332,6 +362,23 @@ class Runtime:
             engine.post(lambda _m: engine.stop())
             self.system("NetPlc stopped by the operator")
 
+    def step_program(self, user: str) -> bool:
+        """Step one scan while NetPlc is stopped (Engine.step, between two scans of the scan
+        thread); False when NetPlc runs or the station is not started."""
+        engine = self.engine
+        if engine is None or engine.state is RunState.RUNNING:
+            return False
+        thread = self.scan_thread
+        if thread is None:
+            return False
+        with thread.lock:
+            if engine.state is RunState.RUNNING:
+                return False
+            engine.step()
+        self.put(Record(self.wallclock(), "operator", source=user, number=engine.scan_counter,
+                        text=f"step one scan (scan {engine.scan_counter})"))
+        return True
+
     # --- status --------------------------------------------------------------------------------
 
     def status(self) -> RuntimeStatus:
@@ -367,4 +414,5 @@ class Runtime:
             records_lost=lost,
             modbus_port=self.modbus.port if self.modbus else None,
             problems=tuple(problems),
+            forced=engine.forces.count if engine else 0,
         )

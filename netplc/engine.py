@@ -28,6 +28,7 @@ from netplc.address import (
 from netplc.backend import Backend
 from netplc.codecache import CodeCache
 from netplc.compiler import compile_program
+from netplc.forcing import Forces
 from netplc.functions._util import Step, bind, fail
 from netplc.functions.registry import Fon, FunctionSpec, NetLink, lookup
 from netplc.interpreter import Interpreter
@@ -114,6 +115,8 @@ class Engine:
         self._faulted: set[int] = set()
         self.mem.bits[TIMEBASE_LO] = 1  # 0.1 s time base after start, as on a CPU-165
         self.mem.bits[TIMEBASE_HI] = 0
+        self.forces = Forces(self)  # netplc/forcing.py: applied by the scan's two force hooks
+        self._stepping = False  # `step`: this scan runs the program although NetPlc is stopped
         self.snapshot: Snapshot = self._publish()
         self.load(program)
 
@@ -313,9 +316,12 @@ class Engine:
         bits[ALWAYS_ONE] = 1
         update_generators(bits, now - self._start)
         self.rtc.update(mem, self.wall_time())
+        forces = self.forces
+        if forces.listing:  # force hook 1: over the queued writes, generators and RTC: what the program reads
+            forces.apply(mem)
         if bits[EMERGENCY_STOP] and self.state is RunState.RUNNING:
             self.stop(11)
-        if self.state is RunState.RUNNING:
+        if self.state is RunState.RUNNING or self._stepping:
             outcome = self._run()
             if outcome == "halt":
                 self.state = RunState.HALTED
@@ -326,6 +332,8 @@ class Engine:
             if bits[EMERGENCY_STOP]:
                 self.stop(11)
             self.rtc.watch(mem)
+        if forces.listing:  # force hook 2: over what the program wrote, before the snapshot
+            forces.apply(mem)
         self.scan_counter += 1
         self.snapshot = self._publish()
         self.stats.add((time.perf_counter() - t0) * 1000.0, self.tick * 1000.0)
@@ -333,5 +341,28 @@ class Engine:
             listener(self.snapshot)
         return self.snapshot
 
+    def step(self) -> Snapshot:
+        """Step one scan: with NetPlc stopped or halted, run exactly one scan with the program, one
+        tick after the previous scan (an injected clock that can `advance`, a FakeClock, is advanced
+        by the tick; another clock is read as the previous scan's time plus the tick). The state
+        stays as it was unless the scan itself halts or stops NetPlc. Call it on the engine thread
+        or between two scans (ScanThread.lock)."""
+        if self.state is RunState.RUNNING:
+            raise RuntimeError("NetPlc is running: stop it to step one scan")
+        clock = self.clock
+        advance = getattr(clock, "advance", None)
+        if callable(advance):
+            advance(self.tick)
+        else:
+            target = self.now + self.tick
+            self.clock = lambda: target
+        self._stepping = True
+        try:
+            return self.scan()
+        finally:
+            self._stepping = False
+            self.clock = clock
+
     def _publish(self) -> Snapshot:
-        return self.mem.snapshot(self.scan_counter, self.now, self.wall_time(), self.state_text)
+        return self.mem.snapshot(self.scan_counter, self.now, self.wall_time(), self.state_text,
+                                 self.forces.listing)

@@ -13,6 +13,7 @@ Words are little-endian; 32-bit values are low word first (docs/architecture.md 
 from __future__ import annotations
 
 from dataclasses import dataclass
+from typing import TYPE_CHECKING
 
 from netplc.address import (
     DATA_SIZE,
@@ -24,6 +25,9 @@ from netplc.address import (
     data_index,
     fmt_octal,
 )
+
+if TYPE_CHECKING:
+    from netplc.forcing import Force
 
 
 class MemoryView:
@@ -133,8 +137,9 @@ class Memory(MemoryView):
         mask = 1 << (hmi & 7)
         self.data[i] = (self.data[i] | mask) if value else (self.data[i] & ~mask & 0xFF)
 
-    def snapshot(self, scan: int = 0, time: float = 0.0, wall: float = 0.0, state: str = "") -> Snapshot:
-        return Snapshot(tuple(self.bits), bytes(self.data), scan, time, wall, state)
+    def snapshot(self, scan: int = 0, time: float = 0.0, wall: float = 0.0, state: str = "",
+                 forces: tuple[Force, ...] = ()) -> Snapshot:
+        return Snapshot(tuple(self.bits), bytes(self.data), scan, time, wall, state, forces)
 
     def load(self, view: MemoryView) -> None:
         """Replace the whole contents (used by retentive restore and tests)."""
@@ -152,6 +157,7 @@ class Snapshot(MemoryView):
     time: float = 0.0  # engine clock (monotonic seconds)
     wall: float = 0.0  # wall clock, seconds since the epoch
     state: str = ""  # engine run state
+    forces: tuple[Force, ...] = ()  # what was forced in that scan (netplc/forcing.py): "F: n forced"
 
     @classmethod
     def empty(cls) -> Snapshot:

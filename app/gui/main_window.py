@@ -107,6 +107,9 @@ class MainWindow(QMainWindow):
         self.act_stop = QAction("&Stop NetPlc", self)
         self.act_stop.setShortcut(QKeySequence("Shift+F5"))
         self.act_stop.triggered.connect(self._confirm_stop)
+        program = QAction("&Program…", self)  # the online monitor with forcing (app/gui/monitor/)
+        program.setShortcut(QKeySequence("Ctrl+Shift+P"))
+        program.triggered.connect(self.open_program)
         viewer = QAction("Open journal &viewer…", self)
         viewer.setShortcut(QKeySequence("Ctrl+J"))
         viewer.triggered.connect(self.open_viewer)
@@ -116,6 +119,7 @@ class MainWindow(QMainWindow):
         for a in (self.act_run, self.act_stop):
             station.addAction(a)
         station.addSeparator()
+        station.addAction(program)
         station.addAction(viewer)
         station.addSeparator()
         station.addAction(quit_)
@@ -203,6 +207,16 @@ class MainWindow(QMainWindow):
                                       "but the program's chains are no longer executed.")
         if answer == QMessageBox.StandardButton.Yes:
             self.runtime.stop_program()
+
+    def open_program(self) -> None:
+        """Station -> Program: the listing live, the watch table, forcing, single scans."""
+        from app.gui.monitor.window import may_open_program, open_local
+
+        if not may_open_program(self.runtime.station, self.user):
+            QMessageBox.warning(
+                self, "Program", f"{self.user} may not open the program view (role engineer).")
+            return
+        self.viewers.append(open_local(self.runtime, lambda: self.user))
 
     def open_viewer(self) -> None:
         from app.gui.viewer import ViewerWindow

@@ -44,12 +44,15 @@ class StationStatusBar(QStatusBar):
         self.nodes = Pill()
         self.records = Pill()
         self.server = Pill()
-        for pill in (self.state, self.scan, self.tick, self.nodes, self.records, self.server):
+        self.forced = Pill()  # "F: n forced", always shown (netplc/forcing.py)
+        for pill in (self.state, self.forced, self.scan, self.tick, self.nodes, self.records, self.server):
             self.addPermanentWidget(pill)
 
     def show_status(self, s: RuntimeStatus) -> None:
         running = s.state == "running"
         self.state.show_value(f"NetPlc: {s.state}", OK if running else BAD)
+        self.forced.show_value(f"F: {s.forced} forced", WARN if s.forced else IDLE,
+                               "forces in effect: force > program > live (Station -> Program)")
         late = s.scan_last_ms > s.tick_ms
         self.scan.show_value(f"Scan {s.scan_last_ms:.2f} ms  max {s.scan_max_ms:.2f} ms",
                              WARN if late else OK,

@@ -130,9 +130,11 @@ def state(engine: Engine) -> tuple:
             engine.state_text, engine.scan_counter)
 
 
-def run_both(text: str, inputs: list[list[int]], dts: list[float], data: bytes = b"") -> None:
+def run_both(text: str, inputs: list[list[int]], dts: list[float], data: bytes = b"",
+             forces: tuple[tuple[str, int, int], ...] = ()) -> None:
     """Scan `text` in the reference interpreter and in the compiled engine (usual and tiny chunks,
-    and the usual code once more as a second start takes it from the compiled-program cache)."""
+    and the usual code once more as a second start takes it from the compiled-program cache);
+    `forces` (kind, address, value) are in effect from the second scan to the one before the last."""
     program = parse(text, source="random.stl")
     engines = []
     with tempfile.TemporaryDirectory() as cache:
@@ -147,8 +149,13 @@ def run_both(text: str, inputs: list[list[int]], dts: list[float], data: bytes =
     for engine, _ in engines:
         if data:
             engine.mem.write(INITIAL[0], data)
-    for scan_inputs, dt in zip(inputs, dts):
+    for n, (scan_inputs, dt) in enumerate(zip(inputs, dts)):
         for eng, clock in engines:
+            if forces and n == 1:
+                for kind, addr, value in forces:
+                    eng.forces.force(kind, addr, value, user="test")  # type: ignore[arg-type]
+            elif forces and n == len(inputs) - 1:
+                eng.forces.unforce_all(user="test")
             for addr, v in zip(INPUTS, scan_inputs):
                 eng.mem.bits[addr] = v
             clock.advance(dt)
@@ -167,6 +174,28 @@ def run_both(text: str, inputs: list[list[int]], dts: list[float], data: bytes =
 )
 def test_random_programs_leave_identical_state(text, inputs, dts, data):
     run_both(text, inputs, dts, data)
+
+
+FORCEABLE = st.one_of(
+    st.tuples(st.just("bit"), st.sampled_from([*INPUTS, *COILS, *TIMERS, *COUNTERS, 0o3773]),
+              st.integers(0, 1)),
+    st.tuples(st.just("word"), st.sampled_from([*DATA, 0o4001, 0o2000]), st.integers(0, 65535)),
+    st.tuples(st.just("byte"), st.sampled_from([*DATA, 0o2010]), st.integers(0, 255)),
+)
+
+
+@settings(max_examples=100, deadline=None, suppress_health_check=[HealthCheck.too_slow])
+@given(
+    programs(),
+    st.lists(st.lists(st.integers(0, 1), min_size=len(INPUTS), max_size=len(INPUTS)), min_size=4, max_size=5),
+    st.lists(st.sampled_from([0.05, 0.1, 0.35]), min_size=5, max_size=5),
+    st.binary(min_size=len(INITIAL), max_size=len(INITIAL)),
+    st.lists(FORCEABLE, min_size=1, max_size=4).map(tuple),
+)
+def test_forced_random_programs_leave_identical_state(text, inputs, dts, data, forces):
+    """Forces on inputs, coils, timer and counter bits, the time base and data words: the
+    compiled engine and the interpreter agree, forced and after "unforce all"."""
+    run_both(text, inputs, dts, data, forces)
 
 
 def test_long_chains_are_split_before_the_parser_chokes():

@@ -1,0 +1,266 @@
+"""Where the Program view gets memory from and sends writes to: the station's own runtime (the
+workstation's Station -> Program), or a running station's Modbus server (`main.py monitor`).
+
+Both give the view a `Snapshot` and nothing live, so the monitor never touches the scan: the
+local source hands over the engine's last published snapshot; the remote one polls the cpu165
+map of the station's server on its own thread (the I/O bits, and only the data registers the view
+says it needs) and builds a snapshot from the answers.
+
+Forcing and "step one scan" need the local runtime: the Modbus map has no channel for them, and a
+force that a client could set over a plain Modbus port would bypass the journal of the user who
+forced. So the remote monitor watches and writes (each write journaled by the station with the
+peer's address, and refused where the station's `writable` ranges do not open it), and does not
+force in this version.
+"""
+
+from __future__ import annotations
+
+import asyncio
+import time
+from collections.abc import Iterable
+from dataclasses import dataclass
+from typing import Protocol
+
+from app.runtime import Runtime
+from netplc.address import DATA_SIZE, IO_BITS, data_index, is_data_byte
+from netplc.forcing import Force, Kind
+from netplc.memory import Snapshot
+from netplc.modbus import DeviceError, LinkError, LoopThread, MapError, locate, open_client, parse_endpoint
+from netplc.program import Program, parse
+
+POLL_S = 0.2  # the remote monitor's poll period: 5 reads of the station per second
+TIMEOUT_S = 2.0
+
+
+@dataclass(frozen=True)
+class Caps:
+    force: bool
+    step: bool
+    why_not: str = ""  # shown on the disabled buttons
+
+
+class Source(Protocol):
+    title: str
+    program: Program
+    symbols: dict[str, int]
+    caps: Caps
+
+    def snapshot(self) -> Snapshot | None: ...
+
+    def state(self) -> str: ...
+
+    def timer(self, c: int) -> float | None: ...
+
+    def counter(self, c: int) -> int | None: ...
+
+    def forces(self) -> tuple[Force, ...]: ...
+
+    def need(self, addrs: Iterable[int]) -> None: ...
+
+    def write(self, kind: Kind, addr: int, value: int, user: str) -> None: ...
+
+    def force(self, kind: Kind, addr: int, value: int | None, user: str) -> None: ...
+
+    def unforce(self, kind: Kind, addr: int, user: str) -> None: ...
+
+    def unforce_all(self, user: str) -> None: ...
+
+    def step(self, user: str) -> bool: ...
+
+    def close(self) -> None: ...
+
+
+class LocalSource:
+    """The workstation's own runtime: snapshots, queued writes, forces and single scans."""
+
+    caps = Caps(force=True, step=True)
+
+    def __init__(self, runtime: Runtime) -> None:
+        assert runtime.engine is not None, "the runtime is started before its monitor opens"
+        self.runtime = runtime
+        self.engine = runtime.engine
+        self.program = runtime.program
+        self.symbols = runtime.symbols
+        self.title = f"{runtime.station.name}: {runtime.program.source}"
+
+    def snapshot(self) -> Snapshot | None:
+        return self.engine.snapshot
+
+    def state(self) -> str:
+        return self.engine.snapshot.state
+
+    def timer(self, c: int) -> float | None:
+        return self.engine.tim_ticks[c]
+
+    def counter(self, c: int) -> int | None:
+        return self.engine.ctr_values[c]
+
+    def forces(self) -> tuple[Force, ...]:
+        return self.engine.snapshot.forces  # those of the scan shown
+
+    def need(self, addrs: Iterable[int]) -> None:
+        pass  # the whole snapshot is at hand
+
+    def write(self, kind: Kind, addr: int, value: int, user: str) -> None:
+        """An operator write like any other: queued to the next scan, journaled with the user."""
+        if kind == "bit":
+            self.engine.write_bit(addr, value, user=user, label="monitor")
+        elif kind == "word":
+            self.engine.write_word(addr, value, user=user, label="monitor")
+        else:
+            self.engine.write_bytes(addr, bytes((value,)), user=user)
+
+    def force(self, kind: Kind, addr: int, value: int | None, user: str) -> None:
+        self.engine.forces.force(kind, addr, value, user=user)
+
+    def unforce(self, kind: Kind, addr: int, user: str) -> None:
+        self.engine.forces.unforce(kind, addr, user=user)
+
+    def unforce_all(self, user: str) -> None:
+        self.engine.forces.unforce_all(user=user)
+
+    def step(self, user: str) -> bool:
+        return self.runtime.step_program(user)
+
+    def close(self) -> None:
+        pass
+
+
+class RemoteSource:
+    """A running station over its Modbus server (cpu165 profile): watch and write, no forcing."""
+
+    caps = Caps(force=False, step=False,
+                why_not="forcing and single scans need the station's own workstation (not over Modbus)")
+
+    def __init__(self, host: str, port: int, *, unit: int = 1, program: Program | None = None,
+                 symbols: dict[str, int] | None = None, poll: float = POLL_S) -> None:
+        self.endpoint = parse_endpoint(f"tcp://{host}:{port}")
+        self.unit = unit
+        self.program = program or parse("", source="<no program: give the station to see its listing>")
+        self.symbols = symbols or {}
+        self.title = f"{host}:{port}" + (f": {self.program.source}" if program else "")
+        self.poll = poll
+        self._client = open_client(self.endpoint, TIMEOUT_S)  # the lean client
+        self._loop = LoopThread(f"monitor-{host}:{port}")
+        self._snapshot: Snapshot | None = None
+        self._regs: list[tuple[int, int]] = []  # (first register, count) of the data read each poll
+        self._polls = 0
+        self.error = ""
+        self._lock = asyncio.Lock()  # one transaction at a time on the connection: polls and writes
+        self._loop.start()
+        self._task = asyncio.run_coroutine_threadsafe(self._run(), self._loop.loop)  # type: ignore[arg-type]
+
+    def need(self, addrs: Iterable[int]) -> None:
+        """Read these data bytes (and the words they start) from now on, besides every I/O bit."""
+        wanted = {a >> 1 for x in addrs if x >= IO_BITS for a in (x, x + 1) if is_data_byte(a)}
+        wanted |= {first + k for first, count in self._regs for k in range(count)}
+        runs: list[tuple[int, int]] = []
+        for reg in sorted(wanted):
+            if runs and reg == runs[-1][0] + runs[-1][1] and runs[-1][1] < 125:
+                runs[-1] = (runs[-1][0], runs[-1][1] + 1)
+            else:
+                runs.append((reg, 1))
+        self._regs = runs
+
+    async def _run(self) -> None:
+        while True:
+            try:
+                async with self._lock:
+                    if not self._client.connected:
+                        await self._client.connect()
+                    self._snapshot = await self._read()
+                self.error = ""
+            except (LinkError, DeviceError, OSError) as e:
+                self.error = str(e)
+                self._client.close()
+            await asyncio.sleep(self.poll)
+
+    async def _read(self) -> Snapshot:
+        bits = await self._client.read(self.unit, "coils", 0, 2000)
+        bits += await self._client.read(self.unit, "coils", 2000, IO_BITS - 2000)
+        data = bytearray(DATA_SIZE)
+        for first, count in list(self._regs):
+            words = await self._client.read(self.unit, "holding", first, count)
+            for k, w in enumerate(words):
+                i = data_index(2 * (first + k))
+                data[i], data[i + 1] = w & 0xFF, w >> 8
+        self._polls += 1
+        return Snapshot(tuple(bits), bytes(data), self._polls, time.monotonic(), time.time(), "remote")
+
+    def snapshot(self) -> Snapshot | None:
+        return self._snapshot
+
+    def state(self) -> str:
+        return f"link down: {self.error}" if self.error else f"connected to {self.endpoint}"
+
+    def timer(self, c: int) -> float | None:
+        return None  # not in the Modbus map
+
+    def counter(self, c: int) -> int | None:
+        return None
+
+    def forces(self) -> tuple[Force, ...]:
+        return ()
+
+    def write(self, kind: Kind, addr: int, value: int, user: str) -> None:
+        """Write over Modbus (the station journals it with this peer's address); MapError,
+        LinkError or DeviceError say why not, e.g. exception 2 outside the writable ranges."""
+        self._loop.run(self._write(kind, addr, value), TIMEOUT_S * 3)
+
+    async def _write(self, kind: Kind, addr: int, value: int) -> None:
+        async with self._lock:
+            await self._write_unlocked(kind, addr, value)
+
+    async def _write_unlocked(self, kind: Kind, addr: int, value: int) -> None:
+        client, unit = self._client, self.unit
+        if not client.connected:
+            await client.connect()
+        if kind == "bit" and addr < IO_BITS:
+            await client.write(unit, "coils", addr, [value])
+            return
+        if kind == "bit":  # a data bit: read-modify-write of its byte
+            byte_addr, mask = addr >> 3, 1 << (addr & 7)
+            old = (await self._read_bytes(byte_addr, 1))[0]
+            await self._write_bytes(byte_addr, bytes(((old | mask) if value else (old & ~mask & 0xFF),)))
+            return
+        size = 1 if kind == "byte" else 2
+        await self._write_bytes(addr, value.to_bytes(size, "little"))
+
+    async def _read_bytes(self, addr: int, length: int) -> bytes:
+        block = locate("cpu165", "holding", addr, length)
+        values: list[int] = []
+        for first, count in block.spans(False):
+            values += await self._client.read(self.unit, block.table, first, count)
+        return block.decode(values)
+
+    async def _write_bytes(self, addr: int, payload: bytes) -> None:
+        block = locate("cpu165", "holding", addr, len(payload))
+        if block.bits:
+            values = block.encode(payload)
+        else:
+            first = last = 0
+            if block.skip:
+                first = (await self._client.read(self.unit, "holding", block.address, 1))[0]
+            if block.odd_end:
+                last = (await self._client.read(self.unit, "holding", block.address + block.count - 1, 1))[0]
+            values = block.encode(payload, first, last)
+        for start, count in block.spans(True):
+            await self._client.write(self.unit, block.table, start, values[start - block.address:][:count])
+
+    def force(self, kind: Kind, addr: int, value: int | None, user: str) -> None:
+        raise MapError(self.caps.why_not)
+
+    def unforce(self, kind: Kind, addr: int, user: str) -> None:
+        raise MapError(self.caps.why_not)
+
+    def unforce_all(self, user: str) -> None:
+        raise MapError(self.caps.why_not)
+
+    def step(self, user: str) -> bool:
+        return False
+
+    def close(self) -> None:
+        self._loop.call(self._client.close)  # on the loop, before the loop stops
+        self._task.cancel()
+        self._loop.stop()
+

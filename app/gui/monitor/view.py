@@ -1,0 +1,540 @@
+"""The Program view: the STL listing with live states, a watch table, forcing and single scans.
+
+It reads snapshots only (the source's last one), at most REFRESH_MS apart, and repaints only when
+a new scan arrived; the listing is a painted scroll area that draws the lines on screen and
+nothing else, so a 2,000-line program costs what 40 lines cost (bench/monitor.py measures the
+scan time with it open). The view never writes memory itself: writes, forces and single scans go
+to the source, which queues them to the engine (journaled with the user) or sends them over Modbus.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable
+
+from PySide6.QtCore import QPoint, QRect, Qt, QTimer, Signal
+from PySide6.QtGui import QColor, QContextMenuEvent, QFont, QFontMetrics, QMouseEvent, QPainter, QPaintEvent
+from PySide6.QtWidgets import (
+    QAbstractScrollArea,
+    QComboBox,
+    QHBoxLayout,
+    QHeaderView,
+    QInputDialog,
+    QLabel,
+    QLineEdit,
+    QListWidget,
+    QListWidgetItem,
+    QMenu,
+    QPushButton,
+    QSplitter,
+    QTableWidget,
+    QTableWidgetItem,
+    QVBoxLayout,
+    QWidget,
+)
+
+from app.gui.monitor.listing import (
+    FORMATS,
+    TERMINATORS,
+    Listing,
+    Operand,
+    WatchItem,
+    fmt_value,
+    parse_value,
+    parse_watch,
+)
+from app.gui.monitor.source import Source
+from app.gui.status import IDLE, WARN, Pill
+from netplc.address import fmt_octal
+from netplc.forcing import Force, Kind
+from netplc.memory import Snapshot
+from netplc.program import CONTACTS
+
+REFRESH_MS = 100  # at most 10 refreshes per second
+ON, OFF, FORCED = QColor("#2e7d32"), QColor("#b0b7c0"), QColor("#e65100")
+VALUE_CHARS = 34  # the values column (timers, counters, FON operands) before the source text
+
+
+def forced_text(n: int) -> str:
+    return f"F: {n} forced"
+
+
+class ListingView(QAbstractScrollArea):
+    """The listing, painted line by line for the visible lines only."""
+
+    row_clicked = Signal(int)
+
+    def __init__(self, listing: Listing, source: Source, parent: QWidget | None = None) -> None:
+        super().__init__(parent)
+        self.setObjectName("listing")
+        self.listing = listing
+        self.source = source
+        self.snapshot: Snapshot | None = None
+        self.fmt = "hex"
+        self.forced: set[tuple[Kind, int]] = set()
+        self.current = -1
+        self.marked: set[int] = set()  # found lines and a symbol's uses
+        font = QFont("DejaVu Sans Mono", 9)
+        self.setFont(font)
+        fm = QFontMetrics(font)
+        self.char_w = fm.horizontalAdvance("0")
+        self.line_h = fm.height() + 3
+        self.ascent = fm.ascent() + 1
+        self.viewport().setAutoFillBackground(True)
+        self.painted_rows = 0  # rows drawn by the last paint (tests and the bench look)
+        self._last_shown: tuple = ()
+        self._update_range()
+
+    # --- geometry --------------------------------------------------------------------------------
+
+    def visible_rows(self) -> range:
+        first = self.verticalScrollBar().value()
+        count = self.viewport().height() // self.line_h + 2
+        return range(first, min(len(self.listing), first + count))
+
+    def _update_range(self) -> None:
+        page = max(1, self.viewport().height() // self.line_h)
+        bar = self.verticalScrollBar()
+        bar.setRange(0, max(0, len(self.listing) - page))
+        bar.setPageStep(page)
+        longest = max((len(r.text) for r in self.listing.rows), default=0)
+        width = (12 + VALUE_CHARS + longest) * self.char_w
+        h = self.horizontalScrollBar()
+        h.setRange(0, max(0, width - self.viewport().width()))
+        h.setPageStep(self.viewport().width())
+
+    def resizeEvent(self, event: object) -> None:
+        super().resizeEvent(event)  # type: ignore[arg-type]
+        self._update_range()
+
+    def go_to(self, row: int) -> None:
+        """Select `row` and scroll it to the middle of the view when it is not on screen."""
+        self.current = row
+        if row not in self.visible_rows()[:-2]:
+            self.verticalScrollBar().setValue(max(0, row - self.viewport().height() // self.line_h // 2))
+        self.viewport().update()
+
+    def row_at(self, y: int) -> int:
+        return self.verticalScrollBar().value() + y // self.line_h
+
+    # --- live state ------------------------------------------------------------------------------
+
+    def show_snapshot(self, snapshot: Snapshot, forced: set[tuple[Kind, int]]) -> None:
+        """Take a new snapshot; repaint only when what the visible lines show has changed."""
+        self.snapshot = snapshot
+        self.forced = forced
+        shown = self._shown(snapshot)
+        if shown != self._last_shown:
+            self._last_shown = shown
+            self.viewport().update()
+
+    def _shown(self, snap: Snapshot) -> tuple:
+        """What the visible lines show (bit, chain result, values), with the scroll position."""
+        instrs = self.listing.program.instrs
+        out: list[object] = [self.verticalScrollBar().value(), self.fmt, frozenset(self.forced)]
+        for i in self.visible_rows():
+            index = self.listing.rows[i].instr
+            c = instrs[index].c if index is not None else None
+            if index is not None and c is not None:
+                out += (snap.bits[c], self.listing.chain(snap, index), self._values(index, snap))
+        return tuple(out)
+
+    def paintEvent(self, event: QPaintEvent) -> None:
+        p = QPainter(self.viewport())
+        lh, cw, asc = self.line_h, self.char_w, self.ascent
+        x0 = -self.horizontalScrollBar().value()
+        width = self.viewport().width()
+        snap = self.snapshot
+        rows = self.visible_rows()
+        first = rows.start
+        instrs = self.listing.program.instrs
+        self.painted_rows = 0
+        for i in rows:
+            row = self.listing.rows[i]
+            y = (i - first) * lh
+            if i == self.current:
+                p.fillRect(0, y, width, lh, QColor("#cfe0fb"))
+            elif i in self.marked:
+                p.fillRect(0, y, width, lh, QColor("#fff3c4"))
+            p.setPen(QColor("#8a94a3"))
+            p.drawText(x0 + 2, y + asc, f"{row.line:5d}")
+            if row.instr is not None and snap is not None:
+                ins = instrs[row.instr]
+                if ins.c is not None:
+                    bit = snap.get_bit(ins.c) if ins.c < len(snap.bits) else 0
+                    self._cell(p, x0 + 6 * cw, y, str(bit), ON if bit else OFF, ("bit", ins.c) in self.forced)
+                if ins.op in CONTACTS or ins.op in TERMINATORS:
+                    res = self.listing.chain(snap, row.instr)
+                    self._cell(p, x0 + 9 * cw, y, "\u25b6" if res else "\u00b7", ON if res else OFF, False)
+                p.setPen(QColor("#1d4f91"))
+                p.drawText(x0 + 12 * cw, y + asc, self._values(row.instr, snap)[:VALUE_CHARS - 1])
+            p.setPen(QColor("#263445") if row.instr is not None else QColor("#6b7685"))
+            p.drawText(x0 + (12 + VALUE_CHARS) * cw, y + asc, row.text)
+            self.painted_rows += 1
+        p.end()
+
+    def _cell(self, p: QPainter, x: int, y: int, text: str, colour: QColor, forced: bool) -> None:
+        rect = QRect(x, y + 1, 2 * self.char_w + 2, self.line_h - 2)
+        p.fillRect(rect, FORCED if forced else colour)
+        p.setPen(QColor("#ffffff"))
+        p.drawText(rect, Qt.AlignmentFlag.AlignCenter, "F" if forced else text)
+
+    def _values(self, index: int, snap: Snapshot) -> str:
+        ins = self.listing.program.instrs[index]
+        c = ins.c
+        if c is None:
+            return ""
+        if ins.op == "TIM":
+            t = self.source.timer(c)
+            now = "--" if t is None else f"{t:.1f}"
+            return f"T {now}/{ins.n}  Q={snap.get_bit(c + 1)}"
+        if ins.op == "CTR":
+            v = self.source.counter(c)
+            return f"C {'--' if v is None else v}/{ins.n}  R={snap.get_bit(c + 1)} Q={snap.get_bit(c + 2)}"
+        if ins.op == "FON":
+            outs = "".join(str(snap.get_bit(c + k)) for k in (1, 2, 3))
+            words = " ".join(f"{op.role}={self._word(op, snap)}" for op in self.listing.operands[index][1:])
+            return f"out {outs} {words}"
+        return ""
+
+    def _word(self, op: Operand, snap: Snapshot) -> str:
+        try:
+            text = fmt_value(op.read(snap), self.fmt)
+        except ValueError:
+            return "?"
+        return text + ("F" if ("word", op.addr) in self.forced else "")
+
+    # --- mouse -----------------------------------------------------------------------------------
+
+    def mousePressEvent(self, event: QMouseEvent) -> None:
+        row = self.row_at(int(event.position().y()))
+        if 0 <= row < len(self.listing):
+            self.current = row
+            self.viewport().update()
+            self.row_clicked.emit(row)
+
+    def contextMenuEvent(self, event: QContextMenuEvent) -> None:
+        row = self.row_at(event.pos().y())
+        if 0 <= row < len(self.listing):
+            self.current = row
+            self.row_clicked.emit(row)
+            monitor = self.parent()
+            while monitor is not None and not isinstance(monitor, ProgramMonitor):
+                monitor = monitor.parent()
+            if monitor is not None:
+                monitor.row_menu(row, event.globalPos())
+
+
+class ProgramMonitor(QWidget):
+    """The Program view for one source (local runtime or remote station)."""
+
+    def __init__(self, source: Source, user: Callable[[], str], parent: QWidget | None = None) -> None:
+        super().__init__(parent)
+        self.setObjectName("programMonitor")
+        self.source = source
+        self.user = user
+        self.listing = Listing(source.program)
+        self.watch_items: list[WatchItem] = []
+        self._last: Snapshot | None = None
+        self.refreshes = 0  # views refreshed from a new snapshot (tests and the bench look)
+
+        self.find = QLineEdit()
+        self.find.setPlaceholderText("Find (Enter: next)")
+        self.find.returnPressed.connect(self.find_next)
+        self.labels = QComboBox()
+        self.labels.addItem("Go to label…")
+        self.labels.addItems(sorted(self.listing.labels))
+        self.labels.activated.connect(self._label_chosen)
+        self.formats = QComboBox()
+        self.formats.addItems(list(FORMATS))
+        self.formats.currentTextChanged.connect(self._format_changed)
+        self.step_button = QPushButton("Step one scan")
+        self.step_button.clicked.connect(self.step)
+        self.unforce_button = QPushButton("Unforce all")
+        self.unforce_button.clicked.connect(self.unforce_all)
+        for button in (self.step_button, self.unforce_button):
+            if not (source.caps.step if button is self.step_button else source.caps.force):
+                button.setEnabled(False)
+                button.setToolTip(source.caps.why_not)
+        self.state = QLabel()
+        self.state.setObjectName("monitorState")
+        self.message = QLabel()  # the last refusal: a bad address, a write the station refused
+        self.message.setObjectName("monitorMessage")
+        self.message.setStyleSheet("color: #c62828; font-weight: bold;")
+        self.message.setWordWrap(True)
+        self.forced_pill = Pill(forced_text(0))
+        bar = QHBoxLayout()
+        bar.setContentsMargins(6, 4, 6, 4)
+        bar.addWidget(self.find, 2)
+        bar.addWidget(self.labels, 1)
+        bar.addWidget(QLabel("Words:"))
+        bar.addWidget(self.formats)
+        bar.addWidget(self.step_button)
+        bar.addWidget(self.unforce_button)
+        bar.addWidget(self.state, 2)
+        bar.addWidget(self.forced_pill)
+
+        self.view = ListingView(self.listing, source)
+        self.view.row_clicked.connect(self._row_clicked)
+        self.watch = QTableWidget(0, 5)
+        self.watch.setObjectName("watch")
+        self.watch.setHorizontalHeaderLabels(["Address / symbol", "Value", "Hex", "BCD", "Forced"])
+        self.watch.horizontalHeader().setSectionResizeMode(0, QHeaderView.ResizeMode.Stretch)
+        self.watch.verticalHeader().setVisible(False)
+        self.watch.itemChanged.connect(self._watch_edited)
+        self.watch.setContextMenuPolicy(Qt.ContextMenuPolicy.CustomContextMenu)
+        self.watch.customContextMenuRequested.connect(self._watch_menu)
+        self.uses_title = QLabel("Uses: click a line to follow its operand")
+        self.uses = QListWidget()
+        self.uses.itemActivated.connect(self._use_chosen)
+        self.uses.itemClicked.connect(self._use_chosen)
+        side = QWidget()
+        side_lay = QVBoxLayout(side)
+        side_lay.setContentsMargins(0, 0, 0, 0)
+        side_lay.addWidget(QLabel("Watch: type an address (04000, 040042, 02000:w, 04001:b) or a symbol"))
+        side_lay.addWidget(self.watch, 3)
+        side_lay.addWidget(self.message)
+        side_lay.addWidget(self.uses_title)
+        side_lay.addWidget(self.uses, 2)
+        split = QSplitter(Qt.Orientation.Horizontal)
+        split.addWidget(self.view)
+        split.addWidget(side)
+        split.setStretchFactor(0, 3)
+        split.setStretchFactor(1, 2)
+        split.setSizes([820, 520])
+        lay = QVBoxLayout(self)
+        lay.setContentsMargins(0, 0, 0, 0)
+        lay.addLayout(bar)
+        lay.addWidget(split, 1)
+        self._add_empty_row()
+        self.source.need(op.addr for ops in self.listing.operands for op in ops)
+
+        self.timer = QTimer(self)
+        self.timer.setInterval(REFRESH_MS)
+        self.timer.timeout.connect(self.refresh)
+        self.timer.start()
+        self.refresh()
+
+    # --- refresh ---------------------------------------------------------------------------------
+
+    def refresh(self) -> None:
+        """Show the source's last snapshot, if it is new (at most every REFRESH_MS)."""
+        forces = self.source.forces()
+        self.show_forced(len(forces))
+        self.state.setText(self.source.state())
+        snap = self.source.snapshot()
+        if snap is None or snap is self._last:
+            return
+        self._last = snap
+        self.refreshes += 1
+        forced = {f.key for f in forces}
+        self.view.show_snapshot(snap, forced)
+        self._refresh_watch(snap, {f.key: f for f in forces})
+
+    def show_forced(self, n: int) -> None:
+        self.forced_pill.show_value(forced_text(n), WARN if n else IDLE,
+                                    "forces in effect: force > program > live" if n else "nothing forced")
+
+    def _refresh_watch(self, snap: Snapshot, forces: dict[tuple[Kind, int], Force]) -> None:
+        self.watch.blockSignals(True)
+        try:
+            for r, item in enumerate(self.watch_items):
+                try:
+                    v = Force(item.kind, item.addr, 0).read(snap)
+                except ValueError:
+                    continue
+                digits = 2 if item.kind == "byte" else 4
+                texts = [str(v), "" if item.kind == "bit" else fmt_value(v, "hex", digits),
+                         "" if item.kind == "bit" else fmt_value(v, "BCD", digits)]
+                f = forces.get((item.kind, item.addr))
+                texts.append(f"F {f.value} ({f.user})" if f else "")
+                for col, text in enumerate(texts, start=1):
+                    cell = self.watch.item(r, col)
+                    if cell is not None and cell.text() != text and not self._editing(r, col):
+                        cell.setText(text)
+        finally:
+            self.watch.blockSignals(False)
+
+    def _editing(self, row: int, col: int) -> bool:
+        return self.watch.state() == QTableWidget.State.EditingState and self.watch.currentRow() == row \
+            and self.watch.currentColumn() == col
+
+    # --- watch table -----------------------------------------------------------------------------
+
+    def _add_empty_row(self) -> None:
+        self.watch.blockSignals(True)
+        r = self.watch.rowCount()
+        self.watch.insertRow(r)
+        self.watch.setItem(r, 0, QTableWidgetItem(""))
+        for col in range(1, 5):
+            cell = QTableWidgetItem("")
+            cell.setFlags(cell.flags() & ~Qt.ItemFlag.ItemIsEditable)
+            self.watch.setItem(r, col, cell)
+        self.watch.blockSignals(False)
+
+    def add_watch(self, text: str) -> WatchItem:
+        """Watch an address or symbol; ValueError says why it cannot be watched."""
+        item = parse_watch(text, {**self.source.symbols, **self.listing.program.symbols})
+        r = len(self.watch_items)
+        self.watch_items.append(item)
+        self.watch.blockSignals(True)
+        self.watch.item(r, 0).setText(text.strip())
+        self.watch.item(r, 0).setToolTip(item.where)
+        value = self.watch.item(r, 1)
+        value.setFlags(value.flags() | Qt.ItemFlag.ItemIsEditable)
+        value.setToolTip("type a value to write it (decimal, 0x1F or 1Fh): journaled with your name")
+        self.watch.blockSignals(False)
+        self._add_empty_row()
+        self.source.need([item.addr >> 3 if item.kind == "bit" and item.addr >= 0o40000 else item.addr])
+        self._last = None  # show it at the next refresh
+        return item
+
+    def _watch_edited(self, cell: QTableWidgetItem) -> None:
+        r, col = cell.row(), cell.column()
+        if col == 0 and r == len(self.watch_items):
+            text = cell.text()
+            if text.strip():
+                try:
+                    self.add_watch(text)
+                except ValueError as e:
+                    self.watch.blockSignals(True)
+                    cell.setText("")
+                    self.watch.blockSignals(False)
+                    self._say(str(e))
+        elif col == 1 and r < len(self.watch_items):
+            item = self.watch_items[r]
+            try:
+                self.write(item, parse_value(cell.text(), item.kind))
+            except ValueError as e:
+                self._say(str(e))
+            self._last = None
+
+    def write(self, item: WatchItem, value: int) -> None:
+        """A write like any operator write: queued (or sent over Modbus), journaled with the user."""
+        try:
+            self.source.write(item.kind, item.addr, value, self.user())
+        except Exception as e:  # LinkError, DeviceError, MapError of a remote station
+            self._say(f"write {item.where} refused: {e}")
+
+    def _watch_menu(self, pos: QPoint) -> None:
+        r = self.watch.rowAt(pos.y())
+        if not 0 <= r < len(self.watch_items):
+            return
+        item = self.watch_items[r]
+        menu = QMenu(self)
+        self._force_actions(menu, item.kind, item.addr, item.where)
+        menu.addSeparator()
+        menu.addAction("Remove from watch", lambda: self.remove_watch(r))
+        menu.exec(self.watch.viewport().mapToGlobal(pos))
+
+    def remove_watch(self, r: int) -> None:
+        del self.watch_items[r]
+        self.watch.removeRow(r)
+
+    # --- forcing and stepping ---------------------------------------------------------------------
+
+    def _force_actions(self, menu: QMenu, kind: Kind, addr: int, where: str) -> None:
+        can = self.source.caps.force
+        for text, slot in ((f"Force {where} at its value (bumpless)", lambda: self.force(kind, addr, None)),
+                           (f"Force {where} to…", lambda: self._ask_force(kind, addr, where)),
+                           (f"Unforce {where}", lambda: self.unforce(kind, addr))):
+            action = menu.addAction(text, slot)
+            action.setEnabled(can)
+            if not can:
+                action.setToolTip(self.source.caps.why_not)
+
+    def _ask_force(self, kind: Kind, addr: int, where: str) -> None:
+        text, ok = QInputDialog.getText(self, "Force", f"Force {where} to (decimal, 0x1F or 1Fh):")
+        if ok:
+            try:
+                self.force(kind, addr, parse_value(text, kind))
+            except ValueError as e:
+                self._say(str(e))
+
+    def force(self, kind: Kind, addr: int, value: int | None) -> None:
+        try:
+            self.source.force(kind, addr, value, self.user())
+        except ValueError as e:
+            self._say(str(e))
+
+    def unforce(self, kind: Kind, addr: int) -> None:
+        self.source.unforce(kind, addr, self.user())
+
+    def unforce_all(self) -> None:
+        self.source.unforce_all(self.user())
+
+    def step(self) -> None:
+        """Step one scan (NetPlc stopped) and show its result at once."""
+        if not self.source.step(self.user()):
+            self._say("Step one scan runs only while NetPlc is stopped (Station -> Stop NetPlc).")
+        self.refresh()
+
+    # --- navigation ------------------------------------------------------------------------------
+
+    def find_next(self) -> None:
+        text = self.find.text()
+        if not text:
+            return
+        row = self.listing.find(text, self.view.current)
+        if row is None:
+            self._say(f"{text!r} not found")
+            return
+        self.view.marked = {row}
+        self.view.go_to(row)
+
+    def _label_chosen(self, index: int) -> None:
+        if index > 0:
+            self.go_to_label(self.labels.itemText(index))
+        self.labels.setCurrentIndex(0)
+
+    def go_to_label(self, label: str) -> None:
+        self.view.go_to(self.listing.labels[label])
+
+    def _format_changed(self, fmt: str) -> None:
+        self.view.fmt = fmt
+        self.view.viewport().update()
+
+    def _row_clicked(self, row: int) -> None:
+        index = self.listing.rows[row].instr
+        ops = self.listing.operands[index] if index is not None else []
+        if ops:
+            self.follow(ops[0].addr)
+
+    def follow(self, addr: int) -> list[int]:
+        """List the lines using `addr` (a symbol's uses) and mark them in the listing."""
+        rows = self.listing.uses(addr)
+        names = [n for n, a in self.listing.program.symbols.items() if a == addr]
+        self.uses_title.setText(f"Uses of {' / '.join(names) or fmt_octal(addr)} ({fmt_octal(addr)}): "
+                                f"{len(rows)} lines")
+        self.uses.clear()
+        for row in rows:
+            r = self.listing.rows[row]
+            item = QListWidgetItem(f"{r.line:5d}  {r.text.strip()}")
+            item.setData(Qt.ItemDataRole.UserRole, row)
+            self.uses.addItem(item)
+        self.view.marked = set(rows)
+        self.view.viewport().update()
+        return rows
+
+    def _use_chosen(self, item: QListWidgetItem) -> None:
+        self.view.go_to(int(item.data(Qt.ItemDataRole.UserRole)))
+
+    def row_menu(self, row: int, where: QPoint) -> None:
+        index = self.listing.rows[row].instr
+        if index is None:
+            return
+        menu = QMenu(self)
+        for op in self.listing.operands[index]:
+            name = op.kind if op.kind == "bit" else f"{op.role} word"
+            text = fmt_octal(op.addr) + ("" if op.kind == "bit" else ":w")
+            menu.addAction(f"Follow uses of {name} {fmt_octal(op.addr)}", lambda a=op.addr: self.follow(a))
+            menu.addAction(f"Watch {text}", lambda t=text: self.add_watch(t))
+            self._force_actions(menu, op.kind, op.addr, text)
+            menu.addSeparator()
+        menu.exec(where)
+
+    def _say(self, text: str) -> None:
+        self.message.setText(text)
+
+    def closeEvent(self, event: object) -> None:
+        self.timer.stop()
+        super().closeEvent(event)  # type: ignore[arg-type]

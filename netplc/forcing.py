@@ -1,0 +1,213 @@
+"""Forcing: an engineer pins a bit, a byte or a word of NetPlc memory to a value while commissioning
+(docs/architecture.md section 10; DIVAR's FRC mode of seed 004: forcing has the highest priority,
+is bumpless, always visible and audited).
+
+Priority is force > program > live: the engine applies the forces after the queued writes (the
+exchange's results, operator, HMI and Modbus-server writes) and its own generator bits and RTC
+bytes, just before the program, so the program reads the forced value, and again after the
+program, so no snapshot ever shows an unforced value (`Forces.apply` at both points, in the
+compiled engine and the interpreter alike). A force does not change the compiled program: a coil
+the program writes in the middle of its scan is seen as written by the contacts after it within
+that scan, and pinned again before anyone outside the engine reads it.
+
+Commands come from any thread (the monitor, the runtime) and are queued to the engine thread like
+writes, so the table changes between two scans only. Bumpless: a force without a value pins what
+the memory holds when the force is applied. Every force and unforce is an 'operator' record naming
+the user. `listing` is an immutable tuple replaced on each change: any thread reads it, and its
+length is the "F: n forced" count. With no force the engine's cost is one truth test per hook.
+"""
+
+from __future__ import annotations
+
+import json
+from collections.abc import Callable, Iterable
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Literal, Protocol
+
+from netplc.address import HMI_DATA_BIT_BASE, IO_BITS, check_operand, fmt_octal, parse_hmi_bit, parse_octal
+from netplc.memory import Memory, MemoryView
+from netplc.records import Record, RecordSink
+
+Kind = Literal["bit", "byte", "word"]
+KINDS: tuple[Kind, ...] = ("bit", "byte", "word")
+_SIZE = {"byte": 1, "word": 2}
+_MASK = {"bit": 1, "byte": 0xFF, "word": 0xFFFF}
+SOURCE = "force"  # journal text prefix, so the viewer filters forcing with one word
+
+
+class ForceError(ValueError):
+    """A force that names no memory, or a value that does not fit."""
+
+
+@dataclass(frozen=True, slots=True)
+class Force:
+    kind: Kind
+    addr: int  # bit: an HMI bit address (I/O bit, or byte*8+bit >= 040000); byte, word: an operand
+    value: int
+    user: str = ""
+
+    @property
+    def key(self) -> tuple[Kind, int]:
+        return self.kind, self.addr
+
+    @property
+    def where(self) -> str:
+        """The address as the documents print it, with its kind for bytes and words."""
+        if self.kind == "bit":
+            return fmt_octal(self.addr, 6 if self.addr >= HMI_DATA_BIT_BASE else 5)
+        return f"{fmt_octal(self.addr)}:{self.kind}"
+
+    def read(self, mem: MemoryView) -> int:
+        if self.kind == "bit":
+            return mem.get_hmi_bit(self.addr)
+        return mem.get_byte(self.addr) if self.kind == "byte" else mem.get_word(self.addr)
+
+    def apply(self, mem: Memory) -> None:
+        if self.kind == "bit":
+            if self.addr < IO_BITS:
+                mem.bits[self.addr] = self.value
+            else:
+                mem.set_hmi_bit(self.addr, self.value)
+        elif self.kind == "byte":
+            mem.set_byte(self.addr, self.value)
+        else:
+            mem.set_word(self.addr, self.value)
+
+
+def check_target(kind: str, addr: int) -> None:
+    """ForceError unless `kind` at `addr` names memory a force can pin."""
+    if kind not in KINDS:
+        raise ForceError(f"force kind {kind!r} is not one of {', '.join(KINDS)}")
+    try:
+        if kind == "bit":
+            parse_hmi_bit(addr)
+        else:
+            check_operand(addr, _SIZE[kind])
+    except ValueError as e:
+        raise ForceError(f"cannot force {kind} {fmt_octal(addr)}: {e}") from None
+
+
+def check_value(kind: Kind, value: int) -> int:
+    if not 0 <= value <= _MASK[kind]:
+        raise ForceError(f"{value} does not fit a {kind} (0..{_MASK[kind]})")
+    return value
+
+
+class ForceHost(Protocol):
+    """What the forces need of the engine: its queue, its sink and its wall clock."""
+
+    sink: RecordSink
+
+    def post(self, fn: Callable[[Memory], None]) -> None: ...
+
+    def wall_time(self) -> float: ...
+
+
+class Forces:
+    """The force table of one engine."""
+
+    def __init__(self, host: ForceHost) -> None:
+        self.host = host
+        self.listing: tuple[Force, ...] = ()  # what is forced now; replaced, never changed in place
+
+    @property
+    def count(self) -> int:
+        return len(self.listing)
+
+    def forced(self, kind: Kind, addr: int) -> Force | None:
+        return next((f for f in self.listing if f.kind == kind and f.addr == addr), None)
+
+    def apply(self, mem: Memory) -> None:
+        """Pin every forced value (the engine calls this before and after the program)."""
+        for force in self.listing:
+            force.apply(mem)
+
+    # --- commands: from any thread, applied by the engine thread between two scans -------------
+
+    def force(self, kind: Kind, addr: int, value: int | None = None, *, user: str) -> None:
+        """Force `kind` at `addr` to `value`, or bumpless to what it holds when applied.
+        ForceError at once for an address or a value that cannot be forced."""
+        check_target(kind, addr)
+        if value is not None:
+            check_value(kind, value)
+
+        def apply(mem: Memory) -> None:
+            current = Force(kind, addr, 0).read(mem)
+            old = self.forced(kind, addr)
+            new = Force(kind, addr, current if value is None else value, user)
+            self.listing = (*(f for f in self.listing if f.key != new.key), new)
+            new.apply(mem)
+            was = f"forced {old.value}" if old else str(current)
+            how = " (bumpless)" if value is None else ""
+            self._journal(user, new, f"force {new.where}: {was} -> {new.value}{how}")
+
+        self.host.post(apply)
+
+    def unforce(self, kind: Kind, addr: int, *, user: str) -> None:
+        """Release one force: the memory keeps the value and live writers take over again."""
+
+        def apply(_mem: Memory) -> None:
+            old = self.forced(kind, addr)
+            if old is not None:
+                self.listing = tuple(f for f in self.listing if f.key != old.key)
+                self._journal(user, old, f"unforce {old.where} (was forced {old.value})")
+
+        self.host.post(apply)
+
+    def unforce_all(self, *, user: str) -> None:
+        """"Unforce all" as one command: every force released in the same scan, each journaled."""
+
+        def apply(_mem: Memory) -> None:
+            released, self.listing = self.listing, ()
+            for old in released:
+                self._journal(user, old, f"unforce {old.where} (was forced {old.value}; unforce all)")
+
+        self.host.post(apply)
+
+    def restore(self, forces: Iterable[Force], *, user: str) -> None:
+        """Install retained forces (RetainForces = true), each journaled as forced again."""
+        for f in forces:
+            self.force(f.kind, f.addr, f.value, user=user)
+
+    def _journal(self, user: str, force: Force, text: str) -> None:
+        self.host.sink.put(Record(self.host.wall_time(), "operator", source=user, number=force.addr,
+                                  value=float(force.value), text=text))
+
+
+# --- retained forces (RetainForces = true) --------------------------------------------------------
+
+
+def save_forces(path: Path, forces: Iterable[Force]) -> None:
+    """Write the forces beside the retentive memory (write then rename: never half a file)."""
+    rows = [{"kind": f.kind, "addr": fmt_octal(f.addr), "value": f.value, "user": f.user} for f in forces]
+    tmp = path.with_name(path.name + ".tmp")
+    tmp.write_text(json.dumps(rows, indent=1) + "\n", encoding="utf-8")
+    tmp.replace(path)
+
+
+def load_forces(path: Path) -> tuple[list[Force], list[str]]:
+    """The forces saved in `path` and the problems of the entries that cannot be used, each
+    naming the file and the entry; no file is no forces."""
+    try:
+        rows = json.loads(path.read_text(encoding="utf-8"))
+    except FileNotFoundError:
+        return [], []
+    except (OSError, UnicodeDecodeError, json.JSONDecodeError) as e:
+        return [], [f"{path}: cannot read the retained forces: {e}"]
+    if not isinstance(rows, list):
+        return [], [f"{path}: not a list of forces"]
+    forces: list[Force] = []
+    problems: list[str] = []
+    for i, row in enumerate(rows):
+        try:
+            kind, addr, value = row["kind"], parse_octal(str(row["addr"])), row["value"]
+            check_target(kind, addr)
+            if not isinstance(value, int):
+                raise ForceError(f"value {value!r} is not an integer")
+            forces.append(Force(kind, addr, check_value(kind, value), str(row.get("user", ""))))
+        except KeyError as e:
+            problems.append(f"{path}: force [{i}]: missing {e}")
+        except (TypeError, ValueError) as e:
+            problems.append(f"{path}: force [{i}]: {e}")
+    return forces, problems

@@ -1,0 +1,337 @@
+"""The Program view: the listing with live states, the watch table (writes journaled with the user),
+forcing and single scans from the view, find / go to label / uses; and the remote monitor against
+a real station over a loopback Modbus port."""
+
+from __future__ import annotations
+
+import socket
+import time
+from pathlib import Path
+
+import pytest
+from PySide6.QtWidgets import QApplication
+
+from app.config import load_station
+from app.gui.monitor.listing import Listing, fmt_value, parse_value, parse_watch
+from app.gui.monitor.source import LocalSource, RemoteSource
+from app.gui.monitor.view import ON, ProgramMonitor
+from app.gui.monitor.window import remote_source
+from app.runtime import Runtime
+from netplc.memory import Memory
+from netplc.problems import Problems
+from netplc.program import parse
+from netplc.records import Record
+from tests.app.conftest import write_station
+
+PROGRAM = """; the monitor's test program
+TNA $00000
+TNA $00001
+YON PUMP
+TNA $00002
+TIM $03000 N:50
+TNA $00003
+CTR $03010 N:5
+loop: TNA PUMP
+JMN end
+TNA $03760
+FON C:$02100 N:MOV S:$04000 D:$04002
+end: NOP
+"""
+SYMBOLS = "name,address,comment\nPUMP,02000,pump\nLEVEL,04000,level\n"
+
+
+def station(folder: Path, port: int = 0) -> Path:
+    toml = (f'NetPlcProgram = "p.stl"\nSymbols = "s.csv"\nNetSyncTime = 20\n'
+            f'[modbus_server]\nport = {port}\nwritable = [["00000", "02177"], ["04000", "04777"]]\n')
+    return write_station(folder, toml, {"p.stl": PROGRAM, "s.csv": SYMBOLS})
+
+
+@pytest.fixture
+def runtime(tmp_path: Path):
+    rt = Runtime(load_station(station(tmp_path / "st")))
+    records: list[Record] = []
+    rt.subscribe(records.append)
+    rt.records = records  # type: ignore[attr-defined]
+    rt.start()
+    yield rt
+    rt.stop()
+
+
+def wait(qtbot, what, timeout: int = 5000) -> None:
+    qtbot.waitUntil(what, timeout=timeout)
+
+
+def operator_texts(rt: Runtime) -> list[tuple[str, str]]:
+    return [(r.source or "", r.text or "") for r in rt.records if r.kind == "operator"]  # type: ignore[attr-defined]
+
+
+# --- the Qt-free part -------------------------------------------------------------------------------
+
+
+def test_listing_rows_labels_chain_results_and_uses(tmp_path: Path) -> None:
+    path = tmp_path / "p.stl"
+    path.write_text(PROGRAM, encoding="utf-8")
+    program = parse(PROGRAM, source=str(path), symbols={"PUMP": 0o2000})
+    listing = Listing(program)
+    assert len(listing) == PROGRAM.count("\n") and listing.rows[0].instr is None
+    assert listing.labels == {"loop": 8, "end": 12}
+    mem = Memory()
+    mem.bits[0] = 1
+    assert listing.chain(mem, 0) == 1 and listing.chain(mem, 1) == 0  # TNA 0 = 1, then TNA 1 = 0
+    mem.bits[1] = 1
+    assert listing.chain(mem, 2) == 1  # YON sees RES = 1
+    assert [listing.rows[r].line for r in listing.uses(0o2000)] == [4, 9]  # YON PUMP, TNA PUMP
+    assert [listing.rows[r].line for r in listing.uses(0o4003)] == [12]  # inside the MOV's D word
+    assert listing.find("jmn") == 9 and listing.find("nothing") is None
+    assert listing.find("TNA", after=9) == 10  # the next one, wrapping
+
+
+def test_watch_entries_values_and_formats() -> None:
+    symbols = {"PUMP": 0o2000, "LEVEL": 0o4000}
+    assert (parse_watch("PUMP", symbols).kind, parse_watch("LEVEL", symbols).kind) == ("bit", "word")
+    assert parse_watch("040042", {}).addr == 0o40042
+    assert parse_watch("04001:b", {}).kind == "byte" and parse_watch("02000:w", {}).kind == "word"
+    with pytest.raises(ValueError, match="neither an octal address nor a symbol"):
+        parse_watch("NOPE", symbols)
+    with pytest.raises(ValueError, match="010000"):
+        parse_watch("010000", {})
+    assert parse_value("0x1F", "word") == 31 and parse_value("1Fh", "byte") == 31
+    assert parse_value("7", "word") == 7
+    with pytest.raises(ValueError, match="does not fit a bit"):
+        parse_value("2", "bit")
+    assert [fmt_value(0x1234, f) for f in ("hex", "dec", "BCD")] == ["1234h", "4660", "1234"]
+    assert fmt_value(0x12AB, "BCD") == "----"
+
+
+# --- the view on the local runtime ------------------------------------------------------------------
+
+
+def test_the_view_renders_the_listing_with_live_states(qtbot, runtime: Runtime, tmp_path: Path) -> None:
+    monitor = ProgramMonitor(LocalSource(runtime), lambda: "engineer")
+    qtbot.addWidget(monitor)
+    monitor.resize(1366, 768)
+    monitor.show()
+    engine = runtime.engine
+    assert engine is not None
+    engine.write_bit(0, 1, user="test")
+    engine.write_bit(1, 1, user="test")
+    engine.write_word(0o4000, 0x0042, user="test")
+    wait(qtbot, lambda: engine.snapshot.get_word(0o4002) == 0x0042)
+    wait(qtbot, lambda: monitor.view.snapshot is not None and monitor.view.snapshot.get_word(0o4002) == 0x42)
+    image = monitor.view.viewport().grab().toImage()
+    view = monitor.view
+    row = 3  # line 4: YON PUMP, bit 1 and RES 1
+    y = row * view.line_h + view.line_h // 2
+    assert image.pixelColor(6 * view.char_w + 3, y) == ON
+    assert image.pixelColor(9 * view.char_w + 3, y) == ON
+    assert 0 < view.painted_rows <= len(view.listing)
+    assert monitor.forced_pill.text() == "F: 0 forced"
+    monitor.grab().save(str(tmp_path / "monitor.png"))
+    # FON values: the MOV's S and D words in the listing, in the chosen format
+    assert view._values(view.listing.rows[11].instr, view.snapshot) == "out 000 S=0042h D=0042h"
+    monitor.formats.setCurrentText("dec")
+    assert view._values(view.listing.rows[11].instr, view.snapshot).endswith("S=66 D=66")
+
+
+def test_a_2000_line_listing_paints_only_the_lines_on_screen(qtbot, tmp_path: Path) -> None:
+    text = "".join(f"TNA ${k % 0o2000:05o}\nYON ${0o2000 + k % 0o1000:05o}\n" for k in range(1000))
+    path = tmp_path / "big.stl"
+    path.write_text(text, encoding="utf-8")
+
+    class Still:  # a source that never changes: only the painting is looked at
+        caps = LocalSource.caps
+        title, symbols = "big", {}
+        program = parse(text, source=str(path))
+        snap = Memory().snapshot()
+
+        def snapshot(self):
+            return self.snap
+
+        def state(self) -> str:
+            return "stopped"
+
+        def forces(self):
+            return ()
+
+        def need(self, addrs) -> None:
+            list(addrs)
+
+        def timer(self, c):
+            return 0.0
+
+        counter = timer
+
+    monitor = ProgramMonitor(Still(), lambda: "engineer")  # type: ignore[arg-type]
+    qtbot.addWidget(monitor)
+    monitor.resize(1366, 768)
+    monitor.show()
+    assert len(monitor.listing) == 2000
+    monitor.view.viewport().grab()
+    assert 20 < monitor.view.painted_rows < 60
+    monitor.view.go_to(1500)
+    monitor.view.viewport().grab()
+    assert 1500 in monitor.view.visible_rows() and monitor.view.painted_rows < 60
+    refreshes = monitor.refreshes
+    monitor.refresh()
+    assert monitor.refreshes == refreshes  # the same snapshot: nothing redrawn
+
+
+def test_watch_edit_force_unforce_and_step_from_the_view(qtbot, runtime: Runtime) -> None:
+    monitor = ProgramMonitor(LocalSource(runtime), lambda: "eng1")
+    qtbot.addWidget(monitor)
+    engine = runtime.engine
+    assert engine is not None
+    monitor.watch.item(0, 0).setText("LEVEL")  # typed into the empty row
+    assert monitor.watch_items[0].addr == 0o4000 and monitor.watch.rowCount() == 2
+    monitor.watch.item(1, 0).setText("NOPE")
+    assert "NOPE" in monitor.message.text() and len(monitor.watch_items) == 1
+    monitor.watch.item(0, 1).setText("0x123")  # an edit is a write
+    wait(qtbot, lambda: engine.snapshot.get_word(0o4000) == 0x123)
+    wait(qtbot, lambda: monitor.watch.item(0, 2).text() == "0123h")
+    assert ("eng1", "write monitor (04000): 0 -> 291") in operator_texts(runtime)
+    monitor.force("word", 0o4000, 7)
+    monitor.force("bit", 0o2000, None)  # bumpless
+    wait(qtbot, lambda: monitor.forced_pill.text() == "F: 2 forced")
+    monitor.watch.item(0, 1).setText("9")  # a write loses to the force
+    wait(qtbot, lambda: monitor.watch.item(0, 4).text() == "F 7 (eng1)")
+    assert engine.snapshot.get_word(0o4000) == 7
+    monitor.unforce_button.click()
+    wait(qtbot, lambda: monitor.forced_pill.text() == "F: 0 forced")
+    texts = operator_texts(runtime)
+    assert ("eng1", "unforce 04000:word (was forced 7; unforce all)") in texts
+    assert ("eng1", "force 02000: 0 -> 0 (bumpless)") in texts
+    monitor.step()  # running: refused, said so
+    assert "only while NetPlc is stopped" in monitor.message.text()
+    runtime.stop_program()
+    wait(qtbot, lambda: engine.snapshot.state.startswith("stopped"))
+    before = engine.scan_counter
+    monitor.step_button.click()
+    assert engine.scan_counter > before and monitor.view.snapshot is engine.snapshot
+    assert any(t.startswith("step one scan") for _, t in operator_texts(runtime))
+
+
+def test_find_go_to_label_and_follow_a_symbol(qtbot, runtime: Runtime) -> None:
+    monitor = ProgramMonitor(LocalSource(runtime), lambda: "eng1")
+    qtbot.addWidget(monitor)
+    monitor.find.setText("JMN")
+    monitor.find_next()
+    assert monitor.view.current == 9
+    monitor.go_to_label("end")
+    assert monitor.view.current == 12
+    assert [monitor.listing.rows[r].line for r in monitor.follow(0o2000)] == [4, 9]
+    assert monitor.uses.count() == 2 and monitor.uses_title.text().startswith("Uses of PUMP (02000): 2 lines")
+    monitor._use_chosen(monitor.uses.item(1))
+    assert monitor.view.current == 8
+
+
+# --- the remote monitor ---------------------------------------------------------------------------------
+
+
+def test_the_remote_monitor_watches_and_writes_a_running_station_over_modbus(qtbot, runtime: Runtime) -> None:
+    assert runtime.modbus is not None and runtime.engine is not None
+    source = RemoteSource("127.0.0.1", runtime.modbus.port, program=runtime.program, symbols=runtime.symbols,
+                          poll=0.05)
+    try:
+        monitor = ProgramMonitor(source, lambda: "eng1")
+        qtbot.addWidget(monitor)
+        assert not monitor.unforce_button.isEnabled() and not monitor.step_button.isEnabled()
+        runtime.engine.write_word(0o4000, 0x4242, user="test")
+        runtime.engine.write_bit(0, 1, user="test")
+        runtime.engine.write_bit(1, 1, user="test")
+        wait(qtbot, lambda: (s := source.snapshot()) is not None and s.get_word(0o4002) == 0x4242
+             and s.get_bit(0o2000) == 1)
+        monitor.add_watch("04400")
+        monitor.add_watch("02001")
+        monitor.watch.item(0, 1).setText("513")  # written over Modbus, journaled with the peer
+        monitor.watch.item(1, 1).setText("1")
+        live = runtime.engine
+        wait(qtbot, lambda: live.snapshot.get_word(0o4400) == 513 and live.snapshot.get_bit(0o2001) == 1)
+        wait(qtbot, lambda: monitor.watch.item(0, 1).text() == "513")
+        assert any(s.startswith("modbus 127.0.0.1") and t.startswith("write 04400")
+                   for s, t in operator_texts(runtime))
+        monitor.add_watch("04777:b")
+        monitor.watch.item(2, 1).setText("1")  # 04777 is writable; 05000 is not
+        wait(qtbot, lambda: runtime.engine.snapshot.get_byte(0o4777) == 1)
+        monitor.add_watch("05000")
+        monitor.watch.item(3, 1).setText("1")
+        assert "refused" in monitor.message.text()
+        with pytest.raises(ValueError, match="forcing"):
+            source.force("bit", 0, 1, "eng1")
+        assert source.timer(0o3000) is None and source.forces() == ()
+    finally:
+        source.close()
+
+
+def test_the_monitor_command_target_is_a_station_or_host_port(qtbot, tmp_path: Path) -> None:
+    with socket.socket() as s:
+        s.bind(("127.0.0.1", 0))
+        port = s.getsockname()[1]
+    folder = station(tmp_path / "st", port)
+    rt = Runtime(load_station(folder))
+    rt.start()
+    try:
+        source = remote_source(str(folder))
+        try:
+            assert len(source.program.instrs) == 12 and source.symbols["PUMP"] == 0o2000
+            wait(qtbot, lambda: source.snapshot() is not None)
+            assert source.state().startswith("connected to tcp://127.0.0.1:")
+        finally:
+            source.close()
+    finally:
+        rt.stop()
+    with pytest.raises(Problems, match="neither a station folder nor HOST:PORT"):
+        remote_source("no-such-thing")
+    dead = remote_source(f"127.0.0.1:{port}")  # nothing listens there any more: said, not raised
+    try:
+        deadline = time.monotonic() + 5
+        while not dead.error and time.monotonic() < deadline:
+            QApplication.processEvents()
+            time.sleep(0.02)
+        assert dead.state().startswith("link down: cannot connect")
+    finally:
+        dead.close()
+
+
+# --- the workstation ------------------------------------------------------------------------------------
+
+
+def test_station_menu_opens_the_program_view_and_the_status_bar_counts_forces(qtbot, demo_copy: Path) -> None:
+    from app.gui.main_window import MainWindow
+    from app.gui.monitor.window import ProgramWindow
+
+    runtime = Runtime(load_station(demo_copy))
+    runtime.start()
+    window = MainWindow(runtime)
+    qtbot.addWidget(window)
+    try:
+        menu = window.menuBar().actions()[0].menu()
+        program = next(a for a in menu.actions() if a.text() == "&Program…")
+        assert window.status.forced.text() == "F: 0 forced"
+        program.trigger()
+        opened = [w for w in window.viewers if isinstance(w, ProgramWindow)]
+        assert len(opened) == 1 and opened[0].isVisible()
+        monitor = opened[0].monitor
+        assert len(monitor.listing) > 100
+        monitor.force("bit", 0o2120, 1)
+        wait(qtbot, lambda: runtime.status().forced == 1)
+        window.refresh_status()
+        assert window.status.forced.text() == "F: 1 forced"
+        wait(qtbot, lambda: monitor.forced_pill.text() == "F: 1 forced")
+    finally:
+        window.close()
+        runtime.stop()
+    assert not opened[0].isVisible()
+
+
+def test_main_monitor_command_refuses_a_bad_target_with_a_message() -> None:
+    import os
+    import subprocess
+    import sys
+
+    from tests.app.conftest import REPO
+
+    env = {**os.environ, "QT_QPA_PLATFORM": "offscreen"}
+    r = subprocess.run([sys.executable, "main.py", "monitor", "nowhere"], cwd=REPO, capture_output=True,
+                       text=True, timeout=60, env=env)
+    assert r.returncode == 2 and "nowhere: neither a station folder nor HOST:PORT" in r.stderr
+    assert "Traceback" not in r.stderr
