@@ -33,6 +33,7 @@ from registrar.schema import (
     quoted,
     table_name,
     text_index,
+    zone,
 )
 
 EXPORT_CHUNK = 10_000
@@ -51,6 +52,7 @@ class Filter:
     text: str | None = None  # contains
     since: float | None = None  # seconds since the epoch, inclusive
     until: float | None = None  # seconds since the epoch, exclusive
+    stations: set[str] | frozenset[str] | None = None  # plant archive: these stations only
 
 
 @dataclass(frozen=True, slots=True)
@@ -64,11 +66,13 @@ class Row:
     number: int | None
     value: float | None
     text: str | None
+    station: str | None = None  # plant archive: the station that wrote it
+    tz: dt.tzinfo | None = None  # the zone the archive's days are cut in (None: this machine's)
 
     @property
     def time(self) -> dt.datetime:
-        """Local time of the record."""
-        return dt.datetime.fromtimestamp(self.ts)
+        """Wall time of the record where it was written (naive)."""
+        return dt.datetime.fromtimestamp(self.ts, self.tz).replace(tzinfo=None)
 
 
 class SeriesKey(NamedTuple):
@@ -76,17 +80,52 @@ class SeriesKey(NamedTuple):
     grp: int | None
     type: int | None
     source: str | None
+    station: str | None = None  # plant archive: whose series
 
 
 _SELECT = "SELECT " + ", ".join(COLUMNS)
 
 
 class Archive:
+    """A station's SQLite archive, or the plant archive when given a postgresql:// URL (the same
+    methods, see registrar/pg_query.py)."""
+
+    def __new__(cls, target: str | Path) -> Archive:
+        if cls is Archive and isinstance(target, str) and target.startswith(("postgresql://",
+                                                                               "postgres://")):
+            from registrar.pg_query import PgArchive
+
+            return super().__new__(PgArchive)
+        return super().__new__(cls)
+
     def __init__(self, path: str | Path) -> None:
         self.path = Path(path)
         if not self.path.is_file():
             raise FileNotFoundError(f"{self.path}: no such archive")
         self._con = self._connect()
+        self.tz = self._zone()
+
+    def _zone(self) -> dt.tzinfo | None:
+        """The writer's zone, by the IANA key it stored (older archives: this machine's)."""
+        try:
+            return zone(self.meta().get("timezone_key", ""))
+        except sqlite3.Error:
+            return None
+
+    @property
+    def name(self) -> str:
+        return str(self.path)
+
+    def stations(self) -> list[str]:
+        """The stations that write to the archive: a station's own archive names none."""
+        return []
+
+    def at(self, day: dt.date, time: dt.time) -> float:
+        """Epoch seconds of a wall time of `day` in the archive's zone (the viewer's From/To)."""
+        return dt.datetime.combine(day, time, self.tz).timestamp()
+
+    def local_time(self, ts: float) -> dt.datetime:
+        return dt.datetime.fromtimestamp(ts, self.tz).replace(tzinfo=None)
 
     def _connect(self) -> sqlite3.Connection:
         uri = f"file:{quote(str(self.path.resolve()))}?mode=ro"
@@ -153,20 +192,20 @@ class Archive:
         rows = self._con.execute(f"{_SELECT} FROM {table} NOT INDEXED {_and(where, window)} {page}",
                                  [*args, limit, offset]).fetchall()
         if len(rows) == limit or whole:
-            return [_row(r) for r in rows]
+            return [self._row(r) for r in rows]
         # 2. Rare matches of indexed keys: fetch them through the index and sort them.
         keyed = self._keyed(day, flt) if self._has_index(key_index(table_name(day))) else None
         if keyed is not None:
             where, args = _where(keyed)
             index = f'"{key_index(table_name(day))}"'
-            return [_row(r) for r in self._con.execute(
+            return [self._row(r) for r in self._con.execute(
                 f"{_SELECT} FROM {table} INDEXED BY {index}{where} {page}", [*args, limit, offset])]
         # 3. Everything else: one pass in id order, stopping at the page; a text search passes
         #    over the rows that have a text only.
         source = "NOT INDEXED"
         if flt.text and self._has_index(text_index(table_name(day))):
             source = f'INDEXED BY "{text_index(table_name(day))}"'
-        return [_row(r) for r in self._con.execute(
+        return [self._row(r) for r in self._con.execute(
             f"{_SELECT} FROM {table} {source}{where} {page}", [*args, limit, offset])]
 
     def _keyed(self, day: dt.date, flt: Filter) -> Filter | None:
@@ -212,7 +251,7 @@ class Archive:
             try:
                 while chunk := cur.fetchmany(EXPORT_CHUNK):
                     for r in chunk:
-                        local = dt.datetime.fromtimestamp(r[1] / 1000).isoformat(timespec="milliseconds")
+                        local = self.local_time(r[1] / 1000).isoformat(timespec="milliseconds")
                         out.writerow([r[0], local, *r[1:]])
                     n += len(chunk)
             finally:
@@ -260,6 +299,9 @@ class Archive:
 
     # --- helpers -------------------------------------------------------------------------------
 
+    def _row(self, r: tuple) -> Row:
+        return Row(r[0], r[1] / 1000.0, *r[2:], tz=self.tz)
+
     def _has_index(self, name: str) -> bool:
         return self._con.execute("SELECT 1 FROM sqlite_master WHERE type = 'index' AND name = ?",
                                  (name,)).fetchone() is not None
@@ -280,34 +322,33 @@ def _open_ro(uri: str) -> sqlite3.Connection:
     return con
 
 
-def _row(r: tuple) -> Row:
-    return Row(r[0], r[1] / 1000.0, *r[2:])
 
 
-def _where(flt: Filter) -> tuple[str, list[object]]:
+def _where(flt: Filter, mark: str = "?") -> tuple[str, list[object]]:
+    """The WHERE clause of a filter; `mark` is the driver's placeholder (psycopg: %s)."""
     conds: list[str] = []
     args: list[object] = []
     if flt.kinds is not None:
         kinds = sorted(flt.kinds)
-        conds.append(f"kind IN ({', '.join('?' * len(kinds))})" if kinds else "0")
+        conds.append(f"kind IN ({', '.join([mark] * len(kinds))})" if kinds else "1 = 0")
         args.extend(kinds)
     for col, val in (("grp", flt.grp), ("type", flt.type), ("source", flt.source)):
         if val is not None:
-            conds.append(f"{col} = ?")
+            conds.append(f"{col} = {mark}")
             args.append(val)
     if flt.min_type is not None:
-        conds.append("type >= ?")
+        conds.append(f"type >= {mark}")
         args.append(flt.min_type)
     if flt.since is not None:
-        conds.append("ts >= ?")
+        conds.append(f"ts >= {mark}")
         args.append(round(flt.since * 1000))
     if flt.until is not None:
-        conds.append("ts < ?")
+        conds.append(f"ts < {mark}")
         args.append(round(flt.until * 1000))
     if flt.text:
         # SQLite folds case for ASCII only; the usual spellings of a Cyrillic word are tried too.
         variants = sorted({flt.text, flt.text.lower(), flt.text.upper(), flt.text.capitalize()})
-        likes = " OR ".join("text LIKE ? ESCAPE '\\'" for _ in variants)
+        likes = " OR ".join(f"text LIKE {mark} ESCAPE '\\'" for _ in variants)
         conds.append(f"text IS NOT NULL AND ({likes})")
         args.extend(f"%{_escape_like(v)}%" for v in variants)
     return (" WHERE " + " AND ".join(conds)) if conds else "", args

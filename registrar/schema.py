@@ -7,6 +7,10 @@ day), so retention drops a whole table and a day's queries never touch other day
 from __future__ import annotations
 
 import datetime as dt
+import os
+import time
+import zoneinfo
+from pathlib import Path
 
 SCHEMA_VERSION = "1"
 COLUMNS = ("id", "ts", "kind", "grp", "type", "source", "number", "value", "text")
@@ -81,3 +85,45 @@ def local_day_bounds(ts: float) -> tuple[dt.date, float, float]:
     nxt = day + dt.timedelta(days=1)
     end = dt.datetime(nxt.year, nxt.month, nxt.day).timestamp()
     return day, start, end
+
+
+def local_zone_key() -> str:
+    """The IANA key of this machine's zone ("Europe/Moscow"), stored in `meta` so that a copy of the
+    archive read in another zone still cuts days where the writer did; "" when it cannot be told."""
+    candidates = [os.environ.get("TZ", "").lstrip(":")]
+    try:
+        target = os.path.realpath("/etc/localtime")
+        if "/zoneinfo/" in target:
+            candidates.append(target.split("/zoneinfo/", 1)[1])
+    except OSError:
+        pass
+    try:
+        candidates.append(Path("/etc/timezone").read_text(encoding="ascii").strip())
+    except (OSError, UnicodeDecodeError):
+        pass
+    for key in candidates:
+        if key and zone(key) is not None and _same_offsets(key):
+            return key
+    return ""
+
+
+def zone(key: str) -> zoneinfo.ZoneInfo | None:
+    try:
+        return zoneinfo.ZoneInfo(key) if key else None
+    except (zoneinfo.ZoneInfoNotFoundError, ValueError):
+        return None
+
+
+def _same_offsets(key: str) -> bool:
+    """Whether the zone `key` agrees with what time.localtime says now (TZ may name a POSIX rule)."""
+    tz = zone(key)
+    now = time.time()
+    return tz is not None and dt.datetime.fromtimestamp(now, tz).utcoffset() == dt.timedelta(
+        seconds=time.localtime(now).tm_gmtoff)
+
+
+def day_bounds_in(day: dt.date, tz: dt.tzinfo | None) -> tuple[float, float]:
+    """The epoch seconds of `day`'s midnight and the next one in zone `tz` (None: this machine's)."""
+    nxt = day + dt.timedelta(days=1)
+    return (dt.datetime(day.year, day.month, day.day, tzinfo=tz).timestamp(),
+            dt.datetime(nxt.year, nxt.month, nxt.day, tzinfo=tz).timestamp())

@@ -33,6 +33,7 @@ from registrar.schema import (
     SERIES_SQL,
     index_sql,
     local_day_bounds,
+    local_zone_key,
     parse_table_name,
     table_name,
 )
@@ -194,6 +195,7 @@ class Store:
             "ts_unit": "milliseconds since 1970-01-01 UTC",
             "day_tables": "one per local day, named DD_MM_YYYY",
             "timezone": time.strftime("%Z %z"),
+            "timezone_key": local_zone_key(),  # IANA: readers in another zone cut days as written
             "message_types": "0 info, 1 warning, 2 alarm, 3 critical",
         }
         con.execute("INSERT OR IGNORE INTO meta VALUES ('created', ?)",

@@ -9,7 +9,7 @@ import pytest
 
 from netplc.records import Record
 from registrar.catalog import Catalog, Message
-from registrar.query import Archive, Filter, SeriesKey
+from registrar.query import Archive, Filter
 from registrar.store import Store
 
 from .conftest import wait_for
@@ -29,7 +29,7 @@ def write(db, records):
 
 
 @pytest.fixture
-def archive(db):
+def archive(db, opened):
     records = []
     for i in range(300):
         records.append(Record(T0 + i, "data", 1, 1, "04010", value=float(i)))
@@ -40,7 +40,7 @@ def archive(db):
                           text="write 04030: 0 -> 7"))
     records.append(Record(T0 - 86400, "system", source="app", text="station started"))
     write(db, records)
-    with Archive(db) as a:
+    with opened(db) as a:
         yield a
 
 
@@ -93,19 +93,19 @@ def test_a_missing_day_is_empty(archive):
 
 
 def test_series_keys_and_small_series(archive):
-    assert archive.series_keys(DAY) == [SeriesKey("data", 1, 1, "04010")]
+    assert [key[:4] for key in archive.series_keys(DAY)] == [("data", 1, 1, "04010")]
     assert archive.series_keys(DAY - dt.timedelta(days=1)) == []
     ts, values = archive.series(DAY, grp=1, type=1, source="04010")
     assert np.array_equal(ts, T0 + np.arange(300)) and np.array_equal(values, np.arange(300.0))
 
 
-def test_downsampling_keeps_peaks(db):
+def test_downsampling_keeps_peaks(db, opened):
     n = 20_000
     values = np.sin(np.arange(n) / 500.0) * 100.0
     values[12_345] = 1000.0
     values[777] = -1000.0
     write(db, [Record(T0 + i * 0.1, "data", 3, 4, "04020", value=float(v)) for i, v in enumerate(values)])
-    with Archive(db) as a:
+    with opened(db) as a:
         ts, got = a.series(DAY, grp=3, type=4, points=200)
         _, full = a.series(DAY, grp=3, type=4, points=n)
     assert 100 <= len(ts) <= 200
@@ -121,8 +121,8 @@ def test_export_csv(archive, tmp_path):
     assert archive.export_csv(out, DAY, Filter(kinds={"message"}, min_type=2)) == 10
     with open(out, encoding="utf-8-sig", newline="") as f:
         table = list(csv.reader(f))
-    assert table[0] == ["id", "time", "ts", "kind", "grp", "type", "source", "number", "value", "text"]
-    assert table[1][1] == "2026-03-05T08:00:00.000" and table[1][-1] == "Уровень выше 90 %"
+    assert table[0][:10] == ["id", "time", "ts", "kind", "grp", "type", "source", "number", "value", "text"]
+    assert table[1][1] == "2026-03-05T08:00:00.000" and table[1][9] == "Уровень выше 90 %"
     assert len(table) == 11
     assert out.read_bytes().startswith(b"\xef\xbb\xbf")
 
@@ -175,7 +175,7 @@ def test_reading_while_the_writer_writes(db):
     assert store.stats.last_error == ""
 
 
-def test_every_page_strategy_gives_the_reference_answer(db, monkeypatch):
+def test_every_page_strategy_gives_the_reference_answer(db, opened, monkeypatch):
     """Small probe and index limits force all three ways of finding a page on a modest day."""
     import random
 
@@ -199,7 +199,7 @@ def test_every_page_strategy_gives_the_reference_answer(db, monkeypatch):
         Filter(grp=0), Filter(grp=2, type=3), Filter(kinds={"data"}, grp=1), Filter(text="связь"),
         Filter(kinds={"message"}, min_type=2), Filter(kinds={"data"}, until=T0 + 100), Filter(grp=9),
     ]
-    with Archive(db) as a:
+    with opened(db) as a:
         everything = a.records(DAY, limit=10_000, newest_first=False)
         assert len(everything) == 3000
         for flt in filters:
