@@ -83,6 +83,7 @@ class Station:
     nodes: tuple[NodeSettings, ...] = ()
     simulators: tuple[SimulatorSettings, ...] = ()
     users: tuple[str, ...] = ("operator",)
+    plant_archive: str | None = None  # `Archive` given as a postgresql:// URL: forwarded there
 
     @property
     def folder(self) -> Path:
@@ -192,7 +193,8 @@ def read_station(path: str | Path) -> tuple[Station | None, list[str]]:
     symbols = top.path("Symbols", base)
     hmi = top.path("HMIload", base)
     sync = top.number("NetSyncTime", 100, 10, 60_000)
-    archive = top.path("Archive", base, "archive/journal.sqlite")
+    plant = _plant_archive(top)  # marks a URL `Archive` known, valid or not
+    archive = None if "Archive" in top.known else top.path("Archive", base, "archive/journal.sqlite")
     messages = top.path("Messages", base)
     keep_days = top.number("keep_days", 0, 0, 36_500)
     retain = top.path("Retain", base)
@@ -220,9 +222,24 @@ def read_station(path: str | Path) -> tuple[Station | None, list[str]]:
         path=file.resolve(), name=name or base.name, NetPlcLoad=bool(load), NetPlcProgram=program,
         Symbols=symbols, HMIload=hmi, NetSyncTime=sync, Archive=archive, Messages=messages,
         keep_days=keep_days, Retain=retain or archive.with_name("retain.bin"), modbus_server=server,
-        nodes=tuple(nodes), simulators=tuple(runnable), users=users,
+        nodes=tuple(nodes), simulators=tuple(runnable), users=users, plant_archive=plant,
     )
     return station, problems
+
+
+def _plant_archive(top: _Reader) -> str | None:
+    """`Archive` as a PostgreSQL URL: the station still writes its default local archive first."""
+    value = top.table.get("Archive")
+    if not (isinstance(value, str) and value.startswith(("postgresql://", "postgres://"))):
+        return None
+    from registrar.pg import url_problem  # psycopg only where a plant archive is named
+
+    top.known.add("Archive")
+    problem = url_problem(value)
+    if problem:
+        top.bad("Archive", problem)
+        return None
+    return value
 
 
 def _existing(r: _Reader, key: str, path: Path | None, must_be_dir: bool) -> Path | None:

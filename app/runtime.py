@@ -19,6 +19,7 @@ from collections.abc import Callable, Iterable
 from concurrent.futures import ThreadPoolExecutor, wait
 from dataclasses import dataclass, field, replace
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 from app.config import NodeSettings, Station
 from netplc.engine import Engine
@@ -32,6 +33,9 @@ from netplc.simulator import Simulator
 from registrar.catalog import Catalog, CatalogError
 from registrar.retain import Retainer
 from registrar.store import Store, StoreStats
+
+if TYPE_CHECKING:
+    from registrar.forward import Forwarder
 
 RecordObserver = Callable[[Record], None]
 UNSTARTED = "tcp://127.0.0.1:1"  # endpoint of a simulated node whose simulator has not started
@@ -147,6 +151,7 @@ class Runtime:
         self.wallclock = wallclock
         self.catalog, self.program, self.node_programs = self._load()
         self.store: Store | None = None
+        self.forwarder: Forwarder | None = None  # to the plant archive, when Archive is a URL
         self.engine: Engine | None = None
         self.retainer: Retainer | None = None
         self.simulators: list[Simulator] = []
@@ -232,6 +237,12 @@ class Runtime:
         except (OSError, sqlite3.Error) as e:
             raise StartError([f"{st.path}: Archive: {e}"]) from None
         self.store = store
+        if st.plant_archive:
+            from registrar.forward import Forwarder  # psycopg only where a plant archive is named
+
+            self.forwarder = Forwarder(st.Archive, st.plant_archive, st.name, keep_days=st.keep_days,
+                                       sink=self.put, wallclock=self.wallclock)
+            self.forwarder.start()  # never fails: PostgreSQL away is a lag, not a start error
         try:
             self._start_parts()
         except StartError as e:
@@ -330,6 +341,9 @@ class Runtime:
             store, self.store = self.store, None
             store.close()  # flushes every queued record
             self._final_store = store.stats
+        if self.forwarder is not None:
+            self.forwarder.close()  # sends the rest if the plant archive answers
+            self.forwarder = None
         self.started = False
 
     # --- NetPlc run control (the workstation's menu) -------------------------------------------
@@ -363,6 +377,10 @@ class Runtime:
                 problems.append(f"archive: {s.last_error}")
             if s.dropped:
                 problems.append(f"archive: {s.dropped} records lost (disk too slow or full)")
+        forwarder = self.forwarder
+        if forwarder is not None and (f := forwarder.stats).lag > forwarder.lag_alarm:
+            problems.append(f"archive: forwarding to the plant archive lags by {f.lag:.0f} s, "
+                            f"{f.backlog} records ({f.last_error or 'catching up'})")
         return RuntimeStatus(
             running=self.started,
             state=engine.state_text if engine else "not started",

@@ -40,10 +40,6 @@ class PgArchive(Archive):
             raise psycopg.OperationalError(f"{url}: no plant archive in this database "
                                            "(no station has forwarded to it yet)") from None
 
-    @property
-    def name(self) -> str:
-        return self.url
-
     def close(self) -> None:
         self._pg.close()
 

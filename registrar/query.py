@@ -112,17 +112,9 @@ class Archive:
         except sqlite3.Error:
             return None
 
-    @property
-    def name(self) -> str:
-        return str(self.path)
-
     def stations(self) -> list[str]:
         """The stations that write to the archive: a station's own archive names none."""
         return []
-
-    def at(self, day: dt.date, time: dt.time) -> float:
-        """Epoch seconds of a wall time of `day` in the archive's zone (the viewer's From/To)."""
-        return dt.datetime.combine(day, time, self.tz).timestamp()
 
     def local_time(self, ts: float) -> dt.datetime:
         return dt.datetime.fromtimestamp(ts, self.tz).replace(tzinfo=None)

@@ -6,6 +6,7 @@ day), so retention drops a whole table and a day's queries never touch other day
 
 from __future__ import annotations
 
+import contextlib
 import datetime as dt
 import os
 import time
@@ -97,10 +98,8 @@ def local_zone_key() -> str:
             candidates.append(target.split("/zoneinfo/", 1)[1])
     except OSError:
         pass
-    try:
+    with contextlib.suppress(OSError, UnicodeDecodeError):
         candidates.append(Path("/etc/timezone").read_text(encoding="ascii").strip())
-    except (OSError, UnicodeDecodeError):
-        pass
     for key in candidates:
         if key and zone(key) is not None and _same_offsets(key):
             return key
