@@ -33,7 +33,9 @@ def _free_port() -> int:
 
 
 class PgCluster:
-    def __init__(self) -> None:
+    def __init__(self, durable: bool = False) -> None:
+        """durable=False: no fsync (tests); True: the server's defaults (benchmarks)."""
+        self.durable = durable
         initdb, postgres = _bin("initdb"), _bin("postgres")
         if initdb is None or postgres is None:
             raise RuntimeError("PostgreSQL is not installed (apt-get install postgresql)")
@@ -68,8 +70,9 @@ class PgCluster:
     def start(self) -> None:
         self.process = subprocess.Popen(
             [self.postgres, "-D", str(self.data), "-p", str(self.port), "-c", "listen_addresses=127.0.0.1",
-             "-c", f"unix_socket_directories={self.folder}", "-c", "fsync=off",
-             "-c", "synchronous_commit=off", "-c", "full_page_writes=off", "-c", "max_connections=50"],
+             "-c", f"unix_socket_directories={self.folder}", "-c", "max_connections=50",
+             *([] if self.durable else ["-c", "fsync=off", "-c", "synchronous_commit=off",
+                                        "-c", "full_page_writes=off"])],
             user=self.user, stdout=subprocess.DEVNULL, stderr=open(self.folder / "log", "ab"))  # noqa: SIM115
         deadline = time.monotonic() + 30
         while True:
