@@ -28,7 +28,9 @@ import numpy as np
 from registrar.schema import (
     COLUMNS,
     DAY_GLOB,
+    fts_table,
     key_index,
+    minutes_table,
     parse_table_name,
     quoted,
     table_name,
@@ -40,6 +42,7 @@ EXPORT_CHUNK = 10_000
 PROBE_ROWS = 20_000  # newest rows tried first for a page (a couple of milliseconds)
 INDEX_ROWS = 50_000  # up to this many index matches are fetched and sorted rather than scanned
 SCAN_ABOVE = 0.125  # a series holding more than this share of its day is read by a table scan
+SUMMARY_ABOVE = 100_000  # a series of more records is read from the per-minute summary
 
 
 @dataclass(frozen=True)
@@ -192,8 +195,16 @@ class Archive:
             index = f'"{key_index(table_name(day))}"'
             return [self._row(r) for r in self._con.execute(
                 f"{_SELECT} FROM {table} INDEXED BY {index}{where} {page}", [*args, limit, offset])]
-        # 3. Everything else: one pass in id order, stopping at the page; a text search passes
-        #    over the rows that have a text only.
+        # 3. A text search: the rows whose text holds every trigram of the text, by the day's
+        #    trigram index (the LIKE filter then decides, as on every other path).
+        candidates = self._text_candidates(day, flt)
+        if candidates:
+            where, args = _where(flt)
+            return [self._row(r) for r in self._con.execute(
+                f"{_SELECT} FROM {table}{_and(where, candidates[0])} {page}",
+                [*args, candidates[1], limit, offset])]
+        # 4. Everything else: one pass in id order, stopping at the page; a text search of a day
+        #    without the trigram index passes over the rows that have a text only.
         source = "NOT INDEXED"
         if flt.text and self._has_index(text_index(table_name(day))):
             source = f'INDEXED BY "{text_index(table_name(day))}"'
@@ -227,8 +238,20 @@ class Archive:
     def count(self, day: dt.date, flt: Filter | None = None) -> int:
         if not self._has(day):
             return 0
-        where, args = _where(flt or Filter())
+        flt = flt or Filter()
+        where, args = _where(flt)
+        candidates = self._text_candidates(day, flt)
+        if candidates:
+            where, args = _and(where, candidates[0]), [*args, candidates[1]]
         return self._con.execute(f"SELECT count(*) FROM {quoted(day)}{where}", args).fetchone()[0]
+
+    def _text_candidates(self, day: dt.date, flt: Filter) -> tuple[str, str] | None:
+        """The condition and argument limiting a text search to the trigram index's candidates
+        (None: no text of 3 or more characters, or a day written before the index)."""
+        if not flt.text or len(flt.text) < 3 or not self._has_table(fts_table(table_name(day))):
+            return None
+        fts = f'"{fts_table(table_name(day))}"'
+        return f"id IN (SELECT rowid FROM {fts} WHERE {fts} MATCH ?)", _trigrams(flt.text)
 
     def export_csv(self, path: str | Path, day: dt.date, flt: Filter | None = None) -> int:
         """Write the selection oldest first; UTF-8 with a BOM so spreadsheets read Cyrillic."""
@@ -270,6 +293,11 @@ class Archive:
                 args.append(val)
         where = " WHERE " + " AND ".join(conds)
         table = quoted(day)
+        if grp is not None and type is not None and source is not None:
+            summary = self._summary(day, grp, type, source)
+            if summary is not None:
+                ts, values = summary
+                return (ts, values) if len(ts) <= points else _min_max(ts, values, max(1, points // 2))
         # A series holding a good part of the day is read faster by a scan than by index lookups.
         total = self._con.execute(f"SELECT max(id) FROM {table}").fetchone()[0] or 0
         many = round(SCAN_ABOVE * total)
@@ -293,6 +321,30 @@ class Archive:
 
     def _row(self, r: tuple) -> Row:
         return Row(r[0], r[1] / 1000.0, *r[2:], tz=self.tz)
+
+    def _summary(self, day: dt.date, grp: int, type: int,
+                 source: str) -> tuple[np.ndarray, np.ndarray] | None:
+        """The series from the per-minute minima and maxima at their own times, when it is long
+        enough for that to pay (None: read the records)."""
+        minutes = minutes_table(table_name(day))
+        if not self._has_table(minutes):
+            return None
+        key = "WHERE grp = ? AND type = ? AND source = ?"
+        total = self._con.execute(f'SELECT sum(n) FROM "{minutes}" {key}', (grp, type, source)).fetchone()[0]
+        if not total or total <= SUMMARY_ABOVE:
+            return None
+        cur = self._con.execute(f'SELECT lo_ts, lo, hi_ts, hi FROM "{minutes}" {key} ORDER BY minute',
+                                (grp, type, source))
+        data = np.fromiter(cur, dtype=[("lo_ts", "i8"), ("lo", "f8"), ("hi_ts", "i8"), ("hi", "f8")])
+        ts = np.column_stack([data["lo_ts"], data["hi_ts"]]).ravel()
+        values = np.column_stack([data["lo"], data["hi"]]).ravel()
+        order = np.argsort(ts, kind="stable")
+        ts, values = ts[order], values[order]
+        keep = np.r_[True, (ts[1:] != ts[:-1]) | (values[1:] != values[:-1])]  # min and max one record
+        return ts[keep] / 1000.0, values[keep]
+
+    def _has_table(self, name: str) -> bool:
+        return self._con.execute("SELECT 1 FROM sqlite_master WHERE name = ?", (name,)).fetchone() is not None
 
     def _has_index(self, name: str) -> bool:
         return self._con.execute("SELECT 1 FROM sqlite_master WHERE type = 'index' AND name = ?",
@@ -344,6 +396,12 @@ def _where(flt: Filter, mark: str = "?") -> tuple[str, list[object]]:
         conds.append(f"text IS NOT NULL AND ({likes})")
         args.extend(f"%{_escape_like(v)}%" for v in variants)
     return (" WHERE " + " AND ".join(conds)) if conds else "", args
+
+
+def _trigrams(text: str) -> str:
+    """An FTS5 query for rows holding every trigram of `text` (the index folds case itself)."""
+    quoted_ = ('"' + text[i:i + 3].replace('"', '""') + '"' for i in range(len(text) - 2))
+    return " AND ".join(dict.fromkeys(quoted_))
 
 
 def _and(where: str, cond: str) -> str:

@@ -52,6 +52,49 @@ def index_sql(table: str) -> list[str]:
             "WHERE text IS NOT NULL"]
 
 
+# Beside each day table, two tables kept in the batch's transaction: a trigram full-text index of
+# the texts (contentless, no positions: it names candidate rows, the LIKE filter decides, so a text
+# search reads only rows holding the text's trigrams), and per series and minute the count, the
+# minimum and the maximum at their own times (a day's series is read from 1,440 rows per key
+# instead of every record). Days written before them have neither: readers fall back.
+def fts_table(table: str) -> str:
+    return f"text_{table}"
+
+
+def minutes_table(table: str) -> str:
+    return f"minutes_{table}"
+
+
+def aux_sql(table: str) -> list[str]:
+    return [f'CREATE VIRTUAL TABLE IF NOT EXISTS "{fts_table(table)}" USING fts5(text, content=\'\', '
+            "detail=none, tokenize=trigram)",
+            f'CREATE TABLE IF NOT EXISTS "{minutes_table(table)}" (grp INTEGER NOT NULL, '
+            "type INTEGER NOT NULL, source TEXT NOT NULL, minute INTEGER NOT NULL, n INTEGER NOT NULL, "
+            "lo REAL, lo_ts INTEGER, hi REAL, hi_ts INTEGER, PRIMARY KEY (grp, type, source, minute)) "
+            "WITHOUT ROWID"]
+
+
+def aux_fill_sql(table: str) -> list[str]:
+    """Statements adding the rows with id > ? to the two tables (the min and the max each need a
+    pass of their own: SQLite gives the ts of the row holding a lone min() or max())."""
+    rows = (f'FROM "{table}" NOT INDEXED WHERE id > ? AND kind = \'data\' AND value IS NOT NULL '
+            "AND grp IS NOT NULL AND type IS NOT NULL AND source IS NOT NULL "
+            "GROUP BY grp, type, source, ts / 60000")
+    into = f'INSERT INTO "{minutes_table(table)}" (grp, type, source, minute, n, lo, lo_ts, hi, hi_ts)'
+    return [
+        f'INSERT INTO "{fts_table(table)}" (rowid, text) SELECT id, text FROM "{table}" '
+        "WHERE id > ? AND text IS NOT NULL",
+        f"{into} SELECT grp, type, source, ts / 60000, count(*), min(value), ts, NULL, NULL {rows} "
+        "ON CONFLICT DO UPDATE SET n = n + excluded.n, "
+        "lo_ts = CASE WHEN excluded.lo < lo THEN excluded.lo_ts ELSE lo_ts END, "
+        "lo = CASE WHEN excluded.lo < lo THEN excluded.lo ELSE lo END",
+        f"{into} SELECT grp, type, source, ts / 60000, 0, NULL, NULL, max(value), ts {rows} "
+        "ON CONFLICT DO UPDATE SET "
+        "hi_ts = CASE WHEN hi IS NULL OR excluded.hi > hi THEN excluded.hi_ts ELSE hi_ts END, "
+        "hi = CASE WHEN hi IS NULL OR excluded.hi > hi THEN excluded.hi ELSE hi END",
+    ]
+
+
 META_SQL = "CREATE TABLE IF NOT EXISTS meta (key TEXT PRIMARY KEY, value TEXT)"
 MESSAGES_SQL = ("CREATE TABLE IF NOT EXISTS messages "
                 "(number INTEGER PRIMARY KEY, grp INTEGER, type INTEGER, text TEXT)")

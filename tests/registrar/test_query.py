@@ -234,3 +234,68 @@ def test_a_series_stays_in_time_order_when_the_clock_was_set_back(db):
         ts, values = a.series(DAY, grp=1, type=1, source="04000")
         assert list(ts) == sorted(stamps) and list(values) == [2.0, 0.0, 1.0, 3.0]
         assert [r.value for r in a.records(DAY, newest_first=False)] == [0.0, 1.0, 2.0, 3.0]
+
+
+def _without_text_index_and_summary(db) -> None:
+    """The file as an archive written before the trigram index and the per-minute summary."""
+    con = sqlite3.connect(db)
+    for (name,) in con.execute("SELECT name FROM sqlite_master WHERE type = 'table' "
+                               "AND (name GLOB 'text_*' OR name GLOB 'minutes_*')").fetchall():
+        if not name.endswith(("_data", "_idx", "_docsize", "_config", "_content")):
+            con.execute(f'DROP TABLE "{name}"')
+    con.commit()
+    con.close()
+
+
+def test_text_search_by_the_trigram_index_equals_the_scan(db):
+    words = ["Авария насоса", "насос в работе", "Связь потеряна", "ПУСК нажат", 'кавычка "x"', "50%_done"]
+    records = [Record(T0 + i, "operator" if i % 7 else "data", 1, 1, "04010", value=float(i),
+                      text=words[i % len(words)] if i % 7 else None) for i in range(3000)]
+    write(db, records)
+    searches = ["авария", "НАСОС", "Насос", "связь", "пуск", '"x"', "0%_", "нет такого", "на", "ё"]
+    with Archive(db) as a:
+        indexed = {t: (a.count(DAY, Filter(text=t)), a.records(DAY, Filter(text=t), limit=50, offset=3))
+                   for t in searches}
+    _without_text_index_and_summary(db)
+    with Archive(db) as a:
+        for t in searches:
+            assert (a.count(DAY, Filter(text=t)), a.records(DAY, Filter(text=t), limit=50, offset=3)) \
+                == indexed[t], t
+    assert indexed["авария"][0] == 3000 * 6 // 7 // 6 and indexed["нет такого"][0] == 0
+
+
+def test_a_long_series_is_read_from_the_minute_summary(db, monkeypatch):
+    import registrar.query as query
+
+    n = 20_000  # 10 records a second: 2,000 s, 34 minutes
+    values = np.cos(np.arange(n) / 700.0) * 50.0
+    values[12_345] = 1000.0
+    values[777] = -1000.0
+    write(db, [Record(T0 + i * 0.1, "data", 3, 4, "04020", value=float(v)) for i, v in enumerate(values)])
+    with Archive(db) as a:
+        raw = a.series(DAY, grp=3, type=4, source="04020", points=200)
+        monkeypatch.setattr(query, "SUMMARY_ABOVE", 1_000)
+        ts, got = a.series(DAY, grp=3, type=4, source="04020", points=200)
+        every, _ = a.series(DAY, grp=3, type=4, source="04020", points=100_000)
+    assert 34 <= len(every) <= 2 * 34  # a minimum and a maximum per minute
+    assert len(ts) <= 200 and np.all(np.diff(ts) > 0)
+    assert got.max() == raw[1].max() == 1000.0 and got.min() == raw[1].min() == -1000.0
+    assert ts[np.argmax(got)] == pytest.approx(T0 + 1234.5)
+    assert ts[np.argmin(got)] == pytest.approx(T0 + 77.7)
+    _without_text_index_and_summary(db)  # an older archive: read from the records, same peaks
+    with Archive(db) as a:
+        old_ts, old = a.series(DAY, grp=3, type=4, source="04020", points=200)
+    assert old.max() == 1000.0 and old_ts[np.argmax(old)] == pytest.approx(T0 + 1234.5)
+
+
+def test_a_day_written_before_the_index_gets_it_filled_when_written_again(db):
+    write(db, [Record(T0 + i, "message", 1, 2, number=3) for i in range(10)])
+    _without_text_index_and_summary(db)
+    write(db, [Record(T0 + 20 + i, "data", 1, 1, "04010", value=float(i)) for i in range(5)])
+    con = sqlite3.connect(db)
+    try:
+        fts = '"text_05_03_2026"'
+        assert con.execute(f"SELECT count(*) FROM {fts} WHERE {fts} MATCH '\"уро\"'").fetchone() == (10,)
+        assert con.execute('SELECT sum(n), max(hi) FROM "minutes_05_03_2026"').fetchone() == (5, 4.0)
+    finally:
+        con.close()
