@@ -81,3 +81,24 @@ def test_the_viewer_reads_the_plant_archive(qtbot, tmp_path: Path, pg_url: str) 
     peaks = sorted(curve.getData()[1].max() for curve in viewer.curves.values())
     assert peaks == [99.0, 198.0]  # each station's own series, on one plot
     viewer.close()
+
+
+def test_the_health_strip_says_when_forwarding_lags(tmp_path: Path) -> None:
+    clock = [T0]
+    dead = "postgresql://station@127.0.0.1:9/plant"  # nothing answers there
+    write_station(tmp_path, f'NetPlcLoad = false\nArchive = "{dead}"\n[modbus_server]\nport = 0\n')
+    runtime = Runtime(load_station(tmp_path), wallclock=lambda: clock[0])
+    runtime.start()
+    try:
+        assert runtime.forwarder is not None
+        wait_for(lambda: runtime.forwarder.stats.last_error != "")
+        assert not [p for p in runtime.status().problems if "plant archive" in p]
+        clock[0] = T0 + 75
+        wait_for(lambda: any("lags by" in p for p in runtime.status().problems))
+        problem = next(p for p in runtime.status().problems if "lags by" in p)
+        assert problem.startswith("archive: forwarding to the plant archive lags by 75 s")
+    finally:
+        runtime.stop()
+    with Archive(tmp_path / "archive" / "journal.sqlite") as local:
+        texts = [r.text for r in local.records(local.days()[0], limit=100)]
+    assert any("lags by 75 s" in (t or "") for t in texts)  # the 'system' record

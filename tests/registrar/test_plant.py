@@ -185,3 +185,19 @@ def test_archive_migrate_is_idempotent(tmp_path, pg_url, capsys):
     assert central(pg_url, "line1") == (2_500, 2_500)
     assert cli(["archive", "migrate", str(db), "postgresql://u:secret@127.0.0.1/plant"]) == 2
     assert "password must not be written" in capsys.readouterr().err
+
+
+def test_a_replay_past_a_lost_position_doubles_nothing(tmp_path, pg_url):
+    store = Store(tmp_path / "journal.sqlite")
+    for i in range(1_000):
+        store.put(Record(T0 + i, "data", 1, 1, "04010", value=float(i)))
+    store.put(Record(T0 + 1_000, "operator", source="ivanov", text="NUL \x00 in a text"))
+    store.start()
+    store.close()
+    assert Forwarder(store.path, pg_url, "st", batch=300).forward_all() == 1_001
+    with psycopg.connect(pg_url) as con:
+        con.execute("DELETE FROM forwarded")  # as if the position were lost
+    assert Forwarder(store.path, pg_url, "st", batch=300).forward_all() == 1_001  # sent again...
+    assert central(pg_url, "st") == (1_001, 1_001)  # ...and refused by the unique key
+    with Archive(pg_url) as plant:
+        assert plant.records(DAY, Filter(kinds={"operator"}))[0].text == "NUL \ufffd in a text"
