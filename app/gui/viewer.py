@@ -43,13 +43,14 @@ from PySide6.QtWidgets import (
 from app.config import DEMO_STATION, ConfigError, load_station, station_file
 from app.gui.series_loader import SeriesLoader
 from app.gui.style import apply_style
-from hmi_forms.widgets.records import RecordsModel, records_view
+from hmi_forms.widgets.records import ARCHIVE_COLUMNS, Column, RecordsModel, records_view
 from registrar.query import Archive, Filter, SeriesKey
 
 PAGE = 500
 SERIES_POINTS = 4000
 KINDS = ("all", "data", "message", "operator", "system")
 TYPES = ("any", "0 info", "1 warning", "2 alarm", "3 critical")
+STATION = Column("Station", lambda r: r.station or "", 100)  # shown for a plant archive only
 PALETTE = ("#1f77b4", "#d62728", "#2ca02c", "#ff7f0e", "#9467bd", "#17becf", "#8c564b", "#e377c2")
 
 
@@ -152,7 +153,7 @@ class ViewerWindow(QMainWindow):
         self.tabs = QTabWidget()
         records = QWidget()
         rec_lay = QVBoxLayout(records)
-        self.model = RecordsModel(parent=self)
+        self.model = RecordsModel((*ARCHIVE_COLUMNS, STATION), parent=self)
         self.table = records_view(self.model, row_height=22)
         rec_lay.addWidget(self.table, 1)
         pager = QHBoxLayout()
@@ -211,6 +212,7 @@ class ViewerWindow(QMainWindow):
             self.stations.addItem(item)
         self.stations.blockSignals(False)
         self.stations_label.setVisible(bool(stations))
+        self.table.setColumnHidden(len(ARCHIVE_COLUMNS), not stations)
         self.stations.setVisible(bool(stations))
         self.days.blockSignals(True)
         self.days.clear()

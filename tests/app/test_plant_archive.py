@@ -68,6 +68,7 @@ def test_the_viewer_reads_the_plant_archive(qtbot, tmp_path: Path, pg_url: str) 
     viewer.stations.item(0).setCheckState(viewer.stations.item(0).checkState().Unchecked)
     assert viewer.total == 1 and viewer.current_filter().stations == {"south"}
     assert viewer.model.index(0, 7).data() == "alarm at south"
+    assert viewer.model.index(0, 8).data() == "south" and not viewer.table.isColumnHidden(8)
     out = tmp_path / "south.csv"
     assert viewer.export_csv(out) == 1
     with open(out, encoding="utf-8-sig", newline="") as f:

@@ -64,3 +64,28 @@ def test_an_archive_without_a_zone_key_reads_in_the_local_zone(db, zone_of):
     con.close()
     with Archive(db) as a:
         assert a.tz is None and a.records(dt.date(2026, 3, 5))[0].time == dt.datetime(2026, 3, 5, 8)
+
+
+def test_the_viewer_cuts_from_and_to_in_the_writers_zone(qtbot, db, zone_of):
+    from PySide6.QtCore import QTime
+
+    from app.gui.viewer import ViewerWindow
+
+    zone_of(WRITER)
+    tz = zoneinfo.ZoneInfo(WRITER)
+    store = Store(db)
+    for hour in (1, 12, 23):
+        store.put(Record(dt.datetime(2026, 3, 5, hour, 30, tzinfo=tz).timestamp(), "data", 1, 1, "04010",
+                         value=float(hour)))
+    store.start()
+    store.close()
+    zone_of("America/New_York")  # 15 hours behind the writer
+    viewer = ViewerWindow(db)
+    qtbot.addWidget(viewer)
+    assert viewer.day == dt.date(2026, 3, 5) and viewer.total == 3
+    viewer.since.setTime(QTime(12, 0))
+    viewer.until.setTime(QTime(23, 59, 59))
+    viewer.apply_filter()
+    assert viewer.total == 2
+    assert [viewer.model.index(r, 0).data() for r in range(2)] == ["12:30:00.000", "23:30:00.000"]
+    viewer.close()
