@@ -82,6 +82,7 @@ class Forwarder:
         self._max_lag = 0.0
         self._alarmed = False
         self._answered = False  # the plant archive answered once (the position is known)
+        self._published = False  # the station's meta and catalog are in the plant archive
         self._error = ""
 
     @property
@@ -137,14 +138,14 @@ class Forwarder:
                     self._connect()
                 n = self._cycle()
                 self._error = ""
-                wait = 0.0 if n >= self.batch else self.interval
+                wait = 0.0 if n else self.interval  # more may wait (this day or the next)
             except (psycopg.Error, sqlite3.Error, OSError) as e:
                 self._error = f"plant archive: {e}".strip()
                 self._disconnect()
                 wait = min(RETRY_MAX, max(2 * wait, self.interval))
                 n = 0
             self._watch_lag()
-            if stopping and (n < self.batch or self._pg is None):
+            if stopping and (n == 0 or self._pg is None):
                 break
 
     def _watch_lag(self) -> None:
@@ -187,6 +188,7 @@ class Forwarder:
         con = pg.connect(self.url)
         try:
             self._tz = pg.ensure_schema(con)
+            self._published = False
             self._publish(con)
             self._done = {d: n for d, n in con.execute(
                 "SELECT day, last_id FROM forwarded WHERE station = %s", (self.station,))}
@@ -212,7 +214,7 @@ class Forwarder:
         """The station's meta and message catalog, as its local archive holds them."""
         local = self._local_con()
         if local is None:
-            return
+            return  # the Store has not made the file yet: published with the first batch
         meta = local.execute("SELECT key, value FROM meta").fetchall()
         messages = local.execute("SELECT number, grp, type, text FROM messages").fetchall()
         with con.transaction(), con.cursor() as cur:
@@ -222,6 +224,7 @@ class Forwarder:
             cur.execute("DELETE FROM messages WHERE station = %s", (self.station,))
             cur.executemany("INSERT INTO messages VALUES (%s, %s, %s, %s, %s)",
                             [(self.station, *m) for m in messages])
+        self._published = True
 
     def _retain(self, con: psycopg.Connection) -> None:
         oldest = self._oldest()
@@ -272,6 +275,8 @@ class Forwarder:
         assert con is not None
         if local is None:
             return 0
+        if not self._published:
+            self._publish(con)
         days = self._days(local)
         if not days:
             return 0
