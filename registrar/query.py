@@ -248,7 +248,8 @@ class Archive:
     def _text_candidates(self, day: dt.date, flt: Filter) -> tuple[str, str] | None:
         """The condition and argument limiting a text search to the trigram index's candidates
         (None: no text of 3 or more characters, or a day written before the index)."""
-        if not flt.text or len(flt.text) < 3 or not self._has_table(fts_table(table_name(day))):
+        if (not flt.text or len(flt.text) < 3 or "\x00" in flt.text  # FTS5 queries end at a NUL
+                or not self._has_table(fts_table(table_name(day)))):
             return None
         fts = f'"{fts_table(table_name(day))}"'
         return f"id IN (SELECT rowid FROM {fts} WHERE {fts} MATCH ?)", _trigrams(flt.text)

@@ -252,7 +252,8 @@ def test_text_search_by_the_trigram_index_equals_the_scan(db):
     records = [Record(T0 + i, "operator" if i % 7 else "data", 1, 1, "04010", value=float(i),
                       text=words[i % len(words)] if i % 7 else None) for i in range(3000)]
     write(db, records)
-    searches = ["авария", "НАСОС", "Насос", "связь", "пуск", '"x"', "0%_", "нет такого", "на", "ё"]
+    searches = ["авария", "НАСОС", "Насос", "связь", "пуск", '"x"', "0%_", "нет такого", "на", "ё",
+                "a\x00b", "NEAR("]
     with Archive(db) as a:
         indexed = {t: (a.count(DAY, Filter(text=t)), a.records(DAY, Filter(text=t), limit=50, offset=3))
                    for t in searches}
