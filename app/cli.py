@@ -16,7 +16,7 @@ import time
 
 from app.config import DEMO_STATION
 
-COMMANDS = ("view", "check", "simulate", "alarms-report", "design", "monitor")
+COMMANDS = ("view", "check", "simulate", "alarms-report", "design", "monitor", "archive")
 
 
 def _main_parser() -> argparse.ArgumentParser:
@@ -27,7 +27,8 @@ def _main_parser() -> argparse.ArgumentParser:
         epilog="other commands: view [ARCHIVE] (offline journal viewer), check STATION (validate a "
                "station), simulate PROGRAM.stl (a simulated CPU-165 node), alarms-report ARCHIVE --day "
                "DD_MM_YYYY (alarm-system health), design [FORM.hmi | STATION] (the form designer), "
-               "monitor STATION_OR_HOST:PORT (the program monitor of a running station); each takes --help.",
+               "monitor STATION_OR_HOST:PORT (the program monitor of a running station), archive migrate "
+               "ARCHIVE.sqlite postgresql://... (copy an archive into the plant archive); each takes --help.",
     )
     p.add_argument("station", nargs="?", default=str(DEMO_STATION),
                    help="station folder or its station.toml (default: the demo station)")
@@ -44,7 +45,23 @@ def _view_parser() -> argparse.ArgumentParser:
                                 description="Open an archive read-only: records by day, filters, "
                                             "series plots, CSV export. No station needs to run.")
     p.add_argument("archive", nargs="?",
-                   help="archive file (journal.sqlite) or a station folder (default: the demo station's)")
+                   help="archive file (journal.sqlite), a station folder (default: the demo station's), "
+                        "or a plant archive postgresql://user@host:5432/plant")
+    return p
+
+
+def _archive_parser() -> argparse.ArgumentParser:
+    p = argparse.ArgumentParser(prog="python main.py archive",
+                                description="Archive tools. migrate: copy a station's SQLite archive into "
+                                            "the plant archive on PostgreSQL; run it again and it copies "
+                                            "only what is not there yet.")
+    sub = p.add_subparsers(dest="action", required=True)
+    m = sub.add_parser("migrate", help="copy ARCHIVE.sqlite into the plant archive")
+    m.add_argument("source", help="the station's archive file (journal.sqlite)")
+    m.add_argument("url", help="the plant archive: postgresql://user@host:5432/plant (password in "
+                               "PGPASSWORD or ~/.pgpass)")
+    m.add_argument("--station", help="the station's name in the plant archive (default: the name of "
+                                     "the station folder holding archive/journal.sqlite)")
     return p
 
 
@@ -113,6 +130,9 @@ def main(argv: list[str] | None = None) -> int:
             from app.gui.monitor.window import run_monitor
 
             return run_monitor(ns.target, ns.user)
+        if command == "archive":
+            ns = _archive_parser().parse_args(rest)
+            return run_migrate(ns.source, ns.url, ns.station)
         return run_viewer(_view_parser().parse_args(rest).archive)
     ns = _main_parser().parse_args(args)
     if ns.duration is not None and not ns.no_gui:
@@ -221,3 +241,39 @@ def run_designer(target: str, screenshot: str | None = None) -> int:
     from app.gui.designer.window import run_designer as designer
 
     return designer(target, screenshot)
+
+
+def run_migrate(source: str, url: str, station: str | None) -> int:
+    """Copy a SQLite archive into the plant archive, with a progress bar on stderr."""
+    import sqlite3
+    from pathlib import Path
+
+    import psycopg
+
+    from registrar.forward import Forwarder
+    from registrar.pg import is_url, url_problem
+
+    problem = url_problem(url) if is_url(url) else "not a postgresql:// URL"
+    if problem:
+        print(f"{url}: {problem}", file=sys.stderr)
+        return 2
+    path = Path(source)
+    if not path.is_file():
+        print(f"{path}: no such archive", file=sys.stderr)
+        return 2
+    folder = path.resolve().parent
+    name = station or (folder.parent.name if folder.name == "archive" else folder.name)
+
+    def progress(sent: int, total: int) -> None:
+        done = min(1.0, sent / total) if total else 1.0
+        bar = "#" * round(30 * done)
+        print(f"\r[{bar:<30}] {sent:,} / {total:,} records", end="", file=sys.stderr, flush=True)
+
+    try:
+        n = Forwarder(path, url, name).forward_all(progress)
+    except (psycopg.Error, sqlite3.Error) as e:
+        print(f"\n{path} -> {url}: {e}", file=sys.stderr)
+        return 1
+    print(("\n" if n else "") + f"{n:,} records copied from {path} to {url} as station {name!r} "
+          "(records already there are not copied again)")
+    return 0

@@ -72,6 +72,7 @@ class Station:
     Tags: Path | None = None  # tags.csv: tags and their alarms (netplc/tags/)
     allow_outside: bool = False  # may station paths (and form images) leave the station folder?
     RetainForces: bool = False  # forces survive a restart (netplc/forcing.py); off: a restart unforces
+    plant_archive: str | None = None  # `Archive` given as a postgresql:// URL: forwarded there
 
     @property
     def folder(self) -> Path:
@@ -201,7 +202,8 @@ def read_station(path: str | Path) -> tuple[Station | None, list[str]]:
     symbols = top.path("Symbols", base)
     hmi = top.path("HMIload", base)
     sync = top.number("NetSyncTime", 100, 10, 60_000)
-    archive = top.path("Archive", base, "archive/journal.sqlite")
+    plant = _plant_archive(top)  # marks a URL `Archive` known, valid or not
+    archive = None if "Archive" in top.known else top.path("Archive", base, "archive/journal.sqlite")
     messages = top.path("Messages", base)
     keep_days = top.number("keep_days", 0, 0, 36_500)
     retain = top.path("Retain", base)
@@ -235,7 +237,7 @@ def read_station(path: str | Path) -> tuple[Station | None, list[str]]:
         Symbols=symbols, HMIload=hmi, NetSyncTime=sync, Archive=archive, Messages=messages,
         keep_days=keep_days, Retain=retain, modbus_server=server,
         nodes=tuple(nodes), simulators=tuple(runnable), users=users, Tags=tags,
-        allow_outside=top.allow_outside, RetainForces=bool(retain_forces),
+        allow_outside=top.allow_outside, RetainForces=bool(retain_forces), plant_archive=plant,
     )
     return station, problems
 
@@ -258,6 +260,21 @@ def _outputs_apart(r: _Reader, file: Path, archive: Path, retain: Path, program:
             r.bad(key, f"{path} is a station input ({what}): writing there would overwrite it")
     if retain == archive:
         r.bad("Retain", f"{retain} is the Archive as well")
+
+
+def _plant_archive(top: _Reader) -> str | None:
+    """`Archive` as a PostgreSQL URL: the station still writes its default local archive first."""
+    value = top.table.get("Archive")
+    if not (isinstance(value, str) and value.startswith(("postgresql://", "postgres://"))):
+        return None
+    from registrar.pg import url_problem  # psycopg only where a plant archive is named
+
+    top.known.add("Archive")
+    problem = url_problem(value)
+    if problem:
+        top.bad("Archive", problem)
+        return None
+    return value
 
 
 def _existing(r: _Reader, key: str, path: Path | None, must_be_dir: bool) -> Path | None:

@@ -23,6 +23,7 @@ import time
 from collections.abc import Callable
 from concurrent.futures import ThreadPoolExecutor, wait
 from dataclasses import dataclass, field, replace
+from typing import TYPE_CHECKING
 
 from app.config import Station
 from app.load import load, load_station_forms
@@ -40,6 +41,9 @@ from netplc.scheduler import ScanThread
 from netplc.simulator import Simulator
 from registrar.retain import Retainer
 from registrar.store import Store, StoreStats
+
+if TYPE_CHECKING:
+    from registrar.forward import Forwarder
 
 RecordObserver = Callable[[Record], None]
 RESOLVE_TIMEOUT = 5.0  # seconds for the host names of all TCP nodes to resolve
@@ -138,6 +142,7 @@ class Runtime:
         self.forms: list[Form] = loaded.forms  # the runtime's own models: evaluated, never shown
         self.form_problems = loaded.form_problems
         self.store: Store | None = None
+        self.forwarder: Forwarder | None = None  # to the plant archive, when Archive is a URL
         self.engine: Engine | None = None
         self.retainer: Retainer | None = None
         self.simulators: list[Simulator] = []
@@ -199,6 +204,12 @@ class Runtime:
         except (OSError, sqlite3.Error) as e:
             raise StartError([f"{st.path}: Archive: {e}"]) from None
         self.store = store
+        if st.plant_archive:
+            from registrar.forward import Forwarder  # psycopg only where a plant archive is named
+
+            self.forwarder = Forwarder(st.Archive, st.plant_archive, st.name, keep_days=st.keep_days,
+                                       sink=self.put, wallclock=self.wallclock)
+            self.forwarder.start()  # never fails: PostgreSQL away is a lag, not a start error
         try:
             self._start_parts()
         except StartError as e:
@@ -346,6 +357,9 @@ class Runtime:
             store, self.store = self.store, None
             store.close()  # flushes every queued record
             self._final_store = store.stats
+        if self.forwarder is not None:
+            self.forwarder.close()  # sends the rest if the plant archive answers
+            self.forwarder = None
         self.started = False
 
     # --- NetPlc run control (the workstation's menu) -------------------------------------------
@@ -399,6 +413,10 @@ class Runtime:
                 problems.append(f"archive: {s.last_error}")
             if s.dropped:
                 problems.append(f"archive: {s.dropped} records lost (disk too slow or full)")
+        forwarder = self.forwarder
+        if forwarder is not None and (f := forwarder.stats).lag > forwarder.lag_alarm:
+            problems.append(f"archive: forwarding to the plant archive lags by {f.lag:.0f} s, "
+                            f"{f.backlog} records ({f.last_error or 'catching up'})")
         return RuntimeStatus(
             running=self.started,
             state=engine.state_text if engine else "not started",

@@ -18,75 +18,68 @@ from __future__ import annotations
 import csv
 import datetime as dt
 import sqlite3
-from dataclasses import dataclass, replace
+from dataclasses import replace
 from pathlib import Path
-from typing import NamedTuple
 from urllib.parse import quote
 
 import numpy as np
 
+from registrar.reading import (
+    EXPORT_CHUNK,
+    ArchiveReader,
+    Filter,
+    Row,
+    SeriesKey,
+    min_max,
+    where_clause,
+)
 from registrar.schema import (
     COLUMNS,
     DAY_GLOB,
+    fts_table,
     key_index,
+    minutes_table,
     parse_table_name,
     quoted,
     table_name,
     text_index,
+    zone,
 )
 
-EXPORT_CHUNK = 10_000
 PROBE_ROWS = 20_000  # newest rows tried first for a page (a couple of milliseconds)
 INDEX_ROWS = 50_000  # up to this many index matches are fetched and sorted rather than scanned
 SCAN_ABOVE = 0.125  # a series holding more than this share of its day is read by a table scan
-
-
-@dataclass(frozen=True)
-class Filter:
-    kinds: set[str] | frozenset[str] | None = None
-    grp: int | None = None
-    type: int | None = None
-    min_type: int | None = None  # e.g. 2: alarms and worse
-    source: str | None = None
-    text: str | None = None  # contains
-    since: float | None = None  # seconds since the epoch, inclusive
-    until: float | None = None  # seconds since the epoch, exclusive
-
-
-@dataclass(frozen=True, slots=True)
-class Row:
-    id: int
-    ts: float  # seconds since the epoch
-    kind: str
-    grp: int | None
-    type: int | None
-    source: str | None
-    number: int | None
-    value: float | None
-    text: str | None
-
-    @property
-    def time(self) -> dt.datetime:
-        """Local time of the record."""
-        return dt.datetime.fromtimestamp(self.ts)
-
-
-class SeriesKey(NamedTuple):
-    kind: str
-    grp: int | None
-    type: int | None
-    source: str | None
+SUMMARY_ABOVE = 100_000  # a series of more records is read from the per-minute summary
 
 
 _SELECT = "SELECT " + ", ".join(COLUMNS)
 
 
-class Archive:
+class Archive(ArchiveReader):
+    """A station's SQLite archive, or the plant archive when given a postgresql:// URL (the same
+    methods, see registrar/pg_query.py)."""
+
+    def __new__(cls, target: str | Path) -> ArchiveReader:  # type: ignore[misc]
+        if cls is Archive and isinstance(target, str) and target.startswith(("postgresql://",
+                                                                               "postgres://")):
+            from registrar.pg_query import PgArchive  # psycopg only where a plant archive is read
+
+            return PgArchive(target)  # not an Archive, so __init__ below is not run on it
+        return super().__new__(cls)
+
     def __init__(self, path: str | Path) -> None:
         self.path = Path(path)
         if not self.path.is_file():
             raise FileNotFoundError(f"{self.path}: no such archive")
         self._con = self._connect()
+        self.tz = self._zone()
+
+    def _zone(self) -> dt.tzinfo | None:
+        """The writer's zone, by the IANA key it stored (older archives: this machine's)."""
+        try:
+            return zone(self.meta().get("timezone_key", ""))
+        except sqlite3.Error:
+            return None
 
     def _connect(self) -> sqlite3.Connection:
         uri = f"file:{quote(str(self.path.resolve()))}?mode=ro"
@@ -102,12 +95,6 @@ class Archive:
 
     def close(self) -> None:
         self._con.close()
-
-    def __enter__(self) -> Archive:
-        return self
-
-    def __exit__(self, *exc: object) -> None:
-        self.close()
 
     # --- days and catalogues -------------------------------------------------------------------
 
@@ -140,7 +127,7 @@ class Archive:
         table = quoted(day)
         order = "DESC" if newest_first else "ASC"
         page = f"ORDER BY id {order} LIMIT ? OFFSET ?"
-        where, args = _where(flt)
+        where, args = where_clause(flt)
         # 1. The newest (oldest) rows only: enough whenever the filter matches commonly.
         hi = self._con.execute(f"SELECT max(id) FROM {table}").fetchone()[0]
         lo = self._con.execute(f"SELECT min(id) FROM {table}").fetchone()[0]
@@ -153,20 +140,28 @@ class Archive:
         rows = self._con.execute(f"{_SELECT} FROM {table} NOT INDEXED {_and(where, window)} {page}",
                                  [*args, limit, offset]).fetchall()
         if len(rows) == limit or whole:
-            return [_row(r) for r in rows]
+            return [self._row(r) for r in rows]
         # 2. Rare matches of indexed keys: fetch them through the index and sort them.
         keyed = self._keyed(day, flt) if self._has_index(key_index(table_name(day))) else None
         if keyed is not None:
-            where, args = _where(keyed)
+            where, args = where_clause(keyed)
             index = f'"{key_index(table_name(day))}"'
-            return [_row(r) for r in self._con.execute(
+            return [self._row(r) for r in self._con.execute(
                 f"{_SELECT} FROM {table} INDEXED BY {index}{where} {page}", [*args, limit, offset])]
-        # 3. Everything else: one pass in id order, stopping at the page; a text search passes
-        #    over the rows that have a text only.
+        # 3. A text search: the rows whose text holds every trigram of the text, by the day's
+        #    trigram index (the LIKE filter then decides, as on every other path).
+        candidates = self._text_candidates(day, flt)
+        if candidates:
+            where, args = where_clause(flt)
+            return [self._row(r) for r in self._con.execute(
+                f"{_SELECT} FROM {table}{_and(where, candidates[0])} {page}",
+                [*args, candidates[1], limit, offset])]
+        # 4. Everything else: one pass in id order, stopping at the page; a text search of a day
+        #    without the trigram index passes over the rows that have a text only.
         source = "NOT INDEXED"
         if flt.text and self._has_index(text_index(table_name(day))):
             source = f'INDEXED BY "{text_index(table_name(day))}"'
-        return [_row(r) for r in self._con.execute(
+        return [self._row(r) for r in self._con.execute(
             f"{_SELECT} FROM {table} {source}{where} {page}", [*args, limit, offset])]
 
     def _keyed(self, day: dt.date, flt: Filter) -> Filter | None:
@@ -186,7 +181,7 @@ class Archive:
             if getattr(flt, col) is None:
                 break
             prefix = replace(prefix, **{col: getattr(flt, col)})
-        where, args = _where(prefix)
+        where, args = where_clause(prefix)
         index = f'"{key_index(table_name(day))}"'
         n = self._con.execute(
             f"SELECT count(*) FROM (SELECT 1 FROM {table} INDEXED BY {index}{where} LIMIT {INDEX_ROWS + 1})",
@@ -196,8 +191,21 @@ class Archive:
     def count(self, day: dt.date, flt: Filter | None = None) -> int:
         if not self._has(day):
             return 0
-        where, args = _where(flt or Filter())
+        flt = flt or Filter()
+        where, args = where_clause(flt)
+        candidates = self._text_candidates(day, flt)
+        if candidates:
+            where, args = _and(where, candidates[0]), [*args, candidates[1]]
         return self._con.execute(f"SELECT count(*) FROM {quoted(day)}{where}", args).fetchone()[0]
+
+    def _text_candidates(self, day: dt.date, flt: Filter) -> tuple[str, str] | None:
+        """The condition and argument limiting a text search to the trigram index's candidates
+        (None: no text of 3 or more characters, or a day written before the index)."""
+        if (not flt.text or len(flt.text) < 3 or "\x00" in flt.text  # FTS5 queries end at a NUL
+                or not self._has_table(fts_table(table_name(day)))):
+            return None
+        fts = f'"{fts_table(table_name(day))}"'
+        return f"id IN (SELECT rowid FROM {fts} WHERE {fts} MATCH ?)", _trigrams(flt.text)
 
     def export_csv(self, path: str | Path, day: dt.date, flt: Filter | None = None) -> int:
         """Write the selection oldest first; UTF-8 with a BOM so spreadsheets read Cyrillic."""
@@ -207,12 +215,12 @@ class Archive:
             out.writerow(["id", "time", *COLUMNS[1:]])
             if not self._has(day):
                 return 0
-            where, args = _where(flt or Filter())
+            where, args = where_clause(flt or Filter())
             cur = self._con.execute(f"{_SELECT} FROM {quoted(day)} NOT INDEXED{where} ORDER BY id", args)
             try:
                 while chunk := cur.fetchmany(EXPORT_CHUNK):
                     for r in chunk:
-                        local = dt.datetime.fromtimestamp(r[1] / 1000).isoformat(timespec="milliseconds")
+                        local = self.local_time(r[1] / 1000).isoformat(timespec="milliseconds")
                         out.writerow([r[0], local, *r[1:]])
                     n += len(chunk)
             finally:
@@ -239,6 +247,11 @@ class Archive:
                 args.append(val)
         where = " WHERE " + " AND ".join(conds)
         table = quoted(day)
+        if grp is not None and type is not None and source is not None:
+            summary = self._summary(day, grp, type, source)
+            if summary is not None:
+                ts, values = summary
+                return (ts, values) if len(ts) <= points else min_max(ts, values, max(1, points // 2))
         # A series holding a good part of the day is read faster by a scan than by index lookups.
         total = self._con.execute(f"SELECT max(id) FROM {table}").fetchone()[0] or 0
         many = round(SCAN_ABOVE * total)
@@ -256,9 +269,36 @@ class Archive:
         ts, values = data["ts"] / 1000.0, data["value"]
         if len(ts) <= points:
             return ts, values
-        return _min_max(ts, values, max(1, points // 2))
+        return min_max(ts, values, max(1, points // 2))
 
     # --- helpers -------------------------------------------------------------------------------
+
+    def _row(self, r: tuple) -> Row:
+        return Row(r[0], r[1] / 1000.0, *r[2:], tz=self.tz)
+
+    def _summary(self, day: dt.date, grp: int, type: int,
+                 source: str) -> tuple[np.ndarray, np.ndarray] | None:
+        """The series from the per-minute minima and maxima at their own times, when it is long
+        enough for that to pay (None: read the records)."""
+        minutes = minutes_table(table_name(day))
+        if not self._has_table(minutes):
+            return None
+        key = "WHERE grp = ? AND type = ? AND source = ?"
+        total = self._con.execute(f'SELECT sum(n) FROM "{minutes}" {key}', (grp, type, source)).fetchone()[0]
+        if not total or total <= SUMMARY_ABOVE:
+            return None
+        cur = self._con.execute(f'SELECT lo_ts, lo, hi_ts, hi FROM "{minutes}" {key} ORDER BY minute',
+                                (grp, type, source))
+        data = np.fromiter(cur, dtype=[("lo_ts", "i8"), ("lo", "f8"), ("hi_ts", "i8"), ("hi", "f8")])
+        ts = np.column_stack([data["lo_ts"], data["hi_ts"]]).ravel()
+        values = np.column_stack([data["lo"], data["hi"]]).ravel()
+        order = np.argsort(ts, kind="stable")
+        ts, values = ts[order], values[order]
+        keep = np.r_[True, (ts[1:] != ts[:-1]) | (values[1:] != values[:-1])]  # min and max one record
+        return ts[keep] / 1000.0, values[keep]
+
+    def _has_table(self, name: str) -> bool:
+        return self._con.execute("SELECT 1 FROM sqlite_master WHERE name = ?", (name,)).fetchone() is not None
 
     def _has_index(self, name: str) -> bool:
         return self._con.execute("SELECT 1 FROM sqlite_master WHERE type = 'index' AND name = ?",
@@ -280,62 +320,13 @@ def _open_ro(uri: str) -> sqlite3.Connection:
     return con
 
 
-def _row(r: tuple) -> Row:
-    return Row(r[0], r[1] / 1000.0, *r[2:])
 
 
-def _where(flt: Filter) -> tuple[str, list[object]]:
-    conds: list[str] = []
-    args: list[object] = []
-    if flt.kinds is not None:
-        kinds = sorted(flt.kinds)
-        conds.append(f"kind IN ({', '.join('?' * len(kinds))})" if kinds else "0")
-        args.extend(kinds)
-    for col, val in (("grp", flt.grp), ("type", flt.type), ("source", flt.source)):
-        if val is not None:
-            conds.append(f"{col} = ?")
-            args.append(val)
-    if flt.min_type is not None:
-        conds.append("type >= ?")
-        args.append(flt.min_type)
-    if flt.since is not None:
-        conds.append("ts >= ?")
-        args.append(round(flt.since * 1000))
-    if flt.until is not None:
-        conds.append("ts < ?")
-        args.append(round(flt.until * 1000))
-    if flt.text:
-        # SQLite folds case for ASCII only; the usual spellings of a Cyrillic word are tried too.
-        variants = sorted({flt.text, flt.text.lower(), flt.text.upper(), flt.text.capitalize()})
-        likes = " OR ".join("text LIKE ? ESCAPE '\\'" for _ in variants)
-        conds.append(f"text IS NOT NULL AND ({likes})")
-        args.extend(f"%{_escape_like(v)}%" for v in variants)
-    return (" WHERE " + " AND ".join(conds)) if conds else "", args
+def _trigrams(text: str) -> str:
+    """An FTS5 query for rows holding every trigram of `text` (the index folds case itself)."""
+    quoted_ = ('"' + text[i:i + 3].replace('"', '""') + '"' for i in range(len(text) - 2))
+    return " AND ".join(dict.fromkeys(quoted_))
 
 
 def _and(where: str, cond: str) -> str:
     return f"{where} AND {cond}" if where else f" WHERE {cond}"
-
-
-def _escape_like(text: str) -> str:
-    return text.replace("\\", "\\\\").replace("%", "\\%").replace("_", "\\_")
-
-
-def _min_max(ts: np.ndarray, values: np.ndarray, buckets: int) -> tuple[np.ndarray, np.ndarray]:
-    """Per equal-time bucket, the minimum and the maximum in the order they occurred."""
-    edges = np.linspace(ts[0], ts[-1], buckets + 1)
-    idx = np.clip(np.searchsorted(edges, ts, side="right") - 1, 0, buckets - 1)
-    starts = np.flatnonzero(np.r_[True, idx[1:] != idx[:-1]])
-    lo = _arg_reduce(values, starts, np.minimum)
-    hi = _arg_reduce(values, starts, np.maximum)
-    keep = np.unique(np.concatenate([lo, hi]))
-    return ts[keep], values[keep]
-
-
-def _arg_reduce(values: np.ndarray, starts: np.ndarray, op: np.ufunc) -> np.ndarray:
-    """Index of the first element equal to each segment's reduction (segments begin at `starts`)."""
-    best = op.reduceat(values, starts)
-    seg = np.repeat(np.arange(len(starts)), np.diff(np.r_[starts, len(values)]))
-    hits = np.flatnonzero(values == best[seg])
-    first = np.r_[True, seg[hits][1:] != seg[hits][:-1]]
-    return hits[first]

@@ -6,7 +6,12 @@ day), so retention drops a whole table and a day's queries never touch other day
 
 from __future__ import annotations
 
+import contextlib
 import datetime as dt
+import os
+import time
+import zoneinfo
+from pathlib import Path
 
 SCHEMA_VERSION = "1"
 COLUMNS = ("id", "ts", "kind", "grp", "type", "source", "number", "value", "text")
@@ -47,6 +52,49 @@ def index_sql(table: str) -> list[str]:
             "WHERE text IS NOT NULL"]
 
 
+# Beside each day table, two tables kept in the batch's transaction: a trigram full-text index of
+# the texts (contentless, no positions: it names candidate rows, the LIKE filter decides, so a text
+# search reads only rows holding the text's trigrams), and per series and minute the count, the
+# minimum and the maximum at their own times (a day's series is read from 1,440 rows per key
+# instead of every record). Days written before them have neither: readers fall back.
+def fts_table(table: str) -> str:
+    return f"text_{table}"
+
+
+def minutes_table(table: str) -> str:
+    return f"minutes_{table}"
+
+
+def aux_sql(table: str) -> list[str]:
+    return [f'CREATE VIRTUAL TABLE IF NOT EXISTS "{fts_table(table)}" USING fts5(text, content=\'\', '
+            "detail=none, tokenize=trigram)",
+            f'CREATE TABLE IF NOT EXISTS "{minutes_table(table)}" (grp INTEGER NOT NULL, '
+            "type INTEGER NOT NULL, source TEXT NOT NULL, minute INTEGER NOT NULL, n INTEGER NOT NULL, "
+            "lo REAL, lo_ts INTEGER, hi REAL, hi_ts INTEGER, PRIMARY KEY (grp, type, source, minute)) "
+            "WITHOUT ROWID"]
+
+
+def aux_fill_sql(table: str) -> list[str]:
+    """Statements adding the rows with id > ? to the two tables (the min and the max each need a
+    pass of their own: SQLite gives the ts of the row holding a lone min() or max())."""
+    rows = (f'FROM "{table}" NOT INDEXED WHERE id > ? AND kind = \'data\' AND value IS NOT NULL '
+            "AND grp IS NOT NULL AND type IS NOT NULL AND source IS NOT NULL "
+            "GROUP BY grp, type, source, ts / 60000")
+    into = f'INSERT INTO "{minutes_table(table)}" (grp, type, source, minute, n, lo, lo_ts, hi, hi_ts)'
+    return [
+        f'INSERT INTO "{fts_table(table)}" (rowid, text) SELECT id, text FROM "{table}" '
+        "WHERE id > ? AND text IS NOT NULL",
+        f"{into} SELECT grp, type, source, ts / 60000, count(*), min(value), ts, NULL, NULL {rows} "
+        "ON CONFLICT DO UPDATE SET n = n + excluded.n, "
+        "lo_ts = CASE WHEN excluded.lo < lo THEN excluded.lo_ts ELSE lo_ts END, "
+        "lo = CASE WHEN excluded.lo < lo THEN excluded.lo ELSE lo END",
+        f"{into} SELECT grp, type, source, ts / 60000, 0, NULL, NULL, max(value), ts {rows} "
+        "ON CONFLICT DO UPDATE SET "
+        "hi_ts = CASE WHEN hi IS NULL OR excluded.hi > hi THEN excluded.hi_ts ELSE hi_ts END, "
+        "hi = CASE WHEN hi IS NULL OR excluded.hi > hi THEN excluded.hi ELSE hi END",
+    ]
+
+
 META_SQL = "CREATE TABLE IF NOT EXISTS meta (key TEXT PRIMARY KEY, value TEXT)"
 MESSAGES_SQL = ("CREATE TABLE IF NOT EXISTS messages "
                 "(number INTEGER PRIMARY KEY, grp INTEGER, type INTEGER, text TEXT)")
@@ -81,3 +129,43 @@ def local_day_bounds(ts: float) -> tuple[dt.date, float, float]:
     nxt = day + dt.timedelta(days=1)
     end = dt.datetime(nxt.year, nxt.month, nxt.day).timestamp()
     return day, start, end
+
+
+def local_zone_key() -> str:
+    """The IANA key of this machine's zone ("Europe/Moscow"), stored in `meta` so that a copy of the
+    archive read in another zone still cuts days where the writer did; "" when it cannot be told."""
+    candidates = [os.environ.get("TZ", "").lstrip(":")]
+    try:
+        target = os.path.realpath("/etc/localtime")
+        if "/zoneinfo/" in target:
+            candidates.append(target.split("/zoneinfo/", 1)[1])
+    except OSError:
+        pass
+    with contextlib.suppress(OSError, UnicodeDecodeError):
+        candidates.append(Path("/etc/timezone").read_text(encoding="ascii").strip())
+    for key in candidates:
+        if key and zone(key) is not None and _same_offsets(key):
+            return key
+    return ""
+
+
+def zone(key: str) -> zoneinfo.ZoneInfo | None:
+    try:
+        return zoneinfo.ZoneInfo(key) if key else None
+    except (zoneinfo.ZoneInfoNotFoundError, ValueError):
+        return None
+
+
+def _same_offsets(key: str) -> bool:
+    """Whether the zone `key` agrees with what time.localtime says now (TZ may name a POSIX rule)."""
+    tz = zone(key)
+    now = time.time()
+    return tz is not None and dt.datetime.fromtimestamp(now, tz).utcoffset() == dt.timedelta(
+        seconds=time.localtime(now).tm_gmtoff)
+
+
+def day_bounds_in(day: dt.date, tz: dt.tzinfo | None) -> tuple[float, float]:
+    """The epoch seconds of `day`'s midnight and the next one in zone `tz` (None: this machine's)."""
+    nxt = day + dt.timedelta(days=1)
+    return (dt.datetime(day.year, day.month, day.day, tzinfo=tz).timestamp(),
+            dt.datetime(nxt.year, nxt.month, nxt.day, tzinfo=tz).timestamp())

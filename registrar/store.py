@@ -31,8 +31,13 @@ from registrar.schema import (
     META_SQL,
     SCHEMA_VERSION,
     SERIES_SQL,
+    aux_fill_sql,
+    aux_sql,
+    fts_table,
     index_sql,
     local_day_bounds,
+    local_zone_key,
+    minutes_table,
     parse_table_name,
     table_name,
 )
@@ -194,6 +199,7 @@ class Store:
             "ts_unit": "milliseconds since 1970-01-01 UTC",
             "day_tables": "one per local day, named DD_MM_YYYY",
             "timezone": time.strftime("%Z %z"),
+            "timezone_key": local_zone_key(),  # IANA: readers in another zone cut days as written
             "message_types": "0 info, 1 warning, 2 alarm, 3 critical",
         }
         con.execute("INSERT OR IGNORE INTO meta VALUES ('created', ?)",
@@ -295,9 +301,12 @@ class Store:
         con.execute("BEGIN IMMEDIATE")
         for table, rows in tables.items():
             self._ensure_table(con, table, rows)
+            last = con.execute(f'SELECT max(id) FROM "{table}"').fetchone()[0] or 0
             con.executemany(
                 f'INSERT INTO "{table}" (ts, kind, grp, type, source, number, value, text) '
                 "VALUES (?, ?, ?, ?, ?, ?, ?, ?)", rows)
+            for sql in aux_fill_sql(table):  # the text index and the per-minute summary
+                con.execute(sql, (last,))
         con.execute("COMMIT")
 
     def _valid(self, batch: list[Record]) -> list[Record]:
@@ -361,6 +370,13 @@ class Store:
             con.execute(f'CREATE TABLE IF NOT EXISTS "{table}" {DAY_COLUMNS_SQL}')
             for sql in index_sql(table):
                 con.execute(sql)
+            older = con.execute("SELECT 1 FROM sqlite_master WHERE name = ?",
+                                (fts_table(table),)).fetchone() is None
+            for sql in aux_sql(table):
+                con.execute(sql)
+            if older:  # a day written before the text index and summary (or a new one): fill them
+                for sql in aux_fill_sql(table):
+                    con.execute(sql, (0,))
             known = {tuple(k) for k in con.execute(
                 "SELECT kind, grp, type, source FROM series WHERE day = ?", (table,))}
             self._known[table] = known
@@ -393,6 +409,8 @@ class Store:
         con.execute("BEGIN IMMEDIATE")
         for name in old:
             con.execute(f'DROP TABLE "{name}"')
+            con.execute(f'DROP TABLE IF EXISTS "{fts_table(name)}"')
+            con.execute(f'DROP TABLE IF EXISTS "{minutes_table(name)}"')
             con.execute("DELETE FROM series WHERE day = ?", (name,))
             self._known.pop(name, None)
         con.execute("COMMIT")

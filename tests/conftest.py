@@ -1,5 +1,43 @@
 """Headless Qt for the whole suite: without this, Qt aborts the process when there is no display."""
 
+import itertools
 import os
 
+import pytest
+
 os.environ.setdefault("QT_QPA_PLATFORM", "offscreen")
+
+_databases = itertools.count(1)
+
+
+def _cluster():
+    from tests.pgcluster import PgCluster
+
+    try:
+        cluster = PgCluster()
+        cluster.start()
+    except RuntimeError as e:
+        pytest.skip(f"no PostgreSQL for the plant-archive tests: {e}")
+    return cluster
+
+
+@pytest.fixture(scope="session")
+def pg_cluster():
+    """One throwaway PostgreSQL cluster for the session (see tests/pgcluster.py)."""
+    cluster = _cluster()
+    yield cluster
+    cluster.remove()
+
+
+@pytest.fixture
+def own_pg_cluster():
+    """A cluster of the test's own, for tests that stop and restart the server."""
+    cluster = _cluster()
+    yield cluster
+    cluster.remove()
+
+
+@pytest.fixture
+def pg_url(pg_cluster) -> str:
+    """A fresh, empty database in the session's cluster."""
+    return pg_cluster.create_database(f"plant_{next(_databases)}")

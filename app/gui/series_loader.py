@@ -15,6 +15,7 @@ import sqlite3
 from concurrent.futures import Future, ThreadPoolExecutor
 from pathlib import Path
 
+import psycopg
 from PySide6.QtCore import QObject, Signal
 
 from registrar.query import Archive, SeriesKey
@@ -31,11 +32,11 @@ class SeriesLoader(QObject):
         self._token = 0
         self._queued: list[Future] = []
 
-    def request(self, path: Path, day: dt.date, key: SeriesKey) -> int:
+    def request(self, path: str | Path, day: dt.date, key: SeriesKey) -> int:
         """Queue a read of `key` on `day`; the token that its `loaded` or `failed` will carry."""
         self._token += 1
         self._queued = [f for f in self._queued if not f.done()]
-        self._queued.append(self._pool.submit(self._load, self._token, Path(path), day, key))
+        self._queued.append(self._pool.submit(self._load, self._token, path, day, key))
         return self._token
 
     def close(self) -> None:
@@ -44,12 +45,14 @@ class SeriesLoader(QObject):
             future.cancel()  # only those not yet started
         self._pool.shutdown(wait=True)
 
-    def _load(self, token: int, path: Path, day: dt.date, key: SeriesKey) -> None:
+    def _load(self, token: int, path: str | Path, day: dt.date, key: SeriesKey) -> None:
+        """`path`: a file, or a plant archive's URL (kept a str: Path would fold its //)."""
+        of_station = {"station": key.station} if key.station is not None else {}
         try:
             with Archive(path) as archive:
                 ts, values = archive.series(day, grp=key.grp, type=key.type, source=key.source,
-                                            points=self.points)
-        except (sqlite3.Error, OSError) as e:
+                                            points=self.points, **of_station)
+        except (sqlite3.Error, OSError, psycopg.Error) as e:
             self.failed.emit(token, key, str(e))
             return
         self.loaded.emit(token, key, ts, values)

@@ -2,7 +2,9 @@
 
 It needs only the archive file (the message texts are stored in it), so an archive copied from a
 plant PC opens on any machine. Records are paged from SQLite rather than loaded whole, so a day
-of a million records opens as fast as a day of ten.
+of a million records opens as fast as a day of ten. Given a postgresql:// URL it opens the plant
+archive read-only instead: a list of stations to tick, and series of several stations on one plot.
+Days and From/To are read in the zone the archive was written in (stored in its meta).
 """
 
 from __future__ import annotations
@@ -13,6 +15,7 @@ import sys
 from pathlib import Path
 
 import numpy as np
+import psycopg
 import pyqtgraph as pg
 from PySide6.QtCore import Qt
 from PySide6.QtGui import QAction, QColor, QKeySequence
@@ -40,13 +43,14 @@ from PySide6.QtWidgets import (
 from app.config import DEMO_STATION, ConfigError, load_station, station_file
 from app.gui.series_loader import SeriesLoader
 from app.gui.style import apply_style
-from hmi_forms.widgets.records import RecordsModel, records_view
+from hmi_forms.widgets.records import ARCHIVE_COLUMNS, Column, RecordsModel, records_view
 from registrar.query import Archive, Filter, SeriesKey
 
 PAGE = 500
 SERIES_POINTS = 4000
 KINDS = ("all", "data", "message", "operator", "system")
 TYPES = ("any", "0 info", "1 warning", "2 alarm", "3 critical")
+STATION = Column("Station", lambda r: r.station or "", 100)  # shown for a plant archive only
 PALETTE = ("#1f77b4", "#d62728", "#2ca02c", "#ff7f0e", "#9467bd", "#17becf", "#8c564b", "#e377c2")
 
 
@@ -57,11 +61,11 @@ def series_label(key: SeriesKey) -> str:
 
 
 class ViewerWindow(QMainWindow):
-    def __init__(self, archive_path: Path | None = None, parent: QWidget | None = None) -> None:
+    def __init__(self, archive_path: Path | str | None = None, parent: QWidget | None = None) -> None:
         super().__init__(parent)
         self.setWindowTitle("NetPlc Station — journal viewer")
         self.archive: Archive | None = None
-        self.archive_path: Path | None = None
+        self.archive_path: Path | str | None = None  # a file, or a plant archive's URL
         self.offset = 0
         self.total = 0
         self.curves: dict[SeriesKey, pg.PlotDataItem] = {}
@@ -104,6 +108,14 @@ class ViewerWindow(QMainWindow):
         self.days = QListWidget()
         self.days.currentRowChanged.connect(self._day_changed)
         side_lay.addWidget(self.days, 1)
+        self.stations_label = QLabel("<b>Stations</b>")
+        self.stations = QListWidget()
+        self.stations.setMaximumHeight(120)
+        self.stations.itemChanged.connect(lambda _item: self.apply_filter())
+        side_lay.addWidget(self.stations_label)
+        side_lay.addWidget(self.stations)
+        self.stations_label.hide()
+        self.stations.hide()
         side_lay.addWidget(QLabel("<b>Filter</b>"))
         form = QFormLayout()
         self.kind = QComboBox()
@@ -141,7 +153,7 @@ class ViewerWindow(QMainWindow):
         self.tabs = QTabWidget()
         records = QWidget()
         rec_lay = QVBoxLayout(records)
-        self.model = RecordsModel(parent=self)
+        self.model = RecordsModel((*ARCHIVE_COLUMNS, STATION), parent=self)
         self.table = records_view(self.model, row_height=22)
         rec_lay.addWidget(self.table, 1)
         pager = QHBoxLayout()
@@ -179,17 +191,29 @@ class ViewerWindow(QMainWindow):
 
     # --- archive and day -----------------------------------------------------------------------
 
-    def open_archive(self, path: Path) -> bool:
+    def open_archive(self, path: Path | str) -> bool:
         try:
             archive = Archive(path)
             days = archive.days()
-        except (sqlite3.Error, OSError) as e:
+            stations = archive.stations()
+        except (sqlite3.Error, OSError, ValueError, psycopg.Error) as e:
             QMessageBox.warning(self, "Journal viewer", f"Cannot open {path}:\n{e}")
             return False
         if self.archive is not None:
             self.archive.close()
-        self.archive, self.archive_path = archive, Path(path)
+        self.archive, self.archive_path = archive, path
         self.path_label.setText(f"<small>{path}</small>")
+        self.stations.blockSignals(True)
+        self.stations.clear()
+        for name in stations:
+            item = QListWidgetItem(name)
+            item.setFlags(item.flags() | Qt.ItemFlag.ItemIsUserCheckable)
+            item.setCheckState(Qt.CheckState.Checked)
+            self.stations.addItem(item)
+        self.stations.blockSignals(False)
+        self.stations_label.setVisible(bool(stations))
+        self.table.setColumnHidden(len(ARCHIVE_COLUMNS), not stations)
+        self.stations.setVisible(bool(stations))
         self.days.blockSignals(True)
         self.days.clear()
         for day in days:
@@ -220,11 +244,18 @@ class ViewerWindow(QMainWindow):
 
     # --- records -------------------------------------------------------------------------------
 
+    def chosen_stations(self) -> frozenset[str] | None:
+        """The ticked stations of a plant archive (None: all of them, or a station's archive)."""
+        items = [self.stations.item(i) for i in range(self.stations.count())]
+        ticked = frozenset(i.text() for i in items if i.checkState() == Qt.CheckState.Checked)
+        return None if len(ticked) == len(items) else ticked
+
     def current_filter(self) -> Filter:
         kind = self.kind.currentText()
         day = self.day or dt.date.today()
-        since = dt.datetime.combine(day, self.since.time().toPython()).timestamp()
-        until = dt.datetime.combine(day, self.until.time().toPython()).timestamp() + 1
+        tz = self.archive.tz if self.archive is not None else None  # the zone it was written in
+        since = dt.datetime.combine(day, self.since.time().toPython(), tz).timestamp()
+        until = dt.datetime.combine(day, self.until.time().toPython(), tz).timestamp() + 1
         return Filter(
             kinds=None if kind == "all" else {kind},
             grp=None if self.group.value() < 0 else self.group.value(),
@@ -233,6 +264,7 @@ class ViewerWindow(QMainWindow):
             text=self.text.text().strip() or None,
             since=since,
             until=until,
+            stations=self.chosen_stations(),
         )
 
     def apply_filter(self) -> None:
@@ -298,7 +330,8 @@ class ViewerWindow(QMainWindow):
             for key in self.archive.series_keys(day):
                 if key.kind != "data":
                     continue
-                item = QListWidgetItem(series_label(key))
+                item = QListWidgetItem(f"{key.station}: {series_label(key)}" if key.station
+                                       else series_label(key))
                 item.setData(Qt.ItemDataRole.UserRole, key)
                 item.setFlags(item.flags() | Qt.ItemFlag.ItemIsUserCheckable)
                 item.setCheckState(Qt.CheckState.Unchecked)
@@ -328,7 +361,8 @@ class ViewerWindow(QMainWindow):
         del self.loading[key]
         color = QColor(PALETTE[len(self.curves) % len(PALETTE)])
         xs, ys = np.asarray(ts, dtype=np.float64), np.asarray(values, dtype=np.float64)
-        self.curves[key] = self.plot.plot(xs, ys, pen=pg.mkPen(color, width=1.5), name=series_label(key),
+        name = f"{key.station}: {series_label(key)}" if key.station else series_label(key)
+        self.curves[key] = self.plot.plot(xs, ys, pen=pg.mkPen(color, width=1.5), name=name,
                                           connect="finite")
         self.plot.enableAutoRange()
         if not self.loading:
@@ -351,9 +385,12 @@ class ViewerWindow(QMainWindow):
         super().closeEvent(event)
 
 
-def archive_of(target: str | None) -> Path:
-    """The archive named on the command line: a file, a station folder, or the demo station's."""
+def archive_of(target: str | None) -> Path | str:
+    """The archive named on the command line: a file, a station folder, the demo station's, or a
+    plant archive's URL."""
 
+    if target is not None and target.startswith(("postgresql://", "postgres://")):
+        return target
     if target is None:
         return load_station(DEMO_STATION).Archive
     p = Path(target)
@@ -368,7 +405,7 @@ def run_viewer(target: str | None) -> int:
     except ConfigError as e:
         print("\n".join(e.problems), file=sys.stderr)
         return 2
-    if not path.is_file():
+    if isinstance(path, Path) and not path.is_file():
         print(f"{path}: no archive here (run the station first, or name an archive file)", file=sys.stderr)
         return 2
     app = QApplication.instance() or QApplication(sys.argv[:1])

@@ -9,7 +9,6 @@ those are the options; the rules for reading a row are written once here.
 
 from __future__ import annotations
 
-import time
 from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass, field
 from typing import Any
@@ -46,8 +45,9 @@ def number(row: Row) -> str:
 
 
 def clock_ms(row: Row) -> str:
+    """The wall clock where the record was written (the archive's zone)."""
     ms = int(row.ts * 1000) % 1000
-    return time.strftime("%H:%M:%S", time.localtime(row.ts)) + f".{ms:03d}"
+    return row.time.strftime("%H:%M:%S") + f".{ms:03d}"
 
 
 @dataclass(frozen=True)
@@ -107,7 +107,7 @@ class RecordsModel(QAbstractTableModel):
 
     def set_rows(self, rows: list[Row]) -> None:
         """Reset only when the rows differ: a reset loses the operator's selection and scroll."""
-        if [r.id for r in rows] == [r.id for r in self.rows]:
+        if [(r.id, r.station) for r in rows] == [(r.id, r.station) for r in self.rows]:
             return
         self.beginResetModel()
         self.rows = list(rows)

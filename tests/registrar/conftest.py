@@ -9,6 +9,9 @@ from pathlib import Path
 
 import pytest
 
+from registrar.forward import Forwarder
+from registrar.query import Archive
+
 
 def wait_for(condition: Callable[[], bool], timeout: float = 10.0) -> None:
     """Poll a condition another thread makes true (the writer commits on its own schedule)."""
@@ -30,3 +33,18 @@ def rows(path: Path, table: str, columns: str = "*") -> list[tuple]:
 @pytest.fixture
 def db(tmp_path: Path) -> Path:
     return tmp_path / "archive" / "journal.sqlite"
+
+
+@pytest.fixture(params=["sqlite", "postgresql"])
+def opened(request) -> Callable[[Path], Archive]:
+    """How a query test opens the archive it wrote: the SQLite file itself, or the plant archive
+    on PostgreSQL after the file was forwarded there (so one test checks both engines)."""
+    if request.param == "sqlite":
+        return Archive
+    url = request.getfixturevalue("pg_url")
+
+    def forwarded(path: Path) -> Archive:
+        Forwarder(path, url, "station").forward_all()
+        return Archive(url)
+
+    return forwarded

@@ -9,7 +9,7 @@ import pytest
 
 from netplc.records import Record
 from registrar.catalog import Catalog, Message
-from registrar.query import Archive, Filter, SeriesKey
+from registrar.query import Archive, Filter
 from registrar.store import Store
 
 from .conftest import wait_for
@@ -29,7 +29,7 @@ def write(db, records):
 
 
 @pytest.fixture
-def archive(db):
+def archive(db, opened):
     records = []
     for i in range(300):
         records.append(Record(T0 + i, "data", 1, 1, "04010", value=float(i)))
@@ -40,7 +40,7 @@ def archive(db):
                           text="write 04030: 0 -> 7"))
     records.append(Record(T0 - 86400, "system", source="app", text="station started"))
     write(db, records)
-    with Archive(db) as a:
+    with opened(db) as a:
         yield a
 
 
@@ -93,19 +93,19 @@ def test_a_missing_day_is_empty(archive):
 
 
 def test_series_keys_and_small_series(archive):
-    assert archive.series_keys(DAY) == [SeriesKey("data", 1, 1, "04010")]
+    assert [key[:4] for key in archive.series_keys(DAY)] == [("data", 1, 1, "04010")]
     assert archive.series_keys(DAY - dt.timedelta(days=1)) == []
     ts, values = archive.series(DAY, grp=1, type=1, source="04010")
     assert np.array_equal(ts, T0 + np.arange(300)) and np.array_equal(values, np.arange(300.0))
 
 
-def test_downsampling_keeps_peaks(db):
+def test_downsampling_keeps_peaks(db, opened):
     n = 20_000
     values = np.sin(np.arange(n) / 500.0) * 100.0
     values[12_345] = 1000.0
     values[777] = -1000.0
     write(db, [Record(T0 + i * 0.1, "data", 3, 4, "04020", value=float(v)) for i, v in enumerate(values)])
-    with Archive(db) as a:
+    with opened(db) as a:
         ts, got = a.series(DAY, grp=3, type=4, points=200)
         _, full = a.series(DAY, grp=3, type=4, points=n)
     assert 100 <= len(ts) <= 200
@@ -121,8 +121,8 @@ def test_export_csv(archive, tmp_path):
     assert archive.export_csv(out, DAY, Filter(kinds={"message"}, min_type=2)) == 10
     with open(out, encoding="utf-8-sig", newline="") as f:
         table = list(csv.reader(f))
-    assert table[0] == ["id", "time", "ts", "kind", "grp", "type", "source", "number", "value", "text"]
-    assert table[1][1] == "2026-03-05T08:00:00.000" and table[1][-1] == "Уровень выше 90 %"
+    assert table[0][:10] == ["id", "time", "ts", "kind", "grp", "type", "source", "number", "value", "text"]
+    assert table[1][1] == "2026-03-05T08:00:00.000" and table[1][9] == "Уровень выше 90 %"
     assert len(table) == 11
     assert out.read_bytes().startswith(b"\xef\xbb\xbf")
 
@@ -175,7 +175,7 @@ def test_reading_while_the_writer_writes(db):
     assert store.stats.last_error == ""
 
 
-def test_every_page_strategy_gives_the_reference_answer(db, monkeypatch):
+def test_every_page_strategy_gives_the_reference_answer(db, opened, monkeypatch):
     """Small probe and index limits force all three ways of finding a page on a modest day."""
     import random
 
@@ -199,7 +199,7 @@ def test_every_page_strategy_gives_the_reference_answer(db, monkeypatch):
         Filter(grp=0), Filter(grp=2, type=3), Filter(kinds={"data"}, grp=1), Filter(text="связь"),
         Filter(kinds={"message"}, min_type=2), Filter(kinds={"data"}, until=T0 + 100), Filter(grp=9),
     ]
-    with Archive(db) as a:
+    with opened(db) as a:
         everything = a.records(DAY, limit=10_000, newest_first=False)
         assert len(everything) == 3000
         for flt in filters:
@@ -234,3 +234,69 @@ def test_a_series_stays_in_time_order_when_the_clock_was_set_back(db):
         ts, values = a.series(DAY, grp=1, type=1, source="04000")
         assert list(ts) == sorted(stamps) and list(values) == [2.0, 0.0, 1.0, 3.0]
         assert [r.value for r in a.records(DAY, newest_first=False)] == [0.0, 1.0, 2.0, 3.0]
+
+
+def _without_text_index_and_summary(db) -> None:
+    """The file as an archive written before the trigram index and the per-minute summary."""
+    con = sqlite3.connect(db)
+    for (name,) in con.execute("SELECT name FROM sqlite_master WHERE type = 'table' "
+                               "AND (name GLOB 'text_*' OR name GLOB 'minutes_*')").fetchall():
+        if not name.endswith(("_data", "_idx", "_docsize", "_config", "_content")):
+            con.execute(f'DROP TABLE "{name}"')
+    con.commit()
+    con.close()
+
+
+def test_text_search_by_the_trigram_index_equals_the_scan(db):
+    words = ["Авария насоса", "насос в работе", "Связь потеряна", "ПУСК нажат", 'кавычка "x"', "50%_done"]
+    records = [Record(T0 + i, "operator" if i % 7 else "data", 1, 1, "04010", value=float(i),
+                      text=words[i % len(words)] if i % 7 else None) for i in range(3000)]
+    write(db, records)
+    searches = ["авария", "НАСОС", "Насос", "связь", "пуск", '"x"', "0%_", "нет такого", "на", "ё",
+                "a\x00b", "NEAR("]
+    with Archive(db) as a:
+        indexed = {t: (a.count(DAY, Filter(text=t)), a.records(DAY, Filter(text=t), limit=50, offset=3))
+                   for t in searches}
+    _without_text_index_and_summary(db)
+    with Archive(db) as a:
+        for t in searches:
+            assert (a.count(DAY, Filter(text=t)), a.records(DAY, Filter(text=t), limit=50, offset=3)) \
+                == indexed[t], t
+    assert indexed["авария"][0] == 3000 * 6 // 7 // 6 and indexed["нет такого"][0] == 0
+
+
+def test_a_long_series_is_read_from_the_minute_summary(db, monkeypatch):
+    import registrar.query as query
+
+    n = 20_000  # 10 records a second: 2,000 s, 34 minutes
+    values = np.cos(np.arange(n) / 700.0) * 50.0
+    values[12_345] = 1000.0
+    values[777] = -1000.0
+    write(db, [Record(T0 + i * 0.1, "data", 3, 4, "04020", value=float(v)) for i, v in enumerate(values)])
+    with Archive(db) as a:
+        raw = a.series(DAY, grp=3, type=4, source="04020", points=200)
+        monkeypatch.setattr(query, "SUMMARY_ABOVE", 1_000)
+        ts, got = a.series(DAY, grp=3, type=4, source="04020", points=200)
+        every, _ = a.series(DAY, grp=3, type=4, source="04020", points=100_000)
+    assert 34 <= len(every) <= 2 * 34  # a minimum and a maximum per minute
+    assert len(ts) <= 200 and np.all(np.diff(ts) > 0)
+    assert got.max() == raw[1].max() == 1000.0 and got.min() == raw[1].min() == -1000.0
+    assert ts[np.argmax(got)] == pytest.approx(T0 + 1234.5)
+    assert ts[np.argmin(got)] == pytest.approx(T0 + 77.7)
+    _without_text_index_and_summary(db)  # an older archive: read from the records, same peaks
+    with Archive(db) as a:
+        old_ts, old = a.series(DAY, grp=3, type=4, source="04020", points=200)
+    assert old.max() == 1000.0 and old_ts[np.argmax(old)] == pytest.approx(T0 + 1234.5)
+
+
+def test_a_day_written_before_the_index_gets_it_filled_when_written_again(db):
+    write(db, [Record(T0 + i, "message", 1, 2, number=3) for i in range(10)])
+    _without_text_index_and_summary(db)
+    write(db, [Record(T0 + 20 + i, "data", 1, 1, "04010", value=float(i)) for i in range(5)])
+    con = sqlite3.connect(db)
+    try:
+        fts = '"text_05_03_2026"'
+        assert con.execute(f"SELECT count(*) FROM {fts} WHERE {fts} MATCH '\"уро\"'").fetchone() == (10,)
+        assert con.execute('SELECT sum(n), max(hi) FROM "minutes_05_03_2026"').fetchone() == (5, 4.0)
+    finally:
+        con.close()

@@ -1,0 +1,132 @@
+"""What both archive readers share: the filter, the rows and series keys they return, the WHERE
+clause of a filter, and the min/max thinning of a series. The station's SQLite archive
+(registrar/query.py) and the plant archive on PostgreSQL (registrar/pg_query.py) each build on it,
+so neither imports the other's driver.
+"""
+
+from __future__ import annotations
+
+import datetime as dt
+from dataclasses import dataclass
+from typing import NamedTuple
+
+import numpy as np
+
+EXPORT_CHUNK = 10_000
+
+
+@dataclass(frozen=True)
+class Filter:
+    kinds: set[str] | frozenset[str] | None = None
+    grp: int | None = None
+    type: int | None = None
+    min_type: int | None = None  # e.g. 2: alarms and worse
+    source: str | None = None
+    text: str | None = None  # contains
+    since: float | None = None  # seconds since the epoch, inclusive
+    until: float | None = None  # seconds since the epoch, exclusive
+    stations: set[str] | frozenset[str] | None = None  # plant archive: these stations only
+
+
+@dataclass(frozen=True, slots=True)
+class Row:
+    id: int
+    ts: float  # seconds since the epoch
+    kind: str
+    grp: int | None
+    type: int | None
+    source: str | None
+    number: int | None
+    value: float | None
+    text: str | None
+    station: str | None = None  # plant archive: the station that wrote it
+    tz: dt.tzinfo | None = None  # the zone the archive's days are cut in (None: this machine's)
+
+    @property
+    def time(self) -> dt.datetime:
+        """Wall time of the record where it was written (naive)."""
+        return dt.datetime.fromtimestamp(self.ts, self.tz).replace(tzinfo=None)
+
+
+class SeriesKey(NamedTuple):
+    kind: str
+    grp: int | None
+    type: int | None
+    source: str | None
+    station: str | None = None  # plant archive: whose series
+
+
+class ArchiveReader:
+    """What every archive reader answers besides its queries: its zone, its stations, local times."""
+
+    tz: dt.tzinfo | None = None
+
+    def stations(self) -> list[str]:
+        """The stations that write to the archive: a station's own archive names none."""
+        return []
+
+    def local_time(self, ts: float) -> dt.datetime:
+        return dt.datetime.fromtimestamp(ts, self.tz).replace(tzinfo=None)
+
+    def close(self) -> None:
+        raise NotImplementedError
+
+    def __enter__(self) -> ArchiveReader:
+        return self
+
+    def __exit__(self, *exc: object) -> None:
+        self.close()
+
+
+def where_clause(flt: Filter, mark: str = "?") -> tuple[str, list[object]]:
+    """The WHERE clause of a filter; `mark` is the driver's placeholder (psycopg: %s)."""
+    conds: list[str] = []
+    args: list[object] = []
+    if flt.kinds is not None:
+        kinds = sorted(flt.kinds)
+        conds.append(f"kind IN ({', '.join([mark] * len(kinds))})" if kinds else "1 = 0")
+        args.extend(kinds)
+    for col, val in (("grp", flt.grp), ("type", flt.type), ("source", flt.source)):
+        if val is not None:
+            conds.append(f"{col} = {mark}")
+            args.append(val)
+    if flt.min_type is not None:
+        conds.append(f"type >= {mark}")
+        args.append(flt.min_type)
+    if flt.since is not None:
+        conds.append(f"ts >= {mark}")
+        args.append(round(flt.since * 1000))
+    if flt.until is not None:
+        conds.append(f"ts < {mark}")
+        args.append(round(flt.until * 1000))
+    if flt.text:
+        # SQLite folds case for ASCII only; the usual spellings of a Cyrillic word are tried too.
+        variants = sorted({flt.text, flt.text.lower(), flt.text.upper(), flt.text.capitalize()})
+        likes = " OR ".join(f"text LIKE {mark} ESCAPE '\\'" for _ in variants)
+        conds.append(f"text IS NOT NULL AND ({likes})")
+        args.extend(f"%{_escape_like(v)}%" for v in variants)
+    return (" WHERE " + " AND ".join(conds)) if conds else "", args
+
+
+def _escape_like(text: str) -> str:
+    return text.replace("\\", "\\\\").replace("%", "\\%").replace("_", "\\_")
+
+
+def min_max(ts: np.ndarray, values: np.ndarray, buckets: int) -> tuple[np.ndarray, np.ndarray]:
+    """Per equal-time bucket, the minimum and the maximum in the order they occurred."""
+    edges = np.linspace(ts[0], ts[-1], buckets + 1)
+    idx = np.clip(np.searchsorted(edges, ts, side="right") - 1, 0, buckets - 1)
+    starts = np.flatnonzero(np.r_[True, idx[1:] != idx[:-1]])
+    lo = _arg_reduce(values, starts, np.minimum)
+    hi = _arg_reduce(values, starts, np.maximum)
+    keep = np.unique(np.concatenate([lo, hi]))
+    return ts[keep], values[keep]
+
+
+def _arg_reduce(values: np.ndarray, starts: np.ndarray, op: np.ufunc) -> np.ndarray:
+    """Index of the first element equal to each segment's reduction (segments begin at `starts`)."""
+    best = op.reduceat(values, starts)
+    seg = np.repeat(np.arange(len(starts)), np.diff(np.r_[starts, len(values)]))
+    hits = np.flatnonzero(values == best[seg])
+    first = np.r_[True, seg[hits][1:] != seg[hits][:-1]]
+    return hits[first]

@@ -1,0 +1,107 @@
+"""A throwaway PostgreSQL cluster for the plant-archive tests: the Debian package's binaries,
+a data folder under /tmp, a free port on 127.0.0.1, the postmaster our own child (stopped by its
+PID). initdb refuses to run as root, so as root the cluster belongs to the `postgres` user the
+package creates; the reason a cluster cannot be had is what the tests are skipped with.
+"""
+
+from __future__ import annotations
+
+import contextlib
+import glob
+import os
+import pwd
+import shutil
+import signal
+import socket
+import subprocess
+import tempfile
+import time
+from pathlib import Path
+
+import psycopg
+
+
+def _bin(name: str) -> str | None:
+    found = sorted(glob.glob(f"/usr/lib/postgresql/*/bin/{name}"), reverse=True)
+    return found[0] if found else shutil.which(name)
+
+
+def _free_port() -> int:
+    with socket.socket() as s:
+        s.bind(("127.0.0.1", 0))
+        return s.getsockname()[1]
+
+
+class PgCluster:
+    def __init__(self, durable: bool = False) -> None:
+        """durable=False: no fsync (tests); True: the server's defaults (benchmarks)."""
+        self.durable = durable
+        initdb, postgres = _bin("initdb"), _bin("postgres")
+        if initdb is None or postgres is None:
+            raise RuntimeError("PostgreSQL is not installed (apt-get install postgresql)")
+        self.postgres = postgres
+        self.user: str | None = None
+        if os.geteuid() == 0:
+            try:
+                pwd.getpwnam("postgres")
+            except KeyError:
+                raise RuntimeError("running as root and there is no 'postgres' user for initdb") from None
+            self.user = "postgres"
+        self.folder = Path(tempfile.mkdtemp(prefix="netplc-pg-"))
+        if self.user:
+            shutil.chown(self.folder, self.user)
+        self.data = self.folder / "data"
+        done = subprocess.run([initdb, "-D", str(self.data), "-U", "postgres", "--auth=trust", "-E", "UTF8",
+                               "--locale=C.UTF-8", "--no-sync"], user=self.user, capture_output=True,
+                              text=True, check=False)
+        if done.returncode != 0:
+            shutil.rmtree(self.folder, ignore_errors=True)
+            raise RuntimeError(f"initdb failed: {done.stderr.strip()[-500:]}")
+        self.port = _free_port()
+        self.process: subprocess.Popen | None = None
+
+    @property
+    def url(self) -> str:
+        return f"postgresql://postgres@127.0.0.1:{self.port}/postgres"
+
+    def database_url(self, name: str) -> str:
+        return f"postgresql://postgres@127.0.0.1:{self.port}/{name}"
+
+    def start(self) -> None:
+        self.process = subprocess.Popen(
+            [self.postgres, "-D", str(self.data), "-p", str(self.port), "-c", "listen_addresses=127.0.0.1",
+             "-c", f"unix_socket_directories={self.folder}", "-c", "max_connections=50",
+             *([] if self.durable else ["-c", "fsync=off", "-c", "synchronous_commit=off",
+                                        "-c", "full_page_writes=off"])],
+            user=self.user, stdout=subprocess.DEVNULL, stderr=open(self.folder / "log", "ab"))  # noqa: SIM115
+        deadline = time.monotonic() + 30
+        while True:
+            try:
+                with psycopg.connect(self.url, connect_timeout=1):
+                    return
+            except psycopg.OperationalError:
+                if self.process.poll() is not None or time.monotonic() > deadline:
+                    log = (self.folder / "log").read_text(errors="replace")[-800:]
+                    raise RuntimeError(f"postgres did not start: {log}") from None
+                time.sleep(0.1)
+
+    def stop(self, sig: signal.Signals = signal.SIGINT) -> None:
+        """SIGINT: PostgreSQL's fast shutdown (open transactions are rolled back)."""
+        if self.process is not None:
+            self.process.send_signal(sig)
+            try:
+                self.process.wait(30)
+            except subprocess.TimeoutExpired:
+                self.process.kill()
+                self.process.wait()
+            self.process = None
+
+    def create_database(self, name: str) -> str:
+        with psycopg.connect(self.url, autocommit=True) as con:
+            con.execute(f'CREATE DATABASE "{name}"')
+        return self.database_url(name)
+
+    def remove(self) -> None:
+        with contextlib.suppress(Exception):
+            self.stop()
+        shutil.rmtree(self.folder, ignore_errors=True)
