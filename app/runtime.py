@@ -36,6 +36,7 @@ from netplc.modbus import ModbusServer, parse_endpoint
 from netplc.problems import Problems
 from netplc.records import Record
 from netplc.scheduler import ScanThread
+from netplc.tags.readings import Readings
 from netplc.simulator import Simulator
 from registrar.retain import Retainer
 from registrar.store import Store, StoreStats
@@ -317,6 +318,13 @@ class Runtime:
             store.close()  # flushes every queued record
             self._final_store = store.stats
         self.started = False
+
+    def readings(self) -> Readings | None:
+        """Every tag's and address's value with its quality and time as of the last scan
+        (netplc/tags/readings.py): what the HMI, the journal and the publishers read; None while
+        the station is not started (a reader then shows its values as not running)."""
+        alarms = self.alarms
+        return alarms.readings if alarms is not None else None
 
     # --- NetPlc run control (the workstation's menu) -------------------------------------------
 

@@ -3,9 +3,14 @@
 `StationAlarms` loads `tags.csv`, works out from the program which node fills which tag, takes
 back the alarm states of the last run, and then, attached to the engine, runs once per scan on
 the engine thread: each tag's quality from the exchange's links and data ages and NetPlc's run
-state, then the alarms over that scan's snapshot and the NMSG numbers journaled in it. Operator
-actions are posted to the engine thread, as writes are, so the alarm states have one writer.
-No Qt: the workstation and `--no-gui` share it.
+state, then the alarms over that scan's snapshot and the NMSG numbers journaled in it. Each scan
+ends by publishing `readings` (netplc/tags/readings.py): the one place the HMI, the journal and
+the publishers read a value's quality. Operator actions are posted to the engine thread, as
+writes are, so the alarm states have one writer. No Qt: the workstation and `--no-gui` share it.
+
+Start-up truth: a node's data is expected only from the first scan of this run of NetPlc in which
+its first exchange attempt is done (`LinkView.since`); before that its tags are "initial", not
+comm-fail, so a start raises no quality alarm for a node that simply has not answered yet.
 """
 
 from __future__ import annotations
@@ -22,6 +27,7 @@ from netplc.program import Program
 from netplc.records import Record, RecordSink
 from netplc.tags.alarms import AlarmSystem, CatalogMessage
 from netplc.tags.quality import LinkView, QualityMap
+from netplc.tags.readings import Readings
 from netplc.tags.table import TagTable, load_tags
 from registrar.alarm_state import AlarmStateFile
 
@@ -38,9 +44,11 @@ class StationAlarms:
         self.system = AlarmSystem(self.table, messages, sink=sink, saved=self.state.load(),
                                   on_change=self.state.update)
         self.quality = np.zeros(len(self.table.tags), dtype=np.int8)  # of the last scan, by tag
+        self.readings: Readings | None = None  # of the last scan; None before the first
         self.engine: Engine | None = None
         self.exchange: Exchange | None = None
         self._messages: list[int] = []
+        self._since: dict[int, int] = {}  # node -> first scan of this run with its link known
 
     def attach(self, engine: Engine, exchange: Exchange | None) -> None:
         """Evaluate after every scan of `engine`; start saving states."""
@@ -55,10 +63,19 @@ class StationAlarms:
 
     def on_scan(self, snapshot: Snapshot) -> None:
         ex = self.exchange
-        links = LinkView(running=snapshot.state == RunState.RUNNING,
+        running = snapshot.state == RunState.RUNNING
+        if not running:
+            self._since.clear()  # after a stop, data is expected afresh from the next start
+        elif ex is not None:
+            for n in ex.configs:
+                if n not in self._since and ex.link_known(n):
+                    self._since[n] = snapshot.scan
+        links = LinkView(running=running,
                          links={n: ex.link_up(n) for n in ex.configs} if ex is not None else {},
-                         refreshed=ex.refreshed if ex is not None else {})
+                         refreshed=dict(ex.refreshed) if ex is not None else {},
+                         since=dict(self._since) if ex is not None else None)
         self.quality = self.quality_map.evaluate(snapshot, links)
+        self.readings = Readings(snapshot, self.quality_map, links, self.quality)
         messages, self._messages = self._messages, []
         self.system.evaluate(snapshot, snapshot.wall, self.quality, messages)
 

@@ -14,7 +14,8 @@ nothing is annunciated, and when it ends an alarm whose condition is active come
 unacknowledged. A latching alarm stays active after its condition has gone until it is
 acknowledged. While a tag's quality is bad its process alarms are frozen where they are (DIVAR:
 "alarm only when not BAD"): a frozen value says nothing about the plant, neither that the alarm
-has come nor that it has gone; the quality alarm says why.
+has come nor that it has gone; the quality alarm says why. They also wait while the quality is
+initial (no value from the plant yet, no quality alarm either: quality.py).
 
 Every change of state is one `Transition`, journaled as one 'alarm' record (grp = priority,
 type = new state, number = old state, source = the alarm's identity, value = the physical value,
@@ -40,7 +41,7 @@ import numpy as np
 
 from netplc.memory import MemoryView
 from netplc.records import NullSink, Record, RecordSink
-from netplc.tags.quality import BAD_CODES
+from netplc.tags.quality import BAD_CODES, HELD_CODES
 from netplc.tags.table import TagTable
 from netplc.tags.tag import Tag, TagReader
 
@@ -310,8 +311,10 @@ class AlarmSystem:
         hyst = self._hyst
         if isinstance(quality, Mapping):
             quality = [quality.get(t.name, 0) for t in self.tags]
-        bad = BAD_CODES[np.asarray(quality, dtype=np.intp)] if quality is not None else None
-        frozen = self._proc_idx[bad[self._proc_tag]] if bad is not None and bad.any() else None
+        codes = np.asarray(quality, dtype=np.intp) if quality is not None else None
+        bad = BAD_CODES[codes] if codes is not None else None
+        held = HELD_CODES[codes] if codes is not None else None
+        frozen = self._proc_idx[held[self._proc_tag]] if held is not None and held.any() else None
         keep = hyst[frozen] if frozen is not None else None
         if len(self._lim_idx):
             x = self._lim_sign * (phy[self._lim_tag] - self._lim_limit)

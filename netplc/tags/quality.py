@@ -9,10 +9,20 @@ block's data in scans, NetPlc's run state and forcing give each address its qual
 - comm-fail: the node whose NREAD fills the address is down (its answers fail or are malformed);
 - stale: the NREAD asks (its rung is on) but its data has not landed for more than STALE_TICKS
   scans beyond the one scan an answer normally takes;
+- initial: nothing is known yet, so the value is not the plant's, but nothing has failed either:
+  the node has not had its first exchange attempt since the station started, or NetPlc has just
+  started (again) and the node's first data since then is still within its normal time to land.
+  It is shown like any quality that is not good, but it is not bad: no quality alarm comes of
+  it (every start would otherwise raise one per tag before the first answer), and process alarms
+  wait for the first real value (`Quality.held`). It turns into good when the data lands, into
+  comm-fail when the first attempt fails, into stale when the data is late;
 - good: anything else, including what the program computes itself while it runs.
 
 Qualities are ordered so that the worst of several blocks (a tag spanning two NREADs) is the
 highest; an address no NREAD fills is good while NetPlc runs.
+
+Forcing (netplc/forcing.py, to come) reaches quality through one hook: `LinkView.forced`, the
+forced operand addresses of the scan; the runtime fills it from the engine's forces.
 """
 
 from __future__ import annotations
@@ -35,10 +45,11 @@ NORMAL_AGE = 1  # scans from a request to its data in memory, normally
 
 class Quality(IntEnum):
     GOOD = 0
-    STALE = 1
-    COMM_FAIL = 2
-    NOT_RUNNING = 3
-    FORCED = 4
+    INITIAL = 1
+    STALE = 2
+    COMM_FAIL = 3
+    NOT_RUNNING = 4
+    FORCED = 5
 
     @property
     def word(self) -> str:
@@ -50,10 +61,16 @@ class Quality(IntEnum):
         """The value cannot be trusted (forced is shown, but it is not bad: someone chose it)."""
         return self in (Quality.STALE, Quality.COMM_FAIL, Quality.NOT_RUNNING)
 
+    @property
+    def held(self) -> bool:
+        """Process alarms wait: the value says nothing about the plant (bad, or not known yet)."""
+        return self.bad or self is Quality.INITIAL
 
-_WORDS = {Quality.GOOD: "good", Quality.STALE: "stale", Quality.COMM_FAIL: "comm-fail",
-          Quality.NOT_RUNNING: "not running", Quality.FORCED: "forced"}
+
+_WORDS = {Quality.GOOD: "good", Quality.INITIAL: "initial", Quality.STALE: "stale",
+          Quality.COMM_FAIL: "comm-fail", Quality.NOT_RUNNING: "not running", Quality.FORCED: "forced"}
 BAD_CODES = np.array([q.bad for q in Quality], dtype=bool)  # indexed by quality code
+HELD_CODES = np.array([q.held for q in Quality], dtype=bool)
 
 
 @dataclass(frozen=True, slots=True)
@@ -91,6 +108,10 @@ class LinkView:
     links: Mapping[int, bool] | None = None  # node -> link up; None: every node is up
     refreshed: Mapping[int, int] | None = None  # NREAD key -> scan its data last landed; None: now
     forced: Collection[int] = ()  # forced operand addresses: I/O bits and data bytes
+    # node -> the scan from which its data is expected: the first scan of this run of NetPlc in
+    # which the node's link state was known (its first exchange attempt done). A node not in it
+    # is initial; None: every node's data has been expected for long.
+    since: Mapping[int, int] | None = None
 
 
 class QualityMap:
@@ -115,6 +136,10 @@ class QualityMap:
         self._first, self._last = spans[:, 0], spans[:, 1]
         self._pos = {t.name: i for i, t in enumerate(self.tags)}
 
+    def position(self, name: str) -> int:
+        """The index of a tag in `tags` and in what `evaluate` returns (KeyError if none)."""
+        return self._pos[name]
+
     def fed_by(self, tag: Tag) -> list[Feed]:
         """The NREADs whose block overlaps the tag."""
         return [self.feeds[k] for k in self.groups[self._member[self._pos[tag.name]]]]
@@ -122,10 +147,18 @@ class QualityMap:
     def feed_quality(self, feed: Feed, view: MemoryView, links: LinkView, scan: int) -> Quality:
         if not links.running:
             return Quality.NOT_RUNNING
+        since = None
+        if links.since is not None:
+            since = links.since.get(feed.node)
+            if since is None:
+                return Quality.INITIAL
         if links.links is not None and not links.links.get(feed.node, False):
             return Quality.COMM_FAIL
         if links.refreshed is not None and view.get_bit(feed.coil):
             landed = links.refreshed.get(feed.key)
+            if since is not None and (landed is None or landed < since):  # nothing since the start
+                late = scan - since > NORMAL_AGE + STALE_TICKS
+                return Quality.STALE if late else Quality.INITIAL
             if landed is None or scan - landed > NORMAL_AGE + STALE_TICKS:
                 return Quality.STALE
         return Quality.GOOD
