@@ -36,8 +36,8 @@ from netplc.modbus import ModbusServer, parse_endpoint
 from netplc.problems import Problems
 from netplc.records import Record
 from netplc.scheduler import ScanThread
-from netplc.tags.readings import Readings
 from netplc.simulator import Simulator
+from netplc.tags.readings import Readings
 from registrar.retain import Retainer
 from registrar.store import Store, StoreStats
 

@@ -169,8 +169,9 @@ class MainWindow(QMainWindow):
     # --- live updates --------------------------------------------------------------------------
 
     def _on_snapshot(self, snapshot: Snapshot) -> None:
+        readings = self.runtime.readings()  # the quality of what every element shows
         for view in self.views:
-            view.refresh(snapshot)
+            view.refresh(snapshot, readings)
 
     def _on_record(self, record: Record) -> None:
         if record.kind == "message":

@@ -120,6 +120,9 @@ class AnalogBase(Scaled):
         assert self.InAddr is not None
         return word_reader(self.InAddr)
 
+    def sources(self) -> tuple[tuple[int, int], ...]:
+        return ((self.InAddr, 2),) if self.InAddr is not None else ()
+
     def zone_of(self, phy: float) -> str:
         """Zone with hysteresis: leaving the current zone needs the value to be Hysteresis inside."""
         lo, hi, hy = self.PhyLow, self.PhyHigh, self.Hysteresis
@@ -192,6 +195,10 @@ class AnalogOutput(Scaled):
 
     hw: int | None = field(default=None, init=False)
     text: str = field(default="", init=False)
+
+    def sources(self) -> tuple[tuple[int, int], ...]:
+        addr = self.InAddr if self.InAddr is not None else self.OutAddr
+        return ((addr, 2),) if addr is not None else ()
 
     def refresh(self, snap: Snapshot) -> bool:
         addr = self.InAddr if self.InAddr is not None else self.OutAddr

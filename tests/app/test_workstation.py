@@ -135,3 +135,27 @@ def test_a_failing_archive_shows_in_the_status_bar(qtbot) -> None:
     assert bar.records.property("level") == "bad"
     assert bar.state.property("level") == "ok"
     assert station_problems(status) == list(status.problems)
+
+
+def test_elements_mark_a_dead_node_and_a_stopped_netplc_the_same_way(qtbot, workstation: MainWindow) -> None:
+    runtime = workstation.runtime
+    level, gauge = element(workstation, "Уровень")
+    trend, _ = element(workstation, "Уровень, тренд")
+    link, label = element(workstation, "Связь")
+    qtbot.waitUntil(lambda: runtime.status().nodes_up == 1 and not level.stale and not link.stale,
+                    timeout=10_000)
+    assert level.quality == "" and "comm-fail" not in gauge.toolTip()
+    form = gauge.parentWidget()  # painted elements are drawn by their form
+    live = form.grab(gauge.geometry()).toImage()
+
+    runtime.simulators[0].stop()  # the node that fills the level dies
+    qtbot.waitUntil(lambda: level.quality == "comm-fail", timeout=10_000)
+    assert gauge.toolTip().startswith("? comm-fail")
+    qtbot.waitUntil(lambda: math.isnan(trend.trend.last), timeout=3000)  # the trend breaks its line
+    assert form.grab(gauge.geometry()).toImage() != live  # greyed and hatched
+
+    runtime.stop_program()
+    qtbot.waitUntil(lambda: level.quality == "not running" and link.quality == "not running",
+                    timeout=5000)
+    assert label.toolTip().startswith("? not running")  # "связь есть" no longer looks live
+    assert math.isnan(trend.trend.last)
