@@ -133,6 +133,7 @@ class Runtime:
         if loaded.problems:
             raise StartError(loaded.problems)
         self.symbols, self.catalog, self.program = loaded.symbols, loaded.catalog, loaded.program
+        self.tags = loaded.tags
         self.node_programs = loaded.node_programs
         self.forms: list[Form] = loaded.forms  # the runtime's own models: evaluated, never shown
         self.form_problems = loaded.form_problems
@@ -273,7 +274,7 @@ class Runtime:
     def open_forms(self) -> tuple[list[Form], list[str]]:
         """Fresh models of the station's forms for a view, which only shows them (the runtime
         evaluates its own); and the problems of the forms that did not load."""
-        return load_station_forms(self.station, self.symbols)
+        return load_station_forms(self.station, self.symbols, self.tags)
 
     def _fill_endpoint(self, node: int, endpoint: str) -> None:
         self.nodes = [replace(n, endpoint=endpoint) if n.node == node and not n.endpoint else n
