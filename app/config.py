@@ -71,6 +71,7 @@ class Station:
     users: tuple[str, ...] = ("operator",)
     Tags: Path | None = None  # tags.csv: tags and their alarms (netplc/tags/)
     allow_outside: bool = False  # may station paths (and form images) leave the station folder?
+    alarm_sound: bool = True  # a new alarm of priority 1-2 sounds until acknowledged or silenced
 
     @property
     def folder(self) -> Path:
@@ -200,6 +201,7 @@ def read_station(path: str | Path) -> tuple[Station | None, list[str]]:
     keep_days = top.number("keep_days", 0, 0, 36_500)
     retain = top.path("Retain", base)
     tags = top.path("Tags", base)
+    alarm_sound = bool(top.get("alarm_sound", bool, True))
     server = _modbus_server(problems, fname, top.get("modbus_server", dict, {}))
     nodes = _nodes(problems, fname, top.get("nodes", list, []))
     simulators = _simulators(problems, fname, top.get("simulators", list, []), base, top.allow_outside)
@@ -228,7 +230,7 @@ def read_station(path: str | Path) -> tuple[Station | None, list[str]]:
         Symbols=symbols, HMIload=hmi, NetSyncTime=sync, Archive=archive, Messages=messages,
         keep_days=keep_days, Retain=retain, modbus_server=server,
         nodes=tuple(nodes), simulators=tuple(runnable), users=users, Tags=tags,
-        allow_outside=top.allow_outside,
+        allow_outside=top.allow_outside, alarm_sound=alarm_sound,
     )
     return station, problems
 

@@ -175,17 +175,6 @@ class Runtime:
     def system(self, text: str) -> None:
         self.put(Record(self.wallclock(), "system", source="station", text=text))
 
-    def message_text(self, record: Record) -> str:
-        """An NMSG record's text as the archive will show it (the catalog resolves it)."""
-        if record.text:
-            return record.text
-        return self.catalog.text_for(record.number) if record.number is not None else ""
-
-    def acknowledge(self, record: Record, user: str) -> None:
-        """An operator acknowledges an alarm: an 'operator' record naming the user and the message."""
-        self.put(Record(self.wallclock(), "operator", grp=record.grp, type=record.type, source=user,
-                        number=record.number, text=f"acknowledged: {self.message_text(record)}"))
-
     # --- start and stop ------------------------------------------------------------------------
 
     def start(self) -> None:

@@ -15,7 +15,7 @@ comm-fail, so a start raises no quality alarm for a node that simply has not ans
 
 from __future__ import annotations
 
-from collections.abc import Callable
+from collections.abc import Callable, Sequence
 from pathlib import Path
 
 import numpy as np
@@ -25,7 +25,7 @@ from netplc.exchange import Exchange
 from netplc.memory import Snapshot
 from netplc.program import Program
 from netplc.records import Record, RecordSink
-from netplc.tags.alarms import AlarmSystem, CatalogMessage
+from netplc.tags.alarms import AlarmRow, AlarmSystem, CatalogMessage
 from netplc.tags.quality import LinkView, QualityMap
 from netplc.tags.readings import Readings
 from netplc.tags.table import TagTable, load_tags
@@ -45,6 +45,10 @@ class StationAlarms:
                                   on_change=self.state.update)
         self.quality = np.zeros(len(self.table.tags), dtype=np.int8)  # of the last scan, by tag
         self.readings: Readings | None = None  # of the last scan; None before the first
+        # the alarm summary, rebuilt on the engine thread whenever a state changed; `version`
+        # counts the rebuilds, so a view redraws only when something changed
+        self.summary: tuple[AlarmRow, ...] = self.system.rows()
+        self.version = 0
         self.engine: Engine | None = None
         self.exchange: Exchange | None = None
         self._messages: list[int] = []
@@ -77,13 +81,22 @@ class StationAlarms:
         self.quality = self.quality_map.evaluate(snapshot, links)
         self.readings = Readings(snapshot, self.quality_map, links, self.quality)
         messages, self._messages = self._messages, []
-        self.system.evaluate(snapshot, snapshot.wall, self.quality, messages)
+        if self.system.evaluate(snapshot, snapshot.wall, self.quality, messages):
+            self._publish()
 
-    def _post(self, action: Callable[[], object]) -> None:
+    def _publish(self) -> None:
+        self.summary = self.system.rows()
+        self.version += 1
+
+    def _post(self, action: Callable[[], Sequence[object]]) -> None:
+        def run() -> None:
+            if action():
+                self._publish()
+
         if self.engine is None:
-            action()
+            run()
         else:
-            self.engine.post(lambda _mem: action())
+            self.engine.post(lambda _mem: run())
 
     # Operator actions: refused at once (AlarmError) for an unknown alarm or a shelving without
     # its operator, reason or duration; done at the start of the next scan.

@@ -19,6 +19,7 @@ from PySide6.QtGui import QAction, QCloseEvent, QKeySequence
 from PySide6.QtWidgets import (
     QApplication,
     QComboBox,
+    QDockWidget,
     QFrame,
     QHBoxLayout,
     QLabel,
@@ -31,7 +32,8 @@ from PySide6.QtWidgets import (
 )
 
 from app.config import load_station
-from app.gui.alarms import Alarm, AlarmBanner, HealthStrip
+from app.gui.alarm_summary import AlarmSummary
+from app.gui.alarms import AlarmBanner, HealthStrip
 from app.gui.bridge import RuntimeBridge
 from app.gui.journal import JournalDock
 from app.gui.status import StationStatusBar, station_problems
@@ -41,7 +43,7 @@ from hmi_forms.elements.target import EngineTarget
 from hmi_forms.widgets.form_view import FormView
 from netplc.memory import Snapshot
 from netplc.problems import Problems
-from netplc.records import Record
+from netplc.tags.alarms import AlarmRow
 
 STATUS_MS = 500
 FRAME_HEIGHT = 380  # menu, header, banner, tabs, journal dock and status bar around a form
@@ -78,14 +80,23 @@ class MainWindow(QMainWindow):
 
         self.journal = JournalDock(station.Archive, self)
         self.addDockWidget(Qt.DockWidgetArea.BottomDockWidgetArea, self.journal)
+        self.summary = AlarmSummary(runtime.alarms, lambda: self.user, sound=station.alarm_sound)
+        self.summary_dock = QDockWidget("Alarms", self)
+        self.summary_dock.setObjectName("alarmSummaryDock")
+        self.summary_dock.setWidget(self.summary)
+        self.addDockWidget(Qt.DockWidgetArea.BottomDockWidgetArea, self.summary_dock)
+        self.tabifyDockWidget(self.journal, self.summary_dock)
+        self.summary_dock.raise_()
         self.status = StationStatusBar()
         self.setStatusBar(self.status)
         self._build_menu()
         self.form_problems = self._load_forms()
 
         self.bridge.snapshot.connect(self._on_snapshot)
-        self.bridge.record.connect(self._on_record)
+        self.summary.changed.connect(self._alarms_changed)
         self.alarms.acknowledged.connect(self._acknowledge)
+        self.alarms.acknowledged_all.connect(self.summary.acknowledge_all)
+        self._alarms_changed()
         self._timer = QTimer(self)
         self._timer.setInterval(STATUS_MS)
         self._timer.timeout.connect(self.refresh_status)
@@ -117,10 +128,14 @@ class MainWindow(QMainWindow):
             station.addAction(a)
         station.addSeparator()
         station.addAction(viewer)
+        health = QAction("Alarm-system &health…", self)
+        health.triggered.connect(self.open_health)
+        station.addAction(health)
         station.addSeparator()
         station.addAction(quit_)
         view = self.menuBar().addMenu("&View")
         view.addAction(self.journal.toggleViewAction())
+        view.addAction(self.summary_dock.toggleViewAction())
         help_ = self.menuBar().addMenu("&Help")
         about = QAction("&About", self)
         about.triggered.connect(self._about)
@@ -173,12 +188,11 @@ class MainWindow(QMainWindow):
         for view in self.views:
             view.refresh(snapshot, readings)
 
-    def _on_record(self, record: Record) -> None:
-        if record.kind == "message":
-            self.alarms.add(record, self.runtime.message_text(record))
+    def _alarms_changed(self) -> None:
+        self.alarms.show_alarms(self.summary.unacknowledged())
 
-    def _acknowledge(self, alarm: Alarm) -> None:
-        self.runtime.acknowledge(alarm.record, self.user)
+    def _acknowledge(self, alarm: AlarmRow) -> None:
+        self.summary.acknowledge([alarm.id])
 
     def _user_changed(self, user: str) -> None:
         """Operator writes and acknowledgements are journaled under the operator on duty."""
@@ -212,6 +226,11 @@ class MainWindow(QMainWindow):
         viewer.show()
         self.viewers.append(viewer)
 
+    def open_health(self) -> None:
+        from app.gui.alarm_health import HealthDialog
+
+        HealthDialog(self.runtime.station.Archive, self).exec()
+
     def _about(self) -> None:
         QMessageBox.about(self, "NetPlc Station",
                           "NetPlc Station: the PC runtime for CPU-165 PLC networks (FregatServer).\n"
@@ -219,6 +238,7 @@ class MainWindow(QMainWindow):
 
     def closeEvent(self, event: QCloseEvent) -> None:
         self._timer.stop()
+        self.summary.stop()
         self.bridge.detach()
         self.journal.close_archive()
         for viewer in self.viewers:

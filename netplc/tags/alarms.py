@@ -148,6 +148,28 @@ class Alarm:
         return State.NORMAL if self.acked else State.RTNUN
 
 
+@dataclass(frozen=True, slots=True)
+class AlarmRow:
+    """One line of the alarm summary, frozen so another thread may show it while states change."""
+
+    id: str
+    priority: int
+    state: State
+    since: float  # wall time of the last activation
+    changed: float  # wall time of the last transition
+    value: float | None  # physical value at the last transition
+    text: str
+    tag: str | None = None
+    shown: str = ""  # the value as an operator reads it: the tag's decimals and unit
+    shelved_until: float | None = None
+    shelved_by: str = ""
+    reason: str = ""
+
+    @property
+    def acked(self) -> bool:
+        return self.state not in (State.UNACK, State.RTNUN)
+
+
 PERSISTED = ("active", "acked", "since", "changed", "value", "shelved_until", "shelved_by", "reason",
              "out_of_service", "oos_by", "suppressed")
 
@@ -516,6 +538,19 @@ class AlarmSystem:
         """Active and unacknowledged alarms, by priority, then newest first."""
         return sorted((a for a in self.alarms if a.state in IN_LIST),
                       key=lambda a: (a.defn.priority, -a.since))
+
+    def rows(self) -> tuple[AlarmRow, ...]:
+        """The summary: listed alarms (by priority, newest first), then the shelved ones."""
+        shelved = sorted((self.alarms[i] for i in self._shelved), key=lambda a: (a.defn.priority, -a.changed))
+        tags = {t.name: t for t in self.tags}
+
+        def shown(a: Alarm) -> str:
+            tag = tags.get(a.defn.tag or "")
+            return "" if a.value is None else tag.format(a.value) if tag is not None else f"{a.value:g}"
+
+        return tuple(AlarmRow(a.id, a.defn.priority, a.state, a.since, a.changed, a.value, a.defn.text,
+                              a.defn.tag, shown(a), a.shelved_until, a.shelved_by, a.reason)
+                     for a in [*self.listed(), *shelved])
 
     def counts(self) -> dict[int, int]:
         """How many alarms of each priority are listed."""
