@@ -147,7 +147,7 @@ class MainWindow(QMainWindow):
             self.tabs.addTab(_placeholder("This station has no HMIload folder."), "No forms")
             return []
         forms, problems = self.runtime.open_forms()  # the views' own models: they only show
-        target = EngineTarget(self.runtime.engine)
+        target = EngineTarget(self.runtime.engine, self.runtime.tags)
         for form in forms:
             view = FormView(form, target, archive_path=station.Archive, user=self.user,
                             started=self.runtime.started_clock)

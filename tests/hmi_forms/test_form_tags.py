@@ -9,7 +9,11 @@ import pytest
 
 from hmi_forms.elements.analog import AnalogBase, AnalogOutput
 from hmi_forms.elements.discrete import DiscreteBase
+from hmi_forms.elements.target import EngineTarget
 from hmi_forms.form import FormError, load_form
+from netplc.engine import Engine
+from netplc.program import parse
+from netplc.records import ListSink
 from netplc.tags.table import load_tags
 from tests.hmi_forms.helpers import write_form
 
@@ -59,3 +63,23 @@ def test_an_unknown_tag_and_a_tag_of_the_wrong_type_are_named(tmp_path: Path, ta
     assert found == ['element "A": InAddr: unknown tag or symbol "LEVL"',
                      'element "B": InAddr: tag "PUMP" is of type bit; this property takes word',
                      'element "C": InAddr: tag "LEVEL" is of type word; this property takes bit']
+
+
+def test_an_operator_write_to_a_tag_is_journaled_in_physical_units_with_the_raw_value(tmp_path: Path) -> None:
+    path = tmp_path / "tags.csv"
+    path.write_text("name,address,type,unit,app_min,app_max,phy_min,phy_max,decimals,description\n"
+                    "TEMP_SP,04030,word,°C,0,4095,-50,150,1,Уставка\nSTART,040042,bit,,,,,,,Пуск\n",
+                    encoding="utf-8")
+    sink = ListSink()
+    engine = Engine(parse("JMP 0\n"), sink=sink)
+    engine.mem.set_word(0o4030, 1024)  # 0.0 °C
+    target = EngineTarget(engine, load_tags(path))
+    target.write_word(0o4030, 3686, user="ivanov", label="Уставка температуры")
+    target.write_bit(0o40042, 1, user="ivanov", label="Пуск")
+    target.write_word(0o4100, 7, user="ivanov", label="Other")
+    engine.scan()
+    texts = [(r.source, r.value, r.text) for r in sink.records if r.kind == "operator"]
+    assert texts[0] == ("ivanov", 3686.0, "write Уставка температуры TEMP_SP: 0.0 -> 130.0 °C "
+                                          "(raw 1024 -> 3686 at 04030)")
+    assert texts[1][2] == "write Пуск START (040042): 0 -> 1"
+    assert texts[2][2] == "write Other (04100): 0 -> 7"  # no tag: as before
