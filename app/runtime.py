@@ -181,7 +181,8 @@ class Runtime:
         """Start every part; StartError names the key of what could not start (the archive, a
         simulator's port, the nodes), after what did start is stopped again."""
         st = self.station
-        store = Store(st.Archive, catalog=self.catalog, keep_days=st.keep_days, wallclock=self.wallclock)
+        store = Store(st.Archive, catalog=self.catalog, keep_days=st.keep_days, wallclock=self.wallclock,
+                      tags=self.tags)
         try:
             store.start()
         except (OSError, sqlite3.Error) as e:

@@ -121,7 +121,8 @@ def test_export_csv(archive, tmp_path):
     assert archive.export_csv(out, DAY, Filter(kinds={"message"}, min_type=2)) == 10
     with open(out, encoding="utf-8-sig", newline="") as f:
         table = list(csv.reader(f))
-    assert table[0] == ["id", "time", "ts", "kind", "grp", "type", "source", "number", "value", "text"]
+    assert table[0] == ["id", "time", "ts", "kind", "grp", "type", "source", "number", "value", "text",
+                        "tag", "physical", "unit"]
     assert table[1][1] == "2026-03-05T08:00:00.000" and table[1][-1] == "Уровень выше 90 %"
     assert len(table) == 11
     assert out.read_bytes().startswith(b"\xef\xbb\xbf")
