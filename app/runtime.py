@@ -141,6 +141,7 @@ class Runtime:
         self.engine: Engine | None = None
         self.retainer: Retainer | None = None
         self.simulators: list[Simulator] = []
+        self.silent: set[int] = set()  # simulators stopped by `simulator_answers`
         self.exchange: Exchange | None = None
         self.modbus: ModbusServer | None = None
         self.alarms: StationAlarms | None = None  # tags, quality and alarms, evaluated every scan
@@ -299,9 +300,11 @@ class Runtime:
         if self.exchange is not None:
             self.exchange.stop()
             self.exchange = None
-        for simulator in reversed(self.simulators):
-            simulator.stop()
+        for i, simulator in reversed(list(enumerate(self.simulators))):
+            if i not in self.silent:
+                simulator.stop()
         self.simulators.clear()
+        self.silent.clear()
         if self.store is not None:
             if self.started:
                 self.system("station stopped")
@@ -309,6 +312,25 @@ class Runtime:
             store.close()  # flushes every queued record
             self._final_store = store.stats
         self.started = False
+
+    def simulator_answers(self, index: int, answering: bool) -> None:
+        """Stop simulated node `index` of station.toml (a pulled cable: its tags go comm-fail and
+        their quality alarms come) or start it again on the same port: the demo's bad-quality case
+        an operator can provoke. Journaled as a 'system' record."""
+        sim, old = self.station.simulators[index], self.simulators[index]
+        if answering == (index not in self.silent):
+            return
+        if not answering:
+            old.stop()
+            self.silent.add(index)
+        else:
+            self.silent.discard(index)
+            new = Simulator(self.node_programs[index], host=sim.host, port=old.port, unit=sim.unit,
+                            tick=sim.tick_ms / 1000)
+            new.engine.mem.load(old.engine.snapshot)  # the plant goes on where it stopped
+            new.start()
+            self.simulators[index] = new
+        self.system(f"simulated node {sim.node} {'answers again' if answering else 'stopped answering'}")
 
     def readings(self) -> Readings | None:
         """Every tag's and address's value with its quality and time as of the last scan

@@ -128,6 +128,13 @@ class MainWindow(QMainWindow):
             station.addAction(a)
         station.addSeparator()
         station.addAction(viewer)
+        for i, sim in enumerate(self.runtime.station.simulators):  # the demo's bad-quality case
+            answers = QAction(f"Simulated node {sim.node} answers", self)
+            answers.setCheckable(True)
+            answers.setChecked(True)
+            answers.setToolTip("Untick to pull the node's cable: its values go comm-fail, their alarms come")
+            answers.toggled.connect(lambda on, i=i: self.runtime.simulator_answers(i, on))
+            station.addAction(answers)
         health = QAction("Alarm-system &health…", self)
         health.triggered.connect(self.open_health)
         station.addAction(health)

@@ -82,3 +82,20 @@ def test_an_unacknowledged_alarm_stays_unacknowledged_across_a_restart(demo_copy
     finally:
         again.stop()
     assert activations(station.Archive, "LEVEL.H") == 1  # raised once, remembered, not raised again
+
+
+def test_the_operator_pulls_and_plugs_a_simulated_nodes_cable(demo_copy: Path) -> None:
+    runtime = Runtime(load_station(demo_copy))
+    runtime.start()
+    try:
+        wait_until(lambda: quality(runtime, "LEVEL") is Quality.GOOD, timeout=10)
+        runtime.simulator_answers(0, False)
+        wait_until(lambda: quality(runtime, "LEVEL") is Quality.COMM_FAIL, timeout=10)
+        wait_until(lambda: runtime.alarms is not None and
+                   runtime.alarms.system.get("LEVEL.BAD").state is State.UNACK, timeout=5)
+        runtime.simulator_answers(0, True)
+        wait_until(lambda: quality(runtime, "LEVEL") is Quality.GOOD, timeout=15)
+        wait_until(lambda: runtime.alarms is not None and
+                   runtime.alarms.system.get("LEVEL.BAD").state is State.RTNUN, timeout=5)
+    finally:
+        runtime.stop()
