@@ -17,6 +17,7 @@ from __future__ import annotations
 
 from collections.abc import Callable, Sequence
 from pathlib import Path
+from typing import Any
 
 import numpy as np
 
@@ -25,13 +26,14 @@ from netplc.exchange import Exchange
 from netplc.memory import Snapshot
 from netplc.program import Program
 from netplc.records import Record, RecordSink
-from netplc.tags.alarms import AlarmRow, AlarmSystem, CatalogMessage
+from netplc.tags.alarms import AlarmRow, AlarmSystem, CatalogMessage, summary_order
 from netplc.tags.quality import LinkView, QualityMap
 from netplc.tags.readings import Readings
 from netplc.tags.table import TagTable, load_tags
 from registrar.alarm_state import AlarmStateFile
 
 STATE_FILE = "alarms.sqlite"  # next to the archive
+PUBLISH_EVERY = 0.25  # s of engine time between two rebuilds of the summary during a flood
 
 
 class StationAlarms:
@@ -42,13 +44,18 @@ class StationAlarms:
         self.quality_map = QualityMap(program, self.table.tags)
         self.state = AlarmStateFile(state_file, sink)
         self.system = AlarmSystem(self.table, messages, sink=sink, saved=self.state.load(),
-                                  on_change=self.state.update)
+                                  on_change=self._changed)
         self.quality = np.zeros(len(self.table.tags), dtype=np.int8)  # of the last scan, by tag
         self.readings: Readings | None = None  # of the last scan; None before the first
-        # the alarm summary, rebuilt on the engine thread whenever a state changed; `version`
-        # counts the rebuilds, so a view redraws only when something changed
+        # The alarm summary, rebuilt on the engine thread after states changed, from the rows of
+        # the alarms that changed (a flood costs one row per transition and one sort per rebuild,
+        # at most every PUBLISH_EVERY); `version` counts the rebuilds, so a view redraws only when
+        # something changed. Operator actions are published at once.
         self.summary: tuple[AlarmRow, ...] = self.system.rows()
         self.version = 0
+        self._rows = {r.id: r for r in self.summary}
+        self._dirty: set[str] = set()
+        self._published = float("-inf")  # engine time of the last rebuild
         self.engine: Engine | None = None
         self.exchange: Exchange | None = None
         self._messages: list[int] = []
@@ -81,16 +88,31 @@ class StationAlarms:
         self.quality = self.quality_map.evaluate(snapshot, links)
         self.readings = Readings(snapshot, self.quality_map, links, self.quality)
         messages, self._messages = self._messages, []
-        if self.system.evaluate(snapshot, snapshot.wall, self.quality, messages):
-            self._publish()
+        self.system.evaluate(snapshot, snapshot.wall, self.quality, messages)
+        if self._dirty and snapshot.time - self._published >= PUBLISH_EVERY:
+            self._publish(snapshot.time)
 
-    def _publish(self) -> None:
-        self.summary = self.system.rows()
+    def _changed(self, changes: dict[str, dict[str, Any]]) -> None:
+        self.state.update(changes)
+        self._dirty.update(changes)
+
+    def _publish(self, now: float | None = None) -> None:
+        for alarm_id in self._dirty:
+            row = self.system.row(alarm_id)
+            if row is None:
+                self._rows.pop(alarm_id, None)
+            else:
+                self._rows[alarm_id] = row
+        self._dirty.clear()
+        self.summary = tuple(sorted(self._rows.values(), key=summary_order))
         self.version += 1
+        if now is not None:
+            self._published = now
 
     def _post(self, action: Callable[[], Sequence[object]]) -> None:
         def run() -> None:
-            if action():
+            action()
+            if self._dirty:
                 self._publish()
 
         if self.engine is None:

@@ -170,6 +170,12 @@ class AlarmRow:
         return self.state not in (State.UNACK, State.RTNUN)
 
 
+def summary_order(row: AlarmRow) -> tuple[bool, int, float]:
+    """Listed alarms by priority, then newest first; after them the shelved ones, likewise."""
+    shelved = row.state is State.SHELVED
+    return shelved, row.priority, -(row.changed if shelved else row.since)
+
+
 PERSISTED = ("active", "acked", "since", "changed", "value", "shelved_until", "shelved_by", "reason",
              "out_of_service", "oos_by", "suppressed")
 
@@ -539,18 +545,24 @@ class AlarmSystem:
         return sorted((a for a in self.alarms if a.state in IN_LIST),
                       key=lambda a: (a.defn.priority, -a.since))
 
+    def row(self, alarm_id: str) -> AlarmRow | None:
+        """The alarm's line of the summary; None if it is not on it (normal, suppressed, out of
+        service)."""
+        i = self._index(alarm_id)
+        a = self.alarms[i]
+        state = a.state
+        if state not in IN_LIST and state is not State.SHELVED:
+            return None
+        t = self._tag_of[i]
+        tag = self.tags[t] if t >= 0 else None
+        shown = "" if a.value is None else tag.format(a.value) if tag is not None else f"{a.value:g}"
+        return AlarmRow(a.id, a.defn.priority, state, a.since, a.changed, a.value, a.defn.text,
+                        a.defn.tag, shown, a.shelved_until, a.shelved_by, a.reason)
+
     def rows(self) -> tuple[AlarmRow, ...]:
         """The summary: listed alarms (by priority, newest first), then the shelved ones."""
-        shelved = sorted((self.alarms[i] for i in self._shelved), key=lambda a: (a.defn.priority, -a.changed))
-        tags = {t.name: t for t in self.tags}
-
-        def shown(a: Alarm) -> str:
-            tag = tags.get(a.defn.tag or "")
-            return "" if a.value is None else tag.format(a.value) if tag is not None else f"{a.value:g}"
-
-        return tuple(AlarmRow(a.id, a.defn.priority, a.state, a.since, a.changed, a.value, a.defn.text,
-                              a.defn.tag, shown(a), a.shelved_until, a.shelved_by, a.reason)
-                     for a in [*self.listed(), *shelved])
+        rows = (self.row(a.id) for a in self.alarms)
+        return tuple(sorted((r for r in rows if r is not None), key=summary_order))
 
     def counts(self) -> dict[int, int]:
         """How many alarms of each priority are listed."""

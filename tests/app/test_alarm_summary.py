@@ -36,7 +36,7 @@ class Station:
         self.mem.set_word(0o4010, level)
         self.mem.set_word(0o4012, temp)
         self.scan += 1
-        self.alarms.on_scan(self.mem.snapshot(self.scan, 0.0, at, "running"))
+        self.alarms.on_scan(self.mem.snapshot(self.scan, at - T0, at, "running"))
 
     def alarm_records(self) -> list[tuple[str, int, int, str]]:
         return [(r.source, r.number, r.type, r.text) for r in self.sink.records if r.kind == "alarm"]
