@@ -12,10 +12,12 @@ import pytest
 from app.gui.alarm_summary import AlarmSummary, Annunciator, row_colours
 from app.gui.alarms import AlarmBanner
 from app.station_alarms import StationAlarms
+from hmi_forms.widgets.records import type_name
 from netplc.memory import Memory
 from netplc.program import parse
 from netplc.records import ListSink
 from netplc.tags.alarms import AlarmError, AlarmRow, State
+from registrar.query import Row
 
 TAGS = ("name,address,type,unit,app_min,app_max,phy_min,phy_max,decimals,description,h,priority\n"
         "LEVEL,04010,word,%,0,4095,0,100,1,Уровень,90,2\n"
@@ -136,3 +138,9 @@ def test_priority_1_and_2_sound_until_acknowledged_or_silenced() -> None:
     off = Annunciator(False, lambda: beeps.append(1))
     off.update([high])
     assert not off.sounding  # the station key alarm_sound = false
+
+
+def test_journals_name_an_alarm_records_new_state() -> None:
+    row = Row(1, T0, "alarm", 2, int(State.UNACK), "LEVEL.H", int(State.NORMAL), 97.0, "LEVEL.H ...")
+    assert type_name(row) == "active-unacknowledged"
+    assert type_name(Row(2, T0, "message", 1, 2, None, 3, None, "x")) == "alarm"  # a message's type
