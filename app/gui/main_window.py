@@ -196,7 +196,10 @@ class MainWindow(QMainWindow):
             view.refresh(snapshot, readings)
 
     def _alarms_changed(self) -> None:
-        self.alarms.show_alarms(self.summary.unacknowledged())
+        unacknowledged = self.summary.unacknowledged()
+        self.alarms.show_alarms(unacknowledged)
+        self.summary_dock.setWindowTitle(f"Alarms — {len(unacknowledged)} unacknowledged"
+                                         if unacknowledged else "Alarms")
 
     def _acknowledge(self, alarm: AlarmRow) -> None:
         self.summary.acknowledge([alarm.id])
