@@ -15,7 +15,7 @@ comm-fail, so a start raises no quality alarm for a node that simply has not ans
 
 from __future__ import annotations
 
-from collections.abc import Callable, Sequence
+from collections.abc import Callable
 from pathlib import Path
 from typing import Any
 
@@ -109,7 +109,7 @@ class StationAlarms:
         if now is not None:
             self._published = now
 
-    def _post(self, action: Callable[[], Sequence[object]]) -> None:
+    def _post(self, action: Callable[[], object]) -> None:
         def run() -> None:
             action()
             if self._dirty:

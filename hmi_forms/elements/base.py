@@ -98,7 +98,7 @@ class Element:
 
     def sources(self) -> tuple[tuple[int, int], ...]:
         """The operands whose value the element shows, as (address, bytes), bytes 0 for one HMI
-        bit: what its data quality is judged on. None by default (static elements)."""
+        bit: what its data quality is judged on; none by default (static elements)."""
         return ()
 
     def update(self, snap: Snapshot, quality: Quality | None = None) -> bool:
