@@ -4,11 +4,13 @@ alarm and the user, shelving with duration and reason, and the sound of prioriti
 
 from __future__ import annotations
 
+import datetime as dt
 from collections.abc import Iterator
 from pathlib import Path
 
 import pytest
 
+from app.gui.alarm_health import HealthDialog, health_text
 from app.gui.alarm_summary import AlarmSummary, Annunciator, row_colours
 from app.gui.alarms import AlarmBanner
 from app.station_alarms import StationAlarms
@@ -144,3 +146,11 @@ def test_journals_name_an_alarm_records_new_state() -> None:
     row = Row(1, T0, "alarm", 2, int(State.UNACK), "LEVEL.H", int(State.NORMAL), 97.0, "LEVEL.H ...")
     assert type_name(row) == "active-unacknowledged"
     assert type_name(Row(2, T0, "message", 1, 2, None, 3, None, "x")) == "alarm"  # a message's type
+
+
+def test_the_health_dialog_shows_the_report_of_a_chosen_day(qtbot, headless_archive, tmp_path: Path) -> None:
+    dialog = HealthDialog(headless_archive[0])
+    qtbot.addWidget(dialog)
+    text = dialog.report.toPlainText()
+    assert text.startswith(f"alarm-system health for {dt.date.today():%d.%m.%Y}") and "chattering" in text
+    assert health_text(tmp_path / "none.sqlite", dt.date.today()).startswith("no alarm-system health")
