@@ -110,6 +110,8 @@ class FormView(QWidget):
         if snapshot is self._last:
             return
         self._last = snapshot
+        if readings is not None:
+            snapshot = readings.live(snapshot)  # link outputs follow the link, not the last scan
         judged: dict[tuple[int, int], Quality] = {}
         for model, widget in self.pairs:
             try:

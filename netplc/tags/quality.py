@@ -21,6 +21,10 @@ block's data in scans, NetPlc's run state and forcing give each address its qual
 Qualities are ordered so that the worst of several blocks (a tag spanning two NREADs) is the
 highest; an address no NREAD fills is good while NetPlc runs.
 
+An NREAD's or NWRITE's link output (C+1) is the program's copy of its node's link, frozen while
+NetPlc is stopped. Readers show the link itself there (`link_outputs`, `Readings.live`): a
+"связь есть" label follows the link, not the last value the program wrote.
+
 Forcing (netplc/forcing.py, to come) reaches quality through one hook: `LinkView.forced`, the
 forced operand addresses of the scan; the runtime fills it from the engine's forces.
 """
@@ -34,9 +38,9 @@ from enum import IntEnum
 import numpy as np
 
 from netplc.address import IO_BITS
-from netplc.exchange import NODE, NREAD, _fon_nodes
+from netplc.exchange import NODE, NREAD, NWRITE, _fon_nodes
 from netplc.memory import MemoryView
-from netplc.program import Program
+from netplc.program import Instr, Program
 from netplc.tags.tag import Tag, span
 
 STALE_TICKS = 2  # scans of lateness tolerated beyond the normal one-scan answer
@@ -85,19 +89,28 @@ class Feed:
     line: int = 0  # of the program text, for messages
 
 
-def nread_feeds(program: Program) -> list[Feed]:
-    """Every NREAD of the program with the node it talks to. One above the first NODE talks to the
+def _exchanges(program: Program) -> list[tuple[int, Instr, int]]:
+    """Every NREAD and NWRITE with the node it talks to. One above the first NODE talks to the
     node of the last NODE in the text (the one selected when the previous scan ended)."""
     nodes = [i.s for i in program.instrs if i.op == "FON" and i.n == NODE]
     wrap = nodes[-1] if nodes else 0
+    return [(fn, ins, wrap if node is None else node) for fn, ins, node in _fon_nodes(program)]
+
+
+def nread_feeds(program: Program) -> list[Feed]:
+    """Every NREAD of the program with the node it talks to and the bytes it fills."""
     index = {id(ins): k for k, ins in enumerate(program.instrs)}
     feeds = []
-    for fn, ins, node in _fon_nodes(program):
-        if fn != NREAD:
-            continue
-        first, last = span(ins.d or 0, ins.r or 0)
-        feeds.append(Feed(index[id(ins)], wrap if node is None else node, ins.c or 0, first, last, ins.line))
+    for fn, ins, node in _exchanges(program):
+        if fn == NREAD:
+            first, last = span(ins.d or 0, ins.r or 0)
+            feeds.append(Feed(index[id(ins)], node, ins.c or 0, first, last, ins.line))
     return feeds
+
+
+def link_outputs(program: Program) -> dict[int, int]:
+    """The link output bit (C+1) of every NREAD and NWRITE -> the node whose link it copies."""
+    return {(ins.c or 0) + 1: node for fn, ins, node in _exchanges(program) if fn in (NREAD, NWRITE)}
 
 
 @dataclass(frozen=True)
@@ -123,6 +136,7 @@ class QualityMap:
 
     def __init__(self, program: Program, tags: Sequence[Tag]) -> None:
         self.feeds = nread_feeds(program)
+        self.link_bits = link_outputs(program)
         self.tags = list(tags)
         groups: dict[tuple[int, ...], int] = {}
         members = []
@@ -187,6 +201,10 @@ class QualityMap:
             f_first, f_last = _forced(addr)
             if f_first < last and first < f_last:
                 return Quality.FORCED
+        node = self.link_bits.get(address) if nbytes == 0 and links.links is not None else None
+        if node is not None:  # a link output shows the link itself (`Readings.live`), known or not
+            known = links.since is None or node in links.since or not links.running
+            return Quality.GOOD if known else Quality.INITIAL
         scan = getattr(view, "scan", 0)
         fed = [self.feed_quality(f, view, links, scan) for f in self.feeds
                if f.first < last and first < f.last]

@@ -12,7 +12,7 @@ the addresses nobody asks about.
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 
 import numpy as np
 
@@ -72,6 +72,22 @@ class Readings:
         """The quality of any operand: `nbytes` bytes at an I/O bit or data address, or with
         `nbytes` 0 the one bit of an HMI bit address (02042, 040005)."""
         return self.quality_map.at(address, nbytes, self.snapshot, self.links)
+
+    def live(self, snapshot: Snapshot) -> Snapshot:
+        """`snapshot` with every NREAD/NWRITE link output bit (C+1) showing its node's link as it
+        is now rather than the program's copy, which is frozen while NetPlc is stopped; the same
+        snapshot when they agree (always, while the program runs and the link holds)."""
+        links = self.links.links
+        if links is None:
+            return snapshot
+        wrong = {bit: links.get(node, False) for bit, node in self.quality_map.link_bits.items()
+                 if bool(snapshot.bits[bit]) != links.get(node, False)}
+        if not wrong:
+            return snapshot
+        bits = list(snapshot.bits)
+        for bit, up in wrong.items():
+            bits[bit] = 1 if up else 0
+        return replace(snapshot, bits=tuple(bits))
 
     def word(self, address: int) -> Reading:
         """An unsigned word of memory with its quality: for a reader that knows no tag."""

@@ -12,7 +12,7 @@ from netplc.exchange import Exchange, NodeConfig
 from netplc.memory import Memory
 from netplc.program import parse
 from netplc.simulator import Simulator
-from netplc.tags.quality import LinkView, Quality, QualityMap, nread_feeds
+from netplc.tags.quality import LinkView, Quality, QualityMap, link_outputs, nread_feeds
 from netplc.tags.readings import Readings
 from netplc.tags.tag import Scaling, Tag, TagType
 from tests.netplc.test_exchange import NODE_PROGRAM, TICK, Station, wait_until
@@ -175,3 +175,22 @@ def test_readings_give_value_quality_and_time_of_tags_and_addresses() -> None:
     assert readings.word(0o4000).quality is Quality.COMM_FAIL
     with pytest.raises(KeyError):
         readings.tag("NOPE")
+
+
+def test_link_outputs_show_the_link_itself() -> None:
+    prog = parse(PROGRAM)
+    assert link_outputs(prog) == {0o2121: 2, 0o2105: 1, 0o2115: 2}
+    qmap = QualityMap(prog, [])
+    mem = asking()
+    mem.set_bit(0o2105, 1)  # the program's copy: node 1 up, as of its last scan
+    stopped = LinkView(running=False, links={1: False, 2: True})
+    snap = mem.snapshot(10, 1.0, 1234.5, "stopped")
+    readings = Readings(snap, qmap, stopped, qmap.evaluate(snap, stopped))
+    live = readings.live(snap)
+    assert (live.get_bit(0o2105), live.get_bit(0o2115), live.get_bit(0o2121)) == (0, 1, 1)
+    assert readings.address(0o2105, 0) is Quality.GOOD  # the link is known, NetPlc or not
+    assert readings.address(0o2104, 0) is Quality.NOT_RUNNING  # the program's own coil
+    up = LinkView(links={1: True, 2: True}, since={})
+    assert qmap.at(0o2105, 0, snap, up) is Quality.INITIAL  # no exchange attempt yet
+    same = mem.snapshot(11)
+    assert Readings(same, qmap, LinkView(links={1: True, 2: False}), qmap.evaluate(same)).live(same) is same
