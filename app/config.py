@@ -73,6 +73,7 @@ class Station:
     allow_outside: bool = False  # may station paths (and form images) leave the station folder?
     RetainForces: bool = False  # forces survive a restart (netplc/forcing.py); off: a restart unforces
     plant_archive: str | None = None  # `Archive` given as a postgresql:// URL: forwarded there
+    alarm_sound: bool = True  # a new alarm of priority 1-2 sounds until acknowledged or silenced
 
     @property
     def folder(self) -> Path:
@@ -209,6 +210,7 @@ def read_station(path: str | Path) -> tuple[Station | None, list[str]]:
     retain = top.path("Retain", base)
     tags = top.path("Tags", base)
     retain_forces = top.get("RetainForces", bool, False)
+    alarm_sound = bool(top.get("alarm_sound", bool, True))
     server = _modbus_server(problems, fname, top.get("modbus_server", dict, {}))
     nodes = _nodes(problems, fname, top.get("nodes", list, []))
     simulators = _simulators(problems, fname, top.get("simulators", list, []), base, top.allow_outside)
@@ -238,6 +240,7 @@ def read_station(path: str | Path) -> tuple[Station | None, list[str]]:
         keep_days=keep_days, Retain=retain, modbus_server=server,
         nodes=tuple(nodes), simulators=tuple(runnable), users=users, Tags=tags,
         allow_outside=top.allow_outside, RetainForces=bool(retain_forces), plant_archive=plant,
+        alarm_sound=alarm_sound,
     )
     return station, problems
 

@@ -19,7 +19,7 @@ from app.config import Station
 from hmi_forms.form import Form, load_forms
 from netplc.exchange import check_program_nodes
 from netplc.program import Program, ProgramError, load_symbols, parse, parse_file
-from netplc.tags.table import read_tags
+from netplc.tags.table import TagTable, read_tags
 from netplc.textfile import TextFileError, read_text
 from registrar.catalog import Catalog, CatalogError
 
@@ -32,6 +32,7 @@ class Loaded:
     catalog: Catalog = field(default_factory=Catalog)
     program: Program = field(default_factory=lambda: parse("", source="<no program>"))
     node_programs: list[Program] = field(default_factory=list)  # one per station.simulators, in order
+    tags: TagTable = field(default_factory=TagTable)  # the good rows of tags.csv
     forms: list[Form] = field(default_factory=list)
     problems: list[str] = field(default_factory=list)  # each one stops a start
     form_problems: list[str] = field(default_factory=list)  # forms that did not load
@@ -60,21 +61,24 @@ def load(station: Station) -> Loaded:
         except CatalogError as e:
             out.problems += e.problems
     if station.Tags is not None:
-        tags, problems = read_tags(station.Tags, out.symbols)
+        out.tags, problems = read_tags(station.Tags, out.symbols)
         out.problems += problems
-        out.notes.append(f"tags {station.Tags.name}: {len(tags.tags)} tags, {len(tags.alarms)} with alarms")
-    out.forms, out.form_problems = load_station_forms(station, out.symbols)
+        out.notes.append(f"tags {station.Tags.name}: {len(out.tags.tags)} tags, "
+                         f"{len(out.tags.alarms)} with alarms")
+    out.forms, out.form_problems = load_station_forms(station, out.symbols, out.tags)
     if station.HMIload is not None:
         out.notes.append(f"forms in {station.HMIload}: {len(out.forms)} loaded")
     return out
 
 
-def load_station_forms(station: Station, symbols: dict[str, int]) -> tuple[list[Form], list[str]]:
+def load_station_forms(station: Station, symbols: dict[str, int],
+                       tags: TagTable | None = None) -> tuple[list[Form], list[str]]:
     """The forms of HMIload (fresh models each call: the runtime's and each view's are their own),
-    and the problems of those that did not load."""
+    and the problems of those that did not load. Their addresses may name `tags`."""
     if station.HMIload is None:
         return [], []
-    return load_forms(station.HMIload, symbols, station=station.folder, allow_outside=station.allow_outside)
+    return load_forms(station.HMIload, symbols, station=station.folder, allow_outside=station.allow_outside,
+                      tags=tags)
 
 
 def _symbols(path: Path | None, out: Loaded) -> dict[str, int]:

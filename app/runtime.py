@@ -39,6 +39,7 @@ from netplc.problems import Problems
 from netplc.records import Record
 from netplc.scheduler import ScanThread
 from netplc.simulator import Simulator
+from netplc.tags.readings import Readings
 from registrar.retain import Retainer
 from registrar.store import Store, StoreStats
 
@@ -138,6 +139,7 @@ class Runtime:
         if loaded.problems:
             raise StartError(loaded.problems)
         self.symbols, self.catalog, self.program = loaded.symbols, loaded.catalog, loaded.program
+        self.tags = loaded.tags
         self.node_programs = loaded.node_programs
         self.forms: list[Form] = loaded.forms  # the runtime's own models: evaluated, never shown
         self.form_problems = loaded.form_problems
@@ -146,6 +148,7 @@ class Runtime:
         self.engine: Engine | None = None
         self.retainer: Retainer | None = None
         self.simulators: list[Simulator] = []
+        self.silent: set[int] = set()  # simulators stopped by `simulator_answers`
         self.exchange: Exchange | None = None
         self.modbus: ModbusServer | None = None
         self.alarms: StationAlarms | None = None  # tags, quality and alarms, evaluated every scan
@@ -181,24 +184,14 @@ class Runtime:
     def system(self, text: str) -> None:
         self.put(Record(self.wallclock(), "system", source="station", text=text))
 
-    def message_text(self, record: Record) -> str:
-        """An NMSG record's text as the archive will show it (the catalog resolves it)."""
-        if record.text:
-            return record.text
-        return self.catalog.text_for(record.number) if record.number is not None else ""
-
-    def acknowledge(self, record: Record, user: str) -> None:
-        """An operator acknowledges an alarm: an 'operator' record naming the user and the message."""
-        self.put(Record(self.wallclock(), "operator", grp=record.grp, type=record.type, source=user,
-                        number=record.number, text=f"acknowledged: {self.message_text(record)}"))
-
     # --- start and stop ------------------------------------------------------------------------
 
     def start(self) -> None:
         """Start every part; StartError names the key of what could not start (the archive, a
         simulator's port, the nodes), after what did start is stopped again."""
         st = self.station
-        store = Store(st.Archive, catalog=self.catalog, keep_days=st.keep_days, wallclock=self.wallclock)
+        store = Store(st.Archive, catalog=self.catalog, keep_days=st.keep_days, wallclock=self.wallclock,
+                      tags=self.tags)
         try:
             store.start()
         except (OSError, sqlite3.Error) as e:
@@ -313,7 +306,7 @@ class Runtime:
     def open_forms(self) -> tuple[list[Form], list[str]]:
         """Fresh models of the station's forms for a view, which only shows them (the runtime
         evaluates its own); and the problems of the forms that did not load."""
-        return load_station_forms(self.station, self.symbols)
+        return load_station_forms(self.station, self.symbols, self.tags)
 
     def _fill_endpoint(self, node: int, endpoint: str) -> None:
         self.nodes = [replace(n, endpoint=endpoint) if n.node == node and not n.endpoint else n
@@ -348,9 +341,11 @@ class Runtime:
         if self.exchange is not None:
             self.exchange.stop()
             self.exchange = None
-        for simulator in reversed(self.simulators):
-            simulator.stop()
+        for i, simulator in reversed(list(enumerate(self.simulators))):
+            if i not in self.silent:
+                simulator.stop()
         self.simulators.clear()
+        self.silent.clear()
         if self.store is not None:
             if self.started:
                 self.system("station stopped")
@@ -361,6 +356,32 @@ class Runtime:
             self.forwarder.close()  # sends the rest if the plant archive answers
             self.forwarder = None
         self.started = False
+
+    def simulator_answers(self, index: int, answering: bool) -> None:
+        """Stop simulated node `index` of station.toml (a pulled cable: its tags go comm-fail and
+        their quality alarms come) or start it again on the same port: the demo's bad-quality case
+        an operator can provoke. Journaled as a 'system' record."""
+        sim, old = self.station.simulators[index], self.simulators[index]
+        if answering == (index not in self.silent):
+            return
+        if not answering:
+            old.stop()
+            self.silent.add(index)
+        else:
+            self.silent.discard(index)
+            new = Simulator(self.node_programs[index], host=sim.host, port=old.port, unit=sim.unit,
+                            tick=sim.tick_ms / 1000)
+            new.engine.mem.load(old.engine.snapshot)  # the plant goes on where it stopped
+            new.start()
+            self.simulators[index] = new
+        self.system(f"simulated node {sim.node} {'answers again' if answering else 'stopped answering'}")
+
+    def readings(self) -> Readings | None:
+        """Every tag's and address's value with its quality and time as of the last scan
+        (netplc/tags/readings.py): what the HMI, the journal and the publishers read; None while
+        the station is not started (a reader then shows its values as not running)."""
+        alarms = self.alarms
+        return alarms.readings if alarms is not None else None
 
     # --- NetPlc run control (the workstation's menu) -------------------------------------------
 

@@ -3,15 +3,21 @@
 `StationAlarms` loads `tags.csv`, works out from the program which node fills which tag, takes
 back the alarm states of the last run, and then, attached to the engine, runs once per scan on
 the engine thread: each tag's quality from the exchange's links and data ages and NetPlc's run
-state, then the alarms over that scan's snapshot and the NMSG numbers journaled in it. Operator
-actions are posted to the engine thread, as writes are, so the alarm states have one writer.
-No Qt: the workstation and `--no-gui` share it.
+state, then the alarms over that scan's snapshot and the NMSG numbers journaled in it. Each scan
+ends by publishing `readings` (netplc/tags/readings.py): the one place the HMI, the journal and
+the publishers read a value's quality. Operator actions are posted to the engine thread, as
+writes are, so the alarm states have one writer. No Qt: the workstation and `--no-gui` share it.
+
+Start-up truth: a node's data is expected only from the first scan of this run of NetPlc in which
+its first exchange attempt is done (`LinkView.since`); before that its tags are "initial", not
+comm-fail, so a start raises no quality alarm for a node that simply has not answered yet.
 """
 
 from __future__ import annotations
 
 from collections.abc import Callable
 from pathlib import Path
+from typing import Any
 
 import numpy as np
 
@@ -20,12 +26,14 @@ from netplc.exchange import Exchange
 from netplc.memory import Snapshot
 from netplc.program import Program
 from netplc.records import Record, RecordSink
-from netplc.tags.alarms import AlarmSystem, CatalogMessage
+from netplc.tags.alarms import AlarmRow, AlarmSystem, CatalogMessage, summary_order
 from netplc.tags.quality import LinkView, QualityMap
+from netplc.tags.readings import Readings
 from netplc.tags.table import TagTable, load_tags
 from registrar.alarm_state import AlarmStateFile
 
 STATE_FILE = "alarms.sqlite"  # next to the archive
+PUBLISH_EVERY = 0.25  # s of engine time between two rebuilds of the summary during a flood
 
 
 class StationAlarms:
@@ -36,11 +44,22 @@ class StationAlarms:
         self.quality_map = QualityMap(program, self.table.tags)
         self.state = AlarmStateFile(state_file, sink)
         self.system = AlarmSystem(self.table, messages, sink=sink, saved=self.state.load(),
-                                  on_change=self.state.update)
+                                  on_change=self._changed)
         self.quality = np.zeros(len(self.table.tags), dtype=np.int8)  # of the last scan, by tag
+        self.readings: Readings | None = None  # of the last scan; None before the first
+        # The alarm summary, rebuilt on the engine thread after states changed, from the rows of
+        # the alarms that changed (a flood costs one row per transition and one sort per rebuild,
+        # at most every PUBLISH_EVERY); `version` counts the rebuilds, so a view redraws only when
+        # something changed. Operator actions are published at once.
+        self.summary: tuple[AlarmRow, ...] = self.system.rows()
+        self.version = 0
+        self._rows = {r.id: r for r in self.summary}
+        self._dirty: set[str] = set()
+        self._published = float("-inf")  # engine time of the last rebuild
         self.engine: Engine | None = None
         self.exchange: Exchange | None = None
         self._messages: list[int] = []
+        self._since: dict[int, int] = {}  # node -> first scan of this run with its link known
 
     def attach(self, engine: Engine, exchange: Exchange | None) -> None:
         """Evaluate after every scan of `engine`; start saving states."""
@@ -55,18 +74,51 @@ class StationAlarms:
 
     def on_scan(self, snapshot: Snapshot) -> None:
         ex = self.exchange
-        links = LinkView(running=snapshot.state == RunState.RUNNING,
+        running = snapshot.state == RunState.RUNNING
+        if not running:
+            self._since.clear()  # after a stop, data is expected afresh from the next start
+        elif ex is not None:
+            for n in ex.configs:
+                if n not in self._since and ex.link_known(n):
+                    self._since[n] = snapshot.scan
+        links = LinkView(running=running,
                          links={n: ex.link_up(n) for n in ex.configs} if ex is not None else {},
-                         refreshed=ex.refreshed if ex is not None else {})
+                         refreshed=dict(ex.refreshed) if ex is not None else {},
+                         since=dict(self._since) if ex is not None else None)
         self.quality = self.quality_map.evaluate(snapshot, links)
+        self.readings = Readings(snapshot, self.quality_map, links, self.quality)
         messages, self._messages = self._messages, []
         self.system.evaluate(snapshot, snapshot.wall, self.quality, messages)
+        if self._dirty and snapshot.time - self._published >= PUBLISH_EVERY:
+            self._publish(snapshot.time)
+
+    def _changed(self, changes: dict[str, dict[str, Any]]) -> None:
+        self.state.update(changes)
+        self._dirty.update(changes)
+
+    def _publish(self, now: float | None = None) -> None:
+        for alarm_id in self._dirty:
+            row = self.system.row(alarm_id)
+            if row is None:
+                self._rows.pop(alarm_id, None)
+            else:
+                self._rows[alarm_id] = row
+        self._dirty.clear()
+        self.summary = tuple(sorted(self._rows.values(), key=summary_order))
+        self.version += 1
+        if now is not None:
+            self._published = now
 
     def _post(self, action: Callable[[], object]) -> None:
-        if self.engine is None:
+        def run() -> None:
             action()
+            if self._dirty:
+                self._publish()
+
+        if self.engine is None:
+            run()
         else:
-            self.engine.post(lambda _mem: action())
+            self.engine.post(lambda _mem: run())
 
     # Operator actions: refused at once (AlarmError) for an unknown alarm or a shelving without
     # its operator, reason or duration; done at the start of the next scan.

@@ -22,8 +22,9 @@ from typing import Any
 
 from hmi_forms.elements import ELEMENT_TYPES, Element
 from hmi_forms.elements import props as p
-from hmi_forms.elements.analog import scaling_problems
+from hmi_forms.elements.analog import Scaled, scaling_problems
 from netplc.problems import Problems
+from netplc.tags.table import TagTable
 from netplc.textfile import TextFileError, read_text
 
 FORM_BACK = (0xDD, 0xE1, 0xE6, 255)
@@ -94,12 +95,12 @@ def _unknown(name: str, known: list[str]) -> str:
 
 class _Loader:
     def __init__(self, path: Path, symbols: dict[str, int], station: Path | None,
-                 allow_outside: bool) -> None:
+                 allow_outside: bool, tags: TagTable | None = None) -> None:
         self.path = path
         self.problems: list[str] = []
         self.fatal = 0  # problems that stop the form from opening (the others only lose a picture)
         self.ctx = p.Context(symbols, path.parent, roots=(station,) if station else (),
-                             allow_outside=allow_outside)
+                             allow_outside=allow_outside, tags=tags or TagTable())
 
     def problem(self, where: str, prop: str | None, text: str, fatal: bool = True) -> None:
         head = f"{self.path}: {where}: {prop}" if prop else f"{self.path}: {where}"
@@ -265,28 +266,30 @@ class _Loader:
         if self.fatal > before:
             return None
         element = cls(**values)
+        if isinstance(element, Scaled):
+            element.take_tag(raw, self.ctx.tags)
         for key, text in element.check(self.ctx):
             self.problem(where, key, text)
         return element
 
 
 def load_form(path: str | Path, symbols: dict[str, int] | None = None, *, station: Path | None = None,
-              allow_outside: bool = False) -> Form:
+              allow_outside: bool = False, tags: TagTable | None = None) -> Form:
     """Load one form; FormError lists every problem of the file. Files it names must be in its
     folder or in the `station` folder unless `allow_outside`; one that is not is left out and
-    named in `Form.problems`."""
-    return _Loader(Path(path), symbols or {}, station, allow_outside).load()
+    named in `Form.problems`. Addresses may name the station's `tags`."""
+    return _Loader(Path(path), symbols or {}, station, allow_outside, tags).load()
 
 
 def load_forms(folder: str | Path, symbols: dict[str, int] | None = None, *, station: Path | None = None,
-               allow_outside: bool = False) -> tuple[list[Form], list[str]]:
+               allow_outside: bool = False, tags: TagTable | None = None) -> tuple[list[Form], list[str]]:
     """Load every `*.hmi` of a folder (sorted by name): the forms that open, and every problem
     (those of the forms that do not open, and the files left out of those that do)."""
     forms: list[Form] = []
     problems: list[str] = []
     for path in sorted(Path(folder).glob("*.hmi")):
         try:
-            form = load_form(path, symbols, station=station, allow_outside=allow_outside)
+            form = load_form(path, symbols, station=station, allow_outside=allow_outside, tags=tags)
         except FormError as e:
             problems.extend(e.problems)
         else:

@@ -249,11 +249,20 @@ class Engine:
 
         self.post(apply)
 
-    def write_word(self, addr: int, value: int, *, user: str = "operator", label: str | None = None) -> None:
+    def write_word(self, addr: int, value: int, *, user: str = "operator", label: str | None = None,
+                   describe: Callable[[int, int], str] | None = None) -> None:
+        """Queue an operator write of a word. `describe(old, new)` says the change in the plant's
+        terms ("0.0 -> 130.0 °C", a tag's); the record keeps the raw words and the address too."""
         def apply(mem: Memory) -> None:
             old = mem.get_word(addr)
             mem.set_word(addr, value)
-            self._journal(user, fmt_octal(addr), old, value & 0xFFFF, addr, label)
+            new = value & 0xFFFF
+            if describe is None:
+                self._journal(user, fmt_octal(addr), old, new, addr, label)
+            else:
+                self.sink.put(Record(self.wall_time(), "operator", source=user, number=addr, value=float(new),
+                                     text=f"write {label}: {describe(old, new)} "
+                                          f"(raw {old} -> {new} at {fmt_octal(addr)})"))
 
         self.post(apply)
 

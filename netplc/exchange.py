@@ -398,6 +398,11 @@ class Exchange:
         stats = self.stats.get(node)
         return stats is not None and stats.up
 
+    def link_known(self, node: int) -> bool:
+        """The node has had its first exchange attempt (up or down is known, not assumed)."""
+        stats = self.stats.get(node)
+        return stats is not None and stats.changed > 0
+
     def request_read(self, key: int, node: int, remote: int, local: int, length: int) -> bool:
         return self._request(node, _Request(key, remote, local, length))
 

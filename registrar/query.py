@@ -24,6 +24,7 @@ from urllib.parse import quote
 
 import numpy as np
 
+from netplc.tags.tag import Tag
 from registrar.reading import (
     EXPORT_CHUNK,
     ArchiveReader,
@@ -42,6 +43,7 @@ from registrar.schema import (
     parse_table_name,
     quoted,
     table_name,
+    tags_by_source,
     text_index,
     zone,
 )
@@ -109,6 +111,14 @@ class Archive(ArchiveReader):
     def message_texts(self) -> dict[int, str]:
         """The catalog as it was copied into the archive."""
         return dict(self._con.execute("SELECT number, text FROM messages").fetchall())
+
+    def tags(self) -> dict[str, Tag]:
+        """The station's one-word tags as copied into the archive, by the `source` of the data
+        records NSTORE writes of them ({} for an archive written without tags)."""
+        try:
+            return tags_by_source(self._con.execute("SELECT * FROM tags").fetchall())
+        except sqlite3.OperationalError:  # no tags table: an archive of an older station
+            return {}
 
     def series_keys(self, day: dt.date) -> list[SeriesKey]:
         rows = self._con.execute(
@@ -208,11 +218,15 @@ class Archive(ArchiveReader):
         return f"id IN (SELECT rowid FROM {fts} WHERE {fts} MATCH ?)", _trigrams(flt.text)
 
     def export_csv(self, path: str | Path, day: dt.date, flt: Filter | None = None) -> int:
-        """Write the selection oldest first; UTF-8 with a BOM so spreadsheets read Cyrillic."""
+        """Write the selection oldest first; UTF-8 with a BOM so spreadsheets read Cyrillic. A data
+        record of a tag's address also names the tag and gives its physical value and unit (the
+        raw value stays in `value`)."""
         n = 0
+        tags = self.tags()
+        at = COLUMNS.index("source")
         with open(path, "w", newline="", encoding="utf-8-sig") as f:
             out = csv.writer(f)
-            out.writerow(["id", "time", *COLUMNS[1:]])
+            out.writerow(["id", "time", *COLUMNS[1:], "tag", "physical", "unit"])
             if not self._has(day):
                 return 0
             where, args = where_clause(flt or Filter())
@@ -221,7 +235,10 @@ class Archive(ArchiveReader):
                 while chunk := cur.fetchmany(EXPORT_CHUNK):
                     for r in chunk:
                         local = self.local_time(r[1] / 1000).isoformat(timespec="milliseconds")
-                        out.writerow([r[0], local, *r[1:]])
+                        tag = tags.get(r[at]) if r[2] == "data" and r[7] is not None else None
+                        phy = [] if tag is None else [
+                            tag.name, f"{tag.word_value(int(r[7])):.{tag.decimals}f}", tag.unit]
+                        out.writerow([r[0], local, *r[1:], *phy])
                     n += len(chunk)
             finally:
                 cur.close()

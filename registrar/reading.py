@@ -12,6 +12,8 @@ from typing import NamedTuple
 
 import numpy as np
 
+from netplc.tags.tag import Tag
+
 EXPORT_CHUNK = 10_000
 
 
@@ -64,6 +66,11 @@ class ArchiveReader:
     def stations(self) -> list[str]:
         """The stations that write to the archive: a station's own archive names none."""
         return []
+
+    def tags(self) -> dict[str, Tag]:
+        """The one-word tags by the `source` of their data records ({}: none kept, as in the plant
+        archive, which forwards records but not the stations' tags)."""
+        return {}
 
     def local_time(self, ts: float) -> dt.datetime:
         return dt.datetime.fromtimestamp(ts, self.tz).replace(tzinfo=None)

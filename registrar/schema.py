@@ -13,6 +13,10 @@ import time
 import zoneinfo
 from pathlib import Path
 
+from netplc.address import fmt_octal
+from netplc.tags.table import TagTable
+from netplc.tags.tag import Scaling, Tag, TagType
+
 SCHEMA_VERSION = "1"
 COLUMNS = ("id", "ts", "kind", "grp", "type", "source", "number", "value", "text")
 DAY_GLOB = "[0-3][0-9]_[01][0-9]_[0-9][0-9][0-9][0-9]"
@@ -98,6 +102,32 @@ def aux_fill_sql(table: str) -> list[str]:
 META_SQL = "CREATE TABLE IF NOT EXISTS meta (key TEXT PRIMARY KEY, value TEXT)"
 MESSAGES_SQL = ("CREATE TABLE IF NOT EXISTS messages "
                 "(number INTEGER PRIMARY KEY, grp INTEGER, type INTEGER, text TEXT)")
+# The station's tags (tags.csv) as they were when the archive was last opened for writing, so the
+# viewer and CSV show data series by tag name in physical units without the station's files.
+TAGS_SQL = ("CREATE TABLE IF NOT EXISTS tags (name TEXT PRIMARY KEY, address INTEGER, type TEXT, unit TEXT, "
+            "app_min REAL, app_max REAL, phy_min REAL, phy_max REAL, decimals INTEGER, description TEXT)")
+
+
+def tag_rows(table: TagTable) -> list[tuple]:
+    """The tags as rows of the archive's `tags` table."""
+    def ranges(s: Scaling | None) -> tuple:
+        return (s.AppMin, s.AppMax, s.PhyMin, s.PhyMax) if s is not None else (None,) * 4
+
+    return [(t.name, t.address, str(t.type), t.unit, *ranges(t.scaling), t.decimals, t.description)
+            for t in table.tags]
+
+
+def tags_by_source(rows: list[tuple]) -> dict[str, Tag]:
+    """The one-word tags of the `tags` table by the `source` their NSTORE data records carry."""
+    out = {}
+    for name, address, kind, unit, a0, a1, p0, p1, decimals, description in rows:
+        scaling = Scaling(a0, a1, p0, p1) if None not in (a0, a1, p0, p1) else None
+        tag = Tag(name, address, TagType(kind), unit or "", scaling, decimals or 0, description or "")
+        if tag.type in (TagType.WORD, TagType.INT16, TagType.BCD):
+            out[fmt_octal(address)] = tag
+    return out
+
+
 # The distinct data series of each day, kept by the writer so the viewer's picker is instant.
 SERIES_SQL = ("CREATE TABLE IF NOT EXISTS series (day TEXT NOT NULL, kind TEXT NOT NULL, grp INTEGER, "
               "type INTEGER, source TEXT, UNIQUE (day, kind, grp, type, source))")

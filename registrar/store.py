@@ -23,6 +23,7 @@ from dataclasses import dataclass
 from pathlib import Path
 
 from netplc.records import Record
+from netplc.tags.table import TagTable
 from registrar.catalog import Catalog
 from registrar.schema import (
     DAY_COLUMNS_SQL,
@@ -31,6 +32,7 @@ from registrar.schema import (
     META_SQL,
     SCHEMA_VERSION,
     SERIES_SQL,
+    TAGS_SQL,
     aux_fill_sql,
     aux_sql,
     fts_table,
@@ -40,6 +42,7 @@ from registrar.schema import (
     minutes_table,
     parse_table_name,
     table_name,
+    tag_rows,
 )
 
 SOURCE = "registrar"
@@ -102,9 +105,11 @@ class Store:
         queue_size: int = 100_000,
         flush_interval: float = 1.0,
         on_commit: Callable[[int], None] | None = None,
+        tags: TagTable | None = None,
     ) -> None:
         self.path = Path(path)
         self.catalog = catalog or Catalog()
+        self.tags = tags or TagTable()  # copied in, like the catalog, so the file explains its data
         self.keep_days = keep_days
         self.wallclock = wallclock
         self.queue_size = queue_size
@@ -194,6 +199,7 @@ class Store:
         con.execute(META_SQL)
         con.execute(MESSAGES_SQL)
         con.execute(SERIES_SQL)
+        con.execute(TAGS_SQL)
         meta = {
             "schema_version": SCHEMA_VERSION,
             "ts_unit": "milliseconds since 1970-01-01 UTC",
@@ -209,6 +215,9 @@ class Store:
             con.execute("DELETE FROM messages")
             con.executemany("INSERT INTO messages VALUES (?, ?, ?, ?)",
                             [(m.number, m.grp, m.type, m.text) for m in self.catalog])
+        if self.tags.tags:
+            con.execute("DELETE FROM tags")
+            con.executemany("INSERT INTO tags VALUES (?, ?, ?, ?, ?, ?, ?, ?, ?, ?)", tag_rows(self.tags))
         con.execute("COMMIT")
 
     def _run(self) -> None:

@@ -1,39 +1,33 @@
-"""The alarm banner: unacknowledged messages of type >= 2 (alarm, critical), newest first.
+"""The alarm banner: the highest-priority unacknowledged alarm of the station's alarm system.
 
 An alarm stays on the banner until an operator acknowledges it, even after its condition has
-gone, because the operator must know it happened. Acknowledging is journaled with the user's name
-by the runtime; the banner only collects and shows.
+gone, because the operator must know it happened. The banner takes its alarms from the alarm
+summary (app/gui/alarm_summary.py), so NMSG alarms (types 2 and 3 of the catalog), limit,
+discrete and quality alarms are one list in one order: priority, then newest first.
+Acknowledging is done and journaled by the alarm system with the user's name, one record per
+alarm; the banner only shows and asks.
 """
 
 from __future__ import annotations
 
 import time
-from dataclasses import dataclass
 
 from PySide6.QtCore import Qt, QTimer, Signal
 from PySide6.QtWidgets import QFrame, QHBoxLayout, QLabel, QPushButton, QWidget
 
-from netplc.records import Record
-
-ALARM_TYPE = 2  # docs/architecture.md section 8: 0 info, 1 warning, 2 alarm, 3 critical
-TYPE_NAMES = {0: "info", 1: "warning", 2: "ALARM", 3: "CRITICAL"}
-
-
-@dataclass(frozen=True)
-class Alarm:
-    record: Record
-    text: str
+from netplc.tags.alarms import PRIORITIES, AlarmRow
 
 
 class AlarmBanner(QFrame):
-    """A red strip with the newest unacknowledged alarm, the count, and Acknowledge / Acknowledge all."""
+    """A red strip with the first unacknowledged alarm, the count, and Acknowledge / Acknowledge all."""
 
-    acknowledged = Signal(object)  # Alarm
+    acknowledged = Signal(object)  # AlarmRow
+    acknowledged_all = Signal()
 
     def __init__(self, parent: QWidget | None = None) -> None:
         super().__init__(parent)
         self.setObjectName("alarmBanner")
-        self.alarms: list[Alarm] = []
+        self.alarms: list[AlarmRow] = []  # unacknowledged, highest priority first
         self._blink = False
         lay = QHBoxLayout(self)
         lay.setContentsMargins(12, 6, 8, 6)
@@ -59,20 +53,20 @@ class AlarmBanner(QFrame):
         self._timer.timeout.connect(self._toggle_blink)
         self._show()
 
-    def add(self, record: Record, text: str) -> None:
-        if record.kind != "message" or (record.type or 0) < ALARM_TYPE:
-            return
-        self.alarms.insert(0, Alarm(record, text))
+    def show_alarms(self, unacknowledged: list[AlarmRow]) -> None:
+        self.alarms = list(unacknowledged)
         self._show()
 
     def acknowledge_newest(self) -> None:
+        """Acknowledge the alarm shown (the highest-priority one); it leaves the banner at once."""
         if self.alarms:
             self.acknowledged.emit(self.alarms.pop(0))
             self._show()
 
     def acknowledge_all(self) -> None:
-        while self.alarms:
-            self.acknowledged.emit(self.alarms.pop(0))
+        if self.alarms:
+            self.alarms.clear()
+            self.acknowledged_all.emit()
         self._show()
 
     def _show(self) -> None:
@@ -80,10 +74,11 @@ class AlarmBanner(QFrame):
             self.setVisible(False)
             self._timer.stop()
             return
-        newest = self.alarms[0]
-        when = time.strftime("%H:%M:%S", time.localtime(newest.record.ts))
-        kind = TYPE_NAMES.get(newest.record.type or 0, "ALARM")
-        self.text.setText(f"{when}   {kind}   {newest.text}")
+        first = self.alarms[0]
+        when = time.strftime("%H:%M:%S", time.localtime(first.since or first.changed))
+        kind = PRIORITIES.get(first.priority, "").upper()
+        self.text.setText(f"{when}   P{first.priority} {kind}   {first.text}   "
+                          f"[{first.id}, {first.state.word}]")
         self.count.setText(f"{len(self.alarms)} unacknowledged" if len(self.alarms) > 1 else "")
         self.ack_all.setVisible(len(self.alarms) > 1)
         self.setVisible(True)

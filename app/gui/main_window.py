@@ -19,6 +19,7 @@ from PySide6.QtGui import QAction, QCloseEvent, QKeySequence
 from PySide6.QtWidgets import (
     QApplication,
     QComboBox,
+    QDockWidget,
     QFrame,
     QHBoxLayout,
     QLabel,
@@ -31,7 +32,8 @@ from PySide6.QtWidgets import (
 )
 
 from app.config import load_station
-from app.gui.alarms import Alarm, AlarmBanner, HealthStrip
+from app.gui.alarm_summary import AlarmSummary
+from app.gui.alarms import AlarmBanner, HealthStrip
 from app.gui.bridge import RuntimeBridge
 from app.gui.journal import JournalDock
 from app.gui.status import StationStatusBar, station_problems
@@ -41,7 +43,7 @@ from hmi_forms.elements.target import EngineTarget
 from hmi_forms.widgets.form_view import FormView
 from netplc.memory import Snapshot
 from netplc.problems import Problems
-from netplc.records import Record
+from netplc.tags.alarms import AlarmRow
 
 STATUS_MS = 500
 FRAME_HEIGHT = 380  # menu, header, banner, tabs, journal dock and status bar around a form
@@ -78,14 +80,23 @@ class MainWindow(QMainWindow):
 
         self.journal = JournalDock(station.Archive, self)
         self.addDockWidget(Qt.DockWidgetArea.BottomDockWidgetArea, self.journal)
+        self.summary = AlarmSummary(runtime.alarms, lambda: self.user, sound=station.alarm_sound)
+        self.summary_dock = QDockWidget("Alarms", self)
+        self.summary_dock.setObjectName("alarmSummaryDock")
+        self.summary_dock.setWidget(self.summary)
+        self.addDockWidget(Qt.DockWidgetArea.BottomDockWidgetArea, self.summary_dock)
+        self.tabifyDockWidget(self.journal, self.summary_dock)
+        self.summary_dock.raise_()
         self.status = StationStatusBar()
         self.setStatusBar(self.status)
         self._build_menu()
         self.form_problems = self._load_forms()
 
         self.bridge.snapshot.connect(self._on_snapshot)
-        self.bridge.record.connect(self._on_record)
+        self.summary.changed.connect(self._alarms_changed)
         self.alarms.acknowledged.connect(self._acknowledge)
+        self.alarms.acknowledged_all.connect(self.summary.acknowledge_all)
+        self._alarms_changed()
         self._timer = QTimer(self)
         self._timer.setInterval(STATUS_MS)
         self._timer.timeout.connect(self.refresh_status)
@@ -121,10 +132,21 @@ class MainWindow(QMainWindow):
         station.addSeparator()
         station.addAction(program)
         station.addAction(viewer)
+        for i, sim in enumerate(self.runtime.station.simulators):  # the demo's bad-quality case
+            answers = QAction(f"Simulated node {sim.node} answers", self)
+            answers.setCheckable(True)
+            answers.setChecked(True)
+            answers.setToolTip("Untick to pull the node's cable: its values go comm-fail, their alarms come")
+            answers.toggled.connect(lambda on, i=i: self.runtime.simulator_answers(i, on))
+            station.addAction(answers)
+        health = QAction("Alarm-system &health…", self)
+        health.triggered.connect(self.open_health)
+        station.addAction(health)
         station.addSeparator()
         station.addAction(quit_)
         view = self.menuBar().addMenu("&View")
         view.addAction(self.journal.toggleViewAction())
+        view.addAction(self.summary_dock.toggleViewAction())
         help_ = self.menuBar().addMenu("&Help")
         about = QAction("&About", self)
         about.triggered.connect(self._about)
@@ -136,7 +158,7 @@ class MainWindow(QMainWindow):
             self.tabs.addTab(_placeholder("This station has no HMIload folder."), "No forms")
             return []
         forms, problems = self.runtime.open_forms()  # the views' own models: they only show
-        target = EngineTarget(self.runtime.engine)
+        target = EngineTarget(self.runtime.engine, self.runtime.tags)
         for form in forms:
             view = FormView(form, target, archive_path=station.Archive, user=self.user,
                             started=self.runtime.started_clock)
@@ -173,15 +195,18 @@ class MainWindow(QMainWindow):
     # --- live updates --------------------------------------------------------------------------
 
     def _on_snapshot(self, snapshot: Snapshot) -> None:
+        readings = self.runtime.readings()  # the quality of what every element shows
         for view in self.views:
-            view.refresh(snapshot)
+            view.refresh(snapshot, readings)
 
-    def _on_record(self, record: Record) -> None:
-        if record.kind == "message":
-            self.alarms.add(record, self.runtime.message_text(record))
+    def _alarms_changed(self) -> None:
+        unacknowledged = self.summary.unacknowledged()
+        self.alarms.show_alarms(unacknowledged)
+        self.summary_dock.setWindowTitle(f"Alarms — {len(unacknowledged)} unacknowledged"
+                                         if unacknowledged else "Alarms")
 
-    def _acknowledge(self, alarm: Alarm) -> None:
-        self.runtime.acknowledge(alarm.record, self.user)
+    def _acknowledge(self, alarm: AlarmRow) -> None:
+        self.summary.acknowledge([alarm.id])
 
     def _user_changed(self, user: str) -> None:
         """Operator writes and acknowledgements are journaled under the operator on duty."""
@@ -225,6 +250,11 @@ class MainWindow(QMainWindow):
         viewer.show()
         self.viewers.append(viewer)
 
+    def open_health(self) -> None:
+        from app.gui.alarm_health import HealthDialog
+
+        HealthDialog(self.runtime.station.Archive, self).exec()
+
     def _about(self) -> None:
         QMessageBox.about(self, "NetPlc Station",
                           "NetPlc Station: the PC runtime for CPU-165 PLC networks (FregatServer).\n"
@@ -232,6 +262,7 @@ class MainWindow(QMainWindow):
 
     def closeEvent(self, event: QCloseEvent) -> None:
         self._timer.stop()
+        self.summary.stop()
         self.bridge.detach()
         self.journal.close_archive()
         for viewer in self.viewers:

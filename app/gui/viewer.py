@@ -44,20 +44,33 @@ from app.config import DEMO_STATION, ConfigError, load_station, station_file
 from app.gui.series_loader import SeriesLoader
 from app.gui.style import apply_style
 from hmi_forms.widgets.records import ARCHIVE_COLUMNS, Column, RecordsModel, records_view
+from netplc.tags.tag import Tag
 from registrar.query import Archive, Filter, SeriesKey
 
 PAGE = 500
 SERIES_POINTS = 4000
-KINDS = ("all", "data", "message", "operator", "system")
+KINDS = ("all", "data", "message", "alarm", "operator", "system")
 TYPES = ("any", "0 info", "1 warning", "2 alarm", "3 critical")
 STATION = Column("Station", lambda r: r.station or "", 100)  # shown for a plant archive only
 PALETTE = ("#1f77b4", "#d62728", "#2ca02c", "#ff7f0e", "#9467bd", "#17becf", "#8c564b", "#e377c2")
 
 
-def series_label(key: SeriesKey) -> str:
+def series_label(key: SeriesKey, tag: Tag | None = None) -> str:
+    """How a series is named: by its tag (name, description, unit) where the archive has one."""
     parts = [f"group {key.grp}" if key.grp is not None else "",
              f"type {key.type}" if key.type is not None else "", key.source or ""]
-    return " / ".join(p for p in parts if p) or key.kind
+    raw = " / ".join(p for p in parts if p) or key.kind
+    if tag is None:
+        return raw
+    described = f"{tag.name} {tag.description}".strip() + (f", {tag.unit}" if tag.unit else "")
+    return f"{described} ({raw})"
+
+
+def physical(tag: Tag | None, values: np.ndarray) -> np.ndarray:
+    """A tag's stored raw words as its physical values (the one conversion of netplc/tags/)."""
+    if tag is None:
+        return values
+    return np.array([tag.word_value(int(v)) if np.isfinite(v) else np.nan for v in values], dtype=np.float64)
 
 
 class ViewerWindow(QMainWindow):
@@ -69,6 +82,7 @@ class ViewerWindow(QMainWindow):
         self.offset = 0
         self.total = 0
         self.curves: dict[SeriesKey, pg.PlotDataItem] = {}
+        self.tags: dict[str, Tag] = {}  # the archive's tags by the source of their data series
         self.loading: dict[SeriesKey, int] = {}  # series asked for and not yet plotted: their token
         self.loader = SeriesLoader(SERIES_POINTS, self)
         self.loader.loaded.connect(self._series_loaded)
@@ -176,7 +190,7 @@ class ViewerWindow(QMainWindow):
         self.plot.setBackground("w")
         self.plot.showGrid(x=True, y=True, alpha=0.25)
         self.plot.addLegend(offset=(10, 10))
-        self.plot.setLabel("left", "value (as stored)")
+        self.plot.setLabel("left", "value (physical for a tag, else as stored)")
         self.plot.setTitle("NSTORE and element series — drag to pan, wheel to zoom")
         plots.addWidget(self.series_list)
         plots.addWidget(self.plot)
@@ -202,6 +216,7 @@ class ViewerWindow(QMainWindow):
         if self.archive is not None:
             self.archive.close()
         self.archive, self.archive_path = archive, path
+        self.tags = archive.tags()
         self.path_label.setText(f"<small>{path}</small>")
         self.stations.blockSignals(True)
         self.stations.clear()
@@ -330,8 +345,8 @@ class ViewerWindow(QMainWindow):
             for key in self.archive.series_keys(day):
                 if key.kind != "data":
                     continue
-                item = QListWidgetItem(f"{key.station}: {series_label(key)}" if key.station
-                                       else series_label(key))
+                item = QListWidgetItem(f"{key.station}: {self.label(key)}" if key.station
+                                       else self.label(key))
                 item.setData(Qt.ItemDataRole.UserRole, key)
                 item.setFlags(item.flags() | Qt.ItemFlag.ItemIsUserCheckable)
                 item.setCheckState(Qt.CheckState.Unchecked)
@@ -353,7 +368,7 @@ class ViewerWindow(QMainWindow):
         if not shown or self.archive_path is None or day is None:
             return
         self.loading[key] = self.loader.request(self.archive_path, day, key)
-        self.statusBar().showMessage(f"reading {series_label(key)}…")
+        self.statusBar().showMessage(f"reading {self.label(key)}…")
 
     def _series_loaded(self, token: int, key: SeriesKey, ts: np.ndarray, values: np.ndarray) -> None:
         if self.loading.get(key) != token:
@@ -361,17 +376,24 @@ class ViewerWindow(QMainWindow):
         del self.loading[key]
         color = QColor(PALETTE[len(self.curves) % len(PALETTE)])
         xs, ys = np.asarray(ts, dtype=np.float64), np.asarray(values, dtype=np.float64)
-        name = f"{key.station}: {series_label(key)}" if key.station else series_label(key)
+        ys = physical(self.tag_of(key), ys)
+        name = f"{key.station}: {self.label(key)}" if key.station else self.label(key)
         self.curves[key] = self.plot.plot(xs, ys, pen=pg.mkPen(color, width=1.5), name=name,
                                           connect="finite")
         self.plot.enableAutoRange()
         if not self.loading:
-            self.statusBar().showMessage(f"{series_label(key)}: {len(ts)} points", 5000)
+            self.statusBar().showMessage(f"{self.label(key)}: {len(ts)} points", 5000)
 
     def _series_failed(self, token: int, key: SeriesKey, why: str) -> None:
         if self.loading.get(key) == token:
             del self.loading[key]
-            self.statusBar().showMessage(f"{series_label(key)} could not be read: {why}", 10000)
+            self.statusBar().showMessage(f"{self.label(key)} could not be read: {why}", 10000)
+
+    def tag_of(self, key: SeriesKey) -> Tag | None:
+        return self.tags.get(key.source or "") if key.kind == "data" else None
+
+    def label(self, key: SeriesKey) -> str:
+        return series_label(key, self.tag_of(key))
 
     def check_series(self, row: int) -> None:
         """Tick a series in the list (what a click does), for scripts and tests."""

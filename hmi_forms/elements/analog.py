@@ -2,7 +2,10 @@
 
 Conversion is linear between the hardware range AppMin..AppMax and the physical range
 PhyMin..PhyMax, taken from a named Device of the form or from the element's own four properties
-(docs/architecture.md section 9). Decisions where the manual is silent:
+(docs/architecture.md section 9), or from the tag of tags.csv the element's address names
+(`"InAddr": "LEVEL"`): the tag gives the conversion, Units, Precision and, for the analog input,
+PhyLow/PhyHigh from its L/H alarm limits, each unless the form gives it. Decisions where the
+manual is silent:
 - PhyLow/PhyHigh split the value into zones low/normal/high; a zone is left only when the value is
   back by Hysteresis (physical units, default 0), so a noisy value at a limit does not flood the
   journal. RegMessages records each zone change (kind "message": NormalMessage with type 0,
@@ -15,14 +18,16 @@ PhyMin..PhyMax, taken from a named Device of the form or from the element's own 
 from __future__ import annotations
 
 import math
+from collections.abc import Mapping
 from dataclasses import dataclass, field
 from functools import cached_property
-from typing import Any
+from typing import Any, ClassVar
 
 from hmi_forms.elements import props as p
 from hmi_forms.elements.base import Element, Reader, word_reader
 from hmi_forms.elements.trend import Trend
 from netplc.memory import Snapshot
+from netplc.tags.table import TagTable
 
 APPEARANCES = ("digital", "hbar", "dial", "semidial", "graph")
 ZONE_TYPES = {"low": 2, "normal": 0, "high": 2}
@@ -41,6 +46,34 @@ class Scaled(Element):
     Units: str = field(default="", metadata=p.prop(p.text))
 
     scaling: p.Scaling = field(default=p.Scaling(0, 1, 0, 1), init=False)
+    tag: str = field(default="", init=False)  # the tag of tags.csv the element's address names
+
+    ADDRESS_KEYS: ClassVar[tuple[str, ...]] = ("InAddr", "Address", "OutAddr")  # where a tag is named
+
+    def take_tag(self, raw: Mapping[str, Any], tags: TagTable) -> None:
+        """Fill from the tag named by the element's address what the form's `raw` properties leave
+        out (the loader calls it before `check`)."""
+        named = (raw.get(k) for k in self.ADDRESS_KEYS)
+        name = next((v for v in named if isinstance(v, str) and v in tags.by_name), None)
+        if name is None:
+            return
+        tag = tags.by_name[name]
+        self.tag = tag.name
+        ranges = ("Device", "AppMin", "AppMax", "PhyMin", "PhyMax")
+        if not any(k in raw for k in ranges):
+            lo, hi = tag.limits
+            sc = tag.scaling or p.Scaling(lo, hi, lo, hi)
+            self.AppMin, self.AppMax, self.PhyMin, self.PhyMax = sc.AppMin, sc.AppMax, sc.PhyMin, sc.PhyMax
+        if "Units" not in raw:
+            self.Units = tag.unit
+        if "Precision" not in raw:
+            self.Precision = tag.decimals
+        alarms = tags.alarms.get(tag.name)
+        if alarms is not None and isinstance(self, AnalogBase):
+            if "PhyLow" not in raw and alarms.l is not None:
+                self.PhyLow = alarms.l
+            if "PhyHigh" not in raw and alarms.h is not None:
+                self.PhyHigh = alarms.h
 
     def check(self, ctx: p.Context) -> list[tuple[str, str]]:
         inline = {k: getattr(self, k) for k in ("AppMin", "AppMax", "PhyMin", "PhyMax")}
@@ -120,6 +153,9 @@ class AnalogBase(Scaled):
         assert self.InAddr is not None
         return word_reader(self.InAddr)
 
+    def sources(self) -> tuple[tuple[int, int], ...]:
+        return ((self.InAddr, 2),) if self.InAddr is not None else ()
+
     def zone_of(self, phy: float) -> str:
         """Zone with hysteresis: leaving the current zone needs the value to be Hysteresis inside."""
         lo, hi, hy = self.PhyLow, self.PhyHigh, self.Hysteresis
@@ -192,6 +228,10 @@ class AnalogOutput(Scaled):
 
     hw: int | None = field(default=None, init=False)
     text: str = field(default="", init=False)
+
+    def sources(self) -> tuple[tuple[int, int], ...]:
+        addr = self.InAddr if self.InAddr is not None else self.OutAddr
+        return ((addr, 2),) if addr is not None else ()
 
     def refresh(self, snap: Snapshot) -> bool:
         addr = self.InAddr if self.InAddr is not None else self.OutAddr

@@ -9,6 +9,10 @@ decided here once, for both:
 - SyncType 0 updates every tick; otherwise only while that bit is 1 (the manual's level sync).
 - QualityAddr (an extension) names a bit such as an NREAD link output: while it is 0 the element
   keeps its last value and marks it stale, so frozen data never looks live.
+- The data quality of what the element shows (`sources()`: its InAddr) comes from the runtime
+  (netplc/tags/quality.py, judged by the view through `Readings`): anything but good is marked
+  the same way, its word in `quality`; a bad or not yet known value is kept, not refreshed
+  (trends sample NaN, a gap), while a forced value is shown as it is, marked forced.
 """
 
 from __future__ import annotations
@@ -23,6 +27,7 @@ from hmi_forms.elements.target import Effects, Target
 from netplc.address import IO_BITS, BitRef, data_index
 from netplc.memory import Snapshot
 from netplc.records import Kind, Record
+from netplc.tags.quality import Quality
 
 Reader = Callable[[Snapshot], int]
 
@@ -70,7 +75,8 @@ class Element:
     BackgroundImage: Any = field(default=None, metadata=p.prop(p.image_file))
     ImageAlign: str = field(default="MiddleCenter", metadata=p.prop(p.alignment))
 
-    stale: bool = field(default=False, init=False)
+    stale: bool = field(default=False, init=False)  # marked: the value shown is not good
+    quality: str = field(default="", init=False)  # why, as the quality word; "" while good
     target: Target | None = field(default=None, init=False, repr=False)  # the operator's writes
     effects: Effects | None = field(default=None, init=False, repr=False)  # the runtime's copy only
     user: str = field(default="operator", init=False)
@@ -90,15 +96,23 @@ class Element:
         runtime evaluates exactly these, from every snapshot."""
         return self.RegData or self.RegMessages
 
-    def update(self, snap: Snapshot) -> bool:
-        """Read one snapshot; True when what the widget shows has changed."""
-        sync, quality = self._gates
+    def sources(self) -> tuple[tuple[int, int], ...]:
+        """The operands whose value the element shows, as (address, bytes), bytes 0 for one HMI
+        bit: what its data quality is judged on; none by default (static elements)."""
+        return ()
+
+    def update(self, snap: Snapshot, quality: Quality | None = None) -> bool:
+        """Read one snapshot; True when what the widget shows has changed. `quality` is the worst
+        quality of `sources()` in that scan (None: not judged, as in the runtime's own copy)."""
+        sync, gate = self._gates
         if sync is not None and not sync(snap):
             return False
-        stale = quality is not None and not quality(snap)
-        changed = stale != self.stale
-        self.stale = stale
-        if stale:
+        word = quality.word if quality is not None and quality is not Quality.GOOD else ""
+        if not word and gate is not None and not gate(snap):  # the derived quality says more
+            word = Quality.STALE.word
+        changed = word != self.quality
+        self.quality, self.stale = word, bool(word)
+        if word and quality is not Quality.FORCED:
             return self.refresh_stale(snap) or changed
         return self.refresh(snap) or changed
 

@@ -39,6 +39,9 @@ class DiscreteBase(Element):
         assert self.InAddr is not None
         return bit_reader(self.InAddr)
 
+    def sources(self) -> tuple[tuple[int, int], ...]:
+        return ((self.InAddr.hmi, 0),) if self.InAddr is not None else ()
+
     @property
     def text(self) -> str:
         return self.TextTrue if self.value else self.TextFalse

@@ -41,6 +41,9 @@ class Graph(Element):
         assert self.Address is not None
         return bit_reader(self.Address)
 
+    def sources(self) -> tuple[tuple[int, int], ...]:
+        return ((self.Address.hmi, 0),) if self.Address is not None else ()
+
     def refresh_stale(self, snap: Snapshot) -> bool:
         return self._sample(snap, math.nan)
 

@@ -14,8 +14,9 @@ from hmi_forms.elements import props as p
 from hmi_forms.elements.base import Element
 from netplc.memory import Snapshot
 
-KINDS = ("message", "operator", "system", "data")
-EVENT_KINDS = ("message", "operator", "system")  # what a journal lists by default; data is for plots
+KINDS = ("message", "alarm", "operator", "system", "data")
+# what a journal lists by default (alarm: the alarm system's transitions); data is for plots
+EVENT_KINDS = ("message", "alarm", "operator", "system")
 
 
 def kinds(value: Any, ctx: p.Context) -> tuple[str, ...]:

@@ -16,7 +16,8 @@ from pathlib import Path
 from typing import Any
 
 from netplc.address import AddressError, BitRef, check_operand, parse_hmi_bit, parse_octal
-from netplc.tags.tag import Scaling  # the one conversion, shared with tags, journal and viewer
+from netplc.tags.table import TagTable
+from netplc.tags.tag import Scaling, TagType  # the one conversion, shared with tags, journal and viewer
 from netplc.textfile import MAX_DIGITS
 
 Color = tuple[int, int, int, int]  # r, g, b, alpha
@@ -48,6 +49,7 @@ class Context:
     images: list[Path | None] = field(default_factory=list)
     roots: tuple[Path, ...] = ()  # folders files may come from besides `folder` (the station's)
     allow_outside: bool = False  # the station allows files anywhere
+    tags: TagTable = field(default_factory=TagTable)  # an address may name a tag of tags.csv
 
 
 Parser = Callable[[Any, Context], Any]
@@ -130,10 +132,17 @@ def choice(*options: str) -> Parser:
     return parse
 
 
-def _address(value: Any, ctx: Context) -> int:
-    """Octal text (`"02000"`), a symbol, or `symbol.k` (bit k of the byte a symbol names)."""
+def _address(value: Any, ctx: Context, kinds: tuple[TagType, ...] = ()) -> int:
+    """Octal text (`"02000"`), a tag of one of `kinds`, a symbol, or `symbol.k` (bit k of the byte
+    a symbol names)."""
     if not isinstance(value, str):
         raise PropError(f'addresses are octal text such as "02000" or a symbol, got {_show(value)}')
+    tag = ctx.tags.get(value)
+    if tag is not None:
+        if tag.type not in kinds:
+            raise PropError(f'tag "{value}" is of type {tag.type}; this property takes '
+                            f'{" or ".join(kinds) or "no tag"}')
+        return tag.address
     name, _, bit = value.partition(".")
     if name in ctx.symbols:
         addr = ctx.symbols[name]
@@ -143,7 +152,7 @@ def _address(value: Any, ctx: Context) -> int:
             raise PropError(f'bit number after "{name}." must be 0-7, got "{bit}"')
         return addr * 8 + int(bit)
     if re.fullmatch(r"[A-Za-z_]\w*(\.\d+)?", value):
-        raise PropError(f'unknown symbol "{name}"')
+        raise PropError(f'unknown {"tag or symbol" if ctx.tags.tags else "symbol"} "{name}"')
     try:
         return parse_octal(value)
     except ValueError:
@@ -153,14 +162,14 @@ def _address(value: Any, ctx: Context) -> int:
 def bit(value: Any, ctx: Context) -> BitRef:
     """An HMI bit: an I/O bit below 04000, or byte*8+bit at 040000 and above."""
     try:
-        return parse_hmi_bit(_address(value, ctx))
+        return parse_hmi_bit(_address(value, ctx, (TagType.BIT,)))
     except AddressError as e:
         raise PropError(str(e)) from None
 
 
 def word(value: Any, ctx: Context) -> int:
-    """The byte address of a 2-byte analog value."""
-    addr = _address(value, ctx)
+    """The byte address of a 2-byte analog value (an unsigned word, as the elements read it)."""
+    addr = _address(value, ctx, (TagType.WORD,))
     try:
         check_operand(addr, 2)
     except AddressError as e:

@@ -15,6 +15,8 @@ from __future__ import annotations
 from typing import TYPE_CHECKING, Protocol
 
 from netplc.records import Record
+from netplc.tags.table import TagTable
+from netplc.tags.tag import Tag, TagType
 
 if TYPE_CHECKING:
     from netplc.engine import Engine
@@ -35,16 +37,35 @@ class Effects(Protocol):
 
 
 class EngineTarget:
-    """The engine as the operator's Target: writes are queued and journaled by the engine."""
+    """The engine as the operator's Target: writes are queued and journaled by the engine. A write
+    to a tag's address is journaled with the tag's name and, for a word, its physical values and
+    unit besides the raw ones (`write Уставка температуры TEMP_SP: 0.0 -> 130.0 °C (raw ...)`)."""
 
-    def __init__(self, engine: Engine) -> None:
+    def __init__(self, engine: Engine, tags: TagTable | None = None) -> None:
         self.engine = engine
+        tags = tags or TagTable()
+        self._bits = {t.address: t for t in tags.tags if t.type is TagType.BIT}
+        self._words = {t.address: t for t in tags.tags if t.type in ONE_WORD}
 
     def write_bit(self, addr: int, value: int, *, user: str, label: str | None = None) -> None:
-        self.engine.write_bit(addr, value, user=user, label=label)
+        tag = self._bits.get(addr)
+        self.engine.write_bit(addr, value, user=user, label=_named(label, tag))
 
     def write_word(self, addr: int, value: int, *, user: str, label: str | None = None) -> None:
-        self.engine.write_word(addr, value, user=user, label=label)
+        tag = self._words.get(addr)
+        if tag is None:
+            self.engine.write_word(addr, value, user=user, label=label)
+        else:
+            self.engine.write_word(addr, value, user=user, label=_named(label, tag), describe=tag.change)
+
+
+ONE_WORD = (TagType.WORD, TagType.INT16, TagType.BCD)
+
+
+def _named(label: str | None, tag: Tag | None) -> str | None:
+    if tag is None:
+        return label
+    return f"{label} {tag.name}" if label else tag.name
 
 
 class NullTarget:

@@ -64,6 +64,18 @@ def draw_pixmap(p: QPainter, pix: QPixmap, rect: QRectF, mode: str = "Zoom",
 
 
 STALE_TIP = "Stale: the data source of this element is not answering; the last value is shown"
+QUALITY_TIPS = {
+    "stale": STALE_TIP,
+    "initial": "? initial: no value from the plant yet (the node has not answered since the start)",
+    "comm-fail": "? comm-fail: the node that fills this value is down; the last value is shown",
+    "not running": "? not running: NetPlc is stopped; the last value is shown, nothing changes",
+    "forced": "? forced: the value is forced by an engineer, not the plant's",
+}
+
+
+def quality_tip(word: str) -> str:
+    """The tooltip of the quality mark: the quality word first, then what it means."""
+    return QUALITY_TIPS.get(word, f"? {word}")
 
 
 def paint_stale(p: QPainter, r: QRectF) -> None:
@@ -136,7 +148,10 @@ class ElementWidget(QWidget):
             self._stale = self.model.stale
             if self._stale:
                 self._tip = self.toolTip()
-            self.setToolTip(STALE_TIP if self._stale else self._tip)
+        if self._stale:
+            self.setToolTip(quality_tip(self.model.quality or "stale"))
+        elif self.toolTip() != self._tip:
+            self.setToolTip(self._tip)
 
     def flush(self) -> None:
         """Bring throttled parts (plots, queries) up to date; plain painted widgets have none."""
@@ -221,6 +236,8 @@ class SelfPainted(ElementWidget):
         if self.model.stale != self.stale_mark.isVisibleTo(self):
             self.stale_mark.setVisible(self.model.stale)
             self.stale_mark.raise_()
+        if self.model.stale:
+            self.stale_mark.setToolTip(quality_tip(self.model.quality or "stale"))
         self.update(self.changed_rect())
 
     def changed_rect(self) -> QRect:

@@ -7,7 +7,9 @@ model reads the snapshot;
 only widgets whose model reports a change are scheduled for repainting, and Qt paints them all in
 one pass. Trend plots are redrawn in staggered turns (a few per tick, each once a second, as PyDM
 does by default) so fifty plots never land in the same tick. A model that raises is reported once, marked
-stale and skipped; the rest of the form keeps running.
+stale and skipped; the rest of the form keeps running. With the runtime's `Readings` of the scan,
+each element is also given the quality of what it shows (one judgement per distinct operand per
+refresh), and marks anything but good.
 """
 
 from __future__ import annotations
@@ -37,6 +39,8 @@ from hmi_forms.widgets.journal import JournalWidget
 from hmi_forms.widgets.static import DateTimeWidget, StaticPictureWidget, StaticTextWidget, SyncWidget
 from hmi_forms.widgets.trend import REDRAW_INTERVAL, TrendWidget
 from netplc.memory import Snapshot
+from netplc.tags.quality import Quality
+from netplc.tags.readings import Readings
 
 
 class FormView(QWidget):
@@ -101,14 +105,19 @@ class FormView(QWidget):
             return StaticPictureWidget(model, images)
         raise TypeError(f"no widget for element type {model.TYPE}")
 
-    def refresh(self, snapshot: Snapshot) -> None:
-        """Update every element from one snapshot; repaint only what changed."""
+    def refresh(self, snapshot: Snapshot, readings: Readings | None = None) -> None:
+        """Update every element from one snapshot, and the quality of what each shows from the
+        runtime's `readings` (None: not judged); repaint only what changed."""
         if snapshot is self._last:
             return
         self._last = snapshot
+        if readings is not None:
+            snapshot = readings.live(snapshot)  # link outputs follow the link, not the last scan
+        judged: dict[tuple[int, int], Quality] = {}
         for model, widget in self.pairs:
             try:
-                changed = model.update(snapshot)
+                quality = None if readings is None else _worst(model.sources(), readings, judged)
+                changed = model.update(snapshot, quality)
             except Exception as e:
                 self._fault(model, e, "update")
                 changed = True
@@ -153,3 +162,15 @@ class FormView(QWidget):
                     self._fault(widget.model, e, "drawing")
         finally:
             p.end()
+
+
+def _worst(sources: tuple[tuple[int, int], ...], readings: Readings,
+           judged: dict[tuple[int, int], Quality]) -> Quality:
+    """The worst quality of an element's operands, each judged once per refresh."""
+    worst = Quality.GOOD
+    for source in sources:
+        quality = judged.get(source)
+        if quality is None:
+            quality = judged[source] = readings.address(*source)
+        worst = max(worst, quality)
+    return worst

@@ -116,7 +116,7 @@ class GaugeWidget(ElementWidget):
             peak = round(m.scaling.fraction(m.maximum) * travel)
         else:
             peak = m.format(m.maximum)
-        return m.text, pointer, peak, m.zone, m.stale
+        return m.text, pointer, peak, m.zone, m.quality
 
     def sync(self) -> None:
         """Repaint only when something moved by a pixel or a text changed (a value that creeps

@@ -18,6 +18,7 @@ from PySide6.QtGui import QColor
 from PySide6.QtWidgets import QAbstractItemView, QHeaderView, QTableView
 
 from netplc.address import fmt_octal
+from netplc.tags.alarms import State
 from registrar.query import Row
 
 TYPE_NAMES = {0: "info", 1: "warning", 2: "alarm", 3: "critical"}
@@ -30,10 +31,16 @@ def format_value(value: float | None) -> str:
     return str(int(value)) if value == int(value) else f"{value:.3f}"
 
 
+STATES = frozenset(int(s) for s in State)
+
+
 def type_name(row: Row) -> str:
-    """Message types by name; other kinds keep their number (a data record's type is not a severity)."""
+    """Message types by name, an alarm's new state by its word; other kinds keep their number (a
+    data record's type is not a severity)."""
     if row.type is None:
         return ""
+    if row.kind == "alarm" and row.type in STATES:
+        return State(row.type).word
     return TYPE_NAMES.get(row.type, str(row.type)) if row.kind == "message" else str(row.type)
 
 
@@ -93,7 +100,7 @@ class Palette:
 
 ARCHIVE_PALETTE = Palette(
     back={1: QColor(255, 243, 205), 2: QColor(255, 214, 214), 3: QColor(239, 154, 154)},
-    kind_fore={"system": QColor(70, 90, 120), "operator": QColor(20, 90, 160)},
+    kind_fore={"system": QColor(70, 90, 120), "operator": QColor(20, 90, 160), "alarm": QColor(170, 30, 30)},
 )
 
 

@@ -102,7 +102,7 @@ class TrendWidget(SelfPainted):
     def sync(self) -> None:
         """A new sample: the plot waits for its turn; the header is repainted only if it changed."""
         self.dirty = True
-        shown = (self.layer_key(), getattr(self.model, "text", None), self.model.stale)
+        shown = (self.layer_key(), getattr(self.model, "text", None), self.model.quality)
         if shown != self._header_shown:
             self._header_shown = shown
             super().sync()

@@ -14,7 +14,8 @@ nothing is annunciated, and when it ends an alarm whose condition is active come
 unacknowledged. A latching alarm stays active after its condition has gone until it is
 acknowledged. While a tag's quality is bad its process alarms are frozen where they are (DIVAR:
 "alarm only when not BAD"): a frozen value says nothing about the plant, neither that the alarm
-has come nor that it has gone; the quality alarm says why.
+has come nor that it has gone; the quality alarm says why. They also wait while the quality is
+initial (no value from the plant yet, no quality alarm either: quality.py).
 
 Every change of state is one `Transition`, journaled as one 'alarm' record (grp = priority,
 type = new state, number = old state, source = the alarm's identity, value = the physical value,
@@ -40,7 +41,7 @@ import numpy as np
 
 from netplc.memory import MemoryView
 from netplc.records import NullSink, Record, RecordSink
-from netplc.tags.quality import BAD_CODES
+from netplc.tags.quality import BAD_CODES, HELD_CODES
 from netplc.tags.table import TagTable
 from netplc.tags.tag import Tag, TagReader
 
@@ -145,6 +146,34 @@ class Alarm:
         if self.active:
             return State.ACKED if self.acked else State.UNACK
         return State.NORMAL if self.acked else State.RTNUN
+
+
+@dataclass(frozen=True, slots=True)
+class AlarmRow:
+    """One line of the alarm summary, frozen so another thread may show it while states change."""
+
+    id: str
+    priority: int
+    state: State
+    since: float  # wall time of the last activation
+    changed: float  # wall time of the last transition
+    value: float | None  # physical value at the last transition
+    text: str
+    tag: str | None = None
+    shown: str = ""  # the value as an operator reads it: the tag's decimals and unit
+    shelved_until: float | None = None
+    shelved_by: str = ""
+    reason: str = ""
+
+    @property
+    def acked(self) -> bool:
+        return self.state not in (State.UNACK, State.RTNUN)
+
+
+def summary_order(row: AlarmRow) -> tuple[bool, int, float]:
+    """Listed alarms by priority, then newest first; after them the shelved ones, likewise."""
+    shelved = row.state is State.SHELVED
+    return shelved, row.priority, -(row.changed if shelved else row.since)
 
 
 PERSISTED = ("active", "acked", "since", "changed", "value", "shelved_until", "shelved_by", "reason",
@@ -310,8 +339,10 @@ class AlarmSystem:
         hyst = self._hyst
         if isinstance(quality, Mapping):
             quality = [quality.get(t.name, 0) for t in self.tags]
-        bad = BAD_CODES[np.asarray(quality, dtype=np.intp)] if quality is not None else None
-        frozen = self._proc_idx[bad[self._proc_tag]] if bad is not None and bad.any() else None
+        codes = np.asarray(quality, dtype=np.intp) if quality is not None else None
+        bad = BAD_CODES[codes] if codes is not None else None
+        held = HELD_CODES[codes] if codes is not None else None
+        frozen = self._proc_idx[held[self._proc_tag]] if held is not None and held.any() else None
         keep = hyst[frozen] if frozen is not None else None
         if len(self._lim_idx):
             x = self._lim_sign * (phy[self._lim_tag] - self._lim_limit)
@@ -513,6 +544,25 @@ class AlarmSystem:
         """Active and unacknowledged alarms, by priority, then newest first."""
         return sorted((a for a in self.alarms if a.state in IN_LIST),
                       key=lambda a: (a.defn.priority, -a.since))
+
+    def row(self, alarm_id: str) -> AlarmRow | None:
+        """The alarm's line of the summary; None if it is not on it (normal, suppressed, out of
+        service)."""
+        i = self._index(alarm_id)
+        a = self.alarms[i]
+        state = a.state
+        if state not in IN_LIST and state is not State.SHELVED:
+            return None
+        t = self._tag_of[i]
+        tag = self.tags[t] if t >= 0 else None
+        shown = "" if a.value is None else tag.format(a.value) if tag is not None else f"{a.value:g}"
+        return AlarmRow(a.id, a.defn.priority, state, a.since, a.changed, a.value, a.defn.text,
+                        a.defn.tag, shown, a.shelved_until, a.shelved_by, a.reason)
+
+    def rows(self) -> tuple[AlarmRow, ...]:
+        """The summary: listed alarms (by priority, newest first), then the shelved ones."""
+        rows = (self.row(a.id) for a in self.alarms)
+        return tuple(sorted((r for r in rows if r is not None), key=summary_order))
 
     def counts(self) -> dict[int, int]:
         """How many alarms of each priority are listed."""

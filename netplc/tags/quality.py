@@ -9,10 +9,24 @@ block's data in scans, NetPlc's run state and forcing give each address its qual
 - comm-fail: the node whose NREAD fills the address is down (its answers fail or are malformed);
 - stale: the NREAD asks (its rung is on) but its data has not landed for more than STALE_TICKS
   scans beyond the one scan an answer normally takes;
+- initial: nothing is known yet, so the value is not the plant's, but nothing has failed either:
+  the node has not had its first exchange attempt since the station started, or NetPlc has just
+  started (again) and the node's first data since then is still within its normal time to land.
+  It is shown like any quality that is not good, but it is not bad: no quality alarm comes of
+  it (every start would otherwise raise one per tag before the first answer), and process alarms
+  wait for the first real value (`Quality.held`). It turns into good when the data lands, into
+  comm-fail when the first attempt fails, into stale when the data is late;
 - good: anything else, including what the program computes itself while it runs.
 
 Qualities are ordered so that the worst of several blocks (a tag spanning two NREADs) is the
 highest; an address no NREAD fills is good while NetPlc runs.
+
+An NREAD's or NWRITE's link output (C+1) is the program's copy of its node's link, frozen while
+NetPlc is stopped. Readers show the link itself there (`link_outputs`, `Readings.live`): a
+"связь есть" label follows the link, not the last value the program wrote.
+
+Forcing (netplc/forcing.py, to come) reaches quality through one hook: `LinkView.forced`, the
+forced operand addresses of the scan; the runtime fills it from the engine's forces.
 """
 
 from __future__ import annotations
@@ -24,9 +38,9 @@ from enum import IntEnum
 import numpy as np
 
 from netplc.address import IO_BITS
-from netplc.exchange import NODE, NREAD, _fon_nodes
+from netplc.exchange import NODE, NREAD, NWRITE, _fon_nodes
 from netplc.memory import MemoryView
-from netplc.program import Program
+from netplc.program import Instr, Program
 from netplc.tags.tag import Tag, span
 
 STALE_TICKS = 2  # scans of lateness tolerated beyond the normal one-scan answer
@@ -35,10 +49,11 @@ NORMAL_AGE = 1  # scans from a request to its data in memory, normally
 
 class Quality(IntEnum):
     GOOD = 0
-    STALE = 1
-    COMM_FAIL = 2
-    NOT_RUNNING = 3
-    FORCED = 4
+    INITIAL = 1
+    STALE = 2
+    COMM_FAIL = 3
+    NOT_RUNNING = 4
+    FORCED = 5
 
     @property
     def word(self) -> str:
@@ -50,10 +65,16 @@ class Quality(IntEnum):
         """The value cannot be trusted (forced is shown, but it is not bad: someone chose it)."""
         return self in (Quality.STALE, Quality.COMM_FAIL, Quality.NOT_RUNNING)
 
+    @property
+    def held(self) -> bool:
+        """Process alarms wait: the value says nothing about the plant (bad, or not known yet)."""
+        return self.bad or self is Quality.INITIAL
 
-_WORDS = {Quality.GOOD: "good", Quality.STALE: "stale", Quality.COMM_FAIL: "comm-fail",
-          Quality.NOT_RUNNING: "not running", Quality.FORCED: "forced"}
+
+_WORDS = {Quality.GOOD: "good", Quality.INITIAL: "initial", Quality.STALE: "stale",
+          Quality.COMM_FAIL: "comm-fail", Quality.NOT_RUNNING: "not running", Quality.FORCED: "forced"}
 BAD_CODES = np.array([q.bad for q in Quality], dtype=bool)  # indexed by quality code
+HELD_CODES = np.array([q.held for q in Quality], dtype=bool)
 
 
 @dataclass(frozen=True, slots=True)
@@ -68,19 +89,28 @@ class Feed:
     line: int = 0  # of the program text, for messages
 
 
-def nread_feeds(program: Program) -> list[Feed]:
-    """Every NREAD of the program with the node it talks to. One above the first NODE talks to the
+def _exchanges(program: Program) -> list[tuple[int, Instr, int]]:
+    """Every NREAD and NWRITE with the node it talks to. One above the first NODE talks to the
     node of the last NODE in the text (the one selected when the previous scan ended)."""
     nodes = [i.s for i in program.instrs if i.op == "FON" and i.n == NODE]
     wrap = nodes[-1] if nodes else 0
+    return [(fn, ins, wrap if node is None else node) for fn, ins, node in _fon_nodes(program)]
+
+
+def nread_feeds(program: Program) -> list[Feed]:
+    """Every NREAD of the program with the node it talks to and the bytes it fills."""
     index = {id(ins): k for k, ins in enumerate(program.instrs)}
     feeds = []
-    for fn, ins, node in _fon_nodes(program):
-        if fn != NREAD:
-            continue
-        first, last = span(ins.d or 0, ins.r or 0)
-        feeds.append(Feed(index[id(ins)], wrap if node is None else node, ins.c or 0, first, last, ins.line))
+    for fn, ins, node in _exchanges(program):
+        if fn == NREAD:
+            first, last = span(ins.d or 0, ins.r or 0)
+            feeds.append(Feed(index[id(ins)], node, ins.c or 0, first, last, ins.line))
     return feeds
+
+
+def link_outputs(program: Program) -> dict[int, int]:
+    """The link output bit (C+1) of every NREAD and NWRITE -> the node whose link it copies."""
+    return {(ins.c or 0) + 1: node for fn, ins, node in _exchanges(program) if fn in (NREAD, NWRITE)}
 
 
 @dataclass(frozen=True)
@@ -91,6 +121,10 @@ class LinkView:
     links: Mapping[int, bool] | None = None  # node -> link up; None: every node is up
     refreshed: Mapping[int, int] | None = None  # NREAD key -> scan its data last landed; None: now
     forced: Collection[int] = ()  # forced operand addresses: I/O bits and data bytes
+    # node -> the scan from which its data is expected: the first scan of this run of NetPlc in
+    # which the node's link state was known (its first exchange attempt done). A node not in it
+    # is initial; None: every node's data has been expected for long.
+    since: Mapping[int, int] | None = None
 
 
 class QualityMap:
@@ -102,6 +136,7 @@ class QualityMap:
 
     def __init__(self, program: Program, tags: Sequence[Tag]) -> None:
         self.feeds = nread_feeds(program)
+        self.link_bits = link_outputs(program)
         self.tags = list(tags)
         groups: dict[tuple[int, ...], int] = {}
         members = []
@@ -115,6 +150,10 @@ class QualityMap:
         self._first, self._last = spans[:, 0], spans[:, 1]
         self._pos = {t.name: i for i, t in enumerate(self.tags)}
 
+    def position(self, name: str) -> int:
+        """The index of a tag in `tags` and in what `evaluate` returns (KeyError if none)."""
+        return self._pos[name]
+
     def fed_by(self, tag: Tag) -> list[Feed]:
         """The NREADs whose block overlaps the tag."""
         return [self.feeds[k] for k in self.groups[self._member[self._pos[tag.name]]]]
@@ -122,10 +161,18 @@ class QualityMap:
     def feed_quality(self, feed: Feed, view: MemoryView, links: LinkView, scan: int) -> Quality:
         if not links.running:
             return Quality.NOT_RUNNING
+        since = None
+        if links.since is not None:
+            since = links.since.get(feed.node)
+            if since is None:
+                return Quality.INITIAL
         if links.links is not None and not links.links.get(feed.node, False):
             return Quality.COMM_FAIL
         if links.refreshed is not None and view.get_bit(feed.coil):
             landed = links.refreshed.get(feed.key)
+            if since is not None and (landed is None or landed < since):  # nothing since the start
+                late = scan - since > NORMAL_AGE + STALE_TICKS
+                return Quality.STALE if late else Quality.INITIAL
             if landed is None or scan - landed > NORMAL_AGE + STALE_TICKS:
                 return Quality.STALE
         return Quality.GOOD
@@ -154,6 +201,10 @@ class QualityMap:
             f_first, f_last = _forced(addr)
             if f_first < last and first < f_last:
                 return Quality.FORCED
+        node = self.link_bits.get(address) if nbytes == 0 and links.links is not None else None
+        if node is not None:  # a link output shows the link itself (`Readings.live`), known or not
+            known = links.since is None or node in links.since or not links.running
+            return Quality.GOOD if known else Quality.INITIAL
         scan = getattr(view, "scan", 0)
         fed = [self.feed_quality(f, view, links, scan) for f in self.feeds
                if f.first < last and first < f.last]

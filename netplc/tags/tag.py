@@ -137,6 +137,22 @@ class Tag:
         raw = self.raw(view)
         return raw if self.scaling is None else self.scaling.to_phy(raw)
 
+    def word_value(self, word: int) -> float:
+        """The physical value of a one-word tag whose word in memory is `word` (NaN: not BCD)."""
+        kind = self.type
+        if kind is TagType.INT16:
+            raw: float = word - 0x10000 if word & 0x8000 else word
+        elif kind is TagType.BCD:
+            v = bcd_to_bin(word)
+            raw = float("nan") if v is None else v
+        else:
+            raw = word
+        return raw if self.scaling is None else self.scaling.to_phy(raw)
+
+    def change(self, old_word: int, new_word: int) -> str:
+        """An operator's write as the journal shows it: "0.0 -> 130.0 °C"."""
+        return f"{self.word_value(old_word):.{self.decimals}f} -> {self.format(self.word_value(new_word))}"
+
     def to_raw(self, phy: float) -> float:
         """The hardware value for a physical one: rounded for whole types, clamped to the range."""
         whole = self.type is not TagType.FLOAT32

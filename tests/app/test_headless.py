@@ -56,6 +56,12 @@ def test_headless_run_for_a_duration(headless_archive: tuple[Path, str]) -> None
     assert lines[-1].startswith("station stopped")
 
 
+def test_a_start_raises_no_quality_alarm_before_the_first_answer(headless_archive: tuple[Path, str]) -> None:
+    """The node's link is not up in the first scans: its tags are initial, not comm-fail."""
+    alarms = kinds(headless_archive[0]).get("alarm", [])
+    assert not [r for r in alarms if r[3].endswith(".BAD")], alarms
+
+
 def test_sigterm_mid_run_exits_0_with_everything_flushed(demo_copy: Path) -> None:
     proc = subprocess.Popen([sys.executable, "main.py", "--no-gui", str(demo_copy), "--status-every", "0.5"],
                             cwd=REPO, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)

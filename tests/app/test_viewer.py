@@ -11,6 +11,9 @@ from PySide6.QtCore import Qt
 
 from app.gui.viewer import ViewerWindow, archive_of
 
+LEVEL = "LEVEL Уровень, % (group 1 / type 1 / 04010)"  # series are named by their tags
+TEMP = "TEMP Температура, °C (group 1 / type 2 / 04012)"
+
 
 def test_viewer_shows_rows_plots_and_exports(qtbot, headless_archive: tuple[Path, str],
                                              tmp_path: Path) -> None:
@@ -35,14 +38,15 @@ def test_viewer_shows_rows_plots_and_exports(qtbot, headless_archive: tuple[Path
     assert viewer.page_label.text().startswith("records 1–")
 
     labels = [viewer.series_list.item(i).text() for i in range(viewer.series_list.count())]
-    level = labels.index("group 1 / type 1 / 04010")
+    level = labels.index(LEVEL)
     viewer.check_series(level)
-    viewer.check_series(labels.index("group 1 / type 2 / 04012"))
+    viewer.check_series(labels.index(TEMP))
     assert len(viewer.loading) == 2  # read in the loader's thread, plotted when done
     qtbot.waitUntil(lambda: len(viewer.curves) == 2, timeout=10_000)
     assert not viewer.loading
     xs, ys = next(iter(viewer.curves.values())).getData()
     assert len(xs) >= 3 and ys[-1] > ys[0]  # the level rises after a start
+    assert ys.min() >= 0 and ys.max() <= 100  # in %, not raw counts
     viewer.series_list.item(level).setCheckState(Qt.CheckState.Unchecked)
     assert len(viewer.curves) == 1
 
@@ -54,6 +58,15 @@ def test_viewer_shows_rows_plots_and_exports(qtbot, headless_archive: tuple[Path
     assert {r["kind"] for r in rows} == {"message"}
     assert "NetPlc запущен" in {r["text"] for r in rows}
 
+    viewer.kind.setCurrentText("data")
+    viewer.apply_filter()
+    viewer.export_csv(out)
+    with open(out, encoding="utf-8-sig", newline="") as f:
+        levels = [r for r in csv.DictReader(f) if r["source"] == "04010"]
+    assert levels and all(r["tag"] == "LEVEL" and r["unit"] == "%" for r in levels)
+    raw = float(levels[-1]["value"])  # the raw value is kept beside the physical one
+    assert levels[-1]["physical"] == f"{raw * 100 / 4095:.1f}"
+
 
 def test_a_series_unticked_while_it_loads_is_not_plotted_and_a_failed_read_is_said(
         qtbot, headless_archive: tuple[Path, str], tmp_path: Path) -> None:
@@ -62,19 +75,19 @@ def test_a_series_unticked_while_it_loads_is_not_plotted_and_a_failed_read_is_sa
     viewer = ViewerWindow(copy)
     qtbot.addWidget(viewer)
     labels = [viewer.series_list.item(i).text() for i in range(viewer.series_list.count())]
-    first, second = labels.index("group 1 / type 1 / 04010"), labels.index("group 1 / type 2 / 04012")
+    first, second = labels.index(LEVEL), labels.index(TEMP)
     viewer.check_series(first)
     viewer.series_list.item(first).setCheckState(Qt.CheckState.Unchecked)  # before its answer arrives
     viewer.check_series(second)
     qtbot.waitUntil(lambda: not viewer.loading, timeout=10_000)  # one worker: first's answer came first
-    assert [curve.name() for curve in viewer.curves.values()] == ["group 1 / type 2 / 04012"]
+    assert [curve.name() for curve in viewer.curves.values()] == [TEMP]
 
     viewer.series_list.item(second).setCheckState(Qt.CheckState.Unchecked)
     copy.write_bytes(b"not an archive" * 100)
     viewer.check_series(first)
     qtbot.waitUntil(lambda: not viewer.loading, timeout=10_000)
     assert not viewer.curves
-    assert viewer.statusBar().currentMessage().startswith("group 1 / type 1 / 04010 could not be read: ")
+    assert viewer.statusBar().currentMessage().startswith(f"{LEVEL} could not be read: ")
 
 
 def test_archive_argument(tmp_path: Path) -> None:

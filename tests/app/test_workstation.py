@@ -101,9 +101,10 @@ def test_an_alarm_is_shown_and_its_acknowledgement_journaled(qtbot, workstation:
     button = banner.ack_all if len(banner.alarms) > 1 else banner.ack
     qtbot.mouseClick(button, Qt.MouseButton.LeftButton)
     assert not banner.alarms and not banner.isVisible()
+    qtbot.waitUntil(lambda: not workstation.summary.unacknowledged(), timeout=3000)
     runtime.stop()  # flushes the archive
-    operator = archive_rows(runtime, "operator")
-    assert ("engineer", 3, "acknowledged: Уровень выше 90 %") in operator
+    acks = [r for r in archive_rows(runtime, "alarm") if r[0] == "MSG3" and "by engineer" in r[2]]
+    assert len(acks) == 1 and "acknowledged" in acks[0][2] and high in acks[0][2]  # one, naming it
     messages = archive_rows(runtime, "message")
     assert (None, 3, "Уровень выше 90 %") in messages
 
@@ -135,3 +136,33 @@ def test_a_failing_archive_shows_in_the_status_bar(qtbot) -> None:
     assert bar.records.property("level") == "bad"
     assert bar.state.property("level") == "ok"
     assert station_problems(status) == list(status.problems)
+
+
+def test_elements_mark_a_dead_node_and_a_stopped_netplc_and_link_labels_follow_the_link(
+        qtbot, workstation: MainWindow) -> None:
+    runtime = workstation.runtime
+    level, gauge = element(workstation, "Уровень")
+    trend, _ = element(workstation, "Уровень, тренд")
+    link, _ = element(workstation, "Связь")  # bound to LEVEL_OK, the NREAD's link output
+    qtbot.waitUntil(lambda: runtime.status().nodes_up == 1 and not level.stale and link.value == 1,
+                    timeout=10_000)
+    assert level.quality == "" and "comm-fail" not in gauge.toolTip()
+    form = gauge.parentWidget()  # painted elements are drawn by their form
+    live = form.grab(gauge.geometry()).toImage()
+
+    runtime.simulator_answers(0, False)  # the node that fills the level stops answering
+    qtbot.waitUntil(lambda: level.quality == "comm-fail", timeout=10_000)
+    assert gauge.toolTip().startswith("? comm-fail")
+    qtbot.waitUntil(lambda: math.isnan(trend.trend.last), timeout=3000)  # the trend breaks its line
+    assert form.grab(gauge.geometry()).toImage() != live  # greyed and hatched
+    qtbot.waitUntil(lambda: link.value == 0, timeout=3000)
+    runtime.simulator_answers(0, True)
+    qtbot.waitUntil(lambda: level.quality == "" and link.value == 1, timeout=15_000)
+
+    runtime.stop_program()
+    qtbot.waitUntil(lambda: level.quality == "not running", timeout=5000)
+    assert math.isnan(trend.trend.last) and gauge.toolTip().startswith("? not running")
+    assert link.value == 1 and link.quality == ""  # the link is up: said, and not marked
+    runtime.simulator_answers(0, False)  # NetPlc is stopped, its copy of the link frozen at 1...
+    qtbot.waitUntil(lambda: link.value == 0, timeout=10_000)  # ...the label follows the link itself
+    assert "нет связи" in link.text and not link.stale

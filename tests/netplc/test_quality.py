@@ -12,8 +12,9 @@ from netplc.exchange import Exchange, NodeConfig
 from netplc.memory import Memory
 from netplc.program import parse
 from netplc.simulator import Simulator
-from netplc.tags.quality import LinkView, Quality, QualityMap, nread_feeds
-from netplc.tags.tag import Tag, TagType
+from netplc.tags.quality import LinkView, Quality, QualityMap, link_outputs, nread_feeds
+from netplc.tags.readings import Readings
+from netplc.tags.tag import Scaling, Tag, TagType
 from tests.netplc.test_exchange import NODE_PROGRAM, TICK, Station, wait_until
 
 PROGRAM = """\
@@ -137,3 +138,59 @@ def test_quality_from_a_real_exchange_a_killed_node_and_netplc_stopped(
     wait_until(lambda: quality() is Quality.COMM_FAIL)
     station.engine.post(lambda _m: station.engine.stop())
     wait_until(lambda: quality() is Quality.NOT_RUNNING)
+
+
+def test_initial_until_the_first_attempt_then_the_first_data_within_its_normal_time() -> None:
+    prog = parse(PROGRAM)
+    qmap = QualityMap(prog, TAGS[:1])  # A: node 1
+    key = next(f.key for f in nread_feeds(prog) if f.node == 1)
+    view = asking().snapshot(10)
+
+    def at(**kw: object) -> Quality:
+        return qmap.quality(TAGS[0], view, LinkView(**kw))  # type: ignore[arg-type]
+
+    assert at(links={1: False}, refreshed={}, since={}) is Quality.INITIAL  # no attempt yet
+    assert at(links={1: True}, refreshed={}, since={1: 8}) is Quality.INITIAL  # data on its way
+    assert at(links={1: True}, refreshed={}, since={1: 6}) is Quality.STALE  # late
+    assert at(links={1: False}, refreshed={}, since={1: 9}) is Quality.COMM_FAIL  # first attempt failed
+    assert at(links={1: True}, refreshed={key: 10}, since={1: 9}) is Quality.GOOD  # data landed
+    # NetPlc started again: data landed before the start does not count, within its normal time
+    assert at(links={1: True}, refreshed={key: 3}, since={1: 9}) is Quality.INITIAL
+    assert Quality.INITIAL.held and not Quality.INITIAL.bad and Quality.INITIAL.word == "initial"
+
+
+def test_readings_give_value_quality_and_time_of_tags_and_addresses() -> None:
+    level = Tag("LEVEL", 0o4000, TagType.WORD, "%", Scaling(0, 4095, 0, 100), 1)
+    qmap = QualityMap(parse(PROGRAM), [level])
+    mem = asking()
+    mem.set_word(0o4000, 4095)
+    links = LinkView(links={1: False, 2: True})
+    snap = mem.snapshot(10, 0.0, 1234.5, "running")
+    readings = Readings(snap, qmap, links, qmap.evaluate(snap, links))
+    r = readings.tag("LEVEL")
+    assert (r.value, r.raw, r.unit, r.quality, r.time) == (100.0, 4095, "%", Quality.COMM_FAIL, 1234.5)
+    assert r.text(1) == "100.0 % ?" and not r.good
+    assert readings.quality("LEVEL") is Quality.COMM_FAIL
+    assert readings.address(0o4004, 1) is Quality.GOOD
+    assert readings.word(0o4000).quality is Quality.COMM_FAIL
+    with pytest.raises(KeyError):
+        readings.tag("NOPE")
+
+
+def test_link_outputs_show_the_link_itself() -> None:
+    prog = parse(PROGRAM)
+    assert link_outputs(prog) == {0o2121: 2, 0o2105: 1, 0o2115: 2}
+    qmap = QualityMap(prog, [])
+    mem = asking()
+    mem.set_bit(0o2105, 1)  # the program's copy: node 1 up, as of its last scan
+    stopped = LinkView(running=False, links={1: False, 2: True})
+    snap = mem.snapshot(10, 1.0, 1234.5, "stopped")
+    readings = Readings(snap, qmap, stopped, qmap.evaluate(snap, stopped))
+    live = readings.live(snap)
+    assert (live.get_bit(0o2105), live.get_bit(0o2115), live.get_bit(0o2121)) == (0, 1, 1)
+    assert readings.address(0o2105, 0) is Quality.GOOD  # the link is known, NetPlc or not
+    assert readings.address(0o2104, 0) is Quality.NOT_RUNNING  # the program's own coil
+    up = LinkView(links={1: True, 2: True}, since={})
+    assert qmap.at(0o2105, 0, snap, up) is Quality.INITIAL  # no exchange attempt yet
+    same = mem.snapshot(11)
+    assert Readings(same, qmap, LinkView(links={1: True, 2: False}), qmap.evaluate(same)).live(same) is same

@@ -1,0 +1,58 @@
+"""The alarm-system health of a chosen day (ISA-18.2 measures, registrar/health.py), in a dialog.
+
+The same report as `main.py alarms-report ARCHIVE --day DD_MM_YYYY`, read from the archive file
+read-only, so the operator and the engineer see the same figures.
+"""
+
+from __future__ import annotations
+
+import datetime as dt
+import sqlite3
+from pathlib import Path
+
+from PySide6.QtCore import QDate
+from PySide6.QtGui import QFont
+from PySide6.QtWidgets import QDateEdit, QDialog, QHBoxLayout, QLabel, QPlainTextEdit, QVBoxLayout, QWidget
+
+from registrar.health import alarm_health
+from registrar.query import Archive
+
+
+def health_text(archive_path: Path, day: dt.date) -> str:
+    """The report's lines, or why there is none (no archive yet, unreadable)."""
+    try:
+        archive = Archive(archive_path)
+    except (OSError, sqlite3.Error) as e:
+        return f"no alarm-system health: {e}"
+    try:
+        return "\n".join(alarm_health(archive, day).lines())
+    except sqlite3.Error as e:
+        return f"{archive_path}: cannot read the archive: {e}"
+    finally:
+        archive.close()
+
+
+class HealthDialog(QDialog):
+    def __init__(self, archive_path: Path, parent: QWidget | None = None) -> None:
+        super().__init__(parent)
+        self.setWindowTitle("Alarm-system health")
+        self.archive_path = archive_path
+        self.resize(720, 520)
+        lay = QVBoxLayout(self)
+        bar = QHBoxLayout()
+        bar.addWidget(QLabel("Day:"))
+        self.day = QDateEdit(QDate.currentDate())
+        self.day.setCalendarPopup(True)
+        self.day.setDisplayFormat("dd.MM.yyyy")
+        self.day.dateChanged.connect(self.show_day)
+        bar.addWidget(self.day)
+        bar.addStretch(1)
+        lay.addLayout(bar)
+        self.report = QPlainTextEdit()
+        self.report.setReadOnly(True)
+        self.report.setFont(QFont("DejaVu Sans Mono", 9))
+        lay.addWidget(self.report, 1)
+        self.show_day()
+
+    def show_day(self) -> None:
+        self.report.setPlainText(health_text(self.archive_path, self.day.date().toPython()))

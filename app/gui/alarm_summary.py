@@ -1,0 +1,326 @@
+"""The alarm summary: the operator's list of what needs attention, from the station's alarm system.
+
+It lists the active and unacknowledged alarms by priority, then newest first (ISA-18.2), then the
+shelved ones; colour says the priority and blinking says "not acknowledged yet". The operator
+acknowledges the selected alarms or all of them, and shelves one for a duration with a reason;
+each action goes to the engine thread through `StationAlarms` and is journaled there as one
+'alarm' record per alarm, naming the alarm and the user. The header counts the listed alarms per
+priority.
+
+The summary only reads `StationAlarms.summary`, an immutable tuple the engine thread rebuilds when
+a state changes, and redraws only when its version moved, so a flood of transitions costs the
+GUI one table reset per refresh, never one per transition. The table is a model/view pair:
+only the visible rows are drawn, whatever the length of the list.
+
+`Annunciator` sounds a new alarm of priority 1-2 until it is acknowledged or silenced; the
+station key `alarm_sound = false` turns sound off.
+"""
+
+from __future__ import annotations
+
+import time
+from collections.abc import Callable
+from typing import Any
+
+from PySide6.QtCore import QAbstractTableModel, QModelIndex, QPersistentModelIndex, Qt, QTimer, Signal
+from PySide6.QtGui import QBrush, QColor
+from PySide6.QtWidgets import (
+    QAbstractItemView,
+    QApplication,
+    QDialog,
+    QDialogButtonBox,
+    QDoubleSpinBox,
+    QFormLayout,
+    QHBoxLayout,
+    QHeaderView,
+    QLabel,
+    QLineEdit,
+    QMessageBox,
+    QPushButton,
+    QTableView,
+    QVBoxLayout,
+    QWidget,
+)
+
+from app.station_alarms import StationAlarms
+from netplc.tags.alarms import PRIORITIES, AlarmError, AlarmRow, State
+
+REFRESH_MS = 250  # how often the summary looks for a new version
+BLINK_MS = 500
+BEEP_MS = 1000
+SOUNDING = (1, 2)  # priorities that sound until acknowledged or silenced
+# background and text per priority: critical red, high orange, medium yellow, low blue
+COLOURS = {1: ("#c62828", "#ffffff"), 2: ("#ef6c00", "#ffffff"), 3: ("#fdd835", "#263445"),
+           4: ("#90caf9", "#263445")}
+QUIET = ("#eceff1", "#607d8b")  # shelved
+COLUMNS = ("Priority", "Time", "Alarm", "State", "Value", "Text")
+
+Index = QModelIndex | QPersistentModelIndex
+
+
+def row_colours(row: AlarmRow, blink_on: bool) -> tuple[QColor, QColor]:
+    """Background and text of a row: the priority's colour; an unacknowledged alarm blinks
+    (alternates with white), a returned-unacknowledged one shows the colour as text only."""
+    if row.state is State.SHELVED:
+        back, fore = QUIET
+    else:
+        back, fore = COLOURS.get(row.priority, COLOURS[4])
+    if row.state is State.RTNUN:
+        return QColor("#ffffff") if blink_on else QColor("#f5f5f5"), QColor(back)
+    if row.state is State.UNACK and not blink_on:
+        return QColor("#ffffff"), QColor(back)
+    return QColor(back), QColor(fore)
+
+
+def stamp(ts: float) -> str:
+    return time.strftime("%d.%m %H:%M:%S", time.localtime(ts)) if ts else ""
+
+
+class AlarmTableModel(QAbstractTableModel):
+    def __init__(self, parent: QWidget | None = None) -> None:
+        super().__init__(parent)
+        self.rows: list[AlarmRow] = []
+        self.blink_on = True
+
+    def set_rows(self, rows: list[AlarmRow]) -> None:
+        self.beginResetModel()
+        self.rows = rows
+        self.endResetModel()
+
+    def rowCount(self, parent: Index = QModelIndex()) -> int:  # noqa: B008 - Qt's signature
+        return 0 if parent.isValid() else len(self.rows)
+
+    def columnCount(self, parent: Index = QModelIndex()) -> int:  # noqa: B008
+        return 0 if parent.isValid() else len(COLUMNS)
+
+    def headerData(self, section: int, orientation: Qt.Orientation, role: int = 0) -> Any:
+        if orientation == Qt.Orientation.Horizontal and role == Qt.ItemDataRole.DisplayRole:
+            return COLUMNS[section]
+        return None
+
+    def data(self, index: Index, role: int = 0) -> Any:
+        row = self.rows[index.row()]
+        if role == Qt.ItemDataRole.DisplayRole:
+            col = index.column()
+            if col == 0:
+                return f"{row.priority} {PRIORITIES.get(row.priority, '')}"
+            if col == 1:
+                return stamp(row.since or row.changed)
+            if col == 2:
+                return row.id
+            if col == 3:
+                if row.state is State.SHELVED and row.shelved_until is not None:
+                    return f"shelved by {row.shelved_by} until {stamp(row.shelved_until)}: {row.reason}"
+                return row.state.word
+            if col == 4:
+                return row.shown
+            return row.text
+        if role in (Qt.ItemDataRole.BackgroundRole, Qt.ItemDataRole.ForegroundRole):
+            back, fore = row_colours(row, self.blink_on)
+            return QBrush(back if role == Qt.ItemDataRole.BackgroundRole else fore)
+        return None
+
+
+class ShelveDialog(QDialog):
+    """Shelving needs a duration and a reason (ISA-18.2: a shelved alarm comes back by itself)."""
+
+    def __init__(self, alarm: str, parent: QWidget | None = None) -> None:
+        super().__init__(parent)
+        self.setWindowTitle(f"Shelve {alarm}")
+        lay = QFormLayout(self)
+        self.minutes = QDoubleSpinBox()
+        self.minutes.setRange(1, 7 * 24 * 60)
+        self.minutes.setValue(60)
+        self.minutes.setSuffix(" min")
+        self.reason = QLineEdit()
+        self.reason.setPlaceholderText("why (required)")
+        lay.addRow("Duration", self.minutes)
+        lay.addRow("Reason", self.reason)
+        ok, cancel = QDialogButtonBox.StandardButton.Ok, QDialogButtonBox.StandardButton.Cancel
+        buttons = QDialogButtonBox(ok | cancel)
+        buttons.accepted.connect(self.accept)
+        buttons.rejected.connect(self.reject)
+        lay.addRow(buttons)
+
+
+class Annunciator:
+    """Sounds while an unacknowledged alarm of priority 1-2 that came after the last silence is
+    listed. `QApplication.beep` works on every platform Qt runs on, offscreen included (silent)."""
+
+    def __init__(self, enabled: bool, beep: Callable[[], None] = QApplication.beep) -> None:
+        self.enabled = enabled
+        self.beep = beep
+        self.silenced_at = 0.0  # wall time of the last silence
+        self.sounding = False
+
+    def update(self, rows: list[AlarmRow]) -> None:
+        self.sounding = self.enabled and any(
+            r.state is State.UNACK and r.priority in SOUNDING and r.since > self.silenced_at for r in rows)
+
+    def silence(self, now: float | None = None) -> None:
+        self.silenced_at = time.time() if now is None else now
+        self.sounding = False
+
+    def tick(self) -> None:
+        if self.sounding:
+            self.beep()
+
+
+class AlarmSummary(QWidget):
+    """The summary as a widget (the workstation docks it)."""
+
+    changed = Signal()  # the rows changed: the banner follows
+
+    def __init__(self, alarms: StationAlarms | None, user: Callable[[], str], *, sound: bool = True,
+                 parent: QWidget | None = None) -> None:
+        super().__init__(parent)
+        self.setObjectName("alarmSummary")
+        self.alarms = alarms
+        self.user = user
+        self.rows: list[AlarmRow] = []
+        self._version = -1
+        self.annunciator = Annunciator(sound)
+        lay = QVBoxLayout(self)
+        lay.setContentsMargins(4, 4, 4, 4)
+        head = QHBoxLayout()
+        self.counts: dict[int, QLabel] = {}
+        for priority, word in PRIORITIES.items():
+            label = QLabel()
+            label.setObjectName("alarmCountP")
+            back, fore = COLOURS[priority]
+            label.setStyleSheet(f"background: {back}; color: {fore}; border-radius: 3px; padding: 2px 8px;")
+            label.setToolTip(f"listed alarms of priority {priority} ({word})")
+            self.counts[priority] = label
+            head.addWidget(label)
+        self.filter = QLineEdit()
+        self.filter.setPlaceholderText("Filter: alarm, text or state")
+        self.filter.setClearButtonEnabled(True)
+        self.filter.textChanged.connect(self._apply)
+        head.addWidget(self.filter, 1)
+        self.ack = QPushButton("Acknowledge")
+        self.ack_all = QPushButton("Acknowledge all")
+        self.shelve = QPushButton("Shelve…")
+        self.unshelve = QPushButton("Unshelve")
+        self.silence = QPushButton("Silence")
+        self.silence.setToolTip("Stop the sound; the alarms stay unacknowledged")
+        for b in (self.ack, self.ack_all, self.shelve, self.unshelve, self.silence):
+            head.addWidget(b)
+        lay.addLayout(head)
+        self.model = AlarmTableModel(self)
+        self.table = QTableView()
+        self.table.setModel(self.model)
+        self.table.setSelectionBehavior(QAbstractItemView.SelectionBehavior.SelectRows)
+        self.table.setSelectionMode(QAbstractItemView.SelectionMode.ExtendedSelection)
+        self.table.verticalHeader().setVisible(False)
+        self.table.verticalHeader().setDefaultSectionSize(22)
+        header = self.table.horizontalHeader()
+        for col, width in enumerate((90, 110, 130, 170, 90)):
+            self.table.setColumnWidth(col, width)
+        header.setSectionResizeMode(len(COLUMNS) - 1, QHeaderView.ResizeMode.Stretch)
+        lay.addWidget(self.table, 1)
+        self.ack.clicked.connect(self.acknowledge_selected)
+        self.ack_all.clicked.connect(self.acknowledge_all)
+        self.shelve.clicked.connect(self._shelve_dialog)
+        self.unshelve.clicked.connect(self.unshelve_selected)
+        self.silence.clicked.connect(self.silence_sound)
+        self._timer = QTimer(self)
+        self._timer.setInterval(REFRESH_MS)
+        self._timer.timeout.connect(self.refresh)
+        self._timer.start()
+        self._blink = QTimer(self)
+        self._blink.setInterval(BLINK_MS)
+        self._blink.timeout.connect(self._toggle_blink)
+        self._blink.start()
+        self._beep = QTimer(self)
+        self._beep.setInterval(BEEP_MS)
+        self._beep.timeout.connect(self.annunciator.tick)
+        self._beep.start()
+        self.refresh()
+
+    # --- data ------------------------------------------------------------------------------------
+
+    def refresh(self) -> None:
+        """Take the alarm system's newest summary, if it changed."""
+        alarms = self.alarms
+        if alarms is None or alarms.version == self._version:
+            return
+        self._version = alarms.version
+        self.rows = list(alarms.summary)
+        self.annunciator.update(self.rows)
+        self._apply()
+        self.changed.emit()
+
+    def _apply(self) -> None:
+        words = self.filter.text().strip().casefold().split()
+        rows = [r for r in self.rows
+                if all(w in f"{r.id} {r.text} {r.state.word} {r.tag or ''}".casefold() for w in words)]
+        selected = set(self.selected())
+        self.model.set_rows(rows)
+        for i, r in enumerate(rows):
+            if r.id in selected:
+                self.table.selectRow(i)
+        listed = [r for r in self.rows if r.state is not State.SHELVED]
+        for priority, label in self.counts.items():
+            n = sum(r.priority == priority for r in listed)
+            label.setText(f"P{priority} {PRIORITIES[priority]}: {n}")
+        self.silence.setEnabled(self.annunciator.sounding)
+
+    def unacknowledged(self) -> list[AlarmRow]:
+        """Unacknowledged alarms, highest priority first, newest first: the banner's order."""
+        return [r for r in self.rows if not r.acked]
+
+    def selected(self) -> list[str]:
+        rows = self.model.rows
+        return [rows[i.row()].id for i in self.table.selectionModel().selectedRows() if i.row() < len(rows)]
+
+    # --- operator actions -----------------------------------------------------------------------
+
+    def acknowledge(self, alarm_ids: list[str]) -> None:
+        if self.alarms is None:
+            return
+        for alarm_id in alarm_ids:
+            self.alarms.acknowledge(alarm_id, self.user())
+
+    def acknowledge_selected(self) -> None:
+        self.acknowledge(self.selected())
+
+    def acknowledge_all(self) -> None:
+        if self.alarms is not None:
+            self.alarms.acknowledge_all(self.user())
+
+    def shelve_alarm(self, alarm_id: str, minutes: float, reason: str) -> None:
+        """AlarmError (shown to the operator by the dialog) for a missing reason or duration."""
+        if self.alarms is not None:
+            self.alarms.shelve(alarm_id, self.user(), reason, minutes * 60)
+
+    def unshelve_selected(self) -> None:
+        if self.alarms is not None:
+            for alarm_id in self.selected():
+                self.alarms.unshelve(alarm_id, self.user())
+
+    def _shelve_dialog(self) -> None:
+        ids = self.selected()
+        if not ids:
+            QMessageBox.information(self, "Shelve", "Select the alarm to shelve first.")
+            return
+        dialog = ShelveDialog(ids[0], self)
+        if dialog.exec() != QDialog.DialogCode.Accepted:
+            return
+        try:
+            for alarm_id in ids:
+                self.shelve_alarm(alarm_id, dialog.minutes.value(), dialog.reason.text())
+        except AlarmError as e:
+            QMessageBox.warning(self, "Shelve", str(e))
+
+    def silence_sound(self) -> None:
+        self.annunciator.silence()
+        self.silence.setEnabled(False)
+
+    def _toggle_blink(self) -> None:
+        self.model.blink_on = not self.model.blink_on
+        if any(r.state in (State.UNACK, State.RTNUN) for r in self.model.rows):
+            self.table.viewport().update()
+
+    def stop(self) -> None:
+        for timer in (self._timer, self._blink, self._beep):
+            timer.stop()

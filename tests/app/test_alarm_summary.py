@@ -1,0 +1,156 @@
+"""The alarm summary and banner over a real alarm system (no engine: actions run at once): order,
+colours and blinking, counts, filter, acknowledge selected / all with one record each naming the
+alarm and the user, shelving with duration and reason, and the sound of priorities 1-2."""
+
+from __future__ import annotations
+
+import datetime as dt
+from collections.abc import Iterator
+from pathlib import Path
+
+import pytest
+
+from app.gui.alarm_health import HealthDialog, health_text
+from app.gui.alarm_summary import AlarmSummary, Annunciator, row_colours
+from app.gui.alarms import AlarmBanner
+from app.station_alarms import StationAlarms
+from hmi_forms.widgets.records import type_name
+from netplc.memory import Memory
+from netplc.program import parse
+from netplc.records import ListSink
+from netplc.tags.alarms import AlarmError, AlarmRow, State
+from registrar.query import Row
+
+TAGS = ("name,address,type,unit,app_min,app_max,phy_min,phy_max,decimals,description,h,priority\n"
+        "LEVEL,04010,word,%,0,4095,0,100,1,Уровень,90,2\n"
+        "TEMP,04012,word,°C,0,1000,-50,150,1,Температура,120,3\n")
+T0 = 1_800_000_000.0
+
+
+class Station:
+    def __init__(self, folder: Path) -> None:
+        (folder / "tags.csv").write_text(TAGS, encoding="utf-8")
+        self.sink = ListSink()
+        self.alarms = StationAlarms(folder / "tags.csv", parse("JMP 0\n"), [], self.sink,
+                                    folder / "alarms.sqlite")
+        self.mem = Memory()
+        self.scan = 0
+
+    def step(self, level: int, temp: int, at: float) -> None:
+        self.mem.set_word(0o4010, level)
+        self.mem.set_word(0o4012, temp)
+        self.scan += 1
+        self.alarms.on_scan(self.mem.snapshot(self.scan, at - T0, at, "running"))
+
+    def alarm_records(self) -> list[tuple[str, int, int, str]]:
+        return [(r.source, r.number, r.type, r.text) for r in self.sink.records if r.kind == "alarm"]
+
+
+@pytest.fixture
+def station(tmp_path: Path) -> Iterator[Station]:
+    s = Station(tmp_path)
+    yield s
+    s.alarms.close()
+
+
+def test_listed_by_priority_then_time_with_counts_colours_and_filter(qtbot, station: Station) -> None:
+    station.step(4000, 900, T0)  # both high: LEVEL.H (priority 2), TEMP.H (priority 3)
+    summary = AlarmSummary(station.alarms, lambda: "ivanov")
+    qtbot.addWidget(summary)
+    assert [r.id for r in summary.model.rows] == ["LEVEL.H", "TEMP.H"]
+    assert [summary.counts[p].text() for p in (1, 2, 3, 4)] == [
+        "P1 critical: 0", "P2 high: 1", "P3 medium: 1", "P4 low: 0"]
+    level = summary.model.rows[0]
+    assert level.shown == "97.7 %" and level.state is State.UNACK
+    assert row_colours(level, True) != row_colours(level, False)  # unacknowledged blinks
+    summary.filter.setText("темп")
+    assert [r.id for r in summary.model.rows] == ["TEMP.H"]
+    summary.filter.clear()
+    summary.resize(900, 200)
+    assert not summary.grab().isNull()
+
+
+def test_acknowledge_selected_and_all_one_record_each_naming_alarm_and_user(qtbot, station: Station) -> None:
+    station.step(4000, 900, T0)
+    summary = AlarmSummary(station.alarms, lambda: "ivanov")
+    qtbot.addWidget(summary)
+    summary.table.selectRow(1)  # TEMP.H
+    summary.acknowledge_selected()
+    summary.refresh()
+    assert station.alarms.system.get("TEMP.H").state is State.ACKED
+    assert station.alarms.system.get("LEVEL.H").state is State.UNACK
+    station.step(0, 0, T0 + 5)  # both return; LEVEL.H is still unacknowledged
+    summary.refresh()
+    assert [(r.id, r.state) for r in summary.unacknowledged()] == [("LEVEL.H", State.RTNUN)]
+    before = len(station.alarm_records())
+    summary.acknowledge_all()
+    summary.refresh()
+    new = station.alarm_records()[before:]
+    assert len(new) == 1 and new[0][0] == "LEVEL.H" and "by ivanov" in new[0][3]
+    assert not summary.unacknowledged() and summary.model.rows == []
+
+
+def test_shelve_needs_a_reason_and_comes_back_by_itself(qtbot, station: Station) -> None:
+    station.step(4000, 0, T0)
+    summary = AlarmSummary(station.alarms, lambda: "petrov")
+    qtbot.addWidget(summary)
+    with pytest.raises(AlarmError):
+        summary.shelve_alarm("LEVEL.H", 10, " ")
+    summary.shelve_alarm("LEVEL.H", 10, "датчик на поверке")
+    summary.refresh()
+    row = summary.model.rows[0]
+    assert row.state is State.SHELVED and row.shelved_by == "petrov" and row.reason == "датчик на поверке"
+    assert summary.counts[2].text() == "P2 high: 0"  # shelved alarms are not counted as listed
+    assert "shelved by petrov" in summary.model.data(summary.model.index(0, 3))
+    station.step(4000, 0, T0 + 10 * 60 + 1)  # the shelving has run out, the level is still high
+    summary.refresh()
+    assert summary.model.rows[0].state is State.UNACK
+
+
+def test_the_banner_shows_the_highest_priority_unacknowledged_alarm(qtbot, station: Station) -> None:
+    station.step(0, 900, T0)  # TEMP.H, priority 3
+    station.step(4000, 900, T0 + 1)  # LEVEL.H, priority 2, after it
+    summary = AlarmSummary(station.alarms, lambda: "ivanov")
+    banner = AlarmBanner()
+    qtbot.addWidget(summary)
+    qtbot.addWidget(banner)
+    banner.show_alarms(summary.unacknowledged())
+    assert "LEVEL.H" in banner.text.text() and "P2" in banner.text.text()
+    assert banner.count.text() == "2 unacknowledged"
+
+
+def test_priority_1_and_2_sound_until_acknowledged_or_silenced() -> None:
+    beeps: list[int] = []
+    horn = Annunciator(True, lambda: beeps.append(1))
+    high = AlarmRow("LEVEL.H", 2, State.UNACK, T0, T0, 97.0, "high")
+    medium = AlarmRow("TEMP.H", 3, State.UNACK, T0, T0, 130.0, "high")
+    horn.update([medium])
+    horn.tick()
+    assert not horn.sounding and beeps == []
+    horn.update([high, medium])
+    horn.tick()
+    assert horn.sounding and beeps == [1]
+    horn.silence(T0 + 1)
+    horn.update([high])
+    assert not horn.sounding  # silenced: only a newer alarm sounds again
+    horn.update([AlarmRow("LEVEL.HH", 1, State.UNACK, T0 + 2, T0 + 2, 99.0, "hh")])
+    assert horn.sounding
+    horn.update([AlarmRow("LEVEL.HH", 1, State.ACKED, T0 + 2, T0 + 3, 99.0, "hh")])
+    assert not horn.sounding  # acknowledged
+    off = Annunciator(False, lambda: beeps.append(1))
+    off.update([high])
+    assert not off.sounding  # the station key alarm_sound = false
+
+
+def test_journals_name_an_alarm_records_new_state() -> None:
+    row = Row(1, T0, "alarm", 2, int(State.UNACK), "LEVEL.H", int(State.NORMAL), 97.0, "LEVEL.H ...")
+    assert type_name(row) == "active-unacknowledged"
+    assert type_name(Row(2, T0, "message", 1, 2, None, 3, None, "x")) == "alarm"  # a message's type
+
+
+def test_the_health_dialog_shows_the_report_of_a_chosen_day(qtbot, headless_archive, tmp_path: Path) -> None:
+    dialog = HealthDialog(headless_archive[0])
+    qtbot.addWidget(dialog)
+    text = dialog.report.toPlainText()
+    assert text.startswith(f"alarm-system health for {dt.date.today():%d.%m.%Y}") and "chattering" in text
+    assert health_text(tmp_path / "none.sqlite", dt.date.today()).startswith("no alarm-system health")

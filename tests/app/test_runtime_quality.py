@@ -1,0 +1,101 @@
+"""Quality and alarms through the whole runtime on the demo station: what readers get from
+`runtime.readings()` while the node answers, after it is killed and with NetPlc stopped; and the
+alarm states across a restart of the runtime."""
+
+from __future__ import annotations
+
+import sqlite3
+from pathlib import Path
+
+from app.config import load_station
+from app.runtime import Runtime
+from netplc.tags.alarms import State
+from netplc.tags.quality import Quality
+from tests.netplc.test_exchange import wait_until
+
+LEVEL = 0o4010
+
+
+def quality(runtime: Runtime, tag: str) -> Quality | None:
+    readings = runtime.readings()
+    return readings.tag(tag).quality if readings is not None else None
+
+
+def test_readings_from_a_killed_node_and_from_netplc_stopped(demo_copy: Path) -> None:
+    runtime = Runtime(load_station(demo_copy))
+    runtime.start()
+    try:
+        wait_until(lambda: quality(runtime, "LEVEL") is Quality.GOOD, timeout=10)
+        readings = runtime.readings()
+        assert readings is not None
+        level = readings.tag("LEVEL")
+        assert level.unit == "%" and level.name == "LEVEL" and level.raw is not None
+        assert abs(level.value - level.raw * 100 / 4095) < 1e-9 and level.time > 0
+        assert readings.address(LEVEL, 2) is Quality.GOOD
+        runtime.simulators[0].stop()
+        wait_until(lambda: quality(runtime, "LEVEL") is Quality.COMM_FAIL, timeout=10)
+        assert quality(runtime, "TEMP") is Quality.COMM_FAIL
+        assert quality(runtime, "TEMP_SP") is Quality.GOOD  # NetPlc's own word: nothing fills it
+        wait_until(lambda: runtime.alarms is not None and
+                   runtime.alarms.system.get("LEVEL.BAD").state is State.UNACK, timeout=5)
+        runtime.stop_program()
+        wait_until(lambda: quality(runtime, "TEMP_SP") is Quality.NOT_RUNNING, timeout=5)
+        assert quality(runtime, "LEVEL") is Quality.NOT_RUNNING
+    finally:
+        runtime.stop()
+    assert runtime.readings() is None  # a stopped station gives no values to trust
+
+
+def activations(archive: Path, alarm: str) -> int:
+    con = sqlite3.connect(f"file:{archive}?mode=ro", uri=True)
+    try:
+        tables = [t for (t,) in con.execute("SELECT name FROM sqlite_master WHERE type='table'")
+                  if t[:2].isdigit()]
+        return sum(con.execute(f'SELECT count(*) FROM "{t}" WHERE kind = ? AND source = ? AND type = ?',
+                               ("alarm", alarm, int(State.UNACK))).fetchone()[0] for t in tables)
+    finally:
+        con.close()
+
+
+def test_an_unacknowledged_alarm_stays_unacknowledged_across_a_restart(demo_copy: Path) -> None:
+    station = load_station(demo_copy)
+    runtime = Runtime(station)
+    runtime.start()
+    try:
+        wait_until(lambda: runtime.status().nodes_up == 1, timeout=10)
+        runtime.simulators[0].engine.write_word(LEVEL, 3900)  # 95 %: LEVEL.H and LEVEL.HH
+        wait_until(lambda: runtime.alarms is not None and
+                   runtime.alarms.system.get("LEVEL.H").state is State.UNACK, timeout=10)
+    finally:
+        runtime.stop()
+    assert activations(station.Archive, "LEVEL.H") == 1
+
+    again = Runtime(station)
+    again.start()
+    try:
+        assert again.alarms is not None
+        assert again.alarms.system.get("LEVEL.H").state in (State.UNACK, State.RTNUN)  # not forgotten
+        assert any(r.id == "LEVEL.H" and not r.acked for r in again.alarms.summary)
+        wait_until(lambda: quality(again, "LEVEL") is Quality.GOOD, timeout=10)
+        wait_until(lambda: again.status().scans > 20, timeout=5)
+        assert not again.alarms.system.get("LEVEL.H").acked
+    finally:
+        again.stop()
+    assert activations(station.Archive, "LEVEL.H") == 1  # raised once, remembered, not raised again
+
+
+def test_the_operator_pulls_and_plugs_a_simulated_nodes_cable(demo_copy: Path) -> None:
+    runtime = Runtime(load_station(demo_copy))
+    runtime.start()
+    try:
+        wait_until(lambda: quality(runtime, "LEVEL") is Quality.GOOD, timeout=10)
+        runtime.simulator_answers(0, False)
+        wait_until(lambda: quality(runtime, "LEVEL") is Quality.COMM_FAIL, timeout=10)
+        wait_until(lambda: runtime.alarms is not None and
+                   runtime.alarms.system.get("LEVEL.BAD").state is State.UNACK, timeout=5)
+        runtime.simulator_answers(0, True)
+        wait_until(lambda: quality(runtime, "LEVEL") is Quality.GOOD, timeout=15)
+        wait_until(lambda: runtime.alarms is not None and
+                   runtime.alarms.system.get("LEVEL.BAD").state is State.RTNUN, timeout=5)
+    finally:
+        runtime.stop()

@@ -1,0 +1,99 @@
+"""The data quality of what elements show, from the runtime's Readings, drawn the same way on every
+element type: greyed and hatched, "?" and the quality word in the tooltip; the last value kept,
+trends broken; a forced value shown as it is, marked."""
+
+from __future__ import annotations
+
+import math
+from pathlib import Path
+
+import pytest
+
+from hmi_forms.elements.target import NullTarget
+from hmi_forms.form import load_form
+from hmi_forms.widgets.form_view import FormView
+from netplc.memory import Memory
+from netplc.program import parse
+from netplc.tags.quality import LinkView, Quality, QualityMap
+from netplc.tags.readings import Readings
+from tests.hmi_forms.helpers import write_form
+from tests.hmi_forms.test_widgets import differs
+
+PROGRAM = "TNA $03760\nFON C:$02110 N:NREAD S:4000 D:$04010 R:4\nJMP 0\n"  # node 0 fills 04010-04013
+BOX = {"x": 0, "y": 0, "w": 200, "h": 120}
+LEVEL = {"AppMin": 0, "AppMax": 4095, "PhyMin": 0, "PhyMax": 100}
+ELEMENTS = [
+    {"type": "AnalogBase", "Name": "dial", **BOX, "InAddr": "04010", **LEVEL, "Appearance": "dial"},
+    {"type": "AnalogBase", "Name": "digital", **BOX, "x": 200, "InAddr": "04010", **LEVEL},
+    {"type": "AnalogBase", "Name": "trend", **BOX, "x": 400, "InAddr": "04010", **LEVEL,
+     "Appearance": "graph"},
+    {"type": "AnalogOutput", "Name": "setpoint", **BOX, "y": 120, "OutAddr": "04012", **LEVEL},
+    {"type": "DiscreteColorLabel", "Name": "label", **BOX, "x": 200, "y": 120, "InAddr": "040100",
+     "TextTrue": "связь есть", "TextFalse": "нет связи"},
+    {"type": "Graph", "Name": "bits", **BOX, "x": 400, "y": 120, "Address": "040101"},
+    {"type": "AnalogBase", "Name": "local", **BOX, "y": 240, "InAddr": "04100", **LEVEL},
+]
+FED = ["dial", "digital", "trend", "setpoint", "label", "bits"]  # all but "local" are filled by node 0
+
+
+def readings(mem: Memory, scan: int, links: LinkView) -> tuple[Readings, object]:
+    qmap = QualityMap(parse(PROGRAM), [])
+    snap = mem.snapshot(scan, scan * 0.1, 1_800_000_000.0 + scan, "running" if links.running else "stopped")
+    return Readings(snap, qmap, links, qmap.evaluate(snap, links)), snap
+
+
+@pytest.fixture
+def view(qtbot, tmp_path: Path) -> FormView:
+    form = load_form(write_form(tmp_path, ELEMENTS))
+    form.width, form.height = 600, 360
+    v = FormView(form, NullTarget())
+    qtbot.addWidget(v)
+    v.show()
+    return v
+
+
+def models(view: FormView) -> dict:
+    return {m.Name: (m, w) for m, w in view.pairs}
+
+
+@pytest.mark.parametrize(("links", "word"), [
+    (LinkView(links={0: False}), "comm-fail"),
+    (LinkView(running=False), "not running"),
+    (LinkView(links={0: True}, since={}), "initial"),
+])
+def test_every_element_marks_a_value_that_is_not_good_the_same_way(view: FormView, links: LinkView,
+                                                                   word: str) -> None:
+    mem = Memory()
+    mem.set_word(0o4010, 2048)
+    mem.set_hmi_bit(0o40100, 1)
+    good = LinkView(links={0: True})
+    for scan in (1, 2):
+        r, snap = readings(mem, scan, good)
+        view.refresh(snap, r)
+    by_name = models(view)
+    assert all(not m.stale for m, _ in by_name.values())
+    live = view.grab().toImage()
+
+    mem.set_word(0o4010, 0)  # a value that arrives while the quality is not good is not shown
+    r, snap = readings(mem, 3, links)
+    view.refresh(snap, r)
+    for name in FED:
+        model, widget = by_name[name]
+        assert model.quality == word, name
+        tip = widget.stale_mark.toolTip() if hasattr(widget, "stale_mark") else widget.toolTip()
+        assert tip.startswith(f"? {word}"), (name, tip)
+    assert by_name["digital"][0].text == "50.0"  # the last good value, marked
+    assert math.isnan(by_name["trend"][0].trend.last) and math.isnan(by_name["bits"][0].trend.last)
+    local, _ = by_name["local"]
+    assert local.quality == ("not running" if word == "not running" else "")  # nothing fills it
+    assert differs(live, view.grab().toImage()) > 1000  # greyed and hatched
+
+
+def test_a_forced_value_is_shown_as_it_is_and_marked(view: FormView) -> None:
+    mem = Memory()
+    mem.set_word(0o4100, 4095)
+    r, snap = readings(mem, 1, LinkView(links={0: True}, forced=[0o4100]))
+    view.refresh(snap, r)
+    local, widget = models(view)["local"]
+    assert local.quality == Quality.FORCED.word and local.text == "100.0"
+    assert widget.toolTip().startswith("? forced")
