@@ -15,14 +15,16 @@ comm-fail, so a start raises no quality alarm for a node that simply has not ans
 
 from __future__ import annotations
 
-from collections.abc import Callable
+from collections.abc import Callable, Iterable
 from pathlib import Path
 from typing import Any
 
 import numpy as np
 
+from netplc.address import IO_BITS
 from netplc.engine import Engine, RunState
 from netplc.exchange import Exchange
+from netplc.forcing import Force
 from netplc.memory import Snapshot
 from netplc.program import Program
 from netplc.records import Record, RecordSink
@@ -84,7 +86,8 @@ class StationAlarms:
         links = LinkView(running=running,
                          links={n: ex.link_up(n) for n in ex.configs} if ex is not None else {},
                          refreshed=dict(ex.refreshed) if ex is not None else {},
-                         since=dict(self._since) if ex is not None else None)
+                         since=dict(self._since) if ex is not None else None,
+                         forced=forced_operands(snapshot.forces))
         self.quality = self.quality_map.evaluate(snapshot, links)
         self.readings = Readings(snapshot, self.quality_map, links, self.quality)
         messages, self._messages = self._messages, []
@@ -145,3 +148,17 @@ class StationAlarms:
     def close(self) -> None:
         """After the scan thread has stopped: write the last states."""
         self.state.close()
+
+
+
+def forced_operands(forces: Iterable[Force]) -> list[int]:
+    """The I/O bits and data bytes the forces cover, as quality reads them (LinkView.forced)."""
+    out: list[int] = []
+    for f in forces:
+        if f.kind == "bit":
+            out.append(f.addr if f.addr < IO_BITS else f.addr // 8)  # HMI bit: byte*8 + bit
+        else:
+            size = 1 if f.kind == "byte" else 2
+            out += (range(f.addr, f.addr + 8 * size) if f.addr < IO_BITS
+                    else range(f.addr, f.addr + size))  # below 04000: the bits starting at the address
+    return out

@@ -25,8 +25,9 @@ An NREAD's or NWRITE's link output (C+1) is the program's copy of its node's lin
 NetPlc is stopped. Readers show the link itself there (`link_outputs`, `Readings.live`): a
 "связь есть" label follows the link, not the last value the program wrote.
 
-Forcing (netplc/forcing.py, to come) reaches quality through one hook: `LinkView.forced`, the
-forced operand addresses of the scan; the runtime fills it from the engine's forces.
+Forcing (netplc/forcing.py) reaches quality through one hook: `LinkView.forced`, the forced
+operand addresses of the scan, which the runtime fills from the snapshot's forces
+(app/station_alarms.py, `forced_operands`).
 """
 
 from __future__ import annotations

@@ -134,3 +134,29 @@ def test_nmsg_alarm_messages_reach_the_alarms_through_the_record_observer(tmp_pa
         assert alarms.system.get("MSG3").state is State.NORMAL
     finally:
         alarms.close()
+
+
+def test_a_forced_tag_has_the_forced_quality_and_unforced_its_own_again(tmp_path: Path) -> None:
+    (tmp_path / "tags.csv").write_text(TAGS + "SP,04020,word,,,,,,0,Уставка,\nRUN,040042,bit,,,,,,,Пуск,\n",
+                                       encoding="utf-8")
+    program = parse("JMP 0\n")
+    clock = FakeClock(100.0)
+    engine = Engine(program, clock=clock, wallclock=clock, sink=ListSink())
+    alarms = StationAlarms(tmp_path / "tags.csv", program, [], ListSink(), tmp_path / "alarms.sqlite",
+                           {"LEVEL_SYM": 0o4010})
+    alarms.attach(engine, None)
+    names = [t.name for t in alarms.table.tags]
+    try:
+        engine.scan()
+        assert {alarms.readings.quality(n) for n in ("SP", "RUN")} == {Quality.GOOD}
+        engine.forces.force("word", 0o4021, 7, user="engineer")  # covers the high byte of SP only
+        engine.forces.force("bit", 0o40042, 1, user="engineer")  # an HMI bit: byte 04004 bit 2
+        engine.scan()
+        assert alarms.quality[names.index("SP")] == Quality.FORCED
+        assert alarms.quality[names.index("RUN")] == Quality.FORCED
+        assert alarms.quality[names.index("LEVEL")] == Quality.GOOD
+        engine.forces.unforce_all(user="engineer")
+        engine.scan()
+        assert {alarms.readings.quality(n) for n in ("SP", "RUN")} == {Quality.GOOD}
+    finally:
+        alarms.close()
