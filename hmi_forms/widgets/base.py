@@ -16,7 +16,7 @@ from collections.abc import Hashable
 from pathlib import Path
 
 from PySide6.QtCore import QPointF, QRect, QRectF, Qt
-from PySide6.QtGui import QBrush, QColor, QPainter, QPaintEvent, QPen, QPixmap, QResizeEvent
+from PySide6.QtGui import QBrush, QColor, QMoveEvent, QPainter, QPaintEvent, QPen, QPixmap, QResizeEvent
 from PySide6.QtWidgets import QWidget
 
 from hmi_forms.elements import Element
@@ -115,6 +115,8 @@ class ElementWidget(QWidget):
         if model.Cursor in CURSORS:
             self.setCursor(CURSORS[model.Cursor])
         self._layers: dict[Hashable, QPixmap] = {}
+        self._look = self.look()
+        self._rect: QRect | None = None  # the geometry, kept: sync asks for it every tick
         self._stale = False
         self._tip = ""
 
@@ -128,14 +130,34 @@ class ElementWidget(QWidget):
 
     def sync(self) -> None:
         """The model changed: have the form repaint this element's rectangle."""
-        parent = self.parentWidget()
-        if parent is not None:
-            parent.update(self.geometry())
+        self.repaint_part(None)
         if self.model.stale != self._stale:
             self._stale = self.model.stale
             if self._stale:
                 self._tip = self.toolTip()
             self.setToolTip(STALE_TIP if self._stale else self._tip)
+
+    def repaint_part(self, part: QRect | None) -> None:
+        """Have the form repaint `part` of this element (in its own coordinates), or all of it."""
+        parent = self.parentWidget()
+        if parent is None:
+            return
+        rect = self._rect
+        if rect is None:
+            rect = self._rect = self.geometry()
+        parent.update(rect if part is None else part.translated(rect.topLeft()).intersected(rect))
+
+    def look(self) -> tuple[object, ...]:
+        """The properties the cached pictures are drawn with besides the state: when one changes (a
+        form designer sets a colour), `draw` rebuilds them."""
+        m = self.model
+        return (m.BackColor, m.ForeColor, m.BorderStyle, m.Font, m.BackgroundImage, m.ImageAlign,
+                m.TextAlign, m.Name)
+
+    def restyle(self) -> None:
+        """Forget the cached pictures: the look changed."""
+        self._layers.clear()
+        self._look = self.look()
 
     def flush(self) -> None:
         """Bring throttled parts (plots, queries) up to date; plain painted widgets have none."""
@@ -146,6 +168,8 @@ class ElementWidget(QWidget):
 
     def draw(self, p: QPainter, r: QRectF) -> None:
         """Draw the element into `r`, its own rectangle, with its top-left corner at the origin."""
+        if self.look() != self._look:
+            self.restyle()
         p.drawPixmap(0, 0, self.layer())
         self.paint_dynamic(p, r)
         if self.model.stale:
@@ -193,7 +217,12 @@ class ElementWidget(QWidget):
 
     def resizeEvent(self, event: QResizeEvent) -> None:
         self._layers.clear()
+        self._rect = None
         super().resizeEvent(event)
+
+    def moveEvent(self, event: QMoveEvent) -> None:
+        self._rect = None
+        super().moveEvent(event)
 
     def paint_border(self, p: QPainter, r: QRectF) -> None:
         style = self.model.BorderStyle
@@ -229,6 +258,8 @@ class SelfPainted(ElementWidget):
     def paintEvent(self, event: QPaintEvent) -> None:
         p = QPainter(self)
         try:  # a painter left active after an error would crash Qt
+            if self.look() != self._look:
+                self.restyle()
             p.drawPixmap(0, 0, self.layer())
             p.setRenderHint(QPainter.RenderHint.Antialiasing)
             self.paint_dynamic(p, QRectF(self.rect()))

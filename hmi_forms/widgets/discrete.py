@@ -17,6 +17,8 @@ from hmi_forms.elements.discrete import DiscreteBase, DiscreteColorLabel
 from hmi_forms.widgets import theme
 from hmi_forms.widgets.base import ElementWidget, Images, draw_pixmap
 
+STATE_COLORS = ("BackColorFalse", "BackColorTrue", "ForeColorFalse", "ForeColorTrue")
+
 
 class DiscreteWidget(ElementWidget):
     model: DiscreteBase
@@ -39,6 +41,11 @@ class DiscreteWidget(ElementWidget):
         if isinstance(self.model, DiscreteColorLabel):
             return theme.qcolor(self.model.fore_color, theme.TEXT)
         return super().fore_color()
+
+    def look(self) -> tuple[object, ...]:
+        m = self.model
+        return (*super().look(), m.TextFalse, m.TextTrue, m.ImageFalse, m.ImageTrue, m.Enabled,
+                *(getattr(m, name, None) for name in STATE_COLORS))
 
     def layer_key(self) -> Hashable:
         m = self.model

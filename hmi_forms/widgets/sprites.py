@@ -1,0 +1,101 @@
+"""Pixmaps of what a form draws again and again: value texts and dial needles, rendered once.
+
+A readout shows a few hundred distinct texts over a shift and a needle a few hundred positions,
+and dials and readouts of one size share them all; laying out a text or rasterising an
+antialiased polygon costs several times a pixmap copy. So a tick draws each changing value as one
+pixmap copy from a cache shared by the whole process, keyed by everything that decides its
+pixels, least recently used first out, bounded in bytes.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Hashable
+
+from PySide6.QtCore import QPoint, QRect, QRectF, QSize, Qt
+from PySide6.QtGui import QColor, QFont, QPainter, QPixmap
+
+BUDGET = 64 * 2**20  # bytes of cached pixmaps in all
+
+
+Sprite = tuple[QPoint, QPixmap]  # a pixmap and where its top-left corner goes
+
+
+class SpriteCache:
+    """Sprites by key. Once `budget` bytes are held it starts afresh: a hit must cost one dict
+    lookup (it happens thousands of times a tick), and what is on screen is back within a tick."""
+
+    def __init__(self, budget: int = BUDGET) -> None:
+        self.budget = budget
+        self.bytes = 0
+        self.items: dict[Hashable, Sprite] = {}
+
+    def __len__(self) -> int:
+        return len(self.items)
+
+    def put(self, key: Hashable, sprite: Sprite) -> Sprite:
+        pix = sprite[1]
+        size = pix.width() * pix.height() * 4
+        if self.bytes + size > self.budget:
+            self.clear()
+        self.items[key] = sprite
+        self.bytes += size
+        return sprite
+
+    def clear(self) -> None:
+        self.items.clear()
+        self.bytes = 0
+
+
+SPRITES = SpriteCache()
+
+
+def blank(size: QSize, dpr: float, fill: QColor | None) -> QPixmap:
+    """A pixmap of `size` logical pixels, filled (opaque: copied without blending) or transparent."""
+    pix = QPixmap(size * dpr)
+    pix.setDevicePixelRatio(dpr)
+    pix.fill(fill if fill is not None else Qt.GlobalColor.transparent)
+    return pix
+
+
+class TextSlot:
+    """A text box drawn from cached pixmaps, pixel for pixel what `drawText(box, align, text)` gives.
+
+    The pixmaps cover `area` (by default the box with a margin for glyphs that overhang it): opaque
+    when drawn with `back`, the flat colour of that area, transparent without."""
+
+    def __init__(self, box: QRectF, font: QFont, align: Qt.AlignmentFlag, dpr: float = 1.0,
+                 area: QRectF | None = None) -> None:
+        area = box.adjusted(-3, -3, 3, 3) if area is None else area
+        left, top = math.ceil(area.left()), math.ceil(area.top())
+        self.at = QPoint(left, top)
+        self.size = QSize(max(1, math.floor(area.right()) - left), max(1, math.floor(area.bottom()) - top))
+        self.box = box.translated(-left, -top)  # where the text goes inside the pixmap
+        self.font = font
+        self.align = align
+        self.dpr = dpr
+        self.key = (self.box.getRect(), self.size.toTuple(), font.key(), int(align.value), dpr)
+
+    @property
+    def rect(self) -> QRect:
+        """What a new text repaints, in the element's coordinates."""
+        return QRect(self.at, self.size)
+
+    def draw(self, p: QPainter, text: str, fore: QColor, back: QColor | None = None) -> None:
+        key = (self.key, text, fore.rgba(), None if back is None else back.rgba())
+        sprite = SPRITES.items.get(key)
+        if sprite is None:
+            sprite = SPRITES.put(key, (self.at, self._render(text, fore, back)))
+        p.drawPixmap(*sprite)
+
+    def _render(self, text: str, fore: QColor, back: QColor | None) -> QPixmap:
+        pix = blank(self.size, self.dpr, back)
+        p = QPainter(pix)
+        try:  # a painter left open on a pixmap crashes Qt when the pixmap goes
+            p.setRenderHint(QPainter.RenderHint.Antialiasing)
+            p.setFont(self.font)
+            p.setPen(fore)
+            p.drawText(self.box, self.align, text)
+        finally:
+            p.end()
+        return pix
