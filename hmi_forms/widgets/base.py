@@ -15,7 +15,7 @@ from __future__ import annotations
 from collections.abc import Hashable
 from pathlib import Path
 
-from PySide6.QtCore import QPointF, QRect, QRectF, Qt
+from PySide6.QtCore import QEvent, QPointF, QRect, QRectF, Qt
 from PySide6.QtGui import QBrush, QColor, QMoveEvent, QPainter, QPaintEvent, QPen, QPixmap, QResizeEvent
 from PySide6.QtWidgets import QWidget
 
@@ -23,6 +23,8 @@ from hmi_forms.elements import Element
 from hmi_forms.widgets import theme
 
 MAX_LAYERS = 6  # cached layers per widget: enough for every state of a discrete element
+MAX_SHARED = 4096  # layers kept for widgets that look alike (by type, look, state and size)
+SHARED_LAYERS: dict[Hashable, QPixmap] = {}
 CURSORS = {"Hand": Qt.CursorShape.PointingHandCursor, "Cross": Qt.CursorShape.CrossCursor,
            "IBeam": Qt.CursorShape.IBeamCursor, "No": Qt.CursorShape.ForbiddenCursor}
 
@@ -100,8 +102,9 @@ class ElementWidget(QWidget):
     """An element on a form: its geometry, input and tooltip, and the code that draws it.
 
     Elements drawn only with QPainter are painted by the form itself, in one pass with one painter
-    (`draw`), and their widget stays an invisible proxy for the mouse, cursor and tooltip: a
-    QPainter per widget per tick costs more than drawing a whole gauge. Elements made of child
+    (`draw`), and their widget stays an invisible proxy for the mouse, cursor and tooltip, with
+    its own updates off: a QPainter, or only a paint event, per widget per tick costs more than
+    drawing a whole gauge. Elements made of child
     widgets (`SelfPainted`) paint themselves and carry a StaleMark child instead.
     """
 
@@ -112,11 +115,16 @@ class ElementWidget(QWidget):
         self.model = model
         self.images = images
         self.setGeometry(model.x, model.y, model.w, model.h)
+        # drawn by the form (`draw`): Qt is spared a paint event of this widget's own, which costs
+        # more than drawing the element (SelfPainted widgets turn it back on)
+        self.setUpdatesEnabled(False)
         if model.Cursor in CURSORS:
             self.setCursor(CURSORS[model.Cursor])
         self._layers: dict[Hashable, QPixmap] = {}
+        self._style = self.style()
         self._look = self.look()
-        self._rect: QRect | None = None  # the geometry, kept: sync asks for it every tick
+        # the form and the rectangle on it, kept: asking Qt for them costs more than the repaint
+        self._where: tuple[QWidget | None, QRect] | None = None
         self._stale = False
         self._tip = ""
 
@@ -130,7 +138,9 @@ class ElementWidget(QWidget):
 
     def sync(self) -> None:
         """The model changed: have the form repaint this element's rectangle."""
-        self.repaint_part(None)
+        parent, rect = self._where or self._locate()
+        if parent is not None:
+            parent.update(rect)
         if self.model.stale != self._stale:
             self._stale = self.model.stale
             if self._stale:
@@ -139,24 +149,31 @@ class ElementWidget(QWidget):
 
     def repaint_part(self, part: QRect | None) -> None:
         """Have the form repaint `part` of this element (in its own coordinates), or all of it."""
-        parent = self.parentWidget()
-        if parent is None:
-            return
-        rect = self._rect
-        if rect is None:
-            rect = self._rect = self.geometry()
-        parent.update(rect if part is None else part.translated(rect.topLeft()).intersected(rect))
+        parent, rect = self._where or self._locate()
+        if parent is not None:
+            parent.update(rect if part is None else part.translated(rect.topLeft()).intersected(rect))
+
+    def _locate(self) -> tuple[QWidget | None, QRect]:
+        where = self._where = (self.parentWidget(), self.geometry())
+        return where
+
+    def style(self) -> tuple[object, ...]:
+        """The colours, frame, font and name: checked at every draw, so that a change (a form
+        designer sets a colour) rebuilds the cached pictures by itself. Other properties the
+        pictures are drawn from are in `look`: after changing one, call `restyle`."""
+        m = self.model
+        return m.BackColor, m.ForeColor, m.BorderStyle, m.Font, m.Name
 
     def look(self) -> tuple[object, ...]:
-        """The properties the cached pictures are drawn with besides the state: when one changes (a
-        form designer sets a colour), `draw` rebuilds them."""
+        """Everything the cached layer is drawn from besides the state and the size: widgets
+        with equal looks share their layers."""
         m = self.model
-        return (m.BackColor, m.ForeColor, m.BorderStyle, m.Font, m.BackgroundImage, m.ImageAlign,
-                m.TextAlign, m.Name)
+        return (*self.style(), m.BackgroundImage, m.ImageAlign, m.TextAlign)
 
     def restyle(self) -> None:
         """Forget the cached pictures: the look changed."""
         self._layers.clear()
+        self._style = self.style()
         self._look = self.look()
 
     def flush(self) -> None:
@@ -168,7 +185,7 @@ class ElementWidget(QWidget):
 
     def draw(self, p: QPainter, r: QRectF) -> None:
         """Draw the element into `r`, its own rectangle, with its top-left corner at the origin."""
-        if self.look() != self._look:
+        if self.style() != self._style:
             self.restyle()
         p.drawPixmap(0, 0, self.layer())
         self.paint_dynamic(p, r)
@@ -179,7 +196,15 @@ class ElementWidget(QWidget):
         key = self.layer_key()
         layer = self._layers.get(key)
         if layer is None:
-            layer = self._layers[key] = self._render_layer()
+            # elements that look alike share their layers: fewer pixmaps to render, and a copy
+            # of a pixmap still in the processor's cache is several times faster
+            shared = (type(self), self._look, key, self.size().toTuple(), self.devicePixelRatioF())
+            layer = SHARED_LAYERS.get(shared)
+            if layer is None:
+                if len(SHARED_LAYERS) >= MAX_SHARED:
+                    SHARED_LAYERS.clear()  # the widgets keep those they use
+                layer = SHARED_LAYERS[shared] = self._render_layer()
+            self._layers[key] = layer
             if len(self._layers) > MAX_LAYERS:
                 del self._layers[next(iter(self._layers))]
         return layer
@@ -217,12 +242,17 @@ class ElementWidget(QWidget):
 
     def resizeEvent(self, event: QResizeEvent) -> None:
         self._layers.clear()
-        self._rect = None
+        self._where = None
         super().resizeEvent(event)
 
     def moveEvent(self, event: QMoveEvent) -> None:
-        self._rect = None
+        self._where = None
         super().moveEvent(event)
+
+    def changeEvent(self, event: QEvent) -> None:
+        if event.type() == QEvent.Type.ParentChange:
+            self._where = None
+        super().changeEvent(event)
 
     def paint_border(self, p: QPainter, r: QRectF) -> None:
         style = self.model.BorderStyle
@@ -239,6 +269,7 @@ class SelfPainted(ElementWidget):
 
     def __init__(self, model: Element, images: Images, parent: QWidget | None = None) -> None:
         super().__init__(model, images, parent)
+        self.setUpdatesEnabled(True)
         self.stale_mark = StaleMark(self)
         self.stale_mark.setGeometry(self.rect())
         back = self.back_color()
@@ -258,7 +289,7 @@ class SelfPainted(ElementWidget):
     def paintEvent(self, event: QPaintEvent) -> None:
         p = QPainter(self)
         try:  # a painter left active after an error would crash Qt
-            if self.look() != self._look:
+            if self.style() != self._style:
                 self.restyle()
             p.drawPixmap(0, 0, self.layer())
             p.setRenderHint(QPainter.RenderHint.Antialiasing)

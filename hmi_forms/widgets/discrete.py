@@ -17,8 +17,6 @@ from hmi_forms.elements.discrete import DiscreteBase, DiscreteColorLabel
 from hmi_forms.widgets import theme
 from hmi_forms.widgets.base import ElementWidget, Images, draw_pixmap
 
-STATE_COLORS = ("BackColorFalse", "BackColorTrue", "ForeColorFalse", "ForeColorTrue")
-
 
 class DiscreteWidget(ElementWidget):
     model: DiscreteBase
@@ -42,10 +40,15 @@ class DiscreteWidget(ElementWidget):
             return theme.qcolor(self.model.fore_color, theme.TEXT)
         return super().fore_color()
 
+    def style(self) -> tuple[object, ...]:
+        m = self.model
+        if isinstance(m, DiscreteColorLabel):
+            return (*super().style(), m.BackColorFalse, m.BackColorTrue, m.ForeColorFalse, m.ForeColorTrue)
+        return super().style()
+
     def look(self) -> tuple[object, ...]:
         m = self.model
-        return (*super().look(), m.TextFalse, m.TextTrue, m.ImageFalse, m.ImageTrue, m.Enabled,
-                *(getattr(m, name, None) for name in STATE_COLORS))
+        return (*super().look(), m.TextFalse, m.TextTrue, m.ImageFalse, m.ImageTrue, m.Enabled)
 
     def layer_key(self) -> Hashable:
         m = self.model

@@ -30,7 +30,7 @@ from PySide6.QtWidgets import QWidget
 from hmi_forms.elements.analog import AnalogBase
 from hmi_forms.widgets import theme
 from hmi_forms.widgets.base import ElementWidget, Images
-from hmi_forms.widgets.sprites import SPRITES, Sprite, TextSlot, blank
+from hmi_forms.widgets.sprites import SPRITES, Ink, Sprite, TextSlot, blank
 
 
 def nice_step(span: float, max_ticks: int) -> float:
@@ -58,9 +58,14 @@ def scale_ticks(lo: float, hi: float, max_major: int) -> tuple[list[float], list
 
 SMALL_DIAL = 45.0  # radius in px below which a dial drops its labels and enlarges the readout
 SPRITE_DIAL = 64.0  # radius in px up to which needles are cached pixmaps (larger: drawn each time)
+PART_AREA = 150 * 150  # px²: from this size on, a change of text alone repaints only its box
 HUB = QColor("#33393f")
-DARKER = {zone: color.darker(115) for zone, color in theme.ZONE_COLORS.items()}  # bar texts by zone
 WHITE = QColor("#ffffff")
+# the value's colours by zone: in a readout box (dials, digital) and over the element (bars)
+BOXED = {None: Ink(theme.TEXT, WHITE), "normal": Ink(theme.TEXT, WHITE), "low": Ink(theme.TEXT, theme.WARN),
+         "high": Ink(WHITE, theme.ALARM)}
+BARE = {None: Ink(theme.TEXT), "normal": Ink(theme.TEXT), "low": Ink(theme.WARN.darker(115)),
+        "high": Ink(theme.ALARM.darker(115))}
 
 
 class GaugeWidget(ElementWidget):
@@ -81,7 +86,8 @@ class GaugeWidget(ElementWidget):
         self._units = f" {model.Units}" if model.Units else ""
         self._fill = QRect()  # the bar's fill at zero length
         self._value: TextSlot | None = None  # where the value text goes, drawn from cached pixmaps
-        self._sprite_key: tuple[object, ...] | None = None  # the needle's pixmaps (None: drawn each time)
+        self._part: QRect | None = None  # what a new text alone repaints (None: the whole element)
+        self._needles: dict[Hashable, Sprite] | None = None  # the needle by position (None: drawn each time)
         self._shown: tuple[object, ...] | None = None
         self.setToolTip(f"{model.Name}: word {oct(model.InAddr or 0)[2:].rjust(5, '0')}, "
                         f"{model.format(lo)} … {model.format(hi)}{self._units}"
@@ -128,7 +134,13 @@ class GaugeWidget(ElementWidget):
                 self._value = TextSlot(box, theme.sized_font(size, bold=True, family=theme.MONO),
                                        Qt.AlignmentFlag.AlignCenter, dpr, box.adjusted(2, 2, -2, -2))
                 key = (c.toTuple(), r, start, sweep, self._travel, dpr)
-                self._sprite_key = key if r <= SPRITE_DIAL else None
+                self._needles = SPRITES.family(key) if r <= SPRITE_DIAL else None
+            # a new text alone repaints its box, in a large gauge: in a small one the pixels
+            # saved are fewer than what cutting the form's repainted region into more
+            # rectangles costs Qt
+            part = self._value.rect
+            area = self.width() * self.height()
+            self._part = part if area >= PART_AREA and part.width() * part.height() * 4 < area else None
 
     def resizeEvent(self, event: QResizeEvent) -> None:
         self._laid_out = False
@@ -164,8 +176,8 @@ class GaugeWidget(ElementWidget):
         if shown == old:
             return
         self._shown = shown
-        if old is not None and old[1:] == shown[1:] and self._value is not None:
-            self.repaint_part(self._value.rect)  # only the text changed: its box is all that changes
+        if self._part is not None and old is not None and old[1:] == shown[1:]:
+            self.repaint_part(self._part)  # only the text changed: its box is all that changes
             return
         super().sync()
 
@@ -356,18 +368,18 @@ class GaugeWidget(ElementWidget):
             p.setBrush(theme.ALARM)
             p.drawPolygon(QPolygonF([tip, left, right]))
         assert self._value is not None
-        high = m.zone == "high"
-        self._value.draw(p, m.text or "---", WHITE if high else theme.TEXT, self._box_color())
+        self._value.draw(p, m.text or "---", BOXED[m.zone])
         if m.hw is None:
             return
-        if self._sprite_key is None:
+        if self._needles is None:
             self._draw_needle(p, c, r, start + sweep * m.fraction)
             return
         # the needle to the nearest pixel its tip travels, as `shown` tells a move
-        key = (self._sprite_key, round(m.fraction * self._travel))
-        sprite = SPRITES.items.get(key)
+        pointer = round(m.fraction * self._travel)
+        sprite = self._needles.get(pointer)
         if sprite is None:
-            sprite = SPRITES.put(key, self._render_needle(c, r, start + sweep * key[1] / self._travel))
+            sprite = SPRITES.put(self._needles, pointer,
+                                 self._render_needle(c, r, start + sweep * pointer / self._travel))
         p.drawPixmap(*sprite)
 
     def _render_needle(self, c: QPointF, r: float, angle: float) -> Sprite:
@@ -398,10 +410,6 @@ class GaugeWidget(ElementWidget):
         hub = r * 0.07
         p.drawEllipse(c, hub, hub)
 
-    def _box_color(self) -> QColor:
-        zone_color = theme.ZONE_COLORS.get(self.model.zone or "")
-        return zone_color if zone_color is not None else WHITE
-
     def _paint_bar_value(self, p: QPainter) -> None:
         m = self.model
         track = self._bar_geometry()
@@ -415,7 +423,7 @@ class GaugeWidget(ElementWidget):
             p.setPen(QPen(theme.ALARM, 2))
             p.drawLine(QPointF(x, track.top() - 3), QPointF(x, track.bottom()))
         assert self._value is not None
-        self._value.draw(p, (m.text or "---") + self._units, DARKER.get(m.zone or "", theme.TEXT))
+        self._value.draw(p, (m.text or "---") + self._units, BARE[m.zone])
 
     @staticmethod
     def _bar_font(name_height: float) -> QFont:
@@ -458,10 +466,11 @@ class GaugeWidget(ElementWidget):
     def _paint_digital_value(self, p: QPainter) -> None:
         m = self.model
         box, size, _ = self._digital_geometry()
-        fg = WHITE if m.zone == "high" else theme.TEXT
         assert self._value is not None
-        self._value.draw(p, m.text or "---", fg, self._box_color())
+        ink = BOXED[m.zone]
+        self._value.draw(p, m.text or "---", ink)
         if m.maximum is not None and box.height() > 30:
+            fg = ink.fore
             p.setFont(theme.sized_font(max(8.0, size * 0.38)))
             p.setPen(fg if m.zone else theme.ALARM)
             p.drawText(box.adjusted(6, 2, 0, 0), Qt.AlignmentFlag.AlignLeft | Qt.AlignmentFlag.AlignTop,

@@ -22,28 +22,33 @@ Sprite = tuple[QPoint, QPixmap]  # a pixmap and where its top-left corner goes
 
 
 class SpriteCache:
-    """Sprites by key. Once `budget` bytes are held it starts afresh: a hit must cost one dict
-    lookup (it happens thousands of times a tick), and what is on screen is back within a tick."""
+    """Sprites in families (the pictures of one kind of text box or needle, by text or position),
+    so that a hit costs one lookup of a short key in the family a widget holds. Once `budget`
+    bytes are held it starts afresh: what is on screen is back within a tick."""
 
     def __init__(self, budget: int = BUDGET) -> None:
         self.budget = budget
         self.bytes = 0
-        self.items: dict[Hashable, Sprite] = {}
+        self.families: dict[Hashable, dict[Hashable, Sprite]] = {}
 
     def __len__(self) -> int:
-        return len(self.items)
+        return sum(len(family) for family in self.families.values())
 
-    def put(self, key: Hashable, sprite: Sprite) -> Sprite:
+    def family(self, key: Hashable) -> dict[Hashable, Sprite]:
+        return self.families.setdefault(key, {})
+
+    def put(self, family: dict[Hashable, Sprite], key: Hashable, sprite: Sprite) -> Sprite:
         pix = sprite[1]
         size = pix.width() * pix.height() * 4
         if self.bytes + size > self.budget:
             self.clear()
-        self.items[key] = sprite
+        family[key] = sprite
         self.bytes += size
         return sprite
 
     def clear(self) -> None:
-        self.items.clear()
+        for family in self.families.values():  # emptied in place: widgets hold them
+            family.clear()
         self.bytes = 0
 
 
@@ -56,6 +61,16 @@ def blank(size: QSize, dpr: float, fill: QColor | None) -> QPixmap:
     pix.setDevicePixelRatio(dpr)
     pix.fill(fill if fill is not None else Qt.GlobalColor.transparent)
     return pix
+
+
+class Ink:
+    """A text colour and the flat colour under it (None: whatever is there), with their key."""
+
+    __slots__ = ("back", "fore", "key")
+
+    def __init__(self, fore: QColor, back: QColor | None = None) -> None:
+        self.fore, self.back = fore, back
+        self.key = fore.rgba() << 33 | (0 if back is None else 1 << 32 | back.rgba())  # one int: fast to hash
 
 
 class TextSlot:
@@ -74,18 +89,20 @@ class TextSlot:
         self.font = font
         self.align = align
         self.dpr = dpr
-        self.key = (self.box.getRect(), self.size.toTuple(), font.key(), int(align.value), dpr)
+        # the texts of every box like this one, by text and colours
+        family = (self.box.getRect(), self.size.toTuple(), font.key(), int(align.value), dpr)
+        self.sprites = SPRITES.family(family)
 
     @property
     def rect(self) -> QRect:
         """What a new text repaints, in the element's coordinates."""
         return QRect(self.at, self.size)
 
-    def draw(self, p: QPainter, text: str, fore: QColor, back: QColor | None = None) -> None:
-        key = (self.key, text, fore.rgba(), None if back is None else back.rgba())
-        sprite = SPRITES.items.get(key)
+    def draw(self, p: QPainter, text: str, ink: Ink) -> None:
+        key = (text, ink.key)
+        sprite = self.sprites.get(key)
         if sprite is None:
-            sprite = SPRITES.put(key, (self.at, self._render(text, fore, back)))
+            sprite = SPRITES.put(self.sprites, key, (self.at, self._render(text, ink.fore, ink.back)))
         p.drawPixmap(*sprite)
 
     def _render(self, text: str, fore: QColor, back: QColor | None) -> QPixmap:
