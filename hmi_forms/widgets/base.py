@@ -158,11 +158,11 @@ class ElementWidget(QWidget):
         return where
 
     def style(self) -> tuple[object, ...]:
-        """The colours, frame, font and name: checked at every draw, so that a change (a form
+        """The colours, frame and font: checked at every draw, so that a change (a form
         designer sets a colour) rebuilds the cached pictures by itself. Other properties the
         pictures are drawn from are in `look`: after changing one, call `restyle`."""
         m = self.model
-        return m.BackColor, m.ForeColor, m.BorderStyle, m.Font, m.Name
+        return m.BackColor, m.ForeColor, m.BorderStyle, m.Font
 
     def look(self) -> tuple[object, ...]:
         """Everything the cached layer is drawn from besides the state and the size: widgets

@@ -146,6 +146,9 @@ class GaugeWidget(ElementWidget):
         self._laid_out = False
         super().resizeEvent(event)
 
+    def style(self) -> tuple[object, ...]:
+        return (*super().style(), self.model.Name)  # drawn in the layer
+
     def look(self) -> tuple[object, ...]:
         m = self.model
         return (*super().look(), m.Appearance, m.Units, m.scaling, m.Precision, m.PhyLow, m.PhyHigh)

@@ -85,12 +85,13 @@ class TextSlot:
         left, top = math.ceil(area.left()), math.ceil(area.top())
         self.at = QPoint(left, top)
         self.size = QSize(max(1, math.floor(area.right()) - left), max(1, math.floor(area.bottom()) - top))
-        self.box = box.translated(-left, -top)  # where the text goes inside the pixmap
+        self.box = box
         self.font = font
         self.align = align
         self.dpr = dpr
         # the texts of every box like this one, by text and colours
-        family = (self.box.getRect(), self.size.toTuple(), font.key(), int(align.value), dpr)
+        inside = box.translated(-left, -top).getRect()
+        family = (inside, self.size.toTuple(), font.key(), int(align.value), dpr)
         self.sprites = SPRITES.family(family)
 
     @property
@@ -110,6 +111,9 @@ class TextSlot:
         p = QPainter(pix)
         try:  # a painter left open on a pixmap crashes Qt when the pixmap goes
             p.setRenderHint(QPainter.RenderHint.Antialiasing)
+            # moved by whole pixels, the text is laid out where it would be drawn: the same
+            # rounding, the same pixels
+            p.translate(-self.at.x(), -self.at.y())
             p.setFont(self.font)
             p.setPen(fore)
             p.drawText(self.box, self.align, text)

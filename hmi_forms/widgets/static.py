@@ -73,7 +73,7 @@ class SyncWidget(ElementWidget):
 
     def look(self) -> tuple[object, ...]:
         m = self.model
-        return (*super().look(), m.Period0, m.Phase0, m.Period1, m.Phase1, type(m))
+        return (*super().look(), m.Name, m.Period0, m.Phase0, m.Period1, m.Phase1, type(m))
 
     def layer_key(self) -> Hashable:
         return self.model.pair, self.model.output, self.model.enabled
