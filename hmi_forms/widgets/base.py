@@ -13,15 +13,18 @@ drawn identically for all element types: an operator learns it once.
 from __future__ import annotations
 
 from collections.abc import Hashable
+from operator import attrgetter
 from pathlib import Path
 
-from PySide6.QtCore import QEvent, QPointF, QRect, QRectF, Qt
+from PySide6.QtCore import QEvent, QPoint, QPointF, QRect, QRectF, Qt
 from PySide6.QtGui import QBrush, QColor, QMoveEvent, QPainter, QPaintEvent, QPen, QPixmap, QResizeEvent
 from PySide6.QtWidgets import QWidget
 
 from hmi_forms.elements import Element
 from hmi_forms.widgets import theme
 
+STYLE = ("BackColor", "ForeColor", "BorderStyle", "Font")  # checked at every draw (`style`)
+ORIGIN = QPoint(0, 0)
 MAX_LAYERS = 6  # cached layers per widget: enough for every state of a discrete element
 MAX_SHARED = 4096  # layers kept for widgets that look alike (by type, look, state and size)
 SHARED_LAYERS: dict[Hashable, QPixmap] = {}
@@ -121,6 +124,7 @@ class ElementWidget(QWidget):
         if model.Cursor in CURSORS:
             self.setCursor(CURSORS[model.Cursor])
         self._layers: dict[Hashable, QPixmap] = {}
+        self._style_of = attrgetter(*self.style_props())  # one call in C at every draw
         self._style = self.style()
         self._look = self.look()
         # the form and the rectangle on it, kept: asking Qt for them costs more than the repaint
@@ -157,12 +161,15 @@ class ElementWidget(QWidget):
         where = self._where = (self.parentWidget(), self.geometry())
         return where
 
+    def style_props(self) -> tuple[str, ...]:
+        """The model's properties `style` is made of."""
+        return STYLE
+
     def style(self) -> tuple[object, ...]:
         """The colours, frame and font: checked at every draw, so that a change (a form
         designer sets a colour) rebuilds the cached pictures by itself. Other properties the
         pictures are drawn from are in `look`: after changing one, call `restyle`."""
-        m = self.model
-        return m.BackColor, m.ForeColor, m.BorderStyle, m.Font
+        return self._style_of(self.model)
 
     def look(self) -> tuple[object, ...]:
         """Everything the cached layer is drawn from besides the state and the size: widgets
@@ -185,9 +192,9 @@ class ElementWidget(QWidget):
 
     def draw(self, p: QPainter, r: QRectF) -> None:
         """Draw the element into `r`, its own rectangle, with its top-left corner at the origin."""
-        if self.style() != self._style:
+        if self._style_of(self.model) != self._style:
             self.restyle()
-        p.drawPixmap(0, 0, self.layer())
+        p.drawPixmap(ORIGIN, self.layer())
         self.paint_dynamic(p, r)
         if self.model.stale:
             paint_stale(p, r)

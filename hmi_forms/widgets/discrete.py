@@ -15,7 +15,7 @@ from PySide6.QtWidgets import QWidget
 
 from hmi_forms.elements.discrete import DiscreteBase, DiscreteColorLabel
 from hmi_forms.widgets import theme
-from hmi_forms.widgets.base import ElementWidget, Images, draw_pixmap
+from hmi_forms.widgets.base import STYLE, ElementWidget, Images, draw_pixmap
 
 
 class DiscreteWidget(ElementWidget):
@@ -40,11 +40,10 @@ class DiscreteWidget(ElementWidget):
             return theme.qcolor(self.model.fore_color, theme.TEXT)
         return super().fore_color()
 
-    def style(self) -> tuple[object, ...]:
-        m = self.model
-        if isinstance(m, DiscreteColorLabel):
-            return (*super().style(), m.BackColorFalse, m.BackColorTrue, m.ForeColorFalse, m.ForeColorTrue)
-        return super().style()
+    def style_props(self) -> tuple[str, ...]:
+        if isinstance(self.model, DiscreteColorLabel):
+            return (*STYLE, "BackColorFalse", "BackColorTrue", "ForeColorFalse", "ForeColorTrue")
+        return STYLE
 
     def look(self) -> tuple[object, ...]:
         m = self.model

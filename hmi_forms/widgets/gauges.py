@@ -10,7 +10,7 @@ the element's size, so a gauge stays legible from a 90-pixel tile to a full pane
 from __future__ import annotations
 
 import math
-from collections.abc import Hashable
+from collections.abc import Callable, Hashable
 
 from PySide6.QtCore import QPointF, QRect, QRectF, Qt
 from PySide6.QtGui import (
@@ -29,7 +29,7 @@ from PySide6.QtWidgets import QWidget
 
 from hmi_forms.elements.analog import AnalogBase
 from hmi_forms.widgets import theme
-from hmi_forms.widgets.base import ElementWidget, Images
+from hmi_forms.widgets.base import STYLE, ElementWidget, Images
 from hmi_forms.widgets.sprites import SPRITES, Ink, Sprite, TextSlot, blank
 
 
@@ -85,8 +85,10 @@ class GaugeWidget(ElementWidget):
         self._travel = 0.0  # pixels the pointer (needle tip, bar end) travels over the whole scale
         self._units = f" {model.Units}" if model.Units else ""
         self._fill = QRect()  # the bar's fill at zero length
+        self._track = QRectF()  # the bar's track
         self._value: TextSlot | None = None  # where the value text goes, drawn from cached pixmaps
         self._part: QRect | None = None  # what a new text alone repaints (None: the whole element)
+        self._paint_value: Callable[[QPainter], None] = self._paint_needle  # by Appearance
         self._needles: dict[Hashable, Sprite] | None = None  # the needle by position (None: drawn each time)
         self._shown: tuple[object, ...] | None = None
         self.setToolTip(f"{model.Name}: word {oct(model.InAddr or 0)[2:].rjust(5, '0')}, "
@@ -107,7 +109,8 @@ class GaugeWidget(ElementWidget):
             appearance = self.model.Appearance
             dpr = self.devicePixelRatioF()
             if appearance == "hbar":
-                track = self._bar_geometry()
+                self._paint_value = self._paint_bar_value
+                track = self._track = self._bar_geometry()
                 self._travel = track.width()
                 top = math.ceil(track.top() + 1)  # pixel-aligned: a fractional fill costs twice as much
                 self._fill = QRect(math.ceil(track.left() + 1), top, 0, math.floor(track.bottom()) - top)
@@ -120,12 +123,14 @@ class GaugeWidget(ElementWidget):
                 area.setLeft(max(area.left(), area.right() - widest))
                 self._value = TextSlot(box, font, theme.RIGHT, dpr, area)
             elif appearance == "digital":
+                self._paint_value = self._paint_digital_value
                 box, size, units_w = self._digital
                 text = box.adjusted(6, 0, -6 - units_w, 0)  # the units keep 8 px clear on its right
                 fill = QRectF(box.left() + 2, box.top() + 2, text.right() + 6 - box.left(), box.height() - 4)
                 font = theme.sized_font(size, bold=True, family=theme.MONO)
                 self._value = TextSlot(text, font, theme.RIGHT, dpr, fill)
             else:
+                self._paint_value = self._paint_needle
                 c, r, start, sweep = self._dial
                 self._travel = abs(math.radians(sweep)) * r  # the maximum mark's outer corner
                 self._needle = QPolygonF([QPointF(0.8 * r, 0), QPointF(0, 0.045 * r),
@@ -146,8 +151,8 @@ class GaugeWidget(ElementWidget):
         self._laid_out = False
         super().resizeEvent(event)
 
-    def style(self) -> tuple[object, ...]:
-        return (*super().style(), self.model.Name)  # drawn in the layer
+    def style_props(self) -> tuple[str, ...]:
+        return (*STYLE, "Name")  # the name is drawn in the layer
 
     def look(self) -> tuple[object, ...]:
         m = self.model
@@ -234,13 +239,8 @@ class GaugeWidget(ElementWidget):
             p.drawRoundedRect(box, 3, 3)
 
     def paint_dynamic(self, p: QPainter, r: QRectF) -> None:
-        appearance = self.model.Appearance
-        if appearance == "digital":
-            self._paint_digital_value(p)
-        elif appearance == "hbar":
-            self._paint_bar_value(p)
-        else:
-            self._paint_needle(p)
+        self._layout()
+        self._paint_value(p)
 
     def _paint_name(self, p: QPainter) -> None:
         nh = self._name_height()
@@ -363,7 +363,7 @@ class GaugeWidget(ElementWidget):
 
     def _paint_needle(self, p: QPainter) -> None:
         m = self.model
-        c, r, start, sweep = self._dial_geometry()
+        c, r, start, sweep = self._dial
         if m.maximum is not None:
             a = start + sweep * m.scaling.fraction(m.maximum)
             tip, left, right = self._at(c, r * 0.9, a), self._at(c, r, a + 4), self._at(c, r, a - 4)
@@ -415,7 +415,7 @@ class GaugeWidget(ElementWidget):
 
     def _paint_bar_value(self, p: QPainter) -> None:
         m = self.model
-        track = self._bar_geometry()
+        track = self._track
         zone_color = theme.ZONE_COLORS.get(m.zone or "")
         if m.hw is not None:
             fill = self._fill
