@@ -47,7 +47,9 @@ class DiscreteWidget(ElementWidget):
 
     def look(self) -> tuple[object, ...]:
         m = self.model
-        return (*super().look(), m.TextFalse, m.TextTrue, m.ImageFalse, m.ImageTrue, m.Enabled)
+        # image numbers index the form's own list: the files themselves tell two forms apart
+        return (*super().look(), m.TextFalse, m.TextTrue, m.ImageFalse, m.ImageTrue, m.Enabled,
+                tuple(self.images.files))
 
     def layer_key(self) -> Hashable:
         m = self.model
