@@ -107,8 +107,8 @@ class ElementWidget(QWidget):
     Elements drawn only with QPainter are painted by the form itself, in one pass with one painter
     (`draw`), and their widget stays an invisible proxy for the mouse, cursor and tooltip, with
     its own updates off: a QPainter, or only a paint event, per widget per tick costs more than
-    drawing a whole gauge. Elements made of child
-    widgets (`SelfPainted`) paint themselves and carry a StaleMark child instead.
+    drawing a whole gauge. Elements made of child widgets (`SelfPainted`) paint themselves and
+    carry a StaleMark child instead.
     """
 
     default_back: QColor | None = theme.PANEL  # None = transparent
@@ -142,9 +142,7 @@ class ElementWidget(QWidget):
 
     def sync(self) -> None:
         """The model changed: have the form repaint this element's rectangle."""
-        parent, rect = self._where or self._locate()
-        if parent is not None:
-            parent.update(rect)
+        self.repaint_part(None)
         if self.model.stale != self._stale:
             self._stale = self.model.stale
             if self._stale:

@@ -13,7 +13,7 @@ import math
 from collections.abc import Hashable
 
 from PySide6.QtCore import QPoint, QRect, QRectF, QSize, Qt
-from PySide6.QtGui import QColor, QFont, QPainter, QPixmap
+from PySide6.QtGui import QColor, QFont, QFontMetricsF, QPainter, QPixmap
 
 BUDGET = 64 * 2**20  # bytes of cached pixmaps in all
 
@@ -93,6 +93,16 @@ class TextSlot:
         inside = box.translated(-left, -top).getRect()
         family = (inside, self.size.toTuple(), font.key(), int(align.value), dpr)
         self.sprites = SPRITES.family(family)
+        # the widest text the pixmaps hold where the alignment puts it (with a pixel for overhang)
+        right = left + self.size.width()
+        if align & Qt.AlignmentFlag.AlignRight:
+            span = box.right() - left
+        elif align & Qt.AlignmentFlag.AlignHCenter:
+            span = 2 * min(box.center().x() - left, right - box.center().x())
+        else:
+            span = right - box.left()
+        self.span = span - 2
+        self.metrics = QFontMetricsF(font)
 
     @property
     def rect(self) -> QRect:
@@ -103,6 +113,11 @@ class TextSlot:
         key = (text, ink.key)
         sprite = self.sprites.get(key)
         if sprite is None:
+            if self.metrics.horizontalAdvance(text) > self.span:  # a value far out of its range
+                p.setFont(self.font)
+                p.setPen(ink.fore)
+                p.drawText(self.box, self.align, text)  # drawn whole, as before there was a cache
+                return
             sprite = SPRITES.put(self.sprites, key, (self.at, self._render(text, ink.fore, ink.back)))
         p.drawPixmap(*sprite)
 

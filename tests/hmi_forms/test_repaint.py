@@ -216,3 +216,21 @@ def test_a_3000_element_bench_form_fits_the_form_limits(tmp_path) -> None:
     assert len(form.elements) == 3000 and form.height <= 10_000 and form.width <= 10_000
     plots = load_form(bench.generate(tmp_path, 600, True))
     assert sum(e.TYPE == "Graph" for e in plots.elements) == 100
+
+
+def test_a_text_too_wide_for_its_cached_box_is_drawn_whole(qtbot, tmp_path) -> None:
+    """A word far beyond AppMax gives a value wider than the scale's: it must not be cut."""
+    doc = [{"type": "AnalogBase", "Name": "B", "x": 0, "y": 0, "w": 160, "h": 64, "InAddr": "04010",
+            "Device": "Level", "Appearance": "hbar", "Units": "%"}]
+    view = form_of(tmp_path, doc)
+    qtbot.addWidget(view)
+    slot = view.painted[0]
+    view.refresh(snap(words={0o4010: 65535}))  # 1600.4 %
+    assert view.pairs[0][0].text == "1600.4"
+    picture = view.grab().toImage()
+    value = slot._value
+    assert all(text != "1600.4 %" for text, _ in value.sprites)  # not cached...
+    start = round(value.box.right() - value.metrics.horizontalAdvance("1600.4 %"))
+    assert start < value.at.x() - 2  # ...since it starts left of what the pixmaps cover
+    left_of_cache = [(x, y) for x in range(start, value.at.x()) for y in range(2, 22)]
+    assert any(picture.pixelColor(x, y).lightness() < 120 for x, y in left_of_cache)  # drawn all the same
