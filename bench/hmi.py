@@ -1,25 +1,31 @@
-"""HMI form update cost: a generated 300-element form driven by memory that changes every tick.
+"""HMI form update cost at plant size, against plain QLabels with setText in the same run.
 
-100 dials, 100 discrete colour labels, 50 bit graphs and 50 digital readouts, all bound to values
-that change on every tick. One tick = FormView.refresh(snapshot) plus the repaint Qt does for it
-(processEvents), under the offscreen platform. Prints milliseconds per update (mean, median, p95)
+A generated form of N elements (`--elements`, default 300) laid out in a square grid of 64 px tiles
+(3,000 elements make a 3,520 x 3,520 px form, inside the 10,000 px limit): per six elements two
+dials, two discrete colour labels, one digital readout and one bar, every one bound to a value that
+changes on every tick. One tick = what the workstation does with a snapshot: FormView.refresh
+(models, change detection, repaint scheduling) and the paint that follows (processEvents). The
+yardstick is N plain QLabels on the same grid, each given a new text per tick with setText and
+painted the same way. Ticks of the two alternate, so both see the same machine load. Prints per
+tick the mean, median and p95 of the form, the yardstick beside it and the ratio of the medians,
 and the resident memory after warm-up and after all ticks (flat = no growth).
 
-What is on screen stays current: gauges and labels repaint in the tick their text changes or a
-pointer moves by a pixel; each plot is redrawn at most once per REDRAW_INTERVAL of the (fake,
-100 ms a tick) clock, in staggered turns, so a plot lags its data by at most that interval.
+`--plots` makes every sixth element a trend plot (four tiles wide) instead of a bar, as the
+300-element bench of the first releases did: the plots are redrawn once per REDRAW_INTERVAL of the
+(fake, 100 ms a tick) clock, in staggered turns, so a plot lags its data by at most that interval.
 
-    QT_QPA_PLATFORM=offscreen python bench/hmi.py [ticks]
+    QT_QPA_PLATFORM=offscreen python bench/hmi.py [--elements N] [--ticks T] [--plots]
 """
 
 from __future__ import annotations
 
+import argparse
 import ctypes
 import json
+import math
 import os
 import resource
 import statistics
-import sys
 import tempfile
 import time
 from array import array
@@ -27,7 +33,7 @@ from pathlib import Path
 
 os.environ.setdefault("QT_QPA_PLATFORM", "offscreen")
 
-from PySide6.QtWidgets import QApplication
+from PySide6.QtWidgets import QApplication, QLabel, QWidget
 
 from hmi_forms.elements.target import NullTarget
 from hmi_forms.form import load_form
@@ -36,8 +42,8 @@ from hmi_forms.widgets.trend import REDRAW_INTERVAL
 from netplc.engine import FakeClock
 from netplc.memory import Memory
 
-COLS = 20
 TILE = 64
+TICK_MS = 100.0
 
 
 def rss_mb() -> float:
@@ -56,33 +62,54 @@ def rss_pair() -> tuple[float, float]:
     return raw, rss_mb()
 
 
-def generate(folder: Path) -> Path:
-    elements = []
+def columns(tiles: int) -> int:
+    """A square grid: 3,000 tiles make 55 x 55, far inside the 10,000 px form limit."""
+    return max(10, math.ceil(math.sqrt(tiles)))
+
+
+def word_addr(i: int) -> int:
+    """The word of element i: 1,024 words per data bank, banks 0-7 (k*010000 + 04000)."""
+    bank, k = divmod(i, 1024)
+    return bank * 0o10000 + 0o4000 + 2 * k
+
+
+def bit_addr(i: int) -> int:
+    """The bit of element i: internal I/O bits 02000-03677, clear of the special bits 03700-03777."""
+    return 0o2000 + i % 0o1700
+
+
+def kinds(n: int, plots: bool) -> list[str]:
+    pattern = ("dial", "label", "dial", "label", "digital", "graph" if plots else "hbar")
+    return [pattern[i % len(pattern)] for i in range(n)]
+
+
+def generate(folder: Path, n: int, plots: bool) -> Path:
+    tiles = sum(4 if k == "graph" else 1 for k in kinds(n, plots))
+    cols = columns(tiles)
     tile = 0
+    elements = []
 
-    def place(w: int = TILE, h: int = TILE) -> dict[str, int]:
+    def place(span: int = 1) -> dict[str, int]:
         nonlocal tile
-        x, y = tile % COLS * TILE, tile // COLS * TILE
-        tile += 1
-        return {"x": x, "y": y, "w": w, "h": h}
+        if tile % cols + span > cols:  # a plot does not wrap around the row's end
+            tile += cols - tile % cols
+        x, y = tile % cols * TILE, tile // cols * TILE
+        tile += span
+        return {"x": x, "y": y, "w": span * TILE, "h": TILE}
 
-    for i in range(100):
-        elements.append({"type": "AnalogBase", "Name": f"D{i}", **place(), "InAddr": f"0{0o4000 + 2 * i:o}",
-                         "Device": "Raw", "Units": "%", "Appearance": "dial", "PhyHigh": 90})
-    for i in range(100):
-        elements.append({"type": "DiscreteColorLabel", "Name": f"L{i}", **place(),
-                         "InAddr": f"0{0o2000 + i:o}", "TextFalse": "OFF", "TextTrue": "ON",
-                         "BackColorTrue": "#2e7d32", "ForeColorTrue": "#ffffff"})
-    for i in range(50):
-        elements.append({"type": "AnalogBase", "Name": f"N{i}", **place(), "InAddr": f"0{0o4400 + 2 * i:o}",
-                         "Device": "Raw", "Units": "%", "Appearance": "digital"})
-    for i in range(50):
-        tile += (-tile) % 4  # graphs take four tiles in a row
-        elements.append({"type": "Graph", "Name": f"G{i}", **place(4 * TILE, TILE),
-                         "Address": f"0{0o2200 + i:o}", "Elements": 100})
-        tile += 3
-    rows = (tile + COLS - 1) // COLS
-    doc = {"form": {"title": "bench", "width": COLS * TILE, "height": rows * TILE},
+    for i, kind in enumerate(kinds(n, plots)):
+        word, bit = f"0{word_addr(i):o}", f"0{bit_addr(i):o}"
+        if kind == "label":
+            elements.append({"type": "DiscreteColorLabel", "Name": f"L{i}", **place(), "InAddr": bit,
+                             "TextFalse": "OFF", "TextTrue": "ON", "BackColorTrue": "#2e7d32",
+                             "ForeColorTrue": "#ffffff"})
+        elif kind == "graph":
+            elements.append({"type": "Graph", "Name": f"G{i}", **place(4), "Address": bit, "Elements": 100})
+        else:
+            elements.append({"type": "AnalogBase", "Name": f"A{i}", **place(), "InAddr": word,
+                             "Device": "Raw", "Units": "%", "Appearance": kind, "PhyHigh": 90})
+    rows = (tile + cols - 1) // cols
+    doc = {"form": {"title": "bench", "width": cols * TILE, "height": rows * TILE},
            "devices": [{"Name": "Raw", "AppMin": 0, "AppMax": 1000, "PhyMin": 0, "PhyMax": 100}],
            "elements": elements}
     path = folder / "bench.hmi"
@@ -90,31 +117,57 @@ def generate(folder: Path) -> Path:
     return path
 
 
-def drive(mem: Memory, tick: int) -> None:
-    for i in range(100):
-        mem.set_word(0o4000 + 2 * i, (tick * 7 + i * 13) % 1001)
-        mem.set_bit(0o2000 + i, (tick + i) // 3 % 2)
-    for i in range(50):
-        mem.set_word(0o4400 + 2 * i, (tick * 3 + i) % 1001)
-        mem.set_bit(0o2200 + i, (tick + i) // 5 % 2)
+def drive(mem: Memory, n: int, tick: int) -> None:
+    """Every element's value changes on every tick: words step by at least 0.7 % of the range,
+    bits toggle."""
+    for i in range(n):
+        mem.set_word(word_addr(i), (tick * 7 + i * 13) % 1001)
+    for i in range(min(n, 0o1700)):
+        mem.set_bit(0o2000 + i, (tick + i) % 2)
+
+
+def labels(n: int) -> tuple[QWidget, list[QLabel]]:
+    """The yardstick: n plain QLabels on the same grid of tiles."""
+    cols = columns(n)
+    window = QWidget()
+    window.setFixedSize(cols * TILE, (n + cols - 1) // cols * TILE)
+    out = []
+    for i in range(n):
+        label = QLabel("---", window)
+        label.setGeometry(i % cols * TILE, i // cols * TILE, TILE, TILE)
+        out.append(label)
+    return window, out
+
+
+def stats(values: array) -> tuple[float, float, float]:
+    return statistics.mean(values), statistics.median(values), statistics.quantiles(values, n=20)[-1]
 
 
 def main() -> None:
-    ticks = int(sys.argv[1]) if len(sys.argv) > 1 else 10_000
+    parser = argparse.ArgumentParser(description=__doc__.split("\n")[0])
+    parser.add_argument("--elements", type=int, default=300, help="elements on the form (default 300)")
+    parser.add_argument("--ticks", type=int, default=1000, help="ticks measured (default 1000)")
+    parser.add_argument("--plots", action="store_true", help="every sixth element a trend plot, not a bar")
+    args = parser.parse_args()
+    n, ticks = args.elements, args.ticks
     app = QApplication.instance() or QApplication([])
     with tempfile.TemporaryDirectory() as tmp:
-        form = load_form(generate(Path(tmp)))
+        form = load_form(generate(Path(tmp), n, args.plots))
     clock = FakeClock()  # 100 ms ticks for the plot redraw pacing, however fast the replay runs
     view = FormView(form, NullTarget(), clock=clock)
     view.show()
+    window, plain = labels(n)
+    window.show()
     mem = Memory()
+    app.processEvents()
     # allocated up front, so that the measurement itself does not grow the memory it measures
     times = array("d", bytes(8 * ticks))
-    models = array("d", bytes(8 * ticks))  # the refresh part: models, change detection, plot setData
-    warm = min(500, ticks // 10)
+    models = array("d", bytes(8 * ticks))  # the refresh part: models, change detection, scheduling
+    yard = array("d", bytes(8 * ticks))
+    warm = min(200, ticks // 10)
     rss_warm = (0.0, 0.0)
     for tick in range(ticks):
-        drive(mem, tick)
+        drive(mem, n, tick)
         snap = mem.snapshot(tick, tick * 0.1, 1.8e9 + tick * 0.1)
         clock.advance(0.1)
         t0 = time.perf_counter()
@@ -124,19 +177,28 @@ def main() -> None:
         t2 = time.perf_counter()
         times[tick] = (t2 - t0) * 1000
         models[tick] = (t1 - t0) * 1000
+        t0 = time.perf_counter()
+        for i, label in enumerate(plain):  # the text a model would make of the same word
+            label.setText(f"{snap.get_word(word_addr(i)) / 10:.1f}")
+        app.processEvents()
+        yard[tick] = (time.perf_counter() - t0) * 1000
         if tick + 1 == warm:
             rss_warm = rss_pair()
     rss_end = rss_pair()
-    steady = times[warm:]
-    p95 = statistics.quantiles(steady, n=20)[-1]
-    mean, refresh = statistics.mean(steady), statistics.mean(models[warm:])
-    print(f"hmi form update, 300 elements: {mean:.2f} ms mean, {statistics.median(steady):.2f} ms median, "
-          f"{p95:.2f} ms p95 over {len(steady)} ticks (target <= 10 ms); of it refresh {refresh:.2f} ms, "
-          f"repaint {mean - refresh:.2f} ms; plots redrawn every {REDRAW_INTERVAL:g} s (staggered), "
-          f"everything else in the tick it changes")
-    for what, start, end in (("resident", rss_warm[0], rss_end[0]),
+    mean, median, p95 = stats(times[warm:])
+    y_mean, y_median, y_p95 = stats(yard[warm:])
+    refresh = statistics.mean(models[warm:])
+    what = f"plots redrawn every {REDRAW_INTERVAL:g} s (staggered), " if args.plots else ""
+    print(f"hmi form update, {n} elements all changing every tick, {form.width}x{form.height} px: "
+          f"{mean:.2f} ms mean, {median:.2f} ms median, {p95:.2f} ms p95 over {ticks - warm} ticks "
+          f"(of it refresh {refresh:.2f} ms, paint {mean - refresh:.2f} ms); {what}"
+          f"target <= {TICK_MS / 2:g} ms")
+    print(f"  yardstick, {n} QLabels with setText: {y_mean:.2f} ms mean, {y_median:.2f} ms median, "
+          f"{y_p95:.2f} ms p95; form / yardstick (medians) {median / y_median:.2f}x "
+          f"(target <= 1.00x)")
+    for name, start, end in (("resident", rss_warm[0], rss_end[0]),
                              ("resident after malloc_trim", rss_warm[1], rss_end[1])):
-        print(f"hmi {what} memory: {start:.1f} MB after {warm} ticks, {end:.1f} MB after {ticks} ticks "
+        print(f"hmi {name} memory: {start:.1f} MB after {warm} ticks, {end:.1f} MB after {ticks} ticks "
               f"({end - start:+.2f} MB)")
 
 

@@ -13,16 +13,21 @@ drawn identically for all element types: an operator learns it once.
 from __future__ import annotations
 
 from collections.abc import Hashable
+from operator import attrgetter
 from pathlib import Path
 
-from PySide6.QtCore import QPointF, QRect, QRectF, Qt
-from PySide6.QtGui import QBrush, QColor, QPainter, QPaintEvent, QPen, QPixmap, QResizeEvent
+from PySide6.QtCore import QEvent, QPoint, QPointF, QRect, QRectF, Qt
+from PySide6.QtGui import QBrush, QColor, QMoveEvent, QPainter, QPaintEvent, QPen, QPixmap, QResizeEvent
 from PySide6.QtWidgets import QWidget
 
 from hmi_forms.elements import Element
 from hmi_forms.widgets import theme
 
+STYLE = ("BackColor", "ForeColor", "BorderStyle", "Font")  # checked at every draw (`style`)
+ORIGIN = QPoint(0, 0)
 MAX_LAYERS = 6  # cached layers per widget: enough for every state of a discrete element
+MAX_SHARED = 4096  # layers kept for widgets that look alike (by type, look, state and size)
+SHARED_LAYERS: dict[Hashable, QPixmap] = {}
 CURSORS = {"Hand": Qt.CursorShape.PointingHandCursor, "Cross": Qt.CursorShape.CrossCursor,
            "IBeam": Qt.CursorShape.IBeamCursor, "No": Qt.CursorShape.ForbiddenCursor}
 
@@ -113,9 +118,10 @@ class ElementWidget(QWidget):
     """An element on a form: its geometry, input and tooltip, and the code that draws it.
 
     Elements drawn only with QPainter are painted by the form itself, in one pass with one painter
-    (`draw`), and their widget stays an invisible proxy for the mouse, cursor and tooltip: a
-    QPainter per widget per tick costs more than drawing a whole gauge. Elements made of child
-    widgets (`SelfPainted`) paint themselves and carry a StaleMark child instead.
+    (`draw`), and their widget stays an invisible proxy for the mouse, cursor and tooltip, with
+    its own updates off: a QPainter, or only a paint event, per widget per tick costs more than
+    drawing a whole gauge. Elements made of child widgets (`SelfPainted`) paint themselves and
+    carry a StaleMark child instead.
     """
 
     default_back: QColor | None = theme.PANEL  # None = transparent
@@ -125,9 +131,17 @@ class ElementWidget(QWidget):
         self.model = model
         self.images = images
         self.setGeometry(model.x, model.y, model.w, model.h)
+        # drawn by the form (`draw`): Qt is spared a paint event of this widget's own, which costs
+        # more than drawing the element (SelfPainted widgets turn it back on)
+        self.setUpdatesEnabled(False)
         if model.Cursor in CURSORS:
             self.setCursor(CURSORS[model.Cursor])
         self._layers: dict[Hashable, QPixmap] = {}
+        self._style_of = attrgetter(*self.style_props())  # one call in C at every draw
+        self._style = self.style()
+        self._look = self.look()
+        # the form and the rectangle on it, kept: asking Qt for them costs more than the repaint
+        self._where: tuple[QWidget | None, QRect] | None = None
         self._stale = False
         self._tip = ""
 
@@ -141,9 +155,7 @@ class ElementWidget(QWidget):
 
     def sync(self) -> None:
         """The model changed: have the form repaint this element's rectangle."""
-        parent = self.parentWidget()
-        if parent is not None:
-            parent.update(self.geometry())
+        self.repaint_part(None)
         if self.model.stale != self._stale:
             self._stale = self.model.stale
             if self._stale:
@@ -152,6 +164,38 @@ class ElementWidget(QWidget):
             self.setToolTip(quality_tip(self.model.quality or "stale"))
         elif self.toolTip() != self._tip:
             self.setToolTip(self._tip)
+
+    def repaint_part(self, part: QRect | None) -> None:
+        """Have the form repaint `part` of this element (in its own coordinates), or all of it."""
+        parent, rect = self._where or self._locate()
+        if parent is not None:
+            parent.update(rect if part is None else part.translated(rect.topLeft()).intersected(rect))
+
+    def _locate(self) -> tuple[QWidget | None, QRect]:
+        where = self._where = (self.parentWidget(), self.geometry())
+        return where
+
+    def style_props(self) -> tuple[str, ...]:
+        """The model's properties `style` is made of."""
+        return STYLE
+
+    def style(self) -> tuple[object, ...]:
+        """The colours, frame and font: checked at every draw, so that a change (a form
+        designer sets a colour) rebuilds the cached pictures by itself. Other properties the
+        pictures are drawn from are in `look`: after changing one, call `restyle`."""
+        return self._style_of(self.model)
+
+    def look(self) -> tuple[object, ...]:
+        """Everything the cached layer is drawn from besides the state and the size: widgets
+        with equal looks share their layers."""
+        m = self.model
+        return (*self.style(), m.BackgroundImage, m.ImageAlign, m.TextAlign)
+
+    def restyle(self) -> None:
+        """Forget the cached pictures: the look changed."""
+        self._layers.clear()
+        self._style = self.style()
+        self._look = self.look()
 
     def flush(self) -> None:
         """Bring throttled parts (plots, queries) up to date; plain painted widgets have none."""
@@ -162,7 +206,9 @@ class ElementWidget(QWidget):
 
     def draw(self, p: QPainter, r: QRectF) -> None:
         """Draw the element into `r`, its own rectangle, with its top-left corner at the origin."""
-        p.drawPixmap(0, 0, self.layer())
+        if self._style_of(self.model) != self._style:
+            self.restyle()
+        p.drawPixmap(ORIGIN, self.layer())
         self.paint_dynamic(p, r)
         if self.model.stale:
             paint_stale(p, r)
@@ -171,7 +217,15 @@ class ElementWidget(QWidget):
         key = self.layer_key()
         layer = self._layers.get(key)
         if layer is None:
-            layer = self._layers[key] = self._render_layer()
+            # elements that look alike share their layers: fewer pixmaps to render, and a copy
+            # of a pixmap still in the processor's cache is several times faster
+            shared = (type(self), self._look, key, self.size().toTuple(), self.devicePixelRatioF())
+            layer = SHARED_LAYERS.get(shared)
+            if layer is None:
+                if len(SHARED_LAYERS) >= MAX_SHARED:
+                    SHARED_LAYERS.clear()  # the widgets keep those they use
+                layer = SHARED_LAYERS[shared] = self._render_layer()
+            self._layers[key] = layer
             if len(self._layers) > MAX_LAYERS:
                 del self._layers[next(iter(self._layers))]
         return layer
@@ -209,7 +263,17 @@ class ElementWidget(QWidget):
 
     def resizeEvent(self, event: QResizeEvent) -> None:
         self._layers.clear()
+        self._where = None
         super().resizeEvent(event)
+
+    def moveEvent(self, event: QMoveEvent) -> None:
+        self._where = None
+        super().moveEvent(event)
+
+    def changeEvent(self, event: QEvent) -> None:
+        if event.type() == QEvent.Type.ParentChange:
+            self._where = None
+        super().changeEvent(event)
 
     def paint_border(self, p: QPainter, r: QRectF) -> None:
         style = self.model.BorderStyle
@@ -226,6 +290,7 @@ class SelfPainted(ElementWidget):
 
     def __init__(self, model: Element, images: Images, parent: QWidget | None = None) -> None:
         super().__init__(model, images, parent)
+        self.setUpdatesEnabled(True)
         self.stale_mark = StaleMark(self)
         self.stale_mark.setGeometry(self.rect())
         back = self.back_color()
@@ -247,6 +312,8 @@ class SelfPainted(ElementWidget):
     def paintEvent(self, event: QPaintEvent) -> None:
         p = QPainter(self)
         try:  # a painter left active after an error would crash Qt
+            if self.style() != self._style:
+                self.restyle()
             p.drawPixmap(0, 0, self.layer())
             p.setRenderHint(QPainter.RenderHint.Antialiasing)
             self.paint_dynamic(p, QRectF(self.rect()))

@@ -15,7 +15,7 @@ from PySide6.QtWidgets import QWidget
 
 from hmi_forms.elements.discrete import DiscreteBase, DiscreteColorLabel
 from hmi_forms.widgets import theme
-from hmi_forms.widgets.base import ElementWidget, Images, draw_pixmap
+from hmi_forms.widgets.base import STYLE, ElementWidget, Images, draw_pixmap
 
 
 class DiscreteWidget(ElementWidget):
@@ -39,6 +39,17 @@ class DiscreteWidget(ElementWidget):
         if isinstance(self.model, DiscreteColorLabel):
             return theme.qcolor(self.model.fore_color, theme.TEXT)
         return super().fore_color()
+
+    def style_props(self) -> tuple[str, ...]:
+        if isinstance(self.model, DiscreteColorLabel):
+            return (*STYLE, "BackColorFalse", "BackColorTrue", "ForeColorFalse", "ForeColorTrue")
+        return STYLE
+
+    def look(self) -> tuple[object, ...]:
+        m = self.model
+        # image numbers index the form's own list: the files themselves tell two forms apart
+        return (*super().look(), m.TextFalse, m.TextTrue, m.ImageFalse, m.ImageTrue, m.Enabled,
+                tuple(self.images.files))
 
     def layer_key(self) -> Hashable:
         m = self.model

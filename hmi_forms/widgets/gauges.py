@@ -10,11 +10,12 @@ the element's size, so a gauge stays legible from a 90-pixel tile to a full pane
 from __future__ import annotations
 
 import math
-from collections.abc import Hashable
+from collections.abc import Callable, Hashable
 
-from PySide6.QtCore import QPointF, QRectF, Qt
+from PySide6.QtCore import QPointF, QRect, QRectF, Qt
 from PySide6.QtGui import (
     QColor,
+    QFont,
     QFontMetricsF,
     QMouseEvent,
     QPainter,
@@ -22,12 +23,14 @@ from PySide6.QtGui import (
     QPen,
     QPolygonF,
     QResizeEvent,
+    QTransform,
 )
 from PySide6.QtWidgets import QWidget
 
 from hmi_forms.elements.analog import AnalogBase
 from hmi_forms.widgets import theme
-from hmi_forms.widgets.base import ElementWidget, Images
+from hmi_forms.widgets.base import STYLE, ElementWidget, Images
+from hmi_forms.widgets.sprites import SPRITES, Ink, Sprite, TextSlot, blank
 
 
 def nice_step(span: float, max_ticks: int) -> float:
@@ -54,8 +57,15 @@ def scale_ticks(lo: float, hi: float, max_major: int) -> tuple[list[float], list
 
 
 SMALL_DIAL = 45.0  # radius in px below which a dial drops its labels and enlarges the readout
+SPRITE_DIAL = 64.0  # radius in px up to which needles are cached pixmaps (larger: drawn each time)
+PART_AREA = 150 * 150  # px²: from this size on, a change of text alone repaints only its box
 HUB = QColor("#33393f")
 WHITE = QColor("#ffffff")
+# the value's colours by zone: in a readout box (dials, digital) and over the element (bars)
+BOXED = {None: Ink(theme.TEXT, WHITE), "normal": Ink(theme.TEXT, WHITE), "low": Ink(theme.TEXT, theme.WARN),
+         "high": Ink(WHITE, theme.ALARM)}
+BARE = {None: Ink(theme.TEXT), "normal": Ink(theme.TEXT), "low": Ink(theme.WARN.darker(115)),
+        "high": Ink(theme.ALARM.darker(115))}
 
 
 class GaugeWidget(ElementWidget):
@@ -73,11 +83,16 @@ class GaugeWidget(ElementWidget):
         self._digital: tuple[QRectF, float, float] = (QRectF(), 0.0, 0.0)
         self._needle = QPolygonF()  # pointing at 3 o'clock from the centre; the painter turns it
         self._travel = 0.0  # pixels the pointer (needle tip, bar end) travels over the whole scale
+        self._units = f" {model.Units}" if model.Units else ""
+        self._fill = QRect()  # the bar's fill at zero length
+        self._track = QRectF()  # the bar's track
+        self._value: TextSlot | None = None  # where the value text goes, drawn from cached pixmaps
+        self._part: QRect | None = None  # what a new text alone repaints (None: the whole element)
+        self._paint_value: Callable[[QPainter], None] = self._paint_needle  # by Appearance
+        self._needles: dict[Hashable, Sprite] | None = None  # the needle by position (None: drawn each time)
         self._shown: tuple[object, ...] | None = None
-        units = f" {model.Units}" if model.Units else ""
-        lo, hi = model.scaling.phy_range
         self.setToolTip(f"{model.Name}: word {oct(model.InAddr or 0)[2:].rjust(5, '0')}, "
-                        f"{model.format(lo)} … {model.format(hi)}{units}"
+                        f"{model.format(lo)} … {model.format(hi)}{self._units}"
                         + ("; double-click resets the maximum" if model.KeepMaxValue else ""))
 
     # --- geometry shared by the static layer and the pointer ----------------------------------
@@ -92,17 +107,61 @@ class GaugeWidget(ElementWidget):
             self._box = self._compute_readout_box()
             self._digital = self._compute_digital_geometry()
             appearance = self.model.Appearance
+            dpr = self.devicePixelRatioF()
             if appearance == "hbar":
-                self._travel = self._bar_geometry().width()
-            elif appearance != "digital":
-                _, r, _, sweep = self._dial
+                self._paint_value = self._paint_bar_value
+                track = self._track = self._bar_geometry()
+                self._travel = track.width()
+                top = math.ceil(track.top() + 1)  # pixel-aligned: a fractional fill costs twice as much
+                self._fill = QRect(math.ceil(track.left() + 1), top, 0, math.floor(track.bottom()) - top)
+                nh = max(self._name_height(), self.height() * 0.28)
+                font = self._bar_font(nh)
+                box = QRectF(6, 2, self.width() - 12, nh + 2)
+                # the pixmaps cover the widest value, not the name on the same line
+                widest = QFontMetricsF(font).horizontalAdvance("0" * self.digits + self._units) + 6
+                area = box.adjusted(-3, -3, 3, 3)
+                area.setLeft(max(area.left(), area.right() - widest))
+                self._value = TextSlot(box, font, theme.RIGHT, dpr, area)
+            elif appearance == "digital":
+                self._paint_value = self._paint_digital_value
+                box, size, units_w = self._digital
+                text = box.adjusted(6, 0, -6 - units_w, 0)  # the units keep 8 px clear on its right
+                fill = QRectF(box.left() + 2, box.top() + 2, text.right() + 6 - box.left(), box.height() - 4)
+                font = theme.sized_font(size, bold=True, family=theme.MONO)
+                self._value = TextSlot(text, font, theme.RIGHT, dpr, fill)
+            else:
+                self._paint_value = self._paint_needle
+                c, r, start, sweep = self._dial
                 self._travel = abs(math.radians(sweep)) * r  # the maximum mark's outer corner
                 self._needle = QPolygonF([QPointF(0.8 * r, 0), QPointF(0, 0.045 * r),
                                           QPointF(-0.12 * r, 0), QPointF(0, -0.045 * r)])
+                box, size = self._box
+                self._value = TextSlot(box, theme.sized_font(size, bold=True, family=theme.MONO),
+                                       Qt.AlignmentFlag.AlignCenter, dpr, box.adjusted(2, 2, -2, -2))
+                key = (c.toTuple(), r, start, sweep, self._travel, dpr)
+                self._needles = SPRITES.family(key) if r <= SPRITE_DIAL else None
+            # a new text alone repaints its box, in a large gauge: in a small one the pixels
+            # saved are fewer than what cutting the form's repainted region into more
+            # rectangles costs Qt
+            part = self._value.rect
+            area = self.width() * self.height()
+            self._part = part if area >= PART_AREA and part.width() * part.height() * 4 < area else None
 
     def resizeEvent(self, event: QResizeEvent) -> None:
         self._laid_out = False
         super().resizeEvent(event)
+
+    def style_props(self) -> tuple[str, ...]:
+        return (*STYLE, "Name")  # the name is drawn in the layer
+
+    def look(self) -> tuple[object, ...]:
+        m = self.model
+        return (*super().look(), m.Appearance, m.Units, m.scaling, m.Precision, m.PhyLow, m.PhyHigh)
+
+    def restyle(self) -> None:
+        super().restyle()
+        self._laid_out = False
+        self._shown = None
 
     def shown(self) -> tuple[object, ...]:
         """What the operator can see change: the texts, and the pointers to the nearest pixel."""
@@ -121,10 +180,14 @@ class GaugeWidget(ElementWidget):
     def sync(self) -> None:
         """Repaint only when something moved by a pixel or a text changed (a value that creeps
         below a pixel per tick costs no paint until it has moved one)."""
-        shown = self.shown()
-        if shown != self._shown:
-            self._shown = shown
-            super().sync()
+        shown, old = self.shown(), self._shown
+        if shown == old:
+            return
+        self._shown = shown
+        if self._part is not None and old is not None and old[1:] == shown[1:]:
+            self.repaint_part(self._part)  # only the text changed: its box is all that changes
+            return
+        super().sync()
 
     def _dial_geometry(self) -> tuple[QPointF, float, float, float]:
         """Centre, radius, start angle and sweep (degrees, counter-clockwise from 3 o'clock)."""
@@ -176,13 +239,8 @@ class GaugeWidget(ElementWidget):
             p.drawRoundedRect(box, 3, 3)
 
     def paint_dynamic(self, p: QPainter, r: QRectF) -> None:
-        appearance = self.model.Appearance
-        if appearance == "digital":
-            self._paint_digital_value(p)
-        elif appearance == "hbar":
-            self._paint_bar_value(p)
-        else:
-            self._paint_needle(p)
+        self._layout()
+        self._paint_value(p)
 
     def _paint_name(self, p: QPainter) -> None:
         nh = self._name_height()
@@ -305,22 +363,48 @@ class GaugeWidget(ElementWidget):
 
     def _paint_needle(self, p: QPainter) -> None:
         m = self.model
-        c, r, start, sweep = self._dial_geometry()
+        c, r, start, sweep = self._dial
         if m.maximum is not None:
             a = start + sweep * m.scaling.fraction(m.maximum)
             tip, left, right = self._at(c, r * 0.9, a), self._at(c, r, a + 4), self._at(c, r, a - 4)
             p.setPen(Qt.PenStyle.NoPen)
             p.setBrush(theme.ALARM)
             p.drawPolygon(QPolygonF([tip, left, right]))
-        box, size = self._box
-        p.setFont(theme.sized_font(size, bold=True, family=theme.MONO))
-        p.setPen(WHITE if m.zone == "high" else theme.TEXT)
-        p.drawText(box, Qt.AlignmentFlag.AlignCenter, m.text or "---")
+        assert self._value is not None
+        self._value.draw(p, m.text or "---", BOXED[m.zone])
         if m.hw is None:
             return
+        if self._needles is None:
+            self._draw_needle(p, c, r, start + sweep * m.fraction)
+            return
+        # the needle to the nearest pixel its tip travels, as `shown` tells a move
+        pointer = round(m.fraction * self._travel)
+        sprite = self._needles.get(pointer)
+        if sprite is None:
+            sprite = SPRITES.put(self._needles, pointer,
+                                 self._render_needle(c, r, start + sweep * pointer / self._travel))
+        p.drawPixmap(*sprite)
+
+    def _render_needle(self, c: QPointF, r: float, angle: float) -> Sprite:
+        """The needle at `angle` in a pixmap just large enough for it (less to blend per tick)."""
+        hub = r * 0.07
+        turned = QTransform().translate(c.x(), c.y()).rotate(-angle).map(self._needle)
+        box = turned.boundingRect().united(QRectF(c.x() - hub, c.y() - hub, 2 * hub, 2 * hub))
+        at = box.adjusted(-1, -1, 1, 1).toAlignedRect()
+        pix = blank(at.size(), self.devicePixelRatioF(), None)
+        p = QPainter(pix)
+        try:  # a painter left open on a pixmap crashes Qt when the pixmap goes
+            p.setRenderHint(QPainter.RenderHint.Antialiasing)
+            p.translate(-at.x(), -at.y())
+            self._draw_needle(p, c, r, angle)
+        finally:
+            p.end()
+        return at.topLeft(), pix
+
+    def _draw_needle(self, p: QPainter, c: QPointF, r: float, angle: float) -> None:
         at = p.transform()
         p.translate(c)
-        p.rotate(-(start + sweep * m.fraction))  # the needle is laid out pointing at 3 o'clock
+        p.rotate(-angle)  # the needle is laid out pointing at 3 o'clock
         p.setPen(Qt.PenStyle.NoPen)  # filled only: a stroke would double the rasterising
         p.setBrush(theme.ACCENT)
         p.drawPolygon(self._needle)
@@ -331,21 +415,22 @@ class GaugeWidget(ElementWidget):
 
     def _paint_bar_value(self, p: QPainter) -> None:
         m = self.model
-        track = self._bar_geometry()
+        track = self._track
         zone_color = theme.ZONE_COLORS.get(m.zone or "")
         if m.hw is not None:
-            width = (track.width() - 1) * m.fraction
-            p.fillRect(QRectF(track.left() + 1, track.top() + 1, width, track.height() - 1),
-                       zone_color or theme.ACCENT)
+            fill = self._fill
+            fill.setWidth(round((track.width() - 1) * m.fraction))
+            p.fillRect(fill, zone_color or theme.ACCENT)
         if m.maximum is not None:
             x = track.left() + m.scaling.fraction(m.maximum) * track.width()
             p.setPen(QPen(theme.ALARM, 2))
             p.drawLine(QPointF(x, track.top() - 3), QPointF(x, track.bottom()))
-        nh = max(self._name_height(), self.height() * 0.28)
-        units = f" {m.Units}" if m.Units else ""
-        p.setFont(theme.sized_font(max(10.0, nh * 0.8), bold=True, family=theme.MONO))
-        p.setPen(zone_color.darker(115) if zone_color is not None else theme.TEXT)
-        p.drawText(QRectF(6, 2, self.width() - 12, nh + 2), theme.RIGHT, (m.text or "---") + units)
+        assert self._value is not None
+        self._value.draw(p, (m.text or "---") + self._units, BARE[m.zone])
+
+    @staticmethod
+    def _bar_font(name_height: float) -> QFont:
+        return theme.sized_font(max(10.0, name_height * 0.8), bold=True, family=theme.MONO)
 
     def _digital_geometry(self) -> tuple[QRectF, float, float]:
         self._layout()
@@ -383,12 +468,12 @@ class GaugeWidget(ElementWidget):
 
     def _paint_digital_value(self, p: QPainter) -> None:
         m = self.model
-        box, size, units_w = self._digital_geometry()
-        fg = QColor("#ffffff") if m.zone == "high" else theme.TEXT
-        p.setFont(theme.sized_font(size, bold=True, family=theme.MONO))
-        p.setPen(fg)
-        p.drawText(box.adjusted(6, 0, -6 - units_w, 0), theme.RIGHT, m.text or "---")
+        box, size, _ = self._digital_geometry()
+        assert self._value is not None
+        ink = BOXED[m.zone]
+        self._value.draw(p, m.text or "---", ink)
         if m.maximum is not None and box.height() > 30:
+            fg = ink.fore
             p.setFont(theme.sized_font(max(8.0, size * 0.38)))
             p.setPen(fg if m.zone else theme.ALARM)
             p.drawText(box.adjusted(6, 2, 0, 0), Qt.AlignmentFlag.AlignLeft | Qt.AlignmentFlag.AlignTop,

@@ -17,6 +17,9 @@ class StaticTextWidget(ElementWidget):
     model: StaticText
     default_back = None
 
+    def look(self) -> tuple[object, ...]:
+        return (*super().look(), self.model.Text)
+
     def paint_static(self, p: QPainter, r: QRectF) -> None:
         p.setFont(theme.qfont(self.model.Font, 11))
         p.setPen(self.fore_color())
@@ -27,6 +30,9 @@ class StaticTextWidget(ElementWidget):
 class StaticPictureWidget(ElementWidget):
     model: StaticPicture
     default_back = None
+
+    def look(self) -> tuple[object, ...]:
+        return (*super().look(), self.model.Image, self.model.SizeMode)
 
     def paint_static(self, p: QPainter, r: QRectF) -> None:
         if self.model.Image is not None:
@@ -64,6 +70,10 @@ class SyncWidget(ElementWidget):
     """A generator's state at a glance: its pair (period, phase), enable, and the output pulse."""
 
     model: SyncGenerator
+
+    def look(self) -> tuple[object, ...]:
+        m = self.model
+        return (*super().look(), m.Name, m.Period0, m.Phase0, m.Period1, m.Phase1, type(m))
 
     def layer_key(self) -> Hashable:
         return self.model.pair, self.model.output, self.model.enabled

@@ -1,0 +1,236 @@
+"""What a form repaints and what it caches: each optimisation of the widgets keeps its test here.
+
+Painted elements are drawn by the form (`ElementWidget.draw`), so a repaint is counted as a call
+of `draw` after Qt has processed the paint; the pictures are really rendered with grab()."""
+
+from __future__ import annotations
+
+import json
+from pathlib import Path
+
+from PySide6.QtCore import QEvent, QObject, QPoint, QRect, QRectF, QSize, Qt
+from PySide6.QtGui import QColor, QImage, QPainter
+from PySide6.QtWidgets import QApplication
+
+from hmi_forms.elements.target import NullTarget
+from hmi_forms.form import load_form
+from hmi_forms.widgets import theme
+from hmi_forms.widgets.base import ElementWidget
+from hmi_forms.widgets.form_view import FormView
+from hmi_forms.widgets.gauges import BOXED
+from hmi_forms.widgets.sprites import Ink, SpriteCache, TextSlot, blank
+from tests.hmi_forms.helpers import snap
+
+LEVEL = {"Name": "Level", "AppMin": 0, "AppMax": 4095, "PhyMin": 0, "PhyMax": 100}
+
+
+def form_of(tmp_path: Path, elements: list[dict], width: int = 600, height: int = 300) -> FormView:
+    doc = {"form": {"title": "t", "width": width, "height": height}, "devices": [LEVEL], "elements": elements}
+    path = tmp_path / "t.hmi"
+    path.write_text(json.dumps(doc), encoding="utf-8")
+    view = FormView(load_form(path), NullTarget())
+    view.show()
+    return view
+
+
+def dial(name: str, x: int, addr: str, size: int = 140, **props) -> dict:
+    return {"type": "AnalogBase", "Name": name, "x": x, "y": 0, "w": size, "h": size, "InAddr": addr,
+            "Device": "Level", "Appearance": "dial", "Precision": 0, **props}
+
+
+class Draws:
+    """Counts the form's draws of each painted element."""
+
+    def __init__(self, view: FormView) -> None:
+        self.counts: dict[str, int] = {}
+        for widget in view.painted:
+            self._wrap(widget)
+
+    def _wrap(self, widget: ElementWidget) -> None:
+        name, draw = widget.model.Name, widget.draw
+        self.counts[name] = 0
+
+        def counted(p: QPainter, r: QRectF) -> None:
+            self.counts[name] += 1
+            draw(p, r)
+
+        widget.draw = counted  # type: ignore[method-assign]
+
+
+def settle() -> None:
+    """Let Qt paint what the refresh asked for."""
+    QApplication.processEvents()
+
+
+def test_only_the_element_whose_shown_value_changed_is_repainted(qtbot, tmp_path) -> None:
+    view = form_of(tmp_path, [dial("A", 0, "04010"), dial("B", 200, "04012"),
+                              {"type": "DiscreteColorLabel", "Name": "L", "x": 400, "y": 0, "w": 120, "h": 40,
+                               "InAddr": "02120", "TextFalse": "OFF", "TextTrue": "ON"}])
+    qtbot.addWidget(view)
+    view.refresh(snap(words={0o4010: 1000, 0o4012: 1000}))
+    view.repaint()
+    settle()
+    draws = Draws(view)
+    view.refresh(snap(scan=1, words={0o4010: 3000, 0o4012: 1000}))  # A moves, B and L stay
+    settle()
+    assert draws.counts == {"A": 1, "B": 0, "L": 0}
+    view.refresh(snap(scan=2, words={0o4010: 3000, 0o4012: 1000}))  # an equal value: nothing at all
+    settle()
+    assert draws.counts == {"A": 1, "B": 0, "L": 0}
+    view.refresh(snap(scan=3, words={0o4010: 3000, 0o4012: 1000}, bits={0o2120: 1}))
+    settle()
+    assert draws.counts == {"A": 1, "B": 0, "L": 1}
+
+
+def test_painted_elements_get_no_paint_events_of_their_own(qtbot, tmp_path) -> None:
+    """The form draws them: a paint event per element widget would cost more than the drawing."""
+    view = form_of(tmp_path, [dial("A", 0, "04010")])
+    qtbot.addWidget(view)
+    widget = view.painted[0]
+    seen: list[QEvent.Type] = []
+
+    class Spy(QObject):
+        def eventFilter(self, obj: QObject, event: QEvent) -> bool:
+            seen.append(event.type())
+            return False
+
+    spy = Spy()
+    widget.installEventFilter(spy)
+    before = view.grab().toImage()
+    view.refresh(snap(scan=1, words={0o4010: 3000}))
+    settle()
+    assert QEvent.Type.Paint not in seen
+    assert before != view.grab().toImage()  # ...and yet it is repainted, by the form
+
+
+def test_a_new_text_alone_repaints_only_its_box_in_a_large_gauge(qtbot, tmp_path) -> None:
+    view = form_of(tmp_path, [dial("A", 0, "04010", size=280)], height=300)
+    qtbot.addWidget(view)
+    asked: list[tuple] = []
+    view.update = lambda *rect: asked.append(rect)  # type: ignore[method-assign]
+    view.refresh(snap(words={0o4010: 2067}))  # 50.48 %: "50"
+    view.refresh(snap(scan=1, words={0o4010: 2068}))  # "51", the needle stays within its pixel
+    view.refresh(snap(scan=2, words={0o4010: 3000}))  # the needle moves
+    whole = QRect(0, 0, 280, 280)
+    assert asked[0] == (whole,) and asked[2] == (whole,)
+    (part,) = asked[1]
+    assert whole.contains(part) and part.width() * part.height() * 10 < 280 * 280
+
+
+def test_a_cached_face_is_rebuilt_when_the_colours_or_the_size_change(qtbot, tmp_path) -> None:
+    view = form_of(tmp_path, [dial("A", 0, "04010")])
+    qtbot.addWidget(view)
+    view.refresh(snap(words={0o4010: 1000}))
+    widget = view.painted[0]
+    corner = view.grab().toImage().pixelColor(2, 2)
+    assert corner == theme.PANEL
+    widget.model.BackColor = (200, 30, 30, 255)  # as a form designer would set it
+    view.update()
+    assert view.grab().toImage().pixelColor(2, 2) == QColor(200, 30, 30)
+    assert widget.layer().size() == QSize(140, 140)
+    widget.resize(100, 100)
+    assert widget.layer().size() == QSize(100, 100)
+    assert view.errors == []
+
+
+def test_elements_that_look_alike_share_their_layers(qtbot, tmp_path) -> None:
+    label = {"type": "DiscreteColorLabel", "y": 0, "w": 100, "h": 40, "InAddr": "02120", "TextFalse": "OFF",
+             "TextTrue": "ON", "BackColorTrue": "#2e7d32"}
+    view = form_of(tmp_path, [{**label, "Name": "L1", "x": 0}, {**label, "Name": "L2", "x": 110},
+                              {**label, "Name": "L3", "x": 220, "TextTrue": "RUN"}])
+    qtbot.addWidget(view)
+    view.refresh(snap(bits={0o2120: 1}))
+    one, two, three = (w.layer() for w in view.painted)
+    assert one is two and one is not three
+    assert two.toImage().pixelColor(50, 2) == QColor("#2e7d32")
+
+
+def test_a_text_from_the_cache_is_pixel_for_pixel_the_drawn_text(qtbot) -> None:
+    font = theme.sized_font(15, bold=True, family=theme.MONO)
+    box = QRectF(10.4, 6.7, 61.3, 21.2)
+    for ink, align in ((Ink(theme.TEXT, QColor("#ffffff")), Qt.AlignmentFlag.AlignCenter),
+                       (Ink(theme.TEXT), theme.RIGHT)):
+        area = box.adjusted(2, 2, -2, -2) if ink.back is not None else None
+        slot = TextSlot(box, font, align, area=area)
+        pictures = []
+        for how in ("drawn", "rendered into the cache", "from the cache"):
+            picture = QImage(90, 40, QImage.Format.Format_ARGB32)
+            picture.fill(QColor("#ffffff"))
+            p = QPainter(picture)
+            p.setRenderHint(QPainter.RenderHint.Antialiasing)
+            if how == "drawn":
+                p.setFont(font)
+                p.setPen(ink.fore)
+                p.drawText(box, align, "-12.5")
+            else:
+                slot.draw(p, "-12.5", ink)
+            p.end()
+            pictures.append(picture)
+        assert pictures[0] == pictures[1] == pictures[2]
+        assert len(slot.sprites) == 1
+
+
+def test_the_sprite_cache_starts_afresh_past_its_budget(qtbot) -> None:
+    cache = SpriteCache(budget=3 * 10 * 10 * 4)
+    family = cache.family("f")
+    for k in range(3):
+        cache.put(family, k, (QPoint(), blank(QSize(10, 10), 1.0, None)))
+    assert len(cache) == 3 and cache.bytes == 1200
+    cache.put(family, 3, (QPoint(), blank(QSize(10, 10), 1.0, None)))
+    assert list(family) == [3] and cache.bytes == 400  # the family the widgets hold stays the same dict
+
+
+def test_dial_needles_come_from_the_cache_and_follow_the_value(qtbot, tmp_path) -> None:
+    view = form_of(tmp_path, [dial("A", 0, "04010"), dial("B", 200, "04012")])
+    qtbot.addWidget(view)
+    a, b = view.painted
+    pictures = []
+    for hw in (0, 2048, 4095):
+        view.refresh(snap(scan=hw, words={0o4010: hw, 0o4012: hw}))
+        pictures.append(view.grab().toImage())
+    assert pictures[0] != pictures[1] != pictures[2]
+    assert a._needles is b._needles  # two dials of one size share them
+    assert {0, round(a._travel * 2048 / 4095), round(a._travel)} <= set(a._needles)
+    assert view.errors == []
+
+
+def test_a_high_value_is_white_on_the_alarm_colour(qtbot, tmp_path) -> None:
+    view = form_of(tmp_path, [dial("A", 0, "04010", PhyHigh=90)])
+    qtbot.addWidget(view)
+    view.refresh(snap(words={0o4010: 4095}))
+    assert view.pairs[0][0].zone == "high" and BOXED["high"].back == theme.ALARM
+    box = view.painted[0]._value.rect
+    picture = view.grab().toImage()
+    colours = {picture.pixelColor(x, box.center().y()).name() for x in range(box.left(), box.right())}
+    assert theme.ALARM.name() in colours and "#ffffff" in colours
+
+
+def test_a_3000_element_bench_form_fits_the_form_limits(tmp_path) -> None:
+    import importlib.util
+
+    spec = importlib.util.spec_from_file_location("bench_hmi", Path(__file__).parents[2] / "bench" / "hmi.py")
+    assert spec is not None and spec.loader is not None
+    bench = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(bench)
+    form = load_form(bench.generate(tmp_path, 3000, False))
+    assert len(form.elements) == 3000 and form.height <= 10_000 and form.width <= 10_000
+    plots = load_form(bench.generate(tmp_path, 600, True))
+    assert sum(e.TYPE == "Graph" for e in plots.elements) == 100
+
+
+def test_a_text_too_wide_for_its_cached_box_is_drawn_whole(qtbot, tmp_path) -> None:
+    """A word far beyond AppMax gives a value wider than the scale's: it must not be cut."""
+    doc = [{"type": "AnalogBase", "Name": "B", "x": 0, "y": 0, "w": 160, "h": 64, "InAddr": "04010",
+            "Device": "Level", "Appearance": "hbar", "Units": "%"}]
+    view = form_of(tmp_path, doc)
+    qtbot.addWidget(view)
+    slot = view.painted[0]
+    view.refresh(snap(words={0o4010: 65535}))  # 1600.4 %
+    assert view.pairs[0][0].text == "1600.4"
+    picture = view.grab().toImage()
+    value = slot._value
+    assert all(text != "1600.4 %" for text, _ in value.sprites)  # not cached...
+    start = round(value.box.right() - value.metrics.horizontalAdvance("1600.4 %"))
+    assert start < value.at.x() - 2  # ...since it starts left of what the pixmaps cover
+    left_of_cache = [(x, y) for x in range(start, value.at.x()) for y in range(2, 22)]
+    assert any(picture.pixelColor(x, y).lightness() < 120 for x, y in left_of_cache)  # drawn all the same
