@@ -171,6 +171,17 @@ class Runtime:
         for observer in list(self._observers):
             observer(record)
 
+    def after_commit(self, callback: Callable[[], None]) -> None:
+        """`callback()` once every record put so far is on disk (the engine answers a Modbus write then)."""
+        if self.store is not None:
+            self.store.after_commit(callback)
+        else:
+            callback()
+
+    def room(self) -> int:
+        """Records the archive queue takes before it drops (the engine applies no write beyond it)."""
+        return self.store.room() if self.store is not None else 1 << 30
+
     def subscribe(self, observer: RecordObserver) -> None:
         """Call `observer(record)` for every record, from the thread that produced it."""
         self._observers.append(observer)

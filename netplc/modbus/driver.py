@@ -16,9 +16,13 @@ back, which a queued write has not reached yet).
 from __future__ import annotations
 
 import asyncio
+import contextlib
+import functools
 import logging
 import struct
 import threading
+import time
+from collections import deque
 from collections.abc import Awaitable, Callable, Coroutine
 from dataclasses import dataclass
 from typing import Any, Protocol, TypeVar
@@ -355,13 +359,38 @@ class LeanTcpClient:
 
 # --- server --------------------------------------------------------------------------------------
 
+ADU_MAX = 260  # the longest Modbus TCP frame: MBAP header 7 + PDU 253
+BUSY = 6  # Modbus exception 6, server device busy: the engine's queue of outside writes is full
+_READ_HEAD = struct.Struct(">HHHBBB")  # MBAP + function code + byte count of a read answer
+_ADDRESS_COUNT = struct.Struct(">HH")
+
+Answer = Callable[[bytes], None]  # takes the response PDU of a write once it is journaled
+
+
+@dataclass(frozen=True, slots=True)
+class ServerLimits:
+    """What one Modbus TCP server grants its clients (station.toml [modbus_server])."""
+
+    max_connections: int = 16  # the next connection is closed at once
+    idle_timeout: float = 60.0  # s without a whole request (silent, or a half frame): closed
+    max_inflight: int = 32  # requests a connection may have unanswered or answers unread
+
 
 class ServeHandler(Protocol):
-    """What a Modbus server serves; MapError from either method answers exception 2."""
+    """What a Modbus server serves; MapError from any method answers exception 2."""
 
-    def read(self, table: Table, address: int, count: int) -> list[int]: ...
+    def registers(self, address: int, count: int) -> bytes:
+        """`count` registers from `address` as the answer carries them (big-endian words)."""
+        ...
 
-    def write(self, table: Table, address: int, values: list[int], peer: str) -> None: ...
+    def bits(self, address: int, count: int) -> bytes:
+        """`count` coils from `address`, packed as the answer carries them."""
+        ...
+
+    def write(self, table: Table, address: int, values: list[int], peer: str,
+              done: Callable[[bool], None]) -> bool:
+        """Queue a write; `done(ok)` once it is applied and journaled. False: busy (exception 6)."""
+        ...
 
 
 _READ_TABLES: dict[int, Table] = {1: "coils", 2: "discrete", 3: "holding", 4: "input"}
@@ -372,44 +401,26 @@ class _Refuse(Exception):
         self.code = code
 
 
-def answer(handler: ServeHandler, pdu: bytes, peer: str) -> bytes:
-    """The response PDU to one request PDU (function codes 1-6, 15, 16; others: exception 1)."""
+def answer(handler: ServeHandler, pdu: bytes, peer: str, later: Answer) -> bytes | None:
+    """The response PDU to one request PDU (function codes 1-6, 15, 16; others: exception 1), or
+    None for an accepted write, whose response goes to `later` once the write is applied and its
+    journal record is durable (or exception 4 if it could not be applied)."""
     fc = pdu[0]
     try:
         if fc in _READ_TABLES:
             if len(pdu) != 5:
                 raise _Refuse(3)
-            address, count = struct.unpack_from(">HH", pdu, 1)
+            address, count = _ADDRESS_COUNT.unpack_from(pdu, 1)
             if not 1 <= count <= (MAX_READ_BITS if fc <= 2 else MAX_READ_REGISTERS):
                 raise _Refuse(3)
-            values = handler.read(_READ_TABLES[fc], address, count)
-            data = bytes_from_bits(values) if fc <= 2 else struct.pack(f">{count}H", *values)
+            data = handler.bits(address, count) if fc <= 2 else handler.registers(address, count)
             return bytes((fc, len(data))) + data
-        if fc in (5, 6):
-            if len(pdu) != 5:
-                raise _Refuse(3)
-            address, value = struct.unpack_from(">HH", pdu, 1)
-            if fc == 5:
-                if value not in (0, 0xFF00):
-                    raise _Refuse(3)
-                handler.write("coils", address, [1 if value else 0], peer)
-            else:
-                handler.write("holding", address, [value], peer)
-            return pdu
-        if fc in (15, 16):
-            if len(pdu) < 6:
-                raise _Refuse(3)
-            address, count, nbytes = struct.unpack_from(">HHB", pdu, 1)
-            data = pdu[6:]
-            if fc == 15:
-                if not 1 <= count <= MAX_WRITE_BITS or nbytes != (count + 7) // 8 or len(data) != nbytes:
-                    raise _Refuse(3)
-                handler.write("coils", address, bits_from_bytes(data)[:count], peer)
-            else:
-                if not 1 <= count <= MAX_WRITE_REGISTERS or nbytes != 2 * count or len(data) != nbytes:
-                    raise _Refuse(3)
-                handler.write("holding", address, list(struct.unpack(f">{count}H", data)), peer)
-            return struct.pack(">BHH", fc, address, count)
+        if fc in (5, 6, 15, 16):
+            table, address, values, echo = _write_request(pdu)
+            failed = bytes((fc | 0x80, 4))
+            if handler.write(table, address, values, peer, lambda ok: later(echo if ok else failed)):
+                return None
+            raise _Refuse(BUSY)
         code = 1
     except _Refuse as e:
         code = e.code
@@ -421,58 +432,266 @@ def answer(handler: ServeHandler, pdu: bytes, peer: str) -> bytes:
     return bytes((fc | 0x80, code))
 
 
+def _write_request(pdu: bytes) -> tuple[Table, int, list[int], bytes]:
+    """(table, address, values, echo) of a write request; _Refuse(3) if it is malformed."""
+    fc = pdu[0]
+    if fc in (5, 6):
+        if len(pdu) != 5:
+            raise _Refuse(3)
+        address, value = _ADDRESS_COUNT.unpack_from(pdu, 1)
+        if fc == 6:
+            return "holding", address, [value], pdu
+        if value not in (0, 0xFF00):
+            raise _Refuse(3)
+        return "coils", address, [1 if value else 0], pdu
+    if len(pdu) < 6:
+        raise _Refuse(3)
+    address, count, nbytes = struct.unpack_from(">HHB", pdu, 1)
+    data = pdu[6:]
+    echo = pdu[:5]
+    if fc == 15:
+        if not 1 <= count <= MAX_WRITE_BITS or nbytes != (count + 7) // 8 or len(data) != nbytes:
+            raise _Refuse(3)
+        return "coils", address, bits_from_bytes(data)[:count], echo
+    if not 1 <= count <= MAX_WRITE_REGISTERS or nbytes != 2 * count or len(data) != nbytes:
+        raise _Refuse(3)
+    return "holding", address, list(struct.unpack(f">{count}H", data)), echo
+
+
+class Throttle:
+    """One journal line per cause per minute: a flood of refused connections, malformed frames or
+    loop errors must not flood the journal or the log (issue 18). What was held back is counted in
+    the cause's next line."""
+
+    def __init__(self, emit: Callable[[str], None], period: float = 60.0,
+                 clock: Callable[[], float] = time.monotonic) -> None:
+        self.emit = emit
+        self.period = period
+        self.clock = clock
+        self._last: dict[str, float] = {}
+        self._held: dict[str, int] = {}
+
+    def __call__(self, cause: str, text: str) -> None:
+        now = self.clock()
+        last = self._last.get(cause)
+        if last is not None and now - last < self.period:
+            self._held[cause] = self._held.get(cause, 0) + 1
+            return
+        self._last[cause] = now
+        held = self._held.pop(cause, 0)
+        self.emit(f"{text} (and {held} more like it in the last minute)" if held else text)
+
+
 class _Connection(asyncio.Protocol):
+    """One client. Answers leave in the order of the requests: behind a write waiting for its
+    scan and journal record, later answers wait too. A connection stops being read while
+    `max_inflight` requests wait for answers or the client leaves that many answers unread."""
+
     def __init__(self, server: TcpServer) -> None:
         self.server = server
         self.buf = bytearray()
         self.transport: asyncio.Transport | None = None
         self.peer = "?"
+        self.held: deque[list[Any]] = deque()  # [frame or None (waiting), tid, unit] behind a write
+        self.blocked = False  # the client does not read its answers (the transport's buffer is full)
+        self.reading = True
+        self.last = 0.0  # loop time of the last data
 
     def connection_made(self, transport: asyncio.BaseTransport) -> None:
         assert isinstance(transport, asyncio.Transport)
-        self.transport = transport
+        server = self.server
         peer = transport.get_extra_info("peername")
         self.peer = f"{peer[0]}:{peer[1]}" if isinstance(peer, tuple) else str(peer)
-        self.server.connections.add(self)
+        limit = server.limits.max_connections
+        if len(server.connections) >= limit:
+            transport.close()
+            server.note("connections", f"Modbus server refused a connection from {self.peer}: "
+                                       f"{limit} connections are open (max_connections)")
+            return
+        self.transport = transport
+        self.last = server.loop_time()
+        server.connections.add(self)
+        transport.set_write_buffer_limits(high=server.limits.max_inflight * ADU_MAX)
 
     def connection_lost(self, exc: Exception | None) -> None:
+        self.transport = None
+        self.held.clear()
         self.server.connections.discard(self)
 
+    def pause_writing(self) -> None:
+        self.blocked = True
+
+    def resume_writing(self) -> None:
+        self.blocked = False
+        self._serve()
+
     def data_received(self, data: bytes) -> None:
-        self.buf += data
-        frames = take_frames(self.buf)
-        if frames is None:  # not Modbus TCP: drop the peer, as devices do
-            assert self.transport is not None
-            self.transport.close()
+        if self.transport is None:
             return
-        out = bytearray()
-        for tid, unit, pdu in frames:
-            if self.server.unit is not None and unit != self.server.unit:
-                response = bytes((pdu[0] | 0x80, 0x0B))  # gateway: target device failed to respond
+        self.buf += data
+        self.last = self.server.last_data = self.server.loop_time()
+        self._serve()
+
+    def _serve(self) -> None:
+        """Answer the whole requests in the buffer, as many as the limits allow."""
+        transport = self.transport
+        if transport is None:
+            return
+        server = self.server
+        handler, only, limit = server.handler, server.unit, server.limits.max_inflight
+        buf, held = self.buf, self.held
+        pos, end, out, n = 0, len(self.buf), bytearray(), 0
+        while end - pos >= 8 and not self.blocked and len(held) < limit:
+            tid, proto, length, unit = _MBAP.unpack_from(buf, pos)
+            if proto != 0 or not 2 <= length <= 254:
+                server.note("frames", f"Modbus server closed the connection of {self.peer}: "
+                                      f"not Modbus TCP (protocol {proto}, length {length})")
+                transport.close()
+                self.transport = None
+                return
+            nxt = pos + 6 + length
+            if nxt > end:
+                break
+            fc = buf[pos + 7]
+            if only is not None and unit != only:
+                out += _MBAP.pack(tid, 0, 3, unit) + bytes((fc | 0x80, 0x0B))  # gateway: no such unit
+            elif (fc == 3 or fc == 4) and length == 6:  # the hot path: registers from the snapshot
+                address, count = _ADDRESS_COUNT.unpack_from(buf, pos + 8)
+                try:
+                    if not 1 <= count <= MAX_READ_REGISTERS:
+                        raise _Refuse(3)
+                    data = handler.registers(address, count)
+                except _Refuse as e:
+                    out += _MBAP.pack(tid, 0, 3, unit) + bytes((fc | 0x80, e.code))
+                except MapError:
+                    out += _MBAP.pack(tid, 0, 3, unit) + bytes((fc | 0x80, 2))
+                else:
+                    out += _READ_HEAD.pack(tid, 0, len(data) + 3, unit, fc, len(data))
+                    out += data
             else:
-                response = answer(self.server.handler, pdu, self.peer)
-            out += _MBAP.pack(tid, 0, len(response) + 1, unit) + response
-        if out and self.transport is not None:
-            self.transport.write(bytes(out))
+                slot: list[Any] = [None, tid, unit]
+                response = answer(handler, bytes(buf[pos + 7 : nxt]), self.peer,
+                                  functools.partial(server.finished, self, slot))
+                if response is None:  # a write waiting for its scan: what follows waits behind it
+                    if out:
+                        self._send(out)
+                        out = bytearray()
+                    held.append(slot)
+                else:
+                    out += _MBAP.pack(tid, 0, len(response) + 1, unit) + response
+            pos = nxt
+            n += 1
+            if n % limit == 0 and out:  # a client that does not read stops us here (pause_writing)
+                self._send(out)
+                out = bytearray()
+        if pos:
+            del buf[:pos]
+        if out:
+            self._send(out)
+        if self.transport is None:
+            return
+        stop = self.blocked or len(held) >= limit
+        if stop and self.reading:
+            self.reading = False
+            transport.pause_reading()
+        elif not stop and not self.reading:
+            self.reading = True
+            transport.resume_reading()
+
+    def _send(self, frames: bytearray | bytes) -> None:
+        if self.held:
+            self.held.append([bytes(frames), 0, 0])
+        elif self.transport is not None:
+            self.transport.write(frames)
+
+    def answered(self, slot: list[Any], response: bytes) -> None:
+        """A held write is journaled (server loop): send it and the answers held behind it."""
+        if self.transport is None:
+            return
+        slot[0] = _MBAP.pack(slot[1], 0, len(response) + 1, slot[2]) + response
+        held = self.held
+        out = bytearray()
+        while held and held[0][0] is not None:
+            out += held.popleft()[0]
+        if out:
+            self.transport.write(out)
+        if self.buf or not self.reading:
+            self._serve()
 
 
 class TcpServer:
     """A listening Modbus TCP server on the running loop; `close()` also drops its connections,
-    so clients see a stopped server at once, as they would a switched-off device."""
+    so clients see a stopped server at once, as they would a switched-off device.
 
-    def __init__(self, handler: ServeHandler, unit: int | None) -> None:
+    `note(text)` journals what the operator should know (refused connections, idle connections
+    closed, loop errors), at most one line per cause per minute."""
+
+    def __init__(self, handler: ServeHandler, unit: int | None, limits: ServerLimits | None = None,
+                 note: Callable[[str], None] | None = None) -> None:
         self.handler = handler
         self.unit = unit
+        self.limits = limits or ServerLimits()
+        self.note = Throttle(note or logging.getLogger(__name__).warning)
         self.connections: set[_Connection] = set()
         self._server: asyncio.Server | None = None
+        self._loop: asyncio.AbstractEventLoop | None = None
+        self._sweep: asyncio.TimerHandle | None = None
+        self._finished: deque[tuple[_Connection, list[Any], bytes]] = deque()
+        self._wake = False
+        self.last_data = 0.0
         self.port = 0
 
+    def loop_time(self) -> float:
+        assert self._loop is not None
+        return self._loop.time()
+
     async def listen(self, host: str, port: int) -> None:
-        loop = asyncio.get_running_loop()
+        loop = self._loop = asyncio.get_running_loop()
+        loop.set_exception_handler(self._loop_error)
         self._server = await loop.create_server(lambda: _Connection(self), host, port)
         self.port = self._server.sockets[0].getsockname()[1]
+        self._schedule_sweep()
+
+    def _loop_error(self, loop: asyncio.AbstractEventLoop, context: dict[str, Any]) -> None:
+        """asyncio's own errors (accept() out of file descriptors, ...): one line per cause a minute."""
+        message = context.get("message", "error")
+        error = context.get("exception")
+        self.note(f"loop: {message}", f"Modbus server: {message}{f': {error}' if error else ''}")
+
+    def _schedule_sweep(self) -> None:
+        assert self._loop is not None
+        self._sweep = self._loop.call_later(min(1.0, self.limits.idle_timeout / 4), self._close_idle)
+
+    def _close_idle(self) -> None:
+        """One timer for the whole server: connections silent (or holding half a frame) for
+        idle_timeout are closed."""
+        now, idle = self.loop_time(), self.limits.idle_timeout
+        for conn in list(self.connections):
+            if now - conn.last > idle and conn.transport is not None:
+                what = "half a frame" if conn.buf else "nothing"
+                self.note("idle", f"Modbus server closed the connection of {conn.peer}: {what} "
+                                  f"received for {idle:g} s (idle_timeout)")
+                conn.transport.abort()
+        self._schedule_sweep()
+
+    def finished(self, conn: _Connection, slot: list[Any], response: bytes) -> None:
+        """A write's answer is due (any thread): handed to the loop, one wake-up per batch."""
+        self._finished.append((conn, slot, response))
+        if not self._wake and self._loop is not None:
+            self._wake = True
+            with contextlib.suppress(RuntimeError):  # a closed loop: the server stopped, nobody to answer
+                self._loop.call_soon_threadsafe(self._deliver)
+
+    def _deliver(self) -> None:
+        self._wake = False
+        finished = self._finished
+        while finished:
+            conn, slot, response = finished.popleft()
+            conn.answered(slot, response)
 
     async def close(self) -> None:
+        if self._sweep is not None:
+            self._sweep.cancel()
         if self._server is not None:
             self._server.close()
         for conn in list(self.connections):
