@@ -127,6 +127,7 @@ class Engine:
         self.write_budget = write_budget
         self.write_queue = write_queue
         self.writes_refused = 0  # outside writes refused because the queue was full
+        self.writes_applied = 0  # outside writes applied (refused addresses included)
         self._stop_by = ""  # who set the emergency-stop bit 03770 from outside, for the record
         self._faulted: set[int] = set()
         self.mem.bits[TIMEBASE_LO] = 1  # 0.1 s time base after start, as on a CPU-165
@@ -415,6 +416,7 @@ class Engine:
                 self._stop_by = user
             if done is not None:
                 finished.append((done, ok))
+        self.writes_applied += n
         if not finished:
             return
 
