@@ -23,7 +23,7 @@ from pathlib import Path
 from app.config import NodeSettings, Station
 from netplc.engine import Engine
 from netplc.exchange import Exchange, NodeConfig, check_program_nodes
-from netplc.modbus.driver import parse_endpoint
+from netplc.modbus.driver import ServerLimits, parse_endpoint
 from netplc.modbus.server import ModbusServer
 from netplc.program import Program, ProgramError, load_symbols, parse, parse_file
 from netplc.records import Record
@@ -278,8 +278,9 @@ class Runtime:
         self.exchange.start()
         server = st.modbus_server
         if server.enabled:
+            limits = ServerLimits(server.max_connections, server.idle_timeout, server.max_inflight)
             modbus = ModbusServer(self.engine, host=server.host, port=server.port,
-                                  writable=list(server.writable), unit=server.unit)
+                                  writable=list(server.writable), unit=server.unit, limits=limits)
             try:
                 modbus.start()
                 self.modbus = modbus
