@@ -185,9 +185,10 @@ class _Node:
                 self.busy = True
                 try:
                     data, error = await (self.probe() if req is PROBE else self.serve(req))
-                except Exception as e:  # a bug must not end the node's task: report, go on
+                except Exception as e:  # a bug must not end the node's task, nor show the link up
                     self.line.failed()
                     data, error = None, f"internal error: {e!r}"
+                    self.down(error)
                 self.active, self.busy = time.monotonic(), False
                 if req is not PROBE:
                     self.exchange.complete(self, req, data, error)
@@ -238,14 +239,18 @@ class _Node:
         except (MapError, DeviceError) as e:  # the device answered: the link is up
             self.link(True, "")
             return None, f"{where}: {e}"
-        except LinkError as e:
-            self.retry_at = time.monotonic() + self.delay
-            self.delay = min(2 * self.delay, self.config.backoff_max)
-            self.link(False, str(e))
+        except LinkError as e:  # no answer, or one that is not the request's (ProtocolError)
+            self.down(str(e))
             return None, str(e)
         self.delay = self.config.backoff
         self.link(True, "")
         return result, ""
+
+    def down(self, error: str) -> None:
+        """Every attempt failed: the link is down and the node backs off."""
+        self.retry_at = time.monotonic() + self.delay
+        self.delay = min(2 * self.delay, self.config.backoff_max)
+        self.link(False, error)
 
     async def attempts(self, call: Callable[[], Awaitable[T]]) -> T:
         for attempt in range(self.config.retries + 1):

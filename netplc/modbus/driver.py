@@ -55,6 +55,11 @@ class LinkError(Exception):
     """The transport failed: connection refused or lost, or no answer within the timeout."""
 
 
+class ProtocolError(LinkError):
+    """An answer that is not the request's: too short, another function code or unit, a wrong
+    byte count or echo. It counts as a failed attempt, like no answer at all."""
+
+
 class DeviceError(Exception):
     """The device answered with a Modbus exception (2 = illegal data address, ...)."""
 
@@ -181,12 +186,13 @@ class PymodbusClient:
         self.endpoint = endpoint
         self.timeout = timeout
         self._client: AsyncModbusTcpClient | AsyncModbusSerialClient | None = None
+        self._malformed = ""  # what the last TCP frame received had wrong (pymodbus decodes leniently)
 
     def _make(self) -> AsyncModbusTcpClient | AsyncModbusSerialClient:
         ep = self.endpoint
         if ep.scheme == "tcp":
             return AsyncModbusTcpClient(ep.host, port=ep.port, timeout=self.timeout, retries=0,
-                                        reconnect_delay=0)
+                                        reconnect_delay=0, trace_packet=self._inspect)
         return AsyncModbusSerialClient(ep.device, framer=FramerType.RTU, baudrate=ep.baudrate,
                                        parity=ep.parity, bytesize=ep.bytesize, stopbits=ep.stopbits,
                                        timeout=self.timeout, retries=0, reconnect_delay=0)
@@ -207,13 +213,35 @@ class PymodbusClient:
             self._client.close()
             self._client = None
 
-    async def _call(self, what: str, request: Awaitable[Any]) -> Any:
+    def _inspect(self, sending: bool, data: bytes) -> bytes:
+        """pymodbus hands over what a TCP connection received: a read answer whose byte count is
+        not what its frame holds is malformed, though pymodbus would decode what it can of it."""
+        if not sending:
+            pos = 0
+            while len(data) - pos >= 9:
+                length = _MBAP.unpack_from(data, pos)[2]
+                pdu = data[pos + 7 : pos + 6 + length]
+                if len(pdu) < length - 1:
+                    break
+                if pdu[0] in _READ_TABLES and (len(pdu) != 2 + pdu[1] or (pdu[0] > 2 and pdu[1] % 2)):
+                    self._malformed = f"answer of {len(pdu)} bytes with byte count {pdu[1]}"
+                pos += 6 + length
+        return data
+
+    async def _call(self, what: str, request: Awaitable[Any], fc: int) -> Any:
+        """The answer to a request of function `fc`: a DeviceError for a Modbus exception, a
+        LinkError for no answer, a ProtocolError for an answer to another function."""
+        self._malformed = ""
         try:
             response = await request
         except (TimeoutError, ModbusException, OSError) as e:
             raise LinkError(f"{what}: {e}") from None
+        if self._malformed:
+            raise ProtocolError(f"{what}: {self._malformed}")
         if response.isError():
             raise DeviceError(getattr(response, "exception_code", 4), what)
+        if getattr(response, "function_code", None) != fc:
+            raise ProtocolError(f"{what}: answer with function {getattr(response, 'function_code', '?')}")
         return response
 
     async def read(self, unit: int, table: Table, address: int, count: int) -> list[int]:
@@ -222,18 +250,15 @@ class PymodbusClient:
         if c is None:
             raise LinkError(f"not connected to {self.endpoint}")
         what = f"read {table} {address}+{count}"
-        if table == "coils":
-            rr = await self._call(what, c.read_coils(address, count=count, device_id=unit))
-        elif table == "discrete":
-            rr = await self._call(what, c.read_discrete_inputs(address, count=count, device_id=unit))
-        elif table == "holding":
-            rr = await self._call(what, c.read_holding_registers(address, count=count, device_id=unit))
-        else:
-            rr = await self._call(what, c.read_input_registers(address, count=count, device_id=unit))
+        calls = {"coils": c.read_coils, "discrete": c.read_discrete_inputs,
+                 "holding": c.read_holding_registers, "input": c.read_input_registers}
+        rr = await self._call(what, calls[table](address, count=count, device_id=unit), _READ_CODES[table])
         if table in BIT_TABLES:
+            if len(rr.bits) != 8 * ((count + 7) // 8):
+                raise ProtocolError(f"{what}: {len(rr.bits)} coils in the answer")
             return [1 if b else 0 for b in rr.bits[:count]]
         if len(rr.registers) != count:
-            raise LinkError(f"{what}: {len(rr.registers)} registers in the answer")
+            raise ProtocolError(f"{what}: {len(rr.registers)} registers in the answer")
         return list(rr.registers)
 
     async def write(self, unit: int, table: Table, address: int, values: list[int]) -> None:
@@ -242,11 +267,13 @@ class PymodbusClient:
             raise LinkError(f"not connected to {self.endpoint}")
         what = f"write {table} {address}+{len(values)}"
         if table == "coils":
-            await self._call(what, c.write_coils(address, [bool(v) for v in values], device_id=unit))
+            rr = await self._call(what, c.write_coils(address, [bool(v) for v in values], device_id=unit), 15)
         elif table == "holding":
-            await self._call(what, c.write_registers(address, values, device_id=unit))
+            rr = await self._call(what, c.write_registers(address, values, device_id=unit), 16)
         else:
             raise MapError(f"{table} is a read-only table")
+        if (rr.address, rr.count) != (address, len(values)):
+            raise ProtocolError(f"{what}: the answer echoes {rr.address}+{rr.count}")
 
 
 class _Answers(asyncio.Protocol):
@@ -257,6 +284,7 @@ class _Answers(asyncio.Protocol):
         self.transport: asyncio.Transport | None = None
         self.waiter: asyncio.Future[bytes] | None = None
         self.tid = 0  # the transaction awaited; late answers to abandoned ones are dropped
+        self.unit = 0  # the unit it was sent to: an answer from another unit is a failed attempt
 
     def connection_made(self, transport: asyncio.BaseTransport) -> None:
         assert isinstance(transport, asyncio.Transport)
@@ -269,10 +297,13 @@ class _Answers(asyncio.Protocol):
             assert self.transport is not None
             self.transport.abort()
             return
-        for tid, _, pdu in frames:
+        for tid, unit, pdu in frames:
             waiter = self.waiter
             if tid == self.tid and waiter is not None and not waiter.done():
-                waiter.set_result(pdu)
+                if unit == self.unit:
+                    waiter.set_result(pdu)
+                else:
+                    waiter.set_exception(ProtocolError(f"answer from unit {unit}, not {self.unit}"))
 
     def connection_lost(self, exc: Exception | None) -> None:
         self.transport = None
@@ -285,7 +316,12 @@ class LeanTcpClient:
     """A Modbus TCP client of our own for the exchange's hot path: one request at a time per
     connection, an MBAP frame in and out, no per-request objects beyond the bytes. pymodbus's
     client spends most of NetPlc's CPU at a few thousand block reads per second (bench/exchange.py
-    shows both); this one also fails a request the moment its connection drops."""
+    shows both); this one also fails a request the moment its connection drops.
+
+    It has one waiter slot: the exchange holds its line's lock around every transaction, and a
+    second transaction started while one is in flight is refused (RuntimeError), never mixed up.
+    Every answer is checked against its request (unit id, function code, byte count, the echo of
+    a write); one that does not match is a ProtocolError."""
 
     def __init__(self, endpoint: Endpoint, timeout: float) -> None:
         self.endpoint = endpoint
@@ -316,20 +352,24 @@ class LeanTcpClient:
         proto = self._proto
         if proto is None or proto.transport is None:
             raise LinkError(f"{what}: not connected to {self.endpoint}")
+        if proto.waiter is not None:
+            raise RuntimeError(f"{what}: a transaction with {self.endpoint} is already in flight")
         self._tid = tid = self._tid % 0xFFFF + 1
         waiter = asyncio.get_running_loop().create_future()
-        proto.tid, proto.waiter = tid, waiter
+        proto.tid, proto.unit, proto.waiter = tid, unit, waiter
         proto.transport.write(_MBAP.pack(tid, 0, len(pdu) + 1, unit) + pdu)
         try:
             reply = await asyncio.wait_for(waiter, self.timeout)
         except TimeoutError:
             raise LinkError(f"{what}: no answer within {self.timeout:g} s") from None
+        except ProtocolError as e:
+            raise ProtocolError(f"{what}: {e}") from None
         finally:
             proto.waiter = None
-        if reply[0] == pdu[0] | 0x80 and len(reply) == 2:
+        if len(reply) == 2 and reply[0] == pdu[0] | 0x80:
             raise DeviceError(reply[1], what)
         if reply[0] != pdu[0]:
-            raise LinkError(f"{what}: answer with function {reply[0]}")
+            raise ProtocolError(f"{what}: answer with function {reply[0]} ({reply.hex(' ')})")
         return reply
 
     async def read(self, unit: int, table: Table, address: int, count: int) -> list[int]:
@@ -337,12 +377,12 @@ class LeanTcpClient:
         fc = _READ_CODES[table]
         reply = await self._transact(unit, struct.pack(">BHH", fc, address, count), what)
         data = reply[2:]
+        size = (count + 7) // 8 if table in BIT_TABLES else 2 * count
+        if len(reply) < 2 or reply[1] != size or len(data) != size:
+            raise ProtocolError(f"{what}: answer of {len(reply)} bytes ({reply[:8].hex(' ')}), "
+                                f"not {size} bytes of data")
         if table in BIT_TABLES:
-            if len(data) != reply[1] or len(data) != (count + 7) // 8:
-                raise LinkError(f"{what}: {len(data)} bytes of coils in the answer")
             return bits_from_bytes(data)[:count]
-        if len(data) != reply[1] or len(data) != 2 * count:
-            raise LinkError(f"{what}: {len(data) // 2} registers in the answer")
         return list(struct.unpack(f">{count}H", data))
 
     async def write(self, unit: int, table: Table, address: int, values: list[int]) -> None:
@@ -350,11 +390,14 @@ class LeanTcpClient:
         n = len(values)
         if table == "coils":
             data = bytes_from_bits(values)
-            await self._transact(unit, struct.pack(">BHHB", 15, address, n, len(data)) + data, what)
+            request = struct.pack(">BHHB", 15, address, n, len(data)) + data
         elif table == "holding":
-            await self._transact(unit, struct.pack(f">BHHB{n}H", 16, address, n, 2 * n, *values), what)
+            request = struct.pack(f">BHHB{n}H", 16, address, n, 2 * n, *values)
         else:
             raise MapError(f"{table} is a read-only table")
+        reply = await self._transact(unit, request, what)
+        if reply != request[:5]:
+            raise ProtocolError(f"{what}: the answer {reply.hex(' ')} does not echo {request[:5].hex(' ')}")
 
 
 # --- server --------------------------------------------------------------------------------------
