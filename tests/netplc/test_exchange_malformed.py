@@ -1,10 +1,13 @@
 """A node that answers, but not the request's answer (issue 18 items 2 and 9): a reply holding
 only the function code, another function code or unit id, a wrong byte count, a write echo that
 does not match. Each is a failed attempt: retries, then the link is down (link bit, presence byte,
-status) and journaled with the reason, with our lean client and with pymodbus's alike."""
+status) and journaled with the reason, with our lean client and with pymodbus's alike, over TCP
+and RTU."""
 
 from __future__ import annotations
 
+import os
+import select
 import socket
 import struct
 import threading
@@ -13,6 +16,7 @@ from collections.abc import Callable, Iterator
 import pytest
 
 from netplc.exchange import NodeConfig
+from netplc.modbus.rtu import crc16, take_frames
 from tests.netplc.test_exchange import Station, wait_until
 
 MBAP = struct.Struct(">HHHB")
@@ -125,3 +129,52 @@ def echo_elsewhere(unit: int, pdu: bytes) -> tuple[int, bytes]:
 def test_a_write_echo_that_does_not_match_is_a_failed_attempt(bad_node: BadNode, lean: bool) -> None:
     reason = link_goes_down(WRITE, bad_node, lean)
     assert "write holding 1024+2" in reason and "echo" in reason
+
+
+class BadRtuDevice:
+    """An RTU 'device' on a pty's master side answering every request with `reply(unit, pdu)`."""
+
+    def __init__(self, reply: Reply) -> None:
+        self.reply = reply
+        self.master, self.slave = os.openpty()
+        self.port = os.ttyname(self.slave)
+        self.stop = threading.Event()
+        self.thread = threading.Thread(target=self.serve, daemon=True)
+        self.thread.start()
+
+    def serve(self) -> None:
+        buf = bytearray()
+        while not self.stop.is_set():
+            if not select.select([self.master], [], [], 0.05)[0]:
+                continue
+            buf += os.read(self.master, 256)
+            requests, _ = take_frames(buf)
+            for frame in requests:
+                unit, answer = self.reply(frame[0], frame[1:-2])
+                out = bytes([unit]) + answer
+                os.write(self.master, out + crc16(out))
+
+    def close(self) -> None:
+        self.stop.set()
+        self.thread.join()
+        os.close(self.master)
+        os.close(self.slave)
+
+
+@pytest.mark.parametrize("reply", [MALFORMED["another function code"], MALFORMED["another unit id"]],
+                         ids=["another function code", "another unit id"])
+def test_a_malformed_rtu_answer_is_a_failed_attempt(reply: Reply) -> None:
+    device = BadRtuDevice(reply)
+    try:
+        st = Station(READ, [NodeConfig(1, f"rtu://{device.port}?baudrate=115200", timeout=0.3, retries=1,
+                                       backoff=0.1, backoff_max=0.2)])
+        st.start()
+        try:
+            wait_until(lambda: st.exchange.stats[1].errors >= 2, timeout=5)
+            assert st.engine.snapshot.get_bit(0o2105) == 0 and not st.exchange.link_up(1)
+            downs = [r.text or "" for r in st.sink.records if r.kind == "system" and r.source == "node 1"]
+            assert downs and all("link down" in t and "read holding 1024+1" in t for t in downs)
+        finally:
+            st.stop()
+    finally:
+        device.close()
