@@ -162,6 +162,10 @@ class RtuServer:
     def start(self) -> None:
         self._thread.start()
 
+    @property
+    def thread_alive(self) -> bool:
+        return self._thread.is_alive()
+
     def stop(self) -> None:
         self._stop.set()
         self._thread.join(2.0)
