@@ -136,6 +136,7 @@ def parse_endpoint(text: str) -> Endpoint:
 
 _MBAP = struct.Struct(">HHHB")  # Modbus TCP header: transaction, protocol 0, length, unit
 _READ_CODES: dict[str, int] = {"coils": 1, "discrete": 2, "holding": 3, "input": 4}
+_ADDRESS_REQUEST = struct.Struct(">BHH")  # function code, address, count (or value)
 
 
 def take_frames(buf: bytearray) -> list[tuple[int, int, bytes]] | None:
@@ -166,6 +167,8 @@ class ModbusClient(Protocol):
     def close(self) -> None: ...
 
     async def read(self, unit: int, table: Table, address: int, count: int) -> list[int]: ...
+
+    async def read_bytes(self, unit: int, table: Table, address: int, count: int) -> bytes: ...
 
     async def write(self, unit: int, table: Table, address: int, values: list[int]) -> None: ...
 
@@ -261,6 +264,12 @@ class PymodbusClient:
             raise ProtocolError(f"{what}: {len(rr.registers)} registers in the answer")
         return list(rr.registers)
 
+    async def read_bytes(self, unit: int, table: Table, address: int, count: int) -> bytes:
+        values = await self.read(unit, table, address, count)
+        if table in BIT_TABLES:
+            return bytes_from_bits(values)
+        return struct.pack(f">{count}H", *values)
+
     async def write(self, unit: int, table: Table, address: int, values: list[int]) -> None:
         c = self._client
         if c is None:
@@ -277,7 +286,12 @@ class PymodbusClient:
 
 
 class _Answers(asyncio.Protocol):
-    """Collects Modbus TCP answers on a client connection and hands the awaited one over."""
+    """Collects Modbus TCP answers on a client connection and hands the awaited one over.
+
+    One timer per connection watches the transaction in flight: it is armed once and, when it
+    fires, fails the transaction whose deadline has passed or re-arms for the one now in flight,
+    so a request costs no timer handle of its own (asyncio.wait_for costs one, a future and an
+    extra turn of the event loop per request)."""
 
     def __init__(self) -> None:
         self.buf = bytearray()
@@ -285,10 +299,27 @@ class _Answers(asyncio.Protocol):
         self.waiter: asyncio.Future[bytes] | None = None
         self.tid = 0  # the transaction awaited; late answers to abandoned ones are dropped
         self.unit = 0  # the unit it was sent to: an answer from another unit is a failed attempt
+        self.deadline = 0.0  # loop time by which the transaction in flight must be answered
+        self.timer: asyncio.TimerHandle | None = None
 
     def connection_made(self, transport: asyncio.BaseTransport) -> None:
         assert isinstance(transport, asyncio.Transport)
         self.transport = transport
+
+    def arm(self, loop: asyncio.AbstractEventLoop, timeout: float) -> None:
+        self.deadline = loop.time() + timeout
+        if self.timer is None:
+            self.timer = loop.call_at(self.deadline, self._expire, loop)
+
+    def _expire(self, loop: asyncio.AbstractEventLoop) -> None:
+        self.timer = None
+        waiter = self.waiter
+        if waiter is None or waiter.done():
+            return
+        if loop.time() + 1e-3 >= self.deadline:  # call_at may run up to the clock's resolution early
+            waiter.set_exception(TimeoutError())
+        else:
+            self.timer = loop.call_at(self.deadline, self._expire, loop)
 
     def data_received(self, data: bytes) -> None:
         self.buf += data
@@ -307,6 +338,9 @@ class _Answers(asyncio.Protocol):
 
     def connection_lost(self, exc: Exception | None) -> None:
         self.transport = None
+        if self.timer is not None:
+            self.timer.cancel()
+            self.timer = None
         waiter = self.waiter
         if waiter is not None and not waiter.done():
             waiter.set_exception(LinkError(f"connection lost{f': {exc}' if exc else ''}"))
@@ -314,9 +348,10 @@ class _Answers(asyncio.Protocol):
 
 class LeanTcpClient:
     """A Modbus TCP client of our own for the exchange's hot path: one request at a time per
-    connection, an MBAP frame in and out, no per-request objects beyond the bytes. pymodbus's
-    client spends most of NetPlc's CPU at a few thousand block reads per second (bench/exchange.py
-    shows both); this one also fails a request the moment its connection drops.
+    connection, an MBAP frame in and out, no per-request objects beyond the bytes and a future,
+    and the answer's data handed over as bytes (no list of ints). pymodbus's client spends most
+    of NetPlc's CPU at a few thousand block reads per second (bench/exchange.py shows both); this
+    one also fails a request the moment its connection drops.
 
     It has one waiter slot: the exchange holds its line's lock around every transaction, and a
     second transaction started while one is in flight is refused (RuntimeError), never mixed up.
@@ -355,11 +390,13 @@ class LeanTcpClient:
         if proto.waiter is not None:
             raise RuntimeError(f"{what}: a transaction with {self.endpoint} is already in flight")
         self._tid = tid = self._tid % 0xFFFF + 1
-        waiter = asyncio.get_running_loop().create_future()
+        loop = asyncio.get_running_loop()
+        waiter = loop.create_future()
         proto.tid, proto.unit, proto.waiter = tid, unit, waiter
+        proto.arm(loop, self.timeout)
         proto.transport.write(_MBAP.pack(tid, 0, len(pdu) + 1, unit) + pdu)
         try:
-            reply = await asyncio.wait_for(waiter, self.timeout)
+            reply = await waiter
         except TimeoutError:
             raise LinkError(f"{what}: no answer within {self.timeout:g} s") from None
         except ProtocolError as e:
@@ -372,15 +409,18 @@ class LeanTcpClient:
             raise ProtocolError(f"{what}: answer with function {reply[0]} ({reply.hex(' ')})")
         return reply
 
-    async def read(self, unit: int, table: Table, address: int, count: int) -> list[int]:
+    async def read_bytes(self, unit: int, table: Table, address: int, count: int) -> bytes:
+        """The answer's data as the wire carries it: registers big-endian, coils packed."""
         what = f"read {table} {address}+{count}"
-        fc = _READ_CODES[table]
-        reply = await self._transact(unit, struct.pack(">BHH", fc, address, count), what)
-        data = reply[2:]
+        reply = await self._transact(unit, _ADDRESS_REQUEST.pack(_READ_CODES[table], address, count), what)
         size = (count + 7) // 8 if table in BIT_TABLES else 2 * count
-        if len(reply) < 2 or reply[1] != size or len(data) != size:
+        if len(reply) != size + 2 or reply[1] != size:
             raise ProtocolError(f"{what}: answer of {len(reply)} bytes ({reply[:8].hex(' ')}), "
                                 f"not {size} bytes of data")
+        return reply[2:]
+
+    async def read(self, unit: int, table: Table, address: int, count: int) -> list[int]:
+        data = await self.read_bytes(unit, table, address, count)
         if table in BIT_TABLES:
             return bits_from_bytes(data)[:count]
         return list(struct.unpack(f">{count}H", data))

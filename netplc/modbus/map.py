@@ -158,6 +158,16 @@ class Block:
         raw = bytes_from_bits(values) if self.bits else bytes_from_words(values)
         return raw[self.skip : self.skip + self.length]
 
+    def decode_wire(self, data: bytes) -> bytes:
+        """The block's bytes straight from the answers' data as the wire carries it (registers
+        big-endian, coils packed bit 0 first): a byte swap by slicing, no list of ints."""
+        if self.bits:
+            return data[: self.length]
+        raw = bytearray(len(data))
+        raw[0::2] = data[1::2]
+        raw[1::2] = data[0::2]
+        return bytes(raw[self.skip : self.skip + self.length])
+
     def encode(self, payload: bytes, first: int = 0, last: int = 0) -> list[int]:
         """Register/coil values writing `payload`; `first`/`last` are the edge registers' current
         values, whose bytes outside the block are kept (read-modify-write of an odd edge)."""

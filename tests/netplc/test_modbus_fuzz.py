@@ -72,7 +72,8 @@ def read_check_over_tcp(port: int) -> bytes:
 
 @settings(max_examples=60, deadline=None, suppress_health_check=[HealthCheck.function_scoped_fixture])
 @given(chunks=streams)
-def test_tcp_server_survives_any_byte_stream(station: tuple[Engine, ModbusServer], chunks: list[bytes]) -> None:
+def test_tcp_server_survives_any_byte_stream(station: tuple[Engine, ModbusServer],
+                                             chunks: list[bytes]) -> None:
     _, server = station
     with socket.create_connection(("127.0.0.1", server.port), timeout=5) as sock:
         for chunk in chunks:

@@ -114,3 +114,12 @@ def test_bad_blocks_name_the_problem(
 ) -> None:
     with pytest.raises(MapError, match=message):
         locate(profile, table, remote, length)
+
+
+@pytest.mark.parametrize(("remote", "length"),
+                         [(0o4000, 4), (0o4001, 2), (0o4001, 5), (0o4000, 251), (0o2040, 3)])
+def test_decoding_the_wire_bytes_equals_decoding_the_values(remote: int, length: int) -> None:
+    block = locate("cpu165", "holding", remote, length)
+    values = [(0x1234 + 0x0101 * i) & (1 if block.bits else 0xFFFF) for i in range(block.count)]
+    wire = bytes_from_bits(values) if block.bits else b"".join(v.to_bytes(2, "big") for v in values)
+    assert block.decode_wire(wire) == block.decode(values)
