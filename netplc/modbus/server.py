@@ -42,11 +42,14 @@ class ModbusServer:
     coils, data byte addresses for registers (the two never overlap). None: read-only.
     `unit` None answers every unit id; otherwise other unit ids get exception 0x0B.
     `limits` bounds what clients may hold (connections, idle time, requests in flight).
+    `loop`: an event-loop thread to listen on, shared with other servers (many simulated nodes in
+    one process); by default the server has a thread of its own.
     """
 
     def __init__(self, engine: Engine, host: str = "127.0.0.1", port: int = 0,
                  writable: list[tuple[int, int]] | None = None, unit: int | None = None,
-                 serial: Endpoint | None = None, limits: ServerLimits | None = None) -> None:
+                 serial: Endpoint | None = None, limits: ServerLimits | None = None,
+                 loop: LoopThread | None = None) -> None:
         self.engine = engine
         self.host = host
         self.requested_port = port
@@ -58,7 +61,8 @@ class ModbusServer:
         self.serial = serial
         self.rtu: RtuServer | None = None
         self._server = TcpServer(self, unit, limits, self.journal)
-        self._thread = LoopThread(f"modbus-server-{host}:{port}")
+        self._own_thread = loop is None
+        self._thread = loop or LoopThread(f"modbus-server-{host}:{port}")
 
     @property
     def port(self) -> int:
@@ -76,11 +80,13 @@ class ModbusServer:
                                  reopen=lambda: open_line(serial), note=self.journal)
             self.rtu.start()
             return
-        self._thread.start()
+        if self._own_thread:
+            self._thread.start()
         try:
             self._thread.run(self._server.listen(self.host, self.requested_port))
         except BaseException:
-            self._thread.stop()
+            if self._own_thread:
+                self._thread.stop()
             raise
 
     def stop(self) -> None:
@@ -89,7 +95,8 @@ class ModbusServer:
             self.rtu = None
         if self._thread.loop is not None:
             self._thread.run(self._server.close())
-        self._thread.stop()
+        if self._own_thread:
+            self._thread.stop()
 
     # --- ServeHandler (on the server's loop) ------------------------------------------------------
 
