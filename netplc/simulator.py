@@ -21,8 +21,17 @@ from netplc.engine import Engine
 from netplc.modbus.driver import Endpoint, parse_endpoint
 from netplc.modbus.server import ALL_MEMORY, ModbusServer
 from netplc.program import Program, ProgramError, load_program
-from netplc.records import RecordSink
+from netplc.records import Record, RecordSink
 from netplc.scheduler import ScanThread
+
+
+class ConsoleSink:
+    """The simulator's journal when it runs on its own: the 'system' records (a serial port that
+    failed and works again, refused connections) on stderr; its writes are not worth a line each."""
+
+    def put(self, record: Record) -> None:
+        if record.kind == "system":
+            print(f"simulate: {record.text}", file=sys.stderr, flush=True)
 
 
 class Simulator:
@@ -90,7 +99,8 @@ def main(argv: list[str] | None = None) -> int:
     except OSError as e:
         print(f"simulate: {e}", file=sys.stderr)
         return 2
-    sim = Simulator(program, args.host, args.port, args.unit, args.tick / 1000.0, serial=serial)
+    sim = Simulator(program, args.host, args.port, args.unit, args.tick / 1000.0, sink=ConsoleSink(),
+                    serial=serial)
     where = f"{args.host}:{args.port}" if serial is None else serial.device
     try:
         sim.start()

@@ -68,6 +68,11 @@ class ModbusServer:
     def port(self) -> int:
         return self._server.port
 
+    @property
+    def fault(self) -> str:
+        """The serial port's failure while it lasts ("" when it works, and always over TCP)."""
+        return self.rtu.fault if self.rtu is not None else ""
+
     def journal(self, text: str) -> None:
         """A 'system' record of the server's own (refused connections, a serial port fault)."""
         self.engine.sink.put(Record(time.time(), "system", source="modbus server", text=text))
