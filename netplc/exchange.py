@@ -397,6 +397,8 @@ class Exchange:
         return stats is not None and stats.up
 
     def request_read(self, key: int, node: int, remote: int, local: int, length: int) -> bool:
+        if key in self._inflight:  # the usual case at a fast tick: nothing to build
+            return node in self._present
         return self._request(node, _Request(key, remote, local, length))
 
     def request_write(self, key: int, node: int, remote: int, payload: bytes) -> bool:
