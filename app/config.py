@@ -66,7 +66,7 @@ class ModbusServerSettings:
     unit: int | None = None  # the unit id answered; None: every unit id
     max_connections: int = 16  # the next connection is closed (one journal line a minute)
     idle_timeout: float = 60.0  # s without a whole request before a connection is closed
-    max_inflight: int = 32  # requests a connection may have unanswered or answers unread
+    max_inflight: int = 32  # answers (of the longest size) a connection may leave unread or waiting
 
 
 @dataclass(frozen=True)

@@ -456,7 +456,7 @@ class ServerLimits:
 
     max_connections: int = 16  # the next connection is closed at once
     idle_timeout: float = 60.0  # s without a whole request (silent, or a half frame): closed
-    max_inflight: int = 32  # requests a connection may have unanswered or answers unread
+    max_inflight: int = 32  # answers (of the longest size) a connection may leave unread or waiting
 
 
 class ServeHandler(Protocol):
@@ -567,8 +567,9 @@ class Throttle:
 
 class _Connection(asyncio.Protocol):
     """One client. Answers leave in the order of the requests: behind a write waiting for its
-    scan and journal record, later answers wait too. A connection stops being read while
-    `max_inflight` requests wait for answers or the client leaves that many answers unread."""
+    scan and journal record, later answers wait too. A connection stops being read while more
+    than `max_inflight` answers' worth of bytes wait to be read by the client or wait behind a
+    write; the writes themselves are bounded by the engine's queue (exception 6 when it is full)."""
 
     def __init__(self, server: TcpServer) -> None:
         self.server = server
@@ -576,6 +577,8 @@ class _Connection(asyncio.Protocol):
         self.transport: asyncio.Transport | None = None
         self.peer = "?"
         self.held: deque[list[Any]] = deque()  # [frame or None (waiting), tid, unit] behind a write
+        self.held_bytes = 0  # of the answers ready in `held`
+        self.high = server.limits.max_inflight * ADU_MAX  # answer bytes that may wait unread
         self.blocked = False  # the client does not read its answers (the transport's buffer is full)
         self.reading = True
         self.last = 0.0  # loop time of the last data
@@ -594,11 +597,12 @@ class _Connection(asyncio.Protocol):
         self.transport = transport
         self.last = server.loop_time()
         server.connections.add(self)
-        transport.set_write_buffer_limits(high=server.limits.max_inflight * ADU_MAX)
+        transport.set_write_buffer_limits(high=self.high)
 
     def connection_lost(self, exc: Exception | None) -> None:
         self.transport = None
         self.held.clear()
+        self.held_bytes = 0
         self.server.connections.discard(self)
 
     def pause_writing(self) -> None:
@@ -624,7 +628,7 @@ class _Connection(asyncio.Protocol):
         handler, only, limit = server.handler, server.unit, server.limits.max_inflight
         buf, held = self.buf, self.held
         pos, end, out, n = 0, len(self.buf), bytearray(), 0
-        while end - pos >= 8 and not self.blocked and len(held) < limit:
+        while end - pos >= 8 and not self.blocked and self.held_bytes < self.high:
             tid, proto, length, unit = _MBAP.unpack_from(buf, pos)
             if proto != 0 or not 2 <= length <= 254:
                 server.note("frames", f"Modbus server closed the connection of {self.peer}: "
@@ -673,7 +677,7 @@ class _Connection(asyncio.Protocol):
             self._send(out)
         if self.transport is None:
             return
-        stop = self.blocked or len(held) >= limit
+        stop = self.blocked or self.held_bytes >= self.high
         if stop and self.reading:
             self.reading = False
             transport.pause_reading()
@@ -684,6 +688,7 @@ class _Connection(asyncio.Protocol):
     def _send(self, frames: bytearray | bytes) -> None:
         if self.held:
             self.held.append([bytes(frames), 0, 0])
+            self.held_bytes += len(frames)
         elif self.transport is not None:
             self.transport.write(frames)
 
@@ -691,11 +696,13 @@ class _Connection(asyncio.Protocol):
         """A held write is journaled (server loop): send it and the answers held behind it."""
         if self.transport is None:
             return
-        slot[0] = _MBAP.pack(slot[1], 0, len(response) + 1, slot[2]) + response
+        slot[0] = frame = _MBAP.pack(slot[1], 0, len(response) + 1, slot[2]) + response
+        self.held_bytes += len(frame)
         held = self.held
         out = bytearray()
         while held and held[0][0] is not None:
             out += held.popleft()[0]
+        self.held_bytes -= len(out)
         if out:
             self.transport.write(out)
         if self.buf or not self.reading:

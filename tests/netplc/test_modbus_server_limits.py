@@ -98,7 +98,7 @@ def test_a_write_flood_is_bounded_per_scan_answered_busy_when_full_and_loses_no_
         archive: Store) -> None:
     clock = FakeClock()
     engine = Engine(parse("TNA $03760\nJMP 0\n"), clock=clock, sink=archive, write_budget=8, write_queue=64)
-    server = ModbusServer(engine, writable=ALL_MEMORY, limits=ServerLimits(max_inflight=5000))
+    server = ModbusServer(engine, writable=ALL_MEMORY)  # the default limits
     server.start()
     n = 3000
     try:
