@@ -10,6 +10,7 @@ the child's user + system time (Linux /proc) over the requests; the ratio is our
 Runs alternate between the two servers; medians are printed.
 
     .venv/bin/python bench/modbus_server.py [--requests N] [--runs R]
+    .venv/bin/python bench/modbus_server.py --flood 300000    # the write flood of issue 18
 """
 
 from __future__ import annotations
@@ -112,14 +113,72 @@ def hammer(port: int, requests: bytes, n: int, pid: int) -> tuple[float, float]:
     return 1e6 * cpu / n, n / wall
 
 
+def flood(n: int) -> None:
+    """Issue 18's write flood: n pipelined single-register writes from one client to a server with
+    the default limits and write budget, its engine's records going to a real archive, the scans
+    run back to back (a fake clock, 10 ms apart). Prints the longest scan, busy answers, records lost."""
+    import tempfile
+
+    from netplc.engine import Engine, FakeClock
+    from netplc.modbus.server import ALL_MEMORY, ModbusServer
+    from netplc.program import parse
+    from registrar.store import Store
+
+    with tempfile.TemporaryDirectory() as tmp:
+        store = Store(Path(tmp) / "journal.sqlite")
+        store.start()
+        clock = FakeClock()
+        engine = Engine(parse("TNA $03760\nJMP 0\n"), clock=clock, sink=store)
+        server = ModbusServer(engine, writable=ALL_MEMORY)
+        server.start()
+        sock = socket.create_connection(("127.0.0.1", server.port))
+        writes = b"".join(struct.pack(">HHHBBHH", i & 0xFFFF, 0, 6, 1, 6, 1024 + i % 1000, i & 0xFFFF)
+                          for i in range(n))
+        answers = {"done": 0, "busy": 0}
+
+        def read() -> None:
+            buf = b""
+            while answers["done"] + answers["busy"] < n:
+                data = sock.recv(1 << 20)
+                if not data:
+                    return
+                buf += data
+                while len(buf) >= 9 and len(buf) >= 6 + struct.unpack_from(">H", buf, 4)[0]:
+                    end = 6 + struct.unpack_from(">H", buf, 4)[0]
+                    answers["done" if buf[7] == 6 else "busy"] += 1
+                    buf = buf[end:]
+
+        reader = threading.Thread(target=read)
+        reader.start()
+        threading.Thread(target=sock.sendall, args=(writes,), daemon=True).start()
+        longest, scans, t0 = 0.0, 0, time.monotonic()
+        while reader.is_alive() and time.monotonic() - t0 < 300:
+            t = time.perf_counter()
+            clock.advance(0.1)
+            engine.scan()
+            longest = max(longest, 1000 * (time.perf_counter() - t))
+            scans += 1
+            time.sleep(0.01)
+        server.stop()
+        sock.close()
+        store.close()
+        print(f"flood: {n:,} pipelined writes: {answers['done']:,} done, {answers['busy']:,} busy "
+              f"(exception 6) in {scans} scans; longest scan {longest:.1f} ms (budget "
+              f"{engine.write_budget} writes per scan); archive records dropped {store.stats.dropped}")
+
+
 def main() -> int:
     p = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     p.add_argument("--requests", type=int, default=300_000, help="pipelined requests per run")
     p.add_argument("--runs", type=int, default=5, help="runs per server (alternating)")
+    p.add_argument("--flood", type=int, metavar="N", help="instead: N pipelined writes (issue 18's flood)")
     p.add_argument("--serve", choices=("ours", "floor"), help=argparse.SUPPRESS)
     args = p.parse_args()
     if args.serve:
         (serve_ours if args.serve == "ours" else serve_floor)()
+        return 0
+    if args.flood:
+        flood(args.flood)
         return 0
     n = args.requests
     requests = b"".join(struct.pack(">HHHBBHH", i & 0xFFFF, 0, 6, 1, 3, 1024, REGISTERS) for i in range(n))
