@@ -50,6 +50,9 @@ class ModbusServerSettings:
     port: int = 1502
     writable: tuple[tuple[int, int], ...] = DEFAULT_WRITABLE
     unit: int | None = None  # the unit id answered; None: every unit id
+    max_connections: int = 16  # the next connection is closed (one journal line a minute)
+    idle_timeout: float = 60.0  # s without a whole request before a connection is closed
+    max_inflight: int = 32  # answers (of the longest size) a connection may leave unread or waiting
 
 
 @dataclass(frozen=True)
@@ -294,9 +297,13 @@ def _modbus_server(problems: list[str], fname: str, table: dict[str, Any]) -> Mo
     port = r.number("port", 1502, 0, 65535)
     ranges = r.get("writable", list, None)
     unit = r.number("unit", None, 1, 247)
+    max_connections = r.number("max_connections", 16, 1, 1000)
+    max_inflight = r.number("max_inflight", 32, 1, 10_000)
+    idle_timeout = _seconds(r, "idle_timeout", 60.0, 0.1, 86_400.0)
     r.finish()
     writable = DEFAULT_WRITABLE if ranges is None else _ranges(r, ranges)
-    return ModbusServerSettings(enabled, host, port, writable, unit)
+    return ModbusServerSettings(enabled, host, port, writable, unit, max_connections, idle_timeout,
+                                max_inflight)
 
 
 def _ranges(r: _Reader, ranges: list[Any]) -> tuple[tuple[int, int], ...]:

@@ -34,7 +34,7 @@ from hmi_forms.form import Form
 from netplc.engine import Engine, RunState
 from netplc.exchange import Exchange, NodeConfig
 from netplc.forcing import Force, load_forces, save_forces
-from netplc.modbus import ModbusServer, parse_endpoint
+from netplc.modbus import ModbusServer, ServerLimits, parse_endpoint
 from netplc.problems import Problems
 from netplc.records import Record
 from netplc.scheduler import ScanThread
@@ -173,6 +173,17 @@ class Runtime:
         for observer in list(self._observers):
             observer(record)
 
+    def after_commit(self, callback: Callable[[], None]) -> None:
+        """`callback()` once every record put so far is on disk (the engine answers a Modbus write then)."""
+        if self.store is not None:
+            self.store.after_commit(callback)
+        else:
+            callback()
+
+    def room(self) -> int:
+        """Records the archive queue takes before it drops (the engine applies no write beyond it)."""
+        return self.store.room() if self.store is not None else 1 << 30
+
     def subscribe(self, observer: RecordObserver) -> None:
         """Call `observer(record)` for every record, from the thread that produced it."""
         self._observers.append(observer)
@@ -251,8 +262,9 @@ class Runtime:
         self.alarms.attach(self.engine, self.exchange)
         server = st.modbus_server
         if server.enabled:
+            limits = ServerLimits(server.max_connections, server.idle_timeout, server.max_inflight)
             modbus = ModbusServer(self.engine, host=server.host, port=server.port,
-                                  writable=list(server.writable), unit=server.unit)
+                                  writable=list(server.writable), unit=server.unit, limits=limits)
             try:
                 modbus.start()
                 self.modbus = modbus

@@ -2,8 +2,17 @@
 
 Only the engine thread mutates memory. Everything else (network results, operator writes, Modbus
 server writes) is queued with `post`/`write_*` and applied at the start of the next scan, and
-readers use the immutable snapshot published after each scan. The program is compiled once into
-generated Python (netplc/compiler.py); netplc/interpreter.py is the plain reference kept beside it.
+readers use the immutable snapshot published after each scan.
+
+Writes from outside (HMI operators, Modbus clients) are the one input nobody inside the station
+bounds, so they have a queue of their own with a per-scan budget (DESIGN 1): a scan applies at most
+`write_budget` of them, so the scan period holds whatever clients send, and a full queue refuses
+the next write (`write_*` returns False; the Modbus server answers exception 6, server busy). A
+writer that must answer someone passes `done`: it is called with True once the write is applied
+and its journal record is durable (the sink's `after_commit`), False if it could not be applied.
+
+The program is compiled once into generated Python (netplc/compiler.py); netplc/interpreter.py is
+the plain reference kept beside it.
 """
 
 from __future__ import annotations
@@ -37,6 +46,12 @@ from netplc.program import Program
 from netplc.records import NullSink, Record, RecordSink
 from netplc.rtc import Rtc
 from netplc.timers import held, make_ctr, make_tim, update_generators
+
+WRITE_BUDGET = 256  # outside writes applied per scan: a few ms at most, whatever clients send
+WRITE_QUEUE = 4096  # outside writes waiting; the next one is refused (Modbus exception 6)
+JOURNAL_ROOM = 1000  # records the sink must have room for beyond a scan's writes to apply them
+
+Done = Callable[[bool], None]
 
 
 class RunState(StrEnum):
@@ -88,6 +103,8 @@ class Engine:
         memory: Memory | None = None,
         compiled: bool = True,
         code_cache: str | Path | None = None,
+        write_budget: int = WRITE_BUDGET,
+        write_queue: int = WRITE_QUEUE,
     ) -> None:
         self.mem = memory or Memory()
         self.clock = clock
@@ -112,6 +129,13 @@ class Engine:
         self.rtc = Rtc()
         self.listeners: list[Callable[[Snapshot], None]] = []
         self._queue: deque[Callable[[Memory], None]] = deque()
+        # outside writes: (apply, done, user), at most write_queue waiting, write_budget per scan
+        self._writes: deque[tuple[Callable[[Memory], None], Done | None, str]] = deque()
+        self.write_budget = write_budget
+        self.write_queue = write_queue
+        self.writes_refused = 0  # outside writes refused because the queue was full
+        self.writes_applied = 0  # outside writes applied (refused addresses included)
+        self._stop_by = ""  # who set the emergency-stop bit 03770 from outside, for the record
         self._faulted: set[int] = set()
         self.mem.bits[TIMEBASE_LO] = 1  # 0.1 s time base after start, as on a CPU-165
         self.mem.bits[TIMEBASE_HI] = 0
@@ -231,14 +255,25 @@ class Engine:
     # --- queued writes -------------------------------------------------------------------------
 
     def post(self, fn: Callable[[Memory], None]) -> None:
-        """Run `fn(memory)` at the start of the next scan (thread-safe)."""
+        """Run `fn(memory)` at the start of the next scan (thread-safe). For the station's own
+        producers (exchange results, retentive capture, sync generators): outside writers go
+        through `write_*`, which are bounded."""
         self._queue.append(fn)
 
+    def _write(self, apply: Callable[[Memory], None], user: str, done: Done | None) -> bool:
+        if len(self._writes) >= self.write_queue:
+            self.writes_refused += 1
+            return False
+        self._writes.append((apply, done, user))
+        return True
+
     def write_bit(
-        self, addr: int | BitRef, value: int, *, user: str = "operator", label: str | None = None
-    ) -> None:
+        self, addr: int | BitRef, value: int, *, user: str = "operator", label: str | None = None,
+        done: Done | None = None,
+    ) -> bool:
         """Queue an operator write of an HMI bit address (journaled when applied, naming `label`,
-        e.g. the HMI element, so the log reads "write Пуск (040042)" rather than a bare address)."""
+        e.g. the HMI element, so the log reads "write Пуск (040042)" rather than a bare address).
+        False: the queue of outside writes is full and the write is refused."""
         hmi = addr.hmi if isinstance(addr, BitRef) else addr
 
         def apply(mem: Memory) -> None:
@@ -247,10 +282,25 @@ class Engine:
             where = fmt_octal(hmi, 6 if hmi >= 0o40000 else 5)
             self._journal(user, where, old, 1 if value else 0, hmi, label)
 
-        self.post(apply)
+        return self._write(apply, user, done)
+
+    def write_bits(self, addr: int, values: list[int], *, user: str = "operator",
+                   done: Done | None = None) -> bool:
+        """Queue a write of consecutive I/O bits from `addr`: one journal record for the block."""
+        new = "".join("1" if v else "0" for v in values)
+
+        def apply(mem: Memory) -> None:
+            bits = mem.bits
+            if addr < 0 or addr + len(values) > IO_BITS:
+                raise ValueError(f"bits {fmt_octal(addr)}+{len(values)} are not I/O bits")
+            old = "".join("1" if b else "0" for b in bits[addr : addr + len(values)])
+            bits[addr : addr + len(values)] = [1 if v else 0 for v in values]
+            self._journal(user, f"{fmt_octal(addr)}:{len(values)} bits", old, new, addr)
+
+        return self._write(apply, user, done)
 
     def write_word(self, addr: int, value: int, *, user: str = "operator", label: str | None = None,
-                   describe: Callable[[int, int], str] | None = None) -> None:
+                   describe: Callable[[int, int], str] | None = None, done: Done | None = None) -> bool:
         """Queue an operator write of a word. `describe(old, new)` says the change in the plant's
         terms ("0.0 -> 130.0 °C", a tag's); the record keeps the raw words and the address too."""
         def apply(mem: Memory) -> None:
@@ -264,15 +314,20 @@ class Engine:
                                      text=f"write {label}: {describe(old, new)} "
                                           f"(raw {old} -> {new} at {fmt_octal(addr)})"))
 
-        self.post(apply)
+        return self._write(apply, user, done)
 
-    def write_bytes(self, addr: int, payload: bytes, *, user: str = "operator") -> None:
+    def write_bytes(self, addr: int, payload: bytes, *, user: str = "operator",
+                    done: Done | None = None) -> bool:
         def apply(mem: Memory) -> None:
             old = mem.read(addr, len(payload))
             mem.write(addr, payload)
             self._journal(user, f"{fmt_octal(addr)}:{len(payload)}", old.hex(" "), payload.hex(" "), addr)
 
-        self.post(apply)
+        return self._write(apply, user, done)
+
+    @property
+    def writes_waiting(self) -> int:
+        return len(self._writes)
 
     def _journal(self, user: str, where: str, old: object, new: object, addr: int,
                  label: str | None = None) -> None:
@@ -312,15 +367,9 @@ class Engine:
         mem = self.mem
         queue = self._queue
         while queue:
-            fn = queue.popleft()
-            try:
-                fn(mem)
-            except ValueError as e:  # a queued write to an address that does not exist
-                self.sink.put(Record(self.wall_time(), "system", source="netplc", text=f"write refused: {e}"))
-            except Exception as e:  # a faulty producer must not cost the scan or the writes after it
-                text = f"queued write failed: {type(e).__name__}: {e}"
-                self.sink.put(Record(self.wall_time(), "system", source="netplc", text=text))
-            self.rtc.watch(mem)
+            self._apply(queue.popleft(), mem)
+        if self._writes:
+            self._apply_writes(mem)
         bits = mem.bits
         bits[ALWAYS_ONE] = 1
         update_generators(bits, now - self._start)
@@ -330,6 +379,11 @@ class Engine:
             forces.apply(mem)
         if bits[EMERGENCY_STOP] and self.state is RunState.RUNNING:
             self.stop(11)
+            if self._stop_by:
+                self.sink.put(Record(self.wall_time(), "system", source=self._stop_by, number=EMERGENCY_STOP,
+                                     text=f"NetPlc stopped, code 11: emergency-stop bit 03770 "
+                                          f"written by {self._stop_by}"))
+        self._stop_by = ""
         if self.state is RunState.RUNNING or self._stepping:
             outcome = self._run()
             if outcome == "halt":
@@ -371,6 +425,52 @@ class Engine:
         finally:
             self._stepping = False
             self.clock = clock
+
+    def _apply(self, fn: Callable[[Memory], None], mem: Memory) -> bool:
+        try:
+            fn(mem)
+        except ValueError as e:  # a queued write to an address that does not exist
+            self.sink.put(Record(self.wall_time(), "system", source="netplc", text=f"write refused: {e}"))
+            return False
+        except Exception as e:  # a faulty producer must not cost the scan or the writes after it
+            text = f"queued write failed: {type(e).__name__}: {e}"
+            self.sink.put(Record(self.wall_time(), "system", source="netplc", text=text))
+            return False
+        finally:
+            self.rtc.watch(mem)
+        return True
+
+    def _apply_writes(self, mem: Memory) -> None:
+        """This scan's share of the outside writes: at most the budget, and none the journal has no
+        room for (a write is never applied without its record). Their writers are told once the
+        records are durable: one commit for the whole scan's writes."""
+        writes, bits = self._writes, mem.bits
+        n = min(len(writes), self.write_budget)
+        room = getattr(self.sink, "room", None)
+        if room is not None:
+            n = min(n, max(0, room() - JOURNAL_ROOM))
+        finished: list[tuple[Done, bool]] = []
+        for _ in range(n):
+            apply, done, user = writes.popleft()
+            stopped = bits[EMERGENCY_STOP]
+            ok = self._apply(apply, mem)
+            if not stopped and bits[EMERGENCY_STOP]:
+                self._stop_by = user
+            if done is not None:
+                finished.append((done, ok))
+        self.writes_applied += n
+        if not finished:
+            return
+
+        def tell() -> None:
+            for done, ok in finished:
+                done(ok)
+
+        after_commit = getattr(self.sink, "after_commit", None)
+        if after_commit is None:
+            tell()
+        else:
+            after_commit(tell)
 
     def _publish(self) -> Snapshot:
         return self.mem.snapshot(self.scan_counter, self.now, self.wall_time(), self.state_text,

@@ -188,6 +188,7 @@ class _Node:
         self.idle = max(config.timeout, PROBE_IDLE)
         self.active = time.monotonic()  # when the last request or probe ended
         self.busy = False  # a request or probe is being served
+        self.blocks: dict[tuple[int, int], Block] = {}  # (remote, length) -> where it is
 
     async def run(self) -> None:
         watch = asyncio.get_running_loop().create_task(self.watch(), name=f"node {self.config.node} probe")
@@ -197,9 +198,10 @@ class _Node:
                 self.busy = True
                 try:
                     data, error = await (self.probe() if req is PROBE else self.serve(req))
-                except Exception as e:  # a bug must not end the node's task: report, go on
+                except Exception as e:  # a bug must not end the node's task, nor show the link up
                     self.line.failed()
                     data, error = None, f"internal error: {e!r}"
+                    self.down(error)
                 self.active, self.busy = time.monotonic(), False
                 if req is not PROBE:
                     self.exchange.complete(self, req, data, error)
@@ -230,11 +232,14 @@ class _Node:
         if now < self.retry_at:
             return None, self.stats.last_error or "link down"
         where = describe(self.config.profile, req.remote)
-        try:
-            block = locate(self.config.profile, self.config.table,
-                           req.remote, req.length if req.payload is None else len(req.payload))
-        except MapError as e:
-            return None, f"{where}: {e}"
+        length = req.length if req.payload is None else len(req.payload)
+        block = self.blocks.get((req.remote, length))
+        if block is None:  # an instruction asks for the same block every scan: map it once
+            try:
+                block = locate(self.config.profile, self.config.table, req.remote, length)
+            except MapError as e:
+                return None, f"{where}: {e}"
+            self.blocks[req.remote, length] = block
         if req.payload is None:
             data, error = await self.transact(lambda: self.read(block), where)
         else:
@@ -250,18 +255,26 @@ class _Node:
         except (MapError, DeviceError) as e:  # the device answered: the link is up
             self.link(True, "")
             return None, f"{where}: {e}"
-        except LinkError as e:
-            self.retry_at = time.monotonic() + self.delay
-            self.delay = min(2 * self.delay, self.config.backoff_max)
-            self.link(False, str(e))
+        except LinkError as e:  # no answer, or one that is not the request's (ProtocolError)
+            self.down(str(e))
             return None, str(e)
         self.delay = self.config.backoff
         self.link(True, "")
         return result, ""
 
+    def down(self, error: str) -> None:
+        """Every attempt failed: the link is down and the node backs off."""
+        self.retry_at = time.monotonic() + self.delay
+        self.delay = min(2 * self.delay, self.config.backoff_max)
+        self.link(False, error)
+
     async def attempts(self, call: Callable[[], Awaitable[T]]) -> T:
         for attempt in range(self.config.retries + 1):
             try:
+                if not self.line.serial:  # a TCP node's connection is its own: nothing to share
+                    if not self.client.connected:
+                        await self.client.connect()
+                    return await call()
                 async with self.line.lock:
                     if not self.client.connected:
                         await self.client.connect()
@@ -273,10 +286,11 @@ class _Node:
         raise AssertionError("unreachable")
 
     async def read(self, block: Block) -> bytes:
-        values: list[int] = []
-        for address, count in block.spans(write=False):
-            values += await self.client.read(self.config.unit, block.table, address, count)
-        return block.decode(values)
+        spans = block.spans(write=False)
+        unit, table, client = self.config.unit, block.table, self.client
+        if len(spans) == 1:
+            return block.decode_wire(await client.read_bytes(unit, table, *spans[0]))
+        return block.decode_wire(b"".join([await client.read_bytes(unit, table, a, n) for a, n in spans]))
 
     async def write(self, block: Block, payload: bytes) -> bytes:
         if block.table not in WRITABLE_TABLES:
@@ -404,6 +418,8 @@ class Exchange:
         return stats is not None and stats.changed > 0
 
     def request_read(self, key: int, node: int, remote: int, local: int, length: int) -> bool:
+        if key in self._inflight:  # the usual case at a fast tick: nothing to build
+            return node in self._present
         return self._request(node, _Request(key, remote, local, length))
 
     def request_write(self, key: int, node: int, remote: int, payload: bytes) -> bool:

@@ -6,6 +6,7 @@ and tests use ListSink. Columns mirror the archive table (docs/architecture.md s
 
 from __future__ import annotations
 
+from collections.abc import Callable
 from dataclasses import dataclass
 from typing import Literal, Protocol
 
@@ -26,6 +27,16 @@ class Record:
 
 class RecordSink(Protocol):
     def put(self, record: Record) -> None: ...
+
+
+class DurableSink(RecordSink, Protocol):
+    """A sink that can say when records are on disk (the registrar's Store): the engine answers an
+    outside writer only then (DESIGN 1), and applies no write whose record it has no room for.
+    A sink without these methods counts a record as journaled once `put`."""
+
+    def after_commit(self, callback: Callable[[], None]) -> None: ...
+
+    def room(self) -> int: ...
 
 
 class ListSink:

@@ -20,8 +20,17 @@ import threading
 from netplc.engine import Engine
 from netplc.modbus import ALL_MEMORY, Endpoint, ModbusServer, parse_endpoint
 from netplc.program import Program, ProgramError, load_program
-from netplc.records import RecordSink
+from netplc.records import Record, RecordSink
 from netplc.scheduler import ScanThread
+
+
+class ConsoleSink:
+    """The simulator's journal when it runs on its own: the 'system' records (a serial port that
+    failed and works again, refused connections) on stderr; its writes are not worth a line each."""
+
+    def put(self, record: Record) -> None:
+        if record.kind == "system":
+            print(f"simulate: {record.text}", file=sys.stderr, flush=True)
 
 
 class Simulator:
@@ -89,7 +98,8 @@ def main(argv: list[str] | None = None) -> int:
     except OSError as e:
         print(f"simulate: {e}", file=sys.stderr)
         return 2
-    sim = Simulator(program, args.host, args.port, args.unit, args.tick / 1000.0, serial=serial)
+    sim = Simulator(program, args.host, args.port, args.unit, args.tick / 1000.0, sink=ConsoleSink(),
+                    serial=serial)
     where = f"{args.host}:{args.port}" if serial is None else serial.device
     try:
         sim.start()

@@ -83,6 +83,15 @@ def _day_of(ms: int) -> tuple[int, int, str]:
     return round(start * 1000), round(end * 1000), table_name(day)
 
 
+class _Barrier:
+    """A place in the queue: its callback runs once every record queued before it is committed."""
+
+    __slots__ = ("callback",)
+
+    def __init__(self, callback: Callable[[], None]) -> None:
+        self.callback = callback
+
+
 @dataclass(frozen=True)
 class StoreStats:
     queued: int = 0  # records waiting in the queue
@@ -131,6 +140,8 @@ class Store:
         self._reported_drops = 0
         self._failing_since: float | None = None
         self._new_day = False  # a day table was opened: run retention after the commit
+        self._barriers = 0  # _Barrier items in the queue (under the lock)
+        self._due: list[_Barrier] = []  # barriers taken with the batch being written
 
     # --- producer side (any thread) ------------------------------------------------------------
 
@@ -148,6 +159,21 @@ class Store:
         queue.append(record)
         if len(queue) >= BATCH_MAX:
             self._wake.set()
+
+    def after_commit(self, callback: Callable[[], None]) -> None:
+        """Call `callback()` in the writer thread once every record put before this call is
+        committed (durable through a crash of the process): a Modbus write is answered only then.
+        The writer is woken at once, so the wait is one commit rather than a flush interval, and
+        the barriers of one moment share that commit. A record dropped by a full queue is never
+        committed, so writers check `room()` before they produce records that must not be lost."""
+        with self._lock:
+            self._barriers += 1
+            self._queue.append(_Barrier(callback))  # type: ignore[arg-type]
+        self._wake.set()
+
+    def room(self) -> int:
+        """Records the queue takes before it drops."""
+        return self.queue_size - len(self._queue)
 
     @property
     def stats(self) -> StoreStats:
@@ -250,16 +276,34 @@ class Store:
             if not pending:
                 pending = self._take()
                 if not pending:
+                    self._release()  # barriers with no record behind them
                     return []
             if not self._write(pending):
                 return pending
             pending = []
+            self._release()
+
+    def _release(self) -> None:
+        """The barriers taken with a committed batch: their writers may now be answered."""
+        due, self._due = self._due, []
+        for barrier in due:
+            try:
+                barrier.callback()
+            except Exception as e:  # a waiter's bug must not stop the archive
+                self._queue.append(Record(self.wallclock(), "system", source=SOURCE,
+                                          text=f"archive commit waiter failed: {e!r}"))
 
     def _take(self) -> list[Record]:
         queue = self._queue
         n = min(len(queue), BATCH_MAX)
-        batch = [queue.popleft() for _ in range(n)]
         with self._lock:
+            batch = [queue.popleft() for _ in range(n)]
+            if self._barriers:
+                due = [b for b in batch if type(b) is _Barrier]
+                if due:
+                    self._barriers -= len(due)
+                    self._due += due  # type: ignore[arg-type]
+                    batch = [r for r in batch if type(r) is not _Barrier]
             dropped = self._dropped
             if self._overflowing and len(queue) < self.queue_size:
                 self._overflowing = False

@@ -13,6 +13,7 @@ from netplc.modbus.driver import (
     LinkError,
     LoopThread,
     ModbusClient,
+    ServerLimits,
     open_client,
     parse_endpoint,
 )
@@ -32,8 +33,26 @@ from netplc.modbus.map import (
 from netplc.modbus.server import ALL_MEMORY, ModbusServer
 
 __all__ = [
-    "ALL_MEMORY", "MAX_READ_BITS", "MAX_READ_REGISTERS", "PROFILES", "TABLES", "WRITABLE_TABLES",
-    "Block", "DeviceError", "Endpoint", "LeanTcpClient", "LinkError", "LoopThread", "MapError",
-    "ModbusClient", "ModbusServer", "Table", "bytes_from_words", "describe", "locate", "open_client",
+    "ALL_MEMORY",
+    "MAX_READ_BITS",
+    "MAX_READ_REGISTERS",
+    "PROFILES",
+    "TABLES",
+    "WRITABLE_TABLES",
+    "Block",
+    "DeviceError",
+    "Endpoint",
+    "LeanTcpClient",
+    "LinkError",
+    "LoopThread",
+    "MapError",
+    "ModbusClient",
+    "ModbusServer",
+    "ServerLimits",
+    "Table",
+    "bytes_from_words",
+    "describe",
+    "locate",
+    "open_client",
     "parse_endpoint",
 ]

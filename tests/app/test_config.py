@@ -117,6 +117,33 @@ backoff_max = 2
     assert load_station(tmp_path).modbus_server.unit is None  # every unit id is answered
 
 
+def test_modbus_server_limits_have_safe_defaults_and_are_checked(tmp_path: Path) -> None:
+    write_station(tmp_path, "NetPlcLoad = false\n")
+    server = load_station(tmp_path).modbus_server
+    assert (server.max_connections, server.idle_timeout, server.max_inflight) == (16, 60.0, 32)
+    write_station(tmp_path, """
+NetPlcLoad = false
+[modbus_server]
+max_connections = 4
+idle_timeout = 5
+max_inflight = 8
+""")
+    server = load_station(tmp_path).modbus_server
+    assert (server.max_connections, server.idle_timeout, server.max_inflight) == (4, 5.0, 8)
+    write_station(tmp_path, """
+NetPlcLoad = false
+[modbus_server]
+max_connections = 0
+idle_timeout = -1
+max_inflight = "many"
+""")
+    with pytest.raises(ConfigError) as e:
+        load_station(tmp_path)
+    text = str(e.value)
+    for key in ("max_connections: 0 is outside", "idle_timeout:", "max_inflight: expected an integer"):
+        assert f"modbus_server.{key}" in text
+
+
 def test_node_timing_and_line_problems_are_named_by_key(tmp_path: Path) -> None:
     write_station(tmp_path, """
 NetPlcLoad = false

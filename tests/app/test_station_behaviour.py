@@ -89,7 +89,8 @@ def drive(runtime: Runtime, scans: Scans, wait) -> None:
     wait(lambda: runtime.status().nodes_up == 1)
     engine.write_bit(ENABLE, 1, user="test")
     engine.write_bit(PUMP, 1, user="test")
-    runtime.simulators[0].engine.write_word(TEMP, 900)  # raw 900 = 130 °C
+    # raw 1000 = 150 °C: the node pulls it back 1/32 a scan, so it stays over 120 °C for ~1 s
+    runtime.simulators[0].engine.write_word(TEMP, 1000)
     start = scans.count()
     wait(lambda: scans.count() > start + 30)
 

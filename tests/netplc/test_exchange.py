@@ -64,9 +64,9 @@ def wait_until(cond: Callable[[], bool], timeout: float = 3.0) -> float:
 class Station:
     """A NetPlc engine on its scan thread with an exchange to the given nodes."""
 
-    def __init__(self, program: str, nodes: list[NodeConfig], tick: float = TICK) -> None:
+    def __init__(self, program: str, nodes: list[NodeConfig], tick: float = TICK, lean: bool = True) -> None:
         self.sink = ListSink()
-        self.exchange = Exchange(nodes, self.sink)
+        self.exchange = Exchange(nodes, self.sink, lean=lean)
         self.engine = Engine(parse(program, "netplc.stl"), tick=tick, sink=self.sink)
         self.exchange.attach(self.engine)
         self.scan = ScanThread(self.engine, tick)

@@ -12,7 +12,7 @@ from netplc.modbus.map import (
     bytes_from_bits,
     locate,
     read_bits,
-    read_registers,
+    register_slice,
     registers_target,
     words_from_bytes,
 )
@@ -22,11 +22,11 @@ def test_register_1024_is_word_04000_little_endian() -> None:
     mem = Memory()
     mem.set_word(0o4000, 0x1234)
     mem.set_word(0o4002, 0xBEEF)
-    assert read_registers(mem, 1024, 2) == [0x1234, 0xBEEF]
+    assert register_slice(mem.data, 1024, 2) == bytes([0x12, 0x34, 0xBE, 0xEF])  # as the answer carries them
     assert registers_target(1024, 1) == 0o4000
     # bank 1 starts at 014000 = register 3072
     mem.set_word(0o14000, 7)
-    assert read_registers(mem, 0o14000 // 2, 1) == [7]
+    assert register_slice(mem.data, 0o14000 // 2, 1) == b"\x00\x07"
 
 
 def test_coil_n_is_io_bit_n() -> None:
@@ -39,11 +39,11 @@ def test_coil_n_is_io_bit_n() -> None:
 @pytest.mark.parametrize(
     ("address", "count"),
     [(0, 1), (1023, 1), (0o4000 // 2 - 1, 2), (0o10000 // 2, 1), (0o14000 // 2 - 1, 2),
-     (0o77777 // 2 + 1, 1)],
+     (0o77777 // 2 + 1, 1), (0o77776 // 2, 2), (65535, 125)],
 )
 def test_registers_outside_data_memory_are_refused(address: int, count: int) -> None:
     with pytest.raises(MapError):
-        read_registers(Memory(), address, count)
+        register_slice(Memory().data, address, count)
     with pytest.raises(MapError):
         registers_target(address, count)
 
@@ -114,3 +114,12 @@ def test_bad_blocks_name_the_problem(
 ) -> None:
     with pytest.raises(MapError, match=message):
         locate(profile, table, remote, length)
+
+
+@pytest.mark.parametrize(("remote", "length"),
+                         [(0o4000, 4), (0o4001, 2), (0o4001, 5), (0o4000, 251), (0o2040, 3)])
+def test_decoding_the_wire_bytes_equals_decoding_the_values(remote: int, length: int) -> None:
+    block = locate("cpu165", "holding", remote, length)
+    values = [(0x1234 + 0x0101 * i) & (1 if block.bits else 0xFFFF) for i in range(block.count)]
+    wire = bytes_from_bits(values) if block.bits else b"".join(v.to_bytes(2, "big") for v in values)
+    assert block.decode_wire(wire) == block.decode(values)

@@ -5,6 +5,7 @@ from __future__ import annotations
 
 import socket
 import struct
+import threading
 from collections.abc import Iterator
 
 import pytest
@@ -56,23 +57,52 @@ def test_reads_outside_memory_answer_exception_2(client: ModbusTcpClient) -> Non
         assert rr.isError() and rr.exception_code == 2
 
 
+class Scanning:
+    """Scans the engine on a thread of its own while the test's client waits for its answers (a
+    write is answered once a scan has applied and journaled it), the clock stepped by hand."""
+
+    def __init__(self, engine: Engine) -> None:
+        self.engine = engine
+        self.stop = threading.Event()
+        self.thread = threading.Thread(target=self.run, daemon=True)
+
+    def run(self) -> None:
+        clock = self.engine.clock
+        assert isinstance(clock, FakeClock)
+        while not self.stop.wait(0.005):
+            clock.advance(0.1)
+            self.engine.scan()
+
+    def __enter__(self) -> Scanning:
+        self.thread.start()
+        return self
+
+    def __exit__(self, *exc: object) -> None:
+        self.stop.set()
+        self.thread.join()
+
+
 def test_writes_are_queued_into_the_scan_and_journaled_with_the_peer(
     served: tuple[Engine, ModbusServer, ListSink], client: ModbusTcpClient
 ) -> None:
     engine, _, sink = served
-    assert not client.write_register(1026, 0xBEEF, device_id=1).isError()  # word 04004
-    assert not client.write_registers(1028, [1, 2], device_id=1).isError()  # 04010..04013
-    assert not client.write_coil(0o2043, True, device_id=1).isError()
-    assert not client.write_coils(0o2050, [True] + [False] * 6 + [True], device_id=1).isError()
-    assert engine.snapshot.get_word(0o4004) == 0  # not before the next scan
-    engine.scan()
+    scans = engine.scan_counter
+    with Scanning(engine):
+        assert not client.write_register(1026, 0xBEEF, device_id=1).isError()  # word 04004
+        assert engine.scan_counter > scans  # answered only once a scan applied it
+        assert not client.write_registers(1028, [1, 2], device_id=1).isError()  # 04010..04013
+        assert not client.write_coil(0o2043, True, device_id=1).isError()
+        assert not client.write_coils(0o2050, [True] + [False] * 6 + [True], device_id=1).isError()
+        assert not client.write_coils(0o2060, [True, False, True], device_id=1).isError()
     snap = engine.snapshot
     assert snap.get_word(0o4004) == 0xBEEF
     assert snap.read(0o4010, 4) == bytes([1, 0, 2, 0])
     assert snap.get_bit(0o2043) == 1
     assert [snap.get_bit(0o2050 + i) for i in range(8)] == [1, 0, 0, 0, 0, 0, 0, 1]
+    assert [snap.get_bit(0o2060 + i) for i in range(4)] == [1, 0, 1, 0]
     ops = [r for r in sink.records if r.kind == "operator"]
-    assert len(ops) == 4
+    assert len(ops) == 5  # one record per request, also for coils that are not whole bytes
+    assert ops[4].text == "write 02060:3 bits: 000 -> 101"
     local_port = client.socket.getsockname()[1]
     assert {r.source for r in ops} == {f"modbus 127.0.0.1:{local_port}"}
     assert ops[0].text == "write 04004: 0 -> 48879"

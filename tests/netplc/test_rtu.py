@@ -8,11 +8,13 @@ plays the RTU master on the master side, byte for byte.
 
 from __future__ import annotations
 
+import contextlib
 import os
 import select
 import subprocess
 import sys
 import time
+import tty
 from collections.abc import Iterator
 from pathlib import Path
 
@@ -20,7 +22,7 @@ import pytest
 
 from netplc.engine import Engine
 from netplc.exchange import NodeConfig
-from netplc.modbus.rtu import RtuServer, crc16, request_length
+from netplc.modbus.rtu import RtuServer, crc16, request_length, take_frames
 from netplc.modbus.server import ALL_MEMORY, ModbusServer
 from netplc.program import parse
 from netplc.scheduler import ScanThread
@@ -214,7 +216,99 @@ def test_the_rtu_slave_ignores_bad_frames_and_other_units_and_refuses_unknown_co
 def test_rtu_request_lengths() -> None:
     assert request_length(b"\x05") == 0 and request_length(b"\x05\x03") == 8
     assert request_length(bytes.fromhex("05 10 0000 0002 04")) == 13 and request_length(b"\x05\x10\x00") == 0
-    assert request_length(b"\x05\x2b") is None  # the silence ends it
+    assert request_length(bytes.fromhex("05 2b 0e 01 00")) == 7  # pymodbus knows every code's length
+    assert request_length(b"\x05\x63") is None  # a code nobody knows: its CRC or the silence ends it
+
+
+ASK2 = frame(2, bytes.fromhex("03 0400 0040"))  # the master polls unit 2 for 64 registers
+ANSWER2 = frame(2, bytes([3, 128]) + bytes(range(128)))  # unit 2 answers
+ASK5 = frame(UNIT, bytes.fromhex("03 0400 0001"))  # then polls us
+
+
+def test_frames_are_found_by_length_and_crc_on_a_shared_bus() -> None:
+    buf = bytearray((ASK2 + ANSWER2 + ASK5) * 5)
+    requests, skipped = take_frames(buf)
+    assert requests == [ASK2, ASK5] * 5 and skipped == 0 and not buf
+    # noise before a frame is skipped byte by byte; a split frame waits for the rest
+    buf = bytearray(b"\xff\x00" + ASK5 + ASK5[:3])
+    assert take_frames(buf) == ([ASK5], 2) and buf == ASK5[:3]
+    buf += ASK5[3:]
+    assert take_frames(buf) == ([ASK5], 0)
+    unknown = frame(UNIT, bytes.fromhex("63 01 02 03"))  # found by its CRC
+    buf = bytearray(unknown + ASK5)
+    assert take_frames(buf)[0] == [unknown, ASK5]
+    buf = bytearray(b"\x07\x03\x99\x00")  # looks like the start of a long answer: the silence ends it
+    assert take_frames(buf) == ([], 0) and take_frames(buf, silent=True) == ([], 4) and not buf
+
+
+def raw_slave_side(port: str) -> int:
+    fd = os.open(port, os.O_RDWR | os.O_NOCTTY)
+    tty.setraw(fd)
+    return fd
+
+
+def replies(fd: int, size: int, wait: float = 3.0) -> bytes:
+    data = b""
+    deadline = time.monotonic() + wait
+    while len(data) < size and time.monotonic() < deadline:
+        if select.select([fd], [], [], 0.05)[0]:
+            data += os.read(fd, 1024)
+    return data
+
+
+def test_the_slave_answers_every_poll_on_a_shared_bus_with_no_idle_gap(rtu_node: RtuNode) -> None:
+    fd = raw_slave_side(rtu_node.port)
+    try:
+        os.write(fd, (ASK2 + ANSWER2 + ASK5) * 5)
+        answer = frame(UNIT, bytes.fromhex("03 02 5aa5"))
+        assert replies(fd, 5 * len(answer)) == answer * 5
+        deadline = time.monotonic() + 3.0  # the count follows the write of the answer
+        while rtu_node.server.answered < 5 and time.monotonic() < deadline:
+            time.sleep(0.01)
+        assert rtu_node.server.answered == 5
+    finally:
+        os.close(fd)
+
+
+def test_a_broadcast_write_is_done_and_a_broadcast_read_is_not(rtu_node: RtuNode) -> None:
+    fd = raw_slave_side(rtu_node.port)
+    try:
+        os.write(fd, frame(0, bytes.fromhex("03 0400 0001")) + frame(0, bytes.fromhex("06 0402 0077")))
+        wait_until(lambda: rtu_node.engine.snapshot.get_word(0o4004) == 0x0077)
+        assert replies(fd, 1, wait=0.3) == b""
+        assert rtu_node.server.answered == 0
+    finally:
+        os.close(fd)
+
+
+def test_a_serial_port_failure_is_journaled_and_retried() -> None:
+    engine = Engine(parse("JMP 0\n"), tick=0.01)
+    notes: list[str] = []
+    ptys: list[tuple[int, int]] = [os.openpty()]
+
+    def reopen() -> PtyLine:
+        ptys.append(os.openpty())
+        return PtyLine(ptys[-1][0])
+
+    server = RtuServer(ModbusServer(engine, writable=ALL_MEMORY), UNIT, PtyLine(ptys[0][0]), "pty",
+                       reopen=reopen, note=notes.append)
+    server.start()
+    try:
+        os.close(ptys[0][1])  # the adapter is unplugged: reading the line fails (EIO)
+        wait_until(lambda: len(notes) >= 1)
+        assert notes[0].startswith("Modbus RTU on pty failed: ") and "retrying every 1 s" in notes[0]
+        wait_until(lambda: notes[-1] == "Modbus RTU on pty works again", timeout=5)
+        assert server.fault == ""
+        fd = ptys[-1][1]
+        tty.setraw(fd)
+        os.write(fd, ASK5)
+        assert replies(fd, 7) == frame(UNIT, bytes.fromhex("03 02 0000"))
+    finally:
+        server.stop()
+        for master, slave in ptys:
+            for f in (master, slave):
+                with contextlib.suppress(OSError):
+                    os.close(f)
 
 
 def test_simulate_with_a_serial_port_that_cannot_be_opened(tmp_path: Path) -> None:
