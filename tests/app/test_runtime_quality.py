@@ -9,7 +9,7 @@ from pathlib import Path
 
 from app.config import load_station
 from app.runtime import Runtime
-from netplc.tags.alarms import State
+from netplc.tags.alarms import STOPPED_ID, State
 from netplc.tags.quality import Quality
 from tests.netplc.test_exchange import wait_until
 
@@ -99,3 +99,26 @@ def test_the_operator_pulls_and_plugs_a_simulated_nodes_cable(demo_copy: Path) -
                    runtime.alarms.system.get("LEVEL.BAD").state is State.RTNUN, timeout=5)
     finally:
         runtime.stop()
+
+
+def test_stopping_netplc_raises_one_station_alarm_and_running_again_nothing_spurious(demo_copy: Path) -> None:
+    runtime = Runtime(load_station(demo_copy))
+    seen: list = []
+    runtime.subscribe(lambda r: seen.append(r) if r.kind == "alarm" else None)
+    runtime.start()
+    try:
+        wait_until(lambda: quality(runtime, "LEVEL") is Quality.GOOD, timeout=10)
+        assert runtime.alarms is not None
+        runtime.stop_program()
+        wait_until(lambda: runtime.alarms is not None and
+                   runtime.alarms.system.get(STOPPED_ID).state is State.UNACK, timeout=5)
+        assert quality(runtime, "LEVEL") is Quality.NOT_RUNNING
+        runtime.run_program()
+        wait_until(lambda: quality(runtime, "LEVEL") is Quality.GOOD, timeout=10)
+        wait_until(lambda: runtime.alarms is not None and
+                   runtime.alarms.system.get(STOPPED_ID).state is State.RTNUN, timeout=5)
+    finally:
+        runtime.stop()
+    assert not [r for r in seen if r.source.endswith(".BAD")]  # not one quality alarm per tag
+    stops = [(r.number, r.type) for r in seen if r.source == STOPPED_ID]
+    assert stops == [(State.NORMAL, State.UNACK), (State.UNACK, State.RTNUN)]
