@@ -21,8 +21,8 @@ EXPORT_CHUNK = 10_000
 class Filter:
     kinds: set[str] | frozenset[str] | None = None
     grp: int | None = None
-    type: int | None = None
-    min_type: int | None = None  # e.g. 2: alarms and worse
+    type: int | None = None  # a message type (`type_clause`: alarm records by its priority)
+    min_type: int | None = None  # e.g. 2: alarms and worse (messages and alarm records only)
     source: str | None = None
     text: str | None = None  # contains
     since: float | None = None  # seconds since the epoch, inclusive
@@ -93,13 +93,16 @@ def where_clause(flt: Filter, mark: str = "?") -> tuple[str, list[object]]:
         kinds = sorted(flt.kinds)
         conds.append(f"kind IN ({', '.join([mark] * len(kinds))})" if kinds else "1 = 0")
         args.extend(kinds)
-    for col, val in (("grp", flt.grp), ("type", flt.type), ("source", flt.source)):
+    for col, val in (("grp", flt.grp), ("source", flt.source)):
         if val is not None:
             conds.append(f"{col} = {mark}")
             args.append(val)
+    if flt.type is not None:
+        conds.append(f"((kind = 'alarm' AND grp = {mark}) OR (kind <> 'alarm' AND type = {mark}))")
+        args += [alarm_priority(flt.type), flt.type]
     if flt.min_type is not None:
-        conds.append(f"type >= {mark}")
-        args.append(flt.min_type)
+        conds.append(f"((kind = 'message' AND type >= {mark}) OR (kind = 'alarm' AND grp <= {mark}))")
+        args += [flt.min_type, alarm_priority(flt.min_type)]
     if flt.since is not None:
         conds.append(f"ts >= {mark}")
         args.append(round(flt.since * 1000))
@@ -113,6 +116,15 @@ def where_clause(flt: Filter, mark: str = "?") -> tuple[str, list[object]]:
         conds.append(f"text IS NOT NULL AND ({likes})")
         args.extend(f"%{_escape_like(v)}%" for v in variants)
     return (" WHERE " + " AND ".join(conds)) if conds else "", args
+
+
+def alarm_priority(message_type: int) -> int:
+    """The alarm priority of a message type's severity, for a type filter over `alarm` records,
+    whose type column is the alarm's new state and whose grp is its priority: 3 critical ->
+    priority 1 and 2 alarm -> 2 (as NMSG's alarms are raised, netplc/tags/alarms.py), 1 warning ->
+    3 (medium), 0 info -> 4 (low). A minimum type is then a maximum priority number, and records
+    of other kinds than message and alarm (operator, system, data) have no severity to pass it."""
+    return 4 - message_type
 
 
 def _escape_like(text: str) -> str:

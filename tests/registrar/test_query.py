@@ -191,6 +191,9 @@ def test_every_page_strategy_gives_the_reference_answer(db, opened, monkeypatch)
             records.append(Record(T0 + i, "message", rnd.randrange(3), rnd.randrange(4), number=number))
         elif i % 500 == 0:
             records.append(Record(T0 + i, "system", source="app", text="station started"))
+        elif i % 37 == 0:  # an alarm's transition: grp = priority 1-4, type = new state 0-6
+            records.append(Record(T0 + i, "alarm", rnd.randrange(1, 5), rnd.randrange(7), "LEVEL.H",
+                                  rnd.randrange(7), text="LEVEL.H"))
         else:
             records.append(Record(T0 + i, "data", 1 + i % 2, 1, "04010", value=float(i)))
     write(db, records)
@@ -198,6 +201,8 @@ def test_every_page_strategy_gives_the_reference_answer(db, opened, monkeypatch)
         Filter(kinds={"message"}), Filter(kinds={"message", "system"}), Filter(kinds={"message"}, grp=2),
         Filter(grp=0), Filter(grp=2, type=3), Filter(kinds={"data"}, grp=1), Filter(text="связь"),
         Filter(kinds={"message"}, min_type=2), Filter(kinds={"data"}, until=T0 + 100), Filter(grp=9),
+        Filter(min_type=2), Filter(min_type=3), Filter(kinds={"alarm", "message"}, min_type=1),
+        Filter(type=2), Filter(kinds={"alarm"}, type=3), Filter(kinds={"alarm"}, grp=2, type=2),
     ]
     with opened(db) as a:
         everything = a.records(DAY, limit=10_000, newest_first=False)
@@ -214,8 +219,9 @@ def test_every_page_strategy_gives_the_reference_answer(db, opened, monkeypatch)
 
 def _matches(r, flt: Filter) -> bool:
     return ((flt.kinds is None or r.kind in flt.kinds) and (flt.grp is None or r.grp == flt.grp)
-            and (flt.type is None or r.type == flt.type)
-            and (flt.min_type is None or (r.type is not None and r.type >= flt.min_type))
+            and (flt.type is None or (r.grp == 4 - flt.type if r.kind == "alarm" else r.type == flt.type))
+            and (flt.min_type is None or (r.kind == "message" and r.type >= flt.min_type)
+                 or (r.kind == "alarm" and r.grp <= 4 - flt.min_type))
             and (flt.until is None or r.ts < flt.until)
             and (flt.text is None or (r.text is not None and flt.text.lower() in r.text.lower())))
 
