@@ -20,7 +20,7 @@ alarm returns, and the tags are initial until fresh data lands, as at start.
 
 from __future__ import annotations
 
-from collections.abc import Callable, Iterable
+from collections.abc import Callable, Iterable, Mapping, Sequence
 from pathlib import Path
 from typing import Any
 
@@ -36,6 +36,7 @@ from netplc.records import Record, RecordSink
 from netplc.tags.alarms import AlarmRow, AlarmSystem, CatalogMessage, summary_order
 from netplc.tags.quality import LinkView, QualityMap
 from netplc.tags.readings import Readings
+from netplc.tags.series import SeriesQuality
 from netplc.tags.table import TagTable, load_tags
 from registrar.alarm_state import AlarmStateFile
 
@@ -46,10 +47,14 @@ PUBLISH_EVERY = 0.25  # s of engine time between two rebuilds of the summary dur
 
 class StationAlarms:
     def __init__(self, tags: Path | None, program: Program, messages: list[CatalogMessage], sink: RecordSink,
-                 state_file: Path, symbols: dict[str, int] | None = None) -> None:
-        """TagError (every problem of tags.csv) if the tags cannot be used."""
+                 state_file: Path, symbols: dict[str, int] | None = None,
+                 regdata: Mapping[str, Sequence[tuple[int, int]]] | None = None) -> None:
+        """TagError (every problem of tags.csv) if the tags cannot be used. `regdata`: the forms'
+        RegData elements by name, with their operands (netplc/tags/series.py)."""
         self.table = load_tags(tags, symbols) if tags is not None else TagTable()
         self.quality_map = QualityMap(program, self.table.tags)
+        self.sink = sink
+        self.series = SeriesQuality(program, regdata or {})
         self.state = AlarmStateFile(state_file, sink)
         self.system = AlarmSystem(self.table, messages, sink=sink, saved=self.state.load(),
                                   on_change=self._changed, station=True)
@@ -96,11 +101,18 @@ class StationAlarms:
                          forced=forced_operands(snapshot.forces))
         self.quality = self.quality_map.evaluate(snapshot, links)
         self.readings = Readings(snapshot, self.quality_map, links, self.quality)
+        for record in self.series.evaluate(snapshot, links, snapshot.wall):
+            self.sink.put(record)
         messages, self._messages = self._messages, []
         self.system.evaluate(snapshot, snapshot.wall, self.quality, messages,
                              "" if running else stop_reason(snapshot.state))
         if self._dirty and snapshot.time - self._published >= PUBLISH_EVERY:
             self._publish(snapshot.time)
+
+    def stamp(self, record: Record) -> Record:
+        """A data record (NSTORE, RegData) with its value's quality as its text when not good,
+        as of the last scan; the runtime's sink calls it on the engine thread."""
+        return self.series.stamp(record)
 
     def _changed(self, changes: dict[str, dict[str, Any]]) -> None:
         self.state.update(changes)

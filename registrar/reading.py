@@ -131,6 +131,27 @@ def _escape_like(text: str) -> str:
     return text.replace("\\", "\\\\").replace("%", "\\%").replace("_", "\\_")
 
 
+def thinned(ts: np.ndarray, values: np.ndarray, points: int) -> tuple[np.ndarray, np.ndarray]:
+    """A series in time order reduced to about `points` points by `min_max`. A NaN is a gap (a
+    record whose value was not good, registrar/schema.py GAP_SQL): the first of each run of them
+    is kept where it was, so a plot breaks its line there, and the values between are reduced."""
+    gap = np.isnan(values)
+    if gap.any():
+        keep = ~gap | np.r_[True, ~gap[:-1]]  # the values and the first NaN of each run
+        ts, values, gap = ts[keep], values[keep], gap[keep]
+    if len(ts) <= points:
+        return ts, values
+    buckets = max(1, points // 2)
+    if not gap.any():
+        return min_max(ts, values, buckets)
+    good_ts, good = (min_max(ts[~gap], values[~gap], buckets) if not gap.all()
+                     else (np.empty(0), np.empty(0)))
+    ts = np.concatenate((good_ts, ts[gap]))
+    values = np.concatenate((good, values[gap]))
+    order = np.argsort(ts, kind="stable")
+    return ts[order], values[order]
+
+
 def min_max(ts: np.ndarray, values: np.ndarray, buckets: int) -> tuple[np.ndarray, np.ndarray]:
     """Per equal-time bucket, the minimum and the maximum in the order they occurred."""
     edges = np.linspace(ts[0], ts[-1], buckets + 1)

@@ -306,3 +306,38 @@ def test_a_day_written_before_the_index_gets_it_filled_when_written_again(db):
         assert con.execute('SELECT sum(n), max(hi) FROM "minutes_05_03_2026"').fetchone() == (5, 4.0)
     finally:
         con.close()
+
+
+def _gappy() -> list[Record]:
+    """A level stored every second; the node is down from 10 s (one mark without a value, then
+    records of the frozen value with their quality), good again from 15 s; a forced value at 20 s."""
+    out = [Record(T0 + i, "data", 1, 1, "04010", value=float(i)) for i in range(10)]
+    out.append(Record(T0 + 10, "data", 1, 1, "04010", value=None, text="comm-fail"))
+    out += [Record(T0 + 10.5 + i, "data", 1, 1, "04010", value=9.0, text="comm-fail") for i in range(5)]
+    out += [Record(T0 + 15 + i, "data", 1, 1, "04010", value=float(15 + i)) for i in range(5)]
+    out.append(Record(T0 + 20, "data", 1, 1, "04010", value=99.0, text="forced"))
+    out.append(Record(T0 + 21, "data", 1, 1, "04010", value=None, text="not running"))
+    return out
+
+
+def test_a_series_breaks_over_records_whose_value_was_not_good(db, opened):
+    write(db, _gappy())
+    with opened(db) as a:
+        ts, values = a.series(DAY, grp=1, type=1, source="04010")
+        few_ts, few = a.series(DAY, grp=1, type=1, source="04010", points=8)
+    gaps = ts[np.isnan(values)]
+    assert list(gaps - T0) == [10.0, 21.0]  # the first record of each run that was not good
+    assert list(values[~np.isnan(values)]) == [*map(float, range(10)), *map(float, range(15, 20)), 99.0]
+    assert list(few_ts[np.isnan(few)] - T0) == [10.0, 21.0] and len(few) <= 8 + 2
+    assert np.all(np.diff(few_ts) >= 0) and 99.0 in few
+
+
+def test_a_long_series_from_the_minute_summary_keeps_its_gaps(db, monkeypatch):
+    import registrar.query as query
+
+    write(db, _gappy())
+    monkeypatch.setattr(query, "SUMMARY_ABOVE", 5)
+    with Archive(db) as a:
+        ts, values = a.series(DAY, grp=1, type=1, source="04010")
+    assert list(ts[np.isnan(values)] - T0) == [10.0, 21.0]
+    assert list(values[~np.isnan(values)]) == [0.0, 99.0]  # the minute's extremes; frozen values none
