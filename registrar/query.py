@@ -39,6 +39,7 @@ from registrar.schema import (
     DAY_GLOB,
     GAP_SQL,
     fts_table,
+    gap_index,
     key_index,
     minutes_table,
     parse_table_name,
@@ -311,9 +312,12 @@ class Archive(ArchiveReader):
         order = np.argsort(ts, kind="stable")
         ts, values = ts[order], values[order]
         keep = np.r_[True, (ts[1:] != ts[:-1]) | (values[1:] != values[:-1])]  # min and max one record
-        gaps = np.fromiter((t for (t,) in self._con.execute(
-            f"SELECT ts FROM {quoted(day)} WHERE kind = 'data' AND grp = ? AND type = ? AND source = ? "
-            f"AND {GAP_SQL}", (grp, type, source))), dtype=np.int64)
+        gaps = np.empty(0, dtype=np.int64)
+        index = gap_index(table_name(day))
+        if self._has_index(index):  # a day written without it has no gaps
+            gaps = np.fromiter((t for (t,) in self._con.execute(
+                f'SELECT ts FROM {quoted(day)} INDEXED BY "{index}" WHERE kind = \'data\' AND grp = ? '
+                f"AND type = ? AND source = ? AND {GAP_SQL}", (grp, type, source))), dtype=np.int64)
         ts = np.concatenate((ts[keep], gaps))
         values = np.concatenate((values[keep], np.full(len(gaps), np.nan)))
         order = np.argsort(ts, kind="stable")

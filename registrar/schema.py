@@ -57,10 +57,19 @@ def text_index(table: str) -> str:
     return f"{table}_text"
 
 
+def gap_index(table: str) -> str:
+    return f"{table}_gaps"
+
+
 def index_sql(table: str) -> list[str]:
+    """The key and text indexes, and the gap index: the data records that are no point of their
+    series only (few, so it costs nearly nothing), which a series read from the per-minute summary
+    asks for its gaps."""
     return [f'CREATE INDEX IF NOT EXISTS "{key_index(table)}" ON "{table}" {KEY_INDEX_COLUMNS}',
             f'CREATE INDEX IF NOT EXISTS "{text_index(table)}" ON "{table}" (id, text) '
-            "WHERE text IS NOT NULL"]
+            "WHERE text IS NOT NULL",
+            f'CREATE INDEX IF NOT EXISTS "{gap_index(table)}" ON "{table}" (grp, type, source, ts) '
+            f"WHERE kind = 'data' AND {GAP_SQL}"]
 
 
 # Beside each day table, two tables kept in the batch's transaction: a trigram full-text index of
