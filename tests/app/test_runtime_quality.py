@@ -1,9 +1,11 @@
 """Quality and alarms through the whole runtime on the demo station: what readers get from
-`runtime.readings()` while the node answers, after it is killed and with NetPlc stopped; and the
-alarm states across a restart of the runtime."""
+`runtime.readings()` while the node answers, after it is killed and with NetPlc stopped; the
+alarm states across a restart of the runtime; NetPlc stopped and run again; and the archived
+series (NSTORE, RegData) breaking over a node that is down and over NetPlc stopped."""
 
 from __future__ import annotations
 
+import json
 import sqlite3
 from pathlib import Path
 
@@ -165,3 +167,24 @@ def test_the_archived_series_breaks_while_a_node_is_down_and_while_netplc_is_sto
     gaps = np.flatnonzero(np.isnan(values))
     assert len(gaps) == 2 and 0 < gaps[0] < gaps[1] < len(values) - 1  # good points around each gap
     assert not np.isnan(values[gaps[0] - 1]) and not np.isnan(values[gaps[1] + 1])
+
+
+def test_a_forms_regdata_series_is_marked_when_its_node_goes_down(demo_copy: Path) -> None:
+    form = demo_copy / "forms" / "02_analog.hmi"
+    doc = json.loads(form.read_text(encoding="utf-8"))
+    level = next(e for e in doc["elements"] if e["Name"] == "Уровень")
+    level["RegData"] = True
+    form.write_text(json.dumps(doc, ensure_ascii=False), encoding="utf-8")
+    runtime = Runtime(load_station(demo_copy))
+    stored: list = []
+    runtime.subscribe(lambda r: stored.append(r) if r.kind == "data" and r.source == "Уровень" else None)
+    runtime.start()
+    try:
+        wait_until(lambda: quality(runtime, "LEVEL") is Quality.GOOD, timeout=10)
+        wait_until(lambda: any(r.value is not None for r in list(stored)), timeout=10)
+        runtime.simulator_answers(0, False)
+        wait_until(lambda: any(r.value is None for r in list(stored)), timeout=10)
+    finally:
+        runtime.stop()
+    mark = next(r for r in stored if r.value is None)
+    assert mark.text in ("comm-fail", "stale") and mark.grp is None and mark.type is None
