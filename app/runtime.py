@@ -168,6 +168,9 @@ class Runtime:
 
     def put(self, record: Record) -> None:
         """The sink every part writes to: the registrar, then whoever watches (alarm banner)."""
+        alarms = self.alarms
+        if record.kind == "data" and alarms is not None:
+            record = alarms.stamp(record)  # a value that is not good keeps its quality in the archive
         if self.store is not None:
             self.store.put(record)
         for observer in list(self._observers):
@@ -256,8 +259,9 @@ class Runtime:
         self.exchange = Exchange(self.nodes, self)
         self.exchange.attach(self.engine)
         self.exchange.start()
+        regdata = {el.Name: el.sources() for _, el in behaviour.elements if el.RegData}
         self.alarms = StationAlarms(st.Tags, self.program, list(self.catalog), self,
-                                    st.Archive.with_name(ALARM_STATE_FILE), self.symbols)
+                                    st.Archive.with_name(ALARM_STATE_FILE), self.symbols, regdata)
         self.subscribe(self.alarms.observe)
         self.alarms.attach(self.engine, self.exchange)
         server = st.modbus_server

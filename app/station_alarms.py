@@ -11,17 +11,22 @@ writes are, so the alarm states have one writer. No Qt: the workstation and `--n
 Start-up truth: a node's data is expected only from the first scan of this run of NetPlc in which
 its first exchange attempt is done (`LinkView.since`); before that its tags are "initial", not
 comm-fail, so a start raises no quality alarm for a node that simply has not answered yet.
+
+NetPlc not running (the operator's Stop, an emergency stop by bit 03770, HLT, the watchdog): every
+tag is "not running" and its alarms, quality alarms included, stay as they were; one station alarm,
+NETPLC.STOPPED, says that NetPlc is not running and why (`stop_reason`). When it runs again the
+alarm returns, and the tags are initial until fresh data lands, as at start.
 """
 
 from __future__ import annotations
 
-from collections.abc import Callable, Iterable
+from collections.abc import Callable, Iterable, Mapping, Sequence
 from pathlib import Path
 from typing import Any
 
 import numpy as np
 
-from netplc.address import IO_BITS
+from netplc.address import EMERGENCY_STOP, IO_BITS, fmt_octal
 from netplc.engine import Engine, RunState
 from netplc.exchange import Exchange
 from netplc.forcing import Force
@@ -31,22 +36,28 @@ from netplc.records import Record, RecordSink
 from netplc.tags.alarms import AlarmRow, AlarmSystem, CatalogMessage, summary_order
 from netplc.tags.quality import LinkView, QualityMap
 from netplc.tags.readings import Readings
+from netplc.tags.series import SeriesQuality
 from netplc.tags.table import TagTable, load_tags
 from registrar.alarm_state import AlarmStateFile
 
 STATE_FILE = "alarms.sqlite"  # next to the archive
+EMERGENCY_STOP_CODE = 11  # the engine's stop code for the emergency-stop bit
 PUBLISH_EVERY = 0.25  # s of engine time between two rebuilds of the summary during a flood
 
 
 class StationAlarms:
     def __init__(self, tags: Path | None, program: Program, messages: list[CatalogMessage], sink: RecordSink,
-                 state_file: Path, symbols: dict[str, int] | None = None) -> None:
-        """TagError (every problem of tags.csv) if the tags cannot be used."""
+                 state_file: Path, symbols: dict[str, int] | None = None,
+                 regdata: Mapping[str, Sequence[tuple[int, int]]] | None = None) -> None:
+        """TagError (every problem of tags.csv) if the tags cannot be used. `regdata`: the forms'
+        RegData elements by name, with their operands (netplc/tags/series.py)."""
         self.table = load_tags(tags, symbols) if tags is not None else TagTable()
         self.quality_map = QualityMap(program, self.table.tags)
+        self.sink = sink
+        self.series = SeriesQuality(program, regdata or {})
         self.state = AlarmStateFile(state_file, sink)
         self.system = AlarmSystem(self.table, messages, sink=sink, saved=self.state.load(),
-                                  on_change=self._changed)
+                                  on_change=self._changed, station=True)
         self.quality = np.zeros(len(self.table.tags), dtype=np.int8)  # of the last scan, by tag
         self.readings: Readings | None = None  # of the last scan; None before the first
         # The alarm summary, rebuilt on the engine thread after states changed, from the rows of
@@ -90,10 +101,18 @@ class StationAlarms:
                          forced=forced_operands(snapshot.forces))
         self.quality = self.quality_map.evaluate(snapshot, links)
         self.readings = Readings(snapshot, self.quality_map, links, self.quality)
+        for record in self.series.evaluate(snapshot, links, snapshot.wall):
+            self.sink.put(record)
         messages, self._messages = self._messages, []
-        self.system.evaluate(snapshot, snapshot.wall, self.quality, messages)
+        self.system.evaluate(snapshot, snapshot.wall, self.quality, messages,
+                             "" if running else stop_reason(snapshot.state))
         if self._dirty and snapshot.time - self._published >= PUBLISH_EVERY:
             self._publish(snapshot.time)
+
+    def stamp(self, record: Record) -> Record:
+        """A data record (NSTORE, RegData) with its value's quality as its text when not good,
+        as of the last scan; the runtime's sink calls it on the engine thread."""
+        return self.series.stamp(record)
 
     def _changed(self, changes: dict[str, dict[str, Any]]) -> None:
         self.state.update(changes)
@@ -149,6 +168,18 @@ class StationAlarms:
         """After the scan thread has stopped: write the last states."""
         self.state.close()
 
+
+
+def stop_reason(state: str) -> str:
+    """Why NetPlc is not running, from the snapshot's run state (Engine.state_text), with its
+    stop code."""
+    if state == RunState.HALTED:
+        return "halted by HLT"
+    if state == f"{RunState.STOPPED}, code {EMERGENCY_STOP_CODE}":
+        return f"emergency stop by bit {fmt_octal(EMERGENCY_STOP)} (code {EMERGENCY_STOP_CODE})"
+    if state == RunState.STOPPED:
+        return "stopped by the operator or the watchdog (code 0)"
+    return state
 
 
 def forced_operands(forces: Iterable[Force]) -> list[int]:

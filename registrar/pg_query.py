@@ -17,8 +17,8 @@ import numpy as np
 import psycopg
 
 from registrar import pg
-from registrar.reading import EXPORT_CHUNK, ArchiveReader, Filter, Row, SeriesKey, min_max, where_clause
-from registrar.schema import COLUMNS, table_name
+from registrar.reading import EXPORT_CHUNK, ArchiveReader, Filter, Row, SeriesKey, thinned, where_clause
+from registrar.schema import COLUMNS, GAP_SQL, table_name
 
 _SELECT = "SELECT " + ", ".join(COLUMNS) + ", station"
 
@@ -124,22 +124,19 @@ class PgArchive(ArchiveReader):
         empty = (np.empty(0), np.empty(0))
         if not self._has(day):
             return empty
-        conds, args = ["kind = 'data'", "value IS NOT NULL"], []
+        conds, args = ["kind = 'data'", f"(value IS NOT NULL OR {GAP_SQL})"], []
         for col, val in (("station", station), ("grp", grp), ("type", type), ("source", source)):
             if val is not None:
                 conds.append(f"{col} = %s")
                 args.append(val)
         with self._pg.cursor(binary=True) as cur:
-            cur.execute(f'SELECT ts, value FROM "{table_name(day)}" WHERE {" AND ".join(conds)} '
-                        "ORDER BY ts", args)
+            cur.execute(f'SELECT ts, coalesce(value, 0), {GAP_SQL} FROM "{table_name(day)}" '
+                        f'WHERE {" AND ".join(conds)} ORDER BY ts', args)
             rows = cur.fetchall()
         if not rows:
             return empty
-        data = np.array(rows, dtype=[("ts", "i8"), ("value", "f8")])
-        ts, values = data["ts"] / 1000.0, data["value"]
-        if len(ts) <= points:
-            return ts, values
-        return min_max(ts, values, max(1, points // 2))
+        data = np.array(rows, dtype=[("ts", "i8"), ("value", "f8"), ("gap", "?")])
+        return thinned(data["ts"] / 1000.0, np.where(data["gap"], np.nan, data["value"]), points)
 
     # --- helpers -------------------------------------------------------------------------------
 

@@ -31,13 +31,15 @@ from registrar.reading import (
     Filter,
     Row,
     SeriesKey,
-    min_max,
+    thinned,
     where_clause,
 )
 from registrar.schema import (
     COLUMNS,
     DAY_GLOB,
+    GAP_SQL,
     fts_table,
+    gap_index,
     key_index,
     minutes_table,
     parse_table_name,
@@ -267,8 +269,7 @@ class Archive(ArchiveReader):
         if grp is not None and type is not None and source is not None:
             summary = self._summary(day, grp, type, source)
             if summary is not None:
-                ts, values = summary
-                return (ts, values) if len(ts) <= points else min_max(ts, values, max(1, points // 2))
+                return thinned(*summary, points)
         # A series holding a good part of the day is read faster by a scan than by index lookups.
         total = self._con.execute(f"SELECT max(id) FROM {table}").fetchone()[0] or 0
         many = round(SCAN_ABOVE * total)
@@ -278,15 +279,14 @@ class Archive(ArchiveReader):
             return empty
         hint = " NOT INDEXED" if n > many else ""
         cur = self._con.execute(
-            f"SELECT ts, value FROM {table}{hint}{where} AND value IS NOT NULL ORDER BY id", args)
-        data = np.fromiter(cur, dtype=[("ts", "i8"), ("value", "f8")])
+            f"SELECT ts, coalesce(value, 0), {GAP_SQL} FROM {table}{hint}{where} "
+            f"AND (value IS NOT NULL OR {GAP_SQL}) ORDER BY id", args)
+        data = np.fromiter(cur, dtype=[("ts", "i8"), ("value", "f8"), ("gap", "?")])
         ts = data["ts"]
         if len(ts) > 1 and np.any(ts[1:] < ts[:-1]):  # the wall clock was set back
             data = data[np.argsort(ts, kind="stable")]
-        ts, values = data["ts"] / 1000.0, data["value"]
-        if len(ts) <= points:
-            return ts, values
-        return min_max(ts, values, max(1, points // 2))
+        values = np.where(data["gap"], np.nan, data["value"])
+        return thinned(data["ts"] / 1000.0, values, points)
 
     # --- helpers -------------------------------------------------------------------------------
 
@@ -296,7 +296,7 @@ class Archive(ArchiveReader):
     def _summary(self, day: dt.date, grp: int, type: int,
                  source: str) -> tuple[np.ndarray, np.ndarray] | None:
         """The series from the per-minute minima and maxima at their own times, when it is long
-        enough for that to pay (None: read the records)."""
+        enough for that to pay (None: read the records), with its gaps (NaN) at their times."""
         minutes = minutes_table(table_name(day))
         if not self._has_table(minutes):
             return None
@@ -312,7 +312,16 @@ class Archive(ArchiveReader):
         order = np.argsort(ts, kind="stable")
         ts, values = ts[order], values[order]
         keep = np.r_[True, (ts[1:] != ts[:-1]) | (values[1:] != values[:-1])]  # min and max one record
-        return ts[keep] / 1000.0, values[keep]
+        gaps = np.empty(0, dtype=np.int64)
+        index = gap_index(table_name(day))
+        if self._has_index(index):  # a day written without it has no gaps
+            gaps = np.fromiter((t for (t,) in self._con.execute(
+                f'SELECT ts FROM {quoted(day)} INDEXED BY "{index}" WHERE kind = \'data\' AND grp = ? '
+                f"AND type = ? AND source = ? AND {GAP_SQL}", (grp, type, source))), dtype=np.int64)
+        ts = np.concatenate((ts[keep], gaps))
+        values = np.concatenate((values[keep], np.full(len(gaps), np.nan)))
+        order = np.argsort(ts, kind="stable")
+        return ts[order] / 1000.0, values[order]
 
     def _has_table(self, name: str) -> bool:
         return self._con.execute("SELECT 1 FROM sqlite_master WHERE name = ?", (name,)).fetchone() is not None

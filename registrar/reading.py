@@ -21,8 +21,8 @@ EXPORT_CHUNK = 10_000
 class Filter:
     kinds: set[str] | frozenset[str] | None = None
     grp: int | None = None
-    type: int | None = None
-    min_type: int | None = None  # e.g. 2: alarms and worse
+    type: int | None = None  # a message type (`type_clause`: alarm records by its priority)
+    min_type: int | None = None  # e.g. 2: alarms and worse (messages and alarm records only)
     source: str | None = None
     text: str | None = None  # contains
     since: float | None = None  # seconds since the epoch, inclusive
@@ -93,13 +93,16 @@ def where_clause(flt: Filter, mark: str = "?") -> tuple[str, list[object]]:
         kinds = sorted(flt.kinds)
         conds.append(f"kind IN ({', '.join([mark] * len(kinds))})" if kinds else "1 = 0")
         args.extend(kinds)
-    for col, val in (("grp", flt.grp), ("type", flt.type), ("source", flt.source)):
+    for col, val in (("grp", flt.grp), ("source", flt.source)):
         if val is not None:
             conds.append(f"{col} = {mark}")
             args.append(val)
+    if flt.type is not None:
+        conds.append(f"((kind = 'alarm' AND grp = {mark}) OR (kind <> 'alarm' AND type = {mark}))")
+        args += [alarm_priority(flt.type), flt.type]
     if flt.min_type is not None:
-        conds.append(f"type >= {mark}")
-        args.append(flt.min_type)
+        conds.append(f"((kind = 'message' AND type >= {mark}) OR (kind = 'alarm' AND grp <= {mark}))")
+        args += [flt.min_type, alarm_priority(flt.min_type)]
     if flt.since is not None:
         conds.append(f"ts >= {mark}")
         args.append(round(flt.since * 1000))
@@ -115,8 +118,38 @@ def where_clause(flt: Filter, mark: str = "?") -> tuple[str, list[object]]:
     return (" WHERE " + " AND ".join(conds)) if conds else "", args
 
 
+def alarm_priority(message_type: int) -> int:
+    """The alarm priority of a message type's severity, for a type filter over `alarm` records,
+    whose type column is the alarm's new state and whose grp is its priority: 3 critical ->
+    priority 1 and 2 alarm -> 2 (as NMSG's alarms are raised, netplc/tags/alarms.py), 1 warning ->
+    3 (medium), 0 info -> 4 (low). A minimum type is then a maximum priority number, and records
+    of other kinds than message and alarm (operator, system, data) have no severity to pass it."""
+    return 4 - message_type
+
+
 def _escape_like(text: str) -> str:
     return text.replace("\\", "\\\\").replace("%", "\\%").replace("_", "\\_")
+
+
+def thinned(ts: np.ndarray, values: np.ndarray, points: int) -> tuple[np.ndarray, np.ndarray]:
+    """A series in time order reduced to about `points` points by `min_max`. A NaN is a gap (a
+    record whose value was not good, registrar/schema.py GAP_SQL): the first of each run of them
+    is kept where it was, so a plot breaks its line there, and the values between are reduced."""
+    gap = np.isnan(values)
+    if gap.any():
+        keep = ~gap | np.r_[True, ~gap[:-1]]  # the values and the first NaN of each run
+        ts, values, gap = ts[keep], values[keep], gap[keep]
+    if len(ts) <= points:
+        return ts, values
+    buckets = max(1, points // 2)
+    if not gap.any():
+        return min_max(ts, values, buckets)
+    good_ts, good = (min_max(ts[~gap], values[~gap], buckets) if not gap.all()
+                     else (np.empty(0), np.empty(0)))
+    ts = np.concatenate((good_ts, ts[gap]))
+    values = np.concatenate((good, values[gap]))
+    order = np.argsort(ts, kind="stable")
+    return ts[order], values[order]
 
 
 def min_max(ts: np.ndarray, values: np.ndarray, buckets: int) -> tuple[np.ndarray, np.ndarray]:

@@ -14,6 +14,7 @@ import zoneinfo
 from pathlib import Path
 
 from netplc.address import fmt_octal
+from netplc.tags.series import GAP_WORDS
 from netplc.tags.table import TagTable
 from netplc.tags.tag import Scaling, Tag, TagType
 
@@ -41,6 +42,12 @@ DAY_COLUMNS_SQL = """(
 # with the text beside it, so a text search reads those alone and never the table's data rows.
 KEY_INDEX_COLUMNS = "(kind, grp, type, source)"
 
+# A data record's text is NULL while its value is good, else its quality word; one held by bad or
+# not yet known quality (or one marking that its series turned so, without a value) is no point
+# of its series: readers break the line there and the per-minute summary leaves it out
+# (netplc/tags/series.py).
+GAP_SQL = f"(text IS NOT NULL AND text IN ({', '.join(repr(w) for w in GAP_WORDS)}))"
+
 
 def key_index(table: str) -> str:
     return f"{table}_key"
@@ -50,10 +57,19 @@ def text_index(table: str) -> str:
     return f"{table}_text"
 
 
+def gap_index(table: str) -> str:
+    return f"{table}_gaps"
+
+
 def index_sql(table: str) -> list[str]:
+    """The key and text indexes, and the gap index: the data records that are no point of their
+    series only (few, so it costs nearly nothing), which a series read from the per-minute summary
+    asks for its gaps."""
     return [f'CREATE INDEX IF NOT EXISTS "{key_index(table)}" ON "{table}" {KEY_INDEX_COLUMNS}',
             f'CREATE INDEX IF NOT EXISTS "{text_index(table)}" ON "{table}" (id, text) '
-            "WHERE text IS NOT NULL"]
+            "WHERE text IS NOT NULL",
+            f'CREATE INDEX IF NOT EXISTS "{gap_index(table)}" ON "{table}" (grp, type, source, ts) '
+            f"WHERE kind = 'data' AND {GAP_SQL}"]
 
 
 # Beside each day table, two tables kept in the batch's transaction: a trigram full-text index of
@@ -82,6 +98,7 @@ def aux_fill_sql(table: str) -> list[str]:
     """Statements adding the rows with id > ? to the two tables (the min and the max each need a
     pass of their own: SQLite gives the ts of the row holding a lone min() or max())."""
     rows = (f'FROM "{table}" NOT INDEXED WHERE id > ? AND kind = \'data\' AND value IS NOT NULL '
+            f"AND NOT {GAP_SQL} "
             "AND grp IS NOT NULL AND type IS NOT NULL AND source IS NOT NULL "
             "GROUP BY grp, type, source, ts / 60000")
     into = f'INSERT INTO "{minutes_table(table)}" (grp, type, source, minute, n, lo, lo_ts, hi, hi_ts)'

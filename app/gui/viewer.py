@@ -140,6 +140,9 @@ class ViewerWindow(QMainWindow):
         self.group.setValue(-1)
         self.type = QComboBox()
         self.type.addItems(TYPES)
+        self.type.setToolTip("A message's type; an alarm record by the priority of that severity "
+                             "(3 critical: priority 1, 2 alarm: 2, 1 warning: 3, 0 info: 4); "
+                             "a data record by its type")
         self.source = QLineEdit()
         self.source.setPlaceholderText("exact source")
         self.text = QLineEdit()

@@ -1,9 +1,10 @@
 """The ISA-18.2 alarm life cycle, evaluated once per scan on the engine thread.
 
 Sources: analog limits HH/H/L/LL (deadband, on and off delay), a bit's value (`alarm_when`), the
-program's NMSG messages of type 2 (alarm) and 3 (critical), and a tag's bad quality. Each alarm is
-one identity (`LEVEL.HH`, `TRIG.ALARM`, `LEVEL.BAD`, `MSG3`) with a priority 1-4 and a text, and
-its state is one of
+program's NMSG messages of type 2 (alarm) and 3 (critical), a tag's bad quality, and NetPlc not
+running (the station's one NETPLC.STOPPED alarm, with why in its text). Each alarm is one identity
+(`LEVEL.HH`, `TRIG.ALARM`, `LEVEL.BAD`, `MSG3`) with a priority 1-4 and a text, and its state is
+one of
 
     normal, active-unacknowledged, active-acknowledged, returned-unacknowledged,
     shelved (by a named operator, with a reason, until an end time), suppressed (by design, while
@@ -15,7 +16,10 @@ unacknowledged. A latching alarm stays active after its condition has gone until
 acknowledged. While a tag's quality is bad its process alarms are frozen where they are (DIVAR:
 "alarm only when not BAD"): a frozen value says nothing about the plant, neither that the alarm
 has come nor that it has gone; the quality alarm says why. They also wait while the quality is
-initial (no value from the plant yet, no quality alarm either: quality.py).
+initial (no value from the plant yet, no quality alarm either: quality.py). While NetPlc is not
+running every tag is frozen, its quality alarm too: a deliberate stop raises NETPLC.STOPPED only,
+not one quality alarm per tag, and after the next start the values are initial until fresh data
+lands, so nothing comes or goes before the plant has said so.
 
 Every change of state is one `Transition`, journaled as one 'alarm' record (grp = priority,
 type = new state, number = old state, source = the alarm's identity, value = the physical value,
@@ -41,13 +45,16 @@ import numpy as np
 
 from netplc.memory import MemoryView
 from netplc.records import NullSink, Record, RecordSink
-from netplc.tags.quality import BAD_CODES, HELD_CODES
+from netplc.tags.quality import ALARMED_CODES, HELD_CODES
 from netplc.tags.table import TagTable
 from netplc.tags.tag import Tag, TagReader
 
 PRIORITIES = {1: "critical", 2: "high", 3: "medium", 4: "low"}
 MESSAGE_PRIORITY = {3: 1, 2: 2}  # NMSG type 3 critical -> priority 1, type 2 alarm -> priority 2
 LIMIT_WORDS = {"HH": "high-high", "H": "high", "L": "low", "LL": "low-low"}
+# NetPlc not running: the plant goes uncontrolled by the program and every value is frozen, so the
+# operator must know at once (high: it sounds), deliberate stop or not.
+STOPPED_ID, STOPPED_PRIORITY = "NETPLC.STOPPED", 2
 
 
 class State(IntEnum):
@@ -76,6 +83,7 @@ class Source(StrEnum):
     DISCRETE = "discrete"
     MESSAGE = "message"
     QUALITY = "quality"
+    STATION = "station"  # NetPlc's run state: STOPPED_ID
 
 
 class AlarmError(ValueError):
@@ -126,10 +134,15 @@ class Alarm:
     out_of_service: bool = False
     oos_by: str = ""
     suppressed: bool = False
+    detail: str = ""  # what the text alone cannot say: why NetPlc is not running
 
     @property
     def id(self) -> str:
         return self.defn.id
+
+    @property
+    def text(self) -> str:
+        return f"{self.defn.text}: {self.detail}" if self.detail else self.defn.text
 
     @property
     def overlaid(self) -> bool:
@@ -177,7 +190,7 @@ def summary_order(row: AlarmRow) -> tuple[bool, int, float]:
 
 
 PERSISTED = ("active", "acked", "since", "changed", "value", "shelved_until", "shelved_by", "reason",
-             "out_of_service", "oos_by", "suppressed")
+             "out_of_service", "oos_by", "suppressed", "detail")
 
 
 @dataclass(frozen=True)
@@ -196,8 +209,10 @@ class Transition:
                       number=int(self.old), value=self.value, text=self.text)
 
 
-def alarm_defs(table: TagTable, messages: Iterable[CatalogMessage] = ()) -> list[AlarmDef]:
-    """Every alarm of the tags and of the catalog's alarm and critical messages."""
+def alarm_defs(table: TagTable, messages: Iterable[CatalogMessage] = (),
+               station: bool = False) -> list[AlarmDef]:
+    """Every alarm of the tags and of the catalog's alarm and critical messages; with `station`,
+    NetPlc's own NETPLC.STOPPED too."""
     out: list[AlarmDef] = []
     for tag in table.tags:
         spec = table.alarms.get(tag.name)
@@ -221,6 +236,8 @@ def alarm_defs(table: TagTable, messages: Iterable[CatalogMessage] = ()) -> list
         if m.type in MESSAGE_PRIORITY:
             out.append(AlarmDef(f"MSG{m.number}", Source.MESSAGE, m.text, MESSAGE_PRIORITY[m.type],
                                 number=m.number))
+    if station:
+        out.append(AlarmDef(STOPPED_ID, Source.STATION, "NetPlc is not running", STOPPED_PRIORITY))
     return out
 
 
@@ -242,7 +259,9 @@ class AlarmSystem:
     def __init__(self, table: TagTable, messages: Iterable[CatalogMessage] = (), *,
                  sink: RecordSink | None = None, saved: Mapping[str, Mapping[str, Any]] | None = None,
                  on_change: Callable[[dict[str, dict[str, Any]]], None] | None = None,
-                 clock: Callable[[], float] = time.time) -> None:
+                 clock: Callable[[], float] = time.time, station: bool = False) -> None:
+        """`station`: the alarm system of a running station, with NETPLC.STOPPED (`evaluate`'s
+        `stopped` says why NetPlc is not running)."""
         self.table = table
         self.sink: RecordSink = sink or NullSink()
         self.on_change = on_change
@@ -250,16 +269,19 @@ class AlarmSystem:
         self.tags: list[Tag] = list(table.tags)
         self.reader = TagReader(self.tags)
         pos = {t.name: i for i, t in enumerate(self.tags)}
-        self.defs = alarm_defs(table, messages)
+        self.defs = alarm_defs(table, messages, station)
         self.alarms = [Alarm(d) for d in self.defs]
         self.by_id = {a.id: i for i, a in enumerate(self.alarms)}
         n = len(self.defs)
         groups = {s: _Group() for s in Source}
         self._msg: dict[int, int] = {}
+        self._stopped: int | None = None  # NETPLC.STOPPED
         for i, d in enumerate(self.defs):
             if d.tag is not None:
                 groups[d.source].idx.append(i)
                 groups[d.source].tag.append(pos[d.tag])
+            elif d.source is Source.STATION:
+                self._stopped = i
             else:
                 self._msg[d.number or 0] = i
         self._lim_idx, self._lim_tag = groups[Source.LIMIT].arrays()
@@ -325,11 +347,11 @@ class AlarmSystem:
 
     def evaluate(self, snapshot: MemoryView, now: float | None = None,
                  quality: np.ndarray | Sequence[int] | Mapping[str, int] | None = None,
-                 messages: Iterable[int] = ()) -> list[Transition]:
+                 messages: Iterable[int] = (), stopped: str = "") -> list[Transition]:
         """One scan: `quality` holds each tag's quality code in table order (as
         `QualityMap.evaluate` gives it) or by tag name (None, or a tag not named: good),
-        `messages` the NMSG numbers journaled in the scan. Returns the transitions, which are
-        journaled as well."""
+        `messages` the NMSG numbers journaled in the scan, `stopped` why NetPlc is not running
+        ("" while it runs). Returns the transitions, which are journaled as well."""
         if now is None:
             now = getattr(snapshot, "wall", 0.0) or self.clock()
         out: list[Transition] = []
@@ -340,9 +362,12 @@ class AlarmSystem:
         if isinstance(quality, Mapping):
             quality = [quality.get(t.name, 0) for t in self.tags]
         codes = np.asarray(quality, dtype=np.intp) if quality is not None else None
-        bad = BAD_CODES[codes] if codes is not None else None
+        alarmed = ALARMED_CODES[codes] if codes is not None else None
         held = HELD_CODES[codes] if codes is not None else None
-        frozen = self._proc_idx[held[self._proc_tag]] if held is not None and held.any() else None
+        frozen = None
+        if held is not None and held.any():  # process alarms while held, quality ones unless alarmed
+            frozen = np.concatenate((self._proc_idx[held[self._proc_tag]],
+                                     self._q_idx[held[self._q_tag] & ~alarmed[self._q_tag]]))
         keep = hyst[frozen] if frozen is not None else None
         if len(self._lim_idx):
             x = self._lim_sign * (phy[self._lim_tag] - self._lim_limit)
@@ -350,13 +375,16 @@ class AlarmSystem:
         if len(self._disc_idx):
             hyst[self._disc_idx] = phy[self._disc_tag] == self._disc_when
         if len(self._q_idx):
-            hyst[self._q_idx] = bad[self._q_tag] if bad is not None else False
+            hyst[self._q_idx] = alarmed[self._q_tag] if alarmed is not None else False
         if len(self._msg_idx):
             hyst[self._msg_idx] = False
             for number in messages:
                 i = self._msg.get(number)
                 if i is not None:
                     hyst[i] = True
+        if self._stopped is not None:
+            self._stop_detail(self._stopped, stopped)
+            hyst[self._stopped] = bool(stopped)
         differs = (hyst != self._cond) | ~np.isnan(self._pending)
         if frozen is not None:
             hyst[frozen] = keep
@@ -376,6 +404,13 @@ class AlarmSystem:
                               shelved_until=None, shelved_by="", reason="")
         self._flush_changes()
         return out
+
+    def _stop_detail(self, i: int, stopped: str) -> None:
+        """NETPLC.STOPPED says why while NetPlc is not running, and keeps it after it runs again."""
+        a = self.alarms[i]
+        if stopped and stopped != a.detail:
+            a.detail = stopped
+            self._changed.add(i)
 
     def _debounce(self, i: int, cond: bool, now: float, out: list[Transition]) -> None:
         if cond == self._cond[i]:
@@ -435,7 +470,7 @@ class AlarmSystem:
         phy, raw = self._value(i)
         a.changed = now
         a.value = phy
-        text = f"{a.id} {old.word} -> {new.word}: {a.defn.text}"
+        text = f"{a.id} {old.word} -> {new.word}: {a.text}"
         t = self._tag_of[i]
         if phy is not None and raw is not None:
             tag = self.tags[t]
@@ -556,7 +591,7 @@ class AlarmSystem:
         t = self._tag_of[i]
         tag = self.tags[t] if t >= 0 else None
         shown = "" if a.value is None else tag.format(a.value) if tag is not None else f"{a.value:g}"
-        return AlarmRow(a.id, a.defn.priority, state, a.since, a.changed, a.value, a.defn.text,
+        return AlarmRow(a.id, a.defn.priority, state, a.since, a.changed, a.value, a.text,
                         a.defn.tag, shown, a.shelved_until, a.shelved_by, a.reason)
 
     def rows(self) -> tuple[AlarmRow, ...]:

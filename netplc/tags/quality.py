@@ -5,7 +5,10 @@ each NREAD, as the exchange itself resolves it). At run time the node's link, th
 block's data in scans, NetPlc's run state and forcing give each address its quality:
 
 - forced: the value is forced by an engineer (it is what it is, but not the plant's);
-- not running: NetPlc is stopped or halted, so nothing in memory changes any more;
+- not running: NetPlc is stopped or halted, so nothing in memory changes any more. The value
+  cannot be trusted (bad), but no quality alarm comes of it: a deliberate stop would flood the
+  alarm list with one per tag. One station alarm says it instead (NETPLC.STOPPED,
+  app/station_alarms.py), and the tags' alarms are frozen where they were (`Quality.alarmed`);
 - comm-fail: the node whose NREAD fills the address is down (its answers fail or are malformed);
 - stale: the NREAD asks (its rung is on) but its data has not landed for more than STALE_TICKS
   scans beyond the one scan an answer normally takes;
@@ -67,6 +70,13 @@ class Quality(IntEnum):
         return self in (Quality.STALE, Quality.COMM_FAIL, Quality.NOT_RUNNING)
 
     @property
+    def alarmed(self) -> bool:
+        """A tag's quality alarm comes of it: the plant's data is failing. Not running and initial
+        hold a tag's alarms, its quality alarm too, where they are: NetPlc's own state is one
+        station alarm, and nothing has failed yet while the first data is on its way."""
+        return self in (Quality.STALE, Quality.COMM_FAIL)
+
+    @property
     def held(self) -> bool:
         """Process alarms wait: the value says nothing about the plant (bad, or not known yet)."""
         return self.bad or self is Quality.INITIAL
@@ -74,7 +84,7 @@ class Quality(IntEnum):
 
 _WORDS = {Quality.GOOD: "good", Quality.INITIAL: "initial", Quality.STALE: "stale",
           Quality.COMM_FAIL: "comm-fail", Quality.NOT_RUNNING: "not running", Quality.FORCED: "forced"}
-BAD_CODES = np.array([q.bad for q in Quality], dtype=bool)  # indexed by quality code
+ALARMED_CODES = np.array([q.alarmed for q in Quality], dtype=bool)  # indexed by quality code
 HELD_CODES = np.array([q.held for q in Quality], dtype=bool)
 
 

@@ -1,16 +1,21 @@
 """Quality and alarms through the whole runtime on the demo station: what readers get from
-`runtime.readings()` while the node answers, after it is killed and with NetPlc stopped; and the
-alarm states across a restart of the runtime."""
+`runtime.readings()` while the node answers, after it is killed and with NetPlc stopped; the
+alarm states across a restart of the runtime; NetPlc stopped and run again; and the archived
+series (NSTORE, RegData) breaking over a node that is down and over NetPlc stopped."""
 
 from __future__ import annotations
 
+import json
 import sqlite3
 from pathlib import Path
 
+import numpy as np
+
 from app.config import load_station
 from app.runtime import Runtime
-from netplc.tags.alarms import State
+from netplc.tags.alarms import STOPPED_ID, State
 from netplc.tags.quality import Quality
+from registrar.query import Archive
 from tests.netplc.test_exchange import wait_until
 
 LEVEL = 0o4010
@@ -99,3 +104,87 @@ def test_the_operator_pulls_and_plugs_a_simulated_nodes_cable(demo_copy: Path) -
                    runtime.alarms.system.get("LEVEL.BAD").state is State.RTNUN, timeout=5)
     finally:
         runtime.stop()
+
+
+def test_stopping_netplc_raises_one_station_alarm_and_running_again_nothing_spurious(demo_copy: Path) -> None:
+    runtime = Runtime(load_station(demo_copy))
+    seen: list = []
+    runtime.subscribe(lambda r: seen.append(r) if r.kind == "alarm" else None)
+    runtime.start()
+    try:
+        wait_until(lambda: quality(runtime, "LEVEL") is Quality.GOOD, timeout=10)
+        assert runtime.alarms is not None
+        runtime.stop_program()
+        wait_until(lambda: runtime.alarms is not None and
+                   runtime.alarms.system.get(STOPPED_ID).state is State.UNACK, timeout=5)
+        assert quality(runtime, "LEVEL") is Quality.NOT_RUNNING
+        runtime.run_program()
+        wait_until(lambda: quality(runtime, "LEVEL") is Quality.GOOD, timeout=10)
+        wait_until(lambda: runtime.alarms is not None and
+                   runtime.alarms.system.get(STOPPED_ID).state is State.RTNUN, timeout=5)
+    finally:
+        runtime.stop()
+    assert not [r for r in seen if r.source.endswith(".BAD")]  # not one quality alarm per tag
+    stops = [(r.number, r.type) for r in seen if r.source == STOPPED_ID]
+    assert stops == [(State.NORMAL, State.UNACK), (State.UNACK, State.RTNUN)]
+
+
+def test_the_archived_series_breaks_while_a_node_is_down_and_while_netplc_is_stopped(demo_copy: Path) -> None:
+    station = load_station(demo_copy)
+    runtime = Runtime(station)
+    stored: list = []
+    runtime.subscribe(lambda r: stored.append(r) if r.kind == "data" and r.source == "04010" else None)
+
+    def stores(n: int) -> int:
+        return sum(1 for r in list(stored) if r.value is not None and r.text is None) + n
+
+    runtime.start()
+    try:
+        wait_until(lambda: quality(runtime, "LEVEL") is Quality.GOOD, timeout=10)
+        target = stores(2)
+        wait_until(lambda: stores(0) >= target, timeout=10)  # NSTORE once a second
+        runtime.simulator_answers(0, False)  # the node's cable pulled
+        wait_until(lambda: any(r.value is None for r in list(stored)), timeout=10)  # the demo stores
+        # only while the node answers: the mark is what breaks the line
+        runtime.simulator_answers(0, True)
+        wait_until(lambda: quality(runtime, "LEVEL") is Quality.GOOD, timeout=15)
+        target = stores(1)
+        wait_until(lambda: stores(0) >= target, timeout=10)
+        runtime.stop_program()
+        wait_until(lambda: any(r.text == "not running" for r in list(stored)), timeout=5)
+        runtime.run_program()
+        wait_until(lambda: quality(runtime, "LEVEL") is Quality.GOOD, timeout=10)
+        target = stores(1)
+        wait_until(lambda: stores(0) >= target, timeout=10)
+    finally:
+        runtime.stop()
+    marks = [r.text for r in stored if r.value is None]
+    assert marks in (["comm-fail", "not running"], ["stale", "not running"])  # one as each outage began
+
+    with Archive(station.Archive) as archive:
+        day = archive.days()[0]
+        _, values = archive.series(day, grp=1, type=1, source="04010")
+    gaps = np.flatnonzero(np.isnan(values))
+    assert len(gaps) == 2 and 0 < gaps[0] < gaps[1] < len(values) - 1  # good points around each gap
+    assert not np.isnan(values[gaps[0] - 1]) and not np.isnan(values[gaps[1] + 1])
+
+
+def test_a_forms_regdata_series_is_marked_when_its_node_goes_down(demo_copy: Path) -> None:
+    form = demo_copy / "forms" / "02_analog.hmi"
+    doc = json.loads(form.read_text(encoding="utf-8"))
+    level = next(e for e in doc["elements"] if e["Name"] == "Уровень")
+    level["RegData"] = True
+    form.write_text(json.dumps(doc, ensure_ascii=False), encoding="utf-8")
+    runtime = Runtime(load_station(demo_copy))
+    stored: list = []
+    runtime.subscribe(lambda r: stored.append(r) if r.kind == "data" and r.source == "Уровень" else None)
+    runtime.start()
+    try:
+        wait_until(lambda: quality(runtime, "LEVEL") is Quality.GOOD, timeout=10)
+        wait_until(lambda: any(r.value is not None for r in list(stored)), timeout=10)
+        runtime.simulator_answers(0, False)
+        wait_until(lambda: any(r.value is None for r in list(stored)), timeout=10)
+    finally:
+        runtime.stop()
+    mark = next(r for r in stored if r.value is None)
+    assert mark.text in ("comm-fail", "stale") and mark.grp is None and mark.type is None

@@ -93,3 +93,26 @@ def test_a_series_unticked_while_it_loads_is_not_plotted_and_a_failed_read_is_sa
 def test_archive_argument(tmp_path: Path) -> None:
     assert archive_of(str(tmp_path / "a.sqlite")) == tmp_path / "a.sqlite"
     assert archive_of(None).name == "journal.sqlite"
+
+
+def test_a_series_plot_breaks_over_records_whose_value_was_not_good(qtbot, tmp_path: Path) -> None:
+    from netplc.records import Record
+    from registrar.store import Store
+
+    archive = tmp_path / "journal.sqlite"
+    t0 = dt.datetime.combine(dt.date.today(), dt.time(0, 0, 1)).timestamp()
+    store = Store(archive, wallclock=lambda: t0)
+    for i in range(4):
+        store.put(Record(t0 + i, "data", 1, 1, "04010", value=float(i)))
+    store.put(Record(t0 + 4, "data", 1, 1, "04010", value=None, text="not running"))  # NetPlc stopped
+    store.put(Record(t0 + 5, "data", 1, 1, "04010", value=3.0, text="initial"))  # no fresh data yet
+    for i in range(6, 9):
+        store.put(Record(t0 + i, "data", 1, 1, "04010", value=float(i)))
+    store.start()
+    store.close()
+    viewer = ViewerWindow(archive)
+    qtbot.addWidget(viewer)
+    viewer.check_series(0)
+    qtbot.waitUntil(lambda: len(viewer.curves) == 1, timeout=10_000)
+    _, ys = next(iter(viewer.curves.values())).getData()
+    assert [str(y) for y in ys] == ["0.0", "1.0", "2.0", "3.0", "nan", "6.0", "7.0", "8.0"]

@@ -222,7 +222,7 @@ def test_bad_quality_is_its_own_alarm_and_freezes_the_process_alarms() -> None:
 
 def test_quality_may_be_given_by_tag_name() -> None:
     r = Rig(TagAlarms(h=90, quality_alarm=True))
-    out = r.system.evaluate(r.mem.snapshot(), T0, {"LEVEL": Quality.NOT_RUNNING})
+    out = r.system.evaluate(r.mem.snapshot(), T0, {"LEVEL": Quality.COMM_FAIL})
     assert [(t.alarm, t.new) for t in out] == [("LEVEL.BAD", State.UNACK)]
 
 

@@ -191,6 +191,9 @@ def test_every_page_strategy_gives_the_reference_answer(db, opened, monkeypatch)
             records.append(Record(T0 + i, "message", rnd.randrange(3), rnd.randrange(4), number=number))
         elif i % 500 == 0:
             records.append(Record(T0 + i, "system", source="app", text="station started"))
+        elif i % 37 == 0:  # an alarm's transition: grp = priority 1-4, type = new state 0-6
+            records.append(Record(T0 + i, "alarm", rnd.randrange(1, 5), rnd.randrange(7), "LEVEL.H",
+                                  rnd.randrange(7), text="LEVEL.H"))
         else:
             records.append(Record(T0 + i, "data", 1 + i % 2, 1, "04010", value=float(i)))
     write(db, records)
@@ -198,6 +201,8 @@ def test_every_page_strategy_gives_the_reference_answer(db, opened, monkeypatch)
         Filter(kinds={"message"}), Filter(kinds={"message", "system"}), Filter(kinds={"message"}, grp=2),
         Filter(grp=0), Filter(grp=2, type=3), Filter(kinds={"data"}, grp=1), Filter(text="связь"),
         Filter(kinds={"message"}, min_type=2), Filter(kinds={"data"}, until=T0 + 100), Filter(grp=9),
+        Filter(min_type=2), Filter(min_type=3), Filter(kinds={"alarm", "message"}, min_type=1),
+        Filter(type=2), Filter(kinds={"alarm"}, type=3), Filter(kinds={"alarm"}, grp=2, type=2),
     ]
     with opened(db) as a:
         everything = a.records(DAY, limit=10_000, newest_first=False)
@@ -214,8 +219,9 @@ def test_every_page_strategy_gives_the_reference_answer(db, opened, monkeypatch)
 
 def _matches(r, flt: Filter) -> bool:
     return ((flt.kinds is None or r.kind in flt.kinds) and (flt.grp is None or r.grp == flt.grp)
-            and (flt.type is None or r.type == flt.type)
-            and (flt.min_type is None or (r.type is not None and r.type >= flt.min_type))
+            and (flt.type is None or (r.grp == 4 - flt.type if r.kind == "alarm" else r.type == flt.type))
+            and (flt.min_type is None or (r.kind == "message" and r.type >= flt.min_type)
+                 or (r.kind == "alarm" and r.grp <= 4 - flt.min_type))
             and (flt.until is None or r.ts < flt.until)
             and (flt.text is None or (r.text is not None and flt.text.lower() in r.text.lower())))
 
@@ -300,3 +306,38 @@ def test_a_day_written_before_the_index_gets_it_filled_when_written_again(db):
         assert con.execute('SELECT sum(n), max(hi) FROM "minutes_05_03_2026"').fetchone() == (5, 4.0)
     finally:
         con.close()
+
+
+def _gappy() -> list[Record]:
+    """A level stored every second; the node is down from 10 s (one mark without a value, then
+    records of the frozen value with their quality), good again from 15 s; a forced value at 20 s."""
+    out = [Record(T0 + i, "data", 1, 1, "04010", value=float(i)) for i in range(10)]
+    out.append(Record(T0 + 10, "data", 1, 1, "04010", value=None, text="comm-fail"))
+    out += [Record(T0 + 10.5 + i, "data", 1, 1, "04010", value=9.0, text="comm-fail") for i in range(5)]
+    out += [Record(T0 + 15 + i, "data", 1, 1, "04010", value=float(15 + i)) for i in range(5)]
+    out.append(Record(T0 + 20, "data", 1, 1, "04010", value=99.0, text="forced"))
+    out.append(Record(T0 + 21, "data", 1, 1, "04010", value=None, text="not running"))
+    return out
+
+
+def test_a_series_breaks_over_records_whose_value_was_not_good(db, opened):
+    write(db, _gappy())
+    with opened(db) as a:
+        ts, values = a.series(DAY, grp=1, type=1, source="04010")
+        few_ts, few = a.series(DAY, grp=1, type=1, source="04010", points=8)
+    gaps = ts[np.isnan(values)]
+    assert list(gaps - T0) == [10.0, 21.0]  # the first record of each run that was not good
+    assert list(values[~np.isnan(values)]) == [*map(float, range(10)), *map(float, range(15, 20)), 99.0]
+    assert list(few_ts[np.isnan(few)] - T0) == [10.0, 21.0] and len(few) <= 8 + 2
+    assert np.all(np.diff(few_ts) >= 0) and 99.0 in few
+
+
+def test_a_long_series_from_the_minute_summary_keeps_its_gaps(db, monkeypatch):
+    import registrar.query as query
+
+    write(db, _gappy())
+    monkeypatch.setattr(query, "SUMMARY_ABOVE", 5)
+    with Archive(db) as a:
+        ts, values = a.series(DAY, grp=1, type=1, source="04010")
+    assert list(ts[np.isnan(values)] - T0) == [10.0, 21.0]
+    assert list(values[~np.isnan(values)]) == [0.0, 99.0]  # the minute's extremes; frozen values none
