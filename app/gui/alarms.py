@@ -11,8 +11,20 @@ import time
 from dataclasses import dataclass
 
 from PySide6.QtCore import Qt, QTimer, Signal
-from PySide6.QtWidgets import QFrame, QHBoxLayout, QLabel, QPushButton, QWidget
+from PySide6.QtWidgets import (
+    QDialog,
+    QDialogButtonBox,
+    QFrame,
+    QGridLayout,
+    QHBoxLayout,
+    QLabel,
+    QPlainTextEdit,
+    QPushButton,
+    QVBoxLayout,
+    QWidget,
+)
 
+from app.gui.elided import ElidedLabel
 from netplc.records import Record
 
 ALARM_TYPE = 2  # docs/architecture.md section 8: 0 info, 1 warning, 2 alarm, 3 critical
@@ -39,7 +51,7 @@ class AlarmBanner(QFrame):
         lay.setContentsMargins(12, 6, 8, 6)
         self.icon = QLabel("\u26a0")
         self.icon.setObjectName("alarmIcon")
-        self.text = QLabel()
+        self.text = ElidedLabel()
         self.text.setObjectName("alarmText")
         self.count = QLabel()
         self.count.setObjectName("alarmCount")
@@ -104,19 +116,59 @@ class AlarmBanner(QFrame):
 
 class HealthStrip(QFrame):
     """A yellow strip listing what is wrong with the station itself: program stopped, node down,
-    archive failing. Shown only while something is wrong."""
+    archive failing. Shown only while something is wrong, on one line elided to the window's
+    width; Details shows every problem in full."""
 
     def __init__(self, parent: QWidget | None = None) -> None:
         super().__init__(parent)
         self.setObjectName("healthStrip")
+        self.problems: list[str] = []
         lay = QHBoxLayout(self)
-        lay.setContentsMargins(12, 4, 12, 4)
-        self.label = QLabel()
+        lay.setContentsMargins(12, 2, 6, 2)
+        self.label = ElidedLabel()
         self.label.setObjectName("healthText")
-        self.label.setTextInteractionFlags(Qt.TextInteractionFlag.TextSelectableByMouse)
+        self.details = QPushButton(self.tr("Details…"))
+        self.details.setObjectName("healthDetails")
+        self.details.clicked.connect(self.show_details)
         lay.addWidget(self.label, 1)
+        lay.addWidget(self.details)
         self.setVisible(False)
 
     def show_problems(self, problems: list[str]) -> None:
+        self.problems = list(problems)
         self.label.setText("   \u2022   ".join(problems))
         self.setVisible(bool(problems))
+
+    def show_details(self) -> QDialog:
+        dialog = QDialog(self.window())
+        dialog.setWindowTitle(self.tr("Station problems"))
+        dialog.resize(760, 360)
+        lay = QVBoxLayout(dialog)
+        text = QPlainTextEdit("\n".join(self.problems))
+        text.setReadOnly(True)
+        lay.addWidget(text)
+        buttons = QDialogButtonBox(QDialogButtonBox.StandardButton.Close)
+        buttons.rejected.connect(dialog.reject)
+        lay.addWidget(buttons)
+        dialog.setAttribute(Qt.WidgetAttribute.WA_DeleteOnClose)
+        dialog.show()
+        return dialog
+
+
+class FixedLine(QFrame):
+    """A slot of fixed height in the header: a quiet line underneath, a strip (the alarm banner,
+    the health strip) over it while the strip is shown. Nothing below ever moves when an alarm
+    comes or goes (ISA-101: the screen does not move under the operator's hand)."""
+
+    def __init__(self, strip: QWidget, quiet: str, height: int, parent: QWidget | None = None) -> None:
+        super().__init__(parent)
+        self.setObjectName("fixedLine")
+        self.setFixedHeight(height)
+        lay = QGridLayout(self)
+        lay.setContentsMargins(0, 0, 0, 0)
+        self.quiet = QLabel(quiet)
+        self.quiet.setObjectName("quietLine")
+        self.quiet.setContentsMargins(12, 0, 12, 0)
+        lay.addWidget(self.quiet, 0, 0)
+        lay.addWidget(strip, 0, 0)  # added last: drawn over the quiet line while visible
+        self.strip = strip

@@ -24,6 +24,7 @@ from PySide6.QtWidgets import (
     QLabel,
     QMainWindow,
     QMessageBox,
+    QPlainTextEdit,
     QScrollArea,
     QTabWidget,
     QVBoxLayout,
@@ -31,7 +32,7 @@ from PySide6.QtWidgets import (
 )
 
 from app.config import load_station
-from app.gui.alarms import Alarm, AlarmBanner, HealthStrip
+from app.gui.alarms import Alarm, AlarmBanner, FixedLine, HealthStrip
 from app.gui.bridge import RuntimeBridge
 from app.gui.journal import JournalDock
 from app.gui.status import StationStatusBar, station_problems
@@ -45,7 +46,8 @@ from netplc.records import Record
 
 STATUS_MS = 500
 FRAME_HEIGHT = 380  # menu, header, banner, tabs, journal dock and status bar around a form
-MIN_SIZE = (1024, 720)
+MIN_SIZE = (1024, 600)  # the window's minimum fits a 1366x768 screen, whatever the forms hold
+ALARM_LINE, HEALTH_LINE = 40, 28  # the header's fixed lines: their content changes, never their size
 JOURNAL_HEIGHT = 190
 
 
@@ -71,8 +73,8 @@ class MainWindow(QMainWindow):
         self.tabs.setObjectName("forms")
         self.tabs.setDocumentMode(True)
         lay.addWidget(self.header)
-        lay.addWidget(self.alarms)
-        lay.addWidget(self.health)
+        lay.addWidget(FixedLine(self.alarms, self.tr("No unacknowledged alarms"), ALARM_LINE))
+        lay.addWidget(FixedLine(self.health, "", HEALTH_LINE))
         lay.addWidget(self.tabs, 1)
         self.setCentralWidget(central)
 
@@ -143,8 +145,7 @@ class MainWindow(QMainWindow):
             scroll.setFrameShape(QFrame.Shape.NoFrame)
             self.tabs.addTab(scroll, form.title)
         if problems:
-            self.tabs.addTab(_placeholder("Forms that could not be opened:\n\n" + "\n".join(problems)),
-                             "Form problems")
+            self.tabs.addTab(_problems_page(problems), "Form problems")
         if not forms and not problems:
             self.tabs.addTab(_placeholder(f"No .hmi forms in {station.HMIload}."), "No forms")
         self.header.user.currentTextChanged.connect(self._user_changed)
@@ -253,6 +254,14 @@ class _Header(QFrame):
 
     def tick(self) -> None:
         self.clock.setText(time.strftime("%d.%m.%Y  %H:%M:%S"))
+
+
+def _problems_page(problems: list[str]) -> QWidget:
+    """Each problem in full, wrapped: a long path must not widen the window."""
+    text = QPlainTextEdit("Forms that could not be opened:\n\n" + "\n".join(problems))
+    text.setReadOnly(True)
+    text.setLineWrapMode(QPlainTextEdit.LineWrapMode.WidgetWidth)
+    return text
 
 
 def _placeholder(text: str) -> QWidget:

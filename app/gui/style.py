@@ -27,6 +27,9 @@ QMainWindow, #central { background: #d9dde3; }
 #alarmAck:hover { background: #ffebee; }
 #healthStrip { background: #ffe082; border-bottom: 1px solid #c79a00; }
 #healthText { color: #4e3b00; font-weight: bold; }
+#healthDetails { padding: 1px 10px; }
+#fixedLine { background: #cfd4db; border-bottom: 1px solid #b9c0ca; }
+#quietLine { color: #6b7684; }
 QTabWidget#forms::pane { border: none; background: #d9dde3; }
 QTabBar::tab { background: #c3c9d2; color: #263445; padding: 7px 18px; margin-right: 1px;
                border-top-left-radius: 3px; border-top-right-radius: 3px; }
