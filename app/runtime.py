@@ -305,17 +305,22 @@ class Runtime:
 
     # --- NetPlc run control (the workstation's menu) -------------------------------------------
 
-    def run_program(self) -> None:
+    def run_program(self, user: str) -> None:
         engine = self.engine
         if engine is not None:
             engine.post(lambda _m: engine.start())
-            self.system("NetPlc started by the operator")
+            self.operator(user, "NetPlc started")
 
-    def stop_program(self) -> None:
+    def stop_program(self, user: str) -> None:
         engine = self.engine
         if engine is not None:
             engine.post(lambda _m: engine.stop())
-            self.system("NetPlc stopped by the operator")
+            self.operator(user, "NetPlc stopped")
+
+    def operator(self, user: str, text: str) -> None:
+        """What a user did at the workstation (run, stop, log in and out): an 'operator' record
+        naming the user, as writes and acknowledgements are."""
+        self.put(Record(self.wallclock(), "operator", source=user or "nobody", text=text))
 
     # --- status --------------------------------------------------------------------------------
 

@@ -14,17 +14,17 @@ import signal
 import sys
 import time
 
-from PySide6.QtCore import QSize, Qt, QTimer
+from PySide6.QtCore import QEvent, QObject, QSize, Qt, QTimer
 from PySide6.QtGui import QAction, QCloseEvent, QKeySequence
 from PySide6.QtWidgets import (
     QApplication,
-    QComboBox,
     QFrame,
     QHBoxLayout,
     QLabel,
     QMainWindow,
     QMessageBox,
     QPlainTextEdit,
+    QPushButton,
     QScrollArea,
     QTabWidget,
     QVBoxLayout,
@@ -35,9 +35,12 @@ from app.config import load_station
 from app.gui.alarms import Alarm, AlarmBanner, FixedLine, HealthStrip
 from app.gui.bridge import RuntimeBridge
 from app.gui.journal import JournalDock
+from app.gui.login import LoginDialog
 from app.gui.status import StationStatusBar, station_problems
 from app.gui.style import apply_style
 from app.runtime import Runtime
+from app.users import ENGINEER, OPERATOR, Session, Users
+from hmi_forms.elements.base import Writer
 from hmi_forms.elements.target import EngineTarget
 from hmi_forms.widgets.form_view import FormView
 from netplc.memory import Snapshot
@@ -45,6 +48,7 @@ from netplc.problems import Problems
 from netplc.records import Record
 
 STATUS_MS = 500
+REFUSAL_MS = 10_000
 FRAME_HEIGHT = 380  # menu, header, banner, tabs, journal dock and status bar around a form
 MIN_SIZE = (1024, 600)  # the window's minimum fits a 1366x768 screen, whatever the forms hold
 ALARM_LINE, HEALTH_LINE = 40, 28  # the header's fixed lines: their content changes, never their size
@@ -58,6 +62,9 @@ class MainWindow(QMainWindow):
         station = runtime.station
         self.setWindowTitle(f"NetPlc Station — {station.name}")
         self.bridge = RuntimeBridge(runtime, self)
+        self.session = Session(Users(station.folder), default=station.operator.default_user,
+                               idle=station.operator.idle_logout)
+        self._quitting = False
         self.views: list[FormView] = []
         self.viewers: list[QWidget] = []
 
@@ -66,7 +73,8 @@ class MainWindow(QMainWindow):
         lay = QVBoxLayout(central)
         lay.setContentsMargins(0, 0, 0, 0)
         lay.setSpacing(0)
-        self.header = _Header(station.name, station.users)
+        self.header = _Header(station.name)
+        self.header.login.clicked.connect(self.log_in_or_out)
         self.alarms = AlarmBanner()
         self.health = HealthStrip()
         self.tabs = QTabWidget()
@@ -94,29 +102,39 @@ class MainWindow(QMainWindow):
         self._timer.start()
         self.refresh_status()
         self._fit_to_forms()
+        self._user_changed()
+        self._activity = _Activity(self.session, self)
 
     @property
     def user(self) -> str:
-        return self.header.user.currentText()
+        """The name journaled with what the workstation does ("" while nobody is logged in)."""
+        return self.session.name
 
     # --- building ------------------------------------------------------------------------------
 
     def _build_menu(self) -> None:
         station = self.menuBar().addMenu("&Station")
-        self.act_run = QAction("&Run NetPlc", self)
-        self.act_run.setShortcut(QKeySequence("F5"))
-        self.act_run.triggered.connect(self.runtime.run_program)
-        self.act_stop = QAction("&Stop NetPlc", self)
-        self.act_stop.setShortcut(QKeySequence("Shift+F5"))
-        self.act_stop.triggered.connect(self._confirm_stop)
+        # no single key runs or stops the PLC: both ask, and need the engineer role
+        self.act_run = QAction(self.tr("&Run NetPlc…"), self)
+        self.act_run.triggered.connect(self.run_program)
+        self.act_stop = QAction(self.tr("&Stop NetPlc…"), self)
+        self.act_stop.triggered.connect(self.stop_program)
+        self.act_login = QAction(self.tr("&Log in / switch user…"), self)
+        self.act_login.setShortcut(QKeySequence("Ctrl+L"))
+        self.act_login.triggered.connect(self.log_in)
+        self.act_logout = QAction(self.tr("Log &out"), self)
+        self.act_logout.triggered.connect(self.log_out)
         viewer = QAction("Open journal &viewer…", self)
         viewer.setShortcut(QKeySequence("Ctrl+J"))
         viewer.triggered.connect(self.open_viewer)
-        quit_ = QAction("&Quit", self)
-        quit_.setShortcut(QKeySequence.StandardKey.Quit)
-        quit_.triggered.connect(self.close)
+        self.act_quit = quit_ = QAction(self.tr("&Quit…"), self)
+        quit_.setShortcut(QKeySequence("Ctrl+Q"))  # on every platform; it asks before anything stops
+        quit_.triggered.connect(self.request_quit)
         for a in (self.act_run, self.act_stop):
             station.addAction(a)
+        station.addSeparator()
+        station.addAction(self.act_login)
+        station.addAction(self.act_logout)
         station.addSeparator()
         station.addAction(viewer)
         station.addSeparator()
@@ -137,7 +155,7 @@ class MainWindow(QMainWindow):
         target = EngineTarget(self.runtime.engine)
         for form in forms:
             view = FormView(form, target, archive_path=station.Archive, user=self.user,
-                            started=self.runtime.started_clock)
+                            started=self.runtime.started_clock, guard=self._guard)
             self.views.append(view)
             scroll = QScrollArea()
             scroll.setWidget(view)
@@ -148,7 +166,6 @@ class MainWindow(QMainWindow):
             self.tabs.addTab(_problems_page(problems), "Form problems")
         if not forms and not problems:
             self.tabs.addTab(_placeholder(f"No .hmi forms in {station.HMIload}."), "No forms")
-        self.header.user.currentTextChanged.connect(self._user_changed)
         return problems
 
     def preferred_size(self) -> QSize:
@@ -178,11 +195,21 @@ class MainWindow(QMainWindow):
     def _acknowledge(self, alarm: Alarm) -> None:
         self.runtime.acknowledge(alarm.record, self.user)
 
-    def _user_changed(self, user: str) -> None:
-        """Operator writes and acknowledgements are journaled under the operator on duty."""
+    def _user_changed(self) -> None:
+        """Operator writes and acknowledgements are journaled under the user on duty; what the
+        user may not do is greyed, with the reason in its tooltip."""
+        user = self.user
         for view in self.views:
             for model in view.form.elements:
                 model.user = user
+        current = self.session.current
+        self.header.show_user(current.name if current else "", current.role if current else "",
+                              logged_in=self.session.user is not None)
+        ack = self.session.refusal(OPERATOR, self.tr("Acknowledge"))
+        for button in (self.alarms.ack, self.alarms.ack_all):
+            button.setEnabled(ack is None)
+            button.setToolTip(ack or "")
+        self.act_logout.setEnabled(self.session.user is not None)
 
     def refresh_status(self) -> None:
         status = self.runtime.status()
@@ -193,15 +220,84 @@ class MainWindow(QMainWindow):
         self.act_run.setEnabled(not running)
         self.act_stop.setEnabled(running)
         self.header.tick()
+        if (idle := self.session.idle_expired()) is not None:
+            self.runtime.operator(idle.name, "logged out: idle")
+            self._user_changed()
 
     # --- actions -------------------------------------------------------------------------------
 
-    def _confirm_stop(self) -> None:
-        answer = QMessageBox.question(self, "Stop NetPlc",
-                                      "Stop the NetPlc program? Exchange, archive and forms keep running, "
-                                      "but the program's chains are no longer executed.")
-        if answer == QMessageBox.StandardButton.Yes:
-            self.runtime.stop_program()
+    def ask(self, title: str, text: str) -> bool:
+        """The second step of a command: the operator confirms it (tests answer for them)."""
+        answer = QMessageBox.question(self, title, text)
+        return answer == QMessageBox.StandardButton.Yes
+
+    def refuse(self, why: str) -> None:
+        """A refused action says why, where the operator looks: the status bar."""
+        self.status.showMessage(self.tr("Refused: ") + why, REFUSAL_MS)
+
+    def allowed(self, role: str, action: str) -> bool:
+        why = self.session.refusal(role, action)
+        if why is not None:
+            self.refuse(why)
+        return why is None
+
+    def _guard(self, element: Writer, what: str) -> str | None:
+        """Before a form element writes: its Role, then its Confirm."""
+        why = self.session.refusal(element.Role, what)
+        if why is not None:
+            self.refuse(why)
+            return why
+        if element.Confirm and not self.ask(self.tr("Confirm"), what + "?"):
+            return self.tr("cancelled")
+        return None
+
+    def run_program(self) -> None:
+        if self.allowed(ENGINEER, self.tr("Run NetPlc")) and self.ask(
+                self.tr("Run NetPlc"), self.tr("Run the NetPlc program? Its chains act on the plant "
+                                               "from the next scan.")):
+            self.runtime.run_program(self.user)
+
+    def stop_program(self) -> None:
+        if self.allowed(ENGINEER, self.tr("Stop NetPlc")) and self.ask(
+                self.tr("Stop NetPlc"), self.tr("Stop the NetPlc program? Exchange, archive and forms "
+                                                "keep running, but the program's chains are no longer "
+                                                "executed.")):
+            self.runtime.stop_program(self.user)
+
+    def request_quit(self) -> bool:
+        """Quit stops the whole station (soft PLC, exchange, archive): the engineer's, and asked."""
+        if self.allowed(ENGINEER, self.tr("Quit")) and self.ask(
+                self.tr("Quit"), self.tr("Quit NetPlc Station? The NetPlc program, the exchange with the "
+                                         "nodes and the archive stop.")):
+            self.runtime.operator(self.user, "station quit")
+            self._quitting = True
+            self.close()
+        return self._quitting
+
+    def log_in(self) -> None:
+        LoginDialog(sorted(self.session.users.users), self.login, self).exec()
+
+    def login(self, name: str, password: str) -> None:
+        """Log a user in (switching from the one logged in); Refused when the name or password is wrong."""
+        before = self.session.user
+        user = self.session.login(name, password)
+        if before is not None and before is not user:
+            self.runtime.operator(before.name, "logged out: user switched")
+        self.runtime.operator(user.name, f"logged in as {user.role}")
+        self._user_changed()
+
+    def log_out(self) -> None:
+        if self.session.user is not None:
+            self.runtime.operator(self.user, "logged out")
+            self.session.logout()
+            self._user_changed()
+
+    def log_in_or_out(self) -> None:
+        if self.session.user is None:
+            self.log_in()
+        else:
+            self.log_out()
+
 
     def open_viewer(self) -> None:
         from app.gui.viewer import ViewerWindow
@@ -216,6 +312,16 @@ class MainWindow(QMainWindow):
                           f"Station: {self.runtime.station.path}")
 
     def closeEvent(self, event: QCloseEvent) -> None:
+        """The window manager's close button is Quit; a close from the program (SIGTERM, Ctrl+C,
+        tests) closes at once, flushing the archive."""
+        if event.spontaneous() and not self._quitting and not self.request_quit():
+            event.ignore()
+            return
+        self._activity.stop()
+        for view in self.views:  # the guards refer back to the window: no cycle left for the GC
+            for model in view.form.elements:
+                if isinstance(model, Writer):
+                    model.guard = None
         self._timer.stop()
         self.bridge.detach()
         self.journal.close_archive()
@@ -224,10 +330,34 @@ class MainWindow(QMainWindow):
         super().closeEvent(event)
 
 
-class _Header(QFrame):
-    """Station name, operator on duty, date and time: the strip every SCADA screen starts with."""
+class _Activity(QObject):
+    """Any key, click or wheel in the application keeps the user logged in: the idle logout
+    counts from the last one."""
 
-    def __init__(self, name: str, users: tuple[str, ...]) -> None:
+    INPUT = (QEvent.Type.KeyPress, QEvent.Type.MouseButtonPress, QEvent.Type.Wheel)
+
+    def __init__(self, session: Session, parent: QObject) -> None:
+        super().__init__(parent)
+        self.session = session
+        self.app = QApplication.instance()
+        if self.app is not None:
+            self.app.installEventFilter(self)
+
+    def eventFilter(self, watched: QObject, event: QEvent) -> bool:
+        if event.type() in self.INPUT:
+            self.session.touch()
+        return False
+
+    def stop(self) -> None:
+        if self.app is not None:
+            self.app.removeEventFilter(self)
+            self.app = None
+
+
+class _Header(QFrame):
+    """Station name, user on duty, date and time: the strip every SCADA screen starts with."""
+
+    def __init__(self, name: str) -> None:
         super().__init__()
         self.setObjectName("header")
         lay = QHBoxLayout(self)
@@ -236,21 +366,24 @@ class _Header(QFrame):
         title.setObjectName("headerTitle")
         product = QLabel("NetPlc Station")
         product.setObjectName("headerProduct")
-        self.user = QComboBox()
+        self.user = QLabel()
         self.user.setObjectName("headerUser")
-        self.user.addItems(list(users))
+        self.login = QPushButton()
+        self.login.setObjectName("headerLogin")
         self.clock = QLabel()
         self.clock.setObjectName("headerClock")
         lay.addWidget(product)
         lay.addWidget(title)
         lay.addStretch(1)
-        who = QLabel("Operator:")
-        who.setObjectName("headerLabel")
-        lay.addWidget(who)
         lay.addWidget(self.user)
+        lay.addWidget(self.login)
         lay.addSpacing(18)
         lay.addWidget(self.clock)
         self.tick()
+
+    def show_user(self, name: str, role: str, *, logged_in: bool) -> None:
+        self.user.setText(f"{name} ({role})" if name else self.tr("nobody logged in"))
+        self.login.setText(self.tr("Log out") if logged_in else self.tr("Log in…"))
 
     def tick(self) -> None:
         self.clock.setText(time.strftime("%d.%m.%Y  %H:%M:%S"))

@@ -22,6 +22,7 @@ from PySide6.QtWidgets import QWidget
 
 from hmi_forms.elements import Element
 from hmi_forms.elements.analog import AnalogBase, AnalogOutput
+from hmi_forms.elements.base import Guard, Writer
 from hmi_forms.elements.discrete import DiscreteBase
 from hmi_forms.elements.graph import Graph
 from hmi_forms.elements.journal import MessageJournal
@@ -42,10 +43,11 @@ from netplc.memory import Snapshot
 class FormView(QWidget):
     def __init__(self, form: Form, target: Target, *, archive_path: str | Path | None = None,
                  user: str = "operator", started: float | None = None,
-                 clock: Callable[[], float] = time.monotonic,
+                 clock: Callable[[], float] = time.monotonic, guard: Guard | None = None,
                  parent: QWidget | None = None) -> None:
         """`started` is the engine-clock time the station started (for DateTime's time since start);
-        `clock` paces the plot redraws (a benchmark replays ticks faster than real time)."""
+        `clock` paces the plot redraws (a benchmark replays ticks faster than real time); `guard`
+        decides each write of the operator before it is made (role, confirmation)."""
         super().__init__(parent)
         self.form = form
         self.setFixedSize(QSize(form.width, form.height))
@@ -62,6 +64,8 @@ class FormView(QWidget):
         archive = Path(archive_path) if archive_path is not None else None
         for model in form.elements:
             model.bind(target, user)
+            if isinstance(model, Writer):
+                model.guard = guard
             if isinstance(model, DateTime) and started is not None:
                 model.started = started
             widget = self._widget(model, archive)

@@ -3,10 +3,13 @@ fits a 1366x768 screen whatever the forms hold."""
 
 from __future__ import annotations
 
+import datetime as dt
+import sqlite3
 from collections.abc import Iterator
 from pathlib import Path
 
 import pytest
+from PySide6.QtCore import Qt
 from PySide6.QtWidgets import QPlainTextEdit
 
 from app.config import load_station
@@ -14,6 +17,7 @@ from app.gui.main_window import MainWindow
 from app.runtime import Runtime
 
 LEVEL = 0o4010
+START_BIT = 0o40042
 BROKEN = ('{"form": {"title": "broken", "width": 100, "height": 100}, "elements": [{"type": "StaticText", '
           '"Name": "' + "a_very_long_element_name_" * 40 + '", "x": "not a number"}]}')
 
@@ -59,3 +63,119 @@ def test_the_forms_stay_put_when_an_alarm_comes(qtbot, console: MainWindow) -> N
     console.alarms.acknowledge_all()
     qtbot.wait(50)
     assert console.tabs.mapTo(console, console.tabs.rect().topLeft()) == top
+
+
+def element(window: MainWindow, name: str):
+    for view in window.views:
+        for model, widget in view.pairs:
+            if model.Name == name:
+                return model, widget
+    raise AssertionError(f"no element {name!r}")
+
+
+def operator_rows(runtime: Runtime) -> list[tuple[str, str]]:
+    con = sqlite3.connect(f"file:{runtime.station.Archive}?mode=ro", uri=True)
+    try:
+        return con.execute(f'SELECT source, text FROM "{dt.date.today():%d_%m_%Y}" WHERE kind = ? '
+                           "ORDER BY id", ("operator",)).fetchall()
+    finally:
+        con.close()
+
+
+class Answers:
+    """The operator's answers to the confirmations, and the questions asked."""
+
+    def __init__(self, answer: bool) -> None:
+        self.answer = answer
+        self.asked: list[str] = []
+
+    def __call__(self, title: str, text: str) -> bool:
+        self.asked.append(f"{title}: {text}")
+        return self.answer
+
+
+def test_the_demo_opens_as_its_viewer_who_may_not_act(qtbot, console: MainWindow) -> None:
+    engine = console.runtime.engine
+    assert console.user == "viewer" and "viewer (viewer)" in console.header.user.text()
+    model, button = element(console, "Пуск")
+    qtbot.waitUntil(lambda: model.value is not None, timeout=5000)
+    qtbot.mouseClick(button, Qt.MouseButton.LeftButton)
+    assert "Refused: Пуск \u2192" in console.status.currentMessage()
+    assert "needs the operator role; viewer is viewer" in console.status.currentMessage()
+    setpoint, _ = element(console, "Уставка температуры")
+    ok, why = setpoint.submit("50")
+    assert not ok and "needs the operator role" in why
+    assert not console.alarms.ack.isEnabled() and "needs the operator role" in console.alarms.ack.toolTip()
+    qtbot.wait(300)
+    assert engine.snapshot.get_hmi_bit(START_BIT) == 0
+
+
+def test_run_stop_and_quit_need_the_engineer_and_ask(qtbot, console: MainWindow) -> None:
+    runtime = console.runtime
+    console.ask = no = Answers(False)
+    console.login("operator", "operator")
+    console.stop_program()
+    assert "Stop NetPlc: needs the engineer role; operator is operator" in console.status.currentMessage()
+    assert console.request_quit() is False and console.isVisible()
+    assert not no.asked  # refused before anything is asked
+    console.login("engineer", "engineer")
+    console.stop_program()
+    assert console.request_quit() is False and console.isVisible()
+    assert [q.split(":")[0] for q in no.asked] == ["Stop NetPlc", "Quit"]
+    qtbot.wait(300)
+    assert runtime.status().state == "running"  # both answered no
+    console.ask = Answers(True)
+    console.stop_program()
+    qtbot.waitUntil(lambda: runtime.status().state != "running", timeout=3000)
+    console.run_program()
+    qtbot.waitUntil(lambda: runtime.status().state == "running", timeout=3000)
+    assert console.request_quit() is True
+    runtime.stop()
+    rows = operator_rows(runtime)
+    assert rows[-5:] == [("operator", "logged out: user switched"), ("engineer", "logged in as engineer"),
+                         ("engineer", "NetPlc stopped"), ("engineer", "NetPlc started"),
+                         ("engineer", "station quit")]
+
+
+def test_ctrl_q_and_f5_no_longer_act_at_once(console: MainWindow) -> None:
+    assert console.act_run.shortcut().isEmpty() and console.act_stop.shortcut().isEmpty()
+    assert console.act_quit.shortcut().toString() == "Ctrl+Q"
+    console.ask = Answers(True)
+    console.act_quit.trigger()  # the viewer may not quit the station
+    assert console.isVisible() and "Quit: needs the engineer role" in console.status.currentMessage()
+
+
+def test_an_element_asks_when_the_form_says_confirm_and_checks_its_role(qtbot, console: MainWindow) -> None:
+    engine = console.runtime.engine
+    model, button = element(console, "Пуск")
+    qtbot.waitUntil(lambda: model.value == 0, timeout=5000)
+    console.login("operator", "operator")
+    model.Confirm = True
+    console.ask = no = Answers(False)
+    assert model.click() is False
+    assert no.asked == ["Confirm: Пуск \u2192 1?"]
+    qtbot.wait(300)
+    assert engine.snapshot.get_hmi_bit(START_BIT) == 0
+    console.ask = Answers(True)
+    qtbot.mouseClick(button, Qt.MouseButton.LeftButton)
+    qtbot.waitUntil(lambda: engine.snapshot.get_hmi_bit(START_BIT) == 1, timeout=3000)
+    model.Role = "engineer"
+    qtbot.waitUntil(lambda: model.value == 1, timeout=3000)
+    assert model.click() is False
+    assert "Пуск \u2192 0: needs the engineer role; operator is operator" in console.status.currentMessage()
+    console.runtime.stop()
+    writes = [t for s, t in operator_rows(console.runtime) if s == "operator" and "Пуск" in t]
+    assert len(writes) == 1, writes
+
+
+def test_an_idle_user_is_logged_out_and_it_is_journaled(qtbot, console: MainWindow) -> None:
+    now = [0.0]
+    console.session.clock = lambda: now[0]
+    console.session.idle = 900
+    console.login("operator", "operator")
+    assert console.user == "operator"
+    now[0] += 901
+    console.refresh_status()
+    assert console.user == "viewer" and "Log in" in console.header.login.text()
+    console.runtime.stop()
+    assert operator_rows(console.runtime)[-1] == ("operator", "logged out: idle")
