@@ -13,6 +13,7 @@ from __future__ import annotations
 import signal
 import sys
 import time
+from collections.abc import Callable
 
 from PySide6.QtCore import QEvent, QObject, QSize, Qt, QTimer
 from PySide6.QtGui import QAction, QCloseEvent, QKeySequence
@@ -25,7 +26,6 @@ from PySide6.QtWidgets import (
     QMessageBox,
     QPlainTextEdit,
     QPushButton,
-    QScrollArea,
     QTabWidget,
     QVBoxLayout,
     QWidget,
@@ -38,6 +38,7 @@ from app.gui.journal import JournalDock
 from app.gui.login import LoginDialog
 from app.gui.status import StationStatusBar, station_problems
 from app.gui.style import apply_style
+from app.gui.zoom import ACTUAL, FIT_WIDTH, FIT_WINDOW, ZoomArea, ZoomSettings
 from app.runtime import Runtime
 from app.users import ENGINEER, OPERATOR, Session, Users
 from hmi_forms.elements.base import Writer
@@ -66,6 +67,8 @@ class MainWindow(QMainWindow):
                                idle=station.operator.idle_logout)
         self._quitting = False
         self.views: list[FormView] = []
+        self.zooms: list[ZoomArea] = []
+        self.zoom_settings = ZoomSettings(station.Archive.parent / "workstation.ini")
         self.viewers: list[QWidget] = []
 
         central = QWidget()
@@ -139,8 +142,19 @@ class MainWindow(QMainWindow):
         station.addAction(viewer)
         station.addSeparator()
         station.addAction(quit_)
-        view = self.menuBar().addMenu("&View")
+        view = self.menuBar().addMenu(self.tr("&View"))
         view.addAction(self.journal.toggleViewAction())
+        view.addSeparator()
+        for text, keys, act in (
+                (self.tr("Fit &width"), "Ctrl+1", lambda a: a.set_mode(FIT_WIDTH)),
+                (self.tr("Fit &window"), "Ctrl+2", lambda a: a.set_mode(FIT_WINDOW)),
+                (self.tr("&100 %"), "Ctrl+0", lambda a: a.set_mode(ACTUAL)),
+                (self.tr("Zoom &in"), "Ctrl++", lambda a: a.zoom_by(1)),
+                (self.tr("Zoom &out"), "Ctrl+-", lambda a: a.zoom_by(-1))):
+            action = QAction(text, self)
+            action.setShortcut(QKeySequence(keys))
+            action.triggered.connect(lambda _=False, act=act: self._zoom(act))
+            view.addAction(action)
         help_ = self.menuBar().addMenu("&Help")
         about = QAction("&About", self)
         about.triggered.connect(self._about)
@@ -157,16 +171,31 @@ class MainWindow(QMainWindow):
             view = FormView(form, target, archive_path=station.Archive, user=self.user,
                             started=self.runtime.started_clock, guard=self._guard)
             self.views.append(view)
-            scroll = QScrollArea()
-            scroll.setWidget(view)
-            scroll.setAlignment(Qt.AlignmentFlag.AlignHCenter | Qt.AlignmentFlag.AlignTop)
-            scroll.setFrameShape(QFrame.Shape.NoFrame)
-            self.tabs.addTab(scroll, form.title)
+            area = ZoomArea(view)
+            area.restore(self.zoom_settings.get(form.path))
+            area.zoomed.connect(lambda _label, a=area: self._zoomed(a))
+            self.zooms.append(area)
+            self.tabs.addTab(area, form.title)
         if problems:
             self.tabs.addTab(_problems_page(problems), "Form problems")
         if not forms and not problems:
             self.tabs.addTab(_placeholder(f"No .hmi forms in {station.HMIload}."), "No forms")
         return problems
+
+    def current_zoom(self) -> ZoomArea | None:
+        page = self.tabs.currentWidget()
+        return page if isinstance(page, ZoomArea) else None
+
+    def _zoom(self, act: Callable[[ZoomArea], None]) -> None:
+        area = self.current_zoom()
+        if area is not None:
+            act(area)
+
+    def _zoomed(self, area: ZoomArea) -> None:
+        """Remember the choice for this form, and show it."""
+        self.zoom_settings.put(area.form_view.form.path, area.choice)
+        if area is self.current_zoom():
+            self.status.showMessage(self.tr("Zoom: ") + area.label(), 3000)
 
     def preferred_size(self) -> QSize:
         """Large enough to show the biggest form above the journal."""

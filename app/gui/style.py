@@ -16,7 +16,8 @@ QMainWindow, #central { background: #d9dde3; }
 #headerTitle { color: #ffffff; font-size: 13pt; font-weight: bold; }
 #headerLabel { color: #b8c4d4; }
 #headerClock { color: #ffffff; font-family: "DejaVu Sans Mono"; font-size: 12pt; }
-#headerUser { min-width: 110px; }
+#headerUser { color: #ffffff; font-weight: bold; padding-right: 8px; }
+#headerLogin { padding: 3px 12px; }
 #alarmBanner { background: #b71c1c; border-bottom: 1px solid #7f0000; }
 #alarmBanner[blink="true"] { background: #d32f2f; }
 #alarmIcon { color: #ffeb3b; font-size: 16pt; }

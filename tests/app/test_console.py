@@ -14,6 +14,7 @@ from PySide6.QtWidgets import QPlainTextEdit
 
 from app.config import load_station
 from app.gui.main_window import MainWindow
+from app.gui.zoom import ACTUAL, FIT_WIDTH, FIT_WINDOW
 from app.runtime import Runtime
 
 LEVEL = 0o4010
@@ -179,3 +180,36 @@ def test_an_idle_user_is_logged_out_and_it_is_journaled(qtbot, console: MainWind
     assert console.user == "viewer" and "Log in" in console.header.login.text()
     console.runtime.stop()
     assert operator_rows(console.runtime)[-1] == ("operator", "logged out: idle")
+
+
+def test_every_demo_form_fits_a_1366x768_window(qtbot, console: MainWindow) -> None:
+    assert console.minimumSizeHint().width() <= 1366
+    assert console.zooms and len(console.zooms) == len(console.views)
+    for i, area in enumerate(console.zooms):
+        console.tabs.setCurrentIndex(i)
+        area.set_mode(FIT_WINDOW)
+        qtbot.wait(20)
+        assert area.viewport().width() > 1000
+        assert not area.cut_off(), (area.form_view.form.path.name, area.shown_rect(), area.viewport().rect())
+        image = console.grab().toImage()
+        assert image.width() == 1366 and image.height() == 768
+    area = console.zooms[0]
+    console.tabs.setCurrentIndex(0)
+    area.set_mode(ACTUAL)
+    assert area.factor == 1.0 and area.cut_off()  # 760 px of form above the journal: it needs the zoom
+
+
+def test_the_zoom_is_remembered_per_form(qtbot, console: MainWindow) -> None:
+    first, second = console.zooms[0], console.zooms[1]
+    console.tabs.setCurrentIndex(1)
+    second.set_mode(FIT_WIDTH)
+    first.zoom_by(-2)
+    factor = first.factor
+    again = MainWindow(console.runtime)
+    qtbot.addWidget(again)
+    try:
+        assert again.zooms[1].mode == FIT_WIDTH
+        assert again.zooms[0].mode == "" and abs(again.zooms[0].factor - factor) < 0.001
+        assert again.zooms[2].mode == FIT_WINDOW  # the default
+    finally:
+        again.close()

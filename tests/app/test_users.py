@@ -45,7 +45,7 @@ def test_add_remove_and_passwd_say_what_is_wrong(tmp_path: Path) -> None:
     with pytest.raises(UserError, match="no user 'ivan'"):
         users.remove("ivan")
     (tmp_path / "users.json").write_text("{", encoding="utf-8")
-    with pytest.raises(UserError, match="users.json: not a users file"):
+    with pytest.raises(UserError, match=r"users\.json: not a users file"):
         Users(tmp_path)
 
 
@@ -77,7 +77,8 @@ def test_each_role_allows_what_the_ones_below_do(users: Users, role: str, allowe
 
 def test_logged_out_is_the_default_viewer_or_nobody(users: Users) -> None:
     nobody = Session(users)
-    assert nobody.name == "" and nobody.refusal("viewer", "Look") == "Look: nobody is logged in (viewer needed)"
+    assert nobody.name == ""
+    assert nobody.refusal("viewer", "Look") == "Look: nobody is logged in (viewer needed)"
     default = Session(users, default="viewer")
     assert default.name == "viewer" and default.refusal("viewer", "Look") is None
     assert default.refusal("operator", "Пуск") == "Пуск: needs the operator role; viewer is viewer"
