@@ -54,6 +54,7 @@ def scale_ticks(lo: float, hi: float, max_major: int) -> tuple[list[float], list
 
 
 SMALL_DIAL = 45.0  # radius in px below which a dial drops its labels and enlarges the readout
+SEMI_END_LABEL = 12.0  # degrees: a semidial's end labels stand this far above its baseline
 HUB = QColor("#33393f")
 WHITE = QColor("#ffffff")
 
@@ -249,6 +250,8 @@ class GaugeWidget(ElementWidget):
             # at the ends of the scale moves inwards instead of running into the tick and the band
             text = f"{v:.{decimals}f}"
             w, h = metrics.horizontalAdvance(text), metrics.capHeight()
+            if sweep == -180.0:  # the needle rests on the baseline at either end: labels sit above it
+                a = min(max(a, SEMI_END_LABEL), 180.0 - SEMI_END_LABEL)
             rad = math.radians(a)
             reach = abs(math.cos(rad)) * w / 2 + abs(math.sin(rad)) * h / 2
             label_at = self._at(c, r * 0.68 - reach, a)
@@ -258,9 +261,12 @@ class GaugeWidget(ElementWidget):
         if m.Units and not small:
             p.setPen(theme.TEXT_DIM)
             p.setFont(theme.sized_font(max(8.0, r * 0.13)))
-            uy = c.y() + r * 0.25 if sweep == -270.0 else c.y() - r * 0.3
-            p.drawText(QRectF(c.x() - r * 0.5, uy - r * 0.09, r, r * 0.18), Qt.AlignmentFlag.AlignCenter,
-                       m.Units)
+            if sweep == -270.0:
+                p.drawText(QRectF(c.x() - r * 0.5, c.y() + r * 0.16, r, r * 0.18),
+                           Qt.AlignmentFlag.AlignCenter, m.Units)
+            else:  # right of the readout, under the baseline: no needle position covers it
+                p.drawText(QRectF(c.x() + r * 0.5, c.y() + r * 0.1, r * 0.5, r * 0.3),
+                           Qt.AlignmentFlag.AlignLeft | Qt.AlignmentFlag.AlignVCenter, m.Units)
 
     def _paint_bar_scale(self, p: QPainter) -> None:
         m = self.model

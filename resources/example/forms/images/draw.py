@@ -45,6 +45,7 @@ def pump(path: Path, running: bool, angle: float) -> None:
 
 
 def tank(path: Path) -> None:
+    """The vessel only: a painted fill would show one level forever (the level is on the gauges)."""
     w, h = 120, 160
     img = QImage(w, h, QImage.Format.Format_ARGB32)
     img.fill(Qt.GlobalColor.transparent)
@@ -52,12 +53,6 @@ def tank(path: Path) -> None:
     p.setRenderHint(QPainter.RenderHint.Antialiasing)
     p.setPen(QPen(QColor("#33393f"), 3))
     p.setBrush(QColor("#e3e6ea"))
-    p.drawRoundedRect(QRectF(10, 14, w - 20, h - 28), 14, 14)
-    p.setBrush(QColor("#9ec5e8"))
-    p.setPen(Qt.PenStyle.NoPen)
-    p.drawRoundedRect(QRectF(13, h * 0.45, w - 26, h * 0.45 - 17), 11, 11)
-    p.setPen(QPen(QColor("#33393f"), 3))
-    p.setBrush(Qt.BrushStyle.NoBrush)
     p.drawRoundedRect(QRectF(10, 14, w - 20, h - 28), 14, 14)
     p.drawLine(QPointF(w / 2, 0), QPointF(w / 2, 14))
     p.end()
