@@ -132,7 +132,7 @@ def main() -> None:
     mean, refresh = statistics.mean(steady), statistics.mean(models[warm:])
     print(f"hmi form update, 300 elements: {mean:.2f} ms mean, {statistics.median(steady):.2f} ms median, "
           f"{p95:.2f} ms p95 over {len(steady)} ticks (target <= 10 ms); of it refresh {refresh:.2f} ms, "
-          f"repaint {mean - refresh:.2f} ms; plots redrawn every {REDRAW_INTERVAL:g} s (staggered), "
+          f"repaint {mean - refresh:.2f} ms; plots redrawn every {REDRAW_INTERVAL:g} s (together per form), "
           f"everything else in the tick it changes")
     for what, start, end in (("resident", rss_warm[0], rss_end[0]),
                              ("resident after malloc_trim", rss_warm[1], rss_end[1])):

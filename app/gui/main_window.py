@@ -38,6 +38,7 @@ from app.gui.journal import JournalDock
 from app.gui.login import LoginDialog
 from app.gui.status import StationStatusBar, station_problems
 from app.gui.style import apply_style
+from app.gui.trend_history import TrendHistory
 from app.gui.zoom import ACTUAL, FIT_WIDTH, FIT_WINDOW, ZoomArea, ZoomSettings
 from app.runtime import Runtime
 from app.users import ENGINEER, OPERATOR, Session, Users
@@ -67,6 +68,7 @@ class MainWindow(QMainWindow):
                                idle=station.operator.idle_logout)
         self._quitting = False
         self.views: list[FormView] = []
+        self.history: TrendHistory | None = None
         self.zooms: list[ZoomArea] = []
         self.zoom_settings = ZoomSettings(station.Archive.parent / "workstation.ini")
         self.viewers: list[QWidget] = []
@@ -167,10 +169,12 @@ class MainWindow(QMainWindow):
             return []
         forms, problems = self.runtime.open_forms()  # the views' own models: they only show
         target = EngineTarget(self.runtime.engine)
+        self.history = TrendHistory(station.Archive, self)
         for form in forms:
             view = FormView(form, target, archive_path=station.Archive, user=self.user,
                             started=self.runtime.started_clock, guard=self._guard)
             self.views.append(view)
+            self.history.attach(view)
             area = ZoomArea(view)
             area.restore(self.zoom_settings.get(form.path))
             area.zoomed.connect(lambda _label, a=area: self._zoomed(a))
@@ -354,6 +358,8 @@ class MainWindow(QMainWindow):
         self._timer.stop()
         self.bridge.detach()
         self.journal.close_archive()
+        if self.history is not None:
+            self.history.close()
         for viewer in self.viewers:
             viewer.close()
         super().closeEvent(event)

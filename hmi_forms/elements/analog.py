@@ -169,7 +169,7 @@ class AnalogBase(Scaled):
         if self.trend is None or snap.scan == self.last_scan:
             return False
         self.last_scan = snap.scan
-        self.trend.add(math.nan if hw is None else self.scaling.to_phy(hw))
+        self.trend.add(math.nan if hw is None else self.scaling.to_phy(hw), snap.wall)
         return True
 
     def reset_max(self) -> None:

@@ -5,9 +5,9 @@ skips some when the window lags: a view only shows, and forwards the operator's 
 form does to the station, the runtime does from every snapshot, hmi_forms/behaviour.py). Every
 model reads the snapshot;
 only widgets whose model reports a change are scheduled for repainting, and Qt paints them all in
-one pass. Trend plots are redrawn in staggered turns (a few per tick, each once a second, as PyDM
-does by default) so fifty plots never land in the same tick. A model that raises is reported once, marked
-stale and skipped; the rest of the form keeps running.
+one pass. Trend plots are redrawn once a second (as PyDM does by default), all plots of a form in
+the same tick on one clock-time axis, so two trends never disagree about when something happened.
+A model that raises is reported once, marked stale and skipped; the rest of the form keeps running.
 """
 
 from __future__ import annotations
@@ -16,6 +16,7 @@ import time
 from collections.abc import Callable
 from pathlib import Path
 
+import numpy as np
 from PySide6.QtCore import QRectF, QSize, Qt
 from PySide6.QtGui import QColor, QPainter, QPaintEvent, QTransform
 from PySide6.QtWidgets import QWidget
@@ -78,9 +79,16 @@ class FormView(QWidget):
         # where each painted element goes, worked out once: the paint loop runs 200 times a tick
         self._slots = [(w, w.geometry(), QTransform.fromTranslate(w.x(), w.y()), QRectF(w.rect()))
                        for w in self.painted]
-        start = clock()
-        for i, w in enumerate(self.trends):  # stagger the redraw turns over one interval
-            w.next_flush = start + REDRAW_INTERVAL * i / max(len(self.trends), 1)
+        self.live = True  # the trends follow the clock; paused, the operator pans and zooms them
+        self.history_wanted: Callable[[TrendWidget, float, float], None] | None = None
+        self._next_flush = clock()
+        for w in self.trends:  # one time axis for the form: panning one pans them all
+            if w is not self.trends[0]:
+                w.plot.getPlotItem().setXLink(self.trends[0].plot.getPlotItem())
+            w.view_box.sigRangeChangedManually.connect(self.pause)
+            w.pause_button.clicked.connect(self.toggle_live)
+        if self.trends:
+            self.trends[0].view_box.sigXRangeChanged.connect(self._range_changed)
 
     def _widget(self, model: Element, archive: Path | None) -> ElementWidget:
         images = self.images
@@ -118,8 +126,46 @@ class FormView(QWidget):
             if changed:
                 widget.sync()
         now = self.clock()
+        if self.trends and now >= self._next_flush:  # all plots of the form in the same tick
+            self._next_flush = max(self._next_flush + REDRAW_INTERVAL, now)
+            self._redraw(snapshot.wall)
+
+    def _redraw(self, wall: float) -> None:
         for trend in self.trends:
-            trend.flush_due(now)
+            trend.flush()
+        if self.live:
+            span = max(t.span for t in self.trends)
+            self.trends[0].show_window(wall - span, wall)  # the others are linked to it
+
+    def pause(self) -> None:
+        """Stop following the clock (the operator pans, zooms or reads a value)."""
+        if self.live:
+            self.live = False
+            for trend in self.trends:
+                trend.set_live(False)
+
+    def resume(self) -> None:
+        self.live = True
+        for trend in self.trends:
+            trend.set_live(True)
+        if self._last is not None:
+            self._redraw(self._last.wall)
+
+    def toggle_live(self) -> None:
+        if self.live:
+            self.pause()
+        else:
+            self.resume()
+
+    def _range_changed(self, _box: object, x_range: tuple[float, float]) -> None:
+        """Scrolled back past the live samples: each trend asks for its history there."""
+        if self.history_wanted is None:
+            return
+        for trend in self.trends:
+            t = trend.trend.times()
+            first = t[0] if len(t) and not np.isnan(t[0]) else float("inf")
+            if x_range[0] < first:
+                self.history_wanted(trend, x_range[0], x_range[1])
 
     def _fault(self, model: Element, error: Exception, what: str) -> None:
         text = f'{self.form.path}: element "{model.Name}": {what} failed: {error!r}'
@@ -131,6 +177,8 @@ class FormView(QWidget):
         """Bring every throttled part up to date (before a screenshot)."""
         for _, widget in self.pairs:
             widget.flush()
+        if self.trends and self._last is not None and self.live:
+            self._redraw(self._last.wall)
 
     def save_png(self, path: str | Path) -> bool:
         self.flush()

@@ -213,3 +213,51 @@ def test_the_zoom_is_remembered_per_form(qtbot, console: MainWindow) -> None:
         assert again.zooms[2].mode == FIT_WINDOW  # the default
     finally:
         again.close()
+
+
+def test_the_trends_of_a_form_share_one_clock_time_axis(qtbot, console: MainWindow) -> None:
+    import pyqtgraph as pg
+
+    view = console.views[0]
+    first, second = view.trends[:2]
+    qtbot.waitUntil(lambda: first.trend.count > 15 and second.trend.count > 15, timeout=10_000)
+    view.flush()
+    assert isinstance(first.plot.getPlotItem().getAxis("bottom"), pg.DateAxisItem)
+    assert first.view_box.viewRange()[0] == second.view_box.viewRange()[0]
+    x0, x1 = first.view_box.viewRange()[0]
+    assert abs(x1 - view._last.wall) < 0.01 and x1 - x0 > 10  # clock time, ending now
+    assert first.shown == first.trend.count and second.shown == second.trend.count  # redrawn together
+    t, v = first.trend.times()[-3], first.trend.values()[-3]
+    assert first.value_at(t + 0.01) == (t, v)  # the cursor reads the nearest sample
+
+    second.view_box.setXRange(x0 - 30, x1 - 30, padding=0)
+    second.view_box.sigRangeChangedManually.emit([True, False])  # as a drag does
+    assert not view.live and first.pause_button.text() == "\u25b6"
+    assert first.view_box.viewRange()[0] == second.view_box.viewRange()[0]  # linked
+    qtbot.wait(1200)
+    assert first.view_box.viewRange()[0][1] < view._last.wall - 20  # paused: it stays where it was put
+    first.pause_button.click()
+    assert view.live
+    assert abs(first.view_box.viewRange()[0][1] - view._last.wall) < 0.01
+
+
+def test_a_trend_starts_with_the_archives_history(qtbot, demo_copy: Path) -> None:
+    first = Runtime(load_station(demo_copy))
+    first.start()
+    try:
+        qtbot.waitUntil(lambda: first.status().records_written > 30, timeout=15_000)
+        qtbot.wait(2500)  # NSTORE of the level, once a second
+    finally:
+        first.stop()
+    runtime = Runtime(load_station(demo_copy))
+    runtime.start()
+    window = MainWindow(runtime)
+    qtbot.addWidget(window)
+    try:
+        level = next(t for v in window.views for t in v.trends if t.model.Name == "Уровень, тренд")
+        qtbot.waitUntil(lambda: len(level.hist_times) > 1, timeout=10_000)
+        assert level.hist_times[-1] < runtime.wallclock()
+        assert all(0 <= v <= 100 for v in level.hist_values)  # raw NSTORE words, scaled to %
+    finally:
+        window.close()
+        runtime.stop()
