@@ -46,7 +46,8 @@ from registrar.query import Archive, Filter, SeriesKey
 PAGE = 500
 SERIES_POINTS = 4000
 KINDS = ("all", "data", "message", "operator", "system")
-TYPES = ("any", "0 info", "1 warning", "2 alarm", "3 critical")
+# a severity and everything worse, as alarm consoles filter: "2 alarm" keeps the critical ones too
+TYPES = ("any", "0 info and above", "1 warning and above", "2 alarm and above", "3 critical")
 PALETTE = ("#1f77b4", "#d62728", "#2ca02c", "#ff7f0e", "#9467bd", "#17becf", "#8c564b", "#e377c2")
 
 
@@ -223,12 +224,13 @@ class ViewerWindow(QMainWindow):
     def current_filter(self) -> Filter:
         kind = self.kind.currentText()
         day = self.day or dt.date.today()
-        since = dt.datetime.combine(day, self.since.time().toPython()).timestamp()
-        until = dt.datetime.combine(day, self.until.time().toPython()).timestamp() + 1
+        # both bounds are whole seconds as shown: To 10:00:05 takes 10:00:05.999, never 10:00:06
+        since = dt.datetime.combine(day, self.since.time().toPython().replace(microsecond=0)).timestamp()
+        until = dt.datetime.combine(day, self.until.time().toPython().replace(microsecond=0)).timestamp() + 1
         return Filter(
             kinds=None if kind == "all" else {kind},
             grp=None if self.group.value() < 0 else self.group.value(),
-            type=None if self.type.currentIndex() == 0 else self.type.currentIndex() - 1,
+            min_type=None if self.type.currentIndex() == 0 else self.type.currentIndex() - 1,
             source=self.source.text().strip() or None,
             text=self.text.text().strip() or None,
             since=since,
