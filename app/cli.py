@@ -195,7 +195,7 @@ def run_headless(station: str, duration: float | None, every: float) -> int:
         runtime.stop()
         for s, handler in previous.items():
             signal.signal(s, handler)
-    print(f"station stopped: {runtime.status().line()}", flush=True)
+    print(f"station stopped after {runtime.status().line()}", flush=True)
     return 0
 
 

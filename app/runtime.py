@@ -77,7 +77,13 @@ class RuntimeStatus:
         return sum(n.up for n in self.nodes)
 
     def line(self) -> str:
-        """The one-line status of `--no-gui`."""
+        """The one-line status of `--no-gui`; once stopped, what the run did (a stopped station
+        has no program state or links to report: "running" and "DOWN" there read as faults)."""
+        if not self.running:
+            text = f"{self.scans} scans, {self.records_written} records written"
+            if self.records_lost:
+                text += f", {self.records_lost} lost"
+            return text
         nodes = ", ".join(f"{n.node}:{'up' if n.up else 'DOWN'}" for n in self.nodes) or "none"
         text = (f"NetPlc {self.state} | scan {self.scan_last_ms:.2f} ms (max {self.scan_max_ms:.2f}, "
                 f"tick {self.tick_ms} ms, {self.overruns} overruns, {self.scans} scans) | "

@@ -7,7 +7,6 @@ by the runtime; the banner only collects and shows.
 
 from __future__ import annotations
 
-import time
 from dataclasses import dataclass
 
 from PySide6.QtCore import Qt, QTimer, Signal
@@ -25,6 +24,7 @@ from PySide6.QtWidgets import (
 )
 
 from app.gui.elided import ElidedLabel
+from hmi_forms.elements import formats
 from netplc.records import Record
 
 ALARM_TYPE = 2  # docs/architecture.md section 8: 0 info, 1 warning, 2 alarm, 3 critical
@@ -93,7 +93,7 @@ class AlarmBanner(QFrame):
             self._timer.stop()
             return
         newest = self.alarms[0]
-        when = time.strftime("%H:%M:%S", time.localtime(newest.record.ts))
+        when = formats.clock(newest.record.ts)
         kind = TYPE_NAMES.get(newest.record.type or 0, "ALARM")
         self.text.setText(f"{when}   {kind}   {newest.text}")
         self.count.setText(f"{len(self.alarms)} unacknowledged" if len(self.alarms) > 1 else "")

@@ -14,6 +14,7 @@ import signal
 import sys
 import time
 from collections.abc import Callable
+from importlib import metadata
 
 from PySide6.QtCore import QEvent, QObject, QSize, Qt, QTimer
 from PySide6.QtGui import QAction, QCloseEvent, QKeySequence
@@ -42,6 +43,7 @@ from app.gui.trend_history import TrendHistory
 from app.gui.zoom import ACTUAL, FIT_WIDTH, FIT_WINDOW, ZoomArea, ZoomSettings
 from app.runtime import Runtime
 from app.users import ENGINEER, OPERATOR, Session, Users
+from hmi_forms.elements import formats
 from hmi_forms.elements.base import Writer
 from hmi_forms.elements.target import EngineTarget
 from hmi_forms.widgets.form_view import FormView
@@ -339,10 +341,12 @@ class MainWindow(QMainWindow):
         viewer.show()
         self.viewers.append(viewer)
 
+    def about_text(self) -> str:
+        return (self.tr("NetPlc Station {0}: the PC runtime for CPU-165 PLC networks (FregatServer).")
+                .format(version()) + "\n" + self.tr("Station: {0}").format(self.runtime.station.path))
+
     def _about(self) -> None:
-        QMessageBox.about(self, "NetPlc Station",
-                          "NetPlc Station: the PC runtime for CPU-165 PLC networks (FregatServer).\n"
-                          f"Station: {self.runtime.station.path}")
+        QMessageBox.about(self, "NetPlc Station", self.about_text())
 
     def closeEvent(self, event: QCloseEvent) -> None:
         """The window manager's close button is Quit; a close from the program (SIGTERM, Ctrl+C,
@@ -421,7 +425,15 @@ class _Header(QFrame):
         self.login.setText(self.tr("Log out") if logged_in else self.tr("Log in…"))
 
     def tick(self) -> None:
-        self.clock.setText(time.strftime("%d.%m.%Y  %H:%M:%S"))
+        self.clock.setText(formats.date_time(time.time()))
+
+
+def version() -> str:
+    """The installed package's version (pyproject.toml), or "dev" when run from a bare checkout."""
+    try:
+        return metadata.version("netplc-station")
+    except metadata.PackageNotFoundError:
+        return "dev"
 
 
 def _problems_page(problems: list[str]) -> QWidget:

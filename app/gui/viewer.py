@@ -40,6 +40,7 @@ from PySide6.QtWidgets import (
 from app.config import DEMO_STATION, ConfigError, load_station, station_file
 from app.gui.series_loader import SeriesLoader
 from app.gui.style import apply_style
+from hmi_forms.elements import formats
 from hmi_forms.widgets.records import RecordsModel, records_view
 from registrar.query import Archive, Filter, SeriesKey
 
@@ -194,7 +195,7 @@ class ViewerWindow(QMainWindow):
         self.days.blockSignals(True)
         self.days.clear()
         for day in days:
-            item = QListWidgetItem(day.strftime("%d.%m.%Y  (%a)"))
+            item = QListWidgetItem(f"{formats.date(day)}  ({day:%a})")
             item.setData(Qt.ItemDataRole.UserRole, day)
             self.days.addItem(item)
         self.days.blockSignals(False)

@@ -9,7 +9,6 @@ those are the options; the rules for reading a row are written once here.
 
 from __future__ import annotations
 
-import time
 from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass, field
 from typing import Any
@@ -18,6 +17,7 @@ from PySide6.QtCore import QAbstractTableModel, QModelIndex, QPersistentModelInd
 from PySide6.QtGui import QColor
 from PySide6.QtWidgets import QAbstractItemView, QHeaderView, QTableView
 
+from hmi_forms.elements import formats
 from netplc.address import fmt_octal
 from registrar.query import Row
 
@@ -46,8 +46,7 @@ def number(row: Row) -> str:
 
 
 def clock_ms(row: Row) -> str:
-    ms = int(row.ts * 1000) % 1000
-    return time.strftime("%H:%M:%S", time.localtime(row.ts)) + f".{ms:03d}"
+    return formats.clock_ms(row.ts)
 
 
 @dataclass(frozen=True)
@@ -71,7 +70,7 @@ ARCHIVE_COLUMNS = (TIME, KIND, GROUP, TYPE, SOURCE, NUMBER, VALUE, TEXT)
 """The workstation's columns: every field of a record, text last to take the spare width."""
 
 JOURNAL_COLUMNS = (
-    Column("Time", lambda r: r.time.strftime("%H.%M.%S"), 70),
+    Column("Time", lambda r: formats.clock(r.ts), 70),
     Column("Kind", KIND.text, 70),
     Column("Group", GROUP.text, 50),
     Column("Type", type_name, 64),

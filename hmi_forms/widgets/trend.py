@@ -13,7 +13,6 @@ and scroll back into the archive's history, drawn lighter behind the live sample
 from __future__ import annotations
 
 import math
-import time
 from collections.abc import Hashable
 
 import numpy as np
@@ -22,6 +21,7 @@ from PySide6.QtCore import QCoreApplication, QPointF, QRect, QRectF, Qt
 from PySide6.QtGui import QColor, QPainter, QPen
 from PySide6.QtWidgets import QGraphicsItem, QToolButton, QWidget
 
+from hmi_forms.elements import formats
 from hmi_forms.elements.analog import AnalogBase
 from hmi_forms.elements.graph import Graph
 from hmi_forms.elements.props import Color
@@ -190,7 +190,7 @@ class TrendWidget(SelfPainted):
         value = "---" if math.isnan(y) else (str(int(y)) if isinstance(self.model, Graph)
                                              else f"{self.model.format(y)} {self.model.Units}".rstrip())
         self.cursor.setPos(t)
-        self.cursor_label.setText(f"{time.strftime('%X', time.localtime(t))}  {value}")
+        self.cursor_label.setText(f"{formats.clock(t)}  {value}")
         (x0, x1), (_, y1) = self.view_box.viewRange()
         self.cursor_label.setAnchor((1, 0) if t > (x0 + x1) / 2 else (0, 0))
         self.cursor_label.setPos(t, y1)

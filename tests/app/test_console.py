@@ -261,3 +261,7 @@ def test_a_trend_starts_with_the_archives_history(qtbot, demo_copy: Path) -> Non
     finally:
         window.close()
         runtime.stop()
+
+
+def test_about_names_the_version(console: MainWindow) -> None:
+    assert "NetPlc Station 0.1.0" in console.about_text()
