@@ -9,7 +9,7 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 
-from PySide6.QtCore import Qt, QTimer, Signal
+from PySide6.QtCore import QT_TRANSLATE_NOOP, Qt, QTimer, Signal
 from PySide6.QtWidgets import (
     QDialog,
     QDialogButtonBox,
@@ -28,7 +28,8 @@ from hmi_forms.elements import formats
 from netplc.records import Record
 
 ALARM_TYPE = 2  # docs/architecture.md section 8: 0 info, 1 warning, 2 alarm, 3 critical
-TYPE_NAMES = {0: "info", 1: "warning", 2: "ALARM", 3: "CRITICAL"}
+TYPE_NAMES = {0: QT_TRANSLATE_NOOP("AlarmBanner", "info"), 1: QT_TRANSLATE_NOOP("AlarmBanner", "warning"),
+              2: QT_TRANSLATE_NOOP("AlarmBanner", "ALARM"), 3: QT_TRANSLATE_NOOP("AlarmBanner", "CRITICAL")}
 
 
 @dataclass(frozen=True)
@@ -55,9 +56,9 @@ class AlarmBanner(QFrame):
         self.text.setObjectName("alarmText")
         self.count = QLabel()
         self.count.setObjectName("alarmCount")
-        self.ack = QPushButton("Acknowledge")
+        self.ack = QPushButton(self.tr("Acknowledge"))
         self.ack.setObjectName("alarmAck")
-        self.ack_all = QPushButton("Acknowledge all")
+        self.ack_all = QPushButton(self.tr("Acknowledge all"))
         self.ack_all.setObjectName("alarmAck")
         lay.addWidget(self.icon)
         lay.addWidget(self.text, 1)
@@ -94,9 +95,10 @@ class AlarmBanner(QFrame):
             return
         newest = self.alarms[0]
         when = formats.clock(newest.record.ts)
-        kind = TYPE_NAMES.get(newest.record.type or 0, "ALARM")
+        kind = self.tr(TYPE_NAMES.get(newest.record.type or 0, "ALARM"))
         self.text.setText(f"{when}   {kind}   {newest.text}")
-        self.count.setText(f"{len(self.alarms)} unacknowledged" if len(self.alarms) > 1 else "")
+        many = len(self.alarms) > 1
+        self.count.setText(self.tr("{0} unacknowledged").format(len(self.alarms)) if many else "")
         self.ack_all.setVisible(len(self.alarms) > 1)
         self.setVisible(True)
         if not self._timer.isActive():

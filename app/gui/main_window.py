@@ -33,6 +33,7 @@ from PySide6.QtWidgets import (
 )
 
 from app.config import load_station
+from app.gui import i18n
 from app.gui.alarms import Alarm, AlarmBanner, FixedLine, HealthStrip
 from app.gui.bridge import RuntimeBridge
 from app.gui.journal import JournalDock
@@ -88,8 +89,10 @@ class MainWindow(QMainWindow):
         self.tabs.setObjectName("forms")
         self.tabs.setDocumentMode(True)
         lay.addWidget(self.header)
-        lay.addWidget(FixedLine(self.alarms, self.tr("No unacknowledged alarms"), ALARM_LINE))
-        lay.addWidget(FixedLine(self.health, "", HEALTH_LINE))
+        self.fixed_lines = (FixedLine(self.alarms, self.tr("No unacknowledged alarms"), ALARM_LINE),
+                            FixedLine(self.health, "", HEALTH_LINE))
+        for line in self.fixed_lines:
+            lay.addWidget(line)
         lay.addWidget(self.tabs, 1)
         self.setCentralWidget(central)
 
@@ -120,7 +123,7 @@ class MainWindow(QMainWindow):
     # --- building ------------------------------------------------------------------------------
 
     def _build_menu(self) -> None:
-        station = self.menuBar().addMenu("&Station")
+        station = self.menuBar().addMenu(self.tr("&Station"))
         # no single key runs or stops the PLC: both ask, and need the engineer role
         self.act_run = QAction(self.tr("&Run NetPlc…"), self)
         self.act_run.triggered.connect(self.run_program)
@@ -131,7 +134,7 @@ class MainWindow(QMainWindow):
         self.act_login.triggered.connect(self.log_in)
         self.act_logout = QAction(self.tr("Log &out"), self)
         self.act_logout.triggered.connect(self.log_out)
-        viewer = QAction("Open journal &viewer…", self)
+        viewer = QAction(self.tr("Open journal &viewer…"), self)
         viewer.setShortcut(QKeySequence("Ctrl+J"))
         viewer.triggered.connect(self.open_viewer)
         self.act_quit = quit_ = QAction(self.tr("&Quit…"), self)
@@ -159,15 +162,16 @@ class MainWindow(QMainWindow):
             action.setShortcut(QKeySequence(keys))
             action.triggered.connect(lambda _=False, act=act: self._zoom(act))
             view.addAction(action)
-        help_ = self.menuBar().addMenu("&Help")
-        about = QAction("&About", self)
+        help_ = self.menuBar().addMenu(self.tr("&Help"))
+        about = QAction(self.tr("&About"), self)
         about.triggered.connect(self._about)
         help_.addAction(about)
 
     def _load_forms(self) -> list[str]:
         station = self.runtime.station
         if station.HMIload is None:
-            self.tabs.addTab(_placeholder("This station has no HMIload folder."), "No forms")
+            self.tabs.addTab(_placeholder(self.tr("This station has no HMIload folder.")),
+                             self.tr("No forms"))
             return []
         forms, problems = self.runtime.open_forms()  # the views' own models: they only show
         target = EngineTarget(self.runtime.engine)
@@ -183,9 +187,10 @@ class MainWindow(QMainWindow):
             self.zooms.append(area)
             self.tabs.addTab(area, form.title)
         if problems:
-            self.tabs.addTab(_problems_page(problems), "Form problems")
+            self.tabs.addTab(_problems_page(problems), self.tr("Form problems"))
         if not forms and not problems:
-            self.tabs.addTab(_placeholder(f"No .hmi forms in {station.HMIload}."), "No forms")
+            self.tabs.addTab(_placeholder(self.tr("No .hmi forms in {0}.").format(station.HMIload)),
+                             self.tr("No forms"))
         return problems
 
     def current_zoom(self) -> ZoomArea | None:
@@ -457,7 +462,9 @@ def run_workstation(station_path: str) -> int:
     app = QApplication.instance() or QApplication(sys.argv[:1])
     apply_style(app)
     try:
-        runtime = Runtime(load_station(station_path))
+        station = load_station(station_path)
+        i18n.install(app, station.Language)
+        runtime = Runtime(station)
         runtime.start()
     except Problems as e:
         print("\n".join(e.problems), file=sys.stderr)

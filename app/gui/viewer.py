@@ -14,7 +14,7 @@ from pathlib import Path
 
 import numpy as np
 import pyqtgraph as pg
-from PySide6.QtCore import Qt
+from PySide6.QtCore import QT_TRANSLATE_NOOP, Qt
 from PySide6.QtGui import QAction, QColor, QKeySequence
 from PySide6.QtWidgets import (
     QApplication,
@@ -38,6 +38,7 @@ from PySide6.QtWidgets import (
 )
 
 from app.config import DEMO_STATION, ConfigError, load_station, station_file
+from app.gui import i18n
 from app.gui.series_loader import SeriesLoader
 from app.gui.style import apply_style
 from hmi_forms.elements import formats
@@ -48,7 +49,10 @@ PAGE = 500
 SERIES_POINTS = 4000
 KINDS = ("all", "data", "message", "operator", "system")
 # a severity and everything worse, as alarm consoles filter: "2 alarm" keeps the critical ones too
-TYPES = ("any", "0 info and above", "1 warning and above", "2 alarm and above", "3 critical")
+TYPES = (QT_TRANSLATE_NOOP("ViewerWindow", "any"), QT_TRANSLATE_NOOP("ViewerWindow", "0 info and above"),
+         QT_TRANSLATE_NOOP("ViewerWindow", "1 warning and above"),
+         QT_TRANSLATE_NOOP("ViewerWindow", "2 alarm and above"),
+         QT_TRANSLATE_NOOP("ViewerWindow", "3 critical"))
 PALETTE = ("#1f77b4", "#d62728", "#2ca02c", "#ff7f0e", "#9467bd", "#17becf", "#8c564b", "#e377c2")
 
 
@@ -61,7 +65,7 @@ def series_label(key: SeriesKey) -> str:
 class ViewerWindow(QMainWindow):
     def __init__(self, archive_path: Path | None = None, parent: QWidget | None = None) -> None:
         super().__init__(parent)
-        self.setWindowTitle("NetPlc Station — journal viewer")
+        self.setWindowTitle(self.tr("NetPlc Station — journal viewer"))
         self.archive: Archive | None = None
         self.archive_path: Path | None = None
         self.offset = 0
@@ -79,17 +83,17 @@ class ViewerWindow(QMainWindow):
     # --- building ------------------------------------------------------------------------------
 
     def _build(self) -> None:
-        menu = self.menuBar().addMenu("&Archive")
-        open_ = QAction("&Open…", self)
+        menu = self.menuBar().addMenu(self.tr("&Archive"))
+        open_ = QAction(self.tr("&Open…"), self)
         open_.setShortcut(QKeySequence.StandardKey.Open)
         open_.triggered.connect(self._choose_archive)
-        self.act_export = QAction("&Export selection to CSV…", self)
+        self.act_export = QAction(self.tr("&Export selection to CSV…"), self)
         self.act_export.setShortcut(QKeySequence("Ctrl+E"))
         self.act_export.triggered.connect(self._choose_export)
-        reload_ = QAction("&Reload", self)
+        reload_ = QAction(self.tr("&Reload"), self)
         reload_.setShortcut(QKeySequence.StandardKey.Refresh)
         reload_.triggered.connect(self.reload)
-        close = QAction("&Close", self)
+        close = QAction(self.tr("&Close"), self)
         close.setShortcut(QKeySequence.StandardKey.Close)
         close.triggered.connect(self.close)
         for a in (open_, self.act_export, reload_):
@@ -100,13 +104,13 @@ class ViewerWindow(QMainWindow):
         side = QWidget()
         side.setObjectName("viewerSide")
         side_lay = QVBoxLayout(side)
-        self.path_label = QLabel("no archive")
+        self.path_label = QLabel(self.tr("no archive"))
         self.path_label.setWordWrap(True)
-        side_lay.addWidget(QLabel("<b>Days</b>"))
+        side_lay.addWidget(QLabel(self.tr("<b>Days</b>")))
         self.days = QListWidget()
         self.days.currentRowChanged.connect(self._day_changed)
         side_lay.addWidget(self.days, 1)
-        side_lay.addWidget(QLabel("<b>Filter</b>"))
+        side_lay.addWidget(QLabel(self.tr("<b>Filter</b>")))
         form = QFormLayout()
         self.kind = QComboBox()
         self.kind.addItems(KINDS)
@@ -115,7 +119,7 @@ class ViewerWindow(QMainWindow):
         self.group.setSpecialValueText("any")
         self.group.setValue(-1)
         self.type = QComboBox()
-        self.type.addItems(TYPES)
+        self.type.addItems([self.tr(t) for t in TYPES])
         self.source = QLineEdit()
         self.source.setPlaceholderText("exact source")
         self.text = QLineEdit()
@@ -125,16 +129,17 @@ class ViewerWindow(QMainWindow):
         self.until = QTimeEdit()
         self.until.setDisplayFormat("HH:mm:ss")
         self.until.setTime(self.until.maximumTime())
-        for label, w in (("Kind", self.kind), ("Group", self.group), ("Type", self.type),
-                         ("Source", self.source), ("Text", self.text), ("From", self.since),
-                         ("To", self.until)):
+        for label, w in ((self.tr("Kind"), self.kind), (self.tr("Group"), self.group),
+                         (self.tr("Type"), self.type), (self.tr("Source"), self.source),
+                         (self.tr("Text"), self.text), (self.tr("From"), self.since),
+                         (self.tr("To"), self.until)):
             form.addRow(label, w)
         side_lay.addLayout(form)
-        apply = QPushButton("Apply filter")
+        apply = QPushButton(self.tr("Apply filter"))
         apply.clicked.connect(self.apply_filter)
         self.source.returnPressed.connect(self.apply_filter)
         self.text.returnPressed.connect(self.apply_filter)
-        export = QPushButton("Export CSV…")
+        export = QPushButton(self.tr("Export CSV…"))
         export.clicked.connect(self._choose_export)
         side_lay.addWidget(apply)
         side_lay.addWidget(export)
@@ -147,9 +152,9 @@ class ViewerWindow(QMainWindow):
         self.table = records_view(self.model, row_height=22)
         rec_lay.addWidget(self.table, 1)
         pager = QHBoxLayout()
-        self.first = QPushButton("\u00ab First")
-        self.prev = QPushButton("\u2039 Previous")
-        self.next = QPushButton("Next \u203a")
+        self.first = QPushButton(self.tr("\u00ab First"))
+        self.prev = QPushButton(self.tr("\u2039 Previous"))
+        self.next = QPushButton(self.tr("Next \u203a"))
         self.page_label = QLabel()
         for b, step in ((self.first, None), (self.prev, -PAGE), (self.next, PAGE)):
             b.clicked.connect(lambda _=False, s=step: self.page(s))
@@ -157,7 +162,7 @@ class ViewerWindow(QMainWindow):
         pager.addStretch(1)
         pager.addWidget(self.page_label)
         rec_lay.addLayout(pager)
-        self.tabs.addTab(records, "Records")
+        self.tabs.addTab(records, self.tr("Records"))
 
         plots = QSplitter(Qt.Orientation.Horizontal)
         self.series_list = QListWidget()
@@ -171,7 +176,7 @@ class ViewerWindow(QMainWindow):
         plots.addWidget(self.series_list)
         plots.addWidget(self.plot)
         plots.setSizes([260, 1000])
-        self.tabs.addTab(plots, "Series")
+        self.tabs.addTab(plots, self.tr("Series"))
 
         split = QSplitter(Qt.Orientation.Horizontal)
         split.addWidget(side)
@@ -186,7 +191,7 @@ class ViewerWindow(QMainWindow):
             archive = Archive(path)
             days = archive.days()
         except (sqlite3.Error, OSError) as e:
-            QMessageBox.warning(self, "Journal viewer", f"Cannot open {path}:\n{e}")
+            QMessageBox.warning(self, self.tr("Journal viewer"), f"Cannot open {path}:\n{e}")
             return False
         if self.archive is not None:
             self.archive.close()
@@ -275,14 +280,15 @@ class ViewerWindow(QMainWindow):
         day = self.day
         if day is None:
             return
-        name, _ = QFileDialog.getSaveFileName(self, "Export selection", f"journal_{day:%d_%m_%Y}.csv",
+        name, _ = QFileDialog.getSaveFileName(self, self.tr("Export selection"),
+                                              f"journal_{day:%d_%m_%Y}.csv",
                                               "CSV files (*.csv)")
         if name:
             n = self.export_csv(Path(name))
             self.statusBar().showMessage(f"{n} records exported to {name}", 8000)
 
     def _choose_archive(self) -> None:
-        name, _ = QFileDialog.getOpenFileName(self, "Open archive", "",
+        name, _ = QFileDialog.getOpenFileName(self, self.tr("Open archive"), "",
                                               "Archives (*.sqlite *.db);;All files (*)")
         if name:
             self.open_archive(Path(name))
@@ -376,6 +382,7 @@ def run_viewer(target: str | None) -> int:
         return 2
     app = QApplication.instance() or QApplication(sys.argv[:1])
     apply_style(app)
+    i18n.install(app)  # the viewer has no station file: the system locale decides
     window = ViewerWindow(path)
     window.show()
     return app.exec()

@@ -37,10 +37,6 @@ def _pen_color(color: Color | None) -> QColor:
     return theme.qcolor(color, theme.ACCENT)
 
 
-def _tr(text: str) -> str:
-    return QCoreApplication.translate("TrendWidget", text)
-
-
 class FixedCurve(pg.PlotCurveItem):
     """A curve whose extent is set from outside: pyqtgraph would otherwise measure the data (with
     pixel padding) after every setData, for nothing, since the view never rescales to it."""
@@ -118,7 +114,7 @@ class TrendWidget(SelfPainted):
         self.pause_button.setAutoRaise(True)
         self.pause_button.setGeometry(model.w - self.header - 2, 1, self.header, self.header - 2)
         self.pause_button.setText(PAUSE)
-        self.pause_button.setToolTip(_tr("Pause (drag or wheel in the plot also pauses)"))
+        self.set_live(True)
         self.stale_mark.raise_()
         self.shown = -1  # trend.count when last drawn
         self.hist_times = self.hist_values = np.empty(0)
@@ -156,8 +152,9 @@ class TrendWidget(SelfPainted):
 
     def set_live(self, live: bool) -> None:
         self.pause_button.setText(PAUSE if live else LIVE)
-        self.pause_button.setToolTip(_tr("Pause (drag or wheel in the plot also pauses)") if live
-                                     else _tr("Back to live"))
+        self.pause_button.setToolTip(
+            QCoreApplication.translate("TrendWidget", "Pause (dragging or wheeling in the plot also pauses)")
+            if live else QCoreApplication.translate("TrendWidget", "Back to live"))
 
     def set_history(self, times: np.ndarray, values: np.ndarray) -> None:
         """The archive's samples of this trend, drawn lighter behind the live ones."""

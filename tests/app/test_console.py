@@ -265,3 +265,51 @@ def test_a_trend_starts_with_the_archives_history(qtbot, demo_copy: Path) -> Non
 
 def test_about_names_the_version(console: MainWindow) -> None:
     assert "NetPlc Station 0.1.0" in console.about_text()
+
+
+@pytest.fixture
+def russian(qapp) -> Iterator[None]:
+    from app.gui import i18n
+
+    assert i18n.install(qapp, "ru") == "ru"
+    try:
+        yield
+    finally:
+        i18n.uninstall(qapp)
+
+
+def test_the_console_speaks_russian_and_the_forms_keep_their_texts(qtbot, russian, demo_copy: Path) -> None:
+    from app.gui import i18n
+
+    assert i18n.compiled("ru") is not None  # the .ts in the repository compiles with PySide6's lrelease
+    runtime = Runtime(load_station(demo_copy))
+    runtime.start()
+    window = MainWindow(runtime)
+    qtbot.addWidget(window)
+    try:
+        menus = [a.text() for a in window.menuBar().actions()]
+        assert menus == ["&Станция", "&Вид", "&Справка"]
+        assert window.act_run.text() == "&Запустить NetPlc…" and window.act_quit.text() == "В&ыход…"
+        heads = [window.journal.model.headerData(i, Qt.Orientation.Horizontal) for i in range(3)]
+        assert heads == ["Время", "Вид", "Группа"]
+        assert window.alarms.ack.text() == "Квитировать"
+        assert window.fixed_lines[0].quiet.text() == "Нет неквитированных аварий"
+        window.refresh_status()
+        assert window.status.state.text() == "NetPlc: работает"
+        assert window.journal.windowTitle() == "Журнал — сегодня"
+        titles = [v.form.title for v in window.views]
+        assert [window.tabs.tabText(i) for i in range(3)] == titles  # as the engineer wrote them
+        assert "Пуск" in [m.Name for v in window.views for m in v.form.elements]
+        import datetime as dt
+
+        assert window.header.clock.text().startswith(f"{dt.date.today():%d.%m.%Y}")
+    finally:
+        window.close()
+        runtime.stop()
+
+
+def test_the_language_comes_from_station_toml(demo_copy: Path) -> None:
+    toml = demo_copy / "station.toml"
+    toml.write_text(toml.read_text(encoding="utf-8").replace('# Language = "ru"', 'Language = "en"'),
+                    encoding="utf-8")
+    assert load_station(demo_copy).Language == "en"
