@@ -26,6 +26,7 @@ QMainWindow, #central { background: #d9dde3; }
 #alarmAck { background: #ffffff; color: #b71c1c; font-weight: bold; border: 1px solid #7f0000;
             border-radius: 3px; padding: 4px 14px; }
 #alarmAck:hover { background: #ffebee; }
+#alarmAck:disabled { background: #e8b4b4; color: #7f3b3b; }
 #healthStrip { background: #ffe082; border-bottom: 1px solid #c79a00; }
 #healthText { color: #4e3b00; font-weight: bold; }
 #healthDetails { padding: 1px 10px; }
