@@ -41,9 +41,10 @@ from app.gui.login import LoginDialog
 from app.gui.status import StationStatusBar, station_problems
 from app.gui.style import apply_style
 from app.gui.trend_history import TrendHistory
+from app.gui.users_dialog import UsersDialog
 from app.gui.zoom import ACTUAL, FIT_WIDTH, FIT_WINDOW, ZoomArea, ZoomSettings
 from app.runtime import Runtime
-from app.users import ENGINEER, OPERATOR, Session, Users
+from app.users import ADMIN, ENGINEER, OPERATOR, Session, Users
 from hmi_forms.elements import formats
 from hmi_forms.elements.base import Writer
 from hmi_forms.elements.target import EngineTarget
@@ -134,6 +135,8 @@ class MainWindow(QMainWindow):
         self.act_login.triggered.connect(self.log_in)
         self.act_logout = QAction(self.tr("Log &out"), self)
         self.act_logout.triggered.connect(self.log_out)
+        self.act_users = QAction(self.tr("&Users…"), self)
+        self.act_users.triggered.connect(self.manage_users)
         viewer = QAction(self.tr("Open journal &viewer…"), self)
         viewer.setShortcut(QKeySequence("Ctrl+J"))
         viewer.triggered.connect(self.open_viewer)
@@ -145,6 +148,7 @@ class MainWindow(QMainWindow):
         station.addSeparator()
         station.addAction(self.act_login)
         station.addAction(self.act_logout)
+        station.addAction(self.act_users)
         station.addSeparator()
         station.addAction(viewer)
         station.addSeparator()
@@ -325,6 +329,15 @@ class MainWindow(QMainWindow):
             self.runtime.operator(before.name, "logged out: user switched")
         self.runtime.operator(user.name, f"logged in as {user.role}")
         self._user_changed()
+
+    def manage_users(self) -> UsersDialog | None:
+        """The users dialog, for an admin only; its changes are journaled under the admin."""
+        if not self.allowed(ADMIN, self.tr("Users")):
+            return None
+        admin = self.user
+        dialog = UsersDialog(self.session.users, lambda text: self.runtime.operator(admin, text), self)
+        dialog.show()
+        return dialog
 
     def log_out(self) -> None:
         if self.session.user is not None:

@@ -313,3 +313,25 @@ def test_the_language_comes_from_station_toml(demo_copy: Path) -> None:
     toml.write_text(toml.read_text(encoding="utf-8").replace('# Language = "ru"', 'Language = "en"'),
                     encoding="utf-8")
     assert load_station(demo_copy).Language == "en"
+
+
+def test_only_an_admin_manages_users_and_it_is_journaled(qtbot, console: MainWindow) -> None:
+    from app.users import Users
+
+    for name in ("operator", "engineer"):
+        console.login(name, name)
+        assert console.manage_users() is None
+        assert f"Users: needs the admin role; {name} is {name}" in console.status.currentMessage()
+    console.login("admin", "admin")
+    dialog = console.manage_users()
+    assert dialog is not None and dialog.table.rowCount() == 4
+    assert dialog.add_user("ivan", "operator", "pw") and dialog.table.rowCount() == 5
+    assert not dialog.add_user("ivan", "viewer", "x") and "exists already" in dialog.message.text()
+    assert dialog.set_password("ivan", "new") and dialog.remove_user("viewer")
+    dialog.close()
+    folder = console.runtime.station.folder
+    assert Users(folder).verify("ivan", "new").role == "operator" and Users(folder).get("viewer") is None
+    console.runtime.stop()
+    rows = operator_rows(console.runtime)
+    assert rows[-3:] == [("admin", "user ivan added as operator"), ("admin", "password of ivan changed"),
+                         ("admin", "user viewer removed")]

@@ -129,6 +129,10 @@
         <translation>В&amp;ыйти из системы</translation>
     </message>
     <message>
+        <source>&amp;Users…</source>
+        <translation>&amp;Пользователи…</translation>
+    </message>
+    <message>
         <source>Open journal &amp;viewer…</source>
         <translation>Открыть &amp;просмотр журнала…</translation>
     </message>
@@ -229,6 +233,10 @@
         <translation>Завершить NetPlc Station? Программа NetPlc, обмен с узлами и архив будут остановлены.</translation>
     </message>
     <message>
+        <source>Users</source>
+        <translation>Пользователи</translation>
+    </message>
+    <message>
         <source>NetPlc Station {0}: the PC runtime for CPU-165 PLC networks (FregatServer).</source>
         <translation>NetPlc Station {0}: среда исполнения ПК для сетей контроллеров CPU-165 (FregatServer).</translation>
     </message>
@@ -305,6 +313,53 @@
     <message>
         <source>Back to live</source>
         <translation>Вернуться к текущему времени</translation>
+    </message>
+</context>
+<context>
+    <name>UsersDialog</name>
+    <message>
+        <source>Users</source>
+        <translation>Пользователи</translation>
+    </message>
+    <message>
+        <source>User</source>
+        <translation>Пользователь</translation>
+    </message>
+    <message>
+        <source>Role</source>
+        <translation>Роль</translation>
+    </message>
+    <message>
+        <source>Add…</source>
+        <translation>Добавить…</translation>
+    </message>
+    <message>
+        <source>Remove</source>
+        <translation>Удалить</translation>
+    </message>
+    <message>
+        <source>Password…</source>
+        <translation>Пароль…</translation>
+    </message>
+    <message>
+        <source>Add user</source>
+        <translation>Новый пользователь</translation>
+    </message>
+    <message>
+        <source>Name:</source>
+        <translation>Имя:</translation>
+    </message>
+    <message>
+        <source>Role:</source>
+        <translation>Роль:</translation>
+    </message>
+    <message>
+        <source>Password</source>
+        <translation>Пароль</translation>
+    </message>
+    <message>
+        <source>Password:</source>
+        <translation>Пароль:</translation>
     </message>
 </context>
 <context>
