@@ -24,7 +24,7 @@ from hmi_forms.elements.base import Element, Reader, Writer, word_reader
 from hmi_forms.elements.trend import Trend
 from netplc.memory import Snapshot
 
-APPEARANCES = ("digital", "hbar", "dial", "semidial", "graph")
+APPEARANCES = ("digital", "hbar", "dial", "semidial", "graph", "tank")  # tank: an extension
 ZONE_TYPES = {"low": 2, "normal": 0, "high": 2}
 
 

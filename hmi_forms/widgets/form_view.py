@@ -37,6 +37,7 @@ from hmi_forms.widgets.discrete import DiscreteWidget
 from hmi_forms.widgets.gauges import GaugeWidget
 from hmi_forms.widgets.journal import JournalWidget
 from hmi_forms.widgets.static import DateTimeWidget, StaticPictureWidget, StaticTextWidget, SyncWidget
+from hmi_forms.widgets.tank import TankWidget
 from hmi_forms.widgets.trend import REDRAW_INTERVAL, TrendWidget
 from netplc.memory import Snapshot
 
@@ -95,6 +96,8 @@ class FormView(QWidget):
         if isinstance(model, DiscreteBase):
             return DiscreteWidget(model, images)
         if isinstance(model, AnalogBase):
+            if model.Appearance == "tank":
+                return TankWidget(model, images)
             return TrendWidget(model, images) if model.Appearance == "graph" else GaugeWidget(model, images)
         if isinstance(model, Graph):
             return TrendWidget(model, images)
