@@ -59,12 +59,26 @@ def tank(path: Path) -> None:
     img.save(str(path))
 
 
+def pipe(path: Path) -> None:
+    """The pipe from the tank to the pump: a static part of the mimic, drawn under both."""
+    w, h = 60, 16
+    img = QImage(w, h, QImage.Format.Format_ARGB32)
+    img.fill(Qt.GlobalColor.transparent)
+    p = QPainter(img)
+    p.setPen(QPen(QColor("#33393f"), 2))
+    p.setBrush(QColor("#9aa1ab"))
+    p.drawRect(QRectF(1, 3, w - 2, h - 6))
+    p.end()
+    img.save(str(path))
+
+
 def main() -> None:
     QGuiApplication([])
     pump(HERE / "pump_off.png", False, 90)
     for i in range(4):
         pump(HERE / f"pump_on_{i}.png", True, 90 - i * 30)
     tank(HERE / "tank.png")
+    pipe(HERE / "pipe.png")
 
 
 if __name__ == "__main__":
