@@ -241,10 +241,13 @@ class GaugeWidget(ElementWidget):
         font = theme.sized_font(max(8.0, r * 0.14))
         p.setFont(font)
         metrics = QFontMetricsF(font)
-        for v in majors:
+        # a semidial's end labels stand above its baseline, where the next ones were: it labels
+        # every other major tick once there are more than five
+        every = 2 if sweep == -180.0 and len(majors) > 5 else 1
+        for i, v in enumerate(majors):
             a = start + sweep * m.scaling.fraction(v)
             p.drawLine(self._at(c, r * 0.88, a), self._at(c, r * 0.74, a))
-            if small:
+            if small or i % every:
                 continue
             # each label keeps the same gap to its tick whatever its width: a wide "-50" or "100"
             # at the ends of the scale moves inwards instead of running into the tick and the band
