@@ -123,10 +123,14 @@ def child(mode: str, t0: float) -> None:
         runtime.stop()
 
 
-def cpu_over(app: QApplication, seconds: float) -> float:
-    """% of one core used by the whole process over `seconds` of the event loop."""
+def cpu_over(app: QApplication, seconds: float, samples: list[float] | None = None) -> float:
+    """% of one core used by the whole process over `seconds` of the event loop; the resident
+    memory at ten even steps of it goes to `samples` (is it flat, or still growing at the end?)."""
     c0, w0 = time.process_time(), time.monotonic()
-    pump(app, seconds)
+    for _ in range(10):
+        pump(app, seconds / 10)
+        if samples is not None:
+            samples.append(rss_mb())
     return 100 * (time.process_time() - c0) / (time.monotonic() - w0)
 
 
@@ -155,8 +159,9 @@ def main(argv: list[str] | None = None) -> int:
         try:
             pump(app, WARMUP)
             mem0 = rss_mb()
-            cpu = cpu_over(app, seconds)
-            mem1 = rss_mb()
+            samples: list[float] = []
+            cpu = cpu_over(app, seconds, samples)
+            mem1 = samples[-1]
             status = runtime.status()
         finally:
             window.close()
@@ -169,7 +174,8 @@ def main(argv: list[str] | None = None) -> int:
           f"{cpu:.1f} % of one core (the headless runtime alone: {base_cpu:.1f} %, the window adds "
           f"{cpu - base_cpu:.1f} %); {status.scans} scans, {status.overruns} overruns")
     print(f"resident memory after {WARMUP:.0f} s warm-up {mem0:.1f} MB, after the run {mem1:.1f} MB "
-          f"({mem1 - mem0:+.1f} MB)")
+          f"({mem1 - mem0:+.1f} MB); at each tenth of the run: "
+          + " ".join(f"{m:.1f}" for m in samples))
     return 0
 
 
