@@ -16,7 +16,7 @@ import time
 
 from app.config import DEMO_STATION
 
-COMMANDS = ("view", "check", "simulate", "alarms-report", "design", "monitor", "archive")
+COMMANDS = ("view", "check", "simulate", "alarms-report", "design", "monitor", "archive", "users")
 
 
 def _main_parser() -> argparse.ArgumentParser:
@@ -28,7 +28,8 @@ def _main_parser() -> argparse.ArgumentParser:
                "station), simulate PROGRAM.stl (a simulated CPU-165 node), alarms-report ARCHIVE --day "
                "DD_MM_YYYY (alarm-system health), design [FORM.hmi | STATION] (the form designer), "
                "monitor STATION_OR_HOST:PORT (the program monitor of a running station), archive migrate "
-               "ARCHIVE.sqlite postgresql://... (copy an archive into the plant archive); each takes --help.",
+               "ARCHIVE.sqlite postgresql://... (copy an archive into the plant archive), "
+               "users (the station's users and roles); each takes --help.",
     )
     p.add_argument("station", nargs="?", default=str(DEMO_STATION),
                    help="station folder or its station.toml (default: the demo station)")
@@ -109,6 +110,66 @@ def _monitor_parser() -> argparse.ArgumentParser:
     return p
 
 
+def _users_parser() -> argparse.ArgumentParser:
+    from hmi_forms.elements.base import ROLES
+
+    p = argparse.ArgumentParser(prog="python main.py users",
+                                description="The station's users and roles (users.json in the station "
+                                            "folder: salted scrypt hashes, never the passwords). The "
+                                            "password is asked twice on a terminal, else read as one "
+                                            "line from standard input.")
+    p.add_argument("--station", default=str(DEMO_STATION),
+                   help="station folder or its station.toml (default: the demo station)")
+    sub = p.add_subparsers(dest="action", required=True)
+    add = sub.add_parser("add", help="add a user")
+    add.add_argument("name")
+    add.add_argument("--role", required=True, choices=ROLES)
+    sub.add_parser("list", help="list the users and their roles")
+    remove = sub.add_parser("remove", help="remove a user")
+    remove.add_argument("name")
+    passwd = sub.add_parser("passwd", help="change a user's password")
+    passwd.add_argument("name")
+    return p
+
+
+def run_users(argv: list[str]) -> int:
+    from app.config import station_file
+    from app.users import UserError, Users
+
+    ns = _users_parser().parse_args(argv)
+    try:
+        users = Users(station_file(ns.station).parent)
+        if ns.action == "list":
+            for user in users.users.values():
+                print(f"{user.name}\t{user.role}")
+        elif ns.action == "remove":
+            users.remove(ns.name)
+            print(f"user {ns.name} removed")
+        elif ns.action == "add":
+            users.add(ns.name, ns.role, _password())
+            print(f"user {ns.name} added as {ns.role}")
+        else:
+            users.passwd(ns.name, _password())
+            print(f"password of {ns.name} changed")
+    except UserError as e:
+        print(f"users: {e}", file=sys.stderr)
+        return 1
+    return 0
+
+
+def _password() -> str:
+    if not sys.stdin.isatty():
+        return sys.stdin.readline().rstrip("\r\n")
+    import getpass
+
+    from app.users import UserError
+
+    first = getpass.getpass("password: ")
+    if getpass.getpass("again: ") != first:
+        raise UserError("the two passwords differ")
+    return first
+
+
 def main(argv: list[str] | None = None) -> int:
     args = list(sys.argv[1:] if argv is None else argv)
     if args and args[0] in COMMANDS:
@@ -133,6 +194,8 @@ def main(argv: list[str] | None = None) -> int:
         if command == "archive":
             ns = _archive_parser().parse_args(rest)
             return run_migrate(ns.source, ns.url, ns.station)
+        if command == "users":
+            return run_users(rest)
         return run_viewer(_view_parser().parse_args(rest).archive)
     ns = _main_parser().parse_args(args)
     if ns.duration is not None and not ns.no_gui:
@@ -221,7 +284,7 @@ def run_headless(station: str, duration: float | None, every: float) -> int:
         runtime.stop()
         for s, handler in previous.items():
             signal.signal(s, handler)
-    print(f"station stopped: {runtime.status().line()}", flush=True)
+    print(f"station stopped after {runtime.status().line()}", flush=True)
     return 0
 
 

@@ -56,6 +56,18 @@ class ModbusServerSettings:
 
 
 @dataclass(frozen=True)
+class OperatorSettings:
+    """Who is at the workstation before anyone logs in, and when a user is logged out again.
+    The users themselves are in users.json (app/users.py), managed by `main.py users`."""
+
+    default_user: str = ""  # a viewer shown as logged in while nobody is; "": logged out
+    idle_logout: int = 0  # seconds without input before a user is logged out; 0: never
+
+
+LANGUAGES = ("ru", "en")
+
+
+@dataclass(frozen=True)
 class Station:
     path: Path  # the station.toml file
     name: str
@@ -71,7 +83,8 @@ class Station:
     modbus_server: ModbusServerSettings
     nodes: tuple[NodeConfig, ...] = ()
     simulators: tuple[SimulatorSettings, ...] = ()
-    users: tuple[str, ...] = ("operator",)
+    operator: OperatorSettings = OperatorSettings()
+    Language: str = ""  # "ru" or "en"; "" follows the system locale
     Tags: Path | None = None  # tags.csv: tags and their alarms (netplc/tags/)
     allow_outside: bool = False  # may station paths (and form images) leave the station folder?
     RetainForces: bool = False  # forces survive a restart (netplc/forcing.py); off: a restart unforces
@@ -217,7 +230,11 @@ def read_station(path: str | Path) -> tuple[Station | None, list[str]]:
     server = _modbus_server(problems, fname, top.get("modbus_server", dict, {}))
     nodes = _nodes(problems, fname, top.get("nodes", list, []))
     simulators = _simulators(problems, fname, top.get("simulators", list, []), base, top.allow_outside)
-    users = _users(problems, fname, top.get("operator", dict, {}))
+    operator = _operator(problems, fname, top.get("operator", dict, {}))
+    language = top.get("Language", str, "")
+    if language and language not in LANGUAGES:
+        top.bad("Language", f"{language!r} is not one of {', '.join(LANGUAGES)}")
+        language = ""
     top.finish()
     nodes = _with_simulated_nodes(problems, fname, nodes, simulators)
     _ports_in_common(problems, fname, server, simulators)
@@ -241,7 +258,7 @@ def read_station(path: str | Path) -> tuple[Station | None, list[str]]:
         path=file.resolve(), name=name or base.name, NetPlcLoad=bool(load), NetPlcProgram=program,
         Symbols=symbols, HMIload=hmi, NetSyncTime=sync, Archive=archive, Messages=messages,
         keep_days=keep_days, Retain=retain, modbus_server=server,
-        nodes=tuple(nodes), simulators=tuple(runnable), users=users, Tags=tags,
+        nodes=tuple(nodes), simulators=tuple(runnable), operator=operator, Language=language, Tags=tags,
         allow_outside=top.allow_outside, RetainForces=bool(retain_forces), plant_archive=plant,
         alarm_sound=alarm_sound,
     )
@@ -422,14 +439,16 @@ def _simulators(problems: list[str], fname: str, items: list[Any], base: Path,
     return sims
 
 
-def _users(problems: list[str], fname: str, table: dict[str, Any]) -> tuple[str, ...]:
+def _operator(problems: list[str], fname: str, table: dict[str, Any]) -> OperatorSettings:
     r = _Reader(problems, fname, table, "operator.")
-    users = r.get("users", list, ["operator"])
+    if "users" in table:
+        r.known.add("users")
+        r.bad("users", "users are kept in users.json with their roles and passwords now: "
+                       "`main.py users add NAME --role viewer|operator|engineer|admin`")
+    default = r.get("default_user", str, "")
+    idle = r.number("idle_logout", 0, 0, 86_400)
     r.finish()
-    if not users or not all(isinstance(u, str) and u.strip() for u in users):
-        r.bad("users", "expected a non-empty list of user names")
-        return ("operator",)
-    return tuple(users)
+    return OperatorSettings(default.strip(), idle)
 
 
 def _ports_in_common(problems: list[str], fname: str, server: ModbusServerSettings,

@@ -87,7 +87,13 @@ class RuntimeStatus:
         return sum(n.up for n in self.nodes)
 
     def line(self) -> str:
-        """The one-line status of `--no-gui`."""
+        """The one-line status of `--no-gui`; once stopped, what the run did (a stopped station
+        has no program state or links to report: "running" and "DOWN" there read as faults)."""
+        if not self.running:
+            text = f"{self.scans} scans, {self.records_written} records written"
+            if self.records_lost:
+                text += f", {self.records_lost} lost"
+            return text
         nodes = ", ".join(f"{n.node}:{'up' if n.up else 'DOWN'}" for n in self.nodes) or "none"
         text = (f"NetPlc {self.state} | scan {self.scan_last_ms:.2f} ms (max {self.scan_max_ms:.2f}, "
                 f"tick {self.tick_ms} ms, {self.overruns} overruns, {self.scans} scans) | "
@@ -401,17 +407,22 @@ class Runtime:
 
     # --- NetPlc run control (the workstation's menu) -------------------------------------------
 
-    def run_program(self) -> None:
+    def run_program(self, user: str) -> None:
         engine = self.engine
         if engine is not None:
             engine.post(lambda _m: engine.start())
-            self.system("NetPlc started by the operator")
+            self.operator(user, "NetPlc started")
 
-    def stop_program(self) -> None:
+    def stop_program(self, user: str) -> None:
         engine = self.engine
         if engine is not None:
             engine.post(lambda _m: engine.stop())
-            self.system("NetPlc stopped by the operator")
+            self.operator(user, "NetPlc stopped")
+
+    def operator(self, user: str, text: str) -> None:
+        """What a user did at the workstation (run, stop, log in and out): an 'operator' record
+        naming the user, as writes and acknowledgements are."""
+        self.put(Record(self.wallclock(), "operator", source=user or "nobody", text=text))
 
     def step_program(self, user: str) -> bool:
         """Step one scan while NetPlc is stopped (Engine.step, between two scans of the scan

@@ -10,11 +10,22 @@ alarm; the banner only shows and asks.
 
 from __future__ import annotations
 
-import time
-
 from PySide6.QtCore import Qt, QTimer, Signal
-from PySide6.QtWidgets import QFrame, QHBoxLayout, QLabel, QPushButton, QWidget
+from PySide6.QtWidgets import (
+    QDialog,
+    QDialogButtonBox,
+    QFrame,
+    QGridLayout,
+    QHBoxLayout,
+    QLabel,
+    QPlainTextEdit,
+    QPushButton,
+    QVBoxLayout,
+    QWidget,
+)
 
+from app.gui.elided import ElidedLabel
+from hmi_forms.elements import formats
 from netplc.tags.alarms import PRIORITIES, AlarmRow
 
 
@@ -33,13 +44,13 @@ class AlarmBanner(QFrame):
         lay.setContentsMargins(12, 6, 8, 6)
         self.icon = QLabel("\u26a0")
         self.icon.setObjectName("alarmIcon")
-        self.text = QLabel()
+        self.text = ElidedLabel()
         self.text.setObjectName("alarmText")
         self.count = QLabel()
         self.count.setObjectName("alarmCount")
-        self.ack = QPushButton("Acknowledge")
+        self.ack = QPushButton(self.tr("Acknowledge"))
         self.ack.setObjectName("alarmAck")
-        self.ack_all = QPushButton("Acknowledge all")
+        self.ack_all = QPushButton(self.tr("Acknowledge all"))
         self.ack_all.setObjectName("alarmAck")
         lay.addWidget(self.icon)
         lay.addWidget(self.text, 1)
@@ -75,11 +86,12 @@ class AlarmBanner(QFrame):
             self._timer.stop()
             return
         first = self.alarms[0]
-        when = time.strftime("%H:%M:%S", time.localtime(first.since or first.changed))
+        when = formats.clock(first.since or first.changed)
         kind = PRIORITIES.get(first.priority, "").upper()
         self.text.setText(f"{when}   P{first.priority} {kind}   {first.text}   "
                           f"[{first.id}, {first.state.word}]")
-        self.count.setText(f"{len(self.alarms)} unacknowledged" if len(self.alarms) > 1 else "")
+        many = len(self.alarms) > 1
+        self.count.setText(self.tr("{0} unacknowledged").format(len(self.alarms)) if many else "")
         self.ack_all.setVisible(len(self.alarms) > 1)
         self.setVisible(True)
         if not self._timer.isActive():
@@ -99,19 +111,59 @@ class AlarmBanner(QFrame):
 
 class HealthStrip(QFrame):
     """A yellow strip listing what is wrong with the station itself: program stopped, node down,
-    archive failing. Shown only while something is wrong."""
+    archive failing. Shown only while something is wrong, on one line elided to the window's
+    width; Details shows every problem in full."""
 
     def __init__(self, parent: QWidget | None = None) -> None:
         super().__init__(parent)
         self.setObjectName("healthStrip")
+        self.problems: list[str] = []
         lay = QHBoxLayout(self)
-        lay.setContentsMargins(12, 4, 12, 4)
-        self.label = QLabel()
+        lay.setContentsMargins(12, 2, 6, 2)
+        self.label = ElidedLabel()
         self.label.setObjectName("healthText")
-        self.label.setTextInteractionFlags(Qt.TextInteractionFlag.TextSelectableByMouse)
+        self.details = QPushButton(self.tr("Details…"))
+        self.details.setObjectName("healthDetails")
+        self.details.clicked.connect(self.show_details)
         lay.addWidget(self.label, 1)
+        lay.addWidget(self.details)
         self.setVisible(False)
 
     def show_problems(self, problems: list[str]) -> None:
+        self.problems = list(problems)
         self.label.setText("   \u2022   ".join(problems))
         self.setVisible(bool(problems))
+
+    def show_details(self) -> QDialog:
+        dialog = QDialog(self.window())
+        dialog.setWindowTitle(self.tr("Station problems"))
+        dialog.resize(760, 360)
+        lay = QVBoxLayout(dialog)
+        text = QPlainTextEdit("\n".join(self.problems))
+        text.setReadOnly(True)
+        lay.addWidget(text)
+        buttons = QDialogButtonBox(QDialogButtonBox.StandardButton.Close)
+        buttons.rejected.connect(dialog.reject)
+        lay.addWidget(buttons)
+        dialog.setAttribute(Qt.WidgetAttribute.WA_DeleteOnClose)
+        dialog.show()
+        return dialog
+
+
+class FixedLine(QFrame):
+    """A slot of fixed height in the header: a quiet line underneath, a strip (the alarm banner,
+    the health strip) over it while the strip is shown. Nothing below ever moves when an alarm
+    comes or goes (ISA-101: the screen does not move under the operator's hand)."""
+
+    def __init__(self, strip: QWidget, quiet: str, height: int, parent: QWidget | None = None) -> None:
+        super().__init__(parent)
+        self.setObjectName("fixedLine")
+        self.setFixedHeight(height)
+        lay = QGridLayout(self)
+        lay.setContentsMargins(0, 0, 0, 0)
+        self.quiet = QLabel(quiet)
+        self.quiet.setObjectName("quietLine")
+        self.quiet.setContentsMargins(12, 0, 12, 0)
+        lay.addWidget(self.quiet, 0, 0)
+        lay.addWidget(strip, 0, 0)  # added last: drawn over the quiet line while visible
+        self.strip = strip

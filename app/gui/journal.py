@@ -23,7 +23,8 @@ REFRESH_MS = 1500
 
 class JournalDock(QDockWidget):
     def __init__(self, archive_path: Path, parent: QWidget | None = None) -> None:
-        super().__init__("Journal — today", parent)
+        super().__init__(parent)
+        self.setWindowTitle(self.tr("Journal — today"))
         self.setObjectName("journalDock")
         self.archive_path = archive_path
         self._archive: Archive | None = None
@@ -31,7 +32,7 @@ class JournalDock(QDockWidget):
         lay = QVBoxLayout(body)
         lay.setContentsMargins(4, 4, 4, 4)
         bar = QHBoxLayout()
-        self.messages_only = QCheckBox("Events only (messages, operator actions, system)")
+        self.messages_only = QCheckBox(self.tr("Events only (messages, operator actions, system)"))
         self.messages_only.setChecked(True)  # data records are for the viewer's plots
         self.messages_only.toggled.connect(self._filter_changed)
         self.summary = QLabel()
@@ -53,7 +54,7 @@ class JournalDock(QDockWidget):
     def refresh(self) -> None:
         archive = self._open()
         if archive is None:
-            self.summary.setText("no archive yet")
+            self.summary.setText(self.tr("no archive yet"))
             return
         flt = Filter(kinds=frozenset(EVENT_KINDS)) if self.messages_only.isChecked() else None
         today = dt.date.today()
@@ -61,14 +62,14 @@ class JournalDock(QDockWidget):
             total = archive.count(today, flt)
             rows = archive.records(today, flt, 0, JOURNAL_ROWS)
         except sqlite3.Error as e:
-            self.summary.setText(f"archive unreadable: {e}")
+            self.summary.setText(self.tr("archive unreadable: {0}").format(e))
             return
         newest = rows[0].id if rows else 0
         if self._last != (newest, total):
             self._last = (newest, total)
             self.model.set_rows(rows)
-        shown = f", newest {len(rows)} shown" if total > len(rows) else ""
-        self.summary.setText(f"{total} records today{shown}")
+        shown = self.tr(", newest {0} shown").format(len(rows)) if total > len(rows) else ""
+        self.summary.setText(self.tr("{0} records today").format(total) + shown)
 
     def _filter_changed(self) -> None:
         self._last = None

@@ -13,32 +13,42 @@ from __future__ import annotations
 import signal
 import sys
 import time
+from collections.abc import Callable
+from importlib import metadata
 
-from PySide6.QtCore import QSize, Qt, QTimer
+from PySide6.QtCore import QEvent, QObject, QSize, Qt, QTimer
 from PySide6.QtGui import QAction, QCloseEvent, QKeySequence
 from PySide6.QtWidgets import (
     QApplication,
-    QComboBox,
     QDockWidget,
     QFrame,
     QHBoxLayout,
     QLabel,
     QMainWindow,
     QMessageBox,
-    QScrollArea,
+    QPlainTextEdit,
+    QPushButton,
     QTabWidget,
     QVBoxLayout,
     QWidget,
 )
 
 from app.config import load_station
+from app.gui import i18n
 from app.gui.alarm_summary import AlarmSummary
-from app.gui.alarms import AlarmBanner, HealthStrip
+from app.gui.alarms import AlarmBanner, FixedLine, HealthStrip
 from app.gui.bridge import RuntimeBridge
 from app.gui.journal import JournalDock
+from app.gui.login import LoginDialog
 from app.gui.status import StationStatusBar, station_problems
 from app.gui.style import apply_style
+from app.gui.trend_history import TrendHistory
+from app.gui.users_dialog import UsersDialog
+from app.gui.zoom import ACTUAL, FIT_WIDTH, FIT_WINDOW, ZoomArea, ZoomSettings
 from app.runtime import Runtime
+from app.users import ADMIN, ENGINEER, OPERATOR, Session, Users
+from hmi_forms.elements import formats
+from hmi_forms.elements.base import Writer
 from hmi_forms.elements.target import EngineTarget
 from hmi_forms.widgets.form_view import FormView
 from netplc.memory import Snapshot
@@ -46,8 +56,10 @@ from netplc.problems import Problems
 from netplc.tags.alarms import AlarmRow
 
 STATUS_MS = 500
+REFUSAL_MS = 10_000
 FRAME_HEIGHT = 380  # menu, header, banner, tabs, journal dock and status bar around a form
-MIN_SIZE = (1024, 720)
+MIN_SIZE = (1024, 600)  # the window's minimum fits a 1366x768 screen, whatever the forms hold
+ALARM_LINE, HEALTH_LINE = 40, 28  # the header's fixed lines: their content changes, never their size
 JOURNAL_HEIGHT = 190
 
 
@@ -58,7 +70,13 @@ class MainWindow(QMainWindow):
         station = runtime.station
         self.setWindowTitle(f"NetPlc Station — {station.name}")
         self.bridge = RuntimeBridge(runtime, self)
+        self.session = Session(Users(station.folder), default=station.operator.default_user,
+                               idle=station.operator.idle_logout)
+        self._quitting = False
         self.views: list[FormView] = []
+        self.history: TrendHistory | None = None
+        self.zooms: list[ZoomArea] = []
+        self.zoom_settings = ZoomSettings(station.Archive.parent / "workstation.ini")
         self.viewers: list[QWidget] = []
 
         central = QWidget()
@@ -66,15 +84,18 @@ class MainWindow(QMainWindow):
         lay = QVBoxLayout(central)
         lay.setContentsMargins(0, 0, 0, 0)
         lay.setSpacing(0)
-        self.header = _Header(station.name, station.users)
+        self.header = _Header(station.name)
+        self.header.login.clicked.connect(self.log_in_or_out)
         self.alarms = AlarmBanner()
         self.health = HealthStrip()
         self.tabs = QTabWidget()
         self.tabs.setObjectName("forms")
         self.tabs.setDocumentMode(True)
         lay.addWidget(self.header)
-        lay.addWidget(self.alarms)
-        lay.addWidget(self.health)
+        self.fixed_lines = (FixedLine(self.alarms, self.tr("No unacknowledged alarms"), ALARM_LINE),
+                            FixedLine(self.health, "", HEALTH_LINE))
+        for line in self.fixed_lines:
+            lay.addWidget(line)
         lay.addWidget(self.tabs, 1)
         self.setCentralWidget(central)
 
@@ -103,34 +124,47 @@ class MainWindow(QMainWindow):
         self._timer.start()
         self.refresh_status()
         self._fit_to_forms()
+        self._user_changed()
+        self._activity = _Activity(self.session, self)
 
     @property
     def user(self) -> str:
-        return self.header.user.currentText()
+        """The name journaled with what the workstation does ("" while nobody is logged in)."""
+        return self.session.name
 
     # --- building ------------------------------------------------------------------------------
 
     def _build_menu(self) -> None:
-        station = self.menuBar().addMenu("&Station")
-        self.act_run = QAction("&Run NetPlc", self)
-        self.act_run.setShortcut(QKeySequence("F5"))
-        self.act_run.triggered.connect(self.runtime.run_program)
-        self.act_stop = QAction("&Stop NetPlc", self)
-        self.act_stop.setShortcut(QKeySequence("Shift+F5"))
-        self.act_stop.triggered.connect(self._confirm_stop)
-        program = QAction("&Program…", self)  # the online monitor with forcing (app/gui/monitor/)
+        station = self.menuBar().addMenu(self.tr("&Station"))
+        # no single key runs or stops the PLC: both ask, and need the engineer role
+        self.act_run = QAction(self.tr("&Run NetPlc…"), self)
+        self.act_run.triggered.connect(self.run_program)
+        self.act_stop = QAction(self.tr("&Stop NetPlc…"), self)
+        self.act_stop.triggered.connect(self.stop_program)
+        self.act_login = QAction(self.tr("&Log in / switch user…"), self)
+        self.act_login.setShortcut(QKeySequence("Ctrl+L"))
+        self.act_login.triggered.connect(self.log_in)
+        self.act_logout = QAction(self.tr("Log &out"), self)
+        self.act_logout.triggered.connect(self.log_out)
+        self.act_users = QAction(self.tr("&Users…"), self)
+        self.act_users.triggered.connect(self.manage_users)
+        program = QAction(self.tr("&Program…"), self)  # the online monitor with forcing (app/gui/monitor/)
         program.setShortcut(QKeySequence("Ctrl+Shift+P"))
         program.triggered.connect(self.open_program)
-        viewer = QAction("Open journal &viewer…", self)
+        viewer = QAction(self.tr("Open journal &viewer…"), self)
         viewer.setShortcut(QKeySequence("Ctrl+J"))
         viewer.triggered.connect(self.open_viewer)
-        quit_ = QAction("&Quit", self)
-        quit_.setShortcut(QKeySequence.StandardKey.Quit)
-        quit_.triggered.connect(self.close)
+        self.act_quit = quit_ = QAction(self.tr("&Quit…"), self)
+        quit_.setShortcut(QKeySequence("Ctrl+Q"))  # on every platform; it asks before anything stops
+        quit_.triggered.connect(self.request_quit)
         for a in (self.act_run, self.act_stop):
             station.addAction(a)
         station.addSeparator()
         station.addAction(program)
+        station.addAction(self.act_login)
+        station.addAction(self.act_logout)
+        station.addAction(self.act_users)
+        station.addSeparator()
         station.addAction(viewer)
         for i, sim in enumerate(self.runtime.station.simulators):  # the demo's bad-quality case
             answers = QAction(f"Simulated node {sim.node} answers", self)
@@ -144,39 +178,65 @@ class MainWindow(QMainWindow):
         station.addAction(health)
         station.addSeparator()
         station.addAction(quit_)
-        view = self.menuBar().addMenu("&View")
+        view = self.menuBar().addMenu(self.tr("&View"))
         view.addAction(self.journal.toggleViewAction())
         view.addAction(self.summary_dock.toggleViewAction())
-        help_ = self.menuBar().addMenu("&Help")
-        about = QAction("&About", self)
+        view.addSeparator()
+        for text, keys, act in (
+                (self.tr("Fit &width"), "Ctrl+1", lambda a: a.set_mode(FIT_WIDTH)),
+                (self.tr("Fit &window"), "Ctrl+2", lambda a: a.set_mode(FIT_WINDOW)),
+                (self.tr("&100 %"), "Ctrl+0", lambda a: a.set_mode(ACTUAL)),
+                (self.tr("Zoom &in"), "Ctrl++", lambda a: a.zoom_by(1)),
+                (self.tr("Zoom &out"), "Ctrl+-", lambda a: a.zoom_by(-1))):
+            action = QAction(text, self)
+            action.setShortcut(QKeySequence(keys))
+            action.triggered.connect(lambda _=False, act=act: self._zoom(act))
+            view.addAction(action)
+        help_ = self.menuBar().addMenu(self.tr("&Help"))
+        about = QAction(self.tr("&About"), self)
         about.triggered.connect(self._about)
         help_.addAction(about)
 
     def _load_forms(self) -> list[str]:
         station = self.runtime.station
         if station.HMIload is None:
-            self.tabs.addTab(_placeholder("This station has no HMIload folder."), "No forms")
+            self.tabs.addTab(_placeholder(self.tr("This station has no HMIload folder.")),
+                             self.tr("No forms"))
             return []
         forms, problems = self.runtime.open_forms()  # the views' own models: they only show
         target = EngineTarget(self.runtime.engine, self.runtime.tags)
+        self.history = TrendHistory(station.Archive, self)
         for form in forms:
             view = FormView(form, target, archive_path=station.Archive, user=self.user,
-                            started=self.runtime.started_clock)
+                            started=self.runtime.started_clock, guard=self._guard)
             self.views.append(view)
-            scroll = QScrollArea()
-            scroll.setWidget(view)
-            scroll.setAlignment(Qt.AlignmentFlag.AlignHCenter | Qt.AlignmentFlag.AlignTop)
-            scroll.setFrameShape(QFrame.Shape.NoFrame)
-            self.tabs.addTab(scroll, form.title)
+            self.history.attach(view)
+            area = ZoomArea(view)
+            area.restore(self.zoom_settings.get(form.path))
+            area.zoomed.connect(lambda _label, a=area: self._zoomed(a))
+            self.zooms.append(area)
+            self.tabs.addTab(area, form.title)
         if problems:
-            self.tabs.addTab(_placeholder("Form problems (a form with a wrong property does not open; "
-                                          "one naming a file outside the station opens without it):\n\n"
-                                          + "\n".join(problems)),
-                             "Form problems")
+            self.tabs.addTab(_problems_page(problems), self.tr("Form problems"))
         if not forms and not problems:
-            self.tabs.addTab(_placeholder(f"No .hmi forms in {station.HMIload}."), "No forms")
-        self.header.user.currentTextChanged.connect(self._user_changed)
+            self.tabs.addTab(_placeholder(self.tr("No .hmi forms in {0}.").format(station.HMIload)),
+                             self.tr("No forms"))
         return problems
+
+    def current_zoom(self) -> ZoomArea | None:
+        page = self.tabs.currentWidget()
+        return page if isinstance(page, ZoomArea) else None
+
+    def _zoom(self, act: Callable[[ZoomArea], None]) -> None:
+        area = self.current_zoom()
+        if area is not None:
+            act(area)
+
+    def _zoomed(self, area: ZoomArea) -> None:
+        """Remember the choice for this form, and show it."""
+        self.zoom_settings.put(area.form_view.form.path, area.choice)
+        if area is self.current_zoom():
+            self.status.showMessage(self.tr("Zoom: ") + area.label(), 3000)
 
     def preferred_size(self) -> QSize:
         """Large enough to show the biggest form above the journal."""
@@ -208,11 +268,21 @@ class MainWindow(QMainWindow):
     def _acknowledge(self, alarm: AlarmRow) -> None:
         self.summary.acknowledge([alarm.id])
 
-    def _user_changed(self, user: str) -> None:
-        """Operator writes and acknowledgements are journaled under the operator on duty."""
+    def _user_changed(self) -> None:
+        """Operator writes and acknowledgements are journaled under the user on duty; what the
+        user may not do is greyed, with the reason in its tooltip."""
+        user = self.user
         for view in self.views:
             for model in view.form.elements:
                 model.user = user
+        current = self.session.current
+        self.header.show_user(current.name if current else "", current.role if current else "",
+                              logged_in=self.session.user is not None)
+        ack = self.session.refusal(OPERATOR, self.tr("Acknowledge"))
+        for button in (self.alarms.ack, self.alarms.ack_all):
+            button.setEnabled(ack is None)
+            button.setToolTip(ack or "")
+        self.act_logout.setEnabled(self.session.user is not None)
 
     def refresh_status(self) -> None:
         status = self.runtime.status()
@@ -223,23 +293,99 @@ class MainWindow(QMainWindow):
         self.act_run.setEnabled(not running)
         self.act_stop.setEnabled(running)
         self.header.tick()
+        if (idle := self.session.idle_expired()) is not None:
+            self.runtime.operator(idle.name, "logged out: idle")
+            self._user_changed()
 
     # --- actions -------------------------------------------------------------------------------
 
-    def _confirm_stop(self) -> None:
-        answer = QMessageBox.question(self, "Stop NetPlc",
-                                      "Stop the NetPlc program? Exchange, archive and forms keep running, "
-                                      "but the program's chains are no longer executed.")
-        if answer == QMessageBox.StandardButton.Yes:
-            self.runtime.stop_program()
+    def ask(self, title: str, text: str) -> bool:
+        """The second step of a command: the operator confirms it (tests answer for them)."""
+        answer = QMessageBox.question(self, title, text)
+        return answer == QMessageBox.StandardButton.Yes
+
+    def refuse(self, why: str) -> None:
+        """A refused action says why, where the operator looks: the status bar."""
+        self.status.showMessage(self.tr("Refused: ") + why, REFUSAL_MS)
+
+    def allowed(self, role: str, action: str) -> bool:
+        why = self.session.refusal(role, action)
+        if why is not None:
+            self.refuse(why)
+        return why is None
+
+    def _guard(self, element: Writer, what: str) -> str | None:
+        """Before a form element writes: its Role, then its Confirm."""
+        why = self.session.refusal(element.Role, what)
+        if why is not None:
+            self.refuse(why)
+            return why
+        if element.Confirm and not self.ask(self.tr("Confirm"), what + "?"):
+            return self.tr("cancelled")
+        return None
+
+    def run_program(self) -> None:
+        if self.allowed(ENGINEER, self.tr("Run NetPlc")) and self.ask(
+                self.tr("Run NetPlc"), self.tr("Run the NetPlc program? Its chains act on the plant "
+                                               "from the next scan.")):
+            self.runtime.run_program(self.user)
+
+    def stop_program(self) -> None:
+        if self.allowed(ENGINEER, self.tr("Stop NetPlc")) and self.ask(
+                self.tr("Stop NetPlc"), self.tr("Stop the NetPlc program? Exchange, archive and forms "
+                                                "keep running, but the program's chains are no longer "
+                                                "executed.")):
+            self.runtime.stop_program(self.user)
+
+    def request_quit(self) -> bool:
+        """Quit stops the whole station (soft PLC, exchange, archive): the engineer's, and asked."""
+        if self.allowed(ENGINEER, self.tr("Quit")) and self.ask(
+                self.tr("Quit"), self.tr("Quit NetPlc Station? The NetPlc program, the exchange with the "
+                                         "nodes and the archive stop.")):
+            self.runtime.operator(self.user, "station quit")
+            self._quitting = True
+            self.close()
+        return self._quitting
+
+    def log_in(self) -> None:
+        LoginDialog(sorted(self.session.users.users), self.login, self).exec()
+
+    def login(self, name: str, password: str) -> None:
+        """Log a user in (switching from the one logged in); Refused when the name or password is wrong."""
+        before = self.session.user
+        user = self.session.login(name, password)
+        if before is not None and before is not user:
+            self.runtime.operator(before.name, "logged out: user switched")
+        self.runtime.operator(user.name, f"logged in as {user.role}")
+        self._user_changed()
+
+    def manage_users(self) -> UsersDialog | None:
+        """The users dialog, for an admin only; its changes are journaled under the admin."""
+        if not self.allowed(ADMIN, self.tr("Users")):
+            return None
+        admin = self.user
+        dialog = UsersDialog(self.session.users, lambda text: self.runtime.operator(admin, text), self)
+        dialog.show()
+        return dialog
+
+    def log_out(self) -> None:
+        if self.session.user is not None:
+            self.runtime.operator(self.user, "logged out")
+            self.session.logout()
+            self._user_changed()
+
+    def log_in_or_out(self) -> None:
+        if self.session.user is None:
+            self.log_in()
+        else:
+            self.log_out()
+
 
     def open_program(self) -> None:
         """Station -> Program: the listing live, the watch table, forcing, single scans."""
-        from app.gui.monitor.window import may_open_program, open_local
+        from app.gui.monitor.window import open_local
 
-        if not may_open_program(self.runtime.station, self.user):
-            QMessageBox.warning(
-                self, "Program", f"{self.user} may not open the program view (role engineer).")
+        if not self.allowed(ENGINEER, self.tr("open the program view (forcing, single scans)")):
             return
         self.viewers.append(open_local(self.runtime, lambda: self.user))
 
@@ -255,25 +401,63 @@ class MainWindow(QMainWindow):
 
         HealthDialog(self.runtime.station.Archive, self).exec()
 
+    def about_text(self) -> str:
+        return (self.tr("NetPlc Station {0}: the PC runtime for CPU-165 PLC networks (FregatServer).")
+                .format(version()) + "\n" + self.tr("Station: {0}").format(self.runtime.station.path))
+
     def _about(self) -> None:
-        QMessageBox.about(self, "NetPlc Station",
-                          "NetPlc Station: the PC runtime for CPU-165 PLC networks (FregatServer).\n"
-                          f"Station: {self.runtime.station.path}")
+        QMessageBox.about(self, "NetPlc Station", self.about_text())
 
     def closeEvent(self, event: QCloseEvent) -> None:
+        """The window manager's close button is Quit; a close from the program (SIGTERM, Ctrl+C,
+        tests) closes at once, flushing the archive."""
+        if event.spontaneous() and not self._quitting and not self.request_quit():
+            event.ignore()
+            return
+        self._activity.stop()
+        for view in self.views:  # the guards refer back to the window: no cycle left for the GC
+            for model in view.form.elements:
+                if isinstance(model, Writer):
+                    model.guard = None
         self._timer.stop()
         self.summary.stop()
         self.bridge.detach()
         self.journal.close_archive()
+        if self.history is not None:
+            self.history.close()
         for viewer in self.viewers:
             viewer.close()
         super().closeEvent(event)
 
 
-class _Header(QFrame):
-    """Station name, operator on duty, date and time: the strip every SCADA screen starts with."""
+class _Activity(QObject):
+    """Any key, click or wheel in the application keeps the user logged in: the idle logout
+    counts from the last one."""
 
-    def __init__(self, name: str, users: tuple[str, ...]) -> None:
+    INPUT = (QEvent.Type.KeyPress, QEvent.Type.MouseButtonPress, QEvent.Type.Wheel)
+
+    def __init__(self, session: Session, parent: QObject) -> None:
+        super().__init__(parent)
+        self.session = session
+        self.app = QApplication.instance()
+        if self.app is not None:
+            self.app.installEventFilter(self)
+
+    def eventFilter(self, watched: QObject, event: QEvent) -> bool:
+        if event.type() in self.INPUT:
+            self.session.touch()
+        return False
+
+    def stop(self) -> None:
+        if self.app is not None:
+            self.app.removeEventFilter(self)
+            self.app = None
+
+
+class _Header(QFrame):
+    """Station name, user on duty, date and time: the strip every SCADA screen starts with."""
+
+    def __init__(self, name: str) -> None:
         super().__init__()
         self.setObjectName("header")
         lay = QHBoxLayout(self)
@@ -282,24 +466,43 @@ class _Header(QFrame):
         title.setObjectName("headerTitle")
         product = QLabel("NetPlc Station")
         product.setObjectName("headerProduct")
-        self.user = QComboBox()
+        self.user = QLabel()
         self.user.setObjectName("headerUser")
-        self.user.addItems(list(users))
+        self.login = QPushButton()
+        self.login.setObjectName("headerLogin")
         self.clock = QLabel()
         self.clock.setObjectName("headerClock")
         lay.addWidget(product)
         lay.addWidget(title)
         lay.addStretch(1)
-        who = QLabel("Operator:")
-        who.setObjectName("headerLabel")
-        lay.addWidget(who)
         lay.addWidget(self.user)
+        lay.addWidget(self.login)
         lay.addSpacing(18)
         lay.addWidget(self.clock)
         self.tick()
 
+    def show_user(self, name: str, role: str, *, logged_in: bool) -> None:
+        self.user.setText(f"{name} ({role})" if name else self.tr("nobody logged in"))
+        self.login.setText(self.tr("Log out") if logged_in else self.tr("Log in…"))
+
     def tick(self) -> None:
-        self.clock.setText(time.strftime("%d.%m.%Y  %H:%M:%S"))
+        self.clock.setText(formats.date_time(time.time()))
+
+
+def version() -> str:
+    """The installed package's version (pyproject.toml), or "dev" when run from a bare checkout."""
+    try:
+        return metadata.version("netplc-station")
+    except metadata.PackageNotFoundError:
+        return "dev"
+
+
+def _problems_page(problems: list[str]) -> QWidget:
+    """Each problem in full, wrapped: a long path must not widen the window."""
+    text = QPlainTextEdit("Forms that could not be opened:\n\n" + "\n".join(problems))
+    text.setReadOnly(True)
+    text.setLineWrapMode(QPlainTextEdit.LineWrapMode.WidgetWidth)
+    return text
 
 
 def _placeholder(text: str) -> QWidget:
@@ -315,7 +518,9 @@ def run_workstation(station_path: str) -> int:
     app = QApplication.instance() or QApplication(sys.argv[:1])
     apply_style(app)
     try:
-        runtime = Runtime(load_station(station_path))
+        station = load_station(station_path)
+        i18n.install(app, station.Language)
+        runtime = Runtime(station)
         runtime.start()
     except Problems as e:
         print("\n".join(e.problems), file=sys.stderr)

@@ -26,6 +26,7 @@ if TYPE_CHECKING:
     from app.runtime import Runtime
 
 SIZE = (1400, 900)  # the viewer's
+WINDOW_SIZES = ((1366, 768), (1920, 1080))  # the smallest screen the workstation must fit; a common one
 RUN_SECONDS = 24.0
 START_BIT = 0o40042
 PUMP, PUMP_IND = 0o2120, 0o2121
@@ -67,17 +68,20 @@ def main(argv: list[str] | None = None) -> int:
         runtime = Runtime(load_station(copy_station(Path(tmp) / "station")))
         runtime.start()
         window = MainWindow(runtime)
-        window.resize(window.preferred_size())
+        window.resize(*WINDOW_SIZES[0])
         window.show()
         try:
             _play_operator(runtime, lambda s: _pump_events(app, s), args.seconds)
-            for i, view in enumerate(window.views):
-                window.tabs.setCurrentIndex(i)
-                _pump_events(app, 0.3)
-                view.flush()
-                path = args.out / f"workstation-{slug(view.form.path.stem)}.png"
-                window.grab().save(str(path))
-                written.append(path)
+            for size in WINDOW_SIZES:
+                window.resize(*size)
+                suffix = "" if size == WINDOW_SIZES[0] else f"-{size[0]}x{size[1]}"
+                for i, view in enumerate(window.views):
+                    window.tabs.setCurrentIndex(i)
+                    _pump_events(app, 0.3)
+                    view.flush()
+                    path = args.out / f"workstation-{slug(view.form.path.stem)}{suffix}.png"
+                    window.grab().save(str(path))
+                    written.append(path)
             written.append(_designer(runtime, args.out, lambda s: _pump_events(app, s)))
         finally:
             window.close()

@@ -6,6 +6,7 @@ attention (amber) or is failing (red), with the figures beside it for whoever lo
 
 from __future__ import annotations
 
+from PySide6.QtCore import QT_TRANSLATE_NOOP
 from PySide6.QtWidgets import QLabel, QStatusBar, QWidget
 
 from app.runtime import RuntimeStatus
@@ -50,29 +51,38 @@ class StationStatusBar(QStatusBar):
 
     def show_status(self, s: RuntimeStatus) -> None:
         running = s.state == "running"
-        self.state.show_value(f"NetPlc: {s.state}", OK if running else BAD)
-        self.forced.show_value(f"F: {s.forced} forced", WARN if s.forced else IDLE,
-                               "forces in effect: force > program > live (Station -> Program)")
+        self.state.show_value(self.tr("NetPlc: {0}").format(self.tr(s.state)), OK if running else BAD)
+        self.forced.show_value(self.tr("F: {0} forced").format(s.forced), WARN if s.forced else IDLE,
+                               self.tr("forces in effect: force > program > live (Station -> Program)"))
         late = s.scan_last_ms > s.tick_ms
-        self.scan.show_value(f"Scan {s.scan_last_ms:.2f} ms  max {s.scan_max_ms:.2f} ms",
+        scan = self.tr("Scan {0:.2f} ms  max {1:.2f} ms").format(s.scan_last_ms, s.scan_max_ms)
+        self.scan.show_value(scan,
                              WARN if late else OK,
-                             f"{s.scans} scans, mean {s.scan_mean_ms:.3f} ms, {s.overruns} overruns")
-        self.tick.show_value(f"Tick {s.tick_ms} ms", WARN if s.overruns else OK,
-                             f"NetSyncTime {s.tick_ms} ms; {s.overruns} scans took longer")
+                             self.tr("{0} scans, mean {1:.3f} ms, {2} overruns").format(
+                                 s.scans, s.scan_mean_ms, s.overruns))
+        self.tick.show_value(self.tr("Tick {0} ms").format(s.tick_ms), WARN if s.overruns else OK,
+                             self.tr("NetSyncTime {0} ms; {1} scans took longer").format(
+                                 s.tick_ms, s.overruns))
         down = [n for n in s.nodes if not n.up]
         links = "  ".join(f"{n.node}{UP if n.up else DOWN}" for n in s.nodes)
-        self.nodes.show_value(f"Nodes {s.nodes_up}/{len(s.nodes)}  {links}",
+        self.nodes.show_value(self.tr("Nodes {0}/{1}").format(s.nodes_up, len(s.nodes)) + f"  {links}",
                               IDLE if not s.nodes else (BAD if down else OK),
                               "\n".join(f"node {n.node} {n.endpoint}: {'up' if n.up else 'DOWN'}"
                                         for n in s.nodes))
         archive_bad = s.records_lost > 0 or any(p.startswith("archive") for p in s.problems)
-        self.records.show_value(f"Archive {s.records_written} records",
+        self.records.show_value(self.tr("Archive {0} records").format(s.records_written),
                                 BAD if archive_bad else (WARN if s.records_pending > 10_000 else OK),
-                                f"{s.records_pending} waiting, {s.records_lost} lost")
+                                self.tr("{0} waiting, {1} lost").format(s.records_pending, s.records_lost))
         if s.modbus_port:
-            self.server.show_value(f"Modbus :{s.modbus_port}", OK, "NetPlc memory served over Modbus TCP")
+            self.server.show_value(f"Modbus :{s.modbus_port}", OK,
+                                   self.tr("NetPlc memory served over Modbus TCP"))
         else:
-            self.server.show_value("Modbus off", IDLE)
+            self.server.show_value(self.tr("Modbus off"), IDLE)
+
+
+# the engine's state texts, for the translation sources (the status bar translates them as shown)
+STATES = (QT_TRANSLATE_NOOP("StationStatusBar", "running"), QT_TRANSLATE_NOOP("StationStatusBar", "stopped"),
+          QT_TRANSLATE_NOOP("StationStatusBar", "halted"), QT_TRANSLATE_NOOP("StationStatusBar", "idle"))
 
 
 def station_problems(s: RuntimeStatus) -> list[str]:

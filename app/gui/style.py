@@ -16,7 +16,8 @@ QMainWindow, #central { background: #d9dde3; }
 #headerTitle { color: #ffffff; font-size: 13pt; font-weight: bold; }
 #headerLabel { color: #b8c4d4; }
 #headerClock { color: #ffffff; font-family: "DejaVu Sans Mono"; font-size: 12pt; }
-#headerUser { min-width: 110px; }
+#headerUser { color: #ffffff; font-weight: bold; padding-right: 8px; }
+#headerLogin { padding: 3px 12px; }
 #alarmBanner { background: #b71c1c; border-bottom: 1px solid #7f0000; }
 #alarmBanner[blink="true"] { background: #d32f2f; }
 #alarmIcon { color: #ffeb3b; font-size: 16pt; }
@@ -25,8 +26,12 @@ QMainWindow, #central { background: #d9dde3; }
 #alarmAck { background: #ffffff; color: #b71c1c; font-weight: bold; border: 1px solid #7f0000;
             border-radius: 3px; padding: 4px 14px; }
 #alarmAck:hover { background: #ffebee; }
+#alarmAck:disabled { background: #e8b4b4; color: #7f3b3b; }
 #healthStrip { background: #ffe082; border-bottom: 1px solid #c79a00; }
 #healthText { color: #4e3b00; font-weight: bold; }
+#healthDetails { padding: 1px 10px; }
+#fixedLine { background: #cfd4db; border-bottom: 1px solid #b9c0ca; }
+#quietLine { color: #6b7684; }
 QTabWidget#forms::pane { border: none; background: #d9dde3; }
 QTabBar::tab { background: #c3c9d2; color: #263445; padding: 7px 18px; margin-right: 1px;
                border-top-left-radius: 3px; border-top-right-radius: 3px; }

@@ -17,7 +17,7 @@ from pathlib import Path
 import numpy as np
 import psycopg
 import pyqtgraph as pg
-from PySide6.QtCore import Qt
+from PySide6.QtCore import QT_TRANSLATE_NOOP, Qt
 from PySide6.QtGui import QAction, QColor, QKeySequence
 from PySide6.QtWidgets import (
     QApplication,
@@ -41,8 +41,10 @@ from PySide6.QtWidgets import (
 )
 
 from app.config import DEMO_STATION, ConfigError, load_station, station_file
+from app.gui import i18n
 from app.gui.series_loader import SeriesLoader
 from app.gui.style import apply_style
+from hmi_forms.elements import formats
 from hmi_forms.widgets.records import ARCHIVE_COLUMNS, Column, RecordsModel, records_view
 from netplc.tags.tag import Tag
 from registrar.query import Archive, Filter, SeriesKey
@@ -50,7 +52,11 @@ from registrar.query import Archive, Filter, SeriesKey
 PAGE = 500
 SERIES_POINTS = 4000
 KINDS = ("all", "data", "message", "alarm", "operator", "system")
-TYPES = ("any", "0 info", "1 warning", "2 alarm", "3 critical")
+# a severity and everything worse, as alarm consoles filter: "2 alarm" keeps the critical ones too
+TYPES = (QT_TRANSLATE_NOOP("ViewerWindow", "any"), QT_TRANSLATE_NOOP("ViewerWindow", "0 info and above"),
+         QT_TRANSLATE_NOOP("ViewerWindow", "1 warning and above"),
+         QT_TRANSLATE_NOOP("ViewerWindow", "2 alarm and above"),
+         QT_TRANSLATE_NOOP("ViewerWindow", "3 critical"))
 STATION = Column("Station", lambda r: r.station or "", 100)  # shown for a plant archive only
 PALETTE = ("#1f77b4", "#d62728", "#2ca02c", "#ff7f0e", "#9467bd", "#17becf", "#8c564b", "#e377c2")
 
@@ -76,7 +82,7 @@ def physical(tag: Tag | None, values: np.ndarray) -> np.ndarray:
 class ViewerWindow(QMainWindow):
     def __init__(self, archive_path: Path | str | None = None, parent: QWidget | None = None) -> None:
         super().__init__(parent)
-        self.setWindowTitle("NetPlc Station — journal viewer")
+        self.setWindowTitle(self.tr("NetPlc Station — journal viewer"))
         self.archive: Archive | None = None
         self.archive_path: Path | str | None = None  # a file, or a plant archive's URL
         self.offset = 0
@@ -95,17 +101,17 @@ class ViewerWindow(QMainWindow):
     # --- building ------------------------------------------------------------------------------
 
     def _build(self) -> None:
-        menu = self.menuBar().addMenu("&Archive")
-        open_ = QAction("&Open…", self)
+        menu = self.menuBar().addMenu(self.tr("&Archive"))
+        open_ = QAction(self.tr("&Open…"), self)
         open_.setShortcut(QKeySequence.StandardKey.Open)
         open_.triggered.connect(self._choose_archive)
-        self.act_export = QAction("&Export selection to CSV…", self)
+        self.act_export = QAction(self.tr("&Export selection to CSV…"), self)
         self.act_export.setShortcut(QKeySequence("Ctrl+E"))
         self.act_export.triggered.connect(self._choose_export)
-        reload_ = QAction("&Reload", self)
+        reload_ = QAction(self.tr("&Reload"), self)
         reload_.setShortcut(QKeySequence.StandardKey.Refresh)
         reload_.triggered.connect(self.reload)
-        close = QAction("&Close", self)
+        close = QAction(self.tr("&Close"), self)
         close.setShortcut(QKeySequence.StandardKey.Close)
         close.triggered.connect(self.close)
         for a in (open_, self.act_export, reload_):
@@ -116,13 +122,13 @@ class ViewerWindow(QMainWindow):
         side = QWidget()
         side.setObjectName("viewerSide")
         side_lay = QVBoxLayout(side)
-        self.path_label = QLabel("no archive")
+        self.path_label = QLabel(self.tr("no archive"))
         self.path_label.setWordWrap(True)
-        side_lay.addWidget(QLabel("<b>Days</b>"))
+        side_lay.addWidget(QLabel(self.tr("<b>Days</b>")))
         self.days = QListWidget()
         self.days.currentRowChanged.connect(self._day_changed)
         side_lay.addWidget(self.days, 1)
-        self.stations_label = QLabel("<b>Stations</b>")
+        self.stations_label = QLabel(self.tr("<b>Stations</b>"))
         self.stations = QListWidget()
         self.stations.setMaximumHeight(120)
         self.stations.itemChanged.connect(lambda _item: self.apply_filter())
@@ -130,7 +136,7 @@ class ViewerWindow(QMainWindow):
         side_lay.addWidget(self.stations)
         self.stations_label.hide()
         self.stations.hide()
-        side_lay.addWidget(QLabel("<b>Filter</b>"))
+        side_lay.addWidget(QLabel(self.tr("<b>Filter</b>")))
         form = QFormLayout()
         self.kind = QComboBox()
         self.kind.addItems(KINDS)
@@ -139,10 +145,10 @@ class ViewerWindow(QMainWindow):
         self.group.setSpecialValueText("any")
         self.group.setValue(-1)
         self.type = QComboBox()
-        self.type.addItems(TYPES)
-        self.type.setToolTip("A message's type; an alarm record by the priority of that severity "
-                             "(3 critical: priority 1, 2 alarm: 2, 1 warning: 3, 0 info: 4); "
-                             "a data record by its type")
+        self.type.addItems([self.tr(t) for t in TYPES])
+        self.type.setToolTip(self.tr("A message's type and worse; an alarm record by the priority of that "
+                                     "severity (3 critical: priority 1, 2 alarm: 1-2, 1 warning: 1-3); "
+                                     "a data record by its type"))
         self.source = QLineEdit()
         self.source.setPlaceholderText("exact source")
         self.text = QLineEdit()
@@ -152,16 +158,17 @@ class ViewerWindow(QMainWindow):
         self.until = QTimeEdit()
         self.until.setDisplayFormat("HH:mm:ss")
         self.until.setTime(self.until.maximumTime())
-        for label, w in (("Kind", self.kind), ("Group", self.group), ("Type", self.type),
-                         ("Source", self.source), ("Text", self.text), ("From", self.since),
-                         ("To", self.until)):
+        for label, w in ((self.tr("Kind"), self.kind), (self.tr("Group"), self.group),
+                         (self.tr("Type"), self.type), (self.tr("Source"), self.source),
+                         (self.tr("Text"), self.text), (self.tr("From"), self.since),
+                         (self.tr("To"), self.until)):
             form.addRow(label, w)
         side_lay.addLayout(form)
-        apply = QPushButton("Apply filter")
+        apply = QPushButton(self.tr("Apply filter"))
         apply.clicked.connect(self.apply_filter)
         self.source.returnPressed.connect(self.apply_filter)
         self.text.returnPressed.connect(self.apply_filter)
-        export = QPushButton("Export CSV…")
+        export = QPushButton(self.tr("Export CSV…"))
         export.clicked.connect(self._choose_export)
         side_lay.addWidget(apply)
         side_lay.addWidget(export)
@@ -174,9 +181,9 @@ class ViewerWindow(QMainWindow):
         self.table = records_view(self.model, row_height=22)
         rec_lay.addWidget(self.table, 1)
         pager = QHBoxLayout()
-        self.first = QPushButton("\u00ab First")
-        self.prev = QPushButton("\u2039 Previous")
-        self.next = QPushButton("Next \u203a")
+        self.first = QPushButton(self.tr("\u00ab First"))
+        self.prev = QPushButton(self.tr("\u2039 Previous"))
+        self.next = QPushButton(self.tr("Next \u203a"))
         self.page_label = QLabel()
         for b, step in ((self.first, None), (self.prev, -PAGE), (self.next, PAGE)):
             b.clicked.connect(lambda _=False, s=step: self.page(s))
@@ -184,7 +191,7 @@ class ViewerWindow(QMainWindow):
         pager.addStretch(1)
         pager.addWidget(self.page_label)
         rec_lay.addLayout(pager)
-        self.tabs.addTab(records, "Records")
+        self.tabs.addTab(records, self.tr("Records"))
 
         plots = QSplitter(Qt.Orientation.Horizontal)
         self.series_list = QListWidget()
@@ -198,7 +205,7 @@ class ViewerWindow(QMainWindow):
         plots.addWidget(self.series_list)
         plots.addWidget(self.plot)
         plots.setSizes([260, 1000])
-        self.tabs.addTab(plots, "Series")
+        self.tabs.addTab(plots, self.tr("Series"))
 
         split = QSplitter(Qt.Orientation.Horizontal)
         split.addWidget(side)
@@ -214,7 +221,7 @@ class ViewerWindow(QMainWindow):
             days = archive.days()
             stations = archive.stations()
         except (sqlite3.Error, OSError, ValueError, psycopg.Error) as e:
-            QMessageBox.warning(self, "Journal viewer", f"Cannot open {path}:\n{e}")
+            QMessageBox.warning(self, self.tr("Journal viewer"), f"Cannot open {path}:\n{e}")
             return False
         if self.archive is not None:
             self.archive.close()
@@ -235,7 +242,7 @@ class ViewerWindow(QMainWindow):
         self.days.blockSignals(True)
         self.days.clear()
         for day in days:
-            item = QListWidgetItem(day.strftime("%d.%m.%Y  (%a)"))
+            item = QListWidgetItem(f"{formats.date(day)}  ({day:%a})")
             item.setData(Qt.ItemDataRole.UserRole, day)
             self.days.addItem(item)
         self.days.blockSignals(False)
@@ -271,13 +278,16 @@ class ViewerWindow(QMainWindow):
     def current_filter(self) -> Filter:
         kind = self.kind.currentText()
         day = self.day or dt.date.today()
-        tz = self.archive.tz if self.archive is not None else None  # the zone it was written in
-        since = dt.datetime.combine(day, self.since.time().toPython(), tz).timestamp()
-        until = dt.datetime.combine(day, self.until.time().toPython(), tz).timestamp() + 1
+        # both bounds are whole seconds as shown, in the zone the archive was written in:
+        # To 10:00:05 takes 10:00:05.999, never 10:00:06
+        tz = self.archive.tz if self.archive is not None else None
+        since, until = (dt.datetime.combine(day, e.time().toPython().replace(microsecond=0), tz).timestamp()
+                        for e in (self.since, self.until))
+        until += 1
         return Filter(
             kinds=None if kind == "all" else {kind},
             grp=None if self.group.value() < 0 else self.group.value(),
-            type=None if self.type.currentIndex() == 0 else self.type.currentIndex() - 1,
+            min_type=None if self.type.currentIndex() == 0 else self.type.currentIndex() - 1,
             source=self.source.text().strip() or None,
             text=self.text.text().strip() or None,
             since=since,
@@ -322,14 +332,15 @@ class ViewerWindow(QMainWindow):
         day = self.day
         if day is None:
             return
-        name, _ = QFileDialog.getSaveFileName(self, "Export selection", f"journal_{day:%d_%m_%Y}.csv",
+        name, _ = QFileDialog.getSaveFileName(self, self.tr("Export selection"),
+                                              f"journal_{day:%d_%m_%Y}.csv",
                                               "CSV files (*.csv)")
         if name:
             n = self.export_csv(Path(name))
             self.statusBar().showMessage(f"{n} records exported to {name}", 8000)
 
     def _choose_archive(self) -> None:
-        name, _ = QFileDialog.getOpenFileName(self, "Open archive", "",
+        name, _ = QFileDialog.getOpenFileName(self, self.tr("Open archive"), "",
                                               "Archives (*.sqlite *.db);;All files (*)")
         if name:
             self.open_archive(Path(name))
@@ -435,6 +446,7 @@ def run_viewer(target: str | None) -> int:
         return 2
     app = QApplication.instance() or QApplication(sys.argv[:1])
     apply_style(app)
+    i18n.install(app)  # the viewer has no station file: the system locale decides
     window = ViewerWindow(path)
     window.show()
     return app.exec()

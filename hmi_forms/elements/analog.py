@@ -24,12 +24,12 @@ from functools import cached_property
 from typing import Any, ClassVar
 
 from hmi_forms.elements import props as p
-from hmi_forms.elements.base import Element, Reader, word_reader
+from hmi_forms.elements.base import Element, Reader, Writer, word_reader
 from hmi_forms.elements.trend import Trend
 from netplc.memory import Snapshot
 from netplc.tags.table import TagTable
 
-APPEARANCES = ("digital", "hbar", "dial", "semidial", "graph")
+APPEARANCES = ("digital", "hbar", "dial", "semidial", "graph", "tank")  # tank: an extension
 ZONE_TYPES = {"low": 2, "normal": 0, "high": 2}
 
 
@@ -205,7 +205,7 @@ class AnalogBase(Scaled):
         if self.trend is None or snap.scan == self.last_scan:
             return False
         self.last_scan = snap.scan
-        self.trend.add(math.nan if hw is None else self.scaling.to_phy(hw))
+        self.trend.add(math.nan if hw is None else self.scaling.to_phy(hw), snap.wall)
         return True
 
     def reset_max(self) -> None:
@@ -217,7 +217,7 @@ class AnalogBase(Scaled):
 
 
 @dataclass(eq=False)
-class AnalogOutput(Scaled):
+class AnalogOutput(Scaled, Writer):
     """The operator enters a physical value; it is checked, converted, clamped and written."""
 
     TYPE = "AnalogOutput"
@@ -259,6 +259,8 @@ class AnalogOutput(Scaled):
             return False, f"{entry.strip()} is out of range {self.format(lo)} … {self.format(hi)}{units}"
         hw = self.scaling.to_hw(phy)
         assert self.OutAddr is not None
+        if why := self.refused(f"{self.Name} \u2192 {self.format(self.scaling.to_phy(hw))}{units}"):
+            return False, why
         if self.target is not None:
             self.target.write_word(self.OutAddr, hw, user=self.user, label=self.Name)
         return True, f"Set to {self.format(self.scaling.to_phy(hw))}{units}"

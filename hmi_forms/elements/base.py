@@ -30,6 +30,7 @@ from netplc.records import Kind, Record
 from netplc.tags.quality import Quality
 
 Reader = Callable[[Snapshot], int]
+ROLES = ("viewer", "operator", "engineer", "admin")  # ordered: each allows what the one before does
 
 
 def bit_reader(ref: BitRef) -> Reader:
@@ -131,3 +132,23 @@ class Element:
     def record(self, snap: Snapshot, kind: Kind, **fields: Any) -> None:
         if self.effects is not None:
             self.effects.put(Record(snap.wall, kind, source=self.Name, **fields))
+
+
+@dataclass(eq=False)
+class Writer:
+    """What an element that writes adds: the role needed (an extension, default operator) and
+    whether the operator confirms first (`Confirm: true`: two steps, for a command that cannot be
+    taken back). A view's `guard` decides both before anything is written; it returns why the
+    write is refused (role, cancelled), or None. Without a guard (tests, benchmarks) nothing asks."""
+
+    Role: str = field(default="operator", metadata=p.prop(p.choice(*ROLES)))
+    Confirm: bool = field(default=False, metadata=p.prop(p.boolean))
+
+    guard: Guard | None = field(default=None, init=False, repr=False)
+
+    def refused(self, what: str) -> str | None:
+        """Why `what` (the write, in words for the confirmation) may not be done now, or None."""
+        return self.guard(self, what) if self.guard is not None else None
+
+
+Guard = Callable[[Writer, str], "str | None"]

@@ -15,13 +15,13 @@ from dataclasses import dataclass, field
 from functools import cached_property
 
 from hmi_forms.elements import props as p
-from hmi_forms.elements.base import Element, Reader, bit_reader
+from hmi_forms.elements.base import Element, Reader, Writer, bit_reader
 from netplc.address import BitRef
 from netplc.memory import Snapshot
 
 
 @dataclass(eq=False)
-class DiscreteBase(Element):
+class DiscreteBase(Element, Writer):
     TYPE = "DiscreteBase"
 
     InAddr: BitRef | None = field(default=None, metadata=p.prop(p.bit, required=True, alias="Address"))
@@ -77,7 +77,10 @@ class DiscreteBase(Element):
             return False
         out = self.OutAddr or self.InAddr
         assert out is not None
-        self.target.write_bit(out.hmi, 0 if self.value else 1, user=self.user, label=self.Name)
+        new = 0 if self.value else 1
+        if self.refused(f"{self.Name} \u2192 {new}"):
+            return False
+        self.target.write_bit(out.hmi, new, user=self.user, label=self.Name)
         return True
 
 

@@ -51,5 +51,5 @@ class Graph(Element):
         if snap.scan == self.last_scan:
             return False
         self.last_scan = snap.scan
-        self.trend.add(value)
+        self.trend.add(value, snap.wall)
         return True

@@ -6,10 +6,10 @@ be greyed out with the data it labels.
 
 from __future__ import annotations
 
-import time
 from dataclasses import dataclass, field
 from pathlib import Path
 
+from hmi_forms.elements import formats
 from hmi_forms.elements import props as p
 from hmi_forms.elements.base import Element
 from netplc.memory import Snapshot
@@ -33,16 +33,18 @@ class StaticPicture(Element):
 
 
 def format_span(seconds: float) -> str:
-    """Time since start as the manual prints times (HH.MM.SS), with days in front once past 24 h."""
+    """Time since start in the console's one time format (HH:MM:SS, where the manual printed
+    HH.MM.SS), with days in front once past 24 h."""
     s = int(max(seconds, 0))
     days, s = divmod(s, 86400)
-    hms = f"{s // 3600:02d}.{s // 60 % 60:02d}.{s % 60:02d}"
+    hms = f"{s // 3600:02d}:{s // 60 % 60:02d}:{s % 60:02d}"
     return f"{days} d {hms}" if days else hms
 
 
 @dataclass(eq=False)
 class DateTime(Element):
-    """Current time as HH.MM.SS (local) and the time since the station started.
+    """Current time as HH:MM:SS (local; the console's one time format) and the time since the
+    station started.
 
     The start is the engine-clock time given by `started`; without it, the first snapshot seen."""
 
@@ -59,9 +61,8 @@ class DateTime(Element):
     def refresh(self, snap: Snapshot) -> bool:
         if self.started is None:
             self.started = snap.time
-        t = time.localtime(snap.wall)
         since = format_span(snap.time - self.started)
-        shown = (time.strftime("%H.%M.%S", t), time.strftime("%d.%m.%Y", t), since)
+        shown = (formats.clock(snap.wall), formats.date(snap.wall), since)
         if shown == (self.clock, self.date, self.uptime):
             return False
         self.clock, self.date, self.uptime = shown

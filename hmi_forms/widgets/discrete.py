@@ -9,7 +9,7 @@ from __future__ import annotations
 
 from collections.abc import Hashable
 
-from PySide6.QtCore import QRectF, Qt
+from PySide6.QtCore import QCoreApplication, QRectF, Qt
 from PySide6.QtGui import QColor, QLinearGradient, QMouseEvent, QPainter, QPen
 from PySide6.QtWidgets import QWidget
 
@@ -102,6 +102,11 @@ class DiscreteWidget(ElementWidget):
             p.setPen(self.fore_color() if m.value is not None else theme.TEXT_DIM)
             p.drawText(r.adjusted(4, 0, -4, 0), theme.alignment(m.TextAlign) | theme.WRAP,
                        text)
+        elif not m.indicating:  # switched off by its EnableAddr: say so, not an empty box
+            p.setFont(theme.qfont(m.Font))
+            p.setPen(theme.TEXT_DIM)
+            p.drawText(r, Qt.AlignmentFlag.AlignCenter, QCoreApplication.translate("DiscreteWidget",
+                                                                                  "(indication off)"))
 
     def mousePressEvent(self, event: QMouseEvent) -> None:
         if event.button() == Qt.MouseButton.LeftButton and self.model.clickable:

@@ -5,11 +5,11 @@ skips some when the window lags: a view only shows, and forwards the operator's 
 form does to the station, the runtime does from every snapshot, hmi_forms/behaviour.py). Every
 model reads the snapshot;
 only widgets whose model reports a change are scheduled for repainting, and Qt paints them all in
-one pass. Trend plots are redrawn in staggered turns (a few per tick, each once a second, as PyDM
-does by default) so fifty plots never land in the same tick. A model that raises is reported once, marked
-stale and skipped; the rest of the form keeps running. With the runtime's `Readings` of the scan,
-each element is also given the quality of what it shows (one judgement per distinct operand per
-refresh), and marks anything but good.
+one pass. Trend plots are redrawn once a second (as PyDM does by default), all plots of a form in
+the same tick on one clock-time axis, so two trends never disagree about when something happened.
+A model that raises is reported once, marked stale and skipped; the rest of the form keeps running.
+With the runtime's `Readings` of the scan, each element is also given the quality of what it shows
+(one judgement per distinct operand per refresh), and marks anything but good.
 """
 
 from __future__ import annotations
@@ -18,12 +18,14 @@ import time
 from collections.abc import Callable
 from pathlib import Path
 
+import numpy as np
 from PySide6.QtCore import QRectF, QSize, Qt
 from PySide6.QtGui import QColor, QPainter, QPaintEvent, QTransform
 from PySide6.QtWidgets import QWidget
 
 from hmi_forms.elements import Element
 from hmi_forms.elements.analog import AnalogBase, AnalogOutput
+from hmi_forms.elements.base import Guard, Writer
 from hmi_forms.elements.discrete import DiscreteBase
 from hmi_forms.elements.graph import Graph
 from hmi_forms.elements.journal import MessageJournal
@@ -37,6 +39,7 @@ from hmi_forms.widgets.discrete import DiscreteWidget
 from hmi_forms.widgets.gauges import GaugeWidget
 from hmi_forms.widgets.journal import JournalWidget
 from hmi_forms.widgets.static import DateTimeWidget, StaticPictureWidget, StaticTextWidget, SyncWidget
+from hmi_forms.widgets.tank import TankWidget
 from hmi_forms.widgets.trend import REDRAW_INTERVAL, TrendWidget
 from netplc.memory import Snapshot
 from netplc.tags.quality import Quality
@@ -46,10 +49,11 @@ from netplc.tags.readings import Readings
 class FormView(QWidget):
     def __init__(self, form: Form, target: Target, *, archive_path: str | Path | None = None,
                  user: str = "operator", started: float | None = None,
-                 clock: Callable[[], float] = time.monotonic,
+                 clock: Callable[[], float] = time.monotonic, guard: Guard | None = None,
                  parent: QWidget | None = None) -> None:
         """`started` is the engine-clock time the station started (for DateTime's time since start);
-        `clock` paces the plot redraws (a benchmark replays ticks faster than real time)."""
+        `clock` paces the plot redraws (a benchmark replays ticks faster than real time); `guard`
+        decides each write of the operator before it is made (role, confirmation)."""
         super().__init__(parent)
         self.form = form
         self.setFixedSize(QSize(form.width, form.height))
@@ -66,6 +70,8 @@ class FormView(QWidget):
         archive = Path(archive_path) if archive_path is not None else None
         for model in form.elements:
             model.bind(target, user)
+            if isinstance(model, Writer):
+                model.guard = guard
             if isinstance(model, DateTime) and started is not None:
                 model.started = started
             widget = self.element_widget(model, self.images, archive)
@@ -78,9 +84,16 @@ class FormView(QWidget):
         # where each painted element goes, worked out once: the paint loop runs 200 times a tick
         self._slots = [(w, w.geometry(), QTransform.fromTranslate(w.x(), w.y()), QRectF(w.rect()))
                        for w in self.painted]
-        start = clock()
-        for i, w in enumerate(self.trends):  # stagger the redraw turns over one interval
-            w.next_flush = start + REDRAW_INTERVAL * i / max(len(self.trends), 1)
+        self.live = True  # the trends follow the clock; paused, the operator pans and zooms them
+        self.history_wanted: Callable[[TrendWidget, float, float], None] | None = None
+        self._next_flush = clock()
+        for w in self.trends:  # one time axis for the form: panning one pans them all
+            if w is not self.trends[0]:
+                w.plot.getPlotItem().setXLink(self.trends[0].plot.getPlotItem())
+            w.view_box.sigRangeChangedManually.connect(self.pause)
+            w.pause_button.clicked.connect(self.toggle_live)
+        if self.trends:
+            self.trends[0].view_box.sigXRangeChanged.connect(self._range_changed)
 
     @staticmethod
     def element_widget(model: Element, images: Images, archive: Path | None) -> ElementWidget:
@@ -88,6 +101,8 @@ class FormView(QWidget):
         if isinstance(model, DiscreteBase):
             return DiscreteWidget(model, images)
         if isinstance(model, AnalogBase):
+            if model.Appearance == "tank":
+                return TankWidget(model, images)
             return TrendWidget(model, images) if model.Appearance == "graph" else GaugeWidget(model, images)
         if isinstance(model, Graph):
             return TrendWidget(model, images)
@@ -124,8 +139,46 @@ class FormView(QWidget):
             if changed:
                 widget.sync()
         now = self.clock()
+        if self.trends and now >= self._next_flush:  # all plots of the form in the same tick
+            self._next_flush = max(self._next_flush + REDRAW_INTERVAL, now)
+            self._redraw(snapshot.wall)
+
+    def _redraw(self, wall: float) -> None:
         for trend in self.trends:
-            trend.flush_due(now)
+            trend.flush()
+        if self.live:
+            span = max(t.span for t in self.trends)
+            self.trends[0].show_window(wall - span, wall)  # the others are linked to it
+
+    def pause(self) -> None:
+        """Stop following the clock (the operator pans, zooms or reads a value)."""
+        if self.live:
+            self.live = False
+            for trend in self.trends:
+                trend.set_live(False)
+
+    def resume(self) -> None:
+        self.live = True
+        for trend in self.trends:
+            trend.set_live(True)
+        if self._last is not None:
+            self._redraw(self._last.wall)
+
+    def toggle_live(self) -> None:
+        if self.live:
+            self.pause()
+        else:
+            self.resume()
+
+    def _range_changed(self, _box: object, x_range: tuple[float, float]) -> None:
+        """Scrolled back past the live samples: each trend asks for its history there."""
+        if self.history_wanted is None:
+            return
+        for trend in self.trends:
+            t = trend.trend.times()
+            first = t[0] if len(t) and not np.isnan(t[0]) else float("inf")
+            if x_range[0] < first:
+                self.history_wanted(trend, x_range[0], x_range[1])
 
     def _fault(self, model: Element, error: Exception, what: str) -> None:
         text = f'{self.form.path}: element "{model.Name}": {what} failed: {error!r}'
@@ -137,6 +190,8 @@ class FormView(QWidget):
         """Bring every throttled part up to date (before a screenshot)."""
         for _, widget in self.pairs:
             widget.flush()
+        if self.trends and self._last is not None and self.live:
+            self._redraw(self._last.wall)
 
     def save_png(self, path: str | Path) -> bool:
         self.flush()

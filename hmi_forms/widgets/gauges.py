@@ -59,6 +59,7 @@ def scale_ticks(lo: float, hi: float, max_major: int) -> tuple[list[float], list
 SMALL_DIAL = 45.0  # radius in px below which a dial drops its labels and enlarges the readout
 SPRITE_DIAL = 64.0  # radius in px up to which needles are cached pixmaps (larger: drawn each time)
 PART_AREA = 150 * 150  # px²: from this size on, a change of text alone repaints only its box
+SEMI_END_LABEL = 12.0  # degrees: a semidial's end labels stand this far above its baseline
 HUB = QColor("#33393f")
 WHITE = QColor("#ffffff")
 # the value's colours by zone: in a readout box (dials, digital) and over the element (bars)
@@ -298,15 +299,20 @@ class GaugeWidget(ElementWidget):
         font = theme.sized_font(max(8.0, r * 0.14))
         p.setFont(font)
         metrics = QFontMetricsF(font)
-        for v in majors:
+        # a semidial's end labels stand above its baseline, where the next ones were: it labels
+        # every other major tick once there are more than five
+        every = 2 if sweep == -180.0 and len(majors) > 5 else 1
+        for i, v in enumerate(majors):
             a = start + sweep * m.scaling.fraction(v)
             p.drawLine(self._at(c, r * 0.88, a), self._at(c, r * 0.74, a))
-            if small:
+            if small or i % every:
                 continue
             # each label keeps the same gap to its tick whatever its width: a wide "-50" or "100"
             # at the ends of the scale moves inwards instead of running into the tick and the band
             text = f"{v:.{decimals}f}"
             w, h = metrics.horizontalAdvance(text), metrics.capHeight()
+            if sweep == -180.0:  # the needle rests on the baseline at either end: labels sit above it
+                a = min(max(a, SEMI_END_LABEL), 180.0 - SEMI_END_LABEL)
             rad = math.radians(a)
             reach = abs(math.cos(rad)) * w / 2 + abs(math.sin(rad)) * h / 2
             label_at = self._at(c, r * 0.68 - reach, a)
@@ -316,9 +322,12 @@ class GaugeWidget(ElementWidget):
         if m.Units and not small:
             p.setPen(theme.TEXT_DIM)
             p.setFont(theme.sized_font(max(8.0, r * 0.13)))
-            uy = c.y() + r * 0.25 if sweep == -270.0 else c.y() - r * 0.3
-            p.drawText(QRectF(c.x() - r * 0.5, uy - r * 0.09, r, r * 0.18), Qt.AlignmentFlag.AlignCenter,
-                       m.Units)
+            if sweep == -270.0:
+                p.drawText(QRectF(c.x() - r * 0.5, c.y() + r * 0.16, r, r * 0.18),
+                           Qt.AlignmentFlag.AlignCenter, m.Units)
+            else:  # right of the readout, under the baseline: no needle position covers it
+                p.drawText(QRectF(c.x() + r * 0.5, c.y() + r * 0.1, r * 0.5, r * 0.3),
+                           Qt.AlignmentFlag.AlignLeft | Qt.AlignmentFlag.AlignVCenter, m.Units)
 
     def _paint_bar_scale(self, p: QPainter) -> None:
         m = self.model

@@ -24,6 +24,7 @@ from PySide6.QtWidgets import (
     QWidget,
 )
 
+from hmi_forms.elements import formats
 from hmi_forms.elements.journal import KINDS, MessageJournal
 from hmi_forms.widgets import theme
 from hmi_forms.widgets.base import Images, SelfPainted
@@ -130,8 +131,8 @@ class JournalWidget(SelfPainted):
             return
         self.table.set_rows(rows)
         if total is not None:
-            self.status.setText(f"{len(rows)} of {total} records, {day:%d.%m.%Y}" if total > len(rows)
-                                else f"{total} records, {day:%d.%m.%Y}")
+            self.status.setText(f"{len(rows)} of {total} records, {formats.date(day)}" if total > len(rows)
+                                else f"{total} records, {formats.date(day)}")
 
     def close_archive(self) -> None:
         if self.archive is not None:

@@ -13,15 +13,29 @@ from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass, field
 from typing import Any
 
-from PySide6.QtCore import QAbstractTableModel, QModelIndex, QPersistentModelIndex, Qt
+from PySide6.QtCore import (
+    QT_TRANSLATE_NOOP,
+    QAbstractTableModel,
+    QCoreApplication,
+    QModelIndex,
+    QPersistentModelIndex,
+    Qt,
+)
 from PySide6.QtGui import QColor
 from PySide6.QtWidgets import QAbstractItemView, QHeaderView, QTableView
 
+from hmi_forms.elements import formats
 from netplc.address import fmt_octal
 from netplc.tags.alarms import State
 from registrar.query import Row
 
-TYPE_NAMES = {0: "info", 1: "warning", 2: "alarm", 3: "critical"}
+TYPE_NAMES = {0: QT_TRANSLATE_NOOP("records", "info"), 1: QT_TRANSLATE_NOOP("records", "warning"),
+              2: QT_TRANSLATE_NOOP("records", "alarm"), 3: QT_TRANSLATE_NOOP("records", "critical")}
+# the column heads, for the translation sources (RecordsModel translates them as shown)
+HEADS = (QT_TRANSLATE_NOOP("records", "Time"), QT_TRANSLATE_NOOP("records", "Kind"),
+         QT_TRANSLATE_NOOP("records", "Group"), QT_TRANSLATE_NOOP("records", "Type"),
+         QT_TRANSLATE_NOOP("records", "Source"), QT_TRANSLATE_NOOP("records", "No."),
+         QT_TRANSLATE_NOOP("records", "Value"), QT_TRANSLATE_NOOP("records", "Text"))
 Index = QModelIndex | QPersistentModelIndex
 
 
@@ -41,7 +55,9 @@ def type_name(row: Row) -> str:
         return ""
     if row.kind == "alarm" and row.type in STATES:
         return State(row.type).word
-    return TYPE_NAMES.get(row.type, str(row.type)) if row.kind == "message" else str(row.type)
+    if row.kind != "message" or row.type not in TYPE_NAMES:
+        return str(row.type)
+    return QCoreApplication.translate("records", TYPE_NAMES[row.type])
 
 
 def number(row: Row) -> str:
@@ -53,8 +69,7 @@ def number(row: Row) -> str:
 
 def clock_ms(row: Row) -> str:
     """The wall clock where the record was written (the archive's zone)."""
-    ms = int(row.ts * 1000) % 1000
-    return row.time.strftime("%H:%M:%S") + f".{ms:03d}"
+    return formats.clock_ms(row.ts, row.tz)
 
 
 @dataclass(frozen=True)
@@ -66,19 +81,21 @@ class Column:
 
 
 TIME = Column("Time", clock_ms, 96)
-KIND = Column("Kind", lambda r: r.kind, 70)
-GROUP = Column("Group", lambda r: "" if r.grp is None else str(r.grp), 52, right=True)
+KINDS = (QT_TRANSLATE_NOOP("records", "data"), QT_TRANSLATE_NOOP("records", "message"),
+         QT_TRANSLATE_NOOP("records", "operator"), QT_TRANSLATE_NOOP("records", "system"))
+KIND = Column("Kind", lambda r: QCoreApplication.translate("records", r.kind), 76)
+GROUP = Column("Group", lambda r: "" if r.grp is None else str(r.grp), 64, right=True)
 TYPE = Column("Type", type_name, 64, right=True)
 SOURCE = Column("Source", lambda r: r.source or "", 120)
 NUMBER = Column("No.", number, 64, right=True)
-VALUE = Column("Value", lambda r: format_value(r.value), 70, right=True)
+VALUE = Column("Value", lambda r: format_value(r.value), 84, right=True)
 TEXT = Column("Text", lambda r: r.text or "")
 
 ARCHIVE_COLUMNS = (TIME, KIND, GROUP, TYPE, SOURCE, NUMBER, VALUE, TEXT)
 """The workstation's columns: every field of a record, text last to take the spare width."""
 
 JOURNAL_COLUMNS = (
-    Column("Time", lambda r: r.time.strftime("%H.%M.%S"), 70),
+    Column("Time", lambda r: formats.clock(r.ts), 70),
     Column("Kind", KIND.text, 70),
     Column("Group", GROUP.text, 50),
     Column("Type", type_name, 64),
@@ -129,7 +146,7 @@ class RecordsModel(QAbstractTableModel):
     def headerData(self, section: int, orientation: Qt.Orientation,
                    role: int = Qt.ItemDataRole.DisplayRole) -> Any:
         if role == Qt.ItemDataRole.DisplayRole and orientation == Qt.Orientation.Horizontal:
-            return self.columns[section].title
+            return QCoreApplication.translate("records", self.columns[section].title)
         return None
 
     def data(self, index: Index, role: int = Qt.ItemDataRole.DisplayRole) -> Any:

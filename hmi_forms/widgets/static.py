@@ -4,7 +4,7 @@ from __future__ import annotations
 
 from collections.abc import Hashable
 
-from PySide6.QtCore import QRectF, Qt
+from PySide6.QtCore import QCoreApplication, QRectF, Qt
 from PySide6.QtGui import QColor, QPainter, QPen
 
 from hmi_forms.elements.static import DateTime, StaticPicture, StaticText
@@ -63,7 +63,7 @@ class DateTimeWidget(ElementWidget):
             y += big * 0.75
         if m.ShowUptime:
             p.drawText(QRectF(r.left(), y, r.width(), big * 0.75), Qt.AlignmentFlag.AlignCenter,
-                       f"since start {m.uptime}")
+                       QCoreApplication.translate("DateTimeWidget", "since start {0}").format(m.uptime))
 
 
 class SyncWidget(ElementWidget):

@@ -1,22 +1,27 @@
 """Trends with pyqtgraph: the Graph element (a bit) and AnalogBase with Appearance "graph".
 
-Following docs/architecture.md section 9: the plot and its curve are created once per widget and fed with
-`setData` (a bare PlotCurveItem: PlotDataItem's per-call bookkeeping cost five times the data
-itself); the axes have fixed ranges (no autorange per frame) and are cached as pixmaps; mouse
-interaction, menus and buttons are off (an operator panel, not an analysis tool); and redraws are
-throttled: the model samples every scan, the plot is redrawn when `flush_due` says its turn has
-come. Plots are never destroyed while the form lives (the PySide6 PlotItem leak).
+Following docs/architecture.md section 9: the plot and its curves are created once per widget and
+fed with `setData` (bare PlotCurveItems: PlotDataItem's per-call bookkeeping cost five times the
+data itself); the y range is fixed (no autorange per frame) and the axes are cached as pixmaps.
+The x axis is clock time: the form (FormView) moves the time window of all its trends at once,
+and redraws them in the same tick, so two trends of one form never disagree about when something
+happened. The operator may pause a trend (its button, or by dragging or wheeling in it: the
+form's trends are linked and all pause), pan and zoom in time, read the value under the mouse,
+and scroll back into the archive's history, drawn lighter behind the live samples.
 """
 
 from __future__ import annotations
 
+import math
 from collections.abc import Hashable
 
+import numpy as np
 import pyqtgraph as pg
-from PySide6.QtCore import QRect, QRectF, Qt
+from PySide6.QtCore import QCoreApplication, QPointF, QRect, QRectF, Qt
 from PySide6.QtGui import QColor, QPainter, QPen
-from PySide6.QtWidgets import QGraphicsItem, QWidget
+from PySide6.QtWidgets import QGraphicsItem, QToolButton, QWidget
 
+from hmi_forms.elements import formats
 from hmi_forms.elements.analog import AnalogBase
 from hmi_forms.elements.graph import Graph
 from hmi_forms.elements.props import Color
@@ -24,26 +29,26 @@ from hmi_forms.elements.trend import Trend
 from hmi_forms.widgets import theme
 from hmi_forms.widgets.base import Images, SelfPainted
 
-REDRAW_INTERVAL = 1.0  # seconds between redraws of one plot (samples are kept every scan)
+REDRAW_INTERVAL = 1.0  # seconds between redraws of a form's plots (samples are kept every scan)
+PAUSE, LIVE = "\u275a\u275a", "\u25b6"
 
 
 def _pen_color(color: Color | None) -> QColor:
     return theme.qcolor(color, theme.ACCENT)
 
 
-def extent(points: int, lo: float, hi: float) -> QRectF:
-    """The data rectangle of a trend of `points` samples ending at x = 0, with room for the pen."""
-    pad_x, pad_y = points * 0.05, (hi - lo) * 0.05
-    return QRectF(-(points - 1) - pad_x, lo - pad_y, points - 1 + 2 * pad_x, hi - lo + 2 * pad_y)
-
-
 class FixedCurve(pg.PlotCurveItem):
-    """A curve whose extent is the plot's fixed range: pyqtgraph would otherwise measure the data
-    (with pixel padding) after every setData, for nothing, since the view never rescales to it."""
+    """A curve whose extent is set from outside: pyqtgraph would otherwise measure the data (with
+    pixel padding) after every setData, for nothing, since the view never rescales to it."""
 
     def __init__(self, extent: QRectF, **opts: object) -> None:
         super().__init__(**opts)
         self.extent = extent
+
+    def set_extent(self, extent: QRectF) -> None:
+        if extent != self.extent:
+            self.prepareGeometryChange()
+            self.extent = extent
 
     def boundingRect(self) -> QRectF:
         return self.extent
@@ -56,11 +61,12 @@ class TrendWidget(SelfPainted):
         super().__init__(model, images, parent)
         self.trend: Trend = model.trend  # type: ignore[assignment]
         self.header = max(16, min(22, round(model.h * 0.14)))
-        plot = pg.PlotWidget(self, background=theme.qcolor(model.BackColor, QColor("#ffffff")))
+        plot = pg.PlotWidget(self, background=theme.qcolor(model.BackColor, QColor("#ffffff")),
+                             axisItems={"bottom": pg.DateAxisItem(orientation="bottom")})
         plot.setGeometry(1, self.header, model.w - 2, model.h - self.header - 1)
         plot.setFrameShape(plot.Shape.NoFrame)
         item = plot.getPlotItem()
-        item.setMouseEnabled(x=False, y=False)
+        item.setMouseEnabled(x=True, y=False)  # pan and zoom in time; the y range is the scale's
         item.setMenuEnabled(False)
         item.hideButtons()
         item.showGrid(x=True, y=isinstance(model, AnalogBase), alpha=0.25)
@@ -70,60 +76,121 @@ class TrendWidget(SelfPainted):
             axis.setPen(pg.mkPen(theme.BORDER))
             axis.setTextPen(pg.mkPen(theme.TEXT_DIM))
             axis.setStyle(tickFont=tick_font, tickLength=-4)
-        n = model.Elements
-        item.setXRange(-(n - 1), 0, padding=0.02)
-        item.getAxis("bottom").setTickSpacing(major=model.LabelInt, minor=max(1, model.LabelInt / 5))
-        pen = pg.mkPen(_pen_color(model.Colors), width=model.LineWidth)
+        color = _pen_color(model.Colors)
+        pen = pg.mkPen(color, width=model.LineWidth)
+        faded = QColor(color)
+        faded.setAlpha(110)
         if isinstance(model, Graph):
-            lo, hi = -0.15, 1.15
-            item.setYRange(lo, hi, padding=0)
+            self.lo, self.hi = -0.15, 1.15
+            item.setYRange(self.lo, self.hi, padding=0)
             item.getAxis("left").setTicks([[(0, "0"), (1, "1")]])
             item.getAxis("left").setWidth(18)
-            self.curve = FixedCurve(extent(n, lo, hi), pen=pen, stepMode="left", connect="finite")
+            step = {"stepMode": "left"}
         else:
-            lo, hi = model.scaling.phy_range
-            item.setYRange(lo, hi, padding=0.04)
+            self.lo, self.hi = model.scaling.phy_range
+            item.setYRange(self.lo, self.hi, padding=0.04)
             item.getAxis("left").setWidth(38)
-            for limit, color in ((model.PhyLow, theme.WARN), (model.PhyHigh, theme.ALARM)):
+            for limit, zone in ((model.PhyLow, theme.WARN), (model.PhyHigh, theme.ALARM)):
                 if limit is not None:
-                    pen_limit = pg.mkPen(color, style=Qt.PenStyle.DashLine)
-                    item.addItem(pg.InfiniteLine(limit, angle=0, pen=pen_limit))
-            self.curve = FixedCurve(extent(n, lo, hi), pen=pen, connect="finite")
+                    dash = pg.mkPen(zone, style=Qt.PenStyle.DashLine)
+                    item.addItem(pg.InfiniteLine(limit, angle=0, pen=dash))
+            step = {}
+        self.history = FixedCurve(QRectF(), pen=pg.mkPen(faded, width=model.LineWidth), connect="finite",
+                                  **step)
+        self.curve = FixedCurve(QRectF(), pen=pen, connect="finite", **step)
+        item.addItem(self.history)
         item.addItem(self.curve)
-        for name in ("left", "bottom"):  # fixed ranges: axes and grid are blitted, not re-stroked
-            item.getAxis(name).setCacheMode(QGraphicsItem.CacheMode.DeviceCoordinateCache)
+        self.cursor = pg.InfiniteLine(angle=90, pen=pg.mkPen(theme.TEXT_DIM, style=Qt.PenStyle.DotLine))
+        self.cursor_label = pg.TextItem(color=theme.TEXT, fill=pg.mkBrush(255, 255, 255, 220), anchor=(0, 0))
+        for extra in (self.cursor, self.cursor_label):
+            extra.setVisible(False)
+            item.addItem(extra, ignoreBounds=True)
+        item.getAxis("left").setCacheMode(QGraphicsItem.CacheMode.DeviceCoordinateCache)
+        plot.scene().sigMouseMoved.connect(self._mouse_moved)
         self.plot = plot
+        self.view_box = item.getViewBox()
+        self.pause_button = QToolButton(self)
+        self.pause_button.setObjectName("trendPause")
+        self.pause_button.setAutoRaise(True)
+        self.pause_button.setGeometry(model.w - self.header - 2, 1, self.header, self.header - 2)
+        self.pause_button.setText(PAUSE)
+        self.set_live(True)
         self.stale_mark.raise_()
-        self.dirty = False
         self.shown = -1  # trend.count when last drawn
-        self.next_flush = 0.0
+        self.hist_times = self.hist_values = np.empty(0)
         self._header_shown: tuple[object, ...] = ()
 
+    @property
+    def span(self) -> float:
+        """Seconds of the live window: the samples the element keeps, at the sampling period."""
+        t = self.trend.times()
+        t = t[~np.isnan(t)]
+        period = float(np.median(np.diff(t))) if len(t) > 2 else 0.1
+        return self.trend.size * max(period, 0.001)
+
     def sync(self) -> None:
-        """A new sample: the plot waits for its turn; the header is repainted only if it changed."""
-        self.dirty = True
+        """A new sample: the plot waits for the form's redraw; the header is repainted if it changed."""
         shown = (self.layer_key(), getattr(self.model, "text", None), self.model.quality)
         if shown != self._header_shown:
             self._header_shown = shown
             super().sync()
 
     def changed_rect(self) -> QRect:
-        return QRect(0, 0, self.width(), self.header)  # the plot is redrawn by flush_due
+        return QRect(0, 0, self.width(), self.header)  # the plot is redrawn by the form
 
     def flush(self) -> None:
         if self.trend.count == self.shown:
             return
-        y = self.trend.values()
-        n = len(y)
-        self.curve.setData(self.trend.x[:n] - (n - 1), y)
+        t, y = self.trend.times(), self.trend.values()
+        if len(t):
+            self.curve.setData(t, y)
+            self.curve.set_extent(QRectF(t[0], self.lo, max(t[-1] - t[0], 1e-3), self.hi - self.lo))
         self.shown = self.trend.count
-        self.dirty = False
 
-    def flush_due(self, now: float) -> None:
-        """Redraw if there is news and this plot's turn has come (turns are staggered by the form)."""
-        if self.dirty and now >= self.next_flush:
-            self.flush()
-            self.next_flush = max(self.next_flush + REDRAW_INTERVAL, now)
+    def show_window(self, t0: float, t1: float) -> None:
+        self.view_box.setXRange(t0, t1, padding=0)
+
+    def set_live(self, live: bool) -> None:
+        self.pause_button.setText(PAUSE if live else LIVE)
+        self.pause_button.setToolTip(
+            QCoreApplication.translate("TrendWidget", "Pause (dragging or wheeling in the plot also pauses)")
+            if live else QCoreApplication.translate("TrendWidget", "Back to live"))
+
+    def set_history(self, times: np.ndarray, values: np.ndarray) -> None:
+        """The archive's samples of this trend, drawn lighter behind the live ones."""
+        self.hist_times, self.hist_values = times, values
+        self.history.setData(times, values)
+        if len(times):
+            self.history.set_extent(QRectF(times[0], self.lo, max(times[-1] - times[0], 1e-3),
+                                           self.hi - self.lo))
+
+    def value_at(self, x: float) -> tuple[float, float] | None:
+        """The sample nearest to time `x`, live or from the history: (time, value)."""
+        best: tuple[float, float] | None = None
+        for t, y in ((self.trend.times(), self.trend.values()), (self.hist_times, self.hist_values)):
+            if not len(t):
+                continue
+            i = int(np.clip(np.searchsorted(t, x), 1, len(t) - 1)) if len(t) > 1 else 0
+            j = i - 1 if len(t) > 1 and abs(t[i - 1] - x) < abs(t[i] - x) else i
+            if not math.isnan(t[j]) and (best is None or abs(t[j] - x) < abs(best[0] - x)):
+                best = (float(t[j]), float(y[j]))
+        return best
+
+    def _mouse_moved(self, pos: QPointF) -> None:
+        inside = self.view_box.sceneBoundingRect().contains(pos)
+        found = self.value_at(self.view_box.mapSceneToView(pos).x()) if inside else None
+        self.cursor.setVisible(found is not None)
+        self.cursor_label.setVisible(found is not None)
+        if found is None:
+            return
+        t, y = found
+        value = "---" if math.isnan(y) else (str(int(y)) if isinstance(self.model, Graph)
+                                             else f"{self.model.format(y)} {self.model.Units}".rstrip())
+        self.cursor.setPos(t)
+        self.cursor_label.setText(f"{formats.clock(t)}  {value}")
+        (x0, x1), (_, y1) = self.view_box.viewRange()
+        self.cursor_label.setAnchor((1, 0) if t > (x0 + x1) / 2 else (0, 0))
+        self.cursor_label.setPos(t, y1)
 
     def layer_key(self) -> Hashable:
         m = self.model
@@ -131,7 +198,7 @@ class TrendWidget(SelfPainted):
 
     def paint_static(self, p: QPainter, r: QRectF) -> None:
         m = self.model
-        hr = QRectF(6, 0, r.width() - 12, self.header)
+        hr = QRectF(6, 0, r.width() - 12 - self.header, self.header)
         p.setFont(theme.sized_font(self.header * 0.62, bold=True))
         p.setPen(theme.TEXT_DIM)
         p.drawText(hr, theme.LEFT, m.Name)
@@ -152,4 +219,5 @@ class TrendWidget(SelfPainted):
             color = theme.ZONE_COLORS.get(m.zone or "")
             p.setPen(color.darker(115) if color is not None else theme.TEXT)
             p.setFont(theme.sized_font(self.header * 0.66, bold=True, family=theme.MONO))
-            p.drawText(QRectF(6, 0, r.width() - 12, self.header), theme.RIGHT, (m.text or "---") + units)
+            p.drawText(QRectF(6, 0, r.width() - 12 - self.header, self.header), theme.RIGHT,
+                       (m.text or "---") + units)

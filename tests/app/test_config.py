@@ -22,7 +22,7 @@ def test_demo_station_loads_with_paths_relative_to_its_file() -> None:
     assert [s.node for s in st.simulators] == [0]
     node = st.nodes[0]
     assert (node.node, node.endpoint, node.timeout) == (0, "", 0.5)  # the simulator fills it in
-    assert st.users == ("operator", "engineer")
+    assert st.operator.default_user == "viewer" and st.operator.idle_logout == 900
 
 
 def test_defaults(tmp_path: Path) -> None:
@@ -31,13 +31,14 @@ def test_defaults(tmp_path: Path) -> None:
     assert st.NetSyncTime == 100
     assert st.Archive == tmp_path / "archive" / "journal.sqlite"
     assert st.Retain == tmp_path / "archive" / "retain.bin"
-    assert st.keep_days == 0 and st.nodes == () and st.users == ("operator",)
+    assert st.keep_days == 0 and st.nodes == () and st.operator.default_user == ""
     assert st.modbus_server.host == "127.0.0.1"
 
 
 def test_every_problem_is_named_by_its_key(tmp_path: Path) -> None:
     write_station(tmp_path, """
 NetPlcProgram = "missing.stl"
+Language = "de"
 NetSyncTime = "fast"
 keep_days = -1
 Colour = "red"
@@ -58,6 +59,7 @@ node = 9
 program = "nowhere.stl"
 [operator]
 users = []
+idle_logout = -5
 """)
     with pytest.raises(ConfigError) as e:
         load_station(tmp_path)
@@ -70,7 +72,9 @@ users = []
         "modbus_server.writable[3]: a range must lie within", "nodes[0].endpoint: endpoint 'tcp://plc:99999'",
         "nodes[0].profile: 's7'", "nodes[1].node: node 3 is configured twice",
         "nodes[1].endpoint: endpoint 'com1'",
-        "node 5 has no endpoint and no simulator", "simulators[0].program: file", "operator.users",
+        "node 5 has no endpoint and no simulator", "simulators[0].program: file",
+        "operator.users: users are kept in users.json",
+        "operator.idle_logout: -5 is outside", "Language: 'de' is not one of ru, en",
     ):
         assert expected in text, expected
     assert all(p.startswith(str(tmp_path / "station.toml")) for p in e.value.problems)

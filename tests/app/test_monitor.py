@@ -202,7 +202,7 @@ def test_watch_edit_force_unforce_and_step_from_the_view(qtbot, runtime: Runtime
     assert ("eng1", "force 02000: 0 -> 0 (bumpless)") in texts
     monitor.step()  # running: refused, said so
     assert "only while NetPlc is stopped" in monitor.message.text()
-    runtime.stop_program()
+    runtime.stop_program("engineer")
     wait(qtbot, lambda: engine.snapshot.state.startswith("stopped"))
     before = engine.scan_counter
     monitor.step_button.click()
@@ -307,6 +307,10 @@ def test_station_menu_opens_the_program_view_and_the_status_bar_counts_forces(qt
         menu = window.menuBar().actions()[0].menu()
         program = next(a for a in menu.actions() if a.text() == "&Program…")
         assert window.status.forced.text() == "F: 0 forced"
+        program.trigger()  # the demo opens as a viewer: the view needs the engineer role
+        assert not [w for w in window.viewers if isinstance(w, ProgramWindow)]
+        assert "engineer" in window.status.currentMessage()
+        window.login("engineer", "engineer")
         program.trigger()
         opened = [w for w in window.viewers if isinstance(w, ProgramWindow)]
         assert len(opened) == 1 and opened[0].isVisible()

@@ -107,3 +107,36 @@ def test_a_failing_save_is_journaled_once_shown_and_cleared(tmp_path: Path, qtbo
         window.close()
         runtime.stop()
     assert (folder / "blocked" / "retain.bin").exists()
+
+
+def test_a_start_left_pressed_is_no_new_press_after_a_restart(tmp_path: Path) -> None:
+    """Пуск is retained (data memory) and so is its edge memory: the journal records one press,
+    not one more at every restart."""
+    from tests.app.conftest import copy_demo
+
+    station = load_station(copy_demo(tmp_path / "station"))
+    start_bit = 0o40042
+    for run in range(2):
+        runtime = Runtime(station)
+        runtime.start()
+        try:
+            assert runtime.engine is not None
+            if run == 0:
+                runtime.engine.write_bit(start_bit, 1, user="operator", label="Пуск")
+            deadline = time.monotonic() + 5
+            while runtime.engine.snapshot.scan < 15 and time.monotonic() < deadline:
+                time.sleep(0.05)
+            assert runtime.engine.snapshot.get_hmi_bit(start_bit) == 1
+        finally:
+            runtime.stop()
+    import sqlite3
+
+    con = sqlite3.connect(f"file:{station.Archive}?mode=ro", uri=True)
+    try:
+        texts = [t for (name,) in con.execute("SELECT name FROM sqlite_master WHERE type = 'table' "
+                                             "AND name GLOB '[0-9][0-9]_[0-9][0-9]_*'")
+                 for (t,) in con.execute(f'SELECT text FROM "{name}" WHERE kind = ?', ("message",))]
+    finally:
+        con.close()
+    assert texts.count("Пуск нажат") == 1
+    assert texts.count("NetPlc запущен") == 2

@@ -43,7 +43,7 @@ def test_readings_from_a_killed_node_and_from_netplc_stopped(demo_copy: Path) ->
         assert quality(runtime, "TEMP_SP") is Quality.GOOD  # NetPlc's own word: nothing fills it
         wait_until(lambda: runtime.alarms is not None and
                    runtime.alarms.system.get("LEVEL.BAD").state is State.UNACK, timeout=5)
-        runtime.stop_program()
+        runtime.stop_program("engineer")
         wait_until(lambda: quality(runtime, "TEMP_SP") is Quality.NOT_RUNNING, timeout=5)
         assert quality(runtime, "LEVEL") is Quality.NOT_RUNNING
     finally:
@@ -114,11 +114,11 @@ def test_stopping_netplc_raises_one_station_alarm_and_running_again_nothing_spur
     try:
         wait_until(lambda: quality(runtime, "LEVEL") is Quality.GOOD, timeout=10)
         assert runtime.alarms is not None
-        runtime.stop_program()
+        runtime.stop_program("engineer")
         wait_until(lambda: runtime.alarms is not None and
                    runtime.alarms.system.get(STOPPED_ID).state is State.UNACK, timeout=5)
         assert quality(runtime, "LEVEL") is Quality.NOT_RUNNING
-        runtime.run_program()
+        runtime.run_program("engineer")
         wait_until(lambda: quality(runtime, "LEVEL") is Quality.GOOD, timeout=10)
         wait_until(lambda: runtime.alarms is not None and
                    runtime.alarms.system.get(STOPPED_ID).state is State.RTNUN, timeout=5)
@@ -150,9 +150,9 @@ def test_the_archived_series_breaks_while_a_node_is_down_and_while_netplc_is_sto
         wait_until(lambda: quality(runtime, "LEVEL") is Quality.GOOD, timeout=15)
         target = stores(1)
         wait_until(lambda: stores(0) >= target, timeout=10)
-        runtime.stop_program()
+        runtime.stop_program("engineer")
         wait_until(lambda: any(r.text == "not running" for r in list(stored)), timeout=5)
-        runtime.run_program()
+        runtime.run_program("engineer")
         wait_until(lambda: quality(runtime, "LEVEL") is Quality.GOOD, timeout=10)
         target = stores(1)
         wait_until(lambda: stores(0) >= target, timeout=10)

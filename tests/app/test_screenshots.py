@@ -14,7 +14,12 @@ def test_screenshots_of_every_form_and_the_viewer(qtbot, tmp_path: Path) -> None
     names = sorted(p.name for p in tmp_path.glob("*.png"))
     forms = sorted(p.stem for p in (Path(__file__).parents[2] / "resources/example/forms").glob("*.hmi"))
     assert names == sorted([*(f"workstation-{f.replace('_', '-')}.png" for f in forms),
+                            *(f"workstation-{f.replace('_', '-')}-1920x1080.png" for f in forms),
                             "designer-02-analog.png", "viewer-records.png", "viewer-series.png"])
+    small, large = QImage(str(tmp_path / "workstation-01-trigger.png")), QImage(
+        str(tmp_path / "workstation-01-trigger-1920x1080.png"))
+    assert (small.width(), small.height()) == (1366, 768)
+    assert (large.width(), large.height()) == (1920, 1080)
     image = QImage(str(tmp_path / names[-1]))
     assert image.width() > 1000 and image.height() > 700
     colours = {image.pixel(x, y) for x in range(0, image.width(), 37) for y in range(0, image.height(), 41)}

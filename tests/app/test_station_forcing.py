@@ -112,7 +112,7 @@ def test_step_one_scan_runs_the_stopped_program_once(demo_copy: Path) -> None:
         engine = runtime.engine
         assert engine is not None
         assert runtime.step_program("engineer") is False  # running: nothing to step
-        runtime.stop_program()
+        runtime.stop_program("engineer")
         wait_for(runtime, lambda s: s.state.startswith("stopped"))
         after_scans(runtime)
         before = engine.scan_counter

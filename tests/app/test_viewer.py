@@ -116,3 +116,32 @@ def test_a_series_plot_breaks_over_records_whose_value_was_not_good(qtbot, tmp_p
     qtbot.waitUntil(lambda: len(viewer.curves) == 1, timeout=10_000)
     _, ys = next(iter(viewer.curves.values())).getData()
     assert [str(y) for y in ys] == ["0.0", "1.0", "2.0", "3.0", "nan", "6.0", "7.0", "8.0"]
+
+
+def test_the_to_bound_is_exact_and_a_severity_keeps_the_worse_ones(qtbot, tmp_path: Path) -> None:
+    from PySide6.QtCore import QTime
+
+    from netplc.records import Record
+    from registrar.store import Store
+
+    day = dt.date.today()
+    at = dt.datetime.combine(day, dt.time(10, 0, 5)).timestamp()
+    store = Store(tmp_path / "journal.sqlite")
+    store.start()
+    for ts, typ, text in ((at + 0.5, 2, "alarm at :05.5"), (at + 0.999, 3, "critical at :05.999"),
+                          (at + 1.2, 2, "alarm at :06.2"), (at - 1, 1, "warning at :04")):
+        store.put(Record(ts, "message", grp=1, type=typ, text=text))
+    store.close()
+    viewer = ViewerWindow(tmp_path / "journal.sqlite")
+    qtbot.addWidget(viewer)
+
+    def shown() -> set[str]:
+        viewer.apply_filter()
+        return {viewer.model.index(r, 7).data() for r in range(viewer.model.rowCount())}
+
+    viewer.until.setTime(QTime(10, 0, 5))
+    assert shown() == {"alarm at :05.5", "critical at :05.999", "warning at :04"}
+    viewer.type.setCurrentText("2 alarm and above")
+    assert shown() == {"alarm at :05.5", "critical at :05.999"}
+    viewer.until.setTime(viewer.until.maximumTime())
+    assert shown() == {"alarm at :05.5", "critical at :05.999", "alarm at :06.2"}

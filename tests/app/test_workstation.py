@@ -30,6 +30,7 @@ def workstation(qtbot, demo_copy: Path) -> Iterator[MainWindow]:
     window = MainWindow(runtime)
     qtbot.addWidget(window)
     window.show()
+    window.login("operator", "operator")  # the demo opens as its viewer, who may not act
     try:
         yield window
     finally:
@@ -88,7 +89,7 @@ def test_start_twice_changes_the_trigger_output_once(qtbot, workstation: MainWin
 def test_an_alarm_is_shown_and_its_acknowledgement_journaled(qtbot, workstation: MainWindow) -> None:
     runtime = workstation.runtime
     qtbot.waitUntil(lambda: runtime.status().nodes_up == 1, timeout=10_000)
-    workstation.header.user.setCurrentText("engineer")
+    workstation.login("engineer", "engineer")
     # the plant: node 0's level jumps close to the top; its program keeps it rising past 90 %
     runtime.simulators[0].engine.write_word(LEVEL, 3700)
     high = "Уровень выше 90 %"
@@ -115,7 +116,7 @@ def test_a_dead_node_and_a_stopped_program_show_in_the_window(qtbot, workstation
     qtbot.waitUntil(lambda: runtime.status().scans > 35, timeout=10_000)  # past the start-up grace
     runtime.simulators[0].stop()
     qtbot.waitUntil(lambda: runtime.status().nodes_up == 0, timeout=10_000)
-    runtime.stop_program()  # after the link is seen down: a stopped program sends no more requests
+    runtime.stop_program("engineer")  # after the link is seen down: a stopped program sends no more requests
     text = workstation.health.label.text
     qtbot.waitUntil(lambda: "NetPlc program stopped" in text() and "no link to node 0" in text(),
                     timeout=3000)
@@ -159,7 +160,7 @@ def test_elements_mark_a_dead_node_and_a_stopped_netplc_and_link_labels_follow_t
     runtime.simulator_answers(0, True)
     qtbot.waitUntil(lambda: level.quality == "" and link.value == 1, timeout=15_000)
 
-    runtime.stop_program()
+    runtime.stop_program("engineer")
     qtbot.waitUntil(lambda: level.quality == "not running", timeout=5000)
     assert math.isnan(trend.trend.last) and gauge.toolTip().startswith("? not running")
     assert link.value == 1 and link.quality == ""  # the link is up: said, and not marked

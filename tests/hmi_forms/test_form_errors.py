@@ -107,7 +107,7 @@ def test_element_cross_checks(tmp_path) -> None:
     ])
     assert found == [
         'element "G": Phase0: phase 5 must be less than the period 5',
-        'element "A": Appearance: "gauge" is not one of digital, hbar, dial, semidial, graph',
+        'element "A": Appearance: "gauge" is not one of digital, hbar, dial, semidial, graph, tank',
         f'element "P": Image: image file "missing.png" not found in {tmp_path}',
     ]
 

@@ -271,11 +271,11 @@ def test_analog_output_validates_converts_and_writes(tmp_path) -> None:
 def test_date_time_shows_clock_and_time_since_start(tmp_path) -> None:
     d = element(tmp_path, "DateTime")
     assert d.update(snap(time=100.0, wall=0.0))
-    assert d.uptime == "00.00.00" and len(d.clock) == 8 and d.clock.count(".") == 2
+    assert d.uptime == "00:00:00" and len(d.clock) == 8 and d.clock.count(":") == 2
     assert not d.update(snap(time=100.2, wall=0.2))
     assert d.update(snap(time=100.0 + 3723, wall=3723.0))
-    assert d.uptime == "01.02.03"
-    assert format_span(2 * 86400 + 61) == "2 d 00.01.01"
+    assert d.uptime == "01:02:03"
+    assert format_span(2 * 86400 + 61) == "2 d 00:01:01"
 
 
 def test_journal_refreshes_today_every_refresh_ticks(tmp_path) -> None:

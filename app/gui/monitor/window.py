@@ -11,7 +11,7 @@ from pathlib import Path
 from PySide6.QtGui import QCloseEvent
 from PySide6.QtWidgets import QApplication, QMainWindow, QWidget
 
-from app.config import Station, load_station
+from app.config import load_station
 from app.gui.monitor.source import LocalSource, RemoteSource, Source
 from app.gui.monitor.view import ProgramMonitor
 from app.gui.style import apply_style
@@ -20,16 +20,6 @@ from app.runtime import Runtime
 from netplc.problems import Problems
 
 SIZE = (1366, 768)
-
-
-def may_open_program(station: Station, user: str) -> bool:
-    """The one gate of the Program view: role engineer when the station has users with roles.
-
-    Roles arrive with app/users.py (viewer < operator < engineer < admin), built beside this
-    view; point this function at its role check. Until then station.toml's users carry no
-    roles, and every user on duty of the workstation may open the view.
-    """
-    return bool(user) or not station.users
 
 
 class ProgramWindow(QMainWindow):

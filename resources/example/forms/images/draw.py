@@ -45,6 +45,7 @@ def pump(path: Path, running: bool, angle: float) -> None:
 
 
 def tank(path: Path) -> None:
+    """The vessel only: a painted fill would show one level forever (the level is on the gauges)."""
     w, h = 120, 160
     img = QImage(w, h, QImage.Format.Format_ARGB32)
     img.fill(Qt.GlobalColor.transparent)
@@ -53,13 +54,20 @@ def tank(path: Path) -> None:
     p.setPen(QPen(QColor("#33393f"), 3))
     p.setBrush(QColor("#e3e6ea"))
     p.drawRoundedRect(QRectF(10, 14, w - 20, h - 28), 14, 14)
-    p.setBrush(QColor("#9ec5e8"))
-    p.setPen(Qt.PenStyle.NoPen)
-    p.drawRoundedRect(QRectF(13, h * 0.45, w - 26, h * 0.45 - 17), 11, 11)
-    p.setPen(QPen(QColor("#33393f"), 3))
-    p.setBrush(Qt.BrushStyle.NoBrush)
-    p.drawRoundedRect(QRectF(10, 14, w - 20, h - 28), 14, 14)
     p.drawLine(QPointF(w / 2, 0), QPointF(w / 2, 14))
+    p.end()
+    img.save(str(path))
+
+
+def pipe(path: Path) -> None:
+    """The pipe from the tank to the pump: a static part of the mimic, drawn under both."""
+    w, h = 60, 16
+    img = QImage(w, h, QImage.Format.Format_ARGB32)
+    img.fill(Qt.GlobalColor.transparent)
+    p = QPainter(img)
+    p.setPen(QPen(QColor("#33393f"), 2))
+    p.setBrush(QColor("#9aa1ab"))
+    p.drawRect(QRectF(1, 3, w - 2, h - 6))
     p.end()
     img.save(str(path))
 
@@ -70,6 +78,7 @@ def main() -> None:
     for i in range(4):
         pump(HERE / f"pump_on_{i}.png", True, 90 - i * 30)
     tank(HERE / "tank.png")
+    pipe(HERE / "pipe.png")
 
 
 if __name__ == "__main__":

@@ -1,0 +1,574 @@
+<?xml version='1.0' encoding='utf-8'?>
+<TS version="2.1" language="ru_RU">
+<context>
+    <name>AlarmBanner</name>
+    <message>
+        <source>info</source>
+        <translation>информация</translation>
+    </message>
+    <message>
+        <source>warning</source>
+        <translation>предупреждение</translation>
+    </message>
+    <message>
+        <source>ALARM</source>
+        <translation>АВАРИЯ</translation>
+    </message>
+    <message>
+        <source>CRITICAL</source>
+        <translation>КРИТИЧЕСКАЯ</translation>
+    </message>
+    <message>
+        <source>Acknowledge</source>
+        <translation>Квитировать</translation>
+    </message>
+    <message>
+        <source>Acknowledge all</source>
+        <translation>Квитировать все</translation>
+    </message>
+    <message>
+        <source>{0} unacknowledged</source>
+        <translation>неквитированных: {0}</translation>
+    </message>
+</context>
+<context>
+    <name>DateTimeWidget</name>
+    <message>
+        <source>since start {0}</source>
+        <translation>с пуска {0}</translation>
+    </message>
+</context>
+<context>
+    <name>DiscreteWidget</name>
+    <message>
+        <source>(indication off)</source>
+        <translation>(индикация выключена)</translation>
+    </message>
+</context>
+<context>
+    <name>HealthStrip</name>
+    <message>
+        <source>Details…</source>
+        <translation>Подробно…</translation>
+    </message>
+    <message>
+        <source>Station problems</source>
+        <translation>Неисправности станции</translation>
+    </message>
+</context>
+<context>
+    <name>JournalDock</name>
+    <message>
+        <source>Journal — today</source>
+        <translation>Журнал — сегодня</translation>
+    </message>
+    <message>
+        <source>Events only (messages, operator actions, system)</source>
+        <translation>Только события (сообщения, действия операторов, система)</translation>
+    </message>
+    <message>
+        <source>no archive yet</source>
+        <translation>архива ещё нет</translation>
+    </message>
+    <message>
+        <source>archive unreadable: {0}</source>
+        <translation>архив не читается: {0}</translation>
+    </message>
+    <message>
+        <source>, newest {0} shown</source>
+        <translation>, показаны последние {0}</translation>
+    </message>
+    <message>
+        <source>{0} records today</source>
+        <translation>{0} записей сегодня</translation>
+    </message>
+</context>
+<context>
+    <name>LoginDialog</name>
+    <message>
+        <source>Log in</source>
+        <translation>Вход</translation>
+    </message>
+    <message>
+        <source>User:</source>
+        <translation>Пользователь:</translation>
+    </message>
+    <message>
+        <source>Password:</source>
+        <translation>Пароль:</translation>
+    </message>
+    <message>
+        <source>This station has no users yet: main.py users add NAME --role ROLE</source>
+        <translation>У этой станции ещё нет пользователей: main.py users add ИМЯ --role РОЛЬ</translation>
+    </message>
+</context>
+<context>
+    <name>MainWindow</name>
+    <message>
+        <source>No unacknowledged alarms</source>
+        <translation>Нет неквитированных аварий</translation>
+    </message>
+    <message>
+        <source>&amp;Station</source>
+        <translation>&amp;Станция</translation>
+    </message>
+    <message>
+        <source>&amp;Run NetPlc…</source>
+        <translation>&amp;Запустить NetPlc…</translation>
+    </message>
+    <message>
+        <source>&amp;Stop NetPlc…</source>
+        <translation>&amp;Остановить NetPlc…</translation>
+    </message>
+    <message>
+        <source>&amp;Log in / switch user…</source>
+        <translation>&amp;Вход / смена пользователя…</translation>
+    </message>
+    <message>
+        <source>Log &amp;out</source>
+        <translation>В&amp;ыйти из системы</translation>
+    </message>
+    <message>
+        <source>&amp;Users…</source>
+        <translation>&amp;Пользователи…</translation>
+    </message>
+    <message>
+        <source>Open journal &amp;viewer…</source>
+        <translation>Открыть &amp;просмотр журнала…</translation>
+    </message>
+    <message>
+        <source>&amp;Quit…</source>
+        <translation>В&amp;ыход…</translation>
+    </message>
+    <message>
+        <source>&amp;View</source>
+        <translation>&amp;Вид</translation>
+    </message>
+    <message>
+        <source>Fit &amp;width</source>
+        <translation>По &amp;ширине</translation>
+    </message>
+    <message>
+        <source>Fit &amp;window</source>
+        <translation>По &amp;окну</translation>
+    </message>
+    <message>
+        <source>&amp;100 %</source>
+        <translation>&amp;100 %</translation>
+    </message>
+    <message>
+        <source>Zoom &amp;in</source>
+        <translation>&amp;Крупнее</translation>
+    </message>
+    <message>
+        <source>Zoom &amp;out</source>
+        <translation>&amp;Мельче</translation>
+    </message>
+    <message>
+        <source>&amp;Help</source>
+        <translation>&amp;Справка</translation>
+    </message>
+    <message>
+        <source>&amp;About</source>
+        <translation>&amp;О программе</translation>
+    </message>
+    <message>
+        <source>This station has no HMIload folder.</source>
+        <translation>У этой станции нет папки HMIload.</translation>
+    </message>
+    <message>
+        <source>No forms</source>
+        <translation>Нет форм</translation>
+    </message>
+    <message>
+        <source>Form problems</source>
+        <translation>Ошибки форм</translation>
+    </message>
+    <message>
+        <source>No .hmi forms in {0}.</source>
+        <translation>В {0} нет форм .hmi.</translation>
+    </message>
+    <message>
+        <source>Zoom: </source>
+        <translation>Масштаб: </translation>
+    </message>
+    <message>
+        <source>Acknowledge</source>
+        <translation>Квитировать</translation>
+    </message>
+    <message>
+        <source>Refused: </source>
+        <translation>Отказано: </translation>
+    </message>
+    <message>
+        <source>Confirm</source>
+        <translation>Подтверждение</translation>
+    </message>
+    <message>
+        <source>cancelled</source>
+        <translation>отменено</translation>
+    </message>
+    <message>
+        <source>Run NetPlc</source>
+        <translation>Запуск NetPlc</translation>
+    </message>
+    <message>
+        <source>Run the NetPlc program? Its chains act on the plant from the next scan.</source>
+        <translation>Запустить программу NetPlc? Её цепи начнут действовать на объект со следующего цикла.</translation>
+    </message>
+    <message>
+        <source>Stop NetPlc</source>
+        <translation>Останов NetPlc</translation>
+    </message>
+    <message>
+        <source>Stop the NetPlc program? Exchange, archive and forms keep running, but the program's chains are no longer executed.</source>
+        <translation>Остановить программу NetPlc? Обмен, архив и формы продолжат работу, но цепи программы выполняться не будут.</translation>
+    </message>
+    <message>
+        <source>Quit</source>
+        <translation>Выход</translation>
+    </message>
+    <message>
+        <source>Quit NetPlc Station? The NetPlc program, the exchange with the nodes and the archive stop.</source>
+        <translation>Завершить NetPlc Station? Программа NetPlc, обмен с узлами и архив будут остановлены.</translation>
+    </message>
+    <message>
+        <source>Users</source>
+        <translation>Пользователи</translation>
+    </message>
+    <message>
+        <source>NetPlc Station {0}: the PC runtime for CPU-165 PLC networks (FregatServer).</source>
+        <translation>NetPlc Station {0}: среда исполнения ПК для сетей контроллеров CPU-165 (FregatServer).</translation>
+    </message>
+    <message>
+        <source>Station: {0}</source>
+        <translation>Станция: {0}</translation>
+    </message>
+</context>
+<context>
+    <name>StationStatusBar</name>
+    <message>
+        <source>NetPlc: {0}</source>
+        <translation>NetPlc: {0}</translation>
+    </message>
+    <message>
+        <source>Scan {0:.2f} ms  max {1:.2f} ms</source>
+        <translation>Цикл {0:.2f} мс  макс. {1:.2f} мс</translation>
+    </message>
+    <message>
+        <source>{0} scans, mean {1:.3f} ms, {2} overruns</source>
+        <translation>{0} циклов, в среднем {1:.3f} мс, {2} превышений</translation>
+    </message>
+    <message>
+        <source>Tick {0} ms</source>
+        <translation>Такт {0} мс</translation>
+    </message>
+    <message>
+        <source>NetSyncTime {0} ms; {1} scans took longer</source>
+        <translation>NetSyncTime {0} мс; дольше шли {1} циклов</translation>
+    </message>
+    <message>
+        <source>Nodes {0}/{1}</source>
+        <translation>Узлы {0}/{1}</translation>
+    </message>
+    <message>
+        <source>Archive {0} records</source>
+        <translation>Архив: {0} записей</translation>
+    </message>
+    <message>
+        <source>{0} waiting, {1} lost</source>
+        <translation>{0} в очереди, {1} потеряно</translation>
+    </message>
+    <message>
+        <source>NetPlc memory served over Modbus TCP</source>
+        <translation>Память NetPlc доступна по Modbus TCP</translation>
+    </message>
+    <message>
+        <source>Modbus off</source>
+        <translation>Modbus выключен</translation>
+    </message>
+    <message>
+        <source>running</source>
+        <translation>работает</translation>
+    </message>
+    <message>
+        <source>stopped</source>
+        <translation>остановлен</translation>
+    </message>
+    <message>
+        <source>halted</source>
+        <translation>остановлен (HLT)</translation>
+    </message>
+    <message>
+        <source>idle</source>
+        <translation>простой</translation>
+    </message>
+</context>
+<context>
+    <name>TrendWidget</name>
+    <message>
+        <source>Pause (dragging or wheeling in the plot also pauses)</source>
+        <translation>Пауза (перетаскивание или колесо мыши на графике тоже ставят паузу)</translation>
+    </message>
+    <message>
+        <source>Back to live</source>
+        <translation>Вернуться к текущему времени</translation>
+    </message>
+</context>
+<context>
+    <name>UsersDialog</name>
+    <message>
+        <source>Users</source>
+        <translation>Пользователи</translation>
+    </message>
+    <message>
+        <source>User</source>
+        <translation>Пользователь</translation>
+    </message>
+    <message>
+        <source>Role</source>
+        <translation>Роль</translation>
+    </message>
+    <message>
+        <source>Add…</source>
+        <translation>Добавить…</translation>
+    </message>
+    <message>
+        <source>Remove</source>
+        <translation>Удалить</translation>
+    </message>
+    <message>
+        <source>Password…</source>
+        <translation>Пароль…</translation>
+    </message>
+    <message>
+        <source>Add user</source>
+        <translation>Новый пользователь</translation>
+    </message>
+    <message>
+        <source>Name:</source>
+        <translation>Имя:</translation>
+    </message>
+    <message>
+        <source>Role:</source>
+        <translation>Роль:</translation>
+    </message>
+    <message>
+        <source>Password</source>
+        <translation>Пароль</translation>
+    </message>
+    <message>
+        <source>Password:</source>
+        <translation>Пароль:</translation>
+    </message>
+</context>
+<context>
+    <name>ViewerWindow</name>
+    <message>
+        <source>any</source>
+        <translation>любой</translation>
+    </message>
+    <message>
+        <source>0 info and above</source>
+        <translation>0 информация и выше</translation>
+    </message>
+    <message>
+        <source>1 warning and above</source>
+        <translation>1 предупреждение и выше</translation>
+    </message>
+    <message>
+        <source>2 alarm and above</source>
+        <translation>2 авария и выше</translation>
+    </message>
+    <message>
+        <source>3 critical</source>
+        <translation>3 критическая</translation>
+    </message>
+    <message>
+        <source>NetPlc Station — journal viewer</source>
+        <translation>NetPlc Station — просмотр журнала</translation>
+    </message>
+    <message>
+        <source>&amp;Archive</source>
+        <translation>&amp;Архив</translation>
+    </message>
+    <message>
+        <source>&amp;Open…</source>
+        <translation>&amp;Открыть…</translation>
+    </message>
+    <message>
+        <source>&amp;Export selection to CSV…</source>
+        <translation>&amp;Экспорт выборки в CSV…</translation>
+    </message>
+    <message>
+        <source>&amp;Reload</source>
+        <translation>&amp;Обновить</translation>
+    </message>
+    <message>
+        <source>&amp;Close</source>
+        <translation>&amp;Закрыть</translation>
+    </message>
+    <message>
+        <source>no archive</source>
+        <translation>нет архива</translation>
+    </message>
+    <message>
+        <source>&lt;b&gt;Days&lt;/b&gt;</source>
+        <translation>&lt;b&gt;Дни&lt;/b&gt;</translation>
+    </message>
+    <message>
+        <source>&lt;b&gt;Filter&lt;/b&gt;</source>
+        <translation>&lt;b&gt;Фильтр&lt;/b&gt;</translation>
+    </message>
+    <message>
+        <source>Kind</source>
+        <translation>Вид</translation>
+    </message>
+    <message>
+        <source>Group</source>
+        <translation>Группа</translation>
+    </message>
+    <message>
+        <source>Type</source>
+        <translation>Тип</translation>
+    </message>
+    <message>
+        <source>Source</source>
+        <translation>Источник</translation>
+    </message>
+    <message>
+        <source>Text</source>
+        <translation>Текст</translation>
+    </message>
+    <message>
+        <source>From</source>
+        <translation>С</translation>
+    </message>
+    <message>
+        <source>To</source>
+        <translation>По</translation>
+    </message>
+    <message>
+        <source>Apply filter</source>
+        <translation>Применить фильтр</translation>
+    </message>
+    <message>
+        <source>Export CSV…</source>
+        <translation>Экспорт CSV…</translation>
+    </message>
+    <message>
+        <source>« First</source>
+        <translation>« В начало</translation>
+    </message>
+    <message>
+        <source>‹ Previous</source>
+        <translation>‹ Назад</translation>
+    </message>
+    <message>
+        <source>Next ›</source>
+        <translation>Далее ›</translation>
+    </message>
+    <message>
+        <source>Records</source>
+        <translation>Записи</translation>
+    </message>
+    <message>
+        <source>Series</source>
+        <translation>Ряды</translation>
+    </message>
+    <message>
+        <source>Journal viewer</source>
+        <translation>Просмотр журнала</translation>
+    </message>
+    <message>
+        <source>Export selection</source>
+        <translation>Экспорт выборки</translation>
+    </message>
+    <message>
+        <source>Open archive</source>
+        <translation>Открыть архив</translation>
+    </message>
+</context>
+<context>
+    <name>_Header</name>
+    <message>
+        <source>nobody logged in</source>
+        <translation>никто не вошёл</translation>
+    </message>
+    <message>
+        <source>Log out</source>
+        <translation>Выйти</translation>
+    </message>
+    <message>
+        <source>Log in…</source>
+        <translation>Войти…</translation>
+    </message>
+</context>
+<context>
+    <name>records</name>
+    <message>
+        <source>info</source>
+        <translation>информация</translation>
+    </message>
+    <message>
+        <source>warning</source>
+        <translation>предупреждение</translation>
+    </message>
+    <message>
+        <source>alarm</source>
+        <translation>авария</translation>
+    </message>
+    <message>
+        <source>critical</source>
+        <translation>критическая</translation>
+    </message>
+    <message>
+        <source>Time</source>
+        <translation>Время</translation>
+    </message>
+    <message>
+        <source>Kind</source>
+        <translation>Вид</translation>
+    </message>
+    <message>
+        <source>Group</source>
+        <translation>Группа</translation>
+    </message>
+    <message>
+        <source>Type</source>
+        <translation>Тип</translation>
+    </message>
+    <message>
+        <source>Source</source>
+        <translation>Источник</translation>
+    </message>
+    <message>
+        <source>No.</source>
+        <translation>№</translation>
+    </message>
+    <message>
+        <source>Value</source>
+        <translation>Значение</translation>
+    </message>
+    <message>
+        <source>Text</source>
+        <translation>Текст</translation>
+    </message>
+    <message>
+        <source>data</source>
+        <translation>данные</translation>
+    </message>
+    <message>
+        <source>message</source>
+        <translation>сообщение</translation>
+    </message>
+    <message>
+        <source>operator</source>
+        <translation>оператор</translation>
+    </message>
+    <message>
+        <source>system</source>
+        <translation>система</translation>
+    </message>
+</context>
+</TS>

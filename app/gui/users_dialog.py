@@ -1,0 +1,103 @@
+"""The admin's users dialog: the station's users and roles, added, removed and given new passwords
+from the workstation (the same users.json `main.py users` manages). Each change is journaled by
+the window under the admin's name; the passwords never leave app/users.py unhashed.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable
+
+from PySide6.QtWidgets import (
+    QDialog,
+    QHBoxLayout,
+    QInputDialog,
+    QLabel,
+    QLineEdit,
+    QPushButton,
+    QTableWidget,
+    QTableWidgetItem,
+    QVBoxLayout,
+    QWidget,
+)
+
+from app.users import UserError, Users
+from hmi_forms.elements.base import ROLES
+
+
+class UsersDialog(QDialog):
+    def __init__(self, users: Users, journal: Callable[[str], None], parent: QWidget | None = None) -> None:
+        """`journal(text)` records a change under the admin's name."""
+        super().__init__(parent)
+        self.users = users
+        self.journal = journal
+        self.setWindowTitle(self.tr("Users"))
+        self.resize(420, 320)
+        lay = QVBoxLayout(self)
+        self.table = QTableWidget(0, 2)
+        self.table.setHorizontalHeaderLabels([self.tr("User"), self.tr("Role")])
+        self.table.horizontalHeader().setStretchLastSection(True)
+        lay.addWidget(self.table)
+        self.message = QLabel("")
+        self.message.setStyleSheet("color: #b71c1c; font-weight: bold;")
+        lay.addWidget(self.message)
+        row = QHBoxLayout()
+        for text, slot in ((self.tr("Add…"), self._ask_add), (self.tr("Remove"), self._ask_remove),
+                           (self.tr("Password…"), self._ask_passwd)):
+            button = QPushButton(text)
+            button.clicked.connect(slot)
+            row.addWidget(button)
+        lay.addLayout(row)
+        self._fill()
+
+    def _fill(self) -> None:
+        self.table.setRowCount(0)
+        for user in self.users.users.values():
+            r = self.table.rowCount()
+            self.table.insertRow(r)
+            self.table.setItem(r, 0, QTableWidgetItem(user.name))
+            self.table.setItem(r, 1, QTableWidgetItem(user.role))
+
+    def _do(self, change: Callable[[], str]) -> bool:
+        try:
+            text = change()
+        except UserError as e:
+            self.message.setText(str(e))
+            return False
+        self.message.setText("")
+        self.journal(text)
+        self._fill()
+        return True
+
+    def add_user(self, name: str, role: str, password: str) -> bool:
+        return self._do(lambda: f"user {self.users.add(name, role, password).name} added as {role}")
+
+    def remove_user(self, name: str) -> bool:
+        return self._do(lambda: (self.users.remove(name), f"user {name} removed")[1])
+
+    def set_password(self, name: str, password: str) -> bool:
+        return self._do(lambda: (self.users.passwd(name, password), f"password of {name} changed")[1])
+
+    def _selected(self) -> str:
+        item = self.table.item(self.table.currentRow(), 0)
+        return item.text() if item is not None else ""
+
+    def _ask_add(self) -> None:
+        name, ok = QInputDialog.getText(self, self.tr("Add user"), self.tr("Name:"))
+        if not ok:
+            return
+        role, ok = QInputDialog.getItem(self, self.tr("Add user"), self.tr("Role:"), list(ROLES), 1, False)
+        if ok and (password := self._ask_password()) is not None:
+            self.add_user(name, role, password)
+
+    def _ask_remove(self) -> None:
+        if name := self._selected():
+            self.remove_user(name)
+
+    def _ask_passwd(self) -> None:
+        if (name := self._selected()) and (password := self._ask_password()) is not None:
+            self.set_password(name, password)
+
+    def _ask_password(self) -> str | None:
+        password, ok = QInputDialog.getText(self, self.tr("Password"), self.tr("Password:"),
+                                            QLineEdit.EchoMode.Password)
+        return password if ok else None

@@ -1,0 +1,337 @@
+"""The operator console on the demo station: a screen that does not move under the hand, and
+fits a 1366x768 screen whatever the forms hold."""
+
+from __future__ import annotations
+
+import datetime as dt
+import sqlite3
+from collections.abc import Iterator
+from pathlib import Path
+
+import pytest
+from PySide6.QtCore import Qt
+from PySide6.QtWidgets import QPlainTextEdit
+
+from app.config import load_station
+from app.gui.main_window import MainWindow
+from app.gui.zoom import ACTUAL, FIT_WIDTH, FIT_WINDOW
+from app.runtime import Runtime
+
+LEVEL = 0o4010
+START_BIT = 0o40042
+BROKEN = ('{"form": {"title": "broken", "width": 100, "height": 100}, "elements": [{"type": "StaticText", '
+          '"Name": "' + "a_very_long_element_name_" * 40 + '", "x": "not a number"}]}')
+
+
+@pytest.fixture
+def console(qtbot, demo_copy: Path) -> Iterator[MainWindow]:
+    (demo_copy / "forms" / "99_broken.hmi").write_text(BROKEN, encoding="utf-8")
+    runtime = Runtime(load_station(demo_copy))
+    runtime.start()
+    window = MainWindow(runtime)
+    qtbot.addWidget(window)
+    window.resize(1366, 768)
+    window.show()
+    try:
+        yield window
+    finally:
+        window.close()
+        runtime.stop()
+
+
+def test_a_broken_form_does_not_widen_the_window(qtbot, console: MainWindow) -> None:
+    qtbot.waitUntil(lambda: console.health.isVisible(), timeout=5000)
+    assert "a_very_long_element_name_" in console.health.label.text()
+    assert console.minimumSizeHint().width() <= 1366
+    assert console.width() == 1366
+    assert console.health.label.shown().endswith("…")  # elided, the whole of it one click away
+    dialog = console.health.show_details()
+    details = dialog.findChild(QPlainTextEdit)
+    assert "a_very_long_element_name_" in details.toPlainText()
+    dialog.close()
+
+
+def test_the_forms_stay_put_when_an_alarm_comes(qtbot, console: MainWindow) -> None:
+    runtime = console.runtime
+    qtbot.waitUntil(lambda: runtime.status().nodes_up == 1, timeout=10_000)
+    top = console.tabs.mapTo(console, console.tabs.rect().topLeft())
+    assert not console.alarms.alarms
+    runtime.simulators[0].engine.write_word(LEVEL, 3700)
+    qtbot.waitUntil(lambda: bool(console.alarms.alarms), timeout=5000)
+    qtbot.wait(50)
+    assert console.alarms.isVisible()
+    assert console.tabs.mapTo(console, console.tabs.rect().topLeft()) == top
+    console.alarms.acknowledge_all()
+    qtbot.wait(50)
+    assert console.tabs.mapTo(console, console.tabs.rect().topLeft()) == top
+
+
+def element(window: MainWindow, name: str):
+    for view in window.views:
+        for model, widget in view.pairs:
+            if model.Name == name:
+                return model, widget
+    raise AssertionError(f"no element {name!r}")
+
+
+def operator_rows(runtime: Runtime) -> list[tuple[str, str]]:
+    con = sqlite3.connect(f"file:{runtime.station.Archive}?mode=ro", uri=True)
+    try:
+        return con.execute(f'SELECT source, text FROM "{dt.date.today():%d_%m_%Y}" WHERE kind = ? '
+                           "ORDER BY id", ("operator",)).fetchall()
+    finally:
+        con.close()
+
+
+class Answers:
+    """The operator's answers to the confirmations, and the questions asked."""
+
+    def __init__(self, answer: bool) -> None:
+        self.answer = answer
+        self.asked: list[str] = []
+
+    def __call__(self, title: str, text: str) -> bool:
+        self.asked.append(f"{title}: {text}")
+        return self.answer
+
+
+def test_the_demo_opens_as_its_viewer_who_may_not_act(qtbot, console: MainWindow) -> None:
+    engine = console.runtime.engine
+    assert console.user == "viewer" and "viewer (viewer)" in console.header.user.text()
+    model, button = element(console, "Пуск")
+    qtbot.waitUntil(lambda: model.value is not None, timeout=5000)
+    qtbot.mouseClick(button, Qt.MouseButton.LeftButton)
+    assert "Refused: Пуск \u2192" in console.status.currentMessage()
+    assert "needs the operator role; viewer is viewer" in console.status.currentMessage()
+    setpoint, _ = element(console, "Уставка температуры")
+    ok, why = setpoint.submit("50")
+    assert not ok and "needs the operator role" in why
+    assert not console.alarms.ack.isEnabled() and "needs the operator role" in console.alarms.ack.toolTip()
+    qtbot.wait(300)
+    assert engine.snapshot.get_hmi_bit(START_BIT) == 0
+
+
+def test_run_stop_and_quit_need_the_engineer_and_ask(qtbot, console: MainWindow) -> None:
+    runtime = console.runtime
+    console.ask = no = Answers(False)
+    console.login("operator", "operator")
+    console.stop_program()
+    assert "Stop NetPlc: needs the engineer role; operator is operator" in console.status.currentMessage()
+    assert console.request_quit() is False and console.isVisible()
+    assert not no.asked  # refused before anything is asked
+    console.login("engineer", "engineer")
+    console.stop_program()
+    assert console.request_quit() is False and console.isVisible()
+    assert [q.split(":")[0] for q in no.asked] == ["Stop NetPlc", "Quit"]
+    qtbot.wait(300)
+    assert runtime.status().state == "running"  # both answered no
+    console.ask = Answers(True)
+    console.stop_program()
+    qtbot.waitUntil(lambda: runtime.status().state != "running", timeout=3000)
+    console.run_program()
+    qtbot.waitUntil(lambda: runtime.status().state == "running", timeout=3000)
+    assert console.request_quit() is True
+    runtime.stop()
+    rows = operator_rows(runtime)
+    assert rows[-5:] == [("operator", "logged out: user switched"), ("engineer", "logged in as engineer"),
+                         ("engineer", "NetPlc stopped"), ("engineer", "NetPlc started"),
+                         ("engineer", "station quit")]
+
+
+def test_ctrl_q_and_f5_no_longer_act_at_once(console: MainWindow) -> None:
+    assert console.act_run.shortcut().isEmpty() and console.act_stop.shortcut().isEmpty()
+    assert console.act_quit.shortcut().toString() == "Ctrl+Q"
+    console.ask = Answers(True)
+    console.act_quit.trigger()  # the viewer may not quit the station
+    assert console.isVisible() and "Quit: needs the engineer role" in console.status.currentMessage()
+
+
+def test_an_element_asks_when_the_form_says_confirm_and_checks_its_role(qtbot, console: MainWindow) -> None:
+    engine = console.runtime.engine
+    model, button = element(console, "Пуск")
+    qtbot.waitUntil(lambda: model.value == 0, timeout=5000)
+    console.login("operator", "operator")
+    model.Confirm = True
+    console.ask = no = Answers(False)
+    assert model.click() is False
+    assert no.asked == ["Confirm: Пуск \u2192 1?"]
+    qtbot.wait(300)
+    assert engine.snapshot.get_hmi_bit(START_BIT) == 0
+    console.ask = Answers(True)
+    qtbot.mouseClick(button, Qt.MouseButton.LeftButton)
+    qtbot.waitUntil(lambda: engine.snapshot.get_hmi_bit(START_BIT) == 1, timeout=3000)
+    model.Role = "engineer"
+    qtbot.waitUntil(lambda: model.value == 1, timeout=3000)
+    assert model.click() is False
+    assert "Пуск \u2192 0: needs the engineer role; operator is operator" in console.status.currentMessage()
+    console.runtime.stop()
+    writes = [t for s, t in operator_rows(console.runtime) if s == "operator" and "Пуск" in t]
+    assert len(writes) == 1, writes
+
+
+def test_an_idle_user_is_logged_out_and_it_is_journaled(qtbot, console: MainWindow) -> None:
+    now = [0.0]
+    console.session.clock = lambda: now[0]
+    console.session.idle = 900
+    console.login("operator", "operator")
+    assert console.user == "operator"
+    now[0] += 901
+    console.refresh_status()
+    assert console.user == "viewer" and "Log in" in console.header.login.text()
+    console.runtime.stop()
+    assert operator_rows(console.runtime)[-1] == ("operator", "logged out: idle")
+
+
+def test_every_demo_form_fits_a_1366x768_window(qtbot, console: MainWindow) -> None:
+    assert console.minimumSizeHint().width() <= 1366
+    assert console.zooms and len(console.zooms) == len(console.views)
+    for i, area in enumerate(console.zooms):
+        console.tabs.setCurrentIndex(i)
+        area.set_mode(FIT_WINDOW)
+        qtbot.wait(20)
+        assert area.viewport().width() > 1000
+        assert not area.cut_off(), (area.form_view.form.path.name, area.shown_rect(), area.viewport().rect())
+        image = console.grab().toImage()
+        assert image.width() == 1366 and image.height() == 768
+    area = console.zooms[0]
+    console.tabs.setCurrentIndex(0)
+    area.set_mode(ACTUAL)
+    assert area.factor == 1.0 and area.cut_off()  # 760 px of form above the journal: it needs the zoom
+
+
+def test_the_zoom_is_remembered_per_form(qtbot, console: MainWindow) -> None:
+    first, second = console.zooms[0], console.zooms[1]
+    console.tabs.setCurrentIndex(1)
+    second.set_mode(FIT_WIDTH)
+    first.zoom_by(-2)
+    factor = first.factor
+    again = MainWindow(console.runtime)
+    qtbot.addWidget(again)
+    try:
+        assert again.zooms[1].mode == FIT_WIDTH
+        assert again.zooms[0].mode == "" and abs(again.zooms[0].factor - factor) < 0.001
+        assert again.zooms[2].mode == FIT_WINDOW  # the default
+    finally:
+        again.close()
+
+
+def test_the_trends_of_a_form_share_one_clock_time_axis(qtbot, console: MainWindow) -> None:
+    import pyqtgraph as pg
+
+    view = console.views[0]
+    first, second = view.trends[:2]
+    qtbot.waitUntil(lambda: first.trend.count > 15 and second.trend.count > 15, timeout=10_000)
+    view.flush()
+    assert isinstance(first.plot.getPlotItem().getAxis("bottom"), pg.DateAxisItem)
+    assert first.view_box.viewRange()[0] == second.view_box.viewRange()[0]
+    x0, x1 = first.view_box.viewRange()[0]
+    assert abs(x1 - view._last.wall) < 0.01 and x1 - x0 > 10  # clock time, ending now
+    assert first.shown == first.trend.count and second.shown == second.trend.count  # redrawn together
+    t, v = first.trend.times()[-3], first.trend.values()[-3]
+    assert first.value_at(t + 0.01) == (t, v)  # the cursor reads the nearest sample
+
+    second.view_box.setXRange(x0 - 30, x1 - 30, padding=0)
+    second.view_box.sigRangeChangedManually.emit([True, False])  # as a drag does
+    assert not view.live and first.pause_button.text() == "\u25b6"
+    assert first.view_box.viewRange()[0] == second.view_box.viewRange()[0]  # linked
+    qtbot.wait(1200)
+    assert first.view_box.viewRange()[0][1] < view._last.wall - 20  # paused: it stays where it was put
+    first.pause_button.click()
+    assert view.live
+    assert abs(first.view_box.viewRange()[0][1] - view._last.wall) < 0.01
+
+
+def test_a_trend_starts_with_the_archives_history(qtbot, demo_copy: Path) -> None:
+    first = Runtime(load_station(demo_copy))
+    first.start()
+    try:
+        qtbot.waitUntil(lambda: first.status().records_written > 30, timeout=15_000)
+        qtbot.wait(2500)  # NSTORE of the level, once a second
+    finally:
+        first.stop()
+    runtime = Runtime(load_station(demo_copy))
+    runtime.start()
+    window = MainWindow(runtime)
+    qtbot.addWidget(window)
+    try:
+        level = next(t for v in window.views for t in v.trends if t.model.Name == "Уровень, тренд")
+        qtbot.waitUntil(lambda: len(level.hist_times) > 1, timeout=10_000)
+        assert level.hist_times[-1] < runtime.wallclock()
+        assert all(0 <= v <= 100 for v in level.hist_values)  # raw NSTORE words, scaled to %
+    finally:
+        window.close()
+        runtime.stop()
+
+
+def test_about_names_the_version(console: MainWindow) -> None:
+    assert "NetPlc Station 0.1.0" in console.about_text()
+
+
+@pytest.fixture
+def russian(qapp) -> Iterator[None]:
+    from app.gui import i18n
+
+    assert i18n.install(qapp, "ru") == "ru"
+    try:
+        yield
+    finally:
+        i18n.uninstall(qapp)
+
+
+def test_the_console_speaks_russian_and_the_forms_keep_their_texts(qtbot, russian, demo_copy: Path) -> None:
+    from app.gui import i18n
+
+    assert i18n.compiled("ru") is not None  # the .ts in the repository compiles with PySide6's lrelease
+    runtime = Runtime(load_station(demo_copy))
+    runtime.start()
+    window = MainWindow(runtime)
+    qtbot.addWidget(window)
+    try:
+        menus = [a.text() for a in window.menuBar().actions()]
+        assert menus == ["&Станция", "&Вид", "&Справка"]
+        assert window.act_run.text() == "&Запустить NetPlc…" and window.act_quit.text() == "В&ыход…"
+        heads = [window.journal.model.headerData(i, Qt.Orientation.Horizontal) for i in range(3)]
+        assert heads == ["Время", "Вид", "Группа"]
+        assert window.alarms.ack.text() == "Квитировать"
+        assert window.fixed_lines[0].quiet.text() == "Нет неквитированных аварий"
+        window.refresh_status()
+        assert window.status.state.text() == "NetPlc: работает"
+        assert window.journal.windowTitle() == "Журнал — сегодня"
+        titles = [v.form.title for v in window.views]
+        assert [window.tabs.tabText(i) for i in range(3)] == titles  # as the engineer wrote them
+        assert "Пуск" in [m.Name for v in window.views for m in v.form.elements]
+        import datetime as dt
+
+        assert window.header.clock.text().startswith(f"{dt.date.today():%d.%m.%Y}")
+    finally:
+        window.close()
+        runtime.stop()
+
+
+def test_the_language_comes_from_station_toml(demo_copy: Path) -> None:
+    toml = demo_copy / "station.toml"
+    toml.write_text(toml.read_text(encoding="utf-8").replace('# Language = "ru"', 'Language = "en"'),
+                    encoding="utf-8")
+    assert load_station(demo_copy).Language == "en"
+
+
+def test_only_an_admin_manages_users_and_it_is_journaled(qtbot, console: MainWindow) -> None:
+    from app.users import Users
+
+    for name in ("operator", "engineer"):
+        console.login(name, name)
+        assert console.manage_users() is None
+        assert f"Users: needs the admin role; {name} is {name}" in console.status.currentMessage()
+    console.login("admin", "admin")
+    dialog = console.manage_users()
+    assert dialog is not None and dialog.table.rowCount() == 4
+    assert dialog.add_user("ivan", "operator", "pw") and dialog.table.rowCount() == 5
+    assert not dialog.add_user("ivan", "viewer", "x") and "exists already" in dialog.message.text()
+    assert dialog.set_password("ivan", "new") and dialog.remove_user("viewer")
+    dialog.close()
+    folder = console.runtime.station.folder
+    assert Users(folder).verify("ivan", "new").role == "operator" and Users(folder).get("viewer") is None
+    console.runtime.stop()
+    rows = operator_rows(console.runtime)
+    assert rows[-3:] == [("admin", "user ivan added as operator"), ("admin", "password of ivan changed"),
+                         ("admin", "user viewer removed")]
