@@ -78,6 +78,15 @@ def _python(kind: ua.VariantType) -> Callable[[float], Any]:
     return int
 
 
+async def station_certificate(folder: Path, uri: str, host: str, station: str) -> tuple[Path, Path]:
+    """The station's certificate and key in its folder: made on first start (and again when
+    missing or expired), kept afterwards so clients that trusted it once go on trusting it."""
+    key, cert = folder / KEY_FILE, folder / CERT_FILE
+    await setup_self_signed_certificate(key, cert, uri, host, [ExtendedKeyUsageOID.SERVER_AUTH],
+                                        {"commonName": f"NetPlc Station {station}"})
+    return cert, key
+
+
 @dataclass
 class OpcUaStatus:
     clients: int = 0
@@ -206,9 +215,7 @@ class OpcUaServer:
     async def _secure(self, server: Server, uri: str) -> None:
         """Basic256Sha256 Sign&Encrypt with the station's own certificate, made on first start."""
         host = urlsplit(self.endpoint).hostname or "localhost"
-        key, cert = self.folder / KEY_FILE, self.folder / CERT_FILE
-        await setup_self_signed_certificate(key, cert, uri, host, [ExtendedKeyUsageOID.SERVER_AUTH],
-                                            {"commonName": f"NetPlc Station {self.station}"})
+        cert, key = await station_certificate(self.folder, uri, host, self.station)
         await server.load_certificate(str(cert))
         await server.load_private_key(str(key))
         server.set_security_policy([ua.SecurityPolicyType.Basic256Sha256_SignAndEncrypt])
