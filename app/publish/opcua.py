@@ -42,12 +42,14 @@ from netplc.tags.quality import Quality
 from netplc.tags.tag import Tag, TagType
 
 CERT_FILE, KEY_FILE = "opcua-cert.der", "opcua-key.pem"  # generated in the station folder
-START_TIMEOUT = 20.0
+START_TIMEOUT = 60.0
 UNECE_UNITS = "http://www.opcfoundation.org/UA/units/un/cefact"
 STATUS = {Quality.GOOD: ua.StatusCodes.Good, Quality.STALE: ua.StatusCodes.UncertainLastUsableValue,
           Quality.COMM_FAIL: ua.StatusCodes.BadCommunicationError,
           Quality.NOT_RUNNING: ua.StatusCodes.BadOutOfService,
           Quality.FORCED: ua.StatusCodes.GoodLocalOverride}
+CODES = [ua.StatusCode(STATUS[q]) for q in Quality]  # by quality code
+YIELD_EVERY = 500  # variable writes between two turns of the event loop
 SEVERITY = {1: 900, 2: 700, 3: 500, 4: 300}  # alarm priority -> OPC UA severity 1-1000
 PasswordCheck = Callable[[str, str], bool]
 
@@ -231,11 +233,21 @@ class OpcUaServer:
         self.convert = [_python(k) for k in self.kinds]
         self.nodeids: list[ua.NodeId] = []
         self.by_nodeid: dict[ua.NodeId, str] = {}
-        for tag, kind in zip(self.tags, self.kinds):
+        # asyncua checks each new child against all of its parent's references (quadratic: a
+        # minute for 10,000 tags); tag names are unique, so each tag is added to a folder whose
+        # reference list is set aside meanwhile and put back with the new reference appended.
+        folder_data = server.iserver.aspace.get(folder.nodeid)
+        references = folder_data.references
+        for i, (tag, kind) in enumerate(zip(self.tags, self.kinds)):
             nodeid = ua.NodeId(f"Tags.{tag.name}", idx)
-            initial = ua.DataValue(ua.Variant(self.convert[self.tags.index(tag)](0), kind),
+            initial = ua.DataValue(ua.Variant(self.convert[i](0), kind),
                                    StatusCode=ua.StatusCode(ua.StatusCodes.BadWaitingForInitialData))
-            var = await folder.add_variable(nodeid, f"{idx}:{tag.name}", initial, kind)
+            folder_data.references = []
+            try:
+                var = await folder.add_variable(nodeid, f"{idx}:{tag.name}", initial, kind)
+            finally:
+                references.extend(folder_data.references)
+                folder_data.references = references
             if tag.description:
                 await var.write_attribute(ua.AttributeIds.Description,
                                           ua.DataValue(ua.Variant(ua.LocalizedText(tag.description))))
@@ -292,15 +304,17 @@ class OpcUaServer:
         when = datetime.fromtimestamp(reading.wall, UTC)
         write = self.server.iserver.aspace.write_attribute_value
         value_attr = ua.AttributeIds.Value
-        for i in changed.tolist():
+        for n, i in enumerate(changed.tolist()):
+            if n % YIELD_EVERY == YIELD_EVERY - 1:
+                await asyncio.sleep(0)  # let the server answer its clients' requests meanwhile
             v = values[i]
-            code = STATUS[Quality(int(quality[i]))]
+            code = CODES[quality[i]]
             if math.isnan(v):  # a BCD word that is not BCD
                 dv = ua.DataValue(StatusCode=ua.StatusCode(ua.StatusCodes.BadOutOfRange),
                                   SourceTimestamp=when)
             else:
-                dv = ua.DataValue(ua.Variant(self.convert[i](v), self.kinds[i]),
-                                  StatusCode=ua.StatusCode(code), SourceTimestamp=when)
+                dv = ua.DataValue(ua.Variant(self.convert[i](v), self.kinds[i]), StatusCode=code,
+                                  SourceTimestamp=when)
             await write(self.nodeids[i], value_attr, dv)
         self.status.updates += len(changed)
         await self.plc_state.write_value(reading.state)
