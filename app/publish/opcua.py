@@ -35,7 +35,7 @@ from asyncua.crypto.permission_rules import User, UserRole
 from cryptography.x509.oid import ExtendedKeyUsageOID
 
 from app.publish.feed import LatestSnapshot
-from app.publish.points import PointReader, Writer, WriteRefused
+from app.publish.points import PasswordCheck, PointReader, Writer, WriteRefused
 from netplc.records import Record
 from netplc.tags.alarms import PRIORITIES, Alarm, State
 from netplc.tags.quality import Quality
@@ -51,7 +51,6 @@ STATUS = {Quality.GOOD: ua.StatusCodes.Good, Quality.STALE: ua.StatusCodes.Uncer
 CODES = [ua.StatusCode(STATUS[q]) for q in Quality]  # by quality code
 YIELD_EVERY = 500  # variable writes between two turns of the event loop
 SEVERITY = {1: 900, 2: 700, 3: 500, 4: 300}  # alarm priority -> OPC UA severity 1-1000
-PasswordCheck = Callable[[str, str], bool]
 
 
 def is_loopback(endpoint: str) -> bool:

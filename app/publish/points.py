@@ -56,6 +56,7 @@ class Writable:
 
 
 QualitySource = Callable[[], np.ndarray | None]
+PasswordCheck = Callable[[str, str], bool]  # (user, password) -> may this client in?
 
 
 @dataclass(frozen=True)

@@ -5,8 +5,7 @@ from __future__ import annotations
 
 from typing import Any, Protocol
 
-from app.publish.opcua import OpcUaServer, PasswordCheck
-from app.publish.points import PointReader, Writable, Writer, published_tags, runtime_quality
+from app.publish.points import PasswordCheck, PointReader, Writable, Writer, published_tags, runtime_quality
 
 
 class Publisher(Protocol):
@@ -28,6 +27,8 @@ def start_publishers(runtime: Any) -> list[Publisher]:
     reader = PointReader(tags, runtime_quality(runtime))
     started: list[Publisher] = []
     if st.opcua.enabled:
+        from app.publish.opcua import OpcUaServer  # asyncua loads only for a station that serves OPC UA
+
         writer = Writer(runtime.engine, tags, Writable(st.opcua.writable), runtime, runtime.wallclock)
         alarms = runtime.alarms.system.alarms if runtime.alarms is not None else []
         server = OpcUaServer(endpoint=st.opcua.endpoint, station=st.name, folder=st.folder, tags=tags,
@@ -44,6 +45,7 @@ def start_publishers(runtime: Any) -> list[Publisher]:
             runtime.system(f"OPC UA server at {st.opcua.endpoint} ({security}), {len(tags)} tags")
     if st.mqtt.enabled:
         from app.publish.mqtt import SparkplugPublisher
+
         writer = Writer(runtime.engine, tags, Writable(st.mqtt.writable), runtime, runtime.wallclock)
         publisher = SparkplugPublisher(st.mqtt, st.name, tags=tags, reader=reader, writer=writer,
                                        engine=runtime.engine, journal=runtime.system)
@@ -55,7 +57,9 @@ def start_publishers(runtime: Any) -> list[Publisher]:
 
 
 class _Unsubscribing:
-    def __init__(self, server: OpcUaServer, runtime: Any) -> None:
+    """The OPC UA server with its record observer (alarm events), removed when it stops."""
+
+    def __init__(self, server: Any, runtime: Any) -> None:
         self.server, self.runtime = server, runtime
 
     def stop(self) -> None:
