@@ -228,6 +228,8 @@ class SparkplugPublisher:
         self.status.buffered = len(self._buffer)
 
     def _data(self, reading: Reading) -> None:
+        if not self.status.births:  # nothing born yet: the first NBIRTH will carry every value
+            return
         values, sent = reading.values, self._sent_values
         moved = np.abs(values - sent) > self.deadband
         moved |= np.isnan(values) != np.isnan(sent)
