@@ -161,3 +161,18 @@ def test_asyncua_command_line_tools(station: tuple[Runtime, str]) -> None:
                           capture_output=True, text=True, timeout=60)
     assert read.returncode == 0, read.stderr
     assert "running" in read.stdout
+
+
+def test_a_taken_port_is_a_problem_and_the_station_runs_on(tmp_path: Path) -> None:
+    import socket
+    with socket.socket() as taken:
+        taken.bind(("127.0.0.1", 0))
+        taken.listen()
+        url = f"opc.tcp://127.0.0.1:{taken.getsockname()[1]}/netplc/"
+        runtime = demo_with(tmp_path / "station", f'[opcua]\nenabled = true\nendpoint = "{url}"\n')
+        try:
+            status = runtime.status()
+            assert status.running and runtime.publishers == []
+            assert any("OPC UA server not started" in p and "opcua.endpoint" in p for p in status.problems)
+        finally:
+            runtime.stop()
