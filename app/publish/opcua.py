@@ -386,7 +386,7 @@ class OpcUaServer:
             self.writer.write(name, value, user)
         except WriteRefused as e:
             why = str(e)
-            if why == "write queue full":
+            if why.startswith("write queue full"):
                 return ua.StatusCode(ua.StatusCodes.BadTooManyOperations)
             if why == "not a number":
                 return ua.StatusCode(ua.StatusCodes.BadTypeMismatch)

@@ -140,13 +140,16 @@ class Writer:
             self.refuse(name, value, user, "not a number")
         assert tag is not None
         raw = tag.to_raw(value)
-        if tag.type is TagType.BIT:
-            self.engine.write_bit(tag.address, 1 if raw else 0, user=user, label=name)
-        elif tag.type in (TagType.INT32, TagType.FLOAT32):
-            self.engine.write_bytes(tag.address, tag.encode(raw), user=user)
-        else:
-            word = int.from_bytes(tag.encode(raw), "little")
-            self.engine.write_word(tag.address, word, user=user, label=name)
+        try:
+            if tag.type is TagType.BIT:
+                self.engine.write_bit(tag.address, 1 if raw else 0, user=user, label=name)
+            elif tag.type in (TagType.INT32, TagType.FLOAT32):
+                self.engine.write_bytes(tag.address, tag.encode(raw), user=user)
+            else:
+                word = int.from_bytes(tag.encode(raw), "little")
+                self.engine.write_word(tag.address, word, user=user, label=name)
+        except Exception as e:  # the engine pushing back (its write budget): a refusal, never a stall
+            self.refuse(name, value, user, f"write queue full ({e})" if str(e) else "write queue full")
 
     def refuse(self, name: str, value: object, user: str, why: str) -> None:
         self.sink.put(Record(self.wallclock(), "operator", source=user,

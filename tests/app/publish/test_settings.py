@@ -90,3 +90,17 @@ def test_certificate_made_once_and_kept(tmp_path: Path) -> None:
     first = cert.read_bytes()
     asyncio.run(station_certificate(tmp_path, "urn:netplc:station:S", "plant-pc", "S"))
     assert cert.read_bytes() == first and key.exists()
+
+
+def test_an_engine_that_pushes_back_refuses_the_write() -> None:
+    class Budgeted(Engine):  # the per-scan write budget, spent
+        def write_word(self, addr: int, value: int, *, user: str = "operator",
+                       label: str | None = None) -> None:
+            raise OverflowError("write budget of this scan spent")
+
+    sink = ListSink()
+    engine = Budgeted(parse("JMP 0\n"), sink=sink)
+    writer = Writer(engine, [Tag("SP", 0o4000)], Writable(["SP"]), sink, lambda: 0.0)
+    with pytest.raises(WriteRefused, match="write queue full"):
+        writer.write("SP", 1.0, "opcua:bob")
+    assert "refused" in sink.records[-1].text
