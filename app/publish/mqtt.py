@@ -135,7 +135,9 @@ class SparkplugPublisher:
         self.status.connected = True
         self._birth_due = True
         self._wake.set()
-        self.journal(f"MQTT connected to {self.peer} as {self.topics.node} (bdSeq {self.bdseq})")
+        dropped = self.status.dropped
+        lost = f", {dropped} NDATA dropped so far from a full buffer" if dropped else ""
+        self.journal(f"MQTT connected to {self.peer} as {self.topics.node} (bdSeq {self.bdseq}){lost}")
 
     def _on_disconnect(self, client: mqtt.Client, userdata: object, flags: Any, reason: Any,
                        props: Any) -> None:

@@ -90,7 +90,6 @@ async def station_certificate(folder: Path, uri: str, host: str, station: str) -
 
 @dataclass
 class OpcUaStatus:
-    clients: int = 0
     updates: int = 0  # variable values written into the address space
     skipped: int = 0  # snapshots not published because the server lagged
     error: str = ""
