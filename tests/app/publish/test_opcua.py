@@ -192,3 +192,40 @@ def test_a_taken_port_is_a_problem_and_the_station_runs_on(tmp_path: Path) -> No
             assert any("OPC UA server not started" in p and "opcua.endpoint" in p for p in status.problems)
         finally:
             runtime.stop()
+
+
+def test_users_with_passwords_where_the_station_has_users(tmp_path: Path,
+                                                          monkeypatch: pytest.MonkeyPatch) -> None:
+    """The one password check (app/publish/station.py) decides who gets in; the write names the user."""
+    import app.publish.station as publishing
+    monkeypatch.setattr(publishing, "password_check",
+                        lambda _station: lambda user, password: (user, password) == ("alice", "s3cret"))
+    url = f"opc.tcp://127.0.0.1:{free_port()}/netplc/"
+    runtime = demo_with(tmp_path / "station",
+                        f'[opcua]\nenabled = true\nendpoint = "{url}"\nwritable = ["TEMP_SP"]\n')
+    records: list = []
+    runtime.subscribe(records.append)
+
+    async def go() -> None:
+        with pytest.raises(ua.UaStatusCodeError):
+            async with Client(url):
+                pass  # anonymous: refused
+        wrong = Client(url)
+        wrong.set_user("alice")
+        wrong.set_password("guess")
+        with pytest.raises(ua.UaStatusCodeError):
+            async with wrong:
+                pass
+        client = Client(url)
+        client.set_user("alice")
+        client.set_password("s3cret")
+        async with client:
+            sp = await _tag(client, "TEMP_SP")
+            await sp.write_value(ua.DataValue(ua.Variant(20.0, ua.VariantType.Double)))
+
+    try:
+        run(go())
+        wait_until(lambda: any(r.kind == "operator" and "TEMP_SP" in r.text for r in records))
+        assert next(r for r in records if r.kind == "operator").source.startswith("opcua:alice@127.0.0.1:")
+    finally:
+        runtime.stop()
