@@ -18,6 +18,7 @@ from netplc.address import fmt_octal, is_data_byte, is_io_bit, parse_octal
 from netplc.exchange import LIMITS, NODE_NUMBERS, UNITS, NodeConfig, unit_problem
 from netplc.modbus import PROFILES, TABLES, Endpoint, parse_endpoint
 from netplc.problems import Problems
+from netplc.tags.tag import TagType
 from netplc.textfile import TextFileError, read_text
 
 STATION_FILE = "station.toml"
@@ -68,6 +69,32 @@ LANGUAGES = ("ru", "en")
 
 
 @dataclass(frozen=True)
+class OpcUaSettings:
+    """[opcua]: the OPC UA server (app/publish/opcua.py)."""
+
+    enabled: bool = False
+    endpoint: str = "opc.tcp://127.0.0.1:4840/netplc/"
+    writable: tuple[str, ...] = ()  # tag names or patterns a client may write
+
+
+@dataclass(frozen=True)
+class MqttSettings:
+    """[mqtt]: the Sparkplug B publisher (app/publish/mqtt.py)."""
+
+    enabled: bool = False
+    broker: str = "mqtt://127.0.0.1:1883"
+    ca_file: Path | None = None  # for mqtts://
+    group_id: str = "NetPlc"
+    edge_node_id: str = ""  # empty: the station name
+    username: str = ""
+    password: str = ""
+    deadband: tuple[tuple[str, float], ...] = ()  # (tag type, absolute deadband)
+    publish_period: int = 0  # ms between NDATA messages at least; 0: every tick
+    writable: tuple[str, ...] = ()
+    buffer: int = 10_000  # NDATA messages kept while the broker is away
+
+
+@dataclass(frozen=True)
 class Station:
     path: Path  # the station.toml file
     name: str
@@ -90,6 +117,8 @@ class Station:
     RetainForces: bool = False  # forces survive a restart (netplc/forcing.py); off: a restart unforces
     plant_archive: str | None = None  # `Archive` given as a postgresql:// URL: forwarded there
     alarm_sound: bool = True  # a new alarm of priority 1-2 sounds until acknowledged or silenced
+    opcua: OpcUaSettings = OpcUaSettings()
+    mqtt: MqttSettings = MqttSettings()
 
     @property
     def folder(self) -> Path:
@@ -235,6 +264,8 @@ def read_station(path: str | Path) -> tuple[Station | None, list[str]]:
     if language and language not in LANGUAGES:
         top.bad("Language", f"{language!r} is not one of {', '.join(LANGUAGES)}")
         language = ""
+    opcua = _opcua(problems, fname, top.get("opcua", dict, {}))
+    mqtt = _mqtt(problems, fname, top.get("mqtt", dict, {}), base, top.allow_outside)
     top.finish()
     nodes = _with_simulated_nodes(problems, fname, nodes, simulators)
     _ports_in_common(problems, fname, server, simulators)
@@ -260,7 +291,8 @@ def read_station(path: str | Path) -> tuple[Station | None, list[str]]:
         keep_days=keep_days, Retain=retain, modbus_server=server,
         nodes=tuple(nodes), simulators=tuple(runnable), operator=operator, Language=language, Tags=tags,
         allow_outside=top.allow_outside, RetainForces=bool(retain_forces), plant_archive=plant,
-        alarm_sound=alarm_sound,
+        alarm_sound=alarm_sound, opcua=opcua,
+        mqtt=mqtt,
     )
     return station, problems
 
@@ -483,3 +515,59 @@ def _with_simulated_nodes(problems: list[str], fname: str, nodes: list[NodeConfi
         if not n.endpoint and not reported and not any(s.node == n.node for s in sims):
             problems.append(f"{fname}: nodes: node {n.node} has no endpoint and no simulator")
     return sorted(by_node.values(), key=lambda n: n.node)
+
+
+def _names(r: _Reader, key: str) -> tuple[str, ...]:
+    """A list of tag names or patterns."""
+    items = r.get(key, list, [])
+    if not all(isinstance(x, str) and x.strip() for x in items):
+        r.bad(key, "expected a list of tag names or patterns")
+        return ()
+    return tuple(items)
+
+
+def _opcua(problems: list[str], fname: str, table: dict[str, Any]) -> OpcUaSettings:
+    r = _Reader(problems, fname, table, "opcua.")
+    d = OpcUaSettings()
+    enabled = r.get("enabled", bool, d.enabled)
+    endpoint = r.get("endpoint", str, d.endpoint)
+    writable = _names(r, "writable")
+    r.finish()
+    if not endpoint.startswith("opc.tcp://"):
+        r.bad("endpoint", f"{endpoint!r} is not an opc.tcp:// address")
+        endpoint = d.endpoint
+    return OpcUaSettings(enabled, endpoint, writable)
+
+
+def _mqtt(problems: list[str], fname: str, table: dict[str, Any], base: Path,
+          allow_outside: bool) -> MqttSettings:
+    r = _Reader(problems, fname, table, "mqtt.", allow_outside)
+    d = MqttSettings()
+    enabled = r.get("enabled", bool, d.enabled)
+    broker = r.get("broker", str, d.broker)
+    ca_file = r.path("ca_file", base)
+    group = r.get("group_id", str, d.group_id)
+    edge = r.get("edge_node_id", str, d.edge_node_id)
+    username = r.get("username", str, d.username)
+    password = r.get("password", str, d.password)
+    deadband = r.get("deadband", dict, {})
+    period = r.number("publish_period", d.publish_period, 0, 3_600_000)
+    writable = _names(r, "writable")
+    buffer = r.number("buffer", d.buffer, 0, 10_000_000)
+    r.finish()
+    if not broker.startswith(("mqtt://", "mqtts://")):
+        r.bad("broker", f"{broker!r} is not an mqtt:// or mqtts:// address")
+        broker = d.broker
+    for key, value in (("group_id", group), ("edge_node_id", edge)):
+        if any(c in value for c in "/+#"):
+            r.bad(key, f"{value!r} may not hold '/', '+' or '#' (Sparkplug topic levels)")
+    bands: list[tuple[str, float]] = []
+    for kind, value in deadband.items():
+        if kind not in {t.value for t in TagType}:
+            r.bad(f"deadband.{kind}", f"not a tag type ({', '.join(t.value for t in TagType)})")
+        elif isinstance(value, bool) or not isinstance(value, int | float) or value < 0:
+            r.bad(f"deadband.{kind}", f"expected a number >= 0, got {value!r}")
+        else:
+            bands.append((kind, float(value)))
+    return MqttSettings(enabled, broker, ca_file, group, edge, username, password, tuple(bands), period,
+                        writable, buffer)

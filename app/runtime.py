@@ -27,6 +27,7 @@ from typing import TYPE_CHECKING
 
 from app.config import Station
 from app.load import load, load_station_forms
+from app.publish.station import start_publishers
 from app.station_alarms import STATE_FILE as ALARM_STATE_FILE
 from app.station_alarms import StationAlarms
 from hmi_forms.behaviour import FormBehaviour
@@ -159,6 +160,7 @@ class Runtime:
         self.modbus: ModbusServer | None = None
         self.alarms: StationAlarms | None = None  # tags, quality and alarms, evaluated every scan
         self.scan_thread: ScanThread | None = None
+        self.publishers: list = []  # OPC UA server, MQTT publisher (app/publish/)
         self.nodes: list[NodeConfig] = list(station.nodes)
         self.restored = ""  # which retentive save was used: current / previous / zeroes
         self.started_clock: float | None = None
@@ -281,6 +283,7 @@ class Runtime:
             except OSError as e:  # the station runs on without it; the operator sees why
                 self._problem(f"Modbus server not started: {st.path}: modbus_server.port: cannot listen on "
                               f"{server.host}:{server.port}: {_reason(e)}")
+        self.publishers = start_publishers(self)
         self.system(f"program loaded: {self.program.source} ({len(self.program.instrs)} instructions, "
                     f"{self.program.words} words)")
         self.scan_thread = ScanThread(self.engine, st.tick, on_error=self._scan_error)
@@ -349,6 +352,9 @@ class Runtime:
         if self.scan_thread is not None:
             self.scan_thread.stop()
             self.scan_thread = None
+        for publisher in reversed(self.publishers):
+            publisher.stop()
+        self.publishers = []
         if self.alarms is not None:
             self.unsubscribe(self.alarms.observe)
             self.alarms.close()  # the last alarm states, after the last scan

@@ -3,6 +3,7 @@
 - The headless parts never import Qt, not even through another module of the project: the soft
   PLC, the archive, the form models and loader, the runtime, the station configuration.
 - Only the Modbus sub-package imports pymodbus (its API changes at every minor release).
+- Only `app/publish/` imports asyncua, paho-mqtt and protobuf (docs/architecture.md section 2).
 - No import cycles between modules of the project. Imports under `if TYPE_CHECKING:` are left out:
   they never run. Imports inside functions count: they run, only later.
 """
@@ -97,6 +98,12 @@ def test_headless_parts_run_without_qt_loaded() -> None:
 def test_only_the_modbus_subpackage_imports_pymodbus() -> None:
     users = sorted(m for m, deps in graph().items() if any(under(d, ("pymodbus",)) for d in deps))
     assert users and all(under(m, ("netplc.modbus",)) for m in users), users
+
+
+def test_only_the_publishers_import_opcua_mqtt_and_protobuf() -> None:
+    users = sorted(m for m, deps in graph().items() if any(under(d, ("asyncua", "paho", "google.protobuf"))
+                                                           for d in deps))
+    assert users and all(under(m, ("app.publish",)) for m in users), users
 
 
 def test_the_rest_reaches_the_modbus_stack_through_its_face() -> None:

@@ -1,0 +1,232 @@
+"""The OPC UA server of a running headless station, seen by asyncua's own client (and its CLI)."""
+
+from __future__ import annotations
+
+import asyncio
+import subprocess
+import sys
+import time
+from collections.abc import Iterator
+from pathlib import Path
+
+import pytest
+from asyncua import Client, ua
+
+from app.publish.opcua import is_loopback
+from app.runtime import Runtime
+from tests.app.conftest import copy_demo
+from tests.app.publish.conftest import demo_with, free_port
+from tests.netplc.test_exchange import wait_until
+
+
+@pytest.fixture
+def station(tmp_path: Path) -> Iterator[tuple[Runtime, str]]:
+    url = f"opc.tcp://127.0.0.1:{free_port()}/netplc/"
+    runtime = demo_with(tmp_path / "station",
+                        f'[opcua]\nenabled = true\nendpoint = "{url}"\nwritable = ["TEMP_*"]\n',
+                        users=False)  # a station without users: anonymous clients
+    yield runtime, url
+    runtime.stop()
+
+
+def run(coro: object) -> object:
+    return asyncio.run(coro)  # type: ignore[arg-type]
+
+
+async def _tag(client: Client, name: str) -> object:
+    ns = await client.get_namespace_index("urn:netplc:station:Demo station")
+    return client.get_node(ua.NodeId(f"Tags.{name}", ns))
+
+
+def test_security_follows_the_endpoint() -> None:
+    assert is_loopback("opc.tcp://127.0.0.1:4840/netplc/")
+    assert is_loopback("opc.tcp://localhost:4840/")
+    assert not is_loopback("opc.tcp://10.0.0.5:4840/netplc/")
+    assert not is_loopback("opc.tcp://plant-pc:4840/")
+
+
+def test_browse_read_units_and_quality(station: tuple[Runtime, str]) -> None:
+    _, url = station
+
+    async def go() -> None:
+        async with Client(url) as client:
+            root = client.nodes.objects
+            names = [(await n.read_browse_name()).Name for n in await root.get_children()]
+            assert "Demo station" in names
+            ns = await client.get_namespace_index("urn:netplc:station:Demo station")
+            tags = client.get_node(ua.NodeId("Tags", ns))
+            tag_names = {(await n.read_browse_name()).Name for n in await tags.get_children()}
+            assert {"LEVEL", "TEMP", "TEMP_SP", "TRIGGER"} <= tag_names
+            level = await _tag(client, "LEVEL")
+            deadline = time.monotonic() + 5
+            while True:
+                dv = await level.read_data_value(raise_on_bad_status=False)
+                if dv.StatusCode.is_good() or time.monotonic() > deadline:
+                    break
+                await asyncio.sleep(0.05)
+            assert dv.StatusCode.is_good()
+            assert isinstance(dv.Value.Value, float) and dv.SourceTimestamp is not None
+            eu = await (await level.get_child(["0:EngineeringUnits"])).read_value()
+            assert eu.DisplayName.Text == "%"
+            rng = await (await level.get_child(["0:EURange"])).read_value()
+            assert (rng.Low, rng.High) == (0.0, pytest.approx(100 * 65535 / 4095))
+            assert (await level.read_description()).Text == "Уровень"
+            state = client.get_node(ua.NodeId("NetPlc.State", ns))
+            assert await state.read_value() == "running"
+            up = client.get_node(ua.NodeId("Nodes.0.Up", ns))
+            assert await up.read_value() is True
+            alarms = client.get_node(ua.NodeId("Alarms", ns))
+            assert await alarms.get_children()
+
+    run(go())
+
+
+def test_subscription_sees_changes_within_two_ticks(station: tuple[Runtime, str]) -> None:
+    runtime, url = station
+    received: list[tuple[int, float]] = []
+
+    class Handler:
+        def datachange_notification(self, node: object, val: object, data: object) -> None:
+            received.append((runtime.engine.scan_counter, val))
+
+    async def go() -> None:
+        async with Client(url) as client:
+            tick = client.get_node(ua.NodeId("NetPlc.Tick", await client.get_namespace_index(
+                "urn:netplc:station:Demo station")))
+            sub = await client.create_subscription(50, Handler())
+            await sub.subscribe_data_change(tick)
+            await asyncio.sleep(1.0)
+            await sub.delete()
+
+    run(go())
+    assert len(received) >= 5
+    # each notification carries a tick no more than 2 scans behind the engine's at delivery
+    assert all(engine - int(val) <= 2 for engine, val in received[1:])
+
+
+def test_quality_goes_bad_when_the_node_is_killed(station: tuple[Runtime, str]) -> None:
+    """... and TRIGGER's quality alarm comes: its variable's state and an event on the station."""
+    runtime, url = station
+    events: list = []
+
+    class Handler:
+        def event_notification(self, event: object) -> None:
+            events.append(event)
+
+    async def go() -> None:
+        async with Client(url) as client:
+            ns = await client.get_namespace_index("urn:netplc:station:Demo station")
+            sub = await client.create_subscription(50, Handler())
+            await sub.subscribe_events(client.get_node(ua.NodeId("Demo station", ns)))
+            level = await _tag(client, "LEVEL")
+            deadline = time.monotonic() + 5
+            while not (await level.read_data_value(raise_on_bad_status=False)).StatusCode.is_good():
+                assert time.monotonic() < deadline
+                await asyncio.sleep(0.05)
+            runtime.simulators[0].stop()
+            deadline = time.monotonic() + 10
+            while True:
+                dv = await level.read_data_value(raise_on_bad_status=False)
+                if dv.StatusCode.value == ua.StatusCodes.BadCommunicationError:
+                    break
+                assert time.monotonic() < deadline, dv.StatusCode
+                await asyncio.sleep(0.05)
+            alarm = client.get_node(ua.NodeId("Alarms.TRIGGER.BAD", ns))
+            while await alarm.read_value() != "active-unacknowledged":
+                assert time.monotonic() < deadline
+                await asyncio.sleep(0.05)
+            while not any(getattr(e, "SourceName", "") == "TRIGGER.BAD" for e in events):
+                assert time.monotonic() < deadline
+                await asyncio.sleep(0.05)
+
+    run(go())
+
+
+def test_write_accepted_and_journaled_and_write_refused(station: tuple[Runtime, str]) -> None:
+    runtime, url = station
+    records: list = []
+    runtime.subscribe(records.append)
+
+    async def go() -> None:
+        async with Client(url) as client:
+            sp = await _tag(client, "TEMP_SP")
+            await sp.write_value(ua.DataValue(ua.Variant(42.0, ua.VariantType.Double)))
+            level = await _tag(client, "LEVEL")
+            with pytest.raises(ua.UaStatusCodeError) as refused:
+                await level.write_value(ua.DataValue(ua.Variant(1.0, ua.VariantType.Double)))
+            assert refused.value.code == ua.StatusCodes.BadNotWritable
+            deadline = time.monotonic() + 5
+            while abs(await sp.read_value() - 42.0) > 0.1:
+                assert time.monotonic() < deadline
+                await asyncio.sleep(0.05)
+
+    run(go())
+    wait_until(lambda: any(r.kind == "operator" and "TEMP_SP" in r.text for r in records))
+    written = next(r for r in records if r.kind == "operator" and "TEMP_SP" in r.text)
+    assert written.source.startswith("opcua:anonymous@127.0.0.1:")
+    refused = next(r for r in records if r.kind == "operator" and "LEVEL" in r.text)
+    assert "refused" in refused.text and refused.source.startswith("opcua:")
+
+
+def test_asyncua_command_line_tools(station: tuple[Runtime, str]) -> None:
+    _, url = station
+    bindir = Path(sys.executable).parent
+    ls = subprocess.run([str(bindir / "uals"), "-u", url, "-n", "i=85", "-l", "0"],
+                        capture_output=True, text=True, timeout=60)
+    assert ls.returncode == 0, ls.stderr
+    assert "Demo station" in ls.stdout
+    read = subprocess.run([str(bindir / "uaread"), "-u", url, "-n", "ns=1;s=NetPlc.State"],
+                          capture_output=True, text=True, timeout=60)
+    assert read.returncode == 0, read.stderr
+    assert "running" in read.stdout
+
+
+def test_a_taken_port_is_a_problem_and_the_station_runs_on(tmp_path: Path) -> None:
+    import socket
+    with socket.socket() as taken:
+        taken.bind(("127.0.0.1", 0))
+        taken.listen()
+        url = f"opc.tcp://127.0.0.1:{taken.getsockname()[1]}/netplc/"
+        runtime = demo_with(tmp_path / "station", f'[opcua]\nenabled = true\nendpoint = "{url}"\n')
+        try:
+            status = runtime.status()
+            assert status.running and runtime.publishers == []
+            assert any("OPC UA server not started" in p and "opcua.endpoint" in p for p in status.problems)
+        finally:
+            runtime.stop()
+
+
+def test_users_with_passwords_where_the_station_has_users(tmp_path: Path) -> None:
+    """The station's users (app/users.py) decide who gets in; the write names the user."""
+    from app.users import Users
+
+    Users(copy_demo(tmp_path / "station")).add("alice", "operator", "s3cret")
+    url = f"opc.tcp://127.0.0.1:{free_port()}/netplc/"
+    runtime = demo_with(tmp_path / "station",
+                        f'[opcua]\nenabled = true\nendpoint = "{url}"\nwritable = ["TEMP_SP"]\n')
+    records: list = []
+    runtime.subscribe(records.append)
+
+    async def go() -> None:
+        with pytest.raises(ua.UaStatusCodeError):
+            async with Client(url):
+                pass  # anonymous: refused
+        wrong = Client(url)
+        wrong.set_user("alice")
+        wrong.set_password("guess")
+        with pytest.raises(ua.UaStatusCodeError):
+            async with wrong:
+                pass
+        client = Client(url)
+        client.set_user("alice")
+        client.set_password("s3cret")
+        async with client:
+            sp = await _tag(client, "TEMP_SP")
+            await sp.write_value(ua.DataValue(ua.Variant(20.0, ua.VariantType.Double)))
+
+    try:
+        run(go())
+        wait_until(lambda: any(r.kind == "operator" and "TEMP_SP" in r.text for r in records))
+        assert next(r for r in records if r.kind == "operator").source.startswith("opcua:alice@127.0.0.1:")
+    finally:
+        runtime.stop()
