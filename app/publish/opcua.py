@@ -97,14 +97,17 @@ class OpcUaStatus:
 
 
 class _Users:
-    """asyncua's user manager: anonymous users where no users exist, else name and password."""
+    """asyncua's user manager: anonymous users where no users exist or on a loopback endpoint
+    (local clients, as security None is for them only), else name and password; a name given is
+    always checked."""
 
-    def __init__(self, check: PasswordCheck | None) -> None:
+    def __init__(self, check: PasswordCheck | None, anonymous: bool) -> None:
         self.check = check
+        self.anonymous = anonymous
 
     def get_user(self, iserver: object, username: str | None = None, password: str | None = None,
                  certificate: object = None) -> User | None:
-        if self.check is None:
+        if self.check is None or (self.anonymous and not username):
             return User(role=UserRole.User, name=username or "anonymous")
         if username and password is not None and self.check(username, password):
             return User(role=UserRole.User, name=username)
@@ -183,7 +186,7 @@ class OpcUaServer:
     async def _main(self) -> None:
         self._loop = asyncio.get_running_loop()
         self._stop, self._tick = asyncio.Event(), asyncio.Event()
-        server = Server(user_manager=_Users(self.password_check))
+        server = Server(user_manager=_Users(self.password_check, anonymous=not self.secure))
         await server.init()
         server.set_endpoint(self.endpoint)
         server.set_server_name(f"NetPlc Station {self.station}")

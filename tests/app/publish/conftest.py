@@ -24,12 +24,10 @@ def free_port() -> int:
         return s.getsockname()[1]
 
 
-def demo_with(folder: Path, extra: str, users: bool = True) -> Runtime:
+def demo_with(folder: Path, extra: str) -> Runtime:
     """The demo station copied to `folder` (unless there already) with `extra` TOML appended,
-    started headless; without its users file when `users` is false."""
+    started headless."""
     station = folder if (folder / "station.toml").exists() else copy_demo(folder)
-    if not users:
-        (station / "users.json").unlink()
     toml = station / "station.toml"
     toml.write_text(toml.read_text(encoding="utf-8") + "\n" + extra, encoding="utf-8")
     runtime = Runtime(load_station(station))
