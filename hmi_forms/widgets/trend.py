@@ -192,6 +192,11 @@ class TrendWidget(SelfPainted):
         self.cursor_label.setAnchor((1, 0) if t > (x0 + x1) / 2 else (0, 0))
         self.cursor_label.setPos(t, y1)
 
+    def look(self) -> tuple[object, ...]:
+        """The header's name, address and lamp colour are in the cached layer (paint_static)."""
+        m = self.model
+        return (*super().look(), type(m), m.Name, getattr(m, "Address", None), getattr(m, "Colors", None))
+
     def layer_key(self) -> Hashable:
         m = self.model
         return self.trend.last == 1 if isinstance(m, Graph) else m.zone

@@ -117,6 +117,16 @@ def test_a_new_text_alone_repaints_only_its_box_in_a_large_gauge(qtbot, tmp_path
     assert whole.contains(part) and part.width() * part.height() * 10 < 280 * 280
 
 
+def test_two_trends_alike_but_for_their_name_keep_their_own_headers(qtbot, tmp_path) -> None:
+    graph = {"type": "Graph", "y": 0, "w": 280, "h": 120, "Elements": 50}
+    view = form_of(tmp_path, [{**graph, "Name": "TA", "x": 0, "Address": "040003"},
+                              {**graph, "Name": "TA[2]", "x": 290, "Address": "040005"}])
+    qtbot.addWidget(view)
+    view.refresh(snap())
+    one, two = (w.layer() for w in view.trends)
+    assert one is not two and one.toImage() != two.toImage()
+
+
 def test_a_cached_face_is_rebuilt_when_the_colours_or_the_size_change(qtbot, tmp_path) -> None:
     view = form_of(tmp_path, [dial("A", 0, "04010")])
     qtbot.addWidget(view)
