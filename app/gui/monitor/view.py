@@ -357,9 +357,10 @@ class ProgramMonitor(QWidget):
         """Value, hex, BCD and forced columns; a tag's value and force in physical units."""
         if item.tag is not None:
             tag = item.tag
-            words = tag_forces(tag, 0)  # where its bit or words are
-            raw = " ".join(fmt_value(f.read(snap), "hex") for f in words) if item.kind == "word" else ""
-            held = [forces.get(key) for key in tag_keys(tag)]
+            keys = tag_keys(tag)  # its bit, or its words
+            words = [Force(k, a, 0).read(snap) for k, a in keys if k == "word"]
+            raw = " ".join(fmt_value(w, "hex") for w in words)
+            held = [forces.get(key) for key in keys]
             forced = f"F {tag.format(tag.value(snap))} ({held[0].user})" if all(held) and held[0] else ""
             return [tag.format(tag.value(snap)), raw, "", forced]
         v = Force(item.kind, item.addr, 0).read(snap)
@@ -401,7 +402,7 @@ class ProgramMonitor(QWidget):
         value.setToolTip(f"type a value {how} to write it: journaled with your name")
         self.watch.blockSignals(False)
         self._add_empty_row()
-        words = [f.addr for f in tag_forces(item.tag, 0)] if item.tag else [item.addr]
+        words = [a for _, a in tag_keys(item.tag)] if item.tag else [item.addr]
         self.source.need([a >> 3 if item.kind == "bit" and a >= 0o40000 else a for a in words])
         self._last = None  # show it at the next refresh
         return item
@@ -463,20 +464,18 @@ class ProgramMonitor(QWidget):
     # --- forcing and stepping ---------------------------------------------------------------------
 
     def _force_actions(self, menu: QMenu, kind: Kind, addr: int, where: str) -> None:
-        can = self.source.caps.force
-        for text, slot in ((f"Force {where} at its value (bumpless)", lambda: self.force(kind, addr, None)),
-                           (f"Force {where} to…", lambda: self._ask_force(kind, addr, where)),
-                           (f"Unforce {where}", lambda: self.unforce(kind, addr))):
-            action = menu.addAction(text, slot)
-            action.setEnabled(can)
-            if not can:
-                action.setToolTip(self.source.caps.why_not)
+        self._add_force_actions(menu, where, lambda: self.force(kind, addr, None),
+                                lambda: self._ask_force(kind, addr, where), lambda: self.unforce(kind, addr))
 
     def _tag_force_actions(self, menu: QMenu, tag: Tag) -> None:
+        self._add_force_actions(menu, tag.name, lambda: self.force_tag(tag, None),
+                                lambda: self._ask_force_tag(tag), lambda: self.unforce_tag(tag))
+
+    def _add_force_actions(self, menu: QMenu, where: str, bumpless: Callable[[], None],
+                           ask: Callable[[], None], release: Callable[[], None]) -> None:
         can = self.source.caps.force
-        for text, slot in ((f"Force {tag.name} at its value (bumpless)", lambda: self.force_tag(tag, None)),
-                           (f"Force {tag.name} to…", lambda: self._ask_force_tag(tag)),
-                           (f"Unforce {tag.name}", lambda: self.unforce_tag(tag))):
+        for text, slot in ((f"Force {where} at its value (bumpless)", bumpless), (f"Force {where} to…", ask),
+                           (f"Unforce {where}", release)):
             action = menu.addAction(text, slot)
             action.setEnabled(can)
             if not can:
