@@ -339,3 +339,46 @@ def test_main_monitor_command_refuses_a_bad_target_with_a_message() -> None:
                        text=True, timeout=60, env=env)
     assert r.returncode == 2 and "nowhere: neither a station folder nor HOST:PORT" in r.stderr
     assert "Traceback" not in r.stderr
+
+
+def test_the_watch_table_forces_a_tag_in_physical_units(qtbot, tmp_path: Path) -> None:
+    folder = station(tmp_path / "st")
+    (folder / "tags.csv").write_text(
+        "name,address,type,unit,app_min,app_max,phy_min,phy_max,decimals\n"
+        "TEMP_SP,LEVEL,word,°C,0,1000,0,200,1\nFLOW,04010,float32,m3/h,0,100,0,50,2\n", encoding="utf-8")
+    toml = folder / "station.toml"
+    toml.write_text('Tags = "tags.csv"\n' + toml.read_text(encoding="utf-8"), encoding="utf-8")
+    rt = Runtime(load_station(folder))
+    records: list[Record] = []
+    rt.subscribe(records.append)
+    rt.start()
+    try:
+        monitor = ProgramMonitor(LocalSource(rt), lambda: "eng1")
+        qtbot.addWidget(monitor)
+        engine = rt.engine
+        assert engine is not None
+        monitor.watch.item(0, 0).setText("TEMP_SP")
+        monitor.watch.item(1, 0).setText("FLOW")
+        assert [i.where for i in monitor.watch_items] == ["TEMP_SP", "FLOW"]
+        monitor.force_tag(monitor.watch_items[0].tag, 130.0)  # type: ignore[arg-type]
+        monitor.force_tag(monitor.watch_items[1].tag, None)  # bumpless: both words at 0.00
+        wait(qtbot, lambda: monitor.forced_pill.text() == "F: 3 forced")
+        wait(qtbot, lambda: monitor.watch.item(0, 4).text() == "F 130.0 °C (eng1)")
+        assert engine.snapshot.get_word(0o4000) == 650
+        assert monitor.watch.item(0, 1).text() == "130.0 °C" and monitor.watch.item(0, 2).text() == "028Ah"
+        assert monitor.watch.item(1, 4).text() == "F 0.00 m3/h (eng1)"
+        monitor.watch.item(0, 1).setText("10")  # an operator write loses to the force
+        monitor.unforce_tag(monitor.watch_items[1].tag)  # type: ignore[arg-type]
+        wait(qtbot, lambda: monitor.forced_pill.text() == "F: 1 forced")
+        monitor.watch.item(1, 1).setText("12,5")  # a write of both words, once unforced
+        wait(qtbot, lambda: monitor.watch.item(1, 1).text() == "12.50 m3/h")
+        assert engine.snapshot.get_word(0o4000) == 650
+        texts = [(r.source, r.text) for r in records if r.kind == "operator"]
+        assert ("eng1", "force TEMP_SP: 0.0 -> 130.0 °C (raw 028Ah)") in texts
+        assert ("eng1", "force FLOW: 0.00 -> 0.00 m3/h (raw 0000h 0000h) (bumpless)") in texts
+        assert ("eng1", "unforce FLOW (was forced 0.00 m3/h)") in texts
+        monitor.watch.item(0, 1).setText("hot")
+        assert "TEMP_SP" in monitor.message.text()
+        monitor.grab()
+    finally:
+        rt.stop()

@@ -19,6 +19,7 @@ from netplc.forcing import Force, Kind, check_target, check_value
 from netplc.functions.registry import lookup
 from netplc.memory import MemoryView
 from netplc.program import _LABEL, CONTACTS, Instr, Program
+from netplc.tags.tag import Tag, TagType
 
 FORMATS = ("hex", "dec", "BCD")
 TERMINATORS = frozenset({"YON", "SON", "SOF", "SKP", "JMY", "JMN", "TIM", "CTR", "FON"})
@@ -167,18 +168,25 @@ class WatchItem:
     text: str  # as typed
     kind: Kind
     addr: int
+    tag: Tag | None = None  # a tag of tags.csv: shown and forced in physical units
 
     @property
     def where(self) -> str:
+        if self.tag is not None:
+            return self.tag.name
         if self.kind == "bit":
             return fmt_octal(self.addr, 6 if self.addr >= HMI_DATA_BIT_BASE else 5)
         return f"{fmt_octal(self.addr)}:{self.kind}"
 
 
-def parse_watch(text: str, symbols: dict[str, int]) -> WatchItem:
-    """An address or a symbol as the engineer types it: `02000` and `040042` are bits, `04000` a
-    word, `04000:b` a byte, `02000:w` the 16 bits from 02000; ValueError says what is wrong."""
+def parse_watch(text: str, symbols: dict[str, int], tags: dict[str, Tag] | None = None) -> WatchItem:
+    """An address, a symbol or a tag as the engineer types it: `02000` and `040042` are bits,
+    `04000` a word, `04000:b` a byte, `02000:w` the 16 bits from 02000, a tag name its bit or its
+    (first) word in physical units; ValueError says what is wrong."""
     typed = text.strip()
+    tag = (tags or {}).get(typed)
+    if tag is not None:
+        return WatchItem(typed, "bit" if tag.type is TagType.BIT else "word", tag.address, tag)
     m = _SUFFIX.match(typed)
     name, suffix = (m.group(1), WATCH_KINDS[m.group(2).lower()]) if m else (typed, None)
     if not name:
@@ -189,10 +197,23 @@ def parse_watch(text: str, symbols: dict[str, int]) -> WatchItem:
         try:
             addr = parse_octal(name)
         except ValueError:
-            raise ValueError(f"{name!r} is neither an octal address nor a symbol of symbols.csv") from None
+            raise ValueError(f"{name!r} is neither an octal address nor a symbol of symbols.csv "
+                             "nor a tag of tags.csv") from None
     kind: Kind = suffix or ("bit" if addr < IO_BITS or addr >= HMI_DATA_BIT_BASE else "word")
     check_target(kind, addr)  # the rule a force is held to
     return WatchItem(typed, kind, addr)
+
+
+def parse_phy(text: str, tag: Tag) -> float:
+    """A physical value typed for a tag (decimal point or comma); ValueError names the tag."""
+    try:
+        value = float(text.strip().replace(",", "."))
+    except ValueError:
+        raise ValueError(f"{text!r} is not a value for {tag.name} (a number in {tag.unit or 'its units'})") \
+            from None
+    if value != value:
+        raise ValueError(f"{text!r} is not a value for {tag.name}")
+    return value
 
 
 def parse_value(text: str, kind: Kind) -> int:

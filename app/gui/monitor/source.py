@@ -27,6 +27,7 @@ from netplc.forcing import Force, Kind
 from netplc.memory import Snapshot
 from netplc.modbus import DeviceError, LinkError, LoopThread, MapError, locate, open_client, parse_endpoint
 from netplc.program import Program, parse
+from netplc.tags.tag import Tag
 
 POLL_S = 0.2  # the remote monitor's poll period: 5 reads of the station per second
 TIMEOUT_S = 2.0
@@ -43,6 +44,7 @@ class Source(Protocol):
     title: str
     program: Program
     symbols: dict[str, int]
+    tags: dict[str, Tag]  # tags.csv by name: watched in physical units, forced word by word
     caps: Caps
 
     def snapshot(self) -> Snapshot | None: ...
@@ -63,6 +65,10 @@ class Source(Protocol):
 
     def unforce(self, kind: Kind, addr: int, user: str) -> None: ...
 
+    def force_tag(self, tag: Tag, phy: float | None, user: str) -> None: ...
+
+    def unforce_tag(self, tag: Tag, user: str) -> None: ...
+
     def unforce_all(self, user: str) -> None: ...
 
     def step(self, user: str) -> bool: ...
@@ -81,6 +87,7 @@ class LocalSource:
         self.engine = runtime.engine
         self.program = runtime.program
         self.symbols = runtime.symbols
+        self.tags = runtime.tags.by_name
         self.title = f"{runtime.station.name}: {runtime.program.source}"
 
     def snapshot(self) -> Snapshot | None:
@@ -116,6 +123,12 @@ class LocalSource:
     def unforce(self, kind: Kind, addr: int, user: str) -> None:
         self.engine.forces.unforce(kind, addr, user=user)
 
+    def force_tag(self, tag: Tag, phy: float | None, user: str) -> None:
+        self.engine.forces.force_tag(tag, phy, user=user)
+
+    def unforce_tag(self, tag: Tag, user: str) -> None:
+        self.engine.forces.unforce_tag(tag, user=user)
+
     def unforce_all(self, user: str) -> None:
         self.engine.forces.unforce_all(user=user)
 
@@ -133,11 +146,13 @@ class RemoteSource:
                 why_not="forcing and single scans need the station's own workstation (not over Modbus)")
 
     def __init__(self, host: str, port: int, *, unit: int = 1, program: Program | None = None,
-                 symbols: dict[str, int] | None = None, poll: float = POLL_S) -> None:
+                 symbols: dict[str, int] | None = None, tags: dict[str, Tag] | None = None,
+                 poll: float = POLL_S) -> None:
         self.endpoint = parse_endpoint(f"tcp://{host}:{port}")
         self.unit = unit
         self.program = program or parse("", source="<no program: give the station to see its listing>")
         self.symbols = symbols or {}
+        self.tags = tags or {}
         self.title = f"{host}:{port}" + (f": {self.program.source}" if program else "")
         self.poll = poll
         self._client = open_client(self.endpoint, TIMEOUT_S)  # the lean client
@@ -251,6 +266,12 @@ class RemoteSource:
         raise MapError(self.caps.why_not)
 
     def unforce(self, kind: Kind, addr: int, user: str) -> None:
+        raise MapError(self.caps.why_not)
+
+    def force_tag(self, tag: Tag, phy: float | None, user: str) -> None:
+        raise MapError(self.caps.why_not)
+
+    def unforce_tag(self, tag: Tag, user: str) -> None:
         raise MapError(self.caps.why_not)
 
     def unforce_all(self, user: str) -> None:

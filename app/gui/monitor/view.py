@@ -39,15 +39,17 @@ from app.gui.monitor.listing import (
     Operand,
     WatchItem,
     fmt_value,
+    parse_phy,
     parse_value,
     parse_watch,
 )
 from app.gui.monitor.source import Source
 from app.gui.status import IDLE, WARN, Pill
 from netplc.address import fmt_octal
-from netplc.forcing import Force, Kind
+from netplc.forcing import Force, Kind, tag_forces, tag_keys
 from netplc.memory import Snapshot
 from netplc.program import CONTACTS
+from netplc.tags.tag import Tag
 
 REFRESH_MS = 100  # at most 10 refreshes per second
 ON, OFF, FORCED = QColor("#2e7d32"), QColor("#b0b7c0"), QColor("#e65100")
@@ -290,7 +292,8 @@ class ProgramMonitor(QWidget):
         side = QWidget()
         side_lay = QVBoxLayout(side)
         side_lay.setContentsMargins(0, 0, 0, 0)
-        side_lay.addWidget(QLabel("Watch: type an address (04000, 040042, 02000:w, 04001:b) or a symbol"))
+        side_lay.addWidget(QLabel("Watch: type an address (04000, 040042, 02000:w, 04001:b), a symbol or "
+                                  "a tag"))
         side_lay.addWidget(self.watch, 3)
         side_lay.addWidget(self.message)
         side_lay.addWidget(self.uses_title)
@@ -339,20 +342,34 @@ class ProgramMonitor(QWidget):
         try:
             for r, item in enumerate(self.watch_items):
                 try:
-                    v = Force(item.kind, item.addr, 0).read(snap)
+                    texts = self._watch_texts(item, snap, forces)
                 except ValueError:
                     continue
-                digits = 2 if item.kind == "byte" else 4
-                texts = [str(v), "" if item.kind == "bit" else fmt_value(v, "hex", digits),
-                         "" if item.kind == "bit" else fmt_value(v, "BCD", digits)]
-                f = forces.get((item.kind, item.addr))
-                texts.append(f"F {f.value} ({f.user})" if f else "")
                 for col, text in enumerate(texts, start=1):
                     cell = self.watch.item(r, col)
                     if cell is not None and cell.text() != text and not self._editing(r, col):
                         cell.setText(text)
         finally:
             self.watch.blockSignals(False)
+
+    @staticmethod
+    def _watch_texts(item: WatchItem, snap: Snapshot, forces: dict[tuple[Kind, int], Force]) -> list[str]:
+        """Value, hex, BCD and forced columns; a tag's value and force in physical units."""
+        if item.tag is not None:
+            tag = item.tag
+            keys = tag_keys(tag)  # its bit, or its words
+            words = [Force(k, a, 0).read(snap) for k, a in keys if k == "word"]
+            raw = " ".join(fmt_value(w, "hex") for w in words)
+            held = [forces.get(key) for key in keys]
+            forced = f"F {tag.format(tag.value(snap))} ({held[0].user})" if all(held) and held[0] else ""
+            return [tag.format(tag.value(snap)), raw, "", forced]
+        v = Force(item.kind, item.addr, 0).read(snap)
+        digits = 2 if item.kind == "byte" else 4
+        texts = [str(v), "" if item.kind == "bit" else fmt_value(v, "hex", digits),
+                 "" if item.kind == "bit" else fmt_value(v, "BCD", digits)]
+        f = forces.get((item.kind, item.addr))
+        texts.append(f"F {f.value} ({f.user})" if f else "")
+        return texts
 
     def _editing(self, row: int, col: int) -> bool:
         return self.watch.state() == QTableWidget.State.EditingState and self.watch.currentRow() == row \
@@ -373,7 +390,7 @@ class ProgramMonitor(QWidget):
 
     def add_watch(self, text: str) -> WatchItem:
         """Watch an address or symbol; ValueError says why it cannot be watched."""
-        item = parse_watch(text, {**self.source.symbols, **self.listing.program.symbols})
+        item = parse_watch(text, {**self.source.symbols, **self.listing.program.symbols}, self.source.tags)
         r = len(self.watch_items)
         self.watch_items.append(item)
         self.watch.blockSignals(True)
@@ -381,10 +398,12 @@ class ProgramMonitor(QWidget):
         self.watch.item(r, 0).setToolTip(item.where)
         value = self.watch.item(r, 1)
         value.setFlags(value.flags() | Qt.ItemFlag.ItemIsEditable)
-        value.setToolTip("type a value to write it (decimal, 0x1F or 1Fh): journaled with your name")
+        how = f"in {item.tag.unit or 'its units'}" if item.tag else "(decimal, 0x1F or 1Fh)"
+        value.setToolTip(f"type a value {how} to write it: journaled with your name")
         self.watch.blockSignals(False)
         self._add_empty_row()
-        self.source.need([item.addr >> 3 if item.kind == "bit" and item.addr >= 0o40000 else item.addr])
+        words = [a for _, a in tag_keys(item.tag)] if item.tag else [item.addr]
+        self.source.need([a >> 3 if item.kind == "bit" and a >= 0o40000 else a for a in words])
         self._last = None  # show it at the next refresh
         return item
 
@@ -403,7 +422,10 @@ class ProgramMonitor(QWidget):
         elif col == 1 and r < len(self.watch_items):
             item = self.watch_items[r]
             try:
-                self.write(item, parse_value(cell.text(), item.kind))
+                if item.tag is None:
+                    self.write(item, parse_value(cell.text(), item.kind))
+                else:
+                    self.write_tag(item, parse_phy(cell.text(), item.tag))
             except ValueError as e:
                 self._say(str(e))
             self._last = None
@@ -415,13 +437,22 @@ class ProgramMonitor(QWidget):
         except Exception as e:  # LinkError, DeviceError, MapError of a remote station
             self._say(f"write {item.where} refused: {e}")
 
+    def write_tag(self, item: WatchItem, phy: float) -> None:
+        """A tag's physical value written as its raw bit or words, each an operator write."""
+        assert item.tag is not None
+        for f in tag_forces(item.tag, phy):
+            self.write(WatchItem(item.text, f.kind, f.addr), f.value)
+
     def _watch_menu(self, pos: QPoint) -> None:
         r = self.watch.rowAt(pos.y())
         if not 0 <= r < len(self.watch_items):
             return
         item = self.watch_items[r]
         menu = QMenu(self)
-        self._force_actions(menu, item.kind, item.addr, item.where)
+        if item.tag is None:
+            self._force_actions(menu, item.kind, item.addr, item.where)
+        else:
+            self._tag_force_actions(menu, item.tag)
         menu.addSeparator()
         menu.addAction("Remove from watch", lambda: self.remove_watch(r))
         menu.exec(self.watch.viewport().mapToGlobal(pos))
@@ -433,14 +464,42 @@ class ProgramMonitor(QWidget):
     # --- forcing and stepping ---------------------------------------------------------------------
 
     def _force_actions(self, menu: QMenu, kind: Kind, addr: int, where: str) -> None:
+        self._add_force_actions(menu, where, lambda: self.force(kind, addr, None),
+                                lambda: self._ask_force(kind, addr, where), lambda: self.unforce(kind, addr))
+
+    def _tag_force_actions(self, menu: QMenu, tag: Tag) -> None:
+        self._add_force_actions(menu, tag.name, lambda: self.force_tag(tag, None),
+                                lambda: self._ask_force_tag(tag), lambda: self.unforce_tag(tag))
+
+    def _add_force_actions(self, menu: QMenu, where: str, bumpless: Callable[[], None],
+                           ask: Callable[[], None], release: Callable[[], None]) -> None:
         can = self.source.caps.force
-        for text, slot in ((f"Force {where} at its value (bumpless)", lambda: self.force(kind, addr, None)),
-                           (f"Force {where} to…", lambda: self._ask_force(kind, addr, where)),
-                           (f"Unforce {where}", lambda: self.unforce(kind, addr))):
+        for text, slot in ((f"Force {where} at its value (bumpless)", bumpless), (f"Force {where} to…", ask),
+                           (f"Unforce {where}", release)):
             action = menu.addAction(text, slot)
             action.setEnabled(can)
             if not can:
                 action.setToolTip(self.source.caps.why_not)
+
+    def _ask_force_tag(self, tag: Tag) -> None:
+        lo, hi = tag.phy_limits
+        text, ok = QInputDialog.getText(self, "Force", f"Force {tag.name} to ({tag.unit or 'value'}, "
+                                                       f"{lo:g}..{hi:g}):")
+        if ok:
+            try:
+                self.force_tag(tag, parse_phy(text, tag))
+            except ValueError as e:
+                self._say(str(e))
+
+    def force_tag(self, tag: Tag, phy: float | None) -> None:
+        """Force a tag's bit or all its words to a physical value, or bumpless with None."""
+        try:
+            self.source.force_tag(tag, phy, self.user())
+        except ValueError as e:
+            self._say(str(e))
+
+    def unforce_tag(self, tag: Tag) -> None:
+        self.source.unforce_tag(tag, self.user())
 
     def _ask_force(self, kind: Kind, addr: int, where: str) -> None:
         text, ok = QInputDialog.getText(self, "Force", f"Force {where} to (decimal, 0x1F or 1Fh):")

@@ -54,7 +54,7 @@ def remote_source(target: str) -> RemoteSource:
                             "to monitor it over"])
         loaded = load(station)
         return RemoteSource(server.host, server.port, unit=server.unit or 1, program=loaded.program,
-                            symbols=loaded.symbols)
+                            symbols=loaded.symbols, tags=loaded.tags.by_name)
     host, sep, port = target.rpartition(":")
     if not sep or not host or not port.isdigit() or not 0 < int(port) < 65536:
         raise Problems([f"{target}: neither a station folder nor HOST:PORT"])
