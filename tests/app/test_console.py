@@ -311,7 +311,10 @@ def test_the_console_speaks_russian_and_the_forms_keep_their_texts(qtbot, russia
 def test_refusals_roles_and_alarms_speak_russian_too(qtbot, russian, demo_copy: Path) -> None:
     """What the Qt-free models say in English (users.py refusals, roles, alarm priorities and
     states, qualities) the console shows in its language; the journal keeps the English."""
+    import dataclasses
+
     from app.gui.alarms import AlarmBanner
+    from app.gui.status import station_problems
     from hmi_forms.widgets.base import quality_tip
     from netplc.tags.alarms import AlarmRow, State
 
@@ -347,6 +350,8 @@ def test_refusals_roles_and_alarms_speak_russian_too(qtbot, russian, demo_copy: 
         banner.show_alarms(rows[:1])
         assert "P2 ВЫСОКАЯ" in banner.text.text() and "активна, не квитирована" in banner.text.text()
         assert quality_tip("comm-fail").startswith("? нет связи")
+        stopped = dataclasses.replace(runtime.status(), state="stopped")
+        assert "NetPlc: остановлен" in station_problems(stopped)
     finally:
         window.close()
         runtime.stop()

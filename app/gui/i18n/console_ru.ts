@@ -439,6 +439,14 @@
         <source>forces in effect: force &gt; program &gt; live (Station -&gt; Program)</source>
         <translation>действуют форсирования: форсирование &gt; программа &gt; объект (Станция -&gt; Программа)</translation>
     </message>
+    <message>
+        <source>NetPlc program {0}</source>
+        <translation>NetPlc: {0}</translation>
+    </message>
+    <message>
+        <source>no link to node {0} ({1})</source>
+        <translation>нет связи с узлом {0} ({1})</translation>
+    </message>
 </context>
 <context>
     <name>TrendWidget</name>
