@@ -37,6 +37,22 @@ class Refused(Exception):
     """An action the logged-in user may not do; the text says why."""
 
 
+@dataclass(frozen=True)
+class Refusal:
+    """Why the session may not do an action, in parts, so the console can say it in its own
+    language (app/gui/words.py); `str()` is the English sentence the journal and the tests read."""
+
+    action: str
+    role: str  # the role the action needs
+    user: str = ""  # "" when nobody is logged in
+    user_role: str = ""
+
+    def __str__(self) -> str:
+        if not self.user:
+            return f"{self.action}: nobody is logged in ({self.role} needed)"
+        return f"{self.action}: needs the {self.role} role; {self.user} is {self.user_role}"
+
+
 def rank(role: str) -> int:
     return ROLES.index(role)
 
@@ -177,14 +193,19 @@ class Session:
         self.logout()
         return user
 
-    def refusal(self, role: str, action: str) -> str | None:
-        """Why the session may not do `action`, which needs `role`; None when it may."""
+    def denial(self, role: str, action: str) -> Refusal | None:
+        """Why the session may not do `action`, which needs `role`, in parts; None when it may."""
         user = self.current
         if user is None:
-            return f"{action}: nobody is logged in ({role} needed)"
+            return Refusal(action, role)
         if not user.allows(role):
-            return f"{action}: needs the {role} role; {user.name} is {user.role}"
+            return Refusal(action, role, user.name, user.role)
         return None
+
+    def refusal(self, role: str, action: str) -> str | None:
+        """Why the session may not do `action`, which needs `role`; None when it may."""
+        why = self.denial(role, action)
+        return None if why is None else str(why)
 
     def require(self, role: str, action: str) -> str:
         """The user's name if the session may do `action`; Refused saying why otherwise."""

@@ -10,7 +10,7 @@ import datetime as dt
 import sqlite3
 from pathlib import Path
 
-from PySide6.QtCore import QDate
+from PySide6.QtCore import QCoreApplication, QDate
 from PySide6.QtGui import QFont
 from PySide6.QtWidgets import QDateEdit, QDialog, QHBoxLayout, QLabel, QPlainTextEdit, QVBoxLayout, QWidget
 
@@ -23,11 +23,12 @@ def health_text(archive_path: Path, day: dt.date) -> str:
     try:
         archive = Archive(archive_path)
     except (OSError, sqlite3.Error) as e:
-        return f"no alarm-system health: {e}"
+        return QCoreApplication.translate("HealthDialog", "no alarm-system health: {0}").format(e)
     try:
         return "\n".join(alarm_health(archive, day).lines())
     except sqlite3.Error as e:
-        return f"{archive_path}: cannot read the archive: {e}"
+        return QCoreApplication.translate("HealthDialog", "{0}: cannot read the archive: {1}").format(
+            archive_path, e)
     finally:
         archive.close()
 
@@ -35,12 +36,12 @@ def health_text(archive_path: Path, day: dt.date) -> str:
 class HealthDialog(QDialog):
     def __init__(self, archive_path: Path, parent: QWidget | None = None) -> None:
         super().__init__(parent)
-        self.setWindowTitle("Alarm-system health")
+        self.setWindowTitle(self.tr("Alarm-system health"))
         self.archive_path = archive_path
         self.resize(720, 520)
         lay = QVBoxLayout(self)
         bar = QHBoxLayout()
-        bar.addWidget(QLabel("Day:"))
+        bar.addWidget(QLabel(self.tr("Day:")))
         self.day = QDateEdit(QDate.currentDate())
         self.day.setCalendarPopup(True)
         self.day.setDisplayFormat("dd.MM.yyyy")

@@ -22,7 +22,16 @@ import time
 from collections.abc import Callable
 from typing import Any
 
-from PySide6.QtCore import QAbstractTableModel, QModelIndex, QPersistentModelIndex, Qt, QTimer, Signal
+from PySide6.QtCore import (
+    QT_TRANSLATE_NOOP,
+    QAbstractTableModel,
+    QCoreApplication,
+    QModelIndex,
+    QPersistentModelIndex,
+    Qt,
+    QTimer,
+    Signal,
+)
 from PySide6.QtGui import QBrush, QColor
 from PySide6.QtWidgets import (
     QAbstractItemView,
@@ -42,6 +51,7 @@ from PySide6.QtWidgets import (
     QWidget,
 )
 
+from app.gui import words
 from app.station_alarms import StationAlarms
 from netplc.tags.alarms import PRIORITIES, AlarmError, AlarmRow, State
 
@@ -53,7 +63,9 @@ SOUNDING = (1, 2)  # priorities that sound until acknowledged or silenced
 COLOURS = {1: ("#c62828", "#ffffff"), 2: ("#ef6c00", "#ffffff"), 3: ("#fdd835", "#263445"),
            4: ("#90caf9", "#263445")}
 QUIET = ("#eceff1", "#607d8b")  # shelved
-COLUMNS = ("Priority", "Time", "Alarm", "State", "Value", "Text")
+COLUMNS = (QT_TRANSLATE_NOOP("AlarmTableModel", "Priority"), QT_TRANSLATE_NOOP("AlarmTableModel", "Time"),
+           QT_TRANSLATE_NOOP("AlarmTableModel", "Alarm"), QT_TRANSLATE_NOOP("AlarmTableModel", "State"),
+           QT_TRANSLATE_NOOP("AlarmTableModel", "Value"), QT_TRANSLATE_NOOP("AlarmTableModel", "Text"))
 
 Index = QModelIndex | QPersistentModelIndex
 
@@ -95,7 +107,7 @@ class AlarmTableModel(QAbstractTableModel):
 
     def headerData(self, section: int, orientation: Qt.Orientation, role: int = 0) -> Any:
         if orientation == Qt.Orientation.Horizontal and role == Qt.ItemDataRole.DisplayRole:
-            return COLUMNS[section]
+            return QCoreApplication.translate("AlarmTableModel", COLUMNS[section])
         return None
 
     def data(self, index: Index, role: int = 0) -> Any:
@@ -103,15 +115,16 @@ class AlarmTableModel(QAbstractTableModel):
         if role == Qt.ItemDataRole.DisplayRole:
             col = index.column()
             if col == 0:
-                return f"{row.priority} {PRIORITIES.get(row.priority, '')}"
+                return f"{row.priority} {words.priority(row.priority)}"
             if col == 1:
                 return stamp(row.since or row.changed)
             if col == 2:
                 return row.id
             if col == 3:
                 if row.state is State.SHELVED and row.shelved_until is not None:
-                    return f"shelved by {row.shelved_by} until {stamp(row.shelved_until)}: {row.reason}"
-                return row.state.word
+                    shelved = QCoreApplication.translate("AlarmTableModel", "shelved by {0} until {1}: {2}")
+                    return shelved.format(row.shelved_by, stamp(row.shelved_until), row.reason)
+                return words.state(row.state)
             if col == 4:
                 return row.shown
             return row.text
@@ -126,16 +139,16 @@ class ShelveDialog(QDialog):
 
     def __init__(self, alarm: str, parent: QWidget | None = None) -> None:
         super().__init__(parent)
-        self.setWindowTitle(f"Shelve {alarm}")
+        self.setWindowTitle(self.tr("Shelve {0}").format(alarm))
         lay = QFormLayout(self)
         self.minutes = QDoubleSpinBox()
         self.minutes.setRange(1, 7 * 24 * 60)
         self.minutes.setValue(60)
-        self.minutes.setSuffix(" min")
+        self.minutes.setSuffix(self.tr(" min"))
         self.reason = QLineEdit()
-        self.reason.setPlaceholderText("why (required)")
-        lay.addRow("Duration", self.minutes)
-        lay.addRow("Reason", self.reason)
+        self.reason.setPlaceholderText(self.tr("why (required)"))
+        lay.addRow(self.tr("Duration"), self.minutes)
+        lay.addRow(self.tr("Reason"), self.reason)
         ok, cancel = QDialogButtonBox.StandardButton.Ok, QDialogButtonBox.StandardButton.Cancel
         buttons = QDialogButtonBox(ok | cancel)
         buttons.accepted.connect(self.accept)
@@ -184,25 +197,26 @@ class AlarmSummary(QWidget):
         lay.setContentsMargins(4, 4, 4, 4)
         head = QHBoxLayout()
         self.counts: dict[int, QLabel] = {}
-        for priority, word in PRIORITIES.items():
+        for priority in PRIORITIES:
             label = QLabel()
             label.setObjectName("alarmCountP")
             back, fore = COLOURS[priority]
             label.setStyleSheet(f"background: {back}; color: {fore}; border-radius: 3px; padding: 2px 8px;")
-            label.setToolTip(f"listed alarms of priority {priority} ({word})")
+            label.setToolTip(self.tr("listed alarms of priority {0} ({1})").format(
+                priority, words.priority(priority)))
             self.counts[priority] = label
             head.addWidget(label)
         self.filter = QLineEdit()
-        self.filter.setPlaceholderText("Filter: alarm, text or state")
+        self.filter.setPlaceholderText(self.tr("Filter: alarm, text or state"))
         self.filter.setClearButtonEnabled(True)
         self.filter.textChanged.connect(self._apply)
         head.addWidget(self.filter, 1)
-        self.ack = QPushButton("Acknowledge")
-        self.ack_all = QPushButton("Acknowledge all")
-        self.shelve = QPushButton("Shelve…")
-        self.unshelve = QPushButton("Unshelve")
-        self.silence = QPushButton("Silence")
-        self.silence.setToolTip("Stop the sound; the alarms stay unacknowledged")
+        self.ack = QPushButton(self.tr("Acknowledge"))
+        self.ack_all = QPushButton(self.tr("Acknowledge all"))
+        self.shelve = QPushButton(self.tr("Shelve…"))
+        self.unshelve = QPushButton(self.tr("Unshelve"))
+        self.silence = QPushButton(self.tr("Silence"))
+        self.silence.setToolTip(self.tr("Stop the sound; the alarms stay unacknowledged"))
         for b in (self.ack, self.ack_all, self.shelve, self.unshelve, self.silence):
             head.addWidget(b)
         lay.addLayout(head)
@@ -251,9 +265,10 @@ class AlarmSummary(QWidget):
         self.changed.emit()
 
     def _apply(self) -> None:
-        words = self.filter.text().strip().casefold().split()
+        typed = self.filter.text().strip().casefold().split()
         rows = [r for r in self.rows
-                if all(w in f"{r.id} {r.text} {r.state.word} {r.tag or ''}".casefold() for w in words)]
+                if all(w in f"{r.id} {r.text} {r.state.word} {words.state(r.state)} {r.tag or ''}".casefold()
+                       for w in typed)]
         selected = set(self.selected())
         self.model.set_rows(rows)
         for i, r in enumerate(rows):
@@ -262,7 +277,7 @@ class AlarmSummary(QWidget):
         listed = [r for r in self.rows if r.state is not State.SHELVED]
         for priority, label in self.counts.items():
             n = sum(r.priority == priority for r in listed)
-            label.setText(f"P{priority} {PRIORITIES[priority]}: {n}")
+            label.setText(f"P{priority} {words.priority(priority)}: {n}")
         self.silence.setEnabled(self.annunciator.sounding)
 
     def unacknowledged(self) -> list[AlarmRow]:
@@ -301,7 +316,7 @@ class AlarmSummary(QWidget):
     def _shelve_dialog(self) -> None:
         ids = self.selected()
         if not ids:
-            QMessageBox.information(self, "Shelve", "Select the alarm to shelve first.")
+            QMessageBox.information(self, self.tr("Shelve"), self.tr("Select the alarm to shelve first."))
             return
         dialog = ShelveDialog(ids[0], self)
         if dialog.exec() != QDialog.DialogCode.Accepted:
@@ -310,7 +325,7 @@ class AlarmSummary(QWidget):
             for alarm_id in ids:
                 self.shelve_alarm(alarm_id, dialog.minutes.value(), dialog.reason.text())
         except AlarmError as e:
-            QMessageBox.warning(self, "Shelve", str(e))
+            QMessageBox.warning(self, self.tr("Shelve"), str(e))
 
     def silence_sound(self) -> None:
         self.annunciator.silence()

@@ -24,9 +24,10 @@ from PySide6.QtWidgets import (
     QWidget,
 )
 
+from app.gui import words
 from app.gui.elided import ElidedLabel
 from hmi_forms.elements import formats
-from netplc.tags.alarms import PRIORITIES, AlarmRow
+from netplc.tags.alarms import AlarmRow
 
 
 class AlarmBanner(QFrame):
@@ -87,9 +88,9 @@ class AlarmBanner(QFrame):
             return
         first = self.alarms[0]
         when = formats.clock(first.since or first.changed)
-        kind = PRIORITIES.get(first.priority, "").upper()
+        kind = words.priority(first.priority).upper()
         self.text.setText(f"{when}   P{first.priority} {kind}   {first.text}   "
-                          f"[{first.id}, {first.state.word}]")
+                          f"[{first.id}, {words.state(first.state)}]")
         many = len(self.alarms) > 1
         self.count.setText(self.tr("{0} unacknowledged").format(len(self.alarms)) if many else "")
         self.ack_all.setVisible(len(self.alarms) > 1)

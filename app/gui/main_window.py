@@ -34,7 +34,7 @@ from PySide6.QtWidgets import (
 )
 
 from app.config import load_station
-from app.gui import i18n
+from app.gui import i18n, words
 from app.gui.alarm_summary import AlarmSummary
 from app.gui.alarms import AlarmBanner, FixedLine, HealthStrip
 from app.gui.bridge import RuntimeBridge
@@ -46,7 +46,7 @@ from app.gui.trend_history import TrendHistory
 from app.gui.users_dialog import UsersDialog
 from app.gui.zoom import ACTUAL, FIT_WIDTH, FIT_WINDOW, ZoomArea, ZoomSettings
 from app.runtime import Runtime
-from app.users import ADMIN, ENGINEER, OPERATOR, Session, Users
+from app.users import ADMIN, ENGINEER, OPERATOR, Refusal, Session, Users
 from hmi_forms.elements import formats
 from hmi_forms.elements.base import Writer
 from hmi_forms.elements.target import EngineTarget
@@ -102,7 +102,7 @@ class MainWindow(QMainWindow):
         self.journal = JournalDock(station.Archive, self)
         self.addDockWidget(Qt.DockWidgetArea.BottomDockWidgetArea, self.journal)
         self.summary = AlarmSummary(runtime.alarms, lambda: self.user, sound=station.alarm_sound)
-        self.summary_dock = QDockWidget("Alarms", self)
+        self.summary_dock = QDockWidget(self.tr("Alarms"), self)
         self.summary_dock.setObjectName("alarmSummaryDock")
         self.summary_dock.setWidget(self.summary)
         self.addDockWidget(Qt.DockWidgetArea.BottomDockWidgetArea, self.summary_dock)
@@ -167,13 +167,14 @@ class MainWindow(QMainWindow):
         station.addSeparator()
         station.addAction(viewer)
         for i, sim in enumerate(self.runtime.station.simulators):  # the demo's bad-quality case
-            answers = QAction(f"Simulated node {sim.node} answers", self)
+            answers = QAction(self.tr("Simulated node {0} answers").format(sim.node), self)
             answers.setCheckable(True)
             answers.setChecked(True)
-            answers.setToolTip("Untick to pull the node's cable: its values go comm-fail, their alarms come")
+            answers.setToolTip(
+                self.tr("Untick to pull the node's cable: its values go comm-fail, their alarms come"))
             answers.toggled.connect(lambda on, i=i: self.runtime.simulator_answers(i, on))
             station.addAction(answers)
-        health = QAction("Alarm-system &health…", self)
+        health = QAction(self.tr("Alarm-system &health…"), self)
         health.triggered.connect(self.open_health)
         station.addAction(health)
         station.addSeparator()
@@ -262,8 +263,8 @@ class MainWindow(QMainWindow):
     def _alarms_changed(self) -> None:
         unacknowledged = self.summary.unacknowledged()
         self.alarms.show_alarms(unacknowledged)
-        self.summary_dock.setWindowTitle(f"Alarms — {len(unacknowledged)} unacknowledged"
-                                         if unacknowledged else "Alarms")
+        self.summary_dock.setWindowTitle(self.tr("Alarms — {0} unacknowledged").format(len(unacknowledged))
+                                         if unacknowledged else self.tr("Alarms"))
 
     def _acknowledge(self, alarm: AlarmRow) -> None:
         self.summary.acknowledge([alarm.id])
@@ -278,10 +279,10 @@ class MainWindow(QMainWindow):
         current = self.session.current
         self.header.show_user(current.name if current else "", current.role if current else "",
                               logged_in=self.session.user is not None)
-        ack = self.session.refusal(OPERATOR, self.tr("Acknowledge"))
+        ack = self.session.denial(OPERATOR, self.tr("Acknowledge"))
         for button in (self.alarms.ack, self.alarms.ack_all):
             button.setEnabled(ack is None)
-            button.setToolTip(ack or "")
+            button.setToolTip(words.refusal(ack) if ack is not None else "")
         self.act_logout.setEnabled(self.session.user is not None)
 
     def refresh_status(self) -> None:
@@ -304,22 +305,23 @@ class MainWindow(QMainWindow):
         answer = QMessageBox.question(self, title, text)
         return answer == QMessageBox.StandardButton.Yes
 
-    def refuse(self, why: str) -> None:
-        """A refused action says why, where the operator looks: the status bar."""
-        self.status.showMessage(self.tr("Refused: ") + why, REFUSAL_MS)
+    def refuse(self, why: Refusal) -> None:
+        """A refused action says why, where the operator looks: the status bar, in the console's
+        language."""
+        self.status.showMessage(self.tr("Refused: ") + words.refusal(why), REFUSAL_MS)
 
     def allowed(self, role: str, action: str) -> bool:
-        why = self.session.refusal(role, action)
+        why = self.session.denial(role, action)
         if why is not None:
             self.refuse(why)
         return why is None
 
     def _guard(self, element: Writer, what: str) -> str | None:
         """Before a form element writes: its Role, then its Confirm."""
-        why = self.session.refusal(element.Role, what)
+        why = self.session.denial(element.Role, what)
         if why is not None:
             self.refuse(why)
-            return why
+            return words.refusal(why)
         if element.Confirm and not self.ask(self.tr("Confirm"), what + "?"):
             return self.tr("cancelled")
         return None
@@ -482,7 +484,7 @@ class _Header(QFrame):
         self.tick()
 
     def show_user(self, name: str, role: str, *, logged_in: bool) -> None:
-        self.user.setText(f"{name} ({role})" if name else self.tr("nobody logged in"))
+        self.user.setText(f"{name} ({words.role(role)})" if name else self.tr("nobody logged in"))
         self.login.setText(self.tr("Log out") if logged_in else self.tr("Log in…"))
 
     def tick(self) -> None:

@@ -6,7 +6,7 @@ attention (amber) or is failing (red), with the figures beside it for whoever lo
 
 from __future__ import annotations
 
-from PySide6.QtCore import QT_TRANSLATE_NOOP
+from PySide6.QtCore import QT_TRANSLATE_NOOP, QCoreApplication
 from PySide6.QtWidgets import QLabel, QStatusBar, QWidget
 
 from app.runtime import RuntimeStatus
@@ -86,11 +86,14 @@ STATES = (QT_TRANSLATE_NOOP("StationStatusBar", "running"), QT_TRANSLATE_NOOP("S
 
 
 def station_problems(s: RuntimeStatus) -> list[str]:
-    """What the health strip lists: a stopped program, dead links, archive and server failures."""
+    """What the health strip lists, in the console's language: a stopped program, dead links;
+    archive and server failures as the runtime words them."""
     problems: list[str] = []
     if s.state != "running":
-        problems.append(f"NetPlc program {s.state}")
+        state = QCoreApplication.translate("StationStatusBar", s.state)
+        problems.append(QCoreApplication.translate("StationStatusBar", "NetPlc program {0}").format(state))
     if s.scans * s.tick_ms > STARTUP_GRACE_MS:
-        problems += [f"no link to node {n.node} ({n.endpoint})" for n in s.nodes if not n.up]
+        no_link = QCoreApplication.translate("StationStatusBar", "no link to node {0} ({1})")
+        problems += [no_link.format(n.node, n.endpoint) for n in s.nodes if not n.up]
     problems += list(s.problems)
     return problems

@@ -20,6 +20,7 @@ from PySide6.QtWidgets import (
     QWidget,
 )
 
+from app.gui import words
 from app.users import UserError, Users
 from hmi_forms.elements.base import ROLES
 
@@ -55,7 +56,7 @@ class UsersDialog(QDialog):
             r = self.table.rowCount()
             self.table.insertRow(r)
             self.table.setItem(r, 0, QTableWidgetItem(user.name))
-            self.table.setItem(r, 1, QTableWidgetItem(user.role))
+            self.table.setItem(r, 1, QTableWidgetItem(words.role(user.role)))
 
     def _do(self, change: Callable[[], str]) -> bool:
         try:

@@ -16,7 +16,7 @@ from collections.abc import Hashable
 from operator import attrgetter
 from pathlib import Path
 
-from PySide6.QtCore import QEvent, QPoint, QPointF, QRect, QRectF, Qt
+from PySide6.QtCore import QT_TRANSLATE_NOOP, QCoreApplication, QEvent, QPoint, QPointF, QRect, QRectF, Qt
 from PySide6.QtGui import QBrush, QColor, QMoveEvent, QPainter, QPaintEvent, QPen, QPixmap, QResizeEvent
 from PySide6.QtWidgets import QWidget
 
@@ -68,19 +68,25 @@ def draw_pixmap(p: QPainter, pix: QPixmap, rect: QRectF, mode: str = "Zoom",
     p.drawPixmap(QRectF(x, y, w, h), pix, QRectF(0, 0, pix.width(), pix.height()))
 
 
-STALE_TIP = "Stale: the data source of this element is not answering; the last value is shown"
+STALE_TIP = QT_TRANSLATE_NOOP(
+    "quality", "Stale: the data source of this element is not answering; the last value is shown")
 QUALITY_TIPS = {
     "stale": STALE_TIP,
-    "initial": "? initial: no value from the plant yet (the node has not answered since the start)",
-    "comm-fail": "? comm-fail: the node that fills this value is down; the last value is shown",
-    "not running": "? not running: NetPlc is stopped; the last value is shown, nothing changes",
-    "forced": "? forced: the value is forced by an engineer, not the plant's",
+    "initial": QT_TRANSLATE_NOOP(
+        "quality", "? initial: no value from the plant yet (the node has not answered since the start)"),
+    "comm-fail": QT_TRANSLATE_NOOP(
+        "quality", "? comm-fail: the node that fills this value is down; the last value is shown"),
+    "not running": QT_TRANSLATE_NOOP(
+        "quality", "? not running: NetPlc is stopped; the last value is shown, nothing changes"),
+    "forced": QT_TRANSLATE_NOOP("quality", "? forced: the value is forced by an engineer, not the plant's"),
 }
 
 
 def quality_tip(word: str) -> str:
-    """The tooltip of the quality mark: the quality word first, then what it means."""
-    return QUALITY_TIPS.get(word, f"? {word}")
+    """The tooltip of the quality mark: the quality word first, then what it means, in the
+    console's language (the words are Quality.word's, netplc/tags/quality.py)."""
+    tip = QUALITY_TIPS.get(word)
+    return QCoreApplication.translate("quality", tip) if tip else f"? {word}"
 
 
 def paint_stale(p: QPainter, r: QRectF) -> None:
@@ -103,7 +109,7 @@ class StaleMark(QWidget):
     def __init__(self, parent: QWidget) -> None:
         super().__init__(parent)
         self.setAttribute(Qt.WidgetAttribute.WA_TransparentForMouseEvents)
-        self.setToolTip(STALE_TIP)
+        self.setToolTip(quality_tip("stale"))
         self.hide()
 
     def paintEvent(self, event: QPaintEvent) -> None:

@@ -54,7 +54,7 @@ def type_name(row: Row) -> str:
     if row.type is None:
         return ""
     if row.kind == "alarm" and row.type in STATES:
-        return State(row.type).word
+        return QCoreApplication.translate("words", State(row.type).word)  # app/gui/words.py lists them
     if row.kind != "message" or row.type not in TYPE_NAMES:
         return str(row.type)
     return QCoreApplication.translate("records", TYPE_NAMES[row.type])

@@ -308,6 +308,55 @@ def test_the_console_speaks_russian_and_the_forms_keep_their_texts(qtbot, russia
         runtime.stop()
 
 
+def test_refusals_roles_and_alarms_speak_russian_too(qtbot, russian, demo_copy: Path) -> None:
+    """What the Qt-free models say in English (users.py refusals, roles, alarm priorities and
+    states, qualities) the console shows in its language; the journal keeps the English."""
+    import dataclasses
+
+    from app.gui.alarms import AlarmBanner
+    from app.gui.status import station_problems
+    from hmi_forms.widgets.base import quality_tip
+    from netplc.tags.alarms import AlarmRow, State
+
+    runtime = Runtime(load_station(demo_copy))
+    runtime.start()
+    window = MainWindow(runtime)
+    qtbot.addWidget(window)
+    try:
+        assert "viewer (наблюдатель)" in window.header.user.text()
+        model, button = element(window, "Пуск")
+        qtbot.waitUntil(lambda: model.value is not None, timeout=5000)
+        qtbot.mouseClick(button, Qt.MouseButton.LeftButton)
+        assert "Отказано: Пуск \u2192" in window.status.currentMessage()
+        assert "нужна роль «оператор»; viewer — наблюдатель" in window.status.currentMessage()
+        assert "нужна роль «оператор»" in window.alarms.ack.toolTip()
+        assert window.session.refusal("operator", "Пуск") == "Пуск: needs the operator role; viewer is viewer"
+        summary = window.summary
+        heads = [summary.model.headerData(i, Qt.Orientation.Horizontal, Qt.ItemDataRole.DisplayRole)
+                 for i in range(6)]
+        assert heads == ["Приоритет", "Время", "Авария", "Состояние", "Значение", "Текст"]
+        assert summary.counts[1].text().startswith("P1 критическая: ")
+        assert summary.shelve.text() == "Отложить…" and window.summary_dock.windowTitle().startswith("Аварии")
+        shown = (State.UNACK, State.ACKED, State.RTNUN, State.SHELVED, State.SUPPRESSED, State.OUT_OF_SERVICE)
+        rows = [AlarmRow(f"A{s}", 2, s, 1.0, 1.0, None, "текст") for s in shown]
+        summary.model.set_rows(rows)
+        display = Qt.ItemDataRole.DisplayRole
+        states = [summary.model.data(summary.model.index(i, 3), display) for i in range(6)]
+        assert states == ["активна, не квитирована", "активна, квитирована", "вернулась, не квитирована",
+                          "отложена", "подавлена", "выведена из работы"]
+        assert summary.model.data(summary.model.index(0, 0), Qt.ItemDataRole.DisplayRole) == "2 высокая"
+        banner = AlarmBanner()
+        qtbot.addWidget(banner)
+        banner.show_alarms(rows[:1])
+        assert "P2 ВЫСОКАЯ" in banner.text.text() and "активна, не квитирована" in banner.text.text()
+        assert quality_tip("comm-fail").startswith("? нет связи")
+        stopped = dataclasses.replace(runtime.status(), state="stopped")
+        assert "NetPlc: остановлен" in station_problems(stopped)
+    finally:
+        window.close()
+        runtime.stop()
+
+
 def test_the_language_comes_from_station_toml(demo_copy: Path) -> None:
     toml = demo_copy / "station.toml"
     toml.write_text(toml.read_text(encoding="utf-8").replace('# Language = "ru"', 'Language = "en"'),

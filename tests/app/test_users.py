@@ -9,7 +9,7 @@ from pathlib import Path
 
 import pytest
 
-from app.users import Refused, Session, UserError, Users
+from app.users import Refusal, Refused, Session, UserError, Users
 
 REPO = Path(__file__).resolve().parents[2]
 
@@ -82,6 +82,9 @@ def test_logged_out_is_the_default_viewer_or_nobody(users: Users) -> None:
     default = Session(users, default="viewer")
     assert default.name == "viewer" and default.refusal("viewer", "Look") is None
     assert default.refusal("operator", "Пуск") == "Пуск: needs the operator role; viewer is viewer"
+    # in parts too, so the console says it in its own language (app/gui/words.py)
+    assert default.denial("operator", "Пуск") == Refusal("Пуск", "operator", "viewer", "viewer")
+    assert nobody.denial("viewer", "Look") == Refusal("Look", "viewer")
     with pytest.raises(Refused, match="wrong user name or password"):
         default.login("operator", "viewer")
     default.login("operator", "operator")

@@ -3,22 +3,6 @@
 <context>
     <name>AlarmBanner</name>
     <message>
-        <source>info</source>
-        <translation>информация</translation>
-    </message>
-    <message>
-        <source>warning</source>
-        <translation>предупреждение</translation>
-    </message>
-    <message>
-        <source>ALARM</source>
-        <translation>АВАРИЯ</translation>
-    </message>
-    <message>
-        <source>CRITICAL</source>
-        <translation>КРИТИЧЕСКАЯ</translation>
-    </message>
-    <message>
         <source>Acknowledge</source>
         <translation>Квитировать</translation>
     </message>
@@ -29,6 +13,80 @@
     <message>
         <source>{0} unacknowledged</source>
         <translation>неквитированных: {0}</translation>
+    </message>
+</context>
+<context>
+    <name>AlarmSummary</name>
+    <message>
+        <source>listed alarms of priority {0} ({1})</source>
+        <translation>аварий приоритета {0} в списке ({1})</translation>
+    </message>
+    <message>
+        <source>Filter: alarm, text or state</source>
+        <translation>Фильтр: авария, текст или состояние</translation>
+    </message>
+    <message>
+        <source>Acknowledge</source>
+        <translation>Квитировать</translation>
+    </message>
+    <message>
+        <source>Acknowledge all</source>
+        <translation>Квитировать все</translation>
+    </message>
+    <message>
+        <source>Shelve…</source>
+        <translation>Отложить…</translation>
+    </message>
+    <message>
+        <source>Unshelve</source>
+        <translation>Вернуть</translation>
+    </message>
+    <message>
+        <source>Silence</source>
+        <translation>Без звука</translation>
+    </message>
+    <message>
+        <source>Stop the sound; the alarms stay unacknowledged</source>
+        <translation>Выключить звук; аварии остаются неквитированными</translation>
+    </message>
+    <message>
+        <source>Shelve</source>
+        <translation>Отложить</translation>
+    </message>
+    <message>
+        <source>Select the alarm to shelve first.</source>
+        <translation>Сначала выберите аварию, которую нужно отложить.</translation>
+    </message>
+</context>
+<context>
+    <name>AlarmTableModel</name>
+    <message>
+        <source>Priority</source>
+        <translation>Приоритет</translation>
+    </message>
+    <message>
+        <source>Time</source>
+        <translation>Время</translation>
+    </message>
+    <message>
+        <source>Alarm</source>
+        <translation>Авария</translation>
+    </message>
+    <message>
+        <source>State</source>
+        <translation>Состояние</translation>
+    </message>
+    <message>
+        <source>Value</source>
+        <translation>Значение</translation>
+    </message>
+    <message>
+        <source>Text</source>
+        <translation>Текст</translation>
+    </message>
+    <message>
+        <source>shelved by {0} until {1}: {2}</source>
+        <translation>отложена ({0}) до {1}: {2}</translation>
     </message>
 </context>
 <context>
@@ -43,6 +101,25 @@
     <message>
         <source>(indication off)</source>
         <translation>(индикация выключена)</translation>
+    </message>
+</context>
+<context>
+    <name>HealthDialog</name>
+    <message>
+        <source>Alarm-system health</source>
+        <translation>Состояние системы аварийной сигнализации</translation>
+    </message>
+    <message>
+        <source>Day:</source>
+        <translation>День:</translation>
+    </message>
+    <message>
+        <source>no alarm-system health: {0}</source>
+        <translation>нет данных о системе аварийной сигнализации: {0}</translation>
+    </message>
+    <message>
+        <source>{0}: cannot read the archive: {1}</source>
+        <translation>{0}: архив не читается: {1}</translation>
     </message>
 </context>
 <context>
@@ -244,6 +321,57 @@
         <source>Station: {0}</source>
         <translation>Станция: {0}</translation>
     </message>
+    <message>
+        <source>Alarms</source>
+        <translation>Аварии</translation>
+    </message>
+    <message>
+        <source>Alarms — {0} unacknowledged</source>
+        <translation>Аварии — неквитированных: {0}</translation>
+    </message>
+    <message>
+        <source>Simulated node {0} answers</source>
+        <translation>Имитируемый узел {0} отвечает</translation>
+    </message>
+    <message>
+        <source>Untick to pull the node's cable: its values go comm-fail, their alarms come</source>
+        <translation>Снимите флажок, чтобы «выдернуть кабель» узла: его значения получают признак «нет связи», приходят их аварии</translation>
+    </message>
+    <message>
+        <source>Alarm-system &amp;health…</source>
+        <translation>Состояние &amp;аварийной сигнализации…</translation>
+    </message>
+    <message>
+        <source>&amp;Program…</source>
+        <translation>&amp;Программа…</translation>
+    </message>
+    <message>
+        <source>open the program view (forcing, single scans)</source>
+        <translation>открыть просмотр программы (форсирование, одиночные циклы)</translation>
+    </message>
+</context>
+<context>
+    <name>ShelveDialog</name>
+    <message>
+        <source>Shelve {0}</source>
+        <translation>Отложить {0}</translation>
+    </message>
+    <message>
+        <source> min</source>
+        <translation> мин</translation>
+    </message>
+    <message>
+        <source>why (required)</source>
+        <translation>причина (обязательно)</translation>
+    </message>
+    <message>
+        <source>Duration</source>
+        <translation>Длительность</translation>
+    </message>
+    <message>
+        <source>Reason</source>
+        <translation>Причина</translation>
+    </message>
 </context>
 <context>
     <name>StationStatusBar</name>
@@ -302,6 +430,22 @@
     <message>
         <source>idle</source>
         <translation>простой</translation>
+    </message>
+    <message>
+        <source>F: {0} forced</source>
+        <translation>Ф: форсировано {0}</translation>
+    </message>
+    <message>
+        <source>forces in effect: force &gt; program &gt; live (Station -&gt; Program)</source>
+        <translation>действуют форсирования: форсирование &gt; программа &gt; объект (Станция -&gt; Программа)</translation>
+    </message>
+    <message>
+        <source>NetPlc program {0}</source>
+        <translation>NetPlc: {0}</translation>
+    </message>
+    <message>
+        <source>no link to node {0} ({1})</source>
+        <translation>нет связи с узлом {0} ({1})</translation>
     </message>
 </context>
 <context>
@@ -488,6 +632,14 @@
         <source>Open archive</source>
         <translation>Открыть архив</translation>
     </message>
+    <message>
+        <source>&lt;b&gt;Stations&lt;/b&gt;</source>
+        <translation>&lt;b&gt;Станции&lt;/b&gt;</translation>
+    </message>
+    <message>
+        <source>A message's type and worse; an alarm record by the priority of that severity (3 critical: priority 1, 2 alarm: 1-2, 1 warning: 1-3); a data record by its type</source>
+        <translation>Тип сообщения и более тяжёлые; запись аварии — по приоритету этой тяжести (3 критическая: приоритет 1, 2 авария: 1-2, 1 предупреждение: 1-3); запись данных — по её типу</translation>
+    </message>
 </context>
 <context>
     <name>_Header</name>
@@ -502,6 +654,29 @@
     <message>
         <source>Log in…</source>
         <translation>Войти…</translation>
+    </message>
+</context>
+<context>
+    <name>quality</name>
+    <message>
+        <source>Stale: the data source of this element is not answering; the last value is shown</source>
+        <translation>Устарело: источник данных этого элемента не отвечает; показано последнее значение</translation>
+    </message>
+    <message>
+        <source>? initial: no value from the plant yet (the node has not answered since the start)</source>
+        <translation>? нет данных: от объекта ещё нет значения (узел не отвечал с пуска)</translation>
+    </message>
+    <message>
+        <source>? comm-fail: the node that fills this value is down; the last value is shown</source>
+        <translation>? нет связи: узел, который даёт это значение, не отвечает; показано последнее значение</translation>
+    </message>
+    <message>
+        <source>? not running: NetPlc is stopped; the last value is shown, nothing changes</source>
+        <translation>? NetPlc остановлен: показано последнее значение, ничего не меняется</translation>
+    </message>
+    <message>
+        <source>? forced: the value is forced by an engineer, not the plant's</source>
+        <translation>? форсировано: значение задано инженером, а не получено с объекта</translation>
     </message>
 </context>
 <context>
@@ -569,6 +744,101 @@
     <message>
         <source>system</source>
         <translation>система</translation>
+    </message>
+</context>
+<context>
+    <name>words</name>
+    <message>
+        <source>viewer</source>
+        <translation>наблюдатель</translation>
+    </message>
+    <message>
+        <source>operator</source>
+        <translation>оператор</translation>
+    </message>
+    <message>
+        <source>engineer</source>
+        <translation>инженер</translation>
+    </message>
+    <message>
+        <source>admin</source>
+        <translation>администратор</translation>
+    </message>
+    <message>
+        <source>critical</source>
+        <translation>критическая</translation>
+    </message>
+    <message>
+        <source>high</source>
+        <translation>высокая</translation>
+    </message>
+    <message>
+        <source>medium</source>
+        <translation>средняя</translation>
+    </message>
+    <message>
+        <source>low</source>
+        <translation>низкая</translation>
+    </message>
+    <message>
+        <source>normal</source>
+        <translation>норма</translation>
+    </message>
+    <message>
+        <source>active-unacknowledged</source>
+        <translation>активна, не квитирована</translation>
+    </message>
+    <message>
+        <source>active-acknowledged</source>
+        <translation>активна, квитирована</translation>
+    </message>
+    <message>
+        <source>returned-unacknowledged</source>
+        <translation>вернулась, не квитирована</translation>
+    </message>
+    <message>
+        <source>shelved</source>
+        <translation>отложена</translation>
+    </message>
+    <message>
+        <source>suppressed</source>
+        <translation>подавлена</translation>
+    </message>
+    <message>
+        <source>out-of-service</source>
+        <translation>выведена из работы</translation>
+    </message>
+    <message>
+        <source>good</source>
+        <translation>достоверно</translation>
+    </message>
+    <message>
+        <source>initial</source>
+        <translation>нет данных</translation>
+    </message>
+    <message>
+        <source>stale</source>
+        <translation>устарело</translation>
+    </message>
+    <message>
+        <source>comm-fail</source>
+        <translation>нет связи</translation>
+    </message>
+    <message>
+        <source>not running</source>
+        <translation>NetPlc остановлен</translation>
+    </message>
+    <message>
+        <source>forced</source>
+        <translation>форсировано</translation>
+    </message>
+    <message>
+        <source>{0}: nobody is logged in ({1} needed)</source>
+        <translation>{0}: никто не вошёл (нужна роль «{1}»)</translation>
+    </message>
+    <message>
+        <source>{0}: needs the {1} role; {2} is {3}</source>
+        <translation>{0}: нужна роль «{1}»; {2} — {3}</translation>
     </message>
 </context>
 </TS>

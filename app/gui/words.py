@@ -1,0 +1,60 @@
+"""The console's words for what Qt-free models say in English: roles, alarm priorities and states,
+tag qualities, refusals.
+
+The models (app/users.py, netplc/tags/) keep their English words, which the journal, the command
+line and the tests read; the console translates them here, as shown, through Qt's translation
+mechanism (context "words" of app/gui/i18n/console_*.ts). The markers below list every source
+text for the translation files.
+"""
+
+from __future__ import annotations
+
+from PySide6.QtCore import QT_TRANSLATE_NOOP, QCoreApplication
+
+from app.users import Refusal
+from netplc.tags.alarms import PRIORITIES, State
+
+SOURCES = (
+    # roles (hmi_forms/elements/base.py ROLES)
+    QT_TRANSLATE_NOOP("words", "viewer"), QT_TRANSLATE_NOOP("words", "operator"),
+    QT_TRANSLATE_NOOP("words", "engineer"), QT_TRANSLATE_NOOP("words", "admin"),
+    # alarm priorities (netplc/tags/alarms.py PRIORITIES)
+    QT_TRANSLATE_NOOP("words", "critical"), QT_TRANSLATE_NOOP("words", "high"),
+    QT_TRANSLATE_NOOP("words", "medium"), QT_TRANSLATE_NOOP("words", "low"),
+    # alarm states (State.word)
+    QT_TRANSLATE_NOOP("words", "normal"), QT_TRANSLATE_NOOP("words", "active-unacknowledged"),
+    QT_TRANSLATE_NOOP("words", "active-acknowledged"), QT_TRANSLATE_NOOP("words", "returned-unacknowledged"),
+    QT_TRANSLATE_NOOP("words", "shelved"), QT_TRANSLATE_NOOP("words", "suppressed"),
+    QT_TRANSLATE_NOOP("words", "out-of-service"),
+    # tag qualities (netplc/tags/quality.py Quality.word)
+    QT_TRANSLATE_NOOP("words", "good"), QT_TRANSLATE_NOOP("words", "initial"),
+    QT_TRANSLATE_NOOP("words", "stale"), QT_TRANSLATE_NOOP("words", "comm-fail"),
+    QT_TRANSLATE_NOOP("words", "not running"), QT_TRANSLATE_NOOP("words", "forced"),
+)
+
+
+def word(english: str) -> str:
+    """A model's English word in the console's language (itself when there is no translation)."""
+    return QCoreApplication.translate("words", english) if english else english
+
+
+def role(name: str) -> str:
+    return word(name)
+
+
+def priority(p: int) -> str:
+    return word(PRIORITIES.get(p, ""))
+
+
+def state(s: State) -> str:
+    return word(s.word)
+
+
+def refusal(why: Refusal) -> str:
+    """The refusal's sentence in the console's language; the action is the caller's (already
+    translated or the form's own text)."""
+    if not why.user:
+        return QCoreApplication.translate("words", "{0}: nobody is logged in ({1} needed)").format(
+            why.action, role(why.role))
+    return QCoreApplication.translate("words", "{0}: needs the {1} role; {2} is {3}").format(
+        why.action, role(why.role), why.user, role(why.user_role))
