@@ -205,7 +205,7 @@ class MainWindow(QMainWindow):
                              self.tr("No forms"))
             return []
         forms, problems = self.runtime.open_forms()  # the views' own models: they only show
-        target = EngineTarget(self.runtime.engine, self.runtime.tags)
+        target = EngineTarget(self.runtime.engine, self.runtime.tags, on_busy=self.refuse)
         self.history = TrendHistory(station.Archive, self)
         for form in forms:
             view = FormView(form, target, archive_path=station.Archive, user=self.user,

@@ -25,6 +25,7 @@ from typing import Any, ClassVar
 
 from hmi_forms.elements import props as p
 from hmi_forms.elements.base import Element, Reader, Writer, word_reader
+from hmi_forms.elements.target import BUSY
 from hmi_forms.elements.trend import Trend
 from netplc.memory import Snapshot
 from netplc.tags.table import TagTable
@@ -261,6 +262,7 @@ class AnalogOutput(Scaled, Writer):
         assert self.OutAddr is not None
         if why := self.refused(f"{self.Name} \u2192 {self.format(self.scaling.to_phy(hw))}{units}"):
             return False, why
-        if self.target is not None:
-            self.target.write_word(self.OutAddr, hw, user=self.user, label=self.Name)
+        if self.target is not None and self.target.write_word(self.OutAddr, hw, user=self.user,
+                                                              label=self.Name) is False:
+            return False, BUSY
         return True, f"Set to {self.format(self.scaling.to_phy(hw))}{units}"

@@ -80,8 +80,7 @@ class DiscreteBase(Element, Writer):
         new = 0 if self.value else 1
         if self.refused(f"{self.Name} \u2192 {new}"):
             return False
-        self.target.write_bit(out.hmi, new, user=self.user, label=self.Name)
-        return True
+        return self.target.write_bit(out.hmi, new, user=self.user, label=self.Name) is not False
 
 
 @dataclass(eq=False)

@@ -12,6 +12,7 @@ Two channels, because they run in different places (docs/architecture.md section
 
 from __future__ import annotations
 
+from collections.abc import Callable
 from typing import TYPE_CHECKING, Protocol
 
 from netplc.records import Record
@@ -23,9 +24,15 @@ if TYPE_CHECKING:
 
 
 class Target(Protocol):
-    def write_bit(self, addr: int, value: int, *, user: str, label: str | None = None) -> None: ...
+    """`write_*` return False when the station refuses the write: its queue of outside writes is
+    full (the per-scan budget's back-pressure, docs/architecture.md section 1)."""
 
-    def write_word(self, addr: int, value: int, *, user: str, label: str | None = None) -> None: ...
+    def write_bit(self, addr: int, value: int, *, user: str, label: str | None = None) -> bool: ...
+
+    def write_word(self, addr: int, value: int, *, user: str, label: str | None = None) -> bool: ...
+
+
+BUSY = "the station is busy (its queue of outside writes is full): not written, try again"
 
 
 class Effects(Protocol):
@@ -41,22 +48,32 @@ class EngineTarget:
     to a tag's address is journaled with the tag's name and, for a word, its physical values and
     unit besides the raw ones (`write Уставка температуры TEMP_SP: 0.0 -> 130.0 °C (raw ...)`)."""
 
-    def __init__(self, engine: Engine, tags: TagTable | None = None) -> None:
+    def __init__(self, engine: Engine, tags: TagTable | None = None,
+                 on_busy: Callable[[str], None] | None = None) -> None:
+        """`on_busy(text)` tells the operator when the engine refuses a write (a full queue)."""
         self.engine = engine
+        self.on_busy = on_busy
         tags = tags or TagTable()
         self._bits = {t.address: t for t in tags.tags if t.type is TagType.BIT}
         self._words = {t.address: t for t in tags.tags if t.type in ONE_WORD}
 
-    def write_bit(self, addr: int, value: int, *, user: str, label: str | None = None) -> None:
+    def write_bit(self, addr: int, value: int, *, user: str, label: str | None = None) -> bool:
         tag = self._bits.get(addr)
-        self.engine.write_bit(addr, value, user=user, label=_named(label, tag))
+        return self._told(self.engine.write_bit(addr, value, user=user, label=_named(label, tag)), label)
 
-    def write_word(self, addr: int, value: int, *, user: str, label: str | None = None) -> None:
+    def write_word(self, addr: int, value: int, *, user: str, label: str | None = None) -> bool:
         tag = self._words.get(addr)
         if tag is None:
-            self.engine.write_word(addr, value, user=user, label=label)
+            done = self.engine.write_word(addr, value, user=user, label=label)
         else:
-            self.engine.write_word(addr, value, user=user, label=_named(label, tag), describe=tag.change)
+            done = self.engine.write_word(addr, value, user=user, label=_named(label, tag),
+                                          describe=tag.change)
+        return self._told(done, label)
+
+    def _told(self, accepted: bool, label: str | None) -> bool:
+        if not accepted and self.on_busy is not None:
+            self.on_busy(f"{label}: {BUSY}" if label else BUSY)
+        return accepted
 
 
 ONE_WORD = (TagType.WORD, TagType.INT16, TagType.BCD)
@@ -71,8 +88,8 @@ def _named(label: str | None, tag: Tag | None) -> str | None:
 class NullTarget:
     """A form shown without a station (the viewer, a benchmark): the operator's writes go nowhere."""
 
-    def write_bit(self, addr: int, value: int, *, user: str, label: str | None = None) -> None:
-        pass
+    def write_bit(self, addr: int, value: int, *, user: str, label: str | None = None) -> bool:
+        return True
 
-    def write_word(self, addr: int, value: int, *, user: str, label: str | None = None) -> None:
-        pass
+    def write_word(self, addr: int, value: int, *, user: str, label: str | None = None) -> bool:
+        return True

@@ -284,3 +284,28 @@ def test_journal_refreshes_today_every_refresh_ticks(tmp_path) -> None:
     assert j.kinds == ("message",) and j.min_type == 2
     j.day = dt.date(2026, 1, 1)
     assert not any(j.update(snap()) for _ in range(6))
+
+
+def test_a_write_the_station_refuses_with_a_full_queue_is_not_taken_for_done(tmp_path) -> None:
+    """Back-pressure reaches the operator: a full queue of outside writes refuses the click and
+    the setpoint, and the view is told why (the engine keeps the scan period whatever comes)."""
+    from hmi_forms.elements.target import BUSY, EngineTarget
+    from netplc.engine import Engine, FakeClock
+    from netplc.program import parse
+
+    engine = Engine(parse("JMP 0\n"), clock=FakeClock(), write_queue=1)
+    told: list[str] = []
+    target = EngineTarget(engine, on_busy=told.append)
+    (tmp_path / "b").mkdir()
+    (tmp_path / "s").mkdir()
+    button = element(tmp_path / "b", "DiscreteBase", Name="Пуск", InAddr="040042", Enabled=True)
+    setpoint = element(tmp_path / "s", "AnalogOutput", Name="Уставка", OutAddr="04030", AppMin=0,
+                       AppMax=4095, PhyMin=0, PhyMax=100)
+    for model in (button, setpoint):
+        model.bind(target, "operator")
+        model.refresh(engine.snapshot)
+    assert button.click()  # the queue takes one write
+    assert not button.click() and told == [f"Пуск: {BUSY}"]
+    assert setpoint.submit("50") == (False, BUSY)
+    engine.scan()  # the queue drains: writes are taken again
+    assert setpoint.submit("50")[0]
