@@ -16,6 +16,7 @@ from __future__ import annotations
 
 import difflib
 import json
+from collections.abc import Callable
 from dataclasses import dataclass, field, fields
 from pathlib import Path
 from typing import Any
@@ -93,6 +94,25 @@ def _unknown(name: str, known: list[str]) -> str:
     return f'unknown property; did you mean "{close[0]}"?' if close else "unknown property"
 
 
+def parse_form(path: Path, parse_int: Callable[[str], Any] = p.json_int) -> Any:
+    """The JSON of a form file; FormError naming the file and the place for anything else (not
+    text, not JSON, nested too deeply, with the default `parse_int` never a number too long)."""
+    try:
+        raw = read_text(path, "the form")
+    except TextFileError as e:
+        raise FormError([str(e)]) from None
+    try:
+        return json.loads(raw, parse_int=parse_int)
+    except json.JSONDecodeError as e:
+        raise FormError([f"{path}:{e.lineno}:{e.colno}: bad JSON: {e.msg}"]) from None
+    except RecursionError:
+        line, col = _too_deep(raw)
+        raise FormError([f"{path}:{line}:{col}: bad JSON: arrays or objects nested too deeply "
+                         f"(here past {MAX_NESTING} levels)"]) from None
+    except ValueError as e:  # a `parse_int` that refuses a number (int: past 4300 digits)
+        raise FormError([f"{path}: bad JSON: {e}"]) from None
+
+
 class _Loader:
     def __init__(self, path: Path, symbols: dict[str, int], station: Path | None,
                  allow_outside: bool, tags: TagTable | None = None) -> None:
@@ -108,19 +128,7 @@ class _Loader:
         self.fatal += fatal
 
     def load(self) -> Form:
-        try:
-            raw = read_text(self.path, "the form")
-        except TextFileError as e:
-            raise FormError([str(e)]) from None
-        try:
-            doc = json.loads(raw, parse_int=p.json_int)
-        except json.JSONDecodeError as e:
-            raise FormError([f"{self.path}:{e.lineno}:{e.colno}: bad JSON: {e.msg}"]) from None
-        except RecursionError:
-            line, col = _too_deep(raw)
-            raise FormError([f"{self.path}:{line}:{col}: bad JSON: arrays or objects nested too deeply "
-                             f"(here past {MAX_NESTING} levels)"]) from None
-        return self.build(doc)
+        return self.build(parse_form(self.path))
 
     def build(self, doc: Any) -> Form:
         """The form of a parsed document (the designer checks its unsaved document through this)."""

@@ -18,9 +18,8 @@ from typing import Any
 
 from hmi_forms.elements import ELEMENT_TYPES, Element
 from hmi_forms.elements import props as p
-from hmi_forms.form import FormError, _Loader
+from hmi_forms.form import FormError, _Loader, parse_form
 from hmi_forms.form_writer import dump_form, save_form
-from netplc.textfile import TextFileError, read_text
 
 # What a required property stands in with while it is missing or bad, for drawing only.
 PLACEHOLDERS: dict[Any, Any] = {p.bit: "00000", p.word: "04000", p.image_index: -1}
@@ -55,14 +54,7 @@ def read_doc(path: str | Path) -> FormDoc:
     """The document of a form file; FormError when it cannot be edited at all (not JSON, no list
     of element objects). Every other problem is the problems pane's."""
     path = Path(path)
-    try:
-        data = json.loads(read_text(path, "the form"))
-    except TextFileError as e:
-        raise FormError([str(e)]) from None
-    except json.JSONDecodeError as e:
-        raise FormError([f"{path}:{e.lineno}:{e.colno}: bad JSON: {e.msg}"]) from None
-    except RecursionError:
-        raise FormError([f"{path}: bad JSON: arrays or objects nested too deeply"]) from None
+    data = parse_form(path, parse_int=int)  # plain ints: the writer saves what it read
     if not isinstance(data, dict):
         raise FormError([f"{path}: the form must be a JSON object with form, devices, elements"])
     elements = data.get("elements", [])

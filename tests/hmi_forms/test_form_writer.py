@@ -7,7 +7,7 @@ from pathlib import Path
 
 import pytest
 
-from hmi_forms.form import load_form
+from hmi_forms.form import FormError, load_form
 from hmi_forms.form_doc import Reader, new_doc, problems, read_doc
 from hmi_forms.form_writer import dump_form, element_keys, save_form
 from netplc.program import load_symbols
@@ -134,3 +134,17 @@ def test_the_command_line_re_saves_hand_written_forms(tmp_path: Path,
     assert "bad.hmi:1:2: bad JSON" in capsys.readouterr().err
     assert hand.read_text(encoding="utf-8") == dump_form(json.loads(hand.read_text(encoding="utf-8")))
     assert hand.read_text(encoding="utf-8").startswith('{\n "form": {\n  "title": "f",')
+
+
+@pytest.mark.parametrize(("text", "says"), [
+    ('{"form": {"width": 1' + "0" * 5000 + "}}", "4300 digits"),
+    ("[" * 100_000 + "]" * 100_000, "nested too deeply"),
+    ('{"form": ', "bad JSON"),
+])
+def test_a_form_the_designer_cannot_open_is_a_named_error(tmp_path, text: str, says: str) -> None:
+    """The designer reads a form as the loader does (hmi_forms.form.parse_form): never a traceback."""
+    path = tmp_path / "broken.hmi"
+    path.write_text(text, encoding="utf-8")
+    with pytest.raises(FormError) as e:
+        read_doc(path)
+    assert e.value.problems[0].startswith(str(path)) and says in e.value.problems[0]
