@@ -27,9 +27,9 @@ TIM $03000 N:5
 """
 
 
-def engine(compiled: bool = True) -> tuple[Engine, ListSink, FakeClock]:
+def engine(compiled: bool = True, program: str = PROGRAM) -> tuple[Engine, ListSink, FakeClock]:
     sink, clock = ListSink(), FakeClock()
-    eng = Engine(parse(PROGRAM), clock=clock, sink=sink, wallclock=lambda: 1000.0, compiled=compiled)
+    eng = Engine(parse(program), clock=clock, sink=sink, wallclock=lambda: 1000.0, compiled=compiled)
     return eng, sink, clock
 
 

@@ -10,9 +10,10 @@ import pytest
 
 from netplc.engine import Engine, FakeClock
 from netplc.forcing import tag_forces
-from netplc.program import parse
 from netplc.records import ListSink
 from netplc.tags.tag import Scaling, Tag, TagType
+from tests.netplc.test_forcing import engine as forcing_engine
+from tests.netplc.test_forcing import scans, texts
 
 # the program copies the word 04000 to 04002 and the two words 04010/04012 to 04020/04022, and
 # itself writes 04000's neighbour 04004 every scan
@@ -32,19 +33,7 @@ FLOW = Tag("FLOW", 0o4010, TagType.FLOAT32, "m3/h", Scaling(0, 100, 0, 50), 2)
 
 
 def engine(compiled: bool) -> tuple[Engine, ListSink, FakeClock]:
-    sink, clock = ListSink(), FakeClock()
-    eng = Engine(parse(PROGRAM), clock=clock, sink=sink, wallclock=lambda: 1000.0, compiled=compiled)
-    return eng, sink, clock
-
-
-def scans(eng: Engine, clock: FakeClock, n: int = 1) -> None:
-    for _ in range(n):
-        clock.advance(eng.tick)
-        eng.scan()
-
-
-def texts(sink: ListSink) -> list[tuple[str | None, str | None]]:
-    return [(r.source, r.text) for r in sink.records if r.kind == "operator"]
+    return forcing_engine(compiled, PROGRAM)
 
 
 def test_a_tag_and_its_physical_value_become_raw_forces() -> None:
