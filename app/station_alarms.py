@@ -20,16 +20,15 @@ alarm returns, and the tags are initial until fresh data lands, as at start.
 
 from __future__ import annotations
 
-from collections.abc import Callable, Iterable, Mapping, Sequence
+from collections.abc import Callable, Mapping, Sequence
 from pathlib import Path
 from typing import Any
 
 import numpy as np
 
-from netplc.address import EMERGENCY_STOP, IO_BITS, fmt_octal
+from netplc.address import EMERGENCY_STOP, fmt_octal
 from netplc.engine import Engine, RunState
 from netplc.exchange import Exchange
-from netplc.forcing import Force
 from netplc.memory import Snapshot
 from netplc.program import Program
 from netplc.records import Record, RecordSink
@@ -98,7 +97,7 @@ class StationAlarms:
                          links={n: ex.link_up(n) for n in ex.configs} if ex is not None else {},
                          refreshed=dict(ex.refreshed) if ex is not None else {},
                          since=dict(self._since) if ex is not None else None,
-                         forced=forced_operands(snapshot.forces))
+                         forced=[a for f in snapshot.forces for a in f.operands])
         self.quality = self.quality_map.evaluate(snapshot, links)
         self.readings = Readings(snapshot, self.quality_map, links, self.quality)
         for record in self.series.evaluate(snapshot, links, snapshot.wall):
@@ -180,16 +179,3 @@ def stop_reason(state: str) -> str:
     if state == RunState.STOPPED:
         return "stopped by the operator or the watchdog (code 0)"
     return state
-
-
-def forced_operands(forces: Iterable[Force]) -> list[int]:
-    """The I/O bits and data bytes the forces cover, as quality reads them (LinkView.forced)."""
-    out: list[int] = []
-    for f in forces:
-        if f.kind == "bit":
-            out.append(f.addr if f.addr < IO_BITS else f.addr // 8)  # HMI bit: byte*8 + bit
-        else:
-            size = 1 if f.kind == "byte" else 2
-            out += (range(f.addr, f.addr + 8 * size) if f.addr < IO_BITS
-                    else range(f.addr, f.addr + size))  # below 04000: the bits starting at the address
-    return out

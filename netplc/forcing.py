@@ -59,6 +59,16 @@ class Force:
             return fmt_octal(self.addr, 6 if self.addr >= HMI_DATA_BIT_BASE else 5)
         return f"{fmt_octal(self.addr)}:{self.kind}"
 
+    @property
+    def operands(self) -> range:
+        """The I/O bits and data bytes it covers, as quality reads forcing (LinkView.forced)."""
+        if self.kind == "bit":
+            at = self.addr if self.addr < IO_BITS else self.addr // 8  # HMI bit: byte*8 + bit
+            return range(at, at + 1)
+        size = 1 if self.kind == "byte" else 2
+        # below 04000 a byte or word operand is the 8 or 16 bits starting at its address
+        return range(self.addr, self.addr + (8 * size if self.addr < IO_BITS else size))
+
     def read(self, mem: MemoryView) -> int:
         if self.kind == "bit":
             return mem.get_hmi_bit(self.addr)

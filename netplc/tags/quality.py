@@ -30,7 +30,7 @@ NetPlc is stopped. Readers show the link itself there (`link_outputs`, `Readings
 
 Forcing (netplc/forcing.py) reaches quality through one hook: `LinkView.forced`, the forced
 operand addresses of the scan, which the runtime fills from the snapshot's forces
-(app/station_alarms.py, `forced_operands`).
+(`Force.operands`, app/station_alarms.py).
 """
 
 from __future__ import annotations
