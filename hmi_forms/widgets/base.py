@@ -3,7 +3,10 @@
 Painting is split in two: a layer (background, frame and everything that depends only on a few
 states, such as a discrete element's text or a gauge's scale) rendered once per state into a
 pixmap, and a dynamic part (a pointer, a value) drawn over it. A form of hundreds of elements then
-costs one pixmap copy per element and tick plus the few strokes that really change.
+costs one pixmap copy per element and tick plus the few strokes that really change. Where the
+dynamic part also comes from cached pixmaps (texts, needles, bar fills), a change composes the
+element into a short list of pixmap copies at its place on the form (`compose`): painting it then
+needs no painter state, and an unchanged composition is not repainted at all.
 
 Widgets only draw what their model computed. The stale mark (grey wash, hatching and a "?" badge)
 is a child widget kept above everything else, so it also covers plots and input fields, and it is
@@ -12,7 +15,7 @@ drawn identically for all element types: an operator learns it once.
 
 from __future__ import annotations
 
-from collections.abc import Hashable
+from collections.abc import Callable, Hashable
 from operator import attrgetter
 from pathlib import Path
 
@@ -23,6 +26,8 @@ from PySide6.QtWidgets import QWidget
 from hmi_forms.elements import Element
 from hmi_forms.widgets import theme
 
+Op = tuple[Callable[..., None], tuple[object, ...]]  # an unbound QPainter method and its arguments:
+PIX, FILL = QPainter.drawPixmap, QPainter.fillRect  # (x, y, pixmap) and (x, y, w, h, colour)
 STYLE = ("BackColor", "ForeColor", "BorderStyle", "Font")  # checked at every draw (`style`)
 ORIGIN = QPoint(0, 0)
 MAX_LAYERS = 6  # cached layers per widget: enough for every state of a discrete element
@@ -147,9 +152,12 @@ class ElementWidget(QWidget):
         self._style = self.style()
         self._look = self.look()
         # the form and the rectangle on it, kept: asking Qt for them costs more than the repaint
-        self._where: tuple[QWidget | None, QRect] | None = None
+        self._where: tuple[Callable[[QRect], None] | None, QRect, int, int] | None = None
         self._stale = False
-        self._tip = ""
+        self._tip = ""  # the element's own tooltip, kept while the quality mark's is shown
+        # the element as its form draws it now (`compose`), or None: drawn with a painter (`draw`)
+        self.drawn: list[Op] | None = None
+        self._dynamic = type(self).paint_dynamic is not ElementWidget.paint_dynamic
 
     def back_color(self) -> QColor | None:
         if self.model.BackColor is not None:
@@ -160,25 +168,41 @@ class ElementWidget(QWidget):
         return theme.qcolor(self.model.ForeColor, theme.TEXT)
 
     def sync(self) -> None:
-        """The model changed: have the form repaint this element's rectangle."""
+        """The model changed: compose the element anew and have the form repaint it, unless it
+        looks exactly as it did (a value that moved less than a pixel costs no paint)."""
+        drawn = self.compose()
+        if drawn is not None and drawn == self.drawn:
+            return
+        self.drawn = drawn
         self.repaint_part(None)
-        if self.model.stale != self._stale:
-            self._stale = self.model.stale
-            if self._stale:
+        if self._stale or self.model.stale:
+            self.mark_quality()
+
+    def mark_quality(self) -> None:
+        """The quality mark's tooltip while the data are not good; the element's own after."""
+        stale = self.model.stale
+        if stale != self._stale:
+            self._stale = stale
+            if stale:
                 self._tip = self.toolTip()
-        if self._stale:
+            else:
+                self.setToolTip(self._tip)
+        if stale:
             self.setToolTip(quality_tip(self.model.quality or "stale"))
-        elif self.toolTip() != self._tip:
-            self.setToolTip(self._tip)
 
     def repaint_part(self, part: QRect | None) -> None:
         """Have the form repaint `part` of this element (in its own coordinates), or all of it."""
-        parent, rect = self._where or self._locate()
-        if parent is not None:
-            parent.update(rect if part is None else part.translated(rect.topLeft()).intersected(rect))
+        update, rect, _, _ = self._where or self._locate()
+        if update is not None:
+            update(rect if part is None else part.translated(rect.topLeft()).intersected(rect))
 
-    def _locate(self) -> tuple[QWidget | None, QRect]:
-        where = self._where = (self.parentWidget(), self.geometry())
+    def _locate(self) -> tuple[Callable[[QRect], None] | None, QRect, int, int]:
+        """What repaints a part of the form (the form's own scheduler when it has one), and where
+        the element is on it."""
+        parent = self.parentWidget()
+        rect = self.geometry()
+        update = None if parent is None else getattr(parent, "schedule", parent.update)
+        where = self._where = (update, rect, rect.x(), rect.y())
         return where
 
     def style_props(self) -> tuple[str, ...]:
@@ -186,8 +210,8 @@ class ElementWidget(QWidget):
         return STYLE
 
     def style(self) -> tuple[object, ...]:
-        """The colours, frame and font: checked at every draw, so that a change (a form
-        designer sets a colour) rebuilds the cached pictures by itself. Other properties the
+        """The colours, frame and font: checked at every draw and composition, so that a change
+        (a form designer sets a colour) rebuilds the cached pictures by itself. Other properties the
         pictures are drawn from are in `look`: after changing one, call `restyle`."""
         return self._style_of(self.model)
 
@@ -199,6 +223,7 @@ class ElementWidget(QWidget):
 
     def restyle(self) -> None:
         """Forget the cached pictures: the look changed."""
+        self.drawn = None
         self._layers.clear()
         self._style = self.style()
         self._look = self.look()
@@ -218,6 +243,25 @@ class ElementWidget(QWidget):
         self.paint_dynamic(p, r)
         if self.model.stale:
             paint_stale(p, r)
+
+    def compose(self) -> list[Op] | None:
+        """The element as its form draws it now, at its place on the form: pixmap copies and flat
+        fills from the caches, with no painter state and no clip (each lies inside the element).
+        A tick of a large form then costs a C++ call per part instead of a painter set up per
+        element, and two compositions compare equal exactly when the pixels would. None: it
+        needs `draw` this time (the stale mark, or a part no cache holds)."""
+        if self.model.stale:
+            return None
+        if self._style_of(self.model) != self._style:
+            self.restyle()
+        _, _, x, y = self._where or self._locate()
+        dynamic = self.dynamic_ops(x, y)
+        return None if dynamic is None else [(PIX, (x, y, self.layer())), *dynamic]
+
+    def dynamic_ops(self, x: int, y: int) -> list[Op] | None:
+        """What `paint_dynamic` draws, as ops for the element at (x, y) on the form; None where
+        it needs a painter (the default for a widget that has a dynamic part)."""
+        return None if self._dynamic else []
 
     def layer(self) -> QPixmap:
         key = self.layer_key()
@@ -269,11 +313,11 @@ class ElementWidget(QWidget):
 
     def resizeEvent(self, event: QResizeEvent) -> None:
         self._layers.clear()
-        self._where = None
+        self._where = self.drawn = None
         super().resizeEvent(event)
 
     def moveEvent(self, event: QMoveEvent) -> None:
-        self._where = None
+        self._where = self.drawn = None
         super().moveEvent(event)
 
     def changeEvent(self, event: QEvent) -> None:

@@ -3,10 +3,12 @@
 The workstation calls `refresh(snapshot)` with the snapshots the bridge hands to the GUI thread (it
 skips some when the window lags: a view only shows, and forwards the operator's input; what the
 form does to the station, the runtime does from every snapshot, hmi_forms/behaviour.py). Every
-model reads the snapshot;
-only widgets whose model reports a change are scheduled for repainting, and Qt paints them all in
-one pass. Trend plots are redrawn once a second (as PyDM does by default), all plots of a form in
-the same tick on one clock-time axis, so two trends never disagree about when something happened.
+model reads the snapshot; only widgets whose model reports a change compose themselves anew
+(pixmaps from the caches at their places) and, if that differs from what is shown, are scheduled
+for repainting. Qt paints them all in one pass, and one rectangle stands for them when most of a
+large form changed. Trend plots are redrawn once a second (as PyDM does by default), all plots of
+a form in the same tick on one clock-time axis, so two trends never disagree about when something
+happened.
 A model that raises is reported once, marked stale and skipped; the rest of the form keeps running.
 With the runtime's `Readings` of the scan, each element is also given the quality of what it shows
 (one judgement per distinct operand per refresh), and marks anything but good.
@@ -19,7 +21,7 @@ from collections.abc import Callable
 from pathlib import Path
 
 import numpy as np
-from PySide6.QtCore import QRectF, QSize, Qt
+from PySide6.QtCore import QRect, QRectF, QSize, Qt
 from PySide6.QtGui import QColor, QPainter, QPaintEvent, QTransform
 from PySide6.QtWidgets import QWidget
 
@@ -45,6 +47,8 @@ from netplc.memory import Snapshot
 from netplc.tags.quality import Quality
 from netplc.tags.readings import Readings
 
+BATCH = 100  # changed elements from which a refresh that changed most of the form repaints it whole
+
 
 class FormView(QWidget):
     def __init__(self, form: Form, target: Target, *, archive_path: str | Path | None = None,
@@ -67,6 +71,7 @@ class FormView(QWidget):
         self.errors: list[str] = []
         self._last: Snapshot | None = None
         self.clock = clock
+        self._dirty: list[QRect] | None = None  # parts to repaint, gathered during a refresh
         archive = Path(archive_path) if archive_path is not None else None
         for model in form.elements:
             model.bind(target, user)
@@ -82,6 +87,9 @@ class FormView(QWidget):
             if not isinstance(widget, SelfPainted):
                 self.painted.append(widget)
         # where each painted element goes, worked out once: the paint loop runs 200 times a tick
+        self._extent = QRect()  # what the painted elements cover
+        for w in self.painted:
+            self._extent = self._extent.united(w.geometry())
         self._slots = [(w, w.geometry(), QTransform.fromTranslate(w.x(), w.y()), QRectF(w.rect()))
                        for w in self.painted]
         self.live = True  # the trends follow the clock; paused, the operator pans and zooms them
@@ -129,19 +137,36 @@ class FormView(QWidget):
         if readings is not None:
             snapshot = readings.live(snapshot)  # link outputs follow the link, not the last scan
         judged: dict[tuple[int, int], Quality] = {}
-        for model, widget in self.pairs:
-            try:
-                quality = None if readings is None else _worst(model.sources(), readings, judged)
-                changed = model.update(snapshot, quality)
-            except Exception as e:
-                self._fault(model, e, "update")
-                changed = True
-            if changed:
-                widget.sync()
+        dirty = self._dirty = []
+        try:
+            for model, widget in self.pairs:
+                try:
+                    quality = None if readings is None else _worst(model.sources(), readings, judged)
+                    if model.update(snapshot, quality):
+                        widget.sync()
+                except Exception as e:
+                    self._fault(model, e, "update")
+                    widget.sync()  # marked stale: drawn with a painter, which shows the mark
+        finally:
+            self._dirty = None
+        if len(dirty) > BATCH and len(dirty) * 2 > len(self._slots):
+            # most of a large form: one rectangle costs Qt far less than hundreds (a region of n
+            # rectangles costs n² to build), and an element unchanged is one more pixmap copy
+            self.update()
+        else:
+            for part in dirty:
+                self.update(part)
         now = self.clock()
         if self.trends and now >= self._next_flush:  # all plots of the form in the same tick
             self._next_flush = max(self._next_flush + REDRAW_INTERVAL, now)
             self._redraw(snapshot.wall)
+
+    def schedule(self, part: QRect) -> None:
+        """Repaint `part` of the form: at once, or with the rest of a refresh."""
+        if self._dirty is None:
+            self.update(part)
+        else:
+            self._dirty.append(part)
 
     def _redraw(self, wall: float) -> None:
         for trend in self.trends:
@@ -198,23 +223,33 @@ class FormView(QWidget):
         return self.grab().save(str(path))
 
     def paintEvent(self, event: QPaintEvent) -> None:
-        """The background, and every QPainter-drawn element in the repainted region, with one painter."""
+        """The background, and every QPainter-drawn element in the repainted region, with one
+        painter: a composed element (`ElementWidget.compose`) costs a C++ call per part; the
+        others are drawn with the painter moved and clipped to them."""
         p = QPainter(self)
         try:  # a painter left active after an error would crash Qt
             p.fillRect(event.rect(), self._back)
             if self.form.BackgroundImage is not None:
                 draw_pixmap(p, self.images.get(self.form.BackgroundImage), QRectF(self.rect()), "Stretch")
             region = event.region()
+            whole = region.rectCount() == 1 and event.rect().contains(self._extent)  # no test per element
             p.setRenderHint(QPainter.RenderHint.Antialiasing)
-            for widget, geometry, at, rect in self._slots:  # each sets the pens, fonts... it uses
-                if not region.intersects(geometry):
+            for widget, geometry, at, rect in self._slots:
+                if not whole and not region.intersects(geometry):
                     continue
-                p.setTransform(at)
-                p.setClipRect(rect)
                 try:
+                    ops = widget.drawn
+                    if ops is not None:
+                        for method, args in ops:
+                            method(p, *args)
+                        continue
+                    p.setTransform(at)  # each sets the pens, fonts... it uses
+                    p.setClipRect(rect)
                     widget.draw(p, rect)
                 except Exception as e:
                     self._fault(widget.model, e, "drawing")
+                p.setClipping(False)
+                p.resetTransform()
         finally:
             p.end()
 

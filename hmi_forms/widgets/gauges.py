@@ -21,6 +21,7 @@ from PySide6.QtGui import (
     QPainter,
     QPainterPath,
     QPen,
+    QPixmap,
     QPolygonF,
     QResizeEvent,
     QTransform,
@@ -29,7 +30,7 @@ from PySide6.QtWidgets import QWidget
 
 from hmi_forms.elements.analog import AnalogBase
 from hmi_forms.widgets import theme
-from hmi_forms.widgets.base import STYLE, ElementWidget, Images
+from hmi_forms.widgets.base import FILL, PIX, STYLE, ElementWidget, Images, Op
 from hmi_forms.widgets.sprites import SPRITES, Ink, Sprite, TextSlot, blank
 
 
@@ -90,7 +91,11 @@ class GaugeWidget(ElementWidget):
         self._value: TextSlot | None = None  # where the value text goes, drawn from cached pixmaps
         self._part: QRect | None = None  # what a new text alone repaints (None: the whole element)
         self._paint_value: Callable[[QPainter], None] = self._paint_needle  # by Appearance
+        self._value_ops: Callable[[int, int, QPixmap | None], list[Op] | None] = self._needle_ops  # as ops
+        self._text_op: Op | None = None  # the value's part of the last composition
+        self._bar: tuple[int, int, int, float] = (0, 0, 0, 0.0)  # the fill's left, top, height and travel
         self._needles: dict[Hashable, Sprite] | None = None  # the needle by position (None: drawn each time)
+        self._contained = True  # the dial lies inside the element (its sprites need no clip)
         self._shown: tuple[object, ...] | None = None
         self.setToolTip(f"{model.Name}: word {oct(model.InAddr or 0)[2:].rjust(5, '0')}, "
                         f"{model.format(lo)} … {model.format(hi)}{self._units}"
@@ -109,12 +114,14 @@ class GaugeWidget(ElementWidget):
             self._digital = self._compute_digital_geometry()
             appearance = self.model.Appearance
             dpr = self.devicePixelRatioF()
+            bounds = QRectF(self.rect())  # the sprites never reach past the element
             if appearance == "hbar":
-                self._paint_value = self._paint_bar_value
+                self._paint_value, self._value_ops = self._paint_bar_value, self._bar_ops
                 track = self._track = self._bar_geometry()
                 self._travel = track.width()
                 top = math.ceil(track.top() + 1)  # pixel-aligned: a fractional fill costs twice as much
                 self._fill = QRect(math.ceil(track.left() + 1), top, 0, math.floor(track.bottom()) - top)
+                self._bar = (self._fill.x(), top, self._fill.height(), track.width() - 1)
                 nh = max(self._name_height(), self.height() * 0.28)
                 font = self._bar_font(nh)
                 box = QRectF(6, 2, self.width() - 12, nh + 2)
@@ -122,25 +129,30 @@ class GaugeWidget(ElementWidget):
                 widest = QFontMetricsF(font).horizontalAdvance("0" * self.digits + self._units) + 6
                 area = box.adjusted(-3, -3, 3, 3)
                 area.setLeft(max(area.left(), area.right() - widest))
-                self._value = TextSlot(box, font, theme.RIGHT, dpr, area)
+                self._value = TextSlot(box, font, theme.RIGHT, dpr, area, bounds)
             elif appearance == "digital":
-                self._paint_value = self._paint_digital_value
+                self._paint_value, self._value_ops = self._paint_digital_value, self._digital_ops
                 box, size, units_w = self._digital
                 text = box.adjusted(6, 0, -6 - units_w, 0)  # the units keep 8 px clear on its right
                 fill = QRectF(box.left() + 2, box.top() + 2, text.right() + 6 - box.left(), box.height() - 4)
                 font = theme.sized_font(size, bold=True, family=theme.MONO)
-                self._value = TextSlot(text, font, theme.RIGHT, dpr, fill)
+                self._value = TextSlot(text, font, theme.RIGHT, dpr, fill, bounds)
             else:
-                self._paint_value = self._paint_needle
+                self._paint_value, self._value_ops = self._paint_needle, self._needle_ops
                 c, r, start, sweep = self._dial
                 self._travel = abs(math.radians(sweep)) * r  # the maximum mark's outer corner
                 self._needle = QPolygonF([QPointF(0.8 * r, 0), QPointF(0, 0.045 * r),
                                           QPointF(-0.12 * r, 0), QPointF(0, -0.045 * r)])
                 box, size = self._box
                 self._value = TextSlot(box, theme.sized_font(size, bold=True, family=theme.MONO),
-                                       Qt.AlignmentFlag.AlignCenter, dpr, box.adjusted(2, 2, -2, -2))
+                                       Qt.AlignmentFlag.AlignCenter, dpr, box.adjusted(2, 2, -2, -2), bounds)
                 key = (c.toTuple(), r, start, sweep, self._travel, dpr)
                 self._needles = SPRITES.family(key) if r <= SPRITE_DIAL else None
+                # a dial squeezed below its least radius pokes out: its needle needs the clip (a
+                # semidial's needle reaches below its centre only by its tail)
+                below = r * 0.12 if sweep == -180.0 else r
+                reach = QRectF(c.x() - r - 2, c.y() - r - 2, 2 * r + 4, r + below + 4)
+                self._contained = bounds.contains(reach)
             # a new text alone repaints its box, in a large gauge: in a small one the pixels
             # saved are fewer than what cutting the form's repainted region into more
             # rectangles costs Qt
@@ -180,15 +192,28 @@ class GaugeWidget(ElementWidget):
 
     def sync(self) -> None:
         """Repaint only when something moved by a pixel or a text changed (a value that creeps
-        below a pixel per tick costs no paint until it has moved one)."""
-        shown, old = self.shown(), self._shown
-        if shown == old:
+        below a pixel per tick costs no paint until it has moved one): compared by composition,
+        or by `shown` when drawn with a painter."""
+        old = self.drawn
+        drawn = self.compose()
+        if drawn is None:
+            shown, was = self.shown(), self._shown
+            if old is None and shown == was:
+                return
+            self._shown = shown
+            text_only = old is None and was is not None and was[1:] == shown[1:]
+        elif drawn == old:
             return
-        self._shown = shown
-        if self._part is not None and old is not None and old[1:] == shown[1:]:
+        else:
+            self._shown = None
+            text_only = old is not None and len(old) == len(drawn) and all(
+                a == b or b is self._text_op for a, b in zip(old, drawn))
+        self.drawn = drawn
+        if self._part is not None and text_only:
             self.repaint_part(self._part)  # only the text changed: its box is all that changes
             return
-        super().sync()
+        self.repaint_part(None)
+        self.mark_quality()
 
     def _dial_geometry(self) -> tuple[QPointF, float, float, float]:
         """Centre, radius, start angle and sweep (degrees, counter-clockwise from 3 o'clock)."""
@@ -242,6 +267,30 @@ class GaugeWidget(ElementWidget):
     def paint_dynamic(self, p: QPainter, r: QRectF) -> None:
         self._layout()
         self._paint_value(p)
+
+    def compose(self) -> list[Op] | None:
+        """As ElementWidget's, with the common case in one call: a gauge is most of a large form."""
+        m = self.model
+        if m.stale or m.maximum is not None or not self._laid_out or self._style_of(m) != self._style:
+            return super().compose()  # the maximum mark is drawn with a painter
+        layer = self._layers.get(m.zone)
+        _, _, x, y = self._where or self._locate()
+        return self._value_ops(x, y, layer or self.layer())
+
+    def dynamic_ops(self, x: int, y: int) -> list[Op] | None:
+        self._layout()
+        ops = self._value_ops(x, y, None)
+        return None if ops is None else ops[1:]
+
+    def _text(self, x: int, y: int, text: str, ink: Ink) -> Op | None:
+        """The value's text as an op, or None for one no sprite holds."""
+        assert self._value is not None
+        sprite = self._value.sprites.get((text, ink.key)) or self._value.sprite(text, ink)
+        if sprite is None:
+            return None
+        tx, ty, pix = sprite
+        op = self._text_op = (PIX, (x + tx, y + ty, pix))
+        return op
 
     def _paint_name(self, p: QPainter) -> None:
         nh = self._name_height()
@@ -386,13 +435,35 @@ class GaugeWidget(ElementWidget):
         if self._needles is None:
             self._draw_needle(p, c, r, start + sweep * m.fraction)
             return
-        # the needle to the nearest pixel its tip travels, as `shown` tells a move
-        pointer = round(m.fraction * self._travel)
+        p.drawPixmap(*self._needle_sprite())
+
+    def _needle_sprite(self) -> Sprite:
+        """The needle to the nearest pixel its tip travels, as `shown` tells a move."""
+        assert self._needles is not None
+        pointer = round(self.model.fraction * self._travel)
         sprite = self._needles.get(pointer)
         if sprite is None:
+            c, r, start, sweep = self._dial
             sprite = SPRITES.put(self._needles, pointer,
                                  self._render_needle(c, r, start + sweep * pointer / self._travel))
-        p.drawPixmap(*sprite)
+        return sprite
+
+    def _needle_ops(self, x: int, y: int, layer: QPixmap | None) -> list[Op] | None:
+        """The layer (None: left for the caller), value and needle; None where a painter is needed
+        (the maximum mark, a needle no sprite holds, a dial that pokes out of its element)."""
+        m = self.model
+        if m.maximum is not None or not self._contained:
+            return None
+        text = self._text(x, y, m.text or "---", BOXED[m.zone])
+        if text is None:
+            return None
+        if m.hw is None:
+            return [(PIX, (x, y, layer)), text]
+        needles = self._needles
+        if needles is None:
+            return None
+        sprite = needles.get(round(m.fraction * self._travel)) or self._needle_sprite()
+        return [(PIX, (x, y, layer)), text, (PIX, (x + sprite[0], y + sprite[1], sprite[2]))]
 
     def _render_needle(self, c: QPointF, r: float, angle: float) -> Sprite:
         """The needle at `angle` in a pixmap just large enough for it (less to blend per tick)."""
@@ -408,7 +479,7 @@ class GaugeWidget(ElementWidget):
             self._draw_needle(p, c, r, angle)
         finally:
             p.end()
-        return at.topLeft(), pix
+        return at.x(), at.y(), pix
 
     def _draw_needle(self, p: QPainter, c: QPointF, r: float, angle: float) -> None:
         at = p.transform()
@@ -436,6 +507,17 @@ class GaugeWidget(ElementWidget):
             p.drawLine(QPointF(x, track.top() - 3), QPointF(x, track.bottom()))
         assert self._value is not None
         self._value.draw(p, (m.text or "---") + self._units, BARE[m.zone])
+
+    def _bar_ops(self, x: int, y: int, layer: QPixmap | None) -> list[Op] | None:
+        m = self.model
+        if m.maximum is not None:  # the maximum mark is drawn with a painter
+            return None
+        text = self._text(x, y, (m.text or "---") + self._units, BARE[m.zone])
+        if text is None or m.hw is None:
+            return None if text is None else [(PIX, (x, y, layer)), text]
+        left, top, height, travel = self._bar  # the fraction is clamped to the track
+        return [(PIX, (x, y, layer)), (FILL, (x + left, y + top, round(travel * m.fraction), height,
+                                              theme.ZONE_COLORS.get(m.zone or "") or theme.ACCENT)), text]
 
     @staticmethod
     def _bar_font(name_height: float) -> QFont:
@@ -487,6 +569,13 @@ class GaugeWidget(ElementWidget):
             p.setPen(fg if m.zone else theme.ALARM)
             p.drawText(box.adjusted(6, 2, 0, 0), Qt.AlignmentFlag.AlignLeft | Qt.AlignmentFlag.AlignTop,
                        f"max {m.format(m.maximum)}")
+
+    def _digital_ops(self, x: int, y: int, layer: QPixmap | None) -> list[Op] | None:
+        m = self.model
+        if m.maximum is not None and self._digital[0].height() > 30:
+            return None  # the maximum is drawn with a painter
+        text = self._text(x, y, m.text or "---", BOXED[m.zone])
+        return None if text is None else [(PIX, (x, y, layer)), text]
 
     def mouseDoubleClickEvent(self, event: QMouseEvent) -> None:
         if self.model.KeepMaxValue:

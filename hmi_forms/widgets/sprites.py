@@ -18,7 +18,7 @@ from PySide6.QtGui import QColor, QFont, QFontMetricsF, QPainter, QPixmap
 BUDGET = 64 * 2**20  # bytes of cached pixmaps in all
 
 
-Sprite = tuple[QPoint, QPixmap]  # a pixmap and where its top-left corner goes
+Sprite = tuple[int, int, QPixmap]  # where a pixmap's top-left corner goes, and the pixmap
 
 
 class SpriteCache:
@@ -38,7 +38,7 @@ class SpriteCache:
         return self.families.setdefault(key, {})
 
     def put(self, family: dict[Hashable, Sprite], key: Hashable, sprite: Sprite) -> Sprite:
-        pix = sprite[1]
+        pix = sprite[2]
         size = pix.width() * pix.height() * 4
         if self.bytes + size > self.budget:
             self.clear()
@@ -76,14 +76,18 @@ class Ink:
 class TextSlot:
     """A text box drawn from cached pixmaps, pixel for pixel what `drawText(box, align, text)` gives.
 
-    The pixmaps cover `area` (by default the box with a margin for glyphs that overhang it): opaque
-    when drawn with `back`, the flat colour of that area, transparent without."""
+    The pixmaps cover `area` (by default the box with a margin for glyphs that overhang it) inside
+    `bounds` (the element's rectangle: a sprite never needs a clip): opaque when drawn with `back`,
+    the flat colour of that area, transparent without."""
 
     def __init__(self, box: QRectF, font: QFont, align: Qt.AlignmentFlag, dpr: float = 1.0,
-                 area: QRectF | None = None) -> None:
+                 area: QRectF | None = None, bounds: QRectF | None = None) -> None:
         area = box.adjusted(-3, -3, 3, 3) if area is None else area
+        if bounds is not None:
+            area = area.intersected(bounds)
         left, top = math.ceil(area.left()), math.ceil(area.top())
         self.at = QPoint(left, top)
+        self.left, self.top = left, top
         self.size = QSize(max(1, math.floor(area.right()) - left), max(1, math.floor(area.bottom()) - top))
         self.box = box
         self.font = font
@@ -109,16 +113,25 @@ class TextSlot:
         """What a new text repaints, in the element's coordinates."""
         return QRect(self.at, self.size)
 
-    def draw(self, p: QPainter, text: str, ink: Ink) -> None:
+    def sprite(self, text: str, ink: Ink) -> Sprite | None:
+        """The text's pixmap, or None for a text wider than the pixmaps hold (a value far out of
+        its range), which is drawn whole instead (`draw`)."""
+        left, top = self.left, self.top
         key = (text, ink.key)
         sprite = self.sprites.get(key)
         if sprite is None:
-            if self.metrics.horizontalAdvance(text) > self.span:  # a value far out of its range
-                p.setFont(self.font)
-                p.setPen(ink.fore)
-                p.drawText(self.box, self.align, text)  # drawn whole, as before there was a cache
-                return
-            sprite = SPRITES.put(self.sprites, key, (self.at, self._render(text, ink.fore, ink.back)))
+            if self.metrics.horizontalAdvance(text) > self.span:
+                return None
+            sprite = SPRITES.put(self.sprites, key, (left, top, self._render(text, ink.fore, ink.back)))
+        return sprite
+
+    def draw(self, p: QPainter, text: str, ink: Ink) -> None:
+        sprite = self.sprite(text, ink)
+        if sprite is None:
+            p.setFont(self.font)
+            p.setPen(ink.fore)
+            p.drawText(self.box, self.align, text)  # drawn whole, as before there was a cache
+            return
         p.drawPixmap(*sprite)
 
     def _render(self, text: str, fore: QColor, back: QColor | None) -> QPixmap:

@@ -8,7 +8,7 @@ from __future__ import annotations
 import json
 from pathlib import Path
 
-from PySide6.QtCore import QEvent, QObject, QPoint, QRect, QRectF, QSize, Qt
+from PySide6.QtCore import QEvent, QObject, QRect, QRectF, QSize, Qt
 from PySide6.QtGui import QColor, QImage, QPainter
 from PySide6.QtWidgets import QApplication
 
@@ -39,7 +39,8 @@ def dial(name: str, x: int, addr: str, size: int = 140, **props) -> dict:
 
 
 class Draws:
-    """Counts the form's draws of each painted element."""
+    """Counts the form's draws of each painted element: with a painter (`draw`) or from its
+    composition (`compose`, which gets a counting part first)."""
 
     def __init__(self, view: FormView) -> None:
         self.counts: dict[str, int] = {}
@@ -47,14 +48,23 @@ class Draws:
             self._wrap(widget)
 
     def _wrap(self, widget: ElementWidget) -> None:
-        name, draw = widget.model.Name, widget.draw
+        name, draw, compose = widget.model.Name, widget.draw, widget.compose
         self.counts[name] = 0
 
         def counted(p: QPainter, r: QRectF) -> None:
             self.counts[name] += 1
             draw(p, r)
 
+        def count(_p: QPainter) -> None:
+            self.counts[name] += 1
+
+        def composed() -> list | None:
+            ops = compose()
+            return None if ops is None else [(count, ()), *ops]
+
         widget.draw = counted  # type: ignore[method-assign]
+        widget.compose = composed  # type: ignore[method-assign]
+        widget.drawn = composed()  # what it shows now, counted when drawn again
 
 
 def settle() -> None:
@@ -135,7 +145,9 @@ def test_a_cached_face_is_rebuilt_when_the_colours_or_the_size_change(qtbot, tmp
     corner = view.grab().toImage().pixelColor(2, 2)
     assert corner == theme.PANEL
     widget.model.BackColor = (200, 30, 30, 255)  # as a form designer would set it
-    view.update()
+    view.update()  # drawn from what it was composed of: the new colour comes with the next change
+    assert view.grab().toImage().pixelColor(2, 2) == theme.PANEL
+    widget.sync()
     assert view.grab().toImage().pixelColor(2, 2) == QColor(200, 30, 30)
     assert widget.layer().size() == QSize(140, 140)
     widget.resize(100, 100)
@@ -184,9 +196,9 @@ def test_the_sprite_cache_starts_afresh_past_its_budget(qtbot) -> None:
     cache = SpriteCache(budget=3 * 10 * 10 * 4)
     family = cache.family("f")
     for k in range(3):
-        cache.put(family, k, (QPoint(), blank(QSize(10, 10), 1.0, None)))
+        cache.put(family, k, (0, 0, blank(QSize(10, 10), 1.0, None)))
     assert len(cache) == 3 and cache.bytes == 1200
-    cache.put(family, 3, (QPoint(), blank(QSize(10, 10), 1.0, None)))
+    cache.put(family, 3, (0, 0, blank(QSize(10, 10), 1.0, None)))
     assert list(family) == [3] and cache.bytes == 400  # the family the widgets hold stays the same dict
 
 
@@ -244,3 +256,86 @@ def test_a_text_too_wide_for_its_cached_box_is_drawn_whole(qtbot, tmp_path) -> N
     assert start < value.at.x() - 2  # ...since it starts left of what the pixmaps cover
     left_of_cache = [(x, y) for x in range(start, value.at.x()) for y in range(2, 22)]
     assert any(picture.pixelColor(x, y).lightness() < 120 for x, y in left_of_cache)  # drawn all the same
+
+
+def gallery(tmp_path: Path) -> FormView:
+    """Every kind of element the form draws from its composition, side by side, some touching."""
+    def gauge(name: str, x: int, y: int, appearance: str, addr: str, size: int = 90, **props) -> dict:
+        return {**dial(name, x, addr, size, Appearance=appearance, PhyHigh=80, **props), "y": y}
+
+    label = {"type": "DiscreteColorLabel", "w": 90, "h": 40, "TextFalse": "OFF", "TextTrue": "ON",
+             "BackColorTrue": "#2e7d32", "ForeColorTrue": "#ffffff"}
+    return form_of(tmp_path, [
+        gauge("D", 0, 0, "dial", "04010"), gauge("S", 90, 0, "semidial", "04012"),
+        gauge("G", 180, 0, "digital", "04014", Units="%"), gauge("B", 270, 0, "hbar", "04016", Units="%"),
+        gauge("H", 360, 0, "hbar", "04020", size=64, Precision=1),
+        gauge("T", 0, 90, "dial", "04022", size=64), gauge("N", 64, 90, "digital", "04024", size=64),
+        {**label, "Name": "L1", "x": 180, "y": 100, "InAddr": "02120"},
+        {**label, "Name": "L2", "x": 270, "y": 100, "InAddr": "02121"},
+        {"type": "DiscreteBase", "Name": "K", "x": 360, "y": 100, "w": 90, "h": 30, "InAddr": "02122",
+         "TextFalse": "Stop", "TextTrue": "Run"},
+    ], width=460, height=160)
+
+
+def test_a_composed_form_is_pixel_for_pixel_the_form_drawn_with_a_painter(qtbot, tmp_path) -> None:
+    view = gallery(tmp_path)
+    qtbot.addWidget(view)
+    values = [{0o4010: 1234, 0o4012: 3900, 0o4014: 4000, 0o4016: 2000, 0o4020: 0, 0o4022: 4095, 0o4024: 7},
+              {0o4010: 0, 0o4012: 17, 0o4014: 3333, 0o4016: 4095, 0o4020: 4095, 0o4022: 2048, 0o4024: 3500}]
+    for scan, words in enumerate(values):
+        view.refresh(snap(scan=scan, words=words, bits={0o2120: 1, 0o2122: scan}))
+        assert [w.model.Name for w in view.painted if w.drawn is None] == []  # all composed
+        composed = view.grab().toImage()
+        kept = [w.drawn for w in view.painted]
+        for widget in view.painted:
+            widget.drawn = None  # ...and the same elements drawn with a painter, moved and clipped
+        assert view.grab().toImage() == composed
+        for widget, drawn in zip(view.painted, kept):
+            widget.drawn = drawn
+    assert view.errors == []
+
+
+def test_an_element_with_no_value_yet_or_a_stale_one_is_drawn_with_a_painter(qtbot, tmp_path) -> None:
+    view = gallery(tmp_path)
+    qtbot.addWidget(view)
+    dial_widget = view.painted[0]
+    view.refresh(snap(words={0o4010: 1000}))
+    assert dial_widget.drawn is not None
+    dial_widget.model.stale = True  # the stale mark needs a painter
+    dial_widget.sync()
+    assert dial_widget.drawn is None
+    composed_then_painted = view.grab().toImage()
+    assert composed_then_painted.pixelColor(dial_widget.x() + 45, dial_widget.y() + 45) != theme.PANEL
+
+
+def test_an_elements_own_tooltip_outlives_refreshes_and_a_quality_mark(qtbot, tmp_path) -> None:
+    view = form_of(tmp_path, [dial("A", 0, "04010")])
+    qtbot.addWidget(view)
+    widget = view.painted[0]
+    own = widget.toolTip()
+    assert own.startswith("A: word 04010")
+    view.refresh(snap(words={0o4010: 1000}))
+    view.refresh(snap(scan=1, words={0o4010: 2000}))
+    assert widget.toolTip() == own
+    widget.model.stale, widget.model.quality = True, "comm-fail"
+    widget.sync()
+    assert widget.toolTip().startswith("? comm-fail")
+    widget.model.stale, widget.model.quality = False, ""
+    widget.sync()
+    assert widget.toolTip() == own
+
+
+def test_a_refresh_that_changes_most_of_a_large_form_repaints_it_in_one_piece(qtbot, tmp_path) -> None:
+    """Hundreds of rectangles cost Qt more than the one around them; a few stay apart."""
+    labels = [{"type": "DiscreteColorLabel", "Name": f"L{i}", "x": i % 20 * 30, "y": i // 20 * 30, "w": 30,
+               "h": 30, "InAddr": f"0{0o2000 + i:o}", "TextFalse": "0", "TextTrue": "1"} for i in range(200)]
+    view = form_of(tmp_path, labels, width=600, height=300)
+    qtbot.addWidget(view)
+    view.refresh(snap())
+    asked: list[tuple] = []
+    view.update = lambda *rect: asked.append(rect)  # type: ignore[method-assign]
+    view.refresh(snap(scan=1, bits={0o2000 + i: 1 for i in range(150)}))
+    assert asked == [()]
+    asked.clear()
+    view.refresh(snap(scan=2, bits={0o2000 + i: 1 for i in (*range(150), 160, 161)}))
+    assert asked == [(view.painted[160].geometry(),), (view.painted[161].geometry(),)]
