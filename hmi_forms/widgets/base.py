@@ -167,6 +167,12 @@ class ElementWidget(QWidget):
     def fore_color(self) -> QColor:
         return theme.qcolor(self.model.ForeColor, theme.TEXT)
 
+    def covers(self) -> bool:
+        """Whether the element paints every pixel of its rectangle in every state (an opaque
+        background): the form need not paint its own background there first."""
+        back = self.back_color()
+        return back is not None and back.alpha() == 255
+
     def sync(self) -> None:
         """The model changed: compose the element anew and have the form repaint it, unless it
         looks exactly as it did (a value that moved less than a pixel costs no paint)."""

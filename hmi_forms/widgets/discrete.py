@@ -35,6 +35,13 @@ class DiscreteWidget(ElementWidget):
             return theme.qcolor(self.model.back_color, theme.PANEL)
         return super().back_color()
 
+    def covers(self) -> bool:
+        m = self.model
+        if not isinstance(m, DiscreteColorLabel):
+            return super().covers()
+        backs = (m.BackColor, m.BackColorFalse or m.BackColor, m.BackColorTrue or m.BackColor)
+        return all(theme.qcolor(back, theme.PANEL).alpha() == 255 for back in backs)
+
     def fore_color(self) -> QColor:
         if isinstance(self.model, DiscreteColorLabel):
             return theme.qcolor(self.model.fore_color, theme.TEXT)

@@ -22,7 +22,7 @@ from pathlib import Path
 
 import numpy as np
 from PySide6.QtCore import QRect, QRectF, QSize, Qt
-from PySide6.QtGui import QColor, QPainter, QPaintEvent, QTransform
+from PySide6.QtGui import QColor, QPainter, QPaintEvent, QRegion, QTransform
 from PySide6.QtWidgets import QWidget
 
 from hmi_forms.elements import Element
@@ -87,9 +87,12 @@ class FormView(QWidget):
             if not isinstance(widget, SelfPainted):
                 self.painted.append(widget)
         # where each painted element goes, worked out once: the paint loop runs 200 times a tick
-        self._extent = QRect()  # what the painted elements cover
+        self._extent = QRect()  # what the painted elements take
+        self._bare = QRegion(self.rect())  # what no element covers: the form's background shows
         for w in self.painted:
             self._extent = self._extent.united(w.geometry())
+            if w.covers():
+                self._bare -= QRegion(w.geometry())
         self._slots = [(w, w.geometry(), QTransform.fromTranslate(w.x(), w.y()), QRectF(w.rect()))
                        for w in self.painted]
         self.live = True  # the trends follow the clock; paused, the operator pans and zooms them
@@ -228,10 +231,14 @@ class FormView(QWidget):
         others are drawn with the painter moved and clipped to them."""
         p = QPainter(self)
         try:  # a painter left active after an error would crash Qt
-            p.fillRect(event.rect(), self._back)
-            if self.form.BackgroundImage is not None:
-                draw_pixmap(p, self.images.get(self.form.BackgroundImage), QRectF(self.rect()), "Stretch")
             region = event.region()
+            bare = region.intersected(self._bare)  # the background under an opaque element is not seen
+            if not bare.isEmpty():
+                p.setClipRegion(bare)
+                p.fillRect(bare.boundingRect(), self._back)
+                if self.form.BackgroundImage is not None:
+                    draw_pixmap(p, self.images.get(self.form.BackgroundImage), QRectF(self.rect()), "Stretch")
+                p.setClipping(False)
             whole = region.rectCount() == 1 and event.rect().contains(self._extent)  # no test per element
             p.setRenderHint(QPainter.RenderHint.Antialiasing)
             for widget, geometry, at, rect in self._slots:

@@ -8,7 +8,7 @@ from __future__ import annotations
 import json
 from pathlib import Path
 
-from PySide6.QtCore import QEvent, QObject, QRect, QRectF, QSize, Qt
+from PySide6.QtCore import QEvent, QObject, QPoint, QRect, QRectF, QSize, Qt
 from PySide6.QtGui import QColor, QImage, QPainter
 from PySide6.QtWidgets import QApplication
 
@@ -339,3 +339,20 @@ def test_a_refresh_that_changes_most_of_a_large_form_repaints_it_in_one_piece(qt
     asked.clear()
     view.refresh(snap(scan=2, bits={0o2000 + i: 1 for i in (*range(150), 160, 161)}))
     assert asked == [(view.painted[160].geometry(),), (view.painted[161].geometry(),)]
+
+
+def test_the_forms_background_is_painted_only_where_no_element_covers_it(qtbot, tmp_path) -> None:
+    """Under an opaque element the background is never seen: a large form skips filling it."""
+    text = {"type": "StaticText", "Name": "T", "x": 200, "y": 0, "w": 100, "h": 40, "Text": ""}
+    label = {"type": "DiscreteColorLabel", "Name": "L", "x": 320, "y": 0, "w": 100, "h": 40,
+             "InAddr": "02120", "TextFalse": "", "TextTrue": "", "BackColorTrue": "#80ff0000"}
+    view = form_of(tmp_path, [dial("A", 0, "04010"), text, label])
+    qtbot.addWidget(view)
+    bare = view._bare
+    assert not bare.contains(QPoint(70, 70))  # the dial covers its rectangle in every state
+    assert bare.contains(QPoint(250, 20))  # a transparent text does not
+    assert bare.contains(QPoint(370, 20))  # nor a label half transparent in one of its states
+    view.refresh(snap(words={0o4010: 2000}))
+    image = view.grab().toImage()
+    assert image.pixelColor(250, 20) == QColor(*view.form.BackColor)
+    assert image.pixelColor(2, 2) == theme.PANEL
