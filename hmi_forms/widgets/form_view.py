@@ -227,7 +227,7 @@ class FormView(QWidget):
 
     def paintEvent(self, event: QPaintEvent) -> None:
         """The background, and every QPainter-drawn element in the repainted region, with one
-        painter: a composed element (`ElementWidget.compose`) costs a C++ call per part; the
+        painter: a composed element (`Face.compose`) costs a C++ call per part; the
         others are drawn with the painter moved and clipped to them."""
         p = QPainter(self)
         try:  # a painter left active after an error would crash Qt
@@ -245,7 +245,8 @@ class FormView(QWidget):
                 if not whole and not region.intersects(geometry):
                     continue
                 try:
-                    ops = widget.drawn
+                    face = widget.face
+                    ops = None if face is None else face.drawn
                     if ops is not None:
                         for method, args in ops:
                             method(p, *args)

@@ -21,7 +21,6 @@ from PySide6.QtGui import (
     QPainter,
     QPainterPath,
     QPen,
-    QPixmap,
     QPolygonF,
     QResizeEvent,
     QTransform,
@@ -30,7 +29,7 @@ from PySide6.QtWidgets import QWidget
 
 from hmi_forms.elements.analog import AnalogBase
 from hmi_forms.widgets import theme
-from hmi_forms.widgets.base import FILL, PIX, STYLE, ElementWidget, Images, Op
+from hmi_forms.widgets.base import FILL, PIX, STYLE, ElementWidget, Face, Images, Op
 from hmi_forms.widgets.sprites import SPRITES, Ink, Sprite, TextSlot, blank
 
 
@@ -91,12 +90,9 @@ class GaugeWidget(ElementWidget):
         self._value: TextSlot | None = None  # where the value text goes, drawn from cached pixmaps
         self._part: QRect | None = None  # what a new text alone repaints (None: the whole element)
         self._paint_value: Callable[[QPainter], None] = self._paint_needle  # by Appearance
-        self._value_ops: Callable[[int, int, QPixmap | None], list[Op] | None] = self._needle_ops  # as ops
-        self._text_op: Op | None = None  # the value's part of the last composition
         self._bar: tuple[int, int, int, float] = (0, 0, 0, 0.0)  # the fill's left, top, height and travel
         self._needles: dict[Hashable, Sprite] | None = None  # the needle by position (None: drawn each time)
         self._contained = True  # the dial lies inside the element (its sprites need no clip)
-        self._shown: tuple[object, ...] | None = None
         self.setToolTip(f"{model.Name}: word {oct(model.InAddr or 0)[2:].rjust(5, '0')}, "
                         f"{model.format(lo)} … {model.format(hi)}{self._units}"
                         + ("; double-click resets the maximum" if model.KeepMaxValue else ""))
@@ -116,7 +112,7 @@ class GaugeWidget(ElementWidget):
             dpr = self.devicePixelRatioF()
             bounds = QRectF(self.rect())  # the sprites never reach past the element
             if appearance == "hbar":
-                self._paint_value, self._value_ops = self._paint_bar_value, self._bar_ops
+                self._paint_value = self._paint_bar_value
                 track = self._track = self._bar_geometry()
                 self._travel = track.width()
                 top = math.ceil(track.top() + 1)  # pixel-aligned: a fractional fill costs twice as much
@@ -131,14 +127,14 @@ class GaugeWidget(ElementWidget):
                 area.setLeft(max(area.left(), area.right() - widest))
                 self._value = TextSlot(box, font, theme.RIGHT, dpr, area, bounds)
             elif appearance == "digital":
-                self._paint_value, self._value_ops = self._paint_digital_value, self._digital_ops
+                self._paint_value = self._paint_digital_value
                 box, size, units_w = self._digital
                 text = box.adjusted(6, 0, -6 - units_w, 0)  # the units keep 8 px clear on its right
                 fill = QRectF(box.left() + 2, box.top() + 2, text.right() + 6 - box.left(), box.height() - 4)
                 font = theme.sized_font(size, bold=True, family=theme.MONO)
                 self._value = TextSlot(text, font, theme.RIGHT, dpr, fill, bounds)
             else:
-                self._paint_value, self._value_ops = self._paint_needle, self._needle_ops
+                self._paint_value = self._paint_needle
                 c, r, start, sweep = self._dial
                 self._travel = abs(math.radians(sweep)) * r  # the maximum mark's outer corner
                 self._needle = QPolygonF([QPointF(0.8 * r, 0), QPointF(0, 0.045 * r),
@@ -174,7 +170,6 @@ class GaugeWidget(ElementWidget):
     def restyle(self) -> None:
         super().restyle()
         self._laid_out = False
-        self._shown = None
 
     def shown(self) -> tuple[object, ...]:
         """What the operator can see change: the texts, and the pointers to the nearest pixel."""
@@ -190,30 +185,10 @@ class GaugeWidget(ElementWidget):
             peak = m.format(m.maximum)
         return m.text, pointer, peak, m.zone, m.quality
 
-    def sync(self) -> None:
-        """Repaint only when something moved by a pixel or a text changed (a value that creeps
-        below a pixel per tick costs no paint until it has moved one): compared by composition,
-        or by `shown` when drawn with a painter."""
-        old = self.drawn
-        drawn = self.compose()
-        if drawn is None:
-            shown, was = self.shown(), self._shown
-            if old is None and shown == was:
-                return
-            self._shown = shown
-            text_only = old is None and was is not None and was[1:] == shown[1:]
-        elif drawn == old:
-            return
-        else:
-            self._shown = None
-            text_only = old is not None and len(old) == len(drawn) and all(
-                a == b or b is self._text_op for a, b in zip(old, drawn))
-        self.drawn = drawn
-        if self._part is not None and text_only:
-            self.repaint_part(self._part)  # only the text changed: its box is all that changes
-            return
-        self.repaint_part(None)
-        self.mark_quality()
+    def make_face(self) -> Face:
+        self._layout()
+        face = self.face = GaugeFace(self)
+        return face
 
     def _dial_geometry(self) -> tuple[QPointF, float, float, float]:
         """Centre, radius, start angle and sweep (degrees, counter-clockwise from 3 o'clock)."""
@@ -267,30 +242,6 @@ class GaugeWidget(ElementWidget):
     def paint_dynamic(self, p: QPainter, r: QRectF) -> None:
         self._layout()
         self._paint_value(p)
-
-    def compose(self) -> list[Op] | None:
-        """As ElementWidget's, with the common case in one call: a gauge is most of a large form."""
-        m = self.model
-        if m.stale or m.maximum is not None or not self._laid_out or self._style_of(m) != self._style:
-            return super().compose()  # the maximum mark is drawn with a painter
-        layer = self._layers.get(m.zone)
-        _, _, x, y = self._where or self._locate()
-        return self._value_ops(x, y, layer or self.layer())
-
-    def dynamic_ops(self, x: int, y: int) -> list[Op] | None:
-        self._layout()
-        ops = self._value_ops(x, y, None)
-        return None if ops is None else ops[1:]
-
-    def _text(self, x: int, y: int, text: str, ink: Ink) -> Op | None:
-        """The value's text as an op, or None for one no sprite holds."""
-        assert self._value is not None
-        sprite = self._value.sprites.get((text, ink.key)) or self._value.sprite(text, ink)
-        if sprite is None:
-            return None
-        tx, ty, pix = sprite
-        op = self._text_op = (PIX, (x + tx, y + ty, pix))
-        return op
 
     def _paint_name(self, p: QPainter) -> None:
         nh = self._name_height()
@@ -448,23 +399,6 @@ class GaugeWidget(ElementWidget):
                                  self._render_needle(c, r, start + sweep * pointer / self._travel))
         return sprite
 
-    def _needle_ops(self, x: int, y: int, layer: QPixmap | None) -> list[Op] | None:
-        """The layer (None: left for the caller), value and needle; None where a painter is needed
-        (the maximum mark, a needle no sprite holds, a dial that pokes out of its element)."""
-        m = self.model
-        if m.maximum is not None or not self._contained:
-            return None
-        text = self._text(x, y, m.text or "---", BOXED[m.zone])
-        if text is None:
-            return None
-        if m.hw is None:
-            return [(PIX, (x, y, layer)), text]
-        needles = self._needles
-        if needles is None:
-            return None
-        sprite = needles.get(round(m.fraction * self._travel)) or self._needle_sprite()
-        return [(PIX, (x, y, layer)), text, (PIX, (x + sprite[0], y + sprite[1], sprite[2]))]
-
     def _render_needle(self, c: QPointF, r: float, angle: float) -> Sprite:
         """The needle at `angle` in a pixmap just large enough for it (less to blend per tick)."""
         hub = r * 0.07
@@ -507,17 +441,6 @@ class GaugeWidget(ElementWidget):
             p.drawLine(QPointF(x, track.top() - 3), QPointF(x, track.bottom()))
         assert self._value is not None
         self._value.draw(p, (m.text or "---") + self._units, BARE[m.zone])
-
-    def _bar_ops(self, x: int, y: int, layer: QPixmap | None) -> list[Op] | None:
-        m = self.model
-        if m.maximum is not None:  # the maximum mark is drawn with a painter
-            return None
-        text = self._text(x, y, (m.text or "---") + self._units, BARE[m.zone])
-        if text is None or m.hw is None:
-            return None if text is None else [(PIX, (x, y, layer)), text]
-        left, top, height, travel = self._bar  # the fraction is clamped to the track
-        return [(PIX, (x, y, layer)), (FILL, (x + left, y + top, round(travel * m.fraction), height,
-                                              theme.ZONE_COLORS.get(m.zone or "") or theme.ACCENT)), text]
 
     @staticmethod
     def _bar_font(name_height: float) -> QFont:
@@ -570,14 +493,77 @@ class GaugeWidget(ElementWidget):
             p.drawText(box.adjusted(6, 2, 0, 0), Qt.AlignmentFlag.AlignLeft | Qt.AlignmentFlag.AlignTop,
                        f"max {m.format(m.maximum)}")
 
-    def _digital_ops(self, x: int, y: int, layer: QPixmap | None) -> list[Op] | None:
-        m = self.model
-        if m.maximum is not None and self._digital[0].height() > 30:
-            return None  # the maximum is drawn with a painter
-        text = self._text(x, y, m.text or "---", BOXED[m.zone])
-        return None if text is None else [(PIX, (x, y, layer)), text]
-
     def mouseDoubleClickEvent(self, event: QMouseEvent) -> None:
         if self.model.KeepMaxValue:
             self.model.reset_max()
             self.sync()
+
+
+class GaugeFace(Face):
+    """A gauge's composition: the layer of its zone, the value's text and the needle or the bar's
+    fill, each from the caches; the maximum mark, a text no sprite holds, a needle of a dial too
+    large for sprites or one that pokes out of its element are drawn with a painter. Repainted
+    only when something moved by a pixel or a text changed (a value that creeps below a pixel
+    per tick costs no paint until it has moved one), in a large gauge only the text's box when
+    that is all that changed."""
+
+    __slots__ = ("bar", "contained", "inks", "kind", "needles", "part", "shown", "slot", "tall", "text_op",
+                 "texts", "travel", "units")
+
+    def __init__(self, widget: GaugeWidget) -> None:
+        super().__init__(widget)
+        assert widget._value is not None  # laid out
+        kind = self.kind = widget.model.Appearance
+        self.slot, self.texts = widget._value, widget._value.sprites
+        self.inks, self.units = (BARE, widget._units) if kind == "hbar" else (BOXED, "")
+        self.needles, self.travel, self.contained = widget._needles, widget._travel, widget._contained
+        self.bar, self.tall = widget._bar, widget._digital[0].height() > 30
+        part = widget._part
+        self.part = None if part is None else part.translated(self.rect.topLeft()).intersected(self.rect)
+        self.shown: tuple[object, ...] | None = None  # what a painter drew last (`GaugeWidget.shown`)
+        self.text_op: Op | None = None
+
+    def sync(self) -> None:
+        old = self.drawn
+        drawn = self.compose()
+        if drawn is None:  # drawn with a painter: told by what the operator sees
+            shown, was = self.widget.shown(), self.shown
+            if old is None and shown == was:
+                return
+            self.shown = shown
+            text_only = old is None and was is not None and was[1:] == shown[1:]
+        elif drawn == old:
+            return
+        else:
+            self.shown = None
+            text_only = old is not None and len(old) == len(drawn) and all(
+                a == b or b is self.text_op for a, b in zip(old, drawn))
+        self.drawn = drawn
+        self.show(self.part if text_only and self.part is not None else self.rect)
+
+    def compose(self) -> list[Op] | None:
+        m = self.model
+        kind = self.kind
+        if m.stale or not self.contained or (m.maximum is not None and (kind != "digital" or self.tall)):
+            return None
+        if self.style_of(m) != self.style:
+            self.widget.restyle()
+            return None
+        zone, x, y = m.zone, self.x, self.y
+        ink = self.inks[zone]
+        text = (m.text or "---") + self.units
+        sprite = self.texts.get((text, ink.key)) or self.slot.sprite(text, ink)
+        if sprite is None:
+            return None
+        layer = (PIX, (x, y, self.layers.get(zone) or self.widget.layer()))
+        value = self.text_op = (PIX, (x + sprite[0], y + sprite[1], sprite[2]))
+        if m.hw is None or kind == "digital":
+            return [layer, value]
+        if kind == "hbar":  # the fraction is clamped to the track
+            left, top, height, travel = self.bar
+            fill = theme.ZONE_COLORS.get(zone or "") or theme.ACCENT
+            return [layer, (FILL, (x + left, y + top, round(travel * m.fraction), height, fill)), value]
+        if self.needles is None:
+            return None
+        needle = self.needles.get(round(m.fraction * self.travel)) or self.widget._needle_sprite()
+        return [layer, value, (PIX, (x + needle[0], y + needle[1], needle[2]))]

@@ -14,7 +14,7 @@ from PySide6.QtWidgets import QApplication
 
 from hmi_forms.elements.target import NullTarget
 from hmi_forms.form import load_form
-from hmi_forms.widgets import theme
+from hmi_forms.widgets import base, gauges, theme
 from hmi_forms.widgets.base import ElementWidget
 from hmi_forms.widgets.form_view import FormView
 from hmi_forms.widgets.gauges import BOXED
@@ -39,32 +39,35 @@ def dial(name: str, x: int, addr: str, size: int = 140, **props) -> dict:
 
 
 class Draws:
-    """Counts the form's draws of each painted element: with a painter (`draw`) or from its
-    composition (`compose`, which gets a counting part first)."""
+    """Counts the form's draws of each painted element: with a painter (`draw`), or from its
+    composition (the layer's pixmap copied to the element's corner, the first part of every one)."""
 
-    def __init__(self, view: FormView) -> None:
-        self.counts: dict[str, int] = {}
+    def __init__(self, view: FormView, monkeypatch) -> None:
+        self.counts = {w.model.Name: 0 for w in view.painted}
+        corners = {(w.x(), w.y(), w.width(), w.height()): w.model.Name for w in view.painted}
         for widget in view.painted:
             self._wrap(widget)
+        real = base.PIX
+
+        def pix(p: QPainter, *args) -> None:
+            if len(args) == 3 and (name := corners.get((*args[:2], *args[2].size().toTuple()))):
+                self.counts[name] += 1
+            real(p, *args)
+
+        monkeypatch.setattr(base, "PIX", pix)  # what compositions made from now on call
+        monkeypatch.setattr(gauges, "PIX", pix)
 
     def _wrap(self, widget: ElementWidget) -> None:
-        name, draw, compose = widget.model.Name, widget.draw, widget.compose
-        self.counts[name] = 0
+        name, draw = widget.model.Name, widget.draw
 
         def counted(p: QPainter, r: QRectF) -> None:
             self.counts[name] += 1
             draw(p, r)
 
-        def count(_p: QPainter) -> None:
-            self.counts[name] += 1
-
-        def composed() -> list | None:
-            ops = compose()
-            return None if ops is None else [(count, ()), *ops]
-
         widget.draw = counted  # type: ignore[method-assign]
-        widget.compose = composed  # type: ignore[method-assign]
-        widget.drawn = composed()  # what it shows now, counted when drawn again
+
+    def reset(self) -> None:
+        self.counts = dict.fromkeys(self.counts, 0)
 
 
 def settle() -> None:
@@ -72,15 +75,17 @@ def settle() -> None:
     QApplication.processEvents()
 
 
-def test_only_the_element_whose_shown_value_changed_is_repainted(qtbot, tmp_path) -> None:
+def test_only_the_element_whose_shown_value_changed_is_repainted(qtbot, tmp_path, monkeypatch) -> None:
     view = form_of(tmp_path, [dial("A", 0, "04010"), dial("B", 200, "04012"),
                               {"type": "DiscreteColorLabel", "Name": "L", "x": 400, "y": 0, "w": 120, "h": 40,
                                "InAddr": "02120", "TextFalse": "OFF", "TextTrue": "ON"}])
     qtbot.addWidget(view)
+    draws = Draws(view, monkeypatch)
     view.refresh(snap(words={0o4010: 1000, 0o4012: 1000}))
     view.repaint()
     settle()
-    draws = Draws(view)
+    assert draws.counts == {"A": 1, "B": 1, "L": 1}
+    draws.reset()
     view.refresh(snap(scan=1, words={0o4010: 3000, 0o4012: 1000}))  # A moves, B and L stay
     settle()
     assert draws.counts == {"A": 1, "B": 0, "L": 0}
@@ -284,14 +289,14 @@ def test_a_composed_form_is_pixel_for_pixel_the_form_drawn_with_a_painter(qtbot,
               {0o4010: 0, 0o4012: 17, 0o4014: 3333, 0o4016: 4095, 0o4020: 4095, 0o4022: 2048, 0o4024: 3500}]
     for scan, words in enumerate(values):
         view.refresh(snap(scan=scan, words=words, bits={0o2120: 1, 0o2122: scan}))
-        assert [w.model.Name for w in view.painted if w.drawn is None] == []  # all composed
+        assert [w.model.Name for w in view.painted if w.face.drawn is None] == []  # all composed
         composed = view.grab().toImage()
-        kept = [w.drawn for w in view.painted]
+        faces = [w.face for w in view.painted]
         for widget in view.painted:
-            widget.drawn = None  # ...and the same elements drawn with a painter, moved and clipped
+            widget.face = None  # ...and the same elements drawn with a painter, moved and clipped
         assert view.grab().toImage() == composed
-        for widget, drawn in zip(view.painted, kept):
-            widget.drawn = drawn
+        for widget, face in zip(view.painted, faces):
+            widget.face = face
     assert view.errors == []
 
 
@@ -300,10 +305,10 @@ def test_an_element_with_no_value_yet_or_a_stale_one_is_drawn_with_a_painter(qtb
     qtbot.addWidget(view)
     dial_widget = view.painted[0]
     view.refresh(snap(words={0o4010: 1000}))
-    assert dial_widget.drawn is not None
+    assert dial_widget.face.drawn is not None
     dial_widget.model.stale = True  # the stale mark needs a painter
     dial_widget.sync()
-    assert dial_widget.drawn is None
+    assert dial_widget.face.drawn is None
     composed_then_painted = view.grab().toImage()
     assert composed_then_painted.pixelColor(dial_widget.x() + 45, dial_widget.y() + 45) != theme.PANEL
 
