@@ -321,8 +321,8 @@ class Face:
     slots: a tick's loop reads it several times faster than a PySide widget's own attributes.
     `drawn` None: the element is drawn with a painter (`ElementWidget.draw`) this time."""
 
-    __slots__ = ("drawn", "key", "layers", "model", "plain", "rect", "repaint", "style", "style_of",
-                 "widget", "x", "y")
+    __slots__ = ("drawn", "key", "layers", "marked", "model", "plain", "rect", "repaint", "style",
+                 "style_of", "widget", "x", "y")
 
     def __init__(self, widget: ElementWidget) -> None:
         self.widget, self.model = widget, widget.model
@@ -331,6 +331,7 @@ class Face:
         self.style_of, self.style = widget._style_of, widget._style
         self.plain = type(widget).paint_dynamic is ElementWidget.paint_dynamic  # the layer is all of it
         self.drawn: list[Op] | None = None
+        self.marked = widget._stale  # the widget shows the quality mark's tooltip
 
     def sync(self) -> None:
         drawn = self.compose()
@@ -343,8 +344,10 @@ class Face:
         """Have the form repaint `part` of it (form coordinates), and the quality mark follow."""
         if self.repaint is not None:
             self.repaint(part)
-        if self.model.stale or self.widget._stale:
+        stale = self.model.stale
+        if stale or self.marked:
             self.widget.mark_quality()
+            self.marked = stale
 
     def compose(self) -> list[Op] | None:
         m = self.model

@@ -86,6 +86,7 @@ class FormView(QWidget):
                 self.trends.append(widget)
             if not isinstance(widget, SelfPainted):
                 self.painted.append(widget)
+        self._syncs = [(model, widget.sync) for model, widget in self.pairs]  # looked up once
         # where each painted element goes, worked out once: the paint loop runs 200 times a tick
         self._extent = QRect()  # what the painted elements take
         self._bare = QRegion(self.rect())  # what no element covers: the form's background shows
@@ -142,14 +143,14 @@ class FormView(QWidget):
         judged: dict[tuple[int, int], Quality] = {}
         dirty = self._dirty = []
         try:
-            for model, widget in self.pairs:
+            for model, sync in self._syncs:
                 try:
                     quality = None if readings is None else _worst(model.sources(), readings, judged)
                     if model.update(snapshot, quality):
-                        widget.sync()
+                        sync()
                 except Exception as e:
                     self._fault(model, e, "update")
-                    widget.sync()  # marked stale: drawn with a painter, which shows the mark
+                    sync()  # marked stale: drawn with a painter, which shows the mark
         finally:
             self._dirty = None
         if len(dirty) > BATCH and len(dirty) * 2 > len(self._slots):

@@ -536,7 +536,7 @@ class GaugeFace(Face):
             return
         else:
             self.shown = None
-            text_only = old is not None and len(old) == len(drawn) and all(
+            text_only = self.part is not None and old is not None and len(old) == len(drawn) and all(
                 a == b or b is self.text_op for a, b in zip(old, drawn))
         self.drawn = drawn
         self.show(self.part if text_only and self.part is not None else self.rect)
