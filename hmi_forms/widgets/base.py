@@ -136,10 +136,12 @@ class ElementWidget(QWidget):
     """
 
     default_back: QColor | None = theme.PANEL  # None = transparent
+    face_class: type[Face]  # Face, given below its definition; a widget class may have its own
 
     def __init__(self, model: Element, images: Images, parent: QWidget | None = None) -> None:
         super().__init__(parent)
         self.model = model
+        self.face = self.face_class(self)  # how its form draws it (made ready at the first change)
         self.images = images
         self.setGeometry(model.x, model.y, model.w, model.h)
         # drawn by the form (`draw`): Qt is spared a paint event of this widget's own, which costs
@@ -155,7 +157,6 @@ class ElementWidget(QWidget):
         self._where: tuple[Callable[[QRect], None] | None, QRect, int, int] | None = None
         self._stale = False
         self._tip = ""  # the element's own tooltip, kept while the quality mark's is shown
-        self.face: Face | None = None  # how its form draws it now; made at the first change
 
     def back_color(self) -> QColor | None:
         if self.model.BackColor is not None:
@@ -174,11 +175,7 @@ class ElementWidget(QWidget):
     def sync(self) -> None:
         """The model changed: compose the element anew and have the form repaint it, unless it
         looks exactly as it did (a value that moved less than a pixel costs no paint)."""
-        (self.face or self.make_face()).sync()
-
-    def make_face(self) -> Face:
-        face = self.face = Face(self)
-        return face
+        self.face.sync()
 
     def mark_quality(self) -> None:
         """The quality mark's tooltip while the data are not good; the element's own after."""
@@ -219,7 +216,7 @@ class ElementWidget(QWidget):
 
     def restyle(self) -> None:
         """Forget the cached pictures: the look changed."""
-        self.face = None
+        self.face.forget()
         self._layers.clear()
         self._style = self.style()
         self._look = self.look()
@@ -290,16 +287,19 @@ class ElementWidget(QWidget):
 
     def resizeEvent(self, event: QResizeEvent) -> None:
         self._layers.clear()
-        self._where = self.face = None
+        self._where = None
+        self.face.forget()
         super().resizeEvent(event)
 
     def moveEvent(self, event: QMoveEvent) -> None:
-        self._where = self.face = None
+        self._where = None
+        self.face.forget()
         super().moveEvent(event)
 
     def changeEvent(self, event: QEvent) -> None:
         if event.type() == QEvent.Type.ParentChange:
-            self._where = self.face = None
+            self._where = None
+            self.face.forget()
         super().changeEvent(event)
 
     def paint_border(self, p: QPainter, r: QRectF) -> None:
@@ -319,21 +319,36 @@ class Face:
     per element, and two compositions compare equal exactly when the pixels would: an unchanged
     one is not repainted. What a composition is made from is kept here, in a plain object with
     slots: a tick's loop reads it several times faster than a PySide widget's own attributes.
-    `drawn` None: the element is drawn with a painter (`ElementWidget.draw`) this time."""
+    `drawn` None: the element is drawn with a painter (`ElementWidget.draw`) this time. A face
+    lives as long as its widget; what it read of the widget is read again at the first change
+    after the widget moved, was resized or restyled (`forget`)."""
 
-    __slots__ = ("drawn", "key", "layers", "marked", "model", "plain", "rect", "repaint", "style",
+    __slots__ = ("drawn", "fresh", "key", "layers", "marked", "model", "plain", "rect", "repaint", "style",
                  "style_of", "widget", "x", "y")
 
     def __init__(self, widget: ElementWidget) -> None:
         self.widget, self.model = widget, widget.model
+        self.drawn: list[Op] | None = None
+        self.fresh = False  # what is below is read from the widget (`load`)
+        self.marked = False  # the widget shows the quality mark's tooltip
+
+    def load(self) -> None:
+        widget = self.widget
         self.repaint, self.rect, self.x, self.y = widget._where or widget._locate()
         self.layers, self.key = widget._layers, widget.layer_key
         self.style_of, self.style = widget._style_of, widget._style
         self.plain = type(widget).paint_dynamic is ElementWidget.paint_dynamic  # the layer is all of it
-        self.drawn: list[Op] | None = None
-        self.marked = widget._stale  # the widget shows the quality mark's tooltip
+        self.marked = widget._stale
+        self.fresh = True
+
+    def forget(self) -> None:
+        """The widget moved, was resized or restyled: drawn with a painter until the next change."""
+        self.drawn = None
+        self.fresh = False
 
     def sync(self) -> None:
+        if not self.fresh:
+            self.load()
         drawn = self.compose()
         if drawn is not None and drawn == self.drawn:
             return
@@ -357,6 +372,9 @@ class Face:
             self.widget.restyle()  # drawn with a painter once; a new face comes with the next change
             return None
         return [(PIX, (self.x, self.y, self.layers.get(self.key()) or self.widget.layer()))]
+
+
+ElementWidget.face_class = Face
 
 
 class SelfPainted(ElementWidget):

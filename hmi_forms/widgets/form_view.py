@@ -86,7 +86,9 @@ class FormView(QWidget):
                 self.trends.append(widget)
             if not isinstance(widget, SelfPainted):
                 self.painted.append(widget)
-        self._syncs = [(model, widget.sync) for model, widget in self.pairs]  # looked up once
+        # each model's change goes straight to what draws it: the face of a painted element
+        self._syncs = [(model, widget.face.sync if type(widget).sync is ElementWidget.sync else widget.sync)
+                       for model, widget in self.pairs]
         # where each painted element goes, worked out once: the paint loop runs 200 times a tick
         self._extent = QRect()  # what the painted elements take
         self._bare = QRegion(self.rect())  # what no element covers: the form's background shows
@@ -246,8 +248,7 @@ class FormView(QWidget):
                 if not whole and not region.intersects(geometry):
                     continue
                 try:
-                    face = widget.face
-                    ops = None if face is None else face.drawn
+                    ops = widget.face.drawn
                     if ops is not None:
                         for method, args in ops:
                             method(p, *args)

@@ -185,11 +185,6 @@ class GaugeWidget(ElementWidget):
             peak = m.format(m.maximum)
         return m.text, pointer, peak, m.zone, m.quality
 
-    def make_face(self) -> Face:
-        self._layout()
-        face = self.face = GaugeFace(self)
-        return face
-
     def _dial_geometry(self) -> tuple[QPointF, float, float, float]:
         """Centre, radius, start angle and sweep (degrees, counter-clockwise from 3 o'clock)."""
         self._layout()
@@ -510,9 +505,12 @@ class GaugeFace(Face):
     __slots__ = ("bar", "contained", "inks", "kind", "needles", "part", "shown", "slot", "tall", "text_op",
                  "texts", "travel", "units")
 
-    def __init__(self, widget: GaugeWidget) -> None:
-        super().__init__(widget)
-        assert widget._value is not None  # laid out
+    def load(self) -> None:
+        super().load()
+        widget = self.widget
+        assert isinstance(widget, GaugeWidget)
+        widget._layout()
+        assert widget._value is not None
         kind = self.kind = widget.model.Appearance
         self.slot, self.texts = widget._value, widget._value.sprites
         self.inks, self.units = (BARE, widget._units) if kind == "hbar" else (BOXED, "")
@@ -524,6 +522,8 @@ class GaugeFace(Face):
         self.text_op: Op | None = None
 
     def sync(self) -> None:
+        if not self.fresh:
+            self.load()
         old = self.drawn
         drawn = self.compose()
         if drawn is None:  # drawn with a painter: told by what the operator sees
@@ -567,3 +567,6 @@ class GaugeFace(Face):
             return None
         needle = self.needles.get(round(m.fraction * self.travel)) or self.widget._needle_sprite()
         return [layer, value, (PIX, (x + needle[0], y + needle[1], needle[2]))]
+
+
+GaugeWidget.face_class = GaugeFace

@@ -291,12 +291,12 @@ def test_a_composed_form_is_pixel_for_pixel_the_form_drawn_with_a_painter(qtbot,
         view.refresh(snap(scan=scan, words=words, bits={0o2120: 1, 0o2122: scan}))
         assert [w.model.Name for w in view.painted if w.face.drawn is None] == []  # all composed
         composed = view.grab().toImage()
-        faces = [w.face for w in view.painted]
+        kept = [w.face.drawn for w in view.painted]
         for widget in view.painted:
-            widget.face = None  # ...and the same elements drawn with a painter, moved and clipped
+            widget.face.drawn = None  # ...and the same elements drawn with a painter, moved and clipped
         assert view.grab().toImage() == composed
-        for widget, face in zip(view.painted, faces):
-            widget.face = face
+        for widget, drawn in zip(view.painted, kept):
+            widget.face.drawn = drawn
     assert view.errors == []
 
 
