@@ -12,7 +12,8 @@ and the resident memory after warm-up and after all ticks (flat = no growth).
 
 `--plots` makes every sixth element a trend plot (four tiles wide) instead of a bar, as the
 300-element bench of the first releases did: the plots are redrawn once per REDRAW_INTERVAL of the
-(fake, 100 ms a tick) clock, in staggered turns, so a plot lags its data by at most that interval.
+(fake, 100 ms a tick) clock, all plots of the form in the same tick (they share one clock-time
+axis), so a plot lags its data by at most that interval and every tenth tick carries the redraws.
 
     QT_QPA_PLATFORM=offscreen python bench/hmi.py [--elements N] [--ticks T] [--plots]
 """
@@ -188,7 +189,7 @@ def main() -> None:
     mean, median, p95 = stats(times[warm:])
     y_mean, y_median, y_p95 = stats(yard[warm:])
     refresh = statistics.mean(models[warm:])
-    what = f"plots redrawn every {REDRAW_INTERVAL:g} s (staggered), " if args.plots else ""
+    what = f"plots redrawn together every {REDRAW_INTERVAL:g} s, " if args.plots else ""
     print(f"hmi form update, {n} elements all changing every tick, {form.width}x{form.height} px: "
           f"{mean:.2f} ms mean, {median:.2f} ms median, {p95:.2f} ms p95 over {ticks - warm} ticks "
           f"(of it refresh {refresh:.2f} ms, paint {mean - refresh:.2f} ms); {what}"
