@@ -86,8 +86,10 @@ class FormView(QWidget):
                 self.trends.append(widget)
             if not isinstance(widget, SelfPainted):
                 self.painted.append(widget)
-        # each model's change goes straight to what draws it: the face of a painted element
-        self._syncs = [(model, widget.face.sync if type(widget).sync is ElementWidget.sync else widget.sync)
+        # what each element shows is read from fixed operands, and its change goes straight to
+        # what draws it: the face of a painted element
+        self._syncs = [(model, model.sources(),
+                        widget.face.sync if type(widget).sync is ElementWidget.sync else widget.sync)
                        for model, widget in self.pairs]
         # where each painted element goes, worked out once: the paint loop runs 200 times a tick
         self._extent = QRect()  # what the painted elements take
@@ -145,9 +147,9 @@ class FormView(QWidget):
         judged: dict[tuple[int, int], Quality] = {}
         dirty = self._dirty = []
         try:
-            for model, sync in self._syncs:
+            for model, sources, sync in self._syncs:
                 try:
-                    quality = None if readings is None else _worst(model.sources(), readings, judged)
+                    quality = None if readings is None else _worst(sources, readings, judged)
                     if model.update(snapshot, quality):
                         sync()
                 except Exception as e:
