@@ -88,6 +88,9 @@ ALARMED_CODES = np.array([q.alarmed for q in Quality], dtype=bool)  # indexed by
 HELD_CODES = np.array([q.held for q in Quality], dtype=bool)
 
 
+MAX_SPANS = 65536  # operand spans whose feeding NREADs are kept (QualityMap.feeding)
+
+
 @dataclass(frozen=True, slots=True)
 class Feed:
     """One NREAD: the node it asks, its coil (1 while the rung asks) and what it fills."""
@@ -160,6 +163,9 @@ class QualityMap:
         spans = np.array([t.footprint() for t in self.tags], dtype=np.int64).reshape(-1, 2)
         self._first, self._last = spans[:, 0], spans[:, 1]
         self._pos = {t.name: i for i, t in enumerate(self.tags)}
+        # operand span -> the NREADs that fill it: an HMI form asks about thousands of operands on
+        # every refresh, and a plant program has hundreds of NREADs to look through for each
+        self._over: dict[tuple[int, int], tuple[Feed, ...]] = {}
 
     def position(self, name: str) -> int:
         """The index of a tag in `tags` and in what `evaluate` returns (KeyError if none)."""
@@ -217,9 +223,17 @@ class QualityMap:
             known = links.since is None or node in links.since or not links.running
             return Quality.GOOD if known else Quality.INITIAL
         scan = getattr(view, "scan", 0)
-        fed = [self.feed_quality(f, view, links, scan) for f in self.feeds
-               if f.first < last and first < f.last]
+        fed = [self.feed_quality(f, view, links, scan) for f in self.feeding(first, last)]
         return max(fed, default=Quality.GOOD if links.running else Quality.NOT_RUNNING)
+
+    def feeding(self, first: int, last: int) -> tuple[Feed, ...]:
+        """The NREADs whose block overlaps [first, last) of the HMI bit space."""
+        over = self._over.get((first, last))
+        if over is None:
+            if len(self._over) >= MAX_SPANS:
+                self._over.clear()  # asked about more spans than a station has operands: start afresh
+            over = self._over[first, last] = tuple(f for f in self.feeds if f.first < last and first < f.last)
+        return over
 
     def quality(self, tag: Tag, view: MemoryView, links: LinkView | None = None) -> Quality:
         """One tag's quality (the runtime's per-scan path is `evaluate`)."""

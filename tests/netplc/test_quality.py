@@ -14,7 +14,7 @@ from netplc.program import parse
 from netplc.simulator import Simulator
 from netplc.tags.quality import LinkView, Quality, QualityMap, link_outputs, nread_feeds
 from netplc.tags.readings import Readings
-from netplc.tags.tag import Scaling, Tag, TagType
+from netplc.tags.tag import Scaling, Tag, TagType, span
 from tests.netplc.test_exchange import NODE_PROGRAM, TICK, Station, wait_until
 
 PROGRAM = """\
@@ -106,6 +106,20 @@ def test_the_quality_of_any_address() -> None:
     assert qmap.at(0o2200, 0, view, links) is Quality.GOOD  # bit 02200, node 2
     assert qmap.at(0o4100, 2, view, links) is Quality.FORCED
     assert qmap.at(0o4200, 2, view, LinkView(running=False)) is Quality.NOT_RUNNING
+
+
+def test_the_quality_of_an_address_asked_again_follows_the_links_of_each_scan(monkeypatch) -> None:
+    """Which NREADs fill an operand is worked out once; what they say is judged every time."""
+    qmap = QualityMap(parse(PROGRAM), [])
+    view = asking().snapshot(10)
+    assert qmap.at(0o4000, 2, view, LinkView(links={1: True, 2: True})) is Quality.GOOD
+    assert qmap.at(0o4000, 2, view, LinkView(links={1: False, 2: True})) is Quality.COMM_FAIL
+    assert [f.node for f in qmap.feeding(*span(0o4002, 4))] == [1, 2]
+    monkeypatch.setattr("netplc.tags.quality.MAX_SPANS", 2)  # more spans asked than a station has
+    for addr in (0o4000, 0o4002, 0o4004, 0o4100):
+        qmap.at(addr, 2, view, LinkView())
+    assert len(qmap._over) <= 2
+    assert qmap.at(0o4004, 1, view, LinkView(links={1: False, 2: True})) is Quality.GOOD
 
 
 @pytest.fixture
