@@ -5,7 +5,7 @@ states, such as a discrete element's text or a gauge's scale) rendered once per 
 pixmap, and a dynamic part (a pointer, a value) drawn over it. A form of hundreds of elements then
 costs one pixmap copy per element and tick plus the few strokes that really change. Where the
 dynamic part also comes from cached pixmaps (texts, needles, bar fills), a change composes the
-element into a short list of pixmap copies at its place on the form (`compose`): painting it then
+element into a short list of pixmap copies at its place on the form (`Face`): painting it then
 needs no painter state, and an unchanged composition is not repainted at all.
 
 Widgets only draw what their model computed. The stale mark (grey wash, hatching and a "?" badge)
