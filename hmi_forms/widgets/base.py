@@ -366,12 +366,17 @@ class Face:
 
     def compose(self) -> list[Op] | None:
         m = self.model
-        if m.stale or not self.plain:  # the stale mark, or a dynamic part: a painter
-            return None
-        if self.style_of(m) != self.style:
-            self.widget.restyle()  # drawn with a painter once; a new face comes with the next change
+        if m.stale or not self.plain or self.restyled():  # the stale mark, or a dynamic part: a painter
             return None
         return [(PIX, (self.x, self.y, self.layers.get(self.key()) or self.widget.layer()))]
+
+    def restyled(self) -> bool:
+        """Whether the colours, frame or font changed since the face was read: the widget is then
+        restyled, drawn with a painter once, and read again at the next change."""
+        if self.style_of(self.model) == self.style:
+            return False
+        self.widget.restyle()
+        return True
 
 
 ElementWidget.face_class = Face

@@ -544,10 +544,8 @@ class GaugeFace(Face):
     def compose(self) -> list[Op] | None:
         m = self.model
         kind = self.kind
-        if m.stale or not self.contained or (m.maximum is not None and (kind != "digital" or self.tall)):
-            return None
-        if self.style_of(m) != self.style:
-            self.widget.restyle()
+        if m.stale or not self.contained or (m.maximum is not None and (kind != "digital" or self.tall)) \
+                or self.restyled():
             return None
         zone, x, y = m.zone, self.x, self.y
         ink = self.inks[zone]
