@@ -32,6 +32,8 @@ from netplc.tags.table import TagTable
 
 APPEARANCES = ("digital", "hbar", "dial", "semidial", "graph", "tank")  # tank: an extension
 ZONE_TYPES = {"low": 2, "normal": 0, "high": 2}
+MAX_SHOWN = 65536  # words remembered per conversion (`settle`): every word a register can hold
+SHOWN: dict[tuple[object, ...], dict[int, tuple[int, float, str, str | None]]] = {}
 
 
 @dataclass(eq=False)
@@ -174,6 +176,33 @@ class AnalogBase(Scaled):
     def message(self) -> str:
         return {"low": self.LowMessage, "high": self.HighMessage, "normal": self.NormalMessage}.get(
             self.zone or "", "")
+
+    @property
+    def plain(self) -> bool:
+        """Whether what it shows follows from its word alone (no trend, maximum, hysteresis,
+        gating or effects): a view may then read its word together with others' and `settle` it
+        (hmi_forms/elements/bank.py)."""
+        return (self.trend is None and not self.KeepMaxValue and self.Hysteresis == 0
+                and self.SyncType is None and self.QualityAddr is None
+                and (self.effects is None or not self.acts))
+
+    def settle(self, hw: int) -> None:
+        """Take a new word as `refresh` would, for a `plain` element: its value, text and zone
+        are looked up by the word among those of every element with the same conversion."""
+        shown = self._shown.get(hw)
+        if shown is None:
+            phy = self.scaling.to_phy(hw)
+            limited = self.PhyLow is not None or self.PhyHigh is not None  # no hysteresis: the plain rule
+            shown = (hw, phy, self.format(phy), self.zone_of(phy) if limited else None)
+            if len(self._shown) >= MAX_SHOWN:
+                self._shown.clear()
+            self._shown[hw] = shown
+        self.hw, self.phy, self.text, self.zone = shown
+
+    @cached_property
+    def _shown(self) -> dict[int, tuple[int, float, str, str | None]]:
+        key = (self.scaling, self.Precision, self.PhyLow, self.PhyHigh)
+        return SHOWN.setdefault(key, {})
 
     def refresh(self, snap: Snapshot) -> bool:
         hw = self._in(snap)

@@ -368,7 +368,8 @@ class Face:
         m = self.model
         if m.stale or not self.plain or self.restyled():  # the stale mark, or a dynamic part: a painter
             return None
-        return [(PIX, (self.x, self.y, self.layers.get(self.key()) or self.widget.layer()))]
+        layer = self.layers.get(self.key())  # (not `or`: the truth of a QPixmap is a call into Qt)
+        return [(PIX, (self.x, self.y, self.widget.layer() if layer is None else layer))]
 
     def restyled(self) -> bool:
         """Whether the colours, frame or font changed since the face was read: the widget is then

@@ -27,6 +27,7 @@ from PySide6.QtWidgets import QWidget
 
 from hmi_forms.elements import Element
 from hmi_forms.elements.analog import AnalogBase, AnalogOutput
+from hmi_forms.elements.bank import WordBank
 from hmi_forms.elements.base import Guard, Writer
 from hmi_forms.elements.discrete import DiscreteBase
 from hmi_forms.elements.graph import Graph
@@ -43,6 +44,7 @@ from hmi_forms.widgets.journal import JournalWidget
 from hmi_forms.widgets.static import DateTimeWidget, StaticPictureWidget, StaticTextWidget, SyncWidget
 from hmi_forms.widgets.tank import TankWidget
 from hmi_forms.widgets.trend import REDRAW_INTERVAL, TrendWidget
+from netplc.address import IO_BITS
 from netplc.memory import Snapshot
 from netplc.tags.quality import Quality
 from netplc.tags.readings import Readings
@@ -88,9 +90,16 @@ class FormView(QWidget):
                 self.painted.append(widget)
         # what each element shows is read from fixed operands, and its change goes straight to
         # what draws it: the face of a painted element
-        self._syncs = [(model, model.sources(),
-                        widget.face.sync if type(widget).sync is ElementWidget.sync else widget.sync)
-                       for model, widget in self.pairs]
+        syncs = [(model, model.sources(),
+                  widget.face.sync if type(widget).sync is ElementWidget.sync else widget.sync)
+                 for model, widget in self.pairs]
+        # the gauges whose word is all they show are read together, in one array (`WordBank`)
+        banked = [isinstance(w, GaugeWidget) and type(w).sync is ElementWidget.sync
+                  and m.plain and m.InAddr is not None and m.InAddr >= IO_BITS for m, w in self.pairs]
+        self._syncs = [s for s, b in zip(syncs, banked) if not b]
+        self._banked = [s for s, b in zip(syncs, banked) if b]
+        self._bank = WordBank([m.InAddr for m, _, _ in self._banked])
+        self._puts = [w.face.put for (m, w), b in zip(self.pairs, banked) if b]
         # where each painted element goes, worked out once: the paint loop runs 200 times a tick
         self._extent = QRect()  # what the painted elements take
         self._bare = QRegion(self.rect())  # what no element covers: the form's background shows
@@ -98,7 +107,7 @@ class FormView(QWidget):
             self._extent = self._extent.united(w.geometry())
             if w.covers():
                 self._bare -= QRegion(w.geometry())
-        self._slots = [(w, w.geometry(), QTransform.fromTranslate(w.x(), w.y()), QRectF(w.rect()))
+        self._slots = [(w.face, w, w.geometry(), QTransform.fromTranslate(w.x(), w.y()), QRectF(w.rect()))
                        for w in self.painted]
         self.live = True  # the trends follow the clock; paused, the operator pans and zooms them
         self.history_wanted: Callable[[TrendWidget, float, float], None] | None = None
@@ -155,6 +164,7 @@ class FormView(QWidget):
                 except Exception as e:
                     self._fault(model, e, "update")
                     sync()  # marked stale: drawn with a painter, which shows the mark
+            self._refresh_banked(snapshot, readings, judged)
         finally:
             self._dirty = None
         if len(dirty) > BATCH and len(dirty) * 2 > len(self._slots):
@@ -168,6 +178,40 @@ class FormView(QWidget):
         if self.trends and now >= self._next_flush:  # all plots of the form in the same tick
             self._next_flush = max(self._next_flush + REDRAW_INTERVAL, now)
             self._redraw(snapshot.wall)
+
+    def _refresh_banked(self, snapshot: Snapshot, readings: Readings | None,
+                        judged: dict[tuple[int, int], Quality]) -> None:
+        """The gauges of the bank: only those whose word changed are settled and composed. With
+        the runtime's readings, one whose data are not good takes the general path (`update`)
+        and is taken anew once they are."""
+        bank, puts = self._bank, self._puts
+        positions, words = bank.changed(snapshot.data)
+        if readings is None:
+            new = zip(positions, words)
+        else:
+            changed = dict(zip(positions, words))
+            new = []
+            for i, (model, sources, sync) in enumerate(self._banked):
+                quality = _worst(sources, readings, judged)
+                if quality is Quality.GOOD and not model.quality:
+                    if i in changed:
+                        new.append((i, changed[i]))
+                    continue
+                bank.forget(i)
+                try:
+                    if model.update(snapshot, quality):
+                        sync()
+                except Exception as e:
+                    self._fault(model, e, "update")
+                    sync()
+        for i, hw in new:
+            try:
+                puts[i](hw)
+            except Exception as e:
+                model, _, sync = self._banked[i]
+                self._fault(model, e, "update")
+                bank.forget(i)
+                sync()
 
     def schedule(self, part: QRect) -> None:
         """Repaint `part` of the form: at once, or with the rest of a refresh."""
@@ -246,11 +290,11 @@ class FormView(QWidget):
                 p.setClipping(False)
             whole = region.rectCount() == 1 and event.rect().contains(self._extent)  # no test per element
             p.setRenderHint(QPainter.RenderHint.Antialiasing)
-            for widget, geometry, at, rect in self._slots:
+            for face, widget, geometry, at, rect in self._slots:
                 if not whole and not region.intersects(geometry):
                     continue
                 try:
-                    ops = widget.face.drawn
+                    ops = face.drawn
                     if ops is not None:
                         for method, args in ops:
                             method(p, *args)

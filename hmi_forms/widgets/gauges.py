@@ -541,6 +541,14 @@ class GaugeFace(Face):
         self.drawn = drawn
         self.show(self.part if text_only and self.part is not None else self.rect)
 
+    def put(self, hw: int) -> None:
+        """A new word of a plain gauge, read with the rest of the form's (`WordBank`): what
+        `update` would do with it when the data are good."""
+        m = self.model
+        m.stale = False  # a failed draw's mark goes with the next value, as with `update`
+        m.settle(hw)
+        self.sync()
+
     def compose(self) -> list[Op] | None:
         m = self.model
         kind = self.kind
@@ -553,7 +561,8 @@ class GaugeFace(Face):
         sprite = self.texts.get((text, ink.key)) or self.slot.sprite(text, ink)
         if sprite is None:
             return None
-        layer = (PIX, (x, y, self.layers.get(zone) or self.widget.layer()))
+        layer = self.layers.get(zone)  # (not `or`: the truth of a QPixmap is a call into Qt)
+        layer = (PIX, (x, y, self.widget.layer() if layer is None else layer))
         value = self.text_op = (PIX, (x + sprite[0], y + sprite[1], sprite[2]))
         if m.hw is None or kind == "digital":
             return [layer, value]

@@ -97,3 +97,17 @@ def test_a_forced_value_is_shown_as_it_is_and_marked(view: FormView) -> None:
     local, widget = models(view)["local"]
     assert local.quality == Quality.FORCED.word and local.text == "100.0"
     assert widget.toolTip().startswith("? forced")
+
+
+def test_a_value_that_arrived_while_marked_is_shown_once_the_data_are_good_again(view: FormView) -> None:
+    mem = Memory()
+    mem.set_word(0o4010, 2048)
+    view.refresh(*reversed(readings(mem, 1, LinkView(links={0: True}))))
+    mem.set_word(0o4010, 4095)
+    view.refresh(*reversed(readings(mem, 2, LinkView(links={0: False}))))
+    dial, digital = models(view)["dial"][0], models(view)["digital"][0]
+    assert dial.stale and digital.text == "50.0"
+    view.refresh(*reversed(readings(mem, 3, LinkView(links={0: True}))))
+    assert not dial.stale and (dial.text, digital.text) == ("100.0", "100.0")
+    view.refresh(*reversed(readings(mem, 4, LinkView(links={0: True}))))  # and stays so
+    assert not digital.stale and digital.text == "100.0"

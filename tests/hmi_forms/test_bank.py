@@ -1,0 +1,118 @@
+"""The form's bank of plain gauges (hmi_forms/elements/bank.py): words read as one array, and a
+gauge settled from them ends up exactly where its own `update` would have put it."""
+
+from __future__ import annotations
+
+import random
+from pathlib import Path
+
+import pytest
+
+from hmi_forms.elements.analog import AnalogBase
+from hmi_forms.elements.bank import WordBank
+from hmi_forms.elements.target import NullTarget
+from hmi_forms.form import load_form
+from hmi_forms.widgets.form_view import FormView
+from netplc.address import data_address
+from netplc.memory import Memory
+from tests.hmi_forms.helpers import snap, write_form
+
+RANGE = {"AppMin": 0, "AppMax": 1000, "PhyMin": -50, "PhyMax": 150}
+
+
+def test_a_bank_reports_the_words_that_changed_since_they_were_last_taken() -> None:
+    bank = WordBank([0o4010, 0o4012, 0o14000])
+    assert bank.aligned
+    mem = Memory()
+    mem.set_word(0o4012, 515)
+    assert bank.changed(mem.snapshot(0, 0, 0).data) == ([0, 1, 2], [0, 515, 0])  # all new at first
+    assert bank.changed(mem.snapshot(1, 0, 0).data) == ([], [])
+    mem.set_word(0o14000, 0xFFFF)
+    assert bank.changed(mem.snapshot(2, 0, 0).data) == ([2], [0xFFFF])
+    bank.forget(0)
+    assert bank.changed(mem.snapshot(3, 0, 0).data) == ([0], [0])
+
+
+def test_words_at_odd_addresses_are_read_byte_by_byte() -> None:
+    addresses = [0o4011, 0o4020, 0o17775]
+    bank = WordBank(addresses)
+    assert not bank.aligned
+    mem = Memory()
+    for i, a in enumerate(addresses):
+        mem.set_word(a, 0x1234 + i)
+    data = mem.snapshot(0, 0, 0).data
+    assert bank.changed(data) == ([0, 1, 2], [mem.snapshot(0, 0, 0).get_word(a) for a in addresses])
+
+
+def test_a_word_whose_high_byte_is_past_data_memory_is_refused() -> None:
+    with pytest.raises(ValueError, match="past the end"):
+        WordBank([data_address(16 * 1024 - 1)])
+
+
+def gauge(name: str, x: int, addr: str, **props) -> dict:
+    return {"type": "AnalogBase", "Name": name, "x": x, "y": 0, "w": 64, "h": 64, "InAddr": addr,
+            **RANGE, "Precision": 1, "Appearance": "dial", **props}
+
+
+def view_of(qtbot, tmp_path: Path, elements: list[dict]) -> FormView:
+    form = load_form(write_form(tmp_path, elements))
+    form.width, form.height = 700, 100
+    view = FormView(form, NullTarget())
+    qtbot.addWidget(view)
+    view.show()
+    return view
+
+
+def test_only_gauges_whose_word_is_all_they_show_are_banked(qtbot, tmp_path) -> None:
+    view = view_of(qtbot, tmp_path, [
+        gauge("plain", 0, "04010", PhyLow=0, PhyHigh=100),
+        gauge("digital", 70, "04012", Appearance="digital"),
+        gauge("max", 140, "04014", KeepMaxValue=True),
+        gauge("hysteresis", 210, "04016", PhyHigh=100, Hysteresis=2),
+        gauge("gated", 280, "04020", SyncType="02001"),
+        gauge("trend", 350, "04022", Appearance="graph"),
+        gauge("io", 420, "0100"),
+    ])
+    assert [m.Name for m, _, _ in view._banked] == ["plain", "digital"]
+
+
+def test_a_banked_gauge_takes_each_word_as_its_own_update_would(qtbot, tmp_path) -> None:
+    """Across zones and precisions, with words that repeat and words that skip: the same value,
+    text and zone as a copy of the model refreshed on its own, and the same pixels as a painter."""
+    props = [{}, {"PhyLow": 10, "PhyHigh": 90}, {"PhyHigh": 0, "Precision": 0}, {"Precision": 3}]
+    view = view_of(qtbot, tmp_path, [gauge(f"G{i}", 70 * i, f"0{0o4010 + 2 * i:o}", **p)
+                                     for i, p in enumerate(props)])
+    alone = load_form(view.form.path)
+    rng = random.Random(16)
+    for tick in range(60):
+        words = {0o4010 + 2 * i: rng.choice([0, 1, 49, 50, 500, 999, 1000, rng.randrange(1001)])
+                 for i in range(len(props))}
+        s = snap(words=words, scan=tick)
+        view.refresh(s)
+        for (model, _, _), own in zip(view._banked, alone.elements, strict=True):
+            assert isinstance(own, AnalogBase)
+            own.update(s)
+            assert (model.hw, model.phy, model.text, model.zone) == (own.hw, own.phy, own.text, own.zone)
+            assert not model.stale
+    composed = view.grab().toImage()
+    for _, w in view.pairs:
+        w.face.forget()  # drawn with a painter, as before any composition
+    view.update()
+    assert view.grab().toImage() == composed
+
+
+def test_a_banked_gauge_that_fails_is_reported_and_the_form_keeps_running(qtbot, tmp_path,
+                                                                        monkeypatch) -> None:
+    view = view_of(qtbot, tmp_path, [gauge("bad", 0, "04010"), gauge("good", 70, "04012")])
+    bad, good = (m for m, _, _ in view._banked)
+
+    def broken(hw: int) -> None:
+        raise RuntimeError("no conversion")
+
+    monkeypatch.setattr(bad, "settle", broken)
+    view.refresh(snap(words={0o4010: 10, 0o4012: 20}))
+    assert view.errors == [f'{view.form.path}: element "bad": update failed: RuntimeError(\'no conversion\')']
+    assert bad.stale and good.text == "-46.0" and not good.stale
+    monkeypatch.undo()
+    view.refresh(snap(words={0o4010: 10, 0o4012: 20}, scan=1))  # tried again with the same word
+    assert bad.text == "-48.0" and not bad.stale
