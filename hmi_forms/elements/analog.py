@@ -27,6 +27,7 @@ from hmi_forms.elements import props as p
 from hmi_forms.elements.base import Element, Reader, Writer, word_reader
 from hmi_forms.elements.target import BUSY
 from hmi_forms.elements.trend import Trend
+from netplc.address import IO_BITS
 from netplc.memory import Snapshot
 from netplc.tags.table import TagTable
 
@@ -179,16 +180,14 @@ class AnalogBase(Scaled):
 
     @property
     def plain(self) -> bool:
-        """Whether what it shows follows from its word alone (no trend, maximum, hysteresis,
-        gating or effects): a view may then read its word together with others' and `settle` it
-        (hmi_forms/elements/bank.py)."""
-        return (self.trend is None and not self.KeepMaxValue and self.Hysteresis == 0
-                and self.SyncType is None and self.QualityAddr is None
-                and (self.effects is None or not self.acts))
+        """Its word at a data address, with no trend, maximum, hysteresis, gating or effects."""
+        return (self.InAddr is not None and self.InAddr >= IO_BITS and self.trend is None
+                and not self.KeepMaxValue and self.Hysteresis == 0 and self.SyncType is None
+                and self.QualityAddr is None and (self.effects is None or not self.acts))
 
     def settle(self, hw: int) -> None:
-        """Take a new word as `refresh` would, for a `plain` element: its value, text and zone
-        are looked up by the word among those of every element with the same conversion."""
+        """The value, text and zone are looked up by the word among those of every element with
+        the same conversion."""
         shown = self._shown.get(hw)
         if shown is None:
             phy = self.scaling.to_phy(hw)

@@ -1,47 +1,90 @@
-"""The words of a form's plain analog elements, read and compared as one array per snapshot.
+"""The operands of a form's plain elements, read and compared as one array per snapshot.
 
-A form of a thousand gauges reads a thousand words per tick; asking each element's own reader
-costs a Python call, a closure and a comparison per element whether the word moved or not. A
-bank gathers them all with one numpy index into the snapshot's bytes and reports only those that
-changed since they were last taken, so Python runs for what is really new.
+A form of a thousand gauges and lamps reads a thousand operands per tick; asking each element's
+own reader costs a Python call, a closure and a comparison per element whether the value moved or
+not. A bank gathers them all with one numpy index into the snapshot and reports only those that
+changed since they were last taken, so Python runs for what is really new. The elements a bank
+serves are those whose value is all they show (`plain`): they `settle` what the bank read.
 """
 
 from __future__ import annotations
 
 from collections.abc import Sequence
+from operator import itemgetter
 
 import numpy as np
 
-from netplc.address import DATA_SIZE, data_index
+from netplc.address import DATA_SIZE, IO_BITS, data_index
+from netplc.memory import Snapshot
 
-UNKNOWN = -1  # not a word: taken again at the next snapshot, whatever it holds
+UNKNOWN = -1  # no value: taken again at the next snapshot, whatever it holds
 
 
-class WordBank:
+class Bank:
+    """Values last taken, and what changed since."""
+
+    def __init__(self, size: int) -> None:
+        self.last = np.full(size, UNKNOWN, dtype=np.int32)
+
+    def __len__(self) -> int:
+        return len(self.last)
+
+    def read(self, snap: Snapshot) -> np.ndarray:
+        raise NotImplementedError
+
+    def changed(self, snap: Snapshot) -> tuple[list[int], list[int]]:
+        """The positions whose value differs from the one last taken, and their new values."""
+        values = self.read(snap)
+        where = np.flatnonzero(values != self.last)
+        self.last[where] = values[where]
+        return where.tolist(), values[where].tolist()
+
+    def forget(self, position: int) -> None:
+        """Report the value at `position` at the next snapshot even if it did not change."""
+        self.last[position] = UNKNOWN
+
+
+class WordBank(Bank):
     """Little-endian words at data addresses (validated by the form's loader)."""
 
     def __init__(self, addresses: Sequence[int]) -> None:
+        super().__init__(len(addresses))
         index = np.array([data_index(a) for a in addresses], dtype=np.intp)
         if len(index) and int(index.max()) + 1 >= DATA_SIZE:
             raise ValueError("a word's high byte lies past the end of data memory")
         self.aligned = not (index % 2).any()  # read as one array of words: one gather
         self.index = index // 2 if self.aligned else index
-        self.last = np.full(len(index), UNKNOWN, dtype=np.int32)
 
-    def __len__(self) -> int:
-        return len(self.last)
-
-    def changed(self, data: bytes) -> tuple[list[int], list[int]]:
-        """The positions whose word differs from the one last taken, and their new words."""
+    def read(self, snap: Snapshot) -> np.ndarray:
         if self.aligned:
-            words = np.frombuffer(data, dtype="<u2")[self.index]
-        else:
-            raw = np.frombuffer(data, dtype=np.uint8)
-            words = raw[self.index] | raw[self.index + 1].astype(np.uint16) << 8
-        where = np.flatnonzero(words != self.last)
-        self.last[where] = words[where]
-        return where.tolist(), words[where].tolist()
+            return np.frombuffer(snap.data, dtype="<u2")[self.index]
+        raw = np.frombuffer(snap.data, dtype=np.uint8)
+        return raw[self.index] | raw[self.index + 1].astype(np.uint16) << 8
 
-    def forget(self, position: int) -> None:
-        """Report the word at `position` at the next snapshot even if it did not change."""
-        self.last[position] = UNKNOWN
+
+class BitBank(Bank):
+    """HMI bits: I/O bits (< 04000) and bits of data bytes (`byte*8 + bit`)."""
+
+    def __init__(self, hmi_bits: Sequence[int]) -> None:
+        super().__init__(len(hmi_bits))
+        io = [(i, b) for i, b in enumerate(hmi_bits) if b < IO_BITS]
+        data = [(i, b) for i, b in enumerate(hmi_bits) if b >= IO_BITS]
+        self.io_at = np.array([i for i, _ in io], dtype=np.intp)
+        # itemgetter of one index gives the item, not a tuple: ask for it twice, use the first
+        picks = [b for _, b in io]
+        self.io_get = itemgetter(*picks) if len(picks) > 1 else itemgetter(*picks * 2) if picks else None
+        self.io_count = len(picks)
+        self.data_at = np.array([i for i, _ in data], dtype=np.intp)
+        self.byte = np.array([data_index(b >> 3) for _, b in data], dtype=np.intp)
+        self.shift = np.array([b & 7 for _, b in data], dtype=np.uint8)
+        self.values = np.zeros(len(hmi_bits), dtype=np.int32)
+
+    def read(self, snap: Snapshot) -> np.ndarray:
+        values = self.values
+        if self.io_get is not None:
+            picked = np.array(self.io_get(snap.bits), dtype=bool)[:self.io_count]
+            values[self.io_at] = picked
+        if len(self.byte):
+            raw = np.frombuffer(snap.data, dtype=np.uint8)
+            values[self.data_at] = raw[self.byte] >> self.shift & 1
+        return values

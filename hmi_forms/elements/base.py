@@ -97,6 +97,16 @@ class Element:
         runtime evaluates exactly these, from every snapshot."""
         return self.RegData or self.RegMessages
 
+    @property
+    def plain(self) -> bool:
+        """Whether what it shows follows from one operand alone, so that a view may read it with
+        others' at once and `settle` it (hmi_forms/elements/bank.py); none by default."""
+        return False
+
+    def settle(self, value: int) -> None:
+        """Take a new value of its operand as `refresh` would, for a `plain` element."""
+        raise NotImplementedError(f"{self.TYPE} reads its own operands")
+
     def sources(self) -> tuple[tuple[int, int], ...]:
         """The operands whose value the element shows, as (address, bytes), bytes 0 for one HMI
         bit: what its data quality is judged on; none by default (static elements)."""

@@ -58,6 +58,16 @@ class DiscreteBase(Element, Writer):
     def clickable(self) -> bool:
         return self.Enabled and self.value is not None and not self.stale and self.indicating
 
+    @property
+    def plain(self) -> bool:
+        """One bit shown (not a controlled-enable or animated element), with no gating or effects."""
+        return (type(self) in (DiscreteBase, DiscreteColorLabel) and self.InAddr is not None
+                and self.SyncType is None and self.QualityAddr is None
+                and (self.effects is None or not self.acts))
+
+    def settle(self, value: int) -> None:
+        self.value = value
+
     def refresh(self, snap: Snapshot) -> bool:
         v = self._in(snap)
         if v == self.value:

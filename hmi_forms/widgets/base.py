@@ -355,6 +355,14 @@ class Face:
         self.drawn = drawn
         self.show(self.rect)
 
+    def put(self, value: int) -> None:
+        """A new value of a plain element, read with the rest of the form's (a `Bank`): what
+        `update` would do with it while the data are good."""
+        m = self.model
+        m.stale = False  # a failed draw's mark goes with the next value, as with `update`
+        m.settle(value)
+        self.sync()
+
     def show(self, part: QRect) -> None:
         """Have the form repaint `part` of it (form coordinates), and the quality mark follow."""
         if self.repaint is not None:

@@ -17,7 +17,7 @@ With the runtime's `Readings` of the scan, each element is also given the qualit
 from __future__ import annotations
 
 import time
-from collections.abc import Callable
+from collections.abc import Callable, Iterable
 from pathlib import Path
 
 import numpy as np
@@ -27,7 +27,7 @@ from PySide6.QtWidgets import QWidget
 
 from hmi_forms.elements import Element
 from hmi_forms.elements.analog import AnalogBase, AnalogOutput
-from hmi_forms.elements.bank import WordBank
+from hmi_forms.elements.bank import Bank, BitBank, WordBank
 from hmi_forms.elements.base import Guard, Writer
 from hmi_forms.elements.discrete import DiscreteBase
 from hmi_forms.elements.graph import Graph
@@ -44,11 +44,11 @@ from hmi_forms.widgets.journal import JournalWidget
 from hmi_forms.widgets.static import DateTimeWidget, StaticPictureWidget, StaticTextWidget, SyncWidget
 from hmi_forms.widgets.tank import TankWidget
 from hmi_forms.widgets.trend import REDRAW_INTERVAL, TrendWidget
-from netplc.address import IO_BITS
 from netplc.memory import Snapshot
 from netplc.tags.quality import Quality
 from netplc.tags.readings import Readings
 
+Sources = tuple[tuple[int, int], ...]  # what an element's quality is judged on (`Element.sources`)
 BATCH = 100  # changed elements from which a refresh that changed most of the form repaints it whole
 
 
@@ -93,13 +93,19 @@ class FormView(QWidget):
         syncs = [(model, model.sources(),
                   widget.face.sync if type(widget).sync is ElementWidget.sync else widget.sync)
                  for model, widget in self.pairs]
-        # the gauges whose word is all they show are read together, in one array (`WordBank`)
-        banked = [isinstance(w, GaugeWidget) and type(w).sync is ElementWidget.sync
-                  and m.plain and m.InAddr is not None and m.InAddr >= IO_BITS for m, w in self.pairs]
+        # the gauges and lamps whose operand is all they show are read together, in one array
+        kinds = [WordBank if isinstance(w, GaugeWidget) else BitBank if isinstance(w, DiscreteWidget)
+                 else None for _, w in self.pairs]
+        banked = [kind is not None and type(w).sync is ElementWidget.sync and m.plain
+                  for kind, (m, w) in zip(kinds, self.pairs)]
         self._syncs = [s for s, b in zip(syncs, banked) if not b]
-        self._banked = [s for s, b in zip(syncs, banked) if b]
-        self._bank = WordBank([m.InAddr for m, _, _ in self._banked])
-        self._puts = [w.face.put for (m, w), b in zip(self.pairs, banked) if b]
+        self._banks: list[tuple[Bank, list[tuple[Element, Sources, Callable[[], None]]],
+                                list[Callable[[int], None]]]] = []
+        for kind, operand in ((WordBank, lambda m: m.InAddr), (BitBank, lambda m: m.InAddr.hmi)):
+            members = [(s, w) for s, w, k, b in zip(syncs, self.pairs, kinds, banked) if b and k is kind]
+            if members:
+                self._banks.append((kind([operand(s[0]) for s, _ in members]), [s for s, _ in members],
+                                    [w.face.put for s, (_, w) in members]))
         # where each painted element goes, worked out once: the paint loop runs 200 times a tick
         self._extent = QRect()  # what the painted elements take
         self._bare = QRegion(self.rect())  # what no element covers: the form's background shows
@@ -164,7 +170,8 @@ class FormView(QWidget):
                 except Exception as e:
                     self._fault(model, e, "update")
                     sync()  # marked stale: drawn with a painter, which shows the mark
-            self._refresh_banked(snapshot, readings, judged)
+            for bank, banked, puts in self._banks:
+                self._refresh_banked(snapshot, readings, judged, bank, banked, puts)
         finally:
             self._dirty = None
         if len(dirty) > BATCH and len(dirty) * 2 > len(self._slots):
@@ -180,18 +187,20 @@ class FormView(QWidget):
             self._redraw(snapshot.wall)
 
     def _refresh_banked(self, snapshot: Snapshot, readings: Readings | None,
-                        judged: dict[tuple[int, int], Quality]) -> None:
-        """The gauges of the bank: only those whose word changed are settled and composed. With
-        the runtime's readings, one whose data are not good takes the general path (`update`)
-        and is taken anew once they are."""
-        bank, puts = self._bank, self._puts
-        positions, words = bank.changed(snapshot.data)
+                        judged: dict[tuple[int, int], Quality], bank: Bank,
+                        banked: list[tuple[Element, Sources, Callable[[], None]]],
+                        puts: list[Callable[[int], None]]) -> None:
+        """The elements of a bank: only those whose operand changed are settled and composed.
+        With the runtime's readings, one whose data are not good takes the general path
+        (`update`) and is taken anew once they are."""
+        positions, values = bank.changed(snapshot)
+        new: Iterable[tuple[int, int]]
         if readings is None:
-            new = zip(positions, words)
+            new = zip(positions, values)
         else:
-            changed = dict(zip(positions, words))
+            changed = dict(zip(positions, values))
             new = []
-            for i, (model, sources, sync) in enumerate(self._banked):
+            for i, (model, sources, sync) in enumerate(banked):
                 quality = _worst(sources, readings, judged)
                 if quality is Quality.GOOD and not model.quality:
                     if i in changed:
@@ -204,11 +213,11 @@ class FormView(QWidget):
                 except Exception as e:
                     self._fault(model, e, "update")
                     sync()
-        for i, hw in new:
+        for i, value in new:
             try:
-                puts[i](hw)
+                puts[i](value)
             except Exception as e:
-                model, _, sync = self._banked[i]
+                model, _, sync = banked[i]
                 self._fault(model, e, "update")
                 bank.forget(i)
                 sync()

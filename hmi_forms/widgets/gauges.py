@@ -541,14 +541,6 @@ class GaugeFace(Face):
         self.drawn = drawn
         self.show(self.part if text_only and self.part is not None else self.rect)
 
-    def put(self, hw: int) -> None:
-        """A new word of a plain gauge, read with the rest of the form's (`WordBank`): what
-        `update` would do with it when the data are good."""
-        m = self.model
-        m.stale = False  # a failed draw's mark goes with the next value, as with `update`
-        m.settle(hw)
-        self.sync()
-
     def compose(self) -> list[Op] | None:
         m = self.model
         kind = self.kind

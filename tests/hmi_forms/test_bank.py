@@ -9,7 +9,8 @@ from pathlib import Path
 import pytest
 
 from hmi_forms.elements.analog import AnalogBase
-from hmi_forms.elements.bank import WordBank
+from hmi_forms.elements.bank import BitBank, WordBank
+from hmi_forms.elements.discrete import DiscreteBase
 from hmi_forms.elements.target import NullTarget
 from hmi_forms.form import load_form
 from hmi_forms.widgets.form_view import FormView
@@ -25,12 +26,12 @@ def test_a_bank_reports_the_words_that_changed_since_they_were_last_taken() -> N
     assert bank.aligned
     mem = Memory()
     mem.set_word(0o4012, 515)
-    assert bank.changed(mem.snapshot(0, 0, 0).data) == ([0, 1, 2], [0, 515, 0])  # all new at first
-    assert bank.changed(mem.snapshot(1, 0, 0).data) == ([], [])
+    assert bank.changed(mem.snapshot(0, 0, 0)) == ([0, 1, 2], [0, 515, 0])  # all new at first
+    assert bank.changed(mem.snapshot(1, 0, 0)) == ([], [])
     mem.set_word(0o14000, 0xFFFF)
-    assert bank.changed(mem.snapshot(2, 0, 0).data) == ([2], [0xFFFF])
+    assert bank.changed(mem.snapshot(2, 0, 0)) == ([2], [0xFFFF])
     bank.forget(0)
-    assert bank.changed(mem.snapshot(3, 0, 0).data) == ([0], [0])
+    assert bank.changed(mem.snapshot(3, 0, 0)) == ([0], [0])
 
 
 def test_words_at_odd_addresses_are_read_byte_by_byte() -> None:
@@ -40,13 +41,31 @@ def test_words_at_odd_addresses_are_read_byte_by_byte() -> None:
     mem = Memory()
     for i, a in enumerate(addresses):
         mem.set_word(a, 0x1234 + i)
-    data = mem.snapshot(0, 0, 0).data
-    assert bank.changed(data) == ([0, 1, 2], [mem.snapshot(0, 0, 0).get_word(a) for a in addresses])
+    words = [mem.snapshot(0, 0, 0).get_word(a) for a in addresses]
+    assert bank.changed(mem.snapshot(0, 0, 0)) == ([0, 1, 2], words)
 
 
 def test_a_word_whose_high_byte_is_past_data_memory_is_refused() -> None:
     with pytest.raises(ValueError, match="past the end"):
         WordBank([data_address(16 * 1024 - 1)])
+
+
+def test_a_bit_bank_reads_io_bits_and_bits_of_data_bytes() -> None:
+    bank = BitBank([0o2001, 0o40013, 0o2002, 0o41000])
+    mem = Memory()
+    mem.set_hmi_bit(0o2002, 1)
+    mem.set_hmi_bit(0o40013, 1)
+    assert bank.changed(mem.snapshot(0, 0, 0)) == ([0, 1, 2, 3], [0, 1, 1, 0])
+    mem.set_hmi_bit(0o40013, 0)
+    mem.set_hmi_bit(0o41000, 1)
+    mem.set_hmi_bit(0o2001, 1)
+    assert bank.changed(mem.snapshot(1, 0, 0)) == ([0, 1, 3], [1, 0, 1])
+    one = BitBank([0o2002])  # a single I/O bit
+    assert one.changed(mem.snapshot(2, 0, 0)) == ([0], [1])
+
+
+def banked(view: FormView) -> list:
+    return [model for _, members, _ in view._banks for model, _, _ in members]
 
 
 def gauge(name: str, x: int, addr: str, **props) -> dict:
@@ -73,7 +92,7 @@ def test_only_gauges_whose_word_is_all_they_show_are_banked(qtbot, tmp_path) -> 
         gauge("trend", 350, "04022", Appearance="graph"),
         gauge("io", 420, "0100"),
     ])
-    assert [m.Name for m, _, _ in view._banked] == ["plain", "digital"]
+    assert [m.Name for m in banked(view)] == ["plain", "digital"]
 
 
 def test_a_banked_gauge_takes_each_word_as_its_own_update_would(qtbot, tmp_path) -> None:
@@ -89,7 +108,7 @@ def test_a_banked_gauge_takes_each_word_as_its_own_update_would(qtbot, tmp_path)
                  for i in range(len(props))}
         s = snap(words=words, scan=tick)
         view.refresh(s)
-        for (model, _, _), own in zip(view._banked, alone.elements, strict=True):
+        for model, own in zip(banked(view), alone.elements, strict=True):
             assert isinstance(own, AnalogBase)
             own.update(s)
             assert (model.hw, model.phy, model.text, model.zone) == (own.hw, own.phy, own.text, own.zone)
@@ -104,7 +123,7 @@ def test_a_banked_gauge_takes_each_word_as_its_own_update_would(qtbot, tmp_path)
 def test_a_banked_gauge_that_fails_is_reported_and_the_form_keeps_running(qtbot, tmp_path,
                                                                         monkeypatch) -> None:
     view = view_of(qtbot, tmp_path, [gauge("bad", 0, "04010"), gauge("good", 70, "04012")])
-    bad, good = (m for m, _, _ in view._banked)
+    bad, good = banked(view)
 
     def broken(hw: int) -> None:
         raise RuntimeError("no conversion")
@@ -116,3 +135,29 @@ def test_a_banked_gauge_that_fails_is_reported_and_the_form_keeps_running(qtbot,
     monkeypatch.undo()
     view.refresh(snap(words={0o4010: 10, 0o4012: 20}, scan=1))  # tried again with the same word
     assert bad.text == "-48.0" and not bad.stale
+
+
+def test_lamps_whose_bit_is_all_they_show_are_banked_and_follow_it(qtbot, tmp_path) -> None:
+    label = {"type": "DiscreteColorLabel", "y": 0, "w": 64, "h": 30, "TextFalse": "OFF", "TextTrue": "ON",
+             "BackColorTrue": "#2e7d32"}
+    view = view_of(qtbot, tmp_path, [
+        {**label, "Name": "io", "x": 0, "InAddr": "02001"},
+        {**label, "Name": "data", "x": 70, "InAddr": "040013", "type": "DiscreteColorLabel"},
+        {**label, "Name": "enable", "x": 140, "InAddr": "02002", "type": "DiscreteControlledEnable",
+         "EnableAddr": "02003"},
+        {**label, "Name": "gated", "x": 210, "InAddr": "02004", "SyncType": "02005"},
+    ])
+    assert [m.Name for m in banked(view)] == ["io", "data"]
+    alone = load_form(view.form.path).elements[:2]
+    for tick, (a, b) in enumerate([(0, 0), (1, 0), (1, 1), (0, 1), (0, 0)]):
+        s = snap(bits={0o2001: a, 0o40013: b}, scan=tick)
+        view.refresh(s)
+        for model, own in zip(banked(view), alone, strict=True):
+            assert isinstance(own, DiscreteBase)
+            own.update(s)
+            assert (model.value, model.text) == (own.value, own.text)
+    composed = view.grab().toImage()
+    for _, w in view.pairs:
+        w.face.forget()
+    view.update()
+    assert view.grab().toImage() == composed
