@@ -10,20 +10,52 @@ from __future__ import annotations
 from collections.abc import Hashable
 
 from PySide6.QtCore import QCoreApplication, QRectF, Qt
-from PySide6.QtGui import QColor, QLinearGradient, QMouseEvent, QPainter, QPen
+from PySide6.QtGui import QColor, QLinearGradient, QMouseEvent, QPainter, QPen, QPixmap
 from PySide6.QtWidgets import QWidget
 
 from hmi_forms.elements.discrete import DiscreteBase, DiscreteColorLabel
 from hmi_forms.widgets import theme
-from hmi_forms.widgets.base import STYLE, ElementWidget, Images, draw_pixmap
+from hmi_forms.widgets.base import PIX, STYLE, ElementWidget, Face, Images, Op, draw_pixmap
+
+
+class DiscreteFace(Face):
+    """A discrete element's composition: the layer of its state. For an element whose state is its
+    bit alone (`plain`), the layer is looked up by the bit and the press, not by asking the model
+    for every property the layer is drawn from."""
+
+    __slots__ = ("by_state", "pressed", "simple")
+
+    def __init__(self, widget: ElementWidget) -> None:
+        super().__init__(widget)
+        self.pressed = False  # the operator holds the mouse button on it
+        self.by_state: dict[tuple[int | None, bool], QPixmap] = {}
+        self.simple = False
+
+    def load(self) -> None:
+        super().load()
+        self.by_state = {}
+        self.simple = type(self.model) in (DiscreteBase, DiscreteColorLabel)
+
+    def compose(self) -> list[Op] | None:
+        if not self.simple:
+            return super().compose()
+        m = self.model
+        if m.stale or self.restyled():
+            return None
+        state = (m.value, self.pressed)
+        layer = self.by_state.get(state)
+        if layer is None:
+            layer = self.by_state[state] = self.widget.layer()
+        return [(PIX, (self.x, self.y, layer))]
 
 
 class DiscreteWidget(ElementWidget):
     model: DiscreteBase
+    face_class = DiscreteFace
+    face: DiscreteFace
 
     def __init__(self, model: DiscreteBase, images: Images, parent: QWidget | None = None) -> None:
         super().__init__(model, images, parent)
-        self._pressed = False
         has_images = model.ImageFalse >= 0 or model.ImageTrue >= 0
         self.has_lamp = not isinstance(model, DiscreteColorLabel) and not has_images
         if model.Enabled and model.Cursor == "Default":
@@ -60,7 +92,7 @@ class DiscreteWidget(ElementWidget):
 
     def layer_key(self) -> Hashable:
         m = self.model
-        return m.value, m.indicating, m.image, m.text, m.clickable, self._pressed
+        return m.value, m.indicating, m.image, m.text, m.clickable, self.face.pressed
 
     def paint_layer(self, p: QPainter, r: QRectF) -> None:
         if not self.model.Enabled:
@@ -68,7 +100,7 @@ class DiscreteWidget(ElementWidget):
             return
         r = r.adjusted(1, 1, -1, -1)
         base = self.back_color() or theme.PANEL
-        if self._pressed:
+        if self.face.pressed:
             top, bottom = base.darker(112), base.darker(104)
         else:
             top, bottom = base.lighter(108), base.darker(108)
@@ -78,10 +110,10 @@ class DiscreteWidget(ElementWidget):
         p.setPen(QPen(theme.BORDER.darker(115) if self.model.clickable else theme.BORDER, 1))
         p.setBrush(grad)
         p.drawRoundedRect(r, 4, 4)
-        if not self._pressed:
+        if not self.face.pressed:
             p.setPen(QPen(QColor(255, 255, 255, 160), 1))
             p.drawLine(r.left() + 4, r.top() + 1.5, r.right() - 4, r.top() + 1.5)
-        self.paint_static(p, r.adjusted(3, 2, -3, -2).translated(0, 1 if self._pressed else 0))
+        self.paint_static(p, r.adjusted(3, 2, -3, -2).translated(0, 1 if self.face.pressed else 0))
 
     def paint_static(self, p: QPainter, r: QRectF) -> None:
         m = self.model
@@ -117,13 +149,12 @@ class DiscreteWidget(ElementWidget):
 
     def mousePressEvent(self, event: QMouseEvent) -> None:
         if event.button() == Qt.MouseButton.LeftButton and self.model.clickable:
-            self._pressed = True
+            self.face.pressed = True
             self.sync()
 
     def mouseReleaseEvent(self, event: QMouseEvent) -> None:
-        if not self._pressed:
+        if not self.face.pressed:
             return
-        self._pressed = False
         self.sync()
         if self.rect().contains(event.position().toPoint()):
             self.model.click()

@@ -502,8 +502,8 @@ class GaugeFace(Face):
     per tick costs no paint until it has moved one), in a large gauge only the text's box when
     that is all that changed."""
 
-    __slots__ = ("bar", "contained", "inks", "kind", "needles", "part", "shown", "slot", "tall", "text_op",
-                 "texts", "travel", "units")
+    __slots__ = ("bar", "contained", "inks", "kind", "needles", "part", "phy_min", "phy_span", "shown",
+                 "slot", "tall", "text_op", "texts", "travel", "units")
 
     def load(self) -> None:
         super().load()
@@ -516,6 +516,8 @@ class GaugeFace(Face):
         self.inks, self.units = (BARE, widget._units) if kind == "hbar" else (BOXED, "")
         self.needles, self.travel, self.contained = widget._needles, widget._travel, widget._contained
         self.bar, self.tall = widget._bar, widget._digital[0].height() > 30
+        scaling = widget.model.scaling  # `Scaling.fraction`, without two calls per tick
+        self.phy_min, self.phy_span = scaling.PhyMin, scaling.PhyMax - scaling.PhyMin
         part = widget._part
         self.part = None if part is None else part.translated(self.rect.topLeft()).intersected(self.rect)
         self.shown: tuple[object, ...] | None = None  # what a painter drew last (`GaugeWidget.shown`)
@@ -558,13 +560,14 @@ class GaugeFace(Face):
         value = self.text_op = (PIX, (x + sprite[0], y + sprite[1], sprite[2]))
         if m.hw is None or kind == "digital":
             return [layer, value]
+        fraction = min(max((m.phy - self.phy_min) / self.phy_span, 0.0), 1.0)
         if kind == "hbar":  # the fraction is clamped to the track
             left, top, height, travel = self.bar
             fill = theme.ZONE_COLORS.get(zone or "") or theme.ACCENT
-            return [layer, (FILL, (x + left, y + top, round(travel * m.fraction), height, fill)), value]
+            return [layer, (FILL, (x + left, y + top, round(travel * fraction), height, fill)), value]
         if self.needles is None:
             return None
-        needle = self.needles.get(round(m.fraction * self.travel)) or self.widget._needle_sprite()
+        needle = self.needles.get(round(fraction * self.travel)) or self.widget._needle_sprite()
         return [layer, value, (PIX, (x + needle[0], y + needle[1], needle[2]))]
 
 

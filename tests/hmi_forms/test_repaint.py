@@ -14,7 +14,7 @@ from PySide6.QtWidgets import QApplication
 
 from hmi_forms.elements.target import NullTarget
 from hmi_forms.form import load_form
-from hmi_forms.widgets import base, gauges, theme
+from hmi_forms.widgets import base, discrete, gauges, theme
 from hmi_forms.widgets.base import ElementWidget
 from hmi_forms.widgets.form_view import FormView
 from hmi_forms.widgets.gauges import BOXED
@@ -56,6 +56,7 @@ class Draws:
 
         monkeypatch.setattr(base, "PIX", pix)  # what compositions made from now on call
         monkeypatch.setattr(gauges, "PIX", pix)
+        monkeypatch.setattr(discrete, "PIX", pix)
 
     def _wrap(self, widget: ElementWidget) -> None:
         name, draw = widget.model.Name, widget.draw
