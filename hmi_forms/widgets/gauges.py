@@ -67,6 +67,9 @@ BOXED = {None: Ink(theme.TEXT, WHITE), "normal": Ink(theme.TEXT, WHITE), "low": 
          "high": Ink(WHITE, theme.ALARM)}
 BARE = {None: Ink(theme.TEXT), "normal": Ink(theme.TEXT), "low": Ink(theme.WARN.darker(115)),
         "high": Ink(theme.ALARM.darker(115))}
+# what a word shows on a plain gauge: the model's (hw, phy, text, zone), the text's sprite, and the
+# needle's sprite or the bar fill's (width, colour) or None (`GaugeFace.put`)
+Entry = tuple[tuple[int, float, str, "str | None"], Sprite, object]
 
 
 class GaugeWidget(ElementWidget):
@@ -502,8 +505,8 @@ class GaugeFace(Face):
     per tick costs no paint until it has moved one), in a large gauge only the text's box when
     that is all that changed."""
 
-    __slots__ = ("bar", "contained", "inks", "kind", "needles", "part", "phy_min", "phy_span", "shown",
-                 "slot", "tall", "text_op", "texts", "travel", "units")
+    __slots__ = ("bar", "contained", "entries", "fast", "inks", "kind", "needles", "part", "phy_min",
+                 "phy_span", "shown", "slot", "tall", "text_op", "texts", "travel", "units")
 
     def load(self) -> None:
         super().load()
@@ -511,17 +514,24 @@ class GaugeFace(Face):
         assert isinstance(widget, GaugeWidget)
         widget._layout()
         assert widget._value is not None
-        kind = self.kind = widget.model.Appearance
+        m = widget.model
+        kind = self.kind = m.Appearance
         self.slot, self.texts = widget._value, widget._value.sprites
         self.inks, self.units = (BARE, widget._units) if kind == "hbar" else (BOXED, "")
         self.needles, self.travel, self.contained = widget._needles, widget._travel, widget._contained
         self.bar, self.tall = widget._bar, widget._digital[0].height() > 30
-        scaling = widget.model.scaling  # `Scaling.fraction`, without two calls per tick
+        scaling = m.scaling  # `Scaling.fraction`, without two calls per tick
         self.phy_min, self.phy_span = scaling.PhyMin, scaling.PhyMax - scaling.PhyMin
         part = widget._part
         self.part = None if part is None else part.translated(self.rect.topLeft()).intersected(self.rect)
         self.shown: tuple[object, ...] | None = None  # what a painter drew last (`GaugeWidget.shown`)
         self.text_op: Op | None = None
+        # a word taken from the form's bank (`put`) is looked up with what it shows: the same for
+        # every gauge drawn from the same sprites with the same conversion
+        self.fast = m.plain and self.contained and self.part is None and (kind == "digital" or kind == "hbar"
+                                                                        or self.needles is not None)
+        family = ("entries", kind, id(self.texts), id(self.needles), self.travel, self.bar, self.units)
+        self.entries: dict[int, Entry] = SPRITES.family((*family, id(m._shown)))  # emptied with the sprites
 
     def sync(self) -> None:
         if not self.fresh:
@@ -543,32 +553,72 @@ class GaugeFace(Face):
         self.drawn = drawn
         self.show(self.part if text_only and self.part is not None else self.rect)
 
+    def put(self, hw: int) -> None:
+        """`Face.put`, with what the word shows looked up in one step (`entries`): the model's
+        state and the sprites of the composition."""
+        if not self.fresh:
+            self.load()
+        entry = self.entries.get(hw)
+        m = self.model
+        m.stale = False
+        if entry is None or self.style_of(m) != self.style:
+            m.settle(hw)
+            if self.fast and not self.restyled():
+                parts = self._parts(m.text, m.zone, m.phy, False)
+                if parts is not None:
+                    self.entries[hw] = ((m.hw, m.phy, m.text, m.zone), *parts)
+            self.sync()
+            return
+        shown, text, extra = entry
+        m.hw, m.phy, m.text, m.zone = shown
+        drawn = self._ops(shown[3], text, extra)
+        if drawn == self.drawn:
+            return
+        self.drawn, self.shown = drawn, None
+        self.show(self.rect)
+
     def compose(self) -> list[Op] | None:
         m = self.model
-        kind = self.kind
-        if m.stale or not self.contained or (m.maximum is not None and (kind != "digital" or self.tall)) \
-                or self.restyled():
+        marked = m.maximum is not None and (self.kind != "digital" or self.tall)  # drawn by a painter
+        if m.stale or not self.contained or marked or self.restyled():
             return None
-        zone, x, y = m.zone, self.x, self.y
+        parts = self._parts(m.text, m.zone, m.phy, m.hw is None)
+        return None if parts is None else self._ops(m.zone, *parts)
+
+    def _parts(self, text: str, zone: str | None, phy: float, unknown: bool) -> tuple[Sprite, object] | None:
+        """The value's text sprite and the needle's sprite or the bar's fill (width, colour);
+        None where a painter must draw."""
         ink = self.inks[zone]
-        text = (m.text or "---") + self.units
+        text = (text or "---") + self.units
         sprite = self.texts.get((text, ink.key)) or self.slot.sprite(text, ink)
         if sprite is None:
             return None
-        layer = self.layers.get(zone)  # (not `or`: the truth of a QPixmap is a call into Qt)
-        layer = (PIX, (x, y, self.widget.layer() if layer is None else layer))
-        value = self.text_op = (PIX, (x + sprite[0], y + sprite[1], sprite[2]))
-        if m.hw is None or kind == "digital":
-            return [layer, value]
-        fraction = min(max((m.phy - self.phy_min) / self.phy_span, 0.0), 1.0)
+        kind = self.kind
+        if unknown or kind == "digital":
+            return sprite, None
+        fraction = min(max((phy - self.phy_min) / self.phy_span, 0.0), 1.0)
         if kind == "hbar":  # the fraction is clamped to the track
-            left, top, height, travel = self.bar
-            fill = theme.ZONE_COLORS.get(zone or "") or theme.ACCENT
-            return [layer, (FILL, (x + left, y + top, round(travel * fraction), height, fill)), value]
+            return sprite, (round(self.bar[3] * fraction), theme.ZONE_COLORS.get(zone or "") or theme.ACCENT)
         if self.needles is None:
             return None
-        needle = self.needles.get(round(fraction * self.travel)) or self.widget._needle_sprite()
-        return [layer, value, (PIX, (x + needle[0], y + needle[1], needle[2]))]
+        return sprite, self.needles.get(round(fraction * self.travel)) or self.widget._needle_sprite()
+
+    def _ops(self, zone: str | None, text: Sprite, extra: object) -> list[Op]:
+        """The composition at the element's place: its zone's layer, the text, the needle or fill."""
+        x, y = self.x, self.y
+        layer = self.layers.get(zone)  # (not `or`: the truth of a QPixmap is a call into Qt)
+        drawn: list[Op] = [(PIX, (x, y, self.widget.layer() if layer is None else layer))]
+        value = self.text_op = (PIX, (x + text[0], y + text[1], text[2]))
+        if extra is None:
+            drawn.append(value)
+        elif self.kind == "hbar":
+            left, top, height, _ = self.bar
+            width, fill = extra  # type: ignore[misc]
+            drawn += (FILL, (x + left, y + top, width, height, fill)), value
+        else:
+            nx, ny, needle = extra  # type: ignore[misc]
+            drawn += value, (PIX, (x + nx, y + ny, needle))
+        return drawn
 
 
 GaugeWidget.face_class = GaugeFace
