@@ -37,7 +37,7 @@ from hmi_forms.elements.sync import SyncGenerator
 from hmi_forms.elements.target import Target
 from hmi_forms.form import Form
 from hmi_forms.widgets.analog_output import AnalogOutputWidget
-from hmi_forms.widgets.base import ElementWidget, Images, SelfPainted, draw_pixmap
+from hmi_forms.widgets.base import ElementWidget, Face, Images, SelfPainted, draw_pixmap
 from hmi_forms.widgets.discrete import DiscreteWidget
 from hmi_forms.widgets.gauges import GaugeWidget
 from hmi_forms.widgets.journal import JournalWidget
@@ -113,8 +113,10 @@ class FormView(QWidget):
             self._extent = self._extent.united(w.geometry())
             if w.covers():
                 self._bare -= QRegion(w.geometry())
-        self._slots = [(w.face, w, w.geometry(), QTransform.fromTranslate(w.x(), w.y()), QRectF(w.rect()))
-                       for w in self.painted]
+        self._faces = [w.face for w in self.painted]
+        self._places = [w.geometry() for w in self.painted]
+        self._slots = {w.face: (w, QTransform.fromTranslate(w.x(), w.y()), QRectF(w.rect()))
+                       for w in self.painted}
         self.live = True  # the trends follow the clock; paused, the operator pans and zooms them
         self.history_wanted: Callable[[TrendWidget, float, float], None] | None = None
         self._next_flush = clock()
@@ -174,7 +176,7 @@ class FormView(QWidget):
                 self._refresh_banked(snapshot, readings, judged, bank, banked, puts)
         finally:
             self._dirty = None
-        if len(dirty) > BATCH and len(dirty) * 2 > len(self._slots):
+        if len(dirty) > BATCH and len(dirty) * 2 > len(self._faces):
             # most of a large form: one rectangle costs Qt far less than hundreds (a region of n
             # rectangles costs n² to build), and an element unchanged is one more pixmap copy
             self.update()
@@ -297,26 +299,41 @@ class FormView(QWidget):
                 if self.form.BackgroundImage is not None:
                     draw_pixmap(p, self.images.get(self.form.BackgroundImage), QRectF(self.rect()), "Stretch")
                 p.setClipping(False)
-            whole = region.rectCount() == 1 and event.rect().contains(self._extent)  # no test per element
             p.setRenderHint(QPainter.RenderHint.Antialiasing)
-            for face, widget, geometry, at, rect in self._slots:
-                if not whole and not region.intersects(geometry):
-                    continue
-                try:
+            if region.rectCount() == 1 and event.rect().contains(self._extent):  # no test per element
+                for face in self._faces:  # the loop runs a thousand times a tick on a large form
                     ops = face.drawn
-                    if ops is not None:
+                    if ops is None:
+                        self._paint_one(p, face)
+                        continue
+                    try:
                         for method, args in ops:
                             method(p, *args)
-                        continue
-                    p.setTransform(at)  # each sets the pens, fonts... it uses
-                    p.setClipRect(rect)
-                    widget.draw(p, rect)
-                except Exception as e:
-                    self._fault(widget.model, e, "drawing")
-                p.setClipping(False)
-                p.resetTransform()
+                    except Exception as e:
+                        self._fault(face.model, e, "drawing")
+                return
+            for face, geometry in zip(self._faces, self._places):
+                if region.intersects(geometry):
+                    self._paint_one(p, face)
         finally:
             p.end()
+
+    def _paint_one(self, p: QPainter, face: Face) -> None:
+        """One element: from its composition, or with the painter moved and clipped to it."""
+        widget, at, rect = self._slots[face]
+        try:
+            ops = face.drawn
+            if ops is not None:
+                for method, args in ops:
+                    method(p, *args)
+                return
+            p.setTransform(at)  # each sets the pens, fonts... it uses
+            p.setClipRect(rect)
+            widget.draw(p, rect)
+        except Exception as e:
+            self._fault(widget.model, e, "drawing")
+        p.setClipping(False)
+        p.resetTransform()
 
 
 def _worst(sources: tuple[tuple[int, int], ...], readings: Readings,
