@@ -10,12 +10,16 @@ painted the same way. Ticks of the two alternate, so both see the same machine l
 tick the mean, median and p95 of the form, the yardstick beside it and the ratio of the medians,
 and the resident memory after warm-up and after all ticks (flat = no growth).
 
+`--readings` refreshes as the workstation does, with the runtime's Readings of each scan: the
+words come from NREADs of one node (64 words each, link up), so every element's data quality is
+judged on every refresh as well.
+
 `--plots` makes every sixth element a trend plot (four tiles wide) instead of a bar, as the
 300-element bench of the first releases did: the plots are redrawn once per REDRAW_INTERVAL of the
 (fake, 100 ms a tick) clock, all plots of the form in the same tick (they share one clock-time
 axis), so a plot lags its data by at most that interval and every tenth tick carries the redraws.
 
-    QT_QPA_PLATFORM=offscreen python bench/hmi.py [--elements N] [--ticks T] [--plots]
+    QT_QPA_PLATFORM=offscreen python bench/hmi.py [--elements N] [--ticks T] [--plots] [--readings]
 """
 
 from __future__ import annotations
@@ -42,6 +46,9 @@ from hmi_forms.widgets.form_view import FormView
 from hmi_forms.widgets.trend import REDRAW_INTERVAL
 from netplc.engine import FakeClock
 from netplc.memory import Memory
+from netplc.program import parse
+from netplc.tags.quality import LinkView, QualityMap
+from netplc.tags.readings import Readings
 
 TILE = 64
 TICK_MS = 100.0
@@ -118,6 +125,19 @@ def generate(folder: Path, n: int, plots: bool) -> Path:
     return path
 
 
+BLOCK = 64  # words per NREAD of `--readings`
+
+
+def station(n: int) -> QualityMap:
+    """The NREADs that fill the words of n elements, coils in the external bits (clear of the
+    bits the lamps show)."""
+    lines = []
+    for b in range(math.ceil(n / BLOCK)):
+        coil, target = 0o1000 + 4 * b, word_addr(b * BLOCK)
+        lines += ["TNA $03760", f"FON C:$0{coil:o} N:NREAD S:4000 D:$0{target:o} R:{2 * BLOCK}"]
+    return QualityMap(parse("\n".join([*lines, "JMP 0", ""])), [])
+
+
 def drive(mem: Memory, n: int, tick: int) -> None:
     """Every element's value changes on every tick: words step by at least 0.7 % of the range,
     bits toggle."""
@@ -149,6 +169,7 @@ def main() -> None:
     parser.add_argument("--elements", type=int, default=300, help="elements on the form (default 300)")
     parser.add_argument("--ticks", type=int, default=1000, help="ticks measured (default 1000)")
     parser.add_argument("--plots", action="store_true", help="every sixth element a trend plot, not a bar")
+    parser.add_argument("--readings", action="store_true", help="judge data quality as the workstation does")
     args = parser.parse_args()
     n, ticks = args.elements, args.ticks
     app = QApplication.instance() or QApplication([])
@@ -160,6 +181,7 @@ def main() -> None:
     window, plain = labels(n)
     window.show()
     mem = Memory()
+    qmap, links = station(n), LinkView(links={0: True})
     app.processEvents()
     # allocated up front, so that the measurement itself does not grow the memory it measures
     times = array("d", bytes(8 * ticks))
@@ -170,9 +192,10 @@ def main() -> None:
     for tick in range(ticks):
         drive(mem, n, tick)
         snap = mem.snapshot(tick, tick * 0.1, 1.8e9 + tick * 0.1)
+        readings = Readings(snap, qmap, links, qmap.evaluate(snap, links)) if args.readings else None
         clock.advance(0.1)
         t0 = time.perf_counter()
-        view.refresh(snap)
+        view.refresh(snap, readings)
         t1 = time.perf_counter()
         app.processEvents()
         t2 = time.perf_counter()
@@ -190,6 +213,7 @@ def main() -> None:
     y_mean, y_median, y_p95 = stats(yard[warm:])
     refresh = statistics.mean(models[warm:])
     what = f"plots redrawn together every {REDRAW_INTERVAL:g} s, " if args.plots else ""
+    what += f"quality judged against {len(qmap.feeds)} NREADs, " if args.readings else ""
     print(f"hmi form update, {n} elements all changing every tick, {form.width}x{form.height} px: "
           f"{mean:.2f} ms mean, {median:.2f} ms median, {p95:.2f} ms p95 over {ticks - warm} ticks "
           f"(of it refresh {refresh:.2f} ms, paint {mean - refresh:.2f} ms); {what}"

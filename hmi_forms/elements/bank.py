@@ -9,13 +9,16 @@ serves are those whose value is all they show (`plain`): they `settle` what the 
 
 from __future__ import annotations
 
-from collections.abc import Sequence
+from collections.abc import Callable, Iterable, Sequence
 from operator import itemgetter
 
 import numpy as np
 
+from hmi_forms.elements.base import Element
 from netplc.address import DATA_SIZE, IO_BITS, data_index
 from netplc.memory import Snapshot
+from netplc.tags.quality import Operands, Quality, QualityMap
+from netplc.tags.readings import Readings
 
 UNKNOWN = -1  # no value: taken again at the next snapshot, whatever it holds
 
@@ -88,3 +91,67 @@ class BitBank(Bank):
             raw = np.frombuffer(snap.data, dtype=np.uint8)
             values[self.data_at] = raw[self.byte] >> self.shift & 1
         return values
+
+
+class Banked:
+    """The elements one bank serves, refreshed from each snapshot: only those whose operand
+    changed are settled (`put`). With the runtime's readings, the quality of all of them is
+    judged at once (`Readings.judge`); one whose data are not good takes the general path
+    (`Element.update`, then `sync`) and is taken anew from the bank once they are good again."""
+
+    def __init__(self, bank: Bank, models: Sequence[Element], puts: Sequence[Callable[[int], None]],
+                 syncs: Sequence[Callable[[], None]], fault: Callable[[Element, Exception], None]) -> None:
+        self.bank, self.models, self.puts, self.syncs = bank, list(models), list(puts), list(syncs)
+        self.fault = fault
+        self.sources = [m.sources()[0] for m in self.models]  # a plain element shows one operand
+        self.marked = np.zeros(len(self.models), dtype=bool)  # shown with a quality mark
+        self.judged_by: QualityMap | None = None
+        self.operands: Operands | None = None
+        self.links: list[int] = []  # link output bits: judged by their own rule, one by one
+
+    def refresh(self, snap: Snapshot, readings: Readings | None) -> None:
+        positions, values = self.bank.changed(snap)
+        if readings is None:
+            codes = None
+            general = np.flatnonzero(self.marked)  # marked once: cleared by the general path
+        else:
+            codes = self._judge(readings)
+            general = np.flatnonzero((codes != Quality.GOOD) | self.marked)
+        new: Iterable[tuple[int, int]] = zip(positions, values)
+        if len(general):
+            apart = set(general.tolist())
+            new = [(i, v) for i, v in new if i not in apart]
+            for i in apart:
+                self._update(i, snap, None if codes is None else Quality(int(codes[i])))
+        for i, value in new:
+            try:
+                self.puts[i](value)
+            except Exception as e:
+                self._failed(i, e)
+
+    def _judge(self, readings: Readings) -> np.ndarray:
+        qmap = readings.quality_map
+        if self.judged_by is not qmap:  # the station's program (and its NREADs) changed
+            self.judged_by, self.operands = qmap, qmap.operands(self.sources)
+            self.links = [i for i, (a, n) in enumerate(self.sources) if n == 0 and a in qmap.link_bits]
+        assert self.operands is not None
+        codes = readings.judge(self.operands)
+        for i in self.links:
+            codes[i] = readings.address(*self.sources[i])
+        return codes
+
+    def _update(self, i: int, snap: Snapshot, quality: Quality | None) -> None:
+        model = self.models[i]
+        self.bank.forget(i)
+        try:
+            if model.update(snap, quality):
+                self.syncs[i]()
+        except Exception as e:
+            self._failed(i, e)
+        self.marked[i] = bool(model.quality)
+
+    def _failed(self, i: int, error: Exception) -> None:
+        """Reported and marked stale, as a failed update is; its value is taken again next time."""
+        self.fault(self.models[i], error)
+        self.bank.forget(i)
+        self.syncs[i]()

@@ -17,7 +17,7 @@ With the runtime's `Readings` of the scan, each element is also given the qualit
 from __future__ import annotations
 
 import time
-from collections.abc import Callable, Iterable
+from collections.abc import Callable
 from pathlib import Path
 
 import numpy as np
@@ -27,7 +27,7 @@ from PySide6.QtWidgets import QWidget
 
 from hmi_forms.elements import Element
 from hmi_forms.elements.analog import AnalogBase, AnalogOutput
-from hmi_forms.elements.bank import Bank, BitBank, WordBank
+from hmi_forms.elements.bank import Banked, BitBank, WordBank
 from hmi_forms.elements.base import Guard, Writer
 from hmi_forms.elements.discrete import DiscreteBase
 from hmi_forms.elements.graph import Graph
@@ -48,7 +48,6 @@ from netplc.memory import Snapshot
 from netplc.tags.quality import Quality
 from netplc.tags.readings import Readings
 
-Sources = tuple[tuple[int, int], ...]  # what an element's quality is judged on (`Element.sources`)
 BATCH = 100  # changed elements from which a refresh that changed most of the form repaints it whole
 
 
@@ -99,13 +98,14 @@ class FormView(QWidget):
         banked = [kind is not None and type(w).sync is ElementWidget.sync and m.plain
                   for kind, (m, w) in zip(kinds, self.pairs)]
         self._syncs = [s for s, b in zip(syncs, banked) if not b]
-        self._banks: list[tuple[Bank, list[tuple[Element, Sources, Callable[[], None]]],
-                                list[Callable[[int], None]]]] = []
+        self._banks: list[Banked] = []
         for kind, operand in ((WordBank, lambda m: m.InAddr), (BitBank, lambda m: m.InAddr.hmi)):
             members = [(s, w) for s, w, k, b in zip(syncs, self.pairs, kinds, banked) if b and k is kind]
             if members:
-                self._banks.append((kind([operand(s[0]) for s, _ in members]), [s for s, _ in members],
-                                    [w.face.put for s, (_, w) in members]))
+                models = [m for (m, _, _), _ in members]
+                puts, shows = [w.face.put for _, (_, w) in members], [s for (_, _, s), _ in members]
+                self._banks.append(Banked(kind([operand(m) for m in models]), models, puts, shows,
+                                          lambda model, e: self._fault(model, e, "update")))
         # where each painted element goes, worked out once: the paint loop runs 200 times a tick
         self._extent = QRect()  # what the painted elements take
         self._bare = QRegion(self.rect())  # what no element covers: the form's background shows
@@ -172,8 +172,8 @@ class FormView(QWidget):
                 except Exception as e:
                     self._fault(model, e, "update")
                     sync()  # marked stale: drawn with a painter, which shows the mark
-            for bank, banked, puts in self._banks:
-                self._refresh_banked(snapshot, readings, judged, bank, banked, puts)
+            for banked in self._banks:
+                banked.refresh(snapshot, readings)
         finally:
             self._dirty = None
         if len(dirty) > BATCH and len(dirty) * 2 > len(self._faces):
@@ -187,42 +187,6 @@ class FormView(QWidget):
         if self.trends and now >= self._next_flush:  # all plots of the form in the same tick
             self._next_flush = max(self._next_flush + REDRAW_INTERVAL, now)
             self._redraw(snapshot.wall)
-
-    def _refresh_banked(self, snapshot: Snapshot, readings: Readings | None,
-                        judged: dict[tuple[int, int], Quality], bank: Bank,
-                        banked: list[tuple[Element, Sources, Callable[[], None]]],
-                        puts: list[Callable[[int], None]]) -> None:
-        """The elements of a bank: only those whose operand changed are settled and composed.
-        With the runtime's readings, one whose data are not good takes the general path
-        (`update`) and is taken anew once they are."""
-        positions, values = bank.changed(snapshot)
-        new: Iterable[tuple[int, int]]
-        if readings is None:
-            new = zip(positions, values)
-        else:
-            changed = dict(zip(positions, values))
-            new = []
-            for i, (model, sources, sync) in enumerate(banked):
-                quality = _worst(sources, readings, judged)
-                if quality is Quality.GOOD and not model.quality:
-                    if i in changed:
-                        new.append((i, changed[i]))
-                    continue
-                bank.forget(i)
-                try:
-                    if model.update(snapshot, quality):
-                        sync()
-                except Exception as e:
-                    self._fault(model, e, "update")
-                    sync()
-        for i, value in new:
-            try:
-                puts[i](value)
-            except Exception as e:
-                model, _, sync = banked[i]
-                self._fault(model, e, "update")
-                bank.forget(i)
-                sync()
 
     def schedule(self, part: QRect) -> None:
         """Repaint `part` of the form: at once, or with the rest of a refresh."""

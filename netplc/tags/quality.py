@@ -141,27 +141,46 @@ class LinkView:
     since: Mapping[int, int] | None = None
 
 
-class QualityMap:
-    """Which NREADs fill each tag, worked out once at load time; per scan, every tag's quality.
+class Operands:
+    """Spans of the HMI bit space grouped by the set of NREAD blocks they overlap (usually a
+    handful of groups), so that a scan judges each group once and every span by one numpy gather:
+    the station's tags, or the operands a large HMI form shows."""
 
-    Tags are grouped by the set of blocks they overlap (usually a handful of groups), so a scan
-    computes each block's quality once and each tag's by one numpy gather.
-    """
+    def __init__(self, feeds: Sequence[Feed], spans: Sequence[tuple[int, int]]) -> None:
+        groups: dict[tuple[int, ...], int] = {}
+        members = []
+        for first, last in spans:
+            fed = tuple(k for k, f in enumerate(feeds) if f.first < last and first < f.last)
+            members.append(groups.setdefault(fed, len(groups)))
+        self.groups = list(groups)  # group -> indexes into the feeds
+        self.member = np.array(members, dtype=np.intp)
+        bounds = np.array(spans, dtype=np.int64).reshape(-1, 2)
+        self.first, self.last = bounds[:, 0], bounds[:, 1]
+        self.used = sorted({k for g in self.groups for k in g})  # the feeds any span depends on
+
+    def __len__(self) -> int:
+        return len(self.member)
+
+    def evaluate(self, per_feed: Mapping[int, Quality], running: bool, forced: Collection[int]) -> np.ndarray:
+        """Each span's quality code, from the quality of each feed in `used`."""
+        idle = Quality.GOOD if running else Quality.NOT_RUNNING
+        per_group = np.array([max((per_feed[k] for k in g), default=idle) for g in self.groups],
+                             dtype=np.int8)
+        out = per_group[self.member] if len(self.member) else np.zeros(0, dtype=np.int8)
+        for addr in forced:
+            first, last = _forced(addr)
+            out[(self.first < last) & (first < self.last)] = Quality.FORCED
+        return out
+
+
+class QualityMap:
+    """Which NREADs fill each tag, worked out once at load time; per scan, every tag's quality."""
 
     def __init__(self, program: Program, tags: Sequence[Tag]) -> None:
         self.feeds = nread_feeds(program)
         self.link_bits = link_outputs(program)
         self.tags = list(tags)
-        groups: dict[tuple[int, ...], int] = {}
-        members = []
-        for tag in self.tags:
-            first, last = tag.footprint()
-            fed = tuple(k for k, f in enumerate(self.feeds) if f.first < last and first < f.last)
-            members.append(groups.setdefault(fed, len(groups)))
-        self.groups = list(groups)  # group -> indexes into self.feeds
-        self._member = np.array(members, dtype=np.intp)
-        spans = np.array([t.footprint() for t in self.tags], dtype=np.int64).reshape(-1, 2)
-        self._first, self._last = spans[:, 0], spans[:, 1]
+        self._tags = Operands(self.feeds, [t.footprint() for t in self.tags])
         self._pos = {t.name: i for i, t in enumerate(self.tags)}
         # operand span -> the NREADs that fill it: an HMI form asks about thousands of operands on
         # every refresh, and a plant program has hundreds of NREADs to look through for each
@@ -173,7 +192,7 @@ class QualityMap:
 
     def fed_by(self, tag: Tag) -> list[Feed]:
         """The NREADs whose block overlaps the tag."""
-        return [self.feeds[k] for k in self.groups[self._member[self._pos[tag.name]]]]
+        return [self.feeds[k] for k in self._tags.groups[self._tags.member[self._pos[tag.name]]]]
 
     def feed_quality(self, feed: Feed, view: MemoryView, links: LinkView, scan: int) -> Quality:
         if not links.running:
@@ -197,17 +216,20 @@ class QualityMap:
     def evaluate(self, view: MemoryView, links: LinkView | None = None,
                  scan: int | None = None) -> np.ndarray:
         """Every tag's quality code (a `Quality` value) as of this snapshot, in the order of tags."""
+        return self.judge(self._tags, view, links, scan)
+
+    def operands(self, operands: Sequence[tuple[int, int]]) -> Operands:
+        """Operands as `at` takes them, (address, bytes), grouped for `judge`. A link output bit
+        among them is judged by its own rule (`at`): `judge` leaves it to the caller."""
+        return Operands(self.feeds, [(a, a + 1) if n == 0 else span(a, n) for a, n in operands])
+
+    def judge(self, operands: Operands, view: MemoryView, links: LinkView | None = None,
+              scan: int | None = None) -> np.ndarray:
+        """The quality code of every operand of `operands` as of this snapshot."""
         links = links or LinkView()
         scan = getattr(view, "scan", 0) if scan is None else scan
-        per_feed = [self.feed_quality(f, view, links, scan) for f in self.feeds]
-        idle = Quality.GOOD if links.running else Quality.NOT_RUNNING
-        per_group = np.array([max((per_feed[k] for k in g), default=idle) for g in self.groups],
-                             dtype=np.int8)
-        out = per_group[self._member] if len(self.tags) else np.zeros(0, dtype=np.int8)
-        for addr in links.forced:
-            first, last = _forced(addr)
-            out[(self._first < last) & (first < self._last)] = Quality.FORCED
-        return out
+        per_feed = {k: self.feed_quality(self.feeds[k], view, links, scan) for k in operands.used}
+        return operands.evaluate(per_feed, links.running, links.forced)
 
     def at(self, address: int, nbytes: int, view: MemoryView, links: LinkView | None = None) -> Quality:
         """The quality of any address, tag or not: `nbytes` bytes of operand at an I/O bit or data

@@ -17,7 +17,7 @@ from dataclasses import dataclass, replace
 import numpy as np
 
 from netplc.memory import Snapshot
-from netplc.tags.quality import LinkView, Quality, QualityMap
+from netplc.tags.quality import LinkView, Operands, Quality, QualityMap
 
 
 @dataclass(frozen=True, slots=True)
@@ -72,6 +72,11 @@ class Readings:
         """The quality of any operand: `nbytes` bytes at an I/O bit or data address, or with
         `nbytes` 0 the one bit of an HMI bit address (02042, 040005)."""
         return self.quality_map.at(address, nbytes, self.snapshot, self.links)
+
+    def judge(self, operands: Operands) -> np.ndarray:
+        """The quality code of every operand of a set made by `quality_map.operands` (what a
+        large form shows, judged at once), but for link output bits, which `address` judges."""
+        return self.quality_map.judge(operands, self.snapshot, self.links)
 
     def live(self, snapshot: Snapshot) -> Snapshot:
         """`snapshot` with every NREAD/NWRITE link output bit (C+1) showing its node's link as it

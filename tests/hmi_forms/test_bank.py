@@ -65,7 +65,7 @@ def test_a_bit_bank_reads_io_bits_and_bits_of_data_bytes() -> None:
 
 
 def banked(view: FormView) -> list:
-    return [model for _, members, _ in view._banks for model, _, _ in members]
+    return [model for banked in view._banks for model in banked.models]
 
 
 def gauge(name: str, x: int, addr: str, **props) -> dict:

@@ -111,3 +111,31 @@ def test_a_value_that_arrived_while_marked_is_shown_once_the_data_are_good_again
     assert not dial.stale and (dial.text, digital.text) == ("100.0", "100.0")
     view.refresh(*reversed(readings(mem, 4, LinkView(links={0: True}))))  # and stays so
     assert not digital.stale and digital.text == "100.0"
+
+
+def test_a_lamp_on_a_link_output_shows_the_link_itself(qtbot, tmp_path: Path) -> None:
+    """The link output bit (C+1) of an NREAD is judged by its own rule among banked lamps: the
+    link as it is now is good data, while it is not yet known it is initial."""
+    lamp = {"type": "DiscreteColorLabel", "Name": "link", **BOX, "InAddr": "02111", "TextTrue": "связь",
+            "TextFalse": "нет связи"}
+    form = load_form(write_form(tmp_path, [lamp, {**lamp, "Name": "data", "x": 200, "InAddr": "040100"}]))
+    view = FormView(form, NullTarget())
+    qtbot.addWidget(view)
+    link, data = form.elements
+    mem = Memory()
+    mem.set_hmi_bit(0o2111, 1)
+    view.refresh(*reversed(readings(mem, 1, LinkView(links={0: False}))))
+    assert (link.quality, link.value) == ("", 0)  # down, as the link is now, not as the program left it
+    assert data.quality == "comm-fail"
+    view.refresh(*reversed(readings(mem, 2, LinkView(links={0: True}, since={}))))
+    assert link.quality == "initial" and data.quality == "initial"
+    view.refresh(*reversed(readings(mem, 3, LinkView(links={0: True}))))
+    assert (link.quality, link.value, data.quality) == ("", 1, "")
+
+
+def test_a_mark_goes_when_the_view_is_refreshed_without_readings(view: FormView) -> None:
+    mem = Memory()
+    view.refresh(*reversed(readings(mem, 1, LinkView(links={0: False}))))
+    assert models(view)["digital"][0].stale
+    view.refresh(mem.snapshot(2, 0.2, 1_800_000_002.0))
+    assert not any(m.stale for m, _ in models(view).values())

@@ -208,3 +208,18 @@ def test_link_outputs_show_the_link_itself() -> None:
     assert qmap.at(0o2105, 0, snap, up) is Quality.INITIAL  # no exchange attempt yet
     same = mem.snapshot(11)
     assert Readings(same, qmap, LinkView(links={1: True, 2: False}), qmap.evaluate(same)).live(same) is same
+
+
+@pytest.mark.parametrize("links", [
+    LinkView(), LinkView(links={1: False, 2: True}), LinkView(running=False),
+    LinkView(links={1: True, 2: True}, since={1: 0}), LinkView(forced=[0o4003, 0o2207]),
+    LinkView(links={1: True, 2: True}, refreshed={5: 0}),
+])
+def test_operands_judged_at_once_are_judged_as_one_by_one(links: LinkView) -> None:
+    """What a large form asks per refresh (`Readings.judge`) agrees with `at` for every operand."""
+    qmap = QualityMap(parse(PROGRAM), TAGS)
+    operands = [(0o4000, 2), (0o4002, 4), (0o4003, 1), (0o4004, 2), (0o4100, 2), (0o2207, 0),
+                (0o40000 + 7, 0), (0o40030, 0), (0o2220, 0), (0o2200, 1), (0o4004, 2)]
+    view = asking().snapshot(9, 0.9, 0)
+    codes = qmap.judge(qmap.operands(operands), view, links)
+    assert [Quality(int(c)) for c in codes] == [qmap.at(a, n, view, links) for a, n in operands]
