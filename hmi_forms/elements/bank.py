@@ -11,6 +11,7 @@ from __future__ import annotations
 
 from collections.abc import Callable, Iterable, Sequence
 from operator import itemgetter
+from typing import Any, Protocol
 
 import numpy as np
 
@@ -93,15 +94,25 @@ class BitBank(Bank):
         return values
 
 
+class Settles(Protocol):
+    rect: Any
+
+    def put(self, value: int) -> bool: ...
+
+
 class Banked:
     """The elements one bank serves, refreshed from each snapshot: only those whose operand
-    changed are settled (`put`). With the runtime's readings, the quality of all of them is
-    judged at once (`Readings.judge`); one whose data are not good takes the general path
-    (`Element.update`, then `sync`) and is taken anew from the bank once they are good again."""
+    changed are settled (`put`, True when the caller is to repaint the element). With the
+    runtime's readings, the quality of all of them is judged at once (`Readings.judge`); one
+    whose data are not good takes the general path (`Element.update`, then `sync`) and is taken
+    anew from the bank once they are good again."""
 
-    def __init__(self, bank: Bank, models: Sequence[Element], puts: Sequence[Callable[[int], None]],
+    def __init__(self, bank: Bank, models: Sequence[Element], faces: Sequence[Settles],
                  syncs: Sequence[Callable[[], None]], fault: Callable[[Element, Exception], None]) -> None:
-        self.bank, self.models, self.puts, self.syncs = bank, list(models), list(puts), list(syncs)
+        """`faces` are what draw the elements (hmi_forms/widgets/base.py): each settles a value
+        (`put`) and is where it is repainted (`rect`)."""
+        self.bank, self.models, self.faces, self.syncs = bank, list(models), list(faces), list(syncs)
+        self.puts = [f.put for f in self.faces]
         self.fault = fault
         self.sources = [m.sources()[0] for m in self.models]  # a plain element shows one operand
         self.marked = np.zeros(len(self.models), dtype=bool)  # shown with a quality mark
@@ -109,7 +120,8 @@ class Banked:
         self.operands: Operands | None = None
         self.links: list[int] = []  # link output bits: judged by their own rule, one by one
 
-    def refresh(self, snap: Snapshot, readings: Readings | None) -> None:
+    def refresh(self, snap: Snapshot, readings: Readings | None) -> list[int]:
+        """Take the snapshot; the positions of the elements the caller is to repaint."""
         positions, values = self.bank.changed(snap)
         if readings is None:
             codes = None
@@ -123,11 +135,14 @@ class Banked:
             new = [(i, v) for i, v in new if i not in apart]
             for i in apart:
                 self._update(i, snap, None if codes is None else Quality(int(codes[i])))
+        puts, repaint = self.puts, []
         for i, value in new:
             try:
-                self.puts[i](value)
+                if puts[i](value):
+                    repaint.append(i)
             except Exception as e:
                 self._failed(i, e)
+        return repaint
 
     def _judge(self, readings: Readings) -> np.ndarray:
         qmap = readings.quality_map

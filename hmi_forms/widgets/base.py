@@ -355,13 +355,15 @@ class Face:
         self.drawn = drawn
         self.show(self.rect)
 
-    def put(self, value: int) -> None:
+    def put(self, value: int) -> bool:
         """A new value of a plain element, read with the rest of the form's (a `Bank`): what
-        `update` would do with it while the data are good."""
+        `update` would do with it while the data are good. True: the caller is to repaint the
+        element (the form does, in one piece with the rest); otherwise it is scheduled already."""
         m = self.model
         m.stale = False  # a failed draw's mark goes with the next value, as with `update`
         m.settle(value)
         self.sync()
+        return False
 
     def show(self, part: QRect) -> None:
         """Have the form repaint `part` of it (form coordinates), and the quality mark follow."""

@@ -103,8 +103,8 @@ class FormView(QWidget):
             members = [(s, w) for s, w, k, b in zip(syncs, self.pairs, kinds, banked) if b and k is kind]
             if members:
                 models = [m for (m, _, _), _ in members]
-                puts, shows = [w.face.put for _, (_, w) in members], [s for (_, _, s), _ in members]
-                self._banks.append(Banked(kind([operand(m) for m in models]), models, puts, shows,
+                faces, shows = [w.face for _, (_, w) in members], [s for (_, _, s), _ in members]
+                self._banks.append(Banked(kind([operand(m) for m in models]), models, faces, shows,
                                           lambda model, e: self._fault(model, e, "update")))
         # where each painted element goes, worked out once: the paint loop runs 200 times a tick
         self._extent = QRect()  # what the painted elements take
@@ -172,17 +172,20 @@ class FormView(QWidget):
                 except Exception as e:
                     self._fault(model, e, "update")
                     sync()  # marked stale: drawn with a painter, which shows the mark
-            for banked in self._banks:
-                banked.refresh(snapshot, readings)
+            shown = [(banked, banked.refresh(snapshot, readings)) for banked in self._banks]
         finally:
             self._dirty = None
-        if len(dirty) > BATCH and len(dirty) * 2 > len(self._faces):
+        count = len(dirty) + sum(len(positions) for _, positions in shown)
+        if count > BATCH and count * 2 > len(self._faces):
             # most of a large form: one rectangle costs Qt far less than hundreds (a region of n
             # rectangles costs n² to build), and an element unchanged is one more pixmap copy
             self.update()
         else:
             for part in dirty:
                 self.update(part)
+            for banked, positions in shown:
+                for i in positions:
+                    self.update(banked.faces[i].rect)
         now = self.clock()
         if self.trends and now >= self._next_flush:  # all plots of the form in the same tick
             self._next_flush = max(self._next_flush + REDRAW_INTERVAL, now)

@@ -553,7 +553,7 @@ class GaugeFace(Face):
         self.drawn = drawn
         self.show(self.part if text_only and self.part is not None else self.rect)
 
-    def put(self, hw: int) -> None:
+    def put(self, hw: int) -> bool:
         """`Face.put`, with what the word shows looked up in one step (`entries`): the model's
         state and the sprites of the composition."""
         if not self.fresh:
@@ -568,14 +568,17 @@ class GaugeFace(Face):
                 if parts is not None:
                     self.entries[hw] = ((m.hw, m.phy, m.text, m.zone), *parts)
             self.sync()
-            return
+            return False
         shown, text, extra = entry
         m.hw, m.phy, m.text, m.zone = shown
         drawn = self._ops(shown[3], text, extra)
         if drawn == self.drawn:
-            return
+            return False
         self.drawn, self.shown = drawn, None
-        self.show(self.rect)
+        if self.marked:  # the quality mark's tooltip goes with the mark
+            self.widget.mark_quality()
+            self.marked = False
+        return True
 
     def compose(self) -> list[Op] | None:
         m = self.model
