@@ -59,6 +59,7 @@ def scale_ticks(lo: float, hi: float, max_major: int) -> tuple[list[float], list
 SMALL_DIAL = 45.0  # radius in px below which a dial drops its labels and enlarges the readout
 SPRITE_DIAL = 64.0  # radius in px up to which needles are cached pixmaps (larger: drawn each time)
 PART_AREA = 150 * 150  # px²: from this size on, a change of text alone repaints only its box
+MERGED_AREA = 64 * 64  # px² up to which a dial's value text and needle are one pixmap (one copy a tick)
 SEMI_END_LABEL = 12.0  # degrees: a semidial's end labels stand this far above its baseline
 HUB = QColor("#33393f")
 WHITE = QColor("#ffffff")
@@ -505,8 +506,8 @@ class GaugeFace(Face):
     per tick costs no paint until it has moved one), in a large gauge only the text's box when
     that is all that changed."""
 
-    __slots__ = ("bar", "contained", "entries", "fast", "inks", "kind", "needles", "part", "phy_min",
-                 "phy_span", "shown", "slot", "tall", "text_op", "texts", "travel", "units")
+    __slots__ = ("bar", "contained", "entries", "fast", "inks", "kind", "merged", "needles", "part",
+                 "phy_min", "phy_span", "shown", "slot", "tall", "text_op", "texts", "travel", "units")
 
     def load(self) -> None:
         super().load()
@@ -530,6 +531,7 @@ class GaugeFace(Face):
         # every gauge drawn from the same sprites with the same conversion
         self.fast = m.plain and self.contained and self.part is None and (kind == "digital" or kind == "hbar"
                                                                         or self.needles is not None)
+        self.merged: dict[Hashable, Sprite] = SPRITES.family(("merged", id(self.texts), id(self.needles)))
         family = ("entries", kind, id(self.texts), id(self.needles), self.travel, self.bar, self.units)
         self.entries: dict[int, Entry] = SPRITES.family((*family, id(m._shown)))  # emptied with the sprites
 
@@ -604,7 +606,39 @@ class GaugeFace(Face):
             return sprite, (round(self.bar[3] * fraction), theme.ZONE_COLORS.get(zone or "") or theme.ACCENT)
         if self.needles is None:
             return None
-        return sprite, self.needles.get(round(fraction * self.travel)) or self.widget._needle_sprite()
+        pointer = round(fraction * self.travel)
+        needle = self.needles.get(pointer) or self.widget._needle_sprite()
+        if self.part is not None:  # a large dial: its text alone is repainted
+            return sprite, needle
+        merged = self.merged.get((text, ink.key, pointer))
+        if merged is None:
+            merged = self._merge(sprite, needle)
+            if merged is None:
+                return sprite, needle
+            SPRITES.put(self.merged, (text, ink.key, pointer), merged)
+        return merged, None
+
+    def _merge(self, text: Sprite, needle: Sprite) -> Sprite | None:
+        """The value's text with the needle over it in one pixmap, when small: a tick of a form
+        of small dials then copies one pixmap per dial instead of two. The pixels are those of the
+        two drawn in turn: the text is opaque, and where it is not, the needle is blended later
+        over what it would have been blended over."""
+        a = QRect(text[0], text[1], text[2].width(), text[2].height())  # (the sprites' dpr: 1 here)
+        b = QRect(needle[0], needle[1], needle[2].width(), needle[2].height())
+        dpr = text[2].devicePixelRatio()
+        if dpr != 1.0 or needle[2].devicePixelRatio() != 1.0:
+            return None
+        union = a.united(b)
+        if union.width() * union.height() > MERGED_AREA:
+            return None
+        pix = blank(union.size(), dpr, None)
+        p = QPainter(pix)
+        try:  # a painter left open on a pixmap crashes Qt when the pixmap goes
+            p.drawPixmap(a.x() - union.x(), a.y() - union.y(), text[2])
+            p.drawPixmap(b.x() - union.x(), b.y() - union.y(), needle[2])
+        finally:
+            p.end()
+        return union.x(), union.y(), pix
 
     def _ops(self, zone: str | None, text: Sprite, extra: object) -> list[Op]:
         """The composition at the element's place: its zone's layer, the text, the needle or fill."""
