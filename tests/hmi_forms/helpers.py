@@ -50,6 +50,20 @@ def write_form(folder: Path, elements: list[dict[str, Any]], name: str = "t.hmi"
     return path
 
 
+def shown_form(qtbot: Any, tmp_path: Path, elements: list[dict[str, Any]], size: tuple[int, int]) -> Any:
+    """A FormView of `elements` on a form of `size`, shown (Qt is imported here only: the other
+    helpers serve Qt-free tests too)."""
+    from hmi_forms.elements.target import NullTarget
+    from hmi_forms.widgets.form_view import FormView
+
+    form = load_form(write_form(tmp_path, elements))
+    form.width, form.height = size
+    view = FormView(form, NullTarget())
+    qtbot.addWidget(view)
+    view.show()
+    return view
+
+
 def element(tmp_path: Path, type_: str, **props: Any) -> Element:
     """One element loaded through the real loader (so the tests cover the property parsers too)."""
     extra = {k: props.pop(k) for k in ("devices", "images") if k in props}

@@ -11,12 +11,11 @@ import pytest
 from hmi_forms.elements.analog import AnalogBase
 from hmi_forms.elements.bank import BitBank, WordBank
 from hmi_forms.elements.discrete import DiscreteBase
-from hmi_forms.elements.target import NullTarget
 from hmi_forms.form import load_form
 from hmi_forms.widgets.form_view import FormView
 from netplc.address import data_address
 from netplc.memory import Memory
-from tests.hmi_forms.helpers import snap, write_form
+from tests.hmi_forms.helpers import shown_form, snap
 
 RANGE = {"AppMin": 0, "AppMax": 1000, "PhyMin": -50, "PhyMax": 150}
 
@@ -74,12 +73,7 @@ def gauge(name: str, x: int, addr: str, **props) -> dict:
 
 
 def view_of(qtbot, tmp_path: Path, elements: list[dict]) -> FormView:
-    form = load_form(write_form(tmp_path, elements))
-    form.width, form.height = 700, 100
-    view = FormView(form, NullTarget())
-    qtbot.addWidget(view)
-    view.show()
-    return view
+    return shown_form(qtbot, tmp_path, elements, (700, 100))
 
 
 def test_only_gauges_whose_word_is_all_they_show_are_banked(qtbot, tmp_path) -> None:

@@ -16,7 +16,7 @@ from netplc.memory import Memory
 from netplc.program import parse
 from netplc.tags.quality import LinkView, Quality, QualityMap
 from netplc.tags.readings import Readings
-from tests.hmi_forms.helpers import write_form
+from tests.hmi_forms.helpers import shown_form, write_form
 from tests.hmi_forms.test_widgets import differs
 
 PROGRAM = "TNA $03760\nFON C:$02110 N:NREAD S:4000 D:$04010 R:4\nJMP 0\n"  # node 0 fills 04010-04013
@@ -44,12 +44,7 @@ def readings(mem: Memory, scan: int, links: LinkView) -> tuple[Readings, object]
 
 @pytest.fixture
 def view(qtbot, tmp_path: Path) -> FormView:
-    form = load_form(write_form(tmp_path, ELEMENTS))
-    form.width, form.height = 600, 360
-    v = FormView(form, NullTarget())
-    qtbot.addWidget(v)
-    v.show()
-    return v
+    return shown_form(qtbot, tmp_path, ELEMENTS, (600, 360))
 
 
 def models(view: FormView) -> dict:
