@@ -36,6 +36,7 @@ from cryptography.x509.oid import ExtendedKeyUsageOID
 
 from app.publish.feed import LatestSnapshot
 from app.publish.points import PasswordCheck, PointReader, Writer, WriteRefused
+from app.users import rank
 from netplc.records import Record
 from netplc.tags.alarms import PRIORITIES, Alarm, State
 from netplc.tags.quality import Quality
@@ -108,7 +109,7 @@ class _Users:
     def get_user(self, iserver: object, username: str | None = None, password: str | None = None,
                  certificate: object = None) -> User | None:
         if self.check is None or (self.anonymous and not username):
-            return User(role=UserRole.User, name=username or "anonymous")
+            return User(role=UserRole.User, name=username or None)  # no name: anonymous
         if username and password is not None and self.check(username, password):
             return User(role=UserRole.User, name=username)
         return None
@@ -119,7 +120,10 @@ class OpcUaServer:
 
     def __init__(self, *, endpoint: str, station: str, folder: Path, tags: Sequence[Tag], reader: PointReader,
                  writer: Writer, engine: Any, exchange: Any, alarms: Sequence[Alarm] = (),
-                 password_check: PasswordCheck | None = None) -> None:
+                 password_check: PasswordCheck | None = None,
+                 role_of: Callable[[str], str | None] | None = None) -> None:
+        """`role_of` gives a user's role at each write (so a changed role counts at once); None
+        while the station has no users, when any client may write what `writable` names."""
         self.endpoint = endpoint
         self.station = station
         self.folder = folder
@@ -130,6 +134,7 @@ class OpcUaServer:
         self.exchange = exchange
         self.alarms = list(alarms)
         self.password_check = password_check
+        self.role_of = role_of
         self.status = OpcUaStatus()
         self.secure = not is_loopback(endpoint)
         self.feed = LatestSnapshot(reader, self._wake)
@@ -366,29 +371,46 @@ class OpcUaServer:
     async def _write(self, session: Any, params: ua.WriteParameters, service: Any) -> list[ua.StatusCode]:
         results: list[ua.StatusCode | None] = []
         others = []
-        user = session.user.name if session.user is not None and session.user.name else "anonymous"
+        named = session.user.name if session.user is not None and session.user.name else None
         peer = session.name
         peer_text = f"{peer[0]}:{peer[1]}" if isinstance(peer, tuple) and len(peer) >= 2 else str(peer)
+        refusal = self._refusal(named)
         for wv in params.NodesToWrite:
             name = self.by_nodeid.get(wv.NodeId)
             if name is None:
                 others.append(wv)
                 results.append(None)
                 continue
-            results.append(self._write_tag(name, wv, f"opcua:{user}@{peer_text}"))
+            results.append(self._write_tag(name, wv, f"opcua:{named or 'anonymous'}@{peer_text}", refusal))
         if others:
             done = iter(await service(ua.WriteParameters(NodesToWrite=others)))
             results = [r if r is not None else next(done) for r in results]
         return [r for r in results if r is not None]
 
-    def _write_tag(self, name: str, wv: ua.WriteValue, user: str) -> ua.StatusCode:
+    def _refusal(self, user: str | None) -> str | None:
+        """Why `user` (None: anonymous) may not write at all, as in the workstation: the operator
+        role or above, where the station has users."""
+        if self.role_of is None:
+            return None
+        if user is None:
+            return "anonymous clients may only read where the station has users"
+        role = self.role_of(user)
+        if role is None or rank(role) < rank("operator"):
+            return f"{user} is {role or 'no longer a user'}: writing needs the operator role"
+        return None
+
+    def _write_tag(self, name: str, wv: ua.WriteValue, user: str, refusal: str | None) -> ua.StatusCode:
         if wv.AttributeId != ua.AttributeIds.Value:
             return ua.StatusCode(ua.StatusCodes.BadNotWritable)
         value = wv.Value.Value.Value if wv.Value is not None and wv.Value.Value is not None else None
         try:
+            if refusal is not None:
+                self.writer.refuse(name, value, user, refusal)  # journaled, then refused
             self.writer.write(name, value, user)
         except WriteRefused as e:
             why = str(e)
+            if refusal is not None:
+                return ua.StatusCode(ua.StatusCodes.BadUserAccessDenied)
             if why.startswith("write queue full"):
                 return ua.StatusCode(ua.StatusCodes.BadTooManyOperations)
             if why == "not a number":

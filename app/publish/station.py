@@ -3,6 +3,7 @@ window). A publisher that cannot start is a problem the operator sees; the stati
 
 from __future__ import annotations
 
+from collections.abc import Callable
 from typing import Any, Protocol
 
 from app.publish.points import PasswordCheck, PointReader, Writable, Writer, published_tags, runtime_quality
@@ -22,6 +23,19 @@ def password_check(station: Any) -> PasswordCheck | None:
     return lambda name, password: Users(station.folder).verify(name, password) is not None
 
 
+def role_of(station: Any) -> Callable[[str], str | None] | None:
+    """A user's role, read at each client write (a role changed or a user removed counts at
+    once); None while the station has no users (then the `writable` tags are all that limits)."""
+    if not Users(station.folder).users:
+        return None
+
+    def role(name: str) -> str | None:
+        user = Users(station.folder).get(name)
+        return None if user is None else user.role
+
+    return role
+
+
 def start_publishers(runtime: Any) -> list[Publisher]:
     st = runtime.station
     if not (st.opcua.enabled or st.mqtt.enabled):
@@ -37,7 +51,7 @@ def start_publishers(runtime: Any) -> list[Publisher]:
         alarms = runtime.alarms.system.alarms if runtime.alarms is not None else []
         server = OpcUaServer(endpoint=st.opcua.endpoint, station=st.name, folder=st.folder, tags=tags,
                              reader=reader, writer=writer, engine=runtime.engine, exchange=runtime.exchange,
-                             alarms=alarms, password_check=password_check(st))
+                             alarms=alarms, password_check=password_check(st), role_of=role_of(st))
         try:
             server.start()
         except (OSError, RuntimeError) as e:

@@ -147,7 +147,10 @@ def test_write_accepted_and_journaled_and_write_refused(station: tuple[Runtime, 
     runtime.subscribe(records.append)
 
     async def go() -> None:
-        async with Client(url) as client:
+        client = Client(url)
+        client.set_user("operator")  # the demo's operator: writing needs the role, as in the workstation
+        client.set_password("operator")
+        async with client:
             sp = await _tag(client, "TEMP_SP")
             await sp.write_value(ua.DataValue(ua.Variant(42.0, ua.VariantType.Double)))
             level = await _tag(client, "LEVEL")
@@ -162,7 +165,7 @@ def test_write_accepted_and_journaled_and_write_refused(station: tuple[Runtime, 
     run(go())
     wait_until(lambda: any(r.kind == "operator" and "TEMP_SP" in r.text for r in records))
     written = next(r for r in records if r.kind == "operator" and "TEMP_SP" in r.text)
-    assert written.source.startswith("opcua:anonymous@127.0.0.1:")
+    assert written.source.startswith("opcua:operator@127.0.0.1:")
     refused = next(r for r in records if r.kind == "operator" and "LEVEL" in r.text)
     assert "refused" in refused.text and refused.source.startswith("opcua:")
 
@@ -227,5 +230,53 @@ def test_users_with_passwords_where_the_station_has_users(tmp_path: Path) -> Non
         run(go())
         wait_until(lambda: any(r.kind == "operator" and "TEMP_SP" in r.text for r in records))
         assert next(r for r in records if r.kind == "operator").source.startswith("opcua:alice@127.0.0.1:")
+    finally:
+        runtime.stop()
+
+
+def test_writing_needs_the_operator_role_where_the_station_has_users(tmp_path: Path) -> None:
+    """As in the workstation: a viewer and an anonymous local client read, only an operator or
+    above writes; each refusal is journaled with the user, and a role changed counts at once."""
+    from app.users import Users
+
+    users = Users(copy_demo(tmp_path / "station"))
+    users.add("vera", "viewer", "look-only")
+    users.add("oleg", "operator", "s3cret")
+    url = f"opc.tcp://127.0.0.1:{free_port()}/netplc/"
+    runtime = demo_with(tmp_path / "station",
+                        f'[opcua]\nenabled = true\nendpoint = "{url}"\nwritable = ["TEMP_SP"]\n')
+    records: list = []
+    runtime.subscribe(records.append)
+
+    def as_user(name: str | None, password: str = "") -> Client:
+        client = Client(url)
+        if name is not None:
+            client.set_user(name)
+            client.set_password(password)
+        return client
+
+    async def write(client: Client, value: float) -> int:
+        async with client:
+            sp = await _tag(client, "TEMP_SP")
+            assert await sp.read_value() is not None  # reading is for everyone let in
+            try:
+                await sp.write_value(ua.DataValue(ua.Variant(value, ua.VariantType.Double)))
+            except ua.UaStatusCodeError as e:
+                return e.code
+            return ua.StatusCodes.Good
+
+    try:
+        assert run(write(as_user(None), 11.0)) == ua.StatusCodes.BadUserAccessDenied
+        assert run(write(as_user("vera", "look-only"), 12.0)) == ua.StatusCodes.BadUserAccessDenied
+        assert run(write(as_user("oleg", "s3cret"), 13.0)) == ua.StatusCodes.Good
+        wait_until(lambda: any("TEMP_SP" in r.text and "refused" not in r.text and r.kind == "operator"
+                               for r in records))
+        refused = [r for r in records if r.kind == "operator" and "refused" in r.text]
+        assert [r.source.split("@")[0] for r in refused] == ["opcua:anonymous", "opcua:vera"]
+        assert "operator role" in refused[1].text and "only read" in refused[0].text
+        users = Users(tmp_path / "station")
+        users.remove("oleg")
+        users.add("oleg", "viewer", "s3cret")  # demoted while the server runs
+        assert run(write(as_user("oleg", "s3cret"), 14.0)) == ua.StatusCodes.BadUserAccessDenied
     finally:
         runtime.stop()
