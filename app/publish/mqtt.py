@@ -14,11 +14,13 @@ other is refused and journaled.
 
 from __future__ import annotations
 
+import os
 import threading
 import time
 from collections import deque
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass
+from pathlib import Path
 from typing import Any
 from urllib.parse import urlsplit
 
@@ -48,7 +50,11 @@ class MqttStatus:
 
 class SparkplugPublisher:
     def __init__(self, settings: MqttSettings, station: str, *, tags: Sequence[Tag], reader: PointReader,
-                 writer: Writer, engine: Any, journal: Callable[[str], None]) -> None:
+                 writer: Writer, engine: Any, journal: Callable[[str], None],
+                 bdseq_file: Path | None = None) -> None:
+        """`bdseq_file` keeps the bdSeq of the last connection across restarts (Sparkplug 3.0:
+        each connection's bdSeq is the previous one's plus one), so a host application never
+        takes the NDEATH of an old session for the new one's; None: it starts at 0."""
         self.settings = settings
         self.topics = spb.Topics(settings.group_id, settings.edge_node_id or station)
         self.tags = list(tags)
@@ -65,7 +71,8 @@ class SparkplugPublisher:
         self.port = url.port or (8883 if url.scheme == "mqtts" else 1883)
         self.peer = f"{self.host}:{self.port}"
         self.feed = LatestSnapshot(reader, self._wakeup)
-        self.bdseq = 0
+        self.bdseq_file = bdseq_file
+        self.bdseq = (self._stored_bdseq() + 1) % 256  # the next connection's (stored once connected)
         self._seq = 0
         self._birth_due = False
         self._latest: Reading | None = None
@@ -118,6 +125,29 @@ class SparkplugPublisher:
 
     # --- paho's thread -------------------------------------------------------------------------
 
+    def _stored_bdseq(self) -> int:
+        """The bdSeq of the last connection made (-1: none, the first is then 0)."""
+        if self.bdseq_file is None or not self.bdseq_file.exists():
+            return -1
+        try:
+            value = int(self.bdseq_file.read_text(encoding="utf-8").strip())
+            if not 0 <= value <= 255:
+                raise ValueError(f"{value} is not 0..255")
+        except (OSError, ValueError) as e:
+            self.journal(f"MQTT: {self.bdseq_file}: not a bdSeq ({e}); starting again at 0")
+            return -1
+        return value
+
+    def _store_bdseq(self) -> None:
+        if self.bdseq_file is None:
+            return
+        tmp = self.bdseq_file.with_suffix(".tmp")
+        try:
+            tmp.write_text(f"{self.bdseq}\n", encoding="utf-8")
+            os.replace(tmp, self.bdseq_file)
+        except OSError as e:  # the station runs on; a host may then see a bdSeq again after a restart
+            self.journal(f"MQTT: {self.bdseq_file}: bdSeq not kept ({e})")
+
     def _death(self) -> bytes:
         payload = spb.Payload(timestamp=_ms(time.time()))
         metric = payload.metrics.add(name=spb.BDSEQ, datatype=spb.INT64)
@@ -132,6 +162,8 @@ class SparkplugPublisher:
             self.journal(f"MQTT broker {self.peer} refused the connection: {reason}")
             return
         client.subscribe(self.topics.ncmd, qos=1)
+        with self._lock:
+            self._store_bdseq()  # registered with the broker: the one the next start goes on from
         self.status.connected = True
         self._birth_due = True
         self._wake.set()

@@ -9,6 +9,8 @@ from typing import Any, Protocol
 from app.publish.points import PasswordCheck, PointReader, Writable, Writer, published_tags, runtime_quality
 from app.users import Users
 
+BDSEQ_FILE = "sparkplug_bdseq.txt"  # in the station folder: the last MQTT connection's bdSeq
+
 
 class Publisher(Protocol):
     def stop(self) -> None: ...
@@ -66,7 +68,8 @@ def start_publishers(runtime: Any) -> list[Publisher]:
 
         writer = Writer(runtime.engine, tags, Writable(st.mqtt.writable), runtime, runtime.wallclock)
         publisher = SparkplugPublisher(st.mqtt, st.name, tags=tags, reader=reader, writer=writer,
-                                       engine=runtime.engine, journal=runtime.system)
+                                       engine=runtime.engine, journal=runtime.system,
+                                       bdseq_file=st.folder / BDSEQ_FILE)
         publisher.start()
         started.append(publisher)
         runtime.system(f"MQTT Sparkplug B publisher to {st.mqtt.broker} as {publisher.topics.node}, "

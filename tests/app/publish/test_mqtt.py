@@ -176,3 +176,34 @@ def test_ndeath_when_the_station_is_killed(tmp_path: Path, mosquitto: Mosquitto,
     finally:
         proc.kill()
         proc.wait(10)
+
+
+def test_bdseq_goes_on_across_restarts_of_the_station(tmp_path: Path, mosquitto: Mosquitto,
+                                                        host: Host) -> None:
+    """Each connection's bdSeq is the previous one's plus one, also after the station restarts
+    (kept in the station folder), so a host never takes an old session's NDEATH for the new one's;
+    a file that holds no bdSeq is journaled and the count starts again."""
+    from app.config import load_station
+    from app.publish.station import BDSEQ_FILE
+
+    station = copy_demo(tmp_path / "station")
+    toml = station / "station.toml"
+    toml.write_text(toml.read_text(encoding="utf-8") + "\n" + mqtt_section(mosquitto), encoding="utf-8")
+    records: list = []
+
+    def run() -> int:
+        births, deaths = len(host.of("NBIRTH")), len(host.of("NDEATH"))
+        runtime = Runtime(load_station(station))
+        runtime.subscribe(records.append)
+        runtime.start()
+        try:
+            bdseq = metric(host.wait("NBIRTH", after=births), "bdSeq").long_value
+        finally:
+            runtime.stop()
+        assert metric(host.wait("NDEATH", after=deaths), "bdSeq").long_value == bdseq
+        return bdseq
+
+    assert (run(), run()) == (0, 1)
+    (station / BDSEQ_FILE).write_text("many\n", encoding="utf-8")
+    assert run() == 0
+    assert any(BDSEQ_FILE in (r.text or "") and "not a bdSeq" in r.text for r in records)
