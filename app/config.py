@@ -116,6 +116,7 @@ class Station:
     allow_outside: bool = False  # may station paths (and form images) leave the station folder?
     RetainForces: bool = False  # forces survive a restart (netplc/forcing.py); off: a restart unforces
     plant_archive: str | None = None  # `Archive` given as a postgresql:// URL: forwarded there
+    plant_keep_days: int = 0  # days the plant archive keeps (for every station in it); 0: all
     alarm_sound: bool = True  # a new alarm of priority 1-2 sounds until acknowledged or silenced
     opcua: OpcUaSettings = OpcUaSettings()
     mqtt: MqttSettings = MqttSettings()
@@ -252,6 +253,7 @@ def read_station(path: str | Path) -> tuple[Station | None, list[str]]:
     archive = None if "Archive" in top.known else top.path("Archive", base, "archive/journal.sqlite")
     messages = top.path("Messages", base)
     keep_days = top.number("keep_days", 0, 0, 36_500)
+    plant_keep_days = top.number("plant_keep_days", 0, 0, 36_500)
     retain = top.path("Retain", base)
     tags = top.path("Tags", base)
     retain_forces = top.get("RetainForces", bool, False)
@@ -291,6 +293,7 @@ def read_station(path: str | Path) -> tuple[Station | None, list[str]]:
         keep_days=keep_days, Retain=retain, modbus_server=server,
         nodes=tuple(nodes), simulators=tuple(runnable), operator=operator, Language=language, Tags=tags,
         allow_outside=top.allow_outside, RetainForces=bool(retain_forces), plant_archive=plant,
+        plant_keep_days=plant_keep_days,
         alarm_sound=alarm_sound, opcua=opcua,
         mqtt=mqtt,
     )

@@ -222,7 +222,7 @@ class Runtime:
         if st.plant_archive:
             from registrar.forward import Forwarder  # psycopg only where a plant archive is named
 
-            self.forwarder = Forwarder(st.Archive, st.plant_archive, st.name, keep_days=st.keep_days,
+            self.forwarder = Forwarder(st.Archive, st.plant_archive, st.name, keep_days=st.plant_keep_days,
                                        sink=self.put, wallclock=self.wallclock)
             self.forwarder.start()  # never fails: PostgreSQL away is a lag, not a start error
         try:

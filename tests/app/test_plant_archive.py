@@ -103,3 +103,20 @@ def test_the_health_strip_says_when_forwarding_lags(tmp_path: Path) -> None:
     with Archive(tmp_path / "archive" / "journal.sqlite") as local:
         texts = [r.text for r in local.records(local.days()[0], limit=100)]
     assert any("lags by 75 s" in (t or "") for t in texts)  # the 'system' record
+
+
+def test_the_plant_archive_keeps_its_own_days_not_the_stations(tmp_path: Path) -> None:
+    """The plant's day partitions hold every station's records: a station keeping its own archive
+    for a week must not drop the others' older records there (`plant_keep_days`, default all)."""
+    dead = "postgresql://station@127.0.0.1:9/plant"
+    for name, extra, kept in (("short", "", 0), ("plant", "plant_keep_days = 400\n", 400)):
+        write_station(tmp_path / name, f'NetPlcLoad = false\nArchive = "{dead}"\nkeep_days = 7\n{extra}'
+                                       "[modbus_server]\nport = 0\n")
+        station = load_station(tmp_path / name)
+        assert (station.keep_days, station.plant_keep_days) == (7, kept)
+        runtime = Runtime(station)
+        runtime.start()
+        try:
+            assert runtime.forwarder is not None and runtime.forwarder.keep_days == kept
+        finally:
+            runtime.stop()
