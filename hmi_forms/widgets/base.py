@@ -365,6 +365,11 @@ class Face:
         self.sync()
         return False
 
+    def unmark(self) -> None:
+        """Good data again, shown by a `put`: the element's own tooltip comes back."""
+        self.widget.mark_quality()
+        self.marked = False
+
     def show(self, part: QRect) -> None:
         """Have the form repaint `part` of it (form coordinates), and the quality mark follow."""
         if self.repaint is not None:

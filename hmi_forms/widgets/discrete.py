@@ -45,17 +45,12 @@ class DiscreteFace(Face):
         if not self.simple or self.style_of(m) != self.style:
             return super().put(value)
         m.settle(value)
-        state = (value, self.pressed)
-        layer = self.by_state.get(state)
-        if layer is None:
-            layer = self.by_state[state] = self.widget.layer()
-        drawn = [(PIX, (self.x, self.y, layer))]
+        drawn = [(PIX, (self.x, self.y, self._layer()))]
         if drawn == self.drawn:
             return False
         self.drawn = drawn
-        if self.marked:  # the quality mark's tooltip goes with the mark
-            self.widget.mark_quality()
-            self.marked = False
+        if self.marked:
+            self.unmark()
         return True
 
     def compose(self) -> list[Op] | None:
@@ -64,11 +59,14 @@ class DiscreteFace(Face):
         m = self.model
         if m.stale or self.restyled():
             return None
-        state = (m.value, self.pressed)
+        return [(PIX, (self.x, self.y, self._layer()))]
+
+    def _layer(self) -> QPixmap:
+        state = (self.model.value, self.pressed)
         layer = self.by_state.get(state)
         if layer is None:
             layer = self.by_state[state] = self.widget.layer()
-        return [(PIX, (self.x, self.y, layer))]
+        return layer
 
 
 class DiscreteWidget(ElementWidget):

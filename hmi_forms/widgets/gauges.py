@@ -577,9 +577,8 @@ class GaugeFace(Face):
         if drawn == self.drawn:
             return False
         self.drawn, self.shown = drawn, None
-        if self.marked:  # the quality mark's tooltip goes with the mark
-            self.widget.mark_quality()
-            self.marked = False
+        if self.marked:
+            self.unmark()
         return True
 
     def compose(self) -> list[Op] | None:
