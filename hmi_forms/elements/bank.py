@@ -30,9 +30,6 @@ class Bank:
     def __init__(self, size: int) -> None:
         self.last = np.full(size, UNKNOWN, dtype=np.int32)
 
-    def __len__(self) -> int:
-        return len(self.last)
-
     def read(self, snap: Snapshot) -> np.ndarray:
         raise NotImplementedError
 

@@ -158,9 +158,6 @@ class Operands:
         self.first, self.last = bounds[:, 0], bounds[:, 1]
         self.used = sorted({k for g in self.groups for k in g})  # the feeds any span depends on
 
-    def __len__(self) -> int:
-        return len(self.member)
-
     def evaluate(self, per_feed: Mapping[int, Quality], running: bool, forced: Collection[int]) -> np.ndarray:
         """Each span's quality code, from the quality of each feed in `used`."""
         idle = Quality.GOOD if running else Quality.NOT_RUNNING
