@@ -59,7 +59,7 @@ class ModbusServerSettings:
 @dataclass(frozen=True)
 class OperatorSettings:
     """Who is at the workstation before anyone logs in, and when a user is logged out again.
-    The users themselves are in users.json (app/users.py), managed by `main.py users`."""
+    The users themselves are in users.json (app/authority/users.py), managed by `main.py users`."""
 
     default_user: str = ""  # a viewer shown as logged in while nobody is; "": logged out
     idle_logout: int = 0  # seconds without input before a user is logged out; 0: never

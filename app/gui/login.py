@@ -19,7 +19,7 @@ from PySide6.QtWidgets import (
     QWidget,
 )
 
-from app.users import Refused
+from app.authority.users import Refused
 
 
 class LoginDialog(QDialog):

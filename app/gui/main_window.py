@@ -33,6 +33,7 @@ from PySide6.QtWidgets import (
     QWidget,
 )
 
+from app.authority.users import ADMIN, ENGINEER, OPERATOR, Refusal, Session, Users
 from app.config import load_station
 from app.gui import i18n, words
 from app.gui.alarm_summary import AlarmSummary
@@ -46,7 +47,6 @@ from app.gui.trend_history import TrendHistory
 from app.gui.users_dialog import UsersDialog
 from app.gui.zoom import ACTUAL, FIT_WIDTH, FIT_WINDOW, ZoomArea, ZoomSettings
 from app.runtime import Runtime
-from app.users import ADMIN, ENGINEER, OPERATOR, Refusal, Session, Users
 from hmi_forms.elements import formats
 from hmi_forms.elements.base import Writer
 from hmi_forms.elements.target import EngineTarget

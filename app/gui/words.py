@@ -1,7 +1,7 @@
 """The console's words for what Qt-free models say in English: roles, alarm priorities and states,
 tag qualities, refusals.
 
-The models (app/users.py, netplc/tags/) keep their English words, which the journal, the command
+The models (app/authority/users.py, netplc/tags/) keep their English words, which the journal, the command
 line and the tests read; the console translates them here, as shown, through Qt's translation
 mechanism (context "words" of app/gui/i18n/console_*.ts). The markers below list every source
 text for the translation files.
@@ -11,11 +11,11 @@ from __future__ import annotations
 
 from PySide6.QtCore import QT_TRANSLATE_NOOP, QCoreApplication
 
-from app.users import Refusal
+from app.authority.users import Refusal
 from netplc.tags.alarms import PRIORITIES, State
 
 SOURCES = (
-    # roles (hmi_forms/elements/base.py ROLES)
+    # roles (app/authority/policy.py ROLES)
     QT_TRANSLATE_NOOP("words", "viewer"), QT_TRANSLATE_NOOP("words", "operator"),
     QT_TRANSLATE_NOOP("words", "engineer"), QT_TRANSLATE_NOOP("words", "admin"),
     # alarm priorities (netplc/tags/alarms.py PRIORITIES)

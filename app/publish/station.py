@@ -6,8 +6,8 @@ from __future__ import annotations
 from collections.abc import Callable
 from typing import Any, Protocol
 
+from app.authority.users import Users
 from app.publish.points import PasswordCheck, PointReader, Writable, Writer, published_tags, runtime_quality
-from app.users import Users
 
 BDSEQ_FILE = "sparkplug_bdseq.txt"  # in the station folder: the last MQTT connection's bdSeq
 
@@ -18,7 +18,7 @@ class Publisher(Protocol):
 
 def password_check(station: Any) -> PasswordCheck | None:
     """The one place that checks a client's user name and password against the station's users
-    (app/users.py, read at each login, so a user added or removed counts at once); None while the
+    (app/authority/users.py, read at each login, so a user added or removed counts at once); None while the
     station has no users (clients are then anonymous)."""
     if not Users(station.folder).users:
         return None

@@ -365,7 +365,7 @@ def test_the_language_comes_from_station_toml(demo_copy: Path) -> None:
 
 
 def test_only_an_admin_manages_users_and_it_is_journaled(qtbot, console: MainWindow) -> None:
-    from app.users import Users
+    from app.authority.users import Users
 
     for name in ("operator", "engineer"):
         console.login(name, name)

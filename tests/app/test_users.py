@@ -9,7 +9,7 @@ from pathlib import Path
 
 import pytest
 
-from app.users import Refusal, Refused, Session, UserError, Users
+from app.authority.users import Refusal, Refused, Session, UserError, Users
 
 REPO = Path(__file__).resolve().parents[2]
 

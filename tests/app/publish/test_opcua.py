@@ -199,9 +199,9 @@ def test_a_taken_port_is_a_problem_and_the_station_runs_on(tmp_path: Path) -> No
 
 
 def test_users_with_passwords_where_the_station_has_users(tmp_path: Path) -> None:
-    """The station's users (app/users.py) check every name given (and every client on an address
+    """The station's users (app/authority/users.py) check every name given (and every client on an address
     other than loopback); the write names the user."""
-    from app.users import Users
+    from app.authority.users import Users
 
     Users(copy_demo(tmp_path / "station")).add("alice", "operator", "s3cret")
     url = f"opc.tcp://127.0.0.1:{free_port()}/netplc/"
@@ -237,7 +237,7 @@ def test_users_with_passwords_where_the_station_has_users(tmp_path: Path) -> Non
 def test_writing_needs_the_operator_role_where_the_station_has_users(tmp_path: Path) -> None:
     """As in the workstation: a viewer and an anonymous local client read, only an operator or
     above writes; each refusal is journaled with the user, and a role changed counts at once."""
-    from app.users import Users
+    from app.authority.users import Users
 
     users = Users(copy_demo(tmp_path / "station"))
     users.add("vera", "viewer", "look-only")
