@@ -111,7 +111,7 @@ def _monitor_parser() -> argparse.ArgumentParser:
 
 
 def _users_parser() -> argparse.ArgumentParser:
-    from hmi_forms.elements.base import ROLES
+    from app.authority.policy import ROLES
 
     p = argparse.ArgumentParser(prog="python main.py users",
                                 description="The station's users and roles (users.json in the station "
@@ -133,8 +133,8 @@ def _users_parser() -> argparse.ArgumentParser:
 
 
 def run_users(argv: list[str]) -> int:
+    from app.authority.users import UserError, Users
     from app.config import station_file
-    from app.users import UserError, Users
 
     ns = _users_parser().parse_args(argv)
     try:
@@ -162,7 +162,7 @@ def _password() -> str:
         return sys.stdin.readline().rstrip("\r\n")
     import getpass
 
-    from app.users import UserError
+    from app.authority.users import UserError
 
     first = getpass.getpass("password: ")
     if getpass.getpass("again: ") != first:

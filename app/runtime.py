@@ -25,6 +25,8 @@ from concurrent.futures import ThreadPoolExecutor, wait
 from dataclasses import dataclass, field, replace
 from typing import TYPE_CHECKING
 
+from app.authority import Commands
+from app.authority.users import USERS_FILE, Users
 from app.config import Station
 from app.load import load, load_station_forms
 from app.publish.station import start_publishers
@@ -159,6 +161,8 @@ class Runtime:
         self.exchange: Exchange | None = None
         self.modbus: ModbusServer | None = None
         self.alarms: StationAlarms | None = None  # tags, quality and alarms, evaluated every scan
+        self.commands: Commands | None = None  # the one authority: every outside action goes through it
+        self._users: tuple[float, Users] | None = None  # users.json as last read, by its mtime
         self.scan_thread: ScanThread | None = None
         self.publishers: list = []  # OPC UA server, MQTT publisher (app/publish/)
         self.nodes: list[NodeConfig] = list(station.nodes)
@@ -272,6 +276,8 @@ class Runtime:
                                     st.Archive.with_name(ALARM_STATE_FILE), self.symbols, regdata)
         self.subscribe(self.alarms.observe)
         self.alarms.attach(self.engine, self.exchange)
+        self.commands = Commands(self.engine, self, role_of=self.role_of, tags=self.alarms.table.tags,
+                                 alarms=self.alarms, wallclock=self.wallclock)
         server = st.modbus_server
         if server.enabled:
             limits = ServerLimits(server.max_connections, server.idle_timeout, server.max_inflight)
@@ -306,7 +312,7 @@ class Runtime:
         self.engine.forces.restore(forces, user="station (RetainForces)")
         if forces:
             self.system(f"{len(forces)} retained forces restored from {st.forces_file} (RetainForces = true)")
-        self.engine.listeners.append(self._save_forces)
+        self.engine.subscribe(self._save_forces)
 
     def _save_forces(self, _snapshot: object) -> None:
         """An engine listener: the forces are written whenever they changed, so a crash keeps them too."""
@@ -327,6 +333,20 @@ class Runtime:
         for text in unresolved_hosts(self.station):
             if self.started:
                 self.system(f"{text}; the node stays down until it does")
+
+    def role_of(self, name: str) -> str | None:
+        """A user's role as users.json says now (read again when the file changed, so a role changed
+        or a user removed counts at the next command); None when there is no such user."""
+        path = self.station.folder / USERS_FILE
+        try:
+            mtime = path.stat().st_mtime_ns
+        except OSError:
+            return None
+        cached = self._users
+        if cached is None or cached[0] != mtime:
+            cached = self._users = (mtime, Users(self.station.folder))
+        user = cached[1].get(name)
+        return None if user is None else user.role
 
     def open_forms(self) -> tuple[list[Form], list[str]]:
         """Fresh models of the station's forms for a view, which only shows them (the runtime
@@ -456,6 +476,9 @@ class Runtime:
         nodes = tuple(NodeStatus(n.node, n.endpoint, bool(exchange and exchange.link_up(n.node)))
                       for n in self.nodes)
         problems = list(self._problems) + [f"form problem: {p}" for p in self.form_problems[:3]]
+        if engine is not None:
+            faults = engine.listener_faults.items()
+            problems += [f"engine listener {name} failed: {why}" for name, why in faults]
         retain_error = self.retainer.last_error if self.retainer is not None else self._final_retain_error
         if retain_error:  # journaled once by the retainer; shown for as long as saves fail
             problems.append(f"retentive memory not saved: {retain_error}")

@@ -76,7 +76,7 @@ class StationAlarms:
     def attach(self, engine: Engine, exchange: Exchange | None) -> None:
         """Evaluate after every scan of `engine`; start saving states."""
         self.engine, self.exchange = engine, exchange
-        engine.listeners.append(self.on_scan)
+        engine.subscribe(self.on_scan)
         self.state.start()
 
     def observe(self, record: Record) -> None:
@@ -130,11 +130,16 @@ class StationAlarms:
         if now is not None:
             self._published = now
 
+    def run_now(self, action: Callable[[], object]) -> None:
+        """On the engine thread: an operator action on the alarms (the command layer's), then the
+        summary published at once."""
+        action()
+        if self._dirty:
+            self._publish()
+
     def _post(self, action: Callable[[], object]) -> None:
         def run() -> None:
-            action()
-            if self._dirty:
-                self._publish()
+            self.run_now(action)
 
         if self.engine is None:
             run()

@@ -68,7 +68,7 @@ def station() -> tuple[Engine, list[Tag], PointReader, Writer]:
         words = np.frombuffer(mem.data, dtype="<u2", count=WORDS)
         words += 1
 
-    engine.listeners.append(lambda _s: engine.post(bump))  # every word changes in every scan
+    engine.subscribe(lambda _s: engine.post(bump))  # every word changes in every scan
     reader = PointReader(tags, lambda: None)
     return engine, tags, reader, Writer(engine, tags, Writable(()), NullSink(), time.time)
 

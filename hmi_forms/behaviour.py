@@ -48,7 +48,7 @@ class FormBehaviour:
         """Evaluate the snapshot the engine holds now (so scan 0 has its pulses too), then every
         snapshot it publishes. Call it before the scan thread starts, after memory is restored."""
         self(engine.snapshot)
-        engine.listeners.append(self)
+        engine.subscribe(self)
 
     def set_bit(self, addr: int, value: int) -> None:
         self.memory.set_hmi_bit(addr, value)

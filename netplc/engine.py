@@ -17,7 +17,9 @@ the plain reference kept beside it.
 
 from __future__ import annotations
 
+import logging
 import time
+import traceback
 from collections import deque
 from collections.abc import Callable
 from dataclasses import dataclass
@@ -52,6 +54,11 @@ WRITE_QUEUE = 4096  # outside writes waiting; the next one is refused (Modbus ex
 JOURNAL_ROOM = 1000  # records the sink must have room for beyond a scan's writes to apply them
 
 Done = Callable[[bool], None]
+Listener = Callable[[Snapshot], None]
+BUSY = "busy"  # the queue of outside writes is full (Modbus exception 6, OPC UA BadTooManyOperations)
+JOURNAL_FULL = "journal full"  # the archive has no room for the record (Modbus exception 6)
+
+logger = logging.getLogger(__name__)
 
 
 class RunState(StrEnum):
@@ -127,7 +134,10 @@ class Engine:
         self.tim_ticks: list[float] = [0.0] * IO_BITS
         self.ctr_values: list[int] = [0] * IO_BITS
         self.rtc = Rtc()
-        self.listeners: list[Callable[[Snapshot], None]] = []
+        # engine listeners (`subscribe`): replaced whole on change, so the scan iterates a tuple
+        # any thread may swap while it runs; faults by listener name, for the health strip
+        self._listeners: tuple[tuple[str, Listener], ...] = ()
+        self.listener_faults: dict[str, str] = {}
         self._queue: deque[Callable[[Memory], None]] = deque()
         # outside writes: (apply, done, user), at most write_queue waiting, write_budget per scan
         self._writes: deque[tuple[Callable[[Memory], None], Done | None, str]] = deque()
@@ -260,20 +270,36 @@ class Engine:
         through `write_*`, which are bounded."""
         self._queue.append(fn)
 
-    def _write(self, apply: Callable[[Memory], None], user: str, done: Done | None) -> bool:
+    def refusal(self) -> str | None:
+        """Why an outside write or command would be refused now (BUSY, JOURNAL_FULL), or None.
+        A full journal refuses at once rather than leaving the writer without an answer: a Modbus
+        client that gets none retries, and a retried write may have been applied."""
         if len(self._writes) >= self.write_queue:
+            return BUSY
+        room = getattr(self.sink, "room", None)
+        if room is not None and room() <= JOURNAL_ROOM + len(self._writes):
+            return JOURNAL_FULL
+        return None
+
+    def command(self, apply: Callable[[Memory], None], user: str, done: Done | None = None) -> bool:
+        """Queue an outside action (a write, a force, an acknowledgement, run or stop) to be applied
+        at the start of the next scan within the per-scan budget; `apply` journals it. `done(True)`
+        once applied and its record is durable, `done(False)` if it could not be. False at once
+        (nothing queued) when `refusal()` says why not."""
+        if self.refusal() is not None:
             self.writes_refused += 1
             return False
         self._writes.append((apply, done, user))
         return True
 
-    def write_bit(
-        self, addr: int | BitRef, value: int, *, user: str = "operator", label: str | None = None,
-        done: Done | None = None,
-    ) -> bool:
-        """Queue an operator write of an HMI bit address (journaled when applied, naming `label`,
-        e.g. the HMI element, so the log reads "write Пуск (040042)" rather than a bare address).
-        False: the queue of outside writes is full and the write is refused."""
+    # Each outside write is an `apply` closure that changes memory and journals the change as an
+    # 'operator' record naming `user` (the command layer's wording: app/authority/layer.py); the
+    # write_* methods queue one with `command`.
+
+    def bit_writer(self, addr: int | BitRef, value: int, user: str,
+                   label: str | None = None) -> Callable[[Memory], None]:
+        """An HMI bit address, journaled naming `label` (the HMI element or tag), so the log reads
+        "write Пуск (040042)" rather than a bare address."""
         hmi = addr.hmi if isinstance(addr, BitRef) else addr
 
         def apply(mem: Memory) -> None:
@@ -282,11 +308,10 @@ class Engine:
             where = fmt_octal(hmi, 6 if hmi >= 0o40000 else 5)
             self._journal(user, where, old, 1 if value else 0, hmi, label)
 
-        return self._write(apply, user, done)
+        return apply
 
-    def write_bits(self, addr: int, values: list[int], *, user: str = "operator",
-                   done: Done | None = None) -> bool:
-        """Queue a write of consecutive I/O bits from `addr`: one journal record for the block."""
+    def bits_writer(self, addr: int, values: list[int], user: str) -> Callable[[Memory], None]:
+        """Consecutive I/O bits from `addr`: one journal record for the block."""
         new = "".join("1" if v else "0" for v in values)
 
         def apply(mem: Memory) -> None:
@@ -297,12 +322,12 @@ class Engine:
             bits[addr : addr + len(values)] = [1 if v else 0 for v in values]
             self._journal(user, f"{fmt_octal(addr)}:{len(values)} bits", old, new, addr)
 
-        return self._write(apply, user, done)
+        return apply
 
-    def write_word(self, addr: int, value: int, *, user: str = "operator", label: str | None = None,
-                   describe: Callable[[int, int], str] | None = None, done: Done | None = None) -> bool:
-        """Queue an operator write of a word. `describe(old, new)` says the change in the plant's
-        terms ("0.0 -> 130.0 °C", a tag's); the record keeps the raw words and the address too."""
+    def word_writer(self, addr: int, value: int, user: str, label: str | None = None,
+                    describe: Callable[[int, int], str] | None = None) -> Callable[[Memory], None]:
+        """A word. `describe(old, new)` says the change in the plant's terms ("0.0 -> 130.0 °C", a
+        tag's); the record keeps the raw words and the address too."""
         def apply(mem: Memory) -> None:
             old = mem.get_word(addr)
             mem.set_word(addr, value)
@@ -314,16 +339,36 @@ class Engine:
                                      text=f"write {label}: {describe(old, new)} "
                                           f"(raw {old} -> {new} at {fmt_octal(addr)})"))
 
-        return self._write(apply, user, done)
+        return apply
 
-    def write_bytes(self, addr: int, payload: bytes, *, user: str = "operator",
-                    done: Done | None = None) -> bool:
+    def bytes_writer(self, addr: int, payload: bytes, user: str,
+                     label: str | None = None) -> Callable[[Memory], None]:
         def apply(mem: Memory) -> None:
             old = mem.read(addr, len(payload))
             mem.write(addr, payload)
-            self._journal(user, f"{fmt_octal(addr)}:{len(payload)}", old.hex(" "), payload.hex(" "), addr)
+            where = f"{fmt_octal(addr)}:{len(payload)}"
+            self._journal(user, where, old.hex(" "), payload.hex(" "), addr, label)
 
-        return self._write(apply, user, done)
+        return apply
+
+    def write_bit(
+        self, addr: int | BitRef, value: int, *, user: str = "operator", label: str | None = None,
+        done: Done | None = None,
+    ) -> bool:
+        """Queue a write of an HMI bit address; False: refused (`refusal()` says why)."""
+        return self.command(self.bit_writer(addr, value, user, label), user, done)
+
+    def write_bits(self, addr: int, values: list[int], *, user: str = "operator",
+                   done: Done | None = None) -> bool:
+        return self.command(self.bits_writer(addr, values, user), user, done)
+
+    def write_word(self, addr: int, value: int, *, user: str = "operator", label: str | None = None,
+                   describe: Callable[[int, int], str] | None = None, done: Done | None = None) -> bool:
+        return self.command(self.word_writer(addr, value, user, label, describe), user, done)
+
+    def write_bytes(self, addr: int, payload: bytes, *, user: str = "operator",
+                    done: Done | None = None) -> bool:
+        return self.command(self.bytes_writer(addr, payload, user), user, done)
 
     @property
     def writes_waiting(self) -> int:
@@ -400,9 +445,41 @@ class Engine:
         self.scan_counter += 1
         self.snapshot = self._publish()
         self.stats.add((time.perf_counter() - t0) * 1000.0, self.tick * 1000.0)
-        for listener in self.listeners:
-            listener(self.snapshot)
+        for name, listener in self._listeners:
+            try:
+                listener(self.snapshot)
+            except Exception as e:  # isolated: the others, and the scan, go on
+                self._listener_failed(name, e)
         return self.snapshot
+
+    # --- listeners -----------------------------------------------------------------------------
+
+    def subscribe(self, listener: Listener, name: str | None = None) -> Callable[[], None]:
+        """Call `listener(snapshot)` on the engine thread after every scan, in the order subscribed.
+        A listener that raises is logged with its traceback, journaled once per fault and named in
+        `listener_faults` (the health strip); the other listeners and the scan go on. Returns the
+        call that unsubscribes it. Thread-safe."""
+        label = name or getattr(listener, "__qualname__", None) or repr(listener)
+        self._listeners = (*self._listeners, (label, listener))
+        return lambda: self.unsubscribe(listener)
+
+    def unsubscribe(self, listener: Listener) -> None:
+        self._listeners = tuple(e for e in self._listeners if e[1] != listener)
+
+    @property
+    def listeners(self) -> tuple[Listener, ...]:
+        """The subscribed listeners, in order (read-only: subscribe and unsubscribe change them)."""
+        return tuple(listener for _, listener in self._listeners)
+
+    def _listener_failed(self, name: str, e: Exception) -> None:
+        logger.exception("engine listener %s failed at scan %d", name, self.scan_counter)
+        where = traceback.extract_tb(e.__traceback__)[-1:]
+        at = f" at {where[0].filename}:{where[0].lineno}" if where else ""
+        text = f"{type(e).__name__}: {e}{at}"
+        if self.listener_faults.get(name) != text:
+            self.listener_faults[name] = text
+            self.sink.put(Record(self.wall_time(), "system", source="netplc",
+                                 text=f"engine listener {name} failed (the others go on): {text}"))
 
     def step(self) -> Snapshot:
         """Step one scan: with NetPlc stopped or halted, run exactly one scan with the program, one
@@ -447,9 +524,16 @@ class Engine:
         writes, bits = self._writes, mem.bits
         n = min(len(writes), self.write_budget)
         room = getattr(self.sink, "room", None)
-        if room is not None:
-            n = min(n, max(0, room() - JOURNAL_ROOM))
         finished: list[tuple[Done, bool]] = []
+        if room is not None and (left := max(0, room() - JOURNAL_ROOM)) < n:
+            # the journal filled after these were queued: refuse what it cannot take, never hold
+            # a writer without an answer (it would retry a write that may then be applied twice)
+            for _ in range(n - left):
+                _apply, done, _user = writes.pop()
+                self.writes_refused += 1
+                if done is not None:
+                    done(False)
+            n = left
         for _ in range(n):
             apply, done, user = writes.popleft()
             stopped = bits[EMERGENCY_STOP]

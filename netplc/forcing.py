@@ -163,6 +163,25 @@ class Forces:
     def force(self, kind: Kind, addr: int, value: int | None = None, *, user: str) -> None:
         """Force `kind` at `addr` to `value`, or bumpless to what it holds when applied.
         ForceError at once for an address or a value that cannot be forced."""
+        self.host.post(self.forcing(kind, addr, value, user=user))
+
+    def force_tag(self, tag: Tag, phy: float | None = None, *, user: str) -> None:
+        self.host.post(self.forcing_tag(tag, phy, user=user))
+
+    def unforce_tag(self, tag: Tag, *, user: str) -> None:
+        self.host.post(self.unforcing_tag(tag, user=user))
+
+    def unforce(self, kind: Kind, addr: int, *, user: str) -> None:
+        self.host.post(self.unforcing(kind, addr, user=user))
+
+    def unforce_all(self, *, user: str) -> None:
+        self.host.post(self.unforcing_all(user=user))
+
+    # Each command as the closure the engine thread applies between two scans (the command layer
+    # queues these through the engine's bounded queue; the methods above post them directly).
+
+    def forcing(self, kind: Kind, addr: int, value: int | None = None, *,
+                user: str) -> Callable[[Memory], None]:
         check_target(kind, addr)
         if value is not None:
             check_value(kind, value)
@@ -177,9 +196,9 @@ class Forces:
             how = " (bumpless)" if value is None else ""
             self._journal(user, new, f"force {new.where}: {was} -> {new.value}{how}")
 
-        self.host.post(apply)
+        return apply
 
-    def force_tag(self, tag: Tag, phy: float | None = None, *, user: str) -> None:
+    def forcing_tag(self, tag: Tag, phy: float | None = None, *, user: str) -> Callable[[Memory], None]:
         """Force every word of `tag` (or its bit) as one command to the physical value `phy`, or
         bumpless to what it holds when applied; journaled with the tag's name and unit."""
         if phy is not None and phy != phy:
@@ -202,9 +221,9 @@ class Forces:
             text = f"force {tag.name}: {was} -> {tag.format(value)} (raw {raw}){how}"
             self._journal_tag(user, tag, value, text)
 
-        self.host.post(apply)
+        return apply
 
-    def unforce_tag(self, tag: Tag, *, user: str) -> None:
+    def unforcing_tag(self, tag: Tag, *, user: str) -> Callable[[Memory], None]:
         """Release every word (or the bit) of `tag` in one command, journaled once with its name."""
 
         def apply(mem: Memory) -> None:
@@ -214,9 +233,9 @@ class Forces:
                 value = tag.value(mem)
                 self._journal_tag(user, tag, value, f"unforce {tag.name} (was forced {tag.format(value)})")
 
-        self.host.post(apply)
+        return apply
 
-    def unforce(self, kind: Kind, addr: int, *, user: str) -> None:
+    def unforcing(self, kind: Kind, addr: int, *, user: str) -> Callable[[Memory], None]:
         """Release one force: the memory keeps the value and live writers take over again."""
 
         def apply(_mem: Memory) -> None:
@@ -225,9 +244,9 @@ class Forces:
                 self.listing = tuple(f for f in self.listing if f.key != old.key)
                 self._journal(user, old, f"unforce {old.where} (was forced {old.value})")
 
-        self.host.post(apply)
+        return apply
 
-    def unforce_all(self, *, user: str) -> None:
+    def unforcing_all(self, *, user: str) -> Callable[[Memory], None]:
         """"Unforce all" as one command: every force released in the same scan, each journaled."""
 
         def apply(_mem: Memory) -> None:
@@ -235,7 +254,7 @@ class Forces:
             for old in released:
                 self._journal(user, old, f"unforce {old.where} (was forced {old.value}; unforce all)")
 
-        self.host.post(apply)
+        return apply
 
     def restore(self, forces: Iterable[Force], *, user: str) -> None:
         """Install retained forces (RetainForces = true), each journaled as forced again."""

@@ -7,16 +7,19 @@ overrun statistics and the schedule catches up without bursts.
 
 from __future__ import annotations
 
+import logging
 import threading
 import time
 from collections.abc import Callable
 
 from netplc.engine import Engine
 
+logger = logging.getLogger(__name__)
+
 
 class ScanThread:
     def __init__(self, engine: Engine, tick: float | None = None, name: str = "netplc-scan",
-                 on_error: Callable[[BaseException], None] | None = None) -> None:
+                 on_error: Callable[[Exception], None] | None = None) -> None:
         self.engine = engine
         self.tick = tick if tick is not None else engine.tick
         engine.tick = self.tick  # overruns are counted against the tick the scans really run on
@@ -43,7 +46,8 @@ class ScanThread:
             try:
                 with self.lock:
                     self.engine.scan()
-            except BaseException as e:  # reported, and the thread goes on
+            except Exception as e:  # reported, and the thread goes on
+                logger.exception("scan %d failed", self.engine.scan_counter)
                 if self._on_error:
                     self._on_error(e)
             deadline += self.tick

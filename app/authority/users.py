@@ -6,8 +6,8 @@ acknowledges), engineer (runs and stops NetPlc, forces), admin (manages users). 
 an scrypt hash of the password, never the password itself; the file is written whole (a temporary
 file replaced atomically) and readable by its owner only.
 
-Qt-free: the workstation asks the session (`require`, `refusal`) before acting, the command line
-manages the file, and the monitor's forcing calls the same `require("engineer", ...)`.
+Qt-free. The session says who is at the workstation; what that user may do is the command layer's
+to say (`app/authority/layer.py`, from the one policy table): `denial` asks it the same way.
 """
 
 from __future__ import annotations
@@ -22,11 +22,12 @@ from collections.abc import Callable
 from dataclasses import asdict, dataclass
 from pathlib import Path
 
-from hmi_forms.elements.base import ROLES
+from app.authority.policy import ADMIN, ENGINEER, OPERATOR, ROLES, VIEWER, Refusal, rank
 
 USERS_FILE = "users.json"
 SCRYPT = {"n": 2**14, "r": 8, "p": 1}  # RFC 7914's interactive-login cost: ~50 ms per check
-OPERATOR, ENGINEER, ADMIN = "operator", "engineer", "admin"
+__all__ = ["ADMIN", "ENGINEER", "OPERATOR", "VIEWER", "Refusal", "Refused", "Session", "User", "UserError",
+           "Users", "rank"]
 
 
 class UserError(ValueError):
@@ -35,26 +36,6 @@ class UserError(ValueError):
 
 class Refused(Exception):
     """An action the logged-in user may not do; the text says why."""
-
-
-@dataclass(frozen=True)
-class Refusal:
-    """Why the session may not do an action, in parts, so the console can say it in its own
-    language (app/gui/words.py); `str()` is the English sentence the journal and the tests read."""
-
-    action: str
-    role: str  # the role the action needs
-    user: str = ""  # "" when nobody is logged in
-    user_role: str = ""
-
-    def __str__(self) -> str:
-        if not self.user:
-            return f"{self.action}: nobody is logged in ({self.role} needed)"
-        return f"{self.action}: needs the {self.role} role; {self.user} is {self.user_role}"
-
-
-def rank(role: str) -> int:
-    return ROLES.index(role)
 
 
 def _digest(password: str, salt: bytes) -> str:

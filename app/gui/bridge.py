@@ -32,13 +32,13 @@ class RuntimeBridge(QObject):
         self._ready.connect(self._deliver)
         runtime.subscribe(self._on_record)
         if runtime.engine is not None:
-            runtime.engine.listeners.append(self._on_snapshot)
+            runtime.engine.subscribe(self._on_snapshot)
 
     def detach(self) -> None:
         self.runtime.unsubscribe(self._on_record)
         engine = self.runtime.engine
-        if engine is not None and self._on_snapshot in engine.listeners:
-            engine.listeners.remove(self._on_snapshot)
+        if engine is not None:
+            engine.unsubscribe(self._on_snapshot)
 
     def _on_record(self, record: Record) -> None:
         self.record.emit(record)

@@ -1,6 +1,6 @@
 """The admin's users dialog: the station's users and roles, added, removed and given new passwords
 from the workstation (the same users.json `main.py users` manages). Each change is journaled by
-the window under the admin's name; the passwords never leave app/users.py unhashed.
+the window under the admin's name; the passwords never leave app/authority/users.py unhashed.
 """
 
 from __future__ import annotations
@@ -20,9 +20,9 @@ from PySide6.QtWidgets import (
     QWidget,
 )
 
+from app.authority.policy import ROLES
+from app.authority.users import UserError, Users
 from app.gui import words
-from app.users import UserError, Users
-from hmi_forms.elements.base import ROLES
 
 
 class UsersDialog(QDialog):

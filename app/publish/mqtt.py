@@ -104,12 +104,11 @@ class SparkplugPublisher:
         self.client.loop_start()
         self._thread = threading.Thread(target=self._run, name="mqtt-publish", daemon=True)
         self._thread.start()
-        self.engine.listeners.append(self.feed)
+        self.engine.subscribe(self.feed)
 
     def stop(self) -> None:
         """A deliberate stop: NDEATH published by the node itself (spec 3.0), then disconnect."""
-        if self.feed in self.engine.listeners:
-            self.engine.listeners.remove(self.feed)
+        self.engine.unsubscribe(self.feed)
         self._stopping = True
         self._wake.set()
         if self._thread is not None:

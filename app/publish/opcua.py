@@ -34,9 +34,9 @@ from asyncua.crypto.cert_gen import setup_self_signed_certificate
 from asyncua.crypto.permission_rules import User, UserRole
 from cryptography.x509.oid import ExtendedKeyUsageOID
 
+from app.authority.users import rank
 from app.publish.feed import LatestSnapshot
 from app.publish.points import PasswordCheck, PointReader, Writer, WriteRefused
-from app.users import rank
 from netplc.records import Record
 from netplc.tags.alarms import PRIORITIES, Alarm, State
 from netplc.tags.quality import Quality
@@ -154,11 +154,10 @@ class OpcUaServer:
         if self.status.error:
             self._thread.join(5)
             raise RuntimeError(self.status.error)
-        self.engine.listeners.append(self.feed)
+        self.engine.subscribe(self.feed)
 
     def stop(self) -> None:
-        if self.feed in self.engine.listeners:
-            self.engine.listeners.remove(self.feed)
+        self.engine.unsubscribe(self.feed)
         loop, stop = self._loop, self._stop
         if loop is not None and stop is not None and not loop.is_closed():
             loop.call_soon_threadsafe(stop.set)

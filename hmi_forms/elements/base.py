@@ -22,6 +22,7 @@ from dataclasses import dataclass, field
 from functools import cached_property
 from typing import Any, ClassVar
 
+from app.authority.policy import ROLES
 from hmi_forms.elements import props as p
 from hmi_forms.elements.target import Effects, Target
 from netplc.address import IO_BITS, BitRef, data_index
@@ -30,7 +31,6 @@ from netplc.records import Kind, Record
 from netplc.tags.quality import Quality
 
 Reader = Callable[[Snapshot], int]
-ROLES = ("viewer", "operator", "engineer", "admin")  # ordered: each allows what the one before does
 
 
 def bit_reader(ref: BitRef) -> Reader:

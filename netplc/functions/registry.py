@@ -133,11 +133,12 @@ _loaded = False
 
 
 def _load_all() -> None:
-    """Import every function module once so that their @register calls have run."""
+    """Import every function module once so that their @register calls have run. Done only when
+    every import succeeded: a module that fails to import raises here, at every lookup, instead of
+    leaving a registry that answers "unknown function" for all that module held."""
     global _loaded
     if _loaded:
         return
-    _loaded = True
     import importlib
     import pkgutil
 
@@ -146,3 +147,4 @@ def _load_all() -> None:
     for info in pkgutil.iter_modules(pkg.__path__):
         if info.name != "registry":
             importlib.import_module(f"netplc.functions.{info.name}")
+    _loaded = True

@@ -105,7 +105,7 @@ def poll(condition, timeout: float = 15.0) -> None:
 def test_headless_runtime_pulses_every_scan_and_journals_the_forms_records(runtime: Runtime) -> None:
     scans = Scans()
     assert runtime.engine is not None
-    runtime.engine.listeners.append(scans)
+    runtime.engine.subscribe(scans)
     drive(runtime, scans, poll)
     assert check_every_scan(scans) > 10
     runtime.stop()  # flushes the archive
@@ -125,7 +125,7 @@ def test_the_workstation_changes_nothing_even_when_its_window_lags(qtbot, runtim
 
     scans = Scans()
     assert runtime.engine is not None
-    runtime.engine.listeners.append(scans)
+    runtime.engine.subscribe(scans)
     window = MainWindow(runtime)
     qtbot.addWidget(window)
     window.show()
@@ -203,7 +203,7 @@ def test_a_form_that_does_not_load_is_a_problem_the_station_runs_with(tmp_path: 
     rt.start()
     try:
         assert rt.engine is not None
-        rt.engine.listeners.append(scans)
+        rt.engine.subscribe(scans)
         poll(lambda: scans.count() > 6)
         status = rt.status()
     finally:

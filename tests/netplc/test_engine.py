@@ -405,7 +405,7 @@ def test_a_failing_queued_write_costs_neither_the_scan_nor_later_writes():
 def test_snapshot_is_published_after_each_scan_to_listeners(compiled):
     rig = Rig("TNA $0\nYON $02000", compiled)
     seen = []
-    rig.engine.listeners.append(seen.append)
+    rig.engine.subscribe(seen.append)
     before = rig.engine.snapshot
     rig.step(b0=1)
     rig.step(b0=0)
@@ -444,3 +444,28 @@ def test_scan_statistics_mean_is_the_running_average():
         st.add(ms, tick_ms=2.5)
     assert (st.count, st.last_ms, st.max_ms, st.overruns) == (3, 2.0, 3.0, 1)
     assert st.mean_ms == pytest.approx(2.0)
+
+
+@engines
+def test_a_listener_that_raises_is_journaled_and_the_others_go_on(compiled):
+    rig = Rig("NOP", compiled)
+    before, after = [], []
+    calls = []
+
+    def faulty(snap):
+        calls.append(snap.scan)
+        if snap.scan == 2:
+            raise RuntimeError("listener bug")
+
+    rig.engine.subscribe(before.append, "before")
+    rig.engine.subscribe(faulty, "faulty")
+    rig.engine.subscribe(after.append, "after")
+    for _ in range(5):
+        rig.step(0.1)
+    assert [s.scan for s in before] == [s.scan for s in after] == calls == [1, 2, 3, 4, 5]
+    assert "listener bug" in rig.engine.listener_faults["faulty"]
+    faults = [r.text for r in rig.sink.records if "listener" in (r.text or "")]
+    assert len(faults) == 1 and "engine listener faulty failed" in faults[0]
+    unsubscribe = rig.engine.subscribe(lambda s: None, "x")
+    unsubscribe()
+    assert len(rig.engine.listeners) == 3

@@ -20,7 +20,7 @@ def engine_for(text: str) -> Engine:
 def test_scans_run_on_the_tick_and_stop():
     engine = engine_for("TNA $03760\nCTR $03000 N:255")
     done = threading.Event()
-    engine.listeners.append(lambda snap: snap.scan >= 5 and done.set())
+    engine.subscribe(lambda snap: snap.scan >= 5 and done.set())
     thread = ScanThread(engine, tick=0.005)
     assert engine.tick == 0.005  # overruns are counted against the thread's tick
     thread.start()
@@ -40,28 +40,31 @@ def test_a_failing_scan_is_reported_and_the_thread_goes_on():
     engine = engine_for("NOP")
     errors: list[BaseException] = []
     recovered = threading.Event()
+    scan = engine.scan
 
-    def listener(snap):
+    def faulty_scan():
+        snap = scan()
         if snap.scan == 2:
-            raise RuntimeError("listener bug")
+            raise RuntimeError("scan bug")
         if snap.scan >= 4:
             recovered.set()
+        return snap
 
-    engine.listeners.append(listener)
+    engine.scan = faulty_scan
     thread = ScanThread(engine, tick=0.005, on_error=errors.append)
     thread.start()
     try:
         assert recovered.wait(10)
     finally:
         thread.stop()
-    assert [str(e) for e in errors] == ["listener bug"]
+    assert [str(e) for e in errors] == ["scan bug"]
 
 
 def test_lock_holds_the_scans_off():
     engine = engine_for("NOP")
     thread = ScanThread(engine, tick=0.002)
     scanned = threading.Event()
-    engine.listeners.append(lambda snap: scanned.set())
+    engine.subscribe(lambda snap: scanned.set())
     with thread.lock:
         thread.start()
         before = engine.scan_counter
