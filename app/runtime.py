@@ -424,6 +424,24 @@ class Runtime:
             self.simulators[index] = new
         self.system(f"simulated node {sim.node} {'answers again' if answering else 'stopped answering'}")
 
+    def watch(self, callback: Callable[[Readings], None], name: str | None = None) -> Callable[[], None]:
+        """The station's public feed: `callback(readings)` on the engine thread after every scan,
+        once that scan's quality and alarms are evaluated, with the values and their quality of
+        that one scan together (`readings.snapshot` is the scan's snapshot). What the GUI, the
+        publishers and the consoles read; isolated like every engine listener. Returns the call
+        that stops it. Call after `start()`."""
+        engine = self.engine
+        if engine is None:
+            raise RuntimeError("the station is not started")
+
+        def on_scan(snapshot: object) -> None:
+            alarms = self.alarms
+            readings = alarms.readings if alarms is not None else None
+            if readings is not None and readings.snapshot is snapshot:
+                callback(readings)
+
+        return engine.subscribe(on_scan, name or getattr(callback, "__qualname__", None))
+
     def readings(self) -> Readings | None:
         """Every tag's and address's value with its quality and time as of the last scan
         (netplc/tags/readings.py): what the HMI, the journal and the publishers read; None while
