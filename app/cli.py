@@ -13,8 +13,11 @@ import signal
 import sys
 import threading
 import time
+from pathlib import Path
 
+from app import logs
 from app.config import DEMO_STATION
+from app.logs import LEVELS
 
 COMMANDS = ("view", "check", "simulate", "alarms-report", "design", "monitor", "archive", "users")
 
@@ -38,6 +41,9 @@ def _main_parser() -> argparse.ArgumentParser:
                    help="with --no-gui: stop after S seconds (default: until SIGINT/SIGTERM)")
     p.add_argument("--status-every", type=float, default=5.0, metavar="S",
                    help="with --no-gui: seconds between status lines (default 5)")
+    p.add_argument("--log-level", choices=LEVELS, default="WARNING",
+                   help="what is logged to stderr (default WARNING; any command takes it); a running "
+                        "station also logs INFO and above to log/station.log in its folder")
     return p
 
 
@@ -170,8 +176,37 @@ def _password() -> str:
     return first
 
 
+def _log_level(args: list[str]) -> tuple[str, list[str]]:
+    """`--log-level LEVEL` (or `--log-level=LEVEL`) anywhere among the arguments of any command:
+    one logging configuration for all of them (app/logs.py)."""
+    level, rest, i = "WARNING", [], 0
+    while i < len(args):
+        arg = args[i]
+        if arg == "--log-level" and i + 1 < len(args):
+            level, i = args[i + 1].upper(), i + 2
+            continue
+        if arg.startswith("--log-level="):
+            level = arg.split("=", 1)[1].upper()
+        else:
+            rest.append(arg)
+        i += 1
+    if level not in LEVELS:
+        print(f"--log-level: {level!r} is not one of {', '.join(LEVELS)}", file=sys.stderr)
+        raise SystemExit(2)
+    return level, rest
+
+
+def _log_to_station(station: str, level: str) -> None:
+    """A running station logs into its own folder (log/station.log)."""
+    path = Path(station)
+    folder = path.parent if path.suffix == ".toml" else path
+    if folder.is_dir():
+        logs.to_station_folder(folder, level)
+
+
 def main(argv: list[str] | None = None) -> int:
-    args = list(sys.argv[1:] if argv is None else argv)
+    level, args = _log_level(list(sys.argv[1:] if argv is None else argv))
+    logs.configure(level)
     if args and args[0] in COMMANDS:
         command, rest = args[0], args[1:]
         if command == "simulate":
@@ -200,6 +235,7 @@ def main(argv: list[str] | None = None) -> int:
     ns = _main_parser().parse_args(args)
     if ns.duration is not None and not ns.no_gui:
         _main_parser().error("--duration needs --no-gui")
+    _log_to_station(ns.station, level)
     if ns.no_gui:
         return run_headless(ns.station, ns.duration, ns.status_every)
     return run_gui(ns.station)

@@ -15,6 +15,7 @@ consumers (tags and quality, alarms) attach the same way, as engine listeners be
 
 from __future__ import annotations
 
+import logging
 import os
 import socket
 import sqlite3
@@ -49,6 +50,7 @@ from registrar.store import Store, StoreStats
 if TYPE_CHECKING:
     from registrar.forward import Forwarder
 
+logger = logging.getLogger(__name__)
 RecordObserver = Callable[[Record], None]
 RESOLVE_TIMEOUT = 5.0  # seconds for the host names of all TCP nodes to resolve
 CODE_CACHE = "compiled"  # beside the archive: the compiled program, for a fast next start
@@ -208,6 +210,7 @@ class Runtime:
             self._observers.remove(observer)
 
     def system(self, text: str) -> None:
+        logger.info("%s", text)  # the station's own words in its log file too, beside the journal
         self.put(Record(self.wallclock(), "system", source="station", text=text))
 
     # --- start and stop ------------------------------------------------------------------------

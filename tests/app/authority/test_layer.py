@@ -137,7 +137,8 @@ def test_forcing_needs_the_engineer_and_is_journaled_with_who():
     sink.commit()
     assert ticket.result(0).ok and engine.forces.count == 1
     assert sink.records[-1].source == "program view:egor"
-    assert layer.force_tag(Who("egor", Source.CONSOLE), "TEMP_SP", 500.0).result(0).reason is Reason.OUT_OF_RANGE
+    too_hot = layer.force_tag(Who("egor", Source.CONSOLE), "TEMP_SP", 500.0)
+    assert too_hot.result(0).reason is Reason.OUT_OF_RANGE
 
 
 def test_run_and_stop_need_the_engineer():
