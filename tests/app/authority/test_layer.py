@@ -3,6 +3,8 @@ commit, throttled refusals, typed and ranged tag writes, a full journal refused 
 
 from __future__ import annotations
 
+from pathlib import Path
+
 import pytest
 
 from app.authority import Action, Commands, Reason, Source, Who, policy_table
@@ -154,3 +156,8 @@ def test_run_and_stop_need_the_engineer():
 def test_the_policy_table_prints_every_action():
     table = policy_table()
     assert all(f"| {a.value} | {POLICY[a]} |" in table for a in Action)
+
+
+def test_the_readme_prints_the_policy_table_the_layer_uses():
+    readme = (Path(__file__).resolve().parents[3] / "README.md").read_text(encoding="utf-8")
+    assert policy_table() in readme, "README's policy table is stale: paste app.authority.policy_table()"
