@@ -313,8 +313,8 @@ def run_migrate(source: str, url: str, station: str | None) -> int:
 
     import psycopg
 
-    from registrar.forward import Forwarder
-    from registrar.pg import is_url, url_problem
+    from registrar.plant.forward import Forwarder
+    from registrar.plant.schema import is_url, url_problem
 
     problem = url_problem(url) if is_url(url) else "not a postgresql:// URL"
     if problem:

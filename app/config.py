@@ -325,7 +325,7 @@ def _plant_archive(top: _Reader) -> str | None:
     value = top.table.get("Archive")
     if not (isinstance(value, str) and value.startswith(("postgresql://", "postgres://"))):
         return None
-    from registrar.pg import url_problem  # psycopg only where a plant archive is named
+    from registrar.plant.schema import url_problem  # psycopg only where a plant archive is named
 
     top.known.add("Archive")
     problem = url_problem(value)

@@ -61,12 +61,12 @@ _SELECT = "SELECT " + ", ".join(COLUMNS)
 
 class Archive(ArchiveReader):
     """A station's SQLite archive, or the plant archive when given a postgresql:// URL (the same
-    methods, see registrar/pg_query.py)."""
+    methods, see registrar/plant/query.py)."""
 
     def __new__(cls, target: str | Path) -> ArchiveReader:  # type: ignore[misc]
         if cls is Archive and isinstance(target, str) and target.startswith(("postgresql://",
                                                                                "postgres://")):
-            from registrar.pg_query import PgArchive  # psycopg only where a plant archive is read
+            from registrar.plant.query import PgArchive  # psycopg only where a plant archive is read
 
             return PgArchive(target)  # not an Archive, so __init__ below is not run on it
         return super().__new__(cls)

@@ -1,6 +1,6 @@
 """What both archive readers share: the filter, the rows and series keys they return, the WHERE
 clause of a filter, and the min/max thinning of a series. The station's SQLite archive
-(registrar/query.py) and the plant archive on PostgreSQL (registrar/pg_query.py) each build on it,
+(registrar/query.py) and the plant archive on PostgreSQL (registrar/plant/query.py) each build on it,
 so neither imports the other's driver.
 """
 

@@ -16,7 +16,7 @@ from pathlib import Path
 import numpy as np
 import psycopg
 
-from registrar import pg
+from registrar.plant import schema as plant
 from registrar.reading import EXPORT_CHUNK, ArchiveReader, Filter, Row, SeriesKey, thinned, where_clause
 from registrar.schema import COLUMNS, GAP_SQL, table_name
 
@@ -25,17 +25,17 @@ _SELECT = "SELECT " + ", ".join(COLUMNS) + ", station"
 
 class PgArchive(ArchiveReader):
     def __init__(self, url: str) -> None:
-        problem = pg.url_problem(url)
+        problem = plant.url_problem(url)
         if problem:
             raise ValueError(f"{url}: {problem}")
         self.url = url
         try:
-            self._pg = pg.connect(url, read_only=True)
+            self._pg = plant.connect(url, read_only=True)
         except psycopg.Error as e:
             raise psycopg.OperationalError(f"{url}: cannot open the plant archive: {e}") from None
         self._parts: dict[dt.date, str] = {}
         try:
-            self.tz = pg.plant_zone(self._pg)
+            self.tz = plant.plant_zone(self._pg)
         except psycopg.errors.UndefinedTable:
             self._pg.close()
             raise psycopg.OperationalError(f"{url}: no plant archive in this database "
@@ -47,18 +47,19 @@ class PgArchive(ArchiveReader):
     # --- days, stations and catalogues ---------------------------------------------------------
 
     def days(self) -> list[dt.date]:
-        self._parts = pg.partitions(self._pg)
+        self._parts = plant.partitions(self._pg)
         return sorted(self._parts, reverse=True)
 
     def stations(self) -> list[str]:
         return [s for (s,) in self._pg.execute(
-            "SELECT DISTINCT station FROM meta WHERE station <> %s ORDER BY station", (pg.PLANT,))]
+            "SELECT DISTINCT station FROM meta WHERE station <> %s ORDER BY station", (plant.PLANT,))]
 
     def meta(self, station: str | None = None) -> dict[str, str]:
         """The plant's meta, with a station's own over it (the only station's, if there is one)."""
         station = station or self._only_station()
         rows = self._pg.execute("SELECT key, value FROM meta WHERE station = %s OR station = %s "
-                                "ORDER BY station = %s", (pg.PLANT, station or pg.PLANT, station)).fetchall()
+                                "ORDER BY station = %s",
+                                (plant.PLANT, station or plant.PLANT, station)).fetchall()
         return dict(rows)
 
     def message_texts(self, station: str | None = None) -> dict[int, str]:
@@ -152,5 +153,5 @@ class PgArchive(ArchiveReader):
 
     def _has(self, day: dt.date) -> bool:
         if day not in self._parts:
-            self._parts = pg.partitions(self._pg)
+            self._parts = plant.partitions(self._pg)
         return day in self._parts

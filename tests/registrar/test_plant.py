@@ -14,7 +14,7 @@ import pytest
 
 from app.cli import main as cli
 from netplc.records import Record
-from registrar.forward import Forwarder
+from registrar.plant.forward import Forwarder
 from registrar.query import Archive, Filter
 from registrar.store import Store
 
