@@ -17,6 +17,12 @@ from netplc.tags.tag import Tag
 EXPORT_CHUNK = 10_000
 
 
+class ArchiveError(Exception):
+    """The plant archive cannot be opened or read (PostgreSQL away, no such database, a dropped
+    connection). registrar/plant raises it for its driver's errors, so that the viewer and the
+    commands catch them without importing psycopg; the SQLite reader raises sqlite3.Error."""
+
+
 @dataclass(frozen=True)
 class Filter:
     kinds: set[str] | frozenset[str] | None = None

@@ -15,10 +15,10 @@ import sqlite3
 from concurrent.futures import Future, ThreadPoolExecutor
 from pathlib import Path
 
-import psycopg
 from PySide6.QtCore import QObject, Signal
 
 from registrar.query import Archive, SeriesKey
+from registrar.reading import ArchiveError
 
 
 class SeriesLoader(QObject):
@@ -52,7 +52,7 @@ class SeriesLoader(QObject):
             with Archive(path) as archive:
                 ts, values = archive.series(day, grp=key.grp, type=key.type, source=key.source,
                                             points=self.points, **of_station)
-        except (sqlite3.Error, OSError, psycopg.Error) as e:
+        except (sqlite3.Error, OSError, ArchiveError) as e:
             self.failed.emit(token, key, str(e))
             return
         self.loaded.emit(token, key, ts, values)

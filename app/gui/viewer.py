@@ -15,7 +15,6 @@ import sys
 from pathlib import Path
 
 import numpy as np
-import psycopg
 import pyqtgraph as pg
 from PySide6.QtCore import QT_TRANSLATE_NOOP, Qt
 from PySide6.QtGui import QAction, QColor, QKeySequence
@@ -48,6 +47,7 @@ from hmi_forms.elements import formats
 from hmi_forms.widgets.records import ARCHIVE_COLUMNS, Column, RecordsModel, records_view
 from netplc.tags.tag import Tag
 from registrar.query import Archive, Filter, SeriesKey
+from registrar.reading import ArchiveError
 
 PAGE = 500
 SERIES_POINTS = 4000
@@ -220,7 +220,7 @@ class ViewerWindow(QMainWindow):
             archive = Archive(path)
             days = archive.days()
             stations = archive.stations()
-        except (sqlite3.Error, OSError, ValueError, psycopg.Error) as e:
+        except (sqlite3.Error, OSError, ValueError, ArchiveError) as e:
             QMessageBox.warning(self, self.tr("Journal viewer"), f"Cannot open {path}:\n{e}")
             return False
         if self.archive is not None:

@@ -26,6 +26,7 @@ import psycopg
 
 from netplc.records import Record
 from registrar.plant import schema as plant
+from registrar.reading import ArchiveError
 from registrar.schema import DAY_GLOB, parse_table_name, table_name
 
 SOURCE = "forwarder"
@@ -110,7 +111,8 @@ class Forwarder:
 
     def forward_all(self, progress: Progress | None = None) -> int:
         """Copy everything committed now, in the caller's thread (`archive migrate`); raises
-        psycopg.Error or sqlite3.Error when a side fails. The number of records sent."""
+        ArchiveError when the plant archive fails, sqlite3.Error when the local one does. The
+        number of records sent."""
         try:
             self._connect()
             total = self._measure()[0]
@@ -120,6 +122,8 @@ class Forwarder:
                 if progress is not None:
                     progress(sent, total)
             return sent
+        except psycopg.Error as e:
+            raise ArchiveError(str(e)) from e
         finally:
             self._disconnect()
 
