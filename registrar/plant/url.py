@@ -5,12 +5,13 @@ The password never travels in the URL: libpq reads PGPASSWORD or ~/.pgpass.
 
 from __future__ import annotations
 
+from typing import TypeGuard
 from urllib.parse import urlsplit
 
 URL_SCHEMES = ("postgresql://", "postgres://")
 
 
-def is_url(target: object) -> bool:
+def is_url(target: object) -> TypeGuard[str]:
     return isinstance(target, str) and target.startswith(URL_SCHEMES)
 
 
