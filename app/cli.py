@@ -347,10 +347,9 @@ def run_migrate(source: str, url: str, station: str | None) -> int:
     import sqlite3
     from pathlib import Path
 
-    import psycopg
-
-    from registrar.forward import Forwarder
-    from registrar.pg import is_url, url_problem
+    from registrar.plant.forward import Forwarder
+    from registrar.plant.url import is_url, url_problem
+    from registrar.reading import ArchiveError
 
     problem = url_problem(url) if is_url(url) else "not a postgresql:// URL"
     if problem:
@@ -370,7 +369,7 @@ def run_migrate(source: str, url: str, station: str | None) -> int:
 
     try:
         n = Forwarder(path, url, name).forward_all(progress)
-    except (psycopg.Error, sqlite3.Error) as e:
+    except (ArchiveError, sqlite3.Error) as e:
         print(f"\n{path} -> {url}: {e}", file=sys.stderr)
         return 1
     print(("\n" if n else "") + f"{n:,} records copied from {path} to {url} as station {name!r} "

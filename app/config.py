@@ -20,6 +20,7 @@ from netplc.modbus import PROFILES, TABLES, Endpoint, parse_endpoint
 from netplc.problems import Problems
 from netplc.tags.tag import TagType
 from netplc.textfile import TextFileError, read_text
+from registrar.plant.url import is_url, url_problem
 
 STATION_FILE = "station.toml"
 DEMO_STATION = Path(__file__).resolve().parent.parent / "resources" / "example"  # the built-in demo
@@ -323,9 +324,8 @@ def _outputs_apart(r: _Reader, file: Path, archive: Path, retain: Path, program:
 def _plant_archive(top: _Reader) -> str | None:
     """`Archive` as a PostgreSQL URL: the station still writes its default local archive first."""
     value = top.table.get("Archive")
-    if not (isinstance(value, str) and value.startswith(("postgresql://", "postgres://"))):
+    if not is_url(value):
         return None
-    from registrar.pg import url_problem  # psycopg only where a plant archive is named
 
     top.known.add("Archive")
     problem = url_problem(value)

@@ -48,7 +48,7 @@ from registrar.retain import Retainer
 from registrar.store import Store, StoreStats
 
 if TYPE_CHECKING:
-    from registrar.forward import Forwarder
+    from registrar.plant.forward import Forwarder
 
 logger = logging.getLogger(__name__)
 RecordObserver = Callable[[Record], None]
@@ -227,7 +227,7 @@ class Runtime:
             raise StartError([f"{st.path}: Archive: {e}"]) from None
         self.store = store
         if st.plant_archive:
-            from registrar.forward import Forwarder  # psycopg only where a plant archive is named
+            from registrar.plant.forward import Forwarder  # psycopg only where a plant archive is named
 
             self.forwarder = Forwarder(st.Archive, st.plant_archive, st.name, keep_days=st.plant_keep_days,
                                        sink=self.put, wallclock=self.wallclock)

@@ -30,8 +30,8 @@ ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT))
 
 from netplc.records import Record  # noqa: E402
-from registrar import pg  # noqa: E402
-from registrar.forward import Forwarder  # noqa: E402
+from registrar.plant import schema as pg  # noqa: E402
+from registrar.plant.forward import Forwarder  # noqa: E402
 from registrar.query import Archive, Filter  # noqa: E402
 from registrar.store import Store  # noqa: E402
 

@@ -25,6 +25,7 @@ from urllib.parse import quote
 import numpy as np
 
 from netplc.tags.tag import Tag
+from registrar.plant.url import is_url
 from registrar.reading import (
     EXPORT_CHUNK,
     ArchiveReader,
@@ -61,12 +62,11 @@ _SELECT = "SELECT " + ", ".join(COLUMNS)
 
 class Archive(ArchiveReader):
     """A station's SQLite archive, or the plant archive when given a postgresql:// URL (the same
-    methods, see registrar/pg_query.py)."""
+    methods, see registrar/plant/query.py)."""
 
     def __new__(cls, target: str | Path) -> ArchiveReader:  # type: ignore[misc]
-        if cls is Archive and isinstance(target, str) and target.startswith(("postgresql://",
-                                                                               "postgres://")):
-            from registrar.pg_query import PgArchive  # psycopg only where a plant archive is read
+        if cls is Archive and is_url(target):
+            from registrar.plant.query import PgArchive  # psycopg only where a plant archive is read
 
             return PgArchive(target)  # not an Archive, so __init__ below is not run on it
         return super().__new__(cls)

@@ -1,6 +1,6 @@
 """What both archive readers share: the filter, the rows and series keys they return, the WHERE
 clause of a filter, and the min/max thinning of a series. The station's SQLite archive
-(registrar/query.py) and the plant archive on PostgreSQL (registrar/pg_query.py) each build on it,
+(registrar/query.py) and the plant archive on PostgreSQL (registrar/plant/query.py) each build on it,
 so neither imports the other's driver.
 """
 
@@ -15,6 +15,12 @@ import numpy as np
 from netplc.tags.tag import Tag
 
 EXPORT_CHUNK = 10_000
+
+
+class ArchiveError(Exception):
+    """The plant archive cannot be opened or read (PostgreSQL away, no such database, a dropped
+    connection). registrar/plant raises it for its driver's errors, so that the viewer and the
+    commands catch them without importing psycopg; the SQLite reader raises sqlite3.Error."""
 
 
 @dataclass(frozen=True)

@@ -4,6 +4,10 @@
   PLC, the archive, the form models and loader, the runtime, the station configuration.
 - Only the Modbus sub-package imports pymodbus (its API changes at every minor release).
 - Only `app/publish/` imports asyncua, paho-mqtt and protobuf (docs/architecture.md section 2).
+- Only the plant archive (`registrar/plant/`) imports psycopg, and nothing loads it before a plant
+  archive is named: the viewer, the CLI and the station file's check go through registrar.
+- The user roles live in the command layer (`app/authority/policy.py`): `hmi_forms` imports them
+  and names no roles of its own.
 - No import cycles between modules of the project. Imports under `if TYPE_CHECKING:` are left out:
   they never run. Imports inside functions count: they run, only later.
 """
@@ -104,6 +108,38 @@ def test_only_the_publishers_import_opcua_mqtt_and_protobuf() -> None:
     users = sorted(m for m, deps in graph().items() if any(under(d, ("asyncua", "paho", "google.protobuf"))
                                                            for d in deps))
     assert users and all(under(m, ("app.publish",)) for m in users), users
+
+
+def test_only_the_plant_archive_imports_psycopg() -> None:
+    users = sorted(m for m, deps in graph().items() if any(under(d, ("psycopg",)) for d in deps))
+    assert users and all(under(m, ("registrar.plant",)) for m in users), users
+
+
+def test_psycopg_is_not_loaded_until_a_plant_archive_is_named() -> None:
+    code = ("import sys, app.check, app.cli, app.config, app.runtime, registrar.query, registrar.plant.url\n"
+            "print(sorted(m for m in sys.modules if m.split('.')[0] == 'psycopg'))")
+    r = subprocess.run([sys.executable, "-c", code], cwd=REPO, capture_output=True, text=True, timeout=60)
+    assert r.returncode == 0, r.stderr
+    assert r.stdout.strip() == "[]"
+
+
+def test_hmi_forms_names_no_roles_of_its_own() -> None:
+    from app.authority.policy import ROLES
+
+    bad = []
+    for name, path in modules().items():
+        if not under(name, ("hmi_forms",)):
+            continue
+        for node in ast.walk(ast.parse(path.read_text(encoding="utf-8"))):
+            targets = (node.targets if isinstance(node, ast.Assign)
+                       else [node.target] if isinstance(node, (ast.AnnAssign, ast.AugAssign)) else [])
+            if any(isinstance(t, ast.Name) and t.id == "ROLES" for t in targets):
+                bad.append(f"{name}:{node.lineno} assigns ROLES")
+            if isinstance(node, (ast.Tuple, ast.List, ast.Set)):
+                words = {e.value for e in node.elts if isinstance(e, ast.Constant)}
+                if len(words & set(ROLES)) >= 2:
+                    bad.append(f"{name}:{node.lineno} lists roles {sorted(words & set(ROLES))}")
+    assert bad == []
 
 
 def test_the_rest_reaches_the_modbus_stack_through_its_face() -> None:

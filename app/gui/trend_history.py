@@ -12,10 +12,9 @@ from __future__ import annotations
 import datetime as dt
 from pathlib import Path
 
-import numpy as np
 from PySide6.QtCore import QObject
 
-from app.gui.series_loader import SeriesLoader
+from app.gui.series_loader import Series, SeriesLoader
 from hmi_forms.elements.analog import AnalogBase
 from hmi_forms.widgets.form_view import FormView
 from hmi_forms.widgets.trend import TrendWidget
@@ -38,7 +37,8 @@ class TrendHistory(QObject):
         super().__init__(parent)
         self.archive = archive
         self.loader = SeriesLoader(POINTS, self)
-        self.loader.loaded.connect(self._loaded)
+        self.loader.answered.connect(self._loaded)
+        self.loader.failed.connect(lambda token, _why: self._asked.pop(token, None))  # logged by the loader
         self._asked: dict[int, tuple[TrendWidget, bool]] = {}
         self._days: dict[TrendWidget, dt.date] = {}
         self._found: dict[TrendWidget, SeriesKey] = {}
@@ -63,7 +63,8 @@ class TrendHistory(QObject):
                 continue
             self._asked[self.loader.request(self.archive, day, key)] = (trend, raw)
 
-    def _loaded(self, token: int, key: SeriesKey, ts: np.ndarray, values: np.ndarray) -> None:
+    def _loaded(self, token: int, series: Series) -> None:
+        key, ts, values = series
         asked = self._asked.pop(token, None)
         if asked is None or not len(ts):
             return

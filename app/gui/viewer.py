@@ -15,7 +15,6 @@ import sys
 from pathlib import Path
 
 import numpy as np
-import psycopg
 import pyqtgraph as pg
 from PySide6.QtCore import QT_TRANSLATE_NOOP, Qt
 from PySide6.QtGui import QAction, QColor, QKeySequence
@@ -42,12 +41,14 @@ from PySide6.QtWidgets import (
 
 from app.config import DEMO_STATION, ConfigError, load_station, station_file
 from app.gui import i18n
-from app.gui.series_loader import SeriesLoader
+from app.gui.series_loader import Series, SeriesLoader
 from app.gui.style import apply_style
 from hmi_forms.elements import formats
 from hmi_forms.widgets.records import ARCHIVE_COLUMNS, Column, RecordsModel, records_view
 from netplc.tags.tag import Tag
+from registrar.plant.url import is_url
 from registrar.query import Archive, Filter, SeriesKey
+from registrar.reading import ArchiveError
 
 PAGE = 500
 SERIES_POINTS = 4000
@@ -91,7 +92,7 @@ class ViewerWindow(QMainWindow):
         self.tags: dict[str, Tag] = {}  # the archive's tags by the source of their data series
         self.loading: dict[SeriesKey, int] = {}  # series asked for and not yet plotted: their token
         self.loader = SeriesLoader(SERIES_POINTS, self)
-        self.loader.loaded.connect(self._series_loaded)
+        self.loader.answered.connect(self._series_loaded)
         self.loader.failed.connect(self._series_failed)
         self._build()
         self.resize(1280, 820)
@@ -220,7 +221,7 @@ class ViewerWindow(QMainWindow):
             archive = Archive(path)
             days = archive.days()
             stations = archive.stations()
-        except (sqlite3.Error, OSError, ValueError, psycopg.Error) as e:
+        except (sqlite3.Error, OSError, ValueError, ArchiveError) as e:
             QMessageBox.warning(self, self.tr("Journal viewer"), f"Cannot open {path}:\n{e}")
             return False
         if self.archive is not None:
@@ -381,10 +382,11 @@ class ViewerWindow(QMainWindow):
         day = self.day
         if not shown or self.archive_path is None or day is None:
             return
-        self.loading[key] = self.loader.request(self.archive_path, day, key)
+        self.loading[key] = self.loader.request(self.archive_path, day, key, topic=key)
         self.statusBar().showMessage(f"reading {self.label(key)}…")
 
-    def _series_loaded(self, token: int, key: SeriesKey, ts: np.ndarray, values: np.ndarray) -> None:
+    def _series_loaded(self, token: int, series: Series) -> None:
+        key, ts, values = series
         if self.loading.get(key) != token:
             return  # unticked, asked for again, or another day chosen since
         del self.loading[key]
@@ -398,8 +400,9 @@ class ViewerWindow(QMainWindow):
         if not self.loading:
             self.statusBar().showMessage(f"{self.label(key)}: {len(ts)} points", 5000)
 
-    def _series_failed(self, token: int, key: SeriesKey, why: str) -> None:
-        if self.loading.get(key) == token:
+    def _series_failed(self, token: int, why: str) -> None:
+        key = next((k for k, t in self.loading.items() if t == token), None)
+        if key is not None:
             del self.loading[key]
             self.statusBar().showMessage(f"{self.label(key)} could not be read: {why}", 10000)
 
@@ -425,7 +428,7 @@ def archive_of(target: str | None) -> Path | str:
     """The archive named on the command line: a file, a station folder, the demo station's, or a
     plant archive's URL."""
 
-    if target is not None and target.startswith(("postgresql://", "postgres://")):
+    if is_url(target):
         return target
     if target is None:
         return load_station(DEMO_STATION).Archive

@@ -1,7 +1,8 @@
 """The message journal element (manual 2.4.3): the registrar archive, filtered, for a chosen day.
 
 The model keeps what the operator has chosen (day, kinds, group, minimum type) and when the view
-of today should be re-read; the widget runs the queries through `registrar.query.Archive`.
+of today should be re-read; the widget runs the queries through `registrar.query.Archive`, in its
+worker thread (hmi_forms/widgets/journal.py).
 """
 
 from __future__ import annotations

@@ -1,14 +1,21 @@
 """The MessageJournal widget: a table over the registrar archive with filters and a day picker.
 
-The archive is read through `registrar.query.Archive` (read-only, never blocking the writer).
-Today's view is re-read when the model says so (every RefreshTicks ticks); a past day is read
-once per change of filter. Rows are coloured by message type: warnings amber, alarms red,
-critical solid red, so an alarm stands out in a long list.
+The archive is read through `registrar.query.Archive` (read-only, never blocking the writer), in
+the widget's worker thread (hmi_forms/widgets/worker.py): a page may hold 100,000 rows, and the
+GUI thread never waits for SQLite. Each read is a request for the page as chosen now; the newest
+wins, so a tick, a new filter and another day never show an older choice's rows. Today's view is
+re-read when the model says so (every RefreshTicks ticks); a past day is read once per change of
+filter. Rows are coloured by message type: warnings amber, alarms red, critical solid red, so an
+alarm stands out in a long list.
 """
 
 from __future__ import annotations
 
 import datetime as dt
+import logging
+import sqlite3
+from dataclasses import dataclass
+from functools import partial
 from pathlib import Path
 
 from PySide6.QtCore import QDate
@@ -29,11 +36,46 @@ from hmi_forms.elements.journal import KINDS, MessageJournal
 from hmi_forms.widgets import theme
 from hmi_forms.widgets.base import Images, SelfPainted
 from hmi_forms.widgets.records import JOURNAL_COLUMNS, Palette, RecordsModel, records_view
-from registrar.query import Archive, Filter
+from hmi_forms.widgets.worker import Worker
+from registrar.query import Archive, Filter, Row
+
+logger = logging.getLogger(__name__)
 
 MIN_TYPES = (("all types", None), ("warnings and worse", 1), ("alarms and worse", 2), ("critical", 3))
 PALETTE = Palette(back={1: QColor("#fff4d6"), 2: QColor("#fde0dc"), 3: theme.ALARM},
                   fore={2: QColor("#8e1b1b"), 3: QColor("#ffffff")})
+PAGE = "page"  # the worker's one topic: a newer page request supersedes the older ones
+
+
+@dataclass(frozen=True)
+class Page:
+    day: dt.date
+    rows: list[Row]
+    total: int | None  # None: not counted (a tick of today counts only when the page is short)
+
+
+class JournalReader:
+    """The archive as the worker thread reads it: opened once it exists (the registrar creates
+    it with the first batch), closed with the worker."""
+
+    def __init__(self, path: Path) -> None:
+        self.path = path
+        self.archive: Archive | None = None
+
+    def page(self, day: dt.date, flt: Filter, limit: int, count: bool) -> Page | None:
+        """The newest `limit` records of `day`; None while there is no archive yet."""
+        if self.archive is None:
+            if not self.path.is_file():
+                return None
+            self.archive = Archive(self.path)
+        rows = self.archive.records(day, flt, limit=limit)
+        total = len(rows) if len(rows) < limit else self.archive.count(day, flt) if count else None
+        return Page(day, rows, total)
+
+    def close(self) -> None:
+        if self.archive is not None:
+            self.archive.close()
+            self.archive = None
 
 
 class JournalWidget(SelfPainted):
@@ -43,7 +85,12 @@ class JournalWidget(SelfPainted):
                  parent: QWidget | None = None) -> None:
         super().__init__(model, images, parent)
         self.archive_path = archive_path
-        self.archive: Archive | None = None
+        self.reader = JournalReader(archive_path) if archive_path is not None else None
+        self.worker = Worker("journal", (sqlite3.Error, OSError), self,
+                             on_close=self.reader.close if self.reader is not None else None)
+        self.worker.answered.connect(self._shown)
+        self.worker.failed.connect(self._failed)
+        self._count = True  # a count is owed (day or filter changed) until a counted page arrives
         layout = QVBoxLayout(self)
         layout.setContentsMargins(4, 4, 4, 4)
         layout.setSpacing(4)
@@ -100,41 +147,37 @@ class JournalWidget(SelfPainted):
         super().sync()
         self.reload(count=False)
 
-    def _open(self) -> Archive | None:
-        """Open the archive once it exists (the registrar creates it with the first batch)."""
-        if self.archive is None and self.archive_path is not None:
-            try:
-                self.archive = Archive(self.archive_path)
-            except (FileNotFoundError, OSError):
-                return None
-        return self.archive
-
     def reload(self, count: bool = True) -> None:
-        """Query the chosen day; counting a whole day is left to changes of day or filter."""
-        archive = self._open()
-        if archive is None:
-            self.status.setText("no archive yet" if self.archive_path else "no archive configured")
-            self.table.set_rows([])
+        """Ask for the chosen day's page; counting a whole day is left to changes of day or filter."""
+        if self.reader is None:
+            self.status.setText("no archive configured")
             return
+        if self.worker.closed:
+            return  # the window is closing
         m = self.model
         day = m.day or dt.date.today()
         if m.day is None and self.date.date() != QDate(day.year, day.month, day.day):
             self.date.blockSignals(True)  # today moved on past midnight: follow it
             self.date.setDate(QDate(day.year, day.month, day.day))
             self.date.blockSignals(False)
+        self._count = self._count or count
         flt = Filter(kinds=frozenset(m.kinds), grp=m.group, min_type=m.min_type)
-        try:
-            rows = archive.records(day, flt, limit=m.Rows)
-            total = len(rows) if len(rows) < m.Rows else archive.count(day, flt) if count else None
-        except Exception as e:
-            self.status.setText(f"archive unreadable: {e}")
+        self.worker.submit(partial(self.reader.page, day, flt, m.Rows, self._count), PAGE)
+
+    def _shown(self, _token: int, page: Page | None) -> None:
+        if page is None:
+            self.status.setText("no archive yet")
+            self.table.set_rows([])
             return
-        self.table.set_rows(rows)
-        if total is not None:
-            self.status.setText(f"{len(rows)} of {total} records, {formats.date(day)}" if total > len(rows)
-                                else f"{total} records, {formats.date(day)}")
+        self.table.set_rows(page.rows)
+        if page.total is not None:
+            self._count = False
+            n, total, day = len(page.rows), page.total, formats.date(page.day)
+            self.status.setText(f"{n} of {total} records, {day}" if total > n else f"{total} records, {day}")
+
+    def _failed(self, _token: int, why: str) -> None:
+        self.status.setText(f"archive unreadable: {why}")
 
     def close_archive(self) -> None:
-        if self.archive is not None:
-            self.archive.close()
-            self.archive = None
+        """Stop reading (the window closes): the worker and the archive close."""
+        self.worker.close()

@@ -6,7 +6,7 @@ would still leave a series flat where nothing was known: NSTORE does not run whi
 stopped, and RegData writes only a changed value, so a value frozen by a node that is down writes
 nothing. Therefore, when a series' quality turns from good (or forced) to one that holds it (bad
 or initial, `Quality.held`), one record marks it at once: no value, the quality word as its text.
-The readers (registrar/query.py, registrar/pg_query.py) break the series' line at every record
+The readers (registrar/query.py, registrar/plant/query.py) break the series' line at every record
 whose text is such a word (`GAP_WORDS`).
 """
 

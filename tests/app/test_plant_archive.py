@@ -10,7 +10,7 @@ from app.config import load_station
 from app.gui.viewer import ViewerWindow
 from app.runtime import Runtime
 from netplc.records import Record
-from registrar.forward import Forwarder
+from registrar.plant.forward import Forwarder
 from registrar.query import Archive
 from registrar.store import Store
 from tests.registrar.conftest import wait_for

@@ -3,7 +3,6 @@
 from __future__ import annotations
 
 import shutil
-import time
 from pathlib import Path
 
 import pytest
@@ -16,8 +15,7 @@ from hmi_forms.form import Form, load_form, load_forms
 from hmi_forms.widgets.form_view import FormView
 from netplc.engine import Engine, FakeClock
 from netplc.program import load_symbols, parse
-from netplc.records import ListSink, Record
-from registrar.store import Store
+from netplc.records import ListSink
 from tests.hmi_forms.helpers import snap, write_form
 
 EXAMPLE = Path(__file__).resolve().parents[2] / "resources" / "example"
@@ -230,55 +228,6 @@ def test_a_view_only_shows_a_generator_and_journals_nothing(qtbot, tmp_path) -> 
         assert eng.scan().get_bit(0o2001) == 0  # nothing written
     assert outputs == [1, 0, 1, 0, 1, 0] and form.elements[1].value == 1  # shown all the same
     assert [r.kind for r in sink.records] == ["operator"] and view.errors == []
-
-
-def test_message_journal_shows_the_archive(qtbot, tmp_path) -> None:
-    archive = tmp_path / "archive" / "journal.sqlite"
-    form = one(tmp_path, "MessageJournal", w=700, h=240, RefreshTicks=1)
-    view = FormView(form, EngineTarget(engine()[0]), archive_path=archive)
-    qtbot.addWidget(view)
-    widget = view.pairs[0][1]
-    empty = image(view, qtbot)
-    assert widget.status.text() == "no archive yet"
-    store = Store(archive)
-    store.start()
-    now = time.time()
-    store.put(Record(now, "message", grp=1, type=2, source="LT1", text="Уровень выше 90 %"))
-    store.put(Record(now, "message", grp=1, type=0, source="LT1", text="Уровень в норме"))
-    store.put(Record(now, "data", source="LT1", value=5.0))
-    store.close()
-    view.refresh(snap(scan=1))
-    assert [r.text for r in widget.table.rows] == ["Уровень в норме", "Уровень выше 90 %"]
-    assert differs(empty, image(view, qtbot)) > 100
-    widget.min_type.setCurrentIndex(2)  # alarms and worse
-    assert [r.type for r in widget.table.rows] == [2] and widget.status.text().startswith("1 records")
-    widget.close_archive()
-
-
-def test_message_journal_min_type_takes_alarm_records_by_priority_not_by_state(qtbot, tmp_path) -> None:
-    archive = tmp_path / "archive" / "journal.sqlite"
-    form = one(tmp_path, "MessageJournal", w=700, h=240, RefreshTicks=1, MinType=2,
-               Kinds=["message", "alarm", "operator", "system", "data"])
-    store = Store(archive)
-    store.start()
-    now = time.time()
-    # an alarm record: grp = priority, type = the new state, number = the old one
-    store.put(Record(now, "alarm", grp=1, type=0, source="TEMP.HH", number=2, text="TEMP.HH returned"))
-    store.put(Record(now, "alarm", grp=4, type=3, source="TEMP_SP.H", number=1, text="TEMP_SP.H low"))
-    store.put(Record(now, "alarm", grp=2, type=1, source="LEVEL.H", number=0, text="LEVEL.H high"))
-    store.put(Record(now, "message", grp=1, type=3, text="Авария насоса"))
-    store.put(Record(now, "message", grp=1, type=1, text="Связь с узлом 0 потеряна"))
-    store.put(Record(now, "data", grp=1, type=3, source="04010", value=5.0))
-    store.close()
-    view = FormView(form, EngineTarget(engine()[0]), archive_path=archive)
-    qtbot.addWidget(view)
-    widget = view.pairs[0][1]
-    assert [r.text for r in widget.table.rows] == ["Авария насоса", "LEVEL.H high", "TEMP.HH returned"]
-    widget.min_type.setCurrentIndex(3)  # critical: NMSG type 3, alarms of priority 1
-    assert [r.text for r in widget.table.rows] == ["Авария насоса", "TEMP.HH returned"]
-    widget.min_type.setCurrentIndex(1)  # warnings and worse: alarms of priority 1-3
-    assert len(widget.table.rows) == 4 and "TEMP_SP.H low" not in [r.text for r in widget.table.rows]
-    widget.close_archive()
 
 
 def test_demo_forms_load_and_use_every_element_type(qtbot) -> None:

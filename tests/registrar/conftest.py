@@ -9,7 +9,7 @@ from pathlib import Path
 
 import pytest
 
-from registrar.forward import Forwarder
+from registrar.plant.forward import Forwarder
 from registrar.query import Archive
 
 

@@ -5,7 +5,7 @@ import sys
 import time
 
 from netplc.records import Record
-from registrar.forward import Forwarder
+from registrar.plant.forward import Forwarder
 from registrar.store import Store
 
 

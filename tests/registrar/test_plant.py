@@ -4,6 +4,7 @@ restart and a SIGKILL of the station, retention, the lag alarm, `archive migrate
 from __future__ import annotations
 
 import datetime as dt
+import re
 import signal
 import sqlite3
 import threading
@@ -14,8 +15,9 @@ import pytest
 
 from app.cli import main as cli
 from netplc.records import Record
-from registrar.forward import Forwarder
+from registrar.plant.forward import Forwarder
 from registrar.query import Archive, Filter
+from registrar.reading import ArchiveError
 from registrar.store import Store
 
 from .conftest import wait_for
@@ -201,3 +203,27 @@ def test_a_replay_past_a_lost_position_doubles_nothing(tmp_path, pg_url):
     assert central(pg_url, "st") == (1_001, 1_001)  # ...and refused by the unique key
     with Archive(pg_url) as plant:
         assert plant.records(DAY, Filter(kinds={"operator"}))[0].text == "NUL \ufffd in a text"
+
+
+def test_a_plant_archive_that_fails_says_so_as_an_archive_error(tmp_path, pg_url, capsys):
+    """Its callers (the viewer, `archive migrate`) catch ArchiveError and know no psycopg."""
+    dead = "postgresql://station@127.0.0.1:9/plant"  # nothing answers there
+    with pytest.raises(ArchiveError, match="cannot open the plant archive"):
+        Archive(dead)
+    with pytest.raises(ArchiveError, match="no station has forwarded to it yet"):
+        Archive(pg_url)
+    store = Store(tmp_path / "journal.sqlite")
+    store.put(Record(T0, "message", 1, 2, text="alarm"))
+    store.start()
+    store.close()
+    Forwarder(store.path, pg_url, "st").forward_all()
+    archive = Archive(pg_url)
+    assert archive.days() == [DAY]
+    with psycopg.connect(pg_url, autocommit=True) as con:  # the server drops the reader's session
+        con.execute("SELECT pg_terminate_backend(pid) FROM pg_stat_activity "
+                    "WHERE application_name = 'netplc-station' AND pid <> pg_backend_pid()")
+    with pytest.raises(ArchiveError, match=re.escape(pg_url)):
+        archive.records(DAY)
+    archive.close()
+    assert cli(["archive", "migrate", str(store.path), dead]) == 1
+    assert f"{store.path} -> {dead}:" in capsys.readouterr().err

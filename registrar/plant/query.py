@@ -4,63 +4,98 @@
 session is read-only (the server refuses any write) and autocommit, so no read holds a transaction
 open against the forwarders. A day is a partition; pages run in time order across stations (time,
 station, the station's day and id), which for one station is its id order. Filters are the SQLite
-ones, plus `Filter.stations`.
+ones, plus `Filter.stations`. The driver's errors leave it as `ArchiveError`.
 """
 
 from __future__ import annotations
 
 import csv
 import datetime as dt
+import functools
+from collections.abc import Callable
 from pathlib import Path
+from typing import Concatenate, ParamSpec, TypeVar
 
 import numpy as np
 import psycopg
 
-from registrar import pg
-from registrar.reading import EXPORT_CHUNK, ArchiveReader, Filter, Row, SeriesKey, thinned, where_clause
+from registrar.plant import schema as plant
+from registrar.plant.url import url_problem
+from registrar.reading import (
+    EXPORT_CHUNK,
+    ArchiveError,
+    ArchiveReader,
+    Filter,
+    Row,
+    SeriesKey,
+    thinned,
+    where_clause,
+)
 from registrar.schema import COLUMNS, GAP_SQL, table_name
 
 _SELECT = "SELECT " + ", ".join(COLUMNS) + ", station"
+P = ParamSpec("P")
+T = TypeVar("T")
+
+
+def _reading(method: Callable[Concatenate[PgArchive, P], T]) -> Callable[Concatenate[PgArchive, P], T]:
+    """The driver's errors of a read as ArchiveError naming the archive (the readers' callers
+    know no psycopg)."""
+
+    @functools.wraps(method)
+    def read(self: PgArchive, *args: P.args, **kwargs: P.kwargs) -> T:
+        try:
+            return method(self, *args, **kwargs)
+        except psycopg.Error as e:
+            raise ArchiveError(f"{self.url}: {e}") from e
+
+    return read
 
 
 class PgArchive(ArchiveReader):
     def __init__(self, url: str) -> None:
-        problem = pg.url_problem(url)
+        problem = url_problem(url)
         if problem:
             raise ValueError(f"{url}: {problem}")
         self.url = url
         try:
-            self._pg = pg.connect(url, read_only=True)
+            self._pg = plant.connect(url, read_only=True)
         except psycopg.Error as e:
-            raise psycopg.OperationalError(f"{url}: cannot open the plant archive: {e}") from None
+            raise ArchiveError(f"{url}: cannot open the plant archive: {e}") from None
         self._parts: dict[dt.date, str] = {}
         try:
-            self.tz = pg.plant_zone(self._pg)
-        except psycopg.errors.UndefinedTable:
+            self.tz = plant.plant_zone(self._pg)
+        except psycopg.Error as e:
             self._pg.close()
-            raise psycopg.OperationalError(f"{url}: no plant archive in this database "
-                                           "(no station has forwarded to it yet)") from None
+            why = ("no plant archive in this database (no station has forwarded to it yet)"
+                   if isinstance(e, psycopg.errors.UndefinedTable) else f"cannot read the plant archive: {e}")
+            raise ArchiveError(f"{url}: {why}") from None
 
     def close(self) -> None:
         self._pg.close()
 
     # --- days, stations and catalogues ---------------------------------------------------------
 
+    @_reading
     def days(self) -> list[dt.date]:
-        self._parts = pg.partitions(self._pg)
+        self._parts = plant.partitions(self._pg)
         return sorted(self._parts, reverse=True)
 
+    @_reading
     def stations(self) -> list[str]:
         return [s for (s,) in self._pg.execute(
-            "SELECT DISTINCT station FROM meta WHERE station <> %s ORDER BY station", (pg.PLANT,))]
+            "SELECT DISTINCT station FROM meta WHERE station <> %s ORDER BY station", (plant.PLANT,))]
 
+    @_reading
     def meta(self, station: str | None = None) -> dict[str, str]:
         """The plant's meta, with a station's own over it (the only station's, if there is one)."""
         station = station or self._only_station()
         rows = self._pg.execute("SELECT key, value FROM meta WHERE station = %s OR station = %s "
-                                "ORDER BY station = %s", (pg.PLANT, station or pg.PLANT, station)).fetchall()
+                                "ORDER BY station = %s",
+                                (plant.PLANT, station or plant.PLANT, station)).fetchall()
         return dict(rows)
 
+    @_reading
     def message_texts(self, station: str | None = None) -> dict[int, str]:
         station = station or self._only_station()
         return dict(self._pg.execute("SELECT number, text FROM messages WHERE station = %s",
@@ -70,6 +105,7 @@ class PgArchive(ArchiveReader):
         stations = self.stations()
         return stations[0] if len(stations) == 1 else None
 
+    @_reading
     def series_keys(self, day: dt.date) -> list[SeriesKey]:
         rows = self._pg.execute(
             "SELECT kind, grp, type, source, station FROM series WHERE day = %s "
@@ -78,6 +114,7 @@ class PgArchive(ArchiveReader):
 
     # --- records -------------------------------------------------------------------------------
 
+    @_reading
     def records(self, day: dt.date, flt: Filter | None = None, offset: int = 0, limit: int = 200,
                 newest_first: bool = True) -> list[Row]:
         if limit <= 0 or not self._has(day):
@@ -90,12 +127,14 @@ class PgArchive(ArchiveReader):
             [*args, limit, offset]).fetchall()
         return [Row(r[0], r[1] / 1000.0, *r[2:9], station=r[9], tz=self.tz) for r in rows]
 
+    @_reading
     def count(self, day: dt.date, flt: Filter | None = None) -> int:
         if not self._has(day):
             return 0
         where, args = self._where(flt)
         return self._pg.execute(f'SELECT count(*) FROM "{table_name(day)}"{where}', args).fetchone()[0]
 
+    @_reading
     def export_csv(self, path: str | Path, day: dt.date, flt: Filter | None = None) -> int:
         """The SQLite archive's CSV with the station as a last column, oldest first."""
         n = 0
@@ -117,6 +156,7 @@ class PgArchive(ArchiveReader):
 
     # --- series --------------------------------------------------------------------------------
 
+    @_reading
     def series(self, day: dt.date, *, grp: int | None = None, type: int | None = None,
                source: str | None = None, points: int = 1000,
                station: str | None = None) -> tuple[np.ndarray, np.ndarray]:
@@ -152,5 +192,5 @@ class PgArchive(ArchiveReader):
 
     def _has(self, day: dt.date) -> bool:
         if day not in self._parts:
-            self._parts = pg.partitions(self._pg)
+            self._parts = plant.partitions(self._pg)
         return day in self._parts

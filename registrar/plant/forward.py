@@ -25,7 +25,8 @@ from urllib.parse import quote
 import psycopg
 
 from netplc.records import Record
-from registrar import pg
+from registrar.plant import schema as plant
+from registrar.reading import ArchiveError
 from registrar.schema import DAY_GLOB, parse_table_name, table_name
 
 SOURCE = "forwarder"
@@ -110,7 +111,8 @@ class Forwarder:
 
     def forward_all(self, progress: Progress | None = None) -> int:
         """Copy everything committed now, in the caller's thread (`archive migrate`); raises
-        psycopg.Error or sqlite3.Error when a side fails. The number of records sent."""
+        ArchiveError when the plant archive fails, sqlite3.Error when the local one does. The
+        number of records sent."""
         try:
             self._connect()
             total = self._measure()[0]
@@ -120,6 +122,8 @@ class Forwarder:
                 if progress is not None:
                     progress(sent, total)
             return sent
+        except psycopg.Error as e:
+            raise ArchiveError(str(e)) from e
         finally:
             self._disconnect()
 
@@ -185,15 +189,15 @@ class Forwarder:
         return self._sqlite
 
     def _connect(self) -> None:
-        con = pg.connect(self.url)
+        con = plant.connect(self.url)
         try:
-            self._tz = pg.ensure_schema(con)
+            self._tz = plant.ensure_schema(con)
             self._published = False
             self._publish(con)
             self._done = {d: n for d, n in con.execute(
                 "SELECT day, last_id FROM forwarded WHERE station = %s", (self.station,))}
             self._known.clear()
-            self._partitions = set(pg.partitions(con))
+            self._partitions = set(plant.partitions(con))
             self._retain(con)
             self._answered = True
         except BaseException:
@@ -229,8 +233,8 @@ class Forwarder:
     def _retain(self, con: psycopg.Connection) -> None:
         oldest = self._oldest()
         if oldest is not None and any(d < oldest for d in self._partitions):
-            pg.drop_days_before(con, oldest)
-            self._partitions = set(pg.partitions(con))
+            plant.drop_days_before(con, oldest)
+            self._partitions = set(plant.partitions(con))
 
     def _oldest(self) -> dt.date | None:
         if self.keep_days <= 0:
@@ -291,13 +295,13 @@ class Forwarder:
         out = [(station, day, *r) for r in rows]
         last = rows[-1][0]
         try:
-            self._send(con, day, out, last, pg.copy_rows)
+            self._send(con, day, out, last, plant.copy_rows)
         except psycopg.errors.UniqueViolation:
             # Rows already there (a position lost with a dropped plant day, or a migrate run
             # beside the station): keep the ones that are new.
-            self._send(con, day, out, last, pg.insert_rows_once)
+            self._send(con, day, out, last, plant.insert_rows_once)
         except psycopg.DataError:
-            self._send(con, day, [_clean(r) for r in out], last, pg.insert_rows_once)
+            self._send(con, day, [_clean(r) for r in out], last, plant.insert_rows_once)
         self._done[day] = last
         self._forwarded += len(rows)
         return len(rows)
@@ -305,17 +309,17 @@ class Forwarder:
     def _send(self, con: psycopg.Connection, day: dt.date, rows: list[tuple], last: int,
               write: Callable[[psycopg.Connection, list[tuple]], None]) -> None:
         tz = self._tz
-        first_day, last_day = pg.plant_day(rows[0][3], tz), pg.plant_day(rows[-1][3], tz)
+        first_day, last_day = plant.plant_day(rows[0][3], tz), plant.plant_day(rows[-1][3], tz)
         if first_day == last_day:
             days = {first_day: rows}
         else:  # across a plant-zone midnight (or a clock set back): split by partition
             days = {}
             for row in rows:
-                days.setdefault(pg.plant_day(row[3], tz), []).append(row)
+                days.setdefault(plant.plant_day(row[3], tz), []).append(row)
         try:
             with con.transaction():
                 if not set(days) <= self._partitions:
-                    pg.ensure_partitions(con, days, tz)
+                    plant.ensure_partitions(con, days, tz)
                 write(con, rows)
                 self._list_series(con, days)
                 con.execute("INSERT INTO forwarded VALUES (%s, %s, %s) ON CONFLICT (station, day) "

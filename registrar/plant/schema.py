@@ -6,15 +6,13 @@ SQLite day tables; the day is cut in the plant's zone, whose IANA key the first 
 station's name, the station's day table (`day`) and its id there: the unique key (station, day,
 id) of each partition makes a replayed batch fail instead of doubling rows. `forwarded` holds the
 last id copied per station and day, written in the same transaction as the rows, so a batch and
-its position are committed together or not at all. The password never travels in the URL:
-libpq reads PGPASSWORD or ~/.pgpass.
+its position are committed together or not at all.
 """
 
 from __future__ import annotations
 
 import datetime as dt
 from collections.abc import Iterable, Sequence
-from urllib.parse import urlsplit
 
 import psycopg
 
@@ -27,7 +25,6 @@ from registrar.schema import (
     zone,
 )
 
-URL_SCHEMES = ("postgresql://", "postgres://")
 PLANT = ""  # the `station` of the plant-wide meta rows
 COPY_COLUMNS = ("station", "day", "id", "ts", "kind", "grp", "type", "source", "number", "value", "text")
 COPY_TYPES = ("text", "date", "int8", "int8", "text", "int8", "int8", "text", "int8", "float8", "text")
@@ -51,25 +48,6 @@ SCHEMA_SQL = (
     """CREATE TABLE IF NOT EXISTS forwarded (station text NOT NULL, day date NOT NULL,
         last_id bigint NOT NULL, PRIMARY KEY (station, day))""",
 )
-
-
-def is_url(target: object) -> bool:
-    return isinstance(target, str) and target.startswith(URL_SCHEMES)
-
-
-def url_problem(url: str) -> str:
-    """Why `url` cannot name a plant archive ("" if it can)."""
-    try:
-        parts = urlsplit(url)
-        parts.port  # noqa: B018 (raises ValueError on a bad port)
-    except ValueError as e:
-        return f"not a valid PostgreSQL URL: {e}"
-    if parts.password is not None:
-        return ("a password must not be written in station.toml: give it in PGPASSWORD "
-                "or ~/.pgpass")
-    if not parts.path.strip("/"):
-        return "name the database: postgresql://user@host:5432/DATABASE"
-    return ""
 
 
 def connect(url: str, *, read_only: bool = False, timeout: float = 5.0) -> psycopg.Connection:

@@ -1,0 +1,70 @@
+"""The one worker-thread base of the views (hmi_forms/widgets/worker.py): jobs off the GUI thread,
+answers on it, failures said and logged, and the thread stopped with its owner."""
+
+from __future__ import annotations
+
+import logging
+import sqlite3
+import threading
+
+import pytest
+import shiboken6
+from PySide6.QtCore import QObject
+
+from hmi_forms.widgets.worker import Worker
+
+WAIT = 10_000
+
+
+def test_a_job_runs_off_the_gui_thread_and_is_answered_on_it(qtbot) -> None:
+    worker = Worker("test", ())
+    gui = threading.get_ident()
+    answers: list[tuple[int, object, int]] = []
+    worker.answered.connect(lambda token, result: answers.append((token, result, threading.get_ident())))
+    token = worker.submit(threading.get_ident)
+    qtbot.waitUntil(lambda: bool(answers), timeout=WAIT)
+    [(answered, job_thread, slot_thread)] = answers
+    assert answered == token and job_thread != gui and slot_thread == gui
+    worker.close()
+    worker.close()  # a second close does nothing
+    assert worker.closed
+    with pytest.raises(RuntimeError, match="closed"):
+        worker.submit(lambda: None)
+
+
+def test_failures_are_answered_and_logged(qtbot, caplog) -> None:
+    worker = Worker("test", (sqlite3.Error,))
+    failed: list[tuple[int, str]] = []
+    worker.failed.connect(lambda token, why: failed.append((token, why)))
+
+    def gone() -> None:
+        raise sqlite3.OperationalError("unable to open database file")
+
+    def bug() -> None:
+        raise KeyError("x")
+
+    with caplog.at_level(logging.WARNING, logger="hmi_forms.widgets.worker"):
+        first, second = worker.submit(gone), worker.submit(bug)
+        qtbot.waitUntil(lambda: len(failed) == 2, timeout=WAIT)
+    assert failed == [(first, "unable to open database file"), (second, "KeyError: 'x'")]
+    expected, unexpected = caplog.records
+    assert expected.levelno == logging.WARNING and expected.exc_info is None  # said, no traceback
+    assert unexpected.levelno == logging.ERROR and unexpected.exc_info is not None
+    worker.close()
+
+
+def test_the_thread_stops_with_its_owner_and_closes_what_it_opened(qtbot) -> None:
+    closed = threading.Event()
+    owner = QObject()
+    worker = Worker("owned", (), owner, on_close=closed.set)
+    answers: list[object] = []
+    worker.answered.connect(lambda _token, result: answers.append(result))
+    worker.submit(lambda: 1)
+    qtbot.waitUntil(lambda: answers == [1], timeout=WAIT)
+    threads = [t for t in threading.enumerate() if t.name.startswith("owned")]
+    assert threads
+    shiboken6.delete(owner)  # as a window deletes its children, with no close() called
+    assert closed.is_set()
+    for t in threads:
+        t.join(5)
+        assert not t.is_alive()
