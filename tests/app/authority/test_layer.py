@@ -137,7 +137,8 @@ def test_forcing_needs_the_engineer_and_is_journaled_with_who():
     sink.commit()
     assert ticket.result(0).ok and engine.forces.count == 1
     assert sink.records[-1].source == "program view:egor"
-    assert layer.force_tag(Who("egor", Source.CONSOLE), "TEMP_SP", 500.0).result(0).reason is Reason.OUT_OF_RANGE
+    too_hot = layer.force_tag(Who("egor", Source.CONSOLE), "TEMP_SP", 500.0).result(0)
+    assert too_hot.reason is Reason.OUT_OF_RANGE
 
 
 def test_run_and_stop_need_the_engineer():
@@ -153,3 +154,28 @@ def test_run_and_stop_need_the_engineer():
 def test_the_policy_table_prints_every_action():
     table = policy_table()
     assert all(f"| {a.value} | {POLICY[a]} |" in table for a in Action)
+
+
+def test_user_administration_needs_the_admin_and_is_answered_after_the_commit():
+    layer, _engine, sink, _clock, _ = rig()
+    made: list[str] = []
+
+    def change() -> str:
+        made.append("ivan")
+        return "user ivan added as operator"
+
+    assert layer.manage_users(Who("egor", Source.CONSOLE), "ivan", change).result(0).reason is Reason.DENIED
+    assert not made and "refused users ivan: users: needs the admin role" in sink.records[-1].text
+    ticket = layer.manage_users(Who("anna", Source.CONSOLE), "ivan", change)
+    assert made == ["ivan"] and not ticket.done()  # made, not yet on disk
+    sink.commit()
+    assert ticket.result(0).ok and (sink.records[-1].source, sink.records[-1].text) == (
+        "anna", "user ivan added as operator")
+
+    def taken() -> str:
+        from app.authority.users import UserError
+
+        raise UserError("user 'ivan' exists already")
+
+    answer = layer.manage_users(Who("anna", Source.CONSOLE), "ivan", taken).result(0)
+    assert answer.reason is Reason.INVALID and "exists already" in answer.text
