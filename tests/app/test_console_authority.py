@@ -8,35 +8,19 @@ window shows each scan's values with the quality of that same scan."""
 from __future__ import annotations
 
 from collections import Counter
-from collections.abc import Iterator
-from pathlib import Path
 
-import pytest
 from PySide6.QtCore import Qt
 
-from app.config import load_station
 from app.gui.main_window import MainWindow
 from app.gui.monitor.view import ProgramMonitor
 from app.runtime import Runtime
 from netplc.tags.alarms import STOPPED_ID, State
+from tests.app import test_console
 from tests.app.test_console import Answers, element, operator_rows
 
+console = test_console.console  # the fixture: the demo station's console, started, viewer on duty
 START_BIT = 0o40042
 FORCED_BIT = 0o2120
-
-
-@pytest.fixture
-def console(qtbot, demo_copy: Path) -> Iterator[MainWindow]:
-    runtime = Runtime(load_station(demo_copy))
-    runtime.start()
-    window = MainWindow(runtime)
-    qtbot.addWidget(window)
-    window.show()
-    try:
-        yield window
-    finally:
-        window.close()
-        runtime.stop()
 
 
 def program_view(window: MainWindow) -> ProgramMonitor:
