@@ -21,6 +21,7 @@ import time
 from collections.abc import Callable
 from dataclasses import replace
 from importlib import metadata
+from typing import TYPE_CHECKING
 
 from PySide6.QtCore import QEvent, QObject, QSize, Qt, QTimer
 from PySide6.QtGui import QAction, QCloseEvent, QKeySequence
@@ -66,6 +67,9 @@ from netplc.problems import Problems
 from netplc.tags.alarms import AlarmRow
 from netplc.tags.readings import Readings
 
+if TYPE_CHECKING:
+    from app.gui.monitor.window import ProgramWindow
+
 logger = logging.getLogger(__name__)
 
 STATUS_MS = 500
@@ -92,7 +96,7 @@ class MainWindow(QMainWindow):
         self.rights = Rights(self.commands, lambda: self.who)
         # the form elements that write, with their own tooltip
         self.writers: dict[ElementWidget, tuple[DiscreteBase | AnalogOutput, str]] = {}
-        self.seats: list[Callable[[], None]] = []  # update the rights of the Program views opened here
+        self.programs: list[ProgramWindow] = []  # the Program views opened from here
         self._quitting = False
         self.views: list[FormView] = []
         self.history: TrendHistory | None = None
@@ -325,8 +329,9 @@ class MainWindow(QMainWindow):
         status, so a role changed in users.json shows too."""
         self.rights.update()
         self.summary.rights.update()
-        for seat in self.seats:
-            seat()
+        for program in self.programs:
+            if program.isVisible():
+                program.monitor.update_rights()
         who, said = self.who, dict[str, Refusal | None]()
         for widget, (model, tip) in self.writers.items():
             if model.stale:
@@ -446,7 +451,7 @@ class MainWindow(QMainWindow):
 
         window = open_local(self.runtime, lambda: self.user)
         self.viewers.append(window)
-        self.seats.append(window.monitor.update_rights)
+        self.programs.append(window)
 
     def open_viewer(self) -> None:
         from app.gui.viewer import ViewerWindow

@@ -104,7 +104,7 @@ class LocalSource:
         self.runtime = runtime
         self.engine = runtime.engine
         self.commands: Commands | None = runtime.commands
-        self.layer = runtime.commands
+        self.layer = runtime.commands  # the same, known here not to be None
         self.program = runtime.program
         self.symbols = runtime.symbols
         self.tags = runtime.tags.by_name

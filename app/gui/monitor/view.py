@@ -413,8 +413,8 @@ class ProgramMonitor(QWidget):
         self.watch.blockSignals(False)
         self._show_write(r)
         self._add_empty_row()
-        words = [a for _, a in tag_keys(item.tag)] if item.tag else [item.addr]
-        self.source.need([a >> 3 if item.kind == "bit" and a >= 0o40000 else a for a in words])
+        addrs = [a for _, a in tag_keys(item.tag)] if item.tag else [item.addr]
+        self.source.need([a >> 3 if item.kind == "bit" and a >= 0o40000 else a for a in addrs])
         self._last = None  # show it at the next refresh
         return item
 
