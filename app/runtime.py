@@ -26,7 +26,7 @@ from concurrent.futures import ThreadPoolExecutor, wait
 from dataclasses import dataclass, field, replace
 from typing import TYPE_CHECKING
 
-from app.authority import Commands
+from app.authority import Commands, Source, Ticket, Who
 from app.authority.users import USERS_FILE, Users
 from app.config import Station
 from app.load import load, load_station_forms
@@ -35,7 +35,7 @@ from app.station_alarms import STATE_FILE as ALARM_STATE_FILE
 from app.station_alarms import StationAlarms
 from hmi_forms.behaviour import FormBehaviour
 from hmi_forms.form import Form
-from netplc.engine import Engine, RunState
+from netplc.engine import Engine
 from netplc.exchange import Exchange, NodeConfig
 from netplc.forcing import Force, load_forces, save_forces
 from netplc.modbus import ModbusServer, ServerLimits, parse_endpoint
@@ -452,41 +452,22 @@ class Runtime:
         alarms = self.alarms
         return alarms.readings if alarms is not None else None
 
-    # --- NetPlc run control (the workstation's menu) -------------------------------------------
+    # --- NetPlc run control as a user (scripts and tests; the workstation sends its own commands) -
 
-    def run_program(self, user: str) -> None:
-        engine = self.engine
-        if engine is not None:
-            engine.post(lambda _m: engine.start())
-            self.operator(user, "NetPlc started")
+    def run_program(self, user: str) -> Ticket:
+        """Run NetPlc as `user` at the console: the command layer's `run` (checked, journaled,
+        answered once applied)."""
+        assert self.commands is not None, "the station is not started"
+        return self.commands.run(Who(user, Source.CONSOLE))
 
-    def stop_program(self, user: str) -> None:
-        engine = self.engine
-        if engine is not None:
-            engine.post(lambda _m: engine.stop())
-            self.operator(user, "NetPlc stopped")
+    def stop_program(self, user: str) -> Ticket:
+        assert self.commands is not None, "the station is not started"
+        return self.commands.stop(Who(user, Source.CONSOLE))
 
     def operator(self, user: str, text: str) -> None:
-        """What a user did at the workstation (run, stop, log in and out): an 'operator' record
-        naming the user, as writes and acknowledgements are."""
+        """What a user did at the workstation that is not a command (log in and out): an 'operator'
+        record naming the user, as the commands' records do."""
         self.put(Record(self.wallclock(), "operator", source=user or "nobody", text=text))
-
-    def step_program(self, user: str) -> bool:
-        """Step one scan while NetPlc is stopped (Engine.step, between two scans of the scan
-        thread); False when NetPlc runs or the station is not started."""
-        engine = self.engine
-        if engine is None or engine.state is RunState.RUNNING:
-            return False
-        thread = self.scan_thread
-        if thread is None:
-            return False
-        with thread.lock:
-            if engine.state is RunState.RUNNING:
-                return False
-            engine.step()
-        self.put(Record(self.wallclock(), "operator", source=user, number=engine.scan_counter,
-                        text=f"step one scan (scan {engine.scan_counter})"))
-        return True
 
     # --- status --------------------------------------------------------------------------------
 

@@ -150,9 +150,11 @@ def workstation_flood(folder: Path) -> None:
     os.environ.setdefault("QT_QPA_PLATFORM", "offscreen")
     from PySide6.QtWidgets import QApplication, QWidget
 
+    from app.authority import Commands, Source, Who
     from app.gui.alarm_summary import AlarmSummary
     from app.gui.alarms import AlarmBanner
     from app.station_alarms import StationAlarms
+    from netplc.engine import Engine
     from netplc.program import parse
     from netplc.records import ListSink
 
@@ -169,7 +171,8 @@ def workstation_flood(folder: Path) -> None:
         f"DI{i:05d},{0o40000 + i:o},bit,вход {i},1,{1 + i % 4}\n" for i in range(FLOOD)), encoding="utf-8")
     sink = ListSink()
     alarms = StationAlarms(csv, parse("JMP 0\n"), [], sink, folder / "alarms.sqlite")
-    summary = AlarmSummary(alarms, lambda: "operator", sound=False)
+    commands = Commands(Engine(parse("JMP 0\n")), sink, role_of=lambda _name: "operator", alarms=alarms)
+    summary = AlarmSummary(alarms, commands, lambda: Who("operator", Source.CONSOLE), sound=False)
     banner = AlarmBanner()
     summary.changed.connect(lambda: banner.show_alarms(summary.unacknowledged()))
     summary.resize(1366, 300)

@@ -32,6 +32,7 @@ from enum import StrEnum
 from typing import TYPE_CHECKING
 
 from app.authority.policy import ROLE_OF_SOURCE, Action, Refusal, Source, needs, rank
+from app.authority.users import UserError
 from netplc.address import fmt_octal
 from netplc.engine import BUSY, JOURNAL_FULL, Engine, RunState
 from netplc.forcing import ForceError, Kind
@@ -406,6 +407,29 @@ class Commands:
             self._put(who, f"step one scan (scan {engine.scan_counter})", number=engine.scan_counter)
         ticket: Ticket = Future()
         ticket.set_result(APPLIED)
+        return ticket
+
+    # --- user administration ---------------------------------------------------------------------
+
+    def manage_users(self, who: Who, target: str, change: Callable[[], str]) -> Ticket:
+        """A change to the station's users (`target` the user it is about): `change()` makes it and
+        says it for the journal. Users live in users.json, a file and not memory, so the change is
+        made on the caller's thread (the scan never waits for a disk) once the role allows it, and
+        answered once its record is committed; a change that cannot be made (a UserError: a name
+        taken, an empty password) is refused INVALID with its words."""
+        if (denied := self._check(who, Action.USERS, target)) is not None:
+            return denied
+        try:
+            text = change()
+        except UserError as e:
+            return self.refuse(who, Action.USERS, target, Reason.INVALID, str(e))
+        ticket: Ticket = Future()
+        self._put(who, text)
+        after_commit = getattr(self.sink, "after_commit", None)
+        if after_commit is None:
+            ticket.set_result(APPLIED)
+        else:
+            after_commit(lambda: ticket.set_result(APPLIED))
         return ticket
 
     def quit(self, who: Who) -> Ticket:

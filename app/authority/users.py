@@ -6,8 +6,9 @@ acknowledges), engineer (runs and stops NetPlc, forces), admin (manages users). 
 an scrypt hash of the password, never the password itself; the file is written whole (a temporary
 file replaced atomically) and readable by its owner only.
 
-Qt-free. The session says who is at the workstation; what that user may do is the command layer's
-to say (`app/authority/layer.py`, from the one policy table): `denial` asks it the same way.
+Qt-free. The session says who is at the workstation (logged in, the default viewer, idle logout);
+what that user may do is the command layer's alone to say (`app/authority/layer.py`, from the one
+policy table), which the views ask with the session's name.
 """
 
 from __future__ import annotations
@@ -22,12 +23,11 @@ from collections.abc import Callable
 from dataclasses import asdict, dataclass
 from pathlib import Path
 
-from app.authority.policy import ADMIN, ENGINEER, OPERATOR, ROLES, VIEWER, Refusal, rank
+from app.authority.policy import ROLES, rank
 
 USERS_FILE = "users.json"
 SCRYPT = {"n": 2**14, "r": 8, "p": 1}  # RFC 7914's interactive-login cost: ~50 ms per check
-__all__ = ["ADMIN", "ENGINEER", "OPERATOR", "VIEWER", "Refusal", "Refused", "Session", "User", "UserError",
-           "Users", "rank"]
+__all__ = ["Refused", "Session", "User", "UserError", "Users", "rank"]
 
 
 class UserError(ValueError):
@@ -35,7 +35,7 @@ class UserError(ValueError):
 
 
 class Refused(Exception):
-    """An action the logged-in user may not do; the text says why."""
+    """A login that failed; the text says why."""
 
 
 def _digest(password: str, salt: bytes) -> str:
@@ -48,9 +48,6 @@ class User:
     role: str
     salt: str  # hex
     hash: str  # hex scrypt of the password with the salt
-
-    def allows(self, role: str) -> bool:
-        return rank(self.role) >= rank(role)
 
     def check(self, password: str) -> bool:
         return hmac.compare_digest(self.hash, _digest(password, bytes.fromhex(self.salt)))
@@ -173,24 +170,3 @@ class Session:
             return None
         self.logout()
         return user
-
-    def denial(self, role: str, action: str) -> Refusal | None:
-        """Why the session may not do `action`, which needs `role`, in parts; None when it may."""
-        user = self.current
-        if user is None:
-            return Refusal(action, role)
-        if not user.allows(role):
-            return Refusal(action, role, user.name, user.role)
-        return None
-
-    def refusal(self, role: str, action: str) -> str | None:
-        """Why the session may not do `action`, which needs `role`; None when it may."""
-        why = self.denial(role, action)
-        return None if why is None else str(why)
-
-    def require(self, role: str, action: str) -> str:
-        """The user's name if the session may do `action`; Refused saying why otherwise."""
-        why = self.refusal(role, action)
-        if why is not None:
-            raise Refused(why)
-        return self.name

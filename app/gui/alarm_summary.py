@@ -2,10 +2,12 @@
 
 It lists the active and unacknowledged alarms by priority, then newest first (ISA-18.2), then the
 shelved ones; colour says the priority and blinking says "not acknowledged yet". The operator
-acknowledges the selected alarms or all of them, and shelves one for a duration with a reason;
-each action goes to the engine thread through `StationAlarms` and is journaled there as one
-'alarm' record per alarm, naming the alarm and the user. The header counts the listed alarms per
-priority.
+acknowledges the selected alarms or all of them, shelves one for a duration with a reason,
+unshelves, silences the horn: each is a command of the station's command layer, which checks the
+role, applies it on the engine thread and journals it as one 'alarm' record per alarm naming the
+alarm and the user (or refuses it, journaled throttled); its answer comes back through `Answers`.
+A button the user may not use is disabled, its tooltip naming the role. The header counts the
+listed alarms per priority.
 
 The summary only reads `StationAlarms.summary`, an immutable tuple the engine thread rebuilds when
 a state changes, and redraws only when its version moved, so a flood of transitions costs the
@@ -18,6 +20,7 @@ station key `alarm_sound = false` turns sound off.
 
 from __future__ import annotations
 
+import logging
 import time
 from collections.abc import Callable
 from typing import Any
@@ -51,9 +54,14 @@ from PySide6.QtWidgets import (
     QWidget,
 )
 
+from app.authority import Action, Answer, Commands, Who
 from app.gui import words
+from app.gui.bridge import Answers
+from app.gui.rights import Rights
 from app.station_alarms import StationAlarms
-from netplc.tags.alarms import PRIORITIES, AlarmError, AlarmRow, State
+from netplc.tags.alarms import PRIORITIES, AlarmRow, State
+
+logger = logging.getLogger(__name__)
 
 REFRESH_MS = 250  # how often the summary looks for a new version
 BLINK_MS = 500
@@ -180,16 +188,19 @@ class Annunciator:
 
 
 class AlarmSummary(QWidget):
-    """The summary as a widget (the workstation docks it)."""
+    """The summary as a widget (the workstation docks it). It reads `alarms`; what the operator
+    does goes to `commands` as `who()`, and each answer to `answers` (the window's status bar)."""
 
     changed = Signal()  # the rows changed: the banner follows
 
-    def __init__(self, alarms: StationAlarms | None, user: Callable[[], str], *, sound: bool = True,
-                 parent: QWidget | None = None) -> None:
+    def __init__(self, alarms: StationAlarms | None, commands: Commands, who: Callable[[], Who], *,
+                 answers: Answers | None = None, sound: bool = True, parent: QWidget | None = None) -> None:
         super().__init__(parent)
         self.setObjectName("alarmSummary")
         self.alarms = alarms
-        self.user = user
+        self.commands = commands
+        self.who = who
+        self.answers = answers or Answers()
         self.rows: list[AlarmRow] = []
         self._version = -1
         self.annunciator = Annunciator(sound)
@@ -216,9 +227,15 @@ class AlarmSummary(QWidget):
         self.shelve = QPushButton(self.tr("Shelve…"))
         self.unshelve = QPushButton(self.tr("Unshelve"))
         self.silence = QPushButton(self.tr("Silence"))
-        self.silence.setToolTip(self.tr("Stop the sound; the alarms stay unacknowledged"))
         for b in (self.ack, self.ack_all, self.shelve, self.unshelve, self.silence):
             head.addWidget(b)
+        self.rights = Rights(commands, who)
+        for button, action in ((self.ack, Action.ACKNOWLEDGE), (self.ack_all, Action.ACKNOWLEDGE),
+                               (self.shelve, Action.SHELVE), (self.unshelve, Action.UNSHELVE)):
+            self.rights.add(button, action, button.text().rstrip("…"))
+        self.rights.add(self.silence, Action.SILENCE, self.silence.text(),
+                        self.tr("Stop the sound; the alarms stay unacknowledged"),
+                        also=lambda: self.annunciator.sounding)
         lay.addLayout(head)
         self.model = AlarmTableModel(self)
         self.table = QTableView()
@@ -278,7 +295,7 @@ class AlarmSummary(QWidget):
         for priority, label in self.counts.items():
             n = sum(r.priority == priority for r in listed)
             label.setText(f"P{priority} {words.priority(priority)}: {n}")
-        self.silence.setEnabled(self.annunciator.sounding)
+        self.rights.update()  # Silence: only while it sounds
 
     def unacknowledged(self) -> list[AlarmRow]:
         """Unacknowledged alarms, highest priority first, newest first: the banner's order."""
@@ -288,30 +305,28 @@ class AlarmSummary(QWidget):
         rows = self.model.rows
         return [rows[i.row()].id for i in self.table.selectionModel().selectedRows() if i.row() < len(rows)]
 
-    # --- operator actions -----------------------------------------------------------------------
+    # --- operator actions: commands of the station's layer -----------------------------------
 
     def acknowledge(self, alarm_ids: list[str]) -> None:
-        if self.alarms is None:
-            return
         for alarm_id in alarm_ids:
-            self.alarms.acknowledge(alarm_id, self.user())
+            self.answers.follow(self.tr("Acknowledge {0}").format(alarm_id),
+                                self.commands.acknowledge(self.who(), alarm_id))
 
     def acknowledge_selected(self) -> None:
         self.acknowledge(self.selected())
 
     def acknowledge_all(self) -> None:
-        if self.alarms is not None:
-            self.alarms.acknowledge_all(self.user())
+        self.answers.follow(self.tr("Acknowledge all"), self.commands.acknowledge_all(self.who()))
 
     def shelve_alarm(self, alarm_id: str, minutes: float, reason: str) -> None:
-        """AlarmError (shown to the operator by the dialog) for a missing reason or duration."""
-        if self.alarms is not None:
-            self.alarms.shelve(alarm_id, self.user(), reason, minutes * 60)
+        """A missing reason or duration is refused by the layer, and said as every refusal is."""
+        self.answers.follow(self.tr("Shelve {0}").format(alarm_id),
+                            self.commands.shelve(self.who(), alarm_id, reason, minutes * 60))
 
     def unshelve_selected(self) -> None:
-        if self.alarms is not None:
-            for alarm_id in self.selected():
-                self.alarms.unshelve(alarm_id, self.user())
+        for alarm_id in self.selected():
+            self.answers.follow(self.tr("Unshelve {0}").format(alarm_id),
+                                self.commands.unshelve(self.who(), alarm_id))
 
     def _shelve_dialog(self) -> None:
         ids = self.selected()
@@ -321,15 +336,17 @@ class AlarmSummary(QWidget):
         dialog = ShelveDialog(ids[0], self)
         if dialog.exec() != QDialog.DialogCode.Accepted:
             return
-        try:
-            for alarm_id in ids:
-                self.shelve_alarm(alarm_id, dialog.minutes.value(), dialog.reason.text())
-        except AlarmError as e:
-            QMessageBox.warning(self, self.tr("Shelve"), str(e))
+        for alarm_id in ids:
+            self.shelve_alarm(alarm_id, dialog.minutes.value(), dialog.reason.text())
 
     def silence_sound(self) -> None:
-        self.annunciator.silence()
-        self.silence.setEnabled(False)
+        """The horn stops here once the layer has taken the command (journaled naming the user)."""
+        self.answers.follow(self.tr("Silence"), self.commands.silence(self.who()), self._silenced)
+
+    def _silenced(self, answer: Answer) -> None:
+        if answer.ok:
+            self.annunciator.silence()
+            self.rights.update()
 
     def _toggle_blink(self) -> None:
         self.model.blink_on = not self.model.blink_on

@@ -4,11 +4,14 @@ An alarm stays on the banner until an operator acknowledges it, even after its c
 gone, because the operator must know it happened. The banner takes its alarms from the alarm
 summary (app/gui/alarm_summary.py), so NMSG alarms (types 2 and 3 of the catalog), limit,
 discrete and quality alarms are one list in one order: priority, then newest first.
-Acknowledging is done and journaled by the alarm system with the user's name, one record per
-alarm; the banner only shows and asks.
+Acknowledging is a command of the station's command layer, sent by the window as the user on
+duty and journaled by the alarm system with the user's name, one record per alarm; the banner
+only shows and asks (the window greys its buttons for a user who may not acknowledge).
 """
 
 from __future__ import annotations
+
+import logging
 
 from PySide6.QtCore import Qt, QTimer, Signal
 from PySide6.QtWidgets import (
@@ -28,6 +31,8 @@ from app.gui import words
 from app.gui.elided import ElidedLabel
 from hmi_forms.elements import formats
 from netplc.tags.alarms import AlarmRow
+
+logger = logging.getLogger(__name__)
 
 
 class AlarmBanner(QFrame):

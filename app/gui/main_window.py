@@ -1,20 +1,27 @@
 """The operator workstation: the station's HMI forms as tabs around a running Runtime.
 
-The window never owns plant state nor station behaviour: memory comes as snapshots from the scan
-thread (through the bridge, which may skip snapshots when the window lags: only the picture
-skips), operator actions go to the engine's queued writes, and what the forms do by themselves
-(sync generators, element records) the runtime does, window or not.
+The window never owns plant state nor station behaviour: memory and its quality come as the
+`Readings` of one scan from the station's feed (through the bridge, which may skip scans when the
+window lags: only the picture skips), and what the forms do by themselves (sync generators,
+element records) the runtime does, window or not.
+Every operator action (a form's write, acknowledge, shelve, silence, run, stop, quit, user
+administration) is a command of the station's command layer (`runtime.commands`) as the user at
+the workstation: the layer checks the role, journals, and answers; the window says a refusal in
+the status bar and greys what the user may not use, its tooltip naming the role (app/gui/rights.py).
 What is wrong with the station itself (program stopped, node down, archive failing) is shown in
 the window, not only logged, because the operator is the one who must act on it.
 """
 
 from __future__ import annotations
 
+import logging
 import signal
 import sys
 import time
 from collections.abc import Callable
+from dataclasses import replace
 from importlib import metadata
+from typing import TYPE_CHECKING
 
 from PySide6.QtCore import QEvent, QObject, QSize, Qt, QTimer
 from PySide6.QtGui import QAction, QCloseEvent, QKeySequence
@@ -33,14 +40,16 @@ from PySide6.QtWidgets import (
     QWidget,
 )
 
-from app.authority.users import ADMIN, ENGINEER, OPERATOR, Refusal, Session, Users
+from app.authority import Action, Answer, Commands, Refusal, Source, Ticket, Who
+from app.authority.users import Session, Users
 from app.config import load_station
 from app.gui import i18n, words
 from app.gui.alarm_summary import AlarmSummary
 from app.gui.alarms import AlarmBanner, FixedLine, HealthStrip
-from app.gui.bridge import RuntimeBridge
+from app.gui.bridge import Answers, RuntimeBridge
 from app.gui.journal import JournalDock
 from app.gui.login import LoginDialog
+from app.gui.rights import Rights
 from app.gui.status import StationStatusBar, station_problems
 from app.gui.style import apply_style
 from app.gui.trend_history import TrendHistory
@@ -48,12 +57,20 @@ from app.gui.users_dialog import UsersDialog
 from app.gui.zoom import ACTUAL, FIT_WIDTH, FIT_WINDOW, ZoomArea, ZoomSettings
 from app.runtime import Runtime
 from hmi_forms.elements import formats
+from hmi_forms.elements.analog import AnalogOutput
 from hmi_forms.elements.base import Writer
+from hmi_forms.elements.discrete import DiscreteBase
 from hmi_forms.elements.target import EngineTarget
+from hmi_forms.widgets.base import ElementWidget
 from hmi_forms.widgets.form_view import FormView
-from netplc.memory import Snapshot
 from netplc.problems import Problems
 from netplc.tags.alarms import AlarmRow
+from netplc.tags.readings import Readings
+
+if TYPE_CHECKING:
+    from app.gui.monitor.window import ProgramWindow
+
+logger = logging.getLogger(__name__)
 
 STATUS_MS = 500
 REFUSAL_MS = 10_000
@@ -69,9 +86,17 @@ class MainWindow(QMainWindow):
         self.runtime = runtime
         station = runtime.station
         self.setWindowTitle(f"NetPlc Station — {station.name}")
+        assert runtime.commands is not None, "the runtime is started before its window opens"
+        self.commands: Commands = runtime.commands
         self.bridge = RuntimeBridge(runtime, self)
         self.session = Session(Users(station.folder), default=station.operator.default_user,
                                idle=station.operator.idle_logout)
+        self.answers = Answers()  # every command's answer, on the GUI thread
+        self.answers.answered.connect(self._answered)
+        self.rights = Rights(self.commands, lambda: self.who)
+        # the form elements that write, with their own tooltip
+        self.writers: dict[ElementWidget, tuple[DiscreteBase | AnalogOutput, str]] = {}
+        self.programs: list[ProgramWindow] = []  # the Program views opened from here
         self._quitting = False
         self.views: list[FormView] = []
         self.history: TrendHistory | None = None
@@ -87,6 +112,8 @@ class MainWindow(QMainWindow):
         self.header = _Header(station.name)
         self.header.login.clicked.connect(self.log_in_or_out)
         self.alarms = AlarmBanner()
+        for button in (self.alarms.ack, self.alarms.ack_all):
+            self.rights.add(button, Action.ACKNOWLEDGE, button.text())
         self.health = HealthStrip()
         self.tabs = QTabWidget()
         self.tabs.setObjectName("forms")
@@ -101,7 +128,8 @@ class MainWindow(QMainWindow):
 
         self.journal = JournalDock(station.Archive, self)
         self.addDockWidget(Qt.DockWidgetArea.BottomDockWidgetArea, self.journal)
-        self.summary = AlarmSummary(runtime.alarms, lambda: self.user, sound=station.alarm_sound)
+        self.summary = AlarmSummary(runtime.alarms, self.commands, lambda: self.who, answers=self.answers,
+                                    sound=station.alarm_sound)
         self.summary_dock = QDockWidget(self.tr("Alarms"), self)
         self.summary_dock.setObjectName("alarmSummaryDock")
         self.summary_dock.setWidget(self.summary)
@@ -113,7 +141,7 @@ class MainWindow(QMainWindow):
         self._build_menu()
         self.form_problems = self._load_forms()
 
-        self.bridge.snapshot.connect(self._on_snapshot)
+        self.bridge.readings.connect(self._on_readings)
         self.summary.changed.connect(self._alarms_changed)
         self.alarms.acknowledged.connect(self._acknowledge)
         self.alarms.acknowledged_all.connect(self.summary.acknowledge_all)
@@ -131,6 +159,11 @@ class MainWindow(QMainWindow):
     def user(self) -> str:
         """The name journaled with what the workstation does ("" while nobody is logged in)."""
         return self.session.name
+
+    @property
+    def who(self) -> Who:
+        """Who acts from this workstation now, as the command layer knows them."""
+        return Who(self.session.name, Source.CONSOLE)
 
     # --- building ------------------------------------------------------------------------------
 
@@ -157,6 +190,12 @@ class MainWindow(QMainWindow):
         self.act_quit = quit_ = QAction(self.tr("&Quit…"), self)
         quit_.setShortcut(QKeySequence("Ctrl+Q"))  # on every platform; it asks before anything stops
         quit_.triggered.connect(self.request_quit)
+        station.setToolTipsVisible(True)  # a greyed command says which role it needs
+        self._running = True
+        self.rights.add(self.act_run, Action.RUN, self.tr("Run NetPlc"), also=lambda: not self._running)
+        self.rights.add(self.act_stop, Action.STOP, self.tr("Stop NetPlc"), also=lambda: self._running)
+        self.rights.add(self.act_users, Action.USERS, self.tr("Users"))
+        self.rights.add(self.act_quit, Action.QUIT, self.tr("Quit"))
         for a in (self.act_run, self.act_stop):
             station.addAction(a)
         station.addSeparator()
@@ -205,12 +244,15 @@ class MainWindow(QMainWindow):
                              self.tr("No forms"))
             return []
         forms, problems = self.runtime.open_forms()  # the views' own models: they only show
-        target = EngineTarget(self.runtime.engine, self.runtime.tags, on_busy=self.refuse)
+        target = EngineTarget(self.commands, lambda user: Who(user, Source.CONSOLE),
+                              on_answer=self.answers.follow, say=words.answer)
         self.history = TrendHistory(station.Archive, self)
         for form in forms:
             view = FormView(form, target, archive_path=station.Archive, user=self.user,
                             started=self.runtime.started_clock, guard=self._guard)
             self.views.append(view)
+            self.writers.update({widget: (model, widget.toolTip()) for model, widget in view.pairs
+                                 if isinstance(model, (DiscreteBase, AnalogOutput)) and model.Enabled})
             self.history.attach(view)
             area = ZoomArea(view)
             area.restore(self.zoom_settings.get(form.path))
@@ -255,10 +297,10 @@ class MainWindow(QMainWindow):
 
     # --- live updates --------------------------------------------------------------------------
 
-    def _on_snapshot(self, snapshot: Snapshot) -> None:
-        readings = self.runtime.readings()  # the quality of what every element shows
+    def _on_readings(self, readings: Readings) -> None:
+        """One scan's memory and the quality of what every element shows, together."""
         for view in self.views:
-            view.refresh(snapshot, readings)
+            view.refresh(readings.snapshot, readings)
 
     def _alarms_changed(self) -> None:
         unacknowledged = self.summary.unacknowledged()
@@ -270,8 +312,8 @@ class MainWindow(QMainWindow):
         self.summary.acknowledge([alarm.id])
 
     def _user_changed(self) -> None:
-        """Operator writes and acknowledgements are journaled under the user on duty; what the
-        user may not do is greyed, with the reason in its tooltip."""
+        """Operator writes and acknowledgements are commands of the user on duty; what the user
+        may not use is greyed (a form's element keeps its look), the role it needs in its tooltip."""
         user = self.user
         for view in self.views:
             for model in view.form.elements:
@@ -279,24 +321,40 @@ class MainWindow(QMainWindow):
         current = self.session.current
         self.header.show_user(current.name if current else "", current.role if current else "",
                               logged_in=self.session.user is not None)
-        ack = self.session.denial(OPERATOR, self.tr("Acknowledge"))
-        for button in (self.alarms.ack, self.alarms.ack_all):
-            button.setEnabled(ack is None)
-            button.setToolTip(words.refusal(ack) if ack is not None else "")
         self.act_logout.setEnabled(self.session.user is not None)
+        self._show_rights()
+
+    def _show_rights(self) -> None:
+        """Ask the command layer what the user may use now: after a change of user, and with the
+        status, so a role changed in users.json shows too."""
+        self.rights.update()
+        self.summary.rights.update()
+        for program in self.programs:
+            if program.isVisible():
+                program.monitor.update_rights()
+        who, said = self.who, dict[str, Refusal | None]()
+        for widget, (model, tip) in self.writers.items():
+            if model.stale:
+                continue  # the quality mark's tooltip is shown; the element's comes back after
+            if model.Role not in said:
+                said[model.Role] = self.commands.denial(who, Action.WRITE, model.Role)
+            why = said[model.Role]
+            text = tip if why is None else f"{tip}\n{words.refusal(replace(why, action=model.Name))}"
+            if widget.toolTip() != text:
+                widget.setToolTip(text)
 
     def refresh_status(self) -> None:
         status = self.runtime.status()
         self.status.show_status(status)
         problems = station_problems(status)
         self.health.show_problems(problems)
-        running = status.state == "running"
-        self.act_run.setEnabled(not running)
-        self.act_stop.setEnabled(running)
+        self._running = status.state == "running"
         self.header.tick()
         if (idle := self.session.idle_expired()) is not None:
             self.runtime.operator(idle.name, "logged out: idle")
             self._user_changed()
+        else:
+            self._show_rights()
 
     # --- actions -------------------------------------------------------------------------------
 
@@ -305,49 +363,51 @@ class MainWindow(QMainWindow):
         answer = QMessageBox.question(self, title, text)
         return answer == QMessageBox.StandardButton.Yes
 
-    def refuse(self, why: Refusal) -> None:
-        """A refused action says why, where the operator looks: the status bar, in the console's
-        language."""
-        self.status.showMessage(self.tr("Refused: ") + words.refusal(why), REFUSAL_MS)
+    def _answered(self, what: str, answer: Answer) -> None:
+        """A command the layer did not do says why, where the operator looks: the status bar, in
+        the console's language."""
+        if not answer.ok:
+            self.refuse(words.answer(what, answer))
 
-    def allowed(self, role: str, action: str) -> bool:
-        why = self.session.denial(role, action)
-        if why is not None:
-            self.refuse(why)
-        return why is None
+    def refuse(self, text: str) -> None:
+        self.status.showMessage(self.tr("Refused: ") + text, REFUSAL_MS)
+
+    def command(self, action: Action, what: str, send: Callable[[Who], Ticket], question: str = "",
+                then: Callable[[Answer], None] | None = None) -> Ticket | None:
+        """Send a command as the user on duty; the operator confirms first when there is a
+        `question` and the layer would take it (a refused command is refused, not asked)."""
+        who = self.who
+        if question and self.commands.may(who, action) and not self.ask(what, question):
+            return None
+        return self.answers.follow(what, send(who), then)
 
     def _guard(self, element: Writer, what: str) -> str | None:
-        """Before a form element writes: its Role, then its Confirm."""
-        why = self.session.denial(element.Role, what)
-        if why is not None:
-            self.refuse(why)
-            return words.refusal(why)
-        if element.Confirm and not self.ask(self.tr("Confirm"), what + "?"):
+        """Before a form element writes: its Confirm (the layer checks the role when it is sent)."""
+        if element.Confirm and self.commands.may(self.who, Action.WRITE, element.Role) and not self.ask(
+                self.tr("Confirm"), what + "?"):
             return self.tr("cancelled")
         return None
 
-    def run_program(self) -> None:
-        if self.allowed(ENGINEER, self.tr("Run NetPlc")) and self.ask(
-                self.tr("Run NetPlc"), self.tr("Run the NetPlc program? Its chains act on the plant "
-                                               "from the next scan.")):
-            self.runtime.run_program(self.user)
+    def run_program(self) -> Ticket | None:
+        return self.command(Action.RUN, self.tr("Run NetPlc"), self.commands.run, self.tr(
+            "Run the NetPlc program? Its chains act on the plant from the next scan."))
 
-    def stop_program(self) -> None:
-        if self.allowed(ENGINEER, self.tr("Stop NetPlc")) and self.ask(
-                self.tr("Stop NetPlc"), self.tr("Stop the NetPlc program? Exchange, archive and forms "
-                                                "keep running, but the program's chains are no longer "
-                                                "executed.")):
-            self.runtime.stop_program(self.user)
+    def stop_program(self) -> Ticket | None:
+        return self.command(Action.STOP, self.tr("Stop NetPlc"), self.commands.stop, self.tr(
+            "Stop the NetPlc program? Exchange, archive and forms keep running, but the program's "
+            "chains are no longer executed."))
 
-    def request_quit(self) -> bool:
-        """Quit stops the whole station (soft PLC, exchange, archive): the engineer's, and asked."""
-        if self.allowed(ENGINEER, self.tr("Quit")) and self.ask(
-                self.tr("Quit"), self.tr("Quit NetPlc Station? The NetPlc program, the exchange with the "
-                                         "nodes and the archive stop.")):
-            self.runtime.operator(self.user, "station quit")
+    def request_quit(self) -> Ticket | None:
+        """Quit stops the whole station (soft PLC, exchange, archive): the engineer's, and asked;
+        the window closes once the layer has journaled it."""
+        return self.command(Action.QUIT, self.tr("Quit"), self.commands.quit, self.tr(
+            "Quit NetPlc Station? The NetPlc program, the exchange with the nodes and the archive stop."),
+            self._quit)
+
+    def _quit(self, answer: Answer) -> None:
+        if answer.ok:
             self._quitting = True
             self.close()
-        return self._quitting
 
     def log_in(self) -> None:
         LoginDialog(sorted(self.session.users.users), self.login, self).exec()
@@ -362,11 +422,13 @@ class MainWindow(QMainWindow):
         self._user_changed()
 
     def manage_users(self) -> UsersDialog | None:
-        """The users dialog, for an admin only; its changes are journaled under the admin."""
-        if not self.allowed(ADMIN, self.tr("Users")):
+        """The users dialog, for whom the layer lets administer users; each change is a command of
+        the user on duty, journaled naming them."""
+        why = self.commands.denial(self.who, Action.USERS, what=self.tr("Users"))
+        if why is not None:
+            self.refuse(words.refusal(why))
             return None
-        admin = self.user
-        dialog = UsersDialog(self.session.users, lambda text: self.runtime.operator(admin, text), self)
+        dialog = UsersDialog(self.session.users, self.commands, lambda: self.who, self)
         dialog.show()
         return dialog
 
@@ -387,9 +449,9 @@ class MainWindow(QMainWindow):
         """Station -> Program: the listing live, the watch table, forcing, single scans."""
         from app.gui.monitor.window import open_local
 
-        if not self.allowed(ENGINEER, self.tr("open the program view (forcing, single scans)")):
-            return
-        self.viewers.append(open_local(self.runtime, lambda: self.user))
+        window = open_local(self.runtime, lambda: self.user)
+        self.viewers.append(window)
+        self.programs.append(window)
 
     def open_viewer(self) -> None:
         from app.gui.viewer import ViewerWindow
@@ -413,7 +475,8 @@ class MainWindow(QMainWindow):
     def closeEvent(self, event: QCloseEvent) -> None:
         """The window manager's close button is Quit; a close from the program (SIGTERM, Ctrl+C,
         tests) closes at once, flushing the archive."""
-        if event.spontaneous() and not self._quitting and not self.request_quit():
+        if event.spontaneous() and not self._quitting:
+            self.request_quit()  # closes the window once the layer has answered
             event.ignore()
             return
         self._activity.stop()

@@ -1,10 +1,13 @@
 """The admin's users dialog: the station's users and roles, added, removed and given new passwords
-from the workstation (the same users.json `main.py users` manages). Each change is journaled by
-the window under the admin's name; the passwords never leave app/authority/users.py unhashed.
+from the workstation (the same users.json `main.py users` manages). Each change is a command of
+the station's command layer (`Commands.manage_users`) as the user on duty at that moment: the
+layer checks the role, journals it naming them, or refuses it with the reason, said here. The
+passwords never leave app/authority/users.py unhashed.
 """
 
 from __future__ import annotations
 
+import logging
 from collections.abc import Callable
 
 from PySide6.QtWidgets import (
@@ -20,17 +23,23 @@ from PySide6.QtWidgets import (
     QWidget,
 )
 
-from app.authority.policy import ROLES
-from app.authority.users import UserError, Users
+from app.authority import ROLES, Answer, Commands, Who
+from app.authority.users import Users
 from app.gui import words
+from app.gui.bridge import Answers
+
+logger = logging.getLogger(__name__)
 
 
 class UsersDialog(QDialog):
-    def __init__(self, users: Users, journal: Callable[[str], None], parent: QWidget | None = None) -> None:
-        """`journal(text)` records a change under the admin's name."""
+    def __init__(self, users: Users, commands: Commands, who: Callable[[], Who],
+                 parent: QWidget | None = None) -> None:
         super().__init__(parent)
         self.users = users
-        self.journal = journal
+        self.commands = commands
+        self.who = who
+        self.answers = Answers()
+        self.answers.answered.connect(self._answered)
         self.setWindowTitle(self.tr("Users"))
         self.resize(420, 320)
         lay = QVBoxLayout(self)
@@ -58,25 +67,28 @@ class UsersDialog(QDialog):
             self.table.setItem(r, 0, QTableWidgetItem(user.name))
             self.table.setItem(r, 1, QTableWidgetItem(words.role(user.role)))
 
-    def _do(self, change: Callable[[], str]) -> bool:
-        try:
-            text = change()
-        except UserError as e:
-            self.message.setText(str(e))
-            return False
+    def _do(self, what: str, name: str, change: Callable[[], str]) -> bool:
+        """Send the change; False when the layer refused it at once (the reason is shown)."""
         self.message.setText("")
-        self.journal(text)
+        ticket = self.answers.follow(what, self.commands.manage_users(self.who(), name, change))
         self._fill()
-        return True
+        return not (ticket.done() and not ticket.result().ok)
+
+    def _answered(self, what: str, answer: Answer) -> None:
+        if not answer.ok:
+            self.message.setText(words.answer(what, answer))
 
     def add_user(self, name: str, role: str, password: str) -> bool:
-        return self._do(lambda: f"user {self.users.add(name, role, password).name} added as {role}")
+        return self._do(self.tr("Add user {0}").format(name), name,
+                        lambda: f"user {self.users.add(name, role, password).name} added as {role}")
 
     def remove_user(self, name: str) -> bool:
-        return self._do(lambda: (self.users.remove(name), f"user {name} removed")[1])
+        return self._do(self.tr("Remove user {0}").format(name), name,
+                        lambda: (self.users.remove(name), f"user {name} removed")[1])
 
     def set_password(self, name: str, password: str) -> bool:
-        return self._do(lambda: (self.users.passwd(name, password), f"password of {name} changed")[1])
+        return self._do(self.tr("Password of {0}").format(name), name,
+                        lambda: (self.users.passwd(name, password), f"password of {name} changed")[1])
 
     def _selected(self) -> str:
         item = self.table.item(self.table.currentRow(), 0)

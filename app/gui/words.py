@@ -1,7 +1,7 @@
 """The console's words for what Qt-free models say in English: roles, alarm priorities and states,
-tag qualities, refusals.
+tag qualities, the command layer's refusals.
 
-The models (app/authority/users.py, netplc/tags/) keep their English words, which the journal, the command
+The models (app/authority/, netplc/tags/) keep their English words, which the journal, the command
 line and the tests read; the console translates them here, as shown, through Qt's translation
 mechanism (context "words" of app/gui/i18n/console_*.ts). The markers below list every source
 text for the translation files.
@@ -9,9 +9,12 @@ text for the translation files.
 
 from __future__ import annotations
 
+import dataclasses
+import logging
+
 from PySide6.QtCore import QT_TRANSLATE_NOOP, QCoreApplication
 
-from app.authority.users import Refusal
+from app.authority import Answer, Refusal
 from netplc.tags.alarms import PRIORITIES, State
 
 SOURCES = (
@@ -50,11 +53,25 @@ def state(s: State) -> str:
     return word(s.word)
 
 
+logger = logging.getLogger(__name__)
+
+
 def refusal(why: Refusal) -> str:
-    """The refusal's sentence in the console's language; the action is the caller's (already
-    translated or the form's own text)."""
+    """The refusal's sentence in the console's language, naming the role needed; the action is the
+    caller's (already translated or the form's own text)."""
     if not why.user:
         return QCoreApplication.translate("words", "{0}: nobody is logged in ({1} needed)").format(
             why.action, role(why.role))
+    if not why.user_role:
+        return QCoreApplication.translate("words", "{0}: {1} is no longer a user ({2} needed)").format(
+            why.action, why.user, role(why.role))
     return QCoreApplication.translate("words", "{0}: needs the {1} role; {2} is {3}").format(
         why.action, role(why.role), why.user, role(why.user_role))
+
+
+def answer(what: str, said: Answer) -> str:
+    """Why the command layer did not do `what` (the view's words for what it asked): a refusal for
+    the role in the console's language, any other reason in the layer's words."""
+    if said.refusal is not None:
+        return refusal(dataclasses.replace(said.refusal, action=what))
+    return f"{what}: {said.text}"

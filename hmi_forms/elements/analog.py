@@ -17,6 +17,7 @@ manual is silent:
 
 from __future__ import annotations
 
+import logging
 import math
 from collections.abc import Mapping
 from dataclasses import dataclass, field
@@ -25,11 +26,12 @@ from typing import Any, ClassVar
 
 from hmi_forms.elements import props as p
 from hmi_forms.elements.base import Element, Reader, Writer, word_reader
-from hmi_forms.elements.target import BUSY
 from hmi_forms.elements.trend import Trend
 from netplc.address import IO_BITS
 from netplc.memory import Snapshot
 from netplc.tags.table import TagTable
+
+logger = logging.getLogger(__name__)
 
 APPEARANCES = ("digital", "hbar", "dial", "semidial", "graph", "tank")  # tank: an extension
 ZONE_TYPES = {"low": 2, "normal": 0, "high": 2}
@@ -290,7 +292,7 @@ class AnalogOutput(Scaled, Writer):
         assert self.OutAddr is not None
         if why := self.refused(f"{self.Name} \u2192 {self.format(self.scaling.to_phy(hw))}{units}"):
             return False, why
-        if self.target is not None and self.target.write_word(self.OutAddr, hw, user=self.user,
-                                                              label=self.Name) is False:
-            return False, BUSY
+        if self.target is not None and (why := self.target.write_word(
+                self.OutAddr, hw, user=self.user, label=self.Name, at_least=self.Role)) is not None:
+            return False, why
         return True, f"Set to {self.format(self.scaling.to_phy(hw))}{units}"

@@ -11,6 +11,7 @@ Each type extends the previous one, as in the manual: base -> colour label -> co
 
 from __future__ import annotations
 
+import logging
 from dataclasses import dataclass, field
 from functools import cached_property
 
@@ -18,6 +19,8 @@ from hmi_forms.elements import props as p
 from hmi_forms.elements.base import Element, Reader, Writer, bit_reader
 from netplc.address import BitRef
 from netplc.memory import Snapshot
+
+logger = logging.getLogger(__name__)
 
 
 @dataclass(eq=False)
@@ -82,7 +85,8 @@ class DiscreteBase(Element, Writer):
         return True
 
     def click(self) -> bool:
-        """Toggle the bit through the operator write path; False when the click is refused."""
+        """Toggle the bit through the operator write path (the station's command layer, asking at
+        least the element's Role); False when the click is refused."""
         if not self.clickable or self.target is None:
             return False
         out = self.OutAddr or self.InAddr
@@ -90,7 +94,8 @@ class DiscreteBase(Element, Writer):
         new = 0 if self.value else 1
         if self.refused(f"{self.Name} \u2192 {new}"):
             return False
-        return self.target.write_bit(out.hmi, new, user=self.user, label=self.Name) is not False
+        why = self.target.write_bit(out.hmi, new, user=self.user, label=self.Name, at_least=self.Role)
+        return why is None
 
 
 @dataclass(eq=False)

@@ -2,8 +2,10 @@
 
 Two channels, because they run in different places (docs/architecture.md section 9):
 - `Target` (`write_bit`, `write_word`): operator input a widget forwards (a click, an entered
-  setpoint). The engine queues it, applies it at the start of the next scan and journals it as an
-  'operator' record naming the user. Views have it; the runtime does not need it.
+  setpoint). At the workstation it is the station's command layer (`EngineTarget`): it checks the
+  role (the policy's, raised by the element's `Role`), queues the write to the next scan and
+  journals it naming the user, or refuses it, journaled throttled, with the reason. Views have it;
+  the runtime does not need it.
 - `Effects` (`set_bit`, `put`): what a form does to the station by itself: a sync generator's
   output and the RegData/RegMessages and limit records. Only the runtime has it: it evaluates the
   forms' models from every scan's snapshot on the engine thread (`hmi_forms/behaviour.py`), with
@@ -12,27 +14,31 @@ Two channels, because they run in different places (docs/architecture.md section
 
 from __future__ import annotations
 
+import dataclasses
+import logging
 from collections.abc import Callable
 from typing import TYPE_CHECKING, Protocol
 
+from netplc.address import fmt_octal
 from netplc.records import Record
-from netplc.tags.table import TagTable
 from netplc.tags.tag import Tag, TagType
 
 if TYPE_CHECKING:
-    from netplc.engine import Engine
+    from app.authority import Answer, Commands, Ticket, Who
+
+logger = logging.getLogger(__name__)
 
 
 class Target(Protocol):
-    """`write_*` return False when the station refuses the write: its queue of outside writes is
-    full (the per-scan budget's back-pressure, docs/architecture.md section 1)."""
+    """`write_*` return why the write was refused at once (a sentence for the operator: the role,
+    a full queue), or None once it is sent; `at_least` is the element's Role, which may ask more
+    than the station's policy, never less."""
 
-    def write_bit(self, addr: int, value: int, *, user: str, label: str | None = None) -> bool: ...
+    def write_bit(self, addr: int, value: int, *, user: str, label: str | None = None,
+                  at_least: str | None = None) -> str | None: ...
 
-    def write_word(self, addr: int, value: int, *, user: str, label: str | None = None) -> bool: ...
-
-
-BUSY = "the station is busy (its queue of outside writes is full): not written, try again"
+    def write_word(self, addr: int, value: int, *, user: str, label: str | None = None,
+                   at_least: str | None = None) -> str | None: ...
 
 
 class Effects(Protocol):
@@ -44,36 +50,52 @@ class Effects(Protocol):
 
 
 class EngineTarget:
-    """The engine as the operator's Target: writes are queued and journaled by the engine. A write
-    to a tag's address is journaled with the tag's name and, for a word, its physical values and
-    unit besides the raw ones (`write Уставка температуры TEMP_SP: 0.0 -> 130.0 °C (raw ...)`)."""
+    """The station's command layer as the operator's Target. A write to a tag's address is
+    journaled with the tag's name and, for a word, its physical values and unit besides the raw
+    ones (`write Уставка температуры TEMP_SP: 0.0 -> 130.0 °C (raw ...)`). `who(user)` says who
+    writes from where (the console's user); `on_answer(what, ticket)` is given every ticket, `what`
+    the element's label, so the view says a refusal, at once or when the layer answers later;
+    `say(what, answer)` words a refusal for the element (the console's language)."""
 
-    def __init__(self, engine: Engine, tags: TagTable | None = None,
-                 on_busy: Callable[[str], None] | None = None) -> None:
-        """`on_busy(text)` tells the operator when the engine refuses a write (a full queue)."""
-        self.engine = engine
-        self.on_busy = on_busy
-        tags = tags or TagTable()
-        self._bits = {t.address: t for t in tags.tags if t.type is TagType.BIT}
-        self._words = {t.address: t for t in tags.tags if t.type in ONE_WORD}
+    def __init__(self, commands: Commands, who: Callable[[str], Who],
+                 on_answer: Callable[[str, Ticket], object] | None = None,
+                 say: Callable[[str, Answer], str] | None = None) -> None:
+        self.commands = commands
+        self.who = who
+        self.on_answer = on_answer
+        self.say = say or said
+        tags = commands.tags.values()
+        self._bits = {t.address: t for t in tags if t.type is TagType.BIT}
+        self._words = {t.address: t for t in tags if t.type in ONE_WORD}
 
-    def write_bit(self, addr: int, value: int, *, user: str, label: str | None = None) -> bool:
+    def write_bit(self, addr: int, value: int, *, user: str, label: str | None = None,
+                  at_least: str | None = None) -> str | None:
         tag = self._bits.get(addr)
-        return self._told(self.engine.write_bit(addr, value, user=user, label=_named(label, tag)), label)
+        ticket = self.commands.write_bit(self.who(user), addr, value, label=_named(label, tag),
+                                         at_least=at_least)
+        return self._told(ticket, label or fmt_octal(addr))
 
-    def write_word(self, addr: int, value: int, *, user: str, label: str | None = None) -> bool:
+    def write_word(self, addr: int, value: int, *, user: str, label: str | None = None,
+                   at_least: str | None = None) -> str | None:
         tag = self._words.get(addr)
-        if tag is None:
-            done = self.engine.write_word(addr, value, user=user, label=label)
-        else:
-            done = self.engine.write_word(addr, value, user=user, label=_named(label, tag),
-                                          describe=tag.change)
-        return self._told(done, label)
+        ticket = self.commands.write_word(self.who(user), addr, value, label=_named(label, tag),
+                                          at_least=at_least, describe=tag.change if tag else None)
+        return self._told(ticket, label or fmt_octal(addr))
 
-    def _told(self, accepted: bool, label: str | None) -> bool:
-        if not accepted and self.on_busy is not None:
-            self.on_busy(f"{label}: {BUSY}" if label else BUSY)
-        return accepted
+    def _told(self, ticket: Ticket, what: str) -> str | None:
+        if self.on_answer is not None:
+            self.on_answer(what, ticket)
+        if not ticket.done():
+            return None
+        answer: Answer = ticket.result()
+        return None if answer.ok else self.say(what, answer)
+
+
+def said(what: str, answer: Answer) -> str:
+    """The layer's refusal as the element says it, naming what was asked."""
+    if answer.refusal is not None:
+        return str(dataclasses.replace(answer.refusal, action=what))
+    return f"{what}: {answer.text}"
 
 
 ONE_WORD = (TagType.WORD, TagType.INT16, TagType.BCD)
@@ -88,8 +110,10 @@ def _named(label: str | None, tag: Tag | None) -> str | None:
 class NullTarget:
     """A form shown without a station (the viewer, a benchmark): the operator's writes go nowhere."""
 
-    def write_bit(self, addr: int, value: int, *, user: str, label: str | None = None) -> bool:
-        return True
+    def write_bit(self, addr: int, value: int, *, user: str, label: str | None = None,
+                  at_least: str | None = None) -> str | None:
+        return None
 
-    def write_word(self, addr: int, value: int, *, user: str, label: str | None = None) -> bool:
-        return True
+    def write_word(self, addr: int, value: int, *, user: str, label: str | None = None,
+                   at_least: str | None = None) -> str | None:
+        return None

@@ -1,6 +1,7 @@
-"""The alarm summary and banner over a real alarm system (no engine: actions run at once): order,
-colours and blinking, counts, filter, acknowledge selected / all with one record each naming the
-alarm and the user, shelving with duration and reason, and the sound of priorities 1-2."""
+"""The alarm summary and banner over a real alarm system and the command layer over a real engine
+(stepped: an action is applied at the next scan): order, colours and blinking, counts, filter,
+acknowledge selected / all with one record each naming the alarm and the user, shelving with
+duration and reason, the sound of priorities 1-2, and what a viewer may not do."""
 
 from __future__ import annotations
 
@@ -9,22 +10,26 @@ from collections.abc import Iterator
 from pathlib import Path
 
 import pytest
+from PySide6.QtCore import Qt
 
+from app.authority import Commands, Reason, Source, Who
 from app.gui.alarm_health import HealthDialog, health_text
 from app.gui.alarm_summary import AlarmSummary, Annunciator, row_colours
 from app.gui.alarms import AlarmBanner
 from app.station_alarms import StationAlarms
 from hmi_forms.widgets.records import type_name
+from netplc.engine import Engine, FakeClock
 from netplc.memory import Memory
 from netplc.program import parse
 from netplc.records import ListSink
-from netplc.tags.alarms import AlarmError, AlarmRow, State
+from netplc.tags.alarms import AlarmRow, State
 from registrar.query import Row
 
 TAGS = ("name,address,type,unit,app_min,app_max,phy_min,phy_max,decimals,description,h,priority\n"
         "LEVEL,04010,word,%,0,4095,0,100,1,Уровень,90,2\n"
         "TEMP,04012,word,°C,0,1000,-50,150,1,Температура,120,3\n")
 T0 = 1_800_000_000.0
+ROLES = {"ivanov": "operator", "petrov": "operator", "vera": "viewer"}
 
 
 class Station:
@@ -33,8 +38,19 @@ class Station:
         self.sink = ListSink()
         self.alarms = StationAlarms(folder / "tags.csv", parse("JMP 0\n"), [], self.sink,
                                     folder / "alarms.sqlite")
+        self.clock = FakeClock()
+        self.engine = Engine(parse("JMP 0\n"), clock=self.clock, sink=self.sink)
+        self.commands = Commands(self.engine, self.sink, role_of=ROLES.get, alarms=self.alarms)
         self.mem = Memory()
         self.scan = 0
+
+    def summary(self, user: str) -> AlarmSummary:
+        return AlarmSummary(self.alarms, self.commands, lambda: Who(user, Source.CONSOLE))
+
+    def apply(self) -> None:
+        """The engine's next scan: the commands queued are applied (and answered)."""
+        self.clock.advance(self.engine.tick)
+        self.engine.scan()
 
     def step(self, level: int, temp: int, at: float) -> None:
         self.mem.set_word(0o4010, level)
@@ -55,7 +71,7 @@ def station(tmp_path: Path) -> Iterator[Station]:
 
 def test_listed_by_priority_then_time_with_counts_colours_and_filter(qtbot, station: Station) -> None:
     station.step(4000, 900, T0)  # both high: LEVEL.H (priority 2), TEMP.H (priority 3)
-    summary = AlarmSummary(station.alarms, lambda: "ivanov")
+    summary = station.summary("ivanov")
     qtbot.addWidget(summary)
     assert [r.id for r in summary.model.rows] == ["LEVEL.H", "TEMP.H"]
     assert [summary.counts[p].text() for p in (1, 2, 3, 4)] == [
@@ -72,10 +88,11 @@ def test_listed_by_priority_then_time_with_counts_colours_and_filter(qtbot, stat
 
 def test_acknowledge_selected_and_all_one_record_each_naming_alarm_and_user(qtbot, station: Station) -> None:
     station.step(4000, 900, T0)
-    summary = AlarmSummary(station.alarms, lambda: "ivanov")
+    summary = station.summary("ivanov")
     qtbot.addWidget(summary)
     summary.table.selectRow(1)  # TEMP.H
     summary.acknowledge_selected()
+    station.apply()
     summary.refresh()
     assert station.alarms.system.get("TEMP.H").state is State.ACKED
     assert station.alarms.system.get("LEVEL.H").state is State.UNACK
@@ -84,6 +101,7 @@ def test_acknowledge_selected_and_all_one_record_each_naming_alarm_and_user(qtbo
     assert [(r.id, r.state) for r in summary.unacknowledged()] == [("LEVEL.H", State.RTNUN)]
     before = len(station.alarm_records())
     summary.acknowledge_all()
+    station.apply()
     summary.refresh()
     new = station.alarm_records()[before:]
     assert len(new) == 1 and new[0][0] == "LEVEL.H" and "by ivanov" in new[0][3]
@@ -92,11 +110,15 @@ def test_acknowledge_selected_and_all_one_record_each_naming_alarm_and_user(qtbo
 
 def test_shelve_needs_a_reason_and_comes_back_by_itself(qtbot, station: Station) -> None:
     station.step(4000, 0, T0)
-    summary = AlarmSummary(station.alarms, lambda: "petrov")
+    summary = station.summary("petrov")
     qtbot.addWidget(summary)
-    with pytest.raises(AlarmError):
-        summary.shelve_alarm("LEVEL.H", 10, " ")
+    answers: list[tuple[str, Reason]] = []
+    summary.answers.answered.connect(lambda what, answer: answers.append((what, answer.reason)))
+    summary.shelve_alarm("LEVEL.H", 10, " ")
+    assert answers == [("Shelve LEVEL.H", Reason.INVALID)]  # refused by the layer: a reason is needed
     summary.shelve_alarm("LEVEL.H", 10, "датчик на поверке")
+    station.apply()
+    assert answers[-1] == ("Shelve LEVEL.H", Reason.APPLIED)
     summary.refresh()
     row = summary.model.rows[0]
     assert row.state is State.SHELVED and row.shelved_by == "petrov" and row.reason == "датчик на поверке"
@@ -110,7 +132,7 @@ def test_shelve_needs_a_reason_and_comes_back_by_itself(qtbot, station: Station)
 def test_the_banner_shows_the_highest_priority_unacknowledged_alarm(qtbot, station: Station) -> None:
     station.step(0, 900, T0)  # TEMP.H, priority 3
     station.step(4000, 900, T0 + 1)  # LEVEL.H, priority 2, after it
-    summary = AlarmSummary(station.alarms, lambda: "ivanov")
+    summary = station.summary("ivanov")
     banner = AlarmBanner()
     qtbot.addWidget(summary)
     qtbot.addWidget(banner)
@@ -154,3 +176,45 @@ def test_the_health_dialog_shows_the_report_of_a_chosen_day(qtbot, headless_arch
     text = dialog.report.toPlainText()
     assert text.startswith(f"alarm-system health for {dt.date.today():%d.%m.%Y}") and "chattering" in text
     assert health_text(tmp_path / "none.sqlite", dt.date.today()).startswith("no alarm-system health")
+
+
+def test_a_viewer_finds_every_action_greyed_naming_the_role_and_is_refused_once_a_minute(
+        qtbot, station: Station) -> None:
+    station.step(4000, 900, T0)
+    summary = station.summary("vera")
+    qtbot.addWidget(summary)
+    summary.annunciator.sounding = True
+    summary.refresh()
+    for button in (summary.ack, summary.ack_all, summary.shelve, summary.unshelve, summary.silence):
+        assert not button.isEnabled(), button.text()
+        assert "needs the operator role; vera is viewer" in button.toolTip()
+    refused: list[str] = []
+    summary.answers.answered.connect(lambda what, answer: refused.append(what) if not answer.ok else None)
+    for _ in range(3):  # the layer refuses it all the same when asked directly
+        summary.acknowledge_all()
+        summary.shelve_alarm("LEVEL.H", 10, "на поверке")
+        summary.silence_sound()
+    station.apply()
+    assert refused == ["Acknowledge all", "Shelve LEVEL.H", "Silence"] * 3
+    assert station.alarms.system.get("LEVEL.H").state is State.UNACK and summary.annunciator.sounding
+    texts = [r.text for r in station.sink.records if r.kind == "operator"]
+    assert [t.split(":")[0] for t in texts] == ["refused acknowledge all", "refused shelve LEVEL.H",
+                                                "refused silence"]  # one record per cause per minute
+    assert all(r.source == "vera" for r in station.sink.records if r.kind == "operator")
+
+
+def test_an_operator_acknowledges_and_silences_from_the_summary(qtbot, station: Station) -> None:
+    station.step(4000, 900, T0)
+    summary = station.summary("ivanov")
+    qtbot.addWidget(summary)
+    summary.annunciator.sounding = True
+    summary.refresh()
+    assert summary.ack_all.isEnabled() and summary.silence.isEnabled() and summary.ack_all.toolTip() == ""
+    qtbot.mouseClick(summary.silence, Qt.MouseButton.LeftButton)
+    qtbot.mouseClick(summary.ack_all, Qt.MouseButton.LeftButton)
+    assert summary.annunciator.sounding  # not before the layer has answered
+    station.apply()
+    qtbot.waitUntil(lambda: not summary.annunciator.sounding)
+    assert not summary.silence.isEnabled() and "Stop the sound" in summary.silence.toolTip()
+    assert station.alarms.system.get("LEVEL.H").state is State.ACKED
+    assert ("ivanov", "alarm sound silenced") in [(r.source, r.text) for r in station.sink.records]

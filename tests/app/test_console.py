@@ -100,12 +100,12 @@ def test_the_demo_opens_as_its_viewer_who_may_not_act(qtbot, console: MainWindow
     assert console.user == "viewer" and "viewer (viewer)" in console.header.user.text()
     model, button = element(console, "Пуск")
     qtbot.waitUntil(lambda: model.value is not None, timeout=5000)
+    assert "Пуск: needs the operator role; viewer is viewer" in button.toolTip()  # it keeps its look
     qtbot.mouseClick(button, Qt.MouseButton.LeftButton)
-    assert "Refused: Пуск \u2192" in console.status.currentMessage()
-    assert "needs the operator role; viewer is viewer" in console.status.currentMessage()
+    assert console.status.currentMessage() == "Refused: Пуск: needs the operator role; viewer is viewer"
     setpoint, _ = element(console, "Уставка температуры")
     ok, why = setpoint.submit("50")
-    assert not ok and "needs the operator role" in why
+    assert not ok and why == "Уставка температуры: needs the operator role; viewer is viewer"
     assert not console.alarms.ack.isEnabled() and "needs the operator role" in console.alarms.ack.toolTip()
     qtbot.wait(300)
     assert engine.snapshot.get_hmi_bit(START_BIT) == 0
@@ -115,22 +115,29 @@ def test_run_stop_and_quit_need_the_engineer_and_ask(qtbot, console: MainWindow)
     runtime = console.runtime
     console.ask = no = Answers(False)
     console.login("operator", "operator")
-    console.stop_program()
+    assert not console.act_stop.isEnabled()
+    assert "Stop NetPlc: needs the engineer role" in console.act_stop.toolTip()
+    console.stop_program()  # asked all the same (a script, a shortcut): the layer refuses it
     assert "Stop NetPlc: needs the engineer role; operator is operator" in console.status.currentMessage()
-    assert console.request_quit() is False and console.isVisible()
+    console.request_quit()
+    assert "Quit: needs the engineer role" in console.status.currentMessage() and console.isVisible()
     assert not no.asked  # refused before anything is asked
     console.login("engineer", "engineer")
-    console.stop_program()
-    assert console.request_quit() is False and console.isVisible()
+    assert console.act_stop.isEnabled() and console.act_quit.isEnabled()
+    assert console.stop_program() is None and console.request_quit() is None  # answered no
+    assert console.isVisible()
     assert [q.split(":")[0] for q in no.asked] == ["Stop NetPlc", "Quit"]
     qtbot.wait(300)
     assert runtime.status().state == "running"  # both answered no
     console.ask = Answers(True)
     console.stop_program()
     qtbot.waitUntil(lambda: runtime.status().state != "running", timeout=3000)
+    console.refresh_status()
+    assert console.act_run.isEnabled() and not console.act_stop.isEnabled()
     console.run_program()
     qtbot.waitUntil(lambda: runtime.status().state == "running", timeout=3000)
-    assert console.request_quit() is True
+    console.request_quit()
+    qtbot.waitUntil(lambda: not console.isVisible(), timeout=3000)  # closed once the layer answered
     runtime.stop()
     rows = operator_rows(runtime)
     assert rows[-5:] == [("operator", "logged out: user switched"), ("engineer", "logged in as engineer"),
@@ -142,8 +149,10 @@ def test_ctrl_q_and_f5_no_longer_act_at_once(console: MainWindow) -> None:
     assert console.act_run.shortcut().isEmpty() and console.act_stop.shortcut().isEmpty()
     assert console.act_quit.shortcut().toString() == "Ctrl+Q"
     console.ask = Answers(True)
-    console.act_quit.trigger()  # the viewer may not quit the station
-    assert console.isVisible() and "Quit: needs the engineer role" in console.status.currentMessage()
+    assert not console.act_quit.isEnabled()  # the viewer may not quit the station
+    assert console.act_quit.toolTip() == "Quit: needs the engineer role; viewer is viewer"
+    console.act_quit.trigger()
+    assert console.isVisible()
 
 
 def test_an_element_asks_when_the_form_says_confirm_and_checks_its_role(qtbot, console: MainWindow) -> None:
@@ -163,10 +172,11 @@ def test_an_element_asks_when_the_form_says_confirm_and_checks_its_role(qtbot, c
     model.Role = "engineer"
     qtbot.waitUntil(lambda: model.value == 1, timeout=3000)
     assert model.click() is False
-    assert "Пуск \u2192 0: needs the engineer role; operator is operator" in console.status.currentMessage()
+    assert "Пуск: needs the engineer role; operator is operator" in console.status.currentMessage()
     console.runtime.stop()
     writes = [t for s, t in operator_rows(console.runtime) if s == "operator" and "Пуск" in t]
-    assert len(writes) == 1, writes
+    assert writes == ["write Пуск (040042): 0 -> 1",
+                      "refused write Пуск: write: needs the engineer role; operator is operator"]
 
 
 def test_an_idle_user_is_logged_out_and_it_is_journaled(qtbot, console: MainWindow) -> None:
@@ -327,10 +337,12 @@ def test_refusals_roles_and_alarms_speak_russian_too(qtbot, russian, demo_copy: 
         model, button = element(window, "Пуск")
         qtbot.waitUntil(lambda: model.value is not None, timeout=5000)
         qtbot.mouseClick(button, Qt.MouseButton.LeftButton)
-        assert "Отказано: Пуск \u2192" in window.status.currentMessage()
-        assert "нужна роль «оператор»; viewer — наблюдатель" in window.status.currentMessage()
+        assert window.status.currentMessage() == "Отказано: Пуск: нужна роль «оператор»; viewer — наблюдатель"
         assert "нужна роль «оператор»" in window.alarms.ack.toolTip()
-        assert window.session.refusal("operator", "Пуск") == "Пуск: needs the operator role; viewer is viewer"
+        assert "Выход: нужна роль «инженер»" in window.act_quit.toolTip()
+        runtime.stop()  # the journal keeps the English
+        assert ("viewer", "refused write Пуск: write: needs the operator role; viewer is viewer") in [
+            (s, t.split(" (")[0]) for s, t in operator_rows(runtime)]
         summary = window.summary
         heads = [summary.model.headerData(i, Qt.Orientation.Horizontal, Qt.ItemDataRole.DisplayRole)
                  for i in range(6)]
@@ -375,12 +387,20 @@ def test_only_an_admin_manages_users_and_it_is_journaled(qtbot, console: MainWin
     dialog = console.manage_users()
     assert dialog is not None and dialog.table.rowCount() == 4
     assert dialog.add_user("ivan", "operator", "pw") and dialog.table.rowCount() == 5
-    assert not dialog.add_user("ivan", "viewer", "x") and "exists already" in dialog.message.text()
+    assert not dialog.add_user("ivan", "viewer", "x")
+    assert dialog.message.text() == ("Add user ivan: user 'ivan' exists already (passwd changes the "
+                                     "password)")
     assert dialog.set_password("ivan", "new") and dialog.remove_user("viewer")
+    console.log_out()  # the dialog left open: its changes are the commands of whoever is on duty, now
+    assert not dialog.remove_user("ivan")  # the default viewer, just removed
+    assert dialog.message.text() == "Remove user ivan: viewer is no longer a user (admin needed)"
     dialog.close()
     folder = console.runtime.station.folder
     assert Users(folder).verify("ivan", "new").role == "operator" and Users(folder).get("viewer") is None
     console.runtime.stop()
-    rows = operator_rows(console.runtime)
-    assert rows[-3:] == [("admin", "user ivan added as operator"), ("admin", "password of ivan changed"),
-                         ("admin", "user viewer removed")]
+    rows = [(s, t) for s, t in operator_rows(console.runtime) if s == "admin"]
+    assert rows[-5:] == [("admin", "user ivan added as operator"),
+                         ("admin", "refused users ivan: user 'ivan' exists already (passwd changes the "
+                                   "password)"),
+                         ("admin", "password of ivan changed"), ("admin", "user viewer removed"),
+                         ("admin", "logged out")]

@@ -11,6 +11,9 @@ from pathlib import Path
 import pytest
 from PySide6.QtWidgets import QApplication
 
+from app.authority import Reason, Who
+from app.authority import Source as Seat
+from app.authority.users import Users
 from app.config import load_station
 from app.gui.monitor.listing import Listing, fmt_value, parse_value, parse_watch
 from app.gui.monitor.source import LocalSource, RemoteSource
@@ -43,7 +46,11 @@ SYMBOLS = "name,address,comment\nPUMP,02000,pump\nLEVEL,04000,level\n"
 def station(folder: Path, port: int = 0) -> Path:
     toml = (f'NetPlcProgram = "p.stl"\nSymbols = "s.csv"\nNetSyncTime = 20\n'
             f'[modbus_server]\nport = {port}\nwritable = [["00000", "02177"], ["04000", "04777"]]\n')
-    return write_station(folder, toml, {"p.stl": PROGRAM, "s.csv": SYMBOLS})
+    write_station(folder, toml, {"p.stl": PROGRAM, "s.csv": SYMBOLS})
+    users = Users(folder)
+    for name, role in (("eng1", "engineer"), ("olga", "operator"), ("vera", "viewer")):
+        users.add(name, role, name)
+    return folder
 
 
 @pytest.fixture
@@ -141,6 +148,10 @@ def test_a_2000_line_listing_paints_only_the_lines_on_screen(qtbot, tmp_path: Pa
     class Still:  # a source that never changes: only the painting is looked at
         caps = LocalSource.caps
         title, symbols = "big", {}
+        commands = None
+
+        def who(self, user: str) -> Who:
+            return Who(user, Seat.MONITOR)
         program = parse(text, source=str(path))
         snap = Memory().snapshot()
 
@@ -188,21 +199,21 @@ def test_watch_edit_force_unforce_and_step_from_the_view(qtbot, runtime: Runtime
     monitor.watch.item(0, 1).setText("0x123")  # an edit is a write
     wait(qtbot, lambda: engine.snapshot.get_word(0o4000) == 0x123)
     wait(qtbot, lambda: monitor.watch.item(0, 2).text() == "0123h")
-    assert ("eng1", "write monitor (04000): 0 -> 291") in operator_texts(runtime)
+    assert ("program view:eng1", "write 04000: 0 -> 291") in operator_texts(runtime)
     monitor.force("word", 0o4000, 7)
     monitor.force("bit", 0o2000, None)  # bumpless
     wait(qtbot, lambda: monitor.forced_pill.text() == "F: 2 forced")
     monitor.watch.item(0, 1).setText("9")  # a write loses to the force
-    wait(qtbot, lambda: monitor.watch.item(0, 4).text() == "F 7 (eng1)")
+    wait(qtbot, lambda: monitor.watch.item(0, 4).text() == "F 7 (program view:eng1)")
     assert engine.snapshot.get_word(0o4000) == 7
     monitor.unforce_button.click()
     wait(qtbot, lambda: monitor.forced_pill.text() == "F: 0 forced")
     texts = operator_texts(runtime)
-    assert ("eng1", "unforce 04000:word (was forced 7; unforce all)") in texts
-    assert ("eng1", "force 02000: 0 -> 0 (bumpless)") in texts
+    assert ("program view:eng1", "unforce 04000:word (was forced 7; unforce all)") in texts
+    assert ("program view:eng1", "force 02000: 0 -> 0 (bumpless)") in texts
     monitor.step()  # running: refused, said so
-    assert "only while NetPlc is stopped" in monitor.message.text()
-    runtime.stop_program("engineer")
+    assert monitor.message.text() == "Refused: Step one scan: NetPlc is running: stop it to step one scan"
+    runtime.stop_program("eng1")
     wait(qtbot, lambda: engine.snapshot.state.startswith("stopped"))
     before = engine.scan_counter
     monitor.step_button.click()
@@ -254,9 +265,9 @@ def test_the_remote_monitor_watches_and_writes_a_running_station_over_modbus(qtb
         wait(qtbot, lambda: runtime.engine.snapshot.get_byte(0o4777) == 1)
         monitor.add_watch("05000")
         monitor.watch.item(3, 1).setText("1")
-        assert "refused" in monitor.message.text()
-        with pytest.raises(ValueError, match="forcing"):
-            source.force("bit", 0, 1, "eng1")
+        assert monitor.message.text().startswith("Refused: write 05000:word: ")
+        answer = source.force("bit", 0, 1, "eng1").result(0)
+        assert answer.reason is Reason.NOT_WRITABLE and "forcing" in answer.text
         assert source.timer(0o3000) is None and source.forces() == ()
     finally:
         source.close()
@@ -307,15 +318,15 @@ def test_station_menu_opens_the_program_view_and_the_status_bar_counts_forces(qt
         menu = window.menuBar().actions()[0].menu()
         program = next(a for a in menu.actions() if a.text() == "&Program…")
         assert window.status.forced.text() == "F: 0 forced"
-        program.trigger()  # the demo opens as a viewer: the view needs the engineer role
-        assert not [w for w in window.viewers if isinstance(w, ProgramWindow)]
-        assert "engineer" in window.status.currentMessage()
-        window.login("engineer", "engineer")
-        program.trigger()
+        program.trigger()  # the demo opens as a viewer: the view shows, its forcing is greyed
         opened = [w for w in window.viewers if isinstance(w, ProgramWindow)]
         assert len(opened) == 1 and opened[0].isVisible()
         monitor = opened[0].monitor
         assert len(monitor.listing) > 100
+        for button in (monitor.step_button, monitor.unforce_button):
+            assert not button.isEnabled() and "needs the engineer role; viewer is viewer" in button.toolTip()
+        window.login("engineer", "engineer")  # the view follows who is at the workstation
+        assert monitor.step_button.isEnabled() and monitor.unforce_button.isEnabled()
         monitor.force("bit", 0o2120, 1)
         wait(qtbot, lambda: runtime.status().forced == 1)
         window.refresh_status()
@@ -363,10 +374,10 @@ def test_the_watch_table_forces_a_tag_in_physical_units(qtbot, tmp_path: Path) -
         monitor.force_tag(monitor.watch_items[0].tag, 130.0)  # type: ignore[arg-type]
         monitor.force_tag(monitor.watch_items[1].tag, None)  # bumpless: both words at 0.00
         wait(qtbot, lambda: monitor.forced_pill.text() == "F: 3 forced")
-        wait(qtbot, lambda: monitor.watch.item(0, 4).text() == "F 130.0 °C (eng1)")
+        wait(qtbot, lambda: monitor.watch.item(0, 4).text() == "F 130.0 °C (program view:eng1)")
         assert engine.snapshot.get_word(0o4000) == 650
         assert monitor.watch.item(0, 1).text() == "130.0 °C" and monitor.watch.item(0, 2).text() == "028Ah"
-        assert monitor.watch.item(1, 4).text() == "F 0.00 m3/h (eng1)"
+        assert monitor.watch.item(1, 4).text() == "F 0.00 m3/h (program view:eng1)"
         monitor.watch.item(0, 1).setText("10")  # an operator write loses to the force
         monitor.unforce_tag(monitor.watch_items[1].tag)  # type: ignore[arg-type]
         wait(qtbot, lambda: monitor.forced_pill.text() == "F: 1 forced")
@@ -374,9 +385,11 @@ def test_the_watch_table_forces_a_tag_in_physical_units(qtbot, tmp_path: Path) -
         wait(qtbot, lambda: monitor.watch.item(1, 1).text() == "12.50 m3/h")
         assert engine.snapshot.get_word(0o4000) == 650
         texts = [(r.source, r.text) for r in records if r.kind == "operator"]
-        assert ("eng1", "force TEMP_SP: 0.0 -> 130.0 °C (raw 028Ah)") in texts
-        assert ("eng1", "force FLOW: 0.00 -> 0.00 m3/h (raw 0000h 0000h) (bumpless)") in texts
-        assert ("eng1", "unforce FLOW (was forced 0.00 m3/h)") in texts
+        assert ("program view:eng1", "force TEMP_SP: 0.0 -> 130.0 °C (raw 028Ah)") in texts
+        assert ("program view:eng1", "force FLOW: 0.00 -> 0.00 m3/h (raw 0000h 0000h) (bumpless)") in texts
+        assert ("program view:eng1", "unforce FLOW (was forced 0.00 m3/h)") in texts
+        assert any(s == "program view:eng1" and t.startswith("write FLOW") and "12.50 m3/h" in t
+                   for s, t in texts)  # one write of both words, in the tag's units
         monitor.watch.item(0, 1).setText("hot")
         assert "TEMP_SP" in monitor.message.text()
         monitor.grab()

@@ -7,6 +7,7 @@ from __future__ import annotations
 import time
 from pathlib import Path
 
+from app.authority import Reason, Source, Who
 from app.config import load_station
 from app.runtime import Runtime
 from netplc.engine import RunState
@@ -109,14 +110,17 @@ def test_step_one_scan_runs_the_stopped_program_once(demo_copy: Path) -> None:
     runtime.subscribe(records.append)
     runtime.start()
     try:
-        engine = runtime.engine
-        assert engine is not None
-        assert runtime.step_program("engineer") is False  # running: nothing to step
+        engine, commands, thread = runtime.engine, runtime.commands, runtime.scan_thread
+        assert engine is not None and commands is not None and thread is not None
+        engineer = Who("engineer", Source.CONSOLE)
+        answer = commands.step(engineer, thread.lock).result(0)
+        assert answer.reason is Reason.INVALID and "NetPlc is running" in answer.text  # nothing to step
+        assert commands.step(Who("operator", Source.CONSOLE), thread.lock).result(0).reason is Reason.DENIED
         runtime.stop_program("engineer")
         wait_for(runtime, lambda s: s.state.startswith("stopped"))
         after_scans(runtime)
         before = engine.scan_counter
-        assert runtime.step_program("engineer") is True
+        assert commands.step(engineer, thread.lock).result(0).ok
         assert engine.state is RunState.STOPPED and engine.scan_counter >= before + 1
         seconds = engine.snapshot.get_word(0o4100)
         after_scans(runtime, 12)  # the stopped scans that follow do not run the program

@@ -1,4 +1,5 @@
-"""Users and roles, Qt-free: the users file, the session, and the `main.py users` command."""
+"""Users and roles, Qt-free: the users file, the session (who is at the workstation; what they may
+do is the command layer's to say), and the `main.py users` command."""
 
 from __future__ import annotations
 
@@ -9,7 +10,11 @@ from pathlib import Path
 
 import pytest
 
-from app.authority.users import Refusal, Refused, Session, UserError, Users
+from app.authority import Action, Commands, Refusal, Source, Who
+from app.authority.users import Refused, Session, UserError, Users
+from netplc.engine import Engine
+from netplc.program import parse
+from netplc.records import ListSink
 
 REPO = Path(__file__).resolve().parents[2]
 
@@ -57,39 +62,50 @@ def users(tmp_path: Path) -> Users:
     return users
 
 
+def layer(users: Users) -> Commands:
+    """The command layer, reading the roles from these users as the runtime does."""
+    def role_of(name: str) -> str | None:
+        user = users.get(name)
+        return None if user is None else user.role
+
+    return Commands(Engine(parse("JMP 0\n")), ListSink(), role_of=role_of)
+
+
 @pytest.mark.parametrize(("role", "allowed"), [
-    ("viewer", {"viewer"}), ("operator", {"viewer", "operator"}),
-    ("engineer", {"viewer", "operator", "engineer"}), ("admin", {"viewer", "operator", "engineer", "admin"}),
+    ("viewer", set()), ("operator", {Action.WRITE, Action.ACKNOWLEDGE}),
+    ("engineer", {Action.WRITE, Action.ACKNOWLEDGE, Action.FORCE, Action.STOP}),
+    ("admin", {Action.WRITE, Action.ACKNOWLEDGE, Action.FORCE, Action.STOP, Action.USERS}),
 ])
-def test_each_role_allows_what_the_ones_below_do(users: Users, role: str, allowed: set[str]) -> None:
+def test_each_role_allows_what_the_ones_below_do(users: Users, role: str, allowed: set[Action]) -> None:
     session = Session(users)
     session.login(role, role)
-    for needed in ("viewer", "operator", "engineer", "admin"):
-        why = session.refusal(needed, "Run NetPlc")
-        assert (why is None) == (needed in allowed)
+    commands = layer(users)
+    who = Who(session.name, Source.CONSOLE)
+    for action in (Action.WRITE, Action.ACKNOWLEDGE, Action.FORCE, Action.STOP, Action.USERS):
+        why = commands.denial(who, action)
+        assert (why is None) == (action in allowed), action
         if why is not None:
-            assert why == f"Run NetPlc: needs the {needed} role; {role} is {role}"
-            with pytest.raises(Refused, match=f"needs the {needed} role"):
-                session.require(needed, "Run NetPlc")
-        else:
-            assert session.require(needed, "Run NetPlc") == role
+            assert str(why).startswith(f"{action.value}: needs the ")
+            assert str(why).endswith(f"; {role} is {role}")
 
 
 def test_logged_out_is_the_default_viewer_or_nobody(users: Users) -> None:
+    commands = layer(users)
     nobody = Session(users)
     assert nobody.name == ""
-    assert nobody.refusal("viewer", "Look") == "Look: nobody is logged in (viewer needed)"
+    assert commands.denial(Who(nobody.name, Source.CONSOLE), Action.WRITE, what="Пуск") == Refusal(
+        "Пуск", "operator")
     default = Session(users, default="viewer")
-    assert default.name == "viewer" and default.refusal("viewer", "Look") is None
-    assert default.refusal("operator", "Пуск") == "Пуск: needs the operator role; viewer is viewer"
-    # in parts too, so the console says it in its own language (app/gui/words.py)
-    assert default.denial("operator", "Пуск") == Refusal("Пуск", "operator", "viewer", "viewer")
-    assert nobody.denial("viewer", "Look") == Refusal("Look", "viewer")
+    assert default.name == "viewer"
+    # in parts, so the console says it in its own language (app/gui/words.py)
+    assert commands.denial(Who(default.name, Source.CONSOLE), Action.WRITE, what="Пуск") == Refusal(
+        "Пуск", "operator", "viewer", "viewer")
     with pytest.raises(Refused, match="wrong user name or password"):
         default.login("operator", "viewer")
     default.login("operator", "operator")
     default.logout()
     assert default.name == "viewer"
+    assert not hasattr(default, "require") and not hasattr(default, "denial")  # the layer decides
 
 
 def test_an_idle_user_is_logged_out(users: Users) -> None:

@@ -6,10 +6,14 @@ import json
 from pathlib import Path
 from typing import Any
 
+from app.authority import Commands, Source, Who
 from hmi_forms.elements import Element
+from hmi_forms.elements.target import EngineTarget
 from hmi_forms.form import load_form
+from netplc.engine import Engine
 from netplc.memory import Memory, Snapshot
 from netplc.records import Record
+from netplc.tags.table import TagTable
 
 
 def snap(bits: dict[int, int] | None = None, words: dict[int, int] | None = None, scan: int = 0,
@@ -22,6 +26,13 @@ def snap(bits: dict[int, int] | None = None, words: dict[int, int] | None = None
     return mem.snapshot(scan, time, wall)
 
 
+def engine_target(engine: Engine, tags: TagTable | None = None, role: str = "operator",
+                  **kwargs: Any) -> EngineTarget:
+    """A form's writes through the command layer of `engine`, every user acting with `role`."""
+    commands = Commands(engine, engine.sink, role_of=lambda _name: role, tags=tags.tags if tags else ())
+    return EngineTarget(commands, lambda user: Who(user, Source.CONSOLE), **kwargs)
+
+
 class ListTarget:
     """Collects what elements write and record: as a Target, the operator's writes a view forwards;
     as Effects (the runtime's copy of a model), the generators' bits and the element records."""
@@ -30,10 +41,12 @@ class ListTarget:
         self.writes: list[tuple[str, int, int, str | None]] = []
         self.records: list[Record] = []
 
-    def write_bit(self, addr: int, value: int, *, user: str, label: str | None = None) -> None:
+    def write_bit(self, addr: int, value: int, *, user: str, label: str | None = None,
+                  at_least: str | None = None) -> None:
         self.writes.append(("bit", addr, value, user))
 
-    def write_word(self, addr: int, value: int, *, user: str, label: str | None = None) -> None:
+    def write_word(self, addr: int, value: int, *, user: str, label: str | None = None,
+                   at_least: str | None = None) -> None:
         self.writes.append(("word", addr, value, user))
 
     def set_bit(self, addr: int, value: int) -> None:

@@ -6,12 +6,11 @@ from __future__ import annotations
 import shutil
 from pathlib import Path
 
-from hmi_forms.elements.target import EngineTarget
 from hmi_forms.form import load_form, load_forms
 from hmi_forms.widgets.form_view import FormView
 from netplc.engine import Engine, FakeClock
 from netplc.program import parse
-from tests.hmi_forms.helpers import write_form
+from tests.hmi_forms.helpers import engine_target, write_form
 from tests.hmi_forms.test_widgets import EXAMPLE
 
 PICTURE = {"type": "StaticPicture", "Name": "Pic", "x": 0, "y": 0, "w": 50, "h": 50}
@@ -59,7 +58,7 @@ def test_the_form_with_a_left_out_file_still_renders(tmp_path: Path, qtbot) -> N
     write_form(forms, [{**PICTURE, "Image": "/etc/passwd"}, LAMP], images=["off.png", "/etc/passwd"])
     form = load_form(forms / "t.hmi", station=st)
     engine = Engine(parse(""), clock=FakeClock(), wallclock=lambda: 0.0)
-    view = FormView(form, EngineTarget(engine))
+    view = FormView(form, engine_target(engine))
     qtbot.addWidget(view)
     engine.mem.set_bit(0o2000, 1)
     engine.scan()

@@ -9,13 +9,12 @@ import pytest
 
 from hmi_forms.elements.analog import AnalogBase, AnalogOutput
 from hmi_forms.elements.discrete import DiscreteBase
-from hmi_forms.elements.target import EngineTarget
 from hmi_forms.form import FormError, load_form
 from netplc.engine import Engine
 from netplc.program import parse
 from netplc.records import ListSink
 from netplc.tags.table import load_tags
-from tests.hmi_forms.helpers import write_form
+from tests.hmi_forms.helpers import engine_target, write_form
 
 TAGS = """\
 name,address,type,unit,app_min,app_max,phy_min,phy_max,decimals,description,h,l,priority
@@ -73,7 +72,7 @@ def test_an_operator_write_to_a_tag_is_journaled_in_physical_units_with_the_raw_
     sink = ListSink()
     engine = Engine(parse("JMP 0\n"), sink=sink)
     engine.mem.set_word(0o4030, 1024)  # 0.0 °C
-    target = EngineTarget(engine, load_tags(path))
+    target = engine_target(engine, load_tags(path))
     target.write_word(0o4030, 3686, user="ivanov", label="Уставка температуры")
     target.write_bit(0o40042, 1, user="ivanov", label="Пуск")
     target.write_word(0o4100, 7, user="ivanov", label="Other")

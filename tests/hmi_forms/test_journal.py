@@ -7,13 +7,12 @@ import threading
 import time
 from pathlib import Path
 
-from hmi_forms.elements.target import EngineTarget
 from hmi_forms.widgets.form_view import FormView
 from hmi_forms.widgets.journal import JournalWidget
 from netplc.records import Record
 from registrar.query import Archive
 from registrar.store import Store
-from tests.hmi_forms.helpers import snap
+from tests.hmi_forms.helpers import engine_target, snap
 from tests.hmi_forms.test_widgets import differs, engine, image, one
 
 WAIT = 10_000  # ms: the worker's answer arrives through the GUI thread's event loop
@@ -21,7 +20,7 @@ WAIT = 10_000  # ms: the worker's answer arrives through the GUI thread's event 
 
 def journal(qtbot, tmp_path: Path, archive: Path, **props) -> tuple[FormView, JournalWidget]:
     form = one(tmp_path, "MessageJournal", w=700, h=240, RefreshTicks=1, **props)
-    view = FormView(form, EngineTarget(engine()[0]), archive_path=archive)
+    view = FormView(form, engine_target(engine()[0]), archive_path=archive)
     qtbot.addWidget(view)
     widget = view.pairs[0][1]
     assert isinstance(widget, JournalWidget)

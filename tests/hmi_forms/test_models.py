@@ -289,13 +289,14 @@ def test_journal_refreshes_today_every_refresh_ticks(tmp_path) -> None:
 def test_a_write_the_station_refuses_with_a_full_queue_is_not_taken_for_done(tmp_path) -> None:
     """Back-pressure reaches the operator: a full queue of outside writes refuses the click and
     the setpoint, and the view is told why (the engine keeps the scan period whatever comes)."""
-    from hmi_forms.elements.target import BUSY, EngineTarget
     from netplc.engine import Engine, FakeClock
     from netplc.program import parse
+    from tests.hmi_forms.helpers import engine_target
 
     engine = Engine(parse("JMP 0\n"), clock=FakeClock(), write_queue=1)
     told: list[str] = []
-    target = EngineTarget(engine, on_busy=told.append)
+    target = engine_target(engine, on_answer=lambda what, ticket: told.append(what) if ticket.done() and
+                           not ticket.result().ok else None)
     (tmp_path / "b").mkdir()
     (tmp_path / "s").mkdir()
     button = element(tmp_path / "b", "DiscreteBase", Name="Пуск", InAddr="040042", Enabled=True)
@@ -305,7 +306,24 @@ def test_a_write_the_station_refuses_with_a_full_queue_is_not_taken_for_done(tmp
         model.bind(target, "operator")
         model.refresh(engine.snapshot)
     assert button.click()  # the queue takes one write
-    assert not button.click() and told == [f"Пуск: {BUSY}"]
-    assert setpoint.submit("50") == (False, BUSY)
+    assert not button.click() and told == ["Пуск"]
+    ok, why = setpoint.submit("50")
+    assert not ok and why.startswith("Уставка: the station is busy")
     engine.scan()  # the queue drains: writes are taken again
     assert setpoint.submit("50")[0]
+
+
+def test_a_write_asks_at_least_the_elements_role_of_the_command_layer(tmp_path) -> None:
+    """The element's Role may ask more than the station's policy: an operator may not click an
+    element that asks for an engineer, and the refusal names the element and the role."""
+    from netplc.engine import Engine, FakeClock
+    from netplc.program import parse
+    from tests.hmi_forms.helpers import engine_target
+
+    engine = Engine(parse("JMP 0\n"), clock=FakeClock())
+    button = element(tmp_path, "DiscreteBase", Name="Пуск", InAddr="040042", Enabled=True, Role="engineer")
+    button.bind(engine_target(engine, role="operator"), "olga")
+    button.refresh(engine.snapshot)
+    assert not button.click() and engine.writes_waiting == 0
+    button.bind(engine_target(engine, role="engineer"), "egor")
+    assert button.click() and engine.writes_waiting == 1

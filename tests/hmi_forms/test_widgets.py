@@ -10,13 +10,12 @@ from PySide6.QtCore import Qt
 from PySide6.QtGui import QImage
 
 from hmi_forms.elements import ELEMENT_TYPES
-from hmi_forms.elements.target import EngineTarget
 from hmi_forms.form import Form, load_form, load_forms
 from hmi_forms.widgets.form_view import FormView
 from netplc.engine import Engine, FakeClock
 from netplc.program import load_symbols, parse
 from netplc.records import ListSink
-from tests.hmi_forms.helpers import snap, write_form
+from tests.hmi_forms.helpers import engine_target, snap, write_form
 
 EXAMPLE = Path(__file__).resolve().parents[2] / "resources" / "example"
 Q = "02101"  # quality bit used where an element has no state of its own
@@ -89,7 +88,7 @@ def test_each_element_type_renders_its_state(qtbot, tmp_path, type_: str) -> Non
     props, state_a, state_b, probe, *expected = CASES[type_]
     images = pump_images(tmp_path)
     form = one(tmp_path, type_, images=images, **props)
-    view = FormView(form, EngineTarget(engine()[0]))
+    view = FormView(form, engine_target(engine()[0]))
     qtbot.addWidget(view)
     model = form.elements[0]
     pictures = []
@@ -104,7 +103,7 @@ def test_each_element_type_renders_its_state(qtbot, tmp_path, type_: str) -> Non
 
 def test_an_element_whose_refresh_raises_fails_the_rendering_checks(qtbot, tmp_path) -> None:
     form = one(tmp_path, "DiscreteBase", InAddr="02120", TextFalse="Стоп", TextTrue="Работа")
-    view = FormView(form, EngineTarget(engine()[0]))
+    view = FormView(form, engine_target(engine()[0]))
     qtbot.addWidget(view)
     model = form.elements[0]
     view.refresh(snap(bits={0o2120: 0}))
@@ -123,7 +122,7 @@ def test_an_element_whose_refresh_raises_fails_the_rendering_checks(qtbot, tmp_p
 def test_analog_appearances_render_the_value(qtbot, tmp_path, appearance: str) -> None:
     form = one(tmp_path, "AnalogBase", w=240, h=200, InAddr="04010", Device="Level", Units="%",
                Appearance=appearance, PhyHigh=90, devices=LEVEL)
-    view = FormView(form, EngineTarget(engine()[0]))
+    view = FormView(form, engine_target(engine()[0]))
     qtbot.addWidget(view)
     pictures = []
     for base, hw in ((0, 400), (100, 4000)):
@@ -142,7 +141,7 @@ def test_analog_appearances_render_the_value(qtbot, tmp_path, appearance: str) -
 def test_stale_mark_covers_the_last_value(qtbot, tmp_path) -> None:
     form = one(tmp_path, "AnalogBase", InAddr="04010", Device="Level", Appearance="digital", QualityAddr=Q,
                devices=LEVEL)
-    view = FormView(form, EngineTarget(engine()[0]))
+    view = FormView(form, engine_target(engine()[0]))
     qtbot.addWidget(view)
     view.refresh(snap(words={0o4010: 2048}, bits={0o2101: 1}))
     live = image(view, qtbot)
@@ -160,7 +159,7 @@ def test_click_on_an_enabled_discrete_toggles_the_bit_through_the_scan(qtbot, tm
          "Enabled": True},
         {"type": "DiscreteBase", "Name": "Lamp", "x": 0, "y": 50, "w": 120, "h": 40, "InAddr": "02120"},
     ]))
-    view = FormView(form, EngineTarget(eng), user="ivanov")
+    view = FormView(form, engine_target(eng), user="ivanov")
     qtbot.addWidget(view)
     view.refresh(eng.snapshot)
     button, lamp = (w for _, w in view.pairs)
@@ -184,7 +183,7 @@ def test_analog_output_rejects_text_and_out_of_range_values_visibly(qtbot, tmp_p
     eng, sink = engine()
     form = one(tmp_path, "AnalogOutput", w=280, h=110, OutAddr="04030", AppMin=0, AppMax=4095, PhyMin=-50,
                PhyMax=150, Units="°C")
-    view = FormView(form, EngineTarget(eng))
+    view = FormView(form, engine_target(eng))
     qtbot.addWidget(view)
     view.show()
     widget = view.pairs[0][1]
@@ -216,7 +215,7 @@ def test_a_view_only_shows_a_generator_and_journals_nothing(qtbot, tmp_path) -> 
         {"type": "DiscreteBase", "Name": "P", "x": 0, "y": 70, "w": 120, "h": 40, "InAddr": "02120",
          "TextTrue": "Насос работает", "RegMessages": True, "RegData": True},
     ]))
-    view = FormView(form, EngineTarget(eng))
+    view = FormView(form, engine_target(eng))
     qtbot.addWidget(view)
     gen = form.elements[0]
     outputs = []
@@ -242,7 +241,7 @@ def test_demo_forms_load_and_use_every_element_type(qtbot) -> None:
     assert sorted(el.Address.hmi for el in trigger.elements if el.TYPE == "Graph") == [0o40003, 0o40005]
     eng = engine()[0]
     for form in forms:
-        view = FormView(form, EngineTarget(eng))
+        view = FormView(form, engine_target(eng))
         qtbot.addWidget(view)
         view.refresh(eng.snapshot)
         assert not view.grab().isNull() and view.errors == []
@@ -253,7 +252,7 @@ def test_a_failing_element_is_reported_and_the_others_go_on(qtbot, tmp_path) -> 
         {"type": "DiscreteBase", "Name": "A", "x": 0, "y": 0, "w": 100, "h": 30, "InAddr": "02120"},
         {"type": "DiscreteBase", "Name": "B", "x": 0, "y": 40, "w": 100, "h": 30, "InAddr": "02121"},
     ]))
-    view = FormView(form, EngineTarget(engine()[0]))
+    view = FormView(form, engine_target(engine()[0]))
     qtbot.addWidget(view)
 
     def broken(snapshot) -> bool:
@@ -270,7 +269,7 @@ def test_a_failing_element_is_reported_and_the_others_go_on(qtbot, tmp_path) -> 
 def test_a_dial_repaints_when_its_text_changes_or_its_needle_moves_a_pixel(qtbot, tmp_path) -> None:
     form = one(tmp_path, "AnalogBase", w=140, h=140, InAddr="04010", devices=LEVEL, Device="Level",
                Appearance="dial", Precision=0)
-    view = FormView(form, EngineTarget(engine()[0]))
+    view = FormView(form, engine_target(engine()[0]))
     qtbot.addWidget(view)
     asked: list[object] = []
     view.update = lambda *rect: asked.append(rect)  # type: ignore[method-assign]

@@ -7,11 +7,11 @@ from pathlib import Path
 
 import pytest
 
-from hmi_forms.elements.target import EngineTarget
 from netplc.engine import Engine, FakeClock, RunState
 from netplc.forcing import Force, ForceError, load_forces, save_forces
 from netplc.program import parse
 from netplc.records import ListSink
+from tests.hmi_forms.helpers import engine_target
 
 # input 00000 -> coil 02000; the word 04000 is copied to 04002 by the program (MOV), and the
 # program itself writes 04004 every scan; TIM 03000 counts while 00001 is on
@@ -67,7 +67,7 @@ def test_operator_modbus_and_exchange_writes_lose_to_the_force(compiled: bool) -
     eng.forces.force("word", 0o4000, 500, user="eng1")
     eng.forces.force("bit", 0o40050, 1, user="eng1")  # byte 04005 bit 0: an HMI data bit
     scans(eng, clock)
-    hmi = EngineTarget(eng)  # what a form's element writes through
+    hmi = engine_target(eng)  # what a form's element writes through
     hmi.write_word(0o4000, 1, user="operator", label="Setpoint")
     eng.write_bytes(0o4000, b"\x02\x00", user="modbus 127.0.0.1:5000")  # the Modbus server's write
     eng.post(lambda mem: mem.set_word(0o4000, 3))  # how the exchange lands an NREAD result

@@ -57,6 +57,18 @@
         <source>Select the alarm to shelve first.</source>
         <translation>Сначала выберите аварию, которую нужно отложить.</translation>
     </message>
+    <message>
+        <source>Acknowledge {0}</source>
+        <translation>Квитировать {0}</translation>
+    </message>
+    <message>
+        <source>Shelve {0}</source>
+        <translation>Отложить {0}</translation>
+    </message>
+    <message>
+        <source>Unshelve {0}</source>
+        <translation>Вернуть {0}</translation>
+    </message>
 </context>
 <context>
     <name>AlarmTableModel</name>
@@ -345,10 +357,6 @@
         <source>&amp;Program…</source>
         <translation>&amp;Программа…</translation>
     </message>
-    <message>
-        <source>open the program view (forcing, single scans)</source>
-        <translation>открыть просмотр программы (форсирование, одиночные циклы)</translation>
-    </message>
 </context>
 <context>
     <name>ShelveDialog</name>
@@ -504,6 +512,18 @@
     <message>
         <source>Password:</source>
         <translation>Пароль:</translation>
+    </message>
+    <message>
+        <source>Add user {0}</source>
+        <translation>Добавить пользователя {0}</translation>
+    </message>
+    <message>
+        <source>Remove user {0}</source>
+        <translation>Удалить пользователя {0}</translation>
+    </message>
+    <message>
+        <source>Password of {0}</source>
+        <translation>Пароль пользователя {0}</translation>
     </message>
 </context>
 <context>
@@ -839,6 +859,10 @@
     <message>
         <source>{0}: needs the {1} role; {2} is {3}</source>
         <translation>{0}: нужна роль «{1}»; {2} — {3}</translation>
+    </message>
+    <message>
+        <source>{0}: {1} is no longer a user ({2} needed)</source>
+        <translation>{0}: {1} больше не пользователь (нужна роль «{2}»)</translation>
     </message>
 </context>
 </TS>

@@ -1,6 +1,12 @@
 """Where the Program view gets memory from and sends writes to: the station's own runtime (the
 workstation's Station -> Program), or a running station's Modbus server (`main.py monitor`).
 
+Every action of the local view (write, force, unforce, step) is a command of the station's command
+layer as the user at the workstation, from the Program view (`Source.PROGRAM_VIEW`): the layer
+checks the role, journals it naming them, and answers with a `Ticket`, as every other seat's
+actions are; the remote view's writes are answered by the station over Modbus (a ticket too, so
+the view says both alike).
+
 Both give the view a `Snapshot` and nothing live, so the monitor never touches the scan: the
 local source hands over the engine's last published snapshot; the remote one polls the cpu165
 map of the station's server on its own thread (the I/O bits, and only the data registers the view
@@ -16,18 +22,24 @@ force in this version.
 from __future__ import annotations
 
 import asyncio
+import logging
 import time
 from collections.abc import Iterable
+from concurrent.futures import Future
 from dataclasses import dataclass
 from typing import Protocol
 
+from app.authority import APPLIED, Answer, Commands, Reason, Ticket, Who
+from app.authority import Source as Seat
 from app.runtime import Runtime
 from netplc.address import DATA_SIZE, IO_BITS, data_index, is_data_byte
-from netplc.forcing import Force, Kind
+from netplc.forcing import Force, Kind, tag_forces
 from netplc.memory import Snapshot
 from netplc.modbus import DeviceError, LinkError, LoopThread, MapError, locate, open_client, parse_endpoint
 from netplc.program import Program, parse
 from netplc.tags.tag import Tag
+
+logger = logging.getLogger(__name__)
 
 POLL_S = 0.2  # the remote monitor's poll period: 5 reads of the station per second
 TIMEOUT_S = 2.0
@@ -46,6 +58,9 @@ class Source(Protocol):
     symbols: dict[str, int]
     tags: dict[str, Tag]  # tags.csv by name: watched in physical units, forced word by word
     caps: Caps
+    commands: Commands | None  # the station's command layer, when it is this process's
+
+    def who(self, user: str) -> Who: ...
 
     def snapshot(self) -> Snapshot | None: ...
 
@@ -59,32 +74,37 @@ class Source(Protocol):
 
     def need(self, addrs: Iterable[int]) -> None: ...
 
-    def write(self, kind: Kind, addr: int, value: int, user: str) -> None: ...
+    def write(self, kind: Kind, addr: int, value: int, user: str) -> Ticket: ...
 
-    def force(self, kind: Kind, addr: int, value: int | None, user: str) -> None: ...
+    def write_tag(self, tag: Tag, phy: float, user: str) -> Ticket: ...
 
-    def unforce(self, kind: Kind, addr: int, user: str) -> None: ...
+    def force(self, kind: Kind, addr: int, value: int | None, user: str) -> Ticket: ...
 
-    def force_tag(self, tag: Tag, phy: float | None, user: str) -> None: ...
+    def unforce(self, kind: Kind, addr: int, user: str) -> Ticket: ...
 
-    def unforce_tag(self, tag: Tag, user: str) -> None: ...
+    def force_tag(self, tag: Tag, phy: float | None, user: str) -> Ticket: ...
 
-    def unforce_all(self, user: str) -> None: ...
+    def unforce_tag(self, tag: Tag, user: str) -> Ticket: ...
 
-    def step(self, user: str) -> bool: ...
+    def unforce_all(self, user: str) -> Ticket: ...
+
+    def step(self, user: str) -> Ticket: ...
 
     def close(self) -> None: ...
 
 
 class LocalSource:
-    """The workstation's own runtime: snapshots, queued writes, forces and single scans."""
+    """The workstation's own runtime: snapshots; writes, forces and single scans as commands."""
 
     caps = Caps(force=True, step=True)
 
     def __init__(self, runtime: Runtime) -> None:
-        assert runtime.engine is not None, "the runtime is started before its monitor opens"
+        assert runtime.engine is not None and runtime.commands is not None, \
+            "the runtime is started before its monitor opens"
         self.runtime = runtime
         self.engine = runtime.engine
+        self.commands: Commands | None = runtime.commands
+        self.layer = runtime.commands  # the same, known here not to be None
         self.program = runtime.program
         self.symbols = runtime.symbols
         self.tags = runtime.tags.by_name
@@ -108,32 +128,40 @@ class LocalSource:
     def need(self, addrs: Iterable[int]) -> None:
         pass  # the whole snapshot is at hand
 
-    def write(self, kind: Kind, addr: int, value: int, user: str) -> None:
+    def who(self, user: str) -> Who:
+        return Who(user, Seat.PROGRAM_VIEW)
+
+    def write(self, kind: Kind, addr: int, value: int, user: str) -> Ticket:
         """An operator write like any other: queued to the next scan, journaled with the user."""
         if kind == "bit":
-            self.engine.write_bit(addr, value, user=user, label="monitor")
-        elif kind == "word":
-            self.engine.write_word(addr, value, user=user, label="monitor")
-        else:
-            self.engine.write_bytes(addr, bytes((value,)), user=user)
+            return self.layer.write_bit(self.who(user), addr, value)
+        if kind == "word":
+            return self.layer.write_word(self.who(user), addr, value)
+        return self.layer.write_bytes(self.who(user), addr, bytes((value,)))
 
-    def force(self, kind: Kind, addr: int, value: int | None, user: str) -> None:
-        self.engine.forces.force(kind, addr, value, user=user)
+    def write_tag(self, tag: Tag, phy: float, user: str) -> Ticket:
+        """Checked for the tag's type and physical range, journaled with its name and unit."""
+        return self.layer.write_tag(self.who(user), tag.name, phy)
 
-    def unforce(self, kind: Kind, addr: int, user: str) -> None:
-        self.engine.forces.unforce(kind, addr, user=user)
+    def force(self, kind: Kind, addr: int, value: int | None, user: str) -> Ticket:
+        return self.layer.force(self.who(user), kind, addr, value)
 
-    def force_tag(self, tag: Tag, phy: float | None, user: str) -> None:
-        self.engine.forces.force_tag(tag, phy, user=user)
+    def unforce(self, kind: Kind, addr: int, user: str) -> Ticket:
+        return self.layer.unforce(self.who(user), kind, addr)
 
-    def unforce_tag(self, tag: Tag, user: str) -> None:
-        self.engine.forces.unforce_tag(tag, user=user)
+    def force_tag(self, tag: Tag, phy: float | None, user: str) -> Ticket:
+        return self.layer.force_tag(self.who(user), tag.name, phy)
 
-    def unforce_all(self, user: str) -> None:
-        self.engine.forces.unforce_all(user=user)
+    def unforce_tag(self, tag: Tag, user: str) -> Ticket:
+        return self.layer.unforce_tag(self.who(user), tag.name)
 
-    def step(self, user: str) -> bool:
-        return self.runtime.step_program(user)
+    def unforce_all(self, user: str) -> Ticket:
+        return self.layer.unforce_all(self.who(user))
+
+    def step(self, user: str) -> Ticket:
+        """One scan of the stopped program, between two scans of the scan thread."""
+        thread = self.runtime.scan_thread
+        return self.layer.step(self.who(user), thread.lock if thread is not None else None)
 
     def close(self) -> None:
         pass
@@ -144,6 +172,7 @@ class RemoteSource:
 
     caps = Caps(force=False, step=False,
                 why_not="forcing and single scans need the station's own workstation (not over Modbus)")
+    commands: Commands | None = None  # the station's layer is in the station's process: it answers
 
     def __init__(self, host: str, port: int, *, unit: int = 1, program: Program | None = None,
                  symbols: dict[str, int] | None = None, tags: dict[str, Tag] | None = None,
@@ -217,10 +246,32 @@ class RemoteSource:
     def forces(self) -> tuple[Force, ...]:
         return ()
 
-    def write(self, kind: Kind, addr: int, value: int, user: str) -> None:
-        """Write over Modbus (the station journals it with this peer's address); MapError,
-        LinkError or DeviceError say why not, e.g. exception 2 outside the writable ranges."""
-        self._loop.run(self._write(kind, addr, value), TIMEOUT_S * 3)
+    def who(self, user: str) -> Who:
+        return Who(user, Seat.MONITOR)
+
+    def write(self, kind: Kind, addr: int, value: int, user: str) -> Ticket:
+        """Write over Modbus (the station journals it with this peer's address), answered when the
+        station has: not writable (a MapError, exception 2 outside the writable ranges) or failed
+        (the link, another exception), with the reason."""
+        ticket: Ticket = Future()
+        where = Force(kind, addr, 0).where
+        try:
+            self._loop.run(self._write(kind, addr, value), TIMEOUT_S * 3)
+        except (MapError, DeviceError) as e:
+            logger.warning("%s: write %s refused by the station: %s", self.endpoint, where, e)
+            ticket.set_result(Answer(Reason.NOT_WRITABLE, str(e)))
+        except (LinkError, OSError, TimeoutError) as e:
+            logger.warning("%s: write %s failed: %s", self.endpoint, where, e)
+            ticket.set_result(Answer(Reason.FAILED, str(e) or type(e).__name__))
+        else:
+            ticket.set_result(APPLIED)
+        return ticket
+
+    def write_tag(self, tag: Tag, phy: float, user: str) -> Ticket:
+        """A tag's physical value written as its raw bit or words, each a Modbus write; the first
+        that is not done answers for all."""
+        answers = [self.write(f.kind, f.addr, f.value, user) for f in tag_forces(tag, phy)]
+        return next((a for a in answers if not a.result().ok), answers[-1])
 
     async def _write(self, kind: Kind, addr: int, value: int) -> None:
         async with self._lock:
@@ -262,23 +313,28 @@ class RemoteSource:
         for start, count in block.spans(True):
             await self._client.write(self.unit, block.table, start, values[start - block.address:][:count])
 
-    def force(self, kind: Kind, addr: int, value: int | None, user: str) -> None:
-        raise MapError(self.caps.why_not)
+    def _cannot(self) -> Ticket:
+        ticket: Ticket = Future()
+        ticket.set_result(Answer(Reason.NOT_WRITABLE, self.caps.why_not))
+        return ticket
 
-    def unforce(self, kind: Kind, addr: int, user: str) -> None:
-        raise MapError(self.caps.why_not)
+    def force(self, kind: Kind, addr: int, value: int | None, user: str) -> Ticket:
+        return self._cannot()
 
-    def force_tag(self, tag: Tag, phy: float | None, user: str) -> None:
-        raise MapError(self.caps.why_not)
+    def unforce(self, kind: Kind, addr: int, user: str) -> Ticket:
+        return self._cannot()
 
-    def unforce_tag(self, tag: Tag, user: str) -> None:
-        raise MapError(self.caps.why_not)
+    def force_tag(self, tag: Tag, phy: float | None, user: str) -> Ticket:
+        return self._cannot()
 
-    def unforce_all(self, user: str) -> None:
-        raise MapError(self.caps.why_not)
+    def unforce_tag(self, tag: Tag, user: str) -> Ticket:
+        return self._cannot()
 
-    def step(self, user: str) -> bool:
-        return False
+    def unforce_all(self, user: str) -> Ticket:
+        return self._cannot()
+
+    def step(self, user: str) -> Ticket:
+        return self._cannot()
 
     def close(self) -> None:
         self._loop.call(self._client.close)  # on the loop, before the loop stops

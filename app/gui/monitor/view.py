@@ -4,11 +4,15 @@ It reads snapshots only (the source's last one), at most REFRESH_MS apart, and r
 a new scan arrived; the listing is a painted scroll area that draws the lines on screen and
 nothing else, so a 2,000-line program costs what 40 lines cost (bench/monitor.py measures the
 scan time with it open). The view never writes memory itself: writes, forces and single scans go
-to the source, which queues them to the engine (journaled with the user) or sends them over Modbus.
+to the source, which sends them to the station's command layer as the user at the workstation
+(checked, journaled with the user, answered) or over Modbus. Each answer comes back to the GUI
+thread (`Answers`) and a refusal is said under the watch table; what the user may not do is greyed,
+its tooltip naming the role it needs (app/gui/rights.py).
 """
 
 from __future__ import annotations
 
+import logging
 from collections.abc import Callable
 
 from PySide6.QtCore import QPoint, QRect, Qt, QTimer, Signal
@@ -32,6 +36,9 @@ from PySide6.QtWidgets import (
     QWidget,
 )
 
+from app.authority import Action, Answer, Ticket
+from app.gui import words
+from app.gui.bridge import Answers
 from app.gui.monitor.listing import (
     FORMATS,
     TERMINATORS,
@@ -44,12 +51,15 @@ from app.gui.monitor.listing import (
     parse_watch,
 )
 from app.gui.monitor.source import Source
+from app.gui.rights import Right, Rights
 from app.gui.status import IDLE, WARN, Pill
 from netplc.address import fmt_octal
-from netplc.forcing import Force, Kind, tag_forces, tag_keys
+from netplc.forcing import Force, Kind, tag_keys
 from netplc.memory import Snapshot
 from netplc.program import CONTACTS
 from netplc.tags.tag import Tag
+
+logger = logging.getLogger(__name__)
 
 REFRESH_MS = 100  # at most 10 refreshes per second
 ON, OFF, FORCED = QColor("#2e7d32"), QColor("#b0b7c0"), QColor("#e65100")
@@ -238,6 +248,9 @@ class ProgramMonitor(QWidget):
         self.watch_items: list[WatchItem] = []
         self._last: Snapshot | None = None
         self.refreshes = 0  # views refreshed from a new snapshot (tests and the bench look)
+        self.answers = Answers()
+        self.answers.answered.connect(self._answered)
+        self.rights = Rights(source.commands, lambda: source.who(self.user()))
 
         self.find = QLineEdit()
         self.find.setPlaceholderText("Find (Enter: next)")
@@ -253,10 +266,11 @@ class ProgramMonitor(QWidget):
         self.step_button.clicked.connect(self.step)
         self.unforce_button = QPushButton("Unforce all")
         self.unforce_button.clicked.connect(self.unforce_all)
-        for button in (self.step_button, self.unforce_button):
-            if not (source.caps.step if button is self.step_button else source.caps.force):
-                button.setEnabled(False)
-                button.setToolTip(source.caps.why_not)
+        caps = source.caps
+        self.rights.add(self.step_button, Action.STEP, "Step one scan",
+                        "" if caps.step else caps.why_not, also=lambda: caps.step)
+        self.rights.add(self.unforce_button, Action.UNFORCE, "Unforce all",
+                        "" if caps.force else caps.why_not, also=lambda: caps.force)
         self.state = QLabel()
         self.state.setObjectName("monitorState")
         self.message = QLabel()  # the last refusal: a bad address, a write the station refused
@@ -396,16 +410,33 @@ class ProgramMonitor(QWidget):
         self.watch.blockSignals(True)
         self.watch.item(r, 0).setText(text.strip())
         self.watch.item(r, 0).setToolTip(item.where)
-        value = self.watch.item(r, 1)
-        value.setFlags(value.flags() | Qt.ItemFlag.ItemIsEditable)
-        how = f"in {item.tag.unit or 'its units'}" if item.tag else "(decimal, 0x1F or 1Fh)"
-        value.setToolTip(f"type a value {how} to write it: journaled with your name")
         self.watch.blockSignals(False)
+        self._show_write(r)
         self._add_empty_row()
-        words = [a for _, a in tag_keys(item.tag)] if item.tag else [item.addr]
-        self.source.need([a >> 3 if item.kind == "bit" and a >= 0o40000 else a for a in words])
+        addrs = [a for _, a in tag_keys(item.tag)] if item.tag else [item.addr]
+        self.source.need([a >> 3 if item.kind == "bit" and a >= 0o40000 else a for a in addrs])
         self._last = None  # show it at the next refresh
         return item
+
+    def update_rights(self) -> None:
+        """After a change of who is at the workstation: the buttons, and the watched values that
+        may be typed over (a write)."""
+        self.rights.update()
+        for r in range(len(self.watch_items)):
+            self._show_write(r)
+
+    def _show_write(self, r: int) -> None:
+        item, value = self.watch_items[r], self.watch.item(r, 1)
+        commands = self.source.commands
+        why = None if commands is None else commands.denial(self.source.who(self.user()), Action.WRITE,
+                                                            what=f"write {item.where}")
+        how = f"in {item.tag.unit or 'its units'}" if item.tag else "(decimal, 0x1F or 1Fh)"
+        editable = Qt.ItemFlag.ItemIsEditable
+        self.watch.blockSignals(True)
+        value.setFlags(value.flags() | editable if why is None else value.flags() & ~editable)
+        value.setToolTip(f"type a value {how} to write it: journaled with your name" if why is None
+                         else words.refusal(why))
+        self.watch.blockSignals(False)
 
     def _watch_edited(self, cell: QTableWidgetItem) -> None:
         r, col = cell.row(), cell.column()
@@ -430,18 +461,21 @@ class ProgramMonitor(QWidget):
                 self._say(str(e))
             self._last = None
 
-    def write(self, item: WatchItem, value: int) -> None:
-        """A write like any operator write: queued (or sent over Modbus), journaled with the user."""
-        try:
-            self.source.write(item.kind, item.addr, value, self.user())
-        except Exception as e:  # LinkError, DeviceError, MapError of a remote station
-            self._say(f"write {item.where} refused: {e}")
+    def write(self, item: WatchItem, value: int) -> Ticket:
+        """A write like any operator write: a command (or sent over Modbus), journaled with the user."""
+        return self._sent(f"write {item.where}", self.source.write(item.kind, item.addr, value, self.user()))
 
-    def write_tag(self, item: WatchItem, phy: float) -> None:
-        """A tag's physical value written as its raw bit or words, each an operator write."""
+    def write_tag(self, item: WatchItem, phy: float) -> Ticket:
+        """A tag's physical value, checked against its type and range, journaled in its units."""
         assert item.tag is not None
-        for f in tag_forces(item.tag, phy):
-            self.write(WatchItem(item.text, f.kind, f.addr), f.value)
+        return self._sent(f"write {item.tag.name}", self.source.write_tag(item.tag, phy, self.user()))
+
+    def _sent(self, what: str, ticket: Ticket) -> Ticket:
+        return self.answers.follow(what, ticket)
+
+    def _answered(self, what: str, answer: Answer) -> None:
+        if not answer.ok:
+            self._say("Refused: " + words.answer(what, answer))
 
     def _watch_menu(self, pos: QPoint) -> None:
         r = self.watch.rowAt(pos.y())
@@ -473,13 +507,14 @@ class ProgramMonitor(QWidget):
 
     def _add_force_actions(self, menu: QMenu, where: str, bumpless: Callable[[], None],
                            ask: Callable[[], None], release: Callable[[], None]) -> None:
-        can = self.source.caps.force
-        for text, slot in ((f"Force {where} at its value (bumpless)", bumpless), (f"Force {where} to…", ask),
-                           (f"Unforce {where}", release)):
+        caps = self.source.caps
+        menu.setToolTipsVisible(True)  # a greyed action says which role it needs
+        for text, slot, act in ((f"Force {where} at its value (bumpless)", bumpless, Action.FORCE),
+                                (f"Force {where} to…", ask, Action.FORCE),
+                                (f"Unforce {where}", release, Action.UNFORCE)):
             action = menu.addAction(text, slot)
-            action.setEnabled(can)
-            if not can:
-                action.setToolTip(self.source.caps.why_not)
+            self.rights.show(Right(action, act, text.rstrip("…"), "" if caps.force else caps.why_not,
+                                   also=lambda: caps.force))
 
     def _ask_force_tag(self, tag: Tag) -> None:
         lo, hi = tag.phy_limits
@@ -491,15 +526,12 @@ class ProgramMonitor(QWidget):
             except ValueError as e:
                 self._say(str(e))
 
-    def force_tag(self, tag: Tag, phy: float | None) -> None:
+    def force_tag(self, tag: Tag, phy: float | None) -> Ticket:
         """Force a tag's bit or all its words to a physical value, or bumpless with None."""
-        try:
-            self.source.force_tag(tag, phy, self.user())
-        except ValueError as e:
-            self._say(str(e))
+        return self._sent(f"force {tag.name}", self.source.force_tag(tag, phy, self.user()))
 
-    def unforce_tag(self, tag: Tag) -> None:
-        self.source.unforce_tag(tag, self.user())
+    def unforce_tag(self, tag: Tag) -> Ticket:
+        return self._sent(f"unforce {tag.name}", self.source.unforce_tag(tag, self.user()))
 
     def _ask_force(self, kind: Kind, addr: int, where: str) -> None:
         text, ok = QInputDialog.getText(self, "Force", f"Force {where} to (decimal, 0x1F or 1Fh):")
@@ -509,23 +541,22 @@ class ProgramMonitor(QWidget):
             except ValueError as e:
                 self._say(str(e))
 
-    def force(self, kind: Kind, addr: int, value: int | None) -> None:
-        try:
-            self.source.force(kind, addr, value, self.user())
-        except ValueError as e:
-            self._say(str(e))
+    def force(self, kind: Kind, addr: int, value: int | None) -> Ticket:
+        where = Force(kind, addr, 0).where
+        return self._sent(f"force {where}", self.source.force(kind, addr, value, self.user()))
 
-    def unforce(self, kind: Kind, addr: int) -> None:
-        self.source.unforce(kind, addr, self.user())
+    def unforce(self, kind: Kind, addr: int) -> Ticket:
+        where = Force(kind, addr, 0).where
+        return self._sent(f"unforce {where}", self.source.unforce(kind, addr, self.user()))
 
-    def unforce_all(self) -> None:
-        self.source.unforce_all(self.user())
+    def unforce_all(self) -> Ticket:
+        return self._sent("Unforce all", self.source.unforce_all(self.user()))
 
-    def step(self) -> None:
+    def step(self) -> Ticket:
         """Step one scan (NetPlc stopped) and show its result at once."""
-        if not self.source.step(self.user()):
-            self._say("Step one scan runs only while NetPlc is stopped (Station -> Stop NetPlc).")
+        ticket = self._sent("Step one scan", self.source.step(self.user()))
         self.refresh()
+        return ticket
 
     # --- navigation ------------------------------------------------------------------------------
 

@@ -139,8 +139,8 @@ def test_forcing_needs_the_engineer_and_is_journaled_with_who():
     sink.commit()
     assert ticket.result(0).ok and engine.forces.count == 1
     assert sink.records[-1].source == "program view:egor"
-    too_hot = layer.force_tag(Who("egor", Source.CONSOLE), "TEMP_SP", 500.0)
-    assert too_hot.result(0).reason is Reason.OUT_OF_RANGE
+    too_hot = layer.force_tag(Who("egor", Source.CONSOLE), "TEMP_SP", 500.0).result(0)
+    assert too_hot.reason is Reason.OUT_OF_RANGE
 
 
 def test_run_and_stop_need_the_engineer():
@@ -161,3 +161,28 @@ def test_the_policy_table_prints_every_action():
 def test_the_readme_prints_the_policy_table_the_layer_uses():
     readme = (Path(__file__).resolve().parents[3] / "README.md").read_text(encoding="utf-8")
     assert policy_table() in readme, "README's policy table is stale: paste app.authority.policy_table()"
+
+
+def test_user_administration_needs_the_admin_and_is_answered_after_the_commit():
+    layer, _engine, sink, _clock, _ = rig()
+    made: list[str] = []
+
+    def change() -> str:
+        made.append("ivan")
+        return "user ivan added as operator"
+
+    assert layer.manage_users(Who("egor", Source.CONSOLE), "ivan", change).result(0).reason is Reason.DENIED
+    assert not made and "refused users ivan: users: needs the admin role" in sink.records[-1].text
+    ticket = layer.manage_users(Who("anna", Source.CONSOLE), "ivan", change)
+    assert made == ["ivan"] and not ticket.done()  # made, not yet on disk
+    sink.commit()
+    assert ticket.result(0).ok and (sink.records[-1].source, sink.records[-1].text) == (
+        "anna", "user ivan added as operator")
+
+    def taken() -> str:
+        from app.authority.users import UserError
+
+        raise UserError("user 'ivan' exists already")
+
+    answer = layer.manage_users(Who("anna", Source.CONSOLE), "ivan", taken).result(0)
+    assert answer.reason is Reason.INVALID and "exists already" in answer.text
