@@ -191,11 +191,29 @@ class Runtime:
             observer(record)
 
     def after_commit(self, callback: Callable[[], None]) -> None:
-        """`callback()` once every record put so far is on disk (the engine answers a Modbus write then)."""
+        """`callback()` once every record put so far is on disk, and so is the retentive memory of
+        the scan that put them (registrar/retain.py): the engine answers an outside writer then, so
+        an acknowledged write survives a crash both in the journal and in memory."""
+        parts: list[Callable[[Callable[[], None]], None]] = []
         if self.store is not None:
-            self.store.after_commit(callback)
-        else:
+            parts.append(self.store.after_commit)
+        if self.retainer is not None:
+            parts.append(self.retainer.after_save)
+        if not parts:
             callback()
+            return
+        left = [len(parts)]
+        lock = threading.Lock()
+
+        def part_done() -> None:
+            with lock:
+                left[0] -= 1
+                last = left[0] == 0
+            if last:
+                callback()
+
+        for part in parts:
+            part(part_done)
 
     def room(self) -> int:
         """Records the archive queue takes before it drops (the engine applies no write beyond it)."""
@@ -295,9 +313,9 @@ class Runtime:
         self.publishers = start_publishers(self)
         self.system(f"program loaded: {self.program.source} ({len(self.program.instrs)} instructions, "
                     f"{self.program.words} words)")
+        self.retainer.start()  # before the first scan: its writers wait for its saves
         self.scan_thread = ScanThread(self.engine, st.tick, on_error=self._scan_error)
         self.scan_thread.start()
-        self.retainer.start()
         self.started = True
         self.system(f"station started: NetSyncTime {st.NetSyncTime} ms, "
                     f"retentive memory from {self.restored}")

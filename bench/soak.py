@@ -1,6 +1,6 @@
 """A bounded soak of a whole station (issue 18): Modbus clients hammering its server, its node
 killed and restarted every 20 s, the archive writing all along. Reports the longest scan, records
-lost (must be 0), resident memory growth and open file descriptors at the end.
+lost (must be 0), retentive saves, resident memory growth and open file descriptors at the end.
 
 The station runs in this process exactly as `main.py --no-gui` runs it (app.runtime.Runtime on a
 station folder written to a temporary directory): a 100 ms tick, a program that NREADs 64 bytes
@@ -216,6 +216,8 @@ def main() -> int:
             time.sleep(WARMUP)
             runtime.engine.stats = ScanStats()
             rss0, fds0, t0 = rss_mb(), open_fds(), time.monotonic()
+            assert runtime.retainer is not None
+            saves0 = runtime.retainer.saves
             next_kill = t0 + KILL_EVERY
             while time.monotonic() - t0 < args.seconds:
                 time.sleep(0.5)
@@ -226,6 +228,7 @@ def main() -> int:
                     kills += 1
                     next_kill += KILL_EVERY
             rss1, fds1 = rss_mb(), open_fds()
+            saves = runtime.retainer.saves - saves0  # one per scan with answered writes, at most
             out, _ = client.communicate(timeout=60)
             counts = json.loads(out.strip().splitlines()[-1])
             status = runtime.status()
@@ -249,6 +252,8 @@ def main() -> int:
         print(f"archive: {store.committed if store else 0:,} records written; "
               f"records lost: {dropped + unjournaled} (dropped {dropped}, answered writes without a "
               f"record {unjournaled}; {journaled:,} Modbus writes journaled)")
+        print(f"retentive memory: {saves:,} saves ({saves / args.seconds:.1f}/s), each before the "
+              "writes of its scan were answered")
         print(f"memory: RSS {rss0:.1f} -> {rss1:.1f} MB ({rss1 - rss0:+.1f} MB); "
               f"open fds {fds0} -> {fds1}")
         return 0 if dropped + unjournaled == 0 else 1

@@ -9,7 +9,8 @@ bounds, so they have a queue of their own with a per-scan budget (DESIGN 1): a s
 `write_budget` of them, so the scan period holds whatever clients send, and a full queue refuses
 the next write (`write_*` returns False; the Modbus server answers exception 6, server busy). A
 writer that must answer someone passes `done`: it is called with True once the write is applied
-and its journal record is durable (the sink's `after_commit`), False if it could not be applied.
+and durable as the sink's `after_commit` says (the station's: its journal record committed and the
+memory of its scan in the retentive save, registrar/retain.py), False if it could not be applied.
 
 The program is compiled once into generated Python (netplc/compiler.py); netplc/interpreter.py is
 the plain reference kept beside it.
@@ -520,7 +521,8 @@ class Engine:
     def _apply_writes(self, mem: Memory) -> None:
         """This scan's share of the outside writes: at most the budget, and none the journal has no
         room for (a write is never applied without its record). Their writers are told once the
-        records are durable: one commit for the whole scan's writes."""
+        sink says the writes are durable, all at once: one commit and one retentive save for the
+        whole scan's writes (the save is taken at the end of this scan, after the program ran)."""
         writes, bits = self._writes, mem.bits
         n = min(len(writes), self.write_budget)
         room = getattr(self.sink, "room", None)

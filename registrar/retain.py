@@ -4,25 +4,44 @@ That is all data memory, the I/O bits 03000-03477, and the timer and counter cur
 (docs/architecture.md section 3). A save is written to a temporary file, fsynced and renamed over the current
 one, whose last good version is kept as the previous save; a crash at any moment leaves at least
 one complete save. Each save carries a CRC, so a damaged file is recognised and the previous one
-used instead. While the engine scans, a save's state is taken by the engine thread between two
-scans (a queued job, as writes are), so memory and the hidden timer and counter values are of the
-same moment; once the scan thread has stopped, the memory is read as it was left.
+used instead.
+
+An acknowledged outside write survives a crash of the station: a writer is answered only once its
+journal record is committed AND a save holding the memory of the scan that applied it is durable
+(`after_save`, joined with the archive's commit by the runtime's `after_commit`). Saving before
+answering was chosen over replaying, at start, the writes journaled after the last save: a replay
+would need the journal to carry each write's raw bytes, in the exact order the engine applied them
+among the program's own changes and the network's results, and a bug there would silently give
+other memory than the plant had; a save is the state itself. It costs one small fsynced file per
+scan at most, shared by every writer of that scan, written on the retainer's thread (the scan only
+copies the timer and counter values), and a writer's answer comes one fsync later.
+
+The state of a save is taken by an engine listener at the end of a scan, so memory (the published
+snapshot) and the hidden timer and counter values are of the same moment; a save wanted while the
+saver still writes the previous one is taken at the next scan's end and replaces any not yet
+written, so saves never queue up behind a slow disk. Without writers the state is saved once a
+`start` interval, for what the program changes itself; once the scan thread has stopped, the
+memory is read as it was left. A save that fails still answers its writers (they were applied and
+journaled, and holding them would make Modbus clients retry): the failure is journaled once and
+shown, and a start that falls back to an older save says which writes may be lost.
 """
 
 from __future__ import annotations
 
 import json
+import logging
 import os
 import struct
 import threading
 import time
 import zlib
+from collections.abc import Callable
 from dataclasses import dataclass
 from pathlib import Path
 
 from netplc.address import DATA_SIZE, IO_BITS, RETAIN_BITS
 from netplc.engine import Engine
-from netplc.memory import Memory, Snapshot
+from netplc.memory import Snapshot
 from netplc.records import Record, RecordSink
 from netplc.timers import held
 
@@ -30,8 +49,10 @@ MAGIC = b"NPLCRETN"
 VERSION = 1
 HEADER = struct.Struct("<8sHII")  # magic, version, crc32 of the payload, payload length
 SOURCE = "retain"
-CAPTURE_WAIT = 1.0  # seconds a save waits for the engine thread to take the state (3 ticks if longer)
+CAPTURE_WAIT = 1.0  # seconds a wanted save waits for a scan to take the state (3 ticks if longer)
 BITS = slice(RETAIN_BITS.start, RETAIN_BITS.stop)
+
+logger = logging.getLogger(__name__)
 
 
 class SaveError(ValueError):
@@ -49,6 +70,16 @@ class Saved:
     wall: float  # wall clock of the scan that was saved
 
 
+@dataclass
+class _Taken:
+    """The state of one moment, to be saved, and the writers waiting for it to be durable."""
+
+    snap: Snapshot
+    tim: list[float]
+    ctr: list[int]
+    waiters: list[Callable[[], None]]
+
+
 class Retainer:
     def __init__(self, path: str | Path, engine: Engine, sink: RecordSink | None = None) -> None:
         self.path = Path(path)
@@ -59,32 +90,66 @@ class Retainer:
         self.saves = 0
         self.last_error = ""
         self._current_good = False  # the current file is ours and complete: it may become .prev
-        self._lock = threading.Lock()
-        self._stop = threading.Event()
+        self._lock = threading.Lock()  # one save at a time writes the files
+        # between the engine listener, the writers' after_save and the saver thread:
+        self._cond = threading.Condition()
+        self._want = False  # a save is wanted: the next scan's end is taken
+        self._asked = 0.0  # when it was first wanted (monotonic), for the wait on a scan
+        self._waiting: list[Callable[[], None]] = []  # after_save callbacks no state was taken for
+        self._taken: _Taken | None = None  # taken at a scan's end, not yet written
+        self._stopping = False
         self._thread: threading.Thread | None = None
+        self._unsubscribe: Callable[[], None] | None = None
 
     # --- restore -------------------------------------------------------------------------------
 
     def restore(self) -> str:
         """Load the newest good save into the engine; call it before the scan thread starts.
 
-        Returns "current", "previous" or "zeroes" and journals which, and why, as a 'system' record.
+        Returns "current", "previous" or "zeroes" and journals which, and why, as a 'system' record;
+        when a save was there but could not be used, also that acknowledged writes may be lost. A
+        crash between a save's two renames (the current save moved to previous, the new one not yet
+        in its place) leaves the newest save, complete and fsynced, as the temporary file: it is used,
+        and becomes the current save.
         """
         problems: list[str] = []
-        for used, path in (("current", self.path), ("previous", self.previous)):
+        for used, path in (("current", self.path), ("written", self._tmp), ("previous", self.previous)):
             try:
                 saved = read_save(path)
             except SaveError as e:
-                problems.append(f"{used} save {e}")
+                if used != "written":  # it is there only when a crash came while a save was written
+                    problems.append(f"{used} save {e}")
                 continue
             self._apply(saved)
-            self._current_good = used == "current"
             why = f" ({'; '.join(problems)})" if problems else ""
-            self._journal(f"retentive memory restored from the {used} save {path.name}{why}")
+            if used == "written":  # a crash between a save's two renames: the newest save, complete
+                self._journal(f"retentive memory restored from the save written at the crash, "
+                              f"{path.name}{why}")
+                self._promote()
+                return "current"
+            self._current_good = used == "current"
+            text = f"retentive memory restored from the {used} save {path.name}{why}"
+            if used == "previous":
+                text += f": writes acknowledged after {_when(saved.wall)} may be lost"
+            self._journal(text)
             return used
         self._apply(Saved(bytes(len(RETAIN_BITS)), bytes(DATA_SIZE), {}, {}, 0.0))
-        self._journal(f"retentive memory starts from zeroes ({'; '.join(problems)})")
+        text = f"retentive memory starts from zeroes ({'; '.join(problems)})"
+        if any(not p.endswith("is missing") for p in problems):
+            text += ": every write acknowledged before may be lost"
+        self._journal(text)
         return "zeroes"
+
+    def _promote(self) -> None:
+        """Make the save written at a crash the current one, so the next save keeps it as previous."""
+        try:
+            os.replace(self._tmp, self.path)
+            _fsync_dir(self.path.parent)
+        except OSError as e:  # the next save tries again; until then the file is used as it is
+            logger.exception("retentive save %s not renamed to %s", self._tmp, self.path)
+            self._journal(f"retentive memory: {self._tmp.name} could not become {self.path.name}: {e}")
+        else:
+            self._current_good = True
 
     def _apply(self, saved: Saved) -> None:
         engine = self.engine
@@ -100,11 +165,51 @@ class Retainer:
 
     # --- save ----------------------------------------------------------------------------------
 
-    def save(self, *, live: bool = False) -> None:
-        """Write the retentive state; OSError if the disk refuses. `live` while the scan thread
-        runs (the state is then taken between two scans), else the memory is read as it is."""
+    def after_save(self, callback: Callable[[], None]) -> None:
+        """Call `callback()`, on the retainer's thread, once a save of the memory as the current scan
+        leaves it is durable (or was tried and failed, which is journaled). The engine thread calls
+        it while applying a scan's writes; every writer of the scan shares the one save. Thread-safe:
+        from another thread, the save is of the end of a scan that ends after the call."""
+        with self._cond:
+            self._waiting.append(callback)
+            self._ask()
+
+    def _ask(self) -> None:
+        """Want a save (with _cond held)."""
+        if not self._want:
+            self._want, self._asked = True, time.monotonic()
+
+    def _on_scan(self, snapshot: Snapshot) -> None:
+        """The engine listener: take the state at the end of this scan if a save is wanted. Copies
+        of two lists only, so the scan stays short; the saver thread does the rest."""
+        if not self._want:
+            return
         engine = self.engine
-        snap, (tim, ctr) = self._capture() if live else (engine.snapshot, engine.held_values())
+        tim, ctr = engine.tim_ticks.copy(), engine.ctr_values.copy()
+        with self._cond:
+            self._want = False
+            waiters, self._waiting = self._waiting, []
+            if self._taken is not None:  # not yet written: this newer state replaces it
+                waiters[:0] = self._taken.waiters
+            self._taken = _Taken(snapshot, tim, ctr, waiters)
+            self._cond.notify()
+
+    def _as_left(self) -> _Taken:
+        """The state as the engine left it, with every waiter (with _cond held): for a save no
+        scan comes to take (the scan thread stopped)."""
+        engine = self.engine
+        waiters = (self._taken.waiters if self._taken is not None else []) + self._waiting
+        self._taken, self._waiting, self._want = None, [], False
+        return _Taken(engine.snapshot, engine.tim_ticks.copy(), engine.ctr_values.copy(), waiters)
+
+    def save(self) -> None:
+        """Write the retentive state as the engine holds it now; OSError if the disk refuses. Only
+        while no scan runs: while the scan thread runs, the state is taken at the end of a scan
+        (`after_save`, `start`)."""
+        engine = self.engine
+        self._write(engine.snapshot, *engine.held_values())
+
+    def _write(self, snap: Snapshot, tim: dict[int, float], ctr: dict[int, int]) -> None:
         meta = json.dumps({"tim": {str(k): v for k, v in tim.items()},
                            "ctr": {str(k): v for k, v in ctr.items()},
                            "wall": snap.wall, "scan": snap.scan}).encode()
@@ -123,57 +228,74 @@ class Retainer:
             self._current_good = True
             self.saves += 1
 
-    def _capture(self) -> tuple[Snapshot, tuple[dict[int, float], dict[int, int]]]:
-        """Memory and timer/counter values of one moment, taken by the engine thread at the start of
-        its next scan; read directly if no scan comes (the scan thread stopped meanwhile)."""
-        engine = self.engine
-        taken: list[tuple[Snapshot, list[float], list[int]]] = []
-        done = threading.Event()
-
-        def take(mem: Memory) -> None:  # copies only: the scan it delays stays short
-            taken.append((mem.snapshot(engine.scan_counter, engine.now, engine.wall_time()),
-                          engine.tim_ticks.copy(), engine.ctr_values.copy()))
-            done.set()
-
-        engine.post(take)
-        if done.wait(max(CAPTURE_WAIT, 3 * engine.tick)):
-            snap, tim, ctr = taken[0]
-            return snap, held(tim, ctr)
-        return engine.snapshot, engine.held_values()
-
-    def _save_reporting(self, live: bool = False) -> None:
+    def _save_reporting(self, taken: _Taken) -> None:
+        """Save `taken`, journal a failure once and the recovery once, then answer its waiters."""
         try:
-            self.save(live=live)
+            self._write(taken.snap, *held(taken.tim, taken.ctr))
         except OSError as e:
             if not self.last_error:
-                self._journal(f"retentive memory could not be saved: {e}")
+                self._journal(f"retentive memory could not be saved: {e}; writes are answered all the "
+                              "same and come back older after a crash until it is saved again")
             self.last_error = str(e)
         else:
             if self.last_error:
                 self.last_error = ""
                 self._journal("retentive memory is being saved again")
+        for callback in taken.waiters:
+            try:
+                callback()
+            except Exception as e:  # one waiter's bug must not leave the others unanswered
+                logger.exception("a writer waiting for the retentive save failed")
+                self._journal(f"retentive save waiter failed: {e!r}")
 
     # --- background ----------------------------------------------------------------------------
 
     def start(self, interval: float = 1.0) -> None:
-        self._stop.clear()
+        """Take and write saves from now on: promptly for waiters, and every `interval` seconds."""
+        with self._cond:
+            self._stopping = False
+        self._unsubscribe = self.engine.subscribe(self._on_scan, "retentive memory")
         self._thread = threading.Thread(target=self._loop, args=(interval,), name="retain", daemon=True)
         self._thread.start()
 
     def stop(self) -> None:
-        """Stop the periodic saves and save once more (call it after the scan thread stopped)."""
-        self._stop.set()
+        """Stop the saves and save once more, answering every waiter (call it after the scan
+        thread stopped)."""
+        if self._unsubscribe is not None:
+            self._unsubscribe()
+            self._unsubscribe = None
+        with self._cond:
+            self._stopping = True
+            self._cond.notify()
         if self._thread is not None:
             self._thread.join()
             self._thread = None
-        self._save_reporting()
+        with self._cond:
+            last = self._as_left()
+        self._save_reporting(last)
 
     def _loop(self, interval: float) -> None:
-        """Save on a fixed cadence: a slow fsync must not push every later save back as well."""
+        """Write each state as soon as a scan took it; ask for one every `interval` on a fixed
+        cadence (a slow fsync must not push every later save back as well)."""
+        wait = max(CAPTURE_WAIT, 3 * self.engine.tick)
         due = time.monotonic() + interval
-        while not self._stop.wait(max(0.0, due - time.monotonic())):
-            self._save_reporting(live=True)
-            due = max(due + interval, time.monotonic())
+        while True:
+            with self._cond:
+                while self._taken is None and not self._stopping:
+                    now = time.monotonic()
+                    if now >= due:
+                        self._ask()
+                    if self._want and now >= self._asked + wait:
+                        break  # no scan took it: the scan thread has stopped
+                    self._cond.wait((self._asked + wait if self._want else due) - now)
+                if self._stopping:
+                    return  # stop() saves the rest
+                taken = self._taken if self._taken is not None else self._as_left()
+                self._taken = None
+            started = time.monotonic()
+            self._save_reporting(taken)
+            if started >= due:
+                due = max(due + interval, time.monotonic())
 
 
 def read_save(path: Path) -> Saved:
@@ -202,6 +324,11 @@ def read_save(path: Path) -> Saved:
     except (ValueError, KeyError, TypeError, AttributeError) as e:
         raise SaveError(f"has unreadable timer and counter values: {e}") from None
     return Saved(payload[:nbits], payload[nbits:nbits + DATA_SIZE], tim, ctr, wall)
+
+
+def _when(wall: float) -> str:
+    """A save's wall-clock time as the journal's reader reads it (local time, to the millisecond)."""
+    return time.strftime("%Y-%m-%d %H:%M:%S", time.localtime(wall)) + f".{int(wall % 1 * 1000):03d}"
 
 
 def _fsync_dir(directory: Path) -> None:

@@ -1,5 +1,6 @@
 """Retentive memory through the runtime: counting in data memory continues after a clean stop and
-after SIGKILL (at most the last second lost)."""
+after SIGKILL (at most the last second of what the program counted lost); an answered write is in
+the save already (tests/app/test_kill_writes.py kills the station under writes)."""
 
 from __future__ import annotations
 
@@ -7,11 +8,14 @@ import re
 import signal
 import subprocess
 import sys
+import threading
 import time
 from pathlib import Path
 
 from app.config import load_station
 from app.runtime import Runtime
+from netplc.memory import Memory
+from registrar.retain import read_save
 from tests.app.conftest import REPO, write_station
 from tests.app.test_runtime_errors import wait_for
 
@@ -74,6 +78,24 @@ def test_counting_continues_after_sigkill(tmp_path: Path) -> None:
         # the save is at most a second old (50 scans of 20 ms) plus the time one save takes to reach
         # the disk (its fsync: up to a few hundred ms on a disk busy with the fresh .venv's pages)
         assert scans - 75 <= restored <= scans + 50
+    finally:
+        runtime.stop()
+
+
+def test_an_answered_write_is_in_the_retentive_save_already(tmp_path: Path) -> None:
+    station = load_station(counting_station(tmp_path))
+    runtime = Runtime(station)
+    runtime.start()
+    saved = Memory()
+    answered = threading.Semaphore(0)
+    engine = runtime.engine
+    try:
+        assert engine is not None
+        for value in range(1, 31):
+            assert engine.write_word(0o4100, value, user="modbus test", done=lambda ok: answered.release())
+            assert answered.acquire(timeout=10)
+            saved.data[:] = read_save(station.Retain).data
+            assert saved.get_word(0o4100) == value
     finally:
         runtime.stop()
 
