@@ -92,7 +92,7 @@ def archive_problem(path: Path) -> str | None:
     and can be created."""
     try:
         info = path.stat()
-    except FileNotFoundError:
+    except (FileNotFoundError, NotADirectoryError):
         folder = next((f for f in path.parents if f.exists()), None)
         if folder is not None and not folder.is_dir():
             return f"cannot create it: {folder} is a file, not a folder"
