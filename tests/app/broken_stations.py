@@ -42,11 +42,15 @@ def allow_outside(st: Path) -> None:
 
 
 def link(path: Path, target: str | Path) -> None:
-    if path.is_dir() and not path.is_symlink():
-        path.rmdir()
-    else:
-        path.unlink(missing_ok=True)
+    path.unlink(missing_ok=True)
     os.symlink(target, path)
+
+
+def replaced(path: Path, make: Callable[[Path], object]) -> Path:
+    """`path`, its file replaced by what `make` makes there (a folder, a FIFO)."""
+    path.unlink()
+    make(path)
+    return path
 
 
 def users(st: Path, doc: object) -> Path:
@@ -89,9 +93,8 @@ def _users_dev_zero(st: Path) -> str:
 
 
 def _users_folder(st: Path) -> str:
-    (st / "users.json").unlink()
-    (st / "users.json").mkdir()
-    return f"{st / 'users.json'}: cannot read the users file: it is a folder, not a file"
+    path = replaced(st / "users.json", Path.mkdir)
+    return f"{path}: cannot read the users file: it is a folder, not a file"
 
 
 def _program_loop(st: Path) -> str:
@@ -100,15 +103,13 @@ def _program_loop(st: Path) -> str:
 
 
 def _program_fifo(st: Path) -> str:
-    (st / "netplc.stl").unlink()
-    os.mkfifo(st / "netplc.stl")
-    return f"{st / 'station.toml'}: NetPlcProgram: file {st / 'netplc.stl'} is a FIFO (named pipe)"
+    program = replaced(st / "netplc.stl", os.mkfifo)
+    return f"{st / 'station.toml'}: NetPlcProgram: file {program} is a FIFO (named pipe), not a file"
 
 
 def _program_folder(st: Path) -> str:
-    (st / "netplc.stl").unlink()
-    (st / "netplc.stl").mkdir()
-    return f"{st / 'station.toml'}: NetPlcProgram: file {st / 'netplc.stl'} is a folder, not a file"
+    program = replaced(st / "netplc.stl", Path.mkdir)
+    return f"{st / 'station.toml'}: NetPlcProgram: file {program} is a folder, not a file"
 
 
 def _tags_dev_zero_allowed(st: Path) -> str:
