@@ -5,8 +5,9 @@ both call `load`, so `check` reports exactly what a start would refuse.
 Each part is read even when an earlier one failed, the good lines of a broken symbols file are
 kept and a broken program is read again without its bad lines, so the checks that need a whole
 program (the nodes of NREAD/NWRITE) still run on the rest: an engineer gets the whole list at
-once, each line naming its file and place. Forms are apart: a form that does not load is a problem the station runs with (the other
-forms open; its behaviour is missing and said so), never a reason not to start.
+once, each line naming its file and place. Forms are apart: a form that does not load is a
+problem the station runs with (the other forms open; its behaviour is missing and said so), never
+a reason not to start.
 """
 
 from __future__ import annotations
