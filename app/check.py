@@ -2,9 +2,9 @@
 
 It reads the station exactly as a start does (`app.load.load`, the runtime's own loader), so what
 `check` passes a start accepts; on top, it reports what a start only journals: node host names
-that do not resolve, forms that do not load and a Retain that is not a file; and what only the
-start's opening of the archive would find (a folder, or a file that is no SQLite database, where
-the archive should be), in the words the start refuses with.
+that do not resolve and forms that do not load; and what only the start's opening of the archive
+would find (a folder, or a file that is no SQLite database, where the archive should be), in the
+words the start refuses with.
 """
 
 from __future__ import annotations
@@ -15,7 +15,6 @@ from pathlib import Path
 from app.config import read_station
 from app.load import load
 from app.runtime import unresolved_hosts
-from netplc.textfile import MISSING, file_problem
 from registrar.store import archive_problem
 
 
@@ -40,9 +39,6 @@ def check_station(path: str | Path) -> CheckReport:
     if problem := archive_problem(station.Archive):
         report.problems.append(f"{station.path}: Archive: {station.Archive}: cannot open the archive: "
                                f"{problem}")
-    if (why := file_problem(station.Retain)) not in (None, MISSING):
-        report.problems.append(f"{station.path}: Retain: {station.Retain} {why}: the retentive memory "
-                               "could not be saved there")
     loaded = load(station)
     report.problems += loaded.problems + loaded.form_problems
     report.notes += loaded.notes

@@ -22,7 +22,7 @@ from hmi_forms.form import Form, load_forms
 from netplc.exchange import check_program_nodes
 from netplc.program import Program, ProgramError, load_symbols, parse, parse_file, read_symbols
 from netplc.tags.table import TagTable, read_tags
-from netplc.textfile import TextFileError, confine, read_text
+from netplc.textfile import MISSING, TextFileError, confine, file_problem, read_text
 from registrar.catalog import Catalog, CatalogError
 
 RECOVERY_ROUNDS = 5
@@ -68,6 +68,7 @@ def load(station: Station) -> Loaded:
         out.notes.append(f"tags {station.Tags.name}: {len(out.tags.tags)} tags, "
                          f"{len(out.tags.alarms)} with alarms")
     _users(station, out)
+    _state_files(station, out)
     out.forms, out.form_problems = load_station_forms(station, out.symbols, out.tags)
     if station.HMIload is not None:
         out.notes.append(f"forms in {station.HMIload}: {len(out.forms)} loaded")
@@ -119,6 +120,15 @@ def _users(station: Station, out: Loaded) -> None:
     elif users.users:
         out.notes.append(f"users {USERS_FILE}: {len(users.users)}"
                          + (f", {name!r} at the workstation until someone logs in" if name else ""))
+
+
+def _state_files(station: Station, out: Loaded) -> None:
+    """The files the station writes and reads back at its next start (retentive memory, retained
+    forces): a folder, FIFO or device there would be read without end or never saved."""
+    files = [("Retain", station.Retain)] + [("RetainForces", station.forces_file)] * station.RetainForces
+    for key, path in files:
+        if (why := file_problem(path)) not in (None, MISSING):
+            out.problems.append(f"{station.path}: {key}: {path} {why}")
 
 
 def _program(station: Station, out: Loaded) -> Program | None:

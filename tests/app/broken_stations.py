@@ -180,6 +180,20 @@ def _archive_not_sqlite(st: Path) -> str:
     return f"{st / 'station.toml'}: Archive: {archive}: cannot open the archive: not an SQLite database"
 
 
+def _retain_folder(st: Path) -> str:
+    retain = st / "archive" / "retain.bin"
+    retain.mkdir(parents=True)
+    return f"{st / 'station.toml'}: Retain: {retain} is a folder, not a file"
+
+
+def _forces_dev_zero(st: Path) -> str:
+    replace(st / "station.toml", 'name = "Demo station"', 'name = "Demo station"\nRetainForces = true')
+    forces = st / "archive" / "retain.forces.json"
+    forces.parent.mkdir()
+    link(forces, "/dev/zero")
+    return f"{st / 'station.toml'}: RetainForces: {forces} is a character device, not a file"
+
+
 CASES = [
     Broken("default user admin", _default_admin),
     Broken("default user unknown", _default_unknown),
@@ -202,6 +216,8 @@ CASES = [
     Broken("form is /dev/zero (allow_outside)", _form_dev_zero_allowed, "journal"),
     Broken("form is a folder", _form_folder, "journal"),
     Broken("form image links to itself", _image_loop, "journal"),
+    Broken("Retain is a folder", _retain_folder),
+    Broken("retained forces are /dev/zero", _forces_dev_zero),
     Broken("Archive is a folder", _archive_folder, "start"),
     Broken("Archive is not SQLite", _archive_not_sqlite, "start"),
 ]
