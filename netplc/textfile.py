@@ -99,7 +99,7 @@ def file_problem(path: Path, folder: bool = False) -> str | None:
     it is. Links are followed."""
     try:
         mode = path.stat().st_mode
-    except FileNotFoundError:
+    except (FileNotFoundError, NotADirectoryError):  # nothing there, or a file where a folder is named
         return MISSING
     except OSError as e:
         return e.strerror or str(e)
