@@ -2,7 +2,9 @@
 
 It reads the station exactly as a start does (`app.load.load`, the runtime's own loader), so what
 `check` passes a start accepts; on top, it reports what a start only journals: node host names
-that do not resolve and forms that do not load.
+that do not resolve and forms that do not load; and what only the start's opening of the archive
+would find (a folder, or a file that is no SQLite database, where the archive should be), in the
+words the start refuses with.
 """
 
 from __future__ import annotations
@@ -13,6 +15,7 @@ from pathlib import Path
 from app.config import read_station
 from app.load import load
 from app.runtime import unresolved_hosts
+from registrar.store import archive_problem
 
 
 @dataclass
@@ -33,6 +36,9 @@ def check_station(path: str | Path) -> CheckReport:
         return report
     report.notes.append(f"station {station.path}")
     report.problems += unresolved_hosts(station)
+    if problem := archive_problem(station.Archive):
+        report.problems.append(f"{station.path}: Archive: {station.Archive}: cannot open the archive: "
+                               f"{problem}")
     loaded = load(station)
     report.problems += loaded.problems + loaded.form_problems
     report.notes += loaded.notes

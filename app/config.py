@@ -19,7 +19,7 @@ from netplc.exchange import LIMITS, NODE_NUMBERS, UNITS, NodeConfig, unit_proble
 from netplc.modbus import PROFILES, TABLES, Endpoint, parse_endpoint
 from netplc.problems import Problems
 from netplc.tags.tag import TagType
-from netplc.textfile import TextFileError, read_text
+from netplc.textfile import TextFileError, file_problem, read_text, resolve
 from registrar.plant.url import is_url, url_problem
 
 STATION_FILE = "station.toml"
@@ -195,7 +195,11 @@ class _Reader:
         if "\0" in value:
             self.bad(key, "a path cannot hold a NUL character")
             return None
-        path = (base / value).resolve()
+        try:
+            path = resolve(base / value)
+        except TextFileError as e:
+            self.bad(key, f"{e.source}: {e.problem}")
+            return None
         if not self.allow_outside and not path.is_relative_to(base):
             self.bad(key, f"{path} is outside the station folder {base} (allow_outside = true permits it)")
             return None
@@ -228,7 +232,7 @@ def read_station(path: str | Path) -> tuple[Station | None, list[str]]:
     in the returned station; None instead of a station when the file is not TOML at all."""
     file = station_file(path)
     fname = str(file)
-    if not file.exists():
+    if not (file.exists() or file.is_symlink()):  # a link that leads nowhere is named by read_text
         return None, [f"{fname}: no station file here"]
     try:
         data = tomllib.loads(read_text(file, "the station file"))
@@ -279,10 +283,10 @@ def read_station(path: str | Path) -> tuple[Station | None, list[str]]:
                                     ("Tags", tags, False)))
     runnable: list[SimulatorSettings] = []
     for i, sim in enumerate(simulators):
-        missing = [(key, p) for key, p in (("program", sim.program), ("symbols", sim.symbols))
-                   if p is not None and not p.is_file()]
-        for key, p in missing:
-            problems.append(f"{fname}: simulators[{i}].{key}: file {p} does not exist")
+        missing = [(key, p, why) for key, p in (("program", sim.program), ("symbols", sim.symbols))
+                   if p is not None and (why := file_problem(p))]
+        for key, p, why in missing:
+            problems.append(f"{fname}: simulators[{i}].{key}: file {p} {why}")
         if not missing:
             runnable.append(sim)
     archive = archive or base / "archive" / "journal.sqlite"
@@ -336,8 +340,11 @@ def _plant_archive(top: _Reader) -> str | None:
 
 
 def _existing(r: _Reader, key: str, path: Path | None, must_be_dir: bool) -> Path | None:
-    if path is not None and not (path.is_dir() if must_be_dir else path.is_file()):
-        r.bad(key, f"{'folder' if must_be_dir else 'file'} {path} does not exist")
+    """`path` if it is an existing file (folder); else None and the problem, which says what is
+    there instead (a folder, a FIFO, a device) when something is."""
+    why = file_problem(path, must_be_dir) if path is not None else None
+    if why is not None:
+        r.bad(key, f"{'folder' if must_be_dir else 'file'} {path} {why}")
         return None
     return path
 

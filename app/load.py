@@ -1,26 +1,28 @@
 """Everything a station reads before it starts: symbols, the NetPlc program, the simulated nodes'
-programs, the message catalog and the forms. The runtime's start and `check` both call `load`, so
-`check` reports exactly what a start would refuse.
+programs, the message catalog, the tags, the users and the forms. The runtime's start and `check`
+both call `load`, so `check` reports exactly what a start would refuse.
 
-Each part is read even when an earlier one failed, and a broken program or symbols file is read
-again without its bad lines, so the checks that need a whole program (the nodes of NREAD/NWRITE)
-still run on the rest: an engineer gets the whole list at once, each line naming its file and
-place. Forms are apart: a form that does not load is a problem the station runs with (the other
-forms open; its behaviour is missing and said so), never a reason not to start.
+Each part is read even when an earlier one failed, the good lines of a broken symbols file are
+kept and a broken program is read again without its bad lines, so the checks that need a whole
+program (the nodes of NREAD/NWRITE) still run on the rest: an engineer gets the whole list at
+once, each line naming its file and place. Forms are apart: a form that does not load is a
+problem the station runs with (the other forms open; its behaviour is missing and said so), never
+a reason not to start.
 """
 
 from __future__ import annotations
 
-import tempfile
 from dataclasses import dataclass, field
 from pathlib import Path
 
+from app.authority.policy import VIEWER
+from app.authority.users import USERS_FILE, Users, UsersFileError
 from app.config import Station
 from hmi_forms.form import Form, load_forms
 from netplc.exchange import check_program_nodes
-from netplc.program import Program, ProgramError, load_symbols, parse, parse_file
+from netplc.program import Program, ProgramError, load_symbols, parse, parse_file, read_symbols
 from netplc.tags.table import TagTable, read_tags
-from netplc.textfile import TextFileError, read_text
+from netplc.textfile import MISSING, TextFileError, confine, file_problem, read_text
 from registrar.catalog import Catalog, CatalogError
 
 RECOVERY_ROUNDS = 5
@@ -65,6 +67,8 @@ def load(station: Station) -> Loaded:
         out.problems += problems
         out.notes.append(f"tags {station.Tags.name}: {len(out.tags.tags)} tags, "
                          f"{len(out.tags.alarms)} with alarms")
+    _users(station, out)
+    _state_files(station, out)
     out.forms, out.form_problems = load_station_forms(station, out.symbols, out.tags)
     if station.HMIload is not None:
         out.notes.append(f"forms in {station.HMIload}: {len(out.forms)} loaded")
@@ -85,22 +89,46 @@ def _symbols(path: Path | None, out: Loaded) -> dict[str, int]:
     """The symbols; with errors, those of the good lines, so the program is checked against them."""
     if path is None:
         return {}
+    symbols, errors = read_symbols(path)
+    out.problems += [str(d) for d in errors]
+    return symbols
+
+
+def _users(station: Station, out: Loaded) -> None:
+    """users.json, and the user [operator] default_user names: whoever sits at the workstation
+    without logging in acts as that user, so it must exist and be a viewer."""
+    path = station.folder / USERS_FILE
     try:
-        return load_symbols(path)
-    except ProgramError as e:
+        if not station.allow_outside:
+            confine(path, station.folder)
+        users = Users(station.folder)
+    except TextFileError as e:
+        out.problems.append(str(e))
+        return
+    except UsersFileError as e:
         out.problems += e.problems
-        bad = {d.line for d in e.errors}
-    try:
-        text = _blank_lines(path, bad)
-    except TextFileError:
-        return {}  # already reported
-    with tempfile.TemporaryDirectory() as tmp:
-        good = Path(tmp) / path.name
-        good.write_text(text, encoding="utf-8")
-        try:
-            return load_symbols(good)
-        except ProgramError:
-            return {}
+        return
+    name = station.operator.default_user
+    user = users.get(name)
+    key = f"{station.path}: operator.default_user"
+    if name and user is None:
+        out.problems.append(f"{key}: no user {name!r} in {path} (`main.py users add {name} --role viewer` "
+                            "adds one)")
+    elif user is not None and user.role != VIEWER:
+        out.problems.append(f"{key}: {name!r} is of role {user.role}: the default user acts for whoever "
+                            "is at the workstation without logging in, so it must be a viewer")
+    elif users.users:
+        out.notes.append(f"users {USERS_FILE}: {len(users.users)}"
+                         + (f", {name!r} at the workstation until someone logs in" if name else ""))
+
+
+def _state_files(station: Station, out: Loaded) -> None:
+    """The files the station writes and reads back at its next start (retentive memory, retained
+    forces): a folder, FIFO or device there would be read without end or never saved."""
+    files = [("Retain", station.Retain)] + [("RetainForces", station.forces_file)] * station.RetainForces
+    for key, path in files:
+        if (why := file_problem(path)) not in (None, MISSING):
+            out.problems.append(f"{station.path}: {key}: {path} {why}")
 
 
 def _program(station: Station, out: Loaded) -> Program | None:

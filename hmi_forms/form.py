@@ -26,7 +26,7 @@ from hmi_forms.elements import props as p
 from hmi_forms.elements.analog import Scaled, scaling_problems
 from netplc.problems import Problems
 from netplc.tags.table import TagTable
-from netplc.textfile import TextFileError, read_text
+from netplc.textfile import TextFileError, confine, read_text
 
 FORM_BACK = (0xDD, 0xE1, 0xE6, 255)
 FORM_FORE = (0x1A, 0x1A, 0x1A, 255)
@@ -128,6 +128,14 @@ class _Loader:
         self.fatal += fatal
 
     def load(self) -> Form:
+        """The form of the file. A station's form is read only from inside the station folder,
+        links followed (unless allow_outside): one that is a link to /dev/zero or to another
+        station's file is a problem, not read."""
+        if self.ctx.roots and not self.ctx.allow_outside:
+            try:
+                confine(self.path, self.ctx.roots[0])
+            except TextFileError as e:
+                raise FormError([str(e)]) from None
         return self.build(parse_form(self.path))
 
     def build(self, doc: Any) -> Form:

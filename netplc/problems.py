@@ -3,8 +3,8 @@ and place (`file:line: ...`, `station.toml: key: ...`).
 
 An engineer fixing a station wants the whole list at once, not one error per attempt, so loaders
 collect problems and raise this once. Each input keeps a subclass of its own name (ConfigError,
-ProgramError, CatalogError, FormError, StartError) only so a caller can tell what failed; they
-add nothing, and whoever just reports catches `Problems`.
+ProgramError, CatalogError, FormError, TagError, UsersFileError, StartError) only so a caller can
+tell what failed; they add nothing, and whoever just reports catches `Problems`.
 """
 
 from __future__ import annotations

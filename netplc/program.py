@@ -10,7 +10,15 @@ import re
 from dataclasses import dataclass, field
 from pathlib import Path
 
-from netplc.address import IO_BITS, AddressError, check_operand, fmt_octal, parse_octal
+from netplc.address import (
+    IO_BITS,
+    AddressError,
+    check_operand,
+    fmt_octal,
+    is_data_byte,
+    parse_hmi_bit,
+    parse_octal,
+)
 from netplc.functions.registry import DEFINED_CODES, FunctionSpec, lookup
 from netplc.problems import Problems
 from netplc.textfile import MAX_DIGITS, TextFileError, csv_rows, read_text
@@ -88,13 +96,22 @@ class Program:
 
 def load_symbols(path: str | Path) -> dict[str, int]:
     """Read `symbols.csv` (name,address,comment); ProgramError names the file and line."""
+    symbols, errors = read_symbols(path)
+    if errors:
+        raise ProgramError(errors)
+    return symbols
+
+
+def read_symbols(path: str | Path) -> tuple[dict[str, int], list[Diagnostic]]:
+    """The symbols of the good lines of `symbols.csv`, and the problem of each other line (for
+    `check`, which goes on to check the program against the good ones)."""
     path = Path(path)
     errors: list[Diagnostic] = []
     symbols: dict[str, int] = {}
     try:
         text = read_text(path, "symbols")
     except TextFileError as e:
-        raise ProgramError([Diagnostic(str(path), e.line, 0, e.problem)]) from None
+        return {}, [Diagnostic(str(path), e.line, 0, e.problem)]
     for lineno, row in csv_rows(text):
         if isinstance(row, str):
             errors.append(Diagnostic(str(path), lineno, 1, row))
@@ -108,7 +125,7 @@ def load_symbols(path: str | Path) -> dict[str, int]:
             errors.append(Diagnostic(str(path), lineno, 1, f"symbol {name!r} has no address"))
             continue
         try:
-            addr = parse_octal(row[1])
+            addr = _symbol_address(row[1])
         except ValueError as e:
             errors.append(Diagnostic(str(path), lineno, len(row[0]) + 2, str(e)))
             continue
@@ -118,9 +135,27 @@ def load_symbols(path: str | Path) -> dict[str, int]:
             errors.append(Diagnostic(str(path), lineno, 1, f"symbol {name!r} defined twice"))
         else:
             symbols[name] = addr
-    if errors:
-        raise ProgramError(errors)
-    return symbols
+    return symbols, errors
+
+
+def _symbol_address(text: str) -> int:
+    """A symbol's address: an I/O bit, a data byte, or a data bit the HMI way (byte*8 + bit). A
+    symbol no program uses is checked too: an address naming no memory is a typo all the same."""
+    if len(text.strip()) > MAX_DIGITS:
+        raise ValueError(f"an address of {len(text.strip())} characters names no memory")
+    addr = parse_octal(text)
+    if not (is_data_byte(addr) or _is_hmi_bit(addr)):
+        raise AddressError(f"{fmt_octal(addr)} names no memory: neither an I/O bit (00000-03777), a "
+                           "data byte (k*010000 + 04000-07777) nor a data bit (byte*8 + bit)")
+    return addr
+
+
+def _is_hmi_bit(addr: int) -> bool:
+    try:
+        parse_hmi_bit(addr)
+    except AddressError:
+        return False
+    return True
 
 
 def parse_file(path: str | Path, symbols: dict[str, int] | None = None) -> Program:

@@ -1,19 +1,32 @@
-"""Reading the station's text files (programs, symbols.csv, messages.csv, station.toml, forms).
+"""Reading the station's text files (programs, symbols.csv, messages.csv, tags.csv, station.toml,
+forms, users.json).
 
 One decision for every loader: a file is UTF-8, with or without a byte order mark; a file that is
 not valid UTF-8 is read as cp1251, which is what the Windows tools of the manual's era (Notepad,
 Excel "CSV") write for Cyrillic text. A byte cp1251 does not define either is a `TextFileError`
 naming the file and the position, never a UnicodeDecodeError. CSV rows come with their line number,
 and a CSV the csv module refuses (a field over its size limit, a NUL) is a problem of that line.
+
+A station folder is input like any other: only a regular file of at most MAX_BYTES is read, so a
+name that is a link to /dev/zero, a FIFO, a device or a folder is a named problem instead of a
+read that never ends or fills the memory, and a loop of symbolic links is named too (Python 3.11's
+`Path.resolve` raises RuntimeError for one).
 """
 
 from __future__ import annotations
 
 import csv
+import os
+import stat
 from collections.abc import Iterator
 from pathlib import Path
 
 FALLBACK = "cp1251"
+# The largest station text file read: the demo's largest is 20 KB, a full 8 K-word program with
+# comments well under 1 MB; what is larger is a mistake (a log, an archive) and is not read whole.
+MAX_BYTES = 16 * 1024 * 1024
+MISSING = "does not exist"  # what file_problem says of a name with nothing there
+_OPEN = os.O_RDONLY | getattr(os, "O_NONBLOCK", 0) | getattr(os, "O_BINARY", 0)  # a FIFO opens at once
 # Decimal digits accepted in a whole number of a text file: past Python's int() conversion limit
 # (4300 digits) int() raises, and no value of a station needs more than a few digits anyway.
 MAX_DIGITS = 100
@@ -42,19 +55,83 @@ def decode(data: bytes, source: str) -> str:
                                               f"(byte 0x{data[e.start]:02X})") from None
 
 
-def read_text(path: str | Path, what: str = "the file") -> str:
+def read_text(path: str | Path, what: str = "the file", limit: int = MAX_BYTES) -> str:
     """The text of `path` (see `decode`); TextFileError names the file and what it is."""
+    return decode(read_bytes(path, what, limit), str(path))
+
+
+def read_bytes(path: str | Path, what: str = "the file", limit: int = MAX_BYTES) -> bytes:
+    """The bytes of the regular file `path`, at most `limit` of them; TextFileError names the file
+    and why it is not read (not a file, too large, a loop of links, no permission)."""
+    source = str(path)
     try:
-        data = Path(path).read_bytes()
+        fd = os.open(path, _OPEN)
     except OSError as e:
-        raise TextFileError(str(path), 0, f"cannot read {what}: {e.strerror or e}") from None
-    return decode(data, str(path))
+        raise TextFileError(source, 0, f"cannot read {what}: {e.strerror or e}") from None
+    try:
+        info = os.fstat(fd)
+        if not stat.S_ISREG(info.st_mode):
+            raise TextFileError(source, 0, f"cannot read {what}: it is {kind(info.st_mode)}, not a file")
+        with open(fd, "rb", closefd=False) as f:
+            data = f.read(limit + 1) if info.st_size <= limit else b""
+    except OSError as e:
+        raise TextFileError(source, 0, f"cannot read {what}: {e.strerror or e}") from None
+    finally:
+        os.close(fd)
+    if info.st_size > limit or len(data) > limit:
+        raise TextFileError(source, 0, f"cannot read {what}: larger than {limit // 1024 // 1024} MB, "
+                                       "the most a station file may hold")
+    return data
+
+
+def kind(mode: int) -> str:
+    """What a file system entry of `mode` is, for a problem saying it is not what was expected."""
+    for test, what in ((stat.S_ISREG, "a file"), (stat.S_ISDIR, "a folder"),
+                       (stat.S_ISFIFO, "a FIFO (named pipe)"), (stat.S_ISCHR, "a character device"),
+                       (stat.S_ISBLK, "a block device"), (stat.S_ISSOCK, "a socket")):
+        if test(mode):
+            return what
+    return "a special file"
+
+
+def file_problem(path: Path, folder: bool = False) -> str | None:
+    """Why `path` is not an existing regular file (with `folder`, an existing folder); None when
+    it is. Links are followed."""
+    try:
+        mode = path.stat().st_mode
+    except (FileNotFoundError, NotADirectoryError):  # nothing there, or a file where a folder is named
+        return MISSING
+    except OSError as e:
+        return e.strerror or str(e)
+    if stat.S_ISDIR(mode) if folder else stat.S_ISREG(mode):
+        return None
+    return f"is {kind(mode)}, not a {'folder' if folder else 'file'}"
+
+
+def resolve(path: Path) -> Path:
+    """`path` made absolute with every symbolic link followed; TextFileError for a loop of links."""
+    try:
+        return path.resolve()
+    except (OSError, RuntimeError):  # Python 3.11 raises RuntimeError("Symlink loop ...")
+        raise TextFileError(str(path), 0, "a loop of symbolic links") from None
+
+
+def confine(path: Path, folder: Path) -> Path:
+    """`path` with its links followed, if that lies inside `folder`; TextFileError naming it if not
+    (a station reads its own files only, unless its station.toml says allow_outside)."""
+    real, root = resolve(path), resolve(folder)
+    if not real.is_relative_to(root):
+        raise TextFileError(str(path), 0, f"{real} is outside the station folder {root} "
+                                          "(allow_outside = true permits it)")
+    return real
 
 
 def csv_rows(text: str) -> Iterator[tuple[int, list[str] | str]]:
     """(line number, row) of CSV text, or (line number, problem) for a line the csv module refuses.
 
-    The line number is that of the row's first line (a quoted field may span lines).
+    A row is one line: a quoted field that runs on over the next lines (a closing quote missing,
+    or a name split in two by a line break) is a problem of the line it starts on, instead of a
+    field silently made of several lines.
     """
     lines = iter(text.splitlines())
     reader = csv.reader(lines)
@@ -70,7 +147,11 @@ def csv_rows(text: str) -> Iterator[tuple[int, list[str] | str]]:
                 problem = f"a field is longer than {csv.field_size_limit()} characters"
             yield start, problem
         else:
-            yield start, row
+            if reader.line_num > start:
+                yield start, (f"a quoted field runs on to line {reader.line_num}: a row is one line "
+                              "(a closing quote missing?)")
+            else:
+                yield start, row
         start = reader.line_num + 1
 
 

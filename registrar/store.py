@@ -15,6 +15,7 @@ import datetime as dt
 import math
 import operator
 import sqlite3
+import stat
 import threading
 import time
 from collections import deque
@@ -24,6 +25,7 @@ from pathlib import Path
 
 from netplc.records import Record
 from netplc.tags.table import TagTable
+from netplc.textfile import kind
 from registrar.catalog import Catalog
 from registrar.schema import (
     DAY_COLUMNS_SQL,
@@ -49,6 +51,7 @@ SOURCE = "registrar"
 BATCH_MAX = 50_000  # records per transaction: bounds the time one commit holds the writer
 RETRY_MAX = 5.0  # seconds between attempts while the disk keeps failing
 BUSY_TIMEOUT_MS = 1000
+SQLITE_HEADER = b"SQLite format 3\x00"  # the first 16 bytes of every SQLite database file
 
 Row = tuple[int, str, int | None, int | None, str | None, int | None, float | None, str | None]
 _TS = operator.attrgetter("ts")
@@ -81,6 +84,31 @@ def _day_of(ms: int) -> tuple[int, int, str]:
     """The [start, end) milliseconds of the local day holding `ms`, and its table's name."""
     day, start, end = local_day_bounds(ms / 1000)
     return round(start * 1000), round(end * 1000), table_name(day)
+
+
+def archive_problem(path: Path) -> str | None:
+    """Why the archive file at `path` cannot be opened, found without writing anything (what
+    `check` reports and a start refuses); None when it is an SQLite database, or is not there yet
+    and can be created."""
+    try:
+        info = path.stat()
+    except (FileNotFoundError, NotADirectoryError):
+        folder = next((f for f in path.parents if f.exists()), None)
+        if folder is not None and not folder.is_dir():
+            return f"cannot create it: {folder} is a file, not a folder"
+        return None
+    except OSError as e:
+        return e.strerror or str(e)
+    if not stat.S_ISREG(info.st_mode):
+        return f"it is {kind(info.st_mode)}, not an archive file"
+    try:
+        with path.open("rb") as f:
+            head = f.read(len(SQLITE_HEADER))
+    except OSError as e:
+        return f"cannot read it: {e.strerror or e}"
+    if head and head != SQLITE_HEADER:  # SQLite makes an empty file a database
+        return "not an SQLite database: is another file named as the Archive?"
+    return None
 
 
 class _Barrier:
@@ -188,6 +216,9 @@ class Store:
 
     def start(self) -> None:
         """Open (or create) the archive and start the writer; sqlite3.Error names the file."""
+        problem = archive_problem(self.path)
+        if problem is not None:
+            raise sqlite3.DatabaseError(f"{self.path}: cannot open the archive: {problem}")
         self.path.parent.mkdir(parents=True, exist_ok=True)
         try:
             self._con = self._open()

@@ -3,11 +3,20 @@
 The inputs are built from each format's own vocabulary (mnemonics, keys, addresses, property names)
 mixed with arbitrary text, numbers past every limit, deep nesting and bytes that are not UTF-8, so
 that the examples reach the checks behind the syntax. Example counts are bounded: a few seconds each.
+
+Then whole station folders: copies of the demo with files damaged at random (seeded) through
+`check` and the start, in process, and the command line on the worst of the broken stations of
+tests/app/broken_stations.py (whose words tests/app/test_bad_files.py checks, in process): 0
+tracebacks, and every problem names a file of the folder.
 """
 
 from __future__ import annotations
 
 import json
+import os
+import random
+import subprocess
+import sys
 from collections.abc import Callable
 from pathlib import Path
 from typing import Any
@@ -16,11 +25,19 @@ import pytest
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
+from app.authority.policy import ROLES
+from app.authority.users import USERS_FILE, Users, UsersFileError
+from app.check import check_station
 from app.config import ConfigError, load_station, read_station
+from app.runtime import Runtime, StartError
 from hmi_forms.elements import ELEMENT_TYPES
 from hmi_forms.form import FormError, load_form
+from netplc.problems import Problems
 from netplc.program import LOGIC, ProgramError, load_program, load_symbols
+from netplc.tags.table import read_tags
 from registrar.catalog import Catalog, CatalogError
+from tests.app.broken_stations import CASES
+from tests.app.conftest import REPO, copy_demo
 
 FUZZ = settings(max_examples=200, deadline=None, derandomize=True,
                 suppress_health_check=[HealthCheck.too_slow, HealthCheck.data_too_large])
@@ -187,3 +204,141 @@ def test_form_loads_or_names_its_errors(folder: Path, doc: Any, how: str, raw: b
     path.write_bytes(raw if mode == "raw" else encoded(text, how))
     form = loaded(path, lambda p: load_form(p, {"A": 0o2000}), FormError, lambda e: e.problems)
     assert form is None or all(p.startswith(str(path)) for p in form.problems)
+
+
+# --- tags.csv and users.json -------------------------------------------------------------------
+
+TAG_FIELDS = st.one_of(CSV_FIELDS, st.sampled_from([
+    "name", "address", "type", "unit", "h", "hh", "ll", "word", "bit", "float32", "int32", "04000", "040005",
+    "A", "yes", "1e309", "nan", "-0", "Уровень", "°C"]))
+TAG_TEXT = st.lists(st.lists(TAG_FIELDS, max_size=8).map(",".join), max_size=8).map(
+    lambda rows: "\n".join(["name,address,type,unit,app_min,app_max,phy_min,phy_max,h,hh,alarm_when", *rows]))
+
+
+@FUZZ
+@given(text=TAG_TEXT, how=ENCODINGS, raw=RAW, use_raw=st.booleans())
+def test_tags_load_or_name_their_errors(folder: Path, text: str, how: str, raw: bytes, use_raw: bool) -> None:
+    path = folder / "tags.csv"
+    path.write_bytes(raw if use_raw else encoded(text, how))
+    table, problems = read_tags(path, {"A": 0o4000})
+    assert all(p.startswith(f"{path}:") for p in problems), problems
+    assert len({t.name for t in table.tags}) == len(table.tags)
+
+
+USER_ENTRIES = st.one_of(JSON_VALUES, st.fixed_dictionaries({}, optional={
+    "name": st.one_of(st.text(max_size=5), JSON_LEAVES),
+    "role": st.one_of(st.sampled_from(ROLES), JSON_LEAVES),
+    "salt": st.one_of(st.just("00ff"), JSON_LEAVES),
+    "hash": st.one_of(st.just("abcd"), JSON_LEAVES)}))
+USER_DOCS = st.one_of(JSON_VALUES, st.fixed_dictionaries({"users": st.lists(USER_ENTRIES, max_size=4)}))
+
+
+@FUZZ
+@given(doc=USER_DOCS, raw=RAW, use_raw=st.booleans())
+def test_users_load_or_name_their_errors(folder: Path, doc: Any, raw: bytes, use_raw: bool) -> None:
+    path = folder / USERS_FILE
+    path.write_bytes(raw if use_raw else json.dumps(doc).encode())
+    users = loaded(folder, Users, UsersFileError, lambda e: e.problems)
+    for user in users.users.values() if users is not None else ():
+        assert user.role in ROLES and bytes.fromhex(user.salt) and bytes.fromhex(user.hash)
+
+
+# --- whole station folders: check and the start -------------------------------------------------
+
+STATION_FILES = ["station.toml", "netplc.stl", "symbols.csv", "messages.csv", "tags.csv", "users.json",
+                 "node0.stl", "forms/01_trigger.hmi", "forms/02_analog.hmi", "forms/03_sync.hmi"]
+PIECES = [b'"', b"\n", b"\x00", b"\x98", b"\xff\xfe", b"9" * 400, b"[" * 50, "Пуск".encode("cp1251"), b"$",
+          b",,,", b"=", b"\r", b"\\", b"{}", b"0" + b"7" * 30, b"-", b"#", b"'", b"null", b"1e999"]
+
+
+def corrupt(data: bytes, rng: random.Random) -> bytes:
+    """`data` damaged the ways files get damaged: a byte changed, cut short, text pasted in, a line
+    lost or doubled."""
+    lines = data.split(b"\n")
+    at = rng.randrange(len(data) + 1)
+    how = rng.randrange(6)
+    if how == 0:
+        spots = [rng.randrange(len(data)) for _ in range(rng.randint(1, 5))] if data else []
+        out = bytearray(data)
+        for spot in spots:
+            out[spot] = rng.randrange(256)
+        return bytes(out)
+    if how == 1:
+        return data[:at]
+    if how == 2:
+        return data[:at] + rng.choice(PIECES) + data[at:]
+    i = rng.randrange(len(lines))
+    if how == 3:
+        del lines[i]
+    elif how == 4:
+        lines.insert(i, lines[i])
+    else:
+        j = rng.randrange(len(lines))
+        lines[i], lines[j] = lines[j], lines[i]
+    return b"\n".join(lines)
+
+
+def named(problems: list[str], station: Path) -> None:
+    """Problems there are, and each names a file of the station folder."""
+    assert problems and all(p.startswith(f"{station}{os.sep}") for p in problems), problems
+
+
+def checked_and_started(station: Path, start: bool) -> None:
+    """`check` and the start end in a report or in named problems, never in another exception."""
+    report = check_station(station)
+    if not report.ok:
+        named(report.problems, station)
+    try:
+        runtime = Runtime(load_station(station))
+    except Problems as e:
+        named(e.problems, station)
+        assert not report.ok  # what a start refuses, check reports
+        return
+    if not start:
+        return
+    try:
+        runtime.start()
+    except StartError as e:
+        named(e.problems, station)
+    finally:
+        runtime.stop()
+
+
+def test_damaged_demo_stations_end_in_named_problems_or_run(tmp_path: Path) -> None:
+    """30 copies of the demo, 1-3 files of each damaged (seeded). A start only where station.toml is
+    intact (a damaged host name could wait on a name server), and at most 3: a start costs 0.2 s."""
+    starts = 3
+    for seed in range(30):
+        rng = random.Random(seed)
+        station = copy_demo(tmp_path / str(seed))
+        damaged = rng.sample(STATION_FILES, rng.randint(1, 3))
+        for name in damaged:
+            path = station / name
+            path.write_bytes(corrupt(path.read_bytes(), rng))
+        start = starts > 0 and "station.toml" not in damaged
+        starts -= start
+        try:
+            checked_and_started(station, start)
+        except BaseException as e:
+            e.add_note(f"seed {seed}: {', '.join(damaged)} damaged")
+            raise
+
+
+def test_main_check_and_the_headless_start_print_named_problems_not_tracebacks(tmp_path: Path) -> None:
+    """The command line on the two cases that ended in tracebacks (RuntimeError for a program that is
+    a link to itself, MemoryError for a form that is a link to /dev/zero), side by side."""
+    loop, zero = (next(c for c in CASES if c.name == name) for name in ("program links to itself",
+                                                                       "form is /dev/zero"))
+    runs = []
+    for case, args in ((loop, ["check"]), (zero, ["--no-gui", "--duration", "0.5", "--status-every", "0.2"])):
+        station = copy_demo(tmp_path / args[0].strip("-"))
+        expected = case.plant(station)
+        runs.append((expected, subprocess.Popen([sys.executable, "main.py", args[0], str(station), *args[1:]],
+                                                cwd=REPO, stdout=subprocess.PIPE, stderr=subprocess.PIPE,
+                                                text=True)))
+    (expected, check), (shown, start) = runs
+    out, err = check.communicate(timeout=60)
+    assert check.returncode == 1 and "Traceback" not in err and out.startswith(expected), out + err
+    out, err = start.communicate(timeout=60)
+    assert start.returncode == 0 and "Traceback" not in err, err  # the station runs without the form
+    assert f"form problem: {shown}" in out, out

@@ -24,14 +24,24 @@ from dataclasses import asdict, dataclass
 from pathlib import Path
 
 from app.authority.policy import ROLES, rank
+from netplc.problems import Problems
+from netplc.textfile import TextFileError, read_text
 
 USERS_FILE = "users.json"
 SCRYPT = {"n": 2**14, "r": 8, "p": 1}  # RFC 7914's interactive-login cost: ~50 ms per check
-__all__ = ["Refused", "Session", "User", "UserError", "Users", "rank"]
+__all__ = ["Refused", "Session", "User", "UserError", "Users", "UsersFileError", "rank"]
 
 
 class UserError(ValueError):
     """A users-file command that cannot be done, in words for whoever typed it."""
+
+
+class UsersFileError(UserError, Problems):
+    """A users.json that cannot be used: every problem, each naming the file (`check` lists them,
+    a start refuses with them); a UserError too, for whoever manages users."""
+
+    def __init__(self, problems: list[str]) -> None:
+        Problems.__init__(self, problems)
 
 
 class Refused(Exception):
@@ -64,7 +74,7 @@ class Users:
     def __init__(self, folder: Path) -> None:
         self.path = Path(folder) / USERS_FILE
         self.users: dict[str, User] = {}
-        if self.path.exists():
+        if self.path.exists() or self.path.is_symlink():  # a link to nowhere is named by _read
             self.users = _read(self.path)
 
     def get(self, name: str) -> User | None:
@@ -117,12 +127,52 @@ def _password(password: str) -> str:
 
 
 def _read(path: Path) -> dict[str, User]:
+    """The users of a users file; UsersFileError names every problem (read as every station file
+    is: a regular file, with a size limit)."""
     try:
-        items = json.loads(path.read_text(encoding="utf-8"))["users"]
-        users = {u["name"]: User(u["name"], _role(u["role"]), u["salt"], u["hash"]) for u in items}
-    except (OSError, ValueError, KeyError, TypeError) as e:
-        raise UserError(f"{path}: not a users file: {e}") from None
+        doc = json.loads(read_text(path, "the users file"))
+    except TextFileError as e:
+        raise UsersFileError([str(e)]) from None
+    except json.JSONDecodeError as e:
+        raise UsersFileError([f"{path}: not a users file: bad JSON at line {e.lineno}, column {e.colno}: "
+                              f"{e.msg}"]) from None
+    except (ValueError, RecursionError) as e:  # int() past 4300 digits; nesting past the stack
+        raise UsersFileError([f"{path}: not a users file: {type(e).__name__}"]) from None
+    items = doc.get("users") if isinstance(doc, dict) else None
+    if not isinstance(items, list):
+        raise UsersFileError([f'{path}: not a users file: expected {{"users": [...]}}, as `main.py users` '
+                              "writes it"])
+    users: dict[str, User] = {}
+    problems: list[str] = []
+    for i, item in enumerate(items):
+        user, problem = _user(item)
+        name = item.get("name") if isinstance(item, dict) else None
+        where = f"{path}: user {name!r}" if isinstance(name, str) and name else f"{path}: users[{i}]"
+        if problem:
+            problems.append(f"{where}: {problem}")
+        elif user is not None and user.name in users:
+            problems.append(f"{where}: listed twice")
+        elif user is not None:
+            users[user.name] = user
+    if problems:
+        raise UsersFileError(problems)
     return users
+
+
+def _user(item: object) -> tuple[User | None, str]:
+    """One entry of the users file, or what is wrong with it."""
+    if not isinstance(item, dict):
+        return None, "expected an object with name, role, salt and hash"
+    missing = [k for k in ("name", "role", "salt", "hash") if not isinstance(item.get(k), str) or not item[k]]
+    if missing:
+        return None, f"{', '.join(missing)} missing (each a text)"
+    if item["role"] not in ROLES:
+        return None, f"role {item['role']!r} is not one of {', '.join(ROLES)}"
+    try:
+        bytes.fromhex(item["salt"]), bytes.fromhex(item["hash"])
+    except ValueError:
+        return None, "salt and hash must be hexadecimal (set the password again: `main.py users passwd`)"
+    return User(item["name"], item["role"], item["salt"], item["hash"]), ""
 
 
 class Session:

@@ -18,7 +18,7 @@ from typing import Any
 from netplc.address import AddressError, BitRef, check_operand, parse_hmi_bit, parse_octal
 from netplc.tags.table import TagTable
 from netplc.tags.tag import Scaling, TagType  # the one conversion, shared with tags, journal and viewer
-from netplc.textfile import MAX_DIGITS
+from netplc.textfile import MAX_DIGITS, MISSING, TextFileError, file_problem, resolve
 
 Color = tuple[int, int, int, int]  # r, g, b, alpha
 
@@ -227,13 +227,18 @@ def image_file(value: Any, ctx: Context) -> Path:
     name = text(value, ctx)
     if "\0" in name:
         raise PropError(f"image file {_show(name)} has a NUL character")
-    path = (ctx.folder / name).resolve()
+    try:
+        path = resolve(ctx.folder / name)
+    except TextFileError as e:
+        raise PropError(f'image file "{name}": {e.problem}') from None
     roots = (ctx.folder, *ctx.roots)
     if not ctx.allow_outside and not any(path.is_relative_to(root.resolve()) for root in roots):
         raise Outside(f'image file "{name}" is outside the station folder {" and ".join(map(str, roots))} '
                       "(shown without it; allow_outside = true in station.toml allows it)")
-    if not path.is_file():
+    if (why := file_problem(path)) == MISSING:
         raise PropError(f'image file "{name}" not found in {ctx.folder}')
+    if why is not None:
+        raise PropError(f'image file "{name}" {why}')
     return path
 
 

@@ -1,14 +1,14 @@
 """`tags.csv`: the station's tags and their alarms, one per line, checked as a whole.
 
-UTF-8 with or without a BOM, a header line naming the columns (any order; only `name, address,
-type` are required), `#` or `;` comment lines. Every problem is collected and reported as
-`tags.csv:LINE: TAG: problem`, so that `check` and the start name all of them at once; the lines
-that are good still load, so one typo does not take every other tag's alarms away.
+Read as every station text file is (netplc/textfile.py: UTF-8 or cp1251, a size limit, one row a
+line): a header line naming the columns (any order; only `name, address, type` are required), `#`
+or `;` comment lines. Every problem is collected and reported as `tags.csv:LINE: TAG: problem`, so
+that `check` and the start name all of them at once; the lines that are good still load, so one
+typo does not take every other tag's alarms away.
 """
 
 from __future__ import annotations
 
-import csv
 import itertools
 import math
 import re
@@ -16,7 +16,9 @@ from dataclasses import dataclass, field
 from pathlib import Path
 
 from netplc.address import AddressError, parse_hmi_bit, parse_octal
+from netplc.problems import Problems
 from netplc.tags.tag import Scaling, Tag, TagType, check_address
+from netplc.textfile import TextFileError, csv_rows, read_text
 
 REQUIRED = ("name", "address", "type")
 TAG_COLUMNS = ("unit", "app_min", "app_max", "phy_min", "phy_max", "decimals", "description")
@@ -31,12 +33,8 @@ _NAME = re.compile(r"[^\W\d]\w*")
 _YES = {"1": True, "yes": True, "true": True, "0": False, "no": False, "false": False}
 
 
-class TagError(Exception):
+class TagError(Problems):
     """A tags file that cannot be used: every problem, each `file:line: ...`."""
-
-    def __init__(self, problems: list[str]) -> None:
-        self.problems = problems
-        super().__init__("\n".join(problems))
 
 
 @dataclass(frozen=True)
@@ -91,16 +89,20 @@ def read_tags(path: str | Path, symbols: dict[str, int] | None = None) -> tuple[
     path = Path(path)
     fname = str(path)
     try:
-        text = path.read_text(encoding="utf-8-sig")
-    except (OSError, UnicodeDecodeError) as e:
-        return TagTable(source=fname), [f"{fname}:0: cannot read the tags: {e}"]
-    rows = [(n, row) for n, row in enumerate(csv.reader(text.splitlines()), start=1)
-            if row and "".join(row).strip() and not row[0].lstrip().startswith(("#", ";"))]
+        text = read_text(path, "the tags")
+    except TextFileError as e:
+        return TagTable(source=fname), [f"{fname}:{e.line}: {e.problem}"]
+    problems: list[str] = []
+    rows: list[tuple[int, list[str]]] = []
+    for n, row in csv_rows(text):
+        if isinstance(row, str):
+            problems.append(f"{fname}:{n}: {row}")
+        elif row and "".join(row).strip() and not row[0].lstrip().startswith(("#", ";")):
+            rows.append((n, row))
     if not rows:
-        return TagTable(source=fname), []
+        return TagTable(source=fname), problems
     line, header = rows[0]
     columns = [c.strip().lower() for c in header]
-    problems: list[str] = []
     missing = [c for c in REQUIRED if c not in columns]
     if missing:
         problems.append(f"{fname}:{line}: the header must name the columns {', '.join(REQUIRED)} "

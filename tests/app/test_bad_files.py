@@ -1,5 +1,5 @@
-"""Broken station files end as named problems (`file:line: ...`), never as tracebacks: `check`
-exits 1 listing them, a start exits 2, and the forms that are fine still open."""
+"""Broken station files end as named problems (`file:line: ...`), never as tracebacks, hangs or
+an OOM: `check` exits 1 listing them, a start exits 2, and the forms that are fine still open."""
 
 from __future__ import annotations
 
@@ -11,8 +11,10 @@ from pathlib import Path
 import pytest
 
 from app.config import read_station
+from app.runtime import StartError
 from hmi_forms.form import load_forms
 from registrar.catalog import Catalog
+from tests.app.broken_stations import CASES, Broken, replace
 from tests.app.conftest import REPO, copy_demo
 
 NOT_CP1251 = b"\x98"  # a byte that is neither UTF-8 (alone) nor defined in cp1251
@@ -74,13 +76,17 @@ def test_check_lists_every_bad_file_and_exits_1(tmp_path: Path) -> None:
 
 
 def test_a_station_written_in_cp1251_checks_clean(tmp_path: Path) -> None:
+    from netplc.tags.table import load_tags
+
     st = copy_demo(tmp_path / "st")
-    for name in ("netplc.stl", "symbols.csv", "messages.csv"):
+    for name in ("netplc.stl", "symbols.csv", "messages.csv", "tags.csv"):
         path = st / name
         path.write_bytes(path.read_text(encoding="utf-8").encode("cp1251"))
     r = main("check", st)
     assert r.returncode == 0, r.stdout + r.stderr
     assert Catalog.load(st / "messages.csv").text_for(1) == "Пуск нажат"
+    tag = load_tags(st / "tags.csv", {"LEVEL": 0o4010, "TEMP": 0o4012, "SETPOINT": 0o4030}).get("TEMP")
+    assert tag is not None and (tag.description, tag.unit) == ("Температура", "°C")
 
 
 def test_a_start_with_an_unreadable_symbols_file_exits_2_naming_it(tmp_path: Path) -> None:
@@ -166,3 +172,53 @@ def test_the_workstation_opens_the_demo_forms_beside_the_broken_ones(tmp_path: P
     finally:
         window.close()
         runtime.stop()
+
+
+@pytest.mark.parametrize("case", CASES, ids=[c.name for c in CASES])
+def test_each_bad_input_is_named_by_check_and_by_the_start(tmp_path: Path, case: Broken) -> None:
+    from app.check import check_station
+    from app.config import load_station
+    from app.runtime import Runtime
+    from netplc.problems import Problems
+
+    st = copy_demo(tmp_path / "st")
+    expected = case.plant(st)
+    report = check_station(st)
+    assert any(p.startswith(expected) for p in report.problems), (expected, report.problems)
+    if case.refused == "load":
+        with pytest.raises(Problems) as refused:
+            Runtime(load_station(st))
+        assert any(p.startswith(expected) for p in refused.value.problems), refused.value.problems
+        return
+    runtime = Runtime(load_station(st))
+    if case.refused == "journal":
+        assert any(p.startswith(expected) for p in runtime.form_problems), runtime.form_problems
+        return
+    with pytest.raises(StartError) as refused:
+        runtime.start()
+    assert refused.value.problems == [p for p in report.problems if p.startswith(expected)]  # the same words
+
+
+def test_check_exits_1_naming_a_default_user_who_is_no_viewer_and_a_broken_users_file(tmp_path: Path) -> None:
+    st = copy_demo(tmp_path / "st")
+    replace(st / "station.toml", 'default_user = "viewer"', 'default_user = "operator"')
+    r = main("check", st)
+    assert r.returncode == 1 and "Traceback" not in r.stderr
+    toml = st / "station.toml"
+    assert r.stdout.startswith(f"{toml}: operator.default_user: 'operator' is of role operator: the default")
+    (st / "users.json").write_text('{"users": [{"name": "viewer", "role": "viewer"}]}', encoding="utf-8")
+    r = main("--no-gui", st, "--duration", "0.5")
+    assert r.returncode == 2 and "Traceback" not in r.stderr
+    assert r.stderr == f"{st / 'users.json'}: user 'viewer': salt, hash missing (each a text)\n"
+
+
+def test_a_station_without_users_may_have_no_default_user(tmp_path: Path) -> None:
+    from app.check import check_station
+
+    st = copy_demo(tmp_path / "st")
+    (st / "users.json").unlink()
+    assert check_station(st).problems == [
+        f"{st / 'station.toml'}: operator.default_user: no user 'viewer' in {st / 'users.json'} "
+        "(`main.py users add viewer --role viewer` adds one)"]
+    replace(st / "station.toml", 'default_user = "viewer"', 'default_user = ""')
+    assert check_station(st).ok

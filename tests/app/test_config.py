@@ -246,3 +246,27 @@ port = 5021
         "simulators[0].port: 127.0.0.1:5020 is also modbus_server.port",
         "simulators[2].port: 127.0.0.1:5021 is also simulators[1].port",
     ]
+
+
+def test_a_path_says_what_is_there_instead_of_a_file(tmp_path: Path) -> None:
+    """A loop of links, a FIFO or a folder where a file belongs is named by its key and what it is,
+    never a traceback (Python 3.11's Path.resolve raises RuntimeError for a loop) or "does not exist"."""
+    import os
+
+    (tmp_path / "node0.stl").mkdir()
+    os.mkfifo(tmp_path / "messages.csv")
+    os.symlink("p.stl", tmp_path / "p.stl")
+    (tmp_path / "forms").write_text("", encoding="utf-8")
+    write_station(tmp_path, 'NetPlcProgram = "p.stl"\nMessages = "messages.csv"\nHMIload = "forms"\n'
+                            '[[simulators]]\nnode = 0\nprogram = "node0.stl"\n')
+    toml = tmp_path / "station.toml"
+    assert read_station(tmp_path)[1] == [
+        f"{toml}: NetPlcProgram: {tmp_path / 'p.stl'}: a loop of symbolic links",
+        f"{toml}: HMIload: folder {tmp_path / 'forms'} is a file, not a folder",
+        f"{toml}: Messages: file {tmp_path / 'messages.csv'} is a FIFO (named pipe), not a file",
+        f"{toml}: simulators[0].program: file {tmp_path / 'node0.stl'} is a folder, not a file",
+    ]
+    toml.unlink()
+    os.symlink("station.toml", toml)
+    assert read_station(tmp_path)[1] == [
+        f"{toml}: cannot read the station file: Too many levels of symbolic links"]

@@ -8,7 +8,7 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 
 from netplc.functions.registry import BY_NAME, REGISTRY, FunctionSpec
-from netplc.program import PROGRAM_WORDS, ProgramError, load_symbols, parse, parse_file
+from netplc.program import PROGRAM_WORDS, ProgramError, load_symbols, parse, parse_file, read_symbols
 
 
 def errors(text: str, **kw) -> list[str]:
@@ -204,6 +204,24 @@ def test_bad_symbols_file(tmp_path):
     ]
     with pytest.raises(ProgramError, match="cannot read symbols"):
         load_symbols(tmp_path / "missing.csv")
+
+
+def test_symbols_name_memory_and_are_one_line_each_the_good_lines_kept(tmp_path):
+    """A symbol no program uses is checked all the same: a typo there is a typo the next program
+    that uses the name inherits."""
+    f = tmp_path / "s.csv"
+    f.write_text("A,02000\nBITS,040005\nGAP,010000\nHUGE,0" + "7" * 400 + '\n"SPL\nIT",02001\nB,04000\n'
+                 "TOP,0777777\nPAST,01000000\n", encoding="utf-8")
+    symbols, errors = read_symbols(f)
+    assert symbols == {"A": 0o2000, "BITS": 0o40005, "B": 0o4000, "TOP": 0o777777}
+    assert [str(d) for d in errors] == [
+        f"{f}:3:5: 010000 names no memory: neither an I/O bit (00000-03777), a data byte (k*010000 + "
+        "04000-07777) nor a data bit (byte*8 + bit)",
+        f"{f}:4:6: an address of 401 characters names no memory",
+        f"{f}:5:1: a quoted field runs on to line 6: a row is one line (a closing quote missing?)",
+        f"{f}:9:6: 01000000 names no memory: neither an I/O bit (00000-03777), a data byte (k*010000 + "
+        "04000-07777) nor a data bit (byte*8 + bit)",
+    ]
 
 
 LINE_PIECES = [

@@ -10,6 +10,7 @@ import numpy as np
 import pytest
 
 from netplc.memory import Memory
+from netplc.problems import Problems
 from netplc.tags.table import TagError, load_tags, read_tags
 from netplc.tags.tag import Scaling, Tag, TagReader, TagType
 
@@ -185,6 +186,39 @@ def test_a_header_without_the_required_columns(tmp_path: Path) -> None:
 
 def test_an_unreadable_file_is_a_problem_not_a_traceback(tmp_path: Path) -> None:
     path = tmp_path / "tags.csv"
-    path.write_bytes(b"name,address,type\n\xff\xfe,04000,word\n")
+    path.write_bytes(b"name,address,type\nA\x98,04000,word\n")  # 0x98: neither UTF-8 nor cp1251
     _, problems = read_tags(path)
-    assert problems and problems[0].startswith(f"{path}:0: cannot read the tags")
+    assert problems == [f"{path}:2: neither UTF-8 nor cp1251 text (byte 0x98)"]
+    path.unlink()
+    path.mkdir()
+    _, problems = read_tags(path)
+    assert problems == [f"{path}:0: cannot read the tags: it is a folder, not a file"]
+
+
+def test_a_tags_file_written_in_cp1251_loads(tmp_path: Path) -> None:
+    """What Excel saves as "CSV" on a Russian Windows: the same reader as messages.csv and symbols.csv."""
+    path = tmp_path / "tags.csv"
+    path.write_bytes("name,address,type,unit,app_min,app_max,phy_min,phy_max,description,h\n"
+                     "Уровень,04010,word,м³/ч,0,4095,0,100,Уровень в баке,90\n"
+                     "ТЕМП,04012,word,°C,0,1000,-50,150,Температура,\n".encode("cp1251", errors="replace"))
+    table = load_tags(path)
+    assert [(t.name, t.unit, t.description) for t in table.tags] == [
+        ("Уровень", "м?/ч", "Уровень в баке"), ("ТЕМП", "°C", "Температура")]
+    assert table.alarms["Уровень"].h == 90
+
+
+def test_a_row_split_over_two_lines_is_named_by_its_line(tmp_path: Path) -> None:
+    path = tmp_path / "tags.csv"
+    path.write_text('name,address,type\n"SPL\nIT",04000,word\nC,04004,word\n', encoding="utf-8")
+    table, problems = read_tags(path)
+    assert problems == [f"{path}:2: a quoted field runs on to line 3: a row is one line (a closing quote "
+                        "missing?)"]
+    assert [t.name for t in table.tags] == ["C"]
+
+
+def test_tag_error_is_a_problems_list(tmp_path: Path) -> None:
+    path = tmp_path / "tags.csv"
+    path.write_text("name,address,type\nA,09999,word\n", encoding="utf-8")
+    with pytest.raises(Problems) as e:
+        load_tags(path)
+    assert isinstance(e.value, TagError) and e.value.problems[0].startswith(f"{path}:2: A: address '09999'")

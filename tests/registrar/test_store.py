@@ -7,7 +7,7 @@ import pytest
 from netplc.records import Record
 from registrar.catalog import Catalog, Message
 from registrar.schema import table_name
-from registrar.store import Store
+from registrar.store import Store, archive_problem
 
 from .conftest import rows, wait_for
 
@@ -189,6 +189,28 @@ def test_a_file_that_is_no_database_is_named_in_the_error(tmp_path):
     store = Store(path)
     with pytest.raises(sqlite3.DatabaseError, match=r"journal\.sqlite: cannot open the archive"):
         store.start()
+
+
+def test_what_is_no_archive_is_named_before_anything_is_written(tmp_path):
+    """`check` asks archive_problem, and the start refuses in the same words, before it creates a
+    folder or a file."""
+    path = tmp_path / "journal.sqlite"
+    assert archive_problem(path) is None  # created at start
+    path.write_bytes(b"")
+    assert archive_problem(path) is None  # SQLite makes an empty file a database
+    path.write_bytes(b"SQLite format 2")
+    assert archive_problem(path) == "not an SQLite database: is another file named as the Archive?"
+    path.unlink()
+    path.mkdir()
+    assert archive_problem(path) == "it is a folder, not an archive file"
+    with pytest.raises(sqlite3.DatabaseError) as e:
+        Store(path).start()
+    assert str(e.value) == f"{path}: cannot open the archive: it is a folder, not an archive file"
+    (tmp_path / "file").write_bytes(b"")
+    nested = tmp_path / "file" / "archive" / "journal.sqlite"
+    assert archive_problem(nested) == f"cannot create it: {tmp_path / 'file'} is a file, not a folder"
+    Store(tmp_path / "good.sqlite").start()
+    assert archive_problem(tmp_path / "good.sqlite") is None
 
 
 def test_records_are_split_where_their_milliseconds_fall(db):
