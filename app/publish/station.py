@@ -57,7 +57,7 @@ def start_publishers(runtime: Any) -> list[Publisher]:
         try:
             server.start()
         except (OSError, RuntimeError) as e:
-            runtime._problem(f"OPC UA server not started: {st.path}: opcua.endpoint: {e}")
+            runtime.problem(f"OPC UA server not started: {st.path}: opcua.endpoint: {e}")
         else:
             runtime.subscribe(server.on_record)
             started.append(_Unsubscribing(server, runtime))
