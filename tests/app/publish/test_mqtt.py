@@ -131,7 +131,8 @@ def test_rebirth_on_command_and_ncmd_writes(station: Runtime, host: Host) -> Non
     wait_until(lambda: any(r.kind == "operator" and "TEMP_SP" in r.text and "refused" not in r.text
                            for r in records), 10)
     refused = [r for r in records if r.kind == "operator" and "LEVEL" in r.text]
-    assert refused and "refused" in refused[0].text and refused[0].source.startswith("mqtt:")
+    assert refused and "refused" in refused[0].text
+    assert refused[0].source == f"mqtt NCMD Plant/Demo via {station.station.mqtt.broker.split('//')[1]}"
 
 
 def test_reconnect_after_broker_restart_with_new_nbirth_and_buffer(tmp_path: Path, host: Host,
