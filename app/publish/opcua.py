@@ -15,12 +15,15 @@ the node diagnostics, a tag `[opcua] writable` does not name) is Bad_NotWritable
 every refusal. UserAccessLevel is answered per session from the same policy: read for a viewer or
 an anonymous client, read and write for a role that may write. No role is checked here.
 
-Security off loopback: Basic256Sha256 Sign&Encrypt only. asyncua would fall back to a None
-channel when a client asks for one; the station refuses it whatever the client asks, and refuses
-a client certificate that is not in the station's trust list (pki.py), closing the connection (the
-way asyncua answers a refused OpenSecureChannel). Logins are the station's users with a back-off
-per host (app/authority/logins.py). A loopback endpoint (the demo) is for local clients only and
-has no security.
+Security off loopback: sessions only over Basic256Sha256 Sign&Encrypt. asyncua keeps a None channel
+when a client asks for one, and would then create a session over it (a password in clear);
+the station lets a None channel serve discovery only (GetEndpoints, FindServers: how standard
+clients learn the endpoints and the server certificate, as OPC UA Part 4 section 5.4 provides)
+and refuses CreateSession on it with Bad_SecurityPolicyRejected, whatever the client asks. A
+client certificate that is not in the station's trust list (pki.py) is refused when it opens its
+secure channel, by closing the connection (the way asyncua answers a refused OpenSecureChannel).
+Logins are the station's users with a back-off per host (app/authority/logins.py). A loopback
+endpoint (the demo) is for local clients only and has no security.
 
 Alarms: each alarm is a String variable holding its ISA-18.2 state word, and each transition
 fires an event (BaseEventType: SourceName the alarm id, Message its text, Severity from its
@@ -33,6 +36,7 @@ from __future__ import annotations
 
 import asyncio
 import contextlib
+import contextvars
 import ipaddress
 import logging
 import math
@@ -47,12 +51,9 @@ from urllib.parse import urlsplit
 import numpy as np
 from asyncua import Server, ua
 from asyncua.common.callback import CallbackType, ServerItemCallback
+from asyncua.common.utils import ServiceError
 from asyncua.crypto.permission_rules import SimpleRoleRuleset, User, UserRole
-from asyncua.crypto.security_policies import (
-    SecurityPolicyBasic256Sha256,
-    SecurityPolicyFactory,
-    SecurityPolicyNone,
-)
+from asyncua.crypto.security_policies import SecurityPolicyBasic256Sha256, SecurityPolicyFactory
 
 from app.authority import Action, Commands, Reason, Source, Ticket, Who, write_range
 from app.authority.logins import Logins
@@ -123,6 +124,11 @@ def _peer(name: object) -> str:
     return str(name)
 
 
+def _no_registrations(*_args: object) -> None:
+    """The station is no discovery server: RegisterServer(2) is refused."""
+    raise ServiceError(ua.StatusCodes.BadServiceUnsupported)
+
+
 def _who(session: Any) -> Who:
     user = session.user.name if session.user is not None and session.user.name else ""
     return Who(user, Source.OPCUA, _peer(session.name))
@@ -155,20 +161,10 @@ class _Users:
         return None if user is None else User(role=UserRole.User, name=user.name)
 
 
-class _RefuseNone:
-    """A channel with SecurityPolicy None, refused: asyncua keeps None as the policy a channel
-    starts with and takes it whenever a client asks for it and no configured policy matches, so a
-    policy that matches None and refuses stands in front of that fall-back."""
-
-    def __init__(self, refused: Callable[[], None]) -> None:
-        self.refused = refused
-
-    def matches(self, uri: str, mode: ua.MessageSecurityMode | None = None) -> bool:
-        return uri == SecurityPolicyNone.URI
-
-    def create(self, peer_certificate: bytes | None) -> Any:
-        self.refused()
-        raise ua.uaerrors.BadUserAccessDenied()  # asyncua closes the connection
+# Whether the connection being served has a secure channel: set by `_Trusting` in the task asyncua
+# runs each connection's messages in, so its later requests (CreateSession) see it and no other
+# connection does.
+_SECURE_CHANNEL: contextvars.ContextVar[bool] = contextvars.ContextVar("secure_channel", default=False)
 
 
 class _Trusting(SecurityPolicyFactory):
@@ -182,6 +178,7 @@ class _Trusting(SecurityPolicyFactory):
     def create(self, peer_certificate: bytes | None) -> Any:
         if not self.check(peer_certificate):
             raise ua.uaerrors.BadUserAccessDenied()  # asyncua closes the connection
+        _SECURE_CHANNEL.set(True)
         return super().create(peer_certificate)
 
 
@@ -287,8 +284,7 @@ class OpcUaServer:
         if self.secure:  # no await since the listener opened: no client is served before this
             assert server.bserver is not None
             server.bserver.set_policies([
-                _Trusting(server.iserver.certificate, server.iserver.private_key, self._trusted),
-                _RefuseNone(self._none_refused)])
+                _Trusting(server.iserver.certificate, server.iserver.private_key, self._trusted)])
         try:
             self._ready.set()
             while not self._stop.is_set():
@@ -326,7 +322,6 @@ class OpcUaServer:
         if der and self.trust.is_trusted(der):
             return True
         if not der:
-            self._none_refused()
             return False
         try:
             kept = self.trust.reject(der)
@@ -339,11 +334,6 @@ class OpcUaServer:
                          f"{thumb}), kept in {kept.parent}; `python main.py opcua trust {self.folder} "
                          f"{thumb}` trusts it")
         return False
-
-    def _none_refused(self) -> None:
-        self.commands.refuse(Who("", Source.OPCUA), "open a channel", "", Reason.DENIED,
-                             f"security None refused at {self.endpoint}: off loopback only Basic256Sha256 "
-                             "Sign&Encrypt with a trusted client certificate")
 
     async def _build(self, server: Server, uri: str) -> None:
         idx = await server.register_namespace(uri)
@@ -498,6 +488,11 @@ class OpcUaServer:
         users = self.users
 
         def create_session(name: str, user: User | None = None, external: bool = False) -> Any:
+            if external and self.secure and not _SECURE_CHANNEL.get():
+                self.commands.refuse(Who("", Source.OPCUA, _peer(name)), "open a session", "",
+                                     Reason.DENIED, f"security None at {self.endpoint} is for discovery "
+                                     "only (GetEndpoints): sessions need Basic256Sha256 Sign&Encrypt")
+                raise ServiceError(ua.StatusCodes.BadSecurityPolicyRejected)
             session = create(name, user=user or User(role=UserRole.Anonymous), external=external)
             if not external:
                 return session
@@ -518,6 +513,7 @@ class OpcUaServer:
             return session
 
         iserver.create_session = create_session
+        iserver.register_server = _no_registrations  # no session is needed, over any channel
         server.subscribe_server_callback(CallbackType.PostRead, self._user_access_level)
 
     def _user_access_level(self, event: ServerItemCallback, _service: object) -> None:
