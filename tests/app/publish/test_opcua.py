@@ -14,7 +14,7 @@ from asyncua import Client, ua
 
 from app.publish.opcua import is_loopback
 from app.runtime import Runtime
-from tests.app.publish.conftest import demo_with, free_port
+from tests.app.publish.conftest import demo_with, free_port, opcua_client, tag_node
 
 
 @pytest.fixture
@@ -165,3 +165,37 @@ def test_a_taken_port_is_a_problem_and_the_station_runs_on(tmp_path: Path) -> No
             assert any("OPC UA server not started" in p and "opcua.endpoint" in p for p in status.problems)
         finally:
             runtime.stop()
+
+
+def test_symbols_are_served_with_their_quality_where_there_is_no_tags_file(tmp_path: Path) -> None:
+    from tests.app.conftest import copy_demo
+
+    folder = copy_demo(tmp_path / "station")
+    toml = folder / "station.toml"
+    toml.write_text(toml.read_text(encoding="utf-8").replace('Tags = "tags.csv"', ""), encoding="utf-8")
+    url = f"opc.tcp://127.0.0.1:{free_port()}/netplc/"
+    runtime = demo_with(folder, f'[opcua]\nenabled = true\nendpoint = "{url}"\nwritable = ["SETPOINT"]\n')
+
+    async def go() -> tuple[object, int]:
+        async with opcua_client(url, "operator", "operator") as client:
+            level = await tag_node(client, "LEVEL")
+            deadline = time.monotonic() + 5
+            while not (dv := await level.read_data_value(raise_on_bad_status=False)).StatusCode.is_good():
+                assert time.monotonic() < deadline, dv.StatusCode
+                await asyncio.sleep(0.05)
+            kind = dv.Value.VariantType
+            sp = await tag_node(client, "SETPOINT")
+            await sp.write_value(ua.DataValue(ua.Variant(1234, ua.VariantType.UInt16)))
+            written = await sp.read_value()
+            runtime.simulators[0].stop()  # LEVEL is filled by node 0's NREAD: its quality follows the link
+            deadline = time.monotonic() + 10
+            while (dv := await level.read_data_value(raise_on_bad_status=False)).StatusCode.value != \
+                    ua.StatusCodes.BadCommunicationError:
+                assert time.monotonic() < deadline, dv.StatusCode
+                await asyncio.sleep(0.05)
+            return kind, written
+
+    try:
+        assert run(go()) == (ua.VariantType.UInt16, 1234)
+    finally:
+        runtime.stop()

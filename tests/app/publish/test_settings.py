@@ -6,9 +6,13 @@ from pathlib import Path
 
 import numpy as np
 
+from app.authority import Commands, Reason, Source, Who
 from app.config import load_station, read_station
-from app.publish.points import symbol_tags
+from app.publish.points import PointWriter, Writable, symbol_tags
 from app.publish.sparkplug import DOUBLE, INT16, Payload, get_value, set_value
+from netplc.engine import Engine
+from netplc.program import parse
+from netplc.records import ListSink
 from netplc.tags.tag import TagType
 from tests.app.conftest import write_station
 
@@ -62,3 +66,23 @@ def test_sparkplug_values_round_trip() -> None:
     set_value(d, DOUBLE, float(np.float64(2.5)))
     back = Payload.FromString(p.SerializeToString())
     assert get_value(back.metrics[0]) == -5 and get_value(back.metrics[1]) == 2.5
+
+
+def test_symbols_are_written_through_the_layer_as_bits_and_words() -> None:
+    """Where a station has no tags.csv its symbols are the points: a client writes a bit or an
+    unsigned word, never outside it, and only what `writable` names."""
+    sink = ListSink()
+    engine = Engine(parse("JMP 0\n"), sink=sink)
+    layer = Commands(engine, sink, role_of={"olga": "operator"}.get)
+    tags = {t.name: t for t in symbol_tags({"START": 0o2000, "SP": 0o4010, "PV": 0o4012})}
+    writer = PointWriter(layer, Writable(["S*"]), "[mqtt]")
+    olga = Who("olga", Source.MQTT, "broker:1883")
+    started, word = writer.write(olga, tags["START"], True), writer.write(olga, tags["SP"], 1234)
+    engine.scan()
+    assert engine.mem.bits[0o2000] == 1 and engine.mem.get_word(0o4010) == 1234
+    assert started.result(1).ok and word.result(1).ok
+    answers = [writer.write(olga, tags["SP"], 70000), writer.write(olga, tags["SP"], 1.5),
+               writer.write(olga, tags["PV"], 1), writer.write(olga, tags["SP"], 1, "a String for a UInt16"),
+               writer.write(Who("", Source.OPCUA), tags["SP"], 1, "a String for a UInt16")]
+    assert [a.result(0).reason for a in answers] == [
+        Reason.OUT_OF_RANGE, Reason.TYPE_MISMATCH, Reason.NOT_WRITABLE, Reason.TYPE_MISMATCH, Reason.DENIED]
