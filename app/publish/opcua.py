@@ -57,7 +57,7 @@ from asyncua.crypto.security_policies import SecurityPolicyBasic256Sha256, Secur
 
 from app.authority import Action, Commands, Reason, Source, Ticket, Who, write_range
 from app.authority.logins import Logins
-from app.authority.users import Users
+from app.authority.users import UserError, Users
 from app.config import OpcUaSettings
 from app.publish.feed import LatestReadings, Watch
 from app.publish.pki import TrustList, host_names, station_certificate, subject, thumbprint
@@ -155,10 +155,19 @@ class _Users:
     def get_user(self, iserver: object, username: str | None = None, password: str | None = None,
                  certificate: object = None) -> User | None:
         if not username:
-            anonymous = self.loopback or not Users(self.folder).users
+            anonymous = self.loopback or not self.any()
             return User(role=UserRole.User) if anonymous else None
         user = self.logins.login(username, password or "", self.peer)
         return None if user is None else User(role=UserRole.User, name=user.name)
+
+    def any(self) -> bool:
+        """Does the station have users? A users file that cannot be read counts as yes: nobody
+        comes in anonymously because the file broke."""
+        try:
+            return bool(Users(self.folder).users)
+        except UserError:
+            logger.exception("users of %s not readable", self.folder)
+            return True
 
 
 # Whether the connection being served has a secure channel: set by `_Trusting` in the task asyncua
@@ -312,7 +321,7 @@ class OpcUaServer:
         await server.load_private_key(str(own.key))
         server.set_security_policy([ua.SecurityPolicyType.Basic256Sha256_SignAndEncrypt])
         tokens: list[type] = [ua.UserNameIdentityToken]
-        if not Users(self.folder).users:
+        if not self.users.any():
             tokens.append(ua.AnonymousIdentityToken)
         server.set_identity_tokens(tokens)
 
