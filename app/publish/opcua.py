@@ -13,7 +13,8 @@ Read returns it). The variable's DataType is the one a client must send (Boolean
 for a scaled tag...), anything else is Bad_TypeMismatch; a node that is never writable (the state,
 the node diagnostics, a tag `[opcua] writable` does not name) is Bad_NotWritable, journaled like
 every refusal. UserAccessLevel is answered per session from the same policy: read for a viewer or
-an anonymous client, read and write for a role that may write. No role is checked here.
+an anonymous client, read and write for a role that may write. The station object's methods
+(methods.py: run, stop, step, force, unforce) are commands the same way. No role is checked here.
 
 Security off loopback: sessions only over Basic256Sha256 Sign&Encrypt. asyncua keeps a None channel
 when a client asks for one, and would then create a session over it (a password in clear);
@@ -60,6 +61,7 @@ from app.authority.logins import Logins
 from app.authority.users import UserError, Users
 from app.config import OpcUaSettings
 from app.publish.feed import LatestReadings, Watch
+from app.publish.methods import StationMethods, StepLock
 from app.publish.pki import TrustList, host_names, station_certificate, subject, thumbprint
 from app.publish.points import PointReader, PointWriter, Writable
 from netplc.records import Record
@@ -196,9 +198,11 @@ class OpcUaServer:
 
     def __init__(self, *, settings: OpcUaSettings, station: str, folder: Path, tags: Sequence[Tag],
                  commands: Commands, watch: Watch, engine: Any, exchange: Any, alarms: Sequence[Alarm] = (),
-                 journal: Callable[[str], None] = lambda _text: None) -> None:
+                 journal: Callable[[str], None] = lambda _text: None,
+                 step_lock: StepLock = lambda: None) -> None:
         """`journal` takes the system records of the server's security (a certificate made or
-        made private, a client certificate refused)."""
+        made private, a client certificate refused); `step_lock` gives the scan thread's lock, which
+        the Step method needs."""
         self.endpoint = settings.endpoint
         self.settings = settings
         self.station = station
@@ -212,6 +216,7 @@ class OpcUaServer:
         self.journal = journal
         self.writable = Writable(settings.writable)
         self.writer = PointWriter(commands, self.writable, "[opcua]")
+        self.methods = StationMethods(commands, step_lock, ANSWERS)
         self.reader = PointReader(self.tags)
         self.status = OpcUaStatus()
         self.secure = not is_loopback(self.endpoint)
@@ -416,6 +421,7 @@ class OpcUaServer:
             await var.add_property(idx, f"{idx}:Text", alarm.defn.text)
             self.alarm_vars[alarm.id] = var
         self.events = await server.get_event_generator(ua.ObjectIds.BaseEventType, station)
+        await self.methods.add(station, idx)
 
     async def _publish(self, readings: Readings) -> None:
         reading = self.reader.read(readings)
@@ -517,8 +523,13 @@ class OpcUaServer:
             async def write(params: ua.WriteParameters) -> list[ua.StatusCode]:
                 return await self._write(_who(session), params)
 
+            async def call(requests: list[ua.CallMethodRequest]) -> list[ua.CallMethodResult]:
+                return await self._call(_who(session), requests, service)
+
+            service = session.call
             session.activate_session = activate_session
             session.write = write
+            session.call = call
             return session
 
         iserver.create_session = create_session
@@ -526,12 +537,19 @@ class OpcUaServer:
         server.subscribe_server_callback(CallbackType.PostRead, self._user_access_level)
 
     def _user_access_level(self, event: ServerItemCallback, _service: object) -> None:
-        """A tag's UserAccessLevel as the policy answers for the session's user."""
+        """A tag's UserAccessLevel and a station method's UserExecutable as the policy answers
+        for the session's user."""
         if not event.is_external:
             return
         may: bool | None = None
         reads, results = event.request_params.NodesToRead, event.response_params
+        user = event.user.name if event.user is not None and event.user.name else ""
         for n, rv in enumerate(reads):
+            if rv.AttributeId == ua.AttributeIds.UserExecutable:
+                executable = self.methods.executable(Who(user, Source.OPCUA), rv.NodeId)
+                if executable is not None:
+                    results[n] = ua.DataValue(ua.Variant(executable, ua.VariantType.Boolean))
+                continue
             if rv.AttributeId != ua.AttributeIds.UserAccessLevel:
                 continue
             i = self.position.get(rv.NodeId)
@@ -540,11 +558,18 @@ class OpcUaServer:
             level = READ
             if self.writable(self.tags[i].name):
                 if may is None:
-                    user = event.user.name if event.user is not None and event.user.name else ""
                     may = self.commands.may(Who(user, Source.OPCUA), Action.WRITE)
                 if may:
                     level |= WRITE
             results[n] = ua.DataValue(ua.Variant(level, ua.VariantType.Byte))
+
+    async def _call(self, who: Who, requests: list[ua.CallMethodRequest],
+                    service: Callable[[list[ua.CallMethodRequest]], Any]) -> list[ua.CallMethodResult]:
+        """The station's methods as its commands, with the session's user; others to asyncua."""
+        ours = [r.MethodId in self.methods.by_node for r in requests]
+        theirs = [r for r, own in zip(requests, ours) if not own]
+        others = iter(await service(theirs) if theirs else [])
+        return [await self.methods.call(who, r) if own else next(others) for r, own in zip(requests, ours)]
 
     async def _write(self, who: Who, params: ua.WriteParameters) -> list[ua.StatusCode]:
         tickets = [self._command(who, wv) for wv in params.NodesToWrite]

@@ -29,7 +29,8 @@ def start_publishers(runtime: Any) -> list[Publisher]:
         alarms = runtime.alarms.system.alarms if runtime.alarms is not None else []
         server = OpcUaServer(settings=st.opcua, station=st.name, folder=st.folder, tags=tags,
                              commands=runtime.commands, watch=runtime.watch, engine=runtime.engine,
-                             exchange=runtime.exchange, alarms=alarms, journal=runtime.system)
+                             exchange=runtime.exchange, alarms=alarms, journal=runtime.system,
+                             step_lock=lambda: runtime.scan_thread.lock if runtime.scan_thread else None)
         try:
             server.start()
         except (OSError, RuntimeError) as e:
