@@ -19,7 +19,7 @@ from app import logs
 from app.config import DEMO_STATION
 from app.logs import LEVELS
 
-COMMANDS = ("view", "check", "simulate", "alarms-report", "design", "monitor", "archive", "users")
+COMMANDS = ("view", "check", "simulate", "alarms-report", "design", "monitor", "archive", "users", "opcua")
 
 
 def _main_parser() -> argparse.ArgumentParser:
@@ -32,7 +32,8 @@ def _main_parser() -> argparse.ArgumentParser:
                "DD_MM_YYYY (alarm-system health), design [FORM.hmi | STATION] (the form designer), "
                "monitor STATION_OR_HOST:PORT (the program monitor of a running station), archive migrate "
                "ARCHIVE.sqlite postgresql://... (copy an archive into the plant archive), "
-               "users (the station's users and roles); each takes --help.",
+               "users (the station's users and roles), opcua trust STATION THUMBPRINT (trust an OPC UA "
+               "client's certificate); each takes --help.",
     )
     p.add_argument("station", nargs="?", default=str(DEMO_STATION),
                    help="station folder or its station.toml (default: the demo station)")
@@ -231,6 +232,10 @@ def main(argv: list[str] | None = None) -> int:
             return run_migrate(ns.source, ns.url, ns.station)
         if command == "users":
             return run_users(rest)
+        if command == "opcua":
+            from app.publish.trust import main as opcua
+
+            return opcua(rest)
         return run_viewer(_view_parser().parse_args(rest).archive)
     ns = _main_parser().parse_args(args)
     if ns.duration is not None and not ns.no_gui:

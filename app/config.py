@@ -76,6 +76,9 @@ class OpcUaSettings:
     enabled: bool = False
     endpoint: str = "opc.tcp://127.0.0.1:4840/netplc/"
     writable: tuple[str, ...] = ()  # tag names or patterns a client may write
+    # host names and addresses the server's certificate names besides the host's own (clients
+    # check that the name they connect to is one of them): a DNS alias, a NAT address
+    certificate_names: tuple[str, ...] = ()
 
 
 @dataclass(frozen=True)
@@ -536,17 +539,38 @@ def _names(r: _Reader, key: str) -> tuple[str, ...]:
     return tuple(items)
 
 
+def _host_names(r: _Reader, key: str) -> tuple[str, ...]:
+    """A list of DNS names (RFC 1123) and IP addresses."""
+    import ipaddress
+    import re
+
+    label = re.compile(r"(?!-)[A-Za-z0-9-]{1,63}(?<!-)")
+    names = []
+    for item in r.get(key, list, []):
+        if isinstance(item, str):
+            try:
+                names.append(str(ipaddress.ip_address(item)))
+                continue
+            except ValueError:
+                if len(item) <= 253 and all(label.fullmatch(part) for part in item.split(".")):
+                    names.append(item)
+                    continue
+        r.bad(key, f"{item!r} is not a host name or an IP address")
+    return tuple(names)
+
+
 def _opcua(problems: list[str], fname: str, table: dict[str, Any]) -> OpcUaSettings:
     r = _Reader(problems, fname, table, "opcua.")
     d = OpcUaSettings()
     enabled = r.get("enabled", bool, d.enabled)
     endpoint = r.get("endpoint", str, d.endpoint)
     writable = _names(r, "writable")
+    certificate_names = _host_names(r, "certificate_names")
     r.finish()
     if not endpoint.startswith("opc.tcp://"):
         r.bad("endpoint", f"{endpoint!r} is not an opc.tcp:// address")
         endpoint = d.endpoint
-    return OpcUaSettings(enabled, endpoint, writable)
+    return OpcUaSettings(enabled, endpoint, writable, certificate_names)
 
 
 def _mqtt(problems: list[str], fname: str, table: dict[str, Any], base: Path,

@@ -274,7 +274,7 @@ class Runtime:
         self.retainer = Retainer(st.Retain, self.engine, self)
         self.restored = self.retainer.restore()
         self._restore_forces()
-        behaviour = FormBehaviour(self.forms, self.engine.mem, self, self._problem)
+        behaviour = FormBehaviour(self.forms, self.engine.mem, self, self.problem)
         behaviour.attach(self.engine)
         if self.forms:
             self.system(f"forms loaded: {len(self.forms)}, of their elements {len(behaviour.elements)} act "
@@ -308,7 +308,7 @@ class Runtime:
                 modbus.start()
                 self.modbus = modbus
             except OSError as e:  # the station runs on without it; the operator sees why
-                self._problem(f"Modbus server not started: {st.path}: modbus_server.port: cannot listen on "
+                self.problem(f"Modbus server not started: {st.path}: modbus_server.port: cannot listen on "
                               f"{server.host}:{server.port}: {_reason(e)}")
         self.publishers = start_publishers(self)
         self.system(f"program loaded: {self.program.source} ({len(self.program.instrs)} instructions, "
@@ -329,7 +329,7 @@ class Runtime:
             return
         forces, problems = load_forces(st.forces_file)
         for problem in problems:
-            self._problem(f"retained force not restored: {problem}")
+            self.problem(f"retained force not restored: {problem}")
         self.engine.forces.restore(forces, user="station (RetainForces)")
         if forces:
             self.system(f"{len(forces)} retained forces restored from {st.forces_file} (RetainForces = true)")
@@ -379,9 +379,11 @@ class Runtime:
                       for n in self.nodes]
 
     def _scan_error(self, error: BaseException) -> None:
-        self._problem(f"scan failed: {error!r}")
+        self.problem(f"scan failed: {error!r}")
 
-    def _problem(self, text: str) -> None:
+    def problem(self, text: str) -> None:
+        """Something the operator must see and act on (a server that did not start, a scan that
+        failed): journaled once and shown in the status until the station stops."""
         with self._lock:
             if text in self._problems:
                 return

@@ -147,18 +147,20 @@ class Commands:
 
     # --- answers and refusals ------------------------------------------------------------------
 
-    def refuse(self, who: Who, action: Action, target: str, reason: Reason, text: str,
+    def refuse(self, who: Who, action: Action | str, target: str, reason: Reason, text: str,
                refusal: Refusal | None = None) -> Ticket:
-        """A refused command: journaled (throttled), answered at once."""
+        """A refused command: journaled (throttled), answered at once. `action` may be a word for
+        what the policy has no entry for (a failed login, a refused channel)."""
         self._journal_refusal(who, action, target, reason, text)
         ticket: Ticket = Future()
         ticket.set_result(Answer(reason, text, refusal))
         return ticket
 
-    def _journal_refusal(self, who: Who, action: Action, target: str, reason: Reason, text: str) -> None:
+    def _journal_refusal(self, who: Who, action: Action | str, target: str, reason: Reason,
+                         text: str) -> None:
         now = self.monotonic()
         principal = who.user or who.peer.rsplit(":", 1)[0]  # a client reconnecting keeps its host
-        key = (who.source.value, principal, action.value, reason.value)
+        key = (who.source.value, principal, str(action), reason.value)
         with self._lock:
             self.refusals += 1
             entry = self._refused.get(key)
@@ -170,7 +172,7 @@ class Commands:
             if len(self._refused) > 4096:  # bounded: forget the oldest causes
                 for old in sorted(self._refused, key=lambda k: self._refused[k][0])[:1024]:
                     del self._refused[old]
-        what = f"{action.value} {target}".strip()
+        what = f"{action} {target}".strip()
         tail = f" ({more} more refused like it in the minute before)" if more else ""
         self.sink.put(Record(self.wallclock(), "operator", source=who.name,
                              text=f"refused {what}: {text}{tail}"))

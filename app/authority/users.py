@@ -13,6 +13,7 @@ policy table), which the views ask with the session's name.
 
 from __future__ import annotations
 
+import functools
 import hashlib
 import hmac
 import json
@@ -23,7 +24,7 @@ from collections.abc import Callable
 from dataclasses import asdict, dataclass
 from pathlib import Path
 
-from app.authority.policy import ROLES, rank
+from app.authority.policy import ROLES, VIEWER, rank
 from netplc.problems import Problems
 from netplc.textfile import TextFileError, read_text
 
@@ -103,8 +104,14 @@ class Users:
         self.save()
 
     def verify(self, name: str, password: str) -> User | None:
+        """The user if the password is theirs. An unknown name costs the same scrypt as a wrong
+        password (checked against a stand-in), so the time of a refusal does not tell a client
+        which names exist."""
         user = self.users.get(name)
-        return user if user is not None and user.check(password) else None
+        if user is None:
+            _stand_in().check(password)
+            return None
+        return user if user.check(password) else None
 
     def save(self) -> None:
         tmp = self.path.with_suffix(".tmp")
@@ -112,6 +119,12 @@ class Users:
         with os.fdopen(fd, "w", encoding="utf-8") as f:
             json.dump({"users": [asdict(u) for u in self.users.values()]}, f, indent=1)
         os.replace(tmp, self.path)
+
+
+@functools.cache
+def _stand_in() -> User:
+    """A user no name leads to, whose check costs what a real user's does."""
+    return new_user("", VIEWER, secrets.token_hex(16))
 
 
 def _role(role: str) -> str:

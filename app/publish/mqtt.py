@@ -7,13 +7,18 @@ last will, then NBIRTH (every metric with name, alias, datatype, engUnit and Qua
 the bdSeq and Node Control/Rebirth) and then NDATA with only the metrics whose value moved beyond
 the deadband of its tag type or whose quality changed (report by exception), by alias. While the
 broker is away the NDATA are kept in a bounded buffer (oldest dropped first, counted) and sent
-after the next NBIRTH as historical metrics. NCMD Node Control/Rebirth republishes the NBIRTH;
-an NCMD metric that names a writable tag is written through the engine's queue and journaled, any
-other is refused and journaled.
+after the next NBIRTH as historical metrics. NCMD Node Control/Rebirth republishes the NBIRTH.
+
+Every other NCMD metric is a write through the station's command layer (app/authority/), by the
+MQTT source (a command names no user: it acts with the role station.toml grants MQTT), checked
+for the metric's Sparkplug datatype (a String for a Double metric is refused), the tag's physical
+range and `[mqtt] writable`. An NCMD has no answer: the journal is the answer, each refusal
+journaled by the layer, throttled (one record per cause per minute with the count of the others).
 """
 
 from __future__ import annotations
 
+import logging
 import os
 import threading
 import time
@@ -27,11 +32,14 @@ from urllib.parse import urlsplit
 import numpy as np
 import paho.mqtt.client as mqtt
 
+from app.authority import Action, Commands, Reason, Source, Ticket, Who
 from app.config import MqttSettings
 from app.publish import sparkplug as spb
-from app.publish.feed import LatestSnapshot
-from app.publish.points import PointReader, Reading, Writer, WriteRefused
+from app.publish.feed import LatestReadings, Watch
+from app.publish.points import PointReader, PointWriter, Reading, Writable
 from netplc.tags.tag import Tag
+
+logger = logging.getLogger(__name__)
 
 BACKOFF = (1, 30)  # seconds: first reconnect delay, doubling up to the second
 KEEPALIVE = 10  # s: the broker publishes NDEATH within 1.5 of these after the station vanishes
@@ -49,18 +57,19 @@ class MqttStatus:
 
 
 class SparkplugPublisher:
-    def __init__(self, settings: MqttSettings, station: str, *, tags: Sequence[Tag], reader: PointReader,
-                 writer: Writer, engine: Any, journal: Callable[[str], None],
-                 bdseq_file: Path | None = None) -> None:
+    def __init__(self, settings: MqttSettings, station: str, *, tags: Sequence[Tag], commands: Commands,
+                 watch: Watch, journal: Callable[[str], None], bdseq_file: Path | None = None) -> None:
         """`bdseq_file` keeps the bdSeq of the last connection across restarts (Sparkplug 3.0:
         each connection's bdSeq is the previous one's plus one), so a host application never
         takes the NDEATH of an old session for the new one's; None: it starts at 0."""
         self.settings = settings
         self.topics = spb.Topics(settings.group_id, settings.edge_node_id or station)
         self.tags = list(tags)
-        self.reader = reader
-        self.writer = writer
-        self.engine = engine
+        self.index = {t.name: i for i, t in enumerate(self.tags)}
+        self.reader = PointReader(self.tags)
+        self.writer = PointWriter(commands, Writable(settings.writable), "[mqtt]")
+        self.commands = commands
+        self.watch = watch
         self.journal = journal
         self.status = MqttStatus()
         self.kinds = [spb.datatype(t) for t in self.tags]
@@ -70,7 +79,9 @@ class SparkplugPublisher:
         self.host = url.hostname or "127.0.0.1"
         self.port = url.port or (8883 if url.scheme == "mqtts" else 1883)
         self.peer = f"{self.host}:{self.port}"
-        self.feed = LatestSnapshot(reader, self._wakeup)
+        self.who = Who("", Source.MQTT, f"NCMD {self.topics.node} via {self.peer}")
+        self.feed = LatestReadings(self._wakeup)
+        self._unwatch: Callable[[], None] | None = None
         self.bdseq_file = bdseq_file
         self.bdseq = (self._stored_bdseq() + 1) % 256  # the next connection's (stored once connected)
         self._seq = 0
@@ -104,11 +115,13 @@ class SparkplugPublisher:
         self.client.loop_start()
         self._thread = threading.Thread(target=self._run, name="mqtt-publish", daemon=True)
         self._thread.start()
-        self.engine.subscribe(self.feed)
+        self._unwatch = self.watch(self.feed)
 
     def stop(self) -> None:
         """A deliberate stop: NDEATH published by the node itself (spec 3.0), then disconnect."""
-        self.engine.unsubscribe(self.feed)
+        if self._unwatch is not None:
+            self._unwatch()
+            self._unwatch = None
         self._stopping = True
         self._wake.set()
         if self._thread is not None:
@@ -182,28 +195,41 @@ class SparkplugPublisher:
                          "NDATA buffered meanwhile")
 
     def _on_ncmd(self, client: mqtt.Client, userdata: object, message: mqtt.MQTTMessage) -> None:
-        user = f"mqtt:NCMD {self.topics.node} via {self.peer}"
+        who = self.who
         try:
             payload = spb.Payload.FromString(message.payload)
         except Exception as e:  # a malformed command must not cost the connection
-            self.journal(f"MQTT NCMD via {self.peer} ignored: not a Sparkplug B payload ({type(e).__name__})")
+            self._refused(self.commands.refuse(who, Action.WRITE, "", Reason.INVALID,
+                                               f"not a Sparkplug B payload ({type(e).__name__})"))
             return
         for metric in payload.metrics:
             name = metric.name
             if not name and metric.alias:
                 i = int(metric.alias) - 1
                 name = self.tags[i].name if 0 <= i < len(self.tags) else f"alias {metric.alias}"
-            value = spb.get_value(metric)
             if name == spb.REBIRTH:
-                if value:
+                if spb.get_value(metric):
                     self._birth_due = True
                     self._wake.set()
                     self.journal(f"MQTT rebirth requested by NCMD via {self.peer}")
                 continue
-            try:
-                self.writer.write(name, value, user)
-            except WriteRefused:
-                self.status.refused += 1
+            i = self.index.get(name)
+            if i is None:
+                ticket = self.commands.refuse(who, Action.WRITE, name, Reason.UNKNOWN, "no such metric")
+            else:
+                kind = self.kinds[i]
+                ticket = self.writer.write(who, self.tags[i], spb.get_value(metric, kind),
+                                           spb.mismatch(metric, kind))
+            self._refused(ticket)
+
+    def _refused(self, ticket: Ticket) -> None:
+        """Count the command's refusal (the layer journals it) once it is answered."""
+        def answered(done: Ticket) -> None:
+            if not done.result().ok:
+                with self._lock:
+                    self.status.refused += 1
+
+        ticket.add_done_callback(answered)
 
     # --- the publisher's thread ----------------------------------------------------------------
 
@@ -219,7 +245,7 @@ class SparkplugPublisher:
             self._wake.clear()
             item = self.feed.take()
             if item is not None:
-                self._latest = self.reader.read(*item)
+                self._latest = self.reader.read(item)
             reading = self._latest
             if reading is None:
                 continue

@@ -1,11 +1,30 @@
 """The OPC UA server: the station's tags, nodes, NetPlc state and alarms for any OPC UA client.
 
-asyncua runs on a thread and event loop of its own. Values come from the engine's snapshots
-through `LatestSnapshot` (at most one update per tick, none while the loop lags); only the
-variables whose value or quality changed are written, each with the snapshot's wall time as
-source timestamp and a StatusCode from the tag's quality. Client writes to tag variables are
-taken before asyncua's own write service: a writable tag goes into the engine's queue (journaled
-with the OPC UA user and peer), any other gets Bad_NotWritable (journaled as refused).
+asyncua runs on a thread and event loop of its own. Values come from the station's `Readings`
+(`Runtime.watch`, through `LatestReadings`: at most one update per tick, none while the loop
+lags); only the variables whose value or quality changed are written, each with the scan's wall
+time as source timestamp and a StatusCode from the tag's quality.
+
+Client writes are the station's commands (app/authority/): every session's Write service is taken
+before asyncua's own, and a write to a tag variable goes to the command layer with the session's
+user and peer, which checks the role, the tag's physical range and journals it; the Write is
+answered once the value is applied, committed to the journal and readable here (an immediate
+Read returns it). The variable's DataType is the one a client must send (Boolean for a bit, Double
+for a scaled tag...), anything else is Bad_TypeMismatch; a node that is never writable (the state,
+the node diagnostics, a tag `[opcua] writable` does not name) is Bad_NotWritable, journaled like
+every refusal. UserAccessLevel is answered per session from the same policy: read for a viewer or
+an anonymous client, read and write for a role that may write. The station object's methods
+(methods.py: run, stop, step, force, unforce) are commands the same way. No role is checked here.
+
+Security off loopback: sessions only over Basic256Sha256 Sign&Encrypt. asyncua keeps a None channel
+when a client asks for one, and would then create a session over it (a password in clear);
+the station lets a None channel serve discovery only (GetEndpoints, FindServers: how standard
+clients learn the endpoints and the server certificate, as OPC UA Part 4 section 5.4 provides)
+and refuses CreateSession on it with Bad_SecurityPolicyRejected, whatever the client asks. A
+client certificate that is not in the station's trust list (pki.py) is refused when it opens its
+secure channel, by closing the connection (the way asyncua answers a refused OpenSecureChannel).
+Logins are the station's users with a back-off per host (app/authority/logins.py). A loopback
+endpoint (the demo) is for local clients only and has no security.
 
 Alarms: each alarm is a String variable holding its ISA-18.2 state word, and each transition
 fires an event (BaseEventType: SourceName the alarm id, Message its text, Severity from its
@@ -18,7 +37,9 @@ from __future__ import annotations
 
 import asyncio
 import contextlib
+import contextvars
 import ipaddress
+import logging
 import math
 import threading
 from collections.abc import Callable, Sequence
@@ -30,19 +51,27 @@ from urllib.parse import urlsplit
 
 import numpy as np
 from asyncua import Server, ua
-from asyncua.crypto.cert_gen import setup_self_signed_certificate
-from asyncua.crypto.permission_rules import User, UserRole
-from cryptography.x509.oid import ExtendedKeyUsageOID
+from asyncua.common.callback import CallbackType, ServerItemCallback
+from asyncua.common.utils import ServiceError
+from asyncua.crypto.permission_rules import SimpleRoleRuleset, User, UserRole
+from asyncua.crypto.security_policies import SecurityPolicyBasic256Sha256, SecurityPolicyFactory
 
-from app.authority.users import rank
-from app.publish.feed import LatestSnapshot
-from app.publish.points import PasswordCheck, PointReader, Writer, WriteRefused
+from app.authority import Action, Commands, Reason, Source, Ticket, Who, write_range
+from app.authority.logins import Logins
+from app.authority.users import UserError, Users
+from app.config import OpcUaSettings
+from app.publish.feed import LatestReadings, Watch
+from app.publish.methods import StationMethods, StepLock
+from app.publish.pki import TrustList, host_names, station_certificate, subject, thumbprint
+from app.publish.points import PointReader, PointWriter, Writable
 from netplc.records import Record
 from netplc.tags.alarms import PRIORITIES, Alarm, State
 from netplc.tags.quality import Quality
+from netplc.tags.readings import Readings
 from netplc.tags.tag import Tag, TagType
 
-CERT_FILE, KEY_FILE = "opcua-cert.der", "opcua-key.pem"  # generated in the station folder
+logger = logging.getLogger(__name__)
+
 START_TIMEOUT = 60.0
 UNECE_UNITS = "http://www.opcfoundation.org/UA/units/un/cefact"
 STATUS = {Quality.GOOD: ua.StatusCodes.Good, Quality.INITIAL: ua.StatusCodes.BadWaitingForInitialData,
@@ -51,8 +80,17 @@ STATUS = {Quality.GOOD: ua.StatusCodes.Good, Quality.INITIAL: ua.StatusCodes.Bad
           Quality.NOT_RUNNING: ua.StatusCodes.BadOutOfService,
           Quality.FORCED: ua.StatusCodes.GoodLocalOverride}
 CODES = [ua.StatusCode(STATUS[q]) for q in Quality]  # by quality code
+_S = ua.StatusCodes
+ANSWERS = {Reason.APPLIED: _S.Good, Reason.DENIED: _S.BadUserAccessDenied,  # by the layer's Reason
+           Reason.NOT_WRITABLE: _S.BadNotWritable, Reason.UNKNOWN: _S.BadNodeIdUnknown,
+           Reason.TYPE_MISMATCH: _S.BadTypeMismatch, Reason.OUT_OF_RANGE: _S.BadOutOfRange,
+           Reason.INVALID: _S.BadInvalidArgument, Reason.BUSY: _S.BadTooManyOperations,
+           Reason.JOURNAL_FULL: _S.BadResourceUnavailable, Reason.NOT_RUNNING: _S.BadServerHalted,
+           Reason.FAILED: _S.BadInternalError}
+READ, WRITE = 1 << ua.AccessLevel.CurrentRead, 1 << ua.AccessLevel.CurrentWrite
 YIELD_EVERY = 500  # variable writes between two turns of the event loop
 SEVERITY = {1: 900, 2: 700, 3: 500, 4: 300}  # alarm priority -> OPC UA severity 1-1000
+READABLE_WITHIN = 2.0  # s at most an applied write waits for its value to be readable here
 
 
 def is_loopback(endpoint: str) -> bool:
@@ -81,63 +119,113 @@ def _python(kind: ua.VariantType) -> Callable[[float], Any]:
     return int
 
 
-async def station_certificate(folder: Path, uri: str, host: str, station: str) -> tuple[Path, Path]:
-    """The station's certificate and key in its folder: made on first start (and again when
-    missing or expired), kept afterwards so clients that trusted it once go on trusting it."""
-    key, cert = folder / KEY_FILE, folder / CERT_FILE
-    await setup_self_signed_certificate(key, cert, uri, host, [ExtendedKeyUsageOID.SERVER_AUTH],
-                                        {"commonName": f"NetPlc Station {station}"})
-    return cert, key
+def _peer(name: object) -> str:
+    """A session's peer (asyncua names it by the socket's peer address) as host:port."""
+    if isinstance(name, tuple) and len(name) >= 2:
+        return f"{name[0]}:{name[1]}"
+    return str(name)
+
+
+def _no_registrations(*_args: object) -> None:
+    """The station is no discovery server: RegisterServer(2) is refused."""
+    raise ServiceError(ua.StatusCodes.BadServiceUnsupported)
+
+
+def _who(session: Any) -> Who:
+    user = session.user.name if session.user is not None and session.user.name else ""
+    return Who(user, Source.OPCUA, _peer(session.name))
 
 
 @dataclass
 class OpcUaStatus:
     updates: int = 0  # variable values written into the address space
-    skipped: int = 0  # snapshots not published because the server lagged
+    skipped: int = 0  # scans not published because the server lagged
     error: str = ""
 
 
 class _Users:
-    """asyncua's user manager: anonymous users where no users exist or on a loopback endpoint
-    (local clients, as security None is for them only), else name and password; a name given is
-    always checked."""
+    """asyncua's user manager: the station's users (`Logins`: back-off, failures journaled);
+    anonymous clients where the station has no users or on a loopback endpoint (the layer lets
+    them read only: anonymous has no role)."""
 
-    def __init__(self, check: PasswordCheck | None, anonymous: bool) -> None:
-        self.check = check
-        self.anonymous = anonymous
+    def __init__(self, logins: Logins, folder: Path, loopback: bool) -> None:
+        self.logins = logins
+        self.folder = folder
+        self.loopback = loopback
+        self.peer = ""  # of the session being activated (set around asyncua's activate_session)
 
     def get_user(self, iserver: object, username: str | None = None, password: str | None = None,
                  certificate: object = None) -> User | None:
-        if self.check is None or (self.anonymous and not username):
-            return User(role=UserRole.User, name=username or None)  # no name: anonymous
-        if username and password is not None and self.check(username, password):
-            return User(role=UserRole.User, name=username)
-        return None
+        if not username:
+            anonymous = self.loopback or not self.any()
+            return User(role=UserRole.User) if anonymous else None
+        user = self.logins.login(username, password or "", self.peer)
+        return None if user is None else User(role=UserRole.User, name=user.name)
+
+    def any(self) -> bool:
+        """Does the station have users? A users file that cannot be read counts as yes: nobody
+        comes in anonymously because the file broke."""
+        try:
+            return bool(Users(self.folder).users)
+        except UserError:
+            logger.exception("users of %s not readable", self.folder)
+            return True
+
+
+# Whether the connection being served has a secure channel: set by `_Trusting` in the task asyncua
+# runs each connection's messages in, so its later requests (CreateSession) see it and no other
+# connection does.
+_SECURE_CHANNEL: contextvars.ContextVar[bool] = contextvars.ContextVar("secure_channel", default=False)
+
+
+class _Trusting(SecurityPolicyFactory):
+    """Basic256Sha256 Sign&Encrypt for a client whose certificate the station trusts."""
+
+    def __init__(self, certificate: Any, private_key: Any, check: Callable[[bytes | None], bool]) -> None:
+        super().__init__(SecurityPolicyBasic256Sha256, ua.MessageSecurityMode.SignAndEncrypt, certificate,
+                         private_key, permission_ruleset=SimpleRoleRuleset())
+        self.check = check
+
+    def create(self, peer_certificate: bytes | None) -> Any:
+        if not self.check(peer_certificate):
+            raise ua.uaerrors.BadUserAccessDenied()  # asyncua closes the connection
+        _SECURE_CHANNEL.set(True)
+        return super().create(peer_certificate)
 
 
 class OpcUaServer:
     """`start()` (OSError or RuntimeError naming the problem), then `stop()`."""
 
-    def __init__(self, *, endpoint: str, station: str, folder: Path, tags: Sequence[Tag], reader: PointReader,
-                 writer: Writer, engine: Any, exchange: Any, alarms: Sequence[Alarm] = (),
-                 password_check: PasswordCheck | None = None,
-                 role_of: Callable[[str], str | None] | None = None) -> None:
-        """`role_of` gives a user's role at each write (so a changed role counts at once); None
-        while the station has no users, when any client may write what `writable` names."""
-        self.endpoint = endpoint
+    def __init__(self, *, settings: OpcUaSettings, station: str, folder: Path, tags: Sequence[Tag],
+                 commands: Commands, watch: Watch, engine: Any, exchange: Any, alarms: Sequence[Alarm] = (),
+                 journal: Callable[[str], None] = lambda _text: None,
+                 step_lock: StepLock = lambda: None) -> None:
+        """`journal` takes the system records of the server's security (a certificate made or
+        made private, a client certificate refused); `step_lock` gives the scan thread's lock, which
+        the Step method needs."""
+        self.endpoint = settings.endpoint
+        self.settings = settings
         self.station = station
         self.folder = folder
         self.tags = list(tags)
-        self.reader = reader
-        self.writer = writer
+        self.commands = commands
+        self.watch = watch
         self.engine = engine
         self.exchange = exchange
         self.alarms = list(alarms)
-        self.password_check = password_check
-        self.role_of = role_of
+        self.journal = journal
+        self.writable = Writable(settings.writable)
+        self.writer = PointWriter(commands, self.writable, "[opcua]")
+        self.methods = StationMethods(commands, step_lock, ANSWERS)
+        self.reader = PointReader(self.tags)
         self.status = OpcUaStatus()
-        self.secure = not is_loopback(endpoint)
-        self.feed = LatestSnapshot(reader, self._wake)
+        self.secure = not is_loopback(self.endpoint)
+        self.trust = TrustList(folder)
+        self.users = _Users(Logins(lambda: Users(folder), commands, Source.OPCUA), folder, not self.secure)
+        self.feed = LatestReadings(self._wake)
+        self._unwatch: Callable[[], None] | None = None
+        self._published = -1  # the scan whose values the address space holds
+        self._waiting: list[tuple[int, asyncio.Future[None]]] = []  # writes waiting to be readable
         self._loop: asyncio.AbstractEventLoop | None = None
         self._ready = threading.Event()
         self._thread: threading.Thread | None = None
@@ -154,10 +242,12 @@ class OpcUaServer:
         if self.status.error:
             self._thread.join(5)
             raise RuntimeError(self.status.error)
-        self.engine.subscribe(self.feed)
+        self._unwatch = self.watch(self.feed)
 
     def stop(self) -> None:
-        self.engine.unsubscribe(self.feed)
+        if self._unwatch is not None:
+            self._unwatch()
+            self._unwatch = None
         loop, stop = self._loop, self._stop
         if loop is not None and stop is not None and not loop.is_closed():
             loop.call_soon_threadsafe(stop.set)
@@ -184,13 +274,14 @@ class OpcUaServer:
         try:
             asyncio.run(self._main())
         except Exception as e:  # reported by start(), or to the runtime through status
+            logger.exception("OPC UA server at %s failed", self.endpoint)
             self.status.error = f"OPC UA server at {self.endpoint}: {type(e).__name__}: {e}"
             self._ready.set()
 
     async def _main(self) -> None:
         self._loop = asyncio.get_running_loop()
         self._stop, self._tick = asyncio.Event(), asyncio.Event()
-        server = Server(user_manager=_Users(self.password_check, anonymous=not self.secure))
+        server = Server(user_manager=self.users)
         await server.init()
         server.set_endpoint(self.endpoint)
         server.set_server_name(f"NetPlc Station {self.station}")
@@ -202,8 +293,12 @@ class OpcUaServer:
             server.set_security_policy([ua.SecurityPolicyType.NoSecurity])
         self.server = server
         await self._build(server, uri)
-        self._intercept_writes(server)
+        self._intercept(server)
         await server.start()
+        if self.secure:  # no await since the listener opened: no client is served before this
+            assert server.bserver is not None
+            server.bserver.set_policies([
+                _Trusting(server.iserver.certificate, server.iserver.private_key, self._trusted)])
         try:
             self._ready.set()
             while not self._stop.is_set():
@@ -215,19 +310,44 @@ class OpcUaServer:
                 self._tick.clear()
                 item = self.feed.take()
                 if item is not None:
-                    await self._publish(*item)
+                    await self._publish(item)
+                    self._readable(item.snapshot.scan)
                 self.status.skipped = self.feed.skipped
         finally:
             await server.stop()
 
     async def _secure(self, server: Server, uri: str) -> None:
-        """Basic256Sha256 Sign&Encrypt with the station's own certificate, made on first start."""
-        host = urlsplit(self.endpoint).hostname or "localhost"
-        cert, key = await station_certificate(self.folder, uri, host, self.station)
-        await server.load_certificate(str(cert))
-        await server.load_private_key(str(key))
+        """Basic256Sha256 Sign&Encrypt with the station's own certificate (pki.py)."""
+        names = host_names(urlsplit(self.endpoint).hostname or "", self.settings.certificate_names)
+        own = await asyncio.to_thread(station_certificate, self.folder, uri, names, self.station)
+        for note in own.notes:
+            self.journal(f"OPC UA: {note}")
+        await server.load_certificate(str(own.cert))
+        await server.load_private_key(str(own.key))
         server.set_security_policy([ua.SecurityPolicyType.Basic256Sha256_SignAndEncrypt])
-        server.set_security_IDs(["Anonymous" if self.password_check is None else "Username"])
+        tokens: list[type] = [ua.UserNameIdentityToken]
+        if not self.users.any():
+            tokens.append(ua.AnonymousIdentityToken)
+        server.set_identity_tokens(tokens)
+
+    def _trusted(self, der: bytes | None) -> bool:
+        """Is the client's certificate in the trust list? A refused one is kept in pki/rejected/
+        and journaled the first time."""
+        if der and self.trust.is_trusted(der):
+            return True
+        if not der:
+            return False
+        try:
+            kept = self.trust.reject(der)
+        except OSError:
+            logger.exception("refused client certificate not kept")
+            kept = None
+        if kept is not None:
+            thumb = thumbprint(der)
+            self.journal(f"OPC UA: client certificate refused, not trusted: {subject(der)} (thumbprint "
+                         f"{thumb}), kept in {kept.parent}; `python main.py opcua trust {self.folder} "
+                         f"{thumb}` trusts it")
+        return False
 
     async def _build(self, server: Server, uri: str) -> None:
         idx = await server.register_namespace(uri)
@@ -238,7 +358,7 @@ class OpcUaServer:
         self.kinds = [variant_type(t) for t in self.tags]
         self.convert = [_python(k) for k in self.kinds]
         self.nodeids: list[ua.NodeId] = []
-        self.by_nodeid: dict[ua.NodeId, str] = {}
+        self.position: dict[ua.NodeId, int] = {}  # a tag variable's index in `tags`
         # asyncua checks each new child against all of its parent's references (quadratic: a
         # minute for 10,000 tags); tag names are unique, so each tag is added to a folder whose
         # reference list is set aside meanwhile and put back with the new reference appended.
@@ -257,20 +377,21 @@ class OpcUaServer:
             if tag.description:
                 await var.write_attribute(ua.AttributeIds.Description,
                                           ua.DataValue(ua.Variant(ua.LocalizedText(tag.description))))
-            if self.writer.can_write(tag.name):
-                await var.set_writable()
+            if self.writable(tag.name):  # what a client may write at all; UserAccessLevel per session
+                await var.write_attribute(ua.AttributeIds.AccessLevel,
+                                          ua.DataValue(ua.Variant(READ | WRITE, ua.VariantType.Byte)))
             if tag.type is not TagType.BIT:
                 unit = ua.LocalizedText(tag.unit)
                 eu = ua.EUInformation(NamespaceUri=UNECE_UNITS, UnitId=-1, DisplayName=unit, Description=unit)
                 await var.add_property(ua.NodeId(f"Tags.{tag.name}.EngineeringUnits", idx),
                                        ua.QualifiedName("EngineeringUnits", 0), eu,
                                        datatype=ua.NodeId(ua.ObjectIds.EUInformation))
-                lo, hi = tag.phy_limits
+                lo, hi = write_range(tag)  # PhyMin..PhyMax: what a client may write
                 await var.add_property(ua.NodeId(f"Tags.{tag.name}.EURange", idx),
                                        ua.QualifiedName("EURange", 0), ua.Range(Low=lo, High=hi),
                                        datatype=ua.NodeId(ua.ObjectIds.Range))
             self.nodeids.append(nodeid)
-            self.by_nodeid[nodeid] = tag.name
+            self.position[nodeid] = i
         self._last_values = np.full(len(self.tags), np.nan)
         self._last_quality = np.full(len(self.tags), -1, dtype=np.int8)
         plc = await station.add_object(ua.NodeId("NetPlc", idx), f"{idx}:NetPlc")
@@ -300,13 +421,15 @@ class OpcUaServer:
             await var.add_property(idx, f"{idx}:Text", alarm.defn.text)
             self.alarm_vars[alarm.id] = var
         self.events = await server.get_event_generator(ua.ObjectIds.BaseEventType, station)
+        await self.methods.add(station, idx)
 
-    async def _publish(self, snapshot: Any, quality: np.ndarray) -> None:
-        reading = self.reader.read(snapshot, quality)
+    async def _publish(self, readings: Readings) -> None:
+        reading = self.reader.read(readings)
+        quality = reading.quality
         values, last = reading.values, self._last_values
         changed = np.flatnonzero(~((values == last) | (np.isnan(values) & np.isnan(last)))
                                  | (quality != self._last_quality))
-        self._last_values, self._last_quality = values, quality.copy()
+        self._last_values, self._last_quality = values, quality
         when = datetime.fromtimestamp(reading.wall, UTC)
         write = self.server.iserver.aspace.write_attribute_value
         value_attr = ua.AttributeIds.Value
@@ -347,72 +470,134 @@ class OpcUaServer:
         await self.events.trigger(message=f"{record.source}: {State(record.number or 0).word} -> {state.word}"
                                           + (f": {record.text}" if record.text else ""))
 
-    # --- client writes -------------------------------------------------------------------------
+    def _readable(self, scan: int) -> None:
+        """The address space holds the values of `scan`: answer the writes that waited for them."""
+        self._published = scan
+        still = []
+        for after, future in self._waiting:
+            if scan > after:
+                if not future.done():
+                    future.set_result(None)
+            else:
+                still.append((after, future))
+        self._waiting = still
 
-    def _intercept_writes(self, server: Server) -> None:
-        """Every session's Write service passes through `_write` first (the session knows the user
-        and the peer; asyncua's attribute service knows neither)."""
+    async def _until_readable(self, after: int) -> None:
+        """Until a scan newer than `after` is in the address space (bounded: an applied write is
+        answered even while the server lags)."""
+        if self._published > after:
+            return
+        future: asyncio.Future[None] = asyncio.get_running_loop().create_future()
+        self._waiting.append((after, future))
+        with contextlib.suppress(TimeoutError):
+            await asyncio.wait_for(future, max(READABLE_WITHIN, 3 * self.engine.tick))
+
+    # --- client sessions -----------------------------------------------------------------------
+
+    def _intercept(self, server: Server) -> None:
+        """Every client session's Write goes through `_write` instead of asyncua's attribute
+        service (the session knows the user and the peer; that service knows neither), and the
+        login sees its peer; a Read of UserAccessLevel is answered for the session's user."""
         iserver = server.iserver
         create = iserver.create_session
+        users = self.users
 
         def create_session(name: str, user: User | None = None, external: bool = False) -> Any:
+            if external and self.secure and not _SECURE_CHANNEL.get():
+                self.commands.refuse(Who("", Source.OPCUA, _peer(name)), "open a session", "",
+                                     Reason.DENIED, f"security None at {self.endpoint} is for discovery "
+                                     "only (GetEndpoints): sessions need Basic256Sha256 Sign&Encrypt")
+                raise ServiceError(ua.StatusCodes.BadSecurityPolicyRejected)
             session = create(name, user=user or User(role=UserRole.Anonymous), external=external)
-            service = session.write
+            if not external:
+                return session
+            activate = session.activate_session
+
+            def activate_session(params: Any, peer_certificate: bytes | None) -> Any:
+                users.peer = _peer(session.name)
+                try:
+                    return activate(params, peer_certificate)
+                finally:
+                    users.peer = ""
 
             async def write(params: ua.WriteParameters) -> list[ua.StatusCode]:
-                return await self._write(session, params, service)
+                return await self._write(_who(session), params)
 
+            async def call(requests: list[ua.CallMethodRequest]) -> list[ua.CallMethodResult]:
+                return await self._call(_who(session), requests, service)
+
+            service = session.call
+            session.activate_session = activate_session
             session.write = write
+            session.call = call
             return session
 
         iserver.create_session = create_session
+        iserver.register_server = _no_registrations  # no session is needed, over any channel
+        server.subscribe_server_callback(CallbackType.PostRead, self._user_access_level)
 
-    async def _write(self, session: Any, params: ua.WriteParameters, service: Any) -> list[ua.StatusCode]:
-        results: list[ua.StatusCode | None] = []
-        others = []
-        named = session.user.name if session.user is not None and session.user.name else None
-        peer = session.name
-        peer_text = f"{peer[0]}:{peer[1]}" if isinstance(peer, tuple) and len(peer) >= 2 else str(peer)
-        refusal = self._refusal(named)
-        for wv in params.NodesToWrite:
-            name = self.by_nodeid.get(wv.NodeId)
-            if name is None:
-                others.append(wv)
-                results.append(None)
+    def _user_access_level(self, event: ServerItemCallback, _service: object) -> None:
+        """A tag's UserAccessLevel and a station method's UserExecutable as the policy answers
+        for the session's user."""
+        if not event.is_external:
+            return
+        may: bool | None = None
+        reads, results = event.request_params.NodesToRead, event.response_params
+        user = event.user.name if event.user is not None and event.user.name else ""
+        for n, rv in enumerate(reads):
+            if rv.AttributeId == ua.AttributeIds.UserExecutable:
+                executable = self.methods.executable(Who(user, Source.OPCUA), rv.NodeId)
+                if executable is not None:
+                    results[n] = ua.DataValue(ua.Variant(executable, ua.VariantType.Boolean))
                 continue
-            results.append(self._write_tag(name, wv, f"opcua:{named or 'anonymous'}@{peer_text}", refusal))
-        if others:
-            done = iter(await service(ua.WriteParameters(NodesToWrite=others)))
-            results = [r if r is not None else next(done) for r in results]
-        return [r for r in results if r is not None]
+            if rv.AttributeId != ua.AttributeIds.UserAccessLevel:
+                continue
+            i = self.position.get(rv.NodeId)
+            if i is None:
+                continue
+            level = READ
+            if self.writable(self.tags[i].name):
+                if may is None:
+                    may = self.commands.may(Who(user, Source.OPCUA), Action.WRITE)
+                if may:
+                    level |= WRITE
+            results[n] = ua.DataValue(ua.Variant(level, ua.VariantType.Byte))
 
-    def _refusal(self, user: str | None) -> str | None:
-        """Why `user` (None: anonymous) may not write at all, as in the workstation: the operator
-        role or above, where the station has users."""
-        if self.role_of is None:
-            return None
-        if user is None:
-            return "anonymous clients may only read where the station has users"
-        role = self.role_of(user)
-        if role is None or rank(role) < rank("operator"):
-            return f"{user} is {role or 'no longer a user'}: writing needs the operator role"
-        return None
+    async def _call(self, who: Who, requests: list[ua.CallMethodRequest],
+                    service: Callable[[list[ua.CallMethodRequest]], Any]) -> list[ua.CallMethodResult]:
+        """The station's methods as its commands, with the session's user; others to asyncua."""
+        ours = [r.MethodId in self.methods.by_node for r in requests]
+        theirs = [r for r, own in zip(requests, ours) if not own]
+        others = iter(await service(theirs) if theirs else [])
+        return [await self.methods.call(who, r) if own else next(others) for r, own in zip(requests, ours)]
 
-    def _write_tag(self, name: str, wv: ua.WriteValue, user: str, refusal: str | None) -> ua.StatusCode:
+    async def _write(self, who: Who, params: ua.WriteParameters) -> list[ua.StatusCode]:
+        tickets = [self._command(who, wv) for wv in params.NodesToWrite]
+        answers = [await asyncio.wrap_future(t) for t in tickets]
+        if any(a.ok for a in answers):
+            # applied in a scan after the one handed over last: readable once a newer one is
+            await self._until_readable(self.feed.scan)
+        return [ua.StatusCode(ANSWERS[a.reason]) for a in answers]
+
+    def _command(self, who: Who, wv: ua.WriteValue) -> Ticket:
+        """One client write as the station's command, or its refusal (journaled, throttled)."""
+        commands = self.commands
+        i = self.position.get(wv.NodeId)
+        if i is None:
+            target = wv.NodeId.to_string()
+            if wv.NodeId in self.server.iserver.aspace:
+                return commands.refuse(who, Action.WRITE, target, Reason.NOT_WRITABLE,
+                                       "only tags are written over OPC UA")
+            return commands.refuse(who, Action.WRITE, target, Reason.UNKNOWN, "no such node")
+        tag, kind = self.tags[i], self.kinds[i]
         if wv.AttributeId != ua.AttributeIds.Value:
-            return ua.StatusCode(ua.StatusCodes.BadNotWritable)
-        value = wv.Value.Value.Value if wv.Value is not None and wv.Value.Value is not None else None
-        try:
-            if refusal is not None:
-                self.writer.refuse(name, value, user, refusal)  # journaled, then refused
-            self.writer.write(name, value, user)
-        except WriteRefused as e:
-            why = str(e)
-            if refusal is not None:
-                return ua.StatusCode(ua.StatusCodes.BadUserAccessDenied)
-            if why.startswith("write queue full"):
-                return ua.StatusCode(ua.StatusCodes.BadTooManyOperations)
-            if why == "not a number":
-                return ua.StatusCode(ua.StatusCodes.BadTypeMismatch)
-            return ua.StatusCode(ua.StatusCodes.BadNotWritable)
-        return ua.StatusCode(ua.StatusCodes.Good)
+            return commands.refuse(who, Action.WRITE, tag.name, Reason.NOT_WRITABLE,
+                                   f"only the value of a tag is written, not its "
+                                   f"{ua.AttributeIds(wv.AttributeId).name}")
+        variant = wv.Value.Value if wv.Value is not None else None
+        value = variant.Value if variant is not None else None
+        mismatch = ""
+        if variant is None or variant.VariantType != kind or value is None or isinstance(value, list):
+            sent = variant.VariantType.name if variant is not None and value is not None else "no value"
+            mismatch = f"a {sent} for a {kind.name} variable"
+        return self.writer.write(who, tag, value, mismatch)

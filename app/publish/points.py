@@ -1,27 +1,25 @@
-"""What the station publishes, and how a publisher reads and writes it.
+"""What the station publishes, and how a publisher reads it.
 
 The points are the tags of `tags.csv`, or where a station has none its symbols (an I/O or data bit
 as a Boolean, a data address as an unsigned word). A publisher reads values and quality for all of
-them at once from one snapshot (`PointReader`) and writes through the engine's queue, which
-journals every write as an 'operator' record naming the client; `writable` patterns name what a
-client may write at all, and a refused write is journaled too.
+them at once from the station's `Readings` of one scan (`PointReader`). A client's write goes
+through the station's command layer (app/authority/), which checks, journals and answers it;
+`writable` patterns are the station's naming of what a client may write at all.
 """
 
 from __future__ import annotations
 
 import fnmatch
-from collections.abc import Callable, Iterable, Sequence
+from collections.abc import Iterable, Sequence
 from dataclasses import dataclass
 
 import numpy as np
 
+from app.authority import Action, Commands, Reason, Ticket, Who
 from netplc.address import IO_BITS, AddressError
-from netplc.engine import Engine
-from netplc.memory import Snapshot
-from netplc.records import Record, RecordSink
-from netplc.tags.tag import Tag, TagReader, TagType, check_address
-
-MAX_PENDING_WRITES = 1000  # queued engine actions beyond which a client's write is refused, not queued
+from netplc.tags.quality import Operands, QualityMap
+from netplc.tags.readings import Readings
+from netplc.tags.tag import SIZES, Tag, TagReader, TagType, check_address
 
 
 def symbol_tags(symbols: dict[str, int]) -> list[Tag]:
@@ -55,13 +53,9 @@ class Writable:
         return any(fnmatch.fnmatchcase(name, p) for p in self.patterns)
 
 
-QualitySource = Callable[[], np.ndarray | None]
-PasswordCheck = Callable[[str, str], bool]  # (user, password) -> may this client in?
-
-
 @dataclass(frozen=True)
 class Reading:
-    """One snapshot's worth of every point: physical values and quality codes (netplc.tags.quality)."""
+    """One scan's worth of every point: physical values and quality codes (netplc.tags.quality)."""
 
     scan: int
     wall: float
@@ -71,87 +65,68 @@ class Reading:
 
 
 class PointReader:
-    """Values of every point from a snapshot, with the quality the runtime evaluated for that scan.
+    """Values of every point with their quality, from the `Readings` of one scan.
 
-    The quality comes through one callable (today `runtime.alarms.quality`, read on the engine
-    thread right after the scan, so it belongs to the same snapshot); a station without tags.csv
-    publishes symbols, whose quality is that of the run state alone.
+    The station's tags are judged by the station itself every scan (`Readings.codes`); symbols
+    published where there is no tags.csv are judged here, all at once, by the same quality map
+    (which NREADs fill them, their links, run state and forcing).
     """
 
-    def __init__(self, tags: Sequence[Tag], quality: QualitySource) -> None:
+    def __init__(self, tags: Sequence[Tag]) -> None:
         self.tags = list(tags)
         self.reader = TagReader(self.tags)
-        self._quality = quality
+        self._map: QualityMap | None = None
+        self._judge: np.ndarray | Operands = np.zeros(0, dtype=np.intp)
 
-    def quality_now(self, snapshot: Snapshot) -> np.ndarray:
-        """On the engine thread, right after the scan: the quality codes of that scan."""
-        q = self._quality()
-        if q is None or len(q) != len(self.tags):
-            from netplc.tags.quality import Quality
-            code = Quality.GOOD if snapshot.state == "running" else Quality.NOT_RUNNING
-            return np.full(len(self.tags), code, dtype=np.int8)
-        return q
+    def quality(self, readings: Readings) -> np.ndarray:
+        qm = readings.quality_map
+        if qm is not self._map:  # once: where each point's quality comes from
+            self._map = qm
+            try:
+                self._judge = np.array([qm.position(t.name) for t in self.tags], dtype=np.intp)
+            except KeyError:
+                self._judge = qm.operands([(t.address, SIZES[t.type]) for t in self.tags])
+        if isinstance(self._judge, Operands):
+            return readings.judge(self._judge)
+        return readings.codes[self._judge]
 
-    def read(self, snapshot: Snapshot, quality: np.ndarray) -> Reading:
-        return Reading(snapshot.scan, snapshot.wall, snapshot.state, self.reader.read(snapshot), quality)
-
-
-def runtime_quality(runtime: object) -> QualitySource:
-    """The one adapter to the runtime's per-scan quality (StationAlarms.quality today)."""
-    def read() -> np.ndarray | None:
-        alarms = getattr(runtime, "alarms", None)
-        return None if alarms is None else alarms.quality
-    return read
+    def read(self, readings: Readings) -> Reading:
+        snapshot = readings.snapshot
+        return Reading(snapshot.scan, snapshot.wall, snapshot.state, self.reader.read(snapshot),
+                       self.quality(readings))
 
 
-class WriteRefused(Exception):
-    """A client's write that is not done; the text says why (and is journaled)."""
+class PointWriter:
+    """A client's write of a published point, as the station's command: the layer checks the role
+    and the tag's physical range, journals it and answers once applied and committed. What is
+    never writable (`writable` does not name it) and a value of another type than the point's
+    (each protocol says which: `mismatch`) are refused here, journaled by the layer like every
+    refusal."""
 
-
-class Writer:
-    """Client writes into the engine's queue, journaled as 'operator' records by the engine; refusals
-    journaled here. `user` names the protocol, the user and the peer (`opcua:alice@10.0.0.5:51234`)."""
-
-    def __init__(self, engine: Engine, tags: Sequence[Tag], writable: Writable, sink: RecordSink,
-                 wallclock: Callable[[], float]) -> None:
-        self.engine = engine
-        self.by_name = {t.name: t for t in tags}
+    def __init__(self, commands: Commands, writable: Writable, section: str) -> None:
+        self.commands = commands
         self.writable = writable
-        self.sink = sink
-        self.wallclock = wallclock
+        self.section = section  # the station.toml section naming the writable points: "[opcua]"
 
-    def can_write(self, name: str) -> bool:
-        return name in self.by_name and self.writable(name)
-
-    def write(self, name: str, value: float, user: str) -> None:
-        """Queue the write of physical `value` to tag `name`; WriteRefused (journaled) if it may not."""
-        tag = self.by_name.get(name)
-        if tag is None:
-            self.refuse(name, value, user, "no such tag")
-        if not self.writable(name):
-            self.refuse(name, value, user, "not writable")
-        if len(self.engine._queue) >= MAX_PENDING_WRITES:  # back-pressure: refuse, never stall the client
-            self.refuse(name, value, user, "write queue full")
-        try:
-            value = float(value)
-        except (TypeError, ValueError):
-            self.refuse(name, value, user, "not a number")
-        if value != value:
-            self.refuse(name, value, user, "not a number")
-        assert tag is not None
-        raw = tag.to_raw(value)
-        try:
-            if tag.type is TagType.BIT:
-                self.engine.write_bit(tag.address, 1 if raw else 0, user=user, label=name)
-            elif tag.type in (TagType.INT32, TagType.FLOAT32):
-                self.engine.write_bytes(tag.address, tag.encode(raw), user=user)
-            else:
-                word = int.from_bytes(tag.encode(raw), "little")
-                self.engine.write_word(tag.address, word, user=user, label=name)
-        except Exception as e:  # the engine pushing back (its write budget): a refusal, never a stall
-            self.refuse(name, value, user, f"write queue full ({e})" if str(e) else "write queue full")
-
-    def refuse(self, name: str, value: object, user: str, why: str) -> None:
-        self.sink.put(Record(self.wallclock(), "operator", source=user,
-                             text=f"write refused {name} = {value!r}: {why}"))
-        raise WriteRefused(why)
+    def write(self, who: Who, tag: Tag, value: object, mismatch: str = "") -> Ticket:
+        commands = self.commands
+        if not self.writable(tag.name):
+            return commands.refuse(who, Action.WRITE, tag.name, Reason.NOT_WRITABLE,
+                                   f"not among the points {self.section} writable names")
+        if mismatch:
+            if (why := commands.denial(who, Action.WRITE)) is not None:  # the role first, as the layer
+                return commands.refuse(who, Action.WRITE, tag.name, Reason.DENIED, str(why), why)
+            return commands.refuse(who, Action.WRITE, tag.name, Reason.TYPE_MISMATCH, mismatch)
+        if tag.name in commands.tags:
+            return commands.write_tag(who, tag.name, value)
+        # a symbol published where there is no tags.csv: a bit or an unsigned word
+        lo, hi = tag.limits
+        if not isinstance(value, int):
+            return commands.refuse(who, Action.WRITE, tag.name, Reason.TYPE_MISMATCH,
+                                   f"{value!r} is not whole")
+        if not lo <= value <= hi:
+            return commands.refuse(who, Action.WRITE, tag.name, Reason.OUT_OF_RANGE,
+                                   f"{value} is outside {lo:g} .. {hi:g}")
+        if tag.type is TagType.BIT:
+            return commands.write_bit(who, tag.address, 1 if value else 0, label=tag.name)
+        return commands.write_word(who, tag.address, value, label=tag.name)

@@ -23,6 +23,7 @@ PACKAGE = "org.eclipse.tahu.protobuf"
 # Sparkplug B data types (spec section 6.4.16)
 INT8, INT16, INT32, INT64, UINT8, UINT16, UINT32, UINT64 = range(1, 9)
 FLOAT, DOUBLE, BOOLEAN, STRING = 9, 10, 11, 12
+BYTES = 17
 
 REBIRTH = "Node Control/Rebirth"
 BDSEQ = "bdSeq"
@@ -126,15 +127,33 @@ def set_value(metric: Any, kind: int, value: float) -> None:
         metric.int_value = int(value) & 0xFFFFFFFF
 
 
-def get_value(metric: Any) -> Any:
-    """A received metric's value (NCMD), whatever field it came in; None if it has none."""
+FIELDS = {BOOLEAN: "boolean_value", DOUBLE: "double_value", FLOAT: "float_value", STRING: "string_value",
+          INT64: "long_value", UINT64: "long_value", BYTES: "bytes_value"}  # others: int_value
+NAMES = {INT8: "Int8", INT16: "Int16", INT32: "Int32", INT64: "Int64", UINT8: "UInt8", UINT16: "UInt16",
+         UINT32: "UInt32", UINT64: "UInt64", FLOAT: "Float", DOUBLE: "Double", BOOLEAN: "Boolean",
+         STRING: "String", BYTES: "Bytes"}
+
+
+def get_value(metric: Any, kind: int = 0) -> Any:
+    """A received metric's value (NCMD), whatever field it came in; None if it has none. A metric
+    without a datatype is read as `kind`."""
     field = metric.WhichOneof("value")
     if field is None:
         return None
     value = getattr(metric, field)
-    if field == "int_value" and metric.datatype in (INT8, INT16, INT32) and value & 0x80000000:
+    if field == "int_value" and (metric.datatype or kind) in (INT8, INT16, INT32) and value & 0x80000000:
         value -= 1 << 32
     return value
+
+
+def mismatch(metric: Any, kind: int) -> str:
+    """Why a received metric is not a value of the Sparkplug type `kind` ("" when it is): its
+    datatype, when it gives one, and the field its value travels in must be that type's."""
+    field = metric.WhichOneof("value")
+    if metric.datatype not in (0, kind) or field != FIELDS.get(kind, "int_value"):
+        sent = NAMES.get(metric.datatype) or (field or "no value")
+        return f"a {sent} for a {NAMES[kind]} metric"
+    return ""
 
 
 def add_quality(metric: Any, code: int) -> None:

@@ -90,3 +90,24 @@ def mosquitto(tmp_path: Path) -> Iterator[Mosquitto]:
     broker.start()
     yield broker
     broker.stop()
+
+
+STATION_URI = "urn:netplc:station:Demo station"
+
+
+def opcua_client(url: str, user: str | None = None, password: str = "") -> object:
+    """An asyncua client of `url`, logged in as `user` (None: anonymous)."""
+    from asyncua import Client
+
+    client = Client(url)
+    if user is not None:
+        client.set_user(user)
+        client.set_password(password)
+    return client
+
+
+async def tag_node(client: object, name: str) -> object:
+    from asyncua import ua
+
+    ns = await client.get_namespace_index(STATION_URI)  # type: ignore[attr-defined]
+    return client.get_node(ua.NodeId(f"Tags.{name}", ns))  # type: ignore[attr-defined]

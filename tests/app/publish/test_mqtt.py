@@ -131,7 +131,8 @@ def test_rebirth_on_command_and_ncmd_writes(station: Runtime, host: Host) -> Non
     wait_until(lambda: any(r.kind == "operator" and "TEMP_SP" in r.text and "refused" not in r.text
                            for r in records), 10)
     refused = [r for r in records if r.kind == "operator" and "LEVEL" in r.text]
-    assert refused and "refused" in refused[0].text and refused[0].source.startswith("mqtt:")
+    assert refused and "refused" in refused[0].text
+    assert refused[0].source == f"mqtt NCMD Plant/Demo via {station.station.mqtt.broker.split('//')[1]}"
 
 
 def test_reconnect_after_broker_restart_with_new_nbirth_and_buffer(tmp_path: Path, host: Host,
@@ -207,3 +208,36 @@ def test_bdseq_goes_on_across_restarts_of_the_station(tmp_path: Path, mosquitto:
     (station / BDSEQ_FILE).write_text("many\n", encoding="utf-8")
     assert run() == 0
     assert any(BDSEQ_FILE in (r.text or "") and "not a bdSeq" in r.text for r in records)
+
+
+def test_ncmd_writes_are_checked_and_their_refusals_journaled_throttled(station: Runtime, host: Host) -> None:
+    """A String for a Double metric, a value outside PhyMin..PhyMax, a metric not named writable
+    and an unknown one are refused; 3,000 bad commands leave a record per cause, not 3,000."""
+    records: list = []
+    station.subscribe(records.append)
+    host.wait("NBIRTH")
+    publisher = next(p for p in station.publishers if hasattr(p, "topics"))
+
+    def send(name: str, kind: int, field: str, value: object) -> None:
+        payload = spb.Payload(timestamp=int(time.time() * 1000))
+        metric = payload.metrics.add(name=name, datatype=kind)
+        setattr(metric, field, value)
+        host.client.publish(TOPIC.format("NCMD"), payload.SerializeToString(), qos=1)
+
+    for i in range(750):
+        send("TEMP_SP", spb.STRING, "string_value", "42")
+        send("TEMP_SP", spb.DOUBLE, "double_value", 1000.0 + i)
+        send("LEVEL", spb.DOUBLE, "double_value", 12.0)
+        send("NOPE", spb.DOUBLE, "double_value", 1.0)
+    send("TEMP_SP", spb.INT32, "int_value", 42)  # an Int32 for a Double metric: refused too
+    wait_until(lambda: publisher.status.refused == 3001, 30)
+    refused = [r for r in records if r.kind == "operator" and r.text.startswith("refused")]
+    assert len(refused) == 4, [r.text for r in refused]  # the Int32's record is the String's, counted
+    texts = " | ".join(r.text for r in refused)
+    for words in ("a String for a Double metric", "outside -50.0 °C .. 150.0 °C", "[mqtt] writable",
+                  "no such metric"):
+        assert words in texts
+    assert all(r.source.startswith("mqtt NCMD Plant/Demo via 127.0.0.1:") for r in refused)
+    host.command("TEMP_SP", 77.0)  # a right one still goes through
+    wait_until(lambda: abs(station.readings().tag("TEMP_SP").value - 77.0) < 0.05, 10)
+    assert any(r.kind == "operator" and "TEMP_SP" in r.text and "refused" not in r.text for r in records)

@@ -2,20 +2,18 @@
 
 from __future__ import annotations
 
-import asyncio
 from pathlib import Path
 
 import numpy as np
-import pytest
 
+from app.authority import Commands, Reason, Source, Who
 from app.config import load_station, read_station
-from app.publish.opcua import station_certificate
-from app.publish.points import MAX_PENDING_WRITES, Writable, Writer, WriteRefused, symbol_tags
+from app.publish.points import PointWriter, Writable, symbol_tags
 from app.publish.sparkplug import DOUBLE, INT16, Payload, get_value, set_value
 from netplc.engine import Engine
 from netplc.program import parse
 from netplc.records import ListSink
-from netplc.tags.tag import Scaling, Tag, TagType
+from netplc.tags.tag import TagType
 from tests.app.conftest import write_station
 
 PROGRAM = {"p.stl": "JMP 0\n"}
@@ -34,6 +32,7 @@ def test_settings_read_and_every_problem_named(tmp_path: Path) -> None:
 enabled = true
 endpoint = "http://x"
 writable = ["SP_*", 3]
+certificate_names = ["plant-pc.example.org", "10.1.2.3", "bad name", 7]
 color = "red"
 [mqtt]
 enabled = true
@@ -44,6 +43,9 @@ publish_period = 250
 ''', PROGRAM)
     st, problems = read_station(tmp_path)
     text = "\n".join(problems)
+    assert "station.toml: opcua.certificate_names: 'bad name' is not a host name or an IP address" in text
+    assert "station.toml: opcua.certificate_names: 7 is not a host name or an IP address" in text
+    assert st is not None and st.opcua.certificate_names == ("plant-pc.example.org", "10.1.2.3")
     for key in ("opcua.endpoint", "opcua.writable", "opcua.color", "mqtt.broker", "mqtt.group_id",
                 "mqtt.deadband.word", "mqtt.deadband.qword"):
         assert f"station.toml: {key}: " in text, key
@@ -56,25 +58,6 @@ def test_symbols_are_published_where_there_is_no_tags_file() -> None:
     assert tags["LEVEL"].type is TagType.WORD
 
 
-def test_writes_only_to_writable_tags_and_never_past_a_full_queue() -> None:
-    sink = ListSink()
-    engine = Engine(parse("JMP 0\n"), sink=sink)
-    sp = Tag("SP", 0o4000, TagType.WORD, scaling=Scaling(0, 1000, 0, 100))
-    writer = Writer(engine, [sp, Tag("PV", 0o4002)], Writable(["S*"]), sink, lambda: 0.0)
-    writer.write("SP", 50.0, "opcua:alice@10.0.0.5:5000")
-    engine.scan()
-    assert engine.mem.get_word(0o4000) == 500
-    written = [r for r in sink.records if r.kind == "operator"]
-    assert written[-1].source == "opcua:alice@10.0.0.5:5000" and "SP" in written[-1].text
-    with pytest.raises(WriteRefused, match="not writable"):
-        writer.write("PV", 1.0, "mqtt:x")
-    assert "refused" in sink.records[-1].text and sink.records[-1].source == "mqtt:x"
-    for _ in range(MAX_PENDING_WRITES):
-        engine.post(lambda _m: None)
-    with pytest.raises(WriteRefused, match="queue full"):
-        writer.write("SP", 1.0, "opcua:bob")
-
-
 def test_sparkplug_values_round_trip() -> None:
     p = Payload()
     m = p.metrics.add(name="T", datatype=INT16)
@@ -85,22 +68,21 @@ def test_sparkplug_values_round_trip() -> None:
     assert get_value(back.metrics[0]) == -5 and get_value(back.metrics[1]) == 2.5
 
 
-def test_certificate_made_once_and_kept(tmp_path: Path) -> None:
-    cert, key = asyncio.run(station_certificate(tmp_path, "urn:netplc:station:S", "plant-pc", "S"))
-    first = cert.read_bytes()
-    asyncio.run(station_certificate(tmp_path, "urn:netplc:station:S", "plant-pc", "S"))
-    assert cert.read_bytes() == first and key.exists()
-
-
-def test_an_engine_that_pushes_back_refuses_the_write() -> None:
-    class Budgeted(Engine):  # the per-scan write budget, spent
-        def write_word(self, addr: int, value: int, *, user: str = "operator",
-                       label: str | None = None) -> None:
-            raise OverflowError("write budget of this scan spent")
-
+def test_symbols_are_written_through_the_layer_as_bits_and_words() -> None:
+    """Where a station has no tags.csv its symbols are the points: a client writes a bit or an
+    unsigned word, never outside it, and only what `writable` names."""
     sink = ListSink()
-    engine = Budgeted(parse("JMP 0\n"), sink=sink)
-    writer = Writer(engine, [Tag("SP", 0o4000)], Writable(["SP"]), sink, lambda: 0.0)
-    with pytest.raises(WriteRefused, match="write queue full"):
-        writer.write("SP", 1.0, "opcua:bob")
-    assert "refused" in sink.records[-1].text
+    engine = Engine(parse("JMP 0\n"), sink=sink)
+    layer = Commands(engine, sink, role_of={"olga": "operator"}.get)
+    tags = {t.name: t for t in symbol_tags({"START": 0o2000, "SP": 0o4010, "PV": 0o4012})}
+    writer = PointWriter(layer, Writable(["S*"]), "[mqtt]")
+    olga = Who("olga", Source.MQTT, "broker:1883")
+    started, word = writer.write(olga, tags["START"], True), writer.write(olga, tags["SP"], 1234)
+    engine.scan()
+    assert engine.mem.bits[0o2000] == 1 and engine.mem.get_word(0o4010) == 1234
+    assert started.result(1).ok and word.result(1).ok
+    answers = [writer.write(olga, tags["SP"], 70000), writer.write(olga, tags["SP"], 1.5),
+               writer.write(olga, tags["PV"], 1), writer.write(olga, tags["SP"], 1, "a String for a UInt16"),
+               writer.write(Who("", Source.OPCUA), tags["SP"], 1, "a String for a UInt16")]
+    assert [a.result(0).reason for a in answers] == [
+        Reason.OUT_OF_RANGE, Reason.TYPE_MISMATCH, Reason.NOT_WRITABLE, Reason.TYPE_MISMATCH, Reason.DENIED]

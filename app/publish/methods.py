@@ -1,0 +1,116 @@
+"""The station's OPC UA methods: run, stop and step NetPlc, force and unforce, for a remote
+Program view (`main.py monitor opc.tcp://...`) acting as a logged-in user of the station.
+
+Each call is the station's command (app/authority/) with the session's user and peer: the layer
+checks the role, journals it and answers once applied and committed; the call's StatusCode is the
+layer's `Reason` mapped as for writes. asyncua passes a method neither the session nor the user,
+so the OPC UA server takes these calls in the session's Call service (opcua.py) and hands them
+here; the nodes' own callbacks only refuse (a call that did not come through a session).
+UserExecutable is answered per session from the same policy.
+"""
+
+from __future__ import annotations
+
+import asyncio
+import threading
+from collections.abc import Callable
+from dataclasses import dataclass
+
+from asyncua import Node, ua
+
+from app.authority import Action, Commands, Reason, Ticket, Who
+from netplc.address import AddressError, parse_octal
+from netplc.forcing import KINDS
+
+StepLock = Callable[[], "threading.Lock | None"]  # the scan thread's lock; None while not started
+
+
+@dataclass(frozen=True)
+class Method:
+    name: str
+    action: Action
+    inputs: tuple[tuple[str, str], ...] = ()  # (name, description), each a String
+    description: str = ""
+
+
+METHODS = (
+    Method("Run", Action.RUN, description="Run NetPlc's program"),
+    Method("Stop", Action.STOP, description="Stop NetPlc's program"),
+    Method("Step", Action.STEP, description="One scan while NetPlc is stopped"),
+    Method("Force", Action.FORCE, (("Kind", "bit, byte or word"), ("Address", "octal, as 04010"),
+                                   ("Value", "the forced value, a whole number")),
+           "Force an address to a value (force > program > live)"),
+    Method("Unforce", Action.UNFORCE, (("Kind", "bit, byte or word"), ("Address", "octal, as 04010")),
+           "Remove the force of an address"),
+    Method("UnforceAll", Action.UNFORCE, description="Remove every force"),
+)
+
+
+class StationMethods:
+    def __init__(self, commands: Commands, step_lock: StepLock, answers: dict[Reason, int]) -> None:
+        self.commands = commands
+        self.step_lock = step_lock
+        self.answers = answers
+        self.by_node: dict[ua.NodeId, Method] = {}
+
+    async def add(self, parent: Node, idx: int) -> None:
+        for method in METHODS:
+            args = [ua.Argument(Name=name, DataType=ua.NodeId(ua.ObjectIds.String), ValueRank=-1,
+                                Description=ua.LocalizedText(text)) for name, text in method.inputs]
+            if method.name == "Force":
+                args[2].DataType = ua.NodeId(ua.ObjectIds.Int32)
+            node = await parent.add_method(ua.NodeId(f"Station.{method.name}", idx), f"{idx}:{method.name}",
+                                           _not_through_a_session, args, [])
+            await node.write_attribute(ua.AttributeIds.Description,
+                                       ua.DataValue(ua.Variant(ua.LocalizedText(method.description))))
+            self.by_node[node.nodeid] = method
+
+    def executable(self, who: Who, nodeid: ua.NodeId) -> bool | None:
+        """May `who` call the method at `nodeid`? None when it is none of these."""
+        method = self.by_node.get(nodeid)
+        return None if method is None else self.commands.may(who, method.action)
+
+    async def call(self, who: Who, request: ua.CallMethodRequest) -> ua.CallMethodResult:
+        method = self.by_node[request.MethodId]
+        args = [v.Value for v in request.InputArguments or []]
+        result = ua.CallMethodResult()
+        result.InputArgumentResults = [ua.StatusCode() for _ in args]
+        if len(args) != len(method.inputs):
+            few = len(args) < len(method.inputs)
+            result.StatusCode = ua.StatusCode(ua.StatusCodes.BadArgumentsMissing if few else
+                                              ua.StatusCodes.BadTooManyArguments)
+            return result
+        ticket = await self._ticket(who, method, args)
+        answer = await asyncio.wrap_future(ticket)
+        result.StatusCode = ua.StatusCode(self.answers[answer.reason])
+        return result
+
+    async def _ticket(self, who: Who, method: Method, args: list[object]) -> Ticket:
+        commands = self.commands
+        if method.name == "Run":
+            return commands.run(who)
+        if method.name == "Stop":
+            return commands.stop(who)
+        if method.name == "Step":  # waits for the scan in progress: off the server's loop
+            return await asyncio.to_thread(commands.step, who, self.step_lock())
+        if method.name == "UnforceAll":
+            return commands.unforce_all(who)
+        kind, address = args[0], args[1]
+        target = f"{kind} {address}"
+        try:
+            if kind not in KINDS:
+                raise ValueError(f"{kind!r} is not one of {', '.join(KINDS)}")
+            addr = parse_octal(str(address))
+            if method.name == "Force":
+                value = args[2]
+                if not isinstance(value, int) or isinstance(value, bool):
+                    raise ValueError(f"{value!r} is not a whole number")
+        except (AddressError, ValueError) as e:
+            return commands.refuse(who, method.action, target, Reason.INVALID, str(e))
+        if method.name == "Force":
+            return commands.force(who, kind, addr, value)  # type: ignore[arg-type]
+        return commands.unforce(who, kind, addr)  # type: ignore[arg-type]
+
+
+def _not_through_a_session(parent: ua.NodeId, *args: object) -> ua.StatusCode:
+    return ua.StatusCode(ua.StatusCodes.BadUserAccessDenied)
