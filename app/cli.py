@@ -107,13 +107,12 @@ def _design_parser() -> argparse.ArgumentParser:
 
 def _monitor_parser() -> argparse.ArgumentParser:
     p = argparse.ArgumentParser(prog="python main.py monitor",
-                                description="The Program view of a running station over its Modbus server: "
-                                            "the listing with live states and a watch table with writes "
-                                            "(journaled by the station with this peer). Forcing and single "
-                                            "scans need the station's own workstation.")
+                                description="The Program view of a running station over its Modbus server, "
+                                            "read-only (Modbus has no users): the listing with live states "
+                                            "and a watch table. Write, force and step at the station's own "
+                                            "workstation, as a user of that station.")
     p.add_argument("target", help="station folder or station.toml (its program, symbols and Modbus port), "
                                   "or HOST:PORT of a NetPlc Modbus server")
-    p.add_argument("--user", default="engineer", help="the name shown in this window (default engineer)")
     return p
 
 
@@ -226,7 +225,7 @@ def main(argv: list[str] | None = None) -> int:
             ns = _monitor_parser().parse_args(rest)
             from app.gui.monitor.window import run_monitor
 
-            return run_monitor(ns.target, ns.user)
+            return run_monitor(ns.target)
         if command == "archive":
             ns = _archive_parser().parse_args(rest)
             return run_migrate(ns.source, ns.url, ns.station)

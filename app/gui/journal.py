@@ -1,24 +1,35 @@
 """The journal dock: today's records from the archive, newest first, refreshed while the station runs.
 
 It reads the archive file read-only like any other reader, so what the operator sees is what has
-really been committed to disk, not what is still in a queue.
+really been committed to disk, not what is still in a queue. The reads run in the dock's worker
+thread (hmi_forms/widgets/worker.py), with the MessageJournal element's reader: every 1.5 s a
+page of 500 rows and the day's count, which on a busy day or a slow disk takes longer than a
+frame, and a window waiting for them stops repainting. The newest request wins, so a slow read
+never piles refreshes up behind it; an unreadable archive is said in the dock's summary.
 """
 
 from __future__ import annotations
 
 import datetime as dt
+import logging
 import sqlite3
+from functools import partial
 from pathlib import Path
 
 from PySide6.QtCore import Qt, QTimer
 from PySide6.QtWidgets import QCheckBox, QDockWidget, QHBoxLayout, QLabel, QVBoxLayout, QWidget
 
 from hmi_forms.elements.journal import EVENT_KINDS
+from hmi_forms.widgets.journal import JournalReader, Page
 from hmi_forms.widgets.records import RecordsModel, records_view
-from registrar.query import Archive, Filter
+from hmi_forms.widgets.worker import Worker
+from registrar.query import Filter
+
+logger = logging.getLogger(__name__)
 
 JOURNAL_ROWS = 500
 REFRESH_MS = 1500
+PAGE = "page"  # the worker's one topic: a newer refresh supersedes an older one still waiting
 
 
 class JournalDock(QDockWidget):
@@ -27,7 +38,10 @@ class JournalDock(QDockWidget):
         self.setWindowTitle(self.tr("Journal — today"))
         self.setObjectName("journalDock")
         self.archive_path = archive_path
-        self._archive: Archive | None = None
+        self.reader = JournalReader(archive_path)
+        self.worker = Worker("journal dock", (sqlite3.Error, OSError), self, on_close=self.reader.close)
+        self.worker.answered.connect(self._shown)
+        self.worker.failed.connect(self._failed)
         body = QWidget()
         lay = QVBoxLayout(body)
         lay.setContentsMargins(4, 4, 4, 4)
@@ -52,18 +66,17 @@ class JournalDock(QDockWidget):
         self._last: tuple[int, int] | None = None
 
     def refresh(self) -> None:
-        archive = self._open()
-        if archive is None:
+        """Ask for today's newest page and its count; the answer is shown when it arrives."""
+        if self.worker.closed:
+            return  # the window is closing
+        flt = Filter(kinds=frozenset(EVENT_KINDS)) if self.messages_only.isChecked() else Filter()
+        self.worker.submit(partial(self.reader.page, dt.date.today(), flt, JOURNAL_ROWS, True), PAGE)
+
+    def _shown(self, _token: int, page: Page | None) -> None:
+        if page is None:
             self.summary.setText(self.tr("no archive yet"))
             return
-        flt = Filter(kinds=frozenset(EVENT_KINDS)) if self.messages_only.isChecked() else None
-        today = dt.date.today()
-        try:
-            total = archive.count(today, flt)
-            rows = archive.records(today, flt, 0, JOURNAL_ROWS)
-        except sqlite3.Error as e:
-            self.summary.setText(self.tr("archive unreadable: {0}").format(e))
-            return
+        rows, total = page.rows, page.total if page.total is not None else len(page.rows)
         newest = rows[0].id if rows else 0
         if self._last != (newest, total):
             self._last = (newest, total)
@@ -71,20 +84,14 @@ class JournalDock(QDockWidget):
         shown = self.tr(", newest {0} shown").format(len(rows)) if total > len(rows) else ""
         self.summary.setText(self.tr("{0} records today").format(total) + shown)
 
+    def _failed(self, _token: int, why: str) -> None:
+        self.summary.setText(self.tr("archive unreadable: {0}").format(why))
+
     def _filter_changed(self) -> None:
         self._last = None
         self.refresh()
 
-    def _open(self) -> Archive | None:
-        if self._archive is None and self.archive_path.exists():
-            try:
-                self._archive = Archive(self.archive_path)
-            except sqlite3.Error:
-                return None
-        return self._archive
-
     def close_archive(self) -> None:
+        """Stop reading (the window closes): the timer, the worker and the archive."""
         self._timer.stop()
-        if self._archive is not None:
-            self._archive.close()
-            self._archive = None
+        self.worker.close()

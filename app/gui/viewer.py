@@ -5,13 +5,22 @@ plant PC opens on any machine. Records are paged from SQLite rather than loaded 
 of a million records opens as fast as a day of ten. Given a postgresql:// URL it opens the plant
 archive read-only instead: a list of stations to tick, and series of several stations on one plot.
 Days and From/To are read in the zone the archive was written in (stored in its meta).
+
+A page and its count are read in the viewer's worker thread (hmi_forms/widgets/worker.py), as the
+series are (series_loader.py): counting a filtered day of a million records, or any read of a plant
+archive across the network, takes longer than a frame, and a window waiting for it stops answering.
+The newest request wins, and a read that fails (SQLite, or the plant archive's `ArchiveError`) is
+said under the table; the viewer keeps running.
 """
 
 from __future__ import annotations
 
 import datetime as dt
+import logging
 import sqlite3
 import sys
+from dataclasses import dataclass
+from functools import partial
 from pathlib import Path
 
 import numpy as np
@@ -45,12 +54,17 @@ from app.gui.series_loader import Series, SeriesLoader
 from app.gui.style import apply_style
 from hmi_forms.elements import formats
 from hmi_forms.widgets.records import ARCHIVE_COLUMNS, Column, RecordsModel, records_view
+from hmi_forms.widgets.worker import Worker
 from netplc.tags.tag import Tag
 from registrar.plant.url import is_url
 from registrar.query import Archive, Filter, SeriesKey
-from registrar.reading import ArchiveError
+from registrar.reading import ArchiveError, ArchiveReader, Row
 
+logger = logging.getLogger(__name__)
+
+READ_ERRORS = (sqlite3.Error, OSError, ArchiveError)  # an archive gone, unreadable or out of reach
 PAGE = 500
+PAGES = "page"  # the pager's one topic: a newer page request supersedes the older ones
 SERIES_POINTS = 4000
 KINDS = ("all", "data", "message", "alarm", "operator", "system")
 # a severity and everything worse, as alarm consoles filter: "2 alarm" keeps the critical ones too
@@ -80,6 +94,40 @@ def physical(tag: Tag | None, values: np.ndarray) -> np.ndarray:
     return np.array([tag.word_value(int(v)) if np.isfinite(v) else np.nan for v in values], dtype=np.float64)
 
 
+@dataclass(frozen=True)
+class Page:
+    offset: int
+    total: int  # records of the day under the filter
+    rows: list[Row]
+
+
+class PageReader:
+    """The archive as the pager's worker thread reads it, on a connection of its own (the GUI
+    thread's serves the day list, the series list and export): opened at the first page, and
+    again after a failed read (a plant archive's dropped connection) or a reload."""
+
+    def __init__(self) -> None:
+        self.target: Path | str | None = None
+        self.archive: ArchiveReader | None = None
+
+    def page(self, target: Path | str, day: dt.date, flt: Filter, offset: int) -> Page:
+        if self.archive is None or self.target != target:
+            self.close()
+            self.archive, self.target = Archive(target), target
+        try:
+            total = self.archive.count(day, flt)
+            rows = self.archive.records(day, flt, offset, PAGE, newest_first=False)
+        except READ_ERRORS:
+            self.close()  # the next page opens it anew
+            raise
+        return Page(offset, total, rows)
+
+    def close(self) -> None:
+        if self.archive is not None:
+            self.archive.close()
+            self.archive = None
+
+
 class ViewerWindow(QMainWindow):
     def __init__(self, archive_path: Path | str | None = None, parent: QWidget | None = None) -> None:
         super().__init__(parent)
@@ -94,6 +142,11 @@ class ViewerWindow(QMainWindow):
         self.loader = SeriesLoader(SERIES_POINTS, self)
         self.loader.answered.connect(self._series_loaded)
         self.loader.failed.connect(self._series_failed)
+        self.pages = PageReader()
+        self.pager = Worker("viewer pages", READ_ERRORS, self, on_close=self.pages.close)
+        self.pager.answered.connect(self._page_read)
+        self.pager.failed.connect(self._page_failed)
+        self.paging: int | None = None  # the token of the page asked for and not yet shown
         self._build()
         self.resize(1280, 820)
         if archive_path is not None:
@@ -186,6 +239,7 @@ class ViewerWindow(QMainWindow):
         self.prev = QPushButton(self.tr("\u2039 Previous"))
         self.next = QPushButton(self.tr("Next \u203a"))
         self.page_label = QLabel()
+        self.page_label.setWordWrap(True)
         for b, step in ((self.first, None), (self.prev, -PAGE), (self.next, PAGE)):
             b.clicked.connect(lambda _=False, s=step: self.page(s))
             pager.addWidget(b)
@@ -227,6 +281,8 @@ class ViewerWindow(QMainWindow):
         if self.archive is not None:
             self.archive.close()
         self.archive, self.archive_path = archive, path
+        if not self.pager.closed:
+            self.pager.submit(self.pages.close)  # the pages read the archive as it is now, too
         self.tags = archive.tags()
         self.path_label.setText(f"<small>{path}</small>")
         self.stations.blockSignals(True)
@@ -308,20 +364,37 @@ class ViewerWindow(QMainWindow):
         self._load_page()
 
     def _load_page(self) -> None:
+        """Ask for the page at `offset` as the filter is now; it is shown when it arrives."""
         day = self.day
-        if self.archive is None or day is None:
-            self.model.set_rows([])
-            self.page_label.setText("no records")
+        if self.archive is None or self.archive_path is None or day is None:
+            self.paging = None  # an answer still on its way is not shown
+            self._show_page(Page(0, 0, []), "no records")
             return
-        flt = self.current_filter()
-        self.total = self.archive.count(day, flt)
-        rows = self.archive.records(day, flt, self.offset, PAGE, newest_first=False)
-        self.model.set_rows(rows)
-        last = self.offset + len(rows)
-        self.page_label.setText(f"records {self.offset + 1 if rows else 0}–{last} of {self.total}")
-        self.prev.setEnabled(self.offset > 0)
-        self.first.setEnabled(self.offset > 0)
-        self.next.setEnabled(last < self.total)
+        if self.pager.closed:
+            return  # the window is closing
+        job = partial(self.pages.page, self.archive_path, day, self.current_filter(), self.offset)
+        self.paging = self.pager.submit(job, PAGES)
+        self.page_label.setText(self.tr("reading…"))
+
+    def _page_read(self, token: int, page: Page) -> None:
+        if token == self.paging:
+            self.paging = None
+            first, last = page.offset + 1 if page.rows else 0, page.offset + len(page.rows)
+            self._show_page(page, f"records {first}–{last} of {page.total}")
+
+    def _page_failed(self, token: int, why: str) -> None:
+        if token == self.paging:
+            self.paging = None
+            self._show_page(Page(0, 0, []), self.tr("archive unreadable: {0}").format(why))
+
+    def _show_page(self, page: Page, say: str) -> None:
+        self.total = page.total
+        self.model.set_rows(page.rows)
+        self.page_label.setText(say)
+        last = page.offset + len(page.rows)
+        self.prev.setEnabled(page.offset > 0)
+        self.first.setEnabled(page.offset > 0)
+        self.next.setEnabled(last < page.total)
 
     def export_csv(self, path: Path) -> int:
         day = self.day
@@ -337,7 +410,12 @@ class ViewerWindow(QMainWindow):
                                               f"journal_{day:%d_%m_%Y}.csv",
                                               "CSV files (*.csv)")
         if name:
-            n = self.export_csv(Path(name))
+            try:
+                n = self.export_csv(Path(name))
+            except READ_ERRORS as e:
+                logger.warning("export to %s: %s", name, e)
+                self.statusBar().showMessage(f"nothing exported to {name}: {e}", 15000)
+                return
             self.statusBar().showMessage(f"{n} records exported to {name}", 8000)
 
     def _choose_archive(self) -> None:
@@ -357,7 +435,13 @@ class ViewerWindow(QMainWindow):
         self.series_list.clear()
         day = self.day
         if self.archive is not None and day is not None:
-            for key in self.archive.series_keys(day):
+            try:
+                keys = self.archive.series_keys(day)
+            except READ_ERRORS as e:
+                logger.warning("series of %s: %s", day, e)
+                self.statusBar().showMessage(f"series of {formats.date(day)} unreadable: {e}", 15000)
+                keys = []
+            for key in keys:
                 if key.kind != "data":
                     continue
                 item = QListWidgetItem(f"{key.station}: {self.label(key)}" if key.station
@@ -418,6 +502,7 @@ class ViewerWindow(QMainWindow):
 
     def closeEvent(self, event) -> None:
         self.loader.close()
+        self.pager.close()
         if self.archive is not None:
             self.archive.close()
             self.archive = None

@@ -1,6 +1,6 @@
 """The Program view: the listing with live states, the watch table (writes journaled with the user),
 forcing and single scans from the view, find / go to label / uses; and the remote monitor against
-a real station over a loopback Modbus port."""
+a real station over a loopback Modbus port: it watches, and is read-only (Modbus has no users)."""
 
 from __future__ import annotations
 
@@ -9,16 +9,17 @@ import time
 from pathlib import Path
 
 import pytest
-from PySide6.QtWidgets import QApplication
+from PySide6.QtCore import Qt
+from PySide6.QtWidgets import QApplication, QMenu
 
-from app.authority import Reason, Who
 from app.authority import Source as Seat
+from app.authority import Who
 from app.authority.users import Users
 from app.config import load_station
 from app.gui.monitor.listing import Listing, fmt_value, parse_value, parse_watch
-from app.gui.monitor.source import LocalSource, RemoteSource
+from app.gui.monitor.source import READ_ONLY, LocalSource, RemoteSource
 from app.gui.monitor.view import ON, ProgramMonitor
-from app.gui.monitor.window import remote_source
+from app.gui.monitor.window import ProgramWindow, remote_source
 from app.runtime import Runtime
 from netplc.memory import Memory
 from netplc.problems import Problems
@@ -146,12 +147,8 @@ def test_a_2000_line_listing_paints_only_the_lines_on_screen(qtbot, tmp_path: Pa
     path.write_text(text, encoding="utf-8")
 
     class Still:  # a source that never changes: only the painting is looked at
-        caps = LocalSource.caps
-        title, symbols = "big", {}
-        commands = None
-
-        def who(self, user: str) -> Who:
-            return Who(user, Seat.MONITOR)
+        title, symbols, tags = "big", {}, {}
+        read_only, acting = "still", None
         program = parse(text, source=str(path))
         snap = Memory().snapshot()
 
@@ -238,39 +235,97 @@ def test_find_go_to_label_and_follow_a_symbol(qtbot, runtime: Runtime) -> None:
 # --- the remote monitor ---------------------------------------------------------------------------------
 
 
-def test_the_remote_monitor_watches_and_writes_a_running_station_over_modbus(qtbot, runtime: Runtime) -> None:
-    assert runtime.modbus is not None and runtime.engine is not None
+def remote_monitor(qtbot, runtime: Runtime) -> tuple[RemoteSource, ProgramMonitor]:
+    assert runtime.modbus is not None
     source = RemoteSource("127.0.0.1", runtime.modbus.port, program=runtime.program, symbols=runtime.symbols,
                           poll=0.05)
+    monitor = ProgramMonitor(source, lambda: "eng1")
+    qtbot.addWidget(monitor)
+    return source, monitor
+
+
+def test_the_remote_monitor_watches_a_running_station_over_modbus(qtbot, runtime: Runtime) -> None:
+    engine = runtime.engine
+    assert engine is not None
+    source, monitor = remote_monitor(qtbot, runtime)
     try:
-        monitor = ProgramMonitor(source, lambda: "eng1")
-        qtbot.addWidget(monitor)
-        assert not monitor.unforce_button.isEnabled() and not monitor.step_button.isEnabled()
-        runtime.engine.write_word(0o4000, 0x4242, user="test")
-        runtime.engine.write_bit(0, 1, user="test")
-        runtime.engine.write_bit(1, 1, user="test")
+        engine.write_word(0o4000, 0x4242, user="test")
+        engine.write_bit(0, 1, user="test")
+        engine.write_bit(1, 1, user="test")
         wait(qtbot, lambda: (s := source.snapshot()) is not None and s.get_word(0o4002) == 0x4242
              and s.get_bit(0o2000) == 1)
+        wait(qtbot, lambda: monitor.state.text().startswith("connected to tcp://127.0.0.1:"))
         monitor.add_watch("04400")
         monitor.add_watch("02001")
-        monitor.watch.item(0, 1).setText("513")  # written over Modbus, journaled with the peer
-        monitor.watch.item(1, 1).setText("1")
-        live = runtime.engine
-        wait(qtbot, lambda: live.snapshot.get_word(0o4400) == 513 and live.snapshot.get_bit(0o2001) == 1)
-        wait(qtbot, lambda: monitor.watch.item(0, 1).text() == "513")
-        assert any(s.startswith("modbus 127.0.0.1") and t.startswith("write 04400")
-                   for s, t in operator_texts(runtime))
-        monitor.add_watch("04777:b")
-        monitor.watch.item(2, 1).setText("1")  # 04777 is writable; 05000 is not
-        wait(qtbot, lambda: runtime.engine.snapshot.get_byte(0o4777) == 1)
-        monitor.add_watch("05000")
-        monitor.watch.item(3, 1).setText("1")
-        assert monitor.message.text().startswith("Refused: write 05000:word: ")
-        answer = source.force("bit", 0, 1, "eng1").result(0)
-        assert answer.reason is Reason.NOT_WRITABLE and "forcing" in answer.text
-        assert source.timer(0o3000) is None and source.forces() == ()
+        engine.write_word(0o4400, 513, user="test")
+        engine.write_bit(0o2001, 1, user="test")
+        wait(qtbot, lambda: [monitor.watch.item(r, 1).text() for r in (0, 1)] == ["513", "1"])
+        assert source.timer(0o3000) is None and source.counter(0o3010) is None  # not in the Modbus map
     finally:
         source.close()
+
+
+def test_the_remote_monitor_is_read_only_and_says_so(qtbot, runtime: Runtime) -> None:
+    """Modbus has no users: no control that would write, force, unforce or step is enabled, a line
+    says the monitor is read-only, and the forces count says they are unknown over Modbus."""
+    engine = runtime.engine
+    assert engine is not None
+    source, monitor = remote_monitor(qtbot, runtime)
+    try:
+        monitor.show()
+        assert monitor.read_only.isVisible() and monitor.read_only.text().startswith("Read-only over Modbus")
+        assert "Its forces are unknown here" in monitor.read_only.text()
+        assert monitor.forced_pill.text() == "F: unknown over Modbus"
+        assert READ_ONLY.startswith("read-only: Modbus has no users; ")
+        for button in (monitor.step_button, monitor.unforce_button):
+            assert not button.isEnabled() and button.toolTip() == READ_ONLY
+        monitor.add_watch("04400")
+        value = monitor.watch.item(0, 1)
+        assert not value.flags() & Qt.ItemFlag.ItemIsEditable and value.toolTip() == READ_ONLY
+        menu = QMenu(monitor)
+        monitor._force_actions(menu, "word", 0o4400, "04400")
+        assert [a.isEnabled() for a in menu.actions()] == [False, False, False]
+        assert {a.toolTip() for a in menu.actions()} == {READ_ONLY}
+        monitor.update_rights()  # a change of user changes nothing here
+        assert not monitor.step_button.isEnabled() and not value.flags() & Qt.ItemFlag.ItemIsEditable
+        value.setText("513")  # even a value put into the cell is not sent
+        with pytest.raises(RuntimeError, match="read-only: Modbus has no users"):
+            monitor.force("bit", 0, 1)
+        assert runtime.commands is not None  # a force at the station: its value is seen, not the force
+        assert runtime.commands.force(Who("eng1", Seat.CONSOLE), "bit", 0o2001, 1).result(5).ok
+        wait(qtbot, lambda: (s := source.snapshot()) is not None and s.get_bit(0o2001) == 1)
+        assert runtime.status().forced == 1 and monitor.forced_pill.text() == "F: unknown over Modbus"
+        assert engine.snapshot.get_word(0o4400) == 0
+        assert not [t for s, t in operator_texts(runtime) if s.startswith("modbus")]  # nothing was written
+        window = ProgramWindow(source, lambda: "")
+        qtbot.addWidget(window)
+        assert window.windowTitle().endswith("(read-only)")
+    finally:
+        source.close()
+
+
+def test_the_remote_monitor_says_what_it_is_doing(qtbot, tmp_path: Path) -> None:
+    """`main.py monitor HOST:PORT`: no program to list, and a station that does not answer: the
+    window says so (connecting, then the error) instead of showing a blank half-window."""
+    with socket.socket() as s:
+        s.bind(("127.0.0.1", 0))
+        port = s.getsockname()[1]  # nothing listens there
+    source = remote_source(f"127.0.0.1:{port}")
+    window = ProgramWindow(source, lambda: "")
+    qtbot.addWidget(window)
+    try:
+        window.resize(800, 500)
+        window.show()
+        monitor = window.monitor
+        assert monitor.state.text().startswith(("connecting to tcp://127.0.0.1:", "link down: "))
+        wait(qtbot, lambda: monitor.state.text().startswith("link down: cannot connect"))
+        assert monitor.state.text().endswith("retrying every 0.2 s")
+        image = monitor.view.viewport().grab().toImage()
+        background = image.pixelColor(image.width() - 2, image.height() - 2)
+        inked = sum(image.pixelColor(x, y) != background for x in range(0, 400, 2) for y in range(10, 40, 2))
+        assert inked > 20  # the hint: no program to list, and what to give instead
+    finally:
+        window.close()  # closes the source
 
 
 def test_the_monitor_command_target_is_a_station_or_host_port(qtbot, tmp_path: Path) -> None:

@@ -61,11 +61,14 @@ def test_the_viewer_reads_the_plant_archive(qtbot, tmp_path: Path, pg_url: str) 
     viewer.show()
     assert viewer.day == DAY and viewer.stations.isVisible()
     assert [viewer.stations.item(i).text() for i in range(viewer.stations.count())] == ["north", "south"]
+    qtbot.waitUntil(lambda: viewer.paging is None)  # pages are read in the viewer's worker thread
     assert viewer.total == 202
     viewer.kind.setCurrentText("message")
     viewer.apply_filter()
+    qtbot.waitUntil(lambda: viewer.paging is None)
     assert viewer.total == 2
     viewer.stations.item(0).setCheckState(viewer.stations.item(0).checkState().Unchecked)
+    qtbot.waitUntil(lambda: viewer.paging is None)
     assert viewer.total == 1 and viewer.current_filter().stations == {"south"}
     assert viewer.model.index(0, 7).data() == "alarm at south"
     assert viewer.model.index(0, 8).data() == "south" and not viewer.table.isColumnHidden(8)

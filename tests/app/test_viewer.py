@@ -1,18 +1,33 @@
-"""The offline viewer on an archive made by the headless run, copied elsewhere as from another PC."""
+"""The offline viewer on an archive made by the headless run, copied elsewhere as from another PC;
+its pages read off the GUI thread, and an unreadable archive said in the view (SQLite, and a plant
+archive whose connection dropped)."""
 
 from __future__ import annotations
 
 import csv
 import datetime as dt
 import shutil
+import time
 from pathlib import Path
 
 from PySide6.QtCore import Qt
 
-from app.gui.viewer import ViewerWindow, archive_of
+from app.gui.viewer import PAGE, ViewerWindow, archive_of
+from tests.app.held_archive import Ticks, archive_with, held
 
 LEVEL = "LEVEL Уровень, % (group 1 / type 1 / 04010)"  # series are named by their tags
 TEMP = "TEMP Температура, °C (group 1 / type 2 / 04012)"
+WAIT = 10_000  # ms: a page is read in the pager's thread and shown through the event loop
+
+
+def settled(qtbot, viewer: ViewerWindow) -> ViewerWindow:
+    """The viewer once the page it asked for is shown."""
+    qtbot.waitUntil(lambda: viewer.paging is None, timeout=WAIT)
+    return viewer
+
+
+def texts(viewer: ViewerWindow) -> list[str]:
+    return [viewer.model.index(r, 7).data() for r in range(viewer.model.rowCount())]
 
 
 def test_viewer_shows_rows_plots_and_exports(qtbot, headless_archive: tuple[Path, str],
@@ -26,14 +41,16 @@ def test_viewer_shows_rows_plots_and_exports(qtbot, headless_archive: tuple[Path
     viewer.show()
 
     assert viewer.day == dt.date.today()
+    settled(qtbot, viewer)
     assert viewer.model.rowCount() > 20
     kinds = {viewer.model.index(r, 1).data() for r in range(viewer.model.rowCount())}
     assert kinds >= {"data", "message", "system"}
-    texts = [viewer.model.index(r, 7).data() for r in range(viewer.model.rowCount())]
-    assert "NetPlc запущен" in texts and texts[-1] == "station stopped"  # oldest first
+    shown = texts(viewer)
+    assert "NetPlc запущен" in shown and shown[-1] == "station stopped"  # oldest first
 
     viewer.kind.setCurrentText("message")
     viewer.apply_filter()
+    settled(qtbot, viewer)
     assert {viewer.model.index(r, 1).data() for r in range(viewer.model.rowCount())} == {"message"}
     assert viewer.page_label.text().startswith("records 1–")
 
@@ -60,6 +77,7 @@ def test_viewer_shows_rows_plots_and_exports(qtbot, headless_archive: tuple[Path
 
     viewer.kind.setCurrentText("data")
     viewer.apply_filter()
+    settled(qtbot, viewer)
     viewer.export_csv(out)
     with open(out, encoding="utf-8-sig", newline="") as f:
         levels = [r for r in csv.DictReader(f) if r["source"] == "04010"]
@@ -137,7 +155,7 @@ def test_the_to_bound_is_exact_and_a_severity_keeps_the_worse_ones(qtbot, tmp_pa
 
     def shown() -> set[str]:
         viewer.apply_filter()
-        return {viewer.model.index(r, 7).data() for r in range(viewer.model.rowCount())}
+        return set(texts(settled(qtbot, viewer)))
 
     viewer.until.setTime(QTime(10, 0, 5))
     assert shown() == {"alarm at :05.5", "critical at :05.999", "warning at :04"}
@@ -145,3 +163,64 @@ def test_the_to_bound_is_exact_and_a_severity_keeps_the_worse_ones(qtbot, tmp_pa
     assert shown() == {"alarm at :05.5", "critical at :05.999"}
     viewer.until.setTime(viewer.until.maximumTime())
     assert shown() == {"alarm at :05.5", "critical at :05.999", "alarm at :06.2"}
+
+
+def test_pages_are_read_off_the_gui_thread_while_the_archive_is_locked(qtbot, tmp_path: Path) -> None:
+    path = archive_with(tmp_path / "journal.sqlite", [f"m{i}" for i in range(PAGE + 10)])
+    viewer = settled(qtbot, ViewerWindow(path))
+    qtbot.addWidget(viewer)
+    assert viewer.total == PAGE + 10 and texts(viewer)[:2] == ["m0", "m1"]
+    ticks = Ticks()
+    try:
+        with held(path):
+            started = time.monotonic()
+            viewer.next.click()  # the count and the page wait for the lock, in the pager's thread
+            assert time.monotonic() - started < 0.5
+            qtbot.wait(600)
+            assert ticks.count >= 5  # the GUI thread ran its timer all the while
+            assert viewer.paging is not None and viewer.page_label.text() == "reading…"
+        settled(qtbot, viewer)
+    finally:
+        ticks.stop()
+    assert texts(viewer) == [f"m{i}" for i in range(PAGE, PAGE + 10)]
+    assert viewer.page_label.text() == f"records {PAGE + 1}–{PAGE + 10} of {PAGE + 10}"
+    assert viewer.prev.isEnabled() and not viewer.next.isEnabled()
+
+
+def test_an_unreadable_archive_is_said_in_the_view_and_the_viewer_goes_on(qtbot, tmp_path: Path) -> None:
+    path = archive_with(tmp_path / "journal.sqlite", ["first", "second"])
+    good = path.read_bytes()
+    viewer = settled(qtbot, ViewerWindow(path))
+    qtbot.addWidget(viewer)
+    assert texts(viewer) == ["first", "second"]
+    path.write_bytes(b"not an archive" * 1000)  # overwritten under the open viewer
+    viewer.apply_filter()
+    settled(qtbot, viewer)
+    assert viewer.page_label.text().startswith("archive unreadable: ")
+    assert viewer.model.rowCount() == 0 and viewer.total == 0 and not viewer.next.isEnabled()
+    path.write_bytes(good)
+    viewer.apply_filter()  # the failed connection was closed: the next page opens the file anew
+    settled(qtbot, viewer)
+    assert texts(viewer) == ["first", "second"] and viewer.page_label.text() == "records 1–2 of 2"
+
+
+def test_a_dropped_plant_archive_connection_is_said_and_the_next_page_reconnects(
+        qtbot, tmp_path: Path, pg_url: str) -> None:
+    import psycopg
+
+    from tests.app.test_plant_archive import plant_of_two
+
+    plant_of_two(tmp_path, pg_url)
+    viewer = settled(qtbot, ViewerWindow(pg_url))
+    qtbot.addWidget(viewer)
+    assert viewer.total == 202
+    with psycopg.connect(pg_url, autocommit=True) as admin:  # as a restarted server does
+        admin.execute("SELECT pg_terminate_backend(pid) FROM pg_stat_activity "
+                      "WHERE datname = current_database() AND pid <> pg_backend_pid()")
+    viewer.apply_filter()
+    settled(qtbot, viewer)
+    assert viewer.page_label.text().startswith(f"archive unreadable: {pg_url}: ")  # an ArchiveError
+    assert viewer.model.rowCount() == 0
+    viewer.apply_filter()
+    settled(qtbot, viewer)
+    assert viewer.total == 202 and viewer.page_label.text() == "records 1–202 of 202"

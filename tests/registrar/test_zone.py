@@ -82,10 +82,12 @@ def test_the_viewer_cuts_from_and_to_in_the_writers_zone(qtbot, db, zone_of):
     zone_of("America/New_York")  # 15 hours behind the writer
     viewer = ViewerWindow(db)
     qtbot.addWidget(viewer)
+    qtbot.waitUntil(lambda: viewer.paging is None)  # pages are read in the viewer's worker thread
     assert viewer.day == dt.date(2026, 3, 5) and viewer.total == 3
     viewer.since.setTime(QTime(12, 0))
     viewer.until.setTime(QTime(23, 59, 59))
     viewer.apply_filter()
+    qtbot.waitUntil(lambda: viewer.paging is None)
     assert viewer.total == 2
     assert [viewer.model.index(r, 0).data() for r in range(2)] == ["12:30:00.000", "23:30:00.000"]
     viewer.close()

@@ -4,10 +4,14 @@ It reads snapshots only (the source's last one), at most REFRESH_MS apart, and r
 a new scan arrived; the listing is a painted scroll area that draws the lines on screen and
 nothing else, so a 2,000-line program costs what 40 lines cost (bench/monitor.py measures the
 scan time with it open). The view never writes memory itself: writes, forces and single scans go
-to the source, which sends them to the station's command layer as the user at the workstation
-(checked, journaled with the user, answered) or over Modbus. Each answer comes back to the GUI
-thread (`Answers`) and a refusal is said under the watch table; what the user may not do is greyed,
-its tooltip naming the role it needs (app/gui/rights.py).
+to the local source, which sends them to the station's command layer as the user at the
+workstation (checked, journaled with the user, answered). Each answer comes back to the GUI thread
+(`Answers`) and a refusal is said under the watch table; what the user may not do is greyed, its
+tooltip naming the role it needs (app/gui/rights.py).
+
+Over Modbus (`main.py monitor`) the view is read-only, and says so in a line of its own: Modbus
+has no users, so every control that would act is greyed with the reason (source.py), and the
+forces count says they are unknown, since the Modbus map cannot show them.
 """
 
 from __future__ import annotations
@@ -29,6 +33,7 @@ from PySide6.QtWidgets import (
     QListWidgetItem,
     QMenu,
     QPushButton,
+    QSizePolicy,
     QSplitter,
     QTableWidget,
     QTableWidgetItem,
@@ -50,8 +55,8 @@ from app.gui.monitor.listing import (
     parse_value,
     parse_watch,
 )
-from app.gui.monitor.source import Source
-from app.gui.rights import Right, Rights
+from app.gui.monitor.source import Acting, Source
+from app.gui.rights import Control, Right, Rights
 from app.gui.status import IDLE, WARN, Pill
 from netplc.address import fmt_octal
 from netplc.forcing import Force, Kind, tag_keys
@@ -64,10 +69,16 @@ logger = logging.getLogger(__name__)
 REFRESH_MS = 100  # at most 10 refreshes per second
 ON, OFF, FORCED = QColor("#2e7d32"), QColor("#b0b7c0"), QColor("#e65100")
 VALUE_CHARS = 34  # the values column (timers, counters, FON operands) before the source text
+NO_LISTING = ("No program to list. Over Modbus, name the station folder (main.py monitor STATION) to see its "
+              "listing; watch addresses, symbols or tags in the table on the right.")
+READ_ONLY_LINE = ("Read-only over Modbus: Modbus has no users, so this monitor only watches. Write, force "
+                  "and step at the station's own workstation, as a user of that station. Its forces are "
+                  "unknown here.")
 
 
-def forced_text(n: int) -> str:
-    return f"F: {n} forced"
+def forced_text(n: int | None) -> str:
+    """The forces count; None: the source cannot see them (over Modbus)."""
+    return "F: unknown over Modbus" if n is None else f"F: {n} forced"
 
 
 class ListingView(QAbstractScrollArea):
@@ -157,6 +168,11 @@ class ListingView(QAbstractScrollArea):
         width = self.viewport().width()
         snap = self.snapshot
         rows = self.visible_rows()
+        if not len(self.listing):
+            p.setPen(QColor("#6b7685"))
+            flags = Qt.AlignmentFlag.AlignLeft | Qt.AlignmentFlag.AlignTop | Qt.TextFlag.TextWordWrap
+            text = f"{self.source.state()}\n\n{NO_LISTING}"  # what the monitor does: the whole line
+            p.drawText(self.viewport().rect().adjusted(12, 12, -12, -12), int(flags), text)
         first = rows.start
         instrs = self.listing.program.instrs
         self.painted_rows = 0
@@ -250,7 +266,8 @@ class ProgramMonitor(QWidget):
         self.refreshes = 0  # views refreshed from a new snapshot (tests and the bench look)
         self.answers = Answers()
         self.answers.answered.connect(self._answered)
-        self.rights = Rights(source.commands, lambda: source.who(self.user()))
+        acting = self.acting = source.acting
+        self.rights = Rights(acting.commands, lambda: acting.who(self.user())) if acting is not None else None
 
         self.find = QLineEdit()
         self.find.setPlaceholderText("Find (Enter: next)")
@@ -266,13 +283,18 @@ class ProgramMonitor(QWidget):
         self.step_button.clicked.connect(self.step)
         self.unforce_button = QPushButton("Unforce all")
         self.unforce_button.clicked.connect(self.unforce_all)
-        caps = source.caps
-        self.rights.add(self.step_button, Action.STEP, "Step one scan",
-                        "" if caps.step else caps.why_not, also=lambda: caps.step)
-        self.rights.add(self.unforce_button, Action.UNFORCE, "Unforce all",
-                        "" if caps.force else caps.why_not, also=lambda: caps.force)
+        self._grant(self.step_button, Action.STEP, "Step one scan")
+        self._grant(self.unforce_button, Action.UNFORCE, "Unforce all")
+        self.read_only = QLabel(READ_ONLY_LINE)
+        self.read_only.setObjectName("monitorReadOnly")
+        self.read_only.setStyleSheet("background: #fff4d6; color: #5d4200; padding: 4px 6px;")
+        self.read_only.setWordWrap(True)
+        self.read_only.setToolTip(source.read_only)
+        self.read_only.setVisible(acting is None)
         self.state = QLabel()
         self.state.setObjectName("monitorState")
+        # a long link error is cut at the window's edge (whole in the tooltip), never widening it
+        self.state.setSizePolicy(QSizePolicy.Policy.Ignored, QSizePolicy.Policy.Preferred)
         self.message = QLabel()  # the last refusal: a bad address, a write the station refused
         self.message.setObjectName("monitorMessage")
         self.message.setStyleSheet("color: #c62828; font-weight: bold;")
@@ -320,6 +342,7 @@ class ProgramMonitor(QWidget):
         split.setSizes([820, 520])
         lay = QVBoxLayout(self)
         lay.setContentsMargins(0, 0, 0, 0)
+        lay.addWidget(self.read_only)
         lay.addLayout(bar)
         lay.addWidget(split, 1)
         self._add_empty_row()
@@ -336,20 +359,26 @@ class ProgramMonitor(QWidget):
     def refresh(self) -> None:
         """Show the source's last snapshot, if it is new (at most every REFRESH_MS)."""
         forces = self.source.forces()
-        self.show_forced(len(forces))
-        self.state.setText(self.source.state())
+        self.show_forced(None if forces is None else len(forces))
+        state = self.source.state()
+        if state != self.state.text():
+            self.state.setText(state)
+            self.state.setToolTip(state)
+            if not len(self.listing):
+                self.view.viewport().update()  # the empty listing says it too
         snap = self.source.snapshot()
         if snap is None or snap is self._last:
             return
         self._last = snap
         self.refreshes += 1
-        forced = {f.key for f in forces}
-        self.view.show_snapshot(snap, forced)
-        self._refresh_watch(snap, {f.key: f for f in forces})
+        known = forces or ()
+        self.view.show_snapshot(snap, {f.key for f in known})
+        self._refresh_watch(snap, {f.key: f for f in known})
 
-    def show_forced(self, n: int) -> None:
-        self.forced_pill.show_value(forced_text(n), WARN if n else IDLE,
-                                    "forces in effect: force > program > live" if n else "nothing forced")
+    def show_forced(self, n: int | None) -> None:
+        why = ("the station's forces are not in the Modbus map: see them at its own workstation" if n is None
+               else "forces in effect: force > program > live" if n else "nothing forced")
+        self.forced_pill.show_value(forced_text(n), WARN if n is None or n else IDLE, why)
 
     def _refresh_watch(self, snap: Snapshot, forces: dict[tuple[Kind, int], Force]) -> None:
         self.watch.blockSignals(True)
@@ -418,24 +447,44 @@ class ProgramMonitor(QWidget):
         self._last = None  # show it at the next refresh
         return item
 
+    def _grant(self, control: Control, action: Action, what: str, keep: bool = True) -> None:
+        """Enabled while the user may do `action`, its tooltip naming the role it needs (again at
+        each change of user when `keep`); on a read-only source greyed, its tooltip saying why."""
+        if self.rights is None:
+            control.setEnabled(False)
+            control.setToolTip(self.source.read_only)
+        elif keep:
+            self.rights.add(control, action, what)
+        else:
+            self.rights.show(Right(control, action, what))
+
+    def _acts(self) -> Acting:
+        """The source to act through; nothing that acts is enabled on a read-only one."""
+        if self.acting is None:
+            raise RuntimeError(f"{self.source.title}: {self.source.read_only}")
+        return self.acting
+
     def update_rights(self) -> None:
         """After a change of who is at the workstation: the buttons, and the watched values that
         may be typed over (a write)."""
-        self.rights.update()
+        if self.rights is not None:
+            self.rights.update()
         for r in range(len(self.watch_items)):
             self._show_write(r)
 
     def _show_write(self, r: int) -> None:
         item, value = self.watch_items[r], self.watch.item(r, 1)
-        commands = self.source.commands
-        why = None if commands is None else commands.denial(self.source.who(self.user()), Action.WRITE,
-                                                            what=f"write {item.where}")
+        acting = self.acting
         how = f"in {item.tag.unit or 'its units'}" if item.tag else "(decimal, 0x1F or 1Fh)"
+        if acting is None:
+            tip: str | None = self.source.read_only
+        else:
+            why = acting.commands.denial(acting.who(self.user()), Action.WRITE, what=f"write {item.where}")
+            tip = None if why is None else words.refusal(why)
         editable = Qt.ItemFlag.ItemIsEditable
         self.watch.blockSignals(True)
-        value.setFlags(value.flags() | editable if why is None else value.flags() & ~editable)
-        value.setToolTip(f"type a value {how} to write it: journaled with your name" if why is None
-                         else words.refusal(why))
+        value.setFlags(value.flags() | editable if tip is None else value.flags() & ~editable)
+        value.setToolTip(f"type a value {how} to write it: journaled with your name" if tip is None else tip)
         self.watch.blockSignals(False)
 
     def _watch_edited(self, cell: QTableWidgetItem) -> None:
@@ -450,7 +499,7 @@ class ProgramMonitor(QWidget):
                     cell.setText("")
                     self.watch.blockSignals(False)
                     self._say(str(e))
-        elif col == 1 and r < len(self.watch_items):
+        elif col == 1 and r < len(self.watch_items) and self.acting is not None:
             item = self.watch_items[r]
             try:
                 if item.tag is None:
@@ -462,13 +511,13 @@ class ProgramMonitor(QWidget):
             self._last = None
 
     def write(self, item: WatchItem, value: int) -> Ticket:
-        """A write like any operator write: a command (or sent over Modbus), journaled with the user."""
-        return self._sent(f"write {item.where}", self.source.write(item.kind, item.addr, value, self.user()))
+        """A write like any operator write: a command, journaled with the user."""
+        return self._sent(f"write {item.where}", self._acts().write(item.kind, item.addr, value, self.user()))
 
     def write_tag(self, item: WatchItem, phy: float) -> Ticket:
         """A tag's physical value, checked against its type and range, journaled in its units."""
         assert item.tag is not None
-        return self._sent(f"write {item.tag.name}", self.source.write_tag(item.tag, phy, self.user()))
+        return self._sent(f"write {item.tag.name}", self._acts().write_tag(item.tag, phy, self.user()))
 
     def _sent(self, what: str, ticket: Ticket) -> Ticket:
         return self.answers.follow(what, ticket)
@@ -507,14 +556,11 @@ class ProgramMonitor(QWidget):
 
     def _add_force_actions(self, menu: QMenu, where: str, bumpless: Callable[[], None],
                            ask: Callable[[], None], release: Callable[[], None]) -> None:
-        caps = self.source.caps
-        menu.setToolTipsVisible(True)  # a greyed action says which role it needs
+        menu.setToolTipsVisible(True)  # a greyed action says which role it needs, or that all are read-only
         for text, slot, act in ((f"Force {where} at its value (bumpless)", bumpless, Action.FORCE),
                                 (f"Force {where} to…", ask, Action.FORCE),
                                 (f"Unforce {where}", release, Action.UNFORCE)):
-            action = menu.addAction(text, slot)
-            self.rights.show(Right(action, act, text.rstrip("…"), "" if caps.force else caps.why_not,
-                                   also=lambda: caps.force))
+            self._grant(menu.addAction(text, slot), act, text.rstrip("…"), keep=False)
 
     def _ask_force_tag(self, tag: Tag) -> None:
         lo, hi = tag.phy_limits
@@ -528,10 +574,10 @@ class ProgramMonitor(QWidget):
 
     def force_tag(self, tag: Tag, phy: float | None) -> Ticket:
         """Force a tag's bit or all its words to a physical value, or bumpless with None."""
-        return self._sent(f"force {tag.name}", self.source.force_tag(tag, phy, self.user()))
+        return self._sent(f"force {tag.name}", self._acts().force_tag(tag, phy, self.user()))
 
     def unforce_tag(self, tag: Tag) -> Ticket:
-        return self._sent(f"unforce {tag.name}", self.source.unforce_tag(tag, self.user()))
+        return self._sent(f"unforce {tag.name}", self._acts().unforce_tag(tag, self.user()))
 
     def _ask_force(self, kind: Kind, addr: int, where: str) -> None:
         text, ok = QInputDialog.getText(self, "Force", f"Force {where} to (decimal, 0x1F or 1Fh):")
@@ -543,18 +589,18 @@ class ProgramMonitor(QWidget):
 
     def force(self, kind: Kind, addr: int, value: int | None) -> Ticket:
         where = Force(kind, addr, 0).where
-        return self._sent(f"force {where}", self.source.force(kind, addr, value, self.user()))
+        return self._sent(f"force {where}", self._acts().force(kind, addr, value, self.user()))
 
     def unforce(self, kind: Kind, addr: int) -> Ticket:
         where = Force(kind, addr, 0).where
-        return self._sent(f"unforce {where}", self.source.unforce(kind, addr, self.user()))
+        return self._sent(f"unforce {where}", self._acts().unforce(kind, addr, self.user()))
 
     def unforce_all(self) -> Ticket:
-        return self._sent("Unforce all", self.source.unforce_all(self.user()))
+        return self._sent("Unforce all", self._acts().unforce_all(self.user()))
 
     def step(self) -> Ticket:
         """Step one scan (NetPlc stopped) and show its result at once."""
-        ticket = self._sent("Step one scan", self.source.step(self.user()))
+        ticket = self._sent("Step one scan", self._acts().step(self.user()))
         self.refresh()
         return ticket
 

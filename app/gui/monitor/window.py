@@ -1,6 +1,6 @@
 """The Program view as a window: from the workstation's Station -> Program (the local runtime, with
-forcing and single scans) or from `main.py monitor STATION_OR_HOST:PORT` (a running station over
-its Modbus server: watch and write only, see source.py)."""
+writes, forcing and single scans) or from `main.py monitor STATION_OR_HOST:PORT` (a running station
+over its Modbus server: read-only, since Modbus has no users; see source.py)."""
 
 from __future__ import annotations
 
@@ -26,7 +26,7 @@ class ProgramWindow(QMainWindow):
     def __init__(self, source: Source, user: Callable[[], str], parent: QWidget | None = None) -> None:
         super().__init__(parent)
         self.source = source
-        self.setWindowTitle(f"Program — {source.title}")
+        self.setWindowTitle(f"Program — {source.title}" + ("" if source.acting else " (read-only)"))
         self.monitor = ProgramMonitor(source, user)
         self.setCentralWidget(self.monitor)
         self.resize(*SIZE)
@@ -61,8 +61,8 @@ def remote_source(target: str) -> RemoteSource:
     return RemoteSource(host, int(port))
 
 
-def run_monitor(target: str, user: str) -> int:
-    """`python main.py monitor STATION_OR_HOST:PORT`."""
+def run_monitor(target: str) -> int:
+    """`python main.py monitor STATION_OR_HOST:PORT`: read-only, so nobody acts through it."""
     app = QApplication.instance() or QApplication(sys.argv[:1])
     apply_style(app)  # type: ignore[arg-type]
     try:
@@ -70,6 +70,6 @@ def run_monitor(target: str, user: str) -> int:
     except Problems as e:
         print("\n".join(e.problems), file=sys.stderr)
         return 2
-    window = ProgramWindow(source, lambda: user)
+    window = ProgramWindow(source, lambda: "")
     window.show()
     return app.exec()
