@@ -176,7 +176,7 @@ def test_an_element_asks_when_the_form_says_confirm_and_checks_its_role(qtbot, c
     console.runtime.stop()
     writes = [t for s, t in operator_rows(console.runtime) if s == "operator" and "Пуск" in t]
     assert writes == ["write Пуск (040042): 0 -> 1",
-                      "refused write Пуск: write: needs the engineer role; operator is operator"]
+                      "refused write Пуск: needs the engineer role; operator is operator"]
 
 
 def test_an_idle_user_is_logged_out_and_it_is_journaled(qtbot, console: MainWindow) -> None:
@@ -341,7 +341,7 @@ def test_refusals_roles_and_alarms_speak_russian_too(qtbot, russian, demo_copy: 
         assert "нужна роль «оператор»" in window.alarms.ack.toolTip()
         assert "Выход: нужна роль «инженер»" in window.act_quit.toolTip()
         runtime.stop()  # the journal keeps the English
-        assert ("viewer", "refused write Пуск: write: needs the operator role; viewer is viewer") in [
+        assert ("viewer", "refused write Пуск: needs the operator role; viewer is viewer") in [
             (s, t.split(" (")[0]) for s, t in operator_rows(runtime)]
         summary = window.summary
         heads = [summary.model.headerData(i, Qt.Orientation.Horizontal, Qt.ItemDataRole.DisplayRole)

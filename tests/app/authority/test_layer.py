@@ -172,7 +172,7 @@ def test_user_administration_needs_the_admin_and_is_answered_after_the_commit():
         return "user ivan added as operator"
 
     assert layer.manage_users(Who("egor", Source.CONSOLE), "ivan", change).result(0).reason is Reason.DENIED
-    assert not made and "refused users ivan: users: needs the admin role" in sink.records[-1].text
+    assert not made and "refused users ivan: needs the admin role" in sink.records[-1].text
     ticket = layer.manage_users(Who("anna", Source.CONSOLE), "ivan", change)
     assert made == ["ivan"] and not ticket.done()  # made, not yet on disk
     sink.commit()
