@@ -129,6 +129,8 @@ def unresolved_hosts(station: Station) -> list[str]:
             why = f"did not resolve within {RESOLVE_TIMEOUT:g} s"
         elif isinstance(error := lookup.exception(), OSError):
             why = f"does not resolve: {error.strerror or error}"
+        elif error is not None:  # a name the resolver cannot even encode (UnicodeError)
+            why = f"is not a host name: {error}"
         else:
             continue
         problems += [f"{station.path}: {key}: host {host!r} {why}" for key in hosts[host]]
@@ -227,8 +229,9 @@ class Runtime:
         if observer in self._observers:
             self._observers.remove(observer)
 
-    def system(self, text: str) -> None:
-        logger.info("%s", text)  # the station's own words in its log file too, beside the journal
+    def system(self, text: str, level: int = logging.INFO) -> None:
+        """A 'system' record, and the same words in the log (at `level`: WARNING for a fault)."""
+        logger.log(level, "%s", text)
         self.put(Record(self.wallclock(), "system", source="station", text=text))
 
     # --- start and stop ------------------------------------------------------------------------
@@ -250,16 +253,17 @@ class Runtime:
             self.forwarder = Forwarder(st.Archive, st.plant_archive, st.name, keep_days=st.plant_keep_days,
                                        sink=self.put, wallclock=self.wallclock)
             self.forwarder.start()  # never fails: PostgreSQL away is a lag, not a start error
+        started = False
         try:
             self._start_parts()
+            started = True
         except StartError as e:
             for problem in e.problems:
                 self.system(f"station cannot start: {problem}")
-            self.stop()
             raise
-        except BaseException:
-            self.stop()
-            raise
+        finally:
+            if not started:  # whatever ended the start, Ctrl+C too: what did start stops again
+                self.stop()
 
     def _start_parts(self) -> None:
         st = self.station
@@ -345,7 +349,8 @@ class Runtime:
         try:
             save_forces(self.station.forces_file, listing)
         except OSError as e:
-            self.system(f"retained forces not saved: {self.station.forces_file}: {e.strerror or e}")
+            self.system(f"retained forces not saved: {self.station.forces_file}: {e.strerror or e}",
+                        logging.WARNING)
 
     def _report_unresolved(self) -> None:
         """Journal each node host name that does not resolve, by its key. The station starts all the
@@ -382,13 +387,14 @@ class Runtime:
         self.problem(f"scan failed: {error!r}")
 
     def problem(self, text: str) -> None:
-        """Something the operator must see and act on (a server that did not start, a scan that
-        failed): journaled once and shown in the status until the station stops."""
+        """What an operator must see, said once (a server that did not start, a scan that failed):
+        the health strip (`RuntimeStatus.problems`) for as long as the station runs, a 'system'
+        record and a warning in the log."""
         with self._lock:
             if text in self._problems:
                 return
             self._problems.append(text)
-        self.system(text)
+        self.system(text, logging.WARNING)
 
     def stop(self) -> None:
         """Stop everything in the reverse order of start; safe to call twice or after a failed start."""

@@ -16,6 +16,7 @@ from the same thread, in scan order.
 
 from __future__ import annotations
 
+import logging
 from collections.abc import Callable, Iterable
 from typing import TYPE_CHECKING
 
@@ -26,6 +27,8 @@ from netplc.records import Record, RecordSink
 
 if TYPE_CHECKING:
     from netplc.engine import Engine
+
+logger = logging.getLogger(__name__)
 
 
 class FormBehaviour:
@@ -63,8 +66,9 @@ class FormBehaviour:
                 element.update(snapshot)
             except Exception as e:  # a faulty element must not cost the scan or the other elements
                 failed.append(element)
+                text = f'{form.path}: element "{element.Name}": evaluation failed, the element is skipped'
+                logger.exception("%s", text)
                 if self.report is not None:
-                    self.report(f'{form.path}: element "{element.Name}": evaluation failed, '
-                                f"the element is skipped: {e!r}")
+                    self.report(f"{text}: {e!r}")
         if failed:
             self.elements = [(f, el) for f, el in self.elements if el not in failed]

@@ -11,12 +11,14 @@ from __future__ import annotations
 
 import contextlib
 import hashlib
+import logging
 import marshal
 import os
 from importlib.util import MAGIC_NUMBER
 from pathlib import Path
 from types import CodeType
 
+logger = logging.getLogger(__name__)
 PREFIX = "program-"
 SUFFIX = ".code"
 
@@ -44,14 +46,21 @@ class CodeCache:
     def load(self, key: bytes) -> CodeType | None:
         """The code stored under `key`, or None (missing, another key or Python, damaged)."""
         header = MAGIC_NUMBER + key
+        path = self._path(key)
         try:
-            data = self._path(key).read_bytes()
+            data = path.read_bytes()
             if not data.startswith(header):
                 return None
             code = marshal.loads(data[len(header):])
-        except (OSError, ValueError, EOFError, TypeError):
+        except FileNotFoundError:
+            return None  # the first start of this program
+        except (OSError, ValueError, EOFError, TypeError) as e:
+            logger.warning("compiled program %s not used, compiling again: %s", path, e)
             return None
-        return code if isinstance(code, CodeType) else None
+        if not isinstance(code, CodeType):
+            logger.warning("compiled program %s not used, compiling again: not a code object", path)
+            return None
+        return code
 
     def store(self, key: bytes, code: CodeType) -> None:
         """Write `code` under `key` (atomically) and drop the files of older programs; a folder
@@ -65,6 +74,7 @@ class CodeCache:
             for old in self.folder.glob(f"{PREFIX}*{SUFFIX}"):
                 if old != path:
                     old.unlink(missing_ok=True)
-        except OSError:
+        except OSError as e:  # each start compiles then: slower, never wrong
+            logger.warning("compiled program not kept in %s: %s", self.folder, e)
             with contextlib.suppress(OSError):
                 tmp.unlink(missing_ok=True)

@@ -197,7 +197,7 @@ class Engine:
             return fail
         try:
             return bind(spec.run, self.mem, fon)
-        except Exception as e:  # a builder bug: fail when the function runs, as the interpreter does
+        except Exception as e:  # no log: a builder bug fails when the function runs, logged by fon_failed
             error = e
 
             def broken(ctx: object) -> None:
@@ -206,9 +206,13 @@ class Engine:
             return broken
 
     def fon_failed(self, index: int, e: Exception) -> None:
+        """FErr1, and the first fault of each FON logged with its traceback and journaled: a FON
+        that raises does so every scan while its chain is on."""
         fon, spec = self.fons[index]
         self.mem.bits[FERR1] = 1
         name = spec.mnemonic if spec else fon.f
+        if index not in self._faulted:
+            logger.error("FON %s at line %d failed (FErr1 set)", name, fon.line, exc_info=e)
         self._fault_once(index, f"FON {name} at line {fon.line}: {type(e).__name__}: {e}")
 
     def _make_fon(self, index: int) -> Callable[[int], None]:
@@ -236,7 +240,7 @@ class Engine:
             if res:
                 try:
                     run(self, fon)
-                except Exception as e:
+                except Exception as e:  # no log: fon_failed logs it
                     self.fon_failed(index, e)
 
         return call
@@ -449,7 +453,7 @@ class Engine:
         for name, listener in self._listeners:
             try:
                 listener(self.snapshot)
-            except Exception as e:  # isolated: the others, and the scan, go on
+            except Exception as e:  # no log: _listener_failed logs it; the others and the scan go on
                 self._listener_failed(name, e)
         return self.snapshot
 
@@ -473,11 +477,13 @@ class Engine:
         return tuple(listener for _, listener in self._listeners)
 
     def _listener_failed(self, name: str, e: Exception) -> None:
-        logger.exception("engine listener %s failed at scan %d", name, self.scan_counter)
+        """Logged with its traceback and journaled once per fault: a listener that raises at every
+        scan must not fill the log and the journal."""
         where = traceback.extract_tb(e.__traceback__)[-1:]
         at = f" at {where[0].filename}:{where[0].lineno}" if where else ""
         text = f"{type(e).__name__}: {e}{at}"
         if self.listener_faults.get(name) != text:
+            logger.error("engine listener %s failed at scan %d", name, self.scan_counter, exc_info=e)
             self.listener_faults[name] = text
             self.sink.put(Record(self.wall_time(), "system", source="netplc",
                                  text=f"engine listener {name} failed (the others go on): {text}"))
@@ -511,6 +517,7 @@ class Engine:
             self.sink.put(Record(self.wall_time(), "system", source="netplc", text=f"write refused: {e}"))
             return False
         except Exception as e:  # a faulty producer must not cost the scan or the writes after it
+            logger.exception("queued write failed")
             text = f"queued write failed: {type(e).__name__}: {e}"
             self.sink.put(Record(self.wall_time(), "system", source="netplc", text=text))
             return False

@@ -11,10 +11,13 @@ control byte returns to 0.
 from __future__ import annotations
 
 import datetime as dt
+import logging
 import math
 
 from netplc.address import RTC_CONTROL, RTC_FIRST, data_index
 from netplc.memory import Memory
+
+logger = logging.getLogger(__name__)
 
 _CTRL = data_index(RTC_CONTROL)
 _FIRST = data_index(RTC_FIRST)
@@ -67,6 +70,7 @@ class Rtc:
         s, mi, h, d, mo, y = (from_bcd(data[_FIRST + i]) for i in range(6))
         try:
             wanted = dt.datetime(2000 + y, mo, d, h, mi, s)
-        except ValueError:
-            return  # an impossible date: keep the clock as it was
+        except ValueError as e:  # an impossible date: keep the clock as it was
+            logger.warning("RTC setting ignored: 20%02d-%02d-%02d %02d:%02d:%02d: %s", y, mo, d, h, mi, s, e)
+            return
         self.offset = wanted.timestamp() - wall

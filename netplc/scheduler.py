@@ -41,13 +41,19 @@ class ScanThread:
         return self._thread.is_alive()
 
     def _loop(self) -> None:
+        """Scan on the tick. A scan that raises is reported and the thread goes on; the same fault
+        at every scan is logged with its traceback once, until a scan succeeds or the fault changes."""
         deadline = time.monotonic()
+        last_fault = ""
         while not self._stop.is_set():
             try:
                 with self.lock:
                     self.engine.scan()
-            except Exception as e:  # reported, and the thread goes on
-                logger.exception("scan %d failed", self.engine.scan_counter)
+                last_fault = ""
+            except Exception as e:
+                if repr(e) != last_fault:
+                    last_fault = repr(e)
+                    logger.exception("scan %d failed", self.engine.scan_counter)
                 if self._on_error:
                     self._on_error(e)
             deadline += self.tick

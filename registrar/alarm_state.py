@@ -16,6 +16,7 @@ from __future__ import annotations
 
 import contextlib
 import json
+import logging
 import os
 import sqlite3
 import threading
@@ -26,6 +27,7 @@ from typing import Any
 
 from netplc.records import NullSink, Record, RecordSink
 
+logger = logging.getLogger(__name__)
 SOURCE = "alarms"
 TABLE_SQL = "CREATE TABLE IF NOT EXISTS alarm_state (alarm TEXT PRIMARY KEY, state TEXT NOT NULL)"
 FLUSH_EVERY = 0.1  # seconds the writer waits for more changes before it writes
@@ -60,8 +62,10 @@ class AlarmStateFile:
             damaged = self.path.with_name(self.path.name + ".damaged")
             with contextlib.suppress(OSError):  # nothing to move aside
                 os.replace(self.path, damaged)
-            self._journal(f"alarm states not restored from {self.path.name}: {e}; every alarm starts "
-                          f"normal (the file is kept as {damaged.name})")
+            text = (f"alarm states not restored from {self.path.name}: {e}; every alarm starts "
+                    f"normal (the file is kept as {damaged.name})")
+            logger.warning("%s", text)
+            self._journal(text)
             return {}
         if states:
             self._journal(f"alarm states restored from {self.path.name}: {len(states)} alarm(s)")
@@ -114,6 +118,8 @@ class AlarmStateFile:
                 with self._lock:
                     self._pending = {**pending, **self._pending}
                 if not self.last_error:
+                    logger.warning("alarm states could not be saved to %s: %s; kept in memory and retried",
+                                   self.path, e)
                     self._journal(f"alarm states could not be saved: {e}; kept in memory and retried")
                 self.last_error = str(e)
                 return

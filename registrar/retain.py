@@ -131,12 +131,14 @@ class Retainer:
             text = f"retentive memory restored from the {used} save {path.name}{why}"
             if used == "previous":
                 text += f": writes acknowledged after {_when(saved.wall)} may be lost"
+                logger.warning("%s", text)
             self._journal(text)
             return used
         self._apply(Saved(bytes(len(RETAIN_BITS)), bytes(DATA_SIZE), {}, {}, 0.0))
         text = f"retentive memory starts from zeroes ({'; '.join(problems)})"
         if any(not p.endswith("is missing") for p in problems):
             text += ": every write acknowledged before may be lost"
+            logger.warning("%s", text)
         self._journal(text)
         return "zeroes"
 
@@ -146,7 +148,7 @@ class Retainer:
             os.replace(self._tmp, self.path)
             _fsync_dir(self.path.parent)
         except OSError as e:  # the next save tries again; until then the file is used as it is
-            logger.exception("retentive save %s not renamed to %s", self._tmp, self.path)
+            logger.warning("retentive save %s not renamed to %s: %s", self._tmp, self.path, e)
             self._journal(f"retentive memory: {self._tmp.name} could not become {self.path.name}: {e}")
         else:
             self._current_good = True
@@ -233,7 +235,8 @@ class Retainer:
         try:
             self._write(taken.snap, *held(taken.tim, taken.ctr))
         except OSError as e:
-            if not self.last_error:
+            if not self.last_error:  # said once; the health strip shows it while it lasts
+                logger.warning("retentive memory could not be saved to %s: %s", self.path, e)
                 self._journal(f"retentive memory could not be saved: {e}; writes are answered all the "
                               "same and come back older after a crash until it is saved again")
             self.last_error = str(e)

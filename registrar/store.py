@@ -12,6 +12,7 @@ from __future__ import annotations
 
 import contextlib
 import datetime as dt
+import logging
 import math
 import operator
 import sqlite3
@@ -46,6 +47,8 @@ from registrar.schema import (
     table_name,
     tag_rows,
 )
+
+logger = logging.getLogger(__name__)
 
 SOURCE = "registrar"
 BATCH_MAX = 50_000  # records per transaction: bounds the time one commit holds the writer
@@ -239,11 +242,13 @@ class Store:
 
     def _open(self) -> sqlite3.Connection:
         con = sqlite3.connect(self.path, isolation_level=None, check_same_thread=False)
+        prepared = False
         try:
             self._prepare(con)
-        except BaseException:
-            con.close()
-            raise
+            prepared = True
+        finally:
+            if not prepared:  # whatever ended it, Ctrl+C too: the file is not left open
+                con.close()
         self._retain(con)
         return con
 
@@ -321,6 +326,7 @@ class Store:
             try:
                 barrier.callback()
             except Exception as e:  # a waiter's bug must not stop the archive
+                logger.exception("archive commit waiter failed")
                 self._queue.append(Record(self.wallclock(), "system", source=SOURCE,
                                           text=f"archive commit waiter failed: {e!r}"))
 
@@ -367,6 +373,7 @@ class Store:
         if self._failing_since is not None:
             seconds = self.wallclock() - self._failing_since
             self._failing_since = None
+            logger.warning("archive writing resumed after %.0f s; no records were lost", seconds)
             self._queue.appendleft(Record(self.wallclock(), "system", source=SOURCE,
                                           text=f"archive writing resumed after {seconds:.0f} s; "
                                                "no records were lost"))
@@ -375,6 +382,7 @@ class Store:
             try:
                 self.on_commit(committed)
             except Exception as e:  # a listener's bug must not stop the archive
+                logger.exception("archive commit listener failed and was removed")
                 self.on_commit = None
                 self._queue.append(Record(self.wallclock(), "system", source=SOURCE,
                                           text=f"archive commit listener failed and was removed: {e!r}"))
@@ -398,6 +406,7 @@ class Store:
         good = [r for r in batch if _well_formed(r)]
         if len(good) < len(batch):
             bad = [r for r in batch if not _well_formed(r)]
+            logger.error("archive refused %d malformed record(s), the first: %.300r", len(bad), bad[0])
             good.append(Record(self.wallclock(), "system", source=SOURCE,
                                text=f"archive refused {len(bad)} malformed record(s), "
                                     f"the first: {bad[0]!r:.300}"))
@@ -408,7 +417,8 @@ class Store:
         self._known.clear()  # tables created in the failed transaction are gone
         text = f"archive write failed: {error}"
         self._last_error = text
-        if self._failing_since is None:
+        if self._failing_since is None:  # said once; the health strip shows it while it lasts
+            logger.warning("%s; records are kept in memory and retried", text)
             self._failing_since = self.wallclock()
             batch.append(Record(self.wallclock(), "system", source=SOURCE,
                                 text=f"{text}; records are kept in memory and retried"))
@@ -480,6 +490,7 @@ class Store:
         except sqlite3.Error as e:
             _rollback(con)
             self._last_error = f"dropping old days failed: {e}"
+            logger.warning("archive %s: %s", self.path, self._last_error)
 
     def _drop_old_days(self, con: sqlite3.Connection) -> None:
         """Whole day tables older than keep_days go; their pages are reused by later days."""

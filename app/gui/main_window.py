@@ -99,6 +99,7 @@ class MainWindow(QMainWindow):
         self.programs: list[ProgramWindow] = []  # the Program views opened from here
         self._quitting = False
         self.views: list[FormView] = []
+        self.view_faults: list[str] = []  # form elements that failed to show: logged, in the health strip
         self.history: TrendHistory | None = None
         self.zooms: list[ZoomArea] = []
         self.zoom_settings = ZoomSettings(station.Archive.parent / "workstation.ini")
@@ -249,7 +250,8 @@ class MainWindow(QMainWindow):
         self.history = TrendHistory(station.Archive, self)
         for form in forms:
             view = FormView(form, target, archive_path=station.Archive, user=self.user,
-                            started=self.runtime.started_clock, guard=self._guard)
+                            started=self.runtime.started_clock, guard=self._guard,
+                            report=self.view_faults.append)
             self.views.append(view)
             self.writers.update({widget: (model, widget.toolTip()) for model, widget in view.pairs
                                  if isinstance(model, (DiscreteBase, AnalogOutput)) and model.Enabled})
@@ -346,8 +348,7 @@ class MainWindow(QMainWindow):
     def refresh_status(self) -> None:
         status = self.runtime.status()
         self.status.show_status(status)
-        problems = station_problems(status)
-        self.health.show_problems(problems)
+        self.health.show_problems(station_problems(status) + self.view_faults)
         self._running = status.state == "running"
         self.header.tick()
         if (idle := self.session.idle_expired()) is not None:

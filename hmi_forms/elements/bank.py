@@ -137,7 +137,7 @@ class Banked:
             try:
                 if puts[i](value):
                     repaint.append(i)
-            except Exception as e:
+            except Exception as e:  # no log: the view's fault handler logs and shows it
                 self._failed(i, e)
         return repaint
 
@@ -158,7 +158,7 @@ class Banked:
         try:
             if model.update(snap, quality):
                 self.syncs[i]()
-        except Exception as e:
+        except Exception as e:  # no log: the view's fault handler logs and shows it
             self._failed(i, e)
         self.marked[i] = bool(model.quality)
 

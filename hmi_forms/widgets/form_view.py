@@ -9,13 +9,16 @@ for repainting. Qt paints them all in one pass, and one rectangle stands for the
 large form changed. Trend plots are redrawn once a second (as PyDM does by default), all plots of
 a form in the same tick on one clock-time axis, so two trends never disagree about when something
 happened.
-A model that raises is reported once, marked stale and skipped; the rest of the form keeps running.
+An element whose update or drawing raises is marked stale (its mark shows it) and the rest of the
+form keeps running; the fault is logged with its traceback and reported (`report`: the workstation's
+health strip) once per element and kind of fault, not at every refresh.
 With the runtime's `Readings` of the scan, each element is also given the quality of what it shows
 (one judgement per distinct operand per refresh), and marks anything but good.
 """
 
 from __future__ import annotations
 
+import logging
 import time
 from collections.abc import Callable
 from pathlib import Path
@@ -48,6 +51,7 @@ from netplc.memory import Snapshot
 from netplc.tags.quality import Quality
 from netplc.tags.readings import Readings
 
+logger = logging.getLogger(__name__)
 BATCH = 100  # changed elements from which a refresh that changed most of the form repaints it whole
 
 
@@ -55,10 +59,11 @@ class FormView(QWidget):
     def __init__(self, form: Form, target: Target, *, archive_path: str | Path | None = None,
                  user: str = "operator", started: float | None = None,
                  clock: Callable[[], float] = time.monotonic, guard: Guard | None = None,
-                 parent: QWidget | None = None) -> None:
+                 report: Callable[[str], None] | None = None, parent: QWidget | None = None) -> None:
         """`started` is the engine-clock time the station started (for DateTime's time since start);
         `clock` paces the plot redraws (a benchmark replays ticks faster than real time); `guard`
-        decides each write of the operator before it is made (role, confirmation)."""
+        decides each write of the operator before it is made (role, confirmation); `report` hears
+        of each element fault once, in words for the operator."""
         super().__init__(parent)
         self.form = form
         self.setFixedSize(QSize(form.width, form.height))
@@ -69,7 +74,9 @@ class FormView(QWidget):
         self.pairs: list[tuple[Element, ElementWidget]] = []
         self.trends: list[TrendWidget] = []
         self.painted: list[ElementWidget] = []  # drawn by this widget's paintEvent, in file order
-        self.errors: list[str] = []
+        self.errors: list[str] = []  # each element fault as reported, once
+        self.report = report
+        self._faults: set[tuple[int, str, type]] = set()  # (element, what failed, exception type)
         self._last: Snapshot | None = None
         self.clock = clock
         self._dirty: list[QRect] | None = None  # parts to repaint, gathered during a refresh
@@ -169,7 +176,7 @@ class FormView(QWidget):
                     quality = None if readings is None else _worst(sources, readings, judged)
                     if model.update(snapshot, quality):
                         sync()
-                except Exception as e:
+                except Exception as e:  # no log: _fault logs it, once
                     self._fault(model, e, "update")
                     sync()  # marked stale: drawn with a painter, which shows the mark
             shown = [(banked, banked.refresh(snapshot, readings)) for banked in self._banks]
@@ -236,10 +243,18 @@ class FormView(QWidget):
                 self.history_wanted(trend, x_range[0], x_range[1])
 
     def _fault(self, model: Element, error: Exception, what: str) -> None:
-        text = f'{self.form.path}: element "{model.Name}": {what} failed: {error!r}'
-        if text not in self.errors:
-            self.errors.append(text)
+        """Mark the element stale; log and report the fault the first time (it recurs at every
+        refresh or repaint until the data that cause it change)."""
         model.stale = True
+        key = (id(model), what, type(error))
+        if key in self._faults:
+            return
+        self._faults.add(key)
+        text = f'{self.form.path}: element "{model.Name}": {what} failed: {error!r}'
+        logger.error("%s", text, exc_info=error)
+        self.errors.append(text)
+        if self.report is not None:
+            self.report(text)
 
     def flush(self) -> None:
         """Bring every throttled part up to date (before a screenshot)."""
@@ -276,7 +291,7 @@ class FormView(QWidget):
                     try:
                         for method, args in ops:
                             method(p, *args)
-                    except Exception as e:
+                    except Exception as e:  # no log: _fault logs it, once
                         self._fault(face.model, e, "drawing")
                 return
             for face, geometry in zip(self._faces, self._places):
@@ -297,7 +312,7 @@ class FormView(QWidget):
             p.setTransform(at)  # each sets the pens, fonts... it uses
             p.setClipRect(rect)
             widget.draw(p, rect)
-        except Exception as e:
+        except Exception as e:  # no log: _fault logs it, once
             self._fault(widget.model, e, "drawing")
         p.setClipping(False)
         p.resetTransform()

@@ -14,6 +14,7 @@ from __future__ import annotations
 
 import contextlib
 import datetime as dt
+import logging
 import sqlite3
 import threading
 import time
@@ -28,6 +29,8 @@ from netplc.records import Record
 from registrar.plant import schema as plant
 from registrar.reading import ArchiveError
 from registrar.schema import DAY_GLOB, parse_table_name, table_name
+
+logger = logging.getLogger(__name__)
 
 SOURCE = "forwarder"
 BATCH = 20_000  # records per PostgreSQL transaction
@@ -143,8 +146,11 @@ class Forwarder:
                 n = self._cycle()
                 self._error = ""
                 wait = 0.0 if n else self.interval  # more may wait (this day or the next)
-            except (psycopg.Error, sqlite3.Error, OSError) as e:
-                self._error = f"plant archive: {e}".strip()
+            except (psycopg.Error, sqlite3.Error, OSError) as e:  # PostgreSQL away: retried
+                error = f"plant archive: {e}".strip()
+                if error != self._error:  # once per cause, not at every retry
+                    logger.warning("forwarding to the plant archive failed, retrying: %s", error)
+                self._error = error
                 self._disconnect()
                 wait = min(RETRY_MAX, max(2 * wait, self.interval))
                 n = 0
@@ -156,7 +162,7 @@ class Forwarder:
         try:
             self._backlog, oldest = self._measure()
         except sqlite3.Error:
-            return
+            return  # the same file fails the next cycle, which says why
         now = self.wallclock()
         if oldest is None:
             self._lag = 0.0
@@ -190,6 +196,7 @@ class Forwarder:
 
     def _connect(self) -> None:
         con = plant.connect(self.url)
+        connected = False
         try:
             self._tz = plant.ensure_schema(con)
             self._published = False
@@ -200,9 +207,10 @@ class Forwarder:
             self._partitions = set(plant.partitions(con))
             self._retain(con)
             self._answered = True
-        except BaseException:
-            con.close()
-            raise
+            connected = True
+        finally:
+            if not connected:  # whatever ended it, Ctrl+C too: no connection left open
+                con.close()
         self._pg = con
 
     def _disconnect(self) -> None:

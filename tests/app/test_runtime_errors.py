@@ -15,7 +15,7 @@ import pytest
 
 from app.check import check_station
 from app.config import load_station
-from app.runtime import Runtime, StartError
+from app.runtime import Runtime, StartError, unresolved_hosts
 from netplc.modbus.driver import DeviceError, LeanTcpClient, parse_endpoint
 from netplc.program import parse
 from netplc.simulator import Simulator
@@ -101,6 +101,21 @@ def test_a_simulator_port_in_use_names_the_key_and_starts_nothing(tmp_path: Path
     runtime.stop()  # a second stop after a failed start does nothing
 
 
+def test_a_start_interrupted_by_ctrl_c_stops_what_had_started(tmp_path: Path, monkeypatch) -> None:
+    write_station(tmp_path, SIMULATED.format(port=0), {"node.stl": "JMP 0\n"})
+    runtime = Runtime(load_station(tmp_path))
+
+    def interrupted(*args: object) -> None:
+        raise KeyboardInterrupt
+
+    monkeypatch.setattr(runtime, "_fill_endpoint", interrupted)  # once the first simulator listens
+    with pytest.raises(KeyboardInterrupt):
+        runtime.start()
+    assert runtime.simulators == [] and runtime.store is None and runtime.retainer is None
+    assert not runtime.started
+    assert "station starting" in " ".join(system_texts(tmp_path / "archive" / "journal.sqlite"))
+
+
 def test_a_node_host_that_does_not_resolve_is_journaled_and_the_node_comes_up_once_it_does(
         tmp_path: Path, monkeypatch) -> None:
     # The resolver is this test's: "not found" until the name server is "up", then 127.0.0.1, where
@@ -134,6 +149,17 @@ def test_a_node_host_that_does_not_resolve_is_journaled_and_the_node_comes_up_on
     finally:
         runtime.stop()
         node.stop()
+
+
+def test_a_host_the_resolver_cannot_encode_is_a_problem_too(tmp_path: Path, monkeypatch) -> None:
+    def resolve(host, *args, **kwargs):
+        raise UnicodeError("encoding with 'idna' codec failed")
+
+    monkeypatch.setattr(socket, "getaddrinfo", resolve)
+    write_station(tmp_path, UNRESOLVABLE.format(port=5020))
+    assert [p.split(": ", 2)[1:] for p in unresolved_hosts(load_station(tmp_path))] == [
+        ["nodes[0].endpoint", "host '127.0.0.1' is not a host name: encoding with 'idna' codec failed"],
+        ["nodes[1].endpoint", "host 'nohost.invalid' is not a host name: encoding with 'idna' codec failed"]]
 
 
 def wait_for(condition, seconds: float = 15.0) -> bool:

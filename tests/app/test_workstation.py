@@ -125,6 +125,19 @@ def test_a_dead_node_and_a_stopped_program_show_in_the_window(qtbot, workstation
     assert workstation.status.nodes.property("level") == "bad"
 
 
+def test_a_form_element_that_fails_is_named_in_the_health_strip(qtbot, workstation: MainWindow) -> None:
+    graph, _ = element(workstation, "TA[2]: выход триггера")
+
+    def broken(*args: object) -> bool:
+        raise RuntimeError("display bug")
+
+    graph.update = broken  # type: ignore[method-assign]  # read at every refresh of its form
+    text = workstation.health.label.text
+    qtbot.waitUntil(lambda: 'element "TA[2]: выход триггера": update failed' in text(), timeout=5000)
+    assert "display bug" in text() and workstation.health.isVisible()
+    assert len(workstation.view_faults) == 1  # once, though it fails at every refresh
+
+
 def test_a_failing_archive_shows_in_the_status_bar(qtbot) -> None:
     status = RuntimeStatus(
         running=True, state="running", scans=100, scan_last_ms=0.3, scan_max_ms=1.0, scan_mean_ms=0.4,

@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import logging
 from pathlib import Path
 
 from hmi_forms.behaviour import FormBehaviour
@@ -63,7 +64,7 @@ def test_transitions_and_limits_are_journaled_once_each_in_scan_order(tmp_path) 
     ]
 
 
-def test_only_acting_elements_are_evaluated_and_a_failing_one_is_reported_once(tmp_path) -> None:
+def test_only_acting_elements_are_evaluated_and_a_failing_one_is_reported_once(tmp_path, caplog) -> None:
     quiet = {**PUMP, "Name": "Лампа", "RegMessages": False, "y": 220}
     reports: list[str] = []
     sink = ListSink()
@@ -76,8 +77,11 @@ def test_only_acting_elements_are_evaluated_and_a_failing_one_is_reported_once(t
         raise RuntimeError("boom")
 
     form.elements[1].refresh = broken
-    behaviour.attach(engine)
-    for _ in range(6):
-        engine.scan()
+    with caplog.at_level(logging.ERROR, logger="hmi_forms.behaviour"):
+        behaviour.attach(engine)
+        for _ in range(6):
+            engine.scan()
     assert len(reports) == 1 and 'element "Насос": evaluation failed' in reports[0]
+    [logged] = caplog.records  # and logged, with the traceback
+    assert "boom" in str(logged.exc_info[1])
     assert engine.snapshot.get_bit(0o2001) == 1  # scan 5: the generator goes on

@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import logging
 import shutil
 from pathlib import Path
 
@@ -247,21 +248,26 @@ def test_demo_forms_load_and_use_every_element_type(qtbot) -> None:
         assert not view.grab().isNull() and view.errors == []
 
 
-def test_a_failing_element_is_reported_and_the_others_go_on(qtbot, tmp_path) -> None:
+def test_a_failing_element_is_reported_and_the_others_go_on(qtbot, tmp_path, caplog) -> None:
     form = load_form(write_form(tmp_path, [
         {"type": "DiscreteBase", "Name": "A", "x": 0, "y": 0, "w": 100, "h": 30, "InAddr": "02120"},
         {"type": "DiscreteBase", "Name": "B", "x": 0, "y": 40, "w": 100, "h": 30, "InAddr": "02121"},
     ]))
-    view = FormView(form, engine_target(engine()[0]))
+    reported: list[str] = []
+    view = FormView(form, engine_target(engine()[0]), report=reported.append)
     qtbot.addWidget(view)
 
     def broken(snapshot) -> bool:
         raise RuntimeError("boom")
 
     form.elements[0].refresh = form.elements[0].settle = broken  # read by its update or the form's bank
-    view.refresh(snap(bits={0o2121: 1}))
-    view.refresh(snap(bits={0o2121: 0}, scan=1))
+    with caplog.at_level(logging.ERROR, logger="hmi_forms.widgets.form_view"):
+        for scan in range(4):  # it fails at every refresh: said once
+            view.refresh(snap(bits={0o2120: scan % 2, 0o2121: 1 - scan % 2}, scan=scan))
     assert len(view.errors) == 1 and 'element "A": update failed' in view.errors[0]
+    assert reported == view.errors  # to the operator (the workstation's health strip)...
+    [logged] = caplog.records  # ...and to the log, with the traceback
+    assert logged.getMessage() == view.errors[0] and "boom" in str(logged.exc_info[1])
     assert form.elements[0].stale and form.elements[1].value == 0
     assert not view.grab().isNull()
 

@@ -5,6 +5,7 @@ the reference interpreter."""
 from __future__ import annotations
 
 import itertools
+import logging
 
 import pytest
 
@@ -469,3 +470,18 @@ def test_a_listener_that_raises_is_journaled_and_the_others_go_on(compiled):
     unsubscribe = rig.engine.subscribe(lambda s: None, "x")
     unsubscribe()
     assert len(rig.engine.listeners) == 3
+
+
+def test_a_listener_that_raises_at_every_scan_is_logged_once(caplog):
+    rig = Rig("NOP")
+
+    def faulty(snap):
+        raise RuntimeError("listener bug")
+
+    rig.engine.subscribe(faulty, "faulty")
+    with caplog.at_level(logging.ERROR, logger="netplc.engine"):
+        for _ in range(5):
+            rig.step(0.1)
+    [logged] = caplog.records
+    assert "engine listener faulty failed" in logged.getMessage() and logged.exc_info is not None
+    assert len([r for r in rig.sink.records if "listener" in (r.text or "")]) == 1

@@ -9,6 +9,7 @@ the outputs C+1.. and FErr1) must be the same after each scan, with the rung on 
 from __future__ import annotations
 
 import itertools
+import logging
 import random
 
 import pytest
@@ -82,7 +83,7 @@ def test_data_operands_are_inlined_and_io_operands_called():
 
 
 @pytest.mark.parametrize("compiled", [True, False], ids=["compiled", "reference"])
-def test_a_builder_that_raises_fails_when_its_fon_runs(compiled, monkeypatch):
+def test_a_builder_that_raises_fails_when_its_fon_runs(compiled, monkeypatch, caplog):
     def build(mem, fon):
         raise RuntimeError("bad table")
 
@@ -95,7 +96,10 @@ def test_a_builder_that_raises_fails_when_its_fon_runs(compiled, monkeypatch):
     engine.scan()
     assert engine.mem.bits[FERR1] == 0 and not sink.records  # loading does not run it
     engine.mem.bits[0o2000] = 1
-    engine.scan()
-    engine.scan()
+    with caplog.at_level(logging.ERROR, logger="netplc.engine"):
+        engine.scan()
+        engine.scan()
     assert engine.mem.bits[FERR1] == 1 and engine.mem.bits[0o3000] == 1
     assert [r.text for r in sink.records] == ["FON BROKEN at line 2: RuntimeError: bad table"]
+    [logged] = caplog.records  # with its traceback, once: it fails at every scan its chain is on
+    assert "FON BROKEN at line 2" in logged.getMessage() and "bad table" in str(logged.exc_info[1])

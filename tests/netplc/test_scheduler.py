@@ -6,6 +6,7 @@ events with generous timeouts instead of sleeping for fixed times.
 
 from __future__ import annotations
 
+import logging
 import threading
 
 from netplc.engine import Engine
@@ -36,7 +37,7 @@ def test_scans_run_on_the_tick_and_stop():
     assert engine.snapshot.scan == count
 
 
-def test_a_failing_scan_is_reported_and_the_thread_goes_on():
+def test_a_failing_scan_is_reported_and_the_thread_goes_on(caplog):
     engine = engine_for("NOP")
     errors: list[BaseException] = []
     recovered = threading.Event()
@@ -44,20 +45,23 @@ def test_a_failing_scan_is_reported_and_the_thread_goes_on():
 
     def faulty_scan():
         snap = scan()
-        if snap.scan == 2:
+        if snap.scan in (2, 3, 5):
             raise RuntimeError("scan bug")
-        if snap.scan >= 4:
+        if snap.scan >= 6:
             recovered.set()
         return snap
 
     engine.scan = faulty_scan
     thread = ScanThread(engine, tick=0.005, on_error=errors.append)
-    thread.start()
-    try:
-        assert recovered.wait(10)
-    finally:
-        thread.stop()
-    assert [str(e) for e in errors] == ["scan bug"]
+    with caplog.at_level(logging.ERROR, logger="netplc.scheduler"):
+        thread.start()
+        try:
+            assert recovered.wait(10)
+        finally:
+            thread.stop()
+    assert [str(e) for e in errors] == ["scan bug"] * 3  # each failed scan is reported...
+    # ...and logged with its traceback once, not again at the next scan; again after a good one
+    assert [r.exc_info is not None for r in caplog.records] == [True, True]
 
 
 def test_lock_holds_the_scans_off():

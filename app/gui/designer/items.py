@@ -10,6 +10,7 @@ the element has problems, and resizing by its handles.
 
 from __future__ import annotations
 
+import logging
 from typing import TYPE_CHECKING, Any
 
 from PySide6.QtCore import QPointF, QRectF, Qt
@@ -22,6 +23,8 @@ from netplc.memory import Snapshot
 
 if TYPE_CHECKING:
     from app.gui.designer.design import Design
+
+logger = logging.getLogger(__name__)
 
 HANDLE = 7.0
 SELECTED = QColor("#1e6fd9")
@@ -84,7 +87,8 @@ class ElementItem(QGraphicsItem):
 
     def show_snapshot(self, snap: Snapshot) -> None:
         """Update the model from a snapshot (live preview) and redraw; a model that cannot read it
-        (a missing address drawn from its placeholder) keeps its first look."""
+        (a missing address drawn from its placeholder) keeps its first look. One that has no
+        problem and still fails is a fault: logged, and marked as a problem of the element."""
         if self.model is None:
             return
         self._unread = False
@@ -92,8 +96,11 @@ class ElementItem(QGraphicsItem):
             return  # placeholders must not show live values as if they were the element's
         try:
             changed = self.model.update(snap)
-        except Exception:
+        except Exception as e:
             changed = False
+            if not self.problems:  # with problems its placeholders may fail to read: expected
+                logger.exception('designer: element "%s" cannot show the snapshot', self.raw.get("Name"))
+                self.problems = [*self.problems, f"update failed: {e!r}"]
         if changed and self.widget is not None:
             self.widget.sync()
             self._pixmap = None
@@ -150,6 +157,7 @@ class ElementItem(QGraphicsItem):
                 p.setClipRect(r)
                 widget.draw(p, r)
         except Exception as e:  # a widget that cannot draw this model: say so, keep the canvas going
+            logger.exception('designer: element "%s" cannot be drawn', self.raw.get("Name"))
             self.problems = [*self.problems, f"drawing failed: {e!r}"]
             self.model = self.widget = None
         finally:

@@ -9,6 +9,7 @@ the qtbase catalogue PySide6 ships. Form texts stay as the engineer wrote them.
 
 from __future__ import annotations
 
+import logging
 import subprocess
 from pathlib import Path
 
@@ -17,6 +18,7 @@ from PySide6.QtCore import QCoreApplication, QLibraryInfo, QLocale, QTranslator
 
 from hmi_forms.elements import formats
 
+logger = logging.getLogger(__name__)
 HERE = Path(__file__).resolve().parent
 LRELEASE = Path(PySide6.__file__).parent / "lrelease"
 
@@ -35,7 +37,8 @@ def compiled(language: str) -> Path | None:
     if not qm.exists() or qm.stat().st_mtime < ts.stat().st_mtime:
         try:
             subprocess.run([str(LRELEASE), "-silent", str(ts), "-qm", str(qm)], check=True, timeout=60)
-        except (OSError, subprocess.SubprocessError):
+        except (OSError, subprocess.SubprocessError) as e:  # the console shows its English source text
+            logger.warning("console language %s not compiled (%s): %s", language, LRELEASE, e)
             return None
     return qm
 
