@@ -6,17 +6,6 @@ simulated CPU-165 node is is `netplc/simulator.py`; both reach the wire through 
 Only this package imports pymodbus, whose API changes at every minor release.
 """
 
-from netplc.modbus.driver import (
-    DeviceError,
-    Endpoint,
-    LeanTcpClient,
-    LinkError,
-    LoopThread,
-    ModbusClient,
-    ServerLimits,
-    open_client,
-    parse_endpoint,
-)
 from netplc.modbus.map import (
     MAX_READ_BITS,
     MAX_READ_REGISTERS,
@@ -31,6 +20,17 @@ from netplc.modbus.map import (
     locate,
 )
 from netplc.modbus.server import ALL_MEMORY, ModbusServer
+from netplc.modbus.tcp_server import (
+    DeviceError,
+    Endpoint,
+    LeanTcpClient,
+    LinkError,
+    LoopThread,
+    ModbusClient,
+    ServerLimits,
+    open_client,
+    parse_endpoint,
+)
 
 __all__ = [
     "ALL_MEMORY",

@@ -28,7 +28,7 @@ from typing import Protocol
 import serial
 from pymodbus.pdu import DecodePDU
 
-from netplc.modbus.driver import Endpoint, ServeHandler, answer
+from netplc.modbus.tcp_server import Endpoint, ServeHandler, answer
 
 BROADCAST = 0
 MAX_FRAME = 256  # an RTU frame's longest: unit, 253 bytes of PDU, CRC

@@ -17,7 +17,6 @@ from collections.abc import Callable
 
 from netplc.address import IO_BITS, fmt_octal
 from netplc.engine import Engine
-from netplc.modbus.driver import Endpoint, LoopThread, ServerLimits, TcpServer
 from netplc.modbus.map import (
     MapError,
     Table,
@@ -29,6 +28,7 @@ from netplc.modbus.map import (
     registers_target,
 )
 from netplc.modbus.rtu import RtuServer, open_line
+from netplc.modbus.tcp_server import Endpoint, LoopThread, ServerLimits, TcpServer
 from netplc.records import Record
 
 ALL_MEMORY: list[tuple[int, int]] = [(0, 0o77777)]  # every I/O bit and every data byte

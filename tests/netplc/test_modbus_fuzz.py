@@ -16,9 +16,9 @@ from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
 from netplc.engine import Engine
-from netplc.modbus.driver import ServerLimits
 from netplc.modbus.rtu import RtuServer, crc16
 from netplc.modbus.server import ModbusServer
+from netplc.modbus.tcp_server import ServerLimits
 from netplc.program import parse
 from netplc.scheduler import ScanThread
 from tests.netplc.test_rtu import PtyLine, raw_slave_side, replies

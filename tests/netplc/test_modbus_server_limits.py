@@ -16,8 +16,8 @@ import pytest
 
 from netplc.address import EMERGENCY_STOP
 from netplc.engine import Engine, FakeClock, RunState
-from netplc.modbus.driver import ServerLimits, Throttle
 from netplc.modbus.server import ALL_MEMORY, ModbusServer
+from netplc.modbus.tcp_server import ServerLimits, Throttle
 from netplc.program import parse
 from netplc.records import ListSink
 from registrar.schema import DAY_GLOB
