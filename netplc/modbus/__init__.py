@@ -6,6 +6,9 @@ simulated CPU-165 node is is `netplc/simulator.py`; both reach the wire through 
 Only this package imports pymodbus, whose API changes at every minor release.
 """
 
+from netplc.modbus.client import LeanTcpClient, ModbusClient, open_client
+from netplc.modbus.endpoint import Endpoint, parse_endpoint
+from netplc.modbus.loop import LoopThread
 from netplc.modbus.map import (
     MAX_READ_BITS,
     MAX_READ_REGISTERS,
@@ -19,18 +22,9 @@ from netplc.modbus.map import (
     describe,
     locate,
 )
+from netplc.modbus.pdu import DeviceError, LinkError
 from netplc.modbus.server import ALL_MEMORY, ModbusServer
-from netplc.modbus.tcp_server import (
-    DeviceError,
-    Endpoint,
-    LeanTcpClient,
-    LinkError,
-    LoopThread,
-    ModbusClient,
-    ServerLimits,
-    open_client,
-    parse_endpoint,
-)
+from netplc.modbus.tcp_server import ServerLimits
 
 __all__ = [
     "ALL_MEMORY",

@@ -28,7 +28,8 @@ from typing import Protocol
 import serial
 from pymodbus.pdu import DecodePDU
 
-from netplc.modbus.tcp_server import Endpoint, ServeHandler, answer
+from netplc.modbus.endpoint import Endpoint
+from netplc.modbus.pdu import ServeHandler, answer
 
 BROADCAST = 0
 MAX_FRAME = 256  # an RTU frame's longest: unit, 253 bytes of PDU, CRC

@@ -17,6 +17,8 @@ from collections.abc import Callable
 
 from netplc.address import IO_BITS, fmt_octal
 from netplc.engine import Engine
+from netplc.modbus.endpoint import Endpoint
+from netplc.modbus.loop import LoopThread
 from netplc.modbus.map import (
     MapError,
     Table,
@@ -28,7 +30,7 @@ from netplc.modbus.map import (
     registers_target,
 )
 from netplc.modbus.rtu import RtuServer, open_line
-from netplc.modbus.tcp_server import Endpoint, LoopThread, ServerLimits, TcpServer
+from netplc.modbus.tcp_server import ServerLimits, TcpServer
 from netplc.records import Record
 
 ALL_MEMORY: list[tuple[int, int]] = [(0, 0o77777)]  # every I/O bit and every data byte
