@@ -14,6 +14,7 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
+from app.authority.policy import OPERATOR, ROLES
 from netplc.address import fmt_octal, is_data_byte, is_io_bit, parse_octal
 from netplc.exchange import LIMITS, NODE_NUMBERS, UNITS, NodeConfig, unit_problem
 from netplc.modbus import PROFILES, TABLES, Endpoint, parse_endpoint
@@ -54,6 +55,8 @@ class ModbusServerSettings:
     max_connections: int = 16  # the next connection is closed (one journal line a minute)
     idle_timeout: float = 60.0  # s without a whole request before a connection is closed
     max_inflight: int = 32  # answers (of the longest size) a connection may leave unread or waiting
+    max_per_peer: int = 4  # connections from one address; the next one is closed
+    role: str = OPERATOR  # what Modbus clients may do (they have no users): viewer = read-only
 
 
 @dataclass(frozen=True)
@@ -352,10 +355,15 @@ def _modbus_server(problems: list[str], fname: str, table: dict[str, Any]) -> Mo
     max_connections = r.number("max_connections", 16, 1, 1000)
     max_inflight = r.number("max_inflight", 32, 1, 10_000)
     idle_timeout = _seconds(r, "idle_timeout", 60.0, 0.1, 86_400.0)
+    max_per_peer = r.number("max_per_peer", 4, 1, 1000)
+    role = r.get("role", str, OPERATOR)
     r.finish()
+    if role not in ROLES:
+        r.bad("role", f"{role!r} is not one of {', '.join(ROLES)}")
+        role = OPERATOR
     writable = DEFAULT_WRITABLE if ranges is None else _ranges(r, ranges)
     return ModbusServerSettings(enabled, host, port, writable, unit, max_connections, idle_timeout,
-                                max_inflight)
+                                max_inflight, max_per_peer, role)
 
 
 def _ranges(r: _Reader, ranges: list[Any]) -> tuple[tuple[int, int], ...]:

@@ -23,6 +23,8 @@ from netplc.modbus.map import (
     bits_from_bytes,
 )
 
+logger = logging.getLogger(__name__)
+
 
 class LinkError(Exception):
     """The transport failed: connection refused or lost, or no answer within the timeout."""
@@ -33,12 +35,26 @@ class ProtocolError(LinkError):
     byte count or echo. It counts as a failed attempt, like no answer at all."""
 
 
+# Modbus exception codes (Modbus Application Protocol 1.1b3, section 7) and what they mean
+APPLIED = 0  # not an exception: what a server's write outcome is when the write was done
+ILLEGAL_FUNCTION, ILLEGAL_ADDRESS, ILLEGAL_VALUE, DEVICE_FAILURE, BUSY = 1, 2, 3, 4, 6
+EXCEPTIONS = {1: "illegal function", 2: "illegal data address", 3: "illegal data value",
+              4: "server device failure", 5: "acknowledge", 6: "server device busy",
+              8: "memory parity error", 10: "gateway path unavailable",
+              11: "gateway target device failed to respond"}
+
+
+def exception_text(code: int) -> str:
+    """`4 (server device failure)`: a code as the journal and the status bar say it."""
+    return f"{code} ({EXCEPTIONS.get(code, 'unknown')})"
+
+
 class DeviceError(Exception):
     """The device answered with a Modbus exception (2 = illegal data address, ...)."""
 
     def __init__(self, code: int, what: str) -> None:
         self.code = code
-        super().__init__(f"{what}: Modbus exception {code}")
+        super().__init__(f"{what}: Modbus exception {exception_text(code)}")
 
 
 MBAP = struct.Struct(">HHHB")  # Modbus TCP header: transaction, protocol 0, length, unit
@@ -62,15 +78,18 @@ def take_frames(buf: bytearray) -> list[tuple[int, int, bytes]] | None:
 
 
 ADU_MAX = 260  # the longest Modbus TCP frame: MBAP header 7 + PDU 253
-BUSY = 6  # Modbus exception 6, server device busy: the engine's queue of outside writes is full
 READ_HEAD = struct.Struct(">HHHBBB")  # MBAP + function code + byte count of a read answer
 ADDRESS_COUNT = struct.Struct(">HH")
+READ_TABLES: dict[int, Table] = {1: "coils", 2: "discrete", 3: "holding", 4: "input"}
 
 Answer = Callable[[bytes], None]  # takes the response PDU of a write once it is journaled
+Done = Callable[[int], None]  # takes a write's outcome: APPLIED, or the exception code refusing it
 
 
 class ServeHandler(Protocol):
-    """What a Modbus server serves; MapError from any method answers exception 2."""
+    """What a Modbus server serves: the server knows frames and connections, the handler what the
+    addresses are and who may write them (the station's command layer, a simulated node's engine).
+    MapError from any method answers exception 2."""
 
     def registers(self, address: int, count: int) -> bytes:
         """`count` registers from `address` as the answer carries them (big-endian words)."""
@@ -80,13 +99,11 @@ class ServeHandler(Protocol):
         """`count` coils from `address`, packed as the answer carries them."""
         ...
 
-    def write(self, table: Table, address: int, values: list[int], peer: str,
-              done: Callable[[bool], None]) -> bool:
-        """Queue a write; `done(ok)` once it is applied and journaled. False: busy (exception 6)."""
+    def write(self, table: Table, address: int, values: list[int], peer: str, done: Done) -> int | None:
+        """Refuse a write at once (its exception code), or take it (None) and call `done(outcome)`
+        once it is applied and journaled (APPLIED) or failed, from any thread, possibly before
+        `write` returns."""
         ...
-
-
-READ_TABLES: dict[int, Table] = {1: "coils", 2: "discrete", 3: "holding", 4: "input"}
 
 
 class Refuse(Exception):
@@ -96,32 +113,33 @@ class Refuse(Exception):
 
 def answer(handler: ServeHandler, pdu: bytes, peer: str, later: Answer) -> bytes | None:
     """The response PDU to one request PDU (function codes 1-6, 15, 16; others: exception 1), or
-    None for an accepted write, whose response goes to `later` once the write is applied and its
-    journal record is durable (or exception 4 if it could not be applied)."""
+    None for a write the handler took, whose response goes to `later` once the write is applied
+    and its journal record is durable (or the exception that failed it)."""
     fc = pdu[0]
     try:
         if fc in READ_TABLES:
             if len(pdu) != 5:
-                raise Refuse(3)
+                raise Refuse(ILLEGAL_VALUE)
             address, count = ADDRESS_COUNT.unpack_from(pdu, 1)
             if not 1 <= count <= (MAX_READ_BITS if fc <= 2 else MAX_READ_REGISTERS):
-                raise Refuse(3)
+                raise Refuse(ILLEGAL_VALUE)
             data = handler.bits(address, count) if fc <= 2 else handler.registers(address, count)
             return bytes((fc, len(data))) + data
         if fc in (5, 6, 15, 16):
             table, address, values, echo = _write_request(pdu)
-            failed = bytes((fc | 0x80, 4))
-            if handler.write(table, address, values, peer, lambda ok: later(echo if ok else failed)):
+            refused = handler.write(table, address, values, peer,
+                                    lambda code: later(bytes((fc | 0x80, code)) if code else echo))
+            if refused is None:
                 return None
-            raise Refuse(BUSY)
-        code = 1
+            raise Refuse(refused)
+        code = ILLEGAL_FUNCTION
     except Refuse as e:
         code = e.code
     except MapError:
-        code = 2
+        code = ILLEGAL_ADDRESS
     except Exception:  # a server bug answers "device failure" and the server goes on
-        logging.getLogger(__name__).exception("Modbus request %s from %s failed", pdu.hex(" "), peer)
-        code = 4
+        logger.exception("Modbus request %s from %s failed", pdu.hex(" "), peer)
+        code = DEVICE_FAILURE
     return bytes((fc | 0x80, code))
 
 
@@ -130,22 +148,22 @@ def _write_request(pdu: bytes) -> tuple[Table, int, list[int], bytes]:
     fc = pdu[0]
     if fc in (5, 6):
         if len(pdu) != 5:
-            raise Refuse(3)
+            raise Refuse(ILLEGAL_VALUE)
         address, value = ADDRESS_COUNT.unpack_from(pdu, 1)
         if fc == 6:
             return "holding", address, [value], pdu
         if value not in (0, 0xFF00):
-            raise Refuse(3)
+            raise Refuse(ILLEGAL_VALUE)
         return "coils", address, [1 if value else 0], pdu
     if len(pdu) < 6:
-        raise Refuse(3)
+        raise Refuse(ILLEGAL_VALUE)
     address, count, nbytes = struct.unpack_from(">HHB", pdu, 1)
     data = pdu[6:]
     echo = pdu[:5]
     if fc == 15:
         if not 1 <= count <= MAX_WRITE_BITS or nbytes != (count + 7) // 8 or len(data) != nbytes:
-            raise Refuse(3)
+            raise Refuse(ILLEGAL_VALUE)
         return "coils", address, bits_from_bytes(data)[:count], echo
     if not 1 <= count <= MAX_WRITE_REGISTERS or nbytes != 2 * count or len(data) != nbytes:
-        raise Refuse(3)
+        raise Refuse(ILLEGAL_VALUE)
     return "holding", address, list(struct.unpack(f">{count}H", data)), echo

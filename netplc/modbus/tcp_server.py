@@ -38,6 +38,10 @@ class ServerLimits:
     max_connections: int = 16  # the next connection is closed at once
     idle_timeout: float = 60.0  # s without a whole request (silent, or a half frame): closed
     max_inflight: int = 32  # answers (of the longest size) a connection may leave unread or waiting
+    max_per_peer: int = 4  # connections from one address (within max_connections); the next is closed
+
+
+TURN = 128  # requests a connection is answered in a row before every other connection's turn
 
 
 class Throttle:
@@ -68,7 +72,12 @@ class _Connection(asyncio.Protocol):
     """One client. Answers leave in the order of the requests: behind a write waiting for its
     scan and journal record, later answers wait too. A connection stops being read while more
     than `max_inflight` answers' worth of bytes wait to be read by the client or wait behind a
-    write; the writes themselves are bounded by the engine's queue (exception 6 when it is full)."""
+    write; the writes themselves are bounded by the station's queue (exception 6 when it is full).
+
+    Service is fair: a connection is answered at most TURN requests in a row, then stops being
+    read and waits for the next turn of the event loop, after every other connection with data
+    has had its own; so a client pipelining requests as fast as it can delays another by a
+    turn of each connection (well under a millisecond each), never by its whole backlog."""
 
     def __init__(self, server: TcpServer) -> None:
         self.server = server
@@ -80,6 +89,8 @@ class _Connection(asyncio.Protocol):
         self.high = server.limits.max_inflight * ADU_MAX  # answer bytes that may wait unread
         self.blocked = False  # the client does not read its answers (the transport's buffer is full)
         self.reading = True
+        self.queued = False  # its next turn is due on the loop
+        self.host = ""  # the peer's address, once the connection is counted against its limits
         self.last = 0.0  # loop time of the last data
 
     def connection_made(self, transport: asyncio.BaseTransport) -> None:
@@ -87,22 +98,37 @@ class _Connection(asyncio.Protocol):
         server = self.server
         peer = transport.get_extra_info("peername")
         self.peer = f"{peer[0]}:{peer[1]}" if isinstance(peer, tuple) else str(peer)
-        limit = server.limits.max_connections
-        if len(server.connections) >= limit:
+        host = str(peer[0]) if isinstance(peer, tuple) else self.peer
+        limits, peers = server.limits, server.peers
+        if peers.get(host, 0) >= limits.max_per_peer:
+            transport.close()
+            server.note("peer", f"Modbus server refused a connection from {self.peer}: "
+                                f"{limits.max_per_peer} connections from {host} are open (max_per_peer)")
+            return
+        if len(server.connections) >= limits.max_connections:
             transport.close()
             server.note("connections", f"Modbus server refused a connection from {self.peer}: "
-                                       f"{limit} connections are open (max_connections)")
+                                       f"{limits.max_connections} connections are open (max_connections)")
             return
         self.transport = transport
+        self.host = host
         self.last = server.loop_time()
         server.connections.add(self)
+        peers[host] = peers.get(host, 0) + 1
         transport.set_write_buffer_limits(high=self.high)
 
     def connection_lost(self, exc: Exception | None) -> None:
         self.transport = None
         self.held.clear()
         self.held_bytes = 0
-        self.server.connections.discard(self)
+        server = self.server
+        if self in server.connections:
+            server.connections.discard(self)
+            left = server.peers[self.host] - 1
+            if left:
+                server.peers[self.host] = left
+            else:
+                del server.peers[self.host]
 
     def pause_writing(self) -> None:
         self.blocked = True
@@ -118,8 +144,12 @@ class _Connection(asyncio.Protocol):
         self.last = self.server.last_data = self.server.loop_time()
         self._serve()
 
+    def _turn(self) -> None:
+        self.queued = False
+        self._serve()
+
     def _serve(self) -> None:
-        """Answer the whole requests in the buffer, as many as the limits allow."""
+        """Answer the whole requests in the buffer, as many as the limits and a turn allow."""
         transport = self.transport
         if transport is None:
             return
@@ -127,7 +157,7 @@ class _Connection(asyncio.Protocol):
         handler, only, limit = server.handler, server.unit, server.limits.max_inflight
         buf, held = self.buf, self.held
         pos, end, out, n = 0, len(self.buf), bytearray(), 0
-        while end - pos >= 8 and not self.blocked and self.held_bytes < self.high:
+        while end - pos >= 8 and n < TURN and not self.blocked and self.held_bytes < self.high:
             tid, proto, length, unit = MBAP.unpack_from(buf, pos)
             if proto != 0 or not 2 <= length <= 254:
                 server.note("frames", f"Modbus server closed the connection of {self.peer}: "
@@ -176,7 +206,11 @@ class _Connection(asyncio.Protocol):
             self._send(out)
         if self.transport is None:
             return
-        stop = self.blocked or self.held_bytes >= self.high
+        waits = self.blocked or self.held_bytes >= self.high  # resume_writing or answered goes on
+        if n >= TURN and not waits and not self.queued:  # the others' turn first, then ours again
+            self.queued = True
+            server.next_turn(self._turn)
+        stop = waits or n >= TURN
         if stop and self.reading:
             self.reading = False
             transport.pause_reading()
@@ -222,6 +256,7 @@ class TcpServer:
         self.limits = limits or ServerLimits()
         self.note = Throttle(note or logging.getLogger(__name__).warning)
         self.connections: set[_Connection] = set()
+        self.peers: dict[str, int] = {}  # open connections by the peer's address
         self._server: asyncio.Server | None = None
         self._loop: asyncio.AbstractEventLoop | None = None
         self._sweep: asyncio.TimerHandle | None = None
@@ -233,6 +268,10 @@ class TcpServer:
     def loop_time(self) -> float:
         assert self._loop is not None
         return self._loop.time()
+
+    def next_turn(self, serve: Callable[[], None]) -> None:
+        assert self._loop is not None
+        self._loop.call_soon(serve)
 
     async def listen(self, host: str, port: int) -> None:
         loop = self._loop = asyncio.get_running_loop()

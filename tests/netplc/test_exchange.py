@@ -216,6 +216,7 @@ def test_modbus_profile_and_device_exceptions(node0: Simulator) -> None:
         snap = lambda: st.engine.snapshot  # noqa: E731
         wait_until(lambda: snap().get_word(0o4020) == 0xCAFE and st.exchange.stats[0].errors >= 1)
         assert snap().get_bit(0o2105) == 1 and snap().get_bit(0o2101) == 1  # the device answered
-        assert st.exchange.stats[0].last_error == "0: read input 0+1: Modbus exception 2"
+        assert st.exchange.stats[0].last_error == ("0: read input 0+1: Modbus exception 2 "
+                                                   "(illegal data address)")
     finally:
         st.stop()
