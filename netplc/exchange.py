@@ -19,7 +19,14 @@ time (the program stopped, a rung that is rarely on). So a node without a reques
 max(timeout, PROBE_IDLE) gets a liveness probe, a one-register read through the same attempts,
 back-off and link-state path: the presence list, `link_up()` and the link up/down records never
 show a dead node as up (nor, after its back-off, a live one as down) for longer than that plus the
-timeouts of the probe. A Modbus exception in answer to the probe is an answer: the link is up.
+timeouts of the probe. The probe asks register 0, which a device need not have: exception 1, 2
+or 3 in answer to it is an answer, and the link is up.
+
+A node that answers, but only with Modbus exceptions, serves no data either: one whose answers
+are exceptions `retries + 1` times in a row (its budget of attempts), with one of its requests
+refused twice in that run (so every request it is asked, not one bad address among good ones),
+is down like a silent one: link down, presence 00, back-off, journaled once with the exception
+("answers only exception 4 (server device failure)"); its first normal answer brings it up.
 """
 
 from __future__ import annotations
@@ -34,6 +41,7 @@ from typing import TYPE_CHECKING, TypeVar
 from netplc.address import PRESENCE_LIST, PRESENCE_NODES, AddressError, check_operand
 from netplc.memory import Memory
 from netplc.modbus import (
+    ILLEGAL_VALUE,
     PROFILES,
     TABLES,
     WRITABLE_TABLES,
@@ -44,6 +52,7 @@ from netplc.modbus import (
     LoopThread,
     MapError,
     describe,
+    exception_text,
     locate,
     open_client,
     parse_endpoint,
@@ -189,6 +198,11 @@ class _Node:
         self.active = time.monotonic()  # when the last request or probe ended
         self.busy = False  # a request or probe is being served
         self.blocks: dict[tuple[int, int], Block] = {}  # (remote, length) -> where it is
+        # the answers since the last normal one, all exceptions: how many, to which requests, which codes
+        self.refusals = 0
+        self.refused: set[int] = set()  # request keys (PROBE's too)
+        self.repeated = False  # a request of the run was refused twice: the node refuses them all
+        self.codes: set[int] = set()
 
     async def run(self) -> None:
         watch = asyncio.get_running_loop().create_task(self.watch(), name=f"node {self.config.node} probe")
@@ -224,8 +238,9 @@ class _Node:
 
     async def probe(self) -> tuple[None, str]:
         self.stats.probes += 1
-        cfg = self.config
-        return None, await self.transact(lambda: self.client.read(cfg.unit, cfg.table, 0, 1), "probe")
+        unit, table = self.config.unit, self.config.table
+        _, error = await self.transact(lambda: self.client.read(unit, table, 0, 1), "probe", PROBE.key)
+        return None, error
 
     async def serve(self, req: _Request) -> tuple[bytes | None, str]:
         now = time.monotonic()
@@ -241,26 +256,55 @@ class _Node:
                 return None, f"{where}: {e}"
             self.blocks[req.remote, length] = block
         if req.payload is None:
-            data, error = await self.transact(lambda: self.read(block), where)
+            data, error = await self.transact(lambda: self.read(block), where, req.key)
         else:
             payload = req.payload
-            data, error = await self.transact(lambda: self.write(block, payload), where)
+            data, error = await self.transact(lambda: self.write(block, payload), where, req.key)
         return data, error
 
-    async def transact(self, call: Callable[[], Awaitable[T]], where: str) -> tuple[T | None, str]:
-        """`call()` with the node's retries; its outcome sets the link state and the back-off.
-        Returns (result, "") or (None, what went wrong)."""
+    async def transact(self, call: Callable[[], Awaitable[T]], where: str, key: int) -> tuple[T | None, str]:
+        """`call()` (request `key`) with the node's retries; its outcome sets the link state and the
+        back-off. Returns (result, "") or (None, what went wrong)."""
         try:
             result = await self.attempts(call)
-        except (MapError, DeviceError) as e:  # the device answered: the link is up
+        except DeviceError as e:  # the device answered, with an exception
+            if key == PROBE.key and e.code <= ILLEGAL_VALUE:  # no register 0 there: an answer
+                self.answered()
+            elif self.only_exceptions(key, e.code):
+                self.down(self.exceptions())
+            else:
+                self.link(True, "")
+            return None, f"{where}: {e}"
+        except MapError as e:  # the block does not fit the node's table: nothing was sent
             self.link(True, "")
             return None, f"{where}: {e}"
         except LinkError as e:  # no answer, or one that is not the request's (ProtocolError)
             self.down(str(e))
             return None, str(e)
-        self.delay = self.config.backoff
-        self.link(True, "")
+        self.answered()
         return result, ""
+
+    def answered(self) -> None:
+        """A normal answer: the link is up, the back-off and the run of exceptions start over."""
+        self.delay = self.config.backoff
+        self.refusals, self.repeated = 0, False
+        self.refused.clear()
+        self.codes.clear()
+        self.link(True, "")
+
+    def only_exceptions(self, key: int, code: int) -> bool:
+        """Count an exception in answer to request `key`: does the node now answer only those?"""
+        self.refusals += 1
+        self.repeated = self.repeated or key in self.refused
+        self.refused.add(key)
+        self.codes.add(code)
+        return self.repeated and self.refusals >= self.config.retries + 1
+
+    def exceptions(self) -> str:
+        codes = sorted(self.codes)
+        if len(codes) == 1:
+            return f"answers only exception {exception_text(codes[0])}"
+        return f"answers only exceptions {', '.join(exception_text(c) for c in codes)}"
 
     def down(self, error: str) -> None:
         """Every attempt failed: the link is down and the node backs off."""

@@ -23,12 +23,17 @@ from netplc.modbus.map import MAX_READ_REGISTERS, MapError
 from netplc.modbus.pdu import (
     ADDRESS_COUNT,
     ADU_MAX,
+    DEVICE_FAILURE,
+    ILLEGAL_ADDRESS,
+    ILLEGAL_VALUE,
     MBAP,
     READ_HEAD,
     Refuse,
     ServeHandler,
     answer,
 )
+
+logger = logging.getLogger(__name__)
 
 
 @dataclass(frozen=True, slots=True)
@@ -175,12 +180,16 @@ class _Connection(asyncio.Protocol):
                 address, count = ADDRESS_COUNT.unpack_from(buf, pos + 8)
                 try:
                     if not 1 <= count <= MAX_READ_REGISTERS:
-                        raise Refuse(3)
+                        raise Refuse(ILLEGAL_VALUE)
                     data = handler.registers(address, count)
                 except Refuse as e:
                     out += MBAP.pack(tid, 0, 3, unit) + bytes((fc | 0x80, e.code))
                 except MapError:
-                    out += MBAP.pack(tid, 0, 3, unit) + bytes((fc | 0x80, 2))
+                    out += MBAP.pack(tid, 0, 3, unit) + bytes((fc | 0x80, ILLEGAL_ADDRESS))
+                except Exception:  # a handler's bug answers "device failure", as in `answer`
+                    logger.exception("Modbus read of %d registers at %d from %s failed", count, address,
+                                     self.peer)
+                    out += MBAP.pack(tid, 0, 3, unit) + bytes((fc | 0x80, DEVICE_FAILURE))
                 else:
                     out += READ_HEAD.pack(tid, 0, len(data) + 3, unit, fc, len(data))
                     out += data
@@ -254,7 +263,7 @@ class TcpServer:
         self.handler = handler
         self.unit = unit
         self.limits = limits or ServerLimits()
-        self.note = Throttle(note or logging.getLogger(__name__).warning)
+        self.note = Throttle(note or logger.warning)
         self.connections: set[_Connection] = set()
         self.peers: dict[str, int] = {}  # open connections by the peer's address
         self._server: asyncio.Server | None = None
