@@ -149,7 +149,7 @@ def test_node_config_reports_bad_endpoints() -> None:
         NodeConfig(3, "rtu:///dev/ttyS0?parity=X")
     with pytest.raises(ValueError, match=r"unknown option 'speed'"):
         NodeConfig(3, "rtu:///dev/ttyS0?speed=9600")
-    with pytest.raises(ValueError, match=r"node 300: the node number must be 0-255"):
+    with pytest.raises(ValueError, match=r"node 300: node 300 is outside 0-255"):
         NodeConfig(300, "tcp://h:502")
     with pytest.raises(ValueError, match=r"profile 'plc' is not one of cpu165, modbus"):
         NodeConfig(1, "tcp://h:502", profile="plc")
