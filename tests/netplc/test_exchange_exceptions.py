@@ -6,7 +6,7 @@ handler that fails every request while the device is unwell."""
 from __future__ import annotations
 
 from netplc.exchange import NodeConfig
-from netplc.modbus import DEVICE_FAILURE, ModbusServer
+from netplc.modbus import DEVICE_FAILURE, Done, ModbusServer, Table
 from netplc.modbus.pdu import Refuse
 from tests.netplc.test_exchange import Station, wait_until
 
@@ -33,13 +33,13 @@ class Unwell:
     def bits(self, address: int, count: int) -> bytes:
         raise Refuse(DEVICE_FAILURE)
 
-    def write(self, table: str, address: int, values: list[int], peer: str, done: object) -> int:
+    def write(self, table: Table, address: int, values: list[int], peer: str, done: Done) -> int:
         return DEVICE_FAILURE
 
 
 def test_a_node_answering_only_exceptions_is_down_and_comes_back_with_its_first_answer() -> None:
     device = Unwell()
-    server = ModbusServer(device)  # type: ignore[arg-type]
+    server = ModbusServer(device)
     server.start()
     endpoint = f"tcp://127.0.0.1:{server.port}"
     st = Station(PROGRAM, [NodeConfig(3, endpoint, timeout=0.3, retries=1, backoff=0.05, backoff_max=0.1)])

@@ -16,6 +16,7 @@ import pytest
 
 from netplc.address import EMERGENCY_STOP
 from netplc.engine import Engine, FakeClock, RunState
+from netplc.modbus import Done, Table
 from netplc.modbus.map import MapError
 from netplc.modbus.pdu import ILLEGAL_FUNCTION
 from netplc.modbus.server import ModbusServer
@@ -337,13 +338,13 @@ class Gated:
     def bits(self, address: int, count: int) -> bytes:
         raise MapError("no coils here")
 
-    def write(self, table: str, address: int, values: list[int], peer: str, done: object) -> int:
+    def write(self, table: Table, address: int, values: list[int], peer: str, done: Done) -> int:
         return ILLEGAL_FUNCTION
 
 
 def test_a_pipelining_client_does_not_make_another_wait_for_its_backlog() -> None:
     handler = Gated()
-    server = ModbusServer(handler)  # type: ignore[arg-type]
+    server = ModbusServer(handler)
     server.start()
     try:
         with connect_from("127.0.0.1", server.port) as greedy, \
