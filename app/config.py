@@ -14,9 +14,9 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
+from app.authority.policy import OPERATOR, ROLES
 from netplc.address import fmt_octal, is_data_byte, is_io_bit, parse_octal
-from netplc.exchange import LIMITS, NODE_NUMBERS, UNITS, NodeConfig, unit_problem
-from netplc.modbus import PROFILES, TABLES, Endpoint, parse_endpoint
+from netplc.exchange import NODE_DEFAULTS, NodeConfig, shared_problems
 from netplc.problems import Problems
 from netplc.tags.tag import TagType
 from netplc.textfile import TextFileError, file_problem, read_text, resolve
@@ -55,6 +55,8 @@ class ModbusServerSettings:
     max_connections: int = 16  # the next connection is closed (one journal line a minute)
     idle_timeout: float = 60.0  # s without a whole request before a connection is closed
     max_inflight: int = 32  # answers (of the longest size) a connection may leave unread or waiting
+    max_per_peer: int = 4  # connections from one address; the next one is closed
+    role: str = OPERATOR  # what Modbus clients may do (they have no users): viewer = read-only
 
 
 @dataclass(frozen=True)
@@ -362,10 +364,15 @@ def _modbus_server(problems: list[str], fname: str, table: dict[str, Any]) -> Mo
     max_connections = r.number("max_connections", 16, 1, 1000)
     max_inflight = r.number("max_inflight", 32, 1, 10_000)
     idle_timeout = _seconds(r, "idle_timeout", 60.0, 0.1, 86_400.0)
+    max_per_peer = r.number("max_per_peer", 4, 1, 1000)
+    role = r.get("role", str, OPERATOR)
     r.finish()
+    if role not in ROLES:
+        r.bad("role", f"{role!r} is not one of {', '.join(ROLES)}")
+        role = OPERATOR
     writable = DEFAULT_WRITABLE if ranges is None else _ranges(r, ranges)
     return ModbusServerSettings(enabled, host, port, writable, unit, max_connections, idle_timeout,
-                                max_inflight)
+                                max_inflight, max_per_peer, role)
 
 
 def _ranges(r: _Reader, ranges: list[Any]) -> tuple[tuple[int, int], ...]:
@@ -408,53 +415,29 @@ def _array_tables(problems: list[str], fname: str, items: list[Any], key: str) -
 
 
 def _nodes(problems: list[str], fname: str, items: list[Any]) -> list[NodeConfig]:
-    """The [[nodes]] tables as NodeConfig, with every problem named by its key; the limits are the
-    model's own (netplc/exchange.py), so a node station.toml accepts is one the exchange runs."""
+    """The [[nodes]] tables as NodeConfig, with every problem named by its key: this reads the
+    TOML types, the model checks the values (netplc/exchange.py `node_problems`), so a node
+    station.toml accepts is one the exchange runs."""
     nodes: list[NodeConfig] = []
-    seen: set[int] = set()
-    lines: dict[str, tuple[int, Endpoint]] = {}  # serial device -> the first node on it
-    d = NodeConfig
+    readers: dict[str, _Reader] = {}  # by the node's key, nodes[i]
     for i, r in _array_tables(problems, fname, items, "nodes"):
-        node = r.number("node", -1, *NODE_NUMBERS, required=True)
-        endpoint = r.get("endpoint", str, "")
-        unit = r.number("unit", d.unit, min(lo for lo, _ in UNITS.values()),
-                        max(hi for _, hi in UNITS.values()))
-        profile = r.get("profile", str, d.profile)
-        timeout = _seconds(r, "timeout", d.timeout, *LIMITS["timeout"])
-        retries = r.number("retries", d.retries, *map(int, LIMITS["retries"]))
-        table_name = r.get("table", str, d.table)
-        backoff = _seconds(r, "backoff", d.backoff, *LIMITS["backoff"])
-        backoff_max = _seconds(r, "backoff_max", d.backoff_max, *LIMITS["backoff_max"])
+        settings = {"node": r.get("node", int, required=True)}
+        for key, default in NODE_DEFAULTS.items():
+            kind = float if isinstance(default, float) else type(default)
+            value = r.get(key, kind, None)
+            if value is not None:
+                settings[key] = value
         r.finish()
-        if backoff > backoff_max:
-            r.bad("backoff", f"{backoff:g} s is more than backoff_max {backoff_max:g} s")
-            backoff = min(d.backoff, backoff_max)
-        if endpoint:
-            try:
-                ep = parse_endpoint(endpoint)
-            except ValueError as e:
-                r.bad("endpoint", str(e))
-                endpoint = ""
-            else:
-                first, line = lines.setdefault(ep.device, (node, ep)) if ep.scheme == "rtu" else (node, ep)
-                if line != ep:
-                    r.bad("endpoint", f"{ep} and node {first}'s {line} share {ep.device} with "
-                                      "different line settings")
-                if problem := unit_problem(ep.scheme, unit):
-                    r.bad("unit", problem)
-                    unit = d.unit
-        if profile not in PROFILES:
-            r.bad("profile", f"{profile!r} is not one of {', '.join(PROFILES)}")
-            profile = d.profile
-        if table_name not in TABLES:
-            r.bad("table", f"{table_name!r} is not one of {', '.join(TABLES)}")
-            table_name = d.table
-        if node in seen:
-            r.bad("node", f"node {node} is configured twice")
-        if node >= 0:
-            seen.add(node)
-            nodes.append(NodeConfig(node, endpoint, unit, profile, timeout, retries, table_name,
-                                    backoff, backoff_max, key=f"nodes[{i}]"))
+        if settings["node"] is None:
+            continue
+        node, found = NodeConfig.settled(settings, key=f"nodes[{i}]")
+        for key, text in found:
+            r.bad(key, text)
+        if node is not None:
+            nodes.append(node)
+            readers[node.key] = r
+    for node, (key, text) in shared_problems(nodes):
+        readers[node.key].bad(key, text)
     return nodes
 
 

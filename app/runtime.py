@@ -27,6 +27,7 @@ from dataclasses import dataclass, field, replace
 from typing import TYPE_CHECKING
 
 from app.authority import Commands, Source, Ticket, Who
+from app.authority.modbus import ModbusCommands
 from app.authority.users import USERS_FILE, Users
 from app.config import Station
 from app.load import load, load_station_forms
@@ -305,9 +306,11 @@ class Runtime:
                                  alarms=self.alarms, wallclock=self.wallclock)
         server = st.modbus_server
         if server.enabled:
-            limits = ServerLimits(server.max_connections, server.idle_timeout, server.max_inflight)
-            modbus = ModbusServer(self.engine, host=server.host, port=server.port,
-                                  writable=list(server.writable), unit=server.unit, limits=limits)
+            self.commands.grant(Source.MODBUS, server.role)
+            limits = ServerLimits(server.max_connections, server.idle_timeout, server.max_inflight,
+                                  server.max_per_peer)
+            modbus = ModbusServer(ModbusCommands(self.commands, server.writable), host=server.host,
+                                  port=server.port, unit=server.unit, limits=limits, sink=self)
             try:
                 modbus.start()
                 self.modbus = modbus

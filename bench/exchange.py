@@ -69,12 +69,13 @@ def serve(k: int) -> None:
     import threading
 
     from netplc.engine import Engine
-    from netplc.modbus import ALL_MEMORY, LoopThread, ModbusServer
+    from netplc.modbus import LoopThread, ModbusServer
+    from netplc.simulator import EngineMemory
 
     loop = LoopThread("nodes")
     loop.start()
     engines = [Engine(parse(NODE_PROGRAM, "node.stl"), tick=0.1) for _ in range(k)]
-    servers = [ModbusServer(e, writable=ALL_MEMORY, loop=loop) for e in engines]
+    servers = [ModbusServer(EngineMemory(e), loop=loop) for e in engines]
     for s in servers:
         s.start()
     stop = threading.Event()

@@ -37,12 +37,13 @@ def serve_ours() -> None:
     from netplc.engine import Engine
     from netplc.modbus import ModbusServer
     from netplc.program import parse
+    from netplc.simulator import EngineMemory
 
     engine = Engine(parse("JMP 0\n"))
     for i in range(REGISTERS):
         engine.mem.set_word(0o4000 + 2 * i, 0x1234 + i)
     engine.scan()
-    server = ModbusServer(engine)
+    server = ModbusServer(EngineMemory(engine, ()))
     server.start()
     print(server.port, flush=True)
     sys.stdin.read()
@@ -120,8 +121,9 @@ def flood(n: int) -> None:
     import tempfile
 
     from netplc.engine import Engine, FakeClock
-    from netplc.modbus import ALL_MEMORY, ModbusServer
+    from netplc.modbus import ModbusServer
     from netplc.program import parse
+    from netplc.simulator import EngineMemory
     from registrar.store import Store
 
     with tempfile.TemporaryDirectory() as tmp:
@@ -129,7 +131,7 @@ def flood(n: int) -> None:
         store.start()
         clock = FakeClock()
         engine = Engine(parse("TNA $03760\nJMP 0\n"), clock=clock, sink=store)
-        server = ModbusServer(engine, writable=ALL_MEMORY)
+        server = ModbusServer(EngineMemory(engine), sink=store)
         server.start()
         sock = socket.create_connection(("127.0.0.1", server.port))
         writes = b"".join(struct.pack(">HHHBBHH", i & 0xFFFF, 0, 6, 1, 6, 1024 + i % 1000, i & 0xFFFF)

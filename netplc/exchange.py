@@ -19,7 +19,14 @@ time (the program stopped, a rung that is rarely on). So a node without a reques
 max(timeout, PROBE_IDLE) gets a liveness probe, a one-register read through the same attempts,
 back-off and link-state path: the presence list, `link_up()` and the link up/down records never
 show a dead node as up (nor, after its back-off, a live one as down) for longer than that plus the
-timeouts of the probe. A Modbus exception in answer to the probe is an answer: the link is up.
+timeouts of the probe. The probe asks register 0, which a device need not have: exception 1, 2
+or 3 in answer to it is an answer, and the link is up.
+
+A node that answers, but only with Modbus exceptions, serves no data either: one whose answers
+are exceptions `retries + 1` times in a row (its budget of attempts), with one of its requests
+refused twice in that run (so every request it is asked, not one bad address among good ones),
+is down like a silent one: link down, presence 00, back-off, journaled once with the exception
+("answers only exception 4 (server device failure)"); its first normal answer brings it up.
 """
 
 from __future__ import annotations
@@ -27,13 +34,14 @@ from __future__ import annotations
 import asyncio
 import time
 from collections import deque
-from collections.abc import Awaitable, Callable, Iterable
-from dataclasses import dataclass, field
-from typing import TYPE_CHECKING, TypeVar
+from collections.abc import Awaitable, Callable, Iterable, Mapping
+from dataclasses import dataclass, field, fields
+from typing import TYPE_CHECKING, Any, TypeVar
 
 from netplc.address import PRESENCE_LIST, PRESENCE_NODES, AddressError, check_operand
 from netplc.memory import Memory
 from netplc.modbus import (
+    ILLEGAL_VALUE,
     PROFILES,
     TABLES,
     WRITABLE_TABLES,
@@ -44,6 +52,7 @@ from netplc.modbus import (
     LoopThread,
     MapError,
     describe,
+    exception_text,
     locate,
     open_client,
     parse_endpoint,
@@ -60,12 +69,12 @@ PROBE_IDLE = 1.0  # seconds without a request before a node's link is probed
 T = TypeVar("T")
 
 
-# What a node's settings may be: station.toml's reader (app/config.py) and the model's own check
-# use these, so the two can never disagree.
+# What a node's settings may be (docs/architecture.md section 7); `node_problems` is the one check.
 NODE_NUMBERS = (0, 255)  # the manual's node range, as in NODE S:n
 UNITS = {"tcp": (0, 255), "rtu": (1, 247)}  # Modbus unit id per scheme (docs/architecture.md section 7)
 LIMITS: dict[str, tuple[float, float]] = {"timeout": (0.01, 60.0), "retries": (0, 10),
                                           "backoff": (0.01, 600.0), "backoff_max": (0.01, 3600.0)}
+Problem = tuple[str, str]  # (setting, what is wrong with it)
 
 
 def unit_problem(scheme: str, unit: int) -> str | None:
@@ -77,10 +86,44 @@ def unit_problem(scheme: str, unit: int) -> str | None:
     return f"unit {unit} is not {lo}-{hi} on {scheme}{why}"
 
 
+def node_problems(settings: Mapping[str, Any]) -> tuple[Endpoint | None, list[Problem]]:
+    """The parsed endpoint (None while there is none) and every setting of a node that is out of
+    bounds, by its station.toml key: the one node validation, which NodeConfig raises and
+    station.toml's reader (app/config.py) reports key by key."""
+    found: list[Problem] = []
+    node = settings["node"]
+    lo, hi = NODE_NUMBERS
+    if not isinstance(node, int) or isinstance(node, bool) or not lo <= node <= hi:
+        found.append(("node", f"{node} is outside {lo}-{hi}"))
+    endpoint = None
+    if settings["endpoint"]:
+        try:
+            endpoint = parse_endpoint(settings["endpoint"])
+        except ValueError as e:
+            found.append(("endpoint", str(e)))
+    if problem := unit_problem(endpoint.scheme if endpoint else "tcp", settings["unit"]):
+        found.append(("unit", problem))
+    for key, names in (("profile", PROFILES), ("table", TABLES)):
+        if settings[key] not in names:
+            found.append((key, f"{settings[key]!r} is not one of {', '.join(names)}"))
+    for key, (least, most) in LIMITS.items():
+        value = settings[key]
+        if not least <= value <= most:
+            if key == "retries":  # a count, perhaps of 400 digits: not a float
+                found.append((key, f"{value} is outside {least:g}-{most:g}"))
+            else:
+                found.append((key, f"{value:g} s is outside {least:g}-{most:g} s"))
+    backoff, backoff_max = settings["backoff"], settings["backoff_max"]
+    if not any(key.startswith("backoff") for key, _ in found) and backoff > backoff_max:
+        found.append(("backoff", f"{backoff:g} s is more than backoff_max {backoff_max:g} s"))
+    return endpoint, found
+
+
 @dataclass
 class NodeConfig:
     """One remote node: where it is and how to talk to it. The one model of a node: station.toml's
-    [[nodes]] tables and embedded simulators become these (app/config.py), the exchange runs them."""
+    [[nodes]] tables and embedded simulators become these (app/config.py), the exchange runs them.
+    ValueError names the node and every setting that is out of bounds."""
 
     node: int
     endpoint: str  # tcp://host:port or rtu://device?...; "" until a simulator on port 0 fills it in
@@ -94,34 +137,53 @@ class NodeConfig:
     key: str = field(default="nodes", compare=False)  # where station.toml sets it (nodes[2]), for messages
 
     def __post_init__(self) -> None:
-        self.parsed: Endpoint | None = self.validate()
+        endpoint, found = node_problems(vars(self))
+        if found:
+            raise ValueError(f"node {self.node}: " + "; ".join(_named(p) for p in found))
+        self.parsed: Endpoint | None = endpoint
 
-    def validate(self) -> Endpoint | None:
-        """The parsed endpoint (None while there is none); ValueError names the node and what is wrong."""
-        where = f"node {self.node}"
-        lo, hi = NODE_NUMBERS
-        if not isinstance(self.node, int) or not lo <= self.node <= hi:
-            raise ValueError(f"{where}: the node number must be {lo}-{hi}")
-        endpoint = None
-        if self.endpoint:
-            try:
-                endpoint = parse_endpoint(self.endpoint)
-            except ValueError as e:
-                raise ValueError(f"{where}: {e}") from None
-        problem = unit_problem(endpoint.scheme if endpoint else "tcp", self.unit)
-        if problem:
-            raise ValueError(f"{where}: {problem}")
-        if self.profile not in PROFILES:
-            raise ValueError(f"{where}: profile {self.profile!r} is not one of {', '.join(PROFILES)}")
-        if self.table not in TABLES:
-            raise ValueError(f"{where}: table {self.table!r} is not one of {', '.join(TABLES)}")
-        for key, (lo_, hi_) in LIMITS.items():
-            if not lo_ <= getattr(self, key) <= hi_:
-                raise ValueError(f"{where}: {key} {getattr(self, key):g} is outside {lo_:g}-{hi_:g}")
-        if self.backoff > self.backoff_max:
-            raise ValueError(f"{where}: backoff {self.backoff:g} must be at most "
-                             f"backoff_max {self.backoff_max:g}")
-        return endpoint
+    @classmethod
+    def settled(cls, settings: dict[str, Any], key: str) -> tuple[NodeConfig | None, list[Problem]]:
+        """A node from station.toml's `settings`: every problem by setting, and the node with each
+        bad setting at its default (a bad back-off pair both), so that one pass over the file finds
+        every problem; None when the node number itself is bad."""
+        _, found = node_problems({**NODE_DEFAULTS, **settings})
+        bad = {setting for setting, _ in found}
+        if "node" in bad:
+            return None, found
+        if bad & {"backoff", "backoff_max"}:
+            bad |= {"backoff", "backoff_max"}
+        return cls(**{**NODE_DEFAULTS, **settings, **{k: NODE_DEFAULTS[k] for k in bad}}, key=key), found
+
+
+NODE_DEFAULTS: dict[str, Any] = {"endpoint": "", **{f.name: f.default for f in fields(NodeConfig)
+                                                   if f.name not in ("node", "endpoint", "key")}}
+
+
+def _named(problem: Problem) -> str:
+    """A problem as a sentence: its text, after its setting unless the text names it already
+    (`unit 256 is not 0-255 on tcp`, `endpoint 'x': ...`)."""
+    key, text = problem
+    return text if text.startswith(f"{key} ") else f"{key} {text}"
+
+
+def shared_problems(nodes: Iterable[NodeConfig]) -> list[tuple[NodeConfig, Problem]]:
+    """What nodes get wrong together, each named on the later node: a number configured twice, and
+    nodes of one serial port with different line settings (they share one line)."""
+    found: list[tuple[NodeConfig, Problem]] = []
+    numbers: set[int] = set()
+    lines: dict[str, NodeConfig] = {}  # serial device -> the first node on it
+    for cfg in nodes:
+        if cfg.node in numbers:
+            found.append((cfg, ("node", f"node {cfg.node} is configured twice")))
+        numbers.add(cfg.node)
+        ep = cfg.parsed
+        if ep is not None and ep.scheme == "rtu":
+            first = lines.setdefault(ep.device, cfg)
+            if first.parsed != ep:
+                found.append((cfg, ("endpoint", f"{ep} and node {first.node}'s {first.parsed} share "
+                                                f"{ep.device} with different line settings")))
+    return found
 
 
 @dataclass
@@ -189,6 +251,11 @@ class _Node:
         self.active = time.monotonic()  # when the last request or probe ended
         self.busy = False  # a request or probe is being served
         self.blocks: dict[tuple[int, int], Block] = {}  # (remote, length) -> where it is
+        # the answers since the last normal one, all exceptions: how many, to which requests, which codes
+        self.refusals = 0
+        self.refused: set[int] = set()  # request keys (PROBE's too)
+        self.repeated = False  # a request of the run was refused twice: the node refuses them all
+        self.codes: set[int] = set()
 
     async def run(self) -> None:
         watch = asyncio.get_running_loop().create_task(self.watch(), name=f"node {self.config.node} probe")
@@ -224,8 +291,9 @@ class _Node:
 
     async def probe(self) -> tuple[None, str]:
         self.stats.probes += 1
-        cfg = self.config
-        return None, await self.transact(lambda: self.client.read(cfg.unit, cfg.table, 0, 1), "probe")
+        unit, table = self.config.unit, self.config.table
+        _, error = await self.transact(lambda: self.client.read(unit, table, 0, 1), "probe", PROBE.key)
+        return None, error
 
     async def serve(self, req: _Request) -> tuple[bytes | None, str]:
         now = time.monotonic()
@@ -241,26 +309,55 @@ class _Node:
                 return None, f"{where}: {e}"
             self.blocks[req.remote, length] = block
         if req.payload is None:
-            data, error = await self.transact(lambda: self.read(block), where)
+            data, error = await self.transact(lambda: self.read(block), where, req.key)
         else:
             payload = req.payload
-            data, error = await self.transact(lambda: self.write(block, payload), where)
+            data, error = await self.transact(lambda: self.write(block, payload), where, req.key)
         return data, error
 
-    async def transact(self, call: Callable[[], Awaitable[T]], where: str) -> tuple[T | None, str]:
-        """`call()` with the node's retries; its outcome sets the link state and the back-off.
-        Returns (result, "") or (None, what went wrong)."""
+    async def transact(self, call: Callable[[], Awaitable[T]], where: str, key: int) -> tuple[T | None, str]:
+        """`call()` (request `key`) with the node's retries; its outcome sets the link state and the
+        back-off. Returns (result, "") or (None, what went wrong)."""
         try:
             result = await self.attempts(call)
-        except (MapError, DeviceError) as e:  # the device answered: the link is up
+        except DeviceError as e:  # the device answered, with an exception
+            if key == PROBE.key and e.code <= ILLEGAL_VALUE:  # no register 0 there: an answer
+                self.answered()
+            elif self.only_exceptions(key, e.code):
+                self.down(self.exceptions())
+            else:
+                self.link(True, "")
+            return None, f"{where}: {e}"
+        except MapError as e:  # the block does not fit the node's table: nothing was sent
             self.link(True, "")
             return None, f"{where}: {e}"
         except LinkError as e:  # no answer, or one that is not the request's (ProtocolError)
             self.down(str(e))
             return None, str(e)
-        self.delay = self.config.backoff
-        self.link(True, "")
+        self.answered()
         return result, ""
+
+    def answered(self) -> None:
+        """A normal answer: the link is up, the back-off and the run of exceptions start over."""
+        self.delay = self.config.backoff
+        self.refusals, self.repeated = 0, False
+        self.refused.clear()
+        self.codes.clear()
+        self.link(True, "")
+
+    def only_exceptions(self, key: int, code: int) -> bool:
+        """Count an exception in answer to request `key`: does the node now answer only those?"""
+        self.refusals += 1
+        self.repeated = self.repeated or key in self.refused
+        self.refused.add(key)
+        self.codes.add(code)
+        return self.repeated and self.refusals >= self.config.retries + 1
+
+    def exceptions(self) -> str:
+        codes = sorted(self.codes)
+        if len(codes) == 1:
+            return f"answers only exception {exception_text(codes[0])}"
+        return f"answers only exceptions {', '.join(exception_text(c) for c in codes)}"
 
     def down(self, error: str) -> None:
         """Every attempt failed: the link is down and the node backs off."""
@@ -325,19 +422,12 @@ class Exchange:
 
     def __init__(self, nodes: list[NodeConfig], sink: RecordSink | None = None, *, lean: bool = True) -> None:
         self.lean = lean  # our lean Modbus TCP client; False: pymodbus's (bench/exchange.py compares)
-        self.configs: dict[int, NodeConfig] = {}
-        serial: dict[str, NodeConfig] = {}
         for cfg in nodes:
-            if cfg.node in self.configs:
-                raise ValueError(f"node {cfg.node} is configured twice")
-            self.configs[cfg.node] = cfg
-            ep = cfg.parsed
-            if ep is None:
+            if cfg.parsed is None:
                 raise ValueError(f"node {cfg.node}: no endpoint")
-            other = serial.setdefault(ep.device, cfg) if ep.scheme == "rtu" else cfg
-            if other.parsed != ep:
-                raise ValueError(f"node {cfg.node}: {ep} and node {other.node}: {other.parsed} share "
-                                 f"{ep.device} with different line settings")
+        for cfg, (key, text) in shared_problems(nodes):
+            raise ValueError(f"node {cfg.node}: {key}: {text}")
+        self.configs: dict[int, NodeConfig] = {cfg.node: cfg for cfg in nodes}
         self.sink: RecordSink = sink or NullSink()
         self.engine: Engine | None = None
         self.stats: dict[int, NodeStats] = {

@@ -16,12 +16,49 @@ from __future__ import annotations
 import argparse
 import sys
 import threading
+from collections.abc import Iterable
 
 from netplc.engine import Engine
-from netplc.modbus import ALL_MEMORY, Endpoint, ModbusServer, parse_endpoint
+from netplc.modbus import (
+    ALL_MEMORY,
+    APPLIED,
+    BUSY,
+    DEVICE_FAILURE,
+    Done,
+    Endpoint,
+    MemoryServed,
+    MemoryWrite,
+    ModbusServer,
+    parse_endpoint,
+)
 from netplc.program import Program, ProgramError, load_program
 from netplc.records import Record, RecordSink
 from netplc.scheduler import ScanThread
+
+
+class EngineMemory(MemoryServed):
+    """A node's memory served straight from its engine. A CPU-165 has no station and so no command
+    layer: a write goes to the engine's bounded queue of outside writes (exception 6 when it is
+    full), applied at the start of a scan and journaled by the engine naming the peer
+    (`modbus 127.0.0.1:40686`), and is answered once that record is durable."""
+
+    def __init__(self, engine: Engine, writable: Iterable[tuple[int, int]] = ALL_MEMORY) -> None:
+        super().__init__(engine, writable)
+        self.engine = engine
+
+    def take(self, change: MemoryWrite, peer: str, done: Done) -> int | None:
+        user = f"modbus {peer}"
+        engine, first = self.engine, change.first
+        if change.bits is not None:
+            apply = (engine.bit_writer(first, change.bits[0], user) if len(change.bits) == 1
+                     else engine.bits_writer(first, change.bits, user))
+        elif len(change.data) == 2:
+            apply = engine.word_writer(first, int.from_bytes(change.data, "little"), user)
+        else:
+            apply = engine.bytes_writer(first, change.data, user)
+        if engine.command(apply, user, lambda ok: done(APPLIED if ok else DEVICE_FAILURE)):
+            return None
+        return BUSY
 
 
 class ConsoleSink:
@@ -38,7 +75,8 @@ class Simulator:
                  tick: float = 0.1, sink: RecordSink | None = None, serial: Endpoint | None = None) -> None:
         self.engine = Engine(program, tick=tick, sink=sink)
         self.scan = ScanThread(self.engine, tick, name="cpu165-sim-scan")
-        self.server = ModbusServer(self.engine, host, port, writable=ALL_MEMORY, unit=unit, serial=serial)
+        self.server = ModbusServer(EngineMemory(self.engine), host, port, unit=unit, serial=serial,
+                                   sink=self.engine.sink)
 
     @property
     def port(self) -> int:
@@ -48,7 +86,7 @@ class Simulator:
         self.scan.start()
         try:
             self.server.start()
-        except BaseException:
+        except Exception:
             self.scan.stop()
             raise
 

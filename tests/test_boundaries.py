@@ -3,6 +3,8 @@
 - The headless parts never import Qt, not even through another module of the project: the soft
   PLC, the archive, the form models and loader, the runtime, the station configuration.
 - Only the Modbus sub-package imports pymodbus (its API changes at every minor release).
+- The Modbus stack imports no engine, not even through another module: what a write to our server
+  does is its handler's (the station's command layer, a simulated node's engine).
 - Only `app/publish/` imports asyncua, paho-mqtt and protobuf (docs/architecture.md section 2).
 - Only the plant archive (`registrar/plant/`) imports psycopg, and nothing loads it before a plant
   archive is named: the viewer, the CLI and the station file's check go through registrar.
@@ -102,6 +104,22 @@ def test_headless_parts_run_without_qt_loaded() -> None:
 def test_only_the_modbus_subpackage_imports_pymodbus() -> None:
     users = sorted(m for m, deps in graph().items() if any(under(d, ("pymodbus",)) for d in deps))
     assert users and all(under(m, ("netplc.modbus",)) for m in users), users
+
+
+def test_the_modbus_stack_imports_no_engine_even_indirectly() -> None:
+    g = graph()
+    bad = []
+    for start in (m for m in g if under(m, ("netplc.modbus",))):
+        seen, todo = {start}, [start]
+        while todo:
+            mod = todo.pop()
+            for dep in g.get(mod, ()):
+                if dep == "netplc.engine":
+                    bad.append(f"{start} imports {dep} (through {mod})")
+                elif dep in g and dep not in seen:
+                    seen.add(dep)
+                    todo.append(dep)
+    assert bad == []
 
 
 def test_only_the_publishers_import_opcua_mqtt_and_protobuf() -> None:

@@ -31,7 +31,7 @@ from dataclasses import dataclass
 from enum import StrEnum
 from typing import TYPE_CHECKING
 
-from app.authority.policy import ROLE_OF_SOURCE, Action, Refusal, Source, needs, rank
+from app.authority.policy import ROLE_OF_SOURCE, ROLES, Action, Refusal, Source, needs, rank
 from app.authority.users import UserError
 from netplc.address import fmt_octal
 from netplc.engine import BUSY, JOURNAL_FULL, Engine, RunState
@@ -144,6 +144,13 @@ class Commands:
 
     def may(self, who: Who, action: Action, at_least: str | None = None) -> bool:
         return self.denial(who, action, at_least) is None
+
+    def grant(self, source: Source, role: str) -> None:
+        """The role a user-less protocol acts with from now on: its station.toml section's `role`
+        (a Modbus server read-only for everyone with "viewer"), set once its server is built."""
+        if role not in ROLES:
+            raise ValueError(f"role {role!r} is not one of {', '.join(ROLES)}")
+        self.source_roles[source] = role
 
     # --- answers and refusals ------------------------------------------------------------------
 

@@ -95,6 +95,8 @@ class Refusal:
     user_role: str = ""
 
     def __str__(self) -> str:
+        if not self.user and self.user_role:  # a protocol without users (Modbus, NCMD): its role
+            return f"{self.action}: needs the {self.role} role; clients with no user act as {self.user_role}"
         if not self.user:
             return f"{self.action}: nobody is logged in ({self.role} needed)"
         if not self.user_role:

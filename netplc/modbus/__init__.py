@@ -2,21 +2,15 @@
 RTU framing, and the CPU-165 Modbus map (how NetPlc memory looks as coils and registers).
 
 It is the wire and nothing more: what NODE/NREAD/NWRITE mean is `netplc/exchange.py`, what a
-simulated CPU-165 node is is `netplc/simulator.py`; both reach the wire through this package.
-Only this package imports pymodbus, whose API changes at every minor release.
+simulated CPU-165 node is is `netplc/simulator.py`; both reach the wire through this package. What
+a write to our server does is its handler's (the station's command layer, a simulated node's
+engine): the stack imports no engine. Only this package imports pymodbus, whose API changes at
+every minor release.
 """
 
-from netplc.modbus.driver import (
-    DeviceError,
-    Endpoint,
-    LeanTcpClient,
-    LinkError,
-    LoopThread,
-    ModbusClient,
-    ServerLimits,
-    open_client,
-    parse_endpoint,
-)
+from netplc.modbus.client import LeanTcpClient, ModbusClient, open_client
+from netplc.modbus.endpoint import Endpoint, parse_endpoint
+from netplc.modbus.loop import LoopThread
 from netplc.modbus.map import (
     MAX_READ_BITS,
     MAX_READ_REGISTERS,
@@ -25,15 +19,38 @@ from netplc.modbus.map import (
     WRITABLE_TABLES,
     Block,
     MapError,
+    MemoryWrite,
     Table,
     bytes_from_words,
     describe,
     locate,
 )
-from netplc.modbus.server import ALL_MEMORY, ModbusServer
+from netplc.modbus.pdu import (
+    APPLIED,
+    BUSY,
+    DEVICE_FAILURE,
+    EXCEPTIONS,
+    ILLEGAL_ADDRESS,
+    ILLEGAL_FUNCTION,
+    ILLEGAL_VALUE,
+    DeviceError,
+    Done,
+    LinkError,
+    ServeHandler,
+    exception_text,
+)
+from netplc.modbus.server import ALL_MEMORY, MemoryServed, ModbusServer
+from netplc.modbus.tcp_server import ServerLimits
 
 __all__ = [
     "ALL_MEMORY",
+    "APPLIED",
+    "BUSY",
+    "DEVICE_FAILURE",
+    "EXCEPTIONS",
+    "ILLEGAL_ADDRESS",
+    "ILLEGAL_FUNCTION",
+    "ILLEGAL_VALUE",
     "MAX_READ_BITS",
     "MAX_READ_REGISTERS",
     "PROFILES",
@@ -41,17 +58,22 @@ __all__ = [
     "WRITABLE_TABLES",
     "Block",
     "DeviceError",
+    "Done",
     "Endpoint",
     "LeanTcpClient",
     "LinkError",
     "LoopThread",
     "MapError",
+    "MemoryServed",
+    "MemoryWrite",
     "ModbusClient",
     "ModbusServer",
+    "ServeHandler",
     "ServerLimits",
     "Table",
     "bytes_from_words",
     "describe",
+    "exception_text",
     "locate",
     "open_client",
     "parse_endpoint",

@@ -119,6 +119,34 @@ def registers_target(address: int, count: int) -> int:
     return _register_bytes(address, count)
 
 
+@dataclass(frozen=True, slots=True)
+class MemoryWrite:
+    """A Modbus write in NetPlc terms: I/O bits from `first` (coils), or data bytes from `first`
+    (registers, each the little-endian word of two bytes)."""
+
+    first: int
+    bits: list[int] | None = None
+    data: bytes = b""
+
+    @property
+    def last(self) -> int:
+        return self.first + (len(self.bits) if self.bits is not None else len(self.data)) - 1
+
+    def __str__(self) -> str:
+        """As the command layer names a write's target: `03770`, `02050:8 bits`, `04000:4`."""
+        first = fmt_octal(self.first)
+        if self.bits is not None:
+            return first if len(self.bits) == 1 else f"{first}:{len(self.bits)} bits"
+        return first if len(self.data) == 2 else f"{first}:{len(self.data)}"
+
+
+def memory_write(table: str, address: int, values: list[int]) -> MemoryWrite:
+    """What a write of `values` to `table` at `address` changes (MapError outside the map)."""
+    if table == "coils":
+        return MemoryWrite(bits_target(address, len(values)), bits=values)
+    return MemoryWrite(registers_target(address, len(values)), data=bytes_from_words(values))
+
+
 # --- client side: where a block of a remote node lives ------------------------------------------
 
 

@@ -12,7 +12,7 @@ ends whatever is left as noise.
 
 Requests for another unit are left unanswered, as a device does; a broadcast (unit 0) write is
 done without a reply, a broadcast read is not done at all. The answers come from `answer`, the
-same request handling the TCP server uses; a write is answered once the engine has applied and
+same request handling the TCP server uses; a write is answered once its handler has applied and
 journaled it. A serial port that fails (an adapter unplugged) is a fault: journaled once, shown
 by `fault`, and the port is reopened every second until it works again.
 """
@@ -28,7 +28,8 @@ from typing import Protocol
 import serial
 from pymodbus.pdu import DecodePDU
 
-from netplc.modbus.driver import Endpoint, ServeHandler, answer
+from netplc.modbus.endpoint import Endpoint
+from netplc.modbus.pdu import ServeHandler, answer
 
 BROADCAST = 0
 MAX_FRAME = 256  # an RTU frame's longest: unit, 253 bytes of PDU, CRC

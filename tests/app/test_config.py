@@ -217,7 +217,7 @@ unit = 256
     assert problems == [
         f"nodes[1].unit: unit 0 is not 1-247 on rtu {WHY}",
         f"nodes[2].unit: unit 248 is not 1-247 on rtu {WHY}",
-        "nodes[3].unit: 256 is outside 0-255",
+        "nodes[3].unit: unit 256 is not 0-255 on tcp",
     ]
     assert station is not None and station.nodes[0].unit == 255
 

@@ -16,7 +16,7 @@ import pytest
 from app.check import check_station
 from app.config import load_station
 from app.runtime import Runtime, StartError, unresolved_hosts
-from netplc.modbus.driver import DeviceError, LeanTcpClient, parse_endpoint
+from netplc.modbus import DeviceError, LeanTcpClient, parse_endpoint
 from netplc.program import parse
 from netplc.simulator import Simulator
 from tests.app.conftest import REPO, write_station

@@ -12,8 +12,7 @@ from app.config import load_station
 from app.runtime import Runtime
 from netplc.engine import RunState
 from netplc.forcing import Force, load_forces
-from netplc.modbus import LoopThread
-from netplc.modbus.driver import LeanTcpClient, parse_endpoint
+from netplc.modbus import LeanTcpClient, LoopThread, parse_endpoint
 from netplc.records import Record
 
 LEVEL, SETPOINT, LEVEL_OK = 0o4010, 0o4030, 0o2131

@@ -11,6 +11,7 @@ import pytest
 
 from app.config import DEFAULT_WRITABLE, ConfigError, load_station, read_station
 from app.runtime import Runtime
+from netplc.records import Record
 from tests.app.conftest import REPO, write_station
 
 PROGRAM = {"p.stl": "TNA $03760\nYON $02000\n", "s.csv": "X,02001,\n"}
@@ -68,6 +69,8 @@ def test_the_special_bits_are_writable_only_when_named(tmp_path: Path) -> None:
     write_station(tmp_path, 'NetPlcProgram = "p.stl"\n[modbus_server]\nport = 0\n', PROGRAM)
     assert not any(lo <= 0o3770 <= hi for lo, hi in DEFAULT_WRITABLE)
     runtime = Runtime(load_station(tmp_path))
+    records: list[Record] = []
+    runtime.subscribe(records.append)
     runtime.start()
     try:
         assert runtime.modbus is not None
@@ -75,9 +78,39 @@ def test_the_special_bits_are_writable_only_when_named(tmp_path: Path) -> None:
         assert client.connect()
         assert client.write_coil(0o3770, True).exception_code == 2  # emergency stop: refused
         assert not client.write_coil(0o3677, True).isError()  # the last default-writable bit
+        peer = f"modbus 127.0.0.1:{client.socket.getsockname()[1]}"
         client.close()
     finally:
         runtime.stop()
     assert runtime.status().state == "running"
+    refused = [r for r in records if r.kind == "operator" and (r.text or "").startswith("refused")]
+    assert [(r.source, r.text) for r in refused] == [
+        (peer, "refused write 03770: not writable over Modbus (station.toml [modbus_server] writable)")]
     write_station(tmp_path, 'NetPlcProgram = "p.stl"\n[modbus_server]\nwritable = [["02000", "03777"]]\n')
     assert load_station(tmp_path).modbus_server.writable == ((0o2000, 0o3777),)
+
+
+def test_modbus_clients_act_with_the_role_the_station_grants_and_a_bounded_share_per_peer(
+        tmp_path: Path) -> None:
+    from pymodbus.client import ModbusTcpClient
+
+    write_station(tmp_path, 'NetPlcProgram = "p.stl"\n', PROGRAM)
+    server = load_station(tmp_path).modbus_server
+    assert (server.role, server.max_per_peer) == ("operator", 4)  # the defaults
+    write_station(tmp_path, 'NetPlcProgram = "p.stl"\n[modbus_server]\nport = 0\nrole = "viewer"\n'
+                            'max_per_peer = 2\n')
+    runtime = Runtime(load_station(tmp_path))
+    runtime.start()
+    try:
+        assert runtime.modbus is not None and runtime.modbus._server.limits.max_per_peer == 2
+        client = ModbusTcpClient("127.0.0.1", port=runtime.modbus.port)
+        assert client.connect()
+        assert client.write_register(1024, 1).exception_code == 1  # read-only: no write function
+        assert not client.read_holding_registers(1024, count=1).isError()
+        client.close()
+    finally:
+        runtime.stop()
+    write_station(tmp_path, 'NetPlcProgram = "p.stl"\n[modbus_server]\nrole = "root"\nmax_per_peer = 0\n')
+    assert problems(tmp_path) == [
+        "modbus_server.max_per_peer: 0 is outside 1-1000",
+        "modbus_server.role: 'root' is not one of viewer, operator, engineer, admin"]

@@ -6,9 +6,10 @@ import sys
 import threading
 
 from netplc.engine import Engine
-from netplc.modbus.server import ALL_MEMORY, ModbusServer
+from netplc.modbus import ModbusServer
 from netplc.program import parse
 from netplc.scheduler import ScanThread
+from netplc.simulator import EngineMemory
 from registrar.store import Store
 
 
@@ -17,7 +18,7 @@ def main(path: str) -> None:
     store.start()
     engine = Engine(parse("TNA $03760\nJMP 0\n"), sink=store, tick=0.01)
     ScanThread(engine, 0.01).start()
-    server = ModbusServer(engine, writable=ALL_MEMORY)
+    server = ModbusServer(EngineMemory(engine), sink=engine.sink)
     server.start()
     print(server.port, flush=True)
     threading.Event().wait()

@@ -149,7 +149,7 @@ def test_node_config_reports_bad_endpoints() -> None:
         NodeConfig(3, "rtu:///dev/ttyS0?parity=X")
     with pytest.raises(ValueError, match=r"unknown option 'speed'"):
         NodeConfig(3, "rtu:///dev/ttyS0?speed=9600")
-    with pytest.raises(ValueError, match=r"node 300: the node number must be 0-255"):
+    with pytest.raises(ValueError, match=r"node 300: node 300 is outside 0-255"):
         NodeConfig(300, "tcp://h:502")
     with pytest.raises(ValueError, match=r"profile 'plc' is not one of cpu165, modbus"):
         NodeConfig(1, "tcp://h:502", profile="plc")
@@ -216,6 +216,7 @@ def test_modbus_profile_and_device_exceptions(node0: Simulator) -> None:
         snap = lambda: st.engine.snapshot  # noqa: E731
         wait_until(lambda: snap().get_word(0o4020) == 0xCAFE and st.exchange.stats[0].errors >= 1)
         assert snap().get_bit(0o2105) == 1 and snap().get_bit(0o2101) == 1  # the device answered
-        assert st.exchange.stats[0].last_error == "0: read input 0+1: Modbus exception 2"
+        assert st.exchange.stats[0].last_error == ("0: read input 0+1: Modbus exception 2 "
+                                                   "(illegal data address)")
     finally:
         st.stop()

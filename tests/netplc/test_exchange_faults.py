@@ -6,9 +6,9 @@ import socket
 import time
 
 from netplc.exchange import NodeConfig
-from netplc.modbus.server import ALL_MEMORY, ModbusServer
+from netplc.modbus import ModbusServer
 from netplc.program import parse
-from netplc.simulator import Simulator
+from netplc.simulator import EngineMemory, Simulator
 from tests.netplc.test_exchange import Station, wait_until
 
 TIMEOUT = 0.3
@@ -61,7 +61,7 @@ def test_dead_node_goes_down_and_comes_back_without_touching_the_other() -> None
         assert rate(st, 2, 0.3) > 0.5 * normal  # node 2 keeps its rate while node 1 is dead
         assert snap().get_bit(0o2115) == 1
 
-        a.server = ModbusServer(a.engine, port=a.port, writable=ALL_MEMORY)
+        a.server = ModbusServer(EngineMemory(a.engine), port=a.port, sink=a.engine.sink)
         a.server.start()  # node 1 switched on again, same address
         t_up = wait_until(lambda: snap().get_bit(0o2105) == 1, timeout=5)
         assert t_up < BACKOFF_MAX + TIMEOUT + 0.1

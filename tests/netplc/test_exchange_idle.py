@@ -7,9 +7,9 @@ from collections.abc import Iterator
 import pytest
 
 from netplc.exchange import PROBE_IDLE, NodeConfig
-from netplc.modbus.server import ALL_MEMORY, ModbusServer
+from netplc.modbus import ModbusServer
 from netplc.program import parse
-from netplc.simulator import Simulator
+from netplc.simulator import EngineMemory, Simulator
 from tests.netplc.test_exchange import NETPLC_PROGRAM, NODE_PROGRAM, Station, wait_until
 
 TIMEOUT = 0.2
@@ -48,7 +48,7 @@ def test_a_node_that_dies_while_the_program_is_stopped_shows_down_and_comes_back
         assert "link down" in node_records(st)[-1]
         assert stats.probes >= 1 and stats.reads == reads  # the probes are not NREADs
 
-        node0.server = ModbusServer(node0.engine, port=node0.port, writable=ALL_MEMORY)
+        node0.server = ModbusServer(EngineMemory(node0.engine), port=node0.port, sink=node0.engine.sink)
         node0.server.start()  # switched on again, the program still stopped
         wait_until(lambda: snap().get_byte(0o77740) == 0xFF, timeout=PROBE_IDLE + BACKOFF_MAX + 3)
         assert st.exchange.link_up(0)

@@ -15,6 +15,7 @@ from netplc.engine import Engine, FakeClock
 from netplc.modbus.server import ModbusServer
 from netplc.program import parse
 from netplc.records import ListSink
+from netplc.simulator import EngineMemory
 
 WRITABLE = [(0o2040, 0o2077), (0o4000, 0o4017)]
 
@@ -27,7 +28,7 @@ def served() -> Iterator[tuple[Engine, ModbusServer, ListSink]]:
     engine.mem.set_word(0o14000, 0x00AB)
     engine.mem.set_bit(0o2042, 1)
     engine.scan()
-    server = ModbusServer(engine, writable=WRITABLE, unit=1)
+    server = ModbusServer(EngineMemory(engine, WRITABLE), unit=1, sink=sink)
     server.start()
     yield engine, server, sink
     server.stop()
@@ -144,9 +145,9 @@ def test_raw_client_exceptions(served: tuple[Engine, ModbusServer, ListSink]) ->
 
 def test_read_only_by_default_and_ranges_are_checked() -> None:
     engine = Engine(parse("JMP 0\n"), clock=FakeClock())
-    server = ModbusServer(engine)
+    server = ModbusServer(EngineMemory(engine, ()))
     with pytest.raises(ValueError, match="not within 00000-077777"):
-        ModbusServer(engine, writable=[(0o4000, 0o100000)])
+        EngineMemory(engine, [(0o4000, 0o100000)])
     server.start()
     try:
         c = ModbusTcpClient("127.0.0.1", port=server.port, timeout=2)

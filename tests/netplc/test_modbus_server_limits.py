@@ -16,10 +16,14 @@ import pytest
 
 from netplc.address import EMERGENCY_STOP
 from netplc.engine import Engine, FakeClock, RunState
-from netplc.modbus.driver import ServerLimits, Throttle
-from netplc.modbus.server import ALL_MEMORY, ModbusServer
+from netplc.modbus import Done, Table
+from netplc.modbus.map import MapError
+from netplc.modbus.pdu import ILLEGAL_FUNCTION
+from netplc.modbus.server import ModbusServer
+from netplc.modbus.tcp_server import ServerLimits, Throttle
 from netplc.program import parse
 from netplc.records import ListSink
+from netplc.simulator import EngineMemory
 from registrar.schema import DAY_GLOB
 from registrar.store import Store
 
@@ -98,7 +102,7 @@ def test_a_write_flood_is_bounded_per_scan_answered_busy_when_full_and_loses_no_
         archive: Store) -> None:
     clock = FakeClock()
     engine = Engine(parse("TNA $03760\nJMP 0\n"), clock=clock, sink=archive, write_budget=8, write_queue=64)
-    server = ModbusServer(engine, writable=ALL_MEMORY)  # the default limits
+    server = ModbusServer(EngineMemory(engine), sink=engine.sink)  # the default limits
     server.start()
     n = 3000
     try:
@@ -130,7 +134,7 @@ def test_a_write_flood_is_bounded_per_scan_answered_busy_when_full_and_loses_no_
 def test_a_write_is_answered_only_once_its_record_is_committed(archive: Store) -> None:
     clock = FakeClock()
     engine = Engine(parse("JMP 0\n"), clock=clock, sink=archive)
-    server = ModbusServer(engine, writable=ALL_MEMORY)
+    server = ModbusServer(EngineMemory(engine), sink=engine.sink)
     server.start()
     try:
         with socket.create_connection(("127.0.0.1", server.port)) as sock:
@@ -150,7 +154,7 @@ def test_a_write_is_answered_only_once_its_record_is_committed(archive: Store) -
 def test_a_stop_by_bit_03770_from_a_client_is_a_system_record_naming_it() -> None:
     sink = ListSink()
     engine = Engine(parse("TNA $03760\nYON $02000\n"), clock=FakeClock(), sink=sink)
-    server = ModbusServer(engine, writable=ALL_MEMORY)
+    server = ModbusServer(EngineMemory(engine), sink=engine.sink)
     server.start()
     try:
         with socket.create_connection(("127.0.0.1", server.port)) as sock:
@@ -173,7 +177,8 @@ def limited() -> Iterator[tuple[Engine, ModbusServer, ListSink]]:
     engine = Engine(parse("JMP 0\n"), clock=FakeClock(), sink=sink)
     engine.mem.set_word(0o4000, 0x1234)
     engine.scan()
-    server = ModbusServer(engine, limits=ServerLimits(max_connections=2, idle_timeout=0.3, max_inflight=4))
+    limits = ServerLimits(max_connections=2, idle_timeout=0.3, max_inflight=4)
+    server = ModbusServer(EngineMemory(engine, ()), limits=limits, sink=sink)
     server.start()
     yield engine, server, sink
     server.stop()
@@ -227,7 +232,7 @@ def test_silent_connections_and_half_frames_are_closed_after_the_idle_timeout(
 def test_a_client_that_does_not_read_its_answers_is_no_longer_read(
         limited: tuple[Engine, ModbusServer, ListSink]) -> None:
     engine = limited[0]
-    server = ModbusServer(engine, limits=ServerLimits(max_connections=2, max_inflight=4))
+    server = ModbusServer(EngineMemory(engine, ()), limits=ServerLimits(max_connections=2, max_inflight=4))
     server.start()
     try:
         a_client_that_does_not_read(server)
@@ -267,3 +272,93 @@ def test_the_throttle_writes_one_line_per_cause_per_minute() -> None:
     now[0] = 61.0
     throttle("a", "refused")
     assert lines == ["refused", "idle", "refused (and 99 more like it in the last minute)"]
+
+
+def connect_from(source: str, port: int) -> socket.socket:
+    """A client from `source`: Linux routes all of 127/8 to lo, so 127.0.0.2 is a second peer."""
+    sock = socket.socket()
+    sock.bind((source, 0))
+    sock.connect(("127.0.0.1", port))
+    return sock
+
+
+def answered(sock: socket.socket, tid: int) -> bool:
+    """A register read on `sock` is answered (False: the server closed the connection)."""
+    try:
+        sock.sendall(read_registers(tid, 1024, 1))
+        sock.settimeout(5)
+        return len(sock.recv(64)) == 11
+    except OSError:  # reset: the server closed it before or after the request came
+        return False
+
+
+def test_one_peer_cannot_take_every_connection() -> None:
+    """Issue 23 item 10: 16 connections from one address each sending a request now and then
+    used to lock every other client out; now one address holds max_per_peer of them (4 by
+    default) and the next are closed at once, one journal line a minute."""
+    sink = ListSink()
+    engine = Engine(parse("JMP 0\n"), clock=FakeClock(), sink=sink)
+    engine.mem.set_word(0o4000, 0x1234)
+    engine.scan()
+    server = ModbusServer(EngineMemory(engine, ()), sink=sink)  # the default limits: 16, 4 per peer
+    server.start()
+    hog = [connect_from("127.0.0.1", server.port) for _ in range(16)]
+    try:
+        served = [answered(s, i) for i, s in enumerate(hog)]
+        assert served == [True] * 4 + [False] * 12
+        other = connect_from("127.0.0.2", server.port)
+        with other:
+            assert answered(other, 99)
+        assert answered(hog[0], 100)  # those it holds are still served
+    finally:
+        for s in hog:
+            s.close()
+        server.stop()
+    refused = [r for r in sink.records if "max_per_peer" in (r.text or "")]
+    assert len(refused) == 1 and refused[0].kind == "system"
+    assert "4 connections from 127.0.0.1 are open" in (refused[0].text or "")
+
+
+class Gated:
+    """A handler that holds the server's loop inside the first read until let go, and notes the
+    register each read asks (so which client's request was answered when)."""
+
+    def __init__(self) -> None:
+        self.order: list[int] = []
+        self.holding = threading.Event()
+        self.gate = threading.Event()
+
+    def registers(self, address: int, count: int) -> bytes:
+        if not self.order:
+            self.holding.set()
+            self.gate.wait(10)
+        self.order.append(address)
+        return bytes(2 * count)
+
+    def bits(self, address: int, count: int) -> bytes:
+        raise MapError("no coils here")
+
+    def write(self, table: Table, address: int, values: list[int], peer: str, done: Done) -> int:
+        return ILLEGAL_FUNCTION
+
+
+def test_a_pipelining_client_does_not_make_another_wait_for_its_backlog() -> None:
+    handler = Gated()
+    server = ModbusServer(handler)
+    server.start()
+    try:
+        with connect_from("127.0.0.1", server.port) as greedy, \
+                connect_from("127.0.0.2", server.port) as polite:
+            greedy.sendall(read_registers(0, 1024, 1))
+            assert handler.holding.wait(5)  # the loop is held: what comes next waits in the kernel
+            backlog = 3000
+            greedy.sendall(b"".join(read_registers(i, 1024, 1) for i in range(1, backlog + 1)))
+            polite.sendall(read_registers(1, 2000, 1))
+            handler.gate.set()
+            answers = Answers(greedy)
+            polite.settimeout(5)
+            assert polite.recv(64)[7:] == bytes.fromhex("03 02 0000")
+            wait_until(lambda: len(answers.got) == backlog + 1)
+    finally:
+        server.stop()
+    assert handler.order.index(2000) < backlog // 10  # after a turn of the greedy one (TURN), not its backlog

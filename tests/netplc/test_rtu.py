@@ -23,9 +23,9 @@ import pytest
 from netplc.engine import Engine
 from netplc.exchange import NodeConfig
 from netplc.modbus.rtu import RtuServer, crc16, request_length, take_frames
-from netplc.modbus.server import ALL_MEMORY, ModbusServer
 from netplc.program import parse
 from netplc.scheduler import ScanThread
+from netplc.simulator import EngineMemory
 from tests.netplc.test_exchange import Station, wait_until
 
 UNIT = 5
@@ -62,7 +62,7 @@ class RtuNode:
         self.master, slave = os.openpty()
         self.port = os.ttyname(slave)
         self._slave = slave
-        self.server = RtuServer(ModbusServer(self.engine, writable=ALL_MEMORY), UNIT, PtyLine(self.master),
+        self.server = RtuServer(EngineMemory(self.engine), UNIT, PtyLine(self.master),
                                 self.port)
 
     def start(self) -> None:
@@ -290,7 +290,7 @@ def test_a_serial_port_failure_is_journaled_and_retried() -> None:
         ptys.append(os.openpty())
         return PtyLine(ptys[-1][0])
 
-    server = RtuServer(ModbusServer(engine, writable=ALL_MEMORY), UNIT, PtyLine(ptys[0][0]), "pty",
+    server = RtuServer(EngineMemory(engine), UNIT, PtyLine(ptys[0][0]), "pty",
                        reopen=reopen, note=notes.append)
     server.start()
     try:

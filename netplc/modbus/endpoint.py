@@ -1,0 +1,69 @@
+"""Where a node is: `tcp://host:port` or `rtu://device?baudrate=...`, parsed once, with an error
+that shows the expected form."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from typing import Any
+from urllib.parse import parse_qsl, urlsplit
+
+PARITIES = ("N", "E", "O")
+
+
+@dataclass(frozen=True, slots=True)
+class Endpoint:
+    """`tcp://host:port` or `rtu:///dev/ttyX?baudrate=19200&parity=N&bytesize=8&stopbits=1`."""
+
+    scheme: str  # "tcp" | "rtu"
+    host: str = ""
+    port: int = 502
+    device: str = ""
+    baudrate: int = 19200
+    parity: str = "N"
+    bytesize: int = 8
+    stopbits: int = 1
+
+    def __str__(self) -> str:
+        if self.scheme == "tcp":
+            return f"tcp://{self.host}:{self.port}"
+        return f"rtu://{self.device}?baudrate={self.baudrate}&parity={self.parity}"
+
+
+def parse_endpoint(text: str) -> Endpoint:
+    """Parse an endpoint; ValueError says what is wrong with it and shows the expected form."""
+    forms = "expected tcp://host:port, rtu:///dev/ttyX?baudrate=19200&parity=N or rtu://COM3?baudrate=..."
+    try:
+        url = urlsplit(text.strip())
+        port = url.port
+    except ValueError as e:
+        raise ValueError(f"endpoint {text!r}: {e} ({forms})") from None
+    if url.scheme == "tcp":
+        if not url.hostname:
+            raise ValueError(f"endpoint {text!r}: no host ({forms})")
+        if url.path not in ("", "/") or url.query:
+            raise ValueError(f"endpoint {text!r}: a tcp endpoint has no path or options ({forms})")
+        try:
+            url.hostname.encode("idna")
+        except UnicodeError:
+            raise ValueError(f"endpoint {text!r}: {url.hostname!r} is not a valid host name") from None
+        return Endpoint("tcp", host=url.hostname, port=port if port is not None else 502)
+    if url.scheme == "rtu":
+        # rtu:///dev/ttyS0 names a device path; rtu://COM3 a Windows port (the URL's "host")
+        device = url.path if not url.netloc else url.netloc if not url.path else ""
+        if not device:
+            raise ValueError(f"endpoint {text!r}: the serial device must follow rtu:// ({forms})")
+        options: dict[str, Any] = {}
+        for key, value in parse_qsl(url.query, keep_blank_values=True):
+            if key == "parity":
+                if value.upper() not in PARITIES:
+                    raise ValueError(f"endpoint {text!r}: parity {value!r} is not N, E or O")
+                options[key] = value.upper()
+            elif key in ("baudrate", "bytesize", "stopbits"):
+                if not value.isdigit() or int(value) <= 0:
+                    raise ValueError(f"endpoint {text!r}: {key} {value!r} is not a positive number")
+                options[key] = int(value)
+            else:
+                raise ValueError(f"endpoint {text!r}: unknown option {key!r} "
+                                 "(baudrate, parity, bytesize, stopbits)")
+        return Endpoint("rtu", device=device, **options)
+    raise ValueError(f"endpoint {text!r}: unknown scheme {url.scheme!r} ({forms})")
