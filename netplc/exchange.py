@@ -32,6 +32,7 @@ is down like a silent one: link down, presence 00, back-off, journaled once with
 from __future__ import annotations
 
 import asyncio
+import logging
 import time
 from collections import deque
 from collections.abc import Awaitable, Callable, Iterable, Mapping
@@ -67,6 +68,8 @@ if TYPE_CHECKING:
 NODE, NREAD, NWRITE = 300, 301, 302
 PROBE_IDLE = 1.0  # seconds without a request before a node's link is probed
 T = TypeVar("T")
+
+logger = logging.getLogger(__name__)
 
 
 # What a node's settings may be (docs/architecture.md section 7); `node_problems` is the one check.
@@ -266,6 +269,7 @@ class _Node:
                 try:
                     data, error = await (self.probe() if req is PROBE else self.serve(req))
                 except Exception as e:  # a bug must not end the node's task, nor show the link up
+                    logger.exception("node %d: request failed inside the exchange", self.config.node)
                     self.line.failed()
                     data, error = None, f"internal error: {e!r}"
                     self.down(error)

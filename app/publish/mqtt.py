@@ -198,7 +198,7 @@ class SparkplugPublisher:
         who = self.who
         try:
             payload = spb.Payload.FromString(message.payload)
-        except Exception as e:  # a malformed command must not cost the connection
+        except Exception as e:  # no log: bad input, answered by the journaled refusal below
             self._refused(self.commands.refuse(who, Action.WRITE, "", Reason.INVALID,
                                                f"not a Sparkplug B payload ({type(e).__name__})"))
             return
