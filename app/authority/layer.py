@@ -31,9 +31,9 @@ from dataclasses import dataclass
 from enum import StrEnum
 from typing import TYPE_CHECKING
 
-from app.authority.policy import ROLE_OF_SOURCE, ROLES, Action, Refusal, Source, needs, rank
+from app.authority.policy import POLICY, ROLE_OF_SOURCE, ROLES, Action, Refusal, Source, needs, rank
 from app.authority.users import UserError
-from netplc.address import fmt_octal
+from netplc.address import EMERGENCY_STOP, IO_BITS, fmt_octal
 from netplc.engine import BUSY, JOURNAL_FULL, Engine, RunState
 from netplc.forcing import ForceError, Kind
 from netplc.memory import Memory
@@ -257,6 +257,7 @@ class Commands:
                   at_least: str | None = None) -> Ticket:
         """Write an HMI bit (a form's button, the Program view, a Modbus coil)."""
         target = label or fmt_octal(addr)
+        at_least = _stopping(range(addr, addr + 1), value, at_least)
         if (denied := self._check(who, Action.WRITE, target, at_least)) is not None:
             return denied
         return self._queue(who, Action.WRITE, target, self.engine.bit_writer(addr, value, who.name, label))
@@ -265,6 +266,9 @@ class Commands:
                    at_least: str | None = None,
                    describe: Callable[[int, int], str] | None = None) -> Ticket:
         target = label or fmt_octal(addr)
+        if addr < IO_BITS:  # a word operand below 04000 is the 16 bits from that bit address
+            at_least = _stopping(range(addr, addr + 16), (value >> (EMERGENCY_STOP - addr)) & 1
+                                 if addr <= EMERGENCY_STOP < addr + 16 else 0, at_least)
         if (denied := self._check(who, Action.WRITE, target, at_least)) is not None:
             return denied
         return self._queue(who, Action.WRITE, target,
@@ -272,7 +276,9 @@ class Commands:
 
     def write_bits(self, who: Who, addr: int, values: list[int]) -> Ticket:
         target = f"{fmt_octal(addr)}:{len(values)} bits"
-        if (denied := self._check(who, Action.WRITE, target)) is not None:
+        stop = values[EMERGENCY_STOP - addr] if addr <= EMERGENCY_STOP < addr + len(values) else 0
+        at_least = _stopping(range(addr, addr + len(values)), stop, None)
+        if (denied := self._check(who, Action.WRITE, target, at_least)) is not None:
             return denied
         return self._queue(who, Action.WRITE, target, self.engine.bits_writer(addr, values, who.name))
 
@@ -452,6 +458,16 @@ class Commands:
         ticket: Ticket = Future()
         ticket.set_result(APPLIED)
         return ticket
+
+
+def _stopping(bits: range, value: int, at_least: str | None) -> str | None:
+    """Setting the emergency-stop bit 03770 stops NetPlc: it needs the role Stop needs, whoever
+    writes it and however (a button, a Modbus coil, a block of bits)."""
+    if EMERGENCY_STOP in bits and value:
+        role = POLICY[Action.STOP]
+        if at_least is None or rank(role) > rank(at_least):
+            return role
+    return at_least
 
 
 def write_range(tag: Tag) -> tuple[float, float]:

@@ -186,3 +186,13 @@ def test_user_administration_needs_the_admin_and_is_answered_after_the_commit():
 
     answer = layer.manage_users(Who("anna", Source.CONSOLE), "ivan", taken).result(0)
     assert answer.reason is Reason.INVALID and "exists already" in answer.text
+
+
+def test_setting_the_stop_bit_needs_the_role_stop_needs_however_it_is_written():
+    layer, *_ = rig()
+    modbus = Who("", Source.MODBUS, "127.0.0.1:9")  # acts as operator
+    assert layer.write_bit(modbus, 0o3770, 1).result(0).reason is Reason.DENIED
+    assert layer.write_bits(modbus, 0o3760, [0] * 8 + [1]).result(0).reason is Reason.DENIED
+    assert layer.write_word(Who("olga", Source.CONSOLE), 0o3760, 1 << 8).result(0).reason is Reason.DENIED
+    assert not layer.write_bit(modbus, 0o3770, 0).done()  # clearing it is a plain write
+    assert not layer.write_bit(Who("egor", Source.CONSOLE), 0o3770, 1).done()  # the engineer may stop
