@@ -15,10 +15,10 @@ from pathlib import Path
 from typing import Any
 
 from app.authority.policy import OPERATOR, ROLES
+from app.scada.tag import TagType
 from netplc.address import fmt_octal, is_data_byte, is_io_bit, parse_octal
 from netplc.exchange import NODE_DEFAULTS, NodeConfig, shared_problems
 from netplc.problems import Problems
-from netplc.tags.tag import TagType
 from netplc.textfile import TextFileError, file_problem, read_text, resolve
 from registrar.plant.url import is_url, url_problem
 
@@ -118,7 +118,7 @@ class Station:
     simulators: tuple[SimulatorSettings, ...] = ()
     operator: OperatorSettings = OperatorSettings()
     Language: str = ""  # "ru" or "en"; "" follows the system locale
-    Tags: Path | None = None  # tags.csv: tags and their alarms (netplc/tags/)
+    Tags: Path | None = None  # tags.csv: tags and their alarms (app/scada/)
     allow_outside: bool = False  # may station paths (and form images) leave the station folder?
     RetainForces: bool = False  # forces survive a restart (netplc/forcing.py); off: a restart unforces
     plant_archive: str | None = None  # `Archive` given as a postgresql:// URL: forwarded there

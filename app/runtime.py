@@ -32,8 +32,9 @@ from app.authority.users import USERS_FILE, Users
 from app.config import Station
 from app.load import load, load_station_forms
 from app.publish.station import start_publishers
-from app.station_alarms import STATE_FILE as ALARM_STATE_FILE
-from app.station_alarms import StationAlarms
+from app.scada.readings import Readings
+from app.scada.station import STATE_FILE as ALARM_STATE_FILE
+from app.scada.station import StationAlarms
 from hmi_forms.behaviour import FormBehaviour
 from hmi_forms.form import Form
 from netplc.engine import Engine
@@ -44,7 +45,6 @@ from netplc.problems import Problems
 from netplc.records import Record
 from netplc.scheduler import ScanThread
 from netplc.simulator import Simulator
-from netplc.tags.readings import Readings
 from registrar.retain import Retainer
 from registrar.store import Store, StoreStats
 
@@ -476,7 +476,7 @@ class Runtime:
 
     def readings(self) -> Readings | None:
         """Every tag's and address's value with its quality and time as of the last scan
-        (netplc/tags/readings.py): what the HMI, the journal and the publishers read; None while
+        (app/scada/readings.py): what the HMI, the journal and the publishers read; None while
         the station is not started (a reader then shows its values as not running)."""
         alarms = self.alarms
         return alarms.readings if alarms is not None else None

@@ -32,11 +32,11 @@ from pathlib import Path
 
 import numpy as np
 
+from app.scada.alarms import AlarmSystem
+from app.scada.table import TagAlarms, TagTable
+from app.scada.tag import Scaling, Tag, TagType
 from netplc.address import data_address
 from netplc.memory import Memory
-from netplc.tags.alarms import AlarmSystem
-from netplc.tags.table import TagAlarms, TagTable
-from netplc.tags.tag import Scaling, Tag, TagType
 from registrar.alarm_state import AlarmStateFile
 from registrar.query import Archive, Filter
 from registrar.store import Store
@@ -153,7 +153,7 @@ def workstation_flood(folder: Path) -> None:
     from app.authority import Commands, Source, Who
     from app.gui.alarm_summary import AlarmSummary
     from app.gui.alarms import AlarmBanner
-    from app.station_alarms import StationAlarms
+    from app.scada.station import StationAlarms
     from netplc.engine import Engine
     from netplc.program import parse
     from netplc.records import ListSink

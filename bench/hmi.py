@@ -40,6 +40,8 @@ os.environ.setdefault("QT_QPA_PLATFORM", "offscreen")
 
 from PySide6.QtWidgets import QApplication, QLabel, QWidget
 
+from app.scada.quality import LinkView, QualityMap
+from app.scada.readings import Readings
 from hmi_forms.elements.target import NullTarget
 from hmi_forms.form import load_form
 from hmi_forms.widgets.form_view import FormView
@@ -47,8 +49,6 @@ from hmi_forms.widgets.trend import REDRAW_INTERVAL
 from netplc.engine import FakeClock
 from netplc.memory import Memory
 from netplc.program import parse
-from netplc.tags.quality import LinkView, QualityMap
-from netplc.tags.readings import Readings
 
 TILE = 64
 TICK_MS = 100.0

@@ -39,13 +39,13 @@ from app.config import MqttSettings
 from app.publish.mqtt import SparkplugPublisher
 from app.publish.opcua import OpcUaServer
 from app.publish.points import PointReader, Writable, Writer
+from app.scada.tag import Tag, TagType
 from netplc.address import data_address
 from netplc.engine import Engine
 from netplc.memory import Memory
 from netplc.program import parse
 from netplc.records import NullSink
 from netplc.scheduler import ScanThread
-from netplc.tags.tag import Tag, TagType
 
 T = TypeVar("T")
 TAGS = 10_000

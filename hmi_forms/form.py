@@ -21,11 +21,11 @@ from dataclasses import dataclass, field, fields
 from pathlib import Path
 from typing import Any
 
+from app.scada.table import TagTable
 from hmi_forms.elements import ELEMENT_TYPES, Element
 from hmi_forms.elements import props as p
 from hmi_forms.elements.analog import Scaled, scaling_problems
 from netplc.problems import Problems
-from netplc.tags.table import TagTable
 from netplc.textfile import TextFileError, confine, read_text
 
 FORM_BACK = (0xDD, 0xE1, 0xE6, 255)

@@ -28,7 +28,6 @@ from typing import Literal, Protocol
 from netplc.address import HMI_DATA_BIT_BASE, IO_BITS, check_operand, fmt_octal, parse_hmi_bit, parse_octal
 from netplc.memory import Memory, MemoryView
 from netplc.records import Record, RecordSink
-from netplc.tags.tag import Tag, TagType
 
 Kind = Literal["bit", "byte", "word"]
 KINDS: tuple[Kind, ...] = ("bit", "byte", "word")
@@ -105,30 +104,6 @@ def check_value(kind: Kind, value: int) -> int:
     return value
 
 
-def tag_forces(tag: Tag, phy: float, user: str = "") -> tuple[Force, ...]:
-    """The forces that pin `tag` at the physical value `phy`: its bit, its word, or both words of a
-    32-bit tag (low word first), converted by the tag's Scaling and type like an operator's write."""
-    raw = tag.to_raw(phy)
-    if tag.type is TagType.BIT:
-        return (Force("bit", tag.address, 1 if raw else 0, user),)
-    data = tag.encode(raw)
-    return tuple(Force("word", addr, int.from_bytes(data[i:i + 2], "little"), user)
-                 for i, addr in zip(range(0, len(data), 2), tag_words(tag), strict=True))
-
-
-def tag_words(tag: Tag) -> tuple[int, ...]:
-    """The word addresses a word or 32-bit tag occupies (an I/O word is 16 bits on)."""
-    step = 16 if tag.address < IO_BITS else 2
-    words = 2 if tag.type in (TagType.INT32, TagType.FLOAT32) else 1
-    return tuple(tag.address + step * k for k in range(words))
-
-
-def tag_keys(tag: Tag) -> tuple[tuple[Kind, int], ...]:
-    if tag.type is TagType.BIT:
-        return (("bit", tag.address),)
-    return tuple(("word", a) for a in tag_words(tag))
-
-
 class ForceHost(Protocol):
     """What the forces need of the engine: its queue, its sink and its wall clock."""
 
@@ -165,12 +140,6 @@ class Forces:
         ForceError at once for an address or a value that cannot be forced."""
         self.host.post(self.forcing(kind, addr, value, user=user))
 
-    def force_tag(self, tag: Tag, phy: float | None = None, *, user: str) -> None:
-        self.host.post(self.forcing_tag(tag, phy, user=user))
-
-    def unforce_tag(self, tag: Tag, *, user: str) -> None:
-        self.host.post(self.unforcing_tag(tag, user=user))
-
     def unforce(self, kind: Kind, addr: int, *, user: str) -> None:
         self.host.post(self.unforcing(kind, addr, user=user))
 
@@ -194,44 +163,7 @@ class Forces:
             new.apply(mem)
             was = f"forced {old.value}" if old else str(current)
             how = " (bumpless)" if value is None else ""
-            self._journal(user, new, f"force {new.where}: {was} -> {new.value}{how}")
-
-        return apply
-
-    def forcing_tag(self, tag: Tag, phy: float | None = None, *, user: str) -> Callable[[Memory], None]:
-        """Force every word of `tag` (or its bit) as one command to the physical value `phy`, or
-        bumpless to what it holds when applied; journaled with the tag's name and unit."""
-        if phy is not None and phy != phy:
-            raise ForceError(f"cannot force {tag.name} to NaN")
-
-        def apply(mem: Memory) -> None:
-            keys = tag_keys(tag)
-            was_forced = all(self.forced(*k) for k in keys)
-            old = tag.value(mem)
-            new = tag_forces(tag, old if phy is None else phy, user)
-            if phy is None:  # bumpless: the raw words as they are, not the round trip of their value
-                new = tuple(Force(f.kind, f.addr, f.read(mem), user) for f in new)
-            self.listing = (*(f for f in self.listing if f.key not in keys), *new)
-            for f in new:
-                f.apply(mem)
-            value = tag.value(mem)
-            was = f"forced {old:.{tag.decimals}f}" if was_forced else f"{old:.{tag.decimals}f}"
-            how = " (bumpless)" if phy is None else ""
-            raw = str(new[0].value) if tag.type is TagType.BIT else " ".join(f"{f.value:04X}h" for f in new)
-            text = f"force {tag.name}: {was} -> {tag.format(value)} (raw {raw}){how}"
-            self._journal_tag(user, tag, value, text)
-
-        return apply
-
-    def unforcing_tag(self, tag: Tag, *, user: str) -> Callable[[Memory], None]:
-        """Release every word (or the bit) of `tag` in one command, journaled once with its name."""
-
-        def apply(mem: Memory) -> None:
-            keys = tag_keys(tag)
-            if any(self.forced(*k) for k in keys):
-                self.listing = tuple(f for f in self.listing if f.key not in keys)
-                value = tag.value(mem)
-                self._journal_tag(user, tag, value, f"unforce {tag.name} (was forced {tag.format(value)})")
+            self.journal(user, new, f"force {new.where}: {was} -> {new.value}{how}")
 
         return apply
 
@@ -242,7 +174,7 @@ class Forces:
             old = self.forced(kind, addr)
             if old is not None:
                 self.listing = tuple(f for f in self.listing if f.key != old.key)
-                self._journal(user, old, f"unforce {old.where} (was forced {old.value})")
+                self.journal(user, old, f"unforce {old.where} (was forced {old.value})")
 
         return apply
 
@@ -252,7 +184,7 @@ class Forces:
         def apply(_mem: Memory) -> None:
             released, self.listing = self.listing, ()
             for old in released:
-                self._journal(user, old, f"unforce {old.where} (was forced {old.value}; unforce all)")
+                self.journal(user, old, f"unforce {old.where} (was forced {old.value}; unforce all)")
 
         return apply
 
@@ -261,11 +193,7 @@ class Forces:
         for f in forces:
             self.force(f.kind, f.addr, f.value, user=user)
 
-    def _journal_tag(self, user: str, tag: Tag, value: float, text: str) -> None:
-        self.host.sink.put(Record(self.host.wall_time(), "operator", source=user, number=tag.address,
-                                  value=float(value), text=text))
-
-    def _journal(self, user: str, force: Force, text: str) -> None:
+    def journal(self, user: str, force: Force, text: str) -> None:
         self.host.sink.put(Record(self.host.wall_time(), "operator", source=user, number=force.addr,
                                   value=float(force.value), text=text))
 

@@ -10,7 +10,7 @@ from collections.abc import Callable
 from dataclasses import dataclass
 from typing import Literal, Protocol
 
-Kind = Literal["data", "message", "operator", "system", "alarm"]  # alarm: netplc/tags/alarms.py
+Kind = Literal["data", "message", "operator", "system", "alarm"]  # alarm: app/scada/alarms.py
 
 
 @dataclass(frozen=True, slots=True)

@@ -2,7 +2,7 @@
 
 What was unacknowledged stays unacknowledged, a shelving keeps its end time, an alarm out of
 service stays out, and a condition that was active is known to be, so it raises no second alarm
-(netplc/tags/alarms.py). The states live in a small SQLite file of their own next to the archive
+(app/scada/alarms.py). The states live in a small SQLite file of their own next to the archive
 (`alarms.sqlite`, one row per alarm that ever changed), so that a change costs a row, not a copy
 of every alarm: a flood of 10,000 transitions writes 10,000 small rows, in a few transactions,
 and a crash at any moment leaves the last committed transaction whole.

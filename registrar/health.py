@@ -14,7 +14,7 @@ from collections import Counter
 from collections.abc import Iterator
 from dataclasses import dataclass, field
 
-from netplc.tags.alarms import State
+from app.scada.alarms import State
 from registrar.query import Archive, Filter, Row
 from registrar.schema import local_day_bounds
 

@@ -24,7 +24,7 @@ from urllib.parse import quote
 
 import numpy as np
 
-from netplc.tags.tag import Tag
+from app.scada.tag import Tag
 from registrar.plant.url import is_url
 from registrar.reading import (
     EXPORT_CHUNK,

@@ -12,7 +12,7 @@ from typing import NamedTuple
 
 import numpy as np
 
-from netplc.tags.tag import Tag
+from app.scada.tag import Tag
 
 EXPORT_CHUNK = 10_000
 
@@ -127,7 +127,7 @@ def where_clause(flt: Filter, mark: str = "?") -> tuple[str, list[object]]:
 def alarm_priority(message_type: int) -> int:
     """The alarm priority of a message type's severity, for a type filter over `alarm` records,
     whose type column is the alarm's new state and whose grp is its priority: 3 critical ->
-    priority 1 and 2 alarm -> 2 (as NMSG's alarms are raised, netplc/tags/alarms.py), 1 warning ->
+    priority 1 and 2 alarm -> 2 (as NMSG's alarms are raised, app/scada/alarms.py), 1 warning ->
     3 (medium), 0 info -> 4 (low). A minimum type is then a maximum priority number, and records
     of other kinds than message and alarm (operator, system, data) have no severity to pass it."""
     return 4 - message_type

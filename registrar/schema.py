@@ -13,10 +13,10 @@ import time
 import zoneinfo
 from pathlib import Path
 
+from app.scada.series import GAP_WORDS
+from app.scada.table import TagTable
+from app.scada.tag import Scaling, Tag, TagType
 from netplc.address import fmt_octal
-from netplc.tags.series import GAP_WORDS
-from netplc.tags.table import TagTable
-from netplc.tags.tag import Scaling, Tag, TagType
 
 SCHEMA_VERSION = "1"
 COLUMNS = ("id", "ts", "kind", "grp", "type", "source", "number", "value", "text")
@@ -45,7 +45,7 @@ KEY_INDEX_COLUMNS = "(kind, grp, type, source)"
 # A data record's text is NULL while its value is good, else its quality word; one held by bad or
 # not yet known quality (or one marking that its series turned so, without a value) is no point
 # of its series: readers break the line there and the per-minute summary leaves it out
-# (netplc/tags/series.py).
+# (app/scada/series.py).
 GAP_SQL = f"(text IS NOT NULL AND text IN ({', '.join(repr(w) for w in GAP_WORDS)}))"
 
 

@@ -24,8 +24,8 @@ from collections.abc import Callable
 from dataclasses import dataclass
 from pathlib import Path
 
+from app.scada.table import TagTable
 from netplc.records import Record
-from netplc.tags.table import TagTable
 from netplc.textfile import kind
 from registrar.catalog import Catalog
 from registrar.schema import (

@@ -25,7 +25,7 @@ REPO = Path(__file__).resolve().parents[1]
 PACKAGES = ("netplc", "registrar", "hmi_forms", "app")
 QT = ("PySide6", "shiboken6", "pyqtgraph")
 HEADLESS = ("netplc", "registrar", "hmi_forms.elements", "hmi_forms.form", "hmi_forms.behaviour",
-            "app.runtime", "app.config", "app.load", "app.check")
+            "app.runtime", "app.config", "app.load", "app.check", "app.scada", "app.authority")
 
 
 def module_name(path: Path) -> str:
@@ -196,3 +196,10 @@ def test_no_import_cycles() -> None:
         if v not in index:
             strongconnect(v)
     assert cycles == []
+
+
+def test_the_soft_plc_knows_nothing_of_the_station() -> None:
+    """netplc/ is the soft PLC: no tags, alarms, archive, forms or station (DESIGN 1, layers)."""
+    above = sorted(f"{m} imports {d}" for m, deps in graph().items() if under(m, ("netplc",))
+                   for d in deps if under(d, ("app", "registrar", "hmi_forms")))
+    assert above == []

@@ -30,11 +30,11 @@ from app.authority.users import USERS_FILE, Users, UsersFileError
 from app.check import check_station
 from app.config import ConfigError, load_station, read_station
 from app.runtime import Runtime, StartError
+from app.scada.table import read_tags
 from hmi_forms.elements import ELEMENT_TYPES
 from hmi_forms.form import FormError, load_form
 from netplc.problems import Problems
 from netplc.program import LOGIC, ProgramError, load_program, load_symbols
-from netplc.tags.table import read_tags
 from registrar.catalog import Catalog, CatalogError
 from tests.app.broken_stations import CASES
 from tests.app.conftest import REPO, copy_demo

@@ -33,15 +33,16 @@ from typing import TYPE_CHECKING
 
 from app.authority.policy import POLICY, ROLE_OF_SOURCE, ROLES, Action, Refusal, Source, needs, rank
 from app.authority.users import UserError
+from app.scada.forcing import forcing_tag, unforcing_tag
+from app.scada.tag import Tag, TagType
 from netplc.address import EMERGENCY_STOP, IO_BITS, fmt_octal
 from netplc.engine import BUSY, JOURNAL_FULL, Engine, RunState
 from netplc.forcing import ForceError, Kind
 from netplc.memory import Memory
 from netplc.records import Record, RecordSink
-from netplc.tags.tag import Tag, TagType
 
 if TYPE_CHECKING:
-    from app.station_alarms import StationAlarms
+    from app.scada.station import StationAlarms
 
 logger = logging.getLogger(__name__)
 
@@ -365,7 +366,7 @@ class Commands:
                 return self.refuse(who, Action.FORCE, name, Reason.OUT_OF_RANGE,
                                    f"{phy!r} is outside {tag.format(lo)} .. {tag.format(hi)}")
         forces = self.engine.forces
-        return self._force(who, Action.FORCE, name, lambda: forces.forcing_tag(tag, phy, user=who.name))
+        return self._force(who, Action.FORCE, name, lambda: forcing_tag(forces, tag, phy, user=who.name))
 
     def unforce(self, who: Who, kind: Kind, addr: int) -> Ticket:
         forces = self.engine.forces
@@ -377,7 +378,7 @@ class Commands:
         if tag is None:
             return self.refuse(who, Action.UNFORCE, name, Reason.UNKNOWN, f"no tag {name!r}")
         forces = self.engine.forces
-        return self._force(who, Action.UNFORCE, name, lambda: forces.unforcing_tag(tag, user=who.name))
+        return self._force(who, Action.UNFORCE, name, lambda: unforcing_tag(forces, tag, user=who.name))
 
     def unforce_all(self, who: Who) -> Ticket:
         forces = self.engine.forces

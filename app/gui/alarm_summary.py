@@ -58,8 +58,8 @@ from app.authority import Action, Answer, Commands, Who
 from app.gui import words
 from app.gui.bridge import Answers
 from app.gui.rights import Rights
-from app.station_alarms import StationAlarms
-from netplc.tags.alarms import PRIORITIES, AlarmRow, State
+from app.scada.alarms import PRIORITIES, AlarmRow, State
+from app.scada.station import StationAlarms
 
 logger = logging.getLogger(__name__)
 

@@ -29,8 +29,8 @@ from PySide6.QtWidgets import (
 
 from app.gui import words
 from app.gui.elided import ElidedLabel
+from app.scada.alarms import AlarmRow
 from hmi_forms.elements import formats
-from netplc.tags.alarms import AlarmRow
 
 logger = logging.getLogger(__name__)
 

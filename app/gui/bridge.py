@@ -25,8 +25,8 @@ from PySide6.QtCore import QObject, Signal
 
 from app.authority import Answer, Ticket
 from app.runtime import Runtime
+from app.scada.readings import Readings
 from netplc.records import Record
-from netplc.tags.readings import Readings
 
 
 class RuntimeBridge(QObject):

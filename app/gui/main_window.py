@@ -56,6 +56,8 @@ from app.gui.trend_history import TrendHistory
 from app.gui.users_dialog import UsersDialog
 from app.gui.zoom import ACTUAL, FIT_WIDTH, FIT_WINDOW, ZoomArea, ZoomSettings
 from app.runtime import Runtime
+from app.scada.alarms import AlarmRow
+from app.scada.readings import Readings
 from hmi_forms.elements import formats
 from hmi_forms.elements.analog import AnalogOutput
 from hmi_forms.elements.base import Writer
@@ -64,8 +66,6 @@ from hmi_forms.elements.target import EngineTarget
 from hmi_forms.widgets.base import ElementWidget
 from hmi_forms.widgets.form_view import FormView
 from netplc.problems import Problems
-from netplc.tags.alarms import AlarmRow
-from netplc.tags.readings import Readings
 
 if TYPE_CHECKING:
     from app.gui.monitor.window import ProgramWindow

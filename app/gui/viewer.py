@@ -52,10 +52,10 @@ from app.config import DEMO_STATION, ConfigError, load_station, station_file
 from app.gui import i18n
 from app.gui.series_loader import Series, SeriesLoader
 from app.gui.style import apply_style
+from app.scada.tag import Tag
 from hmi_forms.elements import formats
 from hmi_forms.widgets.records import ARCHIVE_COLUMNS, Column, RecordsModel, records_view
 from hmi_forms.widgets.worker import Worker
-from netplc.tags.tag import Tag
 from registrar.plant.url import is_url
 from registrar.query import Archive, Filter, SeriesKey
 from registrar.reading import ArchiveError, ArchiveReader, Row
@@ -88,7 +88,7 @@ def series_label(key: SeriesKey, tag: Tag | None = None) -> str:
 
 
 def physical(tag: Tag | None, values: np.ndarray) -> np.ndarray:
-    """A tag's stored raw words as its physical values (the one conversion of netplc/tags/)."""
+    """A tag's stored raw words as its physical values (the one conversion of app/scada/)."""
     if tag is None:
         return values
     return np.array([tag.word_value(int(v)) if np.isfinite(v) else np.nan for v in values], dtype=np.float64)

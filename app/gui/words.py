@@ -1,7 +1,7 @@
 """The console's words for what Qt-free models say in English: roles, alarm priorities and states,
 tag qualities, the command layer's refusals.
 
-The models (app/authority/, netplc/tags/) keep their English words, which the journal, the command
+The models (app/authority/, app/scada/) keep their English words, which the journal, the command
 line and the tests read; the console translates them here, as shown, through Qt's translation
 mechanism (context "words" of app/gui/i18n/console_*.ts). The markers below list every source
 text for the translation files.
@@ -15,13 +15,13 @@ import logging
 from PySide6.QtCore import QT_TRANSLATE_NOOP, QCoreApplication
 
 from app.authority import Answer, Refusal
-from netplc.tags.alarms import PRIORITIES, State
+from app.scada.alarms import PRIORITIES, State
 
 SOURCES = (
     # roles (app/authority/policy.py ROLES)
     QT_TRANSLATE_NOOP("words", "viewer"), QT_TRANSLATE_NOOP("words", "operator"),
     QT_TRANSLATE_NOOP("words", "engineer"), QT_TRANSLATE_NOOP("words", "admin"),
-    # alarm priorities (netplc/tags/alarms.py PRIORITIES)
+    # alarm priorities (app/scada/alarms.py PRIORITIES)
     QT_TRANSLATE_NOOP("words", "critical"), QT_TRANSLATE_NOOP("words", "high"),
     QT_TRANSLATE_NOOP("words", "medium"), QT_TRANSLATE_NOOP("words", "low"),
     # alarm states (State.word)
@@ -29,7 +29,7 @@ SOURCES = (
     QT_TRANSLATE_NOOP("words", "active-acknowledged"), QT_TRANSLATE_NOOP("words", "returned-unacknowledged"),
     QT_TRANSLATE_NOOP("words", "shelved"), QT_TRANSLATE_NOOP("words", "suppressed"),
     QT_TRANSLATE_NOOP("words", "out-of-service"),
-    # tag qualities (netplc/tags/quality.py Quality.word)
+    # tag qualities (app/scada/quality.py Quality.word)
     QT_TRANSLATE_NOOP("words", "good"), QT_TRANSLATE_NOOP("words", "initial"),
     QT_TRANSLATE_NOOP("words", "stale"), QT_TRANSLATE_NOOP("words", "comm-fail"),
     QT_TRANSLATE_NOOP("words", "not running"), QT_TRANSLATE_NOOP("words", "forced"),

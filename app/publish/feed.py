@@ -8,7 +8,7 @@ from __future__ import annotations
 import threading
 from collections.abc import Callable
 
-from netplc.tags.readings import Readings
+from app.scada.readings import Readings
 
 Watch = Callable[[Callable[[Readings], None]], Callable[[], None]]  # Runtime.watch: -> unsubscribe
 

@@ -37,7 +37,7 @@ from app.config import MqttSettings
 from app.publish import sparkplug as spb
 from app.publish.feed import LatestReadings, Watch
 from app.publish.points import PointReader, PointWriter, Reading, Writable
-from netplc.tags.tag import Tag
+from app.scada.tag import Tag
 
 logger = logging.getLogger(__name__)
 

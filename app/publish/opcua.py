@@ -64,11 +64,11 @@ from app.publish.feed import LatestReadings, Watch
 from app.publish.methods import StationMethods, StepLock
 from app.publish.pki import TrustList, host_names, station_certificate, subject, thumbprint
 from app.publish.points import PointReader, PointWriter, Writable
+from app.scada.alarms import PRIORITIES, Alarm, State
+from app.scada.quality import Quality
+from app.scada.readings import Readings
+from app.scada.tag import Tag, TagType
 from netplc.records import Record
-from netplc.tags.alarms import PRIORITIES, Alarm, State
-from netplc.tags.quality import Quality
-from netplc.tags.readings import Readings
-from netplc.tags.tag import Tag, TagType
 
 logger = logging.getLogger(__name__)
 

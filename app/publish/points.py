@@ -16,10 +16,10 @@ from dataclasses import dataclass
 import numpy as np
 
 from app.authority import Action, Commands, Reason, Ticket, Who
+from app.scada.quality import Operands, QualityMap
+from app.scada.readings import Readings
+from app.scada.tag import SIZES, Tag, TagReader, TagType, check_address
 from netplc.address import IO_BITS, AddressError
-from netplc.tags.quality import Operands, QualityMap
-from netplc.tags.readings import Readings
-from netplc.tags.tag import SIZES, Tag, TagReader, TagType, check_address
 
 
 def symbol_tags(symbols: dict[str, int]) -> list[Tag]:
@@ -55,7 +55,7 @@ class Writable:
 
 @dataclass(frozen=True)
 class Reading:
-    """One scan's worth of every point: physical values and quality codes (netplc.tags.quality)."""
+    """One scan's worth of every point: physical values and quality codes (app.scada.quality)."""
 
     scan: int
     wall: float

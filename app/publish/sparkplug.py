@@ -14,8 +14,8 @@ from typing import Any
 
 from google.protobuf import descriptor_pb2, descriptor_pool, message_factory
 
-from netplc.tags.quality import Quality
-from netplc.tags.tag import Tag, TagType
+from app.scada.quality import Quality
+from app.scada.tag import Tag, TagType
 
 NAMESPACE = "spBv1.0"
 PACKAGE = "org.eclipse.tahu.protobuf"

@@ -24,12 +24,12 @@ from dataclasses import dataclass, field
 from functools import cached_property
 from typing import Any, ClassVar
 
+from app.scada.table import TagTable
 from hmi_forms.elements import props as p
 from hmi_forms.elements.base import Element, Reader, Writer, word_reader
 from hmi_forms.elements.trend import Trend
 from netplc.address import IO_BITS
 from netplc.memory import Snapshot
-from netplc.tags.table import TagTable
 
 logger = logging.getLogger(__name__)
 

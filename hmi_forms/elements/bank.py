@@ -15,11 +15,11 @@ from typing import Any, Protocol
 
 import numpy as np
 
+from app.scada.quality import Operands, Quality, QualityMap
+from app.scada.readings import Readings
 from hmi_forms.elements.base import Element
 from netplc.address import DATA_SIZE, IO_BITS, data_index
 from netplc.memory import Snapshot
-from netplc.tags.quality import Operands, Quality, QualityMap
-from netplc.tags.readings import Readings
 
 UNKNOWN = -1  # no value: taken again at the next snapshot, whatever it holds
 

@@ -10,7 +10,7 @@ decided here once, for both:
 - QualityAddr (an extension) names a bit such as an NREAD link output: while it is 0 the element
   keeps its last value and marks it stale, so frozen data never looks live.
 - The data quality of what the element shows (`sources()`: its InAddr) comes from the runtime
-  (netplc/tags/quality.py, judged by the view through `Readings`): anything but good is marked
+  (app/scada/quality.py, judged by the view through `Readings`): anything but good is marked
   the same way, its word in `quality`; a bad or not yet known value is kept, not refreshed
   (trends sample NaN, a gap), while a forced value is shown as it is, marked forced.
 """
@@ -23,12 +23,12 @@ from functools import cached_property
 from typing import Any, ClassVar
 
 from app.authority.policy import ROLES
+from app.scada.quality import Quality
 from hmi_forms.elements import props as p
 from hmi_forms.elements.target import Effects, Target
 from netplc.address import IO_BITS, BitRef, data_index
 from netplc.memory import Snapshot
 from netplc.records import Kind, Record
-from netplc.tags.quality import Quality
 
 Reader = Callable[[Snapshot], int]
 

@@ -15,9 +15,9 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
+from app.scada.table import TagTable
+from app.scada.tag import Scaling, TagType  # the one conversion, shared with tags, journal and viewer
 from netplc.address import AddressError, BitRef, check_operand, parse_hmi_bit, parse_octal
-from netplc.tags.table import TagTable
-from netplc.tags.tag import Scaling, TagType  # the one conversion, shared with tags, journal and viewer
 from netplc.textfile import MAX_DIGITS, MISSING, TextFileError, file_problem, resolve
 
 Color = tuple[int, int, int, int]  # r, g, b, alpha

@@ -19,9 +19,9 @@ import logging
 from collections.abc import Callable
 from typing import TYPE_CHECKING, Protocol
 
+from app.scada.tag import Tag, TagType
 from netplc.address import fmt_octal
 from netplc.records import Record
-from netplc.tags.tag import Tag, TagType
 
 if TYPE_CHECKING:
     from app.authority import Answer, Commands, Ticket, Who

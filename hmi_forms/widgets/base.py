@@ -89,7 +89,7 @@ QUALITY_TIPS = {
 
 def quality_tip(word: str) -> str:
     """The tooltip of the quality mark: the quality word first, then what it means, in the
-    console's language (the words are Quality.word's, netplc/tags/quality.py)."""
+    console's language (the words are Quality.word's, app/scada/quality.py)."""
     tip = QUALITY_TIPS.get(word)
     return QCoreApplication.translate("quality", tip) if tip else f"? {word}"
 

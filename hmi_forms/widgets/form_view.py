@@ -28,6 +28,8 @@ from PySide6.QtCore import QRect, QRectF, QSize, Qt
 from PySide6.QtGui import QColor, QPainter, QPaintEvent, QRegion, QTransform
 from PySide6.QtWidgets import QWidget
 
+from app.scada.quality import Quality
+from app.scada.readings import Readings
 from hmi_forms.elements import Element
 from hmi_forms.elements.analog import AnalogBase, AnalogOutput
 from hmi_forms.elements.bank import Banked, BitBank, WordBank
@@ -48,8 +50,6 @@ from hmi_forms.widgets.static import DateTimeWidget, StaticPictureWidget, Static
 from hmi_forms.widgets.tank import TankWidget
 from hmi_forms.widgets.trend import REDRAW_INTERVAL, TrendWidget
 from netplc.memory import Snapshot
-from netplc.tags.quality import Quality
-from netplc.tags.readings import Readings
 
 logger = logging.getLogger(__name__)
 BATCH = 100  # changed elements from which a refresh that changed most of the form repaints it whole

@@ -24,9 +24,9 @@ from PySide6.QtCore import (
 from PySide6.QtGui import QColor
 from PySide6.QtWidgets import QAbstractItemView, QHeaderView, QTableView
 
+from app.scada.alarms import State
 from hmi_forms.elements import formats
 from netplc.address import fmt_octal
-from netplc.tags.alarms import State
 from registrar.query import Row
 
 TYPE_NAMES = {0: QT_TRANSLATE_NOOP("records", "info"), 1: QT_TRANSLATE_NOOP("records", "warning"),

@@ -16,13 +16,13 @@ from app.authority import Commands, Reason, Source, Who
 from app.gui.alarm_health import HealthDialog, health_text
 from app.gui.alarm_summary import AlarmSummary, Annunciator, row_colours
 from app.gui.alarms import AlarmBanner
-from app.station_alarms import StationAlarms
+from app.scada.alarms import AlarmRow, State
+from app.scada.station import StationAlarms
 from hmi_forms.widgets.records import type_name
 from netplc.engine import Engine, FakeClock
 from netplc.memory import Memory
 from netplc.program import parse
 from netplc.records import ListSink
-from netplc.tags.alarms import AlarmRow, State
 from registrar.query import Row
 
 TAGS = ("name,address,type,unit,app_min,app_max,phy_min,phy_max,decimals,description,h,priority\n"

@@ -76,7 +76,7 @@ def test_check_lists_every_bad_file_and_exits_1(tmp_path: Path) -> None:
 
 
 def test_a_station_written_in_cp1251_checks_clean(tmp_path: Path) -> None:
-    from netplc.tags.table import load_tags
+    from app.scada.table import load_tags
 
     st = copy_demo(tmp_path / "st")
     for name in ("netplc.stl", "symbols.csv", "messages.csv", "tags.csv"):

@@ -325,8 +325,8 @@ def test_refusals_roles_and_alarms_speak_russian_too(qtbot, russian, demo_copy: 
 
     from app.gui.alarms import AlarmBanner
     from app.gui.status import station_problems
+    from app.scada.alarms import AlarmRow, State
     from hmi_forms.widgets.base import quality_tip
-    from netplc.tags.alarms import AlarmRow, State
 
     runtime = Runtime(load_station(demo_copy))
     runtime.start()

@@ -6,13 +6,13 @@ from __future__ import annotations
 
 from pathlib import Path
 
-from app.station_alarms import StationAlarms, stop_reason
+from app.scada.alarms import STOPPED_ID, STOPPED_PRIORITY, State
+from app.scada.quality import Quality
+from app.scada.station import StationAlarms, stop_reason
 from netplc.address import EMERGENCY_STOP
 from netplc.engine import Engine, FakeClock
 from netplc.program import parse
 from netplc.records import ListSink
-from netplc.tags.alarms import STOPPED_ID, STOPPED_PRIORITY, State
-from netplc.tags.quality import Quality
 
 T0 = 1_800_000_000.0
 HALT_BIT = 0o2100  # the program halts while it is 1

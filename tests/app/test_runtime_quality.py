@@ -13,8 +13,8 @@ import numpy as np
 
 from app.config import load_station
 from app.runtime import Runtime
-from netplc.tags.alarms import STOPPED_ID, State
-from netplc.tags.quality import Quality
+from app.scada.alarms import STOPPED_ID, State
+from app.scada.quality import Quality
 from registrar.query import Archive
 from tests.netplc.test_exchange import wait_until
 

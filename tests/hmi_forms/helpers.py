@@ -7,13 +7,13 @@ from pathlib import Path
 from typing import Any
 
 from app.authority import Commands, Source, Who
+from app.scada.table import TagTable
 from hmi_forms.elements import Element
 from hmi_forms.elements.target import EngineTarget
 from hmi_forms.form import load_form
 from netplc.engine import Engine
 from netplc.memory import Memory, Snapshot
 from netplc.records import Record
-from netplc.tags.table import TagTable
 
 
 def snap(bits: dict[int, int] | None = None, words: dict[int, int] | None = None, scan: int = 0,

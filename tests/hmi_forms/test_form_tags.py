@@ -7,13 +7,13 @@ from pathlib import Path
 
 import pytest
 
+from app.scada.table import load_tags
 from hmi_forms.elements.analog import AnalogBase, AnalogOutput
 from hmi_forms.elements.discrete import DiscreteBase
 from hmi_forms.form import FormError, load_form
 from netplc.engine import Engine
 from netplc.program import parse
 from netplc.records import ListSink
-from netplc.tags.table import load_tags
 from tests.hmi_forms.helpers import engine_target, write_form
 
 TAGS = """\

@@ -9,13 +9,13 @@ from pathlib import Path
 
 import pytest
 
+from app.scada.quality import LinkView, Quality, QualityMap
+from app.scada.readings import Readings
 from hmi_forms.elements.target import NullTarget
 from hmi_forms.form import load_form
 from hmi_forms.widgets.form_view import FormView
 from netplc.memory import Memory
 from netplc.program import parse
-from netplc.tags.quality import LinkView, Quality, QualityMap
-from netplc.tags.readings import Readings
 from tests.hmi_forms.helpers import shown_form, write_form
 from tests.hmi_forms.test_widgets import differs
 

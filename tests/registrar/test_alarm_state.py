@@ -8,10 +8,10 @@ from pathlib import Path
 
 import numpy as np
 
+from app.scada.alarms import AlarmSystem, State
+from app.scada.table import load_tags
 from netplc.memory import Memory
 from netplc.records import ListSink
-from netplc.tags.alarms import AlarmSystem, State
-from netplc.tags.table import load_tags
 from registrar.alarm_state import AlarmStateFile
 
 T0 = 1_800_000_000.0

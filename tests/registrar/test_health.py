@@ -9,8 +9,8 @@ from pathlib import Path
 import pytest
 
 from app.cli import main
+from app.scada.alarms import State
 from netplc.records import Record
-from netplc.tags.alarms import State
 from registrar.health import alarm_health
 from registrar.query import Archive
 from registrar.store import Store

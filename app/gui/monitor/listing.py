@@ -14,12 +14,12 @@ import re
 from dataclasses import dataclass
 from pathlib import Path
 
+from app.scada.tag import Tag, TagType
 from netplc.address import HMI_DATA_BIT_BASE, IO_BITS, fmt_octal, is_data_byte, parse_octal
 from netplc.forcing import Force, Kind, check_target, check_value
 from netplc.functions.registry import lookup
 from netplc.memory import MemoryView
 from netplc.program import _LABEL, CONTACTS, Instr, Program
-from netplc.tags.tag import Tag, TagType
 
 FORMATS = ("hex", "dec", "BCD")
 TERMINATORS = frozenset({"YON", "SON", "SOF", "SKP", "JMY", "JMN", "TIM", "CTR", "FON"})

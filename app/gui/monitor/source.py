@@ -29,12 +29,12 @@ from typing import Protocol
 from app.authority import Commands, Ticket, Who
 from app.authority import Source as Seat
 from app.runtime import Runtime
+from app.scada.tag import Tag
 from netplc.address import DATA_SIZE, IO_BITS, data_index, is_data_byte
 from netplc.forcing import Force, Kind
 from netplc.memory import Snapshot
 from netplc.modbus import DeviceError, LinkError, LoopThread, open_client, parse_endpoint
 from netplc.program import Program, parse
-from netplc.tags.tag import Tag
 
 logger = logging.getLogger(__name__)
 

@@ -58,11 +58,12 @@ from app.gui.monitor.listing import (
 from app.gui.monitor.source import Acting, Source
 from app.gui.rights import Control, Right, Rights
 from app.gui.status import IDLE, WARN, Pill
+from app.scada.forcing import tag_keys
+from app.scada.tag import Tag
 from netplc.address import fmt_octal
-from netplc.forcing import Force, Kind, tag_keys
+from netplc.forcing import Force, Kind
 from netplc.memory import Snapshot
 from netplc.program import CONTACTS
-from netplc.tags.tag import Tag
 
 logger = logging.getLogger(__name__)
 

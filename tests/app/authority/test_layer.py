@@ -9,10 +9,10 @@ import pytest
 
 from app.authority import Action, Commands, Reason, Source, Who, policy_table
 from app.authority.policy import POLICY, ROLES
+from app.scada.tag import Scaling, Tag, TagType
 from netplc.engine import Engine, FakeClock
 from netplc.program import parse
 from netplc.records import ListSink
-from netplc.tags.tag import Scaling, Tag, TagType
 
 ROLES_OF = {"vera": "viewer", "olga": "operator", "egor": "engineer", "anna": "admin"}
 SP = Tag("TEMP_SP", 0o4010, TagType.WORD, "°C", Scaling(0, 1000, -50, 150), 1, "Уставка")

@@ -43,11 +43,11 @@ from typing import Any, Protocol
 
 import numpy as np
 
+from app.scada.quality import ALARMED_CODES, HELD_CODES
+from app.scada.table import TagTable
+from app.scada.tag import Tag, TagReader
 from netplc.memory import MemoryView
 from netplc.records import NullSink, Record, RecordSink
-from netplc.tags.quality import ALARMED_CODES, HELD_CODES
-from netplc.tags.table import TagTable
-from netplc.tags.tag import Tag, TagReader
 
 PRIORITIES = {1: "critical", 2: "high", 3: "medium", 4: "low"}
 MESSAGE_PRIORITY = {3: 1, 2: 2}  # NMSG type 3 critical -> priority 1, type 2 alarm -> priority 2

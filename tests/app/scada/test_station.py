@@ -9,15 +9,15 @@ from pathlib import Path
 
 import pytest
 
-from app.station_alarms import StationAlarms
+from app.scada.alarms import AlarmError, State
+from app.scada.quality import Quality
+from app.scada.station import StationAlarms
 from netplc.engine import Engine, FakeClock
 from netplc.exchange import Exchange, NodeConfig
 from netplc.program import parse
 from netplc.records import ListSink, Record
 from netplc.scheduler import ScanThread
 from netplc.simulator import Simulator
-from netplc.tags.alarms import AlarmError, State
-from netplc.tags.quality import Quality
 from registrar.catalog import Message
 from tests.netplc.test_exchange import wait_until
 

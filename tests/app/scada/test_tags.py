@@ -9,10 +9,10 @@ from pathlib import Path
 import numpy as np
 import pytest
 
+from app.scada.table import TagError, load_tags, read_tags
+from app.scada.tag import Scaling, Tag, TagReader, TagType
 from netplc.memory import Memory
 from netplc.problems import Problems
-from netplc.tags.table import TagError, load_tags, read_tags
-from netplc.tags.tag import Scaling, Tag, TagReader, TagType
 
 HEADER = "name,address,type,unit,app_min,app_max,phy_min,phy_max,decimals,description"
 

@@ -1,13 +1,13 @@
 """The quality of the archive's data series: NSTORE and RegData records of a value that is not
-good carry its quality word, and a series turning held is marked at once (netplc/tags/series.py)."""
+good carry its quality word, and a series turning held is marked at once (app/scada/series.py)."""
 
 from __future__ import annotations
 
+from app.scada.quality import LinkView
+from app.scada.series import GAP_WORDS, SeriesQuality
 from netplc.memory import Memory
 from netplc.program import parse
 from netplc.records import Record
-from netplc.tags.quality import LinkView
-from netplc.tags.series import GAP_WORDS, SeriesQuality
 
 PROGRAM = ("TNA $03760\nFON C:$02110 N:NREAD S:4010 D:$04010 R:2\n"
            "FON C:$02170 N:NSTORE S:$04010 D:1 R:1\nFON C:$02174 N:NSTORE S:$04020 D:1 R:2\n")

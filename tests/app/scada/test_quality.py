@@ -8,13 +8,13 @@ from collections.abc import Iterator
 
 import pytest
 
+from app.scada.quality import LinkView, Quality, QualityMap, link_outputs, nread_feeds
+from app.scada.readings import Readings
+from app.scada.tag import Scaling, Tag, TagType, span
 from netplc.exchange import Exchange, NodeConfig
 from netplc.memory import Memory
 from netplc.program import parse
 from netplc.simulator import Simulator
-from netplc.tags.quality import LinkView, Quality, QualityMap, link_outputs, nread_feeds
-from netplc.tags.readings import Readings
-from netplc.tags.tag import Scaling, Tag, TagType, span
 from tests.netplc.test_exchange import NODE_PROGRAM, TICK, Station, wait_until
 
 PROGRAM = """\
@@ -115,7 +115,7 @@ def test_the_quality_of_an_address_asked_again_follows_the_links_of_each_scan(mo
     assert qmap.at(0o4000, 2, view, LinkView(links={1: True, 2: True})) is Quality.GOOD
     assert qmap.at(0o4000, 2, view, LinkView(links={1: False, 2: True})) is Quality.COMM_FAIL
     assert [f.node for f in qmap.feeding(*span(0o4002, 4))] == [1, 2]
-    monkeypatch.setattr("netplc.tags.quality.MAX_SPANS", 2)  # more spans asked than a station has
+    monkeypatch.setattr("app.scada.quality.MAX_SPANS", 2)  # more spans asked than a station has
     for addr in (0o4000, 0o4002, 0o4004, 0o4100):
         qmap.at(addr, 2, view, LinkView())
     assert len(qmap._over) <= 2

@@ -4,7 +4,7 @@
 back the alarm states of the last run, and then, attached to the engine, runs once per scan on
 the engine thread: each tag's quality from the exchange's links and data ages and NetPlc's run
 state, then the alarms over that scan's snapshot and the NMSG numbers journaled in it. Each scan
-ends by publishing `readings` (netplc/tags/readings.py): the one place the HMI, the journal and
+ends by publishing `readings` (app/scada/readings.py): the one place the HMI, the journal and
 the publishers read a value's quality. Operator actions are posted to the engine thread, as
 writes are, so the alarm states have one writer. No Qt: the workstation and `--no-gui` share it.
 
@@ -26,17 +26,17 @@ from typing import Any
 
 import numpy as np
 
+from app.scada.alarms import AlarmRow, AlarmSystem, CatalogMessage, summary_order
+from app.scada.quality import LinkView, QualityMap
+from app.scada.readings import Readings
+from app.scada.series import SeriesQuality
+from app.scada.table import TagTable, load_tags
 from netplc.address import EMERGENCY_STOP, fmt_octal
 from netplc.engine import Engine, RunState
 from netplc.exchange import Exchange
 from netplc.memory import Snapshot
 from netplc.program import Program
 from netplc.records import Record, RecordSink
-from netplc.tags.alarms import AlarmRow, AlarmSystem, CatalogMessage, summary_order
-from netplc.tags.quality import LinkView, QualityMap
-from netplc.tags.readings import Readings
-from netplc.tags.series import SeriesQuality
-from netplc.tags.table import TagTable, load_tags
 from registrar.alarm_state import AlarmStateFile
 
 STATE_FILE = "alarms.sqlite"  # next to the archive
@@ -49,7 +49,7 @@ class StationAlarms:
                  state_file: Path, symbols: dict[str, int] | None = None,
                  regdata: Mapping[str, Sequence[tuple[int, int]]] | None = None) -> None:
         """TagError (every problem of tags.csv) if the tags cannot be used. `regdata`: the forms'
-        RegData elements by name, with their operands (netplc/tags/series.py)."""
+        RegData elements by name, with their operands (app/scada/series.py)."""
         self.table = load_tags(tags, symbols) if tags is not None else TagTable()
         self.quality_map = QualityMap(program, self.table.tags)
         self.sink = sink

@@ -17,12 +17,12 @@ from dataclasses import replace
 
 import numpy as np
 
+from app.scada.quality import HELD_CODES, LinkView, Quality, QualityMap
+from app.scada.tag import Tag, TagType
 from netplc.address import fmt_octal
 from netplc.memory import MemoryView
 from netplc.program import Program
 from netplc.records import Record
-from netplc.tags.quality import HELD_CODES, LinkView, Quality, QualityMap
-from netplc.tags.tag import Tag, TagType
 
 NSTORE = 304
 GAP_WORDS = tuple(q.word for q in Quality if q.held)  # a data record with one of these is no point

@@ -6,12 +6,12 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
+from app.scada.alarms import AlarmError, AlarmSystem, State
+from app.scada.quality import Quality
+from app.scada.table import TagAlarms, TagTable
+from app.scada.tag import Scaling, Tag, TagType
 from netplc.memory import Memory
 from netplc.records import ListSink
-from netplc.tags.alarms import AlarmError, AlarmSystem, State
-from netplc.tags.quality import Quality
-from netplc.tags.table import TagAlarms, TagTable
-from netplc.tags.tag import Scaling, Tag, TagType
 from registrar.catalog import Message
 
 LEVEL = Tag("LEVEL", 0o4010, TagType.WORD, "%", Scaling(0, 4095, 0, 100), 1, "Уровень")

@@ -8,7 +8,7 @@ block's data in scans, NetPlc's run state and forcing give each address its qual
 - not running: NetPlc is stopped or halted, so nothing in memory changes any more. The value
   cannot be trusted (bad), but no quality alarm comes of it: a deliberate stop would flood the
   alarm list with one per tag. One station alarm says it instead (NETPLC.STOPPED,
-  app/station_alarms.py), and the tags' alarms are frozen where they were (`Quality.alarmed`);
+  app/scada/station.py), and the tags' alarms are frozen where they were (`Quality.alarmed`);
 - comm-fail: the node whose NREAD fills the address is down (its answers fail or are malformed);
 - stale: the NREAD asks (its rung is on) but its data has not landed for more than STALE_TICKS
   scans beyond the one scan an answer normally takes;
@@ -30,7 +30,7 @@ NetPlc is stopped. Readers show the link itself there (`link_outputs`, `Readings
 
 Forcing (netplc/forcing.py) reaches quality through one hook: `LinkView.forced`, the forced
 operand addresses of the scan, which the runtime fills from the snapshot's forces
-(`Force.operands`, app/station_alarms.py).
+(`Force.operands`, app/scada/station.py).
 """
 
 from __future__ import annotations
@@ -41,11 +41,11 @@ from enum import IntEnum
 
 import numpy as np
 
+from app.scada.tag import Tag, span
 from netplc.address import IO_BITS
 from netplc.exchange import NODE, NREAD, NWRITE, _fon_nodes
 from netplc.memory import MemoryView
 from netplc.program import Instr, Program
-from netplc.tags.tag import Tag, span
 
 STALE_TICKS = 2  # scans of lateness tolerated beyond the normal one-scan answer
 NORMAL_AGE = 1  # scans from a request to its data in memory, normally

@@ -15,9 +15,9 @@ import re
 from dataclasses import dataclass, field
 from pathlib import Path
 
+from app.scada.tag import Scaling, Tag, TagType, check_address
 from netplc.address import AddressError, parse_hmi_bit, parse_octal
 from netplc.problems import Problems
-from netplc.tags.tag import Scaling, Tag, TagType, check_address
 from netplc.textfile import TextFileError, csv_rows, read_text
 
 REQUIRED = ("name", "address", "type")

@@ -8,10 +8,10 @@ import struct
 
 import pytest
 
+from app.scada.forcing import forcing_tag, tag_forces, unforcing_tag
+from app.scada.tag import Scaling, Tag, TagType
 from netplc.engine import Engine, FakeClock
-from netplc.forcing import tag_forces
 from netplc.records import ListSink
-from netplc.tags.tag import Scaling, Tag, TagType
 from tests.netplc.test_forcing import engine as forcing_engine
 from tests.netplc.test_forcing import scans, texts
 
@@ -51,8 +51,8 @@ def test_word_and_float32_tags_forced_by_physical_value_are_what_the_program_rea
     eng, sink, clock = engine(compiled)
     scans(eng, clock)
     assert eng.snapshot.get_word(0o4010) == 7  # the program writes the float's low word
-    eng.forces.force_tag(TEMP, 130.0, user="eng1")
-    eng.forces.force_tag(FLOW, 12.5, user="eng1")
+    eng.post(forcing_tag(eng.forces, TEMP, 130.0, user="eng1"))
+    eng.post(forcing_tag(eng.forces, FLOW, 12.5, user="eng1"))
     scans(eng, clock, 2)
     snap = eng.snapshot
     assert snap.get_word(0o4000) == 650 and snap.get_word(0o4002) == 650
@@ -73,11 +73,11 @@ def test_a_tag_forced_without_a_value_is_bumpless_and_unforce_releases_every_wor
     eng.write_bytes(0o4010, struct.pack("<f", 40.0), user="op")  # 20.0 m3/h; the program then writes 7
     scans(eng, clock)
     before = eng.snapshot.read(0o4010, 4)
-    eng.forces.force_tag(FLOW, user="eng1")
+    eng.post(forcing_tag(eng.forces, FLOW, user="eng1"))
     scans(eng, clock, 3)
     assert eng.snapshot.read(0o4010, 4) == before and eng.forces.count == 2
     assert texts(sink)[-1][1].endswith("(bumpless)")
-    eng.forces.unforce_tag(FLOW, user="eng2")
+    eng.post(unforcing_tag(eng.forces, FLOW, user="eng2"))
     scans(eng, clock)
     assert eng.forces.count == 0
     assert texts(sink)[-1] == ("eng2", f"unforce FLOW (was forced {FLOW.format(FLOW.value(eng.snapshot))})")
@@ -89,4 +89,4 @@ def test_a_tag_forced_without_a_value_is_bumpless_and_unforce_releases_every_wor
 def test_a_nan_value_is_refused() -> None:
     eng, _, _ = engine(True)
     with pytest.raises(ValueError, match="FLOW"):
-        eng.forces.force_tag(FLOW, float("nan"), user="eng1")
+        eng.post(forcing_tag(eng.forces, FLOW, float("nan"), user="eng1"))

@@ -16,8 +16,8 @@ from dataclasses import dataclass, replace
 
 import numpy as np
 
+from app.scada.quality import LinkView, Operands, Quality, QualityMap
 from netplc.memory import Snapshot
-from netplc.tags.quality import LinkView, Operands, Quality, QualityMap
 
 
 @dataclass(frozen=True, slots=True)
