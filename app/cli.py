@@ -16,8 +16,8 @@ import time
 from pathlib import Path
 
 from app import logs
-from app.config import DEMO_STATION
 from app.logs import LEVELS
+from app.station.config import DEMO_STATION
 
 COMMANDS = ("view", "check", "simulate", "alarms-report", "design", "monitor", "archive", "users", "opcua")
 
@@ -140,7 +140,7 @@ def _users_parser() -> argparse.ArgumentParser:
 
 def run_users(argv: list[str]) -> int:
     from app.authority.users import UserError, Users
-    from app.config import station_file
+    from app.station.config import station_file
 
     ns = _users_parser().parse_args(argv)
     try:
@@ -246,7 +246,7 @@ def main(argv: list[str] | None = None) -> int:
 
 
 def run_check(station: str) -> int:
-    from app.check import check_station
+    from app.station.check import check_station
 
     report = check_station(station)
     for problem in report.problems:
@@ -281,8 +281,8 @@ def run_alarms_report(archive: str, day: str) -> int:
 
 
 def _open_runtime(station: str):  # -> Runtime | None (typed lazily: the runtime imports the parts)
-    from app.config import load_station
-    from app.runtime import Runtime
+    from app.station.config import load_station
+    from app.station.runtime import Runtime
     from netplc.problems import Problems
 
     try:
@@ -294,7 +294,7 @@ def _open_runtime(station: str):  # -> Runtime | None (typed lazily: the runtime
 
 
 def run_headless(station: str, duration: float | None, every: float) -> int:
-    from app.runtime import StartError
+    from app.station.runtime import StartError
 
     runtime = _open_runtime(station)
     if runtime is None:

@@ -24,11 +24,11 @@ from pathlib import Path
 from PySide6.QtWidgets import QApplication
 from scan import generate, pick_functions  # bench/scan.py: the 8 K-word program
 
-from app.config import load_station
 from app.gui.monitor.source import LocalSource
 from app.gui.monitor.window import ProgramWindow
 from app.gui.style import apply_style
-from app.runtime import Runtime
+from app.station.config import load_station
+from app.station.runtime import Runtime
 from netplc.engine import Engine
 from netplc.memory import Snapshot
 

@@ -35,11 +35,11 @@ import numpy as np
 
 sys.path.insert(0, str(Path(__file__).resolve().parent.parent))
 
-from app.config import MqttSettings
 from app.publish.mqtt import SparkplugPublisher
 from app.publish.opcua import OpcUaServer
 from app.publish.points import PointReader, Writable, Writer
 from app.scada.tag import Tag, TagType
+from app.station.config import MqttSettings
 from netplc.address import data_address
 from netplc.engine import Engine
 from netplc.memory import Memory

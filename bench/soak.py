@@ -2,7 +2,7 @@
 killed and restarted every 20 s, the archive writing all along. Reports the longest scan, records
 lost (must be 0), retentive saves, resident memory growth and open file descriptors at the end.
 
-The station runs in this process exactly as `main.py --no-gui` runs it (app.runtime.Runtime on a
+The station runs in this process exactly as `main.py --no-gui` runs it (app.station.runtime.Runtime on a
 station folder written to a temporary directory): a 100 ms tick, a program that NREADs 64 bytes
 of node 0 and NWRITEs 2 bytes back every scan and NSTOREs five values every scan (50 records/s),
 its Modbus server with the default limits. Node 0 is a simulated CPU-165 in a child process,
@@ -195,8 +195,8 @@ def main() -> int:
         clients(int(args.clients[0]), args.clients[1])
         return 0
 
-    from app.config import load_station
-    from app.runtime import Runtime
+    from app.station.config import load_station
+    from app.station.runtime import Runtime
     from netplc.engine import ScanStats
 
     with tempfile.TemporaryDirectory(prefix="soak-") as tmp:

@@ -40,8 +40,8 @@ CHILD = """
 import json, sys, time
 t = {"main": time.time()}
 sys.path.insert(0, sys.argv[2])
-from app.config import load_station
-from app.runtime import Runtime
+from app.station.config import load_station
+from app.station.runtime import Runtime
 t["imported"] = time.time()
 station = load_station(sys.argv[1])
 runtime = Runtime(station)
@@ -115,12 +115,13 @@ def main() -> None:
         print(f"station: {lines}-line program of 8192 words (bench/scan.py, seed 165), archive, "
               f"Modbus server; {args.runs} runs of each, interleaved")
         cache = station / "archive" / "compiled"
-        names = ("python -c pass", "import app.runtime", "cold", "warm")
+        names = ("python -c pass", "import app.station.runtime", "cold", "warm")
         rows: dict[str, list[float]] = {k: [] for k in names}
         parts: dict[str, list[dict[str, float]]] = {"cold": [], "warm": []}
         for _ in range(args.runs):
             rows["python -c pass"].append(timed(["-c", "pass"])[0])
-            rows["import app.runtime"].append(timed(["-c", "import app.config, app.runtime"])[0])
+            imports = ["-c", "import app.station.config, app.station.runtime"]
+            rows["import app.station.runtime"].append(timed(imports)[0])
             for kind in ("cold", "warm"):
                 if kind == "cold":
                     shutil.rmtree(cache, ignore_errors=True)
@@ -136,10 +137,11 @@ def main() -> None:
                   f"{p['loaded'] - p['imported']:.0f}, archive + engine (compile) + server "
                   f"{p['started'] - p['loaded']:.0f}, first scan {p['first_scan'] - p['started']:.0f} ms")
         print(f"  yardsticks: python -c pass {med['python -c pass']:.0f} ms, importing the packages "
-              f"{med['import app.runtime']:.0f} ms")
-        print(f"  warm start = {med['warm'] / med['python -c pass']:.1f}x python -c pass, "
-              f"{med['warm'] / med['import app.runtime']:.2f}x the imports alone; cold start "
-              f"{med['cold'] / med['python -c pass']:.1f}x / {med['cold'] / med['import app.runtime']:.2f}x")
+              f"{med['import app.station.runtime']:.0f} ms")
+        bare, imports = med["python -c pass"], med["import app.station.runtime"]
+        print(f"  warm start = {med['warm'] / bare:.1f}x python -c pass, "
+              f"{med['warm'] / imports:.2f}x the imports alone; cold start "
+              f"{med['cold'] / bare:.1f}x / {med['cold'] / imports:.2f}x")
         print(f"  in process: {phases_in_process(station)}")
         ok = med["cold"] <= 500 and med["warm"] <= 500
         print(f"target first scan <= 500 ms (cold and warm): {'met' if ok else 'NOT met'}")

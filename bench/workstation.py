@@ -31,11 +31,11 @@ os.environ.setdefault("QT_QPA_PLATFORM", "offscreen")
 from PySide6.QtCore import QEvent, QObject
 from PySide6.QtWidgets import QApplication, QLabel, QMainWindow
 
-from app.config import load_station
 from app.gui.main_window import MainWindow
 from app.gui.screenshots import copy_station
 from app.gui.style import apply_style
-from app.runtime import Runtime
+from app.station.config import load_station
+from app.station.runtime import Runtime
 
 SIZE = (1366, 768)
 WARMUP = 10.0  # seconds before the memory baseline: caches, pixmaps and the trend buffers fill

@@ -92,7 +92,7 @@ def unit_problem(scheme: str, unit: int) -> str | None:
 def node_problems(settings: Mapping[str, Any]) -> tuple[Endpoint | None, list[Problem]]:
     """The parsed endpoint (None while there is none) and every setting of a node that is out of
     bounds, by its station.toml key: the one node validation, which NodeConfig raises and
-    station.toml's reader (app/config.py) reports key by key."""
+    station.toml's reader (app/station/config.py) reports key by key."""
     found: list[Problem] = []
     node = settings["node"]
     lo, hi = NODE_NUMBERS
@@ -125,7 +125,7 @@ def node_problems(settings: Mapping[str, Any]) -> tuple[Endpoint | None, list[Pr
 @dataclass
 class NodeConfig:
     """One remote node: where it is and how to talk to it. The one model of a node: station.toml's
-    [[nodes]] tables and embedded simulators become these (app/config.py), the exchange runs them.
+    [[nodes]] tables and embedded simulators become these (app/station/config.py), the exchange runs them.
     ValueError names the node and every setting that is out of bounds."""
 
     node: int

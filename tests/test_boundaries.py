@@ -25,7 +25,7 @@ REPO = Path(__file__).resolve().parents[1]
 PACKAGES = ("netplc", "registrar", "hmi_forms", "app")
 QT = ("PySide6", "shiboken6", "pyqtgraph")
 HEADLESS = ("netplc", "registrar", "hmi_forms.elements", "hmi_forms.form", "hmi_forms.behaviour",
-            "app.runtime", "app.config", "app.load", "app.check", "app.scada", "app.authority")
+            "app.station", "app.scada", "app.authority")
 
 
 def module_name(path: Path) -> str:
@@ -94,7 +94,8 @@ def test_headless_parts_import_no_qt_even_indirectly() -> None:
 
 
 def test_headless_parts_run_without_qt_loaded() -> None:
-    code = ("import sys, app.check, app.runtime, hmi_forms.behaviour, netplc.simulator, registrar.query\n"
+    code = ("import sys, app.station.check, app.station.runtime, hmi_forms.behaviour, netplc.simulator\n"
+            "import registrar.query\n"
             f"print(sorted(m for m in sys.modules if m.split('.')[0] in {QT!r}))")
     r = subprocess.run([sys.executable, "-c", code], cwd=REPO, capture_output=True, text=True, timeout=60)
     assert r.returncode == 0, r.stderr
@@ -134,7 +135,8 @@ def test_only_the_plant_archive_imports_psycopg() -> None:
 
 
 def test_psycopg_is_not_loaded_until_a_plant_archive_is_named() -> None:
-    code = ("import sys, app.check, app.cli, app.config, app.runtime, registrar.query, registrar.plant.url\n"
+    code = ("import sys, app.station.check, app.cli, app.station.config, app.station.runtime\n"
+            "import registrar.query, registrar.plant.url\n"
             "print(sorted(m for m in sys.modules if m.split('.')[0] == 'psycopg'))")
     r = subprocess.run([sys.executable, "-c", code], cwd=REPO, capture_output=True, text=True, timeout=60)
     assert r.returncode == 0, r.stderr

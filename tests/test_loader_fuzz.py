@@ -27,10 +27,10 @@ from hypothesis import strategies as st
 
 from app.authority.policy import ROLES
 from app.authority.users import USERS_FILE, Users, UsersFileError
-from app.check import check_station
-from app.config import ConfigError, load_station, read_station
-from app.runtime import Runtime, StartError
 from app.scada.table import read_tags
+from app.station.check import check_station
+from app.station.config import ConfigError, load_station, read_station
+from app.station.runtime import Runtime, StartError
 from hmi_forms.elements import ELEMENT_TYPES
 from hmi_forms.form import FormError, load_form
 from netplc.problems import Problems

@@ -24,8 +24,8 @@ from collections.abc import Callable
 from PySide6.QtCore import QObject, Signal
 
 from app.authority import Answer, Ticket
-from app.runtime import Runtime
 from app.scada.readings import Readings
+from app.station.runtime import Runtime
 from netplc.records import Record
 
 

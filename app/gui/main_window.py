@@ -42,7 +42,6 @@ from PySide6.QtWidgets import (
 
 from app.authority import Action, Answer, Commands, Refusal, Source, Ticket, Who
 from app.authority.users import Session, Users
-from app.config import load_station
 from app.gui import i18n, words
 from app.gui.alarm_summary import AlarmSummary
 from app.gui.alarms import AlarmBanner, FixedLine, HealthStrip
@@ -55,9 +54,10 @@ from app.gui.style import apply_style
 from app.gui.trend_history import TrendHistory
 from app.gui.users_dialog import UsersDialog
 from app.gui.zoom import ACTUAL, FIT_WIDTH, FIT_WINDOW, ZoomArea, ZoomSettings
-from app.runtime import Runtime
 from app.scada.alarms import AlarmRow
 from app.scada.readings import Readings
+from app.station.config import load_station
+from app.station.runtime import Runtime
 from hmi_forms.elements import formats
 from hmi_forms.elements.analog import AnalogOutput
 from hmi_forms.elements.base import Writer

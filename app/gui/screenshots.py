@@ -18,12 +18,12 @@ from collections.abc import Callable
 from pathlib import Path
 from typing import TYPE_CHECKING
 
-from app.config import DEMO_STATION, load_station
+from app.station.config import DEMO_STATION, load_station
 
 if TYPE_CHECKING:
     from PySide6.QtCore import QCoreApplication
 
-    from app.runtime import Runtime
+    from app.station.runtime import Runtime
 
 SIZE = (1400, 900)  # the viewer's
 WINDOW_SIZES = ((1366, 768), (1920, 1080))  # the smallest screen the workstation must fit; a common one
@@ -58,7 +58,7 @@ def main(argv: list[str] | None = None) -> int:
     from app.gui.main_window import MainWindow
     from app.gui.style import apply_style
     from app.gui.viewer import ViewerWindow
-    from app.runtime import Runtime
+    from app.station.runtime import Runtime
 
     app = QApplication.instance() or QApplication(sys.argv[:1])
     apply_style(app)

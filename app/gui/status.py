@@ -9,7 +9,7 @@ from __future__ import annotations
 from PySide6.QtCore import QT_TRANSLATE_NOOP, QCoreApplication
 from PySide6.QtWidgets import QLabel, QStatusBar, QWidget
 
-from app.runtime import RuntimeStatus
+from app.station.runtime import RuntimeStatus
 
 OK, WARN, BAD, IDLE = "ok", "warn", "bad", "idle"
 UP, DOWN = "\u25cf", "\u25cb"  # filled and hollow circles

@@ -48,11 +48,11 @@ from PySide6.QtWidgets import (
     QWidget,
 )
 
-from app.config import DEMO_STATION, ConfigError, load_station, station_file
 from app.gui import i18n
 from app.gui.series_loader import Series, SeriesLoader
 from app.gui.style import apply_style
 from app.scada.tag import Tag
+from app.station.config import DEMO_STATION, ConfigError, load_station, station_file
 from hmi_forms.elements import formats
 from hmi_forms.widgets.records import ARCHIVE_COLUMNS, Column, RecordsModel, records_view
 from hmi_forms.widgets.worker import Worker

@@ -33,11 +33,11 @@ import numpy as np
 import paho.mqtt.client as mqtt
 
 from app.authority import Action, Commands, Reason, Source, Ticket, Who
-from app.config import MqttSettings
 from app.publish import sparkplug as spb
 from app.publish.feed import LatestReadings, Watch
 from app.publish.points import PointReader, PointWriter, Reading, Writable
 from app.scada.tag import Tag
+from app.station.config import MqttSettings
 
 logger = logging.getLogger(__name__)
 

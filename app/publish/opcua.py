@@ -59,7 +59,6 @@ from asyncua.crypto.security_policies import SecurityPolicyBasic256Sha256, Secur
 from app.authority import Action, Commands, Reason, Source, Ticket, Who, write_range
 from app.authority.logins import Logins
 from app.authority.users import UserError, Users
-from app.config import OpcUaSettings
 from app.publish.feed import LatestReadings, Watch
 from app.publish.methods import StationMethods, StepLock
 from app.publish.pki import TrustList, host_names, station_certificate, subject, thumbprint
@@ -68,6 +67,7 @@ from app.scada.alarms import PRIORITIES, Alarm, State
 from app.scada.quality import Quality
 from app.scada.readings import Readings
 from app.scada.tag import Tag, TagType
+from app.station.config import OpcUaSettings
 from netplc.records import Record
 
 logger = logging.getLogger(__name__)

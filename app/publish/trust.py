@@ -13,8 +13,8 @@ import getpass
 import sqlite3
 import sys
 
-from app.config import ConfigError, load_station, station_file
 from app.publish.pki import TrustError, TrustList, subject, thumbprint
+from app.station.config import ConfigError, load_station, station_file
 from netplc.records import Record
 from registrar.store import Store
 

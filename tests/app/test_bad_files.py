@@ -10,8 +10,8 @@ from pathlib import Path
 
 import pytest
 
-from app.config import read_station
-from app.runtime import StartError
+from app.station.config import read_station
+from app.station.runtime import StartError
 from hmi_forms.form import load_forms
 from registrar.catalog import Catalog
 from tests.app.broken_stations import CASES, Broken, replace
@@ -152,9 +152,9 @@ def test_the_good_forms_still_open_beside_the_broken_ones(tmp_path: Path) -> Non
 
 
 def test_the_workstation_opens_the_demo_forms_beside_the_broken_ones(tmp_path: Path, qtbot) -> None:
-    from app.config import load_station
     from app.gui.main_window import MainWindow
-    from app.runtime import Runtime
+    from app.station.config import load_station
+    from app.station.runtime import Runtime
 
     st = copy_demo(tmp_path / "st")
     expected = bad_forms(st / "forms")
@@ -176,9 +176,9 @@ def test_the_workstation_opens_the_demo_forms_beside_the_broken_ones(tmp_path: P
 
 @pytest.mark.parametrize("case", CASES, ids=[c.name for c in CASES])
 def test_each_bad_input_is_named_by_check_and_by_the_start(tmp_path: Path, case: Broken) -> None:
-    from app.check import check_station
-    from app.config import load_station
-    from app.runtime import Runtime
+    from app.station.check import check_station
+    from app.station.config import load_station
+    from app.station.runtime import Runtime
     from netplc.problems import Problems
 
     st = copy_demo(tmp_path / "st")
@@ -213,7 +213,7 @@ def test_check_exits_1_naming_a_default_user_who_is_no_viewer_and_a_broken_users
 
 
 def test_a_station_without_users_may_have_no_default_user(tmp_path: Path) -> None:
-    from app.check import check_station
+    from app.station.check import check_station
 
     st = copy_demo(tmp_path / "st")
     (st / "users.json").unlink()

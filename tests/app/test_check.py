@@ -77,9 +77,9 @@ def test_every_planted_error_is_found(tmp_path: Path) -> None:
 
 
 def test_check_reports_exactly_what_a_start_refuses(tmp_path: Path) -> None:
-    from app.check import check_station
-    from app.config import load_station
-    from app.runtime import Runtime, StartError
+    from app.station.check import check_station
+    from app.station.config import load_station
+    from app.station.runtime import Runtime, StartError
 
     st = copy_demo(tmp_path / "broken")
     plant(st / "netplc.stl", "TNA ON\nFON C:$02140 N:NODE S:0", "TNX ON\nFON C:$02140 N:NODE S:7")

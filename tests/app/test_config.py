@@ -6,7 +6,7 @@ from pathlib import Path
 
 import pytest
 
-from app.config import ConfigError, load_station, read_station
+from app.station.config import ConfigError, load_station, read_station
 from netplc.exchange import NodeConfig
 from tests.app.conftest import DEMO, write_station
 

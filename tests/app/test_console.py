@@ -12,10 +12,10 @@ import pytest
 from PySide6.QtCore import Qt
 from PySide6.QtWidgets import QPlainTextEdit
 
-from app.config import load_station
 from app.gui.main_window import MainWindow
 from app.gui.zoom import ACTUAL, FIT_WIDTH, FIT_WINDOW
-from app.runtime import Runtime
+from app.station.config import load_station
+from app.station.runtime import Runtime
 
 LEVEL = 0o4010
 START_BIT = 0o40042

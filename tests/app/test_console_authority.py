@@ -13,8 +13,8 @@ from PySide6.QtCore import Qt
 
 from app.gui.main_window import MainWindow
 from app.gui.monitor.view import ProgramMonitor
-from app.runtime import Runtime
 from app.scada.alarms import STOPPED_ID, State
+from app.station.runtime import Runtime
 from tests.app import test_console
 from tests.app.test_console import Answers, element, operator_rows
 

@@ -11,7 +11,7 @@ from pathlib import Path
 import pytest
 
 from app.cli import _log_level
-from app.config import DEMO_STATION
+from app.station.config import DEMO_STATION
 
 REPO = Path(__file__).resolve().parents[2]
 

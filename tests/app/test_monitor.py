@@ -15,12 +15,12 @@ from PySide6.QtWidgets import QApplication, QMenu
 from app.authority import Source as Seat
 from app.authority import Who
 from app.authority.users import Users
-from app.config import load_station
 from app.gui.monitor.listing import Listing, fmt_value, parse_value, parse_watch
 from app.gui.monitor.source import READ_ONLY, LocalSource, RemoteSource
 from app.gui.monitor.view import ON, ProgramMonitor
 from app.gui.monitor.window import ProgramWindow, remote_source
-from app.runtime import Runtime
+from app.station.config import load_station
+from app.station.runtime import Runtime
 from netplc.memory import Memory
 from netplc.problems import Problems
 from netplc.program import parse

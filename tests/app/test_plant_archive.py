@@ -6,9 +6,9 @@ import csv
 import datetime as dt
 from pathlib import Path
 
-from app.config import load_station
 from app.gui.viewer import ViewerWindow
-from app.runtime import Runtime
+from app.station.config import load_station
+from app.station.runtime import Runtime
 from netplc.records import Record
 from registrar.plant.forward import Forwarder
 from registrar.query import Archive

@@ -12,8 +12,8 @@ import threading
 import time
 from pathlib import Path
 
-from app.config import load_station
-from app.runtime import Runtime
+from app.station.config import load_station
+from app.station.runtime import Runtime
 from netplc.memory import Memory
 from registrar.retain import read_save
 from tests.app.conftest import REPO, write_station

@@ -13,9 +13,9 @@ from pathlib import Path
 
 import pytest
 
-from app.check import check_station
-from app.config import load_station
-from app.runtime import Runtime, StartError, unresolved_hosts
+from app.station.check import check_station
+from app.station.config import load_station
+from app.station.runtime import Runtime, StartError, unresolved_hosts
 from netplc.modbus import DeviceError, LeanTcpClient, parse_endpoint
 from netplc.program import parse
 from netplc.simulator import Simulator

@@ -11,10 +11,10 @@ from pathlib import Path
 
 import numpy as np
 
-from app.config import load_station
-from app.runtime import Runtime
 from app.scada.alarms import STOPPED_ID, State
 from app.scada.quality import Quality
+from app.station.config import load_station
+from app.station.runtime import Runtime
 from registrar.query import Archive
 from tests.netplc.test_exchange import wait_until
 

@@ -16,8 +16,8 @@ from pathlib import Path
 
 import pytest
 
-from app.config import load_station
-from app.runtime import Runtime
+from app.station.config import load_station
+from app.station.runtime import Runtime
 from netplc.memory import Snapshot
 from tests.app.conftest import REPO
 

@@ -8,8 +8,8 @@ import time
 from pathlib import Path
 
 from app.authority import Reason, Source, Who
-from app.config import load_station
-from app.runtime import Runtime
+from app.station.config import load_station
+from app.station.runtime import Runtime
 from netplc.engine import RunState
 from netplc.forcing import Force, load_forces
 from netplc.modbus import LeanTcpClient, LoopThread, parse_endpoint

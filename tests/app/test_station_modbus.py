@@ -15,7 +15,7 @@ import pytest
 from app.authority import Commands, Source
 from app.authority.layer import Reason
 from app.authority.modbus import EXCEPTION_OF, ModbusCommands
-from app.config import DEFAULT_WRITABLE
+from app.station.config import DEFAULT_WRITABLE
 from netplc.address import EMERGENCY_STOP
 from netplc.engine import Engine, FakeClock, RunState
 from netplc.modbus import ModbusServer

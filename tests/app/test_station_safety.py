@@ -9,8 +9,8 @@ from pathlib import Path
 
 import pytest
 
-from app.config import DEFAULT_WRITABLE, ConfigError, load_station, read_station
-from app.runtime import Runtime
+from app.station.config import DEFAULT_WRITABLE, ConfigError, load_station, read_station
+from app.station.runtime import Runtime
 from netplc.records import Record
 from tests.app.conftest import REPO, write_station
 

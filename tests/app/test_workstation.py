@@ -12,10 +12,10 @@ from pathlib import Path
 import pytest
 from PySide6.QtCore import Qt
 
-from app.config import load_station
 from app.gui.main_window import MainWindow
 from app.gui.status import StationStatusBar, station_problems
-from app.runtime import NodeStatus, Runtime, RuntimeStatus
+from app.station.config import load_station
+from app.station.runtime import NodeStatus, Runtime, RuntimeStatus
 from hmi_forms.elements import Element
 from hmi_forms.widgets.base import ElementWidget
 

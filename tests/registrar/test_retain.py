@@ -169,7 +169,7 @@ def test_a_save_takes_memory_and_timer_values_of_the_same_moment(tmp_path):
 
 
 class SavingSink(ListSink):
-    """The station's sink in small (app/runtime.py): a record is kept at once, and a writer is
+    """The station's sink in small (app/station/runtime.py): a record is kept at once, and a writer is
     answered once the memory of the scan that applied its write is saved."""
 
     def __init__(self) -> None:

@@ -10,7 +10,7 @@ from __future__ import annotations
 from dataclasses import dataclass, field
 from pathlib import Path
 
-from app.config import STATION_FILE, Station, read_station
+from app.station.config import STATION_FILE, Station, read_station
 from netplc.program import ProgramError, load_symbols
 
 TAGS_FILE = "tags.csv"

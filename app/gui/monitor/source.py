@@ -28,8 +28,8 @@ from typing import Protocol
 
 from app.authority import Commands, Ticket, Who
 from app.authority import Source as Seat
-from app.runtime import Runtime
 from app.scada.tag import Tag
+from app.station.runtime import Runtime
 from netplc.address import DATA_SIZE, IO_BITS, data_index, is_data_byte
 from netplc.forcing import Force, Kind
 from netplc.memory import Snapshot

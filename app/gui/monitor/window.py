@@ -11,12 +11,12 @@ from pathlib import Path
 from PySide6.QtGui import QCloseEvent
 from PySide6.QtWidgets import QApplication, QMainWindow, QWidget
 
-from app.config import load_station
 from app.gui.monitor.source import LocalSource, RemoteSource, Source
 from app.gui.monitor.view import ProgramMonitor
 from app.gui.style import apply_style
-from app.load import load
-from app.runtime import Runtime
+from app.station.config import load_station
+from app.station.load import load
+from app.station.runtime import Runtime
 from netplc.problems import Problems
 
 SIZE = (1366, 768)

@@ -13,8 +13,8 @@ from pathlib import Path
 
 import pytest
 
-from app.config import load_station
-from app.runtime import Runtime
+from app.station.config import load_station
+from app.station.runtime import Runtime
 from tests.app.conftest import copy_demo
 
 

@@ -14,7 +14,7 @@ import paho.mqtt.client as mqtt
 import pytest
 
 from app.publish import sparkplug as spb
-from app.runtime import Runtime
+from app.station.runtime import Runtime
 from tests.app.conftest import REPO, copy_demo
 from tests.app.publish.conftest import Mosquitto, demo_with
 from tests.netplc.test_exchange import wait_until
@@ -184,8 +184,8 @@ def test_bdseq_goes_on_across_restarts_of_the_station(tmp_path: Path, mosquitto:
     """Each connection's bdSeq is the previous one's plus one, also after the station restarts
     (kept in the station folder), so a host never takes an old session's NDEATH for the new one's;
     a file that holds no bdSeq is journaled and the count starts again."""
-    from app.config import load_station
     from app.publish.station import BDSEQ_FILE
+    from app.station.config import load_station
 
     station = copy_demo(tmp_path / "station")
     toml = station / "station.toml"

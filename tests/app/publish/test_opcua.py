@@ -13,7 +13,7 @@ import pytest
 from asyncua import Client, ua
 
 from app.publish.opcua import is_loopback
-from app.runtime import Runtime
+from app.station.runtime import Runtime
 from tests.app.publish.conftest import demo_with, free_port, opcua_client, tag_node
 
 

@@ -10,7 +10,7 @@ from pathlib import Path
 import pytest
 from asyncua import ua
 
-from app.runtime import Runtime
+from app.station.runtime import Runtime
 from tests.app.publish.conftest import STATION_URI, demo_with, free_port, opcua_client
 
 BIT = 0o2120  # the demo's PUMP command bit

@@ -14,7 +14,7 @@ import pytest
 from asyncua import ua
 
 from app.authority.users import Users
-from app.runtime import Runtime
+from app.station.runtime import Runtime
 from tests.app.publish.conftest import STATION_URI, demo_with, free_port, opcua_client, tag_node
 
 READ, WRITE = 1, 2  # AccessLevel bits CurrentRead, CurrentWrite

@@ -7,10 +7,10 @@ from pathlib import Path
 import numpy as np
 
 from app.authority import Commands, Reason, Source, Who
-from app.config import load_station, read_station
 from app.publish.points import PointWriter, Writable, symbol_tags
 from app.publish.sparkplug import DOUBLE, INT16, Payload, get_value, set_value
 from app.scada.tag import TagType
+from app.station.config import load_station, read_station
 from netplc.engine import Engine
 from netplc.program import parse
 from netplc.records import ListSink

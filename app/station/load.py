@@ -17,8 +17,8 @@ from pathlib import Path
 
 from app.authority.policy import VIEWER
 from app.authority.users import USERS_FILE, Users, UsersFileError
-from app.config import Station
 from app.scada.table import TagTable, read_tags
+from app.station.config import Station
 from hmi_forms.form import Form, load_forms
 from netplc.exchange import check_program_nodes
 from netplc.program import Program, ProgramError, load_symbols, parse, parse_file, read_symbols

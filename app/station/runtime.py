@@ -29,12 +29,12 @@ from typing import TYPE_CHECKING
 from app.authority import Commands, Source, Ticket, Who
 from app.authority.modbus import ModbusCommands
 from app.authority.users import USERS_FILE, Users
-from app.config import Station
-from app.load import load, load_station_forms
 from app.publish.station import start_publishers
 from app.scada.readings import Readings
 from app.scada.station import STATE_FILE as ALARM_STATE_FILE
 from app.scada.station import StationAlarms
+from app.station.config import Station
+from app.station.load import load, load_station_forms
 from hmi_forms.behaviour import FormBehaviour
 from hmi_forms.form import Form
 from netplc.engine import Engine

@@ -1,6 +1,6 @@
 """`python main.py check STATION`: every problem of a station before it is started on a plant.
 
-It reads the station exactly as a start does (`app.load.load`, the runtime's own loader), so what
+It reads the station exactly as a start does (`app.station.load.load`, the runtime's own loader), so what
 `check` passes a start accepts; on top, it reports what a start only journals: node host names
 that do not resolve and forms that do not load; and what only the start's opening of the archive
 would find (a folder, or a file that is no SQLite database, where the archive should be), in the
@@ -12,9 +12,9 @@ from __future__ import annotations
 from dataclasses import dataclass, field
 from pathlib import Path
 
-from app.config import read_station
-from app.load import load
-from app.runtime import unresolved_hosts
+from app.station.config import read_station
+from app.station.load import load
+from app.station.runtime import unresolved_hosts
 from registrar.store import archive_problem
 
 
