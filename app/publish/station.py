@@ -5,9 +5,12 @@ and the station runs on."""
 
 from __future__ import annotations
 
-from typing import Any, Protocol
+from typing import TYPE_CHECKING, Any, Protocol
 
 from app.publish.points import published_tags
+
+if TYPE_CHECKING:
+    from app.station.runtime import Runtime
 
 BDSEQ_FILE = "sparkplug_bdseq.txt"  # in the station folder: the last MQTT connection's bdSeq
 
@@ -16,7 +19,7 @@ class Publisher(Protocol):
     def stop(self) -> None: ...
 
 
-def start_publishers(runtime: Any) -> list[Publisher]:
+def start_publishers(runtime: Runtime) -> list[Publisher]:
     st = runtime.station
     if not (st.opcua.enabled or st.mqtt.enabled):
         return []
@@ -26,7 +29,7 @@ def start_publishers(runtime: Any) -> list[Publisher]:
         from app.publish.opcua import OpcUaServer  # asyncua loads only for a station that serves OPC UA
 
         # the alarms' identities and states as the station starts; their transitions follow as records
-        alarms = runtime.alarms.system.alarms if runtime.alarms is not None else []
+        alarms = runtime.alarm_definitions()
         server = OpcUaServer(settings=st.opcua, station=st.name, folder=st.folder, tags=tags,
                              commands=runtime.commands, watch=runtime.watch, engine=runtime.engine,
                              exchange=runtime.exchange, alarms=alarms, journal=runtime.system,
@@ -57,7 +60,7 @@ def start_publishers(runtime: Any) -> list[Publisher]:
 class _Unsubscribing:
     """The OPC UA server with its record observer (alarm events), removed when it stops."""
 
-    def __init__(self, server: Any, runtime: Any) -> None:
+    def __init__(self, server: Any, runtime: Runtime) -> None:
         self.server, self.runtime = server, runtime
 
     def stop(self) -> None:

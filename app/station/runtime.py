@@ -30,6 +30,7 @@ from app.authority import Commands, Source, Ticket, Who
 from app.authority.modbus import ModbusCommands
 from app.authority.users import USERS_FILE, Users
 from app.publish.station import start_publishers
+from app.scada.alarms import Alarm
 from app.scada.readings import Readings
 from app.scada.station import STATE_FILE as ALARM_STATE_FILE
 from app.scada.station import StationAlarms
@@ -473,6 +474,12 @@ class Runtime:
                 callback(readings)
 
         return engine.subscribe(on_scan, name or getattr(callback, "__qualname__", None))
+
+    def alarm_definitions(self) -> list[Alarm]:
+        """The station's alarms, their identities and states as of now: for a publisher that
+        builds its address space before the first scan (their transitions follow as records)."""
+        alarms = self.alarms
+        return list(alarms.system.alarms) if alarms is not None else []
 
     def readings(self) -> Readings | None:
         """Every tag's and address's value with its quality and time as of the last scan
