@@ -60,6 +60,7 @@ logger = logging.getLogger(__name__)
 
 STATION_URI = "urn:netplc:station:"  # the station's namespace: this, then the station's name
 TIMEOUT_S = 5.0
+CLOSE_S = 2.0  # a logout the station does not answer within this is left to its session timeout
 RIGHTS_EVERY_S = 2.0  # what the user may do is asked again this often (a role changed at the station)
 RETRY_S = (0.5, 1.0, 2.0, 5.0, 10.0)  # back-off of reconnections
 KNOWN_STATIONS = "known_stations.json"
@@ -226,11 +227,11 @@ class StationClient:
         return self._submit(self._open())
 
     def close(self) -> None:
-        """Log out and stop (waits for the logout at most a second or two)."""
+        """Log out and stop (waits for the logout at most CLOSE_S)."""
         if self._loop.loop is None:
             return
         with contextlib.suppress(Exception):  # the session may be gone already: nothing to log out
-            self._submit(self._close()).result(2 * TIMEOUT_S)
+            self._submit(self._close()).result(CLOSE_S)
         self._loop.stop()
 
     def may(self, action: Action) -> bool | None:
@@ -344,9 +345,9 @@ class StationClient:
                                       server_certificate=certificate.der)
         client.set_user(self.user)
         client.set_password(self._password)
-        await client.connect()
         connected = False
         try:
+            await client.connect()
             spaces = await client.get_namespace_array()
             station = next(((i, s) for i, s in enumerate(spaces) if s.startswith(STATION_URI)), None)
             if station is None:

@@ -8,6 +8,7 @@ refused by the station, journaled there once a minute naming the user."""
 from __future__ import annotations
 
 import os
+import stat
 import subprocess
 import sys
 from collections.abc import Iterator
@@ -24,7 +25,8 @@ from app.gui.monitor.login import LoginDialog
 from app.gui.monitor.source import RAW_WRITE, OpcUaSource
 from app.gui.monitor.view import ProgramMonitor
 from app.gui.monitor.window import ProgramWindow
-from app.publish.client import StationClient
+from app.publish.client import Certificate, KnownStations, StationClient
+from app.publish.pki import TrustList, thumbprint
 from app.runtime import Runtime
 from netplc.records import Record
 from tests.app.conftest import REPO
@@ -39,13 +41,16 @@ DENIED = "the station answered BadUserAccessDenied"
 class Station:
     """The monitor's test station (users eng1 engineer, olga operator, vera viewer) serving OPC UA."""
 
-    def __init__(self, folder: Path) -> None:
+    def __init__(self, folder: Path, bound: str = "127.0.0.1") -> None:
+        """`bound`: the address the endpoint is bound to (0.0.0.0: off loopback, secured)."""
         station(folder)
         (folder / "tags.csv").write_text(TAGS, encoding="utf-8")
-        self.url = f"opc.tcp://127.0.0.1:{free_port()}/netplc/"
+        port = free_port()
+        self.url = f"opc.tcp://127.0.0.1:{port}/netplc/"
         toml = folder / "station.toml"
         toml.write_text(f'Tags = "tags.csv"\n{toml.read_text(encoding="utf-8")}\n[opcua]\nenabled = true\n'
-                        f'endpoint = "{self.url}"\nwritable = ["TEMP_SP"]\n', encoding="utf-8")
+                        f'endpoint = "opc.tcp://{bound}:{port}/netplc/"\nwritable = ["TEMP_SP"]\n',
+                        encoding="utf-8")
         self.folder = folder
         self.runtime = Runtime(load_station(folder))
         self.records: list[Record] = []
@@ -222,3 +227,69 @@ def test_main_monitor_opcua_refuses_a_wrong_password_with_a_message(remote: Stat
     assert r.returncode == 2 and "nowhere.stl: neither a program file nor a station folder" in r.stderr
     r = monitor(dead, "--user", "eng1", password="eng1")
     assert r.returncode == 2 and f"{dead}: no answer" in r.stderr and "Traceback" not in r.stderr
+
+
+def test_off_loopback_the_monitor_trusts_the_station_once_and_an_admin_trusts_the_monitor(
+        qtbot, tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> None:
+    """A station bound off loopback (0.0.0.0, reached on 127.0.0.1) serves Sign&Encrypt only: the
+    monitor shows the station's certificate the first time and keeps it; the station refuses the
+    monitor's own certificate until its admin trusts it; a station that changed its certificate
+    since is refused before anything is sent."""
+    remote = Station(tmp_path / "st", bound="0.0.0.0")
+    config = tmp_path / "config"
+    shown: list[Certificate] = []
+
+    def login(trust: bool = True) -> LoginDialog:
+        client = StationClient(remote.url, folder=config, period=0.05)
+        remote.clients.append(client)
+        monkeypatch.setattr(LoginDialog, "trust", lambda _self, cert: shown.append(cert) or trust)
+        dialog = LoginDialog(client, "eng1", "eng1")  # a password given: it logs in by itself
+        qtbot.addWidget(dialog)
+        dialog.show()
+        wait(qtbot, lambda: dialog.result() != 0 or dialog.isHidden(), 30000)
+        return dialog
+
+    try:
+        dialog = login()  # first use: the station's certificate shown, trusted, kept
+        station_der = (remote.folder / "pki" / "own" / "cert.der").read_bytes()
+        assert [c.der for c in shown] == [station_der]
+        assert shown[0].sha256 == Certificate(station_der).sha256 and len(shown[0].sha1) == 59
+        assert KnownStations(config).verdict(remote.url, shown[0]) == "known"
+        assert stat.S_IMODE((config / "known_stations.json").stat().st_mode) == 0o600
+        assert stat.S_IMODE((config / "monitor" / "key.pem").stat().st_mode) == 0o600
+        # ... but the station does not trust the monitor yet: said with the command that trusts it
+        assert dialog.result() == QDialog.DialogCode.Rejected
+        mine = thumbprint((config / "monitor" / "cert.der").read_bytes())
+        assert f"python main.py opcua trust STATION {mine}" in dialog.error
+        assert any(f"thumbprint {mine}" in (r.text or "") for r in remote.records)  # the station's journal
+        TrustList(remote.folder).trust(mine)  # what `main.py opcua trust` does, by the station's admin
+        dialog = login()  # known now: not asked again
+        assert dialog.result() == QDialog.DialogCode.Accepted and len(shown) == 1
+        source = OpcUaSource(dialog.client)
+        assert source.force("bit", 0o2000, 1, "eng1").result(10).ok
+        assert "force 02000: 0 -> 1" in remote.operator("eng1")
+        # the station shows another certificate than the one trusted: refused, nothing sent
+        known = config / "known_stations.json"
+        known.write_text(known.read_text(encoding="utf-8").replace(shown[0].sha256[:5], "00:00"),
+                         encoding="utf-8")
+        dialog = login()
+        assert dialog.result() == QDialog.DialogCode.Rejected and len(shown) == 1
+        assert "shows another certificate than the one trusted before" in dialog.error
+        assert dialog.client.snapshot is None
+    finally:
+        remote.stop()
+
+
+def test_a_lost_link_is_said_and_the_monitor_logs_in_again(qtbot, remote: Station, tmp_path: Path) -> None:
+    monitor = monitor_of(qtbot, remote, "eng1", tmp_path)
+    client = remote.clients[-1]
+    wait(qtbot, lambda: monitor.state.text().startswith("eng1 at st: NetPlc running"))
+    remote.runtime.stop()  # the station goes away
+    wait(qtbot, lambda: monitor.state.text().startswith("link down: "))
+    assert monitor.step_button.isEnabled()  # what the station said last still holds: it answers each action
+    assert not monitor.force("bit", 0o2000, 1).result(10).ok  # not sent: said, not raised
+    remote.runtime = Runtime(load_station(remote.folder))  # back, on the same endpoint
+    remote.runtime.subscribe(remote.records.append)
+    remote.runtime.start()
+    wait(qtbot, lambda: monitor.state.text().startswith("eng1 at st: NetPlc running"), 30000)
+    assert client.error == "" and monitor.force("bit", 0o2000, 1).result(10).ok

@@ -50,6 +50,8 @@ class LoginDialog(QDialog):
         self.message = QLabel(f"asking {client.url} what it offers…")
         self.message.setObjectName("loginMessage")
         self.message.setWordWrap(True)
+        self.message.setMinimumHeight(5 * self.message.fontMetrics().height())  # a refusal and what to do
+        self.setMinimumWidth(640)
         self.buttons = QDialogButtonBox(QDialogButtonBox.StandardButton.Cancel)
         self.login = self.buttons.addButton("Log in", QDialogButtonBox.ButtonRole.AcceptRole)
         self.login.setEnabled(False)
@@ -59,8 +61,10 @@ class LoginDialog(QDialog):
         form.addRow("User of the station:", self.user)
         form.addRow("Password:", self.password)
         lay = QVBoxLayout(self)
-        lay.addWidget(QLabel("The monitor acts as this user of the station: the station checks, and "
-                             "journals with this name, everything done from it."))
+        intro = QLabel("The monitor acts as this user of the station: the station checks, and journals "
+                       "with this name, everything done from it.")
+        intro.setWordWrap(True)
+        lay.addWidget(intro)
         lay.addLayout(form)
         lay.addWidget(self.message)
         lay.addWidget(self.buttons)
