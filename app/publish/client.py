@@ -387,16 +387,23 @@ class StationClient:
                     await self._ask_rights()
                 self.error, failures = "", 0
             except (OSError, TimeoutError, ua.UaError, LoginError) as e:
-                why = _why(e)
-                if why != self.error:
-                    logger.warning("%s: %s", self.url, why)  # once per cause, not every try
-                self.error = why
-                client, self._client = self._client, None
-                if client is not None:
-                    with contextlib.suppress(Exception):  # the link is gone: closing it may fail too
-                        await client.disconnect()
-                await asyncio.sleep(RETRY_S[min(failures, len(RETRY_S) - 1)])
+                if _why(e) != self.error:
+                    logger.warning("%s: %s", self.url, _why(e))  # once per cause, not every try
+                await self._lost(_why(e), failures)
                 failures += 1
+            except Exception as e:  # not the link's fault: logged whole, then tried again the same way
+                logger.exception("%s: reading the station failed", self.url)
+                await self._lost(f"{type(e).__name__}: {e}", failures)
+                failures += 1
+
+    async def _lost(self, why: str, failures: int) -> None:
+        """The session is given up (said in `error`) and a new one tried after a back-off."""
+        self.error = why
+        client, self._client = self._client, None
+        if client is not None:
+            with contextlib.suppress(Exception):  # the link is gone: closing it may fail too
+                await client.disconnect()
+        await asyncio.sleep(RETRY_S[min(failures, len(RETRY_S) - 1)])
 
     def _node(self, name: str) -> ua.NodeId:
         return ua.NodeId(name, self._ns)
