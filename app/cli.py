@@ -30,7 +30,8 @@ def _main_parser() -> argparse.ArgumentParser:
         epilog="other commands: view [ARCHIVE] (offline journal viewer), check STATION (validate a "
                "station), simulate PROGRAM.stl (a simulated CPU-165 node), alarms-report ARCHIVE --day "
                "DD_MM_YYYY (alarm-system health), design [FORM.hmi | STATION] (the form designer), "
-               "monitor STATION_OR_HOST:PORT (the program monitor of a running station), archive migrate "
+               "monitor opc.tcp://HOST:PORT/PATH | STATION_OR_HOST:PORT (the program monitor of a running "
+               "station), archive migrate "
                "ARCHIVE.sqlite postgresql://... (copy an archive into the plant archive), "
                "users (the station's users and roles), opcua trust STATION THUMBPRINT (trust an OPC UA "
                "client's certificate); each takes --help.",
@@ -107,12 +108,18 @@ def _design_parser() -> argparse.ArgumentParser:
 
 def _monitor_parser() -> argparse.ArgumentParser:
     p = argparse.ArgumentParser(prog="python main.py monitor",
-                                description="The Program view of a running station over its Modbus server, "
-                                            "read-only (Modbus has no users): the listing with live states "
-                                            "and a watch table. Write, force and step at the station's own "
-                                            "workstation, as a user of that station.")
-    p.add_argument("target", help="station folder or station.toml (its program, symbols and Modbus port), "
-                                  "or HOST:PORT of a NetPlc Modbus server")
+                                description="The Program view of a running station: the listing with live "
+                                            "states and a watch table. Over the station's OPC UA endpoint "
+                                            "as a user of that station (a login dialog), who writes tags, "
+                                            "forces and steps as far as the station lets them; over its "
+                                            "Modbus server read-only (Modbus has no users).")
+    p.add_argument("target", help="opc.tcp://HOST:PORT/PATH of the station's OPC UA endpoint; or, read-only "
+                                  "over Modbus, a station folder or station.toml (its program, symbols and "
+                                  "Modbus port) or HOST:PORT of a NetPlc Modbus server")
+    p.add_argument("--program", metavar="PROGRAM", help="the program to list: PROGRAM.stl, or the station "
+                                                        "folder for its program, symbols and tags")
+    p.add_argument("--user", help="over OPC UA, the user to log in as (the dialog asks the password; when "
+                                  "stdin is not a terminal, its first line is the password)")
     return p
 
 
@@ -225,7 +232,7 @@ def main(argv: list[str] | None = None) -> int:
             ns = _monitor_parser().parse_args(rest)
             from app.gui.monitor.window import run_monitor
 
-            return run_monitor(ns.target)
+            return run_monitor(ns.target, ns.program, ns.user)
         if command == "archive":
             ns = _archive_parser().parse_args(rest)
             return run_migrate(ns.source, ns.url, ns.station)

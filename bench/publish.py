@@ -35,11 +35,14 @@ import numpy as np
 
 sys.path.insert(0, str(Path(__file__).resolve().parent.parent))
 
+from app.authority import Commands
+from app.publish.feed import Watch
 from app.publish.mqtt import SparkplugPublisher
 from app.publish.opcua import OpcUaServer
-from app.publish.points import PointReader, Writable, Writer
+from app.scada.quality import LinkView, QualityMap
+from app.scada.readings import Readings
 from app.scada.tag import Tag, TagType
-from app.station.config import MqttSettings
+from app.station.config import MqttSettings, OpcUaSettings
 from netplc.address import data_address
 from netplc.engine import Engine
 from netplc.memory import Memory
@@ -60,17 +63,25 @@ def free_port() -> int:
         return s.getsockname()[1]
 
 
-def station() -> tuple[Engine, list[Tag], PointReader, Writer]:
+def station() -> tuple[Engine, list[Tag], Commands, Watch]:
+    """The engine, its tags, a command layer (nobody may write: the bench only reads) and the
+    station's feed of `Readings` (every tag good), as the runtime gives them to its publishers."""
     tags = [Tag(f"T{i:05d}", data_address(2 * (i % WORDS)), TagType.WORD) for i in range(TAGS)]
-    engine = Engine(parse("JMP 0\n"), tick=TICK, memory=Memory())
+    program = parse("JMP 0\n")
+    engine = Engine(program, tick=TICK, memory=Memory())
 
     def bump(mem: Memory) -> None:
         words = np.frombuffer(mem.data, dtype="<u2", count=WORDS)
         words += 1
 
     engine.subscribe(lambda _s: engine.post(bump))  # every word changes in every scan
-    reader = PointReader(tags, lambda: None)
-    return engine, tags, reader, Writer(engine, tags, Writable(()), NullSink(), time.time)
+    quality = QualityMap(program, tags)
+    good = np.zeros(len(tags), dtype=np.int8)
+
+    def watch(callback: Callable[[Readings], None]) -> Callable[[], None]:
+        return engine.subscribe(lambda snap: callback(Readings(snap, quality, LinkView(), good)))
+
+    return engine, tags, Commands(engine, NullSink(), role_of=lambda _name: None, tags=tags), watch
 
 
 def cpu_during(fn: Callable[..., T], *args: object) -> tuple[T, float]:
@@ -104,10 +115,11 @@ def bench_plain(seconds: float) -> None:
 
 
 def bench_opcua(seconds: float) -> None:
-    engine, tags, reader, writer = station()
+    engine, tags, commands, watch = station()
     url = f"opc.tcp://127.0.0.1:{free_port()}/netplc/"
-    server = OpcUaServer(endpoint=url, station="Bench", folder=Path(tempfile.mkdtemp()), tags=tags,
-                         reader=reader, writer=writer, engine=engine, exchange=None)
+    server = OpcUaServer(settings=OpcUaSettings(enabled=True, endpoint=url), station="Bench",
+                         folder=Path(tempfile.mkdtemp()), tags=tags, commands=commands, watch=watch,
+                         engine=engine, exchange=None)
     server.start()
     thread = ScanThread(engine, TICK)
     thread.start()
@@ -167,9 +179,9 @@ def bench_mqtt(seconds: float) -> None:
         broker.conf.read_text() + "message_size_limit 0\nmax_inflight_bytes 0\n", encoding="utf-8")
     broker.start()
     try:
-        engine, tags, reader, writer = station()
+        engine, tags, commands, watch = station()
         settings = MqttSettings(enabled=True, broker=broker.url, group_id="Bench", edge_node_id="B")
-        publisher = SparkplugPublisher(settings, "B", tags=tags, reader=reader, writer=writer, engine=engine,
+        publisher = SparkplugPublisher(settings, "B", tags=tags, commands=commands, watch=watch,
                                        journal=lambda _t: None)
         thread = ScanThread(engine, TICK)
         sub = subprocess.Popen([sys.executable, __file__, "--mqtt-client", str(broker.port), str(seconds),

@@ -1,5 +1,5 @@
-"""The station's OPC UA methods: run, stop and step NetPlc, force and unforce, for a remote
-Program view (`main.py monitor opc.tcp://...`) acting as a logged-in user of the station.
+"""The station's OPC UA methods: run, stop and step NetPlc, force and unforce an address or a tag,
+for a remote Program view (`main.py monitor opc.tcp://...`) acting as a logged-in user of the station.
 
 Each call is the station's command (app/authority/) with the session's user and peer: the layer
 checks the role, journals it and answers once applied and committed; the call's StatusCode is the
@@ -29,19 +29,25 @@ StepLock = Callable[[], "threading.Lock | None"]  # the scan thread's lock; None
 class Method:
     name: str
     action: Action
-    inputs: tuple[tuple[str, str], ...] = ()  # (name, description), each a String
+    inputs: tuple[tuple[str, str, int], ...] = ()  # (name, description, DataType: an ObjectIds number)
     description: str = ""
 
 
+_STRING, _INT32, _DOUBLE = ua.ObjectIds.String, ua.ObjectIds.Int32, ua.ObjectIds.Double
+KIND, ADDRESS, TAG = ("Kind", "bit, byte or word", _STRING), ("Address", "octal, as 04010", _STRING), \
+    ("Name", "the tag's name, as in tags.csv", _STRING)
 METHODS = (
     Method("Run", Action.RUN, description="Run NetPlc's program"),
     Method("Stop", Action.STOP, description="Stop NetPlc's program"),
     Method("Step", Action.STEP, description="One scan while NetPlc is stopped"),
-    Method("Force", Action.FORCE, (("Kind", "bit, byte or word"), ("Address", "octal, as 04010"),
-                                   ("Value", "the forced value, a whole number")),
+    Method("Force", Action.FORCE, (KIND, ADDRESS, ("Value", "the forced value, a whole number; Null: its "
+                                                             "present value (bumpless)", _INT32)),
            "Force an address to a value (force > program > live)"),
-    Method("Unforce", Action.UNFORCE, (("Kind", "bit, byte or word"), ("Address", "octal, as 04010")),
-           "Remove the force of an address"),
+    Method("Unforce", Action.UNFORCE, (KIND, ADDRESS), "Remove the force of an address"),
+    Method("ForceTag", Action.FORCE, (TAG, ("Value", "in the tag's physical units; Null: its present "
+                                                     "value (bumpless)", _DOUBLE)),
+           "Force a tag (its bit, or all its words) to a physical value"),
+    Method("UnforceTag", Action.UNFORCE, (TAG,), "Remove the force of a tag (all its words)"),
     Method("UnforceAll", Action.UNFORCE, description="Remove every force"),
 )
 
@@ -55,12 +61,10 @@ class StationMethods:
 
     async def add(self, parent: Node, idx: int) -> None:
         for method in METHODS:
-            args = [ua.Argument(Name=name, DataType=ua.NodeId(ua.ObjectIds.String), ValueRank=-1,
-                                Description=ua.LocalizedText(text)) for name, text in method.inputs]
-            if method.name == "Force":
-                args[2].DataType = ua.NodeId(ua.ObjectIds.Int32)
-            node = await parent.add_method(ua.NodeId(f"Station.{method.name}", idx), f"{idx}:{method.name}",
-                                           _not_through_a_session, args, [])
+            args = [ua.Argument(Name=name, DataType=ua.NodeId(kind), ValueRank=-1,
+                                Description=ua.LocalizedText(text)) for name, text, kind in method.inputs]
+            nodeid, name = ua.NodeId(f"Station.{method.name}", idx), ua.QualifiedName(method.name, idx)
+            node = await parent.add_method(nodeid, name, _not_through_a_session, args, [])
             await node.write_attribute(ua.AttributeIds.Description,
                                        ua.DataValue(ua.Variant(ua.LocalizedText(method.description))))
             self.by_node[node.nodeid] = method
@@ -95,21 +99,33 @@ class StationMethods:
             return await asyncio.to_thread(commands.step, who, self.step_lock())
         if method.name == "UnforceAll":
             return commands.unforce_all(who)
+        if method.name in ("ForceTag", "UnforceTag"):
+            return self._tag(who, method, args)
         kind, address = args[0], args[1]
         target = f"{kind} {address}"
         try:
             if kind not in KINDS:
                 raise ValueError(f"{kind!r} is not one of {', '.join(KINDS)}")
             addr = parse_octal(str(address))
-            if method.name == "Force":
-                value = args[2]
-                if not isinstance(value, int) or isinstance(value, bool):
-                    raise ValueError(f"{value!r} is not a whole number")
+            value = args[2] if method.name == "Force" else None
+            if value is not None and (not isinstance(value, int) or isinstance(value, bool)):
+                raise ValueError(f"{value!r} is not a whole number")
         except (AddressError, ValueError) as e:
             return commands.refuse(who, method.action, target, Reason.INVALID, str(e))
         if method.name == "Force":
             return commands.force(who, kind, addr, value)  # type: ignore[arg-type]
         return commands.unforce(who, kind, addr)  # type: ignore[arg-type]
+
+    def _tag(self, who: Who, method: Method, args: list[object]) -> Ticket:
+        commands, name = self.commands, args[0]
+        if not isinstance(name, str):
+            return commands.refuse(who, method.action, str(name), Reason.INVALID, "a tag's name is a String")
+        if method.name == "UnforceTag":
+            return commands.unforce_tag(who, name)
+        value = args[1]
+        if value is not None and (not isinstance(value, (int, float)) or isinstance(value, bool)):
+            return commands.refuse(who, method.action, name, Reason.INVALID, f"{value!r} is not a number")
+        return commands.force_tag(who, name, None if value is None else float(value))
 
 
 def _not_through_a_session(parent: ua.NodeId, *args: object) -> ua.StatusCode:

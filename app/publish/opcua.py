@@ -14,7 +14,8 @@ for a scaled tag...), anything else is Bad_TypeMismatch; a node that is never wr
 the node diagnostics, a tag `[opcua] writable` does not name) is Bad_NotWritable, journaled like
 every refusal. UserAccessLevel is answered per session from the same policy: read for a viewer or
 an anonymous client, read and write for a role that may write. The station object's methods
-(methods.py: run, stop, step, force, unforce) are commands the same way. No role is checked here.
+(methods.py: run, stop, step, force and unforce an address or a tag) are commands the same way;
+NetPlc's memory and forces are read-only variables for a remote Program view. No role is checked here.
 
 Security off loopback: sessions only over Basic256Sha256 Sign&Encrypt. asyncua keeps a None channel
 when a client asks for one, and would then create a session over it (a password in clear);
@@ -39,6 +40,7 @@ import asyncio
 import contextlib
 import contextvars
 import ipaddress
+import json
 import logging
 import math
 import threading
@@ -50,7 +52,7 @@ from typing import Any
 from urllib.parse import urlsplit
 
 import numpy as np
-from asyncua import Server, ua
+from asyncua import Node, Server, ua
 from asyncua.common.callback import CallbackType, ServerItemCallback
 from asyncua.common.utils import ServiceError
 from asyncua.crypto.permission_rules import SimpleRoleRuleset, User, UserRole
@@ -68,6 +70,9 @@ from app.scada.quality import Quality
 from app.scada.readings import Readings
 from app.scada.tag import Tag, TagType
 from app.station.config import OpcUaSettings
+from netplc.address import DATA_SIZE, IO_BITS, fmt_octal
+from netplc.forcing import Force
+from netplc.memory import Snapshot
 from netplc.records import Record
 
 logger = logging.getLogger(__name__)
@@ -91,6 +96,11 @@ READ, WRITE = 1 << ua.AccessLevel.CurrentRead, 1 << ua.AccessLevel.CurrentWrite
 YIELD_EVERY = 500  # variable writes between two turns of the event loop
 SEVERITY = {1: 900, 2: 700, 3: 500, 4: 300}  # alarm priority -> OPC UA severity 1-1000
 READABLE_WITHIN = 2.0  # s at most an applied write waits for its value to be readable here
+MEMORY_BITS = "NetPlc's I/O bits 00000-03777, one byte each (0 or 1): byte n is bit n"
+MEMORY_DATA = ("NetPlc's data memory, its 8 banks of 2 KB in turn: byte k*2048 + i is address "
+               "k*010000 + 04000 + i (04000..07777, 014000..017777, ... 074000..077777)")
+FORCES = ('what is forced, as JSON: [{"kind": "bit", "address": "02120", "value": 1, "user": "..."}] '
+          "(kind bit, byte or word; address in octal); force > program > live")
 
 
 def is_loopback(endpoint: str) -> bool:
@@ -109,6 +119,17 @@ def variant_type(tag: Tag) -> ua.VariantType:
     return {TagType.BIT: ua.VariantType.Boolean, TagType.WORD: ua.VariantType.UInt16,
             TagType.INT16: ua.VariantType.Int16, TagType.BCD: ua.VariantType.UInt16,
             TagType.INT32: ua.VariantType.Int32, TagType.FLOAT32: ua.VariantType.Float}[tag.type]
+
+
+def forces_json(forces: Sequence[Force]) -> str:
+    return json.dumps([{"kind": f.kind, "address": fmt_octal(f.addr), "value": f.value, "user": f.user}
+                       for f in forces])
+
+
+ENCODE: tuple[Callable[[Any], ua.Variant], ...] = (  # the memory variables' values from a snapshot's
+    lambda bits: ua.Variant(bytes(bits), ua.VariantType.ByteString),  # bits, data and forces
+    lambda data: ua.Variant(data, ua.VariantType.ByteString),
+    lambda forces: ua.Variant(forces_json(forces)))
 
 
 def _python(kind: ua.VariantType) -> Callable[[float], Any]:
@@ -402,6 +423,7 @@ class OpcUaServer:
                                                ua.Variant(0, ua.VariantType.UInt64))
         await plc.add_variable(ua.NodeId("NetPlc.NetSyncTimeMs", idx), f"{idx}:NetSyncTimeMs",
                                ua.Variant(round(self.engine.tick * 1000), ua.VariantType.UInt32))
+        await self._add_memory(plc, idx)
         nodes = await station.add_folder(ua.NodeId("Nodes", idx), f"{idx}:Nodes")
         self.node_vars: dict[int, dict[str, Any]] = {}
         for n, stats in (self.exchange.stats.items() if self.exchange is not None else ()):
@@ -422,6 +444,32 @@ class OpcUaServer:
             self.alarm_vars[alarm.id] = var
         self.events = await server.get_event_generator(ua.ObjectIds.BaseEventType, station)
         await self.methods.add(station, idx)
+
+    async def _add_memory(self, plc: Node, idx: int) -> None:
+        """NetPlc's memory and forces, read-only, for a remote Program view (`main.py monitor
+        opc.tcp://...`), which needs raw memory, not only tags. asyncua's Read ignores IndexRange:
+        a client reads each whole (20 KB in all)."""
+        memory = await plc.add_object(ua.NodeId("NetPlc.Memory", idx), ua.QualifiedName("Memory", idx))
+        nodes = []
+        for parent, name, initial, description in ((memory, "Bits", bytes(IO_BITS), MEMORY_BITS),
+                                                   (memory, "Data", bytes(DATA_SIZE), MEMORY_DATA),
+                                                   (plc, "Forces", "[]", FORCES)):
+            path = "NetPlc." + ("" if parent is plc else "Memory.") + name
+            var = await parent.add_variable(ua.NodeId(path, idx), ua.QualifiedName(name, idx), initial)
+            await var.write_attribute(ua.AttributeIds.Description,
+                                      ua.DataValue(ua.Variant(ua.LocalizedText(description))))
+            nodes.append(var.nodeid)
+        self.memory_nodes = nodes
+        self._memory: tuple[object, ...] = (None, None, None)  # bits, data, forces as last written
+
+    async def _publish_memory(self, snapshot: Snapshot, when: datetime) -> None:
+        """The memory variables as of `snapshot`, each written only when it changed."""
+        write = self.server.iserver.aspace.write_attribute_value
+        now = (snapshot.bits, snapshot.data, snapshot.forces)
+        for node, new, old, encode in zip(self.memory_nodes, now, self._memory, ENCODE):
+            if new is not old and new != old:
+                await write(node, ua.AttributeIds.Value, ua.DataValue(encode(new), SourceTimestamp=when))
+        self._memory = now
 
     async def _publish(self, readings: Readings) -> None:
         reading = self.reader.read(readings)
@@ -446,6 +494,7 @@ class OpcUaServer:
                                   SourceTimestamp=when)
             await write(self.nodeids[i], value_attr, dv)
         self.status.updates += len(changed)
+        await self._publish_memory(readings.snapshot, when)  # before the tick that says which scan
         await self.plc_state.write_value(reading.state)
         await self.plc_scan_ms.write_value(float(self.engine.stats.last_ms))
         await self.plc_tick.write_value(ua.Variant(reading.scan, ua.VariantType.UInt64))

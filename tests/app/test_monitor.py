@@ -345,7 +345,7 @@ def test_the_monitor_command_target_is_a_station_or_host_port(qtbot, tmp_path: P
             source.close()
     finally:
         rt.stop()
-    with pytest.raises(Problems, match="neither a station folder nor HOST:PORT"):
+    with pytest.raises(Problems, match=r"neither an opc\.tcp:// URL, a station folder nor HOST:PORT"):
         remote_source("no-such-thing")
     dead = remote_source(f"127.0.0.1:{port}")  # nothing listens there any more: said, not raised
     try:
@@ -403,7 +403,8 @@ def test_main_monitor_command_refuses_a_bad_target_with_a_message() -> None:
     env = {**os.environ, "QT_QPA_PLATFORM": "offscreen"}
     r = subprocess.run([sys.executable, "main.py", "monitor", "nowhere"], cwd=REPO, capture_output=True,
                        text=True, timeout=60, env=env)
-    assert r.returncode == 2 and "nowhere: neither a station folder nor HOST:PORT" in r.stderr
+    assert r.returncode == 2
+    assert "nowhere: neither an opc.tcp:// URL, a station folder nor HOST:PORT" in r.stderr
     assert "Traceback" not in r.stderr
 
 

@@ -1,21 +1,27 @@
-"""Where the Program view gets memory from: the station's own runtime (the workstation's
-Station -> Program), or a running station's Modbus server (`main.py monitor`).
+"""Where the Program view gets memory from, and what it acts through: the station's own runtime
+(the workstation's Station -> Program), a running station over its OPC UA endpoint as a user of that
+station (`main.py monitor opc.tcp://...`), or a running station's Modbus server (`main.py monitor
+HOST:PORT`, read-only).
 
-Every action of the local view (write, force, unforce, step) is a command of the station's command
-layer as the user at the workstation, from the Program view (`Source.PROGRAM_VIEW`): the layer
-checks the role, journals it naming them, and answers with a `Ticket`, as every other seat's
-actions are. Only the local source acts (`Acting`).
+Every action of the view (write, force, unforce, step) is a command of the station's command layer:
+the local source sends it as the user at the workstation, from the Program view
+(`Source.PROGRAM_VIEW`); the OPC UA source sends it over the station's methods and tag variables as
+the user logged in there (app/publish/client.py), which the station takes as its commands with that
+session's user (`opcua:<user>@<peer>` in its journal). Either way the layer checks the role, journals
+it and answers with a `Ticket`. What the user may do is the layer's answer too (`denial`): the local
+layer's, or the station's (UserExecutable and UserAccessLevel); no source checks a role itself.
+Over OPC UA only tags are written (through their variables): a raw address is not written from a
+remote monitor, there being no method for it.
 
-The remote monitor is read-only: Modbus has no users, so a write or a force sent over it would be
-an action of nobody, journaled with an address and checked against no role. Acting on a remote
-station needs a user of that station, logged in over its OPC UA endpoint (the remote console of
-issue 25); until then it is done at the station's own workstation. Nor can the remote monitor see
-the station's forces (the Modbus map has no channel for them): `forces()` answers None, unknown.
+The Modbus monitor is read-only: Modbus has no users, so a write or a force sent over it would be
+an action of nobody, journaled with an address and checked against no role. Nor can it see the
+station's forces (the Modbus map has no channel for them): `forces()` answers None, unknown.
 
-Both give the view a `Snapshot` and nothing live, so the monitor never touches the scan: the
-local source hands over the engine's last published snapshot; the remote one polls the cpu165
-map of the station's server on its own thread (the I/O bits, and only the data registers the view
-says it needs) and builds a snapshot from the answers.
+All give the view a `Snapshot` and nothing live, so the monitor never touches the scan: the local
+source hands over the engine's last published snapshot; the remote ones read the station on a
+thread of their own (OPC UA: the whole of NetPlc's memory and its forces at the view's refresh
+rate; Modbus: the I/O bits, and only the data registers the view says it needs) and build a
+snapshot from the answers.
 """
 
 from __future__ import annotations
@@ -24,24 +30,31 @@ import asyncio
 import logging
 import time
 from collections.abc import Iterable
-from typing import Protocol
+from concurrent.futures import Future
+from typing import TYPE_CHECKING, Protocol
 
-from app.authority import Commands, Ticket, Who
+from app.authority import Action, Answer, Commands, Reason, Refusal, Ticket, Who
 from app.authority import Source as Seat
 from app.scada.tag import Tag
 from app.station.runtime import Runtime
-from netplc.address import DATA_SIZE, IO_BITS, data_index, is_data_byte
+from netplc.address import DATA_SIZE, IO_BITS, data_index, fmt_octal, is_data_byte
 from netplc.forcing import Force, Kind
 from netplc.memory import Snapshot
 from netplc.modbus import DeviceError, LinkError, LoopThread, open_client, parse_endpoint
 from netplc.program import Program, parse
 
+if TYPE_CHECKING:  # the workstation's Program view loads no OPC UA client
+    from app.publish.client import StationClient
+
 logger = logging.getLogger(__name__)
 
 POLL_S = 0.2  # the remote monitor's poll period: 5 reads of the station per second
 TIMEOUT_S = 2.0
-READ_ONLY = ("read-only: Modbus has no users; write, force and step at the station's own workstation, "
-             "as a user of that station")
+READ_ONLY = ("read-only: Modbus has no users; write, force and step as a user of the station, over its "
+             "OPC UA endpoint (main.py monitor opc.tcp://...) or at its own workstation")
+NO_PROGRAM = "<no program: give --program (the program, or the station folder) to see its listing>"
+RAW_WRITE = ("over OPC UA only tags are written, through their variables; an address is written at the "
+             "station's own workstation")
 
 
 class Source(Protocol):
@@ -74,9 +87,12 @@ class Source(Protocol):
 class Acting(Source, Protocol):
     """A source the view acts through: each action a command of the station's layer."""
 
-    commands: Commands
+    rights: int  # changes whenever what the user may do may have changed (the view asks again)
 
-    def who(self, user: str) -> Who: ...
+    def denial(self, action: Action, user: str, what: str, tag: Tag | None = None) -> Refusal | str | None:
+        """Why `user` may not do `action` (`what`: the view's words for it; for a write, `tag` is the
+        tag written, None for an address), as the station's layer says; None when they may."""
+        ...
 
     def write(self, kind: Kind, addr: int, value: int, user: str) -> Ticket: ...
 
@@ -99,6 +115,7 @@ class LocalSource:
     """The workstation's own runtime: snapshots; writes, forces and single scans as commands."""
 
     read_only = ""
+    rights = 0  # a change of user at the workstation is told to the view (update_rights)
 
     def __init__(self, runtime: Runtime) -> None:
         assert runtime.engine is not None and runtime.commands is not None, \
@@ -136,6 +153,9 @@ class LocalSource:
     def who(self, user: str) -> Who:
         return Who(user, Seat.PROGRAM_VIEW)
 
+    def denial(self, action: Action, user: str, what: str, tag: Tag | None = None) -> Refusal | None:
+        return self.commands.denial(self.who(user), action, what=what)
+
     def write(self, kind: Kind, addr: int, value: int, user: str) -> Ticket:
         """An operator write like any other: queued to the next scan, journaled with the user."""
         if kind == "bit":
@@ -170,6 +190,89 @@ class LocalSource:
 
     def close(self) -> None:
         pass
+
+
+class OpcUaSource:
+    """A running station over its OPC UA endpoint, as the user logged in there (`client`, opened)."""
+
+    read_only = ""
+
+    def __init__(self, client: StationClient, *, program: Program | None = None,
+                 symbols: dict[str, int] | None = None, tags: dict[str, Tag] | None = None) -> None:
+        self.client = client
+        self.program = program or parse("", source=NO_PROGRAM)
+        self.symbols = symbols or {}
+        self.tags = tags or {}
+        self.title = f"{client.user} at {client.url}" + (f": {self.program.source}" if program else "")
+
+    @property
+    def acting(self) -> OpcUaSource:
+        return self
+
+    @property
+    def rights(self) -> int:
+        return self.client.rights
+
+    def snapshot(self) -> Snapshot | None:
+        return self.client.snapshot
+
+    def state(self) -> str:
+        return self.client.state()
+
+    def timer(self, c: int) -> float | None:
+        return None  # not published
+
+    def counter(self, c: int) -> int | None:
+        return None
+
+    def forces(self) -> tuple[Force, ...]:
+        snap = self.client.snapshot
+        return snap.forces if snap is not None else ()
+
+    def need(self, addrs: Iterable[int]) -> None:
+        pass  # the whole of memory is read
+
+    def denial(self, action: Action, user: str, what: str, tag: Tag | None = None) -> str | None:
+        """The station's answer: UserExecutable of its method for `action`, UserAccessLevel of a
+        tag's variable for a write (asked from the first time it is wanted)."""
+        client = self.client
+        if action is Action.WRITE and tag is None:
+            return f"{what}: {RAW_WRITE}"
+        may = client.may_write(tag.name) if tag is not None else client.may(action)
+        if may:
+            return None
+        if may is None:
+            return f"{what}: asking the station what {client.user} may do…"
+        return f"{what}: the station does not let {client.user} do this"
+
+    def write(self, kind: Kind, addr: int, value: int, user: str) -> Ticket:
+        ticket: Ticket = Future()
+        ticket.set_result(Answer(Reason.NOT_WRITABLE, RAW_WRITE))
+        return ticket
+
+    def write_tag(self, tag: Tag, phy: float, user: str) -> Ticket:
+        return self.client.write_tag(tag, phy)
+
+    def force(self, kind: Kind, addr: int, value: int | None, user: str) -> Ticket:
+        return self.client.call("Force", kind, fmt_octal(addr), value)
+
+    def unforce(self, kind: Kind, addr: int, user: str) -> Ticket:
+        return self.client.call("Unforce", kind, fmt_octal(addr))
+
+    def force_tag(self, tag: Tag, phy: float | None, user: str) -> Ticket:
+        return self.client.call("ForceTag", tag.name, phy)
+
+    def unforce_tag(self, tag: Tag, user: str) -> Ticket:
+        return self.client.call("UnforceTag", tag.name)
+
+    def unforce_all(self, user: str) -> Ticket:
+        return self.client.call("UnforceAll")
+
+    def step(self, user: str) -> Ticket:
+        return self.client.call("Step")
+
+    def close(self) -> None:
+        self.client.close()
 
 
 class RemoteSource:

@@ -4,14 +4,16 @@ It reads snapshots only (the source's last one), at most REFRESH_MS apart, and r
 a new scan arrived; the listing is a painted scroll area that draws the lines on screen and
 nothing else, so a 2,000-line program costs what 40 lines cost (bench/monitor.py measures the
 scan time with it open). The view never writes memory itself: writes, forces and single scans go
-to the local source, which sends them to the station's command layer as the user at the
-workstation (checked, journaled with the user, answered). Each answer comes back to the GUI thread
-(`Answers`) and a refusal is said under the watch table; what the user may not do is greyed, its
-tooltip naming the role it needs (app/gui/rights.py).
+to its source, which sends them to the station's command layer as the user at the workstation, or
+over OPC UA as the user logged in to the station (`main.py monitor opc.tcp://...`): checked,
+journaled with the user, answered. Each answer comes back to the GUI thread (`Answers`) and a
+refusal is said under the watch table and in the window's status bar; what the user may not do is
+greyed, its tooltip saying why, as the station's layer says it (`Acting.denial`: the role it needs
+locally; the station's answer over OPC UA, asked again whenever it may have changed).
 
-Over Modbus (`main.py monitor`) the view is read-only, and says so in a line of its own: Modbus
-has no users, so every control that would act is greyed with the reason (source.py), and the
-forces count says they are unknown, since the Modbus map cannot show them.
+Over Modbus (`main.py monitor HOST:PORT`) the view is read-only, and says so in a line of its own:
+Modbus has no users, so every control that would act is greyed with the reason (source.py), and
+the forces count says they are unknown, since the Modbus map cannot show them.
 """
 
 from __future__ import annotations
@@ -41,7 +43,7 @@ from PySide6.QtWidgets import (
     QWidget,
 )
 
-from app.authority import Action, Answer, Ticket
+from app.authority import Action, Answer, Refusal, Ticket
 from app.gui import words
 from app.gui.bridge import Answers
 from app.gui.monitor.listing import (
@@ -56,7 +58,7 @@ from app.gui.monitor.listing import (
     parse_watch,
 )
 from app.gui.monitor.source import Acting, Source
-from app.gui.rights import Control, Right, Rights
+from app.gui.rights import Control
 from app.gui.status import IDLE, WARN, Pill
 from app.scada.forcing import tag_keys
 from app.scada.tag import Tag
@@ -70,11 +72,12 @@ logger = logging.getLogger(__name__)
 REFRESH_MS = 100  # at most 10 refreshes per second
 ON, OFF, FORCED = QColor("#2e7d32"), QColor("#b0b7c0"), QColor("#e65100")
 VALUE_CHARS = 34  # the values column (timers, counters, FON operands) before the source text
-NO_LISTING = ("No program to list. Over Modbus, name the station folder (main.py monitor STATION) to see its "
-              "listing; watch addresses, symbols or tags in the table on the right.")
+NO_LISTING = ("No program to list: give it with --program (the program, or the station folder for its "
+              "symbols and tags too), or over Modbus name the station folder (main.py monitor STATION); "
+              "watch addresses, symbols or tags in the table on the right.")
 READ_ONLY_LINE = ("Read-only over Modbus: Modbus has no users, so this monitor only watches. Write, force "
-                  "and step at the station's own workstation, as a user of that station. Its forces are "
-                  "unknown here.")
+                  "and step as a user of the station: over its OPC UA endpoint (main.py monitor "
+                  "opc.tcp://HOST:PORT/PATH) or at its own workstation. Its forces are unknown here.")
 
 
 def forced_text(n: int | None) -> str:
@@ -256,6 +259,8 @@ class ListingView(QAbstractScrollArea):
 class ProgramMonitor(QWidget):
     """The Program view for one source (local runtime or remote station)."""
 
+    said = Signal(str)  # a refusal or a bad entry, as said under the watch table
+
     def __init__(self, source: Source, user: Callable[[], str], parent: QWidget | None = None) -> None:
         super().__init__(parent)
         self.setObjectName("programMonitor")
@@ -267,8 +272,9 @@ class ProgramMonitor(QWidget):
         self.refreshes = 0  # views refreshed from a new snapshot (tests and the bench look)
         self.answers = Answers()
         self.answers.answered.connect(self._answered)
-        acting = self.acting = source.acting
-        self.rights = Rights(acting.commands, lambda: acting.who(self.user())) if acting is not None else None
+        self.acting = source.acting
+        self.granted: list[tuple[Control, Action, str]] = []  # controls enabled while the user may act
+        self._rights = -1  # the source's `rights` the controls show
 
         self.find = QLineEdit()
         self.find.setPlaceholderText("Find (Enter: next)")
@@ -291,7 +297,7 @@ class ProgramMonitor(QWidget):
         self.read_only.setStyleSheet("background: #fff4d6; color: #5d4200; padding: 4px 6px;")
         self.read_only.setWordWrap(True)
         self.read_only.setToolTip(source.read_only)
-        self.read_only.setVisible(acting is None)
+        self.read_only.setVisible(self.acting is None)
         self.state = QLabel()
         self.state.setObjectName("monitorState")
         # a long link error is cut at the window's edge (whole in the tooltip), never widening it
@@ -367,6 +373,9 @@ class ProgramMonitor(QWidget):
             self.state.setToolTip(state)
             if not len(self.listing):
                 self.view.viewport().update()  # the empty listing says it too
+        acting = self.acting
+        if acting is not None and acting.rights != self._rights:
+            self.update_rights()  # the station answered anew what the user may do
         snap = self.source.snapshot()
         if snap is None or snap is self._last:
             return
@@ -449,15 +458,27 @@ class ProgramMonitor(QWidget):
         return item
 
     def _grant(self, control: Control, action: Action, what: str, keep: bool = True) -> None:
-        """Enabled while the user may do `action`, its tooltip naming the role it needs (again at
-        each change of user when `keep`); on a read-only source greyed, its tooltip saying why."""
-        if self.rights is None:
+        """Enabled while the user may do `action`, its tooltip saying why not (again at each
+        change of user or of the station's answer when `keep`); on a read-only source greyed, its
+        tooltip saying why."""
+        if self.acting is None:
             control.setEnabled(False)
             control.setToolTip(self.source.read_only)
-        elif keep:
-            self.rights.add(control, action, what)
-        else:
-            self.rights.show(Right(control, action, what))
+            return
+        if keep:
+            self.granted.append((control, action, what))
+        self._show_right(control, action, what)
+
+    def _show_right(self, control: Control, action: Action, what: str) -> None:
+        assert self.acting is not None
+        why = self.acting.denial(action, self.user(), what)
+        control.setEnabled(why is None)
+        control.setToolTip("" if why is None else self._words(why))
+
+    @staticmethod
+    def _words(why: Refusal | str) -> str:
+        """A denial in the console's language: the role it needs, or the station's own words."""
+        return words.refusal(why) if isinstance(why, Refusal) else why
 
     def _acts(self) -> Acting:
         """The source to act through; nothing that acts is enabled on a read-only one."""
@@ -466,10 +487,12 @@ class ProgramMonitor(QWidget):
         return self.acting
 
     def update_rights(self) -> None:
-        """After a change of who is at the workstation: the buttons, and the watched values that
-        may be typed over (a write)."""
-        if self.rights is not None:
-            self.rights.update()
+        """After a change of who is at the workstation, or of what the station says the user may
+        do: the buttons, and the watched values that may be typed over (a write)."""
+        if self.acting is not None:
+            self._rights = self.acting.rights
+        for control, action, what in self.granted:
+            self._show_right(control, action, what)
         for r in range(len(self.watch_items)):
             self._show_write(r)
 
@@ -480,8 +503,8 @@ class ProgramMonitor(QWidget):
         if acting is None:
             tip: str | None = self.source.read_only
         else:
-            why = acting.commands.denial(acting.who(self.user()), Action.WRITE, what=f"write {item.where}")
-            tip = None if why is None else words.refusal(why)
+            why = acting.denial(Action.WRITE, self.user(), f"write {item.where}", item.tag)
+            tip = None if why is None else self._words(why)
         editable = Qt.ItemFlag.ItemIsEditable
         self.watch.blockSignals(True)
         value.setFlags(value.flags() | editable if tip is None else value.flags() & ~editable)
@@ -671,6 +694,7 @@ class ProgramMonitor(QWidget):
 
     def _say(self, text: str) -> None:
         self.message.setText(text)
+        self.said.emit(text)
 
     def closeEvent(self, event: object) -> None:
         self.timer.stop()

@@ -1,6 +1,7 @@
 """The Program view as a window: from the workstation's Station -> Program (the local runtime, with
-writes, forcing and single scans) or from `main.py monitor STATION_OR_HOST:PORT` (a running station
-over its Modbus server: read-only, since Modbus has no users; see source.py)."""
+writes, forcing and single scans), or from `main.py monitor`: a running station over its OPC UA
+endpoint as a user of that station (`opc.tcp://...`, after the login dialog: login.py), or over its
+Modbus server (`STATION_OR_HOST:PORT`: read-only, since Modbus has no users; see source.py)."""
 
 from __future__ import annotations
 
@@ -9,15 +10,17 @@ from collections.abc import Callable
 from pathlib import Path
 
 from PySide6.QtGui import QCloseEvent
-from PySide6.QtWidgets import QApplication, QMainWindow, QWidget
+from PySide6.QtWidgets import QApplication, QDialog, QMainWindow, QWidget
 
-from app.gui.monitor.source import LocalSource, RemoteSource, Source
+from app.gui.monitor.source import LocalSource, OpcUaSource, RemoteSource, Source
 from app.gui.monitor.view import ProgramMonitor
 from app.gui.style import apply_style
+from app.scada.tag import Tag
 from app.station.config import load_station
 from app.station.load import load
 from app.station.runtime import Runtime
 from netplc.problems import Problems
+from netplc.program import Program, parse_file
 
 SIZE = (1366, 768)
 
@@ -29,6 +32,7 @@ class ProgramWindow(QMainWindow):
         self.setWindowTitle(f"Program — {source.title}" + ("" if source.acting else " (read-only)"))
         self.monitor = ProgramMonitor(source, user)
         self.setCentralWidget(self.monitor)
+        self.monitor.said.connect(self.statusBar().showMessage)
         self.resize(*SIZE)
 
     def closeEvent(self, event: QCloseEvent) -> None:
@@ -43,33 +47,78 @@ def open_local(runtime: Runtime, user: Callable[[], str]) -> ProgramWindow:
     return window
 
 
-def remote_source(target: str) -> RemoteSource:
+Listing = tuple[Program, dict[str, int], dict[str, Tag]]  # the program, its symbols, the tags by name
+
+
+def listing(path: str) -> Listing:
+    """What the monitor lists: a station folder or station.toml (its program, symbols and tags), or
+    a program file (PROGRAM.stl); Problems names what is wrong."""
+    if Path(path).is_dir() or path.endswith(".toml"):
+        loaded = load(load_station(path))
+        return loaded.program, loaded.symbols, loaded.tags.by_name
+    if not Path(path).is_file():
+        raise Problems([f"{path}: neither a program file nor a station folder"])
+    return parse_file(path), {}, {}
+
+
+def remote_source(target: str, program: str | None = None) -> RemoteSource:
     """A station folder or station.toml (its program, symbols and Modbus server), or HOST:PORT
-    (a bare watch table); Problems names what is wrong."""
+    (a bare watch table, or `program`'s listing); Problems names what is wrong."""
     if Path(target).exists():
         station = load_station(target)
         server = station.modbus_server
         if not server.enabled:
             raise Problems([f"{station.path}: modbus_server.enabled: false: the station serves no Modbus "
                             "to monitor it over"])
-        loaded = load(station)
-        return RemoteSource(server.host, server.port, unit=server.unit or 1, program=loaded.program,
-                            symbols=loaded.symbols, tags=loaded.tags.by_name)
+        listed, symbols, tags = listing(program or target)
+        return RemoteSource(server.host, server.port, unit=server.unit or 1, program=listed, symbols=symbols,
+                            tags=tags)
     host, sep, port = target.rpartition(":")
     if not sep or not host or not port.isdigit() or not 0 < int(port) < 65536:
-        raise Problems([f"{target}: neither a station folder nor HOST:PORT"])
-    return RemoteSource(host, int(port))
+        raise Problems([f"{target}: neither an opc.tcp:// URL, a station folder nor HOST:PORT"])
+    if program is None:
+        return RemoteSource(host, int(port))
+    listed, symbols, tags = listing(program)
+    return RemoteSource(host, int(port), program=listed, symbols=symbols, tags=tags)
 
 
-def run_monitor(target: str) -> int:
-    """`python main.py monitor STATION_OR_HOST:PORT`: read-only, so nobody acts through it."""
+def run_monitor(target: str, program: str | None = None, user: str | None = None) -> int:
+    """`python main.py monitor TARGET [--program P] [--user NAME]`: over OPC UA as a user of the
+    station (the login dialog; with --user and stdin not a terminal, the password is its first
+    line), over Modbus read-only. Exit 2 with the reason when it cannot start, 1 when the login is
+    cancelled."""
     app = QApplication.instance() or QApplication(sys.argv[:1])
     apply_style(app)  # type: ignore[arg-type]
     try:
-        source = remote_source(target)
+        if target.startswith("opc.tcp://"):
+            source: Source | None = station_source(target, program, user)
+            if source is None:
+                return 1
+        else:
+            source = remote_source(target, program)
     except Problems as e:
         print("\n".join(e.problems), file=sys.stderr)
         return 2
-    window = ProgramWindow(source, lambda: "")
+    user = source.client.user if isinstance(source, OpcUaSource) else ""  # the station's user, or nobody
+    window = ProgramWindow(source, lambda: user)
     window.show()
     return app.exec()
+
+
+def station_source(url: str, program: str | None = None, user: str | None = None) -> OpcUaSource | None:
+    """A station over OPC UA, logged in through the login dialog; None when it was cancelled."""
+    from app.gui.monitor.login import LoginDialog
+    from app.publish.client import StationClient  # OPC UA loaded only for a station over OPC UA
+
+    listed = listing(program) if program else None
+    password = sys.stdin.readline().rstrip("\r\n") if user and not sys.stdin.isatty() else None
+    client = StationClient(url)
+    dialog = LoginDialog(client, user or "", password)
+    if dialog.exec() != QDialog.DialogCode.Accepted:
+        client.close()
+        if dialog.error:
+            raise Problems([dialog.error])
+        return None
+    if listed is None:
+        return OpcUaSource(client)
+    return OpcUaSource(client, program=listed[0], symbols=listed[1], tags=listed[2])

@@ -1,16 +1,20 @@
-"""The station's OPC UA methods (run, stop, step, force, unforce) are its commands, with the
-session's user: what a remote Program view needs to act as a logged-in user of the station."""
+"""The station's OPC UA methods (run, stop, step, force and unforce an address or a tag) are its
+commands, with the session's user, and NetPlc's memory and forces are read-only variables: what a
+remote Program view needs to act as a logged-in user of the station."""
 
 from __future__ import annotations
 
 import asyncio
+import json
 from collections.abc import Iterator
 from pathlib import Path
 
 import pytest
 from asyncua import ua
 
+from app.scada.forcing import tag_keys
 from app.station.runtime import Runtime
+from netplc.address import DATA_SIZE, IO_BITS, data_index
 from tests.app.publish.conftest import STATION_URI, demo_with, free_port, opcua_client
 
 BIT = 0o2120  # the demo's PUMP command bit
@@ -111,3 +115,86 @@ def test_user_executable_follows_the_sessions_role(station: tuple[Runtime, str, 
 
     assert run(executable("viewer", "viewer")) == {"Force": False, "Run": False, "UnforceAll": False}
     assert run(executable("engineer", "engineer")) == {"Force": True, "Run": True, "UnforceAll": True}
+
+
+def test_memory_and_forces_are_read_only_variables_of_the_station(station: tuple[Runtime, str, list]) -> None:
+    runtime, url, _ = station
+    engine = runtime.engine
+    assert engine is not None
+    engine.write_word(0o14002, 0xBEEF, user="test")  # bank 1
+    engine.write_bit(0o2177, 1, user="test")
+
+    async def go() -> dict[str, object]:
+        async with opcua_client(url, "engineer", "engineer") as client:
+            ns = await client.get_namespace_index(STATION_URI)
+            assert await call(client, "Force", ua.Variant("word", ua.VariantType.String),
+                              ua.Variant("04010", ua.VariantType.String),
+                              ua.Variant(310, ua.VariantType.Int32)) == ua.StatusCodes.Good
+            await asyncio.sleep(0.5)  # a few scans published
+            plc = client.get_node(ua.NodeId("NetPlc", ns))
+            memory = await plc.get_child(ua.QualifiedName("Memory", ns))
+            bits = await memory.get_child(ua.QualifiedName("Bits", ns))
+            data = client.get_node(ua.NodeId("NetPlc.Memory.Data", ns))
+            forces = client.get_node(ua.NodeId("NetPlc.Forces", ns))
+            out = {"bits id": bits.nodeid, "names": [await n.read_browse_name()
+                                                     for n in (memory, bits, data, forces)],
+                   "bits": await bits.read_value(), "data": await data.read_value(),
+                   "forces": json.loads(await forces.read_value()),
+                   "kind": (await data.read_data_value()).Value.VariantType,
+                   "level": await data.read_attribute(ua.AttributeIds.UserAccessLevel)}
+            try:
+                await data.write_value(ua.Variant(bytes(DATA_SIZE), ua.VariantType.ByteString))
+                out["write"] = ua.StatusCodes.Good
+            except ua.UaStatusCodeError as e:
+                out["write"] = e.code
+            out["ns"] = ns
+            return out
+
+    out = run(go())
+    ns = out["ns"]
+    assert out["bits id"] == ua.NodeId("NetPlc.Memory.Bits", ns)
+    assert out["names"] == [ua.QualifiedName(n, ns) for n in ("Memory", "Bits", "Data", "Forces")]
+    bits, data = out["bits"], out["data"]
+    assert out["kind"] == ua.VariantType.ByteString and len(bits) == IO_BITS and len(data) == DATA_SIZE
+    assert bits[0o2177] == 1 and bits[0o2176] == 0 and bits[0o3760] == 1  # 03760 is always 1
+    i = data_index(0o14002)
+    assert data[i:i + 2] == bytes((0xEF, 0xBE))
+    j = data_index(0o4010)
+    assert data[j:j + 2] == (310).to_bytes(2, "little")  # forced, as every reader sees it
+    assert out["forces"] == [{"kind": "word", "address": "04010", "value": 310,
+                              "user": out["forces"][0]["user"]}]
+    assert out["forces"][0]["user"].startswith("opcua:engineer@127.0.0.1:")
+    assert out["level"].Value.Value == 1 << ua.AccessLevel.CurrentRead  # read only, whoever asks
+    assert out["write"] == ua.StatusCodes.BadNotWritable
+
+
+def test_a_tag_is_forced_in_its_units_and_an_address_at_its_value(station: tuple[Runtime, str, list]) -> None:
+    runtime, url, records = station
+    engine = runtime.engine
+    assert engine is not None
+    temp = runtime.tags.by_name["TEMP_SP"]
+
+    async def go() -> list[int]:
+        async with opcua_client(url, "engineer", "engineer") as client:
+            codes = [await call(client, "ForceTag", ua.Variant("TEMP_SP", ua.VariantType.String),
+                                ua.Variant(55.5, ua.VariantType.Double)),
+                     await call(client, "Force", ua.Variant("bit", ua.VariantType.String),
+                                ua.Variant("02120", ua.VariantType.String), ua.Variant()),  # Null: bumpless
+                     await call(client, "ForceTag", ua.Variant("NOPE", ua.VariantType.String), ua.Variant()),
+                     await call(client, "ForceTag", ua.Variant("TEMP_SP", ua.VariantType.String),
+                                ua.Variant("hot", ua.VariantType.String))]
+            forced = engine.forces.count
+            codes += [await call(client, "UnforceTag", ua.Variant("TEMP_SP", ua.VariantType.String)), forced]
+        async with opcua_client(url, "operator", "operator") as client:
+            codes.append(await call(client, "ForceTag", ua.Variant("TEMP_SP", ua.VariantType.String),
+                                    ua.Variant(1.0, ua.VariantType.Double)))
+        return codes
+
+    good = ua.StatusCodes.Good
+    assert run(go()) == [good, good, ua.StatusCodes.BadNodeIdUnknown, ua.StatusCodes.BadInvalidArgument, good,
+                         len(tag_keys(temp)) + 1, ua.StatusCodes.BadUserAccessDenied]
+    texts = [r.text for r in records if r.kind == "operator" and (r.source or "").startswith("opcua:")]
+    assert any(t.startswith("force TEMP_SP: ") and "-> 55.5" in t for t in texts)
+    assert any(t.startswith("force 02120: ") and t.endswith("(bumpless)") for t in texts)
+    assert any(t.startswith("unforce TEMP_SP") for t in texts)
+    assert engine.forces.count == 1  # the bit stays forced

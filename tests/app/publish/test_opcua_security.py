@@ -201,8 +201,10 @@ def test_logins_back_off_are_journaled_and_unknown_names_take_the_time_of_wrong_
             client.disconnect_socket()
 
     unknown, wrong = run(activations())
-    assert abs(statistics.median(unknown) - statistics.median(wrong)) < 0.2 * statistics.median(wrong), \
-        (unknown, wrong)
+    # pair by pair (taken in turn, so the shared machine's drift hits both): before the stand-in an
+    # unknown name was refused about 10x faster than a wrong password
+    ratio = statistics.median(u / w for u, w in zip(unknown, wrong, strict=True))
+    assert 0.7 < ratio < 1.4, (unknown, wrong)
 
 
 def test_a_key_readable_by_others_is_made_private_and_old_files_are_kept(tmp_path: Path) -> None:
