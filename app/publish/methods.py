@@ -36,6 +36,7 @@ class Method:
 _STRING, _INT32, _DOUBLE = ua.ObjectIds.String, ua.ObjectIds.Int32, ua.ObjectIds.Double
 KIND, ADDRESS, TAG = ("Kind", "bit, byte or word", _STRING), ("Address", "octal, as 04010", _STRING), \
     ("Name", "the tag's name, as in tags.csv", _STRING)
+ALARM = ("AlarmId", "the alarm's identity, as the Alarms folder names it (LEVEL.H, MSG3)", _STRING)
 METHODS = (
     Method("Run", Action.RUN, description="Run NetPlc's program"),
     Method("Stop", Action.STOP, description="Stop NetPlc's program"),
@@ -49,6 +50,13 @@ METHODS = (
            "Force a tag (its bit, or all its words) to a physical value"),
     Method("UnforceTag", Action.UNFORCE, (TAG,), "Remove the force of a tag (all its words)"),
     Method("UnforceAll", Action.UNFORCE, description="Remove every force"),
+    # the alarm summary's actions, until the alarms are OPC UA conditions (Part 9) of their own
+    Method("Acknowledge", Action.ACKNOWLEDGE, (ALARM,), "Acknowledge an alarm"),
+    Method("AcknowledgeAll", Action.ACKNOWLEDGE, description="Acknowledge every unacknowledged alarm"),
+    Method("Shelve", Action.SHELVE, (ALARM, ("Reason", "why it is shelved (journaled)", _STRING),
+                                     ("Seconds", "how long it stays shelved", _DOUBLE)),
+           "Shelve an alarm for a while (ISA-18.2): it neither sounds nor shows until then"),
+    Method("Unshelve", Action.UNSHELVE, (ALARM,), "Return a shelved alarm to the summary"),
 )
 
 
@@ -101,6 +109,10 @@ class StationMethods:
             return commands.unforce_all(who)
         if method.name in ("ForceTag", "UnforceTag"):
             return self._tag(who, method, args)
+        if method.name == "AcknowledgeAll":
+            return commands.acknowledge_all(who)
+        if method.name in ("Acknowledge", "Shelve", "Unshelve"):
+            return self._alarm(who, method, args)
         kind, address = args[0], args[1]
         target = f"{kind} {address}"
         try:
@@ -115,6 +127,22 @@ class StationMethods:
         if method.name == "Force":
             return commands.force(who, kind, addr, value)  # type: ignore[arg-type]
         return commands.unforce(who, kind, addr)  # type: ignore[arg-type]
+
+    def _alarm(self, who: Who, method: Method, args: list[object]) -> Ticket:
+        commands = self.commands
+        alarm = args[0]
+        if not isinstance(alarm, str):
+            return commands.refuse(who, method.action, str(alarm), Reason.INVALID,
+                                   "an alarm's identity is a String")
+        if method.name == "Acknowledge":
+            return commands.acknowledge(who, alarm)
+        if method.name == "Unshelve":
+            return commands.unshelve(who, alarm)
+        reason, seconds = args[1], args[2]
+        if not isinstance(reason, str) or not isinstance(seconds, (int, float)) or isinstance(seconds, bool):
+            return commands.refuse(who, method.action, alarm, Reason.INVALID,
+                                   "Shelve takes a String reason and a number of seconds")
+        return commands.shelve(who, alarm, reason, float(seconds))
 
     def _tag(self, who: Who, method: Method, args: list[object]) -> Ticket:
         commands, name = self.commands, args[0]

@@ -12,6 +12,7 @@ from pathlib import Path
 import pytest
 from asyncua import ua
 
+from app.scada.alarms import STOPPED_ID, State
 from app.scada.forcing import tag_keys
 from app.station.runtime import Runtime
 from netplc.address import DATA_SIZE, IO_BITS, data_index
@@ -198,3 +199,52 @@ def test_a_tag_is_forced_in_its_units_and_an_address_at_its_value(station: tuple
     assert any(t.startswith("force 02120: ") and t.endswith("(bumpless)") for t in texts)
     assert any(t.startswith("unforce TEMP_SP") for t in texts)
     assert engine.forces.count == 1  # the bit stays forced
+
+
+def alarm(alarm_id: str) -> ua.Variant:
+    return ua.Variant(alarm_id, ua.VariantType.String)
+
+
+def test_a_viewer_may_not_acknowledge_or_shelve_an_operator_may(station: tuple[Runtime, str, list]) -> None:
+    """The alarm summary's actions over OPC UA are the same commands as at the workstation."""
+    runtime, url, records = station
+
+    def state() -> State:
+        return runtime.alarms.system.get(STOPPED_ID).state
+
+    async def go() -> dict[str, object]:
+        out: dict[str, object] = {}
+        async with opcua_client(url, "engineer", "engineer") as client:
+            await call(client, "Stop")  # NetPlc stopped: its station alarm comes, unacknowledged
+        deadline = asyncio.get_running_loop().time() + 10
+        while state() is not State.UNACK and asyncio.get_running_loop().time() < deadline:
+            await asyncio.sleep(0.05)
+        async with opcua_client(url, "viewer", "viewer") as client:
+            out["viewer"] = {await call(client, name, *args) for name, args in (
+                ("Acknowledge", (alarm(STOPPED_ID),)), ("Acknowledge", (alarm(STOPPED_ID),)),
+                ("AcknowledgeAll", ()),
+                ("Shelve", (alarm(STOPPED_ID), ua.Variant("test"), ua.Variant(60.0))))}
+        out["still"] = state()
+        async with opcua_client(url, "operator", "operator") as client:
+            out["ack"] = await call(client, "Acknowledge", alarm(STOPPED_ID))
+            out["acked"] = state()
+            out["unknown"] = await call(client, "Acknowledge", alarm("NO.SUCH"))
+            out["shelve"] = await call(client, "Shelve", alarm(STOPPED_ID), ua.Variant("commissioning"),
+                                       ua.Variant(60.0))
+            out["shelved"] = state()
+            out["unshelve"] = await call(client, "Unshelve", alarm(STOPPED_ID))
+        return out
+
+    out = run(go())
+    assert out["viewer"] == {ua.StatusCodes.BadUserAccessDenied} and out["still"] is State.UNACK
+    assert out["ack"] == ua.StatusCodes.Good and out["acked"] is State.ACKED
+    assert out["unknown"] == ua.StatusCodes.BadNodeIdUnknown
+    assert out["shelve"] == ua.StatusCodes.Good and out["shelved"] is State.SHELVED
+    assert out["unshelve"] == ua.StatusCodes.Good
+    refused = [r.text for r in records if r.kind == "operator" and r.source.startswith("opcua:viewer@")
+               and r.text.startswith("refused")]
+    assert sorted(refused) == [  # one record per cause: acknowledge (3 refusals) and shelve
+        f"refused acknowledge {STOPPED_ID}: needs the operator role; viewer is viewer",
+        f"refused shelve {STOPPED_ID}: needs the operator role; viewer is viewer"]
+    acts = [r.text for r in records if r.kind == "alarm" and "operator" in (r.text or "")]
+    assert acts  # the transitions name the operator, as at the workstation
