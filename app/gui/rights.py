@@ -35,11 +35,11 @@ class Right:
 
 
 class Rights:
-    """The controls of one view with the actions they command, for the user `who()` is now.
-    Without `commands` (the remote monitor: the station's layer is in the station's process, and
-    it answers each command) only `also` decides."""
+    """The controls of one view with the actions they command, for the user `who()` is now: the
+    command layer says what that user may do (`Commands.denial`), `also` adds a view's own
+    condition (a control that needs a selection, say)."""
 
-    def __init__(self, commands: Commands | None, who: Callable[[], Who]) -> None:
+    def __init__(self, commands: Commands, who: Callable[[], Who]) -> None:
         self.commands = commands
         self.who = who
         self.rights: list[Right] = []
@@ -60,7 +60,7 @@ class Rights:
     def show(self, right: Right) -> bool:
         """Enable or disable one control, with the role it needs in its tooltip; True if enabled."""
         commands, who = self.commands, self.who()
-        why = None if commands is None else commands.denial(who, right.action, right.at_least, right.what)
+        why = commands.denial(who, right.action, right.at_least, right.what)
         allowed = why is None and (right.also is None or right.also())
         right.control.setEnabled(allowed)
         right.control.setToolTip(right.tip if why is None else words.refusal(why))
