@@ -65,12 +65,14 @@ def _archive_parser() -> argparse.ArgumentParser:
                                             "the plant archive on PostgreSQL; run it again and it copies "
                                             "only what is not there yet.")
     sub = p.add_subparsers(dest="action", required=True)
-    m = sub.add_parser("migrate", help="copy ARCHIVE.sqlite into the plant archive")
-    m.add_argument("source", help="the station's archive file (journal.sqlite)")
+    m = sub.add_parser("migrate", help="copy a station's archive into the plant archive")
+    m.add_argument("source", help="the station folder (or its station.toml), or its archive file "
+                                  "(journal.sqlite)")
     m.add_argument("url", help="the plant archive: postgresql://user@host:5432/plant (password in "
                                "PGPASSWORD or ~/.pgpass)")
-    m.add_argument("--station", help="the station's name in the plant archive (default: the name of "
-                                     "the station folder holding archive/journal.sqlite)")
+    m.add_argument("--station", help="the station's name in the plant archive (default: `name` of the "
+                                     "station.toml whose Archive it is, as its forwarder names it; else "
+                                     "the name the archive keeps)")
     return p
 
 
@@ -354,12 +356,15 @@ def run_designer(target: str, screenshot: str | None = None) -> int:
 
 
 def run_migrate(source: str, url: str, station: str | None) -> int:
-    """Copy a SQLite archive into the plant archive, with a progress bar on stderr."""
+    """Copy a SQLite archive into the plant archive, with a progress bar on stderr, under the name
+    its station's forwarder uses, so the same record never lands twice (the key is station, day, id)."""
     import sqlite3
     from pathlib import Path
 
+    from app.station.config import archive_owner, read_station
     from registrar.plant.forward import Forwarder
     from registrar.plant.url import is_url, url_problem
+    from registrar.query import Archive
     from registrar.reading import ArchiveError
 
     problem = url_problem(url) if is_url(url) else "not a postgresql:// URL"
@@ -367,11 +372,36 @@ def run_migrate(source: str, url: str, station: str | None) -> int:
         print(f"{url}: {problem}", file=sys.stderr)
         return 2
     path = Path(source)
+    a_station = path.is_dir() or path.suffix == ".toml"  # its Archive, by its name
+    if a_station:
+        owner, problems = read_station(path)
+    else:  # an archive file: the station whose Archive it is, unless named
+        owner, problems = archive_owner(path) if station is None else (None, [])
+    if problems and (a_station or owner is not None):
+        print("\n".join(problems), file=sys.stderr)
+        print("the station file has problems (see `main.py check`): fix it, or give the archive file "
+              "and --station NAME", file=sys.stderr)
+        return 2
+    if a_station and owner is not None:
+        path = owner.Archive
     if not path.is_file():
         print(f"{path}: no such archive", file=sys.stderr)
         return 2
-    folder = path.resolve().parent
-    name = station or (folder.parent.name if folder.name == "archive" else folder.name)
+    name, why = station, "--station"
+    if name is None and owner is not None:
+        name, why = owner.name, f"the name in {owner.path}"
+    if name is None:
+        try:
+            with Archive(path) as archive:
+                name, why = archive.meta().get("station"), "the name the archive keeps"
+        except sqlite3.Error as e:
+            print(f"{path}: {e}", file=sys.stderr)
+            return 1
+    if not name:
+        print("\n".join([*problems, f"{path}: cannot tell whose archive it is: no station.toml in its "
+                          "folder or above names it as its Archive, and it keeps no station name; give "
+                          "--station NAME (the `name` in the station's station.toml)"]), file=sys.stderr)
+        return 2
 
     def progress(sent: int, total: int) -> None:
         done = min(1.0, sent / total) if total else 1.0
@@ -384,5 +414,5 @@ def run_migrate(source: str, url: str, station: str | None) -> int:
         print(f"\n{path} -> {url}: {e}", file=sys.stderr)
         return 1
     print(("\n" if n else "") + f"{n:,} records copied from {path} to {url} as station {name!r} "
-          "(records already there are not copied again)")
+          f"({why}; records already there are not copied again)")
     return 0

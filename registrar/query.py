@@ -39,6 +39,7 @@ from registrar.schema import (
     COLUMNS,
     DAY_GLOB,
     GAP_SQL,
+    TAG_ROWS_SQL,
     fts_table,
     gap_index,
     key_index,
@@ -118,7 +119,7 @@ class Archive(ArchiveReader):
         """The station's one-word tags as copied into the archive, by the `source` of the data
         records NSTORE writes of them ({} for an archive written without tags)."""
         try:
-            return tags_by_source(self._con.execute("SELECT * FROM tags").fetchall())
+            return tags_by_source(self._con.execute(TAG_ROWS_SQL).fetchall())
         except sqlite3.OperationalError:  # no tags table: an archive of an older station
             return {}
 

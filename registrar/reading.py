@@ -74,8 +74,7 @@ class ArchiveReader:
         return []
 
     def tags(self) -> dict[str, Tag]:
-        """The one-word tags by the `source` of their data records ({}: none kept, as in the plant
-        archive, which forwards records but not the stations' tags)."""
+        """The one-word tags by the `source` of their data records ({}: none kept)."""
         return {}
 
     def local_time(self, ts: float) -> dt.datetime:

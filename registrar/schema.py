@@ -9,6 +9,7 @@ from __future__ import annotations
 import contextlib
 import datetime as dt
 import os
+import sqlite3
 import time
 import zoneinfo
 from pathlib import Path
@@ -18,7 +19,7 @@ from app.scada.table import TagTable
 from app.scada.tag import Scaling, Tag, TagType
 from netplc.address import fmt_octal
 
-SCHEMA_VERSION = "1"
+SCHEMA_VERSION = "2"  # 2: `tags.source`, the key a tag's data records carry (docs/architecture.md section 8)
 COLUMNS = ("id", "ts", "kind", "grp", "type", "source", "number", "value", "text")
 DAY_GLOB = "[0-3][0-9]_[01][0-9]_[0-9][0-9][0-9][0-9]"
 
@@ -121,17 +122,56 @@ MESSAGES_SQL = ("CREATE TABLE IF NOT EXISTS messages "
                 "(number INTEGER PRIMARY KEY, grp INTEGER, type INTEGER, text TEXT)")
 # The station's tags (tags.csv) as they were when the archive was last opened for writing, so the
 # viewer and CSV show data series by tag name in physical units without the station's files.
+# `source` is the address as the data records of the tag carry it (NSTORE's octal text,
+# netplc.address.fmt_octal: "0" and at least four digits), so plain SQL joins a day table's records
+# to their tags (`USING (source)`), while `address` stays the decimal number older readers know.
+# It is a generated column: a writer that inserts the ten other columns (an older station) still
+# fills it, and an archive written before it gets it by `add_tag_source`, losing nothing.
+TAG_FIELDS = ("name", "address", "type", "unit", "app_min", "app_max", "phy_min", "phy_max", "decimals",
+              "description")
+TAG_SOURCE_SQL = "printf('0%04o', address)"
+TAG_SOURCE_COLUMN = f"source TEXT GENERATED ALWAYS AS ({TAG_SOURCE_SQL}) VIRTUAL"
 TAGS_SQL = ("CREATE TABLE IF NOT EXISTS tags (name TEXT PRIMARY KEY, address INTEGER, type TEXT, unit TEXT, "
-            "app_min REAL, app_max REAL, phy_min REAL, phy_max REAL, decimals INTEGER, description TEXT)")
+            "app_min REAL, app_max REAL, phy_min REAL, phy_max REAL, decimals INTEGER, description TEXT, "
+            f"{TAG_SOURCE_COLUMN})")
+# The rows by name, and with their key: both read an archive of either layout (a reader never writes).
+TAG_ROWS_SQL = f"SELECT {', '.join(TAG_FIELDS)} FROM tags ORDER BY name"
+KEYED_TAG_ROWS_SQL = f"SELECT {', '.join(TAG_FIELDS)}, {TAG_SOURCE_SQL} FROM tags ORDER BY name"
+ONE_WORD_TYPES = ("word", "int16", "bcd")  # the tags whose value one archived word holds whole
+
+
+def add_tag_source(con: sqlite3.Connection) -> None:
+    """Give a `tags` table written before the key its `source` column (inside the caller's
+    transaction); the rows stay as they are."""
+    columns = {row[1] for row in con.execute("PRAGMA table_xinfo(tags)")}
+    if "source" not in columns:
+        con.execute(f"ALTER TABLE tags ADD COLUMN {TAG_SOURCE_COLUMN}")
 
 
 def tag_rows(table: TagTable) -> list[tuple]:
-    """The tags as rows of the archive's `tags` table."""
+    """The tags as rows of the archive's `tags` table (TAG_FIELDS), by name."""
     def ranges(s: Scaling | None) -> tuple:
         return (s.AppMin, s.AppMax, s.PhyMin, s.PhyMax) if s is not None else (None,) * 4
 
-    return [(t.name, t.address, str(t.type), t.unit, *ranges(t.scaling), t.decimals, t.description)
-            for t in table.tags]
+    return sorted((t.name, t.address, str(t.type), t.unit, *ranges(t.scaling), t.decimals, t.description)
+                  for t in table.tags)
+
+
+def physical_sql(word: str, tag: str) -> str:
+    """The physical value of a one-word tag's archived `word` as an SQL expression that SQLite and
+    PostgreSQL both evaluate, `tag` naming the row of the tag (its `type` and ranges): the
+    conversion of app/scada/tag.py (Tag.word_value, then Scaling.to_phy) with the same operations in
+    the same order, so the same double. A BCD word with a digit above 9, NaN there, is NULL here,
+    which SQL's aggregates skip."""
+    w = f"CAST({word} AS INTEGER)"
+    digits = [f"(({w} >> {shift}) & 15)" for shift in (12, 8, 4, 0)]
+    bcd = (f"CASE WHEN {' OR '.join(f'{d} > 9' for d in digits)} THEN NULL "
+           f"ELSE {digits[0]} * 1000 + {digits[1]} * 100 + {digits[2]} * 10 + {digits[3]} END")
+    int16 = f"CASE WHEN {word} >= 32768 THEN {word} - 65536 ELSE {word} END"
+    raw = f"(CASE {tag}.type WHEN 'int16' THEN {int16} WHEN 'bcd' THEN {bcd} ELSE {word} END)"
+    a0, a1, p0, p1 = (f"{tag}.{c}" for c in ("app_min", "app_max", "phy_min", "phy_max"))
+    return (f"CASE WHEN {a0} IS NULL OR {a1} IS NULL OR {p0} IS NULL OR {p1} IS NULL THEN {raw} "
+            f"ELSE {p0} + ({raw} - {a0}) * ({p1} - {p0}) / NULLIF({a1} - {a0}, 0) END")
 
 
 def tags_by_source(rows: list[tuple]) -> dict[str, Tag]:

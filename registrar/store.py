@@ -35,7 +35,10 @@ from registrar.schema import (
     META_SQL,
     SCHEMA_VERSION,
     SERIES_SQL,
+    TAG_FIELDS,
+    TAG_ROWS_SQL,
     TAGS_SQL,
+    add_tag_source,
     aux_fill_sql,
     aux_sql,
     fts_table,
@@ -146,8 +149,10 @@ class Store:
         flush_interval: float = 1.0,
         on_commit: Callable[[int], None] | None = None,
         tags: TagTable | None = None,
+        station: str = "",
     ) -> None:
         self.path = Path(path)
+        self.station = station  # its name, kept in `meta` so the file says whose it is
         self.catalog = catalog or Catalog()
         self.tags = tags or TagTable()  # copied in, like the catalog, so the file explains its data
         self.keep_days = keep_days
@@ -262,6 +267,7 @@ class Store:
         con.execute(MESSAGES_SQL)
         con.execute(SERIES_SQL)
         con.execute(TAGS_SQL)
+        add_tag_source(con)
         meta = {
             "schema_version": SCHEMA_VERSION,
             "ts_unit": "milliseconds since 1970-01-01 UTC",
@@ -270,6 +276,8 @@ class Store:
             "timezone_key": local_zone_key(),  # IANA: readers in another zone cut days as written
             "message_types": "0 info, 1 warning, 2 alarm, 3 critical",
         }
+        if self.station:
+            meta["station"] = self.station
         con.execute("INSERT OR IGNORE INTO meta VALUES ('created', ?)",
                     (dt.datetime.fromtimestamp(self.wallclock()).isoformat(timespec="seconds"),))
         con.executemany("INSERT OR REPLACE INTO meta VALUES (?, ?)", meta.items())
@@ -277,10 +285,21 @@ class Store:
             con.execute("DELETE FROM messages")
             con.executemany("INSERT INTO messages VALUES (?, ?, ?, ?)",
                             [(m.number, m.grp, m.type, m.text) for m in self.catalog])
-        if self.tags.tags:
-            con.execute("DELETE FROM tags")
-            con.executemany("INSERT INTO tags VALUES (?, ?, ?, ?, ?, ?, ?, ?, ?, ?)", tag_rows(self.tags))
+        self._copy_tags(con)
         con.execute("COMMIT")
+
+    def _copy_tags(self, con: sqlite3.Connection) -> None:
+        """The station's tags, when they are not the ones the file holds already, and since when
+        (`tags_since`, ms like `ts`): the plant archive keeps a version of the tags per change and
+        converts each record by the version of its time (registrar/plant/schema.py)."""
+        rows = tag_rows(self.tags)
+        if not rows or con.execute(TAG_ROWS_SQL).fetchall() == rows:
+            return
+        con.execute("DELETE FROM tags")
+        con.executemany(f"INSERT INTO tags ({', '.join(TAG_FIELDS)}) VALUES "
+                        f"({', '.join('?' * len(TAG_FIELDS))})", rows)
+        con.execute("INSERT OR REPLACE INTO meta VALUES ('tags_since', ?)",
+                    (str(round(self.wallclock() * 1000)),))
 
     def _run(self) -> None:
         pending: list[Record] = []

@@ -231,6 +231,23 @@ def load_station(path: str | Path) -> Station:
     return station
 
 
+def archive_owner(archive: str | Path) -> tuple[Station | None, list[str]]:
+    """The station whose station.toml, in the archive's folder or one above it, names `archive` as
+    its Archive (what `archive migrate` forwards it as), and that file's problems; with no such
+    station, the problems of the station files on the way that could not be read."""
+    target = Path(archive).resolve()
+    unread: list[str] = []
+    for folder in target.parents:
+        if not (folder / STATION_FILE).is_file():
+            continue
+        station, problems = read_station(folder)
+        if station is None:
+            unread += problems
+        elif station.Archive.resolve() == target:
+            return station, problems
+    return None, unread
+
+
 def read_station(path: str | Path) -> tuple[Station | None, list[str]]:
     """The station as far as it can be read, and its problems (for `check`, which goes on to
     check the program and forms even when a setting is wrong). Files that do not exist are None

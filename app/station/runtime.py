@@ -243,7 +243,7 @@ class Runtime:
         simulator's port, the nodes), after what did start is stopped again."""
         st = self.station
         store = Store(st.Archive, catalog=self.catalog, keep_days=st.keep_days, wallclock=self.wallclock,
-                      tags=self.tags)
+                      tags=self.tags, station=st.name)
         try:
             store.start()
         except (OSError, sqlite3.Error) as e:

@@ -28,7 +28,7 @@ import psycopg
 from netplc.records import Record
 from registrar.plant import schema as plant
 from registrar.reading import ArchiveError
-from registrar.schema import DAY_GLOB, parse_table_name, table_name
+from registrar.schema import DAY_GLOB, KEYED_TAG_ROWS_SQL, parse_table_name, table_name
 
 logger = logging.getLogger(__name__)
 
@@ -223,12 +223,20 @@ class Forwarder:
             local.close()
 
     def _publish(self, con: psycopg.Connection) -> None:
-        """The station's meta and message catalog, as its local archive holds them."""
+        """The station's meta, message catalog and tags, as its local archive holds them (read in
+        one transaction, so tags and `tags_since` agree though the Store rewrites them)."""
         local = self._local_con()
         if local is None:
             return  # the Store has not made the file yet: published with the first batch
-        meta = local.execute("SELECT key, value FROM meta").fetchall()
-        messages = local.execute("SELECT number, grp, type, text FROM messages").fetchall()
+        local.execute("BEGIN")
+        try:
+            meta = local.execute("SELECT key, value FROM meta").fetchall()
+            messages = local.execute("SELECT number, grp, type, text FROM messages").fetchall()
+            tags = (local.execute(KEYED_TAG_ROWS_SQL).fetchall() if local.execute(
+                "SELECT 1 FROM sqlite_master WHERE name = 'tags'").fetchone() else [])
+        finally:
+            local.execute("COMMIT")
+        since = dict(meta).get("tags_since")
         with con.transaction(), con.cursor() as cur:
             cur.executemany("INSERT INTO meta VALUES (%s, %s, %s) ON CONFLICT (station, key) "
                             "DO UPDATE SET value = excluded.value",
@@ -236,6 +244,7 @@ class Forwarder:
             cur.execute("DELETE FROM messages WHERE station = %s", (self.station,))
             cur.executemany("INSERT INTO messages VALUES (%s, %s, %s, %s, %s)",
                             [(self.station, *m) for m in messages])
+            plant.publish_tags(con, self.station, tags, int(since) if since and since.isdigit() else None)
         self._published = True
 
     def _retain(self, con: psycopg.Connection) -> None:

@@ -19,6 +19,7 @@ from typing import Concatenate, ParamSpec, TypeVar
 import numpy as np
 import psycopg
 
+from app.scada.tag import Tag
 from registrar.plant import schema as plant
 from registrar.plant.url import url_problem
 from registrar.reading import (
@@ -31,7 +32,7 @@ from registrar.reading import (
     thinned,
     where_clause,
 )
-from registrar.schema import COLUMNS, GAP_SQL, table_name
+from registrar.schema import COLUMNS, GAP_SQL, TAG_FIELDS, table_name, tags_by_source
 
 _SELECT = "SELECT " + ", ".join(COLUMNS) + ", station"
 P = ParamSpec("P")
@@ -100,6 +101,17 @@ class PgArchive(ArchiveReader):
         station = station or self._only_station()
         return dict(self._pg.execute("SELECT number, text FROM messages WHERE station = %s",
                                      (station,)).fetchall())
+
+    @_reading
+    def tags(self, station: str | None = None) -> dict[str, Tag]:
+        """A station's current tags (the only station's, if there is one), as Archive.tags."""
+        station = station or self._only_station()
+        try:
+            rows = self._pg.execute(f"SELECT {', '.join(TAG_FIELDS)} FROM tags WHERE station = %s "
+                                    "AND valid_to = 'infinity' ORDER BY name", (station,)).fetchall()
+        except psycopg.errors.UndefinedTable:  # a plant archive no station of this version wrote to
+            return {}
+        return tags_by_source(rows)
 
     def _only_station(self) -> str | None:
         stations = self.stations()

@@ -7,20 +7,31 @@ station's name, the station's day table (`day`) and its id there: the unique key
 id) of each partition makes a replayed batch fail instead of doubling rows. `forwarded` holds the
 last id copied per station and day, written in the same transaction as the rows, so a batch and
 its position are committed together or not at all.
+
+`tags` keeps every version of each station's tags (its tags.csv as the station's archive holds
+it), each valid from the change that made it to the next one, and the view `tag_values` gives
+every data record of a one-word tag by the version of its time: time, station, tag, the physical
+value, unit and quality, the columns Grafana's PostgreSQL data source plots as they are.
 """
 
 from __future__ import annotations
 
 import datetime as dt
+import hashlib
+import json
 from collections.abc import Iterable, Sequence
 
 import psycopg
 
 from registrar.schema import (
+    GAP_SQL,
+    ONE_WORD_TYPES,
     SCHEMA_VERSION,
+    TAG_FIELDS,
     day_bounds_in,
     local_zone_key,
     parse_table_name,
+    physical_sql,
     table_name,
     zone,
 )
@@ -29,6 +40,9 @@ PLANT = ""  # the `station` of the plant-wide meta rows
 COPY_COLUMNS = ("station", "day", "id", "ts", "kind", "grp", "type", "source", "number", "value", "text")
 COPY_TYPES = ("text", "date", "int8", "int8", "text", "int8", "int8", "text", "int8", "float8", "text")
 LOCK_PARTITIONS = 7_165_001  # advisory lock key: one writer at a time creates or drops partitions
+LOCK_TAGS = 7_165_002  # with the station's hash: one writer at a time changes a station's tag versions
+TAG_COLUMNS = (*TAG_FIELDS, "source")  # a tag as the forwarder reads it from the station's archive
+EPOCH = dt.datetime(1970, 1, 1, tzinfo=dt.UTC)
 
 SCHEMA_SQL = (
     """CREATE TABLE IF NOT EXISTS records (
@@ -47,6 +61,31 @@ SCHEMA_SQL = (
         UNIQUE NULLS NOT DISTINCT (station, day, kind, grp, type, source))""",
     """CREATE TABLE IF NOT EXISTS forwarded (station text NOT NULL, day date NOT NULL,
         last_id bigint NOT NULL, PRIMARY KEY (station, day))""",
+    # A station's tags, one row per tag and version: a version converts the records from valid_from
+    # (the first '-infinity') to valid_to (the current 'infinity'); `since` is when the station took
+    # it up (its archive's `tags_since`; NULL: not known); `source` is the key of its data records.
+    """CREATE TABLE IF NOT EXISTS tags (station text NOT NULL, version integer NOT NULL,
+        valid_from timestamptz NOT NULL, valid_to timestamptz NOT NULL, since timestamptz,
+        hash text NOT NULL,
+        name text NOT NULL, address bigint NOT NULL, type text NOT NULL, unit text,
+        app_min double precision, app_max double precision, phy_min double precision,
+        phy_max double precision, decimals integer, description text, source text NOT NULL,
+        PRIMARY KEY (station, version, name))""",
+    "CREATE INDEX IF NOT EXISTS tags_source ON tags (station, source, valid_from)",
+    # Every data record of a one-word tag in physical units, by the tag version of its time, as
+    # the station converts it (registrar/schema.py physical_sql); no value where the station's
+    # readers break a series (the record of a value that was held: GAP_SQL). `ts` is there so a
+    # time filter on it reaches the day partitions (one on `time`, an expression, reads them all).
+    f"""CREATE OR REPLACE VIEW tag_values AS
+        SELECT r.time, r.station, t.name AS tag, t.name AS metric,
+            CASE WHEN r.gap THEN NULL ELSE {physical_sql("r.value", "t")} END AS value,
+            t.unit, coalesce(r.text, 'good') AS quality, r.ts, r.source, r.value AS raw, t.version
+        FROM (SELECT station, ts, source, value, text, {GAP_SQL} AS gap,
+                timestamptz 'epoch' + ts * interval '1 millisecond' AS time
+            FROM records WHERE kind = 'data') r
+        JOIN tags t ON t.station = r.station AND t.source = r.source
+            AND r.time >= t.valid_from AND r.time < t.valid_to
+        WHERE t.type IN ({", ".join(f"'{k}'" for k in ONE_WORD_TYPES)})""",
 )
 
 
@@ -64,10 +103,12 @@ def ensure_schema(con: psycopg.Connection) -> dt.tzinfo | None:
         con.execute("SELECT pg_advisory_xact_lock(%s)", (LOCK_PARTITIONS,))
         for sql in SCHEMA_SQL:
             con.execute(sql)
-        con.execute("INSERT INTO meta VALUES (%s, 'schema_version', %s), (%s, 'timezone_key', %s), "
+        con.execute("INSERT INTO meta VALUES (%s, 'timezone_key', %s), "
                     "(%s, 'day_partitions', 'one per local day of the plant zone, named DD_MM_YYYY') "
-                    "ON CONFLICT DO NOTHING",
-                    (PLANT, SCHEMA_VERSION, PLANT, local_zone_key(), PLANT))
+                    "ON CONFLICT DO NOTHING", (PLANT, local_zone_key(), PLANT))
+        con.execute("INSERT INTO meta VALUES (%s, 'schema_version', %s) ON CONFLICT (station, key) "
+                    "DO UPDATE SET value = excluded.value WHERE meta.value < excluded.value",
+                    (PLANT, SCHEMA_VERSION))
     return plant_zone(con)
 
 
@@ -131,3 +172,54 @@ def insert_rows_once(con: psycopg.Connection, rows: Sequence[tuple]) -> None:
     with con.cursor() as cur:
         cur.executemany(f"INSERT INTO records ({', '.join(COPY_COLUMNS)}) "
                         f"VALUES ({', '.join(['%s'] * len(COPY_COLUMNS))}) ON CONFLICT DO NOTHING", rows)
+
+
+def publish_tags(con: psycopg.Connection, station: str, rows: Sequence[tuple], since_ms: int | None) -> None:
+    """Make `rows` (TAG_COLUMNS) the station's tags from `since_ms` on (None: not known), inside the
+    caller's transaction. The first version is read for records of any time; a set equal to the
+    version in force then changes nothing (a restart, a migrate after the forwarder, twice); another
+    one splits that version there, so the records before keep the tags of their time, or, when it
+    comes from before the version in force was taken up (an older copy of the archive migrated
+    late), takes the time before that. Where a version already starts at that moment, it stays."""
+    if not rows:
+        return
+    digest = tags_hash(rows)
+    since = None if since_ms is None else EPOCH + dt.timedelta(milliseconds=since_ms)
+    at = {"station": station, "at": "-infinity" if since is None else since}
+    con.execute("SELECT pg_advisory_xact_lock(%s, hashtext(%s))", (LOCK_TAGS, station))
+    held = con.execute(
+        "SELECT version, hash = %(hash)s OR valid_from = %(at)s::timestamptz, %(at)s::timestamptz < since, "
+        "valid_from::text, valid_to::text, since::text FROM tags WHERE station = %(station)s "
+        "AND valid_from <= %(at)s::timestamptz AND %(at)s::timestamptz < valid_to LIMIT 1",
+        {**at, "hash": digest}).fetchone()
+    last = con.execute("SELECT coalesce(max(version), 0) FROM tags WHERE station = %s",
+                       (station,)).fetchone()[0]
+    valid_from, valid_to = "-infinity", "infinity"  # the station's first tags
+    if held is not None:
+        old, known, earlier, old_from, old_to, old_since = held
+        if known:
+            return
+        if earlier:  # it held before the version in force was taken up
+            valid_from, valid_to = old_from, old_since
+            con.execute("UPDATE tags SET valid_from = since WHERE station = %s AND version = %s",
+                        (station, old))
+        else:
+            valid_from, valid_to = at["at"], old_to
+            con.execute("UPDATE tags SET valid_to = %(at)s::timestamptz WHERE station = %(station)s "
+                        "AND version = %(old)s", {**at, "old": old})
+    elif last:  # a gap in the versions (edited by hand): this set fills it up to the next one
+        valid_from = at["at"]
+        valid_to = con.execute("SELECT coalesce(min(valid_from), 'infinity')::text FROM tags "
+                               "WHERE station = %s AND valid_from > %s::timestamptz",
+                               (station, valid_from)).fetchone()[0]
+    columns = ("station", "version", "valid_from", "valid_to", "since", "hash", *TAG_COLUMNS)
+    with con.cursor() as cur:
+        cur.executemany(f"INSERT INTO tags ({', '.join(columns)}) VALUES (%s, %s, %s::timestamptz, "
+                        f"%s::timestamptz, {', '.join(['%s'] * (len(columns) - 4))})",
+                        [(station, last + 1, valid_from, valid_to, since, digest, *row) for row in rows])
+
+
+def tags_hash(rows: Sequence[tuple]) -> str:
+    """What tells two tag sets apart: the SHA-256 of their rows in name order."""
+    text = json.dumps(sorted(rows, key=lambda r: r[0]), ensure_ascii=False, separators=(",", ":"))
+    return hashlib.sha256(text.encode()).hexdigest()

@@ -4,8 +4,14 @@ from __future__ import annotations
 
 import csv
 import datetime as dt
+import sqlite3
+import time
+from collections import Counter
 from pathlib import Path
 
+import psycopg
+
+from app.cli import main as cli
 from app.gui.viewer import ViewerWindow
 from app.station.config import load_station
 from app.station.runtime import Runtime
@@ -123,3 +129,92 @@ def test_the_plant_archive_keeps_its_own_days_not_the_stations(tmp_path: Path) -
             assert runtime.forwarder is not None and runtime.forwarder.keep_days == kept
         finally:
             runtime.stop()
+
+
+def run_station(folder: Path, values: range) -> Path:
+    """The station started and stopped, NSTORE-like data of LEVEL put meanwhile: its local archive."""
+    runtime = Runtime(load_station(folder))
+    runtime.start()
+    try:
+        for v in values:
+            runtime.put(Record(time.time(), "data", 1, 1, "04010", value=float(v)))
+    finally:
+        runtime.stop()  # the forwarder, if any, sends the rest
+    return runtime.station.Archive
+
+
+def local_keys(archive: Path, station: str) -> set[tuple]:
+    con = sqlite3.connect(f"file:{archive}?mode=ro", uri=True)
+    try:
+        return {(station, day, i) for day in Archive(archive).days()
+                for (i,) in con.execute(f'SELECT id FROM "{day:%d_%m_%Y}"')}
+    finally:
+        con.close()
+
+
+def plant_keys(url: str) -> Counter:
+    with psycopg.connect(url) as con:
+        return Counter(con.execute("SELECT station, day, id FROM records").fetchall())
+
+
+STATION = 'name = "Demo station"\nNetPlcLoad = false\n{archive}[modbus_server]\nport = 0\n'
+TAGS = "name,address,type,unit,app_min,app_max,phy_min,phy_max\nLEVEL,04010,word,%,0,4095,0,100\n"
+
+
+def test_forward_then_migrate_lands_every_record_once_under_the_stations_name(
+        tmp_path: Path, pg_url: str, capsys) -> None:
+    """The folder is `stpg`, the station's name "Demo station": the forwarder and `archive migrate`
+    name it alike, so the unique key (station, day, id) keeps every record once, in either order."""
+    toml = STATION.format(archive=f'Tags = "tags.csv"\nArchive = "{pg_url}"\n')
+    folder = write_station(tmp_path / "stpg", toml, {"tags.csv": TAGS})
+    archive = run_station(folder, range(500))
+    keys = local_keys(archive, "Demo station")
+    assert len(keys) >= 500 and plant_keys(pg_url) == Counter(keys)  # forwarded
+    for source in (archive, folder, folder / "station.toml"):  # then migrated, and again
+        assert cli(["archive", "migrate", str(source), pg_url]) == 0
+        out = capsys.readouterr().out
+        assert "0 records copied" in out
+        assert f"as station 'Demo station' (the name in {folder / 'station.toml'}" in out
+    assert plant_keys(pg_url) == Counter(keys)
+    with psycopg.connect(pg_url) as con:
+        assert con.execute("SELECT DISTINCT station FROM tags").fetchall() == [("Demo station",)]
+        assert con.execute("SELECT count(*), min(unit) FROM tag_values").fetchone() == (500, "%")
+
+
+def test_migrate_then_forward_lands_every_record_once(tmp_path: Path, pg_url: str, capsys) -> None:
+    folder = write_station(tmp_path / "line2", STATION.format(archive=""))  # its own archive only
+    archive = run_station(folder, range(300))
+    before = local_keys(archive, "Demo station")
+    assert cli(["archive", "migrate", str(folder), pg_url]) == 0
+    assert f"{len(before):,} records copied" in capsys.readouterr().out
+    (folder / "station.toml").write_text(STATION.format(archive=f'Archive = "{pg_url}"\n'), encoding="utf-8")
+    assert run_station(folder, range(300, 400)) == archive  # now it forwards: the rest, not again
+    keys = local_keys(archive, "Demo station")
+    assert len(keys) > len(before) + 100 and plant_keys(pg_url) == Counter(keys)
+    assert cli(["archive", "migrate", str(archive), pg_url]) == 0
+    assert plant_keys(pg_url) == Counter(keys)
+
+
+def test_migrate_says_why_it_cannot_name_the_station(tmp_path: Path, pg_url: str, capsys) -> None:
+    loose = tmp_path / "copies" / "journal.sqlite"  # copied away from its station, written before names
+    store = Store(loose)
+    store.put(Record(T0, "data", 1, 1, "04010", value=1.0))
+    store.start()
+    store.close()
+    assert cli(["archive", "migrate", str(loose), pg_url]) == 2
+    err = capsys.readouterr().err
+    assert f"{loose}: cannot tell whose archive it is" in err and "--station NAME" in err
+    assert cli(["archive", "migrate", str(loose), pg_url, "--station", "line1"]) == 0
+    assert "as station 'line1' (--station" in capsys.readouterr().out
+
+    broken = write_station(tmp_path / "broken", 'name = 5\nNetPlcLoad = false\n')
+    assert cli(["archive", "migrate", str(broken), pg_url]) == 2
+    err = capsys.readouterr().err
+    assert f"{broken / 'station.toml'}: name: expected" in err and "fix it" in err
+    named = Store(tmp_path / "named.sqlite", station="line3")  # an archive keeps its station's name
+    named.put(Record(T0, "data", 1, 1, "04010", value=1.0))
+    named.start()
+    named.close()
+    assert cli(["archive", "migrate", str(named.path), pg_url]) == 0
+    assert "as station 'line3' (the name the archive keeps" in capsys.readouterr().out
+    assert plant_keys(pg_url) == Counter({("line1", DAY, 1): 1, ("line3", DAY, 1): 1})

@@ -173,8 +173,8 @@ def test_a_lag_over_a_minute_is_told_once_and_its_end_too(tmp_path, pg_cluster):
 
 
 def test_archive_migrate_is_idempotent(tmp_path, pg_url, capsys):
-    db = tmp_path / "line1" / "archive" / "journal.sqlite"
-    store = Store(db)
+    db = tmp_path / "copies" / "journal.sqlite"
+    store = Store(db, station="line1")  # the archive keeps its station's name
     for i in range(2_500):
         store.put(Record(T0 + i, "data", 1, 1, "04010", value=float(i)))
     store.start()
