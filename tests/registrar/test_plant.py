@@ -225,5 +225,5 @@ def test_a_plant_archive_that_fails_says_so_as_an_archive_error(tmp_path, pg_url
     with pytest.raises(ArchiveError, match=re.escape(pg_url)):
         archive.records(DAY)
     archive.close()
-    assert cli(["archive", "migrate", str(store.path), dead]) == 1
+    assert cli(["archive", "migrate", str(store.path), dead, "--station", "st"]) == 1
     assert f"{store.path} -> {dead}:" in capsys.readouterr().err

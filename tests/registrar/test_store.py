@@ -73,7 +73,7 @@ def test_schema_reads_sensibly_with_the_catalog_copied_in(db):
                        ("text", "TEXT")]
     assert con.execute("SELECT * FROM messages").fetchall() == [(3, 1, 2, "Уровень выше 90 %")]
     meta = dict(con.execute("SELECT key, value FROM meta"))
-    assert meta["ts_unit"].startswith("milliseconds") and meta["schema_version"] == "1"
+    assert meta["ts_unit"].startswith("milliseconds") and meta["schema_version"] == "2"
     assert con.execute("PRAGMA journal_mode").fetchone() == ("wal",)
 
 
