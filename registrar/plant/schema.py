@@ -72,21 +72,24 @@ SCHEMA_SQL = (
         phy_max double precision, decimals integer, description text, source text NOT NULL,
         PRIMARY KEY (station, version, name))""",
     "CREATE INDEX IF NOT EXISTS tags_source ON tags (station, source, valid_from)",
-    # Every data record of a one-word tag in physical units, by the tag version of its time, as
-    # the station converts it (registrar/schema.py physical_sql); no value where the station's
-    # readers break a series (the record of a value that was held: GAP_SQL). `ts` is there so a
-    # time filter on it reaches the day partitions (one on `time`, an expression, reads them all).
-    f"""CREATE OR REPLACE VIEW tag_values AS
-        SELECT r.time, r.station, t.name AS tag, t.name AS metric,
-            CASE WHEN r.gap THEN NULL ELSE {physical_sql("r.value", "t")} END AS value,
-            t.unit, coalesce(r.text, 'good') AS quality, r.ts, r.source, r.value AS raw, t.version
-        FROM (SELECT station, ts, source, value, text, {GAP_SQL} AS gap,
-                timestamptz 'epoch' + ts * interval '1 millisecond' AS time
-            FROM records WHERE kind = 'data') r
-        JOIN tags t ON t.station = r.station AND t.source = r.source
-            AND r.time >= t.valid_from AND r.time < t.valid_to
-        WHERE t.type IN ({", ".join(f"'{k}'" for k in ONE_WORD_TYPES)})""",
 )
+
+# Every data record of a one-word tag in physical units, by the tag version of its time, as
+# the station converts it (registrar/schema.py physical_sql); no value where the station's
+# readers break a series (the record of a value that was held: GAP_SQL). `ts` is there so a
+# time filter on it reaches the day partitions (one on `time`, an expression, reads them all).
+# Made once, by whoever finds it missing: replacing it needs its owner, and stations may log in
+# as different roles.
+TAG_VALUES_SQL = f"""CREATE VIEW tag_values AS
+    SELECT r.time, r.station, t.name AS tag, t.name AS metric,
+        CASE WHEN r.gap THEN NULL ELSE {physical_sql("r.value", "t")} END AS value,
+        t.unit, coalesce(r.text, 'good') AS quality, r.ts, r.source, r.value AS raw, t.version
+    FROM (SELECT station, ts, source, value, text, {GAP_SQL} AS gap,
+            timestamptz 'epoch' + ts * interval '1 millisecond' AS time
+        FROM records WHERE kind = 'data') r
+    JOIN tags t ON t.station = r.station AND t.source = r.source
+        AND r.time >= t.valid_from AND r.time < t.valid_to
+    WHERE t.type IN ({", ".join(f"'{k}'" for k in ONE_WORD_TYPES)})"""
 
 
 def connect(url: str, *, read_only: bool = False, timeout: float = 5.0) -> psycopg.Connection:
@@ -103,11 +106,14 @@ def ensure_schema(con: psycopg.Connection) -> dt.tzinfo | None:
         con.execute("SELECT pg_advisory_xact_lock(%s)", (LOCK_PARTITIONS,))
         for sql in SCHEMA_SQL:
             con.execute(sql)
+        if con.execute("SELECT to_regclass('tag_values')").fetchone()[0] is None:
+            con.execute(TAG_VALUES_SQL)
         con.execute("INSERT INTO meta VALUES (%s, 'timezone_key', %s), "
                     "(%s, 'day_partitions', 'one per local day of the plant zone, named DD_MM_YYYY') "
                     "ON CONFLICT DO NOTHING", (PLANT, local_zone_key(), PLANT))
         con.execute("INSERT INTO meta VALUES (%s, 'schema_version', %s) ON CONFLICT (station, key) "
-                    "DO UPDATE SET value = excluded.value WHERE meta.value < excluded.value",
+                    "DO UPDATE SET value = excluded.value "
+                    "WHERE lpad(meta.value, 9, '0') < lpad(excluded.value, 9, '0')",  # never back
                     (PLANT, SCHEMA_VERSION))
     return plant_zone(con)
 

@@ -141,3 +141,19 @@ def test_an_older_tag_set_published_late_takes_the_time_before_the_change(tmp_pa
 
 def replace_unit(tag: Tag, unit: str) -> Tag:
     return Tag(tag.name, tag.address, tag.type, unit, tag.scaling, tag.decimals, tag.description)
+
+
+def test_a_plant_archive_of_an_older_version_gets_tags_and_the_view(tmp_path, pg_url):
+    db = archive_of(tmp_path / "journal.sqlite", demo_tags(), T0,
+                    [Record(T0, "data", 1, 1, "04010", value=4095.0)])
+    Forwarder(db, pg_url, "st").forward_all()
+    with psycopg.connect(pg_url) as con:  # as the older version left it
+        con.execute("DROP VIEW tag_values")
+        con.execute("DROP TABLE tags")
+        con.execute("UPDATE meta SET value = '1' WHERE key = 'schema_version'")
+    with Archive(pg_url) as plant:
+        assert plant.tags() == {}  # read as before
+    assert Forwarder(db, pg_url, "st").forward_all() == 0  # the next start of a station of this version
+    with psycopg.connect(pg_url) as con:
+        assert con.execute("SELECT tag, value FROM tag_values").fetchall() == [("LEVEL", 100.0)]
+        assert con.execute("SELECT value FROM meta WHERE key = 'schema_version'").fetchone() == ("2",)
