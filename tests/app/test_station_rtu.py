@@ -18,6 +18,8 @@ from pathlib import Path
 import pytest
 
 from app.authority import Source
+from app.authority.layer import Who
+from app.authority.users import Users
 from app.station.check import check_station
 from app.station.config import load_station
 from app.station.runtime import Runtime
@@ -30,6 +32,7 @@ UNIT = 7
 BANK1 = 0o14000 // 2  # register of data byte 014000: memory, but not writable here
 STATION = """
 NetPlcProgram = "main.stl"
+Tags = "tags.csv"
 NetSyncTime = 10
 [modbus_server]
 transport = "rtu"
@@ -37,6 +40,14 @@ port = "{port}"
 unit = {unit}
 writable = [["02000", "02177"], ["04000", "04777"]]
 """
+# 32-bit tags as two devices place them: big-endian (1234, ABCD) and NetPlc's own (3412, CDAB)
+TAGS = """name,address,type,byte_order
+BIG,04100,int32,1234
+BIGF,04104,float32,ABCD
+OURS,04110,int32,
+OURSF,04114,float32,3412
+"""
+FILES = {"main.stl": "JMP 0\n", "tags.csv": TAGS}
 
 
 class PtyPair:
@@ -95,7 +106,8 @@ class Rtu:
 def rtu(tmp_path_factory: pytest.TempPathFactory) -> Iterator[Rtu]:
     folder = tmp_path_factory.mktemp("rtu")
     pair = socat_pair(folder / "pty")
-    write_station(folder / "station", STATION.format(port=pair.a, unit=UNIT), {"main.stl": "JMP 0\n"})
+    write_station(folder / "station", STATION.format(port=pair.a, unit=UNIT), FILES)
+    Users(folder / "station").add("olga", "operator", "olga")
     runtime = Runtime(load_station(folder / "station"))
     records: list[Record] = []
     runtime.subscribe(records.append)
@@ -139,7 +151,8 @@ def test_refused_writes_answer_the_exceptions_of_the_tcp_server(rtu: Rtu) -> Non
     rtu.runtime.commands.grant(Source.MODBUS, "viewer")
     try:
         assert rtu.ask(bytes.fromhex("06 0400 0001")) == bytes.fromhex("86 01")
-        assert rtu.ask(bytes.fromhex("03 0400 0001")) == bytes.fromhex("03 02 1234")  # reads still do
+        word = rtu.runtime.engine.snapshot.get_word(0o4000)
+        assert rtu.ask(bytes.fromhex("03 0400 0001")) == b"\x03\x02" + word.to_bytes(2, "big")  # reads do
     finally:
         rtu.runtime.commands.grant(Source.MODBUS, "operator")
     peer = f"modbus rtu {rtu.pair.a}"
@@ -154,7 +167,7 @@ def mbpoll(rtu: Rtu, options: str, *writes: int) -> str:
     if shutil.which("mbpoll") is None:
         pytest.skip("mbpoll is not installed (apt-get install mbpoll)")
     command = ["mbpoll", "-m", "rtu", "-a", str(UNIT), "-b", "19200", "-P", "even", "-0", "-1",
-               *options.split(), str(rtu.pair.b), *map(str, writes)]
+               *options.split(), str(rtu.pair.b), *(["--", *map(str, writes)] if writes else [])]
     r = subprocess.run(command, capture_output=True, text=True, timeout=20)
     assert r.returncode == 0, r.stdout + r.stderr
     return r.stdout
@@ -168,7 +181,7 @@ def test_mbpoll_reads_and_writes_the_station(rtu: Rtu) -> None:
     assert "Written 1 references" in mbpoll(rtu, "-t 4 -r 1030", 4321)
     assert rtu.runtime.engine.snapshot.get_word(0o4014) == 4321
     assert "Written 1 references" in mbpoll(rtu, "-t 0 -r 1025", 1)
-    assert values(mbpoll(rtu, "-t 0 -r 1024 -c 3")) == {1024: "1", 1025: "1", 1026: "0"}
+    assert values(mbpoll(rtu, "-t 0 -r 1025 -c 2")) == {1025: "1", 1026: "0"}  # bits 02001, 02002
     # a 32-bit value in NetPlc's order, low word first, is what mbpoll reads without -B
     assert rtu.ask(bytes.fromhex("10 0408 0002 04 cd15 075b")) == bytes.fromhex("10 0408 0002")
     assert values(mbpoll(rtu, "-t 4:int -r 1032")) == {1032: "123456789"}
@@ -178,7 +191,7 @@ def test_mbpoll_reads_and_writes_the_station(rtu: Rtu) -> None:
 def test_a_port_that_cannot_be_opened_is_named_and_the_station_runs_on_and_retries(tmp_path: Path) -> None:
     need_socat()
     port = tmp_path / "pty" / "a"  # the adapter is not plugged in yet
-    write_station(tmp_path / "station", STATION.format(port=port, unit=UNIT), {"main.stl": "JMP 0\n"})
+    write_station(tmp_path / "station", STATION.format(port=port, unit=UNIT), FILES)
     assert check_station(tmp_path / "station").problems == []  # a port may come later: no check problem
     runtime = Runtime(load_station(tmp_path / "station"))
     texts: list[str] = []
@@ -204,3 +217,26 @@ def test_a_port_that_cannot_be_opened_is_named_and_the_station_runs_on_and_retri
         runtime.stop()
         if pair is not None:
             pair.stop()
+
+
+def test_mbpoll_and_the_station_agree_on_32_bit_values_in_the_tags_byte_order(rtu: Rtu) -> None:
+    runtime = rtu.runtime
+
+    def value(name: str) -> float | None:
+        readings = runtime.readings()
+        return None if readings is None else readings.tag(name).value
+
+    # mbpoll as the device: it places each value in its order (-B: big-endian words), the tag reads it
+    for options, tag, written in ((f"-B -t 4:int -r {0o4100 // 2}", "BIG", -123456789),
+                                  (f"-B -t 4:float -r {0o4104 // 2}", "BIGF", -1234.5),
+                                  (f"-t 4:int -r {0o4110 // 2}", "OURS", 123456789),
+                                  (f"-t 4:float -r {0o4114 // 2}", "OURSF", 3.25)):
+        assert "Written 1 references" in mbpoll(rtu, options, written)
+        wait_until(lambda tag=tag, written=written: value(tag) == written)
+    # the station writes each tag (its one conversion, encode), mbpoll reads what a device would get
+    olga = Who("olga", Source.CONSOLE)
+    for options, tag, written, shown in ((f"-B -t 4:int -r {0o4100 // 2}", "BIG", 987654321, "987654321"),
+                                         (f"-B -t 4:float -r {0o4104 // 2}", "BIGF", 0.5, "0.5"),
+                                         (f"-t 4:int -r {0o4110 // 2}", "OURS", -42, "-42")):
+        assert runtime.commands.write_tag(olga, tag, written).result(5).ok
+        assert values(mbpoll(rtu, options))[int(options.rsplit(" ", 1)[1])] == shown
