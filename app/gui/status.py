@@ -76,6 +76,10 @@ class StationStatusBar(QStatusBar):
         if s.modbus_port:
             self.server.show_value(f"Modbus :{s.modbus_port}", OK,
                                    self.tr("NetPlc memory served over Modbus TCP"))
+        elif s.modbus_serial:
+            fault = next((p for p in s.problems if p.startswith("Modbus RTU")), "")
+            self.server.show_value(f"Modbus RTU {s.modbus_serial}", BAD if fault else OK,
+                                   fault or self.tr("NetPlc memory served over Modbus RTU"))
         else:
             self.server.show_value(self.tr("Modbus off"), IDLE)
 

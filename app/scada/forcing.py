@@ -2,7 +2,7 @@
 
 The soft PLC forces bits, bytes and words; a tag is the station's name for memory with a type and
 a conversion, so forcing one by its physical value is the SCADA layer's: the forces that pin a
-tag (its bit, its word, or both words of a 32-bit tag, low word first), converted as an operator's
+tag (its bit, its word, or both words of a 32-bit tag, in its byte order), converted as an operator's
 write is, installed and released as one command and journaled once with the tag's name and unit.
 The command layer (app/authority/layer.py) queues these closures to the engine thread.
 """
@@ -20,7 +20,7 @@ from netplc.records import Record
 
 def tag_forces(tag: Tag, phy: float, user: str = "") -> tuple[Force, ...]:
     """The forces that pin `tag` at the physical value `phy`: its bit, its word, or both words of a
-    32-bit tag (low word first), converted by the tag's Scaling and type like an operator's write."""
+    32-bit tag (in its byte order), converted by the tag's Scaling and type like an operator's write."""
     raw = tag.to_raw(phy)
     if tag.type is TagType.BIT:
         return (Force("bit", tag.address, 1 if raw else 0, user),)

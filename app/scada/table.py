@@ -15,19 +15,21 @@ import re
 from dataclasses import dataclass, field
 from pathlib import Path
 
-from app.scada.tag import Scaling, Tag, TagType, check_address
+from app.scada.tag import BYTE_ORDERS, NETPLC_ORDER, WIDE, Scaling, Tag, TagType, check_address
 from netplc.address import AddressError, parse_hmi_bit, parse_octal
 from netplc.problems import Problems
 from netplc.textfile import TextFileError, csv_rows, read_text
 
 REQUIRED = ("name", "address", "type")
-TAG_COLUMNS = ("unit", "app_min", "app_max", "phy_min", "phy_max", "decimals", "description")
+TAG_COLUMNS = ("unit", "app_min", "app_max", "phy_min", "phy_max", "decimals", "description", "byte_order")
 ALARM_COLUMNS = ("hh", "h", "l", "ll", "deadband", "delay", "on_delay", "off_delay", "alarm_when", "priority",
                  "latching", "suppress_by", "quality_alarm")
 COLUMNS = REQUIRED + TAG_COLUMNS + ALARM_COLUMNS
 LIMIT_KEYS = ("ll", "l", "h", "hh")  # in the order their values must keep
 TYPES = {t.value for t in TagType}
 ALIASES = {"uint16": "word", "int": "int16", "dint": "int32", "real": "float32"}  # IEC 61131-3 names
+# byte orders by the letters other tools use (A the most significant byte)
+ORDER_LETTERS = {"ABCD": "1234", "DCBA": "4321", "BADC": "2143", "CDAB": "3412"}
 DEFAULT_PRIORITY = 3  # medium
 _NAME = re.compile(r"[^\W\d]\w*")
 _YES = {"1": True, "yes": True, "true": True, "0": False, "no": False, "false": False}
@@ -219,16 +221,31 @@ class _Row:
         addr = self.address(kind)
         scaling = self.scaling(kind)
         decimals = self.whole("decimals", 0, 0, 10)
+        order = self.byte_order(kind)
         alarms = self.alarms(kind, scaling)
         if not ok or addr is None or kind is None or self.problems:
             return None
         tag = Tag(self.name, addr, kind, self.cells.get("unit", ""), scaling, decimals or 0,
-                  self.cells.get("description", ""))
+                  self.cells.get("description", ""), order)
         if alarms is not None:
             self.fits(tag, alarms)
         if self.problems or alarms is None:
             return None
         return tag, alarms
+
+    def byte_order(self, kind: TagType | None) -> str:
+        """How the device that fills a 32-bit tag placed its bytes (empty: NetPlc's own)."""
+        text = self.cells.get("byte_order", "")
+        if not text:
+            return NETPLC_ORDER
+        order = ORDER_LETTERS.get(text.upper(), text)
+        if order not in BYTE_ORDERS:
+            self.bad(f"byte_order {text!r} is not one of {', '.join(BYTE_ORDERS)} "
+                     f"(or {', '.join(ORDER_LETTERS)})")
+        elif kind is not None and kind not in WIDE:
+            self.bad(f"byte_order is for int32 and float32 tags; a {kind} tag is read as NetPlc memory "
+                     "holds it")
+        return order if order in BYTE_ORDERS else NETPLC_ORDER
 
     def scaling(self, kind: TagType | None) -> Scaling | None:
         keys = ("app_min", "app_max", "phy_min", "phy_max")

@@ -1,9 +1,11 @@
 """A tag: a named piece of NetPlc memory with its type, unit and hardware/physical conversion.
 
-The conversion is the manual's (section 2.4.1, docs/architecture.md section 9), and it is the only one: forms,
-journal, viewer and CSV convert through `Scaling`. `Scaling.to_phy` is written so that it also runs
-element-wise on numpy arrays, which is how `TagReader` converts thousands of tags in one step
-with the very same arithmetic (and so the very same results) as a single tag.
+The conversion is the manual's (section 2.4.1, docs/architecture.md section 9), and it is the only
+one: forms, journal, viewer and CSV convert through `Scaling`; a 32-bit tag's bytes are read and
+written in its `byte_order` by `raw`, `encode` and `TagReader` alone, so every reader and writer
+follows it. `Scaling.to_phy` is written so that it also runs element-wise on numpy arrays, which
+is how `TagReader` converts thousands of tags in one step with the very same arithmetic (and so
+the very same results) as a single tag.
 """
 
 from __future__ import annotations
@@ -62,8 +64,31 @@ class TagType(StrEnum):
     WORD = "word"  # unsigned 16
     INT16 = "int16"
     BCD = "bcd"  # 4 BCD digits in a word, 0-9999
-    INT32 = "int32"  # two words, low word first (docs/architecture.md section 3)
-    FLOAT32 = "float32"  # IEEE single over two words, low word first
+    INT32 = "int32"  # two words, in the tag's byte order (NetPlc's: low word first)
+    FLOAT32 = "float32"  # IEEE single over two words, in the tag's byte order
+
+
+# The byte order of a 32-bit value over two registers, as Modbus tools name it (mbpoll, Kepware,
+# Modbus Poll): the value's bytes numbered 1 (most significant) to 4, in the order they travel,
+# the first register's high byte first. 1234 is big-endian (ABCD), 4321 little-endian (DCBA),
+# 2143 big-endian with the bytes of each word swapped (BADC), 3412 the words swapped (CDAB).
+BYTE_ORDERS = ("1234", "4321", "2143", "3412")
+NETPLC_ORDER = "3412"  # NetPlc's own (docs/architecture.md section 3): low word first, a word's
+# low byte first in memory and its high byte first in a register: CDAB on the wire
+
+
+def _memory_order(order: str) -> tuple[int, int, int, int]:
+    """Which byte of NetPlc memory holds each byte of the value, most significant first. A register
+    carries its word high byte first and memory keeps it low byte first: the byte that travels
+    at position i is memory byte i ^ 1 (NREAD/NWRITE and our server move the words as they are)."""
+    where = [0, 0, 0, 0]
+    for position, digit in enumerate(order):
+        where[int(digit) - 1] = position ^ 1
+    return tuple(where)  # type: ignore[return-value]
+
+
+MEMORY_ORDER = {order: _memory_order(order) for order in BYTE_ORDERS}
+WIDE = (TagType.INT32, TagType.FLOAT32)  # the types a byte order applies to
 
 
 # bytes in memory, and the lowest and highest hardware value
@@ -99,6 +124,7 @@ class Tag:
     scaling: Scaling | None = None  # None: the physical value is the hardware value
     decimals: int = 0
     description: str = ""
+    byte_order: str = NETPLC_ORDER  # of a 32-bit tag (BYTE_ORDERS): how the device placed it
 
     @property
     def limits(self) -> tuple[float, float]:
@@ -128,9 +154,10 @@ class Tag:
             v = bcd_to_bin(view.get_word(self.address))
             return float("nan") if v is None else v
         data = view.read(self.address, 4)
+        value = bytes(data[i] for i in MEMORY_ORDER[self.byte_order])  # most significant byte first
         if kind is TagType.INT32:
-            return int.from_bytes(data, "little", signed=True)
-        return struct.unpack("<f", data)[0]
+            return int.from_bytes(value, "big", signed=True)
+        return struct.unpack(">f", value)[0]
 
     def value(self, view: MemoryView) -> float:
         """The physical value."""
@@ -163,14 +190,20 @@ class Tag:
         return self.scaling.to_hw(phy, self.limits, whole)
 
     def encode(self, raw: float) -> bytes:
-        """The bytes of a hardware value as they go into memory (not for bits)."""
+        """The bytes of a hardware value as they go into memory (not for bits), a 32-bit one in the
+        tag's byte order."""
         kind = self.type
-        if kind is TagType.FLOAT32:
-            return struct.pack("<f", raw)
+        if kind in WIDE:
+            value = struct.pack(">f", raw) if kind is TagType.FLOAT32 else \
+                (int(raw) & 0xFFFFFFFF).to_bytes(4, "big")
+            data = bytearray(4)
+            for byte, i in zip(value, MEMORY_ORDER[self.byte_order], strict=True):
+                data[i] = byte
+            return bytes(data)
         v = int(raw)
         if kind is TagType.BCD:
             v = (v // 1000) << 12 | (v // 100 % 10) << 8 | (v // 10 % 10) << 4 | v % 10
-        return (v & (0xFFFF if SIZES[kind] == 2 else 0xFFFFFFFF)).to_bytes(SIZES[kind], "little")
+        return (v & 0xFFFF).to_bytes(2, "little")
 
     def format(self, phy: float) -> str:
         """The physical value as an operator reads it: its decimals and unit."""
@@ -199,7 +232,7 @@ class TagReader:
         self._singles: list[tuple[int, Tag]] = []
         io_bits: list[tuple[int, int]] = []
         data_bits: list[tuple[int, int, int]] = []
-        by_type: dict[TagType, list[tuple[int, int]]] = {}
+        by_type: dict[tuple[TagType, str], list[tuple[int, int]]] = {}
         for pos, tag in enumerate(self.tags):
             if tag.type is TagType.BIT:
                 if tag.address < IO_BITS:
@@ -209,11 +242,14 @@ class TagReader:
             elif tag.address < IO_BITS:
                 self._singles.append((pos, tag))
             else:
-                by_type.setdefault(tag.type, []).append((pos, data_index(tag.address)))
-        for kind, items in by_type.items():
+                order = tag.byte_order if tag.type in WIDE else ""
+                by_type.setdefault((tag.type, order), []).append((pos, data_index(tag.address)))
+        for (kind, order), items in by_type.items():
             positions = np.array([p for p, _ in items], dtype=np.intp)
             first = np.array([i for _, i in items], dtype=np.intp)
-            self._groups.append((positions, first[:, None] + np.arange(SIZES[kind]), kind))
+            # a 32-bit tag's bytes gathered most significant first, whatever order memory holds them in
+            offsets = np.array(MEMORY_ORDER[order]) if order else np.arange(SIZES[kind])
+            self._groups.append((positions, first[:, None] + offsets, kind))
         self._io_pos = np.array([p for p, _ in io_bits], dtype=np.intp)
         self._io_get = itemgetter(*(a for _, a in io_bits), 0)  # always a tuple, one item too many
         self._bit_pos = np.array([p for p, _, _ in data_bits], dtype=np.intp)
@@ -235,9 +271,9 @@ class TagReader:
             elif kind is TagType.INT16:
                 out[positions] = block.view("<i2")[:, 0]
             elif kind is TagType.INT32:
-                out[positions] = block.view("<i4")[:, 0]
+                out[positions] = block.view(">i4")[:, 0]
             elif kind is TagType.FLOAT32:
-                out[positions] = block.view("<f4")[:, 0]
+                out[positions] = block.view(">f4")[:, 0]
             else:  # BCD
                 hi, lo = block[:, 1], block[:, 0]
                 nibbles = np.stack((hi >> 4, hi & 15, lo >> 4, lo & 15), 1)

@@ -10,7 +10,7 @@ from __future__ import annotations
 
 import sys
 import tomllib
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from pathlib import Path
 from typing import Any
 
@@ -18,6 +18,7 @@ from app.authority.policy import OPERATOR, ROLES
 from app.scada.tag import TagType
 from netplc.address import fmt_octal, is_data_byte, is_io_bit, parse_octal
 from netplc.exchange import NODE_DEFAULTS, NodeConfig, shared_problems
+from netplc.modbus import Endpoint, line_problems
 from netplc.problems import Problems
 from netplc.textfile import TextFileError, file_problem, read_text, resolve
 from registrar.plant.url import is_url, url_problem
@@ -28,6 +29,10 @@ DEMO_STATION = Path(__file__).resolve().parents[2] / "resources" / "example"  # 
 # data bank, but not the special bits 03700-03777 (03770 stops NetPlc, 03771/03772 are the error
 # flags, 03773/03774 the time base): a range that names them explicitly still opens them.
 DEFAULT_WRITABLE = ((0o2000, 0o3677), (0o4000, 0o7777))
+TRANSPORTS = ("tcp", "rtu")  # [modbus_server] transport
+# the [modbus_server] keys that only one transport has
+_SERVER_KEYS = {"tcp": ("host", "max_connections", "idle_timeout", "max_inflight", "max_per_peer"),
+                "rtu": ("baudrate", "parity", "stopbits")}
 
 
 class ConfigError(Problems):
@@ -51,12 +56,17 @@ class ModbusServerSettings:
     host: str = "127.0.0.1"
     port: int = 1502
     writable: tuple[tuple[int, int], ...] = DEFAULT_WRITABLE
-    unit: int | None = None  # the unit id answered; None: every unit id
+    unit: int | None = None  # the unit id answered; None: every unit id (TCP only)
     max_connections: int = 16  # the next connection is closed (one journal line a minute)
     idle_timeout: float = 60.0  # s without a whole request before a connection is closed
     max_inflight: int = 32  # answers (of the longest size) a connection may leave unread or waiting
     max_per_peer: int = 4  # connections from one address; the next one is closed
     role: str = OPERATOR  # what Modbus clients may do (they have no users): viewer = read-only
+    serial: Endpoint | None = None  # transport = "rtu": the serial port and its line; None: TCP
+
+    @property
+    def transport(self) -> str:
+        return "tcp" if self.serial is None else "rtu"
 
 
 @dataclass(frozen=True)
@@ -297,7 +307,7 @@ def read_station(path: str | Path) -> tuple[Station | None, list[str]]:
     mqtt = _mqtt(problems, fname, top.get("mqtt", dict, {}), base, top.allow_outside)
     top.finish()
     nodes = _with_simulated_nodes(problems, fname, nodes, simulators)
-    _ports_in_common(problems, fname, server, simulators)
+    _ports_in_common(problems, fname, server, simulators, nodes)
     program, symbols, hmi, messages, tags = (
         _existing(top, key, p, must_be_dir)
         for key, p, must_be_dir in (("NetPlcProgram", program, False), ("Symbols", symbols, False),
@@ -373,23 +383,58 @@ def _existing(r: _Reader, key: str, path: Path | None, must_be_dir: bool) -> Pat
 
 def _modbus_server(problems: list[str], fname: str, table: dict[str, Any]) -> ModbusServerSettings:
     r = _Reader(problems, fname, table, "modbus_server.")
-    enabled = r.get("enabled", bool, True)
-    host = r.get("host", str, "127.0.0.1")
-    port = r.number("port", 1502, 0, 65535)
+    d = ModbusServerSettings()
+    enabled = r.get("enabled", bool, d.enabled)
+    transport = r.get("transport", str, "tcp")
+    if transport not in TRANSPORTS:
+        r.bad("transport", f"{transport!r} is not one of {', '.join(TRANSPORTS)}")
+        transport = "tcp"
+    rtu = transport == "rtu"
+    for key in _SERVER_KEYS["tcp" if rtu else "rtu"]:
+        if key in table:
+            r.known.add(key)
+            r.bad(key, f'applies to transport = "{"tcp" if rtu else "rtu"}" only')
     ranges = r.get("writable", list, None)
-    unit = r.number("unit", None, 1, 247)
-    max_connections = r.number("max_connections", 16, 1, 1000)
-    max_inflight = r.number("max_inflight", 32, 1, 10_000)
-    idle_timeout = _seconds(r, "idle_timeout", 60.0, 0.1, 86_400.0)
-    max_per_peer = r.number("max_per_peer", 4, 1, 1000)
+    unit = r.number("unit", 1 if rtu else None, 1, 247)  # a slave on a shared line has one address
     role = r.get("role", str, OPERATOR)
+    if rtu:
+        server = replace(d, serial=_serial_port(r))
+    else:
+        server = ModbusServerSettings(
+            host=r.get("host", str, d.host), port=r.number("port", d.port, 0, 65535),
+            max_connections=r.number("max_connections", d.max_connections, 1, 1000),
+            idle_timeout=_seconds(r, "idle_timeout", d.idle_timeout, 0.1, 86_400.0),
+            max_inflight=r.number("max_inflight", d.max_inflight, 1, 10_000),
+            max_per_peer=r.number("max_per_peer", d.max_per_peer, 1, 1000))
     r.finish()
     if role not in ROLES:
         r.bad("role", f"{role!r} is not one of {', '.join(ROLES)}")
         role = OPERATOR
     writable = DEFAULT_WRITABLE if ranges is None else _ranges(r, ranges)
-    return ModbusServerSettings(enabled, host, port, writable, unit, max_connections, idle_timeout,
-                                max_inflight, max_per_peer, role)
+    return replace(server, enabled=enabled, writable=writable, unit=unit, role=role)
+
+
+def _serial_port(r: _Reader) -> Endpoint | None:
+    """transport = "rtu": `port` names the serial port, and its line settings: 19200 baud, 8 data
+    bits, even parity, as the Modbus over Serial Line specification (2.5.1) makes the default;
+    one stop bit, or two without parity, as it requires."""
+    device = r.get("port", str, None)
+    if device is None:
+        if "port" not in r.table:
+            r.bad("port", 'missing: transport = "rtu" answers on a serial port, '
+                          'such as "/dev/ttyUSB0" or "COM3"')
+        return None
+    if not device.strip() or "\0" in device:
+        r.bad("port", f"{device!r} is not a serial port")
+        return None
+    baudrate = r.get("baudrate", int, 19200)
+    parity = r.get("parity", str, "E").upper()
+    stopbits = r.get("stopbits", int, 2 if parity == "N" else 1)
+    serial = Endpoint("rtu", device=device, baudrate=baudrate, parity=parity, stopbits=stopbits)
+    found = line_problems(serial)
+    for key, text in found:
+        r.bad(key, text)
+    return None if found else serial
 
 
 def _ranges(r: _Reader, ranges: list[Any]) -> tuple[tuple[int, int], ...]:
@@ -497,10 +542,16 @@ def _operator(problems: list[str], fname: str, table: dict[str, Any]) -> Operato
 
 
 def _ports_in_common(problems: list[str], fname: str, server: ModbusServerSettings,
-                     sims: list[SimulatorSettings]) -> None:
-    """Fixed ports that the station itself would listen on twice (port 0 is always a free one)."""
+                     sims: list[SimulatorSettings], nodes: list[NodeConfig]) -> None:
+    """Fixed ports that the station itself would listen on twice (port 0 is always a free one), and
+    a serial port it would answer on as a slave while its exchange polls nodes there as the master."""
+    serial = server.serial if server.enabled else None
+    for n in nodes:
+        if serial is not None and n.parsed is not None and n.parsed.device == serial.device:
+            problems.append(f"{fname}: modbus_server.port: {serial.device} is also the serial port of "
+                            f"{n.key}.endpoint: the station cannot be the master and a slave on one line")
     taken: dict[tuple[str, int], str] = {}
-    if server.enabled and server.port:
+    if server.enabled and server.serial is None and server.port:
         taken[server.host, server.port] = "modbus_server.port"
     for i, sim in enumerate(sims):
         if sim.port:

@@ -41,7 +41,7 @@ from hmi_forms.form import Form
 from netplc.engine import Engine
 from netplc.exchange import Exchange, NodeConfig
 from netplc.forcing import Force, load_forces, save_forces
-from netplc.modbus import ModbusServer, ServerLimits, parse_endpoint
+from netplc.modbus import REOPEN, ModbusServer, ServerLimits, parse_endpoint
 from netplc.problems import Problems
 from netplc.records import Record
 from netplc.scheduler import ScanThread
@@ -86,6 +86,7 @@ class RuntimeStatus:
     records_pending: int
     records_lost: int
     modbus_port: int | None
+    modbus_serial: str = ""  # the serial port the Modbus server answers on (transport = "rtu")
     problems: tuple[str, ...] = field(default=())  # what an operator must see (disk, server, ...)
     forced: int = 0  # forces in effect: the always-visible "F: n forced"
 
@@ -311,13 +312,17 @@ class Runtime:
             limits = ServerLimits(server.max_connections, server.idle_timeout, server.max_inflight,
                                   server.max_per_peer)
             modbus = ModbusServer(ModbusCommands(self.commands, server.writable), host=server.host,
-                                  port=server.port, unit=server.unit, limits=limits, sink=self)
+                                  port=server.port, unit=server.unit, serial=server.serial,
+                                  limits=limits, sink=self)
             try:
-                modbus.start()
+                modbus.start(retry=True)
                 self.modbus = modbus
             except OSError as e:  # the station runs on without it; the operator sees why
                 self.problem(f"Modbus server not started: {st.path}: modbus_server.port: cannot listen on "
                               f"{server.host}:{server.port}: {_reason(e)}")
+            if modbus.fault:  # a serial port not there yet, or held by another program: tried again
+                self.system(f"Modbus server not started yet: {st.path}: modbus_server.port: {modbus.fault}; "
+                            f"retrying every {REOPEN:g} s", logging.WARNING)
         self.publishers = start_publishers(self)
         self.system(f"program loaded: {self.program.source} ({len(self.program.instrs)} instructions, "
                     f"{self.program.words} words)")
@@ -514,6 +519,8 @@ class Runtime:
         nodes = tuple(NodeStatus(n.node, n.endpoint, bool(exchange and exchange.link_up(n.node)))
                       for n in self.nodes)
         problems = list(self._problems) + [f"form problem: {p}" for p in self.form_problems[:3]]
+        if self.modbus is not None and self.modbus.fault:  # journaled when it began and when it ended
+            problems.append(self.modbus.fault)
         if engine is not None:
             faults = engine.listener_faults.items()
             problems += [f"engine listener {name} failed: {why}" for name, why in faults]
@@ -545,7 +552,8 @@ class Runtime:
             records_written=written,
             records_pending=pending,
             records_lost=lost,
-            modbus_port=self.modbus.port if self.modbus else None,
+            modbus_port=self.modbus.port if self.modbus and self.modbus.serial is None else None,
+            modbus_serial=self.modbus.serial.device if self.modbus and self.modbus.serial else "",
             problems=tuple(problems),
             forced=engine.forces.count if engine else 0,
         )

@@ -9,7 +9,7 @@ every minor release.
 """
 
 from netplc.modbus.client import LeanTcpClient, ModbusClient, open_client
-from netplc.modbus.endpoint import Endpoint, parse_endpoint
+from netplc.modbus.endpoint import PARITIES, Endpoint, line_problems, parse_endpoint
 from netplc.modbus.loop import LoopThread
 from netplc.modbus.map import (
     MAX_READ_BITS,
@@ -39,6 +39,7 @@ from netplc.modbus.pdu import (
     ServeHandler,
     exception_text,
 )
+from netplc.modbus.rtu import REOPEN
 from netplc.modbus.server import ALL_MEMORY, MemoryServed, ModbusServer
 from netplc.modbus.tcp_server import ServerLimits
 
@@ -53,7 +54,9 @@ __all__ = [
     "ILLEGAL_VALUE",
     "MAX_READ_BITS",
     "MAX_READ_REGISTERS",
+    "PARITIES",
     "PROFILES",
+    "REOPEN",
     "TABLES",
     "WRITABLE_TABLES",
     "Block",
@@ -74,6 +77,7 @@ __all__ = [
     "bytes_from_words",
     "describe",
     "exception_text",
+    "line_problems",
     "locate",
     "open_client",
     "parse_endpoint",

@@ -7,7 +7,12 @@ from dataclasses import dataclass
 from typing import Any
 from urllib.parse import parse_qsl, urlsplit
 
+from serial import SerialBase
+
 PARITIES = ("N", "E", "O")
+BAUDRATES: tuple[int, ...] = SerialBase.BAUDRATES  # the standard rates every platform's port takes
+STOPBITS = (1, 2)
+BYTESIZES = (5, 6, 7, 8)
 
 
 @dataclass(frozen=True, slots=True)
@@ -65,5 +70,17 @@ def parse_endpoint(text: str) -> Endpoint:
             else:
                 raise ValueError(f"endpoint {text!r}: unknown option {key!r} "
                                  "(baudrate, parity, bytesize, stopbits)")
-        return Endpoint("rtu", device=device, **options)
+        endpoint = Endpoint("rtu", device=device, **options)
+        if problems := line_problems(endpoint):
+            raise ValueError(f"endpoint {text!r}: {problems[0][1]}")
+        return endpoint
     raise ValueError(f"endpoint {text!r}: unknown scheme {url.scheme!r} ({forms})")
+
+
+def line_problems(endpoint: Endpoint) -> list[tuple[str, str]]:
+    """(setting, problem) for each serial line setting of an rtu endpoint that a port cannot take:
+    a typo in a rate would otherwise open the port at a speed nobody on the line talks."""
+    checks = (("baudrate", endpoint.baudrate, BAUDRATES), ("parity", endpoint.parity, PARITIES),
+              ("stopbits", endpoint.stopbits, STOPBITS), ("bytesize", endpoint.bytesize, BYTESIZES))
+    return [(key, f"{key} {value!r} is not one of {', '.join(map(str, allowed))}")
+            for key, value, allowed in checks if value not in allowed]

@@ -143,9 +143,10 @@ class RtuServer:
     """Answers `handler` as unit `unit` (None: every unit) on `line`, from a thread of its own.
 
     `reopen()` opens the port again after a failure (None: keep the same line); `note(text)`
-    journals the port's faults and recoveries."""
+    journals the port's faults and recoveries. `line` None: the port could not be opened yet
+    (`start(fault)` says why), so the thread opens it with `reopen` first."""
 
-    def __init__(self, handler: ServeHandler, unit: int | None, line: SerialLine, name: str,
+    def __init__(self, handler: ServeHandler, unit: int | None, line: SerialLine | None, name: str,
                  reopen: Callable[[], SerialLine] | None = None,
                  note: Callable[[str], None] | None = None) -> None:
         self.handler = handler
@@ -160,7 +161,12 @@ class RtuServer:
         self._stop = threading.Event()
         self._thread = threading.Thread(target=self._serve, name=f"modbus-rtu-{name}", daemon=True)
 
-    def start(self) -> None:
+    def start(self, fault: str = "") -> None:
+        """`fault`: why the port is not open (`line` None); shown as `fault` until it opens. The
+        caller journals it, naming its own setting."""
+        if self.line is None and self.reopen is None:
+            raise ValueError("an RtuServer without a line needs `reopen` to open one")
+        self.fault = fault
         self._thread.start()
 
     @property
@@ -170,12 +176,19 @@ class RtuServer:
     def stop(self) -> None:
         self._stop.set()
         self._thread.join(2.0)
-        with contextlib.suppress(OSError):
-            self.line.close()
+        self._close()
+
+    def _close(self) -> None:
+        if self.line is not None:
+            with contextlib.suppress(OSError):
+                self.line.close()
 
     def _serve(self) -> None:
         buf = bytearray()
+        if self.line is None:
+            self._reopen()
         while not self._stop.is_set():
+            assert self.line is not None
             try:
                 chunk = self.line.read(MAX_FRAME)
             except OSError as e:
@@ -196,11 +209,13 @@ class RtuServer:
         """The port failed: say so once, then try it again every REOPEN seconds until it works."""
         self.fault = f"Modbus RTU on {self.name} failed: {error}"
         self.note(f"{self.fault}; retrying every {REOPEN:g} s")
+        self._reopen()
+
+    def _reopen(self) -> None:
         while not self._stop.wait(REOPEN):
             if self.reopen is None:
                 break
-            with contextlib.suppress(OSError):
-                self.line.close()
+            self._close()
             try:
                 self.line = self.reopen()
             except OSError:

@@ -11,6 +11,7 @@ command layer (app/authority/modbus.py), a simulated CPU-165's straight to its e
 from __future__ import annotations
 
 import logging
+import os
 import time
 from collections.abc import Iterable
 from typing import Protocol
@@ -28,7 +29,7 @@ from netplc.modbus.map import (
     register_slice,
 )
 from netplc.modbus.pdu import ILLEGAL_ADDRESS, Done, ServeHandler
-from netplc.modbus.rtu import RtuServer, open_line
+from netplc.modbus.rtu import RtuServer, SerialLine, open_line
 from netplc.modbus.tcp_server import ServerLimits, TcpServer
 from netplc.records import Record, RecordSink
 
@@ -122,13 +123,25 @@ class ModbusServer:
         else:
             self.sink.put(Record(time.time(), "system", source="modbus server", text=text))
 
-    def start(self) -> None:
-        """OSError if the port cannot be bound or the serial port opened."""
+    def start(self, retry: bool = False) -> None:
+        """OSError if the port cannot be bound or the serial port opened. `retry`: a serial port
+        that cannot be opened is no error: the server starts without it, `fault` says why until it
+        opens, and it is tried every REOPEN seconds (an adapter plugged in later, a port another
+        program holds)."""
         if self.serial is not None:
             serial = self.serial
-            self.rtu = RtuServer(self.handler, self.unit, open_line(serial), serial.device,
+            line: SerialLine | None = None
+            fault = ""
+            try:
+                line = open_line(serial)
+            except OSError as e:
+                if not retry:
+                    raise
+                why = os.strerror(e.errno) if e.errno else str(e)  # pyserial repeats the port in its text
+                fault = f"Modbus RTU on {serial.device} cannot be opened: {why}"
+            self.rtu = RtuServer(self.handler, self.unit, line, serial.device,
                                  reopen=lambda: open_line(serial), note=self.journal)
-            self.rtu.start()
+            self.rtu.start(fault)
             return
         if self._own_thread:
             self._thread.start()

@@ -8,6 +8,7 @@ import pytest
 
 from app.station.config import ConfigError, load_station, read_station
 from netplc.exchange import NodeConfig
+from netplc.modbus import Endpoint
 from tests.app.conftest import DEMO, write_station
 
 
@@ -270,3 +271,54 @@ def test_a_path_says_what_is_there_instead_of_a_file(tmp_path: Path) -> None:
     os.symlink("station.toml", toml)
     assert read_station(tmp_path)[1] == [
         f"{toml}: cannot read the station file: Too many levels of symbolic links"]
+
+
+def test_modbus_server_over_rtu_reads_its_serial_port_and_line(tmp_path: Path) -> None:
+    write_station(tmp_path, 'NetPlcLoad = false\n[modbus_server]\ntransport = "rtu"\nport = "/dev/ttyUSB0"\n')
+    server = load_station(tmp_path).modbus_server
+    assert server.transport == "rtu" and server.unit == 1  # a slave on a shared line has one address
+    assert server.serial == Endpoint("rtu", device="/dev/ttyUSB0", baudrate=19200, parity="E", stopbits=1)
+    write_station(tmp_path, """
+NetPlcLoad = false
+[modbus_server]
+transport = "rtu"
+port = "COM3"
+baudrate = 9600
+parity = "n"
+unit = 17
+role = "viewer"
+""")
+    server = load_station(tmp_path).modbus_server
+    assert server.serial == Endpoint("rtu", device="COM3", baudrate=9600, parity="N", stopbits=2)
+    assert (server.unit, server.role) == (17, "viewer")
+    assert load_station(DEMO).modbus_server.transport == "tcp"
+
+
+@pytest.mark.parametrize(("server", "expected"), [
+    ('transport = "rtu"', ['modbus_server.port: missing: transport = "rtu" answers on a serial port, '
+                           'such as "/dev/ttyUSB0" or "COM3"']),
+    ('transport = "rtu"\nport = 1502', ["modbus_server.port: expected a string, got 1502"]),
+    ('transport = "rtu"\nport = " "', ["modbus_server.port: ' ' is not a serial port"]),
+    ('transport = "rtu"\nport = "/dev/ttyS1"\nbaudrate = 19000\nparity = "X"\nstopbits = 3',
+     ["modbus_server.baudrate: baudrate 19000 is not one of 50, 75, 110, 134, 150, 200, 300, 600, 1200, "
+      "1800, 2400, 4800, 9600, 19200, 38400, 57600, 115200, 230400, 460800, 500000, 576000, 921600, "
+      "1000000, 1152000, 1500000, 2000000, 2500000, 3000000, 3500000, 4000000",
+      "modbus_server.parity: parity 'X' is not one of N, E, O",
+      "modbus_server.stopbits: stopbits 3 is not one of 1, 2"]),
+    ('transport = "rtu"\nport = "/dev/ttyS1"\nbaudrate = "fast"',
+     ["modbus_server.baudrate: expected an integer, got 'fast'"]),
+    ('transport = "rtu"\nport = "/dev/ttyS1"\nhost = "0.0.0.0"\nmax_connections = 2\nunit = 0',
+     ['modbus_server.host: applies to transport = "tcp" only',
+      'modbus_server.max_connections: applies to transport = "tcp" only',
+      "modbus_server.unit: 0 is outside 1-247"]),
+    ('baudrate = 9600', ['modbus_server.baudrate: applies to transport = "rtu" only']),
+    ('transport = "ascii"', ["modbus_server.transport: 'ascii' is not one of tcp, rtu"]),
+    ('transport = "rtu"\nport = "/dev/ttyS1"\n[[nodes]]\nnode = 1\nendpoint = "rtu:///dev/ttyS1"',
+     ["modbus_server.port: /dev/ttyS1 is also the serial port of nodes[0].endpoint: the station cannot "
+      "be the master and a slave on one line"]),
+])
+def test_modbus_server_over_rtu_problems_are_named_by_key(tmp_path: Path, server: str,
+                                                          expected: list[str]) -> None:
+    write_station(tmp_path, f"NetPlcLoad = false\n[modbus_server]\n{server}\n")
+    _, problems = read_station(tmp_path)
+    assert [p.removeprefix(f"{tmp_path / 'station.toml'}: ") for p in problems] == expected

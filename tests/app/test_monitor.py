@@ -451,3 +451,10 @@ def test_the_watch_table_forces_a_tag_in_physical_units(qtbot, tmp_path: Path) -
         monitor.grab()
     finally:
         rt.stop()
+
+
+def test_a_station_serving_modbus_rtu_is_not_monitored_over_tcp(tmp_path: Path) -> None:
+    write_station(tmp_path, 'NetPlcLoad = false\n[modbus_server]\ntransport = "rtu"\nport = "/dev/ttyUSB0"\n')
+    with pytest.raises(Problems, match=r"modbus_server\.transport: the station serves Modbus RTU on "
+                                       r"/dev/ttyUSB0, not TCP: monitor it over OPC UA"):
+        remote_source(str(tmp_path))

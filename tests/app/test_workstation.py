@@ -7,6 +7,7 @@ import itertools
 import math
 import sqlite3
 from collections.abc import Iterator
+from dataclasses import replace
 from pathlib import Path
 
 import pytest
@@ -150,6 +151,10 @@ def test_a_failing_archive_shows_in_the_status_bar(qtbot) -> None:
     assert bar.records.property("level") == "bad"
     assert bar.state.property("level") == "ok"
     assert station_problems(status) == list(status.problems)
+    fault = "Modbus RTU on /dev/ttyUSB0 failed: device disconnected"
+    bar.show_status(replace(status, modbus_serial="/dev/ttyUSB0", problems=(fault,)))
+    assert bar.server.text() == "Modbus RTU /dev/ttyUSB0" and bar.server.property("level") == "bad"
+    assert bar.server.toolTip() == fault
 
 
 def test_elements_mark_a_dead_node_and_a_stopped_netplc_and_link_labels_follow_the_link(

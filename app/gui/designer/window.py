@@ -187,6 +187,10 @@ class DesignerWindow(QMainWindow):
         if station is None or not station.modbus_server.enabled:
             self.preview_action.setEnabled(False)
             self.preview_action.setToolTip("No station with a Modbus server beside this form")
+        elif station.modbus_server.serial is not None:
+            self.preview_action.setEnabled(False)
+            self.preview_action.setToolTip("The station's Modbus server is RTU on a serial port; "
+                                           "the preview reads Modbus TCP")
         view.addSeparator()
         self._action(view, "Zoom in", lambda: self.canvas.scale(1.25, 1.25), keys.ZoomIn)
         self._action(view, "Zoom out", lambda: self.canvas.scale(0.8, 0.8), keys.ZoomOut)

@@ -420,6 +420,10 @@
         <translation>Память NetPlc доступна по Modbus TCP</translation>
     </message>
     <message>
+        <source>NetPlc memory served over Modbus RTU</source>
+        <translation>Память NetPlc доступна по Modbus RTU</translation>
+    </message>
+    <message>
         <source>Modbus off</source>
         <translation>Modbus выключен</translation>
     </message>

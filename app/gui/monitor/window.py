@@ -70,6 +70,9 @@ def remote_source(target: str, program: str | None = None) -> RemoteSource:
         if not server.enabled:
             raise Problems([f"{station.path}: modbus_server.enabled: false: the station serves no Modbus "
                             "to monitor it over"])
+        if server.serial is not None:
+            raise Problems([f"{station.path}: modbus_server.transport: the station serves Modbus RTU on "
+                            f"{server.serial.device}, not TCP: monitor it over OPC UA (opc.tcp://...)"])
         listed, symbols, tags = listing(program or target)
         return RemoteSource(server.host, server.port, unit=server.unit or 1, program=listed, symbols=symbols,
                             tags=tags)
