@@ -7,9 +7,10 @@ from pathlib import Path
 import pytest
 
 from app.gui.screenshots import copy_station
+from app.station.config import DEMO_STATION
 
 REPO = Path(__file__).resolve().parents[2]
-DEMO = REPO / "resources" / "example"
+DEMO = DEMO_STATION
 
 
 def copy_demo(dest: Path) -> Path:
