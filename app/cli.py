@@ -301,12 +301,18 @@ def _open_runtime(station: str):  # -> Runtime | None (typed lazily: the runtime
 
 
 def run_headless(station: str, duration: float | None, every: float) -> int:
+    """The station without a window; under systemd (`Type=notify`) it also tells the service
+    manager that it is ready, that its scan goes on, and that it stops (app/station/service.py)."""
+    from app.station.notify import Notifier
     from app.station.runtime import StartError
+    from app.station.service import Service
 
     runtime = _open_runtime(station)
     if runtime is None:
         return 2
     done = threading.Event()
+    notifier = Notifier()
+    service: Service | None = None
 
     def on_signal(signum: int, _frame: object) -> None:
         print(f"{signal.Signals(signum).name}: stopping", flush=True)
@@ -321,6 +327,8 @@ def run_headless(station: str, duration: float | None, every: float) -> int:
                 print(problem, file=sys.stderr)
             return 2
         print(f"station {runtime.station.name} started: {runtime.station.path}", flush=True)
+        service = Service(runtime, notifier, every)
+        service.start()
         started = time.monotonic()
         while not done.is_set():
             left = every if duration is None else min(every, started + duration - time.monotonic())
@@ -328,7 +336,10 @@ def run_headless(station: str, duration: float | None, every: float) -> int:
                 break
             print(runtime.status().line(), flush=True)
     finally:
+        if service is not None:
+            service.stopping()
         runtime.stop()
+        notifier.close()
         for s, handler in previous.items():
             signal.signal(s, handler)
     print(f"station stopped after {runtime.status().line()}", flush=True)
