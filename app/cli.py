@@ -10,6 +10,7 @@ from __future__ import annotations
 
 import argparse
 import signal
+import sqlite3
 import sys
 import threading
 import time
@@ -63,8 +64,17 @@ def _archive_parser() -> argparse.ArgumentParser:
     p = argparse.ArgumentParser(prog="python main.py archive",
                                 description="Archive tools. migrate: copy a station's SQLite archive into "
                                             "the plant archive on PostgreSQL; run it again and it copies "
-                                            "only what is not there yet.")
+                                            "only what is not there yet. backup: copy a station, running "
+                                            "or not, into a new folder. restore: put a backup back into "
+                                            "a station that is not running.")
     sub = p.add_subparsers(dest="action", required=True)
+    b = sub.add_parser("backup", help="copy a station (its files, users, retentive memory, alarm states "
+                                      "and journal), while it runs or not")
+    b.add_argument("station", help="station folder or its station.toml")
+    b.add_argument("dest", help="the backup's folder: a new or empty one")
+    r = sub.add_parser("restore", help="put a backup back into a station that is not running")
+    r.add_argument("backup", help="the backup's folder")
+    r.add_argument("station", help="station folder (made when missing) or its station.toml")
     m = sub.add_parser("migrate", help="copy ARCHIVE.sqlite into the plant archive")
     m.add_argument("source", help="the station's archive file (journal.sqlite)")
     m.add_argument("url", help="the plant archive: postgresql://user@host:5432/plant (password in "
@@ -235,6 +245,10 @@ def main(argv: list[str] | None = None) -> int:
             return run_monitor(ns.target, ns.program, ns.user)
         if command == "archive":
             ns = _archive_parser().parse_args(rest)
+            if ns.action == "backup":
+                return run_backup(ns.station, ns.dest)
+            if ns.action == "restore":
+                return run_restore(ns.backup, ns.station)
             return run_migrate(ns.source, ns.url, ns.station)
         if command == "users":
             return run_users(rest)
@@ -267,8 +281,6 @@ def run_check(station: str) -> int:
 
 
 def run_alarms_report(archive: str, day: str) -> int:
-    import sqlite3
-
     from registrar.health import alarm_health
     from registrar.query import Archive
     from registrar.schema import parse_table_name
@@ -364,11 +376,35 @@ def run_designer(target: str, screenshot: str | None = None) -> int:
     return designer(target, screenshot)
 
 
+def run_backup(station: str, dest: str) -> int:
+    from app.station.backup import BackupError, backup, describe
+
+    try:
+        report = backup(station, dest)
+    except (BackupError, OSError, sqlite3.Error) as e:
+        print(f"archive backup: {e}", file=sys.stderr)
+        return 1
+    print(f"backup of {station} in {dest}:")
+    print("\n".join(f"  {line}" for line in describe(report)))
+    return 0
+
+
+def run_restore(backup: str, station: str) -> int:
+    from app.station.backup import BackupError, describe, restore
+    from app.station.lock import StationRunning
+
+    try:
+        report = restore(backup, station)
+    except (BackupError, StationRunning, OSError) as e:
+        print(f"archive restore: {e}", file=sys.stderr)
+        return 1
+    print(f"{backup} restored into {station}:")
+    print("\n".join(f"  {line}" for line in describe(report)))
+    return 0
+
+
 def run_migrate(source: str, url: str, station: str | None) -> int:
     """Copy a SQLite archive into the plant archive, with a progress bar on stderr."""
-    import sqlite3
-    from pathlib import Path
-
     from registrar.plant.forward import Forwarder
     from registrar.plant.url import is_url, url_problem
     from registrar.reading import ArchiveError
