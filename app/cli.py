@@ -16,9 +16,10 @@ import threading
 import time
 from pathlib import Path
 
-from app import logs
+from app import __version__, logs
 from app.logs import LEVELS
 from app.station.config import DEMO_STATION
+from registrar.plant.url import is_url
 
 COMMANDS = ("view", "check", "simulate", "alarms-report", "design", "monitor", "archive", "users", "opcua")
 
@@ -39,6 +40,7 @@ def _main_parser() -> argparse.ArgumentParser:
     )
     p.add_argument("station", nargs="?", default=str(DEMO_STATION),
                    help="station folder or its station.toml (default: the demo station)")
+    p.add_argument("--version", action="version", version=f"netplc-station {__version__}")
     p.add_argument("--no-gui", action="store_true", help="run headless, printing a status line")
     p.add_argument("--duration", type=float, metavar="S",
                    help="with --no-gui: stop after S seconds (default: until SIGINT/SIGTERM)")
@@ -240,6 +242,8 @@ def main(argv: list[str] | None = None) -> int:
             return run_alarms_report(ns.archive, ns.day)
         if command == "monitor":
             ns = _monitor_parser().parse_args(rest)
+            if ns.target.startswith("opc.tcp://") and not _installed("opcua", "the monitor over OPC UA"):
+                return 2
             from app.gui.monitor.window import run_monitor
 
             return run_monitor(ns.target, ns.program, ns.user)
@@ -249,14 +253,21 @@ def main(argv: list[str] | None = None) -> int:
                 return run_backup(ns.station, ns.dest)
             if ns.action == "restore":
                 return run_restore(ns.backup, ns.station)
+            if not _installed("postgres", "archive migrate"):
+                return 2
             return run_migrate(ns.source, ns.url, ns.station)
         if command == "users":
             return run_users(rest)
         if command == "opcua":
+            if not _installed("opcua", "opcua trust"):
+                return 2
             from app.publish.trust import main as opcua
 
             return opcua(rest)
-        return run_viewer(_view_parser().parse_args(rest).archive)
+        archive = _view_parser().parse_args(rest).archive
+        if is_url(archive) and not _installed("postgres", "the plant archive"):
+            return 2
+        return run_viewer(archive)
     ns = _main_parser().parse_args(args)
     if ns.duration is not None and not ns.no_gui:
         _main_parser().error("--duration needs --no-gui")
@@ -264,6 +275,16 @@ def main(argv: list[str] | None = None) -> int:
     if ns.no_gui:
         return run_headless(ns.station, ns.duration, ns.status_every)
     return run_gui(ns.station)
+
+
+def _installed(extra: str, what: str) -> bool:
+    """Whether the extra `what` needs is installed; if not, says which and how to install it."""
+    from app.station.extras import needs
+
+    problem = needs(extra, what)
+    if problem:
+        print(problem, file=sys.stderr)
+    return problem is None
 
 
 def run_check(station: str) -> int:
