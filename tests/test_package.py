@@ -15,16 +15,15 @@ from __future__ import annotations
 
 import os
 import shutil
-import signal
 import subprocess
 import sys
 import sysconfig
-import time
 import tomllib
 import zipfile
 from pathlib import Path
 
 from app import __version__
+from tests.app.conftest import stop_once_up
 
 REPO = Path(__file__).resolve().parents[1]
 SOURCES = ("pyproject.toml", "README.md", "app", "netplc", "registrar", "hmi_forms")
@@ -107,19 +106,13 @@ def test_the_wheel_installs_netplc_station_with_the_demo_and_the_translations(tm
                                stderr=subprocess.PIPE, text=True)
     try:
         r = run(venv, command, "check", str(demo))  # while the demo starts
-        assert r.returncode == 0, r.stdout + r.stderr
-        assert f"ok: station {demo / 'station.toml'}" in r.stdout
-        assert station.stdout is not None
-        first = station.stdout.readline()
-        assert first.startswith("station Demo station started"), first
-        deadline = time.monotonic() + 30
-        while time.monotonic() < deadline and "nodes 1/1 up" not in station.stdout.readline():
-            pass
-        station.send_signal(signal.SIGTERM)
-        out, err = station.communicate(timeout=30)
     finally:
-        if station.poll() is None:
-            station.kill()
+        out, err = stop_once_up(station)
+    assert r.returncode == 0, r.stdout + r.stderr
+    assert f"ok: station {demo / 'station.toml'}" in r.stdout
     assert station.returncode == 0, err
-    assert "SIGTERM: stopping" in out and out.splitlines()[-1].startswith("station stopped after")
+    lines = out.splitlines()
+    assert lines[0].startswith("station Demo station started"), out
+    assert "nodes 1/1 up" in out and "SIGTERM: stopping" in out
+    assert lines[-1].startswith("station stopped after")
     assert (demo / "archive" / "journal.sqlite").is_file()  # the installed demo runs where it is
