@@ -10,14 +10,16 @@ from __future__ import annotations
 
 import argparse
 import signal
+import sqlite3
 import sys
 import threading
 import time
 from pathlib import Path
 
-from app import logs
+from app import __version__, logs
 from app.logs import LEVELS
 from app.station.config import DEMO_STATION
+from registrar.plant.url import is_url
 
 COMMANDS = ("view", "check", "simulate", "alarms-report", "design", "monitor", "archive", "users", "opcua")
 
@@ -38,6 +40,7 @@ def _main_parser() -> argparse.ArgumentParser:
     )
     p.add_argument("station", nargs="?", default=str(DEMO_STATION),
                    help="station folder or its station.toml (default: the demo station)")
+    p.add_argument("--version", action="version", version=f"netplc-station {__version__}")
     p.add_argument("--no-gui", action="store_true", help="run headless, printing a status line")
     p.add_argument("--duration", type=float, metavar="S",
                    help="with --no-gui: stop after S seconds (default: until SIGINT/SIGTERM)")
@@ -63,8 +66,17 @@ def _archive_parser() -> argparse.ArgumentParser:
     p = argparse.ArgumentParser(prog="python main.py archive",
                                 description="Archive tools. migrate: copy a station's SQLite archive into "
                                             "the plant archive on PostgreSQL; run it again and it copies "
-                                            "only what is not there yet.")
+                                            "only what is not there yet. backup: copy a station, running "
+                                            "or not, into a new folder. restore: put a backup back into "
+                                            "a station that is not running.")
     sub = p.add_subparsers(dest="action", required=True)
+    b = sub.add_parser("backup", help="copy a station (its files, users, retentive memory, alarm states "
+                                      "and journal), while it runs or not")
+    b.add_argument("station", help="station folder or its station.toml")
+    b.add_argument("dest", help="the backup's folder: a new or empty one")
+    r = sub.add_parser("restore", help="put a backup back into a station that is not running")
+    r.add_argument("backup", help="the backup's folder")
+    r.add_argument("station", help="station folder (made when missing) or its station.toml")
     m = sub.add_parser("migrate", help="copy a station's archive into the plant archive")
     m.add_argument("source", help="the station folder (or its station.toml), or its archive file "
                                   "(journal.sqlite)")
@@ -232,19 +244,32 @@ def main(argv: list[str] | None = None) -> int:
             return run_alarms_report(ns.archive, ns.day)
         if command == "monitor":
             ns = _monitor_parser().parse_args(rest)
+            if ns.target.startswith("opc.tcp://") and not _installed("opcua", "the monitor over OPC UA"):
+                return 2
             from app.gui.monitor.window import run_monitor
 
             return run_monitor(ns.target, ns.program, ns.user)
         if command == "archive":
             ns = _archive_parser().parse_args(rest)
+            if ns.action == "backup":
+                return run_backup(ns.station, ns.dest)
+            if ns.action == "restore":
+                return run_restore(ns.backup, ns.station)
+            if not _installed("postgres", "archive migrate"):
+                return 2
             return run_migrate(ns.source, ns.url, ns.station)
         if command == "users":
             return run_users(rest)
         if command == "opcua":
+            if not _installed("opcua", "opcua trust"):
+                return 2
             from app.publish.trust import main as opcua
 
             return opcua(rest)
-        return run_viewer(_view_parser().parse_args(rest).archive)
+        archive = _view_parser().parse_args(rest).archive
+        if is_url(archive) and not _installed("postgres", "the plant archive"):
+            return 2
+        return run_viewer(archive)
     ns = _main_parser().parse_args(args)
     if ns.duration is not None and not ns.no_gui:
         _main_parser().error("--duration needs --no-gui")
@@ -252,6 +277,16 @@ def main(argv: list[str] | None = None) -> int:
     if ns.no_gui:
         return run_headless(ns.station, ns.duration, ns.status_every)
     return run_gui(ns.station)
+
+
+def _installed(extra: str, what: str) -> bool:
+    """Whether the extra `what` needs is installed; if not, says which and how to install it."""
+    from app.station.extras import needs
+
+    problem = needs(extra, what)
+    if problem:
+        print(problem, file=sys.stderr)
+    return problem is None
 
 
 def run_check(station: str) -> int:
@@ -269,8 +304,6 @@ def run_check(station: str) -> int:
 
 
 def run_alarms_report(archive: str, day: str) -> int:
-    import sqlite3
-
     from registrar.health import alarm_health
     from registrar.query import Archive
     from registrar.schema import parse_table_name
@@ -303,12 +336,18 @@ def _open_runtime(station: str):  # -> Runtime | None (typed lazily: the runtime
 
 
 def run_headless(station: str, duration: float | None, every: float) -> int:
+    """The station without a window; under systemd (`Type=notify`) it also tells the service
+    manager that it is ready, that its scan goes on, and that it stops (app/station/service.py)."""
+    from app.station.notify import Notifier
     from app.station.runtime import StartError
+    from app.station.service import Service
 
     runtime = _open_runtime(station)
     if runtime is None:
         return 2
     done = threading.Event()
+    notifier = Notifier()
+    service: Service | None = None
 
     def on_signal(signum: int, _frame: object) -> None:
         print(f"{signal.Signals(signum).name}: stopping", flush=True)
@@ -323,6 +362,8 @@ def run_headless(station: str, duration: float | None, every: float) -> int:
                 print(problem, file=sys.stderr)
             return 2
         print(f"station {runtime.station.name} started: {runtime.station.path}", flush=True)
+        service = Service(runtime, notifier, every)
+        service.start()
         started = time.monotonic()
         while not done.is_set():
             left = every if duration is None else min(every, started + duration - time.monotonic())
@@ -330,7 +371,10 @@ def run_headless(station: str, duration: float | None, every: float) -> int:
                 break
             print(runtime.status().line(), flush=True)
     finally:
+        if service is not None:
+            service.stopping()
         runtime.stop()
+        notifier.close()
         for s, handler in previous.items():
             signal.signal(s, handler)
     print(f"station stopped after {runtime.status().line()}", flush=True)
@@ -355,12 +399,36 @@ def run_designer(target: str, screenshot: str | None = None) -> int:
     return designer(target, screenshot)
 
 
+def run_backup(station: str, dest: str) -> int:
+    from app.station.backup import BackupError, backup, describe
+
+    try:
+        report = backup(station, dest)
+    except (BackupError, OSError, sqlite3.Error) as e:
+        print(f"archive backup: {e}", file=sys.stderr)
+        return 1
+    print(f"backup of {station} in {dest}:")
+    print("\n".join(f"  {line}" for line in describe(report)))
+    return 0
+
+
+def run_restore(backup: str, station: str) -> int:
+    from app.station.backup import BackupError, describe, restore
+    from app.station.lock import StationRunning
+
+    try:
+        report = restore(backup, station)
+    except (BackupError, StationRunning, OSError) as e:
+        print(f"archive restore: {e}", file=sys.stderr)
+        return 1
+    print(f"{backup} restored into {station}:")
+    print("\n".join(f"  {line}" for line in describe(report)))
+    return 0
+
+
 def run_migrate(source: str, url: str, station: str | None) -> int:
     """Copy a SQLite archive into the plant archive, with a progress bar on stderr, under the name
     its station's forwarder uses, so the same record never lands twice (the key is station, day, id)."""
-    import sqlite3
-    from pathlib import Path
-
     from app.station.config import archive_owner, read_station
     from registrar.plant.forward import Forwarder
     from registrar.plant.url import is_url, url_problem

@@ -5,13 +5,16 @@ A running station (the workstation or `--no-gui`) writes a rotating log file in 
 (`log/station.log`, 5 files of 5 MB at most: a log that cannot fill the disk the archive needs);
 every command also logs to stderr at `--log-level` (default WARNING). Uncaught exceptions of the
 main thread and of any other thread are logged with their traceback, so none reaches the console
-without a log record beside it.
+without a log record beside it. When stderr is systemd's journal (a service: `JOURNAL_STREAM`
+names it), each line carries its syslog priority instead of a time (the journal keeps its own),
+so `journalctl -p warning` finds the station's warnings and errors.
 """
 
 from __future__ import annotations
 
 import logging
 import logging.handlers
+import os
 import sys
 import threading
 from pathlib import Path
@@ -22,6 +25,8 @@ MAX_BYTES = 5 * 1024 * 1024
 BACKUPS = 4
 LEVELS = ("DEBUG", "INFO", "WARNING", "ERROR", "CRITICAL")
 FORMAT = "%(asctime)s %(levelname)s %(threadName)s %(name)s: %(message)s"
+JOURNAL_FORMAT = "%(levelname)s %(threadName)s %(name)s: %(message)s"
+PRIORITIES = {logging.DEBUG: 7, logging.INFO: 6, logging.WARNING: 4, logging.ERROR: 3, logging.CRITICAL: 2}
 
 logger = logging.getLogger(__name__)
 _file_handler: logging.Handler | None = None
@@ -35,11 +40,30 @@ def configure(level: str = "WARNING") -> None:
         root.removeHandler(handler)
     console = logging.StreamHandler(sys.stderr)
     console.setLevel(level)
-    console.setFormatter(logging.Formatter(FORMAT))
+    console.setFormatter(_JournalFormatter(JOURNAL_FORMAT) if _to_journal() else logging.Formatter(FORMAT))
     console._netplc = True  # type: ignore[attr-defined]
     root.addHandler(console)
     sys.excepthook = _uncaught
     threading.excepthook = _uncaught_in_thread
+
+
+class _JournalFormatter(logging.Formatter):
+    """Every line (a traceback's too) prefixed with the record's syslog priority, "<4>" for a
+    warning: the journal reads it (SyslogLevelPrefix=, on by default) and strips it."""
+
+    def format(self, record: logging.LogRecord) -> str:
+        prefix = f"<{PRIORITIES.get(record.levelno, 6)}>"
+        return "\n".join(prefix + line for line in super().format(record).splitlines())
+
+
+def _to_journal() -> bool:
+    """stderr is systemd's journal: JOURNAL_STREAM is the device and inode of that very stream (a
+    service's child writing to a pipe or a file inherits the variable but not the stream)."""
+    try:
+        info = os.fstat(sys.stderr.fileno())
+    except (OSError, ValueError, AttributeError):  # no log: no file behind stderr (a test's capture)
+        return False
+    return os.environ.get("JOURNAL_STREAM") == f"{info.st_dev}:{info.st_ino}"
 
 
 def to_station_folder(folder: Path, level: str = "INFO") -> Path | None:

@@ -83,8 +83,7 @@ class _Taken:
 class Retainer:
     def __init__(self, path: str | Path, engine: Engine, sink: RecordSink | None = None) -> None:
         self.path = Path(path)
-        self.previous = self.path.with_name(self.path.name + ".prev")
-        self._tmp = self.path.with_name(self.path.name + ".tmp")
+        _, (_, self._tmp), (_, self.previous) = save_files(self.path)
         self.engine = engine
         self.sink = sink if sink is not None else engine.sink
         self.saves = 0
@@ -113,7 +112,7 @@ class Retainer:
         and becomes the current save.
         """
         problems: list[str] = []
-        for used, path in (("current", self.path), ("written", self._tmp), ("previous", self.previous)):
+        for used, path in save_files(self.path):
             try:
                 saved = read_save(path)
             except SaveError as e:
@@ -301,6 +300,26 @@ class Retainer:
                 due = max(due + interval, time.monotonic())
 
 
+def save_files(path: Path) -> tuple[tuple[str, Path], ...]:
+    """The files of the save at `path`, in the order a restore tries them: the current save, the
+    one written at a crash between a save's two renames, the previous save."""
+    return (("current", path), ("written", path.with_name(path.name + ".tmp")),
+            ("previous", path.with_name(path.name + ".prev")))
+
+
+def newest_save(path: Path) -> bytes | None:
+    """The save a restore would use now, as bytes (read while saves go on: each file is whole,
+    written then renamed); None when there is none."""
+    for _, file in save_files(path):
+        try:
+            blob = file.read_bytes()
+            parse_save(blob)
+        except (OSError, SaveError):  # no log: the next file is tried, as a restore does
+            continue
+        return blob
+    return None
+
+
 def read_save(path: Path) -> Saved:
     try:
         blob = path.read_bytes()
@@ -308,6 +327,10 @@ def read_save(path: Path) -> Saved:
         raise SaveError("is missing") from None
     except OSError as e:
         raise SaveError(f"cannot be read: {e.strerror}") from None
+    return parse_save(blob)
+
+
+def parse_save(blob: bytes) -> Saved:
     if len(blob) < HEADER.size:
         raise SaveError("is truncated")
     magic, version, crc, length = HEADER.unpack_from(blob)

@@ -35,7 +35,8 @@ LEVEL = 0o4010
 
 
 def copy_station(dest: Path) -> Path:
-    shutil.copytree(DEMO_STATION, dest, ignore=shutil.ignore_patterns("archive", "__pycache__"))
+    shutil.copytree(DEMO_STATION, dest, ignore=shutil.ignore_patterns("archive", "log", "station.lock",
+                                                                      "__pycache__"))
     toml = dest / "station.toml"
     toml.write_text(re.sub(r"(?m)^port = 1502$", "port = 0", toml.read_text(encoding="utf-8")),
                     encoding="utf-8")

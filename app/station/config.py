@@ -24,7 +24,7 @@ from netplc.textfile import TextFileError, file_problem, read_text, resolve
 from registrar.plant.url import is_url, url_problem
 
 STATION_FILE = "station.toml"
-DEMO_STATION = Path(__file__).resolve().parents[2] / "resources" / "example"  # the built-in demo
+DEMO_STATION = Path(__file__).resolve().parent / "demo"  # the built-in demo, package data
 # What Modbus clients may write when station.toml names nothing: the internal bits and the first
 # data bank, but not the special bits 03700-03777 (03770 stops NetPlc, 03771/03772 are the error
 # flags, 03773/03774 the time base): a range that names them explicitly still opens them.

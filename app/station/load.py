@@ -1,5 +1,6 @@
 """Everything a station reads before it starts: symbols, the NetPlc program, the simulated nodes'
-programs, the message catalog, the tags, the users and the forms. The runtime's start and `check`
+programs, the message catalog, the tags, the users and the forms; and whether the optional parts
+its configuration asks for are installed (`extras.py`). The runtime's start and `check`
 both call `load`, so `check` reports exactly what a start would refuse.
 
 Each part is read even when an earlier one failed, the good lines of a broken symbols file are
@@ -19,6 +20,7 @@ from app.authority.policy import VIEWER
 from app.authority.users import USERS_FILE, Users, UsersFileError
 from app.scada.table import TagTable, read_tags
 from app.station.config import Station
+from app.station.extras import station_problems
 from hmi_forms.form import Form, load_forms
 from netplc.exchange import check_program_nodes
 from netplc.program import Program, ProgramError, load_symbols, parse, parse_file, read_symbols
@@ -69,6 +71,7 @@ def load(station: Station) -> Loaded:
                          f"{len(out.tags.alarms)} with alarms")
     _users(station, out)
     _state_files(station, out)
+    out.problems += station_problems(station)  # OPC UA, MQTT or the plant archive without its extra
     out.forms, out.form_problems = load_station_forms(station, out.symbols, out.tags)
     if station.HMIload is not None:
         out.notes.append(f"forms in {station.HMIload}: {len(out.forms)} loaded")

@@ -36,6 +36,7 @@ from app.scada.station import STATE_FILE as ALARM_STATE_FILE
 from app.scada.station import StationAlarms
 from app.station.config import Station
 from app.station.load import load, load_station_forms
+from app.station.lock import StationLock, StationRunning
 from hmi_forms.behaviour import FormBehaviour
 from hmi_forms.form import Form
 from netplc.engine import Engine
@@ -181,6 +182,7 @@ class Runtime:
         self._lock = threading.Lock()
         self._final_store: StoreStats | None = None  # the archive's figures after stop
         self._final_retain_error = ""  # why the final retentive save failed, if it did
+        self._folder_lock = StationLock(station.folder)  # one station per folder (app/station/lock.py)
         self.started = False
 
     # --- records -------------------------------------------------------------------------------
@@ -241,13 +243,22 @@ class Runtime:
 
     def start(self) -> None:
         """Start every part; StartError names the key of what could not start (the archive, a
-        simulator's port, the nodes), after what did start is stopped again."""
+        simulator's port, the nodes), after what did start is stopped again; a station already
+        running in the folder is refused before anything is opened."""
         st = self.station
+        try:
+            self._folder_lock.acquire()
+        except StationRunning as e:
+            raise StartError([str(e)]) from None
+        except OSError as e:
+            raise StartError([f"{st.path}: cannot lock the station folder: {self._folder_lock.path}: "
+                              f"{e.strerror or e}"]) from None
         store = Store(st.Archive, catalog=self.catalog, keep_days=st.keep_days, wallclock=self.wallclock,
                       tags=self.tags, station=st.name)
         try:
             store.start()
         except (OSError, sqlite3.Error) as e:
+            self._folder_lock.release()
             raise StartError([f"{st.path}: Archive: {e}"]) from None
         self.store = store
         if st.plant_archive:
@@ -442,6 +453,7 @@ class Runtime:
             self.forwarder.close()  # sends the rest if the plant archive answers
             self.forwarder = None
         self.started = False
+        self._folder_lock.release()  # last: every file of the station is closed
 
     def simulator_answers(self, index: int, answering: bool) -> None:
         """Stop simulated node `index` of station.toml (a pulled cable: its tags go comm-fail and

@@ -2,14 +2,18 @@
 
 from __future__ import annotations
 
+import signal
+import subprocess
+import time
 from pathlib import Path
 
 import pytest
 
 from app.gui.screenshots import copy_station
+from app.station.config import DEMO_STATION
 
 REPO = Path(__file__).resolve().parents[2]
-DEMO = REPO / "resources" / "example"
+DEMO = DEMO_STATION
 
 
 def copy_demo(dest: Path) -> Path:
@@ -17,6 +21,27 @@ def copy_demo(dest: Path) -> Path:
     copy_station(dest)
     assert "\nport = 0\n" in (dest / "station.toml").read_text(encoding="utf-8")
     return dest
+
+
+def stop_once_up(proc: subprocess.Popen[str], settle: float = 0.0) -> tuple[str, str]:
+    """Wait (at most 30 s) for a `--no-gui` station's status line with its node up, let it run
+    `settle` s more, then stop it with SIGTERM as systemd does: its whole output (killed if it
+    hangs)."""
+    seen: list[str] = []
+    try:
+        assert proc.stdout is not None
+        deadline = time.monotonic() + 30
+        while time.monotonic() < deadline:
+            seen.append(proc.stdout.readline())
+            if not seen[-1] or "nodes 1/1 up" in seen[-1]:  # up, or the station ended
+                break
+        time.sleep(settle)
+        proc.send_signal(signal.SIGTERM)
+        out, err = proc.communicate(timeout=30)
+        return "".join(seen) + out, err
+    finally:
+        if proc.poll() is None:
+            proc.kill()
 
 
 def write_station(folder: Path, toml: str, files: dict[str, str] | None = None) -> Path:

@@ -9,7 +9,7 @@ from pathlib import Path
 
 import pytest
 
-from tests.app.conftest import REPO, copy_demo
+from tests.app.conftest import DEMO, REPO, copy_demo
 
 
 def run_check(station: Path) -> subprocess.CompletedProcess[str]:
@@ -18,7 +18,7 @@ def run_check(station: Path) -> subprocess.CompletedProcess[str]:
 
 
 def test_the_demo_station_is_clean() -> None:
-    r = run_check(REPO / "resources" / "example")
+    r = run_check(DEMO)
     assert r.returncode == 0, r.stdout + r.stderr
     assert "ok: program netplc.stl" in r.stdout
 

@@ -4,14 +4,12 @@ from __future__ import annotations
 
 import datetime as dt
 import re
-import signal
 import sqlite3
 import subprocess
 import sys
-import time
 from pathlib import Path
 
-from tests.app.conftest import REPO
+from tests.app.conftest import REPO, stop_once_up
 
 
 def day_table() -> str:
@@ -66,18 +64,7 @@ def test_a_start_raises_no_quality_alarm_before_the_first_answer(headless_archiv
 def test_sigterm_mid_run_exits_0_with_everything_flushed(demo_copy: Path) -> None:
     proc = subprocess.Popen([sys.executable, "main.py", "--no-gui", str(demo_copy), "--status-every", "0.5"],
                             cwd=REPO, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
-    try:
-        assert proc.stdout is not None
-        deadline = time.monotonic() + 20
-        while time.monotonic() < deadline:
-            if "nodes 1/1 up" in proc.stdout.readline():
-                break
-        time.sleep(1.5)  # at least one NSTORE second after the link is up
-        proc.send_signal(signal.SIGTERM)
-        out, err = proc.communicate(timeout=20)
-    finally:
-        if proc.poll() is None:
-            proc.kill()
+    out, err = stop_once_up(proc, settle=1.5)  # at least one NSTORE second after the link is up
     assert proc.returncode == 0, err
     assert "SIGTERM: stopping" in out
     check_archive(demo_copy / "archive" / "journal.sqlite")

@@ -7,12 +7,13 @@ from pathlib import Path
 from PySide6.QtGui import QImage
 
 from app.gui.screenshots import main
+from app.station.config import DEMO_STATION
 
 
 def test_screenshots_of_every_form_and_the_viewer(qtbot, tmp_path: Path) -> None:
     assert main([str(tmp_path), "--seconds", "1.5"]) == 0
     names = sorted(p.name for p in tmp_path.glob("*.png"))
-    forms = sorted(p.stem for p in (Path(__file__).parents[2] / "resources/example/forms").glob("*.hmi"))
+    forms = sorted(p.stem for p in (DEMO_STATION / "forms").glob("*.hmi"))
     assert names == sorted([*(f"workstation-{f.replace('_', '-')}.png" for f in forms),
                             *(f"workstation-{f.replace('_', '-')}-1920x1080.png" for f in forms),
                             "designer-02-analog.png", "viewer-records.png", "viewer-series.png"])

@@ -7,12 +7,13 @@ from pathlib import Path
 
 import pytest
 
+from app.station.config import DEMO_STATION
 from hmi_forms.form import FormError, load_form
 from hmi_forms.form_doc import Reader, new_doc, problems, read_doc
 from hmi_forms.form_writer import dump_form, element_keys, save_form
 from netplc.program import load_symbols
 
-DEMO = Path(__file__).resolve().parents[2] / "resources" / "example"
+DEMO = DEMO_STATION
 FORMS = sorted((DEMO / "forms").glob("*.hmi"))
 SYMBOLS = load_symbols(DEMO / "symbols.csv")
 

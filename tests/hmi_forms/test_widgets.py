@@ -10,6 +10,7 @@ import pytest
 from PySide6.QtCore import Qt
 from PySide6.QtGui import QImage
 
+from app.station.config import DEMO_STATION
 from hmi_forms.elements import ELEMENT_TYPES
 from hmi_forms.form import Form, load_form, load_forms
 from hmi_forms.widgets.form_view import FormView
@@ -18,7 +19,7 @@ from netplc.program import load_symbols, parse
 from netplc.records import ListSink
 from tests.hmi_forms.helpers import engine_target, snap, write_form
 
-EXAMPLE = Path(__file__).resolve().parents[2] / "resources" / "example"
+EXAMPLE = DEMO_STATION
 Q = "02101"  # quality bit used where an element has no state of its own
 LEVEL = [{"Name": "Level", "AppMin": 0, "AppMax": 4095, "PhyMin": 0, "PhyMax": 100}]
 

@@ -2,9 +2,10 @@ from pathlib import Path
 
 import pytest
 
+from app.station.config import DEMO_STATION
 from registrar.catalog import Catalog, CatalogError, Message
 
-EXAMPLE = Path(__file__).parents[2] / "resources" / "example" / "messages.csv"
+EXAMPLE = DEMO_STATION / "messages.csv"
 
 
 def write(tmp_path: Path, text: str) -> Path:

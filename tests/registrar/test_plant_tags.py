@@ -12,6 +12,7 @@ import psycopg
 
 from app.scada.table import TagTable, load_tags
 from app.scada.tag import Scaling, Tag, TagType
+from app.station.config import DEMO_STATION
 from netplc.address import fmt_octal
 from netplc.program import load_symbols
 from netplc.records import Record
@@ -19,7 +20,7 @@ from registrar.plant.forward import Forwarder
 from registrar.query import Archive
 from registrar.store import Store
 
-DEMO = Path(__file__).resolve().parents[2] / "resources" / "example"
+DEMO = DEMO_STATION
 T0 = dt.datetime(2026, 3, 5, 8, 0).timestamp()
 WORDS = (0, 1, 100, 2047, 2048, 4095, 9999, 0x1234, 0x7FFF, 0x8000, 0x8001, 0xFFFF)
 

@@ -1,10 +1,11 @@
 """The console's language: Russian or English, with Qt's own translation mechanism.
 
 `console_ru.ts` (in this folder, kept in the repository, edited with Qt Linguist or by hand) is
-compiled to `console_ru.qm` by the build (`make translations`, run by `make run` and `make test`)
-with the `lrelease` that PySide6-Essentials ships; a checkout run without make compiles it on
-first use the same way. English is the source text. Qt's own strings (Yes/No, Cancel) come from
-the qtbase catalogue PySide6 ships. Form texts stay as the engineer wrote them.
+compiled to `console_ru.qm` by the build (`make translations`, run by `make run`, `make test` and
+`make dist`, whose wheel carries the .qm) with the `lrelease` that PySide6-Essentials ships; a
+checkout run without make compiles it on first use the same way. English is the source text.
+Qt's own strings (Yes/No, Cancel) come from the qtbase catalogue PySide6 ships. Form texts stay
+as the engineer wrote them.
 """
 
 from __future__ import annotations
@@ -28,12 +29,13 @@ def system_language() -> str:
 
 
 def compiled(language: str) -> Path | None:
-    """The .qm of a language, compiled from its .ts when missing or older; None when there is
-    no catalogue for it (English is the source text) or lrelease fails."""
+    """The .qm of a language, compiled from its .ts when missing or older (an installed package
+    holds the .qm alone, compiled when its wheel was built); None when there is no catalogue for
+    it (English is the source text) or lrelease fails."""
     ts = HERE / f"console_{language}.ts"
-    if not ts.exists():
-        return None
     qm = ts.with_suffix(".qm")
+    if not ts.exists():
+        return qm if qm.exists() else None
     if not qm.exists() or qm.stat().st_mtime < ts.stat().st_mtime:
         try:
             subprocess.run([str(LRELEASE), "-silent", str(ts), "-qm", str(qm)], check=True, timeout=60)

@@ -1,4 +1,5 @@
-"""Draws the demo forms' pictures (pump frames, tank): `python resources/example/forms/images/draw.py`.
+"""Draws the demo forms' pictures (pump frames, tank) into app/station/demo/forms/images/:
+`python resources/demo_images.py`.
 
 Kept as code so the pictures can be regenerated at another size or style; the PNGs are committed.
 """
@@ -14,7 +15,7 @@ os.environ.setdefault("QT_QPA_PLATFORM", "offscreen")
 from PySide6.QtCore import QPointF, QRectF, Qt
 from PySide6.QtGui import QColor, QGuiApplication, QImage, QPainter, QPen, QPolygonF
 
-HERE = Path(__file__).parent
+HERE = Path(__file__).resolve().parents[1] / "app" / "station" / "demo" / "forms" / "images"
 SIZE = 96
 
 
