@@ -398,7 +398,7 @@ def _modbus_server(problems: list[str], fname: str, table: dict[str, Any]) -> Mo
     unit = r.number("unit", 1 if rtu else None, 1, 247)  # a slave on a shared line has one address
     role = r.get("role", str, OPERATOR)
     if rtu:
-        server = replace(d, serial=_serial_port(r))
+        server = replace(d, port=0, serial=_serial_port(r))  # port 0: no TCP port of its own
     else:
         server = ModbusServerSettings(
             host=r.get("host", str, d.host), port=r.number("port", d.port, 0, 65535),
@@ -551,7 +551,7 @@ def _ports_in_common(problems: list[str], fname: str, server: ModbusServerSettin
             problems.append(f"{fname}: modbus_server.port: {serial.device} is also the serial port of "
                             f"{n.key}.endpoint: the station cannot be the master and a slave on one line")
     taken: dict[tuple[str, int], str] = {}
-    if server.enabled and server.serial is None and server.port:
+    if server.enabled and server.port:
         taken[server.host, server.port] = "modbus_server.port"
     for i, sim in enumerate(sims):
         if sim.port:

@@ -331,7 +331,7 @@ class Runtime:
             except OSError as e:  # the station runs on without it; the operator sees why
                 self.problem(f"Modbus server not started: {st.path}: modbus_server.port: cannot listen on "
                               f"{server.host}:{server.port}: {_reason(e)}")
-            if modbus.fault:  # a serial port not there yet, or held by another program: tried again
+            if modbus.fault:  # a serial port not there yet, or not ours to open: tried again
                 self.system(f"Modbus server not started yet: {st.path}: modbus_server.port: {modbus.fault}; "
                             f"retrying every {REOPEN:g} s", logging.WARNING)
         self.publishers = start_publishers(self)

@@ -9,7 +9,7 @@ every minor release.
 """
 
 from netplc.modbus.client import LeanTcpClient, ModbusClient, open_client
-from netplc.modbus.endpoint import PARITIES, Endpoint, line_problems, parse_endpoint
+from netplc.modbus.endpoint import Endpoint, line_problems, parse_endpoint
 from netplc.modbus.loop import LoopThread
 from netplc.modbus.map import (
     MAX_READ_BITS,
@@ -54,7 +54,6 @@ __all__ = [
     "ILLEGAL_VALUE",
     "MAX_READ_BITS",
     "MAX_READ_REGISTERS",
-    "PARITIES",
     "PROFILES",
     "REOPEN",
     "TABLES",

@@ -126,8 +126,8 @@ class ModbusServer:
     def start(self, retry: bool = False) -> None:
         """OSError if the port cannot be bound or the serial port opened. `retry`: a serial port
         that cannot be opened is no error: the server starts without it, `fault` says why until it
-        opens, and it is tried every REOPEN seconds (an adapter plugged in later, a port another
-        program holds)."""
+        opens, and it is tried every REOPEN seconds (an adapter plugged in later, a permission
+        granted)."""
         if self.serial is not None:
             serial = self.serial
             line: SerialLine | None = None
