@@ -26,6 +26,7 @@ import math
 from collections.abc import Mapping
 from dataclasses import dataclass, field
 from functools import cached_property
+from operator import attrgetter
 from typing import Any, ClassVar, NamedTuple
 
 from app.scada.table import TagTable
@@ -133,25 +134,12 @@ class Scaled(Element):
         """The zone `phy` lies in; None: the element has no limits."""
         return None
 
-    @property
-    def hw(self) -> int | None:
-        return self.shown.hw
-
-    @property
-    def phy(self) -> float:
-        return self.shown.phy
-
-    @property
-    def text(self) -> str:
-        return self.shown.text
-
-    @property
-    def zone(self) -> str | None:
-        return self.shown.zone
-
-    @property
-    def fraction(self) -> float:
-        return self.shown.fraction
+    # what it shows now, by part (read only: `shows` makes them all at once)
+    hw = property(attrgetter("shown.hw"))
+    phy = property(attrgetter("shown.phy"))
+    text = property(attrgetter("shown.text"))
+    zone = property(attrgetter("shown.zone"))
+    fraction = property(attrgetter("shown.fraction"))
 
 
 def scaling_problems(ranges: dict[str, Any]) -> list[tuple[str, str]]:
