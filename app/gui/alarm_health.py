@@ -1,19 +1,23 @@
 """The alarm-system health of a chosen day (ISA-18.2 measures, registrar/health.py), in a dialog.
 
 The same report as `main.py alarms-report ARCHIVE --day DD_MM_YYYY`, read from the archive file
-read-only, so the operator and the engineer see the same figures.
+read-only, so the operator and the engineer see the same figures. A day of a busy alarm system is
+many records: the report is made in the dialog's worker thread (hmi_forms/widgets/worker.py), the
+newest day asked for wins.
 """
 
 from __future__ import annotations
 
 import datetime as dt
 import sqlite3
+from functools import partial
 from pathlib import Path
 
 from PySide6.QtCore import QCoreApplication, QDate
 from PySide6.QtGui import QFont
 from PySide6.QtWidgets import QDateEdit, QDialog, QHBoxLayout, QLabel, QPlainTextEdit, QVBoxLayout, QWidget
 
+from hmi_forms.widgets.worker import Worker
 from registrar.health import alarm_health
 from registrar.query import Archive
 
@@ -38,6 +42,10 @@ class HealthDialog(QDialog):
         super().__init__(parent)
         self.setWindowTitle(self.tr("Alarm-system health"))
         self.archive_path = archive_path
+        self.worker = Worker("alarm health", (), self)
+        self.worker.answered.connect(lambda _token, text: self.report.setPlainText(text))
+        self.worker.failed.connect(lambda _token, why: self.report.setPlainText(why))
+        self.finished.connect(self.worker.close)
         self.resize(720, 520)
         lay = QVBoxLayout(self)
         bar = QHBoxLayout()
@@ -56,4 +64,7 @@ class HealthDialog(QDialog):
         self.show_day()
 
     def show_day(self) -> None:
-        self.report.setPlainText(health_text(self.archive_path, self.day.date().toPython()))
+        if self.worker.closed:
+            return
+        self.report.setPlainText(self.tr("reading the archive…"))
+        self.worker.submit(partial(health_text, self.archive_path, self.day.date().toPython()), "day")

@@ -13,6 +13,10 @@ manual is silent:
   already outside the limits at start is reported too.
 - RegData records the value whenever its displayed text (Precision decimals) changes.
 - KeepMaxValue keeps the largest physical value seen until `reset_max` (the widget: double-click).
+
+What a word shows (its physical value, text, zone and place on the scale) is computed in one place,
+`Scaled.shows`, into a `Shown`: the element's own update, `settle` (the form's bank of plain
+gauges) and every view read that, so no path can show a word otherwise than another.
 """
 
 from __future__ import annotations
@@ -22,7 +26,8 @@ import math
 from collections.abc import Mapping
 from dataclasses import dataclass, field
 from functools import cached_property
-from typing import Any, ClassVar
+from operator import attrgetter
+from typing import Any, ClassVar, NamedTuple
 
 from app.scada.table import TagTable
 from hmi_forms.elements import props as p
@@ -35,8 +40,21 @@ logger = logging.getLogger(__name__)
 
 APPEARANCES = ("digital", "hbar", "dial", "semidial", "graph", "tank")  # tank: an extension
 ZONE_TYPES = {"low": 2, "normal": 0, "high": 2}
-MAX_SHOWN = 65536  # words remembered per conversion (`settle`): every word a register can hold
-SHOWN: dict[tuple[object, ...], dict[int, tuple[int, float, str, str | None]]] = {}
+MAX_SHOWN = 65536  # words remembered per conversion (`remembered`): every word a register can hold
+
+
+class Shown(NamedTuple):
+    """What an analog element shows of one word (`Scaled.shows` makes every one)."""
+
+    hw: int | None  # None: no word read yet
+    phy: float
+    text: str  # Precision decimals; "" while unknown
+    zone: str | None  # low, normal or high; None without limits
+    fraction: float  # the place on the scale PhyMin..PhyMax, clamped to 0..1 (pointers, bars)
+
+
+UNKNOWN = Shown(None, math.nan, "", None, 0.0)
+SHOWN: dict[tuple[object, ...], dict[int, Shown]] = {}  # `AnalogBase.remembered`, by conversion
 
 
 @dataclass(eq=False)
@@ -53,6 +71,7 @@ class Scaled(Element):
 
     scaling: p.Scaling = field(default=p.Scaling(0, 1, 0, 1), init=False)
     tag: str = field(default="", init=False)  # the tag of tags.csv the element's address names
+    shown: Shown = field(default=UNKNOWN, init=False)  # what its word shows now
 
     ADDRESS_KEYS: ClassVar[tuple[str, ...]] = ("InAddr", "Address", "OutAddr")  # where a tag is named
 
@@ -105,6 +124,23 @@ class Scaled(Element):
     def format(self, phy: float) -> str:
         return f"{phy:.{self.Precision}f}"
 
+    def shows(self, hw: int) -> Shown:
+        """What the word `hw` shows: the one place where a word becomes a physical value, a text, a
+        zone and a place on the scale."""
+        phy = self.scaling.to_phy(hw)
+        return Shown(hw, phy, self.format(phy), self.zone_of(phy), self.scaling.fraction(phy))
+
+    def zone_of(self, phy: float) -> str | None:
+        """The zone `phy` lies in; None: the element has no limits."""
+        return None
+
+    # what it shows now, by part (read only: `shows` makes them all at once)
+    hw = property(attrgetter("shown.hw"))
+    phy = property(attrgetter("shown.phy"))
+    text = property(attrgetter("shown.text"))
+    zone = property(attrgetter("shown.zone"))
+    fraction = property(attrgetter("shown.fraction"))
+
 
 def scaling_problems(ranges: dict[str, Any]) -> list[tuple[str, str]]:
     """Ranges that would divide by zero; shared by elements and the form's Devices table."""
@@ -134,11 +170,7 @@ class AnalogBase(Scaled):
     LineWidth: int = field(default=1, metadata=p.prop(p.integer(1, 10)))
     LabelInt: int = field(default=50, metadata=p.prop(p.integer(1, 100_000)))
 
-    hw: int | None = field(default=None, init=False)
-    phy: float = field(default=math.nan, init=False)
-    text: str = field(default="", init=False)
     maximum: float | None = field(default=None, init=False)
-    zone: str | None = field(default=None, init=False)
     trend: Trend | None = field(default=None, init=False, repr=False)
     last_scan: int = field(default=-1, init=False)
 
@@ -162,12 +194,15 @@ class AnalogBase(Scaled):
     def sources(self) -> tuple[tuple[int, int], ...]:
         return ((self.InAddr, 2),) if self.InAddr is not None else ()
 
-    def zone_of(self, phy: float) -> str:
+    def zone_of(self, phy: float) -> str | None:
         """Zone with hysteresis: leaving the current zone needs the value to be Hysteresis inside."""
         lo, hi, hy = self.PhyLow, self.PhyHigh, self.Hysteresis
-        if self.zone == "low" and lo is not None and phy < lo + hy:
+        if lo is None and hi is None:
+            return None
+        zone = self.zone
+        if zone == "low" and lo is not None and phy < lo + hy:
             return "low"
-        if self.zone == "high" and hi is not None and phy > hi - hy:
+        if zone == "high" and hi is not None and phy > hi - hy:
             return "high"
         if lo is not None and phy < lo:
             return "low"
@@ -187,64 +222,60 @@ class AnalogBase(Scaled):
                 and not self.KeepMaxValue and self.Hysteresis == 0 and self.SyncType is None
                 and self.QualityAddr is None and (self.effects is None or not self.acts))
 
-    def settle(self, hw: int) -> None:
-        """The value, text and zone are looked up by the word among those of every element with
-        the same conversion."""
-        shown = self._shown.get(hw)
-        if shown is None:
-            phy = self.scaling.to_phy(hw)
-            limited = self.PhyLow is not None or self.PhyHigh is not None  # no hysteresis: the plain rule
-            shown = (hw, phy, self.format(phy), self.zone_of(phy) if limited else None)
-            if len(self._shown) >= MAX_SHOWN:
-                self._shown.clear()
-            self._shown[hw] = shown
-        self.hw, self.phy, self.text, self.zone = shown
+    def settle(self, hw: int) -> Shown:
+        """A new word of a plain element read by its form's bank, while its data are good: what
+        `refresh` would show (a plain element records nothing and keeps no maximum)."""
+        shown = self.shown = self.remembered.get(hw) or self._remember(hw)
+        self.stale = False
+        return shown
 
     @cached_property
-    def _shown(self) -> dict[int, tuple[int, float, str, str | None]]:
-        key = (self.scaling, self.Precision, self.PhyLow, self.PhyHigh)
+    def remembered(self) -> dict[int, Shown]:
+        """What each word shows, as `shows` made it, shared by every element with the same
+        conversion (a form of a thousand gauges shows few distinct words); none are remembered for
+        an element with Hysteresis, whose zone depends on the last one."""
+        key = (self.scaling, self.Precision, self.PhyLow, self.PhyHigh, self.Hysteresis)
         return SHOWN.setdefault(key, {})
+
+    def _remember(self, hw: int) -> Shown:
+        """`shows`, remembered (a `Shown` is a tuple, never false: `remembered.get(hw) or ...`)."""
+        shown = self.shows(hw)
+        remembered = self.remembered
+        if len(remembered) >= MAX_SHOWN:
+            remembered.clear()
+        remembered[hw] = shown
+        return shown
 
     def refresh(self, snap: Snapshot) -> bool:
         hw = self._in(snap)
-        sampled = self._sample(snap, hw)
-        if hw == self.hw:
-            return sampled
-        self.hw = hw
-        phy = self.scaling.to_phy(hw)
-        self.phy = phy
-        text = self.format(phy)
-        if self.RegData and text != self.text:
-            self.record(snap, "data", value=phy)
-        self.text = text
-        if self.KeepMaxValue and (self.maximum is None or phy > self.maximum):
-            self.maximum = phy
-        if self.PhyLow is not None or self.PhyHigh is not None:
-            zone = self.zone_of(phy)
-            report = zone != self.zone and self.RegMessages and (self.zone is not None or zone != "normal")
-            self.zone = zone
-            if report:
-                text = self.message or f"{zone}: {text}"
-                self.record(snap, "message", type=ZONE_TYPES[zone], value=phy, text=text)
-        return True
+        was = self.shown
+        changed = hw != was.hw
+        if changed:
+            shown = self.shows(hw) if self.Hysteresis else self.remembered.get(hw) or self._remember(hw)
+            self.shown = shown
+            if self.RegData and shown.text != was.text:
+                self.record(snap, "data", value=shown.phy)
+            if self.KeepMaxValue and (self.maximum is None or shown.phy > self.maximum):
+                self.maximum = shown.phy
+            zone = shown.zone
+            if zone != was.zone and self.RegMessages and (was.zone is not None or zone != "normal"):
+                text = self.message or f"{zone}: {shown.text}"
+                self.record(snap, "message", type=ZONE_TYPES[zone], value=shown.phy, text=text)
+        return self._sample(snap, self.phy) or changed
 
     def refresh_stale(self, snap: Snapshot) -> bool:
-        return self._sample(snap, None)
+        return self._sample(snap, math.nan)
 
-    def _sample(self, snap: Snapshot, hw: int | None) -> bool:
+    def _sample(self, snap: Snapshot, phy: float) -> bool:
         """One trend sample per scan (NaN while stale, drawn as a gap)."""
         if self.trend is None or snap.scan == self.last_scan:
             return False
         self.last_scan = snap.scan
-        self.trend.add(math.nan if hw is None else self.scaling.to_phy(hw), snap.wall)
+        self.trend.add(phy, snap.wall)
         return True
 
     def reset_max(self) -> None:
         self.maximum = None if math.isnan(self.phy) else self.phy
-
-    @property
-    def fraction(self) -> float:
-        return 0.0 if math.isnan(self.phy) else self.scaling.fraction(self.phy)
 
 
 @dataclass(eq=False)
@@ -257,9 +288,6 @@ class AnalogOutput(Scaled, Writer):
     InAddr: int | None = field(default=None, metadata=p.prop(p.word, alias="Address"))
     Enabled: bool = field(default=True, metadata=p.prop(p.boolean))
 
-    hw: int | None = field(default=None, init=False)
-    text: str = field(default="", init=False)
-
     def sources(self) -> tuple[tuple[int, int], ...]:
         addr = self.InAddr if self.InAddr is not None else self.OutAddr
         return ((addr, 2),) if addr is not None else ()
@@ -270,8 +298,7 @@ class AnalogOutput(Scaled, Writer):
         hw = snap.get_word(addr)
         if hw == self.hw:
             return False
-        self.hw = hw
-        self.text = self.format(self.scaling.to_phy(hw))
+        self.shown = self.shows(hw)
         return True
 
     def submit(self, entry: str) -> tuple[bool, str]:

@@ -4,7 +4,8 @@ A form of a thousand gauges and lamps reads a thousand operands per tick; asking
 own reader costs a Python call, a closure and a comparison per element whether the value moved or
 not. A bank gathers them all with one numpy index into the snapshot and reports only those that
 changed since they were last taken, so Python runs for what is really new. The elements a bank
-serves are those whose value is all they show (`plain`): they `settle` what the bank read.
+serves are those whose value is all they show (`plain`): each model `settle`s what the bank read,
+and what draws it is handed what it shows now.
 """
 
 from __future__ import annotations
@@ -91,27 +92,30 @@ class BitBank(Bank):
         return values
 
 
-class Settles(Protocol):
+class Draws(Protocol):
     rect: Any
 
-    def put(self, value: int) -> bool: ...
+    def put(self, shown: Any) -> bool: ...
 
 
 class Banked:
     """The elements one bank serves, refreshed from each snapshot: only those whose operand
-    changed are settled (`put`, True when the caller is to repaint the element). With the
+    changed are settled (`Element.settle`), and what each shows then is handed to what draws it
+    (`put`, True when the caller is to repaint the element). With the
     runtime's readings, the quality of all of them is judged at once (`Readings.judge`); one
     whose data are not good takes the general path (`Element.update`, then `sync`) and is taken
     anew from the bank once they are good again."""
 
-    def __init__(self, bank: Bank, models: Sequence[Element], faces: Sequence[Settles],
+    def __init__(self, kind: Callable[[list[int]], Bank], models: Sequence[Element], faces: Sequence[Draws],
                  syncs: Sequence[Callable[[], None]], fault: Callable[[Element, Exception], None]) -> None:
-        """`faces` are what draw the elements (hmi_forms/widgets/base.py): each settles a value
-        (`put`) and is where it is repainted (`rect`)."""
-        self.bank, self.models, self.faces, self.syncs = bank, list(models), list(faces), list(syncs)
+        """`kind` the bank that reads the operands; `faces` are what draw the elements
+        (hmi_forms/widgets/base.py): each draws what its model settled (`put`) and is where it is
+        repainted (`rect`)."""
+        self.models, self.faces, self.syncs = list(models), list(faces), list(syncs)
+        self.sources = [m.sources()[0] for m in self.models]  # a plain element shows one operand
+        self.bank = kind([address for address, _ in self.sources])
         self.puts = [f.put for f in self.faces]
         self.fault = fault
-        self.sources = [m.sources()[0] for m in self.models]  # a plain element shows one operand
         self.marked = np.zeros(len(self.models), dtype=bool)  # shown with a quality mark
         self.judged_by: QualityMap | None = None
         self.operands: Operands | None = None
@@ -132,10 +136,10 @@ class Banked:
             new = [(i, v) for i, v in new if i not in apart]
             for i in apart:
                 self._update(i, snap, None if codes is None else Quality(int(codes[i])))
-        puts, repaint = self.puts, []
+        models, puts, repaint = self.models, self.puts, []
         for i, value in new:
             try:
-                if puts[i](value):
+                if puts[i](models[i].settle(value)):
                     repaint.append(i)
             except Exception as e:  # no log: the view's fault handler logs and shows it
                 self._failed(i, e)

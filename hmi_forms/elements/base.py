@@ -103,9 +103,14 @@ class Element:
         others' at once and `settle` it (hmi_forms/elements/bank.py); none by default."""
         return False
 
-    def settle(self, value: int) -> None:
-        """Take a new value of its operand as `refresh` would, for a `plain` element."""
+    def settle(self, value: int) -> object:
+        """Take a new value of its operand, read by its form's bank while its data are good, as
+        `update` would, for a `plain` element; what it shows now (what its face draws)."""
         raise NotImplementedError(f"{self.TYPE} reads its own operands")
+
+    def failed(self) -> None:
+        """Updating or drawing it raised: marked stale until its next good value."""
+        self.stale = True
 
     def sources(self) -> tuple[tuple[int, int], ...]:
         """The operands whose value the element shows, as (address, bytes), bytes 0 for one HMI

@@ -68,8 +68,10 @@ class DiscreteBase(Element, Writer):
                 and self.SyncType is None and self.QualityAddr is None
                 and (self.effects is None or not self.acts))
 
-    def settle(self, value: int) -> None:
+    def settle(self, value: int) -> int:
         self.value = value
+        self.stale = False
+        return value
 
     def refresh(self, snap: Snapshot) -> bool:
         v = self._in(snap)

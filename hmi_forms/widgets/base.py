@@ -8,9 +8,9 @@ dynamic part also comes from cached pixmaps (texts, needles, bar fills), a chang
 element into a short list of pixmap copies at its place on the form (`Face`): painting it then
 needs no painter state, and an unchanged composition is not repainted at all.
 
-Widgets only draw what their model computed. The stale mark (grey wash, hatching and a "?" badge)
-is a child widget kept above everything else, so it also covers plots and input fields, and it is
-drawn identically for all element types: an operator learns it once.
+Widgets only draw what their model computed, and never write it. The stale mark (grey wash,
+hatching and a "?" badge) is a child widget kept above everything else, so it also covers plots
+and input fields, and it is drawn identically for all element types: an operator learns it once.
 """
 
 from __future__ import annotations
@@ -18,12 +18,14 @@ from __future__ import annotations
 from collections.abc import Callable, Hashable
 from operator import attrgetter
 from pathlib import Path
+from typing import ClassVar
 
 from PySide6.QtCore import QT_TRANSLATE_NOOP, QCoreApplication, QEvent, QPoint, QPointF, QRect, QRectF, Qt
 from PySide6.QtGui import QBrush, QColor, QMoveEvent, QPainter, QPaintEvent, QPen, QPixmap, QResizeEvent
 from PySide6.QtWidgets import QWidget
 
 from hmi_forms.elements import Element
+from hmi_forms.elements.bank import Bank
 from hmi_forms.widgets import theme
 
 Op = tuple[Callable[..., None], tuple[object, ...]]  # an unbound QPainter method and its arguments:
@@ -326,6 +328,8 @@ class Face:
     __slots__ = ("drawn", "fresh", "key", "layers", "marked", "model", "plain", "rect", "repaint", "style",
                  "style_of", "widget", "x", "y")
 
+    bank: ClassVar[type[Bank] | None] = None  # what reads the operand of a `plain` element it draws
+
     def __init__(self, widget: ElementWidget) -> None:
         self.widget, self.model = widget, widget.model
         self.drawn: list[Op] | None = None
@@ -355,13 +359,10 @@ class Face:
         self.drawn = drawn
         self.show(self.rect)
 
-    def put(self, value: int) -> bool:
-        """A new value of a plain element, read with the rest of the form's (a `Bank`): what
-        `update` would do with it while the data are good. True: the caller is to repaint the
-        element (the form does, in one piece with the rest); otherwise it is scheduled already."""
-        m = self.model
-        m.stale = False  # a failed draw's mark goes with the next value, as with `update`
-        m.settle(value)
+    def put(self, shown: object) -> bool:
+        """Draw what a plain element shows now (what its model `settle`d from a value read with
+        the rest of the form's, in a `Bank`). True: the caller is to repaint the element (the form
+        does, in one piece with the rest); otherwise it is scheduled already."""
         self.sync()
         return False
 

@@ -13,6 +13,7 @@ from PySide6.QtCore import QCoreApplication, QRectF, Qt
 from PySide6.QtGui import QColor, QLinearGradient, QMouseEvent, QPainter, QPen, QPixmap
 from PySide6.QtWidgets import QWidget
 
+from hmi_forms.elements.bank import BitBank
 from hmi_forms.elements.discrete import DiscreteBase, DiscreteColorLabel
 from hmi_forms.widgets import theme
 from hmi_forms.widgets.base import PIX, STYLE, ElementWidget, Face, Images, Op, draw_pixmap
@@ -25,6 +26,8 @@ class DiscreteFace(Face):
 
     __slots__ = ("by_state", "pressed", "simple")
 
+    bank = BitBank
+
     def __init__(self, widget: ElementWidget) -> None:
         super().__init__(widget)
         self.pressed = False  # the operator holds the mouse button on it
@@ -36,15 +39,12 @@ class DiscreteFace(Face):
         self.by_state = {}
         self.simple = type(self.model) in (DiscreteBase, DiscreteColorLabel)
 
-    def put(self, value: int) -> bool:
-        """`Face.put` of a plain element, in one step: the layer by the bit and the press."""
+    def put(self, shown: int) -> bool:
+        """`Face.put` in one step: the layer by the bit and the press (a plain element is simple)."""
         if not self.fresh:
             self.load()
-        m = self.model
-        m.stale = False
-        if not self.simple or self.style_of(m) != self.style:
-            return super().put(value)
-        m.settle(value)
+        if self.style_of(self.model) != self.style:
+            return super().put(shown)
         drawn = [(PIX, (self.x, self.y, self._layer()))]
         if drawn == self.drawn:
             return False

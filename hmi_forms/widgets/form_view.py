@@ -99,19 +99,17 @@ class FormView(QWidget):
         syncs = [(model, model.sources(),
                   widget.face.sync if type(widget).sync is ElementWidget.sync else widget.sync)
                  for model, widget in self.pairs]
-        # the gauges and lamps whose operand is all they show are read together, in one array
-        kinds = [WordBank if isinstance(w, GaugeWidget) else BitBank if isinstance(w, DiscreteWidget)
-                 else None for _, w in self.pairs]
-        banked = [kind is not None and type(w).sync is ElementWidget.sync and m.plain
-                  for kind, (m, w) in zip(kinds, self.pairs)]
-        self._syncs = [s for s, b in zip(syncs, banked) if not b]
+        # the elements whose operand is all they show (`plain`) are read together, in one array per
+        # bank their face draws from (`Face.bank`: the gauges' words, the lamps' bits)
+        kinds = [w.face.bank if m.plain else None for m, w in self.pairs]
+        self._syncs = [s for s, kind in zip(syncs, kinds) if kind is None]
         self._banks: list[Banked] = []
-        for kind, operand in ((WordBank, lambda m: m.InAddr), (BitBank, lambda m: m.InAddr.hmi)):
-            members = [(s, w) for s, w, k, b in zip(syncs, self.pairs, kinds, banked) if b and k is kind]
+        for kind in (WordBank, BitBank):
+            members = [(s, w) for s, (_, w), k in zip(syncs, self.pairs, kinds) if k is kind]
             if members:
                 models = [m for (m, _, _), _ in members]
-                faces, shows = [w.face for _, (_, w) in members], [s for (_, _, s), _ in members]
-                self._banks.append(Banked(kind([operand(m) for m in models]), models, faces, shows,
+                faces, shows = [w.face for _, w in members], [s for (_, _, s), _ in members]
+                self._banks.append(Banked(kind, models, faces, shows,
                                           lambda model, e: self._fault(model, e, "update")))
         # where each painted element goes, worked out once: the paint loop runs 200 times a tick
         self._extent = QRect()  # what the painted elements take
@@ -245,7 +243,7 @@ class FormView(QWidget):
     def _fault(self, model: Element, error: Exception, what: str) -> None:
         """Mark the element stale; log and report the fault the first time (it recurs at every
         refresh or repaint until the data that cause it change)."""
-        model.stale = True
+        model.failed()
         key = (id(model), what, type(error))
         if key in self._faults:
             return

@@ -27,7 +27,8 @@ from PySide6.QtGui import (
 )
 from PySide6.QtWidgets import QWidget
 
-from hmi_forms.elements.analog import AnalogBase
+from hmi_forms.elements.analog import AnalogBase, Shown
+from hmi_forms.elements.bank import WordBank
 from hmi_forms.widgets import theme
 from hmi_forms.widgets.base import FILL, PIX, STYLE, ElementWidget, Face, Images, Op
 from hmi_forms.widgets.sprites import SPRITES, Ink, Sprite, TextSlot, blank
@@ -68,9 +69,9 @@ BOXED = {None: Ink(theme.TEXT, WHITE), "normal": Ink(theme.TEXT, WHITE), "low": 
          "high": Ink(WHITE, theme.ALARM)}
 BARE = {None: Ink(theme.TEXT), "normal": Ink(theme.TEXT), "low": Ink(theme.WARN.darker(115)),
         "high": Ink(theme.ALARM.darker(115))}
-# what a word shows on a plain gauge: the model's (hw, phy, text, zone), the text's sprite, and the
-# needle's sprite or the bar fill's (width, colour) or None (`GaugeFace.put`)
-Entry = tuple[tuple[int, float, str, "str | None"], Sprite, object]
+# what a gauge draws for what its model shows: that `Shown`, the text's sprite, and the needle's
+# sprite or the bar fill's (width, colour) or None (`GaugeFace.entries`)
+Entry = tuple[Shown, Sprite, object]
 
 
 class GaugeWidget(ElementWidget):
@@ -385,12 +386,11 @@ class GaugeWidget(ElementWidget):
         if self._needles is None:
             self._draw_needle(p, c, r, start + sweep * m.fraction)
             return
-        p.drawPixmap(*self._needle_sprite())
+        p.drawPixmap(*self._needle_sprite(round(m.fraction * self._travel)))
 
-    def _needle_sprite(self) -> Sprite:
-        """The needle to the nearest pixel its tip travels, as `shown` tells a move."""
+    def _needle_sprite(self, pointer: int) -> Sprite:
+        """The needle at `pointer`, the pixel its tip travels to (as `shown` tells a move)."""
         assert self._needles is not None
-        pointer = round(self.model.fraction * self._travel)
         sprite = self._needles.get(pointer)
         if sprite is None:
             c, r, start, sweep = self._dial
@@ -504,10 +504,14 @@ class GaugeFace(Face):
     large for sprites or one that pokes out of its element are drawn with a painter. Repainted
     only when something moved by a pixel or a text changed (a value that creeps below a pixel
     per tick costs no paint until it has moved one), in a large gauge only the text's box when
-    that is all that changed."""
+    that is all that changed. What the model shows (its `Shown`) is drawn with parts looked up in
+    one step (`entries`), the same for every gauge drawn from the same sprites with the same
+    conversion."""
 
-    __slots__ = ("bar", "contained", "entries", "fast", "inks", "kind", "merged", "needles", "part",
-                 "phy_min", "phy_span", "shown", "slot", "tall", "text_op", "texts", "travel", "units")
+    __slots__ = ("bar", "contained", "entries", "inks", "kind", "merged", "needles", "painted", "part",
+                 "slot", "tall", "text_op", "texts", "travel", "units")
+
+    bank = WordBank
 
     def load(self) -> None:
         super().load()
@@ -521,19 +525,15 @@ class GaugeFace(Face):
         self.inks, self.units = (BARE, widget._units) if kind == "hbar" else (BOXED, "")
         self.needles, self.travel, self.contained = widget._needles, widget._travel, widget._contained
         self.bar, self.tall = widget._bar, widget._digital[0].height() > 30
-        scaling = m.scaling  # `Scaling.fraction`, without two calls per tick
-        self.phy_min, self.phy_span = scaling.PhyMin, scaling.PhyMax - scaling.PhyMin
         part = widget._part
         self.part = None if part is None else part.translated(self.rect.topLeft()).intersected(self.rect)
-        self.shown: tuple[object, ...] | None = None  # what a painter drew last (`GaugeWidget.shown`)
+        self.painted: tuple[object, ...] | None = None  # what a painter drew last (`GaugeWidget.shown`)
         self.text_op: Op | None = None
-        # a word taken from the form's bank (`put`) is looked up with what it shows: the same for
-        # every gauge drawn from the same sprites with the same conversion
-        self.fast = m.plain and self.contained and self.part is None and (kind == "digital" or kind == "hbar"
-                                                                        or self.needles is not None)
         self.merged: dict[Hashable, Sprite] = SPRITES.family(("merged", id(self.texts), id(self.needles)))
-        family = ("entries", kind, id(self.texts), id(self.needles), self.travel, self.bar, self.units)
-        self.entries: dict[int, Entry] = SPRITES.family((*family, id(m._shown)))  # emptied with the sprites
+        family = ("entries", kind, id(self.texts), id(self.needles), self.travel, self.bar, self.units,
+                  self.part is None, id(m.remembered))
+        # emptied with the sprites; none for a dial that pokes out of its element (a painter draws it)
+        self.entries: dict[int | None, Entry] = SPRITES.family(family) if self.contained else {}
 
     def sync(self) -> None:
         if not self.fresh:
@@ -541,42 +541,32 @@ class GaugeFace(Face):
         old = self.drawn
         drawn = self.compose()
         if drawn is None:  # drawn with a painter: told by what the operator sees
-            shown, was = self.widget.shown(), self.shown
+            shown, was = self.widget.shown(), self.painted
             if old is None and shown == was:
                 return
-            self.shown = shown
+            self.painted = shown
             text_only = old is None and was is not None and was[1:] == shown[1:]
         elif drawn == old:
             return
         else:
-            self.shown = None
+            self.painted = None
             text_only = self.part is not None and old is not None and len(old) == len(drawn) and all(
                 a == b or b is self.text_op for a, b in zip(old, drawn))
         self.drawn = drawn
         self.show(self.part if text_only and self.part is not None else self.rect)
 
-    def put(self, hw: int) -> bool:
-        """`Face.put`, with what the word shows looked up in one step (`entries`): the model's
-        state and the sprites of the composition."""
+    def put(self, shown: Shown) -> bool:
+        """`Face.put`, with the composition of what the model shows looked up in one step."""
         if not self.fresh:
             self.load()
-        entry = self.entries.get(hw)
-        m = self.model
-        m.stale = False
-        if entry is None or self.style_of(m) != self.style:
-            m.settle(hw)
-            if self.fast and not self.restyled():
-                parts = self._parts(m.text, m.zone, m.phy, False)
-                if parts is not None:
-                    self.entries[hw] = ((m.hw, m.phy, m.text, m.zone), *parts)
+        entry = self.entries.get(shown.hw)
+        if entry is None or entry[0] is not shown or self.style_of(self.model) != self.style:
             self.sync()
             return False
-        shown, text, extra = entry
-        m.hw, m.phy, m.text, m.zone = shown
-        drawn = self._ops(shown[3], text, extra)
+        drawn = self._ops(shown.zone, entry[1], entry[2])
         if drawn == self.drawn:
             return False
-        self.drawn, self.shown = drawn, None
+        self.drawn, self.painted = drawn, None
         if self.marked:
             self.unmark()
         return True
@@ -586,27 +576,34 @@ class GaugeFace(Face):
         marked = m.maximum is not None and (self.kind != "digital" or self.tall)  # drawn by a painter
         if m.stale or not self.contained or marked or self.restyled():
             return None
-        parts = self._parts(m.text, m.zone, m.phy, m.hw is None)
-        return None if parts is None else self._ops(m.zone, *parts)
+        shown = m.shown
+        entry = self.entries.get(shown.hw)
+        if entry is None or entry[0] is not shown:
+            parts = self._parts(shown)
+            if parts is None:
+                return None
+            entry = self.entries[shown.hw] = (shown, *parts)
+        return self._ops(shown.zone, entry[1], entry[2])
 
-    def _parts(self, text: str, zone: str | None, phy: float, unknown: bool) -> tuple[Sprite, object] | None:
+    def _parts(self, shown: Shown) -> tuple[Sprite, object] | None:
         """The value's text sprite and the needle's sprite or the bar's fill (width, colour);
         None where a painter must draw."""
+        zone = shown.zone
         ink = self.inks[zone]
-        text = (text or "---") + self.units
+        text = (shown.text or "---") + self.units
         sprite = self.texts.get((text, ink.key)) or self.slot.sprite(text, ink)
         if sprite is None:
             return None
         kind = self.kind
-        if unknown or kind == "digital":
+        if shown.hw is None or kind == "digital":
             return sprite, None
-        fraction = min(max((phy - self.phy_min) / self.phy_span, 0.0), 1.0)
-        if kind == "hbar":  # the fraction is clamped to the track
-            return sprite, (round(self.bar[3] * fraction), theme.ZONE_COLORS.get(zone or "") or theme.ACCENT)
+        if kind == "hbar":
+            fill = theme.ZONE_COLORS.get(zone or "") or theme.ACCENT
+            return sprite, (round(self.bar[3] * shown.fraction), fill)
         if self.needles is None:
             return None
-        pointer = round(fraction * self.travel)
-        needle = self.needles.get(pointer) or self.widget._needle_sprite()
+        pointer = round(shown.fraction * self.travel)
+        needle = self.needles.get(pointer) or self.widget._needle_sprite(pointer)
         if self.part is not None:  # a large dial: its text alone is repainted
             return sprite, needle
         merged = self.merged.get((text, ink.key, pointer))

@@ -1,13 +1,16 @@
-"""Reads off the GUI thread: one thread of jobs per view, each answer handed back as a signal.
+"""Work off the GUI thread: one thread of jobs per view, each answer handed back as a signal.
 
-A view that reads the archive (the journal element, the viewer's series, trend history) must not
-wait for it on the GUI thread: a journal page of 100,000 rows or a day of a 10 Hz series takes up
-to a second, and a window that waits that long stops repainting and answering. Each view gets one
-thread, so its reads run in order and never share a connection at once; each answer comes back
-to the GUI thread as a queued signal carrying the request's token. Requests under one topic
-supersede each other (the newest request wins): a newer one cancels the older ones still queued
-and drops the answer of one already running, so a slow read never piles up a queue behind it and
-the view never shows an answer older than the last thing asked.
+A view that reads the archive (the journal element and dock, the viewer's pages and series, trend
+history, the alarm-system health) or a station (the remote monitor's login, the designer's live
+preview) must not wait for it on the GUI thread: a journal page of 100,000 rows or a day of a
+10 Hz series takes up to a second, a station that does not answer a few, and a window that waits
+that long stops repainting and answering. Every such view runs its work through this one base.
+Each view gets one thread, so its reads run in order and never share a connection at once; each
+answer comes back to the GUI thread as a queued signal carrying the request's token. Requests
+under one topic supersede each other (the newest request wins): a newer one cancels the older
+ones still queued and drops the answer of one already running, so a slow read never piles up a
+queue behind it and the view never shows an answer older than the last thing asked. A failure is
+logged (with its traceback unless it is one the view expects) and answered, for the view to say.
 
 The thread's state is a plain object apart from the QObject, so that a view destroyed by its
 parent still stops its thread (`destroyed`) and no answer is emitted on a deleted object.
@@ -33,8 +36,9 @@ class Worker(QObject):
 
     def __init__(self, name: str, expected: tuple[type[Exception], ...] = (),
                  parent: QObject | None = None, *, on_close: Callable[[], None] | None = None) -> None:
-        """`expected`: the errors a job may meet in normal use (an archive gone or unreadable),
-        answered as `failed` and logged without a traceback; any other is logged with its own.
+        """`expected`: the errors a job may meet in normal use (an archive gone or unreadable, a
+        link down), answered as `failed` and logged without a traceback, once while the same one
+        repeats; any other is logged with its own.
         `on_close`: runs once no job runs any more (closes what the jobs opened)."""
         super().__init__(parent)
         self._thread = _Thread(name, expected, self.answered.emit, self.failed.emit, on_close)
@@ -71,6 +75,7 @@ class _Thread:
         self.closed = False
         self.newest: dict[Hashable, int] = {}
         self.queued: dict[Hashable, Future] = {}
+        self.said: str | None = None  # the expected failure logged last, until a job succeeds
 
     def submit(self, token: int, job: Job, topic: Hashable | None) -> None:
         with self.lock:
@@ -94,12 +99,15 @@ class _Thread:
         try:
             result = job()
         except self.expected as e:
-            logger.warning("%s: %s", self.name, e)
+            if str(e) != self.said:  # one that repeats (a link down, polled) is logged once
+                self.said = str(e)
+                logger.warning("%s: %s", self.name, e)
             self.answer_with(token, topic, self.fail, str(e))
         except Exception as e:
             logger.exception("%s: a job failed", self.name)
             self.answer_with(token, topic, self.fail, f"{type(e).__name__}: {e}")
         else:
+            self.said = None
             self.answer_with(token, topic, self.answer, result)
 
     def answer_with(self, token: int, topic: Hashable | None, emit: Callable, what: object) -> None:

@@ -173,7 +173,8 @@ def test_journals_name_an_alarm_records_new_state() -> None:
 def test_the_health_dialog_shows_the_report_of_a_chosen_day(qtbot, headless_archive, tmp_path: Path) -> None:
     dialog = HealthDialog(headless_archive[0])
     qtbot.addWidget(dialog)
-    text = dialog.report.toPlainText()
+    qtbot.waitUntil(lambda: dialog.report.toPlainText().startswith("alarm-system"), timeout=10_000)
+    text = dialog.report.toPlainText()  # read in the dialog's worker thread
     assert text.startswith(f"alarm-system health for {dt.date.today():%d.%m.%Y}") and "chattering" in text
     assert health_text(tmp_path / "none.sqlite", dt.date.today()).startswith("no alarm-system health")
 

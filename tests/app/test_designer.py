@@ -6,6 +6,8 @@ from __future__ import annotations
 import copy
 import itertools
 import json
+import logging
+import socket
 from pathlib import Path
 
 import pytest
@@ -375,6 +377,32 @@ def test_preview_live_reads_a_running_modbus_server(qtbot: QtBot, demo_copy: Pat
     finally:
         sim.stop()
     assert sim.engine.snapshot.get_word(0o4030) == 0  # nothing was written (the setpoint stays 0)
+
+
+def test_preview_of_a_station_that_is_down_says_so_and_goes_live_when_it_answers(
+        qtbot: QtBot, demo_copy: Path, caplog) -> None:
+    """Polled in the preview's worker thread: each failure is said in the status bar, the log has it
+    once, and the preview goes live as soon as the station answers on that port."""
+    with socket.socket() as s:  # a port nothing listens on, for now
+        s.bind(("127.0.0.1", 0))
+        port = s.getsockname()[1]
+    w = make_window(qtbot, demo_copy / "forms" / "02_analog.hmi")
+    said: list[str] = []
+    with caplog.at_level(logging.WARNING, logger="hmi_forms.widgets.worker"):
+        w.start_preview("127.0.0.1", port)
+        assert w.preview is not None
+        w.preview.status.connect(said.append)
+        qtbot.waitUntil(lambda: len(said) >= 3, timeout=5000)  # polled again and again, 0.2 s apart
+        assert all(text.startswith("Preview: cannot connect") for text in said)
+        assert "cannot connect" in w.preview_label.text()
+        assert len([r for r in caplog.records if "cannot connect" in r.getMessage()]) == 1
+        sim = Simulator(parse("JMP 0\n"), port=port, tick=0.02)
+        sim.start()
+        try:
+            qtbot.waitUntil(lambda: "Preview live" in w.preview_label.text(), timeout=5000)
+        finally:
+            w.stop_preview()
+            sim.stop()
 
 
 def test_cli_opens_a_form_and_a_station(demo_copy: Path, tmp_path: Path, qtbot: QtBot) -> None:

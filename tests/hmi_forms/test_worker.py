@@ -53,6 +53,26 @@ def test_failures_are_answered_and_logged(qtbot, caplog) -> None:
     worker.close()
 
 
+def test_an_expected_failure_that_repeats_is_said_each_time_and_logged_once(qtbot, caplog) -> None:
+    """A view that polls (the designer's preview of a station that is down) says every failure, and
+    the log has it once until a job succeeds."""
+    worker = Worker("poll", (ConnectionError,))
+    said: list[str] = []
+    worker.failed.connect(lambda _token, why: said.append(why))
+    worker.answered.connect(lambda _token, _result: said.append("ok"))
+
+    def down() -> None:
+        raise ConnectionRefusedError("station down")
+
+    with caplog.at_level(logging.WARNING, logger="hmi_forms.widgets.worker"):
+        for job in (down, down, down, lambda: None, down):
+            worker.submit(job)
+        qtbot.waitUntil(lambda: len(said) == 5, timeout=WAIT)
+    assert said == ["station down"] * 3 + ["ok", "station down"]
+    assert [r.getMessage() for r in caplog.records] == ["poll: station down"] * 2  # again after the success
+    worker.close()
+
+
 def test_the_thread_stops_with_its_owner_and_closes_what_it_opened(qtbot) -> None:
     closed = threading.Event()
     owner = QObject()

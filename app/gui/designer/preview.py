@@ -3,23 +3,26 @@
 Only what the form shows is read (the bits and words its elements name, in as few requests as
 the Modbus limits allow), with the project's lean Modbus TCP client, read-only: the designer never
 writes, and a sync generator on the canvas writes nowhere (its target is a NullTarget). Each poll
-becomes a Snapshot with its own scan counter, so trends advance one sample per poll.
+becomes a Snapshot with its own scan counter, so trends advance one sample per poll. The polls run
+one after the other in the preview's worker thread (hmi_forms/widgets/worker.py), the next
+PERIOD after the last one answered, so a station slow to answer is never asked twice at once.
 """
 
 from __future__ import annotations
 
 import asyncio
-import threading
 import time
 from collections.abc import Iterable
 from dataclasses import fields
+from functools import partial
 
-from PySide6.QtCore import QObject, Signal
+from PySide6.QtCore import QObject, QTimer, Signal
 
 from hmi_forms.elements import Element
 from hmi_forms.elements import props as p
+from hmi_forms.widgets.worker import Worker
 from netplc.address import IO_BITS, BitRef
-from netplc.memory import Memory
+from netplc.memory import Memory, Snapshot
 from netplc.modbus import (
     MAX_READ_BITS,
     MAX_READ_REGISTERS,
@@ -85,8 +88,48 @@ def plan(models: Iterable[Element]) -> list[Request]:
     return requests
 
 
+class Poller:
+    """The station as the preview's worker thread reads it: one connection on an event loop of
+    that thread, opened at the first poll and again after a failed one, closed with the worker."""
+
+    def __init__(self, endpoint: Endpoint, unit: int) -> None:
+        self.client = LeanTcpClient(endpoint, timeout=1.0)
+        self.unit = unit
+        self.loop: asyncio.AbstractEventLoop | None = None
+        self.mem = Memory()
+        self.scan = 0
+
+    def poll(self, requests: list[Request]) -> Snapshot:
+        if self.loop is None:
+            self.loop = asyncio.new_event_loop()
+        try:
+            return self.loop.run_until_complete(self._read(requests))
+        except (LinkError, DeviceError):
+            self.client.close()  # the next poll connects anew
+            raise
+
+    async def _read(self, requests: list[Request]) -> Snapshot:
+        if not self.client.connected:
+            await self.client.connect()
+        for table, address, count in requests:
+            values = await self.client.read(self.unit, table, address, count)
+            if table == "coils":
+                self.mem.bits[address : address + count] = values
+            else:
+                self.mem.write(2 * address, bytes_from_words(values))
+        self.scan += 1
+        return self.mem.snapshot(self.scan, time.monotonic(), time.time(), "preview")
+
+    def close(self) -> None:
+        self.client.close()
+        loop, self.loop = self.loop, None
+        if loop is not None:
+            loop.run_until_complete(asyncio.sleep(0))  # the aborted connection's socket closes
+            loop.close()
+
+
 class Preview(QObject):
-    """Polls on a thread of its own; snapshots and link problems arrive as Qt signals."""
+    """Polls in a worker thread; snapshots and link problems arrive as Qt signals."""
 
     snapshot = Signal(object)
     status = Signal(str)
@@ -96,44 +139,44 @@ class Preview(QObject):
         self.endpoint = Endpoint("tcp", host=host, port=port)
         self.unit = unit
         self.requests: list[Request] = []
-        self._stop = threading.Event()
-        self._thread: threading.Thread | None = None
+        self.worker: Worker | None = None
+        self._poller: Poller | None = None
+        self._up = False
+        self._next = QTimer(self)
+        self._next.setSingleShot(True)
+        self._next.setInterval(round(PERIOD * 1000))
+        self._next.timeout.connect(self._poll)
 
     def start(self) -> None:
-        self._stop.clear()
-        self._thread = threading.Thread(target=lambda: asyncio.run(self._run()), name="designer-preview",
-                                        daemon=True)
-        self._thread.start()
+        self.stop()
+        self._poller = Poller(self.endpoint, self.unit)
+        self.worker = Worker("designer-preview", (LinkError, DeviceError), self, on_close=self._poller.close)
+        self.worker.answered.connect(self._read)
+        self.worker.failed.connect(self._failed)
+        self._poll()
 
     def stop(self) -> None:
-        self._stop.set()
-        if self._thread is not None:
-            self._thread.join(timeout=3)
-            self._thread = None
+        self._next.stop()
+        worker, self.worker = self.worker, None
+        if worker is not None:
+            worker.close()
 
-    async def _run(self) -> None:
-        client = LeanTcpClient(self.endpoint, timeout=1.0)
-        mem = Memory()
-        scan = 0
-        up = False
-        while not self._stop.is_set():
-            try:
-                if not client.connected:
-                    await client.connect()
-                for table, address, count in list(self.requests):
-                    values = await client.read(self.unit, table, address, count)
-                    if table == "coils":
-                        mem.bits[address : address + count] = values
-                    else:
-                        mem.write(2 * address, bytes_from_words(values))
-                scan += 1
-                self.snapshot.emit(mem.snapshot(scan, time.monotonic(), time.time(), "preview"))
-                if not up:
-                    self.status.emit(f"Preview live: {self.endpoint}")
-                up = True
-            except (LinkError, DeviceError) as e:
-                client.close()
-                up = False
-                self.status.emit(f"Preview: {e}")
-            await asyncio.sleep(PERIOD)
-        client.close()
+    def _poll(self) -> None:
+        if self.worker is not None and self._poller is not None:
+            self.worker.submit(partial(self._poller.poll, list(self.requests)))
+
+    def _read(self, _token: int, snap: Snapshot) -> None:
+        if self.worker is None:
+            return  # stopped while the answer was on its way
+        self.snapshot.emit(snap)
+        if not self._up:
+            self._up = True
+            self.status.emit(f"Preview live: {self.endpoint}")
+        self._next.start()
+
+    def _failed(self, _token: int, why: str) -> None:
+        if self.worker is None:
+            return
+        self._up = False
+        self.status.emit(f"Preview: {why}")
+        self._next.start()

@@ -126,6 +126,10 @@
         <translation>День:</translation>
     </message>
     <message>
+        <source>reading the archive…</source>
+        <translation>чтение архива…</translation>
+    </message>
+    <message>
         <source>no alarm-system health: {0}</source>
         <translation>нет данных о системе аварийной сигнализации: {0}</translation>
     </message>
