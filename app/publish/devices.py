@@ -49,7 +49,8 @@ class Device:
 class Layout:
     """The points of the edge node and of each device, worked out once when the publisher starts."""
 
-    def __init__(self, tags: Sequence[Tag], quality_map: QualityMap | None, nodes: Iterable[NodeConfig]) -> None:
+    def __init__(self, tags: Sequence[Tag], quality_map: QualityMap | None,
+                 nodes: Iterable[NodeConfig]) -> None:
         configs = sorted(nodes, key=lambda c: c.node)
         number = {cfg.node: k for k, cfg in enumerate(configs)}
         owner = np.full(len(tags), -1, dtype=np.intp)  # point -> device index, -1: the edge node's
@@ -60,8 +61,8 @@ class Layout:
                     owner[i] = number[node]
         self.owner = owner
         self.node_points = np.flatnonzero(owner < 0)
-        self.devices = [Device(k, cfg.node, cfg.title, np.flatnonzero(owner == k), len(tags) + 1 + k * len(LINK))
-                        for k, cfg in enumerate(configs)]
+        self.devices = [Device(k, cfg.node, cfg.title, np.flatnonzero(owner == k),
+                               len(tags) + 1 + k * len(LINK)) for k, cfg in enumerate(configs)]
         self.by_id = {d.id: d for d in self.devices}
         self.index = {t.name: i for i, t in enumerate(tags)}
 

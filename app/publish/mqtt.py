@@ -233,7 +233,8 @@ class SparkplugPublisher:
         dropped = self.status.dropped
         lost = f", {dropped} NDATA/DDATA dropped so far" if dropped else ""
         waiting = f"; NBIRTH once primary host {self.primary} is online" if self.primary else ""
-        self.journal(f"MQTT connected to {self.peer} as {self.topics.node} (bdSeq {self.bdseq}){lost}{waiting}")
+        self.journal(f"MQTT connected to {self.peer} as {self.topics.node} (bdSeq {self.bdseq})"
+                     f"{lost}{waiting}")
 
     def _on_disconnect(self, client: mqtt.Client, userdata: object, flags: Any, reason: Any,
                        props: Any) -> None:
@@ -306,13 +307,15 @@ class SparkplugPublisher:
             label = name or (self.tags[alias - 1].name if 0 < alias <= len(self.tags) else f"alias {alias}")
             if i is not None:
                 kind = self.kinds[i]
-                ticket = self.writer.write(who, self.tags[i], spb.get_value(metric, kind), spb.mismatch(metric, kind))
+                ticket = self.writer.write(who, self.tags[i], spb.get_value(metric, kind),
+                                           spb.mismatch(metric, kind))
             elif device is not None and (link := layout.link_name(device, name, alias)):
                 ticket = self.commands.refuse(who, Action.WRITE, link, Reason.NOT_WRITABLE,
                                               "a link metric, read-only")
             else:
                 of = f"device {device.id}" if device is not None else self.topics.node
-                ticket = self.commands.refuse(who, Action.WRITE, label, Reason.UNKNOWN, f"no such metric of {of}")
+                ticket = self.commands.refuse(who, Action.WRITE, label, Reason.UNKNOWN,
+                                              f"no such metric of {of}")
             self._refused(ticket)
 
     def _refused(self, ticket: Ticket) -> None:
@@ -365,6 +368,7 @@ class SparkplugPublisher:
         self.client.loop_stop()  # its thread ends with a deliberate disconnect: a new one connects
         self._leaving = False
         if not self._stopping:
+            self.client.reconnect_delay_set(*BACKOFF)  # a deliberate reconnect: its back-off afresh
             self.client.connect_async(self.host, self.port, KEEPALIVE)
             self.client.loop_start()
 
@@ -405,7 +409,7 @@ class SparkplugPublisher:
             self._birth_due = True
             return
         self.status.births += 1
-        self._sent_values[points], self._sent_quality[points] = reading.values[points], reading.quality[points]
+        self._sent(points, reading)
         for device, alive in zip(self.layout.devices, self._alive(), strict=True):
             if alive:
                 self._device_birth(device, reading)
@@ -434,7 +438,12 @@ class SparkplugPublisher:
             self.status.device_births += 1
             self._born.add(device.index)
             self._sent_link[device.index] = link
-            self._sent_values[points], self._sent_quality[points] = reading.values[points], reading.quality[points]
+            self._sent(points, reading)
+
+    def _sent(self, points: np.ndarray, reading: Reading) -> None:
+        """What a birth told of `points`: what their changes are reckoned from."""
+        self._sent_values[points] = reading.values[points]
+        self._sent_quality[points] = reading.quality[points]
 
     def _device_death(self, device: Device) -> None:
         self._born.discard(device.index)

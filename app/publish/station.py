@@ -51,8 +51,8 @@ def start_publishers(runtime: Runtime) -> list[Publisher]:
         runtime.commands.grant(Source.MQTT, st.mqtt.role)
         publisher = SparkplugPublisher(st.mqtt, st.name, tags=tags, commands=runtime.commands,
                                        watch=runtime.watch, journal=runtime.system,
-                                       bdseq_file=st.folder / BDSEQ_FILE, quality_map=runtime.alarms.quality_map,
-                                       exchange=runtime.exchange)
+                                       bdseq_file=st.folder / BDSEQ_FILE, exchange=runtime.exchange,
+                                       quality_map=runtime.alarms.quality_map)
         publisher.start()
         started.append(publisher)
         devices = ", ".join(d.id for d in publisher.layout.devices) or "none"

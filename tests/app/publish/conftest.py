@@ -30,13 +30,15 @@ def free_port() -> int:
         return s.getsockname()[1]
 
 
-def demo_with(folder: Path, extra: str) -> Runtime:
+def demo_with(folder: Path, extra: str, records: list | None = None) -> Runtime:
     """The demo station copied to `folder` (unless there already) with `extra` TOML appended,
-    started headless."""
+    started headless; its records from the start in `records`."""
     station = folder if (folder / "station.toml").exists() else copy_demo(folder)
     toml = station / "station.toml"
     toml.write_text(toml.read_text(encoding="utf-8") + "\n" + extra, encoding="utf-8")
     runtime = Runtime(load_station(station))
+    if records is not None:
+        runtime.subscribe(records.append)
     runtime.start()
     return runtime
 
@@ -71,9 +73,10 @@ class Mosquitto:
                     raise RuntimeError(f"mosquitto did not start: {self.log()}") from None
                 time.sleep(0.05)
 
-    def stop(self) -> None:
+    def stop(self, sig: int = signal.SIGTERM) -> None:
+        """SIGTERM: mosquitto publishes its clients' wills as it shuts down; SIGKILL: it vanishes."""
         if self.proc is not None and self.proc.poll() is None:
-            os.kill(self.proc.pid, signal.SIGTERM)
+            os.kill(self.proc.pid, sig)
             self.proc.wait(10)
         self.proc = None
 
@@ -108,6 +111,35 @@ def broker(tmp_path_factory: pytest.TempPathFactory) -> Iterator[Mosquitto]:
     yield from _broker(tmp_path_factory.mktemp("mqtt") / "broker")
 
 
+def mqtt_section(broker: Mosquitto, extra: str = "", group: str = "Plant", writable: str = "TEMP_SP") -> str:
+    """[mqtt] of a demo station publishing to `broker` as `group`/Demo, which may write `writable`."""
+    return (f'[mqtt]\nenabled = true\nbroker = "{broker.url}"\ngroup_id = "{group}"\nedge_node_id = "Demo"\n'
+            f'writable = ["{writable}"]\ndeadband = {{ word = 0.0 }}\n{extra}')
+
+
+SEQUENCED = ("DBIRTH", "NDATA", "DDATA", "DDEATH")  # after an NBIRTH, one seq counts them all
+
+
+def metric(payload: Any, name: str) -> Any:
+    return next(m for m in payload.metrics if m.name == name)
+
+
+def props(m: Any) -> dict[str, Any]:
+    return dict(zip(m.properties.keys, m.properties.values, strict=True))
+
+
+def session(host: Host, birth: Any) -> list[tuple[str, str, Any]]:
+    """The NBIRTH `birth` and every message of the edge node's session after it that takes a seq
+    (up to its NDEATH or the next NBIRTH; commands are the host's)."""
+    out = [("NBIRTH", "", birth)]
+    for kind, device, payload in host.since(birth):
+        if kind in ("NBIRTH", "NDEATH"):
+            break
+        if kind in SEQUENCED:
+            out.append((kind, device, payload))
+    return out
+
+
 class Host:
     """A Sparkplug host application of one group: every message, decoded, in arrival order, as
     (message type, device id or "", payload); it sends commands and, retained, a STATE. With
@@ -115,7 +147,8 @@ class Host:
     the will, and on every connection, once subscribed, its online STATE (one timestamp for both:
     paho reconnects with the will it has)."""
 
-    def __init__(self, broker: Mosquitto, group: str = "Plant", edge: str = "Demo", primary: str = "") -> None:
+    def __init__(self, broker: Mosquitto, group: str = "Plant", edge: str = "Demo",
+                 primary: str = "") -> None:
         self.group, self.edge, self.primary = group, edge, primary
         self.messages: list[tuple[str, str, Any]] = []
         self.lock = threading.Lock()
@@ -166,7 +199,7 @@ class Host:
             pos = next(i for i, (_, _, p) in enumerate(self.messages) if p is payload)
             return self.messages[pos + 1:]
 
-    def command(self, name: str, value: float | bool | str, device: str = "", kind: int | None = None) -> None:
+    def command(self, name: str, value: float | bool | str, device: str = "") -> None:
         """An NCMD (a DCMD to `device`) of one metric, by name, a Double unless it says otherwise."""
         payload = spb.Payload(timestamp=int(time.time() * 1000))
         metric = payload.metrics.add(name=name)
@@ -176,9 +209,8 @@ class Host:
             metric.datatype, metric.string_value = spb.STRING, value
         else:
             metric.datatype, metric.double_value = spb.DOUBLE, value
-        if kind is not None:
-            metric.datatype = kind
-        topic = f"spBv1.0/{self.group}/{'DCMD' if device else 'NCMD'}/{self.edge}" + (f"/{device}" if device else "")
+        topic = f"spBv1.0/{self.group}/DCMD/{self.edge}/{device}" if device else \
+            f"spBv1.0/{self.group}/NCMD/{self.edge}"
         self.client.publish(topic, payload.SerializeToString(), qos=1).wait_for_publish(5)
 
     def state(self, host_id: str, online: bool, timestamp: int) -> None:

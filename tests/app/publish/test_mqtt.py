@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import signal
 import subprocess
 import sys
 import time
@@ -14,16 +15,10 @@ import pytest
 from app.publish import sparkplug as spb
 from app.station.runtime import Runtime
 from tests.app.conftest import REPO, copy_demo
-from tests.app.publish.conftest import Host, Mosquitto, demo_with
+from tests.app.publish.conftest import Host, Mosquitto, demo_with, metric, mqtt_section, props, session
 from tests.netplc.test_exchange import wait_until
 
 TOPIC = "spBv1.0/Plant/{}/Demo"
-SEQUENCED = ("DBIRTH", "NDATA", "DDATA", "DDEATH")  # after an NBIRTH, one seq counts them all
-
-
-def mqtt_section(broker: Mosquitto, extra: str = "") -> str:
-    return (f'[mqtt]\nenabled = true\nbroker = "{broker.url}"\ngroup_id = "Plant"\nedge_node_id = "Demo"\n'
-            f'writable = ["TEMP_SP"]\ndeadband = {{ word = 0.0 }}\n{extra}')
 
 
 @pytest.fixture
@@ -38,26 +33,6 @@ def station(tmp_path: Path, broker: Mosquitto, host: Host) -> Iterator[Runtime]:
     runtime = demo_with(tmp_path / "station", mqtt_section(broker))
     yield runtime
     runtime.stop()
-
-
-def metric(birth: Any, name: str) -> Any:
-    return next(m for m in birth.metrics if m.name == name)
-
-
-def props(m: Any) -> dict[str, Any]:
-    return {k: v for k, v in zip(m.properties.keys, m.properties.values)}
-
-
-def session(host: Host, birth: Any) -> list[tuple[str, str, Any]]:
-    """The NBIRTH `birth` and every message of the edge node's session after it that takes a seq
-    (up to its NDEATH or the next NBIRTH; commands are the host's)."""
-    out = [("NBIRTH", "", birth)]
-    for kind, device, payload in host.since(birth):
-        if kind in ("NBIRTH", "NDEATH"):
-            break
-        if kind in SEQUENCED:
-            out.append((kind, device, payload))
-    return out
 
 
 def test_nbirth_dbirth_then_ndata_on_change(station: Runtime, host: Host) -> None:
@@ -112,10 +87,12 @@ def test_rebirth_on_command_and_ncmd_writes(station: Runtime, host: Host) -> Non
     peer = station.station.mqtt.broker.split('//')[1]
     assert [(r.text, r.source) for r in refused] == [
         ("refused write LEVEL: no such metric of Plant/Demo", f"mqtt NCMD Plant/Demo via {peer}"),
-        ("refused write LEVEL: not among the points [mqtt] writable names", f"mqtt DCMD Plant/Demo/Node0 via {peer}")]
+        ("refused write LEVEL: not among the points [mqtt] writable names",
+         f"mqtt DCMD Plant/Demo/Node0 via {peer}")]
 
 
-def test_reconnect_after_broker_restart_with_new_nbirth_and_buffer(tmp_path: Path, mosquitto: Mosquitto) -> None:
+def test_reconnect_after_broker_restart_with_new_nbirth_and_buffer(tmp_path: Path,
+                                                                   mosquitto: Mosquitto) -> None:
     """The station waits for its primary host here: after the restart the births come once the
     host is back and subscribed, whoever of the two reconnects first."""
     host = Host(mosquitto, primary="SCADA")
@@ -123,7 +100,7 @@ def test_reconnect_after_broker_restart_with_new_nbirth_and_buffer(tmp_path: Pat
     try:
         first = host.wait("NBIRTH")
         publisher = next(p for p in runtime.publishers if hasattr(p, "topics"))
-        mosquitto.stop()
+        mosquitto.stop(signal.SIGKILL)  # gone: not even the host's will (STATE offline) is published
         wait_until(lambda: not publisher.status.connected, 10)
         # the demo's level and temperature move every scan: NDATA pile up, the oldest dropped
         wait_until(lambda: publisher.status.dropped >= 3, 10)
