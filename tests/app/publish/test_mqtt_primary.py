@@ -12,8 +12,14 @@ from tests.app.publish.conftest import Host, Mosquitto, demo_with, metric, mqtt_
 from tests.netplc.test_exchange import wait_until
 
 
-def publisher_of(runtime: Runtime) -> SparkplugPublisher:
-    return next(p for p in runtime.publishers if isinstance(p, SparkplugPublisher))
+def waiting(folder: Path, broker: Mosquitto, host_id: str,
+            group: str) -> tuple[Runtime, SparkplugPublisher, list]:
+    """A demo station with `primary_host = host_id`, connected to the broker; its records."""
+    records: list = []
+    runtime = demo_with(folder, mqtt_section(broker, f'primary_host = "{host_id}"\n', group), records)
+    publisher = next(p for p in runtime.publishers if isinstance(p, SparkplugPublisher))
+    wait_until(lambda: publisher.status.connected, 5)
+    return runtime, publisher, records
 
 
 def scans(publisher: SparkplugPublisher, n: int) -> None:
@@ -25,12 +31,8 @@ def scans(publisher: SparkplugPublisher, n: int) -> None:
 def test_births_wait_for_the_primary_host_and_a_new_session_follows_its_offline_state(
         tmp_path: Path, broker: Mosquitto) -> None:
     host = Host(broker, group="Primary")  # the test publishes the host's STATE itself
-    records: list = []
-    section = mqtt_section(broker, 'primary_host = "SCADA-1"\n', "Primary")
-    runtime = demo_with(tmp_path / "station", section, records)
+    runtime, publisher, records = waiting(tmp_path / "station", broker, "SCADA-1", "Primary")
     try:
-        publisher = publisher_of(runtime)
-        wait_until(lambda: publisher.status.connected, 5)
         scans(publisher, 3)
         assert publisher.status.births == 0 and not host.of("NBIRTH")  # no STATE yet: no birth
 
@@ -73,12 +75,8 @@ def test_a_state_that_is_no_sparkplug_3_state_is_journaled_and_no_birth_comes_of
     """A Sparkplug 2.2 host's plain ONLINE is not a 3.0 STATE: journaled, and no birth comes of it."""
     host = Host(broker, group="Old")
     host.client.publish("spBv1.0/STATE/OLD-HOST", b"ONLINE", qos=1, retain=True).wait_for_publish(5)
-    records: list = []
-    section = mqtt_section(broker, 'primary_host = "OLD-HOST"\n', "Old")
-    runtime = demo_with(tmp_path / "station", section, records)
+    runtime, publisher, records = waiting(tmp_path / "station", broker, "OLD-HOST", "Old")
     try:
-        publisher = publisher_of(runtime)
-        wait_until(lambda: publisher.status.connected, 5)
         wait_until(lambda: any("STATE of primary host OLD-HOST ignored: not UTF-8 JSON" in (r.text or "")
                                for r in records), 5)
         scans(publisher, 3)
