@@ -77,6 +77,7 @@ NODE_NUMBERS = (0, 255)  # the manual's node range, as in NODE S:n
 UNITS = {"tcp": (0, 255), "rtu": (1, 247)}  # Modbus unit id per scheme (docs/architecture.md section 7)
 LIMITS: dict[str, tuple[float, float]] = {"timeout": (0.01, 60.0), "retries": (0, 10),
                                           "backoff": (0.01, 600.0), "backoff_max": (0.01, 3600.0)}
+NAME_RESERVED = "/+#"  # a node's name is a level of MQTT topics (Sparkplug device id) and of paths
 Problem = tuple[str, str]  # (setting, what is wrong with it)
 
 
@@ -116,6 +117,10 @@ def node_problems(settings: Mapping[str, Any]) -> tuple[Endpoint | None, list[Pr
                 found.append((key, f"{value} is outside {least:g}-{most:g}"))
             else:
                 found.append((key, f"{value:g} s is outside {least:g}-{most:g} s"))
+    name = settings["name"]
+    if any(c in name for c in NAME_RESERVED) or not name.isprintable() or name != name.strip():
+        found.append(("name", f"{name!r} may not hold '/', '+', '#', control characters or outer "
+                              "spaces (it names the node in topics and paths)"))
     backoff, backoff_max = settings["backoff"], settings["backoff_max"]
     if not any(key.startswith("backoff") for key, _ in found) and backoff > backoff_max:
         found.append(("backoff", f"{backoff:g} s is more than backoff_max {backoff_max:g} s"))
@@ -137,6 +142,7 @@ class NodeConfig:
     table: str = "holding"  # profile "modbus": holding, input, coils or discrete
     backoff: float = 0.2  # first reconnect delay after the link went down, seconds
     backoff_max: float = 5.0  # the delay doubles up to this
+    name: str = ""  # what the station calls the node (its Sparkplug device id); "": Node<n>
     key: str = field(default="nodes", compare=False)  # where station.toml sets it (nodes[2]), for messages
 
     def __post_init__(self) -> None:
@@ -144,6 +150,11 @@ class NodeConfig:
         if found:
             raise ValueError(f"node {self.node}: " + "; ".join(_named(p) for p in found))
         self.parsed: Endpoint | None = endpoint
+
+    @property
+    def title(self) -> str:
+        """The node's name, or Node<n> where it has none: unique among a station's nodes."""
+        return self.name or f"Node{self.node}"
 
     @classmethod
     def settled(cls, settings: dict[str, Any], key: str) -> tuple[NodeConfig | None, list[Problem]]:
@@ -171,14 +182,18 @@ def _named(problem: Problem) -> str:
 
 
 def shared_problems(nodes: Iterable[NodeConfig]) -> list[tuple[NodeConfig, Problem]]:
-    """What nodes get wrong together, each named on the later node: a number configured twice, and
-    nodes of one serial port with different line settings (they share one line)."""
+    """What nodes get wrong together, each named on the later node: a number configured twice, a
+    name given twice (or the Node<n> of a node without one), and nodes of one serial port with
+    different line settings (they share one line)."""
     found: list[tuple[NodeConfig, Problem]] = []
     numbers: set[int] = set()
+    titles: dict[str, int] = {}  # name -> the first node called so
     lines: dict[str, NodeConfig] = {}  # serial device -> the first node on it
     for cfg in nodes:
         if cfg.node in numbers:
             found.append((cfg, ("node", f"node {cfg.node} is configured twice")))
+        elif titles.setdefault(cfg.title, cfg.node) != cfg.node:
+            found.append((cfg, ("name", f"{cfg.title!r} already names node {titles[cfg.title]}")))
         numbers.add(cfg.node)
         ep = cfg.parsed
         if ep is not None and ep.scheme == "rtu":

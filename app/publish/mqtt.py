@@ -1,19 +1,32 @@
-"""The MQTT publisher: the station as a Sparkplug B 3.0 edge node (paho-mqtt).
+"""The MQTT publisher: the station as a Sparkplug B 3.0 edge node (paho-mqtt), each node of its
+exchange a device of it (app/publish/devices.py).
 
-One thread of its own takes the newest snapshot (`LatestSnapshot`: the scan never waits) and
-publishes; paho's network thread connects, reconnects with back-off (1 s doubling to 30 s) and
-hands NCMD commands over. Per connection: NDEATH with the connection's bdSeq registered as the
-last will, then NBIRTH (every metric with name, alias, datatype, engUnit and Quality properties,
-the bdSeq and Node Control/Rebirth) and then NDATA with only the metrics whose value moved beyond
-the deadband of its tag type or whose quality changed (report by exception), by alias. While the
-broker is away the NDATA are kept in a bounded buffer (oldest dropped first, counted) and sent
-after the next NBIRTH as historical metrics. NCMD Node Control/Rebirth republishes the NBIRTH.
+One thread of its own takes the newest snapshot (`LatestReadings`: the scan never waits) and
+publishes everything, so one `seq` counts every NBIRTH, DBIRTH, NDATA, DDATA and DDEATH of a
+session; paho's network thread connects, reconnects with back-off (1 s doubling to 30 s) and hands
+commands and STATE messages over. Per connection: NDEATH with the connection's bdSeq registered as
+the last will, then the birth sequence: NBIRTH (the edge node's metrics with name, alias,
+datatype, engUnit and Quality, the bdSeq and Node Control/Rebirth), then a DBIRTH for each device
+whose node's link is up (its link metrics and the points its NREADs fill). Then by exception:
+NDATA and DDATA with only the metrics whose value moved beyond the deadband of its tag type or
+whose quality changed, by alias; a DDEATH when a node's link goes down (its points are then not
+published until it is up again and born anew) and a DBIRTH when it comes back. While no session is
+up the NDATA and DDATA are kept in a bounded buffer (oldest dropped first, counted) and sent after
+the next births as historical metrics. NCMD Node Control/Rebirth republishes the whole sequence.
 
-Every other NCMD metric is a write through the station's command layer (app/authority/), by the
-MQTT source (a command names no user: it acts with the role station.toml grants MQTT), checked
-for the metric's Sparkplug datatype (a String for a Double metric is refused), the tag's physical
-range and `[mqtt] writable`. An NCMD has no answer: the journal is the answer, each refusal
-journaled by the layer, throttled (one record per cause per minute with the count of the others).
+With `[mqtt] primary_host` the node waits for that Primary Host Application (spec 3.0, 5.x Edge
+Node Session Establishment): it subscribes to the host's STATE (`spBv1.0/STATE/<id>`, retained
+JSON) and births only while the host is online. When the host says it is offline (a STATE whose
+timestamp is not older than the last one seen) the node publishes NDEATH, disconnects and connects
+again at once, with the next bdSeq, and births when the host is online again. A STATE older than
+the last one seen (an old session's death delivered late) is ignored.
+
+Every other NCMD metric is a write of an edge node point, every DCMD metric a write of one of the
+device's points, through the station's command layer (app/authority/) by the MQTT source (a
+command names no user: it acts with `[mqtt] role`), checked for the metric's Sparkplug datatype
+(a String for a Double metric is refused), the tag's physical range and `[mqtt] writable`. A
+command has no answer: the journal is the answer, each refusal journaled by the layer, throttled
+(one record per cause per minute with the count of the others).
 """
 
 from __future__ import annotations
@@ -26,7 +39,7 @@ from collections import deque
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass
 from pathlib import Path
-from typing import Any
+from typing import TYPE_CHECKING, Any
 from urllib.parse import urlsplit
 
 import numpy as np
@@ -34,38 +47,51 @@ import paho.mqtt.client as mqtt
 
 from app.authority import Action, Commands, Reason, Source, Ticket, Who
 from app.publish import sparkplug as spb
+from app.publish.devices import LINK, Device, Layout
 from app.publish.feed import LatestReadings, Watch
 from app.publish.points import PointReader, PointWriter, Reading, Writable
+from app.scada.quality import QualityMap
+from app.scada.readings import Readings
 from app.scada.tag import Tag
 from app.station.config import MqttSettings
+
+if TYPE_CHECKING:
+    from netplc.exchange import Exchange
 
 logger = logging.getLogger(__name__)
 
 BACKOFF = (1, 30)  # seconds: first reconnect delay, doubling up to the second
 KEEPALIVE = 10  # s: the broker publishes NDEATH within 1.5 of these after the station vanishes
+NODE = -1  # the edge node itself, where a device index is expected
 
 
 @dataclass
 class MqttStatus:
     connected: bool = False
-    births: int = 0
-    messages: int = 0  # NDATA published
+    births: int = 0  # NBIRTH published
+    device_births: int = 0  # DBIRTH published
+    device_deaths: int = 0  # DDEATH published
+    messages: int = 0  # NDATA and DDATA published
     metrics: int = 0  # metrics in them
-    buffered: int = 0  # NDATA waiting for the broker
-    dropped: int = 0  # NDATA dropped from a full buffer (the oldest first)
-    refused: int = 0  # NCMD writes refused
+    buffered: int = 0  # NDATA and DDATA waiting for a session
+    dropped: int = 0  # NDATA and DDATA dropped from a full buffer (the oldest first) or of a dead device
+    refused: int = 0  # NCMD and DCMD writes refused
+    host_online: bool = False  # the primary host's last STATE (False too until one came)
 
 
 class SparkplugPublisher:
     def __init__(self, settings: MqttSettings, station: str, *, tags: Sequence[Tag], commands: Commands,
-                 watch: Watch, journal: Callable[[str], None], bdseq_file: Path | None = None) -> None:
+                 watch: Watch, journal: Callable[[str], None], bdseq_file: Path | None = None,
+                 quality_map: QualityMap | None = None, exchange: Exchange | None = None) -> None:
         """`bdseq_file` keeps the bdSeq of the last connection across restarts (Sparkplug 3.0:
         each connection's bdSeq is the previous one's plus one), so a host application never
-        takes the NDEATH of an old session for the new one's; None: it starts at 0."""
+        takes the NDEATH of an old session for the new one's; None: it starts at 0. The exchange's
+        nodes are the devices, their points those `quality_map` says their NREADs fill."""
         self.settings = settings
         self.topics = spb.Topics(settings.group_id, settings.edge_node_id or station)
         self.tags = list(tags)
-        self.index = {t.name: i for i, t in enumerate(self.tags)}
+        self.layout = Layout(self.tags, quality_map, exchange.configs.values() if exchange else ())
+        self.exchange = exchange
         self.reader = PointReader(self.tags)
         self.writer = PointWriter(commands, Writable(settings.writable), "[mqtt]")
         self.commands = commands
@@ -80,16 +106,28 @@ class SparkplugPublisher:
         self.port = url.port or (8883 if url.scheme == "mqtts" else 1883)
         self.peer = f"{self.host}:{self.port}"
         self.who = Who("", Source.MQTT, f"NCMD {self.topics.node} via {self.peer}")
+        self.primary = settings.primary_host
         self.feed = LatestReadings(self._wakeup)
         self._unwatch: Callable[[], None] | None = None
         self.bdseq_file = bdseq_file
         self.bdseq = (self._stored_bdseq() + 1) % 256  # the next connection's (stored once connected)
+        # the publisher thread's: the session (births sent on this connection), seq, what was sent
         self._seq = 0
-        self._birth_due = False
+        self._session = False
+        self._born: set[int] = set()  # devices born in this session
+        self._readings: Readings | None = None
         self._latest: Reading | None = None
         self._sent_values = np.full(len(self.tags), np.nan)
         self._sent_quality = np.full(len(self.tags), -1, dtype=np.int8)
-        self._buffer: deque[bytes] = deque()
+        self._sent_link: dict[int, tuple[Any, ...]] = {}
+        self._buffer: deque[tuple[int, bytes]] = deque()  # (device index or NODE, NDATA/DDATA)
+        # set by paho's thread, acted on by the publisher's
+        self._birth_due = False
+        self._host_online = False
+        self._host_time: int | None = None  # the timestamp of the last STATE taken
+        self._state_problem = ""  # the last bad STATE journaled, so that it is said once
+        self._leave_due = False  # the primary host went offline: end the session
+        self._leaving = False
         self._wake = threading.Event()
         self._stopping = False
         self._lock = threading.Lock()  # bdSeq and the will, between paho's thread and stop()
@@ -104,6 +142,9 @@ class SparkplugPublisher:
         client.on_connect = self._on_connect
         client.on_disconnect = self._on_disconnect
         client.message_callback_add(self.topics.ncmd, self._on_ncmd)
+        client.message_callback_add(self.topics.dcmd, self._on_dcmd)
+        if self.primary:
+            client.message_callback_add(spb.state_topic(self.primary), self._on_state)
         self.client = client
         self._set_will()
 
@@ -127,8 +168,7 @@ class SparkplugPublisher:
         if self._thread is not None:
             self._thread.join(10)
         if self.status.connected:
-            info = self.client.publish(self.topics.ndeath, self._death(), qos=1)
-            info.wait_for_publish(2)
+            self._publish_death()
         self.client.disconnect()
         self.client.loop_stop()
 
@@ -169,57 +209,113 @@ class SparkplugPublisher:
     def _set_will(self) -> None:
         self.client.will_set(self.topics.ndeath, self._death(), qos=1, retain=False)
 
+    def _publish_death(self) -> None:
+        """NDEATH by the node itself, before a deliberate disconnect (which cancels the will)."""
+        try:
+            self.client.publish(self.topics.ndeath, self._death(), qos=1).wait_for_publish(2)
+        except (RuntimeError, ValueError) as e:  # the connection went meanwhile: the will says it
+            logger.warning("NDEATH not published: %s", e)
+
     def _on_connect(self, client: mqtt.Client, userdata: object, flags: Any, reason: Any, props: Any) -> None:
         if reason.is_failure:
             self.journal(f"MQTT broker {self.peer} refused the connection: {reason}")
             return
-        client.subscribe(self.topics.ncmd, qos=1)
+        topics = [(self.topics.ncmd, 1), (self.topics.dcmd, 1)]
+        if self.primary:
+            self._host_online = self.status.host_online = False  # until its STATE says so again
+            topics.append((spb.state_topic(self.primary), 1))
+        client.subscribe(topics)
         with self._lock:
             self._store_bdseq()  # registered with the broker: the one the next start goes on from
         self.status.connected = True
         self._birth_due = True
         self._wake.set()
         dropped = self.status.dropped
-        lost = f", {dropped} NDATA dropped so far from a full buffer" if dropped else ""
-        self.journal(f"MQTT connected to {self.peer} as {self.topics.node} (bdSeq {self.bdseq}){lost}")
+        lost = f", {dropped} NDATA/DDATA dropped so far" if dropped else ""
+        waiting = f"; NBIRTH once primary host {self.primary} is online" if self.primary else ""
+        self.journal(f"MQTT connected to {self.peer} as {self.topics.node} (bdSeq {self.bdseq})"
+                     f"{lost}{waiting}")
 
     def _on_disconnect(self, client: mqtt.Client, userdata: object, flags: Any, reason: Any,
                        props: Any) -> None:
         was = self.status.connected
         self.status.connected = False
+        self._session = False
         with self._lock:
             self.bdseq = (self.bdseq + 1) % 256  # the next session's NDEATH, before paho reconnects
             self._set_will()
-        if was and not self._stopping:
+        if was and not (self._stopping or self._leaving):
             self.journal(f"MQTT connection to {self.peer} lost ({reason}); reconnecting with back-off, "
                          "NDATA buffered meanwhile")
 
-    def _on_ncmd(self, client: mqtt.Client, userdata: object, message: mqtt.MQTTMessage) -> None:
-        who = self.who
+    def _on_state(self, client: mqtt.Client, userdata: object, message: mqtt.MQTTMessage) -> None:
+        """The primary host's STATE (spec 3.0): taken unless older than the last one seen."""
         try:
-            payload = spb.Payload.FromString(message.payload)
+            state = spb.parse_state(message.payload)
+        except ValueError as e:
+            problem = f"MQTT: STATE of primary host {self.primary} ignored: {e}"
+            if problem != self._state_problem:  # a retained one comes again at every connection
+                self._state_problem = problem
+                self.journal(problem)
+            return
+        last = self._host_time
+        if last is not None and state.timestamp < last:
+            self.journal(f"MQTT: STATE of primary host {self.primary} ignored: its timestamp "
+                         f"{state.timestamp} is older than {last} (a session of the host's before)")
+            return
+        self._host_time = state.timestamp
+        was, self._host_online = self._host_online, state.online
+        self.status.host_online = state.online
+        if state.online and not was:
+            self.journal(f"MQTT: primary host {self.primary} is online")
+        elif not state.online:
+            self._leave_due = True
+        self._wake.set()
+
+    def _on_ncmd(self, client: mqtt.Client, userdata: object, message: mqtt.MQTTMessage) -> None:
+        self._command(message.payload, None, self.who)
+
+    def _on_dcmd(self, client: mqtt.Client, userdata: object, message: mqtt.MQTTMessage) -> None:
+        name = message.topic.rsplit("/", 1)[1]
+        who = Who("", Source.MQTT, f"DCMD {self.topics.node}/{name} via {self.peer}")
+        device = self.layout.by_id.get(name)
+        if device is None:
+            self._refused(self.commands.refuse(who, Action.WRITE, name, Reason.UNKNOWN,
+                                               f"no such device of {self.topics.node}"))
+            return
+        self._command(message.payload, device, who)
+
+    def _command(self, data: bytes, device: Device | None, who: Who) -> None:
+        """Each metric of an NCMD (`device` None) or a DCMD: a rebirth request (NCMD only), or a
+        write of one of the node's or the device's points through the command layer."""
+        try:
+            payload = spb.Payload.FromString(data)
         except Exception as e:  # no log: bad input, answered by the journaled refusal below
             self._refused(self.commands.refuse(who, Action.WRITE, "", Reason.INVALID,
                                                f"not a Sparkplug B payload ({type(e).__name__})"))
             return
+        layout = self.layout
         for metric in payload.metrics:
-            name = metric.name
-            if not name and metric.alias:
-                i = int(metric.alias) - 1
-                name = self.tags[i].name if 0 <= i < len(self.tags) else f"alias {metric.alias}"
-            if name == spb.REBIRTH:
+            name, alias = metric.name, int(metric.alias)
+            if device is None and name == spb.REBIRTH:
                 if spb.get_value(metric):
                     self._birth_due = True
                     self._wake.set()
                     self.journal(f"MQTT rebirth requested by NCMD via {self.peer}")
                 continue
-            i = self.index.get(name)
-            if i is None:
-                ticket = self.commands.refuse(who, Action.WRITE, name, Reason.UNKNOWN, "no such metric")
-            else:
+            i = layout.point(device, name, alias)
+            label = name or (self.tags[alias - 1].name if 0 < alias <= len(self.tags) else f"alias {alias}")
+            if i is not None:
                 kind = self.kinds[i]
                 ticket = self.writer.write(who, self.tags[i], spb.get_value(metric, kind),
                                            spb.mismatch(metric, kind))
+            elif device is not None and (link := layout.link_name(device, name, alias)):
+                ticket = self.commands.refuse(who, Action.WRITE, link, Reason.NOT_WRITABLE,
+                                              "a link metric, read-only")
+            else:
+                of = f"device {device.id}" if device is not None else self.topics.node
+                ticket = self.commands.refuse(who, Action.WRITE, label, Reason.UNKNOWN,
+                                              f"no such metric of {of}")
             self._refused(ticket)
 
     def _refused(self, ticket: Ticket) -> None:
@@ -245,76 +341,174 @@ class SparkplugPublisher:
             self._wake.clear()
             item = self.feed.take()
             if item is not None:
-                self._latest = self.reader.read(item)
+                self._readings, self._latest = item, self.reader.read(item)
             reading = self._latest
             if reading is None:
                 continue
-            if self._birth_due and self.status.connected:
+            if self._leave_due:
+                self._leave()
+            elif self._birth_due and self.status.connected and (self._host_online or not self.primary):
                 self._birth(reading)
             elif item is not None:
                 self._data(reading)
             last = time.monotonic()
 
+    def _leave(self) -> None:
+        """The primary host is offline: NDEATH, disconnect, and connect again at once (the next
+        bdSeq), to birth when the host is back. Nothing to end while no session is up."""
+        self._leave_due = False
+        if not (self._session and self.status.connected):  # paho reconnects: STATE is awaited again
+            return
+        self._session = False
+        self._leaving = True
+        self.journal(f"MQTT: primary host {self.primary} is offline: NDEATH, session ended; "
+                     "a new one once it is online again, NDATA buffered meanwhile")
+        self._publish_death()
+        self.client.disconnect()
+        self.client.loop_stop()  # its thread ends with a deliberate disconnect: a new one connects
+        self._leaving = False
+        if not self._stopping:
+            self.client.reconnect_delay_set(*BACKOFF)  # a deliberate reconnect: its back-off afresh
+            self.client.connect_async(self.host, self.port, KEEPALIVE)
+            self.client.loop_start()
+
     def _next_seq(self) -> int:
         seq, self._seq = self._seq, (self._seq + 1) % 256
         return seq
 
+    def _alive(self) -> list[bool]:
+        """Each device: is its node's link up as of the newest scan?"""
+        links = self._readings.links.links if self._readings is not None else None
+        return [links is None or links.get(d.node, False) for d in self.layout.devices]
+
+    def _add_points(self, payload: Any, points: Sequence[int], reading: Reading, birth: bool) -> None:
+        ts, values, quality, kinds = _ms(reading.wall), reading.values, reading.quality, self.kinds
+        add = payload.metrics.add
+        for i in points:
+            if birth:
+                metric = add(name=self.tags[i].name, alias=i + 1, datatype=kinds[i], timestamp=ts)
+            else:
+                metric = add(alias=i + 1, datatype=kinds[i], timestamp=ts)
+            spb.set_reading(metric, kinds[i], float(values[i]), int(quality[i]))
+            if birth and self.tags[i].unit:
+                spb.add_units(metric, self.tags[i].unit)
+
     def _birth(self, reading: Reading) -> None:
+        """NBIRTH, a DBIRTH for each device that lives, then what was buffered meanwhile."""
         self._birth_due = False
         self._seq = 0
+        self._born.clear()
         payload = spb.Payload(timestamp=_ms(time.time()), seq=self._next_seq())
         ts = _ms(reading.wall)
         metric = payload.metrics.add(name=spb.BDSEQ, datatype=spb.INT64, timestamp=ts)
         metric.long_value = self.bdseq
         payload.metrics.add(name=spb.REBIRTH, datatype=spb.BOOLEAN, timestamp=ts, boolean_value=False)
-        for i, tag in enumerate(self.tags):
-            metric = payload.metrics.add(name=tag.name, alias=i + 1, datatype=self.kinds[i], timestamp=ts)
-            spb.set_value(metric, self.kinds[i], float(reading.values[i]))
-            if tag.unit:
-                spb.add_units(metric, tag.unit)
-            spb.add_quality(metric, int(reading.quality[i]))
-        if not self._send(self.topics.nbirth, payload.SerializeToString()):
+        points = self.layout.node_points
+        self._add_points(payload, points.tolist(), reading, birth=True)
+        if not self._send(self.topics.nbirth, payload):
             self._birth_due = True
             return
         self.status.births += 1
-        self._sent_values, self._sent_quality = reading.values.copy(), reading.quality.copy()
-        while self._buffer and self.status.connected:  # what happened while the broker was away
-            buffered = spb.Payload.FromString(self._buffer.popleft())
-            buffered.seq = self._next_seq()
+        self._sent(points, reading)
+        for device, alive in zip(self.layout.devices, self._alive(), strict=True):
+            if alive:
+                self._device_birth(device, reading)
+        self._session = True
+        while self._buffer and self.status.connected:  # what happened while no session was up
+            k, data = self._buffer.popleft()
+            if k != NODE and k not in self._born:  # a device that died meanwhile: no data without a birth
+                self.status.dropped += 1
+                continue
+            buffered = spb.Payload.FromString(data)
             for metric in buffered.metrics:
                 metric.is_historical = True
-            self._send(self.topics.ndata, buffered.SerializeToString())
+            self._send(self._data_topic(k), buffered)
         self.status.buffered = len(self._buffer)
 
+    def _device_birth(self, device: Device, reading: Reading) -> None:
+        payload = spb.Payload(timestamp=_ms(time.time()))
+        ts = _ms(reading.wall)
+        link = device.link(self._stats(device))
+        for k, ((name, kind), value) in enumerate(zip(LINK, link, strict=True)):
+            metric = payload.metrics.add(name=name, alias=device.first_alias + k, datatype=kind, timestamp=ts)
+            _set_link(metric, kind, value)
+        points = device.points
+        self._add_points(payload, points.tolist(), reading, birth=True)
+        if self._send(self.topics.of("DBIRTH", device.id), payload):
+            self.status.device_births += 1
+            self._born.add(device.index)
+            self._sent_link[device.index] = link
+            self._sent(points, reading)
+
+    def _sent(self, points: np.ndarray, reading: Reading) -> None:
+        """What a birth told of `points`: what their changes are reckoned from."""
+        self._sent_values[points] = reading.values[points]
+        self._sent_quality[points] = reading.quality[points]
+
+    def _device_death(self, device: Device) -> None:
+        self._born.discard(device.index)
+        if self._send(self.topics.of("DDEATH", device.id), spb.Payload(timestamp=_ms(time.time()))):
+            self.status.device_deaths += 1
+
+    def _stats(self, device: Device) -> Any:
+        return self.exchange.stats.get(device.node) if self.exchange is not None else None
+
+    def _data_topic(self, k: int) -> str:
+        return self.topics.ndata if k == NODE else self.topics.of("DDATA", self.layout.devices[k].id)
+
     def _data(self, reading: Reading) -> None:
-        if not self.status.births:  # nothing born yet: the first NBIRTH will carry every value
+        """Births and deaths of devices whose link changed, then NDATA and DDATA of what changed:
+        sent within a session, kept for the next one otherwise."""
+        if not self.status.births:  # nothing born yet: the first births will carry every value
             return
+        session = self._session and self.status.connected and not self._birth_due
+        alive = self._alive()
+        if session:
+            for device, up in zip(self.layout.devices, alive, strict=True):
+                if device.index in self._born and not up:
+                    self._device_death(device)
+                elif device.index not in self._born and up:
+                    self._device_birth(device, reading)
+            live = self._born
+        else:
+            live = {d.index for d, up in zip(self.layout.devices, alive, strict=True) if up}
         values, sent = reading.values, self._sent_values
         moved = np.abs(values - sent) > self.deadband
         moved |= np.isnan(values) != np.isnan(sent)
         moved |= reading.quality != self._sent_quality
+        owner = self.layout.owner
+        moved &= (owner == NODE) | np.isin(owner, list(live))  # a dead device publishes nothing
         changed = np.flatnonzero(moved)
-        if not len(changed):
-            return
         sent[changed] = values[changed]
         self._sent_quality[changed] = reading.quality[changed]
-        payload = spb.Payload(timestamp=_ms(time.time()))
         ts = _ms(reading.wall)
-        kinds, quality = self.kinds, reading.quality
-        add = payload.metrics.add
-        for i in changed.tolist():
-            metric = add(alias=i + 1, datatype=kinds[i], timestamp=ts)
-            spb.set_value(metric, kinds[i], float(values[i]))
-            spb.add_quality(metric, int(quality[i]))
-        if self.status.connected and not self._birth_due:
-            payload.seq = self._next_seq()
-            if self._send(self.topics.ndata, payload.SerializeToString()):
+        payloads: dict[int, Any] = {}
+        for k in sorted(live):  # link metrics that changed (Up changes by birth and death)
+            device = self.layout.devices[k]
+            link = device.link(self._stats(device))
+            before = self._sent_link.get(k)
+            if before is None or link == before:
+                continue
+            self._sent_link[k] = link
+            payload = payloads[k] = spb.Payload(timestamp=_ms(time.time()))
+            for j, ((_, kind), value) in enumerate(zip(LINK, link, strict=True)):
+                if value != before[j]:
+                    _set_link(payload.metrics.add(alias=device.first_alias + j, datatype=kind, timestamp=ts),
+                              kind, value)
+        if len(changed):
+            for k in np.unique(owner[changed]).tolist():
+                if k not in payloads:
+                    payloads[k] = spb.Payload(timestamp=_ms(time.time()))
+                self._add_points(payloads[k], changed[owner[changed] == k].tolist(), reading, birth=False)
+        for k, payload in payloads.items():
+            if session and self._send(self._data_topic(k), payload):
                 self.status.messages += 1
-                self.status.metrics += len(changed)
-                return
-        self._keep(payload.SerializeToString())
+                self.status.metrics += len(payload.metrics)
+            else:
+                payload.ClearField("seq")
+                self._keep(k, payload.SerializeToString())
 
-    def _keep(self, data: bytes) -> None:
+    def _keep(self, k: int, data: bytes) -> None:
         limit = self.settings.buffer
         if limit <= 0:
             self.status.dropped += 1
@@ -322,12 +516,26 @@ class SparkplugPublisher:
         if len(self._buffer) >= limit:
             self._buffer.popleft()
             self.status.dropped += 1
-        self._buffer.append(data)
+        self._buffer.append((k, data))
         self.status.buffered = len(self._buffer)
 
-    def _send(self, topic: str, data: bytes) -> bool:
-        info = self.client.publish(topic, data, qos=0)
-        return info.rc == mqtt.MQTT_ERR_SUCCESS
+    def _send(self, topic: str, payload: Any) -> bool:
+        """Every message but the NDEATH takes the session's next seq (spec 3.0: one more than the
+        edge node's previous message, NBIRTH's first, 255 wrapping to 0)."""
+        if not payload.HasField("seq"):
+            payload.seq = self._next_seq()
+        info = self.client.publish(topic, payload.SerializeToString(), qos=0)
+        if info.rc != mqtt.MQTT_ERR_SUCCESS:
+            self._seq = (self._seq - 1) % 256  # not sent: the next message takes its number
+            return False
+        return True
+
+
+def _set_link(metric: Any, kind: int, value: Any) -> None:
+    if kind == spb.STRING:
+        metric.string_value = value
+    else:
+        spb.set_value(metric, kind, float(value))
 
 
 def _ms(seconds: float) -> int:

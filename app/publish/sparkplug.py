@@ -9,6 +9,8 @@ are kept as unknown fields when a host sends them, and ignored.
 
 from __future__ import annotations
 
+import json
+import math
 from dataclasses import dataclass
 from typing import Any
 
@@ -27,11 +29,21 @@ BYTES = 17
 
 REBIRTH = "Node Control/Rebirth"
 BDSEQ = "bdSeq"
-# Quality as a metric property "Quality" (Int32), with the OPC DA quality codes Sparkplug hosts
-# (Ignition among them) read: good 192, bad waiting-for-initial-data 32, uncertain-last-usable 68,
-# bad comm-failure 24, bad out-of-service 28, good local-override 216.
-QUALITY_CODES = {Quality.GOOD: 192, Quality.INITIAL: 32, Quality.STALE: 68, Quality.COMM_FAIL: 24,
-                 Quality.NOT_RUNNING: 28, Quality.FORCED: 216}
+# The metric property "Quality" (an Int32): Sparkplug 3.0 (6.4.9.1, Quality Codes) allows exactly
+# 0 BAD, 192 GOOD and 500 STALE, and the Eclipse TCK checks it; Eclipse Tahu's hosts keep the int
+# and take a metric without one for good. There is no uncertain or initial code among them:
+# Ignition 8's own QualityCode ints (Uncertain_InitialValue 1073742082 ...) are no codes an edge
+# node may send, nor are the OPC DA codes (32 waiting for initial data, 216 local override).
+BAD, GOOD, STALE = 0, 192, 500
+QUALITY_CODES = {
+    Quality.GOOD: GOOD,
+    Quality.FORCED: GOOD,  # the value the station uses, chosen by an engineer: no override code
+    Quality.STALE: STALE,  # each of these three: the last value the plant gave, no longer current,
+    Quality.COMM_FAIL: STALE,  # which is STALE as the spec uses it (what a host makes of the
+    Quality.NOT_RUNNING: STALE,  # metrics of an edge node or device that died)
+    Quality.INITIAL: BAD,  # nothing read yet: no value (is_null) and BAD, never a stale or good one
+}
+NULL_QUALITIES = frozenset({Quality.INITIAL})  # published without a value: there is none yet
 
 _F = descriptor_pb2.FieldDescriptorProto
 _OPT, _REP = _F.LABEL_OPTIONAL, _F.LABEL_REPEATED
@@ -157,11 +169,21 @@ def mismatch(metric: Any, kind: int) -> str:
 
 
 def add_quality(metric: Any, code: int) -> None:
+    """The property `Quality` of the station's quality `code` (app.scada.quality)."""
     props = metric.properties
     props.keys.append("Quality")
     pv = props.values.add()
     pv.type = INT32
     pv.int_value = QUALITY_CODES[Quality(code)]
+
+
+def set_reading(metric: Any, kind: int, value: float, code: int) -> None:
+    """A point's value and quality: a value not read yet is null (the spec's is_null), with BAD."""
+    if code in NULL_QUALITIES:
+        metric.is_null = True
+    else:
+        set_value(metric, kind, value)
+    add_quality(metric, code)
 
 
 def add_units(metric: Any, unit: str) -> None:
@@ -174,13 +196,20 @@ def add_units(metric: Any, unit: str) -> None:
 
 @dataclass(frozen=True)
 class Topics:
-    """The topics of one edge node (spec section 4.1: namespace/group_id/message_type/edge_node_id)."""
+    """The topics of one edge node and its devices (spec section 4.1:
+    namespace/group_id/message_type/edge_node_id[/device_id])."""
 
     group: str
     edge: str
 
-    def of(self, message_type: str) -> str:
-        return f"{NAMESPACE}/{self.group}/{message_type}/{self.edge}"
+    def of(self, message_type: str, device: str = "") -> str:
+        tail = f"/{device}" if device else ""
+        return f"{NAMESPACE}/{self.group}/{message_type}/{self.edge}{tail}"
+
+    @property
+    def dcmd(self) -> str:
+        """Every device's DCMD, to subscribe."""
+        return self.of("DCMD", "+")
 
     @property
     def node(self) -> str:
@@ -201,3 +230,33 @@ class Topics:
     @property
     def ncmd(self) -> str:
         return self.of("NCMD")
+
+
+def state_topic(host_id: str) -> str:
+    """Where a Sparkplug 3.0 host application publishes its STATE (spec 4.1: spBv1.0/STATE/id)."""
+    return f"{NAMESPACE}/STATE/{host_id}"
+
+
+@dataclass(frozen=True)
+class HostState:
+    """A host application's STATE: its birth (online) or death (offline) certificate."""
+
+    online: bool
+    timestamp: int  # ms since the epoch, the host's connect time: orders its births and deaths
+
+
+def parse_state(data: bytes) -> HostState:
+    """A Sparkplug 3.0 STATE payload, UTF-8 JSON `{"online": true|false, "timestamp": <ms>}`;
+    ValueError says what is wrong with any other (a 2.2 host's plain ONLINE/OFFLINE among them)."""
+    try:
+        obj = json.loads(data.decode("utf-8"))
+    except (UnicodeDecodeError, json.JSONDecodeError) as e:
+        raise ValueError(f"not UTF-8 JSON ({e})") from None
+    if not isinstance(obj, dict):
+        raise ValueError(f"not a JSON object: {data[:40]!r}")
+    online, ts = obj.get("online"), obj.get("timestamp")
+    if not isinstance(online, bool):
+        raise ValueError(f"'online' is {online!r}, not true or false")
+    if isinstance(ts, bool) or not isinstance(ts, int | float) or not math.isfinite(ts) or ts < 0:
+        raise ValueError(f"'timestamp' is {ts!r}, not ms since the epoch")
+    return HostState(online, int(ts))

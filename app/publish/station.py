@@ -7,6 +7,7 @@ from __future__ import annotations
 
 from typing import TYPE_CHECKING, Any, Protocol
 
+from app.authority import Source
 from app.publish.points import published_tags
 
 if TYPE_CHECKING:
@@ -47,13 +48,17 @@ def start_publishers(runtime: Runtime) -> list[Publisher]:
     if st.mqtt.enabled:
         from app.publish.mqtt import SparkplugPublisher
 
+        runtime.commands.grant(Source.MQTT, st.mqtt.role)
         publisher = SparkplugPublisher(st.mqtt, st.name, tags=tags, commands=runtime.commands,
                                        watch=runtime.watch, journal=runtime.system,
-                                       bdseq_file=st.folder / BDSEQ_FILE)
+                                       bdseq_file=st.folder / BDSEQ_FILE, exchange=runtime.exchange,
+                                       quality_map=runtime.alarms.quality_map)
         publisher.start()
         started.append(publisher)
+        devices = ", ".join(d.id for d in publisher.layout.devices) or "none"
+        primary = f", primary host {st.mqtt.primary_host}" if st.mqtt.primary_host else ""
         runtime.system(f"MQTT Sparkplug B publisher to {st.mqtt.broker} as {publisher.topics.node}, "
-                       f"{len(tags)} metrics")
+                       f"{len(tags)} metrics, devices {devices}{primary}")
     return started
 
 

@@ -107,7 +107,10 @@ class MqttSettings:
     deadband: tuple[tuple[str, float], ...] = ()  # (tag type, absolute deadband)
     publish_period: int = 0  # ms between NDATA messages at least; 0: every tick
     writable: tuple[str, ...] = ()
-    buffer: int = 10_000  # NDATA messages kept while the broker is away
+    buffer: int = 10_000  # NDATA/DDATA messages kept while no Sparkplug session is up
+    # the Primary Host Application's id: births only while its STATE is online; "": none awaited
+    primary_host: str = ""
+    role: str = OPERATOR  # what NCMD/DCMD may do (they name no user): viewer = read-only
 
 
 @dataclass(frozen=True)
@@ -381,6 +384,15 @@ def _existing(r: _Reader, key: str, path: Path | None, must_be_dir: bool) -> Pat
     return path
 
 
+def _role(r: _Reader) -> str:
+    """`role`: what the clients of a protocol without users may do (viewer: read-only)."""
+    role = r.get("role", str, OPERATOR)
+    if role not in ROLES:
+        r.bad("role", f"{role!r} is not one of {', '.join(ROLES)}")
+        return OPERATOR
+    return role
+
+
 def _modbus_server(problems: list[str], fname: str, table: dict[str, Any]) -> ModbusServerSettings:
     r = _Reader(problems, fname, table, "modbus_server.")
     d = ModbusServerSettings()
@@ -396,7 +408,7 @@ def _modbus_server(problems: list[str], fname: str, table: dict[str, Any]) -> Mo
             r.bad(key, f'applies to transport = "{"tcp" if rtu else "rtu"}" only')
     ranges = r.get("writable", list, None)
     unit = r.number("unit", 1 if rtu else None, 1, 247)  # a slave on a shared line has one address
-    role = r.get("role", str, OPERATOR)
+    role = _role(r)
     if rtu:
         server = replace(d, port=0, serial=_serial_port(r))  # port 0: no TCP port of its own
     else:
@@ -407,9 +419,6 @@ def _modbus_server(problems: list[str], fname: str, table: dict[str, Any]) -> Mo
             max_inflight=r.number("max_inflight", d.max_inflight, 1, 10_000),
             max_per_peer=r.number("max_per_peer", d.max_per_peer, 1, 1000))
     r.finish()
-    if role not in ROLES:
-        r.bad("role", f"{role!r} is not one of {', '.join(ROLES)}")
-        role = OPERATOR
     writable = DEFAULT_WRITABLE if ranges is None else _ranges(r, ranges)
     return replace(server, enabled=enabled, writable=writable, unit=unit, role=role)
 
@@ -639,11 +648,13 @@ def _mqtt(problems: list[str], fname: str, table: dict[str, Any], base: Path,
     period = r.number("publish_period", d.publish_period, 0, 3_600_000)
     writable = _names(r, "writable")
     buffer = r.number("buffer", d.buffer, 0, 10_000_000)
+    primary = r.get("primary_host", str, d.primary_host)
+    role = _role(r)
     r.finish()
     if not broker.startswith(("mqtt://", "mqtts://")):
         r.bad("broker", f"{broker!r} is not an mqtt:// or mqtts:// address")
         broker = d.broker
-    for key, value in (("group_id", group), ("edge_node_id", edge)):
+    for key, value in (("group_id", group), ("edge_node_id", edge), ("primary_host", primary)):
         if any(c in value for c in "/+#"):
             r.bad(key, f"{value!r} may not hold '/', '+' or '#' (Sparkplug topic levels)")
     bands: list[tuple[str, float]] = []
@@ -655,4 +666,4 @@ def _mqtt(problems: list[str], fname: str, table: dict[str, Any], base: Path,
         else:
             bands.append((kind, float(value)))
     return MqttSettings(enabled, broker, ca_file, group, edge, username, password, tuple(bands), period,
-                        writable, buffer)
+                        writable, buffer, primary, role)

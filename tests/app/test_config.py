@@ -55,6 +55,11 @@ node = 3
 endpoint = "com1"
 [[nodes]]
 node = 5
+name = "Pump/house"
+[[nodes]]
+node = 6
+endpoint = "tcp://plc:502"
+name = "Node3"
 [[simulators]]
 node = 9
 program = "nowhere.stl"
@@ -73,6 +78,8 @@ idle_logout = -5
         "modbus_server.writable[3]: a range must lie within", "nodes[0].endpoint: endpoint 'tcp://plc:99999'",
         "nodes[0].profile: 's7'", "nodes[1].node: node 3 is configured twice",
         "nodes[1].endpoint: endpoint 'com1'",
+        "nodes[2].name: 'Pump/house' may not hold '/', '+', '#'",
+        "nodes[3].name: 'Node3' already names node 3",
         "node 5 has no endpoint and no simulator", "simulators[0].program: file",
         "operator.users: users are kept in users.json",
         "operator.idle_logout: -5 is outside", "Language: 'de' is not one of ru, en",
