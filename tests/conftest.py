@@ -1,7 +1,9 @@
-"""Headless Qt for the whole suite: without this, Qt aborts the process when there is no display."""
+"""Headless Qt for the whole suite (without it, Qt aborts the process when there is no display),
+PostgreSQL clusters, and OPC UA servers that share one fill of the standard address space."""
 
 import itertools
 import os
+import sys
 
 import pytest
 
@@ -41,3 +43,10 @@ def own_pg_cluster():
 def pg_url(pg_cluster) -> str:
     """A fresh, empty database in the session's cluster."""
     return pg_cluster.create_database(f"plant_{next(_databases)}")
+
+
+def pytest_runtest_setup(item: pytest.Item) -> None:
+    if "asyncua" in sys.modules:  # OPC UA servers may start: see tests/opcua_address_space.py
+        from tests.opcua_address_space import fill_once
+
+        fill_once()

@@ -17,6 +17,7 @@
 from __future__ import annotations
 
 import ast
+import functools
 import subprocess
 import sys
 from pathlib import Path
@@ -33,7 +34,9 @@ def module_name(path: Path) -> str:
     return ".".join(parts[:-1] if parts[-1] == "__init__" else parts)
 
 
+@functools.cache
 def modules() -> dict[str, Path]:
+    """Every module of the project by name (read once per session: the tests only look)."""
     found = {module_name(p): p for pkg in PACKAGES for p in (REPO / pkg).rglob("*.py")}
     found["main"] = REPO / "main.py"
     return found
@@ -45,7 +48,12 @@ def _type_checking(node: ast.If) -> bool:
         isinstance(test, ast.Attribute) and test.attr == "TYPE_CHECKING")
 
 
-def imports(path: Path, known: set[str]) -> set[str]:
+@functools.cache
+def tree(path: Path) -> ast.Module:
+    return ast.parse(path.read_text(encoding="utf-8"))
+
+
+def imports(path: Path, known: frozenset[str]) -> set[str]:
     """Every module `path` imports when it runs: project modules by name, others by top package."""
     out: set[str] = set()
 
@@ -63,13 +71,15 @@ def imports(path: Path, known: set[str]) -> set[str]:
         for child in ast.iter_child_nodes(node):
             visit(child)
 
-    visit(ast.parse(path.read_text(encoding="utf-8")))
+    visit(tree(path))
     return out
 
 
+@functools.cache
 def graph() -> dict[str, set[str]]:
+    """Each module's imports, parsed once per session (the tests only look)."""
     mods = modules()
-    known = set(mods)
+    known = frozenset(mods)
     return {name: imports(path, known) for name, path in mods.items()}
 
 
@@ -150,7 +160,7 @@ def test_hmi_forms_names_no_roles_of_its_own() -> None:
     for name, path in modules().items():
         if not under(name, ("hmi_forms",)):
             continue
-        for node in ast.walk(ast.parse(path.read_text(encoding="utf-8"))):
+        for node in ast.walk(tree(path)):
             targets = (node.targets if isinstance(node, ast.Assign)
                        else [node.target] if isinstance(node, (ast.AnnAssign, ast.AugAssign)) else [])
             if any(isinstance(t, ast.Name) and t.id == "ROLES" for t in targets):
@@ -169,7 +179,8 @@ def test_the_rest_reaches_the_modbus_stack_through_its_face() -> None:
 
 
 def test_no_import_cycles() -> None:
-    g = {m: {d for d in deps if d in modules()} for m, deps in graph().items()}
+    mods = modules()
+    g = {m: {d for d in deps if d in mods} for m, deps in graph().items()}
     index: dict[str, int] = {}
     low: dict[str, int] = {}
     stack: list[str] = []

@@ -168,24 +168,31 @@ PROPERTY_NAMES = sorted({f for cls in ELEMENT_TYPES.values() for f in cls.__data
                         {"type", "Address", "Image", "Device"})
 
 
+# the strategies drawn from, made once: hypothesis validates each new one (more time than the draws)
+ELEMENT_KEYS = st.lists(st.sampled_from(PROPERTY_NAMES), max_size=8)
+FORM_KEYS = st.lists(st.sampled_from(["title", "width", "height", "BackColor", "Font", "BackgroundImage",
+                                      "Nope"]), max_size=8)
+ELEMENT_TYPE, ELEMENT_NAME = st.sampled_from([*ELEMENT_TYPES, "Nope"]), st.text(max_size=4)
+DEVICES = st.lists(st.fixed_dictionaries({}, optional={
+    k: JSON_VALUES for k in ("Name", "AppMin", "AppMax", "PhyMin", "PhyMax")}), max_size=2)
+IMAGES = st.lists(JSON_LEAVES, max_size=3)
+
+
 @st.composite
 def form_documents(draw: st.DrawFn) -> Any:
-    def props(names: list[str]) -> dict[str, Any]:
-        keys = draw(st.lists(st.sampled_from(names), max_size=8))
+    def props(names: st.SearchStrategy[list[str]]) -> dict[str, Any]:
+        keys = draw(names)
         return {k: draw(JSON_VALUES) for k in keys}
 
     elements = []
     for _ in range(draw(st.integers(0, 3))):
-        el = {"type": draw(st.sampled_from([*ELEMENT_TYPES, "Nope"])), "Name": draw(st.text(max_size=4)),
-              "x": 0, "y": 0, "w": 10, "h": 10}
-        el.update(props(PROPERTY_NAMES))
+        el = {"type": draw(ELEMENT_TYPE), "Name": draw(ELEMENT_NAME), "x": 0, "y": 0, "w": 10, "h": 10}
+        el.update(props(ELEMENT_KEYS))
         elements.append(el)
     doc: dict[str, Any] = {
-        "form": {"width": 100, "height": 100, **props(["title", "width", "height", "BackColor", "Font",
-                                                       "BackgroundImage", "Nope"])},
-        "devices": draw(st.lists(st.fixed_dictionaries({}, optional={
-            k: JSON_VALUES for k in ("Name", "AppMin", "AppMax", "PhyMin", "PhyMax")}), max_size=2)),
-        "images": draw(st.lists(JSON_LEAVES, max_size=3)),
+        "form": {"width": 100, "height": 100, **props(FORM_KEYS)},
+        "devices": draw(DEVICES),
+        "images": draw(IMAGES),
         "elements": elements,
     }
     return draw(st.one_of(st.just(doc), JSON_VALUES))

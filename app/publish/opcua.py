@@ -214,6 +214,16 @@ class _Trusting(SecurityPolicyFactory):
         return super().create(peer_certificate)
 
 
+async def _stop_clock(server: Server) -> None:
+    """End asyncua's ServerStatus.CurrentTime clock now: its `stop()` waits for the clock's next tick
+    (up to 1 s) before it closes anything."""
+    task = server.iserver.time_task
+    if task is not None:
+        task.cancel()
+        await asyncio.wait([task])
+        server.iserver.time_task = None
+
+
 class OpcUaServer:
     """`start()` (OSError or RuntimeError naming the problem), then `stop()`."""
 
@@ -335,6 +345,7 @@ class OpcUaServer:
                     self._readable(item.snapshot.scan)
                 self.status.skipped = self.feed.skipped
         finally:
+            await _stop_clock(server)
             await server.stop()
 
     async def _secure(self, server: Server, uri: str) -> None:

@@ -1,31 +1,33 @@
 """An acknowledged outside write survives a SIGKILL of the station (issue 23, item 12).
 
-The real station (`main.py --no-gui`) runs as a child process; Modbus clients over real TCP write
-increasing values to a few registers, each waiting for its answer; the station is killed with
-SIGKILL at a random moment and started again on the same folder. After every restart the last
-acknowledged value of each register must be in memory (read back over Modbus); a write sent but
-not yet answered may or may not be there, so memory lies between the two. At the end every
-acknowledged write must be in the journal (the SQLite archive). The issue's 20 kills take about
-25 s (a start of the station is about 1 s of it); KILL_TEST_KILLS=N runs another number.
+The real station (`main.py --no-gui`) runs as a process of its own, forked from one that has
+imported it (tests/app/station_fork.py: a start is then a tenth of a second, not one); Modbus
+clients over real TCP write increasing values to a few registers, each waiting for its answer;
+once each has had an answer the station is killed with SIGKILL at a random moment of the next
+write and started again on the same folder. After every restart the last acknowledged value of
+each register must be in memory (read back over Modbus); a write sent but not yet answered may or
+may not be there, so memory lies between the two. At the end every acknowledged write must be in
+the journal (the SQLite archive). KILL_TEST_KILLS=N runs another number of kills than the issue's 20.
 """
 
 from __future__ import annotations
 
+import functools
 import os
 import random
 import signal
 import socket
 import sqlite3
 import struct
-import subprocess
-import sys
 import threading
 import time
+from collections.abc import Iterator
 from pathlib import Path
 
 import pytest
 
-from tests.app.conftest import REPO, write_station
+from tests.app.conftest import write_station
+from tests.app.station_fork import Forked, Forks
 
 pytestmark = pytest.mark.skipif(not hasattr(signal, "SIGKILL"), reason="needs POSIX signals")
 
@@ -51,13 +53,12 @@ writable = [["04000", "04777"]]
 """, {"count.stl": PROGRAM})
 
 
-def start(folder: Path) -> subprocess.Popen[bytes]:
-    with open(folder / "stderr.txt", "ab") as err:  # a file, not a pipe nobody reads while it runs
-        return subprocess.Popen([sys.executable, "main.py", "--no-gui", str(folder), "--status-every", "60"],
-                                cwd=REPO, stdout=subprocess.DEVNULL, stderr=err)
+def start(forks: Forks, folder: Path) -> Forked:
+    # stderr to a file, not a pipe nobody reads while it runs
+    return forks.start(["--no-gui", str(folder), "--status-every", "60"], folder / "stderr.txt")
 
 
-def connect(port: int, child: subprocess.Popen[bytes], folder: Path, timeout: float = 30.0) -> socket.socket:
+def connect(port: int, child: Forked, folder: Path, timeout: float = 30.0) -> socket.socket:
     """A connection to the station's Modbus server once it listens (retentive memory is restored
     before the server starts)."""
     deadline = time.monotonic() + timeout
@@ -101,13 +102,14 @@ def read_register(sock: socket.socket, register: int) -> int:
 class Writer(threading.Thread):
     """Writes next, next+1, ... to one register, each after the previous one was answered."""
 
-    def __init__(self, port: int, register: int, first: int) -> None:
+    def __init__(self, port: int, register: int, first: int, answered: threading.Condition) -> None:
         super().__init__(daemon=True)
         self.sock = socket.create_connection(("127.0.0.1", port), timeout=10)
         self.register = register
         self.sent = first - 1  # the last value sent (it may be applied although never answered)
         self.acked: list[int] = []  # values answered as written, in order
         self.error = ""
+        self.answered = answered  # notified at each answer
 
     def run(self) -> None:
         try:
@@ -118,11 +120,20 @@ class Writer(threading.Thread):
                 if answer != struct.pack(">BHH", 6, self.register, value):
                     self.error = f"register {self.register}: {value} answered {answer.hex()}"
                     return
-                self.acked.append(value)
+                with self.answered:
+                    self.acked.append(value)
+                    self.answered.notify_all()
         except OSError:
             return  # the station was killed
         finally:
             self.sock.close()
+            with self.answered:
+                self.answered.notify_all()
+
+
+def under_way(writers: list[Writer]) -> bool:
+    """Each writer had an answer and sent its next write (or one failed: it says why)."""
+    return all(w.acked for w in writers) or any(w.error for w in writers)
 
 
 def journaled_writes(archive: Path) -> set[tuple[int, int]]:
@@ -148,8 +159,15 @@ def system_texts(archive: Path) -> list[str]:
         con.close()
 
 
+@pytest.fixture
+def forks(tmp_path: Path) -> Iterator[Forks]:
+    forks = Forks(tmp_path / "forks-stderr.txt")
+    yield forks
+    forks.close()
+
+
 @pytest.mark.timeout(60 + 6 * KILLS)
-def test_no_acknowledged_write_is_lost_to_sigkill(tmp_path: Path) -> None:
+def test_no_acknowledged_write_is_lost_to_sigkill(tmp_path: Path, forks: Forks) -> None:
     port = free_port()
     folder = station(tmp_path / "station", port)
     seed = random.randrange(1 << 30)
@@ -158,7 +176,7 @@ def test_no_acknowledged_write_is_lost_to_sigkill(tmp_path: Path) -> None:
     acked: dict[int, list[int]] = {r: [] for r in REGISTERS}
     checked = 0
     for kill in range(KILLS + 1):
-        child = start(folder)
+        child = start(forks, folder)
         try:
             sock = connect(port, child, folder)
             with sock:
@@ -173,10 +191,13 @@ def test_no_acknowledged_write_is_lost_to_sigkill(tmp_path: Path) -> None:
                 child.send_signal(signal.SIGTERM)  # the last run stops cleanly: its records are all kept
                 assert child.wait(20) == 0
                 break
-            writers = [Writer(port, r, sent[r] + 1) for r in REGISTERS]
+            answered = threading.Condition()
+            writers = [Writer(port, r, sent[r] + 1, answered) for r in REGISTERS]
             for w in writers:
                 w.start()
-            time.sleep(rng.uniform(0.05, 0.35))
+            with answered:
+                assert answered.wait_for(functools.partial(under_way, writers), timeout=20), "no answer"
+            time.sleep(rng.uniform(0, 0.05))  # the kill falls anywhere in a write's round trip
             child.send_signal(signal.SIGKILL)
             child.wait(10)
             for w in writers:

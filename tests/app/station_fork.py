@@ -1,0 +1,126 @@
+"""Headless stations started as processes of their own, forked from one that has imported them.
+
+`python main.py --no-gui STATION` spends most of its start importing (a second of CPU); a test that
+starts a station twenty times spends it twenty times. Here a child process (`Forks`) imports
+`app.cli` and the runtime once and then forks on request; each fork runs `app.cli.main` with the
+arguments given, exactly as `main.py` does, and ends with its exit code. The test signals the fork
+by its PID like any process and asks the forking process, its parent, for its exit code (`Forked`,
+a small Popen).
+
+    python -m tests.app.station_fork    (requests on stdin, one JSON array a line)
+"""
+
+from __future__ import annotations
+
+import json
+import os
+import select
+import signal
+import subprocess
+import sys
+from pathlib import Path
+
+REPO = Path(__file__).resolve().parents[2]
+
+
+class Forks:
+    """The forking process: start it, `start()` stations, `close()` it."""
+
+    def __init__(self, stderr: Path) -> None:
+        with open(stderr, "ab") as err:
+            self.proc = subprocess.Popen([sys.executable, "-m", "tests.app.station_fork"], cwd=REPO,
+                                         stdin=subprocess.PIPE, stdout=subprocess.PIPE, stderr=err, text=True)
+
+    def ask(self, *request: object) -> object:
+        assert self.proc.stdin is not None and self.proc.stdout is not None
+        self.proc.stdin.write(json.dumps(request) + "\n")
+        self.proc.stdin.flush()
+        answer = self.proc.stdout.readline()
+        if not answer:
+            raise RuntimeError(f"the forking process ended (exit code {self.proc.wait(10)})")
+        return json.loads(answer)
+
+    def start(self, args: list[str], stderr: Path) -> Forked:
+        """`python main.py ARGS` with its stderr appended to `stderr` and its stdout dropped."""
+        pid = self.ask("start", args, str(stderr))
+        assert isinstance(pid, int)
+        return Forked(self, pid)
+
+    def close(self) -> None:
+        assert self.proc.stdin is not None
+        self.proc.stdin.close()
+        assert self.proc.wait(10) == 0
+
+
+class Forked:
+    """One forked station, like a `subprocess.Popen` of it."""
+
+    def __init__(self, forks: Forks, pid: int) -> None:
+        self.forks, self.pid = forks, pid
+        self.returncode: int | None = None
+
+    def send_signal(self, sig: int) -> None:
+        if self.returncode is None:
+            os.kill(self.pid, sig)
+
+    def kill(self) -> None:
+        self.send_signal(signal.SIGKILL)
+
+    def poll(self) -> int | None:
+        return self.wait(0) if self.returncode is None else self.returncode
+
+    def wait(self, timeout: float) -> int | None:
+        """The exit code (minus the signal that ended it), or None if it runs on after `timeout`
+        (`poll()` with 0)."""
+        if self.returncode is None:
+            code = self.forks.ask("wait", self.pid, timeout)
+            if code is None and timeout:
+                raise subprocess.TimeoutExpired(f"station {self.pid}", timeout)
+            self.returncode = code  # type: ignore[assignment]
+        return self.returncode
+
+
+def _fork(args: list[str], stderr: str) -> int:
+    from app.cli import main
+
+    sys.stdout.flush()
+    pid = os.fork()
+    if pid:
+        return pid
+    err = os.open(stderr, os.O_WRONLY | os.O_APPEND | os.O_CREAT, 0o644)
+    null = os.open(os.devnull, os.O_RDWR)
+    os.dup2(null, 0)
+    os.dup2(null, 1)
+    os.dup2(err, 2)
+    os.close(err)
+    os.close(null)
+    sys.exit(main(args))  # and the interpreter ends as main.py's does
+
+
+def _wait(pid: int, timeout: float) -> int | None:
+    """The exit code of the fork `pid` once it ended, or None if it still runs after `timeout` s."""
+    fd = os.pidfd_open(pid)
+    try:
+        select.select([fd], [], [], timeout)
+        done, status = os.waitpid(pid, os.WNOHANG)
+    finally:
+        os.close(fd)
+    return os.waitstatus_to_exitcode(status) if done else None
+
+
+def serve() -> None:
+    # what every fork would import first: the command line and the runtime
+    import app.cli
+    import app.station.runtime  # noqa: F401
+
+    for line in sys.stdin:
+        request = json.loads(line)
+        if request[0] == "start":
+            answer: object = _fork(request[1], request[2])
+        else:
+            answer = _wait(request[1], request[2])
+        print(json.dumps(answer), flush=True)
+
+
+if __name__ == "__main__":
+    serve()
