@@ -14,6 +14,7 @@ import inspect
 import sys
 from pathlib import Path
 
+from app.authority import policy
 from app.authority.policy import ROLES, policy_table
 from app.scada import alarms, quality
 from app.scada.alarms import IN_LIST, PRIORITIES, State
@@ -95,7 +96,7 @@ def functions() -> str:
 
 
 def roles() -> str:
-    return "\n".join(["# Roles and actions", "", _doc(sys.modules[policy_table.__module__]), "",
+    return "\n".join(["# Roles and actions", "", inspect.getdoc(policy) or "", "",
                       "Roles, lowest first: " + ", ".join(f"`{r}`" for r in ROLES) + ".", "",
                       policy_table(), ""])
 
