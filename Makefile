@@ -4,7 +4,7 @@ VENV := .venv
 PY := $(VENV)/bin/python
 STAMP := $(VENV)/.installed
 
-.PHONY: run test lint bench screenshots translations dist clean
+.PHONY: run test lint bench screenshots translations dist docs reference clean
 
 $(STAMP): pyproject.toml
 	test -x $(PY) || $(PYTHON) -m venv $(VENV)
@@ -34,6 +34,14 @@ bench: $(STAMP)
 # the wheel (dist/netplc_station-*.whl) with the demo station and the compiled translations inside
 dist: $(STAMP) $(QM)
 	$(PY) -m pip wheel --no-deps -q -w dist .
+
+# the manual: docs/ built by MkDocs into build/site (make test builds it --strict as well, in
+# tests/test_docs.py); `make reference` rewrites docs/reference/ from the code
+docs: $(STAMP)
+	NO_MKDOCS_2_WARNING=1 $(PY) -m mkdocs build --strict -d build/site
+
+reference: $(STAMP)
+	$(PY) -m docs.gen_reference
 
 screenshots: $(STAMP) $(QM)
 	QT_QPA_PLATFORM=offscreen $(PY) -m app.gui.screenshots docs/screenshots

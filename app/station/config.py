@@ -154,6 +154,139 @@ class Station:
         return self.NetSyncTime / 1000.0
 
 
+@dataclass(frozen=True)
+class Key:
+    """One station.toml setting as the parser reads it (its kind, default and bounds) and as the
+    manual's reference prints it (docs/gen_reference.py): one table, so the two cannot differ. A
+    key the parser reads that is not here is a KeyError at every load."""
+
+    name: str
+    kind: type | tuple[type, ...]
+    default: Any
+    meaning: str
+    bounds: tuple[float, float] | None = None  # of a number
+    said: str = ""  # the default in words where it is settled at load (the folder's name...)
+
+
+def _keys(*keys: Key) -> dict[str, Key]:
+    return {k.name: k for k in keys}
+
+
+_SERVER, _OPCUA = ModbusServerSettings(), OpcUaSettings()
+_MQTT, _OPERATOR = MqttSettings(), OperatorSettings()
+# what each node setting means; its kind and default are NodeConfig's own (netplc/exchange.py)
+_NODE_MEANINGS = {
+    "name": "what the station calls the node (its Sparkplug device id); empty: Node<n>",
+    "endpoint": "`tcp://host:port` or `rtu:///dev/ttyS0?baudrate=19200&parity=N`; empty: its simulator's",
+    "unit": "Modbus unit id: 0-255 over TCP, 1-247 over RTU",
+    "profile": "`cpu165` (a NetPlc node) or `modbus` (any Modbus device)",
+    "timeout": "seconds per attempt (0.01-60)",
+    "retries": "further attempts (0-10) before the link is down",
+    "table": "profile `modbus`: `holding`, `input`, `coils` or `discrete`",
+    "backoff": "seconds before the first reconnect after the link went down",
+    "backoff_max": "the reconnect delay doubles up to this (backoff <= backoff_max)",
+}
+# The station.toml keys by table: "" is the top level, the others are its [tables] and
+# [[arrays of tables]].
+KEYS: dict[str, dict[str, Key]] = {
+    "": _keys(
+        Key("name", str, "", "the station's name (journal, MQTT edge node, window title)",
+            said="the station folder's name"),
+        Key("NetPlcLoad", bool, True, "run the NetPlc program"),
+        Key("NetPlcProgram", str, None, "the STL program (required when NetPlcLoad is true)"),
+        Key("Symbols", str, None, "symbols.csv: name,address,comment for the program and the forms"),
+        Key("HMIload", str, None, "the folder of `.hmi` forms, each opens as a tab"),
+        Key("NetSyncTime", int, 100, "the tick and scan period, ms", (10, 60_000)),
+        Key("Archive", str, "archive/journal.sqlite",
+            "the journal (SQLite); a `postgresql://` URL forwards it to a plant archive, the local "
+            "journal staying at the default path"),
+        Key("Messages", str, None, "messages.csv: number,group,type,text for NMSG"),
+        Key("keep_days", int, 0, "days the local archive keeps; 0: every day", (0, 36_500)),
+        Key("plant_keep_days", int, 0, "days the plant archive keeps, for every station in it; 0: all",
+            (0, 36_500)),
+        Key("Retain", str, None, "the retentive memory's save", said="retain.bin beside the Archive"),
+        Key("Tags", str, None, "tags.csv: the tags, their conversion and alarms"),
+        Key("RetainForces", bool, False, "forces survive a restart (`<Retain>.forces.json`)"),
+        Key("alarm_sound", bool, True, "a new alarm of priority 1-2 sounds until acknowledged or silenced"),
+        Key("allow_outside", bool, False, "station paths (and form images) may leave the station folder"),
+        Key("Language", str, "", f"the console's language: {', '.join(LANGUAGES)}",
+            said="the system locale"),
+        Key("modbus_server", dict, {}, "the Modbus server's table"),
+        Key("nodes", list, [], "the exchange's remote nodes"),
+        Key("simulators", list, [], "embedded simulated CPU-165 nodes"),
+        Key("operator", dict, {}, "who is at the workstation"),
+        Key("opcua", dict, {}, "the OPC UA server's table"),
+        Key("mqtt", dict, {}, "the MQTT Sparkplug B publisher's table"),
+    ),
+    "modbus_server": _keys(
+        Key("enabled", bool, _SERVER.enabled, "serve NetPlc memory over Modbus"),
+        Key("transport", str, "tcp", f"one of {', '.join(TRANSPORTS)}"),
+        Key("host", str, _SERVER.host, "tcp: the address it listens on"),
+        Key("port", (int, str), _SERVER.port,
+            'tcp: the port it listens on; rtu: the serial port ("/dev/ttyUSB0", "COM3"), required',
+            (0, 65535)),
+        Key("writable", list, None, "octal ranges clients may write, `[[\"04000\", \"04777\"], ...]`",
+            said="02000-03677 and 04000-07777 (not the special bits 03700-03777)"),
+        Key("unit", int, None, "the only unit id answered", (1, 247), said="tcp: every unit; rtu: 1"),
+        Key("role", str, _SERVER.role, f"the role its clients act with: {', '.join(ROLES)}"),
+        Key("max_connections", int, _SERVER.max_connections, "tcp: connections at once", (1, 1000)),
+        Key("idle_timeout", float, _SERVER.idle_timeout,
+            "tcp: seconds without a whole request before a connection is closed", (0.1, 86_400.0)),
+        Key("max_inflight", int, _SERVER.max_inflight,
+            "tcp: answers a connection may leave unread before it is no longer read", (1, 10_000)),
+        Key("max_per_peer", int, _SERVER.max_per_peer, "tcp: connections from one address", (1, 1000)),
+        Key("baudrate", int, 19200, "rtu: the line's rate"),
+        Key("parity", str, "E", "rtu: N, E or O"),
+        Key("stopbits", int, 1, "rtu: 1 or 2", said="1; 2 with parity N"),
+    ),
+    "nodes": _keys(
+        Key("node", int, None, "the node number, 0-255 (required)"),
+        *(Key(k, float if isinstance(v, float) else type(v), v, _NODE_MEANINGS[k])
+          for k, v in NODE_DEFAULTS.items()),
+    ),
+    "simulators": _keys(
+        Key("node", int, -1, "the node it simulates (required)", (0, 255)),
+        Key("program", str, None, "its STL program (required)"),
+        Key("symbols", str, None, "its symbols.csv"),
+        Key("host", str, "127.0.0.1", "the address it listens on"),
+        Key("port", int, 0, "the port it listens on; 0: a free one, filled into the node", (0, 65535)),
+        Key("unit", int, 1, "its Modbus unit id", (0, 247)),
+        Key("tick", int, 100, "ms per scan", (10, 60_000)),
+    ),
+    "operator": _keys(
+        Key("default_user", str, _OPERATOR.default_user,
+            "a user of role viewer shown while nobody is logged in; empty: logged out"),
+        Key("idle_logout", int, _OPERATOR.idle_logout,
+            "seconds without input before the user is logged out; 0: never", (0, 86_400)),
+    ),
+    "opcua": _keys(
+        Key("enabled", bool, _OPCUA.enabled, "run the OPC UA server"),
+        Key("endpoint", str, _OPCUA.endpoint, "its `opc.tcp://` address"),
+        Key("writable", list, [], "tag names or patterns (`TEMP_*`) clients may write"),
+        Key("certificate_names", list, [], "names and addresses its certificate holds besides the host's"),
+    ),
+    "mqtt": _keys(
+        Key("enabled", bool, _MQTT.enabled, "run the Sparkplug B publisher"),
+        Key("broker", str, _MQTT.broker, "`mqtt://host:1883` or `mqtts://host:8883`"),
+        Key("ca_file", str, None, "the CA certificate for mqtts://"),
+        Key("group_id", str, _MQTT.group_id, "the Sparkplug group id"),
+        Key("edge_node_id", str, _MQTT.edge_node_id, "the Sparkplug edge node id", said="the station name"),
+        Key("username", str, _MQTT.username, "for the broker"),
+        Key("password", str, _MQTT.password, "for the broker"),
+        Key("deadband", dict, {}, "per tag type, in physical units: `{ float32 = 0.5, word = 2 }`"),
+        Key("publish_period", int, _MQTT.publish_period, "ms between NDATA messages at least; 0: every tick",
+            (0, 3_600_000)),
+        Key("writable", list, [], "tag names or patterns an NCMD may write"),
+        Key("buffer", int, _MQTT.buffer, "NDATA/DDATA messages kept while no Sparkplug session is up",
+            (0, 10_000_000)),
+        Key("primary_host", str, _MQTT.primary_host,
+            "the Primary Host Application's id: births only while its STATE is online; empty: none"),
+        Key("role", str, _MQTT.role, f"what NCMD/DCMD may do (they name no user): {', '.join(ROLES)}"),
+    ),
+}
+_DECLARED: Any = object()  # get()'s default: the one KEYS declares
+
+
 def station_file(path: str | Path) -> Path:
     """A station is named by its folder or by its station.toml."""
     p = Path(path)
@@ -163,20 +296,25 @@ def station_file(path: str | Path) -> Path:
 class _Reader:
     """Typed access to one TOML table that records problems instead of raising at the first."""
 
-    def __init__(self, problems: list[str], fname: str, table: dict[str, Any], prefix: str = "",
-                 allow_outside: bool = False) -> None:
+    def __init__(self, problems: list[str], fname: str, table: dict[str, Any], section: str = "",
+                 prefix: str | None = None, allow_outside: bool = False) -> None:
         self.problems = problems
         self.fname = fname
         self.table = table
-        self.prefix = prefix
+        self.keys = KEYS[section]
+        self.prefix = f"{section}." if prefix is None and section else prefix or ""
         self.allow_outside = allow_outside  # may paths leave the station folder?
         self.known: set[str] = set()
 
     def bad(self, key: str, problem: str) -> None:
         self.problems.append(f"{self.fname}: {self.prefix}{key}: {problem}")
 
-    def get(self, key: str, kind: type | tuple[type, ...], default: Any = None,
-            required: bool = False) -> Any:
+    def get(self, key: str, default: Any = _DECLARED, required: bool = False,
+            kind: type | tuple[type, ...] | None = None) -> Any:
+        """The key's value, of the kind KEYS declares (or `kind`, of a key that takes several)."""
+        declared = self.keys[key]
+        kind = declared.kind if kind is None else kind
+        default = declared.default if default is _DECLARED else default
         self.known.add(key)
         if key not in self.table:
             if required:
@@ -196,15 +334,19 @@ class _Reader:
             return default
         return value
 
-    def number(self, key: str, default: int | None, lo: int, hi: int, required: bool = False) -> Any:
-        value = self.get(key, int, default, required)
+    def number(self, key: str, default: Any = _DECLARED, required: bool = False) -> Any:
+        """An integer within the bounds KEYS declares."""
+        declared = self.keys[key]
+        default = declared.default if default is _DECLARED else default
+        value = self.get(key, default, required, kind=int)
+        lo, hi = declared.bounds or (value, value)
         if value is not None and not lo <= value <= hi:
             self.bad(key, f"{value} is outside {lo}-{hi}")
             return default
         return value
 
-    def path(self, key: str, base: Path, default: str | None = None, required: bool = False) -> Path | None:
-        value = self.get(key, str, default, required)
+    def path(self, key: str, base: Path, required: bool = False) -> Path | None:
+        value = self.get(key, required=required)
         if value is None:
             return None
         if not value.strip():
@@ -282,32 +424,32 @@ def read_station(path: str | Path) -> tuple[Station | None, list[str]]:
     problems: list[str] = []
     base = file.parent.resolve()
     top = _Reader(problems, fname, data)
-    top.allow_outside = bool(top.get("allow_outside", bool, False))
-    name = top.get("name", str, base.name)
-    load = top.get("NetPlcLoad", bool, True)
+    top.allow_outside = bool(top.get("allow_outside"))
+    name = top.get("name")
+    load = top.get("NetPlcLoad")
     program = top.path("NetPlcProgram", base, required=bool(load))
     symbols = top.path("Symbols", base)
     hmi = top.path("HMIload", base)
-    sync = top.number("NetSyncTime", 100, 10, 60_000)
+    sync = top.number("NetSyncTime")
     plant = _plant_archive(top)  # marks a URL `Archive` known, valid or not
-    archive = None if "Archive" in top.known else top.path("Archive", base, "archive/journal.sqlite")
+    archive = None if "Archive" in top.known else top.path("Archive", base)
     messages = top.path("Messages", base)
-    keep_days = top.number("keep_days", 0, 0, 36_500)
-    plant_keep_days = top.number("plant_keep_days", 0, 0, 36_500)
+    keep_days = top.number("keep_days")
+    plant_keep_days = top.number("plant_keep_days")
     retain = top.path("Retain", base)
     tags = top.path("Tags", base)
-    retain_forces = top.get("RetainForces", bool, False)
-    alarm_sound = bool(top.get("alarm_sound", bool, True))
-    server = _modbus_server(problems, fname, top.get("modbus_server", dict, {}))
-    nodes = _nodes(problems, fname, top.get("nodes", list, []))
-    simulators = _simulators(problems, fname, top.get("simulators", list, []), base, top.allow_outside)
-    operator = _operator(problems, fname, top.get("operator", dict, {}))
-    language = top.get("Language", str, "")
+    retain_forces = top.get("RetainForces")
+    alarm_sound = bool(top.get("alarm_sound"))
+    server = _modbus_server(problems, fname, top.get("modbus_server"))
+    nodes = _nodes(problems, fname, top.get("nodes"))
+    simulators = _simulators(problems, fname, top.get("simulators"), base, top.allow_outside)
+    operator = _operator(problems, fname, top.get("operator"))
+    language = top.get("Language")
     if language and language not in LANGUAGES:
         top.bad("Language", f"{language!r} is not one of {', '.join(LANGUAGES)}")
         language = ""
-    opcua = _opcua(problems, fname, top.get("opcua", dict, {}))
-    mqtt = _mqtt(problems, fname, top.get("mqtt", dict, {}), base, top.allow_outside)
+    opcua = _opcua(problems, fname, top.get("opcua"))
+    mqtt = _mqtt(problems, fname, top.get("mqtt"), base, top.allow_outside)
     top.finish()
     nodes = _with_simulated_nodes(problems, fname, nodes, simulators)
     _ports_in_common(problems, fname, server, simulators, nodes)
@@ -386,7 +528,7 @@ def _existing(r: _Reader, key: str, path: Path | None, must_be_dir: bool) -> Pat
 
 def _role(r: _Reader) -> str:
     """`role`: what the clients of a protocol without users may do (viewer: read-only)."""
-    role = r.get("role", str, OPERATOR)
+    role = r.get("role")
     if role not in ROLES:
         r.bad("role", f"{role!r} is not one of {', '.join(ROLES)}")
         return OPERATOR
@@ -394,10 +536,10 @@ def _role(r: _Reader) -> str:
 
 
 def _modbus_server(problems: list[str], fname: str, table: dict[str, Any]) -> ModbusServerSettings:
-    r = _Reader(problems, fname, table, "modbus_server.")
+    r = _Reader(problems, fname, table, "modbus_server")
     d = ModbusServerSettings()
-    enabled = r.get("enabled", bool, d.enabled)
-    transport = r.get("transport", str, "tcp")
+    enabled = r.get("enabled")
+    transport = r.get("transport")
     if transport not in TRANSPORTS:
         r.bad("transport", f"{transport!r} is not one of {', '.join(TRANSPORTS)}")
         transport = "tcp"
@@ -406,18 +548,18 @@ def _modbus_server(problems: list[str], fname: str, table: dict[str, Any]) -> Mo
         if key in table:
             r.known.add(key)
             r.bad(key, f'applies to transport = "{"tcp" if rtu else "rtu"}" only')
-    ranges = r.get("writable", list, None)
-    unit = r.number("unit", 1 if rtu else None, 1, 247)  # a slave on a shared line has one address
+    ranges = r.get("writable")
+    unit = r.number("unit", 1 if rtu else None)  # a slave on a shared line has one address
     role = _role(r)
     if rtu:
         server = replace(d, port=0, serial=_serial_port(r))  # port 0: no TCP port of its own
     else:
         server = ModbusServerSettings(
-            host=r.get("host", str, d.host), port=r.number("port", d.port, 0, 65535),
-            max_connections=r.number("max_connections", d.max_connections, 1, 1000),
-            idle_timeout=_seconds(r, "idle_timeout", d.idle_timeout, 0.1, 86_400.0),
-            max_inflight=r.number("max_inflight", d.max_inflight, 1, 10_000),
-            max_per_peer=r.number("max_per_peer", d.max_per_peer, 1, 1000))
+            host=r.get("host"), port=r.number("port"),
+            max_connections=r.number("max_connections"),
+            idle_timeout=_seconds(r, "idle_timeout"),
+            max_inflight=r.number("max_inflight"),
+            max_per_peer=r.number("max_per_peer"))
     r.finish()
     writable = DEFAULT_WRITABLE if ranges is None else _ranges(r, ranges)
     return replace(server, enabled=enabled, writable=writable, unit=unit, role=role)
@@ -427,7 +569,7 @@ def _serial_port(r: _Reader) -> Endpoint | None:
     """transport = "rtu": `port` names the serial port, and its line settings: 19200 baud, 8 data
     bits, even parity, as the Modbus over Serial Line specification (2.5.1) makes the default;
     one stop bit, or two without parity, as it requires."""
-    device = r.get("port", str, None)
+    device = r.get("port", None, kind=str)
     if device is None:
         if "port" not in r.table:
             r.bad("port", 'missing: transport = "rtu" answers on a serial port, '
@@ -436,9 +578,9 @@ def _serial_port(r: _Reader) -> Endpoint | None:
     if not device.strip() or "\0" in device:
         r.bad("port", f"{device!r} is not a serial port")
         return None
-    baudrate = r.get("baudrate", int, 19200)
-    parity = r.get("parity", str, "E").upper()
-    stopbits = r.get("stopbits", int, 2 if parity == "N" else 1)
+    baudrate = r.get("baudrate")
+    parity = r.get("parity").upper()
+    stopbits = r.get("stopbits", 2 if parity == "N" else 1)
     serial = Endpoint("rtu", device=device, baudrate=baudrate, parity=parity, stopbits=stopbits)
     found = line_problems(serial)
     for key, text in found:
@@ -479,7 +621,7 @@ def _array_tables(problems: list[str], fname: str, items: list[Any], key: str) -
     readers = []
     for i, table in enumerate(items):
         if isinstance(table, dict):
-            readers.append((i, _Reader(problems, fname, table, f"{key}[{i}].")))
+            readers.append((i, _Reader(problems, fname, table, key, f"{key}[{i}].")))
         else:
             problems.append(f"{fname}: {key}[{i}]: expected a [[{key}]] table")
     return readers
@@ -492,10 +634,9 @@ def _nodes(problems: list[str], fname: str, items: list[Any]) -> list[NodeConfig
     nodes: list[NodeConfig] = []
     readers: dict[str, _Reader] = {}  # by the node's key, nodes[i]
     for i, r in _array_tables(problems, fname, items, "nodes"):
-        settings = {"node": r.get("node", int, required=True)}
-        for key, default in NODE_DEFAULTS.items():
-            kind = float if isinstance(default, float) else type(default)
-            value = r.get(key, kind, None)
+        settings = {"node": r.get("node", required=True)}
+        for key in NODE_DEFAULTS:
+            value = r.get(key, None)
             if value is not None:
                 settings[key] = value
         r.finish()
@@ -512,8 +653,10 @@ def _nodes(problems: list[str], fname: str, items: list[Any]) -> list[NodeConfig
     return nodes
 
 
-def _seconds(r: _Reader, key: str, default: float, lo: float, hi: float) -> float:
-    value = r.get(key, float, default)
+def _seconds(r: _Reader, key: str) -> float:
+    default = r.keys[key].default
+    lo, hi = r.keys[key].bounds or (default, default)
+    value = r.get(key)
     if not lo <= value <= hi:
         r.bad(key, f"{value:g} s is outside {lo:g}-{hi:g} s")
         return default
@@ -525,13 +668,13 @@ def _simulators(problems: list[str], fname: str, items: list[Any], base: Path,
     sims: list[SimulatorSettings] = []
     for _i, r in _array_tables(problems, fname, items, "simulators"):
         r.allow_outside = allow_outside
-        node = r.number("node", -1, 0, 255, required=True)
+        node = r.number("node", required=True)
         program = r.path("program", base, required=True)
         symbols = r.path("symbols", base)
-        host = r.get("host", str, "127.0.0.1")
-        port = r.number("port", 0, 0, 65535)
-        unit = r.number("unit", 1, 0, 247)
-        tick = r.number("tick", 100, 10, 60_000)
+        host = r.get("host")
+        port = r.number("port")
+        unit = r.number("unit")
+        tick = r.number("tick")
         r.finish()
         if node >= 0 and program is not None:
             sims.append(SimulatorSettings(node, program, symbols, host, port, unit, tick))
@@ -539,13 +682,13 @@ def _simulators(problems: list[str], fname: str, items: list[Any], base: Path,
 
 
 def _operator(problems: list[str], fname: str, table: dict[str, Any]) -> OperatorSettings:
-    r = _Reader(problems, fname, table, "operator.")
+    r = _Reader(problems, fname, table, "operator")
     if "users" in table:
         r.known.add("users")
         r.bad("users", "users are kept in users.json with their roles and passwords now: "
                        "`main.py users add NAME --role viewer|operator|engineer|admin`")
-    default = r.get("default_user", str, "")
-    idle = r.number("idle_logout", 0, 0, 86_400)
+    default = r.get("default_user")
+    idle = r.number("idle_logout")
     r.finish()
     return OperatorSettings(default.strip(), idle)
 
@@ -592,7 +735,7 @@ def _with_simulated_nodes(problems: list[str], fname: str, nodes: list[NodeConfi
 
 def _names(r: _Reader, key: str) -> tuple[str, ...]:
     """A list of tag names or patterns."""
-    items = r.get(key, list, [])
+    items = r.get(key)
     if not all(isinstance(x, str) and x.strip() for x in items):
         r.bad(key, "expected a list of tag names or patterns")
         return ()
@@ -606,7 +749,7 @@ def _host_names(r: _Reader, key: str) -> tuple[str, ...]:
 
     label = re.compile(r"(?!-)[A-Za-z0-9-]{1,63}(?<!-)")
     names = []
-    for item in r.get(key, list, []):
+    for item in r.get(key):
         if isinstance(item, str):
             try:
                 names.append(str(ipaddress.ip_address(item)))
@@ -620,10 +763,10 @@ def _host_names(r: _Reader, key: str) -> tuple[str, ...]:
 
 
 def _opcua(problems: list[str], fname: str, table: dict[str, Any]) -> OpcUaSettings:
-    r = _Reader(problems, fname, table, "opcua.")
+    r = _Reader(problems, fname, table, "opcua")
     d = OpcUaSettings()
-    enabled = r.get("enabled", bool, d.enabled)
-    endpoint = r.get("endpoint", str, d.endpoint)
+    enabled = r.get("enabled")
+    endpoint = r.get("endpoint")
     writable = _names(r, "writable")
     certificate_names = _host_names(r, "certificate_names")
     r.finish()
@@ -635,20 +778,20 @@ def _opcua(problems: list[str], fname: str, table: dict[str, Any]) -> OpcUaSetti
 
 def _mqtt(problems: list[str], fname: str, table: dict[str, Any], base: Path,
           allow_outside: bool) -> MqttSettings:
-    r = _Reader(problems, fname, table, "mqtt.", allow_outside)
+    r = _Reader(problems, fname, table, "mqtt", allow_outside=allow_outside)
     d = MqttSettings()
-    enabled = r.get("enabled", bool, d.enabled)
-    broker = r.get("broker", str, d.broker)
+    enabled = r.get("enabled")
+    broker = r.get("broker")
     ca_file = r.path("ca_file", base)
-    group = r.get("group_id", str, d.group_id)
-    edge = r.get("edge_node_id", str, d.edge_node_id)
-    username = r.get("username", str, d.username)
-    password = r.get("password", str, d.password)
-    deadband = r.get("deadband", dict, {})
-    period = r.number("publish_period", d.publish_period, 0, 3_600_000)
+    group = r.get("group_id")
+    edge = r.get("edge_node_id")
+    username = r.get("username")
+    password = r.get("password")
+    deadband = r.get("deadband")
+    period = r.number("publish_period")
     writable = _names(r, "writable")
-    buffer = r.number("buffer", d.buffer, 0, 10_000_000)
-    primary = r.get("primary_host", str, d.primary_host)
+    buffer = r.number("buffer")
+    primary = r.get("primary_host")
     role = _role(r)
     r.finish()
     if not broker.startswith(("mqtt://", "mqtts://")):

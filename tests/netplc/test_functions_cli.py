@@ -1,5 +1,6 @@
-"""The README's function tutorial is true: each `$ python -m netplc run ...` line in its console
-blocks is run as a subprocess from the repository root, and its output must be the one shown."""
+"""The function tutorial is true, in the README and in the manual: each `$ python -m netplc run ...`
+line in its console blocks is run as a subprocess from the repository root, and its output must be
+the one shown (a command the two show alike runs once)."""
 
 from __future__ import annotations
 
@@ -12,11 +13,12 @@ import pytest
 
 ROOT = Path(__file__).resolve().parents[2]
 PROMPT = "$ python -m netplc run "
+TUTORIALS = ("README.md", "docs/engineer/programs.md")
 
 
-def tutorial_commands() -> list[tuple[str, list[str]]]:
+def tutorial_commands(name: str) -> list[tuple[str, list[str]]]:
     """(command line, expected output lines) for every command of the `## Function tutorial` section."""
-    text = (ROOT / "README.md").read_text(encoding="utf-8")
+    text = (ROOT / name).read_text(encoding="utf-8")
     section = text.split("\n## Function tutorial\n", 1)[1].split("\n## ", 1)[0]
     commands: list[tuple[str, list[str]]] = []
     in_console = False
@@ -30,17 +32,19 @@ def tutorial_commands() -> list[tuple[str, list[str]]]:
     return commands
 
 
-COMMANDS = tutorial_commands()
+BY_FILE = {name: tutorial_commands(name) for name in TUTORIALS}
+COMMANDS = list({(c, tuple(out)): (c, out) for commands in BY_FILE.values() for c, out in commands}.values())
 
 
-def test_the_tutorial_covers_the_required_examples() -> None:
-    programs = [shlex.split(cmd)[4] for cmd, _ in COMMANDS]
-    for name, times in (("mov", 1), ("bcdw", 1), ("addbcd", 2), ("cmp", 2)):
-        assert programs.count(f"tests/vectors/tutorial/{name}.stl") == times
+@pytest.mark.parametrize("name", TUTORIALS)
+def test_the_tutorial_covers_the_required_examples(name: str) -> None:
+    programs = [shlex.split(cmd)[4] for cmd, _ in BY_FILE[name]]
+    for example, times in (("mov", 1), ("bcdw", 1), ("addbcd", 2), ("cmp", 2)):
+        assert programs.count(f"tests/vectors/tutorial/{example}.stl") == times, name
 
 
 @pytest.mark.parametrize(("command", "expected"), COMMANDS, ids=[c for c, _ in COMMANDS])
-def test_tutorial_command_prints_what_the_readme_shows(command: str, expected: list[str]) -> None:
+def test_tutorial_command_prints_what_the_tutorial_shows(command: str, expected: list[str]) -> None:
     argv = [sys.executable, *shlex.split(command)[1:]]
     done = subprocess.run(argv, cwd=ROOT, capture_output=True, text=True, timeout=60)
     assert (done.stdout + done.stderr).splitlines() == expected
