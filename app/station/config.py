@@ -550,7 +550,6 @@ def _modbus_server(problems: list[str], fname: str, table: dict[str, Any]) -> Mo
             r.bad(key, f'applies to transport = "{"tcp" if rtu else "rtu"}" only')
     ranges = r.get("writable")
     unit = r.number("unit", 1 if rtu else None)  # a slave on a shared line has one address
-    role = _role(r)
     if rtu:
         server = replace(d, port=0, serial=_serial_port(r))  # port 0: no TCP port of its own
     else:
@@ -560,6 +559,7 @@ def _modbus_server(problems: list[str], fname: str, table: dict[str, Any]) -> Mo
             idle_timeout=_seconds(r, "idle_timeout"),
             max_inflight=r.number("max_inflight"),
             max_per_peer=r.number("max_per_peer"))
+    role = _role(r)
     r.finish()
     writable = DEFAULT_WRITABLE if ranges is None else _ranges(r, ranges)
     return replace(server, enabled=enabled, writable=writable, unit=unit, role=role)
