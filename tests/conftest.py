@@ -1,5 +1,6 @@
 """Headless Qt for the whole suite (without it, Qt aborts the process when there is no display),
-PostgreSQL clusters, and OPC UA servers that share one fill of the standard address space."""
+bytecode caches, PostgreSQL clusters, and OPC UA servers that share one fill of the standard
+address space."""
 
 import itertools
 import os
@@ -8,6 +9,12 @@ import sys
 import pytest
 
 os.environ.setdefault("QT_QPA_PLATFORM", "offscreen")
+
+# Bytecode caches (__pycache__, ignored by git) are written even where PYTHONDONTWRITEBYTECODE is set,
+# as container images often do: without them each xdist worker compiles and assertion-rewrites every
+# module again at collection (8 s of CPU each) and each `python main.py` the tests start compiles
+# the project again (a third of its start).
+sys.dont_write_bytecode = False
 
 _databases = itertools.count(1)
 
