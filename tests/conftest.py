@@ -57,3 +57,39 @@ def pytest_runtest_setup(item: pytest.Item) -> None:
         from tests.opcua_address_space import fill_once
 
         fill_once()
+
+
+# --- longest files first ----------------------------------------------------------------------
+# Each run keeps how long each test file took (setup, call and teardown) in pytest's cache; the next
+# run starts with the longest files, so that its two workers end on short tests together instead of
+# one running a long file alone at the end. Tests of a file stay together, in their order.
+
+DURATIONS = "netplc/file_durations"
+_spent: dict[str, float] = {}
+
+
+def _file(nodeid: str) -> str:
+    return nodeid.split("::")[0]
+
+
+def pytest_collection_modifyitems(config: pytest.Config, items: list[pytest.Item]) -> None:
+    cache = getattr(config, "cache", None)  # None under -p no:cacheprovider
+    last: dict[str, float] = cache.get(DURATIONS, {}) if cache is not None else {}
+    if not last:
+        return
+    unknown = max(last.values())  # a new file may be long: it goes among the first
+    order = {}
+    for item in items:
+        order.setdefault(_file(item.nodeid), (-last.get(_file(item.nodeid), unknown), len(order)))
+    items.sort(key=lambda item: order[_file(item.nodeid)])  # stable: a file's tests keep their order
+
+
+def pytest_runtest_logreport(report: pytest.TestReport) -> None:
+    _spent[_file(report.nodeid)] = _spent.get(_file(report.nodeid), 0.0) + report.duration
+
+
+def pytest_sessionfinish(session: pytest.Session) -> None:
+    cache = getattr(session.config, "cache", None)
+    if cache is None or hasattr(session.config, "workerinput") or not _spent:
+        return  # an xdist worker's times reach the controller, which keeps them
+    cache.set(DURATIONS, {**cache.get(DURATIONS, {}), **_spent})
