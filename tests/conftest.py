@@ -1,5 +1,6 @@
 """Headless Qt for the whole suite (without it, Qt aborts the process when there is no display),
-PostgreSQL clusters, and OPC UA servers that share one fill of the standard address space."""
+bytecode caches, PostgreSQL clusters, and OPC UA servers that share one fill of the standard
+address space."""
 
 import itertools
 import os
@@ -8,6 +9,12 @@ import sys
 import pytest
 
 os.environ.setdefault("QT_QPA_PLATFORM", "offscreen")
+
+# Bytecode caches (__pycache__, ignored by git) are written even where PYTHONDONTWRITEBYTECODE is set,
+# as container images often do: without them each xdist worker compiles and assertion-rewrites every
+# module again at collection (8 s of CPU each) and each `python main.py` the tests start compiles
+# the project again (a third of its start).
+sys.dont_write_bytecode = False
 
 _databases = itertools.count(1)
 
@@ -50,3 +57,39 @@ def pytest_runtest_setup(item: pytest.Item) -> None:
         from tests.opcua_address_space import fill_once
 
         fill_once()
+
+
+# --- longest files first ----------------------------------------------------------------------
+# Each run keeps how long each test file took (setup, call and teardown) in pytest's cache; the next
+# run starts with the longest files, so that its two workers end on short tests together instead of
+# one running a long file alone at the end. Tests of a file stay together, in their order.
+
+DURATIONS = "netplc/file_durations"
+_spent: dict[str, float] = {}
+
+
+def _file(nodeid: str) -> str:
+    return nodeid.split("::")[0]
+
+
+def pytest_collection_modifyitems(config: pytest.Config, items: list[pytest.Item]) -> None:
+    cache = getattr(config, "cache", None)  # None under -p no:cacheprovider
+    last: dict[str, float] = cache.get(DURATIONS, {}) if cache is not None else {}
+    if not last:
+        return
+    unknown = max(last.values())  # a new file may be long: it goes among the first
+    order = {}
+    for item in items:
+        order.setdefault(_file(item.nodeid), (-last.get(_file(item.nodeid), unknown), len(order)))
+    items.sort(key=lambda item: order[_file(item.nodeid)])  # stable: a file's tests keep their order
+
+
+def pytest_runtest_logreport(report: pytest.TestReport) -> None:
+    _spent[_file(report.nodeid)] = _spent.get(_file(report.nodeid), 0.0) + report.duration
+
+
+def pytest_sessionfinish(session: pytest.Session) -> None:
+    cache = getattr(session.config, "cache", None)
+    if cache is None or hasattr(session.config, "workerinput") or not _spent:
+        return  # an xdist worker's times reach the controller, which keeps them
+    cache.set(DURATIONS, {**cache.get(DURATIONS, {}), **_spent})

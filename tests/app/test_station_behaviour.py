@@ -5,6 +5,7 @@ from __future__ import annotations
 
 import datetime as dt
 import itertools
+import signal
 import socket
 import sqlite3
 import subprocess
@@ -160,7 +161,7 @@ def test_no_gui_process_pulses_and_journals_what_a_modbus_client_switches(demo_c
     text = toml.read_text(encoding="utf-8").replace(server + "0", server + str(port))
     toml.write_text(text, encoding="utf-8")
     assert f"port = {port}" in toml.read_text(encoding="utf-8")
-    proc = subprocess.Popen([sys.executable, "main.py", "--no-gui", str(demo_copy), "--duration", "6"],
+    proc = subprocess.Popen([sys.executable, "main.py", "--no-gui", str(demo_copy)],
                             cwd=REPO, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
     try:
         client = ModbusTcpClient("127.0.0.1", port=port)
@@ -168,10 +169,11 @@ def test_no_gui_process_pulses_and_journals_what_a_modbus_client_switches(demo_c
         outputs = set()
         poll(lambda: not client.write_coil(PUMP, True).isError())
         deadline = time.monotonic() + 2
-        while time.monotonic() < deadline:
+        while outputs != {False, True} and time.monotonic() < deadline:
             outputs.add(client.read_coils(OUT, count=1).bits[0])
             time.sleep(0.01)
         client.close()
+        proc.send_signal(signal.SIGTERM)  # a stop as the service manager's: everything is flushed
         _, err = proc.communicate(timeout=30)
     finally:
         if proc.poll() is None:
