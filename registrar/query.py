@@ -295,6 +295,8 @@ class Archive(ArchiveReader):
         when none is), found by bisection over the primary key: the writer appends records in
         time order. A wall clock set back breaks that order; `window` still keeps to the times
         asked, but may then miss records written around the change."""
+        if not self._has(day):
+            return 1
         table = quoted(day)
         lo, hi = self._con.execute(f"SELECT min(id), max(id) FROM {table}").fetchone()
         if lo is None:

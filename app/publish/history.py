@@ -124,9 +124,9 @@ class Domain:
     count: int
 
     @property
-    def paged(self) -> bool:
-        """A count with one time only asks for that many values in all (Part 11 6.5.3.2); with both
-        times, for pages of that many."""
+    def in_all(self) -> bool:
+        """Whether `count` is the number of values asked in all: with one time only (Part 11
+        6.5.3.2); with both times it is the size of each answer."""
         return self.count > 0 and (self.start is None or self.end is None)
 
 
@@ -240,37 +240,41 @@ def read_raw(archive: Archive, key: SeriesKey, d: Domain, bounds: bool, after: P
              limit: int) -> tuple[list[Sample], Position | None]:
     """The series' records of the domain after `after`, with its bounds when asked (both times
     given): the starting one first in the first answer, the far one last."""
-    def fetch(times: tuple[int, int] | None) -> Fetch:
-        return lambda day, ids, n: archive.window(day, ids, key=key, times=times,
-                                                  newest_first=not d.forward, limit=n)
+    def fetch(times: tuple[int, int] | None, forward: bool) -> Fetch:
+        return lambda day, ids, n: archive.window(day, ids, key=key, times=times, newest_first=not forward,
+                                                  limit=n)
 
     def neighbour(first: int | None, last: int | None, forward: bool) -> Row | None:
+        """The series' first record of [first, last] in that direction (a bound)."""
         near = Domain(first, last, forward, None, None, 1)
-        rows, _ = walk(archive, near, fetch(None), None, 1)
+        rows, _ = walk(archive, near, fetch(None, forward), None, 1)
         return rows[0] if rows else None
 
     both = bounds and d.start is not None and d.end is not None and d.start != d.end
     out: list[Sample] = []
     if after is None or not after.tail:
-        first = both and after is None  # the starting bound goes first, and counts
-        rows, resume = walk(archive, d, fetch(_times(d)), after, limit - 1 if first else limit)
-        if first and not (rows and round(rows[0].ts * 1000) == d.start):
-            assert d.start is not None
-            bound = (neighbour(None, d.start - 1, False) if d.forward else neighbour(d.start + 1, None, True))
-            out.append((d.start, bound))
-        out += [(round(r.ts * 1000), r) for r in rows]
-        if resume is not None:
+        rows, resume = walk(archive, d, fetch(_times(d), d.forward), after, limit)
+        if both and after is None and not (rows and round(rows[0].ts * 1000) == d.start):
+            assert d.start is not None  # a record at the start is its own bound; else the one beyond
+            bound = neighbour(None, d.start - 1, False) if d.forward else neighbour(d.start + 1, None, True)
+            out.append(_sample(bound, d.start))
+            if len(rows) == limit:  # the bound counts: the page's last record waits for the next
+                rows.pop()
+                resume = Position(_day_of(archive, rows[-1].ts), rows[-1].id) if rows else Position()
+        out += [_sample(r) for r in rows]
+        if resume is not None or not both:
             return out, resume
-        if not both:
-            return out, None
         if len(out) >= limit:  # the far bound in an answer of its own
-            last = rows[-1] if rows else None
-            day = _day_of(archive, last.ts) if last else (after.day if after else 0)
-            return out, Position(day, last.id if last else (after.id if after else 0), True)
+            return out, Position(tail=True)
     assert d.end is not None
     far = neighbour(d.end, None, True) if d.forward else neighbour(None, d.end, False)
-    out.append((d.end, far))
+    out.append(_sample(far, d.end))
     return out, None
+
+
+def _sample(row: Row | None, missing: int = 0) -> Sample:
+    """A record as a sample at its time; none at all (no bound found) at the time `missing`."""
+    return (missing, None) if row is None else (round(row.ts * 1000), row)
 
 
 def read_journal(archive: Archive, d: Domain, after: Position | None, limit: int,
@@ -393,7 +397,7 @@ class StationHistory(HistoryManager):
                 return _failed(_S.BadContinuationPointInvalid)
         cap = MAX_VALUES if raw else MAX_EVENTS
         taken = after.taken if after is not None else 0
-        limit = min(cap, d.count - taken) if d.paged else min(cap, d.count or cap)
+        limit = min(cap, d.count - taken) if d.in_all else min(cap, d.count or cap)
         try:
             if series is not None:
                 result, resume, n = await self._run(self._raw, series, d, details.ReturnBounds, after, limit,
@@ -404,7 +408,7 @@ class StationHistory(HistoryManager):
             logger.exception("history of %s not read from %s", rv.NodeId.to_string(),
                              self.archived.path if self.archived else "no archive")
             return _failed(_S.BadNoData if isinstance(e, FileNotFoundError) else _S.BadInternalError)
-        if resume is not None and d.paged and taken + n >= d.count:
+        if resume is not None and d.in_all and taken + n >= d.count:
             resume = None  # the count asked for is reached
         point = None if resume is None else \
             Position(resume.day, resume.id, resume.tail, taken + n).pack(check)

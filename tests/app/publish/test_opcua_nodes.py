@@ -43,8 +43,10 @@ def demo_tags() -> list[dict[str, str]]:
 
 def test_unece_units() -> None:
     assert unit_id("CEL") == CELSIUS and unit_id("P1") == PERCENT and unit_id("2N") == 12878
-    assert eu_information("°C").UnitId == CELSIUS and eu_information("°C").Description.Text == "degree Celsius"
-    assert eu_information("кПа").UnitId == unit_id("KPA") and eu_information("об/мин").UnitId == unit_id("RPM")
+    celsius = eu_information("°C")
+    assert celsius.UnitId == CELSIUS and celsius.Description.Text == "degree Celsius"
+    assert eu_information("кПа").UnitId == unit_id("KPA")
+    assert eu_information("об/мин").UnitId == unit_id("RPM")
     assert eu_information("м3/ч").UnitId == eu_information("m³/h").UnitId == unit_id("MQH")
     unknown = eu_information("попугаи")
     assert (unknown.UnitId, unknown.DisplayName.Text, unknown.Description.Text) == (-1, "попугаи", "попугаи")
@@ -114,7 +116,8 @@ def test_every_node_of_the_station_has_a_string_nodeid_and_a_plain_browse_name(
             objects = client.nodes.objects
             priority = await objects.get_child([f"{ns}:Demo station", f"{ns}:Alarms", f"{ns}:LEVEL.H",
                                                 f"{ns}:Priority"])
-            eu_range = await objects.get_child([f"{ns}:Demo station", f"{ns}:Tags", f"{ns}:LEVEL", "0:EURange"])
+            eu_range = await objects.get_child([f"{ns}:Demo station", f"{ns}:Tags", f"{ns}:LEVEL",
+                                                "0:EURange"])
         return bad, priority.nodeid, eu_range.nodeid
 
     bad, priority, eu_range = run(go())
