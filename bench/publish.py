@@ -234,7 +234,7 @@ async def opcua_client(url: str, seconds: float, station_name: str) -> None:
             nonlocal count
             count += 1
 
-    async with Client(url, timeout=120) as client:
+    async with Client(url, timeout=120, watchdog_intervall=60) as client:
         ns = await client.get_namespace_index(f"urn:netplc:station:{station_name}")
         nodes = [client.get_node(ua.NodeId(f"Tags.T{i:05d}", ns)) for i in range(TAGS)]
         t0 = time.perf_counter()

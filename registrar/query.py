@@ -289,6 +289,57 @@ class Archive(ArchiveReader):
         values = np.where(data["gap"], np.nan, data["value"])
         return thinned(data["ts"] / 1000.0, values, points)
 
+    # --- time windows, for Historical Access (app/publish/history.py) ---------------------------
+
+    def first_at(self, day: dt.date, ts_ms: int) -> int:
+        """The smallest id of the day whose record is at or after `ts_ms` (one past its last id
+        when none is), found by bisection over the primary key: the writer appends records in
+        time order. A wall clock set back breaks that order; `window` still keeps to the times
+        asked, but may then miss records written around the change."""
+        if not self._has(day):
+            return 1
+        table = quoted(day)
+        lo, hi = self._con.execute(f"SELECT min(id), max(id) FROM {table}").fetchone()
+        if lo is None:
+            return 1
+        hi += 1
+        while lo < hi:
+            mid = (lo + hi) // 2
+            at, ts = self._con.execute(f"SELECT id, ts FROM {table} WHERE id >= ? ORDER BY id LIMIT 1",
+                                       (mid,)).fetchone()
+            if ts >= ts_ms:
+                hi = mid
+            else:
+                lo = at + 1
+        return lo
+
+    def window(self, day: dt.date, ids: tuple[int, int], *, kinds: tuple[str, ...] = (),
+               key: SeriesKey | None = None, times: tuple[int, int] | None = None,
+               newest_first: bool = False, limit: int = 1) -> list[Row]:
+        """Up to `limit` records of the day with ids[0] <= id < ids[1], of `kinds`, of the series
+        `key` (kind, grp, type and source) when given, with times[0] <= ts <= times[1] (ms) when
+        given, in id order. A series is read through the key index (its rows come out in id
+        order); other records by the primary key alone (their window is bounded by the caller)."""
+        if not self._has(day) or ids[0] >= ids[1] or limit <= 0:
+            return []
+        conds = ["id >= ?", "id < ?"]
+        args: list[object] = [*ids]
+        if key is not None:
+            conds += ["kind = ?", "grp = ?", "type = ?", "source = ?"]
+            args += [key.kind, key.grp, key.type, key.source]
+            source = ""
+        else:
+            conds.append(f"kind IN ({', '.join('?' * len(kinds))})")
+            args += kinds
+            source = " NOT INDEXED"
+        if times is not None:
+            conds.append("ts BETWEEN ? AND ?")
+            args += times
+        order = "DESC" if newest_first else "ASC"
+        return [self._row(r) for r in self._con.execute(
+            f"{_SELECT} FROM {quoted(day)}{source} WHERE {' AND '.join(conds)} ORDER BY id {order} LIMIT ?",
+            [*args, limit])]
+
     # --- helpers -------------------------------------------------------------------------------
 
     def _row(self, r: tuple) -> Row:

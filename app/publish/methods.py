@@ -72,9 +72,15 @@ class StationMethods:
             args = [ua.Argument(Name=name, DataType=ua.NodeId(kind), ValueRank=-1,
                                 Description=ua.LocalizedText(text)) for name, text, kind in method.inputs]
             nodeid, name = ua.NodeId(f"Station.{method.name}", idx), ua.QualifiedName(method.name, idx)
-            node = await parent.add_method(nodeid, name, _not_through_a_session, args, [])
+            node = await parent.add_method(nodeid, name, _not_through_a_session, [], [])
             await node.write_attribute(ua.AttributeIds.Description,
                                        ua.DataValue(ua.Variant(ua.LocalizedText(method.description))))
+            if args:  # made here, not by asyncua, for a NodeId that stays the same at every start
+                prop = await node.add_property(ua.NodeId(f"Station.{method.name}.InputArguments", idx),
+                                               ua.QualifiedName("InputArguments", 0), args,
+                                               ua.VariantType.ExtensionObject, ua.ObjectIds.Argument)
+                await prop.write_value_rank(ua.ValueRank.OneDimension)
+                await prop.write_array_dimensions([len(args)])
             self.by_node[node.nodeid] = method
 
     def executable(self, who: Who, nodeid: ua.NodeId) -> bool | None:

@@ -58,17 +58,29 @@ from asyncua.common.utils import ServiceError
 from asyncua.crypto.permission_rules import SimpleRoleRuleset, User, UserRole
 from asyncua.crypto.security_policies import SecurityPolicyBasic256Sha256, SecurityPolicyFactory
 
-from app.authority import Action, Commands, Reason, Source, Ticket, Who, write_range
+from app.authority import Action, Commands, Reason, Source, Ticket, Who
 from app.authority.logins import Logins
 from app.authority.users import UserError, Users
 from app.publish.feed import LatestReadings, Watch
+from app.publish.history import Archived, Series, StationHistory, install, series_of
 from app.publish.methods import StationMethods, StepLock
 from app.publish.pki import TrustList, host_names, station_certificate, subject, thumbprint
 from app.publish.points import PointReader, PointWriter, Writable
+from app.publish.ua_types import (
+    CODES,
+    HISTORY_READ,
+    READ,
+    SEVERITY,
+    WRITE,
+    TagNode,
+    build_info,
+    python,
+    tag_items,
+    variant_type,
+)
 from app.scada.alarms import PRIORITIES, Alarm, State
-from app.scada.quality import Quality
 from app.scada.readings import Readings
-from app.scada.tag import Tag, TagType
+from app.scada.tag import Tag
 from app.station.config import OpcUaSettings
 from netplc.address import DATA_SIZE, IO_BITS, fmt_octal
 from netplc.forcing import Force
@@ -78,13 +90,6 @@ from netplc.records import Record
 logger = logging.getLogger(__name__)
 
 START_TIMEOUT = 60.0
-UNECE_UNITS = "http://www.opcfoundation.org/UA/units/un/cefact"
-STATUS = {Quality.GOOD: ua.StatusCodes.Good, Quality.INITIAL: ua.StatusCodes.BadWaitingForInitialData,
-          Quality.STALE: ua.StatusCodes.UncertainLastUsableValue,
-          Quality.COMM_FAIL: ua.StatusCodes.BadCommunicationError,
-          Quality.NOT_RUNNING: ua.StatusCodes.BadOutOfService,
-          Quality.FORCED: ua.StatusCodes.GoodLocalOverride}
-CODES = [ua.StatusCode(STATUS[q]) for q in Quality]  # by quality code
 _S = ua.StatusCodes
 ANSWERS = {Reason.APPLIED: _S.Good, Reason.DENIED: _S.BadUserAccessDenied,  # by the layer's Reason
            Reason.NOT_WRITABLE: _S.BadNotWritable, Reason.UNKNOWN: _S.BadNodeIdUnknown,
@@ -92,9 +97,7 @@ ANSWERS = {Reason.APPLIED: _S.Good, Reason.DENIED: _S.BadUserAccessDenied,  # by
            Reason.INVALID: _S.BadInvalidArgument, Reason.BUSY: _S.BadTooManyOperations,
            Reason.JOURNAL_FULL: _S.BadResourceUnavailable, Reason.NOT_RUNNING: _S.BadServerHalted,
            Reason.FAILED: _S.BadInternalError}
-READ, WRITE = 1 << ua.AccessLevel.CurrentRead, 1 << ua.AccessLevel.CurrentWrite
 YIELD_EVERY = 500  # variable writes between two turns of the event loop
-SEVERITY = {1: 900, 2: 700, 3: 500, 4: 300}  # alarm priority -> OPC UA severity 1-1000
 READABLE_WITHIN = 2.0  # s at most an applied write waits for its value to be readable here
 MEMORY_BITS = "NetPlc's I/O bits 00000-03777, one byte each (0 or 1): byte n is bit n"
 MEMORY_DATA = ("NetPlc's data memory, its 8 banks of 2 KB in turn: byte k*2048 + i is address "
@@ -113,14 +116,6 @@ def is_loopback(endpoint: str) -> bool:
         return False
 
 
-def variant_type(tag: Tag) -> ua.VariantType:
-    if tag.scaling is not None:
-        return ua.VariantType.Double
-    return {TagType.BIT: ua.VariantType.Boolean, TagType.WORD: ua.VariantType.UInt16,
-            TagType.INT16: ua.VariantType.Int16, TagType.BCD: ua.VariantType.UInt16,
-            TagType.INT32: ua.VariantType.Int32, TagType.FLOAT32: ua.VariantType.Float}[tag.type]
-
-
 def forces_json(forces: Sequence[Force]) -> str:
     return json.dumps([{"kind": f.kind, "address": fmt_octal(f.addr), "value": f.value, "user": f.user}
                        for f in forces])
@@ -130,14 +125,6 @@ ENCODE: tuple[Callable[[Any], ua.Variant], ...] = (  # the memory variables' val
     lambda bits: ua.Variant(bytes(bits), ua.VariantType.ByteString),  # bits, data and forces
     lambda data: ua.Variant(data, ua.VariantType.ByteString),
     lambda forces: ua.Variant(forces_json(forces)))
-
-
-def _python(kind: ua.VariantType) -> Callable[[float], Any]:
-    if kind is ua.VariantType.Boolean:
-        return bool
-    if kind in (ua.VariantType.Double, ua.VariantType.Float):
-        return float
-    return int
 
 
 def _peer(name: object) -> str:
@@ -230,12 +217,16 @@ class OpcUaServer:
     def __init__(self, *, settings: OpcUaSettings, station: str, folder: Path, tags: Sequence[Tag],
                  commands: Commands, watch: Watch, engine: Any, exchange: Any, alarms: Sequence[Alarm] = (),
                  journal: Callable[[str], None] = lambda _text: None,
-                 step_lock: StepLock = lambda: None) -> None:
+                 step_lock: StepLock = lambda: None, archived: Archived | None = None,
+                 language: str = "") -> None:
         """`journal` takes the system records of the server's security (a certificate made or
         made private, a client certificate refused); `step_lock` gives the scan thread's lock, which
-        the Step method needs."""
+        the Step method needs; `archived` what the station archives, for Historical Access;
+        `language` the station's (a bit's TrueState and FalseState are in it)."""
         self.endpoint = settings.endpoint
         self.settings = settings
+        self.archived = archived
+        self.language = language
         self.station = station
         self.folder = folder
         self.tags = list(tags)
@@ -315,7 +306,12 @@ class OpcUaServer:
         server = Server(user_manager=self.users)
         await server.init()
         server.set_endpoint(self.endpoint)
-        server.set_server_name(f"NetPlc Station {self.station}")
+        build = build_info()
+        server.set_server_name(f"{build.product} {self.station}")  # the ApplicationName
+        server.product_uri, server.manufacturer_name = build.product_uri, build.manufacturer
+        server.application_type = ua.ApplicationType.Server
+        await server.set_build_info(build.product_uri, build.manufacturer, build.product, build.version,
+                                    build.build_number, build.build_date)
         uri = f"urn:netplc:station:{self.station}"
         await server.set_application_uri(uri)
         if self.secure:
@@ -384,77 +380,90 @@ class OpcUaServer:
     async def _build(self, server: Server, uri: str) -> None:
         idx = await server.register_namespace(uri)
         self.idx = idx
-        station = await server.nodes.objects.add_object(ua.NodeId(self.station, idx), f"{idx}:{self.station}")
+
+        def name(text: str) -> ua.QualifiedName:
+            return ua.QualifiedName(text, idx)
+
+        station = await server.nodes.objects.add_object(ua.NodeId(self.station, idx), name(self.station))
         self.station_node = station
-        folder = await station.add_folder(ua.NodeId("Tags", idx), f"{idx}:Tags")
+        folder = await station.add_folder(ua.NodeId("Tags", idx), name("Tags"))
         self.kinds = [variant_type(t) for t in self.tags]
-        self.convert = [_python(k) for k in self.kinds]
-        self.nodeids: list[ua.NodeId] = []
-        self.position: dict[ua.NodeId, int] = {}  # a tag variable's index in `tags`
-        # asyncua checks each new child against all of its parent's references (quadratic: a
-        # minute for 10,000 tags); tag names are unique, so each tag is added to a folder whose
-        # reference list is set aside meanwhile and put back with the new reference appended.
-        folder_data = server.iserver.aspace.get(folder.nodeid)
-        references = folder_data.references
-        for i, (tag, kind) in enumerate(zip(self.tags, self.kinds)):
-            nodeid = ua.NodeId(f"Tags.{tag.name}", idx)
-            initial = ua.DataValue(ua.Variant(self.convert[i](0), kind),
-                                   StatusCode=ua.StatusCode(ua.StatusCodes.BadWaitingForInitialData))
-            folder_data.references = []
-            try:
-                var = await folder.add_variable(nodeid, f"{idx}:{tag.name}", initial, kind)
-            finally:
-                references.extend(folder_data.references)
-                folder_data.references = references
-            if tag.description:
-                await var.write_attribute(ua.AttributeIds.Description,
-                                          ua.DataValue(ua.Variant(ua.LocalizedText(tag.description))))
-            if self.writable(tag.name):  # what a client may write at all; UserAccessLevel per session
-                await var.write_attribute(ua.AttributeIds.AccessLevel,
-                                          ua.DataValue(ua.Variant(READ | WRITE, ua.VariantType.Byte)))
-            if tag.type is not TagType.BIT:
-                unit = ua.LocalizedText(tag.unit)
-                eu = ua.EUInformation(NamespaceUri=UNECE_UNITS, UnitId=-1, DisplayName=unit, Description=unit)
-                await var.add_property(ua.NodeId(f"Tags.{tag.name}.EngineeringUnits", idx),
-                                       ua.QualifiedName("EngineeringUnits", 0), eu,
-                                       datatype=ua.NodeId(ua.ObjectIds.EUInformation))
-                lo, hi = write_range(tag)  # PhyMin..PhyMax: what a client may write
-                await var.add_property(ua.NodeId(f"Tags.{tag.name}.EURange", idx),
-                                       ua.QualifiedName("EURange", 0), ua.Range(Low=lo, High=hi),
-                                       datatype=ua.NodeId(ua.ObjectIds.Range))
-            self.nodeids.append(nodeid)
-            self.position[nodeid] = i
+        self.convert = [python(k) for k in self.kinds]
+        self.nodeids = [ua.NodeId(f"Tags.{t.name}", idx) for t in self.tags]
+        self.position = {nodeid: i for i, nodeid in enumerate(self.nodeids)}  # a tag variable's index
+        nstore = self.archived.nstore if self.archived is not None else {}
+        self.series: dict[ua.NodeId, Series] = {
+            nodeid: series for tag, kind, nodeid in zip(self.tags, self.kinds, self.nodeids)
+            if (series := series_of(tag, kind, nstore)) is not None}
+        await self._add_tags(server, folder.nodeid)
         self._last_values = np.full(len(self.tags), np.nan)
         self._last_quality = np.full(len(self.tags), -1, dtype=np.int8)
-        plc = await station.add_object(ua.NodeId("NetPlc", idx), f"{idx}:NetPlc")
-        self.plc_state = await plc.add_variable(ua.NodeId("NetPlc.State", idx), f"{idx}:State", "")
-        self.plc_scan_ms = await plc.add_variable(ua.NodeId("NetPlc.ScanTimeMs", idx), f"{idx}:ScanTimeMs",
+        plc = await station.add_object(ua.NodeId("NetPlc", idx), name("NetPlc"))
+        self.plc_state = await plc.add_variable(ua.NodeId("NetPlc.State", idx), name("State"), "")
+        self.plc_scan_ms = await plc.add_variable(ua.NodeId("NetPlc.ScanTimeMs", idx), name("ScanTimeMs"),
                                                   0.0)
-        self.plc_tick = await plc.add_variable(ua.NodeId("NetPlc.Tick", idx), f"{idx}:Tick",
+        self.plc_tick = await plc.add_variable(ua.NodeId("NetPlc.Tick", idx), name("Tick"),
                                                ua.Variant(0, ua.VariantType.UInt64))
-        await plc.add_variable(ua.NodeId("NetPlc.NetSyncTimeMs", idx), f"{idx}:NetSyncTimeMs",
+        await plc.add_variable(ua.NodeId("NetPlc.NetSyncTimeMs", idx), name("NetSyncTimeMs"),
                                ua.Variant(round(self.engine.tick * 1000), ua.VariantType.UInt32))
         await self._add_memory(plc, idx)
-        nodes = await station.add_folder(ua.NodeId("Nodes", idx), f"{idx}:Nodes")
+        nodes = await station.add_folder(ua.NodeId("Nodes", idx), name("Nodes"))
         self.node_vars: dict[int, dict[str, Any]] = {}
         for n, stats in (self.exchange.stats.items() if self.exchange is not None else ()):
-            obj = await nodes.add_object(ua.NodeId(f"Nodes.{n}", idx), f"{idx}:{n}")
-            await obj.add_variable(ua.NodeId(f"Nodes.{n}.Endpoint", idx), f"{idx}:Endpoint", stats.endpoint)
+            obj = await nodes.add_object(ua.NodeId(f"Nodes.{n}", idx), name(str(n)))
+            await obj.add_variable(ua.NodeId(f"Nodes.{n}.Endpoint", idx), name("Endpoint"), stats.endpoint)
             self.node_vars[n] = {
-                key: await obj.add_variable(ua.NodeId(f"Nodes.{n}.{key}", idx), f"{idx}:{key}", value)
+                key: await obj.add_variable(ua.NodeId(f"Nodes.{n}.{key}", idx), name(key), value)
                 for key, value in (("Up", False), ("Reads", ua.Variant(0, ua.VariantType.UInt64)),
                                    ("Writes", ua.Variant(0, ua.VariantType.UInt64)),
                                    ("Errors", ua.Variant(0, ua.VariantType.UInt64)), ("LastError", ""))}
-        alarms = await station.add_folder(ua.NodeId("Alarms", idx), f"{idx}:Alarms")
+        alarms = await station.add_folder(ua.NodeId("Alarms", idx), name("Alarms"))
         self.alarm_vars = {}
         for alarm in self.alarms:
-            var = await alarms.add_variable(ua.NodeId(f"Alarms.{alarm.id}", idx), f"{idx}:{alarm.id}",
+            var = await alarms.add_variable(ua.NodeId(f"Alarms.{alarm.id}", idx), name(alarm.id),
                                             alarm.state.word)
-            await var.add_property(idx, f"{idx}:Priority", PRIORITIES.get(alarm.defn.priority, ""))
-            await var.add_property(idx, f"{idx}:Text", alarm.defn.text)
+            await var.add_property(ua.NodeId(f"Alarms.{alarm.id}.Priority", idx), name("Priority"),
+                                   PRIORITIES.get(alarm.defn.priority, ""))
+            await var.add_property(ua.NodeId(f"Alarms.{alarm.id}.Text", idx), name("Text"), alarm.defn.text)
             self.alarm_vars[alarm.id] = var
         self.events = await server.get_event_generator(ua.ObjectIds.BaseEventType, station)
         await self.methods.add(station, idx)
+        # after the event generator, which sets the station's EventNotifier
+        notifiers = [ua.NodeId(ua.ObjectIds.Server), station.nodeid] if self.archived is not None else []
+        await install(server, StationHistory(server.iserver, self.archived, self.series, notifiers))
+
+    async def _add_tags(self, server: Server, folder: ua.NodeId) -> None:
+        """The tags' variables, of their standard types with their properties (ua_types.py), added
+        as one batch of nodes. asyncua checks each new child against all of its parent's references
+        (quadratic: a minute for 10,000 tags); tag names are unique, so each tag is added to a
+        folder whose reference list is set aside meanwhile and put back with the new reference
+        appended."""
+        service = server.iserver.node_mgt_service
+        folder_data = server.iserver.aspace.get(folder)
+        references = folder_data.references
+        properties: list[ua.AddNodesItem] = []
+        for tag, nodeid, kind in zip(self.tags, self.nodeids, self.kinds):
+            archived = nodeid in self.series
+            # what a client may do at all; UserAccessLevel is answered per session
+            access = READ | (WRITE if self.writable(tag.name) else 0) | (HISTORY_READ if archived else 0)
+            node = TagNode(tag, nodeid, kind, access, archived)
+            variable, children = tag_items(node, folder, self.language)
+            folder_data.references = []
+            try:
+                added = service.add_nodes([variable])
+            finally:
+                references.extend(folder_data.references)
+                folder_data.references = references
+            added[0].StatusCode.check()
+            properties += children
+        for result in service.add_nodes(properties):
+            result.StatusCode.check()
+        write = server.iserver.aspace.write_attribute_value
+        now = datetime.now(UTC)
+        waiting = ua.StatusCode(ua.StatusCodes.BadWaitingForInitialData)
+        for nodeid in self.nodeids:
+            await write(nodeid, ua.AttributeIds.Value,
+                        ua.DataValue(StatusCode=waiting, SourceTimestamp=now, ServerTimestamp=now))
 
     async def _add_memory(self, plc: Node, idx: int) -> None:
         """NetPlc's memory and forces, read-only, for a remote Program view (`main.py monitor
@@ -473,14 +482,15 @@ class OpcUaServer:
         self.memory_nodes = nodes
         self._memory: tuple[object, ...] = (None, None, None)  # bits, data, forces as last written
 
-    async def _publish_memory(self, snapshot: Snapshot, when: datetime) -> None:
+    async def _publish_memory(self, snapshot: Snapshot, when: datetime, now: datetime) -> None:
         """The memory variables as of `snapshot`, each written only when it changed."""
         write = self.server.iserver.aspace.write_attribute_value
-        now = (snapshot.bits, snapshot.data, snapshot.forces)
-        for node, new, old, encode in zip(self.memory_nodes, now, self._memory, ENCODE):
+        memory = (snapshot.bits, snapshot.data, snapshot.forces)
+        for node, new, old, encode in zip(self.memory_nodes, memory, self._memory, ENCODE):
             if new is not old and new != old:
-                await write(node, ua.AttributeIds.Value, ua.DataValue(encode(new), SourceTimestamp=when))
-        self._memory = now
+                await write(node, ua.AttributeIds.Value,
+                            ua.DataValue(encode(new), SourceTimestamp=when, ServerTimestamp=now))
+        self._memory = memory
 
     async def _publish(self, readings: Readings) -> None:
         reading = self.reader.read(readings)
@@ -489,7 +499,8 @@ class OpcUaServer:
         changed = np.flatnonzero(~((values == last) | (np.isnan(values) & np.isnan(last)))
                                  | (quality != self._last_quality))
         self._last_values, self._last_quality = values, quality
-        when = datetime.fromtimestamp(reading.wall, UTC)
+        when = datetime.fromtimestamp(reading.wall, UTC)  # the scan's: the source timestamp
+        now = datetime.now(UTC)  # when the server took it: the server timestamp
         write = self.server.iserver.aspace.write_attribute_value
         value_attr = ua.AttributeIds.Value
         for n, i in enumerate(changed.tolist()):
@@ -499,13 +510,13 @@ class OpcUaServer:
             code = CODES[quality[i]]
             if math.isnan(v):  # a BCD word that is not BCD
                 dv = ua.DataValue(StatusCode=ua.StatusCode(ua.StatusCodes.BadOutOfRange),
-                                  SourceTimestamp=when)
+                                  SourceTimestamp=when, ServerTimestamp=now)
             else:
                 dv = ua.DataValue(ua.Variant(self.convert[i](v), self.kinds[i]), StatusCode=code,
-                                  SourceTimestamp=when)
+                                  SourceTimestamp=when, ServerTimestamp=now)
             await write(self.nodeids[i], value_attr, dv)
         self.status.updates += len(changed)
-        await self._publish_memory(readings.snapshot, when)  # before the tick that says which scan
+        await self._publish_memory(readings.snapshot, when, now)  # before the tick that says which scan
         await self.plc_state.write_value(reading.state)
         await self.plc_scan_ms.write_value(float(self.engine.stats.last_ms))
         await self.plc_tick.write_value(ua.Variant(reading.scan, ua.VariantType.UInt64))
@@ -598,7 +609,7 @@ class OpcUaServer:
 
     def _user_access_level(self, event: ServerItemCallback, _service: object) -> None:
         """A tag's UserAccessLevel and a station method's UserExecutable as the policy answers
-        for the session's user."""
+        for the session's user (every user may read a tag and its history)."""
         if not event.is_external:
             return
         may: bool | None = None
@@ -615,7 +626,7 @@ class OpcUaServer:
             i = self.position.get(rv.NodeId)
             if i is None:
                 continue
-            level = READ
+            level = READ | (HISTORY_READ if rv.NodeId in self.series else 0)  # history: every user
             if self.writable(self.tags[i].name):
                 if may is None:
                     may = self.commands.may(Who(user, Source.OPCUA), Action.WRITE)

@@ -9,6 +9,7 @@ from typing import TYPE_CHECKING, Any, Protocol
 
 from app.authority import Source
 from app.publish.points import published_tags
+from app.scada.series import nstore_keys
 
 if TYPE_CHECKING:
     from app.station.runtime import Runtime
@@ -27,14 +28,19 @@ def start_publishers(runtime: Runtime) -> list[Publisher]:
     tags = published_tags(runtime.tags.tags, runtime.symbols)
     started: list[Publisher] = []
     if st.opcua.enabled:
+        from app.publish.history import Archived
         from app.publish.opcua import OpcUaServer  # asyncua loads only for a station that serves OPC UA
 
         # the alarms' identities and states as the station starts; their transitions follow as records
         alarms = runtime.alarm_definitions()
+        # the history is the local archive's (where `Archive` names a plant archive the station still
+        # writes its own first: that is the one read here)
+        archived = Archived(st.Archive, nstore_keys(runtime.program))
         server = OpcUaServer(settings=st.opcua, station=st.name, folder=st.folder, tags=tags,
                              commands=runtime.commands, watch=runtime.watch, engine=runtime.engine,
                              exchange=runtime.exchange, alarms=alarms, journal=runtime.system,
-                             step_lock=lambda: runtime.scan_thread.lock if runtime.scan_thread else None)
+                             step_lock=lambda: runtime.scan_thread.lock if runtime.scan_thread else None,
+                             archived=archived, language=st.Language)
         try:
             server.start()
         except (OSError, RuntimeError) as e:

@@ -19,13 +19,23 @@ import numpy as np
 
 from app.scada.quality import HELD_CODES, LinkView, Quality, QualityMap
 from app.scada.tag import Tag, TagType
-from netplc.address import fmt_octal
+from netplc.address import fmt_octal, parse_octal
 from netplc.memory import MemoryView
 from netplc.program import Program
 from netplc.records import Record
 
 NSTORE = 304
 GAP_WORDS = tuple(q.word for q in Quality if q.held)  # a data record with one of these is no point
+
+
+def nstore_keys(program: Program) -> dict[str, set[tuple[int | None, int | None]]]:
+    """The series the program's NSTOREs write: the source of their records (the octal address
+    of the word stored) -> their (group, type)."""
+    keys: dict[str, set[tuple[int | None, int | None]]] = {}
+    for ins in program.instrs:
+        if ins.op == "FON" and ins.n == NSTORE and ins.s is not None:
+            keys.setdefault(fmt_octal(ins.s), set()).add((ins.d, ins.r))
+    return keys
 
 
 class SeriesQuality:
@@ -36,13 +46,9 @@ class SeriesQuality:
     def __init__(self, program: Program, regdata: Mapping[str, Sequence[tuple[int, int]]]) -> None:
         """`regdata`: a RegData element's name (the `source` of its records) -> its operands as
         (address, bytes), bytes 0 for one HMI bit (`Element.sources()`)."""
-        operands: dict[str, Sequence[tuple[int, int]]] = {}
-        self.keys: dict[str, set[tuple[int | None, int | None]]] = {}  # source -> (grp, type)
-        for ins in program.instrs:
-            if ins.op == "FON" and ins.n == NSTORE and ins.s is not None:
-                source = fmt_octal(ins.s)
-                operands[source] = ((ins.s, 2),)
-                self.keys.setdefault(source, set()).add((ins.d, ins.r))
+        self.keys = nstore_keys(program)  # source -> (grp, type); RegData's below
+        operands: dict[str, Sequence[tuple[int, int]]] = {
+            source: ((parse_octal(source), 2),) for source in self.keys}
         for name, sources in regdata.items():
             if sources:
                 operands[name] = sources

@@ -9,7 +9,7 @@ import pytest
 
 from netplc.records import Record
 from registrar.catalog import Catalog, Message
-from registrar.query import Archive, Filter
+from registrar.query import Archive, Filter, SeriesKey
 from registrar.store import Store
 
 from .conftest import wait_for
@@ -341,3 +341,35 @@ def test_a_long_series_from_the_minute_summary_keeps_its_gaps(db, monkeypatch):
         ts, values = a.series(DAY, grp=1, type=1, source="04010")
     assert list(ts[np.isnan(values)] - T0) == [10.0, 21.0]
     assert list(values[~np.isnan(values)]) == [0.0, 99.0]  # the minute's extremes; frozen values none
+
+
+
+def test_time_windows_by_bisection_over_ids(db):
+    """first_at: the first id at or after a time; window: a series' or the journal's records of an
+    id range, in id order either way, within times when given (Historical Access reads by them;
+    the local archive only: the plant archive is not read that way)."""
+    records = []
+    for i in range(300):
+        records.append(Record(T0 + i, "data", 1, 1, "04010", value=float(i)))
+        if i % 10 == 0:
+            records.append(Record(T0 + i, "message", 1, 0, number=1))
+    records.append(Record(T0 + 400, "operator", source="ivanov", text="write 04030: 0 -> 7"))
+    write(db, records)
+    key = SeriesKey("data", 1, 1, "04010")
+    with Archive(db) as archive:
+        ids = [r.id for r in archive.window(DAY, (0, 1 << 40), key=key, limit=1000)]
+        assert len(ids) == 300 and ids == sorted(ids)
+        assert archive.first_at(DAY, round(T0 * 1000)) == ids[0]
+        assert archive.first_at(DAY, round((T0 + 9.5) * 1000)) == ids[10]
+        assert archive.first_at(DAY, round((T0 + 10) * 1000)) == ids[10]
+        assert archive.first_at(DAY, round((T0 + 1000) * 1000)) == ids[-1] + 2  # past the operator's
+        lo = archive.first_at(DAY, round((T0 + 100) * 1000))
+        hi = archive.first_at(DAY, round((T0 + 110) * 1000))
+        series = archive.window(DAY, (lo, hi), key=key, newest_first=True, limit=5)
+        assert [r.value for r in series] == [109.0, 108.0, 107.0, 106.0, 105.0]
+        journal = archive.window(DAY, (lo, hi), kinds=("message",), limit=10)
+        assert [(r.kind, r.ts) for r in journal] == [("message", T0 + 100)]
+        timed = archive.window(DAY, (0, 1 << 40), kinds=("message", "operator"), limit=100,
+                               times=(round((T0 + 250) * 1000), round((T0 + 400) * 1000)))
+        assert [r.ts - T0 for r in timed] == [250, 260, 270, 280, 290, 400]
+        assert archive.first_at(DAY - dt.timedelta(days=3), 0) == 1  # no such day

@@ -17,7 +17,7 @@ from app.authority.users import Users
 from app.station.runtime import Runtime
 from tests.app.publish.conftest import STATION_URI, demo_with, free_port, opcua_client, tag_node
 
-READ, WRITE = 1, 2  # AccessLevel bits CurrentRead, CurrentWrite
+READ, WRITE, HISTORY = 1, 2, 4  # AccessLevel bits CurrentRead, CurrentWrite, HistoryRead
 
 
 @pytest.fixture
@@ -158,10 +158,11 @@ def test_user_access_level_follows_the_sessions_role(station: tuple[Runtime, str
                     (await node.read_attribute(ua.AttributeIds.UserAccessLevel)).Value.Value
             return out
 
-    assert run(levels(None)) == {"TEMP_SP": (READ | WRITE, READ), "LEVEL": (READ, READ)}
-    assert run(levels("viewer", "viewer")) == {"TEMP_SP": (READ | WRITE, READ), "LEVEL": (READ, READ)}
-    assert run(levels("operator", "operator")) == {"TEMP_SP": (READ | WRITE, READ | WRITE),
-                                                   "LEVEL": (READ, READ)}
+    # both are archived (NSTORE): every user may read their history
+    read, both = READ | HISTORY, READ | HISTORY | WRITE
+    assert run(levels(None)) == {"TEMP_SP": (both, read), "LEVEL": (read, read)}
+    assert run(levels("viewer", "viewer")) == {"TEMP_SP": (both, read), "LEVEL": (read, read)}
+    assert run(levels("operator", "operator")) == {"TEMP_SP": (both, both), "LEVEL": (read, read)}
     users = Users(runtime.station.folder)  # demoted while the server runs: counts at the next read
     users.remove("operator")
     users.add("operator", "viewer", "operator")
@@ -172,4 +173,4 @@ def test_user_access_level_follows_the_sessions_role(station: tuple[Runtime, str
             before = (await node.read_attribute(ua.AttributeIds.UserAccessLevel)).Value.Value
             return before, await write(client, "TEMP_SP", ua.Variant(20.0, ua.VariantType.Double))
 
-    assert run(demoted()) == (READ, ua.StatusCodes.BadUserAccessDenied)
+    assert run(demoted()) == (read, ua.StatusCodes.BadUserAccessDenied)

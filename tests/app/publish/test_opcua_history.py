@@ -1,0 +1,295 @@
+"""Historical Access (OPC UA Part 11) from the station's archive, read with a standard client
+(asyncua's): the raw values of an archived tag in physical units with their quality, in pages with
+continuation points that give every value exactly once, bounds, backward reads; the journal as
+events at the station object and the Server object; Bad_HistoryOperationUnsupported elsewhere.
+
+The archive is filled before the station starts with a minute of LEVEL's NSTORE series (5 values a
+second, one of them a gap, one stale) and journal records, all before `T`; every read ends at `T`,
+so what the running station adds after it changes no answer."""
+
+from __future__ import annotations
+
+import asyncio
+import time
+from collections.abc import Iterator
+from datetime import UTC, datetime
+
+import pytest
+from asyncua import Client, ua
+from asyncua.common.events import get_filter_from_event_type
+
+from app.scada.alarms import State
+from app.station.runtime import Runtime
+from netplc.records import Record
+from registrar.store import Store
+from tests.app.conftest import copy_demo
+from tests.app.publish.conftest import STATION_URI, demo_with, free_port
+
+N = 250  # LEVEL values archived, 0.2 s apart, in the minute before T
+GAP, STALE = 100, 101  # the value that is a gap (comm-fail, no value) and the one kept stale
+MESSAGES = 40
+
+
+def level_ts(t: float, k: int) -> int:
+    """The k-th archived LEVEL value's time, ms."""
+    return round((t - 60 + 0.2 * k) * 1000)
+
+
+def raw(k: int) -> int:
+    return (k * 16) % 4096
+
+
+@pytest.fixture(scope="module")
+def station(tmp_path_factory: pytest.TempPathFactory) -> Iterator[tuple[Runtime, str, float]]:
+    folder = copy_demo(tmp_path_factory.mktemp("history") / "station")
+    t = time.time()
+    store = Store(folder / "archive" / "journal.sqlite")
+    store.start()
+    for k in range(N):
+        value, text = (None, "comm-fail") if k == GAP else (raw(k), "stale" if k == STALE else None)
+        store.put(Record(level_ts(t, k) / 1000, "data", grp=1, type=1, source="04010", value=value,
+                         text=text))
+    store.put(Record(t - 50, "message", grp=1, type=2, number=3, text="Уровень выше 90 %"))
+    store.put(Record(t - 49, "alarm", grp=2, type=int(State.UNACK), number=int(State.NORMAL),
+                     source="LEVEL.H"))
+    store.put(Record(t - 48, "operator", source="opcua:operator@127.0.0.1:5000", text="Пуск: 0 -> 1"))
+    store.put(Record(t - 47, "system", source="station", text="station started"))
+    for i in range(MESSAGES):
+        store.put(Record(t - 40 + 0.5 * i, "message", grp=1, type=0, number=2, text=f"Уровень в норме {i}"))
+    store.close()
+    url = f"opc.tcp://127.0.0.1:{free_port()}/netplc/"
+    runtime = demo_with(folder, f'[opcua]\nenabled = true\nendpoint = "{url}"\n')
+    yield runtime, url, t
+    runtime.stop()
+
+
+def run(coro: object) -> object:
+    return asyncio.run(coro)  # type: ignore[arg-type]
+
+
+def utc(ms: float | None) -> datetime:
+    """A time in ms, or DateTime.MinValue (no time given) for None."""
+    return ua.get_win_epoch() if ms is None else datetime.fromtimestamp(ms / 1000, UTC)
+
+
+def details(start: float | None, end: float | None, count: int = 0,
+            bounds: bool = False) -> ua.ReadRawModifiedDetails:
+    return ua.ReadRawModifiedDetails(IsReadModified=False, StartTime=utc(start), EndTime=utc(end),
+                                     NumValuesPerNode=count, ReturnBounds=bounds)
+
+
+def ms(dv: ua.DataValue) -> int:
+    assert dv.SourceTimestamp is not None
+    return round(dv.SourceTimestamp.timestamp() * 1000)
+
+
+async def connect(url: str) -> tuple[Client, int]:
+    client = Client(url)
+    await client.connect()
+    return client, await client.get_namespace_index(STATION_URI)
+
+
+def test_a_minute_of_an_archived_tag_in_physical_units_with_its_quality(
+        station: tuple[Runtime, str, float]) -> None:
+    _, url, t = station
+
+    async def go() -> list[ua.DataValue]:
+        client, ns = await connect(url)
+        try:
+            level = client.get_node(ua.NodeId("Tags.LEVEL", ns))
+            return await level.read_raw_history(utc((t - 61) * 1000), utc(t * 1000), return_bounds=False)
+        finally:
+            await client.disconnect()
+
+    values = run(go())
+    assert [ms(v) for v in values] == [level_ts(t, k) for k in range(N)]
+    for k, dv in enumerate(values):
+        assert dv.ServerTimestamp == dv.SourceTimestamp
+        if k == GAP:
+            assert dv.StatusCode.value == ua.StatusCodes.BadCommunicationError and dv.Value.Value is None
+            continue
+        assert dv.Value.VariantType == ua.VariantType.Double
+        assert dv.Value.Value == pytest.approx(raw(k) * 100 / 4095)  # LEVEL: 0..4095 -> 0..100 %
+        expected = ua.StatusCodes.UncertainLastUsableValue if k == STALE else ua.StatusCodes.Good
+        assert dv.StatusCode.value == expected
+
+
+def test_pages_of_the_clients_limit_give_every_value_exactly_once(
+        station: tuple[Runtime, str, float]) -> None:
+    _, url, t = station
+
+    async def go() -> tuple[list[int], list[bytes | None], int]:
+        client, ns = await connect(url)
+        try:
+            level = client.get_node(ua.NodeId("Tags.LEVEL", ns))
+            asked = details((t - 61) * 1000, t * 1000, count=100)
+            got: list[int] = []
+            points: list[bytes | None] = []
+            point = None
+            while True:
+                result = await level.history_read(asked, point)
+                result.StatusCode.check()
+                got += [ms(v) for v in result.HistoryData.DataValues]
+                point = result.ContinuationPoint
+                points.append(point)
+                if point is None:
+                    break
+            # the same point again is refused for another request; a released point frees nothing
+            other = await level.history_read(details((t - 30) * 1000, t * 1000, count=100), points[0])
+            params = ua.HistoryReadParameters(HistoryReadDetails=asked, ReleaseContinuationPoints=True,
+                                              TimestampsToReturn=ua.TimestampsToReturn.Both,
+                                              NodesToRead=[ua.HistoryReadValueId(NodeId=level.nodeid,
+                                                                                 ContinuationPoint=points[0])])
+            released = (await client.uaclient.history_read(params))[0]
+            assert released.StatusCode.is_good() and not released.HistoryData
+            return got, points, other.StatusCode.value
+        finally:
+            await client.disconnect()
+
+    got, points, other = run(go())
+    assert len(points) == 3 and points[-1] is None and all(points[:2])
+    assert got == [level_ts(t, k) for k in range(N)]  # 100 + 100 + 50, each once, in order
+    assert other == ua.StatusCodes.BadContinuationPointInvalid
+
+
+def test_bounds_and_reading_backward(station: tuple[Runtime, str, float]) -> None:
+    _, url, t = station
+    start, end = level_ts(t, 10) + 50, level_ts(t, 20) + 50  # between values: 11..20 inside
+
+    async def go() -> list[list[ua.DataValue]]:
+        client, ns = await connect(url)
+        try:
+            level = client.get_node(ua.NodeId("Tags.LEVEL", ns))
+            out = []
+            for asked in (details(start, end, bounds=True), details(end, start),
+                          details(end, start, bounds=True), details(start, end, count=3, bounds=True),
+                          details((t - 70) * 1000, level_ts(t, 2), bounds=True),
+                          details(level_ts(t, 5), level_ts(t, 5))):
+                result = await level.history_read(asked)
+                result.StatusCode.check()
+                out.append(result.HistoryData.DataValues)
+            return out
+        finally:
+            await client.disconnect()
+
+    forward, backward, backward_bounded, counted, before, exact = run(go())
+    assert [ms(v) for v in forward] == [level_ts(t, k) for k in range(10, 22)]  # bound 10, 11..20, bound 21
+    assert [ms(v) for v in backward] == [level_ts(t, k) for k in range(20, 10, -1)]
+    assert [ms(v) for v in backward_bounded] == [level_ts(t, k) for k in range(21, 9, -1)]
+    assert [ms(v) for v in counted] == [level_ts(t, k) for k in (10, 11, 12)]  # the bound counts
+    first = before[0]  # nothing before the archive's first value: Bad_BoundNotFound at the start time
+    assert first.StatusCode.value == ua.StatusCodes.BadBoundNotFound and ms(first) == round((t - 70) * 1000)
+    assert [ms(v) for v in before[1:]] == [level_ts(t, k) for k in (0, 1, 2)]  # 2 is the end bound
+    assert [ms(v) for v in exact] == [level_ts(t, 5)]
+
+
+def test_the_journal_as_events_of_the_station_and_the_server(station: tuple[Runtime, str, float]) -> None:
+    _, url, t = station
+
+    async def go() -> tuple[list[list[object]], list[int], list[object], list[object]]:
+        client, ns = await connect(url)
+        try:
+            base = client.get_node(ua.ObjectIds.BaseEventType)
+            evfilter = await get_filter_from_event_type([base])
+            names = [c.BrowsePath[0].Name for c in evfilter.SelectClauses]
+            asked = ua.ReadEventDetails(StartTime=utc((t - 61) * 1000), EndTime=utc(t * 1000),
+                                        NumValuesPerNode=10, Filter=evfilter)
+            pages: list[list[object]] = []
+            sizes: list[int] = []
+            for node in (client.get_node(ua.NodeId("Demo station", ns)), client.nodes.server):
+                events: list[object] = []
+                point = None
+                while True:
+                    params = ua.HistoryReadParameters(
+                        HistoryReadDetails=asked, TimestampsToReturn=ua.TimestampsToReturn.Both,
+                        ReleaseContinuationPoints=False,
+                        NodesToRead=[ua.HistoryReadValueId(NodeId=node.nodeid, ContinuationPoint=point)])
+                    result = (await client.uaclient.history_read(params))[0]
+                    result.StatusCode.check()
+                    sizes.append(len(result.HistoryData.Events))
+                    events += [dict(zip(names, (f.Value for f in e.EventFields)))
+                               for e in result.HistoryData.Events]
+                    point = result.ContinuationPoint
+                    if point is None:
+                        break
+                pages.append(events)
+            system = await client.get_node(ua.NodeId("Demo station", ns)).read_event_history(
+                utc((t - 61) * 1000), utc(t * 1000), evtypes=ua.ObjectIds.SystemEventType)
+            level = client.get_node(ua.NodeId("Tags.LEVEL", ns))
+            asked.NumValuesPerNode = 0
+            params = ua.HistoryReadParameters(HistoryReadDetails=asked, NodesToRead=[
+                ua.HistoryReadValueId(NodeId=level.nodeid)], TimestampsToReturn=ua.TimestampsToReturn.Both,
+                ReleaseContinuationPoints=False)
+            not_events = (await client.uaclient.history_read(params))[0].StatusCode.value
+            return pages, sizes, system, [not_events]
+        finally:
+            await client.disconnect()
+
+    pages, sizes, system, (not_events,) = run(go())
+    station_events, server_events = pages
+    assert max(sizes) <= 10
+    assert len(station_events) == 4 + MESSAGES
+    assert [e["Message"] for e in server_events] == [e["Message"] for e in station_events]
+    assert len({e["EventId"] for e in station_events}) == len(station_events)  # each once
+    message, alarm, operator, record = station_events[:4]
+    assert message["Message"].Text == "Уровень выше 90 %" and message["SourceName"] == "MSG3"
+    assert message["EventType"] == ua.NodeId(ua.ObjectIds.BaseEventType) and message["Severity"] == 700
+    assert message["Time"] == utc(round((t - 50) * 1000)) == message["ReceiveTime"]
+    assert alarm["SourceName"] == "LEVEL.H" and alarm["Severity"] == 700
+    assert alarm["Message"].Text == "LEVEL.H: normal -> active-unacknowledged"
+    assert operator["SourceName"] == "opcua:operator@127.0.0.1:5000"
+    assert operator["Message"].Text == "Пуск: 0 -> 1"
+    assert record["EventType"] == ua.NodeId(ua.ObjectIds.SystemEventType)
+    assert [e["Message"].Text for e in station_events[4:]] == [
+        f"Уровень в норме {i}" for i in range(MESSAGES)]
+    assert [e.Message.Text for e in system] == ["station started"]  # the where clause: one type
+    assert not_events == ua.StatusCodes.BadHistoryOperationUnsupported
+
+
+def test_what_is_not_archived_says_so(station: tuple[Runtime, str, float]) -> None:
+    _, url, t = station
+
+    async def go() -> dict[str, object]:
+        client, ns = await connect(url)
+        try:
+            out: dict[str, object] = {}
+            asked = details((t - 61) * 1000, t * 1000)
+            for name, nodeid in (("TRIGGER", ua.NodeId("Tags.TRIGGER", ns)),
+                                 ("state", ua.NodeId("NetPlc.State", ns)),
+                                 ("unknown", ua.NodeId("Tags.NOSUCH", ns))):
+                out[name] = (await client.get_node(nodeid).history_read(asked)).StatusCode.value
+            level = client.get_node(ua.NodeId("Tags.LEVEL", ns))
+            modified = details((t - 61) * 1000, t * 1000)
+            modified.IsReadModified = True
+            out["modified"] = (await level.history_read(modified)).StatusCode.value
+            out["one time"] = (await level.history_read(details((t - 61) * 1000, None))).StatusCode.value
+            counted = await level.history_read(details(None, t * 1000, count=3))
+            out["last three"] = [ms(v) for v in counted.HistoryData.DataValues], counted.ContinuationPoint
+            later = await level.history_read(details((t + 3600) * 1000, (t + 3601) * 1000))
+            out["later"] = later.StatusCode.value
+            trigger = client.get_node(ua.NodeId("Tags.TRIGGER", ns))
+            out["historizing"] = (await level.read_attribute(ua.AttributeIds.Historizing)).Value.Value, \
+                (await trigger.read_attribute(ua.AttributeIds.Historizing)).Value.Value
+            out["user access"] = (await level.read_attribute(ua.AttributeIds.UserAccessLevel)).Value.Value, \
+                (await trigger.read_attribute(ua.AttributeIds.UserAccessLevel)).Value.Value
+            out["notifier"] = await client.get_node(ua.NodeId("Demo station", ns)).read_event_notifier()
+            out["capabilities"] = [await client.get_node(n).read_value() for n in (
+                ua.ObjectIds.HistoryServerCapabilities_AccessHistoryDataCapability,
+                ua.ObjectIds.HistoryServerCapabilities_AccessHistoryEventsCapability,
+                ua.ObjectIds.HistoryServerCapabilities_InsertDataCapability)]
+            return out
+        finally:
+            await client.disconnect()
+
+    out = run(go())
+    assert out["TRIGGER"] == out["state"] == out["modified"] == ua.StatusCodes.BadHistoryOperationUnsupported
+    assert out["unknown"] == ua.StatusCodes.BadNodeIdUnknown
+    assert out["one time"] == ua.StatusCodes.BadHistoryOperationInvalid  # a start alone and no count
+    # backward from the end, that many and no more
+    assert out["last three"] == ([level_ts(t, k) for k in (N - 1, N - 2, N - 3)], None)
+    assert out["later"] == ua.StatusCodes.GoodNoData
+    assert out["historizing"] == (True, False)
+    history, read = 1 << ua.AccessLevel.HistoryRead, 1 << ua.AccessLevel.CurrentRead
+    assert out["user access"] == (read | history, read)
+    assert ua.EventNotifier.HistoryRead in out["notifier"]
+    assert out["capabilities"] == [True, True, False]

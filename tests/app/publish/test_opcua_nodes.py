@@ -1,0 +1,177 @@
+"""What a SCADA client learns of the station's nodes, browsing it with a standard client (asyncua's):
+the tags as Part 8's AnalogItemType and TwoStateDiscreteType with the ranges and units of tags.csv,
+stable string NodeIds and proper QualifiedNames everywhere, both timestamps on every value, and a
+BuildInfo that names NetPlc Station."""
+
+from __future__ import annotations
+
+import asyncio
+import csv
+import importlib.metadata
+import time
+from collections.abc import Iterator
+
+import pytest
+from asyncua import Client, Node, ua
+
+from app.publish.ua_types import eu_information, unit_id
+from app.station.runtime import Runtime
+from tests.app.conftest import DEMO
+from tests.app.publish.conftest import STATION_URI, demo_with, free_port
+
+PERCENT, CELSIUS = 20529, 4408652  # UnitId of P1 and CEL (OPC UA Part 8 5.6.3)
+
+
+@pytest.fixture(scope="module")
+def station(tmp_path_factory: pytest.TempPathFactory) -> Iterator[tuple[Runtime, str]]:
+    url = f"opc.tcp://127.0.0.1:{free_port()}/netplc/"
+    runtime = demo_with(tmp_path_factory.mktemp("nodes") / "station",
+                        f'[opcua]\nenabled = true\nendpoint = "{url}"\nwritable = ["TEMP_*"]\n')
+    yield runtime, url
+    runtime.stop()
+
+
+def run(coro: object) -> object:
+    return asyncio.run(coro)  # type: ignore[arg-type]
+
+
+def demo_tags() -> list[dict[str, str]]:
+    """tags.csv of the demo as written, read apart from the station's own loader."""
+    lines = (DEMO / "tags.csv").read_text(encoding="utf-8").splitlines()
+    return list(csv.DictReader(line for line in lines if not line.startswith("#")))
+
+
+def test_unece_units() -> None:
+    assert unit_id("CEL") == CELSIUS and unit_id("P1") == PERCENT and unit_id("2N") == 12878
+    celsius = eu_information("°C")
+    assert celsius.UnitId == CELSIUS and celsius.Description.Text == "degree Celsius"
+    assert eu_information("кПа").UnitId == unit_id("KPA")
+    assert eu_information("об/мин").UnitId == unit_id("RPM")
+    assert eu_information("м3/ч").UnitId == eu_information("m³/h").UnitId == unit_id("MQH")
+    unknown = eu_information("попугаи")
+    assert (unknown.UnitId, unknown.DisplayName.Text, unknown.Description.Text) == (-1, "попугаи", "попугаи")
+
+
+def test_tags_are_of_part_8_types_with_the_ranges_and_units_of_tags_csv(station: tuple[Runtime, str]) -> None:
+    _, url = station
+    rows = demo_tags()
+
+    async def go() -> dict[str, dict[str, object]]:
+        out: dict[str, dict[str, object]] = {}
+        async with Client(url) as client:
+            ns = await client.get_namespace_index(STATION_URI)
+            for row in rows:
+                node = client.get_node(ua.NodeId(f"Tags.{row['name']}", ns))
+                props = {}
+                for child in await node.get_children(refs=ua.ObjectIds.HasProperty):
+                    name = await child.read_browse_name()
+                    assert name.NamespaceIndex == 0  # the standard's BrowseNames
+                    assert child.nodeid == ua.NodeId(f"Tags.{row['name']}.{name.Name}", ns)
+                    props[name.Name] = await child.read_value()
+                props["type"] = (await node.read_type_definition()).Identifier
+                out[row["name"]] = props
+        return out
+
+    nodes = run(go())
+    analog = [r for r in rows if r["type"] != "bit"]
+    assert analog and len(analog) < len(rows)
+    for row in analog:
+        props = nodes[row["name"]]
+        assert props["type"] == ua.ObjectIds.AnalogItemType
+        eu_range = props["EURange"]
+        assert (eu_range.Low, eu_range.High) == (float(row["phy_min"]), float(row["phy_max"])), row["name"]
+        raw = props["InstrumentRange"]
+        assert (raw.Low, raw.High) == (float(row["app_min"]), float(row["app_max"])), row["name"]
+        units = props["EngineeringUnits"]
+        assert units.DisplayName.Text == row["unit"]
+        assert units.NamespaceUri == "http://www.opcfoundation.org/UA/units/un/cefact"
+    assert nodes["LEVEL"]["EngineeringUnits"].UnitId == PERCENT
+    assert nodes["TEMP"]["EngineeringUnits"].UnitId == CELSIUS
+    trigger = nodes["TRIGGER"]
+    assert trigger["type"] == ua.ObjectIds.TwoStateDiscreteType
+    assert (trigger["TrueState"].Text, trigger["FalseState"].Text) == ("On", "Off")
+
+
+def test_every_node_of_the_station_has_a_string_nodeid_and_a_plain_browse_name(
+        station: tuple[Runtime, str]) -> None:
+    """... so a NodeId is the same at every start, and a browse path a client builds from the
+    names it sees resolves (an alarm's property, a tag's EURange)."""
+    _, url = station
+
+    async def go() -> tuple[list[str], ua.NodeId, ua.NodeId]:
+        bad: list[str] = []
+        async with Client(url) as client:
+            ns = await client.get_namespace_index(STATION_URI)
+
+            async def walk(node: Node) -> None:
+                for child in await node.get_children():
+                    if child.nodeid.NamespaceIndex != ns:
+                        continue  # a reference to a standard node (a type, a modelling rule)
+                    name = await child.read_browse_name()
+                    if child.nodeid.NodeIdType != ua.NodeIdType.String or ":" in name.Name[:3]:
+                        bad.append(f"{child.nodeid.to_string()} {name.to_string()}")
+                    await walk(child)
+
+            await walk(client.get_node(ua.NodeId("Demo station", ns)))
+            objects = client.nodes.objects
+            priority = await objects.get_child([f"{ns}:Demo station", f"{ns}:Alarms", f"{ns}:LEVEL.H",
+                                                f"{ns}:Priority"])
+            eu_range = await objects.get_child([f"{ns}:Demo station", f"{ns}:Tags", f"{ns}:LEVEL",
+                                                "0:EURange"])
+        return bad, priority.nodeid, eu_range.nodeid
+
+    bad, priority, eu_range = run(go())
+    assert bad == []
+    assert priority == ua.NodeId("Alarms.LEVEL.H.Priority", 1)
+    assert eu_range == ua.NodeId("Tags.LEVEL.EURange", 1)
+
+
+def test_values_carry_source_and_server_timestamps(station: tuple[Runtime, str]) -> None:
+    _, url = station
+
+    async def go() -> list[ua.DataValue]:
+        async with Client(url) as client:
+            ns = await client.get_namespace_index(STATION_URI)
+            level = client.get_node(ua.NodeId("Tags.LEVEL", ns))
+            deadline = time.monotonic() + 10
+            while not (dv := await level.read_data_value(raise_on_bad_status=False)).StatusCode.is_good():
+                assert time.monotonic() < deadline, dv.StatusCode
+                await asyncio.sleep(0.05)
+            data = await client.get_node(ua.NodeId("NetPlc.Memory.Data", ns)).read_data_value()
+            return [dv, data]
+
+    for dv in run(go()):
+        assert dv.SourceTimestamp is not None and dv.ServerTimestamp is not None
+        assert dv.SourceTimestamp <= dv.ServerTimestamp
+
+
+def test_build_info_and_application_name_name_netplc_station(station: tuple[Runtime, str]) -> None:
+    _, url = station
+
+    async def go() -> tuple[ua.BuildInfo, list[ua.ApplicationDescription]]:
+        async with Client(url) as client:
+            info = await client.get_node(ua.ObjectIds.Server_ServerStatus_BuildInfo).read_value()
+            return info, await client.find_servers()
+
+    info, servers = run(go())
+    version = importlib.metadata.version("netplc-station")
+    assert (info.ProductName, info.SoftwareVersion, info.BuildNumber) == ("NetPlc Station", version, version)
+    assert info.ProductUri == "urn:netplc:station" and info.ManufacturerName and info.BuildDate
+    assert [s.ApplicationName.Text for s in servers] == ["NetPlc Station Demo station"]
+    assert servers[0].ProductUri == "urn:netplc:station"
+    assert servers[0].ApplicationType == ua.ApplicationType.Server
+
+
+def test_method_arguments_are_described(station: tuple[Runtime, str]) -> None:
+    _, url = station
+
+    async def go() -> tuple[ua.NodeId, list[ua.Argument], int]:
+        async with Client(url) as client:
+            ns = await client.get_namespace_index(STATION_URI)
+            force = client.get_node(ua.NodeId("Station.Force", ns))
+            args = await force.get_child("0:InputArguments")
+            return args.nodeid, await args.read_value(), await args.read_value_rank()
+
+    nodeid, args, rank = run(go())
+    assert nodeid == ua.NodeId("Station.Force.InputArguments", 1)
+    assert [a.Name for a in args] == ["Kind", "Address", "Value"] and rank == ua.ValueRank.OneDimension
