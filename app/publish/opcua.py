@@ -27,11 +27,9 @@ secure channel, by closing the connection (the way asyncua answers a refused Ope
 Logins are the station's users with a back-off per host (app/authority/logins.py). A loopback
 endpoint (the demo) is for local clients only and has no security.
 
-Alarms: each alarm is a String variable holding its ISA-18.2 state word, and each transition
-fires an event (BaseEventType: SourceName the alarm id, Message its text, Severity from its
-priority) on the station object. asyncua's Alarms & Conditions have no acknowledge/shelve state
-machine behind them, so acknowledging stays with the station's operators (docs/architecture.md
-section 1: every acknowledgement journaled with its user).
+Alarms are OPC UA conditions (Part 9: conditions.py) in the station's Alarms folder, their
+events at the Server object and the station object, their methods (Acknowledge, shelving, out of
+service...) the station's commands like the station's own methods, ConditionRefresh answered.
 """
 
 from __future__ import annotations
@@ -61,11 +59,12 @@ from asyncua.crypto.security_policies import SecurityPolicyBasic256Sha256, Secur
 from app.authority import Action, Commands, Reason, Source, Ticket, Who, write_range
 from app.authority.logins import Logins
 from app.authority.users import UserError, Users
+from app.publish.conditions import Conditions
 from app.publish.feed import LatestReadings, Watch
 from app.publish.methods import StationMethods, StepLock
 from app.publish.pki import TrustList, host_names, station_certificate, subject, thumbprint
 from app.publish.points import PointReader, PointWriter, Writable
-from app.scada.alarms import PRIORITIES, Alarm, State
+from app.scada.alarms import Alarm
 from app.scada.quality import Quality
 from app.scada.readings import Readings
 from app.scada.tag import Tag, TagType
@@ -94,7 +93,6 @@ ANSWERS = {Reason.APPLIED: _S.Good, Reason.DENIED: _S.BadUserAccessDenied,  # by
            Reason.FAILED: _S.BadInternalError}
 READ, WRITE = 1 << ua.AccessLevel.CurrentRead, 1 << ua.AccessLevel.CurrentWrite
 YIELD_EVERY = 500  # variable writes between two turns of the event loop
-SEVERITY = {1: 900, 2: 700, 3: 500, 4: 300}  # alarm priority -> OPC UA severity 1-1000
 READABLE_WITHIN = 2.0  # s at most an applied write waits for its value to be readable here
 MEMORY_BITS = "NetPlc's I/O bits 00000-03777, one byte each (0 or 1): byte n is bit n"
 MEMORY_DATA = ("NetPlc's data memory, its 8 banks of 2 KB in turn: byte k*2048 + i is address "
@@ -238,6 +236,7 @@ class OpcUaServer:
         self.writable = Writable(settings.writable)
         self.writer = PointWriter(commands, self.writable, "[opcua]")
         self.methods = StationMethods(commands, step_lock, ANSWERS)
+        self.conditions = Conditions(commands, ANSWERS, self.alarms)
         self.reader = PointReader(self.tags)
         self.status = OpcUaStatus()
         self.secure = not is_loopback(self.endpoint)
@@ -283,11 +282,10 @@ class OpcUaServer:
                 loop.call_soon_threadsafe(tick.set)
 
     def on_record(self, record: Record) -> None:
-        """The runtime's record observer: alarm transitions become variable states and events."""
-        loop = self._loop
-        if record.kind == "alarm" and loop is not None and self._ready.is_set():
-            with contextlib.suppress(RuntimeError):
-                loop.call_soon_threadsafe(lambda: loop.create_task(self._alarm_event(record)))
+        """The runtime's record observer: an alarm's transition becomes its condition's state and
+        event."""
+        if record.kind == "alarm" and self._ready.is_set():
+            self.conditions.post(record)
 
     # --- the server's own loop -----------------------------------------------------------------
 
@@ -435,14 +433,8 @@ class OpcUaServer:
                                    ("Writes", ua.Variant(0, ua.VariantType.UInt64)),
                                    ("Errors", ua.Variant(0, ua.VariantType.UInt64)), ("LastError", ""))}
         alarms = await station.add_folder(ua.NodeId("Alarms", idx), f"{idx}:Alarms")
-        self.alarm_vars = {}
-        for alarm in self.alarms:
-            var = await alarms.add_variable(ua.NodeId(f"Alarms.{alarm.id}", idx), f"{idx}:{alarm.id}",
-                                            alarm.state.word)
-            await var.add_property(idx, f"{idx}:Priority", PRIORITIES.get(alarm.defn.priority, ""))
-            await var.add_property(idx, f"{idx}:Text", alarm.defn.text)
-            self.alarm_vars[alarm.id] = var
-        self.events = await server.get_event_generator(ua.ObjectIds.BaseEventType, station)
+        sources = {tag.name: nodeid for tag, nodeid in zip(self.tags, self.nodeids)}
+        await self.conditions.build(server, idx, alarms, station, sources, plc, self.plc_state.nodeid)
         await self.methods.add(station, idx)
 
     async def _add_memory(self, plc: Node, idx: int) -> None:
@@ -508,17 +500,6 @@ class OpcUaServer:
                                ("LastError", stats.last_error)):
                 await vars_[key].write_value(value)
 
-    async def _alarm_event(self, record: Record) -> None:
-        var = self.alarm_vars.get(record.source)
-        if var is None:
-            return
-        state = State(record.type or 0)
-        await var.write_value(state.word)
-        self.events.event.SourceName = record.source
-        self.events.event.Severity = SEVERITY.get(record.grp or 3, 500)
-        await self.events.trigger(message=f"{record.source}: {State(record.number or 0).word} -> {state.word}"
-                                          + (f": {record.text}" if record.text else ""))
-
     def _readable(self, scan: int) -> None:
         """The address space holds the values of `scan`: answer the writes that waited for them."""
         self._published = scan
@@ -573,7 +554,7 @@ class OpcUaServer:
                 return await self._write(_who(session), params)
 
             async def call(requests: list[ua.CallMethodRequest]) -> list[ua.CallMethodResult]:
-                return await self._call(_who(session), requests, service)
+                return await self._call(session, requests, service)
 
             service = session.call
             session.activate_session = activate_session
@@ -595,7 +576,10 @@ class OpcUaServer:
         user = event.user.name if event.user is not None and event.user.name else ""
         for n, rv in enumerate(reads):
             if rv.AttributeId == ua.AttributeIds.UserExecutable:
-                executable = self.methods.executable(Who(user, Source.OPCUA), rv.NodeId)
+                who = Who(user, Source.OPCUA)
+                executable = self.methods.executable(who, rv.NodeId)
+                if executable is None:
+                    executable = self.conditions.executable(who, rv.NodeId)
                 if executable is not None:
                     results[n] = ua.DataValue(ua.Variant(executable, ua.VariantType.Boolean))
                 continue
@@ -612,13 +596,18 @@ class OpcUaServer:
                     level |= WRITE
             results[n] = ua.DataValue(ua.Variant(level, ua.VariantType.Byte))
 
-    async def _call(self, who: Who, requests: list[ua.CallMethodRequest],
+    async def _call(self, session: Any, requests: list[ua.CallMethodRequest],
                     service: Callable[[list[ua.CallMethodRequest]], Any]) -> list[ua.CallMethodResult]:
-        """The station's methods as its commands, with the session's user; others to asyncua."""
-        ours = [r.MethodId in self.methods.by_node for r in requests]
-        theirs = [r for r, own in zip(requests, ours) if not own]
+        """The station's methods and its conditions' (and ConditionRefresh) as its commands, with
+        the session's user; others to asyncua."""
+        who = _who(session)
+        station = [r.MethodId in self.methods.by_node for r in requests]
+        condition = [not own and self.conditions.owns(r) for r, own in zip(requests, station)]
+        theirs = [r for r, a, b in zip(requests, station, condition) if not (a or b)]
         others = iter(await service(theirs) if theirs else [])
-        return [await self.methods.call(who, r) if own else next(others) for r, own in zip(requests, ours)]
+        return [await self.methods.call(who, r) if a else
+                await self.conditions.call(who, session.session_id, r) if b else next(others)
+                for r, a, b in zip(requests, station, condition)]
 
     async def _write(self, who: Who, params: ua.WriteParameters) -> list[ua.StatusCode]:
         tickets = [self._command(who, wv) for wv in params.NodesToWrite]

@@ -1,0 +1,694 @@
+"""The station's ISA-18.2 alarms as OPC UA Alarms & Conditions (Part 9), for any A&C client.
+
+Each configured alarm is one condition instance (one per alarm identity, as the station has one),
+an Object in the station's Alarms folder with the stable NodeId `Alarms.<id>` and its children
+`Alarms.<id>.<BrowseName>...`, of the standard type that fits its source:
+
+    H, HH, L, LL limits      ExclusiveLevelAlarmType, its one limit (HighLimit...) and LimitState
+    a bit's value            OffNormalAlarmType (NormalState: a NormalValue variable for a bit)
+    a tag's bad quality      SystemOffNormalAlarmType
+    NetPlc not running       SystemOffNormalAlarmType (InputNode NetPlc.State, normal "running")
+    NMSG alarm messages      AlarmConditionType (raised by the program: no input variable)
+
+with the optional ShelvingState, SuppressedState, OutOfServiceState and the RemoveFromService and
+PlaceInService methods, and three properties of the station's own: State (the ISA-18.2 state
+word), Priority and Text. The source (SourceNode, SourceName) is the alarm's tag variable, or the
+NetPlc object; it has a HasCondition reference to the condition, and the Server object notifies
+the station object (HasNotifier), which has the sources as event sources (HasEventSource).
+
+The station's alarm model stays the one truth (app/scada/alarms.py): a condition is what the last
+transition of its alarm left, copied on the engine thread as the transition is journaled (`post`),
+so its fields and its event agree with the journal record, whichever seat acted. Its fields:
+ActiveState = active (a latched alarm stays active until acknowledged), AckedState = acknowledged,
+EnabledState = in service (out of service is disabled and OutOfServiceState), SuppressedState =
+suppressed by design, ShelvingState Unshelved / TimedShelved / OneShotShelved with UnshelveTime
+(ms left, as of the last event), SuppressedOrShelved, Retain = enabled and (active or
+unacknowledged), Severity from the priority (1 critical 900 ... 4 low 300), Message = the
+transition's journal text, Time = the transition's time, Quality = the input variable's status,
+Comment and ClientUserId = the alarm's last comment and who gave it, BranchId null (no branches).
+
+Every transition is one event: a new EventId, sent to the event monitored items of the Server
+object (i=2253) and of the station object whose filter it passes. The methods are the station's
+commands (app/authority/) with the session's user, taken in the session's Call service like the
+station's own methods (methods.py: `arguments`, `answered`), with the condition's NodeId (or its
+ShelvingState's) as ObjectId and either the instance's method or the type's (Part 9 lets a client
+use the ConditionId with the type's MethodId):
+
+    Acknowledge(EventId, Comment)      acknowledge (operator), the comment journaled with it
+    AddComment(EventId, Comment)       comment (operator): a journal record of the alarm
+    TimedShelve(ShelvingTime ms)       shelve for that long (operator)
+    OneShotShelve()                    shelve until the condition next returns to normal (operator)
+    Unshelve()                         unshelve (operator)
+    Disable(), RemoveFromService()     take out of service (engineer)
+    Enable(), PlaceInService()         return to service (engineer)
+
+Part 9's answers that depend on the condition's state are given from the state its last event
+showed (Bad_EventIdUnknown for an EventId it never sent or no longer knows, Bad_ConditionBranch-
+AlreadyAcked, Bad_ConditionAlreadyShelved, Bad_ConditionNotShelved, Bad_ConditionAlreadyEnabled
+/ Disabled, Bad_ShelvingTimeOutOfRange), each journaled as a refusal by the layer; the role is
+the layer's answer (Bad_UserAccessDenied, journaled once per cause). UserExecutable of a
+condition's methods is answered per session from the same policy.
+
+What asyncua (2.1) has and what is filled here: it ships the types (the standard nodeset) and a
+per-type event class, and nothing behind them. `instantiate` copies a type's nodes but browses the
+type's whole hierarchy for every instance (0.1 s each: minutes for thousands of alarms), so each
+type's instance declarations are read once (`_template`) and the nodes of every condition are added
+in one AddNodes call. Its event generator fires at one notifier and knows nothing of conditions,
+so events are built here from the condition's own fields (the same values its variables hold) and
+queued to the monitored items of each notifier in the chain. The condition methods have no
+implementation; they are taken here. Its ConditionRefresh (bound only on request) keeps one event
+per condition at one notifier, filters the RefreshStart/End events through the client's
+WhereClause (Part 9 4.5: they ignore it) and does not check that the subscription is the
+caller's; ConditionRefresh (i=3875) and ConditionRefresh2 (i=12912) are answered here instead:
+called on the ConditionType (i=2782) with a subscription of the calling session, a RefreshStart
+event to each of its event monitored items (or the one named), the last event of every retained
+condition (same EventId) to each whose filter it passes, then a RefreshEnd event. Monitored items
+are reached through asyncua's MonitoredItemService internals (`_monitored_events`,
+`_monitored_items`), pinned with asyncua ~=2.1.
+
+Where this deviates from Part 9: no ConfirmedState or Confirm (the station's ISA-18.2 model has
+no confirmation); no branches (BranchId is always null: an alarm has one state, as in the
+station's summary); TimedShelve and OneShotShelve carry no reason, so the journal names the method
+as the reason; a OneShotShelved alarm returns after a day at the latest (ONE_SHOT_LIMIT, as
+MaxTimeShelved would); an acknowledgement of a latched alarm whose condition has gone resets it
+(no LatchedState, no Reset); UnshelveTime is as of the last event, not counted down between
+events; AddComment, Acknowledge's comment and the state changes are journaled by the station, no
+Audit events are generated.
+"""
+
+from __future__ import annotations
+
+import asyncio
+import copy
+import logging
+import math
+import time
+import uuid
+from collections import OrderedDict
+from collections.abc import Sequence
+from dataclasses import dataclass, field
+from datetime import UTC, datetime
+from typing import Any
+
+from asyncua import Node, Server, ua
+from asyncua.common.copy_node_util import _read_and_copy_attrs
+from asyncua.common.events import Event
+from asyncua.common.ua_utils import get_node_supertypes
+from asyncua.server.address_space import AttributeValue, NodeData
+
+from app.authority import Action, Commands, Reason, Ticket, Who
+from app.publish.methods import answered, arguments
+from app.scada.alarms import ONE_SHOT_LIMIT, PRIORITIES, Alarm, Source
+from netplc.records import Record
+
+logger = logging.getLogger(__name__)
+
+_O, _S, _V = ua.ObjectIds, ua.StatusCodes, ua.VariantType
+SEVERITY = {1: 900, 2: 700, 3: 500, 4: 300}  # alarm priority -> OPC UA severity 1-1000
+TYPES = {Source.LIMIT: _O.ExclusiveLevelAlarmType, Source.DISCRETE: _O.OffNormalAlarmType,
+         Source.QUALITY: _O.SystemOffNormalAlarmType, Source.STATION: _O.SystemOffNormalAlarmType,
+         Source.MESSAGE: _O.AlarmConditionType}
+PROCESS = (ua.NodeId(_O.ProcessConditionClassType), ua.LocalizedText("Process"))
+SYSTEM = (ua.NodeId(_O.SystemConditionClassType), ua.LocalizedText("System"))
+CLASSES = {Source.LIMIT: PROCESS, Source.DISCRETE: PROCESS, Source.MESSAGE: PROCESS,
+           Source.QUALITY: SYSTEM, Source.STATION: SYSTEM}
+LIMITS = {"HH": ("HighHighLimit", "HighHigh", _O.ExclusiveLimitStateMachineType_HighHigh),
+          "H": ("HighLimit", "High", _O.ExclusiveLimitStateMachineType_High),
+          "L": ("LowLimit", "Low", _O.ExclusiveLimitStateMachineType_Low),
+          "LL": ("LowLowLimit", "LowLow", _O.ExclusiveLimitStateMachineType_LowLow)}
+OPTIONAL = frozenset(("ShelvingState", "SuppressedState", "OutOfServiceState", "RemoveFromService",
+                      "PlaceInService"))
+SHELVING = {None: ("Unshelved", _O.ShelvedStateMachineType_Unshelved),
+            False: ("TimedShelved", _O.ShelvedStateMachineType_TimedShelved),
+            True: ("OneShotShelved", _O.ShelvedStateMachineType_OneShotShelved)}  # by one_shot, None: not shelved
+# the methods of the types, which a client may call with a ConditionId (or a ShelvingState) as ObjectId
+DECLARED = {_O.AcknowledgeableConditionType_Acknowledge: "Acknowledge", _O.ConditionType_AddComment: "AddComment",
+            _O.ConditionType_Enable: "Enable", _O.ConditionType_Disable: "Disable",
+            _O.AlarmConditionType_RemoveFromService: "RemoveFromService",
+            _O.AlarmConditionType_PlaceInService: "PlaceInService",
+            _O.ShelvedStateMachineType_TimedShelve: "TimedShelve",
+            _O.ShelvedStateMachineType_OneShotShelve: "OneShotShelve",
+            _O.ShelvedStateMachineType_Unshelve: "Unshelve",
+            _O.AlarmConditionType_ShelvingState_TimedShelve: "TimedShelve",
+            _O.AlarmConditionType_ShelvingState_OneShotShelve: "OneShotShelve",
+            _O.AlarmConditionType_ShelvingState_Unshelve: "Unshelve"}
+ACTIONS = {"Acknowledge": Action.ACKNOWLEDGE, "AddComment": Action.COMMENT, "TimedShelve": Action.SHELVE,
+           "OneShotShelve": Action.SHELVE, "Unshelve": Action.UNSHELVE, "Disable": Action.OUT_OF_SERVICE,
+           "RemoveFromService": Action.OUT_OF_SERVICE, "Enable": Action.OUT_OF_SERVICE,
+           "PlaceInService": Action.OUT_OF_SERVICE}
+ARITY = {"Acknowledge": 2, "AddComment": 2, "TimedShelve": 1}  # the others take none
+ON_SHELVING = frozenset(("TimedShelve", "OneShotShelve", "Unshelve"))  # methods of the ShelvingState
+REFRESH, REFRESH2 = ua.NodeId(_O.ConditionType_ConditionRefresh), ua.NodeId(_O.ConditionType_ConditionRefresh2)
+REMEMBERED = 64  # EventIds a condition keeps to answer an Acknowledge or AddComment
+TWO_STATES = {"EnabledState": ("Enabled", "Disabled"), "ActiveState": ("Active", "Inactive"),
+              "AckedState": ("Acknowledged", "Unacknowledged"), "SuppressedState": ("Suppressed", "Unsuppressed"),
+              "OutOfServiceState": ("Out of Service", "In Service")}  # Part 9 Annex A's state names
+
+
+@dataclass(frozen=True)
+class _Declared:
+    """One node of a condition type's instances: where it sits and what the type declares of it."""
+
+    path: tuple[str, ...]  # BrowseNames below the condition
+    item: ua.AddNodesItem  # class, BrowseName, reference to its parent, type definition, attributes
+    declaration: ua.NodeId  # the type's node it stands for
+
+
+@dataclass
+class Condition:
+    """One alarm's condition: its nodes, and what its last event said."""
+
+    alarm: Alarm  # as its last transition left it (a copy)
+    nodeid: ua.NodeId
+    type_id: ua.NodeId
+    source: ua.NodeId
+    source_name: str
+    input: ua.NodeId
+    normal: ua.NodeId
+    shelving: ua.NodeId  # its ShelvingState object
+    nodes: dict[str, ua.NodeId]  # its variables by field name ("AckedState/Id")
+    methods: dict[ua.NodeId, str]  # its method nodes -> what they do
+    event: Event | None = None  # the last one: what a refresh sends again
+    retain: bool = False  # of the last event
+    acked: bool = True  # of the last event
+    episode: int = 0  # counts the times it became unacknowledged
+    known: OrderedDict[bytes, int] = field(default_factory=OrderedDict)  # EventId -> its episode
+    comment: tuple[str, str] = ("", "")  # the last comment and who gave it, as shown
+    comment_time: datetime | None = None
+
+
+class Conditions:
+    """The conditions of a station's alarms in one asyncua server; runs on the server's loop except
+    `post` (the engine thread)."""
+
+    def __init__(self, commands: Commands, answers: dict[Reason, int], alarms: Sequence[Alarm]) -> None:
+        self.commands = commands
+        self.answers = answers
+        self.alarms = {a.id: a for a in alarms}  # the station's live alarms (mutated on the engine thread)
+        self.by_id: dict[str, Condition] = {}
+        self.by_node: dict[ua.NodeId, Condition] = {}  # a condition or its ShelvingState
+        self.methods: dict[ua.NodeId, tuple[Condition, str]] = {}  # instance method nodes
+        self.notifiers: list[ua.NodeId] = []
+        self.server: Server | None = None
+        self._loop: asyncio.AbstractEventLoop | None = None
+        self._queue: asyncio.Queue[tuple[Alarm, Record]] | None = None
+        self._worker: asyncio.Task[None] | None = None
+        self._lock = asyncio.Lock()  # events and refreshes one at a time, in order
+        self._refreshing: set[int] = set()  # subscriptions being refreshed
+
+    # --- the address space ---------------------------------------------------------------------
+
+    async def build(self, server: Server, idx: int, folder: Node, station: Node,
+                    sources: dict[str, ua.NodeId], plc: Node, plc_state: ua.NodeId) -> None:
+        """One condition per alarm in `folder`; `sources` the tag variables by tag name."""
+        self.server = server
+        self._loop = asyncio.get_running_loop()
+        self._queue = asyncio.Queue()
+        aspace = server.iserver.aspace
+        first: dict[tuple[int, str, ua.VariantType | None], list[ua.NodeId]] = {}  # the nodes of each shape's first
+        for alarm in self.alarms.values():
+            d = alarm.defn
+            key = d.id.rsplit(".", 1)[-1] if d.source is Source.LIMIT else ""
+            type_id = TYPES[d.source]
+            normal: ua.Variant | None = None
+            if d.source is Source.STATION:
+                normal = ua.Variant("running", _V.String)
+            elif d.source is Source.DISCRETE and d.tag in sources and await _is_bit(server, sources[d.tag]):
+                normal = ua.Variant(not d.when, _V.Boolean)
+            shape = (type_id, key, None if normal is None else normal.VariantType)
+            template = await _template(server, type_id, OPTIONAL | ({LIMITS[key][0]} if key in LIMITS else set()))
+            template = template + _own(idx, shape[2])
+            root = f"Alarms.{d.id}"
+            name = ua.QualifiedName(d.id, idx)
+            ids = [ua.NodeId(root, idx), *(ua.NodeId(".".join((root, *n.path)), idx) for n in template)]
+            if shape in first:
+                _clone(aspace, first[shape], ids, name, alarm.text)
+            else:
+                first[shape] = ids
+                items = [_root(ids[0], name, folder.nodeid, type_id, alarm.text)]
+                for n, nodeid in zip(template, ids[1:]):
+                    item = copy.copy(n.item)
+                    item.RequestedNewNodeId = nodeid
+                    item.ParentNodeId = ua.NodeId(".".join((root, *n.path[:-1])), idx)
+                    items.append(item)
+                await _add(server, items)
+            nodes = {"/".join(n.path): nodeid for n, nodeid in zip(template, ids[1:])
+                     if n.item.NodeClass == ua.NodeClass.Variable and n.path[-1] != "InputArguments"}
+            methods = {nodeid: n.path[-1] for n, nodeid in zip(template, ids[1:])
+                       if n.item.NodeClass == ua.NodeClass.Method}
+            if d.tag is not None and d.tag in sources:
+                source, source_name, input_ = sources[d.tag], d.tag, sources[d.tag]
+            else:
+                source, source_name = plc.nodeid, "NetPlc"
+                input_ = plc_state if d.source is Source.STATION else ua.NodeId()
+            priority = ua.Variant(PRIORITIES.get(d.priority, ""), _V.String)
+            for own, value in (("Priority", priority), ("NormalValue", normal)):
+                if value is not None:
+                    await aspace.write_attribute_value(nodes[own], ua.AttributeIds.Value, ua.DataValue(value))
+            c = Condition(copy.copy(alarm), ids[0], ua.NodeId(type_id), source, source_name, input_,
+                          nodes.get("NormalValue", ua.NodeId()), ua.NodeId(f"{root}.ShelvingState", idx),
+                          nodes, methods)
+            self.by_id[d.id] = self.by_node[c.nodeid] = self.by_node[c.shelving] = c
+            self.methods.update((node, (c, name)) for node, name in methods.items())
+        await self._references(server, station, plc)
+        for c in self.by_id.values():
+            a = c.alarm
+            await self._show(c, f"{a.id} {a.state.word}: {a.text}", a.changed or time.time())
+        self._worker = asyncio.get_running_loop().create_task(self._work())
+
+    async def _references(self, server: Server, station: Node, plc: Node) -> None:
+        """Server -HasNotifier-> station -HasEventSource-> each source -HasCondition-> its conditions."""
+        await station.set_event_notifier([ua.EventNotifier.SubscribeToEvents])
+        server_node = ua.NodeId(_O.Server)
+        self.notifiers = [server_node, station.nodeid]
+        refs = [_reference(server_node, _O.HasNotifier, station.nodeid, ua.NodeClass.Object)]
+        sources: dict[ua.NodeId, None] = {}
+        for c in self.by_id.values():
+            sources.setdefault(c.source)
+            refs.append(_reference(c.source, _O.HasCondition, c.nodeid, ua.NodeClass.Object))
+        refs += [_reference(station.nodeid, _O.HasEventSource, s,
+                            ua.NodeClass.Object if s == plc.nodeid else ua.NodeClass.Variable) for s in sources]
+        for result in await server.iserver.isession.add_references(refs):
+            result.check()
+
+    # --- transitions ---------------------------------------------------------------------------
+
+    def post(self, record: Record) -> None:
+        """The runtime's record observer, on the thread that journals the transition (the engine's):
+        the alarm as this transition left it, handed to the server's loop."""
+        alarm, loop, queue = self.alarms.get(record.source or ""), self._loop, self._queue
+        if alarm is None or loop is None or queue is None:
+            return
+        view = copy.copy(alarm)
+        try:
+            loop.call_soon_threadsafe(queue.put_nowait, (view, record))
+        except RuntimeError:  # no log: the server's loop has closed (the station is stopping)
+            return
+
+    async def _work(self) -> None:
+        assert self._queue is not None
+        while True:
+            alarm, record = await self._queue.get()
+            try:
+                c = self.by_id[alarm.id]
+                c.alarm = alarm
+                async with self._lock:
+                    event = await self._show(c, record.text or "", record.ts)
+                    await self._send(event, list(self._subscriptions()))
+            except Exception:  # the next transition is shown all the same
+                logger.exception("condition %s not updated", record.source)
+
+    async def _show(self, c: Condition, text: str, ts: float) -> Event:
+        """The condition's variables and its new event, as `c.alarm` is now."""
+        assert self.server is not None
+        aspace = self.server.iserver.aspace
+        a = c.alarm
+        when = datetime.fromtimestamp(ts, UTC)
+        if (a.comment, a.comment_by) != c.comment:
+            c.comment, c.comment_time = (a.comment, a.comment_by), when
+        fields = self._fields(c, text, when, aspace)
+        for name, nodeid in c.nodes.items():
+            variant = fields.get(name)
+            if variant is not None:
+                await aspace.write_attribute_value(nodeid, ua.AttributeIds.Value,
+                                                   ua.DataValue(variant, SourceTimestamp=when))
+        for name, value in (("State", a.state.word), ("Text", a.text)):
+            await aspace.write_attribute_value(c.nodes[name], ua.AttributeIds.Value,
+                                               ua.DataValue(ua.Variant(value, _V.String)))
+        event = Event(ua.NodeId(_O.Server))
+        for name, variant in fields.items():
+            event.add_property(name, variant.Value, variant.VariantType)
+        event.add_property("NodeId", c.nodeid, _V.NodeId)  # the ConditionId
+        if c.acked and not a.acked:
+            c.episode += 1  # unacknowledged anew: the events before need no acknowledgement now
+        c.known[fields["EventId"].Value] = c.episode
+        while len(c.known) > REMEMBERED:
+            c.known.popitem(last=False)
+        c.event, c.retain, c.acked = event, fields["Retain"].Value, a.acked
+        return event
+
+    def _fields(self, c: Condition, text: str, when: datetime, aspace: Any) -> dict[str, ua.Variant]:
+        """The condition's event fields (by field name, as its variables' paths) for `c.alarm`."""
+        a, d = c.alarm, c.alarm.defn
+        enabled = not a.out_of_service
+        shelved = None if a.shelved_until is None else a.shelved_until - time.time()
+        severity = ua.Variant(SEVERITY.get(d.priority, 500), _V.UInt16)
+        quality, stamp = ua.StatusCode(_S.Good), when
+        if not c.input.is_null() and c.input in aspace:  # the input variable's status
+            dv = aspace.read_attribute_value(c.input, ua.AttributeIds.Value)
+            quality, stamp = dv.StatusCode or quality, dv.SourceTimestamp or when
+        state_name, state_id = SHELVING[None if shelved is None else a.one_shot]
+        out = {
+            "EventId": ua.Variant(uuid.uuid4().bytes, _V.ByteString),
+            "EventType": ua.Variant(c.type_id, _V.NodeId),
+            "SourceNode": ua.Variant(c.source, _V.NodeId),
+            "SourceName": ua.Variant(c.source_name, _V.String),
+            "Time": ua.Variant(when, _V.DateTime),
+            "ReceiveTime": ua.Variant(datetime.now(UTC), _V.DateTime),
+            "Message": ua.Variant(ua.LocalizedText(text), _V.LocalizedText),
+            "Severity": severity,
+            "ConditionClassId": ua.Variant(CLASSES[d.source][0], _V.NodeId),
+            "ConditionClassName": ua.Variant(CLASSES[d.source][1], _V.LocalizedText),
+            "ConditionName": ua.Variant(d.id, _V.String),
+            "BranchId": ua.Variant(ua.NodeId(), _V.NodeId),
+            "Retain": ua.Variant(enabled and (a.active or not a.acked), _V.Boolean),
+            "Quality": ua.Variant(quality, _V.StatusCode),
+            "Quality/SourceTimestamp": ua.Variant(stamp, _V.DateTime),
+            "LastSeverity": severity,
+            "LastSeverity/SourceTimestamp": ua.Variant(when, _V.DateTime),
+            "Comment": ua.Variant(ua.LocalizedText(a.comment), _V.LocalizedText),
+            "Comment/SourceTimestamp": _maybe(c.comment_time, _V.DateTime),
+            "ClientUserId": ua.Variant(a.comment_by, _V.String),
+            "InputNode": ua.Variant(c.input, _V.NodeId),
+            "SuppressedOrShelved": ua.Variant(a.suppressed or shelved is not None, _V.Boolean),
+            "ShelvingState/CurrentState": ua.Variant(ua.LocalizedText(state_name), _V.LocalizedText),
+            "ShelvingState/CurrentState/Id": ua.Variant(ua.NodeId(state_id), _V.NodeId),
+            "ShelvingState/UnshelveTime": ua.Variant(max(0.0, shelved or 0.0) * 1000.0, _V.Double),
+        }
+        for name, on in (("EnabledState", enabled), ("ActiveState", a.active), ("AckedState", a.acked),
+                         ("SuppressedState", a.suppressed), ("OutOfServiceState", a.out_of_service)):
+            out[name] = ua.Variant(ua.LocalizedText(TWO_STATES[name][0 if on else 1]), _V.LocalizedText)
+            out[f"{name}/Id"] = ua.Variant(on, _V.Boolean)
+        if "NormalState" in c.nodes:
+            out["NormalState"] = ua.Variant(c.normal, _V.NodeId)
+        key = d.id.rsplit(".", 1)[-1]
+        if d.source is Source.LIMIT and key in LIMITS:
+            limit, state, state_node = LIMITS[key]
+            out[limit] = ua.Variant(d.limit, _V.Double)
+            out["LimitState/CurrentState"] = _maybe(ua.LocalizedText(state) if a.active else None, _V.LocalizedText)
+            out["LimitState/CurrentState/Id"] = _maybe(ua.NodeId(state_node) if a.active else None, _V.NodeId)
+        return out
+
+    # --- subscriptions -------------------------------------------------------------------------
+
+    def _subscriptions(self) -> Any:
+        assert self.server is not None
+        return self.server.iserver.subscription_service.subscriptions.values()
+
+    async def _send(self, event: Event, subscriptions: list[Any], mids: set[int] | None = None) -> None:
+        """`event` to the event monitored items of the notifiers in its chain whose filter it
+        passes (of `mids` only, when given)."""
+        for sub in subscriptions:
+            service = sub.monitored_item_srv
+            for notifier in self.notifiers:
+                for mid in list(service._monitored_events.get(notifier, ())):
+                    if mids is None or mid in mids:
+                        await _enqueue(sub, mid, event, bypass=False)
+
+    async def refresh(self, session_id: ua.NodeId, request: ua.CallMethodRequest) -> ua.CallMethodResult:
+        """ConditionRefresh(SubscriptionId) and ConditionRefresh2(SubscriptionId, MonitoredItemId)."""
+        second = request.MethodId == REFRESH2
+        args, result = arguments(request, 2 if second else 1)
+        if not result.StatusCode.is_good():
+            return result
+        if request.ObjectId != ua.NodeId(_O.ConditionType):  # Part 9 5.5.7's answer
+            result.StatusCode = ua.StatusCode(_S.BadUserAccessDenied)
+            return result
+        sub = self.server.iserver.subscription_service.subscriptions.get(args[0]) if self.server else None
+        if sub is None or sub.session_id != session_id:
+            result.StatusCode = ua.StatusCode(_S.BadSubscriptionIdInvalid)
+            return result
+        service = sub.monitored_item_srv
+        mids = {mid for items in service._monitored_events.values() for mid in items}
+        if second:
+            if args[1] not in mids:
+                result.StatusCode = ua.StatusCode(_S.BadMonitoredItemIdInvalid)
+                return result
+            mids = {args[1]}
+        if not mids:
+            result.StatusCode = ua.StatusCode(_S.BadNothingToDo)
+            return result
+        if sub.data.SubscriptionId in self._refreshing:
+            result.StatusCode = ua.StatusCode(_S.BadRefreshInProgress)
+            return result
+        self._refreshing.add(sub.data.SubscriptionId)
+        try:
+            async with self._lock:
+                begin = _bracket(_O.RefreshStartEventType)
+                for mid in sorted(mids):
+                    await _enqueue(sub, mid, begin, bypass=True)
+                for c in self.by_id.values():
+                    if c.event is not None and c.retain:
+                        await self._send(c.event, [sub], mids)
+                end = _bracket(_O.RefreshEndEventType)
+                for mid in sorted(mids):
+                    await _enqueue(sub, mid, end, bypass=True)
+        finally:
+            self._refreshing.discard(sub.data.SubscriptionId)
+        return result
+
+    # --- methods -------------------------------------------------------------------------------
+
+    def owns(self, request: ua.CallMethodRequest) -> bool:
+        method = request.MethodId
+        return method in self.methods or method in (REFRESH, REFRESH2) or (
+            method.NamespaceIndex == 0 and method.Identifier in DECLARED)
+
+    def executable(self, who: Who, nodeid: ua.NodeId) -> bool | None:
+        """May `who` call the condition method at `nodeid`? None when it is none of them."""
+        found = self.methods.get(nodeid)
+        return None if found is None else self.commands.may(who, ACTIONS[found[1]])
+
+    async def call(self, who: Who, session_id: ua.NodeId, request: ua.CallMethodRequest) -> ua.CallMethodResult:
+        if request.MethodId in (REFRESH, REFRESH2):
+            return await self.refresh(session_id, request)
+        c, name = self._resolve(request)
+        args, result = arguments(request, ARITY.get(name, 0) if name else 0)
+        if c is None or not name:
+            result.StatusCode = ua.StatusCode(_S.BadNodeIdInvalid if c is None else _S.BadMethodInvalid)
+            return result
+        if not result.StatusCode.is_good():
+            return result
+        refused = self._refused(c, name, args, result)
+        if refused is not None:
+            code, why = refused
+            self.commands.refuse(who, ACTIONS[name], c.alarm.id, Reason.INVALID, f"{name}: {why}")
+            result.StatusCode = ua.StatusCode(code)
+            return result
+        return await answered(result, self._ticket(who, c, name, args), self.answers)
+
+    def _resolve(self, request: ua.CallMethodRequest) -> tuple[Condition | None, str]:
+        """The condition a call is for and what it asks ("" when the method is not one of its own)."""
+        c = self.by_node.get(request.ObjectId)
+        own = self.methods.get(request.MethodId)
+        if own is not None:
+            name = own[1] if c is own[0] else ""
+        else:
+            name = DECLARED.get(request.MethodId.Identifier, "") if request.MethodId.NamespaceIndex == 0 else ""
+        if c is not None and request.ObjectId == c.shelving and name not in ON_SHELVING:
+            name = ""  # the ShelvingState has the shelving methods; the condition has them all
+        return c, name
+
+    def _refused(self, c: Condition, name: str, args: list[Any],
+                 result: ua.CallMethodResult) -> tuple[int, str] | None:
+        """Part 9's answer when the call does not fit the condition as its last event showed it."""
+        a = c.alarm
+        if name in ("Acknowledge", "AddComment"):
+            eid, comment = args
+            if not isinstance(eid, bytes) or not (comment is None or isinstance(comment, ua.LocalizedText)):
+                result.InputArgumentResults = [ua.StatusCode(_S.Good if ok else _S.BadTypeMismatch)
+                                               for ok in (isinstance(eid, bytes), comment is None
+                                                          or isinstance(comment, ua.LocalizedText))]
+                return _S.BadInvalidArgument, "takes a ByteString EventId and a LocalizedText comment"
+            episode = c.known.get(eid)
+            if episode is None:
+                return _S.BadEventIdUnknown, "the EventId is not one of the condition's recent events"
+            if name == "Acknowledge" and (a.acked or episode != c.episode):
+                return _S.BadConditionBranchAlreadyAcked, "that event's state needs no acknowledgement"
+        elif name == "TimedShelve":
+            ms = args[0]
+            if isinstance(ms, bool) or not isinstance(ms, (int, float)) or not math.isfinite(ms) or ms <= 0:
+                return _S.BadShelvingTimeOutOfRange, f"a shelving time of {ms!r} ms"
+        elif name == "OneShotShelve" and a.shelved_until is not None and a.one_shot:
+            return _S.BadConditionAlreadyShelved, "already shelved once (OneShotShelved)"
+        elif name == "Unshelve" and a.shelved_until is None:
+            return _S.BadConditionNotShelved, "not shelved"
+        elif name in ("Disable", "RemoveFromService") and a.out_of_service:
+            return _S.BadConditionAlreadyDisabled, "already out of service"
+        elif name in ("Enable", "PlaceInService") and not a.out_of_service:
+            return _S.BadConditionAlreadyEnabled, "already in service"
+        return None
+
+    def _ticket(self, who: Who, c: Condition, name: str, args: list[Any]) -> Ticket:
+        commands, alarm_id = self.commands, c.alarm.id
+        if name in ("Acknowledge", "AddComment"):
+            comment = args[1].Text or "" if args[1] is not None else ""
+            if name == "AddComment":
+                return commands.comment(who, alarm_id, comment)
+            return commands.acknowledge(who, alarm_id, comment)
+        if name == "TimedShelve":
+            return commands.shelve(who, alarm_id, "TimedShelve over OPC UA (it gives no reason)", args[0] / 1000.0)
+        if name == "OneShotShelve":
+            return commands.shelve(who, alarm_id, "OneShotShelve over OPC UA (it gives no reason)",
+                                   ONE_SHOT_LIMIT, once=True)
+        if name == "Unshelve":
+            return commands.unshelve(who, alarm_id)
+        return commands.out_of_service(who, alarm_id, name in ("Disable", "RemoveFromService"))
+
+
+# --- helpers -----------------------------------------------------------------------------------
+
+_TEMPLATES: dict[tuple[int, frozenset[str]], list[_Declared]] = {}  # of the standard types: any server's
+
+
+async def _template(server: Server, type_id: int, optional: frozenset[str]) -> list[_Declared]:
+    """The nodes an instance of the type has: the mandatory ones and the `optional` ones named
+    (at the top), parents before children, read once per type and process (what asyncua's
+    `instantiate` reads for every instance)."""
+    key = (type_id, optional)
+    if key not in _TEMPLATES:
+        _TEMPLATES[key] = await _declared(server, type_id, optional)
+    return _TEMPLATES[key]
+
+
+async def _declared(server: Server, type_id: int, optional: frozenset[str]) -> list[_Declared]:
+    out: list[_Declared] = []
+
+    async def children(path: tuple[str, ...], declarations: list[Node]) -> None:
+        seen: set[str] = set()
+        for declaration in declarations:
+            for rdesc in await declaration.get_children_descriptions():
+                name = rdesc.BrowseName.Name
+                if name in seen:
+                    continue
+                child = server.get_node(rdesc.NodeId)
+                rules = await child.get_referenced_nodes(refs=_O.HasModellingRule)
+                if not rules:  # not part of an instance (a subtype, an instance of the type itself)
+                    continue
+                if rules[0].nodeid in (ua.NodeId(_O.ModellingRule_Optional),
+                                       ua.NodeId(_O.ModellingRule_OptionalPlaceholder)) \
+                        and (path or name not in optional):
+                    continue
+                seen.add(name)
+                item = ua.AddNodesItem(BrowseName=rdesc.BrowseName, ReferenceTypeId=rdesc.ReferenceTypeId,
+                                       TypeDefinition=ua.NodeId(rdesc.TypeDefinition.Identifier,
+                                                                      rdesc.TypeDefinition.NamespaceIndex), NodeClass=rdesc.NodeClass)
+                attributes = {ua.NodeClass.Object: ua.ObjectAttributes, ua.NodeClass.Variable: ua.VariableAttributes,
+                              ua.NodeClass.Method: ua.MethodAttributes}[rdesc.NodeClass]()
+                await _read_and_copy_attrs(child, attributes, item)
+                out.append(_Declared((*path, name), item, rdesc.NodeId))
+                await children((*path, name), [child])
+
+    await children((), await get_node_supertypes(server.get_node(type_id), includeitself=True))
+    return out
+
+
+def _root(nodeid: ua.NodeId, name: ua.QualifiedName, folder: ua.NodeId, type_id: int,
+          description: str) -> ua.AddNodesItem:
+    attributes = ua.ObjectAttributes(DisplayName=ua.LocalizedText(name.Name), Description=ua.LocalizedText(description),
+                                     EventNotifier=0)
+    return ua.AddNodesItem(ParentNodeId=folder, ReferenceTypeId=ua.NodeId(_O.Organizes), RequestedNewNodeId=nodeid,
+                           BrowseName=name, NodeClass=ua.NodeClass.Object, NodeAttributes=attributes,
+                           TypeDefinition=ua.NodeId(type_id))
+
+
+def _own(idx: int, normal: ua.VariantType | None) -> list[_Declared]:
+    """The station's own properties of a condition: its ISA-18.2 state word, its priority and text,
+    and the value its input has when normal (`normal`: its type, None when it has none)."""
+    names = [("State", _V.String), ("Priority", _V.String), ("Text", _V.String)]
+    if normal is not None:
+        names.append(("NormalValue", normal))
+    out = []
+    for name, kind in names:
+        initial = ua.Variant(False if kind is _V.Boolean else "", kind)
+        attributes = ua.VariableAttributes(DisplayName=ua.LocalizedText(name), Value=initial,
+                                           DataType=ua.NodeId(kind.value), ValueRank=-1, AccessLevel=1,
+                                           UserAccessLevel=1)
+        item = ua.AddNodesItem(ReferenceTypeId=ua.NodeId(_O.HasProperty), BrowseName=ua.QualifiedName(name, idx),
+                               NodeClass=ua.NodeClass.Variable, NodeAttributes=attributes,
+                               TypeDefinition=ua.NodeId(_O.PropertyType))
+        out.append(_Declared((name,), item, ua.NodeId()))
+    return out
+
+
+def _clone(aspace: Any, first: list[ua.NodeId], ids: list[ua.NodeId], name: ua.QualifiedName,
+           description: str) -> None:
+    """A condition's nodes (`ids`, its root first) as copies of `first`'s, the condition of the
+    same shape added through AddNodes: asyncua builds each attribute of each node afresh (a
+    millisecond a node), a copy shares what never changes (only a node's Value is ever written, by
+    the station; clients' writes are the station's commands, and refused here) and costs a few
+    microseconds."""
+    remap = dict(zip(first, ids))
+    text = ua.LocalizedText(name.Name)
+    value_id, node_id = ua.AttributeIds.Value, ua.AttributeIds.NodeId
+    for old, new in zip(first, ids):
+        original = aspace[old]
+        node = NodeData(new)
+        node.attributes = dict(original.attributes)
+        node.attributes[node_id] = AttributeValue(ua.DataValue(ua.Variant(new, _V.NodeId)))
+        if value_id in original.attributes:
+            node.attributes[value_id] = AttributeValue(original.attributes[value_id].value)
+        node.references = [ref if ref.NodeId not in remap else _pointing(ref, remap[ref.NodeId], name, text)
+                           if ref.NodeId == first[0] else _pointing(ref, remap[ref.NodeId])
+                           for ref in original.references]
+        aspace[new] = node
+    node = aspace[ids[0]]
+    for attribute, value in ((ua.AttributeIds.BrowseName, ua.Variant(name, _V.QualifiedName)),
+                             (ua.AttributeIds.DisplayName, ua.Variant(text, _V.LocalizedText)),
+                             (ua.AttributeIds.Description, ua.Variant(ua.LocalizedText(description),
+                                                                      _V.LocalizedText))):
+        node.attributes[attribute] = AttributeValue(ua.DataValue(value))
+    up = next(r for r in node.references if not r.IsForward and r.ReferenceTypeId == ua.NodeId(_O.Organizes))
+    folder = aspace[up.NodeId]  # its reference to the condition: as to the first, with the condition's names
+    folder.references.append(ua.ReferenceDescription(
+        ReferenceTypeId=up.ReferenceTypeId, IsForward=True, NodeId=ids[0], BrowseName=name, DisplayName=text,
+        NodeClass=ua.NodeClass.Object, TypeDefinition=next(r.NodeId for r in node.references
+                                                           if r.ReferenceTypeId == ua.NodeId(_O.HasTypeDefinition))))
+
+
+def _pointing(ref: ua.ReferenceDescription, to: ua.NodeId, name: ua.QualifiedName | None = None,
+              text: ua.LocalizedText | None = None) -> ua.ReferenceDescription:
+    """`ref` to another node (named `name`, `text` where its names differ too)."""
+    return ua.ReferenceDescription(ReferenceTypeId=ref.ReferenceTypeId, IsForward=ref.IsForward, NodeId=to,
+                                   BrowseName=name or ref.BrowseName, DisplayName=text or ref.DisplayName,
+                                   NodeClass=ref.NodeClass, TypeDefinition=ref.TypeDefinition)
+
+
+async def _add(server: Server, items: list[ua.AddNodesItem]) -> None:
+    for item, result in zip(items, await server.iserver.isession.add_nodes(items)):
+        if not result.StatusCode.is_good():
+            raise RuntimeError(f"condition node {item.RequestedNewNodeId.to_string()} not added: {result.StatusCode}")
+
+
+def _reference(source: ua.NodeId, kind: int, target: ua.NodeId, target_class: ua.NodeClass) -> ua.AddReferencesItem:
+    return ua.AddReferencesItem(SourceNodeId=source, ReferenceTypeId=ua.NodeId(kind), IsForward=True,
+                                TargetNodeId=target, TargetNodeClass=target_class)
+
+
+async def _is_bit(server: Server, variable: ua.NodeId) -> bool:
+    return await server.get_node(variable).read_data_type() == ua.NodeId(_O.Boolean)
+
+
+def _maybe(value: Any, kind: ua.VariantType) -> ua.Variant:
+    """A value, or its type's empty one (a LimitState while inactive, a comment never given)."""
+    if value is None:
+        value = {_V.LocalizedText: ua.LocalizedText(), _V.NodeId: ua.NodeId()}.get(kind)
+    return ua.Variant(value, kind)
+
+
+def _bracket(event_type: int) -> Event:
+    """A RefreshStart or RefreshEnd event: one EventId for every copy of it."""
+    now = datetime.now(UTC)
+    event = Event(ua.NodeId(_O.Server))
+    name = "RefreshStart" if event_type == _O.RefreshStartEventType else "RefreshEnd"
+    for key, value, kind in (("EventId", uuid.uuid4().bytes, _V.ByteString),
+                             ("EventType", ua.NodeId(event_type), _V.NodeId),
+                             ("SourceNode", ua.NodeId(_O.Server), _V.NodeId), ("SourceName", "Server", _V.String),
+                             ("Time", now, _V.DateTime), ("ReceiveTime", now, _V.DateTime),
+                             ("Message", ua.LocalizedText(name), _V.LocalizedText), ("Severity", 1, _V.UInt16)):
+        event.add_property(key, value, kind)
+    return event
+
+
+async def _enqueue(sub: Any, mid: int, event: Event, bypass: bool) -> None:
+    """`event` to one monitored item, through its filter's WhereClause unless `bypass` (the refresh
+    bracket: Part 9 4.5), with the fields its SelectClauses ask."""
+    data = sub.monitored_item_srv._monitored_items.get(mid)
+    if data is None or data.mode == ua.MonitoringMode.Disabled:
+        return
+    if not bypass and (data.where_clause_evaluator is None or not data.where_clause_evaluator.eval(event)):
+        return
+    fields = ua.EventFieldList(ClientHandle=data.client_handle,
+                               EventFields=event.to_event_fields(data.filter.SelectClauses))
+    await sub.enqueue_event(mid, fields, data.queue_size)
+
