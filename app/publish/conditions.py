@@ -49,31 +49,32 @@ AlreadyAcked, Bad_ConditionAlreadyShelved, Bad_ConditionNotShelved, Bad_Conditio
 the layer's answer (Bad_UserAccessDenied, journaled once per cause). UserExecutable of a
 condition's methods is answered per session from the same policy.
 
-What asyncua (2.1) has and what is filled here: it ships the types (the standard nodeset) and a
-per-type event class, and nothing behind them. `instantiate` copies a type's nodes but browses the
-type's whole hierarchy for every instance (0.1 s each: minutes for thousands of alarms), so each
-type's instance declarations are read once (`_template`) and the nodes of every condition are added
-in one AddNodes call. Its event generator fires at one notifier and knows nothing of conditions,
-so events are built here from the condition's own fields (the same values its variables hold) and
-queued to the monitored items of each notifier in the chain. The condition methods have no
-implementation; they are taken here. Its ConditionRefresh (bound only on request) keeps one event
-per condition at one notifier, filters the RefreshStart/End events through the client's
-WhereClause (Part 9 4.5: they ignore it) and does not check that the subscription is the
-caller's; ConditionRefresh (i=3875) and ConditionRefresh2 (i=12912) are answered here instead:
-called on the ConditionType (i=2782) with a subscription of the calling session, a RefreshStart
-event to each of its event monitored items (or the one named), the last event of every retained
-condition (same EventId) to each whose filter it passes, then a RefreshEnd event. Monitored items
-are reached through asyncua's MonitoredItemService internals (`_monitored_events`,
+What asyncua (2.1) has and what is filled here. It ships the types (the standard nodeset) and an
+event class per type, and no behaviour behind them:
+- instances: its `instantiate` browses the type's hierarchy again for every instance (0.1 s each),
+  so condition_nodes.py reads each type's declarations once and copies the nodes of each shape;
+- events: its event generator fires at one notifier and knows nothing of conditions, so each event
+  is built here from the condition's fields (the values its variables hold) and queued to the
+  event monitored items of every notifier in the chain, through each one's filter;
+- methods: the condition methods have no implementation; they are taken here;
+- refresh: its ConditionRefresh (bound only on request) keeps one event per condition at one
+  notifier, passes the RefreshStart/End events through the client's WhereClause (Part 9 4.5: they
+  ignore it) and does not check that the subscription is the caller's. ConditionRefresh (i=3875)
+  and ConditionRefresh2 (i=12912) are answered here instead: called on the ConditionType (i=2782)
+  for a subscription of the calling session, one RefreshStart event to each of its event monitored
+  items (or to the one named), the last event of every retained condition (its EventId unchanged)
+  to each whose filter it passes, then one RefreshEnd event.
+Monitored items are reached through asyncua's MonitoredItemService internals (`_monitored_events`,
 `_monitored_items`), pinned with asyncua ~=2.1.
 
 Where this deviates from Part 9: no ConfirmedState or Confirm (the station's ISA-18.2 model has
 no confirmation); no branches (BranchId is always null: an alarm has one state, as in the
 station's summary); TimedShelve and OneShotShelve carry no reason, so the journal names the method
-as the reason; a OneShotShelved alarm returns after a day at the latest (ONE_SHOT_LIMIT, as
-MaxTimeShelved would); an acknowledgement of a latched alarm whose condition has gone resets it
-(no LatchedState, no Reset); UnshelveTime is as of the last event, not counted down between
-events; AddComment, Acknowledge's comment and the state changes are journaled by the station, no
-Audit events are generated.
+as the reason; a OneShotShelved alarm returns after a day at the latest (ONE_SHOT_LIMIT, as a
+MaxTimeShelved would); no LatchedState or Reset: a latched alarm acknowledged while active is reset
+by the station's own Acknowledge (methods.py) or at the workstation; UnshelveTime is as of the
+last event, not counted down between events; no Audit events (the station's journal records every
+action with its user).
 """
 
 from __future__ import annotations
@@ -91,12 +92,10 @@ from datetime import UTC, datetime
 from typing import Any
 
 from asyncua import Node, Server, ua
-from asyncua.common.copy_node_util import _read_and_copy_attrs
 from asyncua.common.events import Event
-from asyncua.common.ua_utils import get_node_supertypes
-from asyncua.server.address_space import AttributeValue, NodeData
 
 from app.authority import Action, Commands, Reason, Ticket, Who
+from app.publish import condition_nodes as nodes
 from app.publish.methods import answered, arguments
 from app.scada.alarms import ONE_SHOT_LIMIT, PRIORITIES, Alarm, Source
 from netplc.records import Record
@@ -118,12 +117,13 @@ LIMITS = {"HH": ("HighHighLimit", "HighHigh", _O.ExclusiveLimitStateMachineType_
           "LL": ("LowLowLimit", "LowLow", _O.ExclusiveLimitStateMachineType_LowLow)}
 OPTIONAL = frozenset(("ShelvingState", "SuppressedState", "OutOfServiceState", "RemoveFromService",
                       "PlaceInService"))
-SHELVING = {None: ("Unshelved", _O.ShelvedStateMachineType_Unshelved),
+SHELVING = {None: ("Unshelved", _O.ShelvedStateMachineType_Unshelved),  # by one_shot; None: not shelved
             False: ("TimedShelved", _O.ShelvedStateMachineType_TimedShelved),
-            True: ("OneShotShelved", _O.ShelvedStateMachineType_OneShotShelved)}  # by one_shot, None: not shelved
+            True: ("OneShotShelved", _O.ShelvedStateMachineType_OneShotShelved)}
 # the methods of the types, which a client may call with a ConditionId (or a ShelvingState) as ObjectId
-DECLARED = {_O.AcknowledgeableConditionType_Acknowledge: "Acknowledge", _O.ConditionType_AddComment: "AddComment",
-            _O.ConditionType_Enable: "Enable", _O.ConditionType_Disable: "Disable",
+DECLARED = {_O.AcknowledgeableConditionType_Acknowledge: "Acknowledge",
+            _O.ConditionType_AddComment: "AddComment", _O.ConditionType_Enable: "Enable",
+            _O.ConditionType_Disable: "Disable",
             _O.AlarmConditionType_RemoveFromService: "RemoveFromService",
             _O.AlarmConditionType_PlaceInService: "PlaceInService",
             _O.ShelvedStateMachineType_TimedShelve: "TimedShelve",
@@ -138,20 +138,13 @@ ACTIONS = {"Acknowledge": Action.ACKNOWLEDGE, "AddComment": Action.COMMENT, "Tim
            "PlaceInService": Action.OUT_OF_SERVICE}
 ARITY = {"Acknowledge": 2, "AddComment": 2, "TimedShelve": 1}  # the others take none
 ON_SHELVING = frozenset(("TimedShelve", "OneShotShelve", "Unshelve"))  # methods of the ShelvingState
-REFRESH, REFRESH2 = ua.NodeId(_O.ConditionType_ConditionRefresh), ua.NodeId(_O.ConditionType_ConditionRefresh2)
+REFRESH = ua.NodeId(_O.ConditionType_ConditionRefresh)
+REFRESH2 = ua.NodeId(_O.ConditionType_ConditionRefresh2)
 REMEMBERED = 64  # EventIds a condition keeps to answer an Acknowledge or AddComment
 TWO_STATES = {"EnabledState": ("Enabled", "Disabled"), "ActiveState": ("Active", "Inactive"),
-              "AckedState": ("Acknowledged", "Unacknowledged"), "SuppressedState": ("Suppressed", "Unsuppressed"),
+              "AckedState": ("Acknowledged", "Unacknowledged"),
+              "SuppressedState": ("Suppressed", "Unsuppressed"),
               "OutOfServiceState": ("Out of Service", "In Service")}  # Part 9 Annex A's state names
-
-
-@dataclass(frozen=True)
-class _Declared:
-    """One node of a condition type's instances: where it sits and what the type declares of it."""
-
-    path: tuple[str, ...]  # BrowseNames below the condition
-    item: ua.AddNodesItem  # class, BrowseName, reference to its parent, type definition, attributes
-    declaration: ua.NodeId  # the type's node it stands for
 
 
 @dataclass
@@ -205,49 +198,42 @@ class Conditions:
         self._loop = asyncio.get_running_loop()
         self._queue = asyncio.Queue()
         aspace = server.iserver.aspace
-        first: dict[tuple[int, str, ua.VariantType | None], list[ua.NodeId]] = {}  # the nodes of each shape's first
+        first: dict[tuple[int, str, ua.VariantType | None], list[ua.NodeId]] = {}  # of each shape
         for alarm in self.alarms.values():
             d = alarm.defn
             key = d.id.rsplit(".", 1)[-1] if d.source is Source.LIMIT else ""
-            type_id = TYPES[d.source]
-            normal: ua.Variant | None = None
+            normal: ua.Variant | None = None  # the input's value when normal, where it has one
             if d.source is Source.STATION:
                 normal = ua.Variant("running", _V.String)
             elif d.source is Source.DISCRETE and d.tag in sources and await _is_bit(server, sources[d.tag]):
                 normal = ua.Variant(not d.when, _V.Boolean)
-            shape = (type_id, key, None if normal is None else normal.VariantType)
-            template = await _template(server, type_id, OPTIONAL | ({LIMITS[key][0]} if key in LIMITS else set()))
-            template = template + _own(idx, shape[2])
+            shape = (TYPES[d.source], key, None if normal is None else normal.VariantType)
+            optional = OPTIONAL | ({LIMITS[key][0]} if key in LIMITS else set())
+            declared = await nodes.template(server, shape[0], optional) + nodes.own(idx, shape[2])
             root = f"Alarms.{d.id}"
-            name = ua.QualifiedName(d.id, idx)
-            ids = [ua.NodeId(root, idx), *(ua.NodeId(".".join((root, *n.path)), idx) for n in template)]
+            ids = [ua.NodeId(root, idx), *(ua.NodeId(".".join((root, *n.path)), idx) for n in declared)]
             if shape in first:
-                _clone(aspace, first[shape], ids, name, alarm.text)
+                nodes.clone(aspace, first[shape], ids, alarm.text)
             else:
+                await nodes.add(server, ids, declared, folder.nodeid, shape[0], alarm.text)
                 first[shape] = ids
-                items = [_root(ids[0], name, folder.nodeid, type_id, alarm.text)]
-                for n, nodeid in zip(template, ids[1:]):
-                    item = copy.copy(n.item)
-                    item.RequestedNewNodeId = nodeid
-                    item.ParentNodeId = ua.NodeId(".".join((root, *n.path[:-1])), idx)
-                    items.append(item)
-                await _add(server, items)
-            nodes = {"/".join(n.path): nodeid for n, nodeid in zip(template, ids[1:])
-                     if n.item.NodeClass == ua.NodeClass.Variable and n.path[-1] != "InputArguments"}
-            methods = {nodeid: n.path[-1] for n, nodeid in zip(template, ids[1:])
+            variables = {n.field: nodeid for n, nodeid in zip(declared, ids[1:])
+                         if n.item.NodeClass == ua.NodeClass.Variable and n.path[-1] != "InputArguments"}
+            methods = {nodeid: n.path[-1] for n, nodeid in zip(declared, ids[1:])
                        if n.item.NodeClass == ua.NodeClass.Method}
             if d.tag is not None and d.tag in sources:
                 source, source_name, input_ = sources[d.tag], d.tag, sources[d.tag]
             else:
                 source, source_name = plc.nodeid, "NetPlc"
                 input_ = plc_state if d.source is Source.STATION else ua.NodeId()
-            priority = ua.Variant(PRIORITIES.get(d.priority, ""), _V.String)
-            for own, value in (("Priority", priority), ("NormalValue", normal)):
+            for name, value in (("Priority", ua.Variant(PRIORITIES.get(d.priority, ""), _V.String)),
+                                ("NormalValue", normal)):
                 if value is not None:
-                    await aspace.write_attribute_value(nodes[own], ua.AttributeIds.Value, ua.DataValue(value))
-            c = Condition(copy.copy(alarm), ids[0], ua.NodeId(type_id), source, source_name, input_,
-                          nodes.get("NormalValue", ua.NodeId()), ua.NodeId(f"{root}.ShelvingState", idx),
-                          nodes, methods)
+                    await aspace.write_attribute_value(variables[name], ua.AttributeIds.Value,
+                                                       ua.DataValue(value))
+            c = Condition(copy.copy(alarm), ids[0], ua.NodeId(shape[0]), source, source_name, input_,
+                          variables.get("NormalValue", ua.NodeId()), ua.NodeId(f"{root}.ShelvingState", idx),
+                          variables, methods)
             self.by_id[d.id] = self.by_node[c.nodeid] = self.by_node[c.shelving] = c
             self.methods.update((node, (c, name)) for node, name in methods.items())
         await self._references(server, station, plc)
@@ -261,13 +247,14 @@ class Conditions:
         await station.set_event_notifier([ua.EventNotifier.SubscribeToEvents])
         server_node = ua.NodeId(_O.Server)
         self.notifiers = [server_node, station.nodeid]
-        refs = [_reference(server_node, _O.HasNotifier, station.nodeid, ua.NodeClass.Object)]
+        refs = [nodes.reference(server_node, _O.HasNotifier, station.nodeid, ua.NodeClass.Object)]
         sources: dict[ua.NodeId, None] = {}
         for c in self.by_id.values():
             sources.setdefault(c.source)
-            refs.append(_reference(c.source, _O.HasCondition, c.nodeid, ua.NodeClass.Object))
-        refs += [_reference(station.nodeid, _O.HasEventSource, s,
-                            ua.NodeClass.Object if s == plc.nodeid else ua.NodeClass.Variable) for s in sources]
+            refs.append(nodes.reference(c.source, _O.HasCondition, c.nodeid, ua.NodeClass.Object))
+        refs += [nodes.reference(station.nodeid, _O.HasEventSource, s,
+                                 ua.NodeClass.Object if s == plc.nodeid else ua.NodeClass.Variable)
+                 for s in sources]
         for result in await server.iserver.isession.add_references(refs):
             result.check()
 
@@ -375,7 +362,8 @@ class Conditions:
         if d.source is Source.LIMIT and key in LIMITS:
             limit, state, state_node = LIMITS[key]
             out[limit] = ua.Variant(d.limit, _V.Double)
-            out["LimitState/CurrentState"] = _maybe(ua.LocalizedText(state) if a.active else None, _V.LocalizedText)
+            out["LimitState/CurrentState"] = _maybe(ua.LocalizedText(state) if a.active else None,
+                                                    _V.LocalizedText)
             out["LimitState/CurrentState/Id"] = _maybe(ua.NodeId(state_node) if a.active else None, _V.NodeId)
         return out
 
@@ -449,7 +437,8 @@ class Conditions:
         found = self.methods.get(nodeid)
         return None if found is None else self.commands.may(who, ACTIONS[found[1]])
 
-    async def call(self, who: Who, session_id: ua.NodeId, request: ua.CallMethodRequest) -> ua.CallMethodResult:
+    async def call(self, who: Who, session_id: ua.NodeId,
+                   request: ua.CallMethodRequest) -> ua.CallMethodResult:
         if request.MethodId in (REFRESH, REFRESH2):
             return await self.refresh(session_id, request)
         c, name = self._resolve(request)
@@ -474,7 +463,8 @@ class Conditions:
         if own is not None:
             name = own[1] if c is own[0] else ""
         else:
-            name = DECLARED.get(request.MethodId.Identifier, "") if request.MethodId.NamespaceIndex == 0 else ""
+            method = request.MethodId
+            name = DECLARED.get(method.Identifier, "") if method.NamespaceIndex == 0 else ""
         if c is not None and request.ObjectId == c.shelving and name not in ON_SHELVING:
             name = ""  # the ShelvingState has the shelving methods; the condition has them all
         return c, name
@@ -512,12 +502,13 @@ class Conditions:
     def _ticket(self, who: Who, c: Condition, name: str, args: list[Any]) -> Ticket:
         commands, alarm_id = self.commands, c.alarm.id
         if name in ("Acknowledge", "AddComment"):
-            comment = args[1].Text or "" if args[1] is not None else ""
+            comment = (args[1].Text or "") if args[1] is not None else ""
             if name == "AddComment":
                 return commands.comment(who, alarm_id, comment)
             return commands.acknowledge(who, alarm_id, comment)
         if name == "TimedShelve":
-            return commands.shelve(who, alarm_id, "TimedShelve over OPC UA (it gives no reason)", args[0] / 1000.0)
+            return commands.shelve(who, alarm_id, "TimedShelve over OPC UA (it gives no reason)",
+                                   args[0] / 1000.0)
         if name == "OneShotShelve":
             return commands.shelve(who, alarm_id, "OneShotShelve over OPC UA (it gives no reason)",
                                    ONE_SHOT_LIMIT, once=True)
@@ -526,138 +517,7 @@ class Conditions:
         return commands.out_of_service(who, alarm_id, name in ("Disable", "RemoveFromService"))
 
 
-# --- helpers -----------------------------------------------------------------------------------
-
-_TEMPLATES: dict[tuple[int, frozenset[str]], list[_Declared]] = {}  # of the standard types: any server's
-
-
-async def _template(server: Server, type_id: int, optional: frozenset[str]) -> list[_Declared]:
-    """The nodes an instance of the type has: the mandatory ones and the `optional` ones named
-    (at the top), parents before children, read once per type and process (what asyncua's
-    `instantiate` reads for every instance)."""
-    key = (type_id, optional)
-    if key not in _TEMPLATES:
-        _TEMPLATES[key] = await _declared(server, type_id, optional)
-    return _TEMPLATES[key]
-
-
-async def _declared(server: Server, type_id: int, optional: frozenset[str]) -> list[_Declared]:
-    out: list[_Declared] = []
-
-    async def children(path: tuple[str, ...], declarations: list[Node]) -> None:
-        seen: set[str] = set()
-        for declaration in declarations:
-            for rdesc in await declaration.get_children_descriptions():
-                name = rdesc.BrowseName.Name
-                if name in seen:
-                    continue
-                child = server.get_node(rdesc.NodeId)
-                rules = await child.get_referenced_nodes(refs=_O.HasModellingRule)
-                if not rules:  # not part of an instance (a subtype, an instance of the type itself)
-                    continue
-                if rules[0].nodeid in (ua.NodeId(_O.ModellingRule_Optional),
-                                       ua.NodeId(_O.ModellingRule_OptionalPlaceholder)) \
-                        and (path or name not in optional):
-                    continue
-                seen.add(name)
-                item = ua.AddNodesItem(BrowseName=rdesc.BrowseName, ReferenceTypeId=rdesc.ReferenceTypeId,
-                                       TypeDefinition=ua.NodeId(rdesc.TypeDefinition.Identifier,
-                                                                      rdesc.TypeDefinition.NamespaceIndex), NodeClass=rdesc.NodeClass)
-                attributes = {ua.NodeClass.Object: ua.ObjectAttributes, ua.NodeClass.Variable: ua.VariableAttributes,
-                              ua.NodeClass.Method: ua.MethodAttributes}[rdesc.NodeClass]()
-                await _read_and_copy_attrs(child, attributes, item)
-                out.append(_Declared((*path, name), item, rdesc.NodeId))
-                await children((*path, name), [child])
-
-    await children((), await get_node_supertypes(server.get_node(type_id), includeitself=True))
-    return out
-
-
-def _root(nodeid: ua.NodeId, name: ua.QualifiedName, folder: ua.NodeId, type_id: int,
-          description: str) -> ua.AddNodesItem:
-    attributes = ua.ObjectAttributes(DisplayName=ua.LocalizedText(name.Name), Description=ua.LocalizedText(description),
-                                     EventNotifier=0)
-    return ua.AddNodesItem(ParentNodeId=folder, ReferenceTypeId=ua.NodeId(_O.Organizes), RequestedNewNodeId=nodeid,
-                           BrowseName=name, NodeClass=ua.NodeClass.Object, NodeAttributes=attributes,
-                           TypeDefinition=ua.NodeId(type_id))
-
-
-def _own(idx: int, normal: ua.VariantType | None) -> list[_Declared]:
-    """The station's own properties of a condition: its ISA-18.2 state word, its priority and text,
-    and the value its input has when normal (`normal`: its type, None when it has none)."""
-    names = [("State", _V.String), ("Priority", _V.String), ("Text", _V.String)]
-    if normal is not None:
-        names.append(("NormalValue", normal))
-    out = []
-    for name, kind in names:
-        initial = ua.Variant(False if kind is _V.Boolean else "", kind)
-        attributes = ua.VariableAttributes(DisplayName=ua.LocalizedText(name), Value=initial,
-                                           DataType=ua.NodeId(kind.value), ValueRank=-1, AccessLevel=1,
-                                           UserAccessLevel=1)
-        item = ua.AddNodesItem(ReferenceTypeId=ua.NodeId(_O.HasProperty), BrowseName=ua.QualifiedName(name, idx),
-                               NodeClass=ua.NodeClass.Variable, NodeAttributes=attributes,
-                               TypeDefinition=ua.NodeId(_O.PropertyType))
-        out.append(_Declared((name,), item, ua.NodeId()))
-    return out
-
-
-def _clone(aspace: Any, first: list[ua.NodeId], ids: list[ua.NodeId], name: ua.QualifiedName,
-           description: str) -> None:
-    """A condition's nodes (`ids`, its root first) as copies of `first`'s, the condition of the
-    same shape added through AddNodes: asyncua builds each attribute of each node afresh (a
-    millisecond a node), a copy shares what never changes (only a node's Value is ever written, by
-    the station; clients' writes are the station's commands, and refused here) and costs a few
-    microseconds."""
-    remap = dict(zip(first, ids))
-    text = ua.LocalizedText(name.Name)
-    value_id, node_id = ua.AttributeIds.Value, ua.AttributeIds.NodeId
-    for old, new in zip(first, ids):
-        original = aspace[old]
-        node = NodeData(new)
-        node.attributes = dict(original.attributes)
-        node.attributes[node_id] = AttributeValue(ua.DataValue(ua.Variant(new, _V.NodeId)))
-        if value_id in original.attributes:
-            node.attributes[value_id] = AttributeValue(original.attributes[value_id].value)
-        node.references = [ref if ref.NodeId not in remap else _pointing(ref, remap[ref.NodeId], name, text)
-                           if ref.NodeId == first[0] else _pointing(ref, remap[ref.NodeId])
-                           for ref in original.references]
-        aspace[new] = node
-    node = aspace[ids[0]]
-    for attribute, value in ((ua.AttributeIds.BrowseName, ua.Variant(name, _V.QualifiedName)),
-                             (ua.AttributeIds.DisplayName, ua.Variant(text, _V.LocalizedText)),
-                             (ua.AttributeIds.Description, ua.Variant(ua.LocalizedText(description),
-                                                                      _V.LocalizedText))):
-        node.attributes[attribute] = AttributeValue(ua.DataValue(value))
-    up = next(r for r in node.references if not r.IsForward and r.ReferenceTypeId == ua.NodeId(_O.Organizes))
-    folder = aspace[up.NodeId]  # its reference to the condition: as to the first, with the condition's names
-    folder.references.append(ua.ReferenceDescription(
-        ReferenceTypeId=up.ReferenceTypeId, IsForward=True, NodeId=ids[0], BrowseName=name, DisplayName=text,
-        NodeClass=ua.NodeClass.Object, TypeDefinition=next(r.NodeId for r in node.references
-                                                           if r.ReferenceTypeId == ua.NodeId(_O.HasTypeDefinition))))
-
-
-def _pointing(ref: ua.ReferenceDescription, to: ua.NodeId, name: ua.QualifiedName | None = None,
-              text: ua.LocalizedText | None = None) -> ua.ReferenceDescription:
-    """`ref` to another node (named `name`, `text` where its names differ too)."""
-    return ua.ReferenceDescription(ReferenceTypeId=ref.ReferenceTypeId, IsForward=ref.IsForward, NodeId=to,
-                                   BrowseName=name or ref.BrowseName, DisplayName=text or ref.DisplayName,
-                                   NodeClass=ref.NodeClass, TypeDefinition=ref.TypeDefinition)
-
-
-async def _add(server: Server, items: list[ua.AddNodesItem]) -> None:
-    for item, result in zip(items, await server.iserver.isession.add_nodes(items)):
-        if not result.StatusCode.is_good():
-            raise RuntimeError(f"condition node {item.RequestedNewNodeId.to_string()} not added: {result.StatusCode}")
-
-
-def _reference(source: ua.NodeId, kind: int, target: ua.NodeId, target_class: ua.NodeClass) -> ua.AddReferencesItem:
-    return ua.AddReferencesItem(SourceNodeId=source, ReferenceTypeId=ua.NodeId(kind), IsForward=True,
-                                TargetNodeId=target, TargetNodeClass=target_class)
-
-
-async def _is_bit(server: Server, variable: ua.NodeId) -> bool:
-    return await server.get_node(variable).read_data_type() == ua.NodeId(_O.Boolean)
-
+# --- helpers ---------------------------------------------------------------------------------
 
 def _maybe(value: Any, kind: ua.VariantType) -> ua.Variant:
     """A value, or its type's empty one (a LimitState while inactive, a comment never given)."""
@@ -673,9 +533,11 @@ def _bracket(event_type: int) -> Event:
     name = "RefreshStart" if event_type == _O.RefreshStartEventType else "RefreshEnd"
     for key, value, kind in (("EventId", uuid.uuid4().bytes, _V.ByteString),
                              ("EventType", ua.NodeId(event_type), _V.NodeId),
-                             ("SourceNode", ua.NodeId(_O.Server), _V.NodeId), ("SourceName", "Server", _V.String),
+                             ("SourceNode", ua.NodeId(_O.Server), _V.NodeId),
+                             ("SourceName", "Server", _V.String),
                              ("Time", now, _V.DateTime), ("ReceiveTime", now, _V.DateTime),
-                             ("Message", ua.LocalizedText(name), _V.LocalizedText), ("Severity", 1, _V.UInt16)):
+                             ("Message", ua.LocalizedText(name), _V.LocalizedText),
+                             ("Severity", 1, _V.UInt16)):
         event.add_property(key, value, kind)
     return event
 
@@ -692,3 +554,6 @@ async def _enqueue(sub: Any, mid: int, event: Event, bypass: bool) -> None:
                                EventFields=event.to_event_fields(data.filter.SelectClauses))
     await sub.enqueue_event(mid, fields, data.queue_size)
 
+
+async def _is_bit(server: Server, variable: ua.NodeId) -> bool:
+    return await server.get_node(variable).read_data_type() == ua.NodeId(_O.Boolean)

@@ -161,7 +161,8 @@ def arguments(request: ua.CallMethodRequest, count: int) -> tuple[list[Any], ua.
     return args, result
 
 
-async def answered(result: ua.CallMethodResult, ticket: Ticket, answers: dict[Reason, int]) -> ua.CallMethodResult:
+async def answered(result: ua.CallMethodResult, ticket: Ticket,
+                   answers: dict[Reason, int]) -> ua.CallMethodResult:
     """`result` with the command layer's answer as its StatusCode: once applied and committed, or
     refused (`answers` maps the layer's `Reason` to a StatusCode)."""
     answer = await asyncio.wrap_future(ticket)

@@ -598,8 +598,8 @@ class OpcUaServer:
 
     async def _call(self, session: Any, requests: list[ua.CallMethodRequest],
                     service: Callable[[list[ua.CallMethodRequest]], Any]) -> list[ua.CallMethodResult]:
-        """The station's methods and its conditions' (and ConditionRefresh) as its commands, with
-        the session's user; others to asyncua."""
+        """The station's methods and its conditions' as its commands, with the session's user, and
+        ConditionRefresh for the session's subscriptions (conditions.py); others to asyncua."""
         who = _who(session)
         station = [r.MethodId in self.methods.by_node for r in requests]
         condition = [not own and self.conditions.owns(r) for r, own in zip(requests, station)]

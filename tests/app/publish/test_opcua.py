@@ -114,7 +114,8 @@ def test_quality_goes_bad_when_the_node_is_killed(station: tuple[Runtime, str]) 
         async with Client(url) as client:
             ns = await client.get_namespace_index("urn:netplc:station:Demo station")
             sub = await client.create_subscription(50, Handler())
-            await sub.subscribe_events(client.get_node(ua.NodeId("Demo station", ns)), ua.ObjectIds.AlarmConditionType)
+            await sub.subscribe_events(client.get_node(ua.NodeId("Demo station", ns)),
+                                       ua.ObjectIds.AlarmConditionType)
             level = await _tag(client, "LEVEL")
             deadline = time.monotonic() + 5
             while not (await level.read_data_value(raise_on_bad_status=False)).StatusCode.is_good():
