@@ -167,6 +167,7 @@ class Condition:
     episode: int = 0  # counts the times it became unacknowledged
     known: OrderedDict[bytes, int] = field(default_factory=OrderedDict)  # EventId -> its episode
     comment: tuple[str, str] = ("", "")  # the last comment and who gave it, as shown
+    fixed: dict[str, ua.Variant] = field(default_factory=dict)  # what never changes: Priority, NormalValue
     comment_time: datetime | None = None
 
 
@@ -226,14 +227,12 @@ class Conditions:
             else:
                 source, source_name = plc.nodeid, "NetPlc"
                 input_ = plc_state if d.source is Source.STATION else ua.NodeId()
-            for name, value in (("Priority", ua.Variant(PRIORITIES.get(d.priority, ""), _V.String)),
-                                ("NormalValue", normal)):
-                if value is not None:
-                    await aspace.write_attribute_value(variables[name], ua.AttributeIds.Value,
-                                                       ua.DataValue(value))
             c = Condition(copy.copy(alarm), ids[0], ua.NodeId(shape[0]), source, source_name, input_,
                           variables.get("NormalValue", ua.NodeId()), ua.NodeId(f"{root}.ShelvingState", idx),
                           variables, methods)
+            c.fixed["Priority"] = ua.Variant(PRIORITIES.get(d.priority, ""), _V.String)
+            if normal is not None:
+                c.fixed["NormalValue"] = normal
             self.by_id[d.id] = self.by_node[c.nodeid] = self.by_node[c.shelving] = c
             self.methods.update((node, (c, name)) for node, name in methods.items())
         await self._references(server, station, plc)
@@ -294,14 +293,15 @@ class Conditions:
         if (a.comment, a.comment_by) != c.comment:
             c.comment, c.comment_time = (a.comment, a.comment_by), when
         fields = self._fields(c, text, when, aspace)
+        values = {**fields, **c.fixed, "State": ua.Variant(a.state.word, _V.String),
+                  "Text": ua.Variant(a.text, _V.String)}  # the station's own properties: not event fields
         for name, nodeid in c.nodes.items():
-            variant = fields.get(name)
+            variant = values.get(name)
             if variant is not None:
-                await aspace.write_attribute_value(nodeid, ua.AttributeIds.Value,
-                                                   ua.DataValue(variant, SourceTimestamp=when))
-        for name, value in (("State", a.state.word), ("Text", a.text)):
-            await aspace.write_attribute_value(c.nodes[name], ua.AttributeIds.Value,
-                                               ua.DataValue(ua.Variant(value, _V.String)))
+                result = await aspace.write_attribute_value(nodeid, ua.AttributeIds.Value,
+                                                            ua.DataValue(variant, SourceTimestamp=when))
+                if not result.is_good():
+                    logger.error("condition variable %s not written: %s", nodeid.to_string(), result)
         event = Event(ua.NodeId(_O.Server))
         for name, variant in fields.items():
             event.add_property(name, variant.Value, variant.VariantType)
