@@ -53,9 +53,10 @@ What asyncua (2.1) has and what is filled here. It ships the types (the standard
 event class per type, and no behaviour behind them:
 - instances: its `instantiate` browses the type's hierarchy again for every instance (0.1 s each),
   so condition_nodes.py reads each type's declarations once and copies the nodes of each shape;
-- events: its event generator fires at one notifier and knows nothing of conditions, so each event
-  is built here from the condition's fields (the values its variables hold) and queued to the
-  event monitored items of every notifier in the chain, through each one's filter;
+- events: its event generator fires at one notifier and knows nothing of conditions, and its Event
+  deep-copies every field for every monitored item, so each event is a `Notification` built here
+  from the condition's fields (the values its variables hold), queued to the event monitored items
+  of every notifier in the chain through each one's filter;
 - methods: the condition methods have no implementation; they are taken here;
 - refresh: its ConditionRefresh (bound only on request) keeps one event per condition at one
   notifier, passes the RefreshStart/End events through the client's WhereClause (Part 9 4.5: they
@@ -92,7 +93,6 @@ from datetime import UTC, datetime
 from typing import Any
 
 from asyncua import Node, Server, ua
-from asyncua.common.events import Event
 
 from app.authority import Action, Commands, Reason, Ticket, Who
 from app.publish import condition_nodes as nodes
@@ -147,6 +147,30 @@ TWO_STATES = {"EnabledState": ("Enabled", "Disabled"), "ActiveState": ("Active",
               "OutOfServiceState": ("Out of Service", "In Service")}  # Part 9 Annex A's state names
 
 
+class Notification:
+    """One event: its fields by name ("AckedState/Id"; "NodeId" the ConditionId), each Variant made
+    for it alone and shared by every monitored item it goes to (asyncua's Event deep-copies every
+    field for every one). What asyncua's WhereClause evaluation asks of an event: its fields'
+    values as attributes."""
+
+    def __init__(self, fields: dict[str, ua.Variant]) -> None:
+        self.fields = fields
+
+    def __getattr__(self, name: str) -> Any:
+        try:
+            return self.__dict__["fields"][name].Value
+        except KeyError:
+            raise AttributeError(name) from None
+
+    def to_event_fields(self, select: list[ua.SimpleAttributeOperand]) -> list[ua.Variant]:
+        """The fields a monitored item's SelectClauses ask, null where there is none."""
+        return [self.fields.get("/".join(q.Name for q in op.BrowsePath) if op.BrowsePath else
+                                ua.AttributeIds(op.AttributeId).name, NULL) for op in select]
+
+
+NULL = ua.Variant()
+
+
 @dataclass
 class Condition:
     """One alarm's condition: its nodes, and what its last event said."""
@@ -161,13 +185,14 @@ class Condition:
     shelving: ua.NodeId  # its ShelvingState object
     nodes: dict[str, ua.NodeId]  # its variables by field name ("AckedState/Id")
     methods: dict[ua.NodeId, str]  # its method nodes -> what they do
-    event: Event | None = None  # the last one: what a refresh sends again
+    event: Notification | None = None  # the last one: what a refresh sends again
     retain: bool = False  # of the last event
     acked: bool = True  # of the last event
     episode: int = 0  # counts the times it became unacknowledged
     known: OrderedDict[bytes, int] = field(default_factory=OrderedDict)  # EventId -> its episode
     comment: tuple[str, str] = ("", "")  # the last comment and who gave it, as shown
     fixed: dict[str, ua.Variant] = field(default_factory=dict)  # what never changes: Priority, NormalValue
+    shown: dict[str, ua.Variant] = field(default_factory=dict)  # what its variables hold
     comment_time: datetime | None = None
 
 
@@ -272,6 +297,8 @@ class Conditions:
             return
 
     async def _work(self) -> None:
+        """The transitions in the order they were journaled, each giving the loop a turn (a flood
+        of them does not keep the server from its clients)."""
         assert self._queue is not None
         while True:
             alarm, record = await self._queue.get()
@@ -283,8 +310,9 @@ class Conditions:
                     await self._send(event, list(self._subscriptions()))
             except Exception:  # the next transition is shown all the same
                 logger.exception("condition %s not updated", record.source)
+            await asyncio.sleep(0)
 
-    async def _show(self, c: Condition, text: str, ts: float) -> Event:
+    async def _show(self, c: Condition, text: str, ts: float) -> Notification:
         """The condition's variables and its new event, as `c.alarm` is now."""
         assert self.server is not None
         aspace = self.server.iserver.aspace
@@ -297,15 +325,13 @@ class Conditions:
                   "Text": ua.Variant(a.text, _V.String)}  # the station's own properties: not event fields
         for name, nodeid in c.nodes.items():
             variant = values.get(name)
-            if variant is not None:
+            if variant is not None and variant != c.shown.get(name):  # what changed, at its time
                 result = await aspace.write_attribute_value(nodeid, ua.AttributeIds.Value,
                                                             ua.DataValue(variant, SourceTimestamp=when))
                 if not result.is_good():
                     logger.error("condition variable %s not written: %s", nodeid.to_string(), result)
-        event = Event(ua.NodeId(_O.Server))
-        for name, variant in fields.items():
-            event.add_property(name, variant.Value, variant.VariantType)
-        event.add_property("NodeId", c.nodeid, _V.NodeId)  # the ConditionId
+                c.shown[name] = variant
+        event = Notification({**fields, "NodeId": ua.Variant(c.nodeid, _V.NodeId)})  # NodeId: the ConditionId
         if c.acked and not a.acked:
             c.episode += 1  # unacknowledged anew: the events before need no acknowledgement now
         c.known[fields["EventId"].Value] = c.episode
@@ -373,7 +399,8 @@ class Conditions:
         assert self.server is not None
         return self.server.iserver.subscription_service.subscriptions.values()
 
-    async def _send(self, event: Event, subscriptions: list[Any], mids: set[int] | None = None) -> None:
+    async def _send(self, event: Notification, subscriptions: list[Any],
+                    mids: set[int] | None = None) -> None:
         """`event` to the event monitored items of the notifiers in its chain whose filter it
         passes (of `mids` only, when given)."""
         for sub in subscriptions:
@@ -520,29 +547,26 @@ class Conditions:
 # --- helpers ---------------------------------------------------------------------------------
 
 def _maybe(value: Any, kind: ua.VariantType) -> ua.Variant:
-    """A value, or its type's empty one (a LimitState while inactive, a comment never given)."""
+    """A value, or for none its type's empty one where it has one (a LimitState while inactive),
+    else null (the time of a comment never given)."""
     if value is None:
         value = {_V.LocalizedText: ua.LocalizedText(), _V.NodeId: ua.NodeId()}.get(kind)
-    return ua.Variant(value, kind)
+    return NULL if value is None else ua.Variant(value, kind)
 
 
-def _bracket(event_type: int) -> Event:
+def _bracket(event_type: int) -> Notification:
     """A RefreshStart or RefreshEnd event: one EventId for every copy of it."""
-    now = datetime.now(UTC)
-    event = Event(ua.NodeId(_O.Server))
+    now = ua.Variant(datetime.now(UTC), _V.DateTime)
     name = "RefreshStart" if event_type == _O.RefreshStartEventType else "RefreshEnd"
-    for key, value, kind in (("EventId", uuid.uuid4().bytes, _V.ByteString),
-                             ("EventType", ua.NodeId(event_type), _V.NodeId),
-                             ("SourceNode", ua.NodeId(_O.Server), _V.NodeId),
-                             ("SourceName", "Server", _V.String),
-                             ("Time", now, _V.DateTime), ("ReceiveTime", now, _V.DateTime),
-                             ("Message", ua.LocalizedText(name), _V.LocalizedText),
-                             ("Severity", 1, _V.UInt16)):
-        event.add_property(key, value, kind)
-    return event
+    return Notification({"EventId": ua.Variant(uuid.uuid4().bytes, _V.ByteString),
+                         "EventType": ua.Variant(ua.NodeId(event_type), _V.NodeId),
+                         "SourceNode": ua.Variant(ua.NodeId(_O.Server), _V.NodeId),
+                         "SourceName": ua.Variant("Server", _V.String), "Time": now, "ReceiveTime": now,
+                         "Message": ua.Variant(ua.LocalizedText(name), _V.LocalizedText),
+                         "Severity": ua.Variant(1, _V.UInt16)})
 
 
-async def _enqueue(sub: Any, mid: int, event: Event, bypass: bool) -> None:
+async def _enqueue(sub: Any, mid: int, event: Notification, bypass: bool) -> None:
     """`event` to one monitored item, through its filter's WhereClause unless `bypass` (the refresh
     bracket: Part 9 4.5), with the fields its SelectClauses ask."""
     data = sub.monitored_item_srv._monitored_items.get(mid)
