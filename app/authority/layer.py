@@ -309,24 +309,32 @@ class Commands:
         run = act(alarms)
         return self._queue(who, action, alarm_id, lambda _mem: alarms.run_now(run))
 
-    def acknowledge(self, who: Who, alarm_id: str) -> Ticket:
+    def acknowledge(self, who: Who, alarm_id: str, comment: str = "") -> Ticket:
+        """`comment`: the operator's words, journaled with the acknowledgement."""
         return self._alarm(who, Action.ACKNOWLEDGE, alarm_id,
-                           lambda a: lambda: a.system.acknowledge(alarm_id, who.name),
+                           lambda a: lambda: a.system.acknowledge(alarm_id, who.name, comment=comment),
                            lambda a: a.system.get(alarm_id))
 
     def acknowledge_all(self, who: Who) -> Ticket:
         return self._alarm(who, Action.ACKNOWLEDGE, "all",
                            lambda a: lambda: a.system.acknowledge_all(who.name))
 
-    def shelve(self, who: Who, alarm_id: str, reason: str, duration: float) -> Ticket:
+    def shelve(self, who: Who, alarm_id: str, reason: str, duration: float, once: bool = False) -> Ticket:
+        """`once`: shelved until the condition next returns to normal, `duration` at most."""
         return self._alarm(who, Action.SHELVE, alarm_id,
-                           lambda a: lambda: a.system.shelve(alarm_id, who.name, reason, duration),
+                           lambda a: lambda: a.system.shelve(alarm_id, who.name, reason, duration, once=once),
                            lambda a: a.system.check_shelve(alarm_id, who.name, reason, duration))
 
     def unshelve(self, who: Who, alarm_id: str) -> Ticket:
         return self._alarm(who, Action.UNSHELVE, alarm_id,
                            lambda a: lambda: a.system.unshelve(alarm_id, who.name),
                            lambda a: a.system.get(alarm_id))
+
+    def comment(self, who: Who, alarm_id: str, text: str) -> Ticket:
+        """A comment on an alarm, journaled as a record of the alarm naming who."""
+        return self._alarm(who, Action.COMMENT, alarm_id,
+                           lambda a: lambda: a.system.comment(alarm_id, who.name, text),
+                           lambda a: a.system.check_comment(alarm_id, who.name, text))
 
     def out_of_service(self, who: Who, alarm_id: str, out: bool = True) -> Ticket:
         return self._alarm(who, Action.OUT_OF_SERVICE, alarm_id,

@@ -1,8 +1,8 @@
 """The one role policy of the station: which role each action needs, whoever asks and from wherever.
 
 Roles are ordered, each allowing what the one before allows (viewer looks; operator writes,
-acknowledges and shelves; engineer runs and stops NetPlc, forces, takes alarms out of service;
-admin manages users and trusts certificates). Every entry point (the workstation, the Program
+acknowledges, shelves and comments on alarms; engineer runs and stops NetPlc, forces, takes alarms
+out of service; admin manages users and trusts certificates). Every entry point (the workstation, the Program
 view, `main.py monitor`, OPC UA, MQTT, the Modbus server) asks the command layer
 (`app/authority/layer.py`), which reads this table and nothing else; none of them checks a role
 itself. A form element may ask more than the table does (its `Role`), never less.
@@ -26,6 +26,7 @@ class Action(StrEnum):
     ACKNOWLEDGE = "acknowledge"
     SHELVE = "shelve"
     UNSHELVE = "unshelve"
+    COMMENT = "comment"  # an operator's comment on an alarm
     SILENCE = "silence"  # the horn: the alarms stay unacknowledged
     OUT_OF_SERVICE = "out of service"  # take an alarm out of service or back (ISA-18.2)
     FORCE = "force"
@@ -43,6 +44,7 @@ POLICY: dict[Action, str] = {
     Action.ACKNOWLEDGE: OPERATOR,
     Action.SHELVE: OPERATOR,
     Action.UNSHELVE: OPERATOR,
+    Action.COMMENT: OPERATOR,
     Action.SILENCE: OPERATOR,
     Action.OUT_OF_SERVICE: ENGINEER,
     Action.FORCE: ENGINEER,

@@ -15,6 +15,7 @@ import asyncio
 import threading
 from collections.abc import Callable
 from dataclasses import dataclass
+from typing import Any
 
 from asyncua import Node, ua
 
@@ -50,7 +51,7 @@ METHODS = (
            "Force a tag (its bit, or all its words) to a physical value"),
     Method("UnforceTag", Action.UNFORCE, (TAG,), "Remove the force of a tag (all its words)"),
     Method("UnforceAll", Action.UNFORCE, description="Remove every force"),
-    # the alarm summary's actions, until the alarms are OPC UA conditions (Part 9) of their own
+    # the alarm summary's actions by alarm identity (the conditions' own methods are Part 9's: conditions.py)
     Method("Acknowledge", Action.ACKNOWLEDGE, (ALARM,), "Acknowledge an alarm"),
     Method("AcknowledgeAll", Action.ACKNOWLEDGE, description="Acknowledge every unacknowledged alarm"),
     Method("Shelve", Action.SHELVE, (ALARM, ("Reason", "why it is shelved (journaled)", _STRING),
@@ -90,18 +91,10 @@ class StationMethods:
 
     async def call(self, who: Who, request: ua.CallMethodRequest) -> ua.CallMethodResult:
         method = self.by_node[request.MethodId]
-        args = [v.Value for v in request.InputArguments or []]
-        result = ua.CallMethodResult()
-        result.InputArgumentResults = [ua.StatusCode() for _ in args]
-        if len(args) != len(method.inputs):
-            few = len(args) < len(method.inputs)
-            result.StatusCode = ua.StatusCode(ua.StatusCodes.BadArgumentsMissing if few else
-                                              ua.StatusCodes.BadTooManyArguments)
+        args, result = arguments(request, len(method.inputs))
+        if not result.StatusCode.is_good():
             return result
-        ticket = await self._ticket(who, method, args)
-        answer = await asyncio.wrap_future(ticket)
-        result.StatusCode = ua.StatusCode(self.answers[answer.reason])
-        return result
+        return await answered(result, await self._ticket(who, method, args), self.answers)
 
     async def _ticket(self, who: Who, method: Method, args: list[object]) -> Ticket:
         commands = self.commands
@@ -160,6 +153,27 @@ class StationMethods:
         if value is not None and (not isinstance(value, (int, float)) or isinstance(value, bool)):
             return commands.refuse(who, method.action, name, Reason.INVALID, f"{value!r} is not a number")
         return commands.force_tag(who, name, None if value is None else float(value))
+
+
+def arguments(request: ua.CallMethodRequest, count: int) -> tuple[list[Any], ua.CallMethodResult]:
+    """A call's argument values and its result, already Bad_ArgumentsMissing or
+    Bad_TooManyArguments when it does not bring `count` of them."""
+    args = [v.Value for v in request.InputArguments or []]
+    result = ua.CallMethodResult()
+    result.InputArgumentResults = [ua.StatusCode() for _ in args]
+    if len(args) != count:
+        result.StatusCode = ua.StatusCode(ua.StatusCodes.BadArgumentsMissing if len(args) < count else
+                                          ua.StatusCodes.BadTooManyArguments)
+    return args, result
+
+
+async def answered(result: ua.CallMethodResult, ticket: Ticket,
+                   answers: dict[Reason, int]) -> ua.CallMethodResult:
+    """`result` with the command layer's answer as its StatusCode: once applied and committed, or
+    refused (`answers` maps the layer's `Reason` to a StatusCode)."""
+    answer = await asyncio.wrap_future(ticket)
+    result.StatusCode = ua.StatusCode(answers[answer.reason])
+    return result
 
 
 def _not_through_a_session(parent: ua.NodeId, *args: object) -> ua.StatusCode:

@@ -27,11 +27,9 @@ secure channel, by closing the connection (the way asyncua answers a refused Ope
 Logins are the station's users with a back-off per host (app/authority/logins.py). A loopback
 endpoint (the demo) is for local clients only and has no security.
 
-Alarms: each alarm is a String variable holding its ISA-18.2 state word, and each transition
-fires an event (BaseEventType: SourceName the alarm id, Message its text, Severity from its
-priority) on the station object. asyncua's Alarms & Conditions have no acknowledge/shelve state
-machine behind them, so acknowledging stays with the station's operators (docs/architecture.md
-section 1: every acknowledgement journaled with its user).
+Alarms are OPC UA conditions (Part 9: conditions.py) in the station's Alarms folder, their
+events at the Server object and the station object, their methods (Acknowledge, shelving, out of
+service...) the station's commands like the station's own methods, ConditionRefresh answered.
 """
 
 from __future__ import annotations
@@ -61,6 +59,7 @@ from asyncua.crypto.security_policies import SecurityPolicyBasic256Sha256, Secur
 from app.authority import Action, Commands, Reason, Source, Ticket, Who
 from app.authority.logins import Logins
 from app.authority.users import UserError, Users
+from app.publish.conditions import Conditions
 from app.publish.feed import LatestReadings, Watch
 from app.publish.history import Archived, Series, StationHistory, install, series_of
 from app.publish.methods import StationMethods, StepLock
@@ -70,7 +69,6 @@ from app.publish.ua_types import (
     CODES,
     HISTORY_READ,
     READ,
-    SEVERITY,
     WRITE,
     TagNode,
     build_info,
@@ -78,7 +76,7 @@ from app.publish.ua_types import (
     tag_items,
     variant_type,
 )
-from app.scada.alarms import PRIORITIES, Alarm, State
+from app.scada.alarms import Alarm
 from app.scada.readings import Readings
 from app.scada.tag import Tag
 from app.station.config import OpcUaSettings
@@ -239,6 +237,7 @@ class OpcUaServer:
         self.writable = Writable(settings.writable)
         self.writer = PointWriter(commands, self.writable, "[opcua]")
         self.methods = StationMethods(commands, step_lock, ANSWERS)
+        self.conditions = Conditions(commands, ANSWERS, self.alarms)
         self.reader = PointReader(self.tags)
         self.status = OpcUaStatus()
         self.secure = not is_loopback(self.endpoint)
@@ -284,11 +283,10 @@ class OpcUaServer:
                 loop.call_soon_threadsafe(tick.set)
 
     def on_record(self, record: Record) -> None:
-        """The runtime's record observer: alarm transitions become variable states and events."""
-        loop = self._loop
-        if record.kind == "alarm" and loop is not None and self._ready.is_set():
-            with contextlib.suppress(RuntimeError):
-                loop.call_soon_threadsafe(lambda: loop.create_task(self._alarm_event(record)))
+        """The runtime's record observer: an alarm's transition becomes its condition's state and
+        event."""
+        if record.kind == "alarm" and self._ready.is_set():
+            self.conditions.post(record)
 
     # --- the server's own loop -----------------------------------------------------------------
 
@@ -418,15 +416,8 @@ class OpcUaServer:
                                    ("Writes", ua.Variant(0, ua.VariantType.UInt64)),
                                    ("Errors", ua.Variant(0, ua.VariantType.UInt64)), ("LastError", ""))}
         alarms = await station.add_folder(ua.NodeId("Alarms", idx), name("Alarms"))
-        self.alarm_vars = {}
-        for alarm in self.alarms:
-            var = await alarms.add_variable(ua.NodeId(f"Alarms.{alarm.id}", idx), name(alarm.id),
-                                            alarm.state.word)
-            await var.add_property(ua.NodeId(f"Alarms.{alarm.id}.Priority", idx), name("Priority"),
-                                   PRIORITIES.get(alarm.defn.priority, ""))
-            await var.add_property(ua.NodeId(f"Alarms.{alarm.id}.Text", idx), name("Text"), alarm.defn.text)
-            self.alarm_vars[alarm.id] = var
-        self.events = await server.get_event_generator(ua.ObjectIds.BaseEventType, station)
+        sources = {tag.name: nodeid for tag, nodeid in zip(self.tags, self.nodeids)}
+        await self.conditions.build(server, idx, alarms, station, sources, plc, self.plc_state.nodeid)
         await self.methods.add(station, idx)
         # after the event generator, which sets the station's EventNotifier
         notifiers = [ua.NodeId(ua.ObjectIds.Server), station.nodeid] if self.archived is not None else []
@@ -530,17 +521,6 @@ class OpcUaServer:
                                ("LastError", stats.last_error)):
                 await vars_[key].write_value(value)
 
-    async def _alarm_event(self, record: Record) -> None:
-        var = self.alarm_vars.get(record.source)
-        if var is None:
-            return
-        state = State(record.type or 0)
-        await var.write_value(state.word)
-        self.events.event.SourceName = record.source
-        self.events.event.Severity = SEVERITY.get(record.grp or 3, 500)
-        await self.events.trigger(message=f"{record.source}: {State(record.number or 0).word} -> {state.word}"
-                                          + (f": {record.text}" if record.text else ""))
-
     def _readable(self, scan: int) -> None:
         """The address space holds the values of `scan`: answer the writes that waited for them."""
         self._published = scan
@@ -595,7 +575,7 @@ class OpcUaServer:
                 return await self._write(_who(session), params)
 
             async def call(requests: list[ua.CallMethodRequest]) -> list[ua.CallMethodResult]:
-                return await self._call(_who(session), requests, service)
+                return await self._call(session, requests, service)
 
             service = session.call
             session.activate_session = activate_session
@@ -617,7 +597,10 @@ class OpcUaServer:
         user = event.user.name if event.user is not None and event.user.name else ""
         for n, rv in enumerate(reads):
             if rv.AttributeId == ua.AttributeIds.UserExecutable:
-                executable = self.methods.executable(Who(user, Source.OPCUA), rv.NodeId)
+                who = Who(user, Source.OPCUA)
+                executable = self.methods.executable(who, rv.NodeId)
+                if executable is None:
+                    executable = self.conditions.executable(who, rv.NodeId)
                 if executable is not None:
                     results[n] = ua.DataValue(ua.Variant(executable, ua.VariantType.Boolean))
                 continue
@@ -634,13 +617,18 @@ class OpcUaServer:
                     level |= WRITE
             results[n] = ua.DataValue(ua.Variant(level, ua.VariantType.Byte))
 
-    async def _call(self, who: Who, requests: list[ua.CallMethodRequest],
+    async def _call(self, session: Any, requests: list[ua.CallMethodRequest],
                     service: Callable[[list[ua.CallMethodRequest]], Any]) -> list[ua.CallMethodResult]:
-        """The station's methods as its commands, with the session's user; others to asyncua."""
-        ours = [r.MethodId in self.methods.by_node for r in requests]
-        theirs = [r for r, own in zip(requests, ours) if not own]
+        """The station's methods and its conditions' as its commands, with the session's user, and
+        ConditionRefresh for the session's subscriptions (conditions.py); others to asyncua."""
+        who = _who(session)
+        station = [r.MethodId in self.methods.by_node for r in requests]
+        condition = [not own and self.conditions.owns(r) for r, own in zip(requests, station)]
+        theirs = [r for r, a, b in zip(requests, station, condition) if not (a or b)]
         others = iter(await service(theirs) if theirs else [])
-        return [await self.methods.call(who, r) if own else next(others) for r, own in zip(requests, ours)]
+        return [await self.methods.call(who, r) if a else
+                await self.conditions.call(who, session.session_id, r) if b else next(others)
+                for r, a, b in zip(requests, station, condition)]
 
     async def _write(self, who: Who, params: ua.WriteParameters) -> list[ua.StatusCode]:
         tickets = [self._command(who, wv) for wv in params.NodesToWrite]

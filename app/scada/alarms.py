@@ -7,8 +7,9 @@ running (the station's one NETPLC.STOPPED alarm, with why in its text). Each ala
 one of
 
     normal, active-unacknowledged, active-acknowledged, returned-unacknowledged,
-    shelved (by a named operator, with a reason, until an end time), suppressed (by design, while
-    a condition bit is 1), out-of-service.
+    shelved (by a named operator, with a reason, until an end time; or once: until its condition
+    next returns to normal, at most ONE_SHOT_LIMIT), suppressed (by design, while a condition bit
+    is 1), out-of-service.
 
 The last three lay over the first four: while one holds, the condition is still followed but
 nothing is annunciated, and when it ends an alarm whose condition is active comes back
@@ -55,6 +56,10 @@ LIMIT_WORDS = {"HH": "high-high", "H": "high", "L": "low", "LL": "low-low"}
 # NetPlc not running: the plant goes uncontrolled by the program and every value is frozen, so the
 # operator must know at once (high: it sounds), deliberate stop or not.
 STOPPED_ID, STOPPED_PRIORITY = "NETPLC.STOPPED", 2
+# A one-shot shelving ends when its alarm's condition returns to normal, and after this long at the
+# latest: nothing stays shelved for good because its condition never came and went (ISA-18.2 wants
+# shelving bounded; OPC UA Part 9 bounds a OneShotShelved alarm the same way).
+ONE_SHOT_LIMIT = 24 * 3600.0
 
 
 class State(IntEnum):
@@ -131,10 +136,13 @@ class Alarm:
     shelved_until: float | None = None
     shelved_by: str = ""
     reason: str = ""
+    one_shot: bool = False  # shelved until the condition returns to normal (or shelved_until)
     out_of_service: bool = False
     oos_by: str = ""
     suppressed: bool = False
     detail: str = ""  # what the text alone cannot say: why NetPlc is not running
+    comment: str = ""  # the last comment an operator gave it (acknowledging, or on its own)
+    comment_by: str = ""
 
     @property
     def id(self) -> str:
@@ -190,7 +198,8 @@ def summary_order(row: AlarmRow) -> tuple[bool, int, float]:
 
 
 PERSISTED = ("active", "acked", "since", "changed", "value", "shelved_until", "shelved_by", "reason",
-             "out_of_service", "oos_by", "suppressed", "detail")
+             "one_shot", "out_of_service", "oos_by", "suppressed", "detail", "comment", "comment_by")
+UNSHELVED = {"shelved_until": None, "shelved_by": "", "reason": "", "one_shot": False}
 
 
 @dataclass(frozen=True)
@@ -400,8 +409,7 @@ class AlarmSystem:
         for i in sorted(self._shelved):
             a = self.alarms[i]
             if a.shelved_until is not None and now >= a.shelved_until:
-                self._overlay(i, now, out, None, f"shelving by {a.shelved_by} ran out",
-                              shelved_until=None, shelved_by="", reason="")
+                self._overlay(i, now, out, None, f"shelving by {a.shelved_by} ran out", **UNSHELVED)
         self._flush_changes()
         return out
 
@@ -433,6 +441,9 @@ class AlarmSystem:
         elif not cond and a.active and (a.overlaid or not a.defn.latching):
             a.active = False
         self._emit(i, old, now, out)
+        if a.one_shot and not cond:
+            self._overlay(i, now, out, None, f"one-shot shelving by {a.shelved_by} ended: returned to normal",
+                          **UNSHELVED)
 
     def _overlay(self, i: int, now: float, out: list[Transition], user: str | None, note: str,
                  **changes: Any) -> None:
@@ -500,12 +511,14 @@ class AlarmSystem:
         self._flush_changes()
         return out
 
-    def acknowledge(self, alarm_id: str, user: str, now: float | None = None) -> list[Transition]:
-        """Acknowledge one alarm (a latched one whose condition has gone is reset by it)."""
+    def acknowledge(self, alarm_id: str, user: str, now: float | None = None,
+                    comment: str = "") -> list[Transition]:
+        """Acknowledge one alarm (a latched one whose condition has gone is reset by it), with the
+        operator's `comment` if any (journaled with it, and kept as the alarm's last comment)."""
         i = self._index(alarm_id)
-        return self._act(lambda out: self._ack(i, user, self.clock() if now is None else now, out))
+        return self._act(lambda out: self._ack(i, user, self.clock() if now is None else now, out, comment))
 
-    def _ack(self, i: int, user: str, now: float, out: list[Transition]) -> None:
+    def _ack(self, i: int, user: str, now: float, out: list[Transition], comment: str = "") -> None:
         a = self.alarms[i]
         old = a.state
         latched = a.defn.latching and a.active and not self._cond[i]
@@ -515,7 +528,11 @@ class AlarmSystem:
             return
         if latched:
             a.active = False
-        self._emit(i, old, now, out, user, "acknowledged" if old is not State.ACKED else "reset")
+        note = "acknowledged" if old is not State.ACKED else "reset"
+        if comment:
+            a.comment, a.comment_by = comment, user
+            note += f": {comment}"
+        self._emit(i, old, now, out, user, note)
 
     def acknowledge_all(self, user: str, now: float | None = None) -> list[Transition]:
         """Acknowledge every unacknowledged alarm: one transition (and record) for each, naming it."""
@@ -530,15 +547,18 @@ class AlarmSystem:
         return self._act(run)
 
     def shelve(self, alarm_id: str, user: str, reason: str, duration: float,
-               now: float | None = None) -> list[Transition]:
-        """Shelve an alarm for `duration` seconds; it comes back by itself when they have run out."""
+               now: float | None = None, once: bool = False) -> list[Transition]:
+        """Shelve an alarm for `duration` seconds; it comes back by itself when they have run out.
+        `once`: a one-shot shelving, which also ends when the condition next returns to normal."""
         i = self.check_shelve(alarm_id, user, reason, duration)
         when = self.clock() if now is None else now
         until = when + duration
         stamp = time.strftime("%Y-%m-%d %H:%M:%S", time.localtime(until))
+        how = f"shelved once, until it returns to normal (at most until {stamp})" if once else \
+            f"shelved for {duration:g} s until {stamp}"
         return self._act(lambda out: self._overlay(
-            i, when, out, user, f"shelved for {duration:g} s until {stamp}: {reason}",
-            shelved_until=until, shelved_by=user, reason=reason))
+            i, when, out, user, f"{how}: {reason}", shelved_until=until, shelved_by=user, reason=reason,
+            one_shot=once))
 
     def check_shelve(self, alarm_id: str, user: str, reason: str, duration: float) -> int:
         """AlarmError unless the alarm exists and the shelving names its operator, a reason and a
@@ -557,8 +577,29 @@ class AlarmSystem:
         if self.alarms[i].shelved_until is None:
             return []
         when = self.clock() if now is None else now
-        return self._act(lambda out: self._overlay(i, when, out, user, "unshelved", shelved_until=None,
-                                                   shelved_by="", reason=""))
+        return self._act(lambda out: self._overlay(i, when, out, user, "unshelved", **UNSHELVED))
+
+    def comment(self, alarm_id: str, user: str, text: str, now: float | None = None) -> list[Transition]:
+        """An operator's comment on an alarm: journaled as a record of the alarm (its state stays),
+        and kept as its last comment."""
+        i = self.check_comment(alarm_id, user, text)
+        a = self.alarms[i]
+        when = self.clock() if now is None else now
+
+        def run(out: list[Transition]) -> None:
+            a.comment, a.comment_by = text, user
+            self._emit(i, a.state, when, out, user, f"comment: {text}", always=True)
+
+        return self._act(run)
+
+    def check_comment(self, alarm_id: str, user: str, text: str) -> int:
+        """AlarmError unless the alarm exists and the comment names its operator and says something."""
+        i = self._index(alarm_id)
+        if not user.strip():
+            raise AlarmError(f"{alarm_id}: a comment needs the operator's name")
+        if not text.strip():
+            raise AlarmError(f"{alarm_id}: the comment is empty")
+        return i
 
     def set_out_of_service(self, alarm_id: str, user: str, out_of_service: bool = True,
                            now: float | None = None) -> list[Transition]:

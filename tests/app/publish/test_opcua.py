@@ -102,7 +102,7 @@ def test_subscription_sees_changes_within_two_ticks(station: tuple[Runtime, str]
 
 
 def test_quality_goes_bad_when_the_node_is_killed(station: tuple[Runtime, str]) -> None:
-    """... and TRIGGER's quality alarm comes: its variable's state and an event on the station."""
+    """... and TRIGGER's quality alarm comes: its condition's state and an event on the station."""
     runtime, url = station
     events: list = []
 
@@ -114,7 +114,8 @@ def test_quality_goes_bad_when_the_node_is_killed(station: tuple[Runtime, str]) 
         async with Client(url) as client:
             ns = await client.get_namespace_index("urn:netplc:station:Demo station")
             sub = await client.create_subscription(50, Handler())
-            await sub.subscribe_events(client.get_node(ua.NodeId("Demo station", ns)))
+            await sub.subscribe_events(client.get_node(ua.NodeId("Demo station", ns)),
+                                       ua.ObjectIds.AlarmConditionType)
             level = await _tag(client, "LEVEL")
             deadline = time.monotonic() + 5
             while not (await level.read_data_value(raise_on_bad_status=False)).StatusCode.is_good():
@@ -128,11 +129,11 @@ def test_quality_goes_bad_when_the_node_is_killed(station: tuple[Runtime, str]) 
                     break
                 assert time.monotonic() < deadline, dv.StatusCode
                 await asyncio.sleep(0.05)
-            alarm = client.get_node(ua.NodeId("Alarms.TRIGGER.BAD", ns))
+            alarm = client.get_node(ua.NodeId("Alarms.TRIGGER.BAD.State", ns))
             while await alarm.read_value() != "active-unacknowledged":
                 assert time.monotonic() < deadline
                 await asyncio.sleep(0.05)
-            while not any(getattr(e, "SourceName", "") == "TRIGGER.BAD" for e in events):
+            while not any(getattr(e, "ConditionName", "") == "TRIGGER.BAD" for e in events):
                 assert time.monotonic() < deadline
                 await asyncio.sleep(0.05)
 

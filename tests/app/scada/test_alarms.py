@@ -6,7 +6,7 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from app.scada.alarms import AlarmError, AlarmSystem, State
+from app.scada.alarms import ONE_SHOT_LIMIT, AlarmError, AlarmSystem, State
 from app.scada.quality import Quality
 from app.scada.table import TagAlarms, TagTable
 from app.scada.tag import Scaling, Tag, TagType
@@ -175,6 +175,41 @@ def test_shelving_needs_a_name_a_reason_and_a_duration_and_unshelve_ends_it() ->
         r.system.acknowledge("NOPE", "op")
     r.system.shelve("LEVEL.H", "op", "test", 100)
     assert [(t.old, t.new) for t in r.system.unshelve("LEVEL.H", "op")] == [(State.SHELVED, State.NORMAL)]
+
+
+def test_a_one_shot_shelving_ends_when_the_condition_next_returns_to_normal() -> None:
+    r = Rig(TagAlarms(h=90))
+    r.level(50)
+    r.scan(0)
+    once = r.system.shelve("LEVEL.H", "petrov", "known fault", ONE_SHOT_LIMIT, once=True)
+    assert [(t.old, t.new) for t in once] == [(State.NORMAL, State.SHELVED)]
+    assert "shelved once, until it returns to normal" in once[0].text and r.system.get("LEVEL.H").one_shot
+    r.level(95)
+    assert r.scan(1) == []  # comes while shelved: not annunciated
+    r.level(50)
+    back = r.scan(2)  # goes: the shelving has done its one shot
+    assert back == [("LEVEL.H", "shelved", "normal")]
+    assert "one-shot shelving by petrov ended: returned to normal" in r.sink.records[-1].text
+    a = r.system.get("LEVEL.H")
+    assert (a.shelved_until, a.one_shot, a.shelved_by) == (None, False, "")
+    r.system.shelve("LEVEL.H", "petrov", "never comes back", 10, once=True)
+    assert r.scan(12) == [("LEVEL.H", "shelved", "normal")]  # and runs out at its limit
+    assert not r.system.get("LEVEL.H").one_shot
+
+
+def test_comments_are_journaled_with_the_alarm_and_kept_as_its_last() -> None:
+    r = Rig(TagAlarms(h=90))
+    r.level(95)
+    r.scan(0)
+    said = r.system.comment("LEVEL.H", "petrov", "technician called")
+    assert [(t.old, t.new, t.user) for t in said] == [(State.UNACK, State.UNACK, "petrov")]
+    assert "comment: technician called; by petrov" in said[0].text
+    ack = r.system.acknowledge("LEVEL.H", "ivanov", comment="seen, valve closed")
+    assert "acknowledged: seen, valve closed; by ivanov" in ack[0].text
+    a = r.system.get("LEVEL.H")
+    assert (a.comment, a.comment_by) == ("seen, valve closed", "ivanov")
+    with pytest.raises(AlarmError, match="empty"):
+        r.system.comment("LEVEL.H", "petrov", " ")
 
 
 def test_suppressed_by_design_while_the_condition_bit_is_1() -> None:
