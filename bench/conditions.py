@@ -71,19 +71,21 @@ async def main(alarms: int) -> None:
     server.set_endpoint(url)
     server.set_security_policy([ua.SecurityPolicyType.NoSecurity])
     idx = await server.register_namespace("urn:bench")
-    station = await server.nodes.objects.add_object(ua.NodeId("Station", idx), ua.QualifiedName("Station", idx))
+    station = await server.nodes.objects.add_object(ua.NodeId("Station", idx),
+                                                    ua.QualifiedName("Station", idx))
     tag_folder = await station.add_folder(ua.NodeId("Tags", idx), ua.QualifiedName("Tags", idx))
     sources = {}
     for t in tags:
-        var = await tag_folder.add_variable(ua.NodeId(f"Tags.{t.name}", idx), ua.QualifiedName(t.name, idx), 0.0)
+        var = await tag_folder.add_variable(ua.NodeId(f"Tags.{t.name}", idx),
+                                            ua.QualifiedName(t.name, idx), 0.0)
         sources[t.name] = var.nodeid
     plc = await station.add_object(ua.NodeId("NetPlc", idx), ua.QualifiedName("NetPlc", idx))
     state = await plc.add_variable(ua.NodeId("NetPlc.State", idx), ua.QualifiedName("State", idx), "running")
     folder = await station.add_folder(ua.NodeId("Alarms", idx), ua.QualifiedName("Alarms", idx))
 
     t0 = time.perf_counter()
-    await instantiate(folder, server.get_node(ua.ObjectIds.ExclusiveLevelAlarmType), ua.NodeId("Yardstick", idx),
-                      ua.QualifiedName("Yardstick", idx))
+    await instantiate(folder, server.get_node(ua.ObjectIds.ExclusiveLevelAlarmType),
+                      ua.NodeId("Yardstick", idx), ua.QualifiedName("Yardstick", idx))
     yardstick = time.perf_counter() - t0
     conditions = Conditions(None, {}, system.alarms)  # type: ignore[arg-type]  # no methods called here
     before = rss_mb()
