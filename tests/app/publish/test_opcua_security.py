@@ -202,9 +202,10 @@ def test_logins_back_off_are_journaled_and_unknown_names_take_the_time_of_wrong_
 
     unknown, wrong = run(activations())
     # pair by pair (taken in turn, so the shared machine's drift hits both): before the stand-in an
-    # unknown name was refused about 10x faster than a wrong password
+    # unknown name was refused about 10x faster than a wrong password; the band is wide because a
+    # loaded machine stretches single pairs, while a name told apart would show as a ratio near 0.1
     ratio = statistics.median(u / w for u, w in zip(unknown, wrong, strict=True))
-    assert 0.7 < ratio < 1.4, (unknown, wrong)
+    assert 0.5 < ratio < 2.0, (unknown, wrong)
 
 
 def test_a_key_readable_by_others_is_made_private_and_old_files_are_kept(tmp_path: Path) -> None:
