@@ -211,6 +211,8 @@ class FormView(QWidget):
         if self.live:
             span = max(t.span for t in self.trends)
             self.trends[0].show_window(wall - span, wall)  # the others are linked to it
+        for trend in self.trends:  # now: pyqtgraph would move the view in its paint, and paint twice
+            trend.view_box.updateMatrix()
 
     def pause(self) -> None:
         """Stop following the clock (the operator pans, zooms or reads a value)."""

@@ -13,13 +13,14 @@ and scroll back into the archive's history, drawn lighter behind the live sample
 from __future__ import annotations
 
 import math
+import time
 from collections.abc import Hashable
 
 import numpy as np
 import pyqtgraph as pg
 from PySide6.QtCore import QCoreApplication, QPointF, QRect, QRectF, Qt
-from PySide6.QtGui import QColor, QPainter, QPen
-from PySide6.QtWidgets import QGraphicsItem, QToolButton, QWidget
+from PySide6.QtGui import QColor, QFont, QFontMetrics, QPainter, QPen, QPixmap
+from PySide6.QtWidgets import QGraphicsItem, QStyleOptionGraphicsItem, QToolButton, QWidget
 
 from hmi_forms.elements import formats
 from hmi_forms.elements.analog import AnalogBase
@@ -35,6 +36,91 @@ PAUSE, LIVE = "\u275a\u275a", "\u25b6"
 
 def _pen_color(color: Color | None) -> QColor:
     return theme.qcolor(color, theme.ACCENT)
+
+
+# seconds between the clock-time axis's labels: the first that leaves LABEL_GAP px per label
+STEPS = (1, 2, 5, 10, 15, 30, 60, 120, 300, 600, 900, 1800, 3600, 7200, 10800, 21600, 43200, 86400)
+LABEL_GAP = 64
+LABELS_KEPT = 4096  # label pixmaps of all trends of the process, started afresh when full
+_labels: dict[tuple[str, str, int, float], QPixmap] = {}
+
+
+def _label(text: str, font: QFont, color: QColor, ratio: float) -> QPixmap:
+    """The pixmap of one axis label, shared by every trend that shows the same text."""
+    key = (text, font.key(), color.rgba(), ratio)
+    pixmap = _labels.get(key)
+    if pixmap is None:
+        if len(_labels) >= LABELS_KEPT:
+            _labels.clear()
+        metrics = QFontMetrics(font)
+        pixmap = QPixmap(round(metrics.horizontalAdvance(text) * ratio) + 1, round(metrics.height() * ratio))
+        pixmap.setDevicePixelRatio(ratio)
+        pixmap.fill(Qt.GlobalColor.transparent)
+        p = QPainter(pixmap)
+        p.setFont(font)
+        p.setPen(color)
+        p.drawText(0, metrics.ascent(), text)
+        p.end()
+        _labels[key] = pixmap
+    return pixmap
+
+
+def clock_ticks(x0: float, x1: float, pixels: float) -> tuple[int, list[float]]:
+    """Round clock times in [x0, x1] (local time, whole seconds, at least LABEL_GAP px apart)."""
+    per_second = pixels / max(x1 - x0, 1e-9)
+    step = next((s for s in STEPS if s * per_second >= LABEL_GAP), STEPS[-1])
+    while step * per_second < LABEL_GAP:  # zoomed out past a day: whole days
+        step *= 2
+    offset = time.localtime(x0).tm_gmtoff if abs(x0) < 1e11 else 0
+    first = math.ceil((x0 + offset) / step) * step - offset
+    return step, [first + k * step for k in range(int((x1 - first) // step) + 1)]
+
+
+def clock_label(t: float, step: int) -> str:
+    form = "%H:%M:%S" if step < 60 else ("%H:%M" if step < 86400 else "%d.%m")
+    return time.strftime(form, time.localtime(t))
+
+
+class ClockAxis(pg.AxisItem):
+    """The clock-time axis under a trend, drawn directly: ticks on round seconds (minutes, hours,
+    days as zoomed), each label a pixmap shared by all trends of the process. pyqtgraph's
+    DateAxisItem measures and lays out every label at each move of the window, about half of a
+    form's redraw of its plots (issue 28); the window moves at every redraw, so a picture of the
+    axis could not be reused, but its labels can."""
+
+    def __init__(self, font: QFont) -> None:
+        super().__init__(orientation="bottom")
+        self.enableAutoSIPrefix(False)  # else every move of the window sets the axis's HTML label
+        self.setHeight(QFontMetrics(font).height() + self.style["tickTextOffset"][1])
+
+    def paint(self, p: QPainter, _opt: QStyleOptionGraphicsItem, _widget: QWidget | None = None) -> None:
+        view = self.linkedView()
+        if view is None:
+            return
+        bounds = self.mapRectFromParent(self.geometry())
+        grid = self.grid is not False
+        top = view.mapRectToItem(self, view.boundingRect()).top() if grid else bounds.top() - 4
+        x0, x1 = self.range
+        scale = bounds.width() / max(x1 - x0, 1e-9)
+        step, ticks = clock_ticks(x0, x1, bounds.width())
+        pen = QPen(self.pen())
+        p.setPen(pen)
+        p.drawLine(bounds.topLeft(), bounds.topRight())
+        if grid:
+            color = pen.color()
+            color.setAlpha(self.grid)
+            pen.setColor(color)
+            p.setPen(pen)
+        font, color = self.style["tickFont"], self.textPen().color()
+        ratio = p.device().devicePixelRatioF() if p.device() is not None else 1.0
+        y = bounds.top() + self.style["tickTextOffset"][1]
+        for t in ticks:
+            x = bounds.left() + (t - x0) * scale
+            p.drawLine(QPointF(x, top), QPointF(x, bounds.top()))
+            label = _label(clock_label(t, step), font, color, ratio)
+            w = label.width() / ratio
+            if bounds.left() <= x - w / 2 and x + w / 2 <= bounds.right():
+                p.drawPixmap(QPointF(x - w / 2, y), label)
 
 
 class FixedCurve(pg.PlotCurveItem):
@@ -62,7 +148,7 @@ class TrendWidget(SelfPainted):
         self.trend: Trend = model.trend  # type: ignore[assignment]
         self.header = max(16, min(22, round(model.h * 0.14)))
         plot = pg.PlotWidget(self, background=theme.qcolor(model.BackColor, QColor("#ffffff")),
-                             axisItems={"bottom": pg.DateAxisItem(orientation="bottom")})
+                             axisItems={"bottom": ClockAxis(theme.sized_font(10))})
         plot.setGeometry(1, self.header, model.w - 2, model.h - self.header - 1)
         plot.setFrameShape(plot.Shape.NoFrame)
         item = plot.getPlotItem()
@@ -117,16 +203,9 @@ class TrendWidget(SelfPainted):
         self.set_live(True)
         self.stale_mark.raise_()
         self.shown = -1  # trend.count when last drawn
+        self.span = self.trend.size * 0.1  # seconds of the live window, measured at each redraw
         self.hist_times = self.hist_values = np.empty(0)
         self._header_shown: tuple[object, ...] = ()
-
-    @property
-    def span(self) -> float:
-        """Seconds of the live window: the samples the element keeps, at the sampling period."""
-        t = self.trend.times()
-        t = t[~np.isnan(t)]
-        period = float(np.median(np.diff(t))) if len(t) > 2 else 0.1
-        return self.trend.size * max(period, 0.001)
 
     def sync(self) -> None:
         """A new sample: the plot waits for the form's redraw; the header is repainted if it changed."""
@@ -142,6 +221,9 @@ class TrendWidget(SelfPainted):
         if self.trend.count == self.shown:
             return
         t, y = self.trend.times(), self.trend.values()
+        known = t[~np.isnan(t)]
+        if len(known) > 2:  # the samples the element keeps, at the sampling period
+            self.span = self.trend.size * max(float(np.median(np.diff(known))), 0.001)
         if len(t):
             self.curve.setData(t, y)
             self.curve.set_extent(QRectF(t[0], self.lo, max(t[-1] - t[0], 1e-3), self.hi - self.lo))

@@ -226,13 +226,13 @@ def test_the_zoom_is_remembered_per_form(qtbot, console: MainWindow) -> None:
 
 
 def test_the_trends_of_a_form_share_one_clock_time_axis(qtbot, console: MainWindow) -> None:
-    import pyqtgraph as pg
+    from hmi_forms.widgets.trend import ClockAxis
 
     view = console.views[0]
     first, second = view.trends[:2]
     qtbot.waitUntil(lambda: first.trend.count > 15 and second.trend.count > 15, timeout=10_000)
     view.flush()
-    assert isinstance(first.plot.getPlotItem().getAxis("bottom"), pg.DateAxisItem)
+    assert isinstance(first.plot.getPlotItem().getAxis("bottom"), ClockAxis)
     assert first.view_box.viewRange()[0] == second.view_box.viewRange()[0]
     x0, x1 = first.view_box.viewRange()[0]
     assert abs(x1 - view._last.wall) < 0.01 and x1 - x0 > 10  # clock time, ending now
