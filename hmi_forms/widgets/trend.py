@@ -3,9 +3,12 @@
 Following docs/architecture.md section 9: the plot and its curves are created once per widget and
 fed with `setData` (bare PlotCurveItems: PlotDataItem's per-call bookkeeping cost five times the
 data itself); the y range is fixed (no autorange per frame) and the axes are cached as pixmaps.
-The x axis is clock time: the form (FormView) moves the time window of all its trends at once,
-and redraws them in the same tick, so two trends of one form never disagree about when something
-happened. The operator may pause a trend (its button, or by dragging or wheeling in it: the
+The x axis is time: the form (FormView) redraws all its trends in the same tick, on the same
+time, so two trends of one form never disagree about when something happened. Live, the axis is a
+fixed scale of seconds before now (the curves move under it, the axis, grid and view never
+change, so a redraw paints the curve alone: half the cost of the hand-drawn polylines of
+bench/hmi.py, where a clock-time axis moving under every plot cost twice theirs, issue 28);
+paused, it shows clock time. The operator may pause a trend (its button, or by dragging or wheeling in it: the
 form's trends are linked and all pause), pan and zoom in time, read the value under the mouse,
 and scroll back into the archive's history, drawn lighter behind the live samples.
 """
@@ -65,33 +68,51 @@ def _label(text: str, font: QFont, color: QColor, ratio: float) -> QPixmap:
     return pixmap
 
 
-def clock_ticks(x0: float, x1: float, pixels: float) -> tuple[int, list[float]]:
-    """Round clock times in [x0, x1] (local time, whole seconds, at least LABEL_GAP px apart)."""
+def round_ticks(x0: float, x1: float, pixels: float, offset: float = 0.0) -> tuple[int, list[float]]:
+    """Round times in [x0, x1], multiples of a step from STEPS after `offset` is added (the zone's
+    offset for clock times), at least LABEL_GAP px apart."""
     per_second = pixels / max(x1 - x0, 1e-9)
     step = next((s for s in STEPS if s * per_second >= LABEL_GAP), STEPS[-1])
-    while step * per_second < LABEL_GAP:  # zoomed out past a day: whole days
+    while step * per_second < LABEL_GAP:  # zoomed out past the longest step: multiples of it
         step *= 2
-    offset = time.localtime(x0).tm_gmtoff if abs(x0) < 1e11 else 0
     first = math.ceil((x0 + offset) / step) * step - offset
     return step, [first + k * step for k in range(int((x1 - first) // step) + 1)]
 
 
 def clock_label(t: float, step: int) -> str:
-    form = "%H:%M:%S" if step < 60 else ("%H:%M" if step < 86400 else "%d.%m")
-    return time.strftime(form, time.localtime(t))
+    if step >= 86400:
+        return formats.date(t)
+    return time.strftime(formats.TIME if step < 60 else "%H:%M", time.localtime(t))
+
+
+def ago_label(x: float, step: int) -> str:
+    """`x` seconds from now (0 or less) in the unit of `step`."""
+    for unit, text in ((3600, "%1 h"), (60, "%1 min"), (1, "%1 s")):
+        if step >= unit and step % unit == 0:
+            return QCoreApplication.translate("TrendWidget", text).replace("%1", f"{x / unit:g}")
+    return ""  # not reached: every step is a whole number of seconds
 
 
 class ClockAxis(pg.AxisItem):
-    """The clock-time axis under a trend, drawn directly: ticks on round seconds (minutes, hours,
-    days as zoomed), each label a pixmap shared by all trends of the process. pyqtgraph's
-    DateAxisItem measures and lays out every label at each move of the window, about half of a
-    form's redraw of its plots (issue 28); the window moves at every redraw, so a picture of the
-    axis could not be reused, but its labels can."""
+    """The time axis under a trend, in seconds from `origin` (the view's x 0): live, the seconds
+    before now ("-10 s"), which never change, so the axis and its grid are painted once and kept
+    as a pixmap; paused, clock times. Ticks on round seconds (minutes, hours, days as zoomed),
+    each label a pixmap shared by all trends of the process (pyqtgraph's DateAxisItem lays out
+    every label at each change)."""
 
     def __init__(self, font: QFont) -> None:
         super().__init__(orientation="bottom")
-        self.enableAutoSIPrefix(False)  # else every move of the window sets the axis's HTML label
+        self.enableAutoSIPrefix(False)  # else every change of the range sets the axis's HTML label
         self.setHeight(QFontMetrics(font).height() + self.style["tickTextOffset"][1])
+        self.setCacheMode(QGraphicsItem.CacheMode.DeviceCoordinateCache)
+        self.origin = 0.0
+        self.clock = False
+
+    def place(self, origin: float, clock: bool) -> None:
+        """Clock times from `origin`, or seconds before it: repainted only if its labels change."""
+        if clock != self.clock or (clock and origin != self.origin):
+            self.update()
+        self.origin, self.clock = origin, clock
 
     def paint(self, p: QPainter, _opt: QStyleOptionGraphicsItem, _widget: QWidget | None = None) -> None:
         view = self.linkedView()
@@ -102,7 +123,13 @@ class ClockAxis(pg.AxisItem):
         top = view.mapRectToItem(self, view.boundingRect()).top() if grid else bounds.top() - 4
         x0, x1 = self.range
         scale = bounds.width() / max(x1 - x0, 1e-9)
-        step, ticks = clock_ticks(x0, x1, bounds.width())
+        if self.clock:
+            start = x0 + self.origin
+            zone = time.localtime(start).tm_gmtoff if abs(start) < 1e11 else 0
+            step, ticks = round_ticks(start, x1 + self.origin, bounds.width(), zone)
+            ticks = [t - self.origin for t in ticks]
+        else:
+            step, ticks = round_ticks(x0, x1, bounds.width())
         pen = QPen(self.pen())
         p.setPen(pen)
         p.drawLine(bounds.topLeft(), bounds.topRight())
@@ -117,10 +144,12 @@ class ClockAxis(pg.AxisItem):
         for t in ticks:
             x = bounds.left() + (t - x0) * scale
             p.drawLine(QPointF(x, top), QPointF(x, bounds.top()))
-            label = _label(clock_label(t, step), font, color, ratio)
+            text = clock_label(t + self.origin, step) if self.clock else ago_label(t, step)
+            label = _label(text, font, color, ratio)
             w = label.width() / ratio
-            if bounds.left() <= x - w / 2 and x + w / 2 <= bounds.right():
-                p.drawPixmap(QPointF(x - w / 2, y), label)
+            left = min(x - w / 2, bounds.right() - w)  # the newest label (now) ends at the right end
+            if bounds.left() <= left:
+                p.drawPixmap(QPointF(left, y), label)
 
 
 class FixedCurve(pg.PlotCurveItem):
@@ -149,6 +178,7 @@ class TrendWidget(SelfPainted):
         self.header = max(16, min(22, round(model.h * 0.14)))
         plot = pg.PlotWidget(self, background=theme.qcolor(model.BackColor, QColor("#ffffff")),
                              axisItems={"bottom": ClockAxis(theme.sized_font(10))})
+        self.axis: ClockAxis = plot.getPlotItem().getAxis("bottom")
         plot.setGeometry(1, self.header, model.w - 2, model.h - self.header - 1)
         plot.setFrameShape(plot.Shape.NoFrame)
         item = plot.getPlotItem()
@@ -203,6 +233,7 @@ class TrendWidget(SelfPainted):
         self.set_live(True)
         self.stale_mark.raise_()
         self.shown = -1  # trend.count when last drawn
+        self.origin = 0.0  # the time at the view's x 0: the curves are placed at -origin
         self.span = self.trend.size * 0.1  # seconds of the live window, measured at each redraw
         self.hist_times = self.hist_values = np.empty(0)
         self._header_shown: tuple[object, ...] = ()
@@ -229,8 +260,23 @@ class TrendWidget(SelfPainted):
             self.curve.set_extent(QRectF(t[0], self.lo, max(t[-1] - t[0], 1e-3), self.hi - self.lo))
         self.shown = self.trend.count
 
+    def place(self, origin: float, live: bool) -> None:
+        """Put time `origin` at the view's x 0: the curves move, the view does not (live, the
+        axis says seconds before it; paused, the clock times)."""
+        if origin != self.origin:
+            self.origin = origin
+            self.curve.setPos(-origin, 0)
+            self.history.setPos(-origin, 0)
+        self.axis.place(origin, not live)
+
     def show_window(self, t0: float, t1: float) -> None:
-        self.view_box.setXRange(t0, t1, padding=0)
+        """Show the times t0..t1 (the view of each trend linked to this one follows)."""
+        self.view_box.setXRange(t0 - self.origin, t1 - self.origin, padding=0)
+
+    def window(self) -> tuple[float, float]:
+        """The times shown."""
+        x0, x1 = self.view_box.viewRange()[0]
+        return x0 + self.origin, x1 + self.origin
 
     def set_live(self, live: bool) -> None:
         self.pause_button.setText(PAUSE if live else LIVE)
@@ -260,7 +306,7 @@ class TrendWidget(SelfPainted):
 
     def _mouse_moved(self, pos: QPointF) -> None:
         inside = self.view_box.sceneBoundingRect().contains(pos)
-        found = self.value_at(self.view_box.mapSceneToView(pos).x()) if inside else None
+        found = self.value_at(self.view_box.mapSceneToView(pos).x() + self.origin) if inside else None
         self.cursor.setVisible(found is not None)
         self.cursor_label.setVisible(found is not None)
         if found is None:
@@ -268,11 +314,12 @@ class TrendWidget(SelfPainted):
         t, y = found
         value = "---" if math.isnan(y) else (str(int(y)) if isinstance(self.model, Graph)
                                              else f"{self.model.format(y)} {self.model.Units}".rstrip())
-        self.cursor.setPos(t)
+        x = t - self.origin
+        self.cursor.setPos(x)
         self.cursor_label.setText(f"{formats.clock(t)}  {value}")
         (x0, x1), (_, y1) = self.view_box.viewRange()
-        self.cursor_label.setAnchor((1, 0) if t > (x0 + x1) / 2 else (0, 0))
-        self.cursor_label.setPos(t, y1)
+        self.cursor_label.setAnchor((1, 0) if x > (x0 + x1) / 2 else (0, 0))
+        self.cursor_label.setPos(x, y1)
 
     def look(self) -> tuple[object, ...]:
         """The header's name, address and lamp colour are in the cached layer (paint_static)."""
