@@ -206,11 +206,12 @@ class FormView(QWidget):
             self._dirty.append(part)
 
     def _redraw(self, wall: float) -> None:
-        for trend in self.trends:
-            trend.flush()
         if self.live:
             for trend in self.trends:  # now at the views' x 0: they stay, the curves move
                 trend.place(wall, live=True)
+        for trend in self.trends:
+            trend.flush()
+        if self.live:
             span = max(t.span for t in self.trends)
             self.trends[0].show_window(wall - span, wall)  # the others are linked to it
         for trend in self.trends:  # now: pyqtgraph would move a view in its paint, and paint twice

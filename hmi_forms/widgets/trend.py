@@ -233,7 +233,9 @@ class TrendWidget(SelfPainted):
         self.set_live(True)
         self.stale_mark.raise_()
         self.shown = -1  # trend.count when last drawn
-        self.origin = 0.0  # the time at the view's x 0: the curves are placed at -origin
+        self.origin = 0.0  # the time at the view's x 0
+        self._drawn_at = 0.0  # the origin of the live curve's data
+        self.history.setVisible(False)
         self.span = self.trend.size * 0.1  # seconds of the live window, measured at each redraw
         self.hist_times = self.hist_values = np.empty(0)
         self._header_shown: tuple[object, ...] = ()
@@ -249,24 +251,25 @@ class TrendWidget(SelfPainted):
         return QRect(0, 0, self.width(), self.header)  # the plot is redrawn by the form
 
     def flush(self) -> None:
-        if self.trend.count == self.shown:
+        if self.trend.count == self.shown and self.origin == self._drawn_at:
             return
         t, y = self.trend.times(), self.trend.values()
         known = t[~np.isnan(t)]
         if len(known) > 2:  # the samples the element keeps, at the sampling period
             self.span = self.trend.size * max(float(np.median(np.diff(known))), 0.001)
         if len(t):
-            self.curve.setData(t, y)
-            self.curve.set_extent(QRectF(t[0], self.lo, max(t[-1] - t[0], 1e-3), self.hi - self.lo))
-        self.shown = self.trend.count
+            x = t - self.origin
+            self.curve.setData(x, y)
+            self.curve.set_extent(QRectF(x[0], self.lo, max(x[-1] - x[0], 1e-3), self.hi - self.lo))
+        self.shown, self._drawn_at = self.trend.count, self.origin
 
     def place(self, origin: float, live: bool) -> None:
-        """Put time `origin` at the view's x 0: the curves move, the view does not (live, the
-        axis says seconds before it; paused, the clock times)."""
+        """Put time `origin` at the view's x 0: the curves move (at the next flush), the view does
+        not (live, the axis says seconds before it; paused, the clock times)."""
         if origin != self.origin:
             self.origin = origin
-            self.curve.setPos(-origin, 0)
-            self.history.setPos(-origin, 0)
+            if self.history.isVisible():  # long: moved, not set again (the live samples are, at flush)
+                self.history.setPos(-origin, 0)
         self.axis.place(origin, not live)
 
     def show_window(self, t0: float, t1: float) -> None:
@@ -288,6 +291,8 @@ class TrendWidget(SelfPainted):
         """The archive's samples of this trend, drawn lighter behind the live ones."""
         self.hist_times, self.hist_values = times, values
         self.history.setData(times, values)
+        self.history.setPos(-self.origin, 0)
+        self.history.setVisible(len(times) > 0)
         if len(times):
             self.history.set_extent(QRectF(times[0], self.lo, max(times[-1] - times[0], 1e-3),
                                            self.hi - self.lo))
