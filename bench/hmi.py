@@ -288,7 +288,8 @@ def main() -> None:
         f_base, y_base = median, statistics.median(yard[warm:])  # an ordinary tick of each
         f_share, y_share = f_median - f_base, y_median - y_base
         print(f"  the plots' share (a redraw tick less the median tick): {f_share:.2f} ms median, "
-              f"{f_worst - f_base:.2f} ms worst; yardstick {y_share:.2f} ms median, {y_worst - y_base:.2f} ms "
+              f"{f_worst - f_base:.2f} ms worst; yardstick {y_share:.2f} ms median, "
+              f"{y_worst - y_base:.2f} ms "
               f"worst; form / yardstick: worst {(f_worst - f_base) / (y_worst - y_base):.2f}x, median "
               f"{f_share / y_share:.2f}x")
     for name, start, end in (("resident", rss_warm[0], rss_end[0]),

@@ -255,8 +255,8 @@ class TrendWidget(SelfPainted):
             return
         t, y = self.trend.times(), self.trend.values()
         known = t[~np.isnan(t)]
-        if len(known) > 2:  # the samples the element keeps, at the sampling period
-            self.span = self.trend.size * max(float(np.median(np.diff(known))), 0.001)
+        if len(known) > 2:  # the samples the element keeps, at their mean period
+            self.span = self.trend.size * max(float(known[-1] - known[0]) / (len(known) - 1), 0.001)
         if len(t):
             x = t - self.origin
             self.curve.setData(x, y)
