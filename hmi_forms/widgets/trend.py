@@ -93,7 +93,37 @@ def ago_label(x: float, step: int) -> str:
     return ""  # not reached: every step is a whole number of seconds
 
 
-class ClockAxis(pg.AxisItem):
+class KeptAxis(pg.AxisItem):
+    """An axis that keeps its bounding rectangle until it or its view is resized or moved: Qt asks
+    for it several times in every paint of the plot, and pyqtgraph maps it afresh each time
+    (with the grid, the rectangle of the view), a fifth of the plot's paint."""
+
+    _bounds: QRectF | None = None  # a class default: pyqtgraph resizes the axis in its __init__
+
+    def boundingRect(self) -> QRectF:
+        if self._bounds is None:
+            self._bounds = super().boundingRect()
+        return self._bounds
+
+    def _forget(self) -> None:
+        if self._bounds is not None:
+            self.prepareGeometryChange()
+            self._bounds = None
+
+    def resizeEvent(self, ev: object = None) -> None:
+        self._forget()
+        super().resizeEvent(ev)
+
+    def linkedViewChanged(self, view: object, newRange: object = None) -> None:
+        self._forget()
+        super().linkedViewChanged(view, newRange)
+
+    def setGrid(self, grid: int | float | bool) -> None:
+        self._forget()
+        super().setGrid(grid)
+
+
+class ClockAxis(KeptAxis):
     """The time axis under a trend, in seconds from `origin` (the view's x 0): live, the seconds
     before now ("-10 s"), which never change, so the axis and its grid are painted once and kept
     as a pixmap; paused, clock times. Ticks on round seconds (minutes, hours, days as zoomed),
@@ -176,8 +206,8 @@ class TrendWidget(SelfPainted):
         super().__init__(model, images, parent)
         self.trend: Trend = model.trend  # type: ignore[assignment]
         self.header = max(16, min(22, round(model.h * 0.14)))
-        plot = pg.PlotWidget(self, background=theme.qcolor(model.BackColor, QColor("#ffffff")),
-                             axisItems={"bottom": ClockAxis(theme.sized_font(10))})
+        axes = {"bottom": ClockAxis(theme.sized_font(10)), "left": KeptAxis(orientation="left")}
+        plot = pg.PlotWidget(self, background=theme.qcolor(model.BackColor, QColor("#fff")), axisItems=axes)
         self.axis: ClockAxis = plot.getPlotItem().getAxis("bottom")
         plot.setGeometry(1, self.header, model.w - 2, model.h - self.header - 1)
         plot.setFrameShape(plot.Shape.NoFrame)
