@@ -204,11 +204,16 @@ class FormView(QWidget):
             self._dirty.append(part)
 
     def _redraw(self, wall: float) -> None:
+        if self.live:
+            for trend in self.trends:  # now at the views' x 0: they stay, the curves move
+                trend.place(wall, live=True)
         for trend in self.trends:
             trend.flush()
         if self.live:
             span = max(t.span for t in self.trends)
             self.trends[0].show_window(wall - span, wall)  # the others are linked to it
+        for trend in self.trends:  # now: pyqtgraph would move a view in its paint, and paint twice
+            trend.view_box.updateMatrix()
 
     def pause(self) -> None:
         """Stop following the clock (the operator pans, zooms or reads a value)."""
@@ -216,6 +221,7 @@ class FormView(QWidget):
             self.live = False
             for trend in self.trends:
                 trend.set_live(False)
+                trend.place(trend.origin, live=False)
 
     def resume(self) -> None:
         self.live = True
@@ -234,6 +240,7 @@ class FormView(QWidget):
         """Scrolled back past the live samples: each trend asks for its history there."""
         if self.history_wanted is None:
             return
+        x_range = (x_range[0] + self.trends[0].origin, x_range[1] + self.trends[0].origin)
         for trend in self.trends:
             t = trend.trend.times()
             first = t[0] if len(t) and not np.isnan(t[0]) else float("inf")

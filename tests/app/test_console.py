@@ -16,6 +16,7 @@ from app.gui.main_window import MainWindow
 from app.gui.zoom import ACTUAL, FIT_WIDTH, FIT_WINDOW
 from app.station.config import load_station
 from app.station.runtime import Runtime
+from hmi_forms.elements import formats
 from netplc.address import fmt_octal
 from registrar.query import Archive
 
@@ -227,30 +228,35 @@ def test_the_zoom_is_remembered_per_form(qtbot, console: MainWindow) -> None:
         again.close()
 
 
-def test_the_trends_of_a_form_share_one_clock_time_axis(qtbot, console: MainWindow) -> None:
-    import pyqtgraph as pg
+def test_the_trends_of_a_form_share_one_time_axis(qtbot, console: MainWindow) -> None:
+    from hmi_forms.widgets.trend import ClockAxis, ago_label, clock_label
 
     view = console.views[0]
     first, second = view.trends[:2]
     qtbot.waitUntil(lambda: first.trend.count > 15 and second.trend.count > 15, timeout=10_000)
     view.flush()
-    assert isinstance(first.plot.getPlotItem().getAxis("bottom"), pg.DateAxisItem)
+    axis = first.plot.getPlotItem().getAxis("bottom")
+    assert isinstance(axis, ClockAxis) and not axis.clock  # live: seconds before now
     assert first.view_box.viewRange()[0] == second.view_box.viewRange()[0]
     x0, x1 = first.view_box.viewRange()[0]
-    assert abs(x1 - view._last.wall) < 0.01 and x1 - x0 > 10  # clock time, ending now
+    assert x1 == 0 and x0 < -10  # live, the view stays: the curves move under it
+    t0, t1 = first.window()
+    assert abs(t1 - view._last.wall) < 0.01 and t1 - t0 > 10  # ending now
     assert first.shown == first.trend.count and second.shown == second.trend.count  # redrawn together
     t, v = first.trend.times()[-3], first.trend.values()[-3]
     assert first.value_at(t + 0.01) == (t, v)  # the cursor reads the nearest sample
+    assert ago_label(-10, 5) == "-10 s" and ago_label(-120, 60) == "-2 min"
+    assert clock_label(t, 1) == formats.clock(t)
 
     second.view_box.setXRange(x0 - 30, x1 - 30, padding=0)
     second.view_box.sigRangeChangedManually.emit([True, False])  # as a drag does
-    assert not view.live and first.pause_button.text() == "\u25b6"
+    assert not view.live and first.pause_button.text() == "\u25b6" and axis.clock  # paused: clock times
     assert first.view_box.viewRange()[0] == second.view_box.viewRange()[0]  # linked
     qtbot.wait(1200)
-    assert first.view_box.viewRange()[0][1] < view._last.wall - 20  # paused: it stays where it was put
+    assert first.window()[1] < view._last.wall - 20  # paused: it stays where it was put
     first.pause_button.click()
-    assert view.live
-    assert abs(first.view_box.viewRange()[0][1] - view._last.wall) < 0.01
+    assert view.live and not axis.clock
+    assert abs(first.window()[1] - view._last.wall) < 0.01
 
 
 def level_samples(archive: Path) -> int:
