@@ -94,6 +94,9 @@ def _check_parser() -> argparse.ArgumentParser:
                                             "simulator programs, messages and every form. Prints all "
                                             "problems; exit status 1 if there are any.")
     p.add_argument("station", help="station folder or its station.toml")
+    p.add_argument("partner", nargs="?", help="the other station of a hot-standby pair: both are "
+                                              "checked and must hold the same files")
+    p.add_argument("--partner", dest="partner_option", metavar="STATION", help="the same as PARTNER")
     return p
 
 
@@ -238,7 +241,8 @@ def main(argv: list[str] | None = None) -> int:
             ns = _design_parser().parse_args(rest)
             return run_designer(ns.target, ns.screenshot)
         if command == "check":
-            return run_check(_check_parser().parse_args(rest).station)
+            args = _check_parser().parse_args(rest)
+            return run_check(args.station, args.partner or args.partner_option)
         if command == "alarms-report":
             ns = _alarms_report_parser().parse_args(rest)
             return run_alarms_report(ns.archive, ns.day)
@@ -289,12 +293,14 @@ def _installed(extra: str, what: str) -> bool:
     return problem is None
 
 
-def run_check(station: str) -> int:
-    from app.station.check import check_station
+def run_check(station: str, partner: str | None = None) -> int:
+    from app.station.check import check_pair, check_station
 
-    report = check_station(station)
+    report = check_station(station) if partner is None else check_pair(station, partner)
     for problem in report.problems:
         print(problem)
+    for warning in report.warnings:
+        print(f"warning: {warning}")
     if report.ok:
         for note in report.notes:
             print(f"ok: {note}")
