@@ -62,6 +62,7 @@ class Reason(StrEnum):
     BUSY = "busy"  # the queue of outside actions is full (BadTooManyOperations, Modbus 06)
     JOURNAL_FULL = "journal full"  # the archive cannot take the record (BadResourceUnavailable, 06)
     NOT_RUNNING = "not running"  # the station is not started (BadServerHalted, Modbus 06)
+    STANDBY = "standby"  # the standby of a pair: the text names the primary (BadInvalidState, 06)
     FAILED = "failed"  # applying it failed; journaled as a system record (BadInternalError, 04)
 
 
@@ -112,8 +113,10 @@ class Commands:
                  tags: list[Tag] | tuple[Tag, ...] = (), alarms: StationAlarms | None = None,
                  source_roles: dict[Source, str] | None = None,
                  wallclock: Callable[[], float] = time.time,
-                 monotonic: Callable[[], float] = time.monotonic) -> None:
+                 monotonic: Callable[[], float] = time.monotonic,
+                 standby: Callable[[], str | None] = lambda: None) -> None:
         self.engine = engine
+        self.standby = standby  # why this station of a pair takes no commands now (names the primary)
         self.sink = sink
         self.role_of = role_of
         self.tags = {t.name: t for t in tags}
@@ -197,6 +200,8 @@ class Commands:
     def _queue(self, who: Who, action: Action, target: str,
                apply: Callable[[Memory], None]) -> Ticket:
         """Queue `apply` (which journals) to the engine; the ticket is answered after the commit."""
+        if (standby := self.standby()) is not None:
+            return self.refuse(who, action, target, Reason.STANDBY, standby)
         ticket: Ticket = Future()
 
         def done(ok: bool) -> None:
@@ -416,6 +421,8 @@ class Commands:
         engine = self.engine
         if lock is None:
             return self.refuse(who, Action.STEP, "NetPlc", Reason.NOT_RUNNING, "the station is not started")
+        if (standby := self.standby()) is not None:
+            return self.refuse(who, Action.STEP, "NetPlc", Reason.STANDBY, standby)
         with lock:
             if engine.state is RunState.RUNNING:
                 return self.refuse(who, Action.STEP, "NetPlc", Reason.INVALID,

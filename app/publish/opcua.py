@@ -91,7 +91,7 @@ ANSWERS = {Reason.APPLIED: _S.Good, Reason.DENIED: _S.BadUserAccessDenied,  # by
            Reason.TYPE_MISMATCH: _S.BadTypeMismatch, Reason.OUT_OF_RANGE: _S.BadOutOfRange,
            Reason.INVALID: _S.BadInvalidArgument, Reason.BUSY: _S.BadTooManyOperations,
            Reason.JOURNAL_FULL: _S.BadResourceUnavailable, Reason.NOT_RUNNING: _S.BadServerHalted,
-           Reason.FAILED: _S.BadInternalError}
+           Reason.FAILED: _S.BadInternalError, Reason.STANDBY: _S.BadInvalidState}
 READ, WRITE = 1 << ua.AccessLevel.CurrentRead, 1 << ua.AccessLevel.CurrentWrite
 YIELD_EVERY = 500  # variable writes between two turns of the event loop
 SEVERITY = {1: 900, 2: 700, 3: 500, 4: 300}  # alarm priority -> OPC UA severity 1-1000
