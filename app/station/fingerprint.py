@@ -5,7 +5,9 @@ pair whose program, symbols, tags, messages or forms differ would change the pla
 a switchover. The pair compares these hashes when its link comes up and refuses to pair, naming
 the files that differ; `main.py check A B` compares two folders the same way before they run.
 station.toml counts without the keys that must differ between the two ([redundancy] letter,
-listen and partner), as parsed TOML, so a comment or a reordered key does not part a pair.
+listen and partner), as parsed TOML, so a comment or a reordered key does not part a pair. The
+station's name counts too, the name a folder gives when station.toml has none: the plant archive
+keys both stations' records by it, and the arbiter's lease is the name's.
 """
 
 from __future__ import annotations
@@ -18,13 +20,14 @@ from pathlib import Path
 from app.station.config import STATION_FILE, Station
 
 OWN_KEYS = ("letter", "listen", "partner")  # [redundancy] keys of one station of the pair
+NAME = "the station's name"  # not a file: what `differing` names when the names differ
 
 
 def fingerprint(station: Station) -> dict[str, str]:
     """sha256 of each file the pair must share, by its path relative to the station folder (or
     absolute, for a file outside it)."""
     folder = station.folder
-    files: dict[str, str] = {STATION_FILE: _settings_hash(station.path)}
+    files: dict[str, str] = {STATION_FILE: _settings_hash(station.path), NAME: station.name}
     paths = [station.NetPlcProgram, station.Symbols, station.Messages, station.Tags]
     if station.HMIload is not None:
         paths += sorted(p for p in station.HMIload.rglob("*") if p.is_file())

@@ -48,6 +48,7 @@ from netplc.memory import Memory, Snapshot
 
 if TYPE_CHECKING:
     from app.station.runtime import Runtime
+    from registrar.plant.lease import Lease
 
 logger = logging.getLogger(__name__)
 
@@ -126,6 +127,12 @@ class Pair:
         self._server: socket.socket | None = None
         self._threads: list[threading.Thread] = []
         self.port = 0  # the port this station's link listens on
+        self.lease: Lease | None = None  # arbiter = "postgresql://...": the primary's lease
+        if settings.arbiter != "none":
+            from registrar.plant.lease import Lease  # psycopg only where an arbiter is named
+
+            self.lease = Lease(settings.arbiter, runtime.station.name)
+        self._waiting = ""  # why this station may not lead now, as last journaled
 
     @property
     def tick(self) -> float:
@@ -167,6 +174,8 @@ class Pair:
 
     def stop(self) -> None:
         self._stopping.set()
+        if self.lease is not None:
+            self.lease.release()
         with self._changed:
             self._changed.notify_all()
         self._drop_link()
@@ -193,7 +202,33 @@ class Pair:
             return "the station is starting as one of a pair: it takes commands once it is the primary"
         return f"this station ({self.settings.letter}) is the standby: the primary is {self.partner_name}"
 
-    def _become(self, role: Role, cause: str) -> None:
+    def _may_lead(self, cause: str, patience: float = 0.0) -> bool:
+        """Without an arbiter, always; with one, once this station holds its lease (`patience`:
+        seconds to keep trying, for a lease the partner is releasing as it hands over). A
+        refusal is journaled once per cause."""
+        lease = self.lease
+        if lease is None:
+            return True
+        deadline = self.clock() + patience
+        while not lease.take():
+            if self.clock() >= deadline or self._stopping.is_set():
+                if lease.last_error != self._waiting:  # once per cause, not per silent tick
+                    self._waiting = lease.last_error
+                    self.runtime.system(f"pair {self.settings.letter}: stays {self.role.value} ({cause}): "
+                                        f"the arbiter decides: {lease.last_error}", logging.WARNING)
+                return False
+            self._stopping.wait(self.tick / 4)
+        self._waiting = ""
+        return True
+
+    def _become(self, role: Role, cause: str, patience: float = 0.0) -> None:
+        if role is Role.PRIMARY and self.role is not Role.PRIMARY and not self._may_lead(cause, patience):
+            if self.role is Role.STARTING:
+                role, cause = Role.STANDBY, f"{cause}; the partner holds the arbiter's lease"
+            else:
+                return
+        if role is not Role.PRIMARY and self.lease is not None:
+            self.lease.release()
         with self._changed:
             old = self.role
             if old is role:
@@ -274,6 +309,7 @@ class Pair:
 
     def _serve(self, conn: socket.socket) -> None:
         """One link, from hello to its end (a status query answered and closed, or the pair's)."""
+        paired = False
         try:
             conn.settimeout(max(self.failover, 1.0))
             send_frame(conn, HELLO, json.dumps(self._hello()).encode())
@@ -294,9 +330,13 @@ class Pair:
             self._become(decide(self.role, self.settings.letter, Role(hello["role"])),
                          f"partner {hello['letter']} is {hello['role']}")
             self.refused = ""
+            paired = True
             self._run_link(conn)
         except (OSError, LinkError, ValueError) as e:
-            if not self._stopping.is_set():
+            if paired and not self._stopping.is_set():
+                self.runtime.system(f"pair {self.settings.letter}: link to the partner lost "
+                                    f"({self.role.value}): {e or type(e).__name__}", logging.WARNING)
+            elif not self._stopping.is_set():
                 logger.info("pair link ended: %s", e)
         finally:
             with self._changed:
@@ -341,6 +381,8 @@ class Pair:
                 if cap is not None:
                     send_frame(conn, STATE, encoder.frame(cap))
                 if handover:
+                    if self.lease is not None:
+                        self.lease.release()  # for the partner to take
                     send_frame(conn, HANDOVER, json.dumps({"cause": handover}).encode())
                     self._handed.set()
             else:  # a read that times out ends the link: the watch decides on a takeover
@@ -358,7 +400,7 @@ class Pair:
                 self._engine.post(self._load)
         elif kind == HANDOVER:
             cause = json.loads(payload).get("cause", "IntoStandBy")
-            self._become(Role.PRIMARY, f"handed over by the partner: {cause}")
+            self._become(Role.PRIMARY, f"handed over by the partner: {cause}", patience=self.failover)
 
     def _load(self, mem: Memory) -> None:
         """On the engine thread: the newest mirrored state, while this station follows."""
@@ -391,8 +433,13 @@ class Pair:
                                 logging.WARNING)
 
     def _watch(self) -> None:
-        """The standby's watch on the primary's silence."""
+        """The standby's watch on the primary's silence; the primary's on its lease: one that
+        lost both its arbiter and its partner steps down, as the partner may lead by now."""
         while not self._stopping.wait(self.tick / 2):
+            lease = self.lease
+            if self.role is Role.PRIMARY and lease is not None and not lease.alive() \
+                    and not lease.take() and self._link is None:
+                self._become(Role.STANDBY, f"lost the arbiter ({lease.last_error}) and the partner")
             if self.role is not Role.STANDBY:
                 continue
             silent = self.clock() - self._last_frame

@@ -2,8 +2,10 @@
 
 from __future__ import annotations
 
+import contextlib
 import socket
 import struct
+import threading
 import time
 from collections.abc import Callable, Iterator
 from pathlib import Path
@@ -33,6 +35,7 @@ CTR C:$03010 N:255
 JMP 0
 """
 STATION = """\
+name = "pair"
 NetPlcProgram = "pair.stl"
 NetSyncTime = {tick}
 [modbus_server]
@@ -48,6 +51,7 @@ backoff = 0.05
 letter = "{letter}"
 listen = "127.0.0.1:{listen}"
 partner = "127.0.0.1:{partner}"
+arbiter = "{arbiter}"
 """
 OPERATOR = Who("", Source.MODBUS, "test")
 
@@ -127,19 +131,65 @@ def node() -> Iterator[Simulator]:
     sim.stop()
 
 
-@pytest.fixture
-def pair(tmp_path: Path, node: Simulator) -> Iterator[tuple[Station, Station]]:
+def make_pair(tmp_path: Path, node: Simulator, arbiter: str = "none",
+              b_dials: int | None = None) -> tuple[Station, Station]:
+    """A and B of one station; B dials `b_dials` (a proxy's port) instead of A's link."""
     ports = {"A": free_port(), "B": free_port()}
     stations = []
     for letter, other in (("A", "B"), ("B", "A")):
+        partner = b_dials if letter == "B" and b_dials else ports[other]
         folder = write_station(tmp_path / letter, STATION.format(
-            tick=TICK_MS, node=node.port, letter=letter, listen=ports[letter], partner=ports[other]),
-            {"pair.stl": PROGRAM})
+            tick=TICK_MS, node=node.port, letter=letter, listen=ports[letter], partner=partner,
+            arbiter=arbiter), {"pair.stl": PROGRAM})
         stations.append(Station(folder))
-    a, b = stations
+    return stations[0], stations[1]
+
+
+@pytest.fixture
+def pair(tmp_path: Path, node: Simulator) -> Iterator[tuple[Station, Station]]:
+    a, b = make_pair(tmp_path, node)
     yield a, b
     for st in (b, a):
         st.stop()
+
+
+class Proxy:
+    """A TCP proxy between the pair that the test cuts: every connection and the listener."""
+
+    def __init__(self) -> None:
+        self.target = 0
+        self.server = socket.create_server(("127.0.0.1", 0))
+        self.port = self.server.getsockname()[1]
+        self.sockets: list[socket.socket] = []
+        threading.Thread(target=self._accept, daemon=True).start()
+
+    def _accept(self) -> None:
+        while True:
+            try:
+                conn, _ = self.server.accept()
+                upstream = socket.create_connection(("127.0.0.1", self.target))
+            except OSError:
+                return
+            self.sockets += [conn, upstream]
+            for one, other in ((conn, upstream), (upstream, conn)):
+                threading.Thread(target=self._pipe, args=(one, other), daemon=True).start()
+
+    @staticmethod
+    def _pipe(src: socket.socket, dst: socket.socket) -> None:
+        try:
+            while data := src.recv(65536):
+                dst.sendall(data)
+        except OSError:
+            return
+
+    def cut(self) -> None:
+        with contextlib.suppress(OSError):
+            self.server.shutdown(socket.SHUT_RDWR)  # wakes the accept (close alone does not)
+        self.server.close()
+        for s in self.sockets:
+            with contextlib.suppress(OSError):
+                s.shutdown(socket.SHUT_RDWR)
+            s.close()
 
 
 def modbus_write(port: int, register: int, value: int) -> int:

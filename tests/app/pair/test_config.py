@@ -11,6 +11,7 @@ from app.station.config import read_station
 from tests.app.conftest import write_station
 
 PAIR = """\
+name = "pair"
 NetPlcProgram = "p.stl"
 NetSyncTime = 50
 [modbus_server]
@@ -69,6 +70,10 @@ def test_check_of_a_pair_names_the_files_that_differ(tmp_path: Path) -> None:
     (b / "station.toml").write_text((b / "station.toml").read_text().replace("50", "60"))
     report = check_pair(a, b)
     assert any("p.stl, station.toml differ" in p for p in report.problems), report.problems
+    for folder in (a, b):  # no name: each is named by its folder, a and b
+        toml = folder / "station.toml"
+        toml.write_text(toml.read_text().replace('name = "pair"\n', ""))
+    assert any("the station's name" in p for p in check_pair(a, b).problems)
 
 
 def test_a_pair_of_one_letter_is_refused(tmp_path: Path) -> None:
