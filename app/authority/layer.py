@@ -114,9 +114,11 @@ class Commands:
                  source_roles: dict[Source, str] | None = None,
                  wallclock: Callable[[], float] = time.time,
                  monotonic: Callable[[], float] = time.monotonic,
-                 standby: Callable[[], str | None] = lambda: None) -> None:
+                 standby: Callable[[], str | None] = lambda: None,
+                 hand_over: Callable[[str], str | None] | None = None) -> None:
         self.engine = engine
         self.standby = standby  # why this station of a pair takes no commands now (names the primary)
+        self.hand_over = hand_over  # IntoStandBy: None when done, else why not; None: no pair
         self.sink = sink
         self.role_of = role_of
         self.tags = {t.name: t for t in tags}
@@ -433,6 +435,23 @@ class Commands:
         ticket.set_result(APPLIED)
         return ticket
 
+    # --- the hot-standby pair --------------------------------------------------------------------
+
+    def into_standby(self, who: Who) -> Ticket:
+        """IntoStandBy (seed 000): the primary hands its role to the standby at the end of its next
+        scan, that scan's state the last it sends; answered once the record is committed."""
+        if (denied := self._check(who, Action.INTO_STANDBY, "station")) is not None:
+            return denied
+        if (standby := self.standby()) is not None:
+            return self.refuse(who, Action.INTO_STANDBY, "station", Reason.STANDBY, standby)
+        if self.hand_over is None:
+            return self.refuse(who, Action.INTO_STANDBY, "station", Reason.INVALID,
+                               "the station is not one of a hot-standby pair ([redundancy])")
+        if (why := self.hand_over(f"IntoStandBy by {who.name}")) is not None:
+            return self.refuse(who, Action.INTO_STANDBY, "station", Reason.INVALID, why)
+        self._put(who, "IntoStandBy: the primary role goes to the partner")
+        return self._answer_after_commit()
+
     # --- user administration ---------------------------------------------------------------------
 
     def manage_users(self, who: Who, target: str, change: Callable[[], str]) -> Ticket:
@@ -447,8 +466,12 @@ class Commands:
             text = change()
         except UserError as e:
             return self.refuse(who, Action.USERS, target, Reason.INVALID, str(e))
-        ticket: Ticket = Future()
         self._put(who, text)
+        return self._answer_after_commit()
+
+    def _answer_after_commit(self) -> Ticket:
+        """APPLIED once the records put so far are committed."""
+        ticket: Ticket = Future()
         after_commit = getattr(self.sink, "after_commit", None)
         if after_commit is None:
             ticket.set_result(APPLIED)

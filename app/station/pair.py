@@ -59,8 +59,18 @@ class Role(StrEnum):
     STANDBY = "standby"
 
 
-# HSBStatus of seed 000 by role: 0 after power-on, 4 standby, 5 master
+# HSBStatus of seed 000 by role: 0 after power-on, 4 standby, 5 master (6 defect: refused partner)
 HSB_STATUS = {Role.STARTING: 0, Role.PRIMARY: 5, Role.STANDBY: 4}
+DEFECT = 6
+# The pair's status words in NetPlc memory, beside the RTC (077700-077707), each station's own
+# (written after the mirrored memory is put), for a program and an HMI (README "Redundancy")
+HSB_NUM_PLC = 0o77710  # byte: 1 = A, 0 = B (HSBNumPLC)
+HSB_STATUS_BYTE = 0o77711  # byte: HSBStatus
+DGN_HSB = 0o77712  # word: b7 the partner's station differs, b9 the pair link is down, b15 a switchover
+HSB_SWITCH = 0o77714  # word: low byte the last switchover's cause, high byte the switchovers
+HSB_LAG = 0o77716  # byte: the standby's lag in the primary's scans (255 at most)
+# switchover causes (the low byte of HSB_SWITCH), after seed 000's hardware codes
+SILENT, HANDED_OVER, STEPPED_DOWN = 50, 51, 52
 
 
 def decide(mine: Role, letter: str, theirs: Role) -> Role:
@@ -133,6 +143,7 @@ class Pair:
 
             self.lease = Lease(settings.arbiter, runtime.station.name)
         self._waiting = ""  # why this station may not lead now, as last journaled
+        self.cause = 0  # the last switchover's cause code (HSB_SWITCH)
 
     @property
     def tick(self) -> float:
@@ -221,7 +232,7 @@ class Pair:
         self._waiting = ""
         return True
 
-    def _become(self, role: Role, cause: str, patience: float = 0.0) -> None:
+    def _become(self, role: Role, cause: str, patience: float = 0.0, code: int = 0) -> None:
         if role is Role.PRIMARY and self.role is not Role.PRIMARY and not self._may_lead(cause, patience):
             if self.role is Role.STARTING:
                 role, cause = Role.STANDBY, f"{cause}; the partner holds the arbiter's lease"
@@ -238,6 +249,8 @@ class Pair:
             self._changed.notify_all()
         engine = self._engine
         assert engine is not None
+        if code:
+            self.cause = code
         if role is Role.PRIMARY:
             if old is Role.STANDBY:
                 self.switchovers += 1
@@ -257,6 +270,7 @@ class Pair:
             with self._lock:
                 self.mirror.load_into(engine, mem)
         engine.follower = False
+        self._put_words(mem)
 
     def _follow(self, _mem: Memory) -> None:
         engine = self._engine
@@ -289,6 +303,9 @@ class Pair:
             except OSError:
                 if not self._stopping.is_set():
                     logger.exception("pair link: accept failed")
+                return
+            if self._stopping.is_set():
+                conn.close()
                 return
             self._spawn_link(conn)
 
@@ -400,7 +417,8 @@ class Pair:
                 self._engine.post(self._load)
         elif kind == HANDOVER:
             cause = json.loads(payload).get("cause", "IntoStandBy")
-            self._become(Role.PRIMARY, f"handed over by the partner: {cause}", patience=self.failover)
+            self._become(Role.PRIMARY, f"handed over by the partner: {cause}", patience=self.failover,
+                         code=HANDED_OVER)
 
     def _load(self, mem: Memory) -> None:
         """On the engine thread: the newest mirrored state, while this station follows."""
@@ -410,13 +428,27 @@ class Pair:
             self._load_pending = False
             if engine.follower and self.mirror.complete:
                 self.mirror.load_into(engine, mem)
+        self._put_words(mem)
+
+    def _put_words(self, mem: Memory) -> None:
+        """This station's HSB status words (on the engine thread)."""
+        status = self.status()
+        mem.set_byte(HSB_NUM_PLC, 1 if self.settings.letter == "A" else 0)
+        mem.set_byte(HSB_STATUS_BYTE, DEFECT if self.refused else HSB_STATUS[self.role])
+        mem.set_word(DGN_HSB, (1 << 7 if self.refused else 0) | (0 if status.link else 1 << 9)
+                     | (1 << 15 if self.switchovers else 0))
+        mem.set_word(HSB_SWITCH, min(self.switchovers, 255) << 8 | self.cause)
+        mem.set_byte(HSB_LAG, min(status.lag, 255))
 
     def _on_scan(self, snapshot: Snapshot) -> None:
         """An engine listener: the primary's scan, for the link's thread to send. A handover
         asked for happens here, between two scans: this scan's state is the last one sent, and
         from the next scan on this engine follows (writes still queued are refused, unapplied)."""
         engine = self._engine
-        if self.role is not Role.PRIMARY or self._link is None or engine is None:
+        if engine is None:
+            return
+        self._put_words(engine.mem)  # for the next scan's program and snapshot
+        if self.role is not Role.PRIMARY or self._link is None:
             return
         cap = capture(engine, snapshot)
         with self._changed:
@@ -426,6 +458,7 @@ class Pair:
                 self.role = Role.STANDBY
                 engine.follower = True
                 self.switchovers += 1
+                self.cause = HANDED_OVER
                 self._last_frame = self.clock()
             self._changed.notify_all()
         if self._handover:
@@ -439,13 +472,14 @@ class Pair:
             lease = self.lease
             if self.role is Role.PRIMARY and lease is not None and not lease.alive() \
                     and not lease.take() and self._link is None:
-                self._become(Role.STANDBY, f"lost the arbiter ({lease.last_error}) and the partner")
+                self._become(Role.STANDBY, f"lost the arbiter ({lease.last_error}) and the partner",
+                             code=STEPPED_DOWN)
             if self.role is not Role.STANDBY:
                 continue
             silent = self.clock() - self._last_frame
             if silent >= self.failover:
                 self._drop_link()
-                self._become(Role.PRIMARY, f"partner silent for {silent * 1000:.0f} ms")
+                self._become(Role.PRIMARY, f"partner silent for {silent * 1000:.0f} ms", code=SILENT)
 
     def _drop_link(self) -> None:
         with self._changed:

@@ -321,7 +321,8 @@ class Runtime:
         self.subscribe(self.alarms.observe)
         self.alarms.attach(self.engine, self.exchange)
         self.commands = Commands(self.engine, self, role_of=self.role_of, tags=self.alarms.table.tags,
-                                 alarms=self.alarms, wallclock=self.wallclock, standby=self._standby)
+                                 alarms=self.alarms, wallclock=self.wallclock, standby=self._standby,
+                                 hand_over=self._hand_over if st.redundancy is not None else None)
         server = st.modbus_server
         if server.enabled:
             self.commands.grant(Source.MODBUS, server.role)
@@ -375,6 +376,13 @@ class Runtime:
         if pair is None:
             return None if self.station.redundancy is None else "the station is joining its pair"
         return pair.refusal()
+
+    def _hand_over(self, cause: str) -> str | None:
+        """IntoStandBy, for the command layer: None once asked for, else why not."""
+        pair = self.pair
+        if pair is None or not pair.into_standby(cause):
+            return "no standby on the pair link to hand over to"
+        return None
 
     def _restore_forces(self) -> None:
         """RetainForces = true: the forces of the last run are in effect again from the first scan,
