@@ -25,11 +25,11 @@ from netplc.address import DATA_SIZE, IO_BITS, fmt_octal, parse_octal
 from netplc.engine import Engine, RunState
 from netplc.forcing import Force
 from netplc.memory import Memory, Snapshot
-from netplc.timers import held
 
 VERSION = 1
-HELLO, STATE, HANDOVER = 1, 2, 3  # frame kinds
+HELLO, STATE, HANDOVER, ACK = 1, 2, 3, 4  # frame kinds (ACK: the standby holds scan n)
 BLOCK = 64  # bytes compared at a time for a delta
+STRETCH = 2048  # bytes compared first: only a stretch that differs is compared block by block
 IMAGE = IO_BITS + DATA_SIZE
 MAX_FRAME = IMAGE + (1 << 20)  # a whole state and its header, with room to spare
 _HEAD = struct.Struct(">IBB")
@@ -76,8 +76,27 @@ class Capture:
 
 
 def capture(engine: Engine, snapshot: Snapshot) -> Capture:
-    tim, ctr = held(engine.tim_ticks, engine.ctr_values)
-    return Capture(snapshot, tim, ctr, engine.stop_code)
+    """The scan's state; the timers and counters read only at the coils the program has (all
+    2048 of each would cost the scan milliseconds)."""
+    tim, ctr = engine.tim_ticks, engine.ctr_values
+    tims, ctrs = _coils(engine)
+    return Capture(snapshot, {c: tim[c] for c in tims if tim[c]}, {c: ctr[c] for c in ctrs if ctr[c]},
+                   engine.stop_code)
+
+
+_COILS: dict[int, tuple[tuple[int, ...], tuple[int, ...]]] = {}  # by id of the program
+
+
+def _coils(engine: Engine) -> tuple[tuple[int, ...], tuple[int, ...]]:
+    program = engine.program
+    found = _COILS.get(id(program))
+    if found is None:
+        instrs = program.instrs
+        found = (tuple(sorted({i.c or 0 for i in instrs if i.op == "TIM"})),
+                 tuple(sorted({i.c or 0 for i in instrs if i.op == "CTR"})))
+        _COILS.clear()  # one program at a time
+        _COILS[id(program)] = found
+    return found
 
 
 def image(snapshot: Snapshot) -> bytes:
@@ -109,16 +128,23 @@ class Encoder:
 
 
 def _delta(old: bytes, new: bytes) -> list[tuple[int, bytes]]:
-    """The changed 64-byte blocks of `new`, adjacent ones merged."""
+    """The changed 64-byte blocks of `new`, adjacent ones merged; 2 KB stretches that are equal
+    (most of them, most scans) are passed over by one comparison each."""
     runs: list[tuple[int, bytes]] = []
     start = -1
-    for at in range(0, IMAGE, BLOCK):
-        same = old[at : at + BLOCK] == new[at : at + BLOCK]
-        if not same and start < 0:
-            start = at
-        elif same and start >= 0:
-            runs.append((start, new[start:at]))
-            start = -1
+    for outer in range(0, IMAGE, STRETCH):
+        if old[outer : outer + STRETCH] == new[outer : outer + STRETCH]:
+            if start >= 0:
+                runs.append((start, new[start:outer]))
+                start = -1
+            continue
+        for at in range(outer, outer + STRETCH, BLOCK):
+            same = old[at : at + BLOCK] == new[at : at + BLOCK]
+            if not same and start < 0:
+                start = at
+            elif same and start >= 0:
+                runs.append((start, new[start:at]))
+                start = -1
     if start >= 0:
         runs.append((start, new[start:]))
     return runs

@@ -21,7 +21,9 @@ from __future__ import annotations
 
 import json
 import logging
+import select
 import socket
+import struct
 import threading
 import time
 from collections.abc import Callable
@@ -32,6 +34,7 @@ from typing import TYPE_CHECKING
 from app.station.config import RedundancySettings
 from app.station.fingerprint import differing
 from app.station.mirror import (
+    ACK,
     HANDOVER,
     HELLO,
     STATE,
@@ -144,6 +147,7 @@ class Pair:
             self.lease = Lease(settings.arbiter, runtime.station.name)
         self._waiting = ""  # why this station may not lead now, as last journaled
         self.cause = 0  # the last switchover's cause code (HSB_SWITCH)
+        self._awaiting: list[tuple[int, Callable[[], None]]] = []  # (scan, callback): after_mirrored
 
     @property
     def tick(self) -> float:
@@ -200,7 +204,10 @@ class Pair:
 
     def kill(self) -> None:
         """End the link at once with no word to the partner, as a dying station's would (tests,
-        bench/failover.py): the partner learns of it only by the silence."""
+        bench/failover.py): the partner learns of it only by the silence, and the writers waiting
+        for the standby are never answered, as by a dead process."""
+        with self._lock:
+            self._awaiting.clear()
         self.stop()
 
     # --- the role ------------------------------------------------------------------------------
@@ -361,6 +368,7 @@ class Pair:
                     self._link = None
             self._handed.set()
             conn.close()
+            self._mirrored(None)  # no standby to wait for: the primary's own commit stands
 
     def _hello(self) -> dict[str, object]:
         return {"letter": self.settings.letter, "role": self.role.value, "files": self.files,
@@ -397,6 +405,8 @@ class Pair:
                         return
                 if cap is not None:
                     send_frame(conn, STATE, encoder.frame(cap))
+                while select.select([conn], [], [], 0)[0]:  # the standby's acknowledgements
+                    self._received(*read_frame(conn), conn)
                 if handover:
                     if self.lease is not None:
                         self.lease.release()  # for the partner to take
@@ -404,21 +414,44 @@ class Pair:
                     self._handed.set()
             else:  # a read that times out ends the link: the watch decides on a takeover
                 encoder.last = None  # if this station leads again, its first frame is whole
-                self._received(*read_frame(conn))
+                self._received(*read_frame(conn), conn)
 
-    def _received(self, kind: int, payload: bytes) -> None:
+    def _received(self, kind: int, payload: bytes, conn: socket.socket) -> None:
         if kind == STATE:
             with self._lock:
                 self.mirror.apply(payload)
                 self._last_frame = self.clock()
                 post = not self._load_pending
                 self._load_pending = True
+                scan = self.mirror.scan
             if post and self._engine is not None:
                 self._engine.post(self._load)
+            send_frame(conn, ACK, struct.pack(">q", scan))
+        elif kind == ACK and len(payload) == 8:
+            self._mirrored(struct.unpack(">q", payload)[0])
         elif kind == HANDOVER:
             cause = json.loads(payload).get("cause", "IntoStandBy")
             self._become(Role.PRIMARY, f"handed over by the partner: {cause}", patience=self.failover,
                          code=HANDED_OVER)
+
+    def after_mirrored(self, callback: Callable[[], None]) -> None:
+        """`callback()` once the standby holds the scan running now (its acknowledgement of that
+        scan's frame), at once without a standby: the runtime answers an outside write only then,
+        so a write acknowledged by the primary is not lost when the standby takes over."""
+        engine = self._engine
+        with self._lock:
+            if self.role is Role.PRIMARY and self._link is not None and engine is not None:
+                self._awaiting.append((engine.scan_counter + 1, callback))
+                return
+        callback()
+
+    def _mirrored(self, scan: int | None) -> None:
+        """The standby holds `scan` (or None: it is gone): the callbacks waiting for it."""
+        with self._lock:
+            ready = [cb for at, cb in self._awaiting if scan is None or at <= scan]
+            self._awaiting = [] if scan is None else [(at, cb) for at, cb in self._awaiting if at > scan]
+        for callback in ready:
+            callback()
 
     def _load(self, mem: Memory) -> None:
         """On the engine thread: the newest mirrored state, while this station follows."""

@@ -204,13 +204,16 @@ class Runtime:
 
     def after_commit(self, callback: Callable[[], None]) -> None:
         """`callback()` once every record put so far is on disk, and so is the retentive memory of
-        the scan that put them (registrar/retain.py): the engine answers an outside writer then, so
-        an acknowledged write survives a crash both in the journal and in memory."""
+        the scan that put them (registrar/retain.py), and a pair's standby holds that scan: the
+        engine answers an outside writer then, so an acknowledged write survives a crash both in
+        the journal and in memory, and a takeover."""
         parts: list[Callable[[Callable[[], None]], None]] = []
         if self.store is not None:
             parts.append(self.store.after_commit)
         if self.retainer is not None:
             parts.append(self.retainer.after_save)
+        if self.pair is not None:  # and the standby of a pair holds the scan (app/station/pair.py)
+            parts.append(self.pair.after_mirrored)
         if not parts:
             callback()
             return

@@ -56,6 +56,7 @@ def test_kill_the_primary_the_standby_takes_over_and_the_old_one_comes_back_as_s
     assert a.write(0o4000, 1111).ok
     assert a.rt.engine is not None and b.rt.engine is not None
     wait_for(lambda: b.word(0o4000) == 1111 and b.rt.engine.tim_ticks[TIMER] > 2, what="mirrored")
+    assert a.write(0o4000, 1112).ok  # answered once the standby holds it: killed right after
     elapsed, counted = a.rt.engine.tim_ticks[TIMER], a.rt.engine.ctr_values[COUNTER]
     a.kill()
     killed = time.monotonic()
@@ -63,6 +64,7 @@ def test_kill_the_primary_the_standby_takes_over_and_the_old_one_comes_back_as_s
     took = time.monotonic() - killed
     assert took <= (3 + 1) * TICK_MS / 1000 + 0.25, took  # failover_after + one tick, + a loaded CI
     assert any("partner silent for" in t for t in b.texts()), b.texts()
+    wait_for(lambda: b.word(0o4000) == 1112, what="the acknowledged write is not lost")
     assert b.rt.engine.tim_ticks[TIMER] >= elapsed  # the timer kept its elapsed time
     assert b.rt.engine.ctr_values[COUNTER] >= counted  # and the counter its count, no edge twice
     assert b.rt.engine.ctr_values[COUNTER] <= counted + 2
