@@ -106,7 +106,7 @@ def kills(base: Path, node: Simulator, n: int) -> None:
     rts = {letter: Runtime(load_station(paths[letter])) for letter in "AB"}
     rts["A"].start()
     rts["B"].start()
-    acked = [0]
+    acked: dict[int, int] = {}  # the last value each runtime acknowledged, by its id
     stop = threading.Event()
 
     def primary() -> Runtime | None:
@@ -122,7 +122,7 @@ def kills(base: Path, node: Simulator, n: int) -> None:
             value = (value + 1) & 0xFFFF
             try:
                 if rt.commands.write_word(WHO, 0o4000, value).result(1).ok:
-                    acked[0] = value
+                    acked[id(rt)] = value
             except TimeoutError:  # asked of a station killed before it applied it: not acknowledged
                 continue
 
@@ -148,13 +148,16 @@ def kills(base: Path, node: Simulator, n: int) -> None:
                 time.sleep(0.001)
             took.append(time.monotonic() - killed)
             dead.stop()  # its last commits answer the writes of its last scans
-            last = acked[0]
+            last = acked.get(id(dead), 0)
             lag.append(other.pair.status().lag)
             image = other.pair.mirror.image  # the state the new primary led from
             if image[IO_BITS] | image[IO_BITS + 1] << 8 < last:
                 lost += 1
             rts[letter] = Runtime(load_station(paths[letter]))
             rts[letter].start()
+            back = rts[letter].pair
+            while back is None or back.role != "standby" or not back.mirror.complete:
+                time.sleep(0.005)  # the next kill once the pair is whole again
     finally:
         stop.set()
         thread.join(5)

@@ -9,8 +9,8 @@ Modbus and OPC UA servers answer reads from the mirrored memory.
 One TCP link between the two, always dialled by B to A (one dialler: two stations starting
 together never cross two connections); once both said hello the roles decide who sends. The
 roles at a hello: a primary stays primary and the other follows; two primaries (a link healed
-after both acted) or none (both starting): A is the primary. A station that hears no partner
-within its start window (failover_after ticks and two more) starts as primary.
+after both acted): the one that led more scans; none (both starting): A. A station that hears
+no partner within its start window (failover_after ticks and two more, 0.5 s at least) leads.
 
 The standby takes over when the primary's frames have stopped for failover_after ticks: the
 newest mirrored state is put into its engine and the program runs on from it in the next scan
@@ -72,16 +72,21 @@ HSB_STATUS_BYTE = 0o77711  # byte: HSBStatus
 DGN_HSB = 0o77712  # word: b7 the partner's station differs, b9 the pair link is down, b15 a switchover
 HSB_SWITCH = 0o77714  # word: low byte the last switchover's cause, high byte the switchovers
 HSB_LAG = 0o77716  # byte: the standby's lag in the primary's scans (255 at most)
+START_WINDOW = 0.5  # s at least a starting station waits for a partner before it leads alone
 # switchover causes (the low byte of HSB_SWITCH), after seed 000's hardware codes
 SILENT, HANDED_OVER, STEPPED_DOWN = 50, 51, 52
 
 
-def decide(mine: Role, letter: str, theirs: Role) -> Role:
-    """This station's role once both said hello; both sides reach the same answer."""
+def decide(mine: Role, letter: str, theirs: Role, my_scans: int = 0, their_scans: int = 0) -> Role:
+    """This station's role once both said hello; both sides reach the same answer. Two
+    primaries: the one that led more scans (a station that led alone for its start window while
+    the link was slow to come gives way to the one that has the plant's state), then A."""
     if mine is Role.PRIMARY and theirs is not Role.PRIMARY:
         return Role.PRIMARY
     if theirs is Role.PRIMARY and mine is not Role.PRIMARY:
         return Role.STANDBY
+    if mine is Role.PRIMARY and my_scans != their_scans:
+        return Role.PRIMARY if my_scans > their_scans else Role.STANDBY
     return Role.PRIMARY if letter == "A" else Role.STANDBY
 
 
@@ -147,6 +152,7 @@ class Pair:
             self.lease = Lease(settings.arbiter, runtime.station.name)
         self._waiting = ""  # why this station may not lead now, as last journaled
         self.cause = 0  # the last switchover's cause code (HSB_SWITCH)
+        self.led_scans = 0  # scans run as the primary: of two primaries, the one with more leads
         self._awaiting: list[tuple[int, Callable[[], None]]] = []  # (scan, callback): after_mirrored
 
     @property
@@ -178,9 +184,9 @@ class Pair:
         if self.settings.letter == "B":
             self._spawn(self._dial, "pair dial")
         self._spawn(self._watch, "pair watch")
-        if not self._decided.wait(self.failover + 2 * self.tick):
-            self._become(Role.PRIMARY, f"no partner answered within "
-                                       f"{(self.failover + 2 * self.tick) * 1000:.0f} ms of the start")
+        window = max(self.failover + 2 * self.tick, START_WINDOW)
+        if not self._decided.wait(window):
+            self._become(Role.PRIMARY, f"no partner answered within {window * 1000:.0f} ms of the start")
 
     def _spawn(self, target: Callable[[], None], name: str) -> None:
         thread = threading.Thread(target=target, name=name, daemon=True)
@@ -351,8 +357,8 @@ class Pair:
                     old.close()
                 self._link = conn
                 self._last_frame = self.clock()
-            self._become(decide(self.role, self.settings.letter, Role(hello["role"])),
-                         f"partner {hello['letter']} is {hello['role']}")
+            self._become(decide(self.role, self.settings.letter, Role(hello["role"]), self.led_scans,
+                                int(hello.get("led", 0))), f"partner {hello['letter']} is {hello['role']}")
             self.refused = ""
             paired = True
             self._run_link(conn)
@@ -371,8 +377,8 @@ class Pair:
             self._mirrored(None)  # no standby to wait for: the primary's own commit stands
 
     def _hello(self) -> dict[str, object]:
-        return {"letter": self.settings.letter, "role": self.role.value, "files": self.files,
-                "status": self.status().as_dict()}
+        return {"letter": self.settings.letter, "role": self.role.value, "led": self.led_scans,
+                "files": self.files, "status": self.status().as_dict()}
 
     def _pairs_with(self, hello: dict[str, object]) -> bool:
         """The partner holds the same station, and the other letter; else refused, journaled."""
@@ -481,6 +487,8 @@ class Pair:
         if engine is None:
             return
         self._put_words(engine.mem)  # for the next scan's program and snapshot
+        if self.role is Role.PRIMARY:
+            self.led_scans += 1
         if self.role is not Role.PRIMARY or self._link is None:
             return
         cap = capture(engine, snapshot)
