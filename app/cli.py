@@ -21,7 +21,8 @@ from app.logs import LEVELS
 from app.station.config import DEMO_STATION
 from registrar.plant.url import is_url
 
-COMMANDS = ("view", "check", "simulate", "alarms-report", "design", "monitor", "archive", "users", "opcua")
+COMMANDS = ("view", "check", "simulate", "alarms-report", "design", "monitor", "archive", "users", "opcua",
+            "redundancy")
 
 
 def _main_parser() -> argparse.ArgumentParser:
@@ -36,7 +37,8 @@ def _main_parser() -> argparse.ArgumentParser:
                "station), archive migrate "
                "ARCHIVE.sqlite postgresql://... (copy an archive into the plant archive), "
                "users (the station's users and roles), opcua trust STATION THUMBPRINT (trust an OPC UA "
-               "client's certificate); each takes --help.",
+               "client's certificate), redundancy status STATION|HOST:PORT (a hot-standby pair's "
+               "station); each takes --help.",
     )
     p.add_argument("station", nargs="?", default=str(DEMO_STATION),
                    help="station folder or its station.toml (default: the demo station)")
@@ -94,7 +96,45 @@ def _check_parser() -> argparse.ArgumentParser:
                                             "simulator programs, messages and every form. Prints all "
                                             "problems; exit status 1 if there are any.")
     p.add_argument("station", help="station folder or its station.toml")
+    p.add_argument("partner", nargs="?", help="the other station of a hot-standby pair: both are "
+                                              "checked and must hold the same files")
+    p.add_argument("--partner", dest="partner_option", metavar="STATION", help="the same as PARTNER")
     return p
+
+
+def _redundancy_parser() -> argparse.ArgumentParser:
+    p = argparse.ArgumentParser(prog="python main.py redundancy",
+                                description="The state of one station of a hot-standby pair, asked over "
+                                            "its pair link: letter, role, partner, link, last takeover, "
+                                            "lag in scans. Exit status 1 when it does not answer.")
+    p.add_argument("action", choices=["status"])
+    p.add_argument("target", help="the station's folder (its [redundancy] listen) or HOST:PORT of its link")
+    return p
+
+
+def run_redundancy(target: str) -> int:
+    from app.station.config import read_station
+    from app.station.mirror import LinkError
+    from app.station.pair import query
+
+    address = target
+    if Path(target).exists():
+        station, problems = read_station(target)
+        if station is None or station.redundancy is None:
+            print("\n".join(problems) or f"{target}: no [redundancy] in its station.toml", file=sys.stderr)
+            return 1
+        address = station.redundancy.listen
+    try:
+        status = query(address)
+    except (OSError, LinkError, ValueError) as e:
+        print(f"{address}: no answer from the station's pair link: {e}", file=sys.stderr)
+        return 1
+    for key in ("letter", "role", "partner", "link", "last_takeover", "lag", "switchovers"):
+        value = status.get(key)
+        if key == "link":
+            value = "up" if value else "DOWN"
+        print(f"{key.replace('_', ' ')}: {value if value not in ('', None) else '-'}")
+    return 0
 
 
 def _alarms_report_parser() -> argparse.ArgumentParser:
@@ -238,7 +278,8 @@ def main(argv: list[str] | None = None) -> int:
             ns = _design_parser().parse_args(rest)
             return run_designer(ns.target, ns.screenshot)
         if command == "check":
-            return run_check(_check_parser().parse_args(rest).station)
+            args = _check_parser().parse_args(rest)
+            return run_check(args.station, args.partner or args.partner_option)
         if command == "alarms-report":
             ns = _alarms_report_parser().parse_args(rest)
             return run_alarms_report(ns.archive, ns.day)
@@ -260,6 +301,8 @@ def main(argv: list[str] | None = None) -> int:
             return run_migrate(ns.source, ns.url, ns.station)
         if command == "users":
             return run_users(rest)
+        if command == "redundancy":
+            return run_redundancy(_redundancy_parser().parse_args(rest).target)
         if command == "opcua":
             if not _installed("opcua", "opcua trust"):
                 return 2
@@ -289,12 +332,14 @@ def _installed(extra: str, what: str) -> bool:
     return problem is None
 
 
-def run_check(station: str) -> int:
-    from app.station.check import check_station
+def run_check(station: str, partner: str | None = None) -> int:
+    from app.station.check import check_pair, check_station
 
-    report = check_station(station)
+    report = check_station(station) if partner is None else check_pair(station, partner)
     for problem in report.problems:
         print(problem)
+    for warning in report.warnings:
+        print(f"warning: {warning}")
     if report.ok:
         for note in report.notes:
             print(f"ok: {note}")

@@ -152,6 +152,9 @@ class Engine:
         self.mem.bits[TIMEBASE_HI] = 0
         self.forces = Forces(self)  # netplc/forcing.py: applied by the scan's two force hooks
         self._stepping = False  # `step`: this scan runs the program although NetPlc is stopped
+        # the standby of a hot-standby pair: its memory, timers, forces and run state are the
+        # primary's, put by the pair link (app/station/pair.py); it never runs the program
+        self.follower = False
         self.snapshot: Snapshot = self._publish()
         self.load(program)
 
@@ -419,7 +422,10 @@ class Engine:
         while queue:
             self._apply(queue.popleft(), mem)
         if self._writes:
-            self._apply_writes(mem)
+            if self.follower:
+                self._refuse_writes()
+            else:
+                self._apply_writes(mem)
         bits = mem.bits
         bits[ALWAYS_ONE] = 1
         update_generators(bits, now - self._start)
@@ -427,6 +433,10 @@ class Engine:
         forces = self.forces
         if forces.listing:  # force hook 1: over the queued writes, generators and RTC: what the program reads
             forces.apply(mem)
+        if self.follower:  # what the pair link applied is published as it is: no program, no requests
+            self.snapshot = self._publish()
+            self._notify()
+            return self.snapshot
         if bits[EMERGENCY_STOP] and self.state is RunState.RUNNING:
             self.stop(11)
             if self._stop_by:
@@ -450,12 +460,15 @@ class Engine:
         self.scan_counter += 1
         self.snapshot = self._publish()
         self.stats.add((time.perf_counter() - t0) * 1000.0, self.tick * 1000.0)
+        self._notify()
+        return self.snapshot
+
+    def _notify(self) -> None:
         for name, listener in self._listeners:
             try:
                 listener(self.snapshot)
             except Exception as e:  # no log: _listener_failed logs it; the others and the scan go on
                 self._listener_failed(name, e)
-        return self.snapshot
 
     # --- listeners -----------------------------------------------------------------------------
 
@@ -524,6 +537,15 @@ class Engine:
         finally:
             self.rtc.watch(mem)
         return True
+
+    def _refuse_writes(self) -> None:
+        """A follower applies no outside write (its memory is the primary's): the writes queued
+        before it began to follow are answered as not applied, never left waiting."""
+        while self._writes:
+            _apply, done, _user = self._writes.popleft()
+            self.writes_refused += 1
+            if done is not None:
+                done(False)
 
     def _apply_writes(self, mem: Memory) -> None:
         """This scan's share of the outside writes: at most the budget, and none the journal has no

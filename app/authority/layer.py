@@ -62,6 +62,7 @@ class Reason(StrEnum):
     BUSY = "busy"  # the queue of outside actions is full (BadTooManyOperations, Modbus 06)
     JOURNAL_FULL = "journal full"  # the archive cannot take the record (BadResourceUnavailable, 06)
     NOT_RUNNING = "not running"  # the station is not started (BadServerHalted, Modbus 06)
+    STANDBY = "standby"  # the standby of a pair: the text names the primary (BadInvalidState, 06)
     FAILED = "failed"  # applying it failed; journaled as a system record (BadInternalError, 04)
 
 
@@ -112,8 +113,12 @@ class Commands:
                  tags: list[Tag] | tuple[Tag, ...] = (), alarms: StationAlarms | None = None,
                  source_roles: dict[Source, str] | None = None,
                  wallclock: Callable[[], float] = time.time,
-                 monotonic: Callable[[], float] = time.monotonic) -> None:
+                 monotonic: Callable[[], float] = time.monotonic,
+                 standby: Callable[[], str | None] = lambda: None,
+                 hand_over: Callable[[str], str | None] | None = None) -> None:
         self.engine = engine
+        self.standby = standby  # why this station of a pair takes no commands now (names the primary)
+        self.hand_over = hand_over  # IntoStandBy: None when done, else why not; None: no pair
         self.sink = sink
         self.role_of = role_of
         self.tags = {t.name: t for t in tags}
@@ -197,6 +202,8 @@ class Commands:
     def _queue(self, who: Who, action: Action, target: str,
                apply: Callable[[Memory], None]) -> Ticket:
         """Queue `apply` (which journals) to the engine; the ticket is answered after the commit."""
+        if (standby := self.standby()) is not None:
+            return self.refuse(who, action, target, Reason.STANDBY, standby)
         ticket: Ticket = Future()
 
         def done(ok: bool) -> None:
@@ -424,6 +431,8 @@ class Commands:
         engine = self.engine
         if lock is None:
             return self.refuse(who, Action.STEP, "NetPlc", Reason.NOT_RUNNING, "the station is not started")
+        if (standby := self.standby()) is not None:
+            return self.refuse(who, Action.STEP, "NetPlc", Reason.STANDBY, standby)
         with lock:
             if engine.state is RunState.RUNNING:
                 return self.refuse(who, Action.STEP, "NetPlc", Reason.INVALID,
@@ -433,6 +442,23 @@ class Commands:
         ticket: Ticket = Future()
         ticket.set_result(APPLIED)
         return ticket
+
+    # --- the hot-standby pair --------------------------------------------------------------------
+
+    def into_standby(self, who: Who) -> Ticket:
+        """IntoStandBy (seed 000): the primary hands its role to the standby at the end of its next
+        scan, that scan's state the last it sends; answered once the record is committed."""
+        if (denied := self._check(who, Action.INTO_STANDBY, "station")) is not None:
+            return denied
+        if (standby := self.standby()) is not None:
+            return self.refuse(who, Action.INTO_STANDBY, "station", Reason.STANDBY, standby)
+        if self.hand_over is None:
+            return self.refuse(who, Action.INTO_STANDBY, "station", Reason.INVALID,
+                               "the station is not one of a hot-standby pair ([redundancy])")
+        if (why := self.hand_over(f"IntoStandBy by {who.name}")) is not None:
+            return self.refuse(who, Action.INTO_STANDBY, "station", Reason.INVALID, why)
+        self._put(who, "IntoStandBy: the primary role goes to the partner")
+        return self._answer_after_commit()
 
     # --- user administration ---------------------------------------------------------------------
 
@@ -448,8 +474,12 @@ class Commands:
             text = change()
         except UserError as e:
             return self.refuse(who, Action.USERS, target, Reason.INVALID, str(e))
-        ticket: Ticket = Future()
         self._put(who, text)
+        return self._answer_after_commit()
+
+    def _answer_after_commit(self) -> Ticket:
+        """APPLIED once the records put so far are committed."""
+        ticket: Ticket = Future()
         after_commit = getattr(self.sink, "after_commit", None)
         if after_commit is None:
             ticket.set_result(APPLIED)

@@ -47,6 +47,7 @@ EXCEPTION_OF: dict[Reason, int] = {
     Reason.BUSY: BUSY,
     Reason.JOURNAL_FULL: BUSY,
     Reason.NOT_RUNNING: BUSY,
+    Reason.STANDBY: BUSY,  # 06: the write belongs to the primary; the refusal's record names it
     Reason.FAILED: DEVICE_FAILURE,
 }
 

@@ -37,6 +37,7 @@ class Action(StrEnum):
     QUIT = "quit"  # the whole station
     USERS = "users"  # user administration
     TRUST = "trust"  # trust a client certificate
+    INTO_STANDBY = "IntoStandBy"  # hand the primary role of a hot-standby pair to the standby
 
 
 POLICY: dict[Action, str] = {
@@ -55,6 +56,7 @@ POLICY: dict[Action, str] = {
     Action.QUIT: ENGINEER,
     Action.USERS: ADMIN,
     Action.TRUST: ADMIN,
+    Action.INTO_STANDBY: ENGINEER,
 }
 
 

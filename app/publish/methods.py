@@ -42,6 +42,8 @@ METHODS = (
     Method("Run", Action.RUN, description="Run NetPlc's program"),
     Method("Stop", Action.STOP, description="Stop NetPlc's program"),
     Method("Step", Action.STEP, description="One scan while NetPlc is stopped"),
+    Method("IntoStandBy", Action.INTO_STANDBY,
+           description="Hand the primary role of the hot-standby pair to the standby"),
     Method("Force", Action.FORCE, (KIND, ADDRESS, ("Value", "the forced value, a whole number; Null: its "
                                                              "present value (bumpless)", _INT32)),
            "Force an address to a value (force > program > live)"),
@@ -104,6 +106,8 @@ class StationMethods:
             return commands.stop(who)
         if method.name == "Step":  # waits for the scan in progress: off the server's loop
             return await asyncio.to_thread(commands.step, who, self.step_lock())
+        if method.name == "IntoStandBy":
+            return commands.into_standby(who)
         if method.name == "UnforceAll":
             return commands.unforce_all(who)
         if method.name in ("ForceTag", "UnforceTag"):

@@ -94,7 +94,7 @@ ANSWERS = {Reason.APPLIED: _S.Good, Reason.DENIED: _S.BadUserAccessDenied,  # by
            Reason.TYPE_MISMATCH: _S.BadTypeMismatch, Reason.OUT_OF_RANGE: _S.BadOutOfRange,
            Reason.INVALID: _S.BadInvalidArgument, Reason.BUSY: _S.BadTooManyOperations,
            Reason.JOURNAL_FULL: _S.BadResourceUnavailable, Reason.NOT_RUNNING: _S.BadServerHalted,
-           Reason.FAILED: _S.BadInternalError}
+           Reason.FAILED: _S.BadInternalError, Reason.STANDBY: _S.BadInvalidState}
 YIELD_EVERY = 500  # variable writes between two turns of the event loop
 READABLE_WITHIN = 2.0  # s at most an applied write waits for its value to be readable here
 MEMORY_BITS = "NetPlc's I/O bits 00000-03777, one byte each (0 or 1): byte n is bit n"

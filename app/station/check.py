@@ -13,6 +13,7 @@ from dataclasses import dataclass, field
 from pathlib import Path
 
 from app.station.config import read_station
+from app.station.fingerprint import differing, fingerprint
 from app.station.load import load
 from app.station.runtime import unresolved_hosts
 from registrar.store import archive_problem
@@ -22,6 +23,7 @@ from registrar.store import archive_problem
 class CheckReport:
     problems: list[str] = field(default_factory=list)
     notes: list[str] = field(default_factory=list)  # what was found good, for the summary
+    warnings: list[str] = field(default_factory=list)  # allowed, but the engineer must know
 
     @property
     def ok(self) -> bool:
@@ -42,4 +44,35 @@ def check_station(path: str | Path) -> CheckReport:
     loaded = load(station)
     report.problems += loaded.problems + loaded.form_problems
     report.notes += loaded.notes
+    pair = station.redundancy
+    if pair is not None and pair.arbiter == "none":
+        report.warnings.append(f"{station.path}: redundancy.arbiter: \"none\": when the link between "
+                               f"the pair breaks while both run, both act as primary (split brain)")
+    return report
+
+
+def check_pair(path: str | Path, partner: str | Path) -> CheckReport:
+    """Both stations of a hot-standby pair, and that they hold the same station: the files
+    whose hashes differ are named (app/station/fingerprint.py), as the pair link refuses them."""
+    report = check_station(path)
+    other = check_station(partner)
+    report.problems += other.problems
+    report.notes += other.notes
+    report.warnings += [w for w in other.warnings if w not in report.warnings]
+    ours, theirs = read_station(path)[0], read_station(partner)[0]
+    if ours is None or theirs is None:
+        return report
+    for station in (ours, theirs):
+        if station.redundancy is None:
+            report.problems.append(f"{station.path}: [redundancy] missing: not one of a pair")
+    if ours.redundancy is not None and theirs.redundancy is not None \
+            and ours.redundancy.letter == theirs.redundancy.letter:
+        report.problems.append(f"{theirs.path}: redundancy.letter: both stations are "
+                               f"{ours.redundancy.letter}: one must be A, the other B")
+    differ = differing(fingerprint(ours), fingerprint(theirs))
+    if differ:
+        report.problems.append(f"{ours.folder} and {theirs.folder} are not the same station: "
+                               f"{', '.join(differ)} differ")
+    else:
+        report.notes.append(f"pair: {ours.folder} and {theirs.folder} hold the same station")
     return report

@@ -113,6 +113,37 @@ class MqttSettings:
     role: str = OPERATOR  # what NCMD/DCMD may do (they name no user): viewer = read-only
 
 
+LETTERS = ("A", "B")  # HSBNumPLC of seed 000: 1 = A, 0 = B
+FAILOVER_MAX_MS = 1000  # a takeover within about a second: failover_after is bounded by it
+
+
+@dataclass(frozen=True)
+class RedundancySettings:
+    """[redundancy]: this station as one of a hot-standby pair (app/station/pair.py)."""
+
+    letter: str  # "A" or "B": A wins when both start together
+    partner: str  # HOST:PORT of the partner's pair link
+    listen: str = "127.0.0.1:0"  # HOST:PORT of this station's pair link (0: a free port, tests)
+    failover_after: int = 3  # NetSyncTime ticks of silence from the primary before a takeover
+    arbiter: str = "none"  # "none", or the plant archive's postgresql:// URL (a lease)
+
+    @property
+    def listen_address(self) -> tuple[str, int]:
+        return split_address(self.listen)
+
+    @property
+    def partner_address(self) -> tuple[str, int]:
+        return split_address(self.partner)
+
+
+def split_address(text: str) -> tuple[str, int]:
+    """HOST:PORT as (host, port); ValueError when it is not one."""
+    host, sep, port = text.rpartition(":")
+    if not sep or not host or not port.isdigit() or not 0 <= int(port) <= 65535:
+        raise ValueError(f"{text!r} is not HOST:PORT")
+    return host.strip("[]"), int(port)
+
+
 @dataclass(frozen=True)
 class Station:
     path: Path  # the station.toml file
@@ -139,6 +170,7 @@ class Station:
     alarm_sound: bool = True  # a new alarm of priority 1-2 sounds until acknowledged or silenced
     opcua: OpcUaSettings = OpcUaSettings()
     mqtt: MqttSettings = MqttSettings()
+    redundancy: RedundancySettings | None = None  # None: a station on its own
 
     @property
     def folder(self) -> Path:
@@ -217,6 +249,7 @@ KEYS: dict[str, dict[str, Key]] = {
         Key("operator", dict, {}, "who is at the workstation"),
         Key("opcua", dict, {}, "the OPC UA server's table"),
         Key("mqtt", dict, {}, "the MQTT Sparkplug B publisher's table"),
+        Key("redundancy", dict, None, "the hot-standby pair's table; none: a single station"),
     ),
     "modbus_server": _keys(
         Key("enabled", bool, _SERVER.enabled, "serve NetPlc memory over Modbus"),
@@ -252,6 +285,15 @@ KEYS: dict[str, dict[str, Key]] = {
         Key("port", int, 0, "the port it listens on; 0: a free one, filled into the node", (0, 65535)),
         Key("unit", int, 1, "its Modbus unit id", (0, 247)),
         Key("tick", int, 100, "ms per scan", (10, 60_000)),
+    ),
+    "redundancy": _keys(
+        Key("letter", str, "A", "this station's letter in the hot-standby pair: A or B (required)"),
+        Key("partner", str, "", "the partner's pair link, `host:port` (required)"),
+        Key("listen", str, "127.0.0.1:0", "this station's pair link, `host:port`"),
+        Key("failover_after", int, 3, "NetSyncTime ticks of the primary's silence before the standby "
+            "takes over, within about a second", (2, 6_000), said="3, fewer where 3 ticks pass 1 s"),
+        Key("arbiter", str, "none", "`postgresql://...` (a lease in the plant archive's PostgreSQL) or "
+            "`none` (a cut pair link makes both primary)"),
     ),
     "operator": _keys(
         Key("default_user", str, _OPERATOR.default_user,
@@ -450,6 +492,7 @@ def read_station(path: str | Path) -> tuple[Station | None, list[str]]:
         language = ""
     opcua = _opcua(problems, fname, top.get("opcua"))
     mqtt = _mqtt(problems, fname, top.get("mqtt"), base, top.allow_outside)
+    redundancy = _redundancy(problems, fname, top.get("redundancy"), sync)
     top.finish()
     nodes = _with_simulated_nodes(problems, fname, nodes, simulators)
     _ports_in_common(problems, fname, server, simulators, nodes)
@@ -477,7 +520,7 @@ def read_station(path: str | Path) -> tuple[Station | None, list[str]]:
         allow_outside=top.allow_outside, RetainForces=bool(retain_forces), plant_archive=plant,
         plant_keep_days=plant_keep_days,
         alarm_sound=alarm_sound, opcua=opcua,
-        mqtt=mqtt,
+        mqtt=mqtt, redundancy=redundancy,
     )
     return station, problems
 
@@ -810,3 +853,37 @@ def _mqtt(problems: list[str], fname: str, table: dict[str, Any], base: Path,
             bands.append((kind, float(value)))
     return MqttSettings(enabled, broker, ca_file, group, edge, username, password, tuple(bands), period,
                         writable, buffer, primary, role)
+
+
+def _redundancy(problems: list[str], fname: str, table: dict[str, Any] | None,
+                sync: int) -> RedundancySettings | None:
+    """[redundancy], or None when the station has none. failover_after counts NetSyncTime ticks
+    and is bounded so that a takeover comes within about a second (FAILOVER_MAX_MS)."""
+    if table is None:
+        return None
+    r = _Reader(problems, fname, table, "redundancy")
+    letter = r.get("letter", required=True)
+    partner = r.get("partner", required=True)
+    listen = r.get("listen")
+    most = max(2, FAILOVER_MAX_MS // sync)  # the declared bounds hold; the tick bounds it further
+    failover = r.number("failover_after", min(3, most))
+    if failover > most:
+        r.bad("failover_after", f"{failover} ticks of {sync} ms is more than {FAILOVER_MAX_MS} ms")
+        failover = most
+    arbiter = r.get("arbiter")
+    r.finish()
+    if letter not in LETTERS:
+        r.bad("letter", f"{letter!r} is not A or B")
+        letter = "A"
+    for key, value in (("partner", partner), ("listen", listen)):
+        if key == "partner" and not value:
+            continue  # reported missing
+        try:
+            split_address(value)
+        except ValueError as e:
+            r.bad(key, str(e))
+    if arbiter != "none" and (problem := url_problem(arbiter) if is_url(arbiter) else
+                              f"{arbiter!r} is neither \"none\" nor a postgresql:// URL"):
+        r.bad("arbiter", problem)
+        arbiter = "none"
+    return RedundancySettings(letter, partner, listen, failover, arbiter)

@@ -51,6 +51,7 @@ from registrar.retain import Retainer
 from registrar.store import Store, StoreStats
 
 if TYPE_CHECKING:
+    from app.station.pair import Pair
     from registrar.plant.forward import Forwarder
 
 logger = logging.getLogger(__name__)
@@ -90,6 +91,7 @@ class RuntimeStatus:
     modbus_serial: str = ""  # the serial port the Modbus server answers on (transport = "rtu")
     problems: tuple[str, ...] = field(default=())  # what an operator must see (disk, server, ...)
     forced: int = 0  # forces in effect: the always-visible "F: n forced"
+    pair: str = ""  # one of a hot-standby pair: its role and link (PairStatus.line), else ""
 
     @property
     def nodes_up(self) -> int:
@@ -107,6 +109,8 @@ class RuntimeStatus:
         text = (f"NetPlc {self.state} | scan {self.scan_last_ms:.2f} ms (max {self.scan_max_ms:.2f}, "
                 f"tick {self.tick_ms} ms, {self.overruns} overruns, {self.scans} scans) | "
                 f"nodes {self.nodes_up}/{len(self.nodes)} up [{nodes}] | records {self.records_written}")
+        if self.pair:
+            text += f" | {self.pair}"
         if self.problems:
             text += " | " + "; ".join(self.problems)
         return text
@@ -173,6 +177,7 @@ class Runtime:
         self._users: tuple[float, Users] | None = None  # users.json as last read, by its mtime
         self.scan_thread: ScanThread | None = None
         self.publishers: list = []  # OPC UA server, MQTT publisher (app/publish/)
+        self.pair: Pair | None = None  # [redundancy]: this station's side of a hot-standby pair
         self.nodes: list[NodeConfig] = list(station.nodes)
         self.restored = ""  # which retentive save was used: current / previous / zeroes
         self.started_clock: float | None = None
@@ -199,13 +204,16 @@ class Runtime:
 
     def after_commit(self, callback: Callable[[], None]) -> None:
         """`callback()` once every record put so far is on disk, and so is the retentive memory of
-        the scan that put them (registrar/retain.py): the engine answers an outside writer then, so
-        an acknowledged write survives a crash both in the journal and in memory."""
+        the scan that put them (registrar/retain.py), and a pair's standby holds that scan: the
+        engine answers an outside writer then, so an acknowledged write survives a crash both in
+        the journal and in memory, and a takeover."""
         parts: list[Callable[[Callable[[], None]], None]] = []
         if self.store is not None:
             parts.append(self.store.after_commit)
         if self.retainer is not None:
             parts.append(self.retainer.after_save)
+        if self.pair is not None:  # and the standby of a pair holds the scan (app/station/pair.py)
+            parts.append(self.pair.after_mirrored)
         if not parts:
             callback()
             return
@@ -316,7 +324,8 @@ class Runtime:
         self.subscribe(self.alarms.observe)
         self.alarms.attach(self.engine, self.exchange)
         self.commands = Commands(self.engine, self, role_of=self.role_of, tags=self.alarms.table.tags,
-                                 alarms=self.alarms, wallclock=self.wallclock)
+                                 alarms=self.alarms, wallclock=self.wallclock, standby=self._standby,
+                                 hand_over=self._hand_over if st.redundancy is not None else None)
         server = st.modbus_server
         if server.enabled:
             self.commands.grant(Source.MODBUS, server.role)
@@ -338,12 +347,45 @@ class Runtime:
         self.system(f"program loaded: {self.program.source} ({len(self.program.instrs)} instructions, "
                     f"{self.program.words} words)")
         self.retainer.start()  # before the first scan: its writers wait for its saves
+        if st.redundancy is not None:
+            self._start_pair()
         self.scan_thread = ScanThread(self.engine, st.tick, on_error=self._scan_error)
         self.scan_thread.start()
         self.started = True
         self.system(f"station started: NetSyncTime {st.NetSyncTime} ms, "
                     f"retentive memory from {self.restored}")
         threading.Thread(target=self._report_unresolved, name="resolve", daemon=True).start()
+
+    def _start_pair(self) -> None:
+        """Join the pair: the role is decided (a partner heard within the start window, or none)
+        before the first scan, so no program scan and no node request precede it."""
+        from app.station.fingerprint import fingerprint
+        from app.station.pair import Pair
+
+        st = self.station
+        assert st.redundancy is not None and self.engine is not None
+        pair = Pair(self, st.redundancy, fingerprint(st))
+        try:
+            pair.start(self.engine)
+        except OSError as e:
+            pair.stop()
+            raise StartError([f"{st.path}: redundancy.listen: cannot listen on {st.redundancy.listen}: "
+                              f"{_reason(e)}"]) from None
+        self.pair = pair
+
+    def _standby(self) -> str | None:
+        """Why the command layer refuses a write or command now: this station is not the primary."""
+        pair = self.pair
+        if pair is None:
+            return None if self.station.redundancy is None else "the station is joining its pair"
+        return pair.refusal()
+
+    def _hand_over(self, cause: str) -> str | None:
+        """IntoStandBy, for the command layer: None once asked for, else why not."""
+        pair = self.pair
+        if pair is None or not pair.into_standby(cause):
+            return "no standby on the pair link to hand over to"
+        return None
 
     def _restore_forces(self) -> None:
         """RetainForces = true: the forces of the last run are in effect again from the first scan,
@@ -417,7 +459,12 @@ class Runtime:
         self.system(text, logging.WARNING)
 
     def stop(self) -> None:
-        """Stop everything in the reverse order of start; safe to call twice or after a failed start."""
+        """Stop everything in the reverse order of start; safe to call twice or after a failed start.
+        The primary of a pair hands over to its standby first."""
+        if self.pair is not None:
+            self.pair.into_standby("the primary is stopping", wait=1.0)
+            self.pair.stop()
+            self.pair = None
         if self.scan_thread is not None:
             self.scan_thread.stop()
             self.scan_thread = None
@@ -551,6 +598,11 @@ class Runtime:
         if forwarder is not None and (f := forwarder.stats).lag > forwarder.lag_alarm:
             problems.append(f"archive: forwarding to the plant archive lags by {f.lag:.0f} s, "
                             f"{f.backlog} records ({f.last_error or 'catching up'})")
+        pair = self.pair.status() if self.pair is not None else None
+        if self.pair is not None and self.pair.refused:
+            problems.append(self.pair.refused)
+        if pair is not None and not pair.link:
+            problems.append(f"pair link to {pair.partner} down: no standby")
         return RuntimeStatus(
             running=self.started,
             state=engine.state_text if engine else "not started",
@@ -568,4 +620,5 @@ class Runtime:
             modbus_serial=self.modbus.serial.device if self.modbus and self.modbus.serial else "",
             problems=tuple(problems),
             forced=engine.forces.count if engine else 0,
+            pair=pair.line() if pair is not None else "",
         )

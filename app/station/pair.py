@@ -1,0 +1,561 @@
+"""A hot-standby pair of stations (seed 000's HSB; docs/architecture.md section 11).
+
+One station of the pair is the primary: it runs the program, the exchange with the nodes and
+accepts commands; after every scan it sends the standby what changed (app/station/mirror.py). The
+standby's engine follows (`Engine.follower`): it runs no program, so its exchange asks the nodes
+for nothing, and its command layer refuses writes and commands naming the primary, while its
+Modbus and OPC UA servers answer reads from the mirrored memory.
+
+One TCP link between the two, always dialled by B to A (one dialler: two stations starting
+together never cross two connections); once both said hello the roles decide who sends. The
+roles at a hello: a primary stays primary and the other follows; two primaries (a link healed
+after both acted): the one that led more scans; none (both starting): A. A station that hears
+no partner within its start window (failover_after ticks and two more, 0.5 s at least) leads.
+
+The standby takes over when the primary's frames have stopped for failover_after ticks: the
+newest mirrored state is put into its engine and the program runs on from it in the next scan
+(timers keep their elapsed time, edges their memory, NWRITEs resume from the mirrored words).
+"""
+
+from __future__ import annotations
+
+import json
+import logging
+import select
+import socket
+import struct
+import threading
+import time
+from collections.abc import Callable
+from dataclasses import dataclass
+from enum import StrEnum
+from typing import TYPE_CHECKING
+
+from app.station.config import RedundancySettings
+from app.station.fingerprint import differing
+from app.station.mirror import (
+    ACK,
+    HANDOVER,
+    HELLO,
+    STATE,
+    Capture,
+    Encoder,
+    LinkError,
+    Mirror,
+    capture,
+    read_frame,
+    send_frame,
+)
+from netplc.engine import Engine
+from netplc.memory import Memory, Snapshot
+
+if TYPE_CHECKING:
+    from app.station.runtime import Runtime
+    from registrar.plant.lease import Lease
+
+logger = logging.getLogger(__name__)
+
+
+class Role(StrEnum):
+    STARTING = "starting"
+    PRIMARY = "primary"
+    STANDBY = "standby"
+
+
+# HSBStatus of seed 000 by role: 0 after power-on, 4 standby, 5 master (6 defect: refused partner)
+HSB_STATUS = {Role.STARTING: 0, Role.PRIMARY: 5, Role.STANDBY: 4}
+DEFECT = 6
+# The pair's status words in NetPlc memory, beside the RTC (077700-077707), each station's own
+# (written after the mirrored memory is put), for a program and an HMI (README "Redundancy")
+HSB_NUM_PLC = 0o77710  # byte: 1 = A, 0 = B (HSBNumPLC)
+HSB_STATUS_BYTE = 0o77711  # byte: HSBStatus
+DGN_HSB = 0o77712  # word: b7 the partner's station differs, b9 the pair link is down, b15 a switchover
+HSB_SWITCH = 0o77714  # word: low byte the last switchover's cause, high byte the switchovers
+HSB_LAG = 0o77716  # byte: the standby's lag in the primary's scans (255 at most)
+START_WINDOW = 0.5  # s at least a starting station waits for a partner before it leads alone
+# switchover causes (the low byte of HSB_SWITCH), after seed 000's hardware codes
+SILENT, HANDED_OVER, STEPPED_DOWN = 50, 51, 52
+
+
+def decide(mine: Role, letter: str, theirs: Role, my_scans: int = 0, their_scans: int = 0) -> Role:
+    """This station's role once both said hello; both sides reach the same answer. Two
+    primaries: the one that led more scans (a station that led alone for its start window while
+    the link was slow to come gives way to the one that has the plant's state), then A."""
+    if mine is Role.PRIMARY and theirs is not Role.PRIMARY:
+        return Role.PRIMARY
+    if theirs is Role.PRIMARY and mine is not Role.PRIMARY:
+        return Role.STANDBY
+    if mine is Role.PRIMARY and my_scans != their_scans:
+        return Role.PRIMARY if my_scans > their_scans else Role.STANDBY
+    return Role.PRIMARY if letter == "A" else Role.STANDBY
+
+
+@dataclass(frozen=True)
+class PairStatus:
+    """What `main.py redundancy status` and the health strip show."""
+
+    letter: str
+    role: str
+    partner: str
+    link: bool  # a partner of the same station is connected
+    last_takeover: str  # when and why this station last became primary, "" never
+    lag: int  # the standby: scans of the primary's since its last frame; the primary: 0
+    switchovers: int
+
+    def line(self) -> str:
+        link = "up" if self.link else "DOWN"
+        text = f"pair {self.letter}: {self.role}, partner {self.partner} link {link}"
+        if self.role == Role.STANDBY:
+            text += f", lag {self.lag} scans"
+        if self.last_takeover:
+            text += f"; last takeover: {self.last_takeover}"
+        return text
+
+    def as_dict(self) -> dict[str, object]:
+        return {"letter": self.letter, "role": self.role, "partner": self.partner, "link": self.link,
+                "last_takeover": self.last_takeover, "lag": self.lag, "switchovers": self.switchovers}
+
+
+class Pair:
+    """This station's side of the pair: `start()` (returns once the role is decided), `stop()`."""
+
+    def __init__(self, runtime: Runtime, settings: RedundancySettings, files: dict[str, str],
+                 clock: Callable[[], float] = time.monotonic) -> None:
+        self.runtime = runtime
+        self.settings = settings
+        self.files = files
+        self.clock = clock
+        self.role = Role.STARTING
+        self.mirror = Mirror()
+        self.switchovers = 0
+        self.last_takeover = ""
+        self.refused = ""  # why the partner was refused (files differ), for the health strip
+        self._engine: Engine | None = None
+        self._lock = threading.Lock()
+        self._changed = threading.Condition(self._lock)  # a new capture, or a new role
+        self._capture: Capture | None = None
+        self._link: socket.socket | None = None  # the pair link, once both said hello
+        self._last_frame = clock()
+        self._load_pending = False
+        self._handing_over = ""  # into_standby asked for, done by the next scan's listener
+        self._handover = ""  # the cause the link's thread sends after the last frame
+        self._handed = threading.Event()  # the handover was sent (or the link ended)
+        self._stopping = threading.Event()
+        self._decided = threading.Event()
+        self._server: socket.socket | None = None
+        self._threads: list[threading.Thread] = []
+        self.port = 0  # the port this station's link listens on
+        self.lease: Lease | None = None  # arbiter = "postgresql://...": the primary's lease
+        if settings.arbiter != "none":
+            from registrar.plant.lease import Lease  # psycopg only where an arbiter is named
+
+            self.lease = Lease(settings.arbiter, runtime.station.name)
+        self._waiting = ""  # why this station may not lead now, as last journaled
+        self.cause = 0  # the last switchover's cause code (HSB_SWITCH)
+        self.led_scans = 0  # scans run as the primary: of two primaries, the one with more leads
+        self._awaiting: list[tuple[int, Callable[[], None]]] = []  # (scan, callback): after_mirrored
+
+    @property
+    def tick(self) -> float:
+        return self.runtime.station.tick
+
+    @property
+    def failover(self) -> float:
+        return self.settings.failover_after * self.tick
+
+    @property
+    def partner_name(self) -> str:
+        return f"{'B' if self.settings.letter == 'A' else 'A'} at {self.settings.partner}"
+
+    # --- start and stop ------------------------------------------------------------------------
+
+    def start(self, engine: Engine) -> None:
+        """Listen, dial (B), and decide the role within the start window: a partner heard is
+        followed or leads; none heard, this station is the primary."""
+        self._engine = engine
+        engine.follower = True  # no program and no node request before the role is decided
+        engine.subscribe(self._on_scan, "pair link")
+        host, port = self.settings.listen_address
+        server = socket.create_server((host, port))
+        server.settimeout(self.tick)
+        self._server = server
+        self.port = server.getsockname()[1]
+        self._spawn(self._accept, "pair accept")
+        if self.settings.letter == "B":
+            self._spawn(self._dial, "pair dial")
+        self._spawn(self._watch, "pair watch")
+        window = max(self.failover + 2 * self.tick, START_WINDOW)
+        if not self._decided.wait(window):
+            self._become(Role.PRIMARY, f"no partner answered within {window * 1000:.0f} ms of the start")
+
+    def _spawn(self, target: Callable[[], None], name: str) -> None:
+        thread = threading.Thread(target=target, name=name, daemon=True)
+        thread.start()
+        self._threads.append(thread)
+
+    def stop(self) -> None:
+        self._stopping.set()
+        if self.lease is not None:
+            self.lease.release()
+        with self._changed:
+            self._changed.notify_all()
+        self._drop_link()
+        if self._server is not None:
+            self._server.close()
+        for thread in self._threads:
+            thread.join(5)
+        self._threads.clear()
+        if self._engine is not None:
+            self._engine.unsubscribe(self._on_scan)
+
+    def kill(self) -> None:
+        """End the link at once with no word to the partner, as a dying station's would (tests,
+        bench/failover.py): the partner learns of it only by the silence, and the writers waiting
+        for the standby are never answered, as by a dead process."""
+        with self._lock:
+            self._awaiting.clear()
+        self.stop()
+
+    # --- the role ------------------------------------------------------------------------------
+
+    def refusal(self) -> str | None:
+        """Why this station takes no writes or commands now (its command layer's STANDBY), or None."""
+        if self.role is Role.PRIMARY:
+            return None
+        if self.role is Role.STARTING:
+            return "the station is starting as one of a pair: it takes commands once it is the primary"
+        return f"this station ({self.settings.letter}) is the standby: the primary is {self.partner_name}"
+
+    def _may_lead(self, cause: str, patience: float = 0.0) -> bool:
+        """Without an arbiter, always; with one, once this station holds its lease (`patience`:
+        seconds to keep trying, for a lease the partner is releasing as it hands over). A
+        refusal is journaled once per cause."""
+        lease = self.lease
+        if lease is None:
+            return True
+        deadline = self.clock() + patience
+        while not lease.take():
+            if self.clock() >= deadline or self._stopping.is_set():
+                if lease.last_error != self._waiting:  # once per cause, not per silent tick
+                    self._waiting = lease.last_error
+                    self.runtime.system(f"pair {self.settings.letter}: stays {self.role.value} ({cause}): "
+                                        f"the arbiter decides: {lease.last_error}", logging.WARNING)
+                return False
+            self._stopping.wait(self.tick / 4)
+        self._waiting = ""
+        return True
+
+    def _become(self, role: Role, cause: str, patience: float = 0.0, code: int = 0) -> None:
+        if role is Role.PRIMARY and self.role is not Role.PRIMARY and not self._may_lead(cause, patience):
+            if self.role is Role.STARTING:
+                role, cause = Role.STANDBY, f"{cause}; the partner holds the arbiter's lease"
+            else:
+                return
+        if role is not Role.PRIMARY and self.lease is not None:
+            self.lease.release()
+        with self._changed:
+            old = self.role
+            if old is role:
+                self._decided.set()
+                return
+            self.role = role
+            self._changed.notify_all()
+        engine = self._engine
+        assert engine is not None
+        if code:
+            self.cause = code
+        if role is Role.PRIMARY:
+            if old is Role.STANDBY:
+                self.switchovers += 1
+            self.last_takeover = f"{time.strftime('%Y-%m-%d %H:%M:%S')}: {cause}"
+            engine.post(self._lead)
+        else:
+            engine.post(self._follow)
+        self._decided.set()
+        level = logging.WARNING if old is not Role.STARTING else logging.INFO
+        self.runtime.system(f"pair {self.settings.letter}: {old} -> {role}: {cause}", level)
+
+    def _lead(self, mem: Memory) -> None:
+        """On the engine thread: the newest mirrored state, then the program runs on from it."""
+        engine = self._engine
+        assert engine is not None
+        if engine.follower and self.mirror.complete:
+            with self._lock:
+                self.mirror.load_into(engine, mem)
+        engine.follower = False
+        self._put_words(mem)
+
+    def _follow(self, _mem: Memory) -> None:
+        engine = self._engine
+        assert engine is not None
+        engine.follower = True
+
+    def into_standby(self, cause: str, wait: float = 0.0) -> bool:
+        """Hand the primary role to the standby (IntoStandBy) at the end of the next scan: that
+        scan's state is the last frame, then the handover. False when this station is no primary
+        with a standby on the link. `wait`: seconds to wait for the handover to be sent."""
+        with self._changed:
+            if self.role is not Role.PRIMARY or self._link is None:
+                return False
+            self._handing_over = cause
+            self._handed.clear()
+        if wait:
+            self._handed.wait(wait)
+        return True
+
+    # --- the link ------------------------------------------------------------------------------
+
+    def _accept(self) -> None:
+        server = self._server
+        assert server is not None
+        while not self._stopping.is_set():
+            try:
+                conn, _peer = server.accept()
+            except TimeoutError:
+                continue
+            except OSError:
+                if not self._stopping.is_set():
+                    logger.exception("pair link: accept failed")
+                return
+            if self._stopping.is_set():
+                conn.close()
+                return
+            self._spawn_link(conn)
+
+    def _dial(self) -> None:
+        host, port = self.settings.partner_address
+        while not self._stopping.is_set():
+            if self._link is None:
+                try:
+                    conn = socket.create_connection((host, port), timeout=self.tick)
+                except OSError:
+                    self._stopping.wait(self.tick)
+                    continue
+                self._serve(conn)
+            self._stopping.wait(self.tick)
+
+    def _spawn_link(self, conn: socket.socket) -> None:
+        threading.Thread(target=self._serve, args=(conn,), name="pair link", daemon=True).start()
+
+    def _serve(self, conn: socket.socket) -> None:
+        """One link, from hello to its end (a status query answered and closed, or the pair's)."""
+        paired = False
+        try:
+            conn.settimeout(max(self.failover, 1.0))
+            send_frame(conn, HELLO, json.dumps(self._hello()).encode())
+            kind, payload = read_frame(conn)
+            hello = json.loads(payload) if kind == HELLO else None
+            if not isinstance(hello, dict) or "letter" not in hello:
+                raise LinkError("the partner did not say hello")
+            if hello.get("query"):
+                return  # `main.py redundancy status`: our hello was the answer
+            if not self._pairs_with(hello):
+                return
+            with self._changed:
+                if self._link is not None:
+                    old = self._link
+                    old.close()
+                self._link = conn
+                self._last_frame = self.clock()
+            self._become(decide(self.role, self.settings.letter, Role(hello["role"]), self.led_scans,
+                                int(hello.get("led", 0))), f"partner {hello['letter']} is {hello['role']}")
+            self.refused = ""
+            paired = True
+            self._run_link(conn)
+        except (OSError, LinkError, ValueError) as e:
+            if paired and not self._stopping.is_set():
+                self.runtime.system(f"pair {self.settings.letter}: link to the partner lost "
+                                    f"({self.role.value}): {e or type(e).__name__}", logging.WARNING)
+            elif not self._stopping.is_set():
+                logger.info("pair link ended: %s", e)
+        finally:
+            with self._changed:
+                if self._link is conn:
+                    self._link = None
+            self._handed.set()
+            conn.close()
+            self._mirrored(None)  # no standby to wait for: the primary's own commit stands
+
+    def _hello(self) -> dict[str, object]:
+        return {"letter": self.settings.letter, "role": self.role.value, "led": self.led_scans,
+                "files": self.files, "status": self.status().as_dict()}
+
+    def _pairs_with(self, hello: dict[str, object]) -> bool:
+        """The partner holds the same station, and the other letter; else refused, journaled."""
+        theirs = hello.get("files")
+        differ = differing(self.files, theirs if isinstance(theirs, dict) else {})
+        why = ""
+        if hello["letter"] == self.settings.letter:
+            why = f"the partner is {self.settings.letter} as well"
+        elif differ:
+            why = f"the partner's station differs: {', '.join(differ)}"
+        if not why:
+            return True
+        text = f"pair {self.settings.letter}: partner refused: {why}"
+        if text != self.refused:
+            self.refused = text
+            self.runtime.system(text, logging.WARNING)
+        return False
+
+    def _run_link(self, conn: socket.socket) -> None:
+        """Send while primary, receive while standby; the role may turn over on a handover."""
+        encoder = Encoder()
+        while not self._stopping.is_set():
+            if self.role is Role.PRIMARY or self._handover:
+                with self._changed:
+                    self._changed.wait_for(lambda: self._capture is not None or self._stopping.is_set()
+                                           or self._link is not conn, self.tick)
+                    cap, self._capture = self._capture, None
+                    handover, self._handover = self._handover, ""
+                    if self._link is not conn:
+                        return
+                if cap is not None:
+                    send_frame(conn, STATE, encoder.frame(cap))
+                while select.select([conn], [], [], 0)[0]:  # the standby's acknowledgements
+                    self._received(*read_frame(conn), conn)
+                if handover:
+                    if self.lease is not None:
+                        self.lease.release()  # for the partner to take
+                    send_frame(conn, HANDOVER, json.dumps({"cause": handover}).encode())
+                    self._handed.set()
+            else:  # a read that times out ends the link: the watch decides on a takeover
+                encoder.last = None  # if this station leads again, its first frame is whole
+                self._received(*read_frame(conn), conn)
+
+    def _received(self, kind: int, payload: bytes, conn: socket.socket) -> None:
+        if kind == STATE:
+            with self._lock:
+                self.mirror.apply(payload)
+                self._last_frame = self.clock()
+                post = not self._load_pending
+                self._load_pending = True
+                scan = self.mirror.scan
+            if post and self._engine is not None:
+                self._engine.post(self._load)
+            send_frame(conn, ACK, struct.pack(">q", scan))
+        elif kind == ACK and len(payload) == 8:
+            self._mirrored(struct.unpack(">q", payload)[0])
+        elif kind == HANDOVER:
+            cause = json.loads(payload).get("cause", "IntoStandBy")
+            self._become(Role.PRIMARY, f"handed over by the partner: {cause}", patience=self.failover,
+                         code=HANDED_OVER)
+
+    def after_mirrored(self, callback: Callable[[], None]) -> None:
+        """`callback()` once the standby holds the scan running now (its acknowledgement of that
+        scan's frame), at once without a standby: the runtime answers an outside write only then,
+        so a write acknowledged by the primary is not lost when the standby takes over."""
+        engine = self._engine
+        with self._lock:
+            if self.role is Role.PRIMARY and self._link is not None and engine is not None:
+                self._awaiting.append((engine.scan_counter + 1, callback))
+                return
+        callback()
+
+    def _mirrored(self, scan: int | None) -> None:
+        """The standby holds `scan` (or None: it is gone): the callbacks waiting for it."""
+        with self._lock:
+            ready = [cb for at, cb in self._awaiting if scan is None or at <= scan]
+            self._awaiting = [] if scan is None else [(at, cb) for at, cb in self._awaiting if at > scan]
+        for callback in ready:
+            callback()
+
+    def _load(self, mem: Memory) -> None:
+        """On the engine thread: the newest mirrored state, while this station follows."""
+        engine = self._engine
+        assert engine is not None
+        with self._lock:
+            self._load_pending = False
+            if engine.follower and self.mirror.complete:
+                self.mirror.load_into(engine, mem)
+        self._put_words(mem)
+
+    def _put_words(self, mem: Memory) -> None:
+        """This station's HSB status words (on the engine thread)."""
+        status = self.status()
+        mem.set_byte(HSB_NUM_PLC, 1 if self.settings.letter == "A" else 0)
+        mem.set_byte(HSB_STATUS_BYTE, DEFECT if self.refused else HSB_STATUS[self.role])
+        mem.set_word(DGN_HSB, (1 << 7 if self.refused else 0) | (0 if status.link else 1 << 9)
+                     | (1 << 15 if self.switchovers else 0))
+        mem.set_word(HSB_SWITCH, min(self.switchovers, 255) << 8 | self.cause)
+        mem.set_byte(HSB_LAG, min(status.lag, 255))
+
+    def _on_scan(self, snapshot: Snapshot) -> None:
+        """An engine listener: the primary's scan, for the link's thread to send. A handover
+        asked for happens here, between two scans: this scan's state is the last one sent, and
+        from the next scan on this engine follows (writes still queued are refused, unapplied)."""
+        engine = self._engine
+        if engine is None:
+            return
+        self._put_words(engine.mem)  # for the next scan's program and snapshot
+        if self.role is Role.PRIMARY:
+            self.led_scans += 1
+        if self.role is not Role.PRIMARY or self._link is None:
+            return
+        cap = capture(engine, snapshot)
+        with self._changed:
+            self._capture = cap
+            if self._handing_over:
+                self._handover, self._handing_over = self._handing_over, ""
+                self.role = Role.STANDBY
+                engine.follower = True
+                self.switchovers += 1
+                self.cause = HANDED_OVER
+                self._last_frame = self.clock()
+            self._changed.notify_all()
+        if self._handover:
+            self.runtime.system(f"pair {self.settings.letter}: primary -> standby: {self._handover}",
+                                logging.WARNING)
+
+    def _watch(self) -> None:
+        """The standby's watch on the primary's silence; the primary's on its lease: one that
+        lost both its arbiter and its partner steps down, as the partner may lead by now."""
+        while not self._stopping.wait(self.tick / 2):
+            lease = self.lease
+            if self.role is Role.PRIMARY and lease is not None and not lease.alive() \
+                    and not lease.take() and self._link is None:
+                self._become(Role.STANDBY, f"lost the arbiter ({lease.last_error}) and the partner",
+                             code=STEPPED_DOWN)
+            if self.role is not Role.STANDBY:
+                continue
+            silent = self.clock() - self._last_frame
+            if silent >= self.failover:
+                self._drop_link()
+                self._become(Role.PRIMARY, f"partner silent for {silent * 1000:.0f} ms", code=SILENT)
+
+    def _drop_link(self) -> None:
+        with self._changed:
+            link, self._link = self._link, None
+            self._changed.notify_all()
+        if link is not None:
+            try:
+                link.shutdown(socket.SHUT_RDWR)
+            except OSError:
+                logger.debug("pair link already down")
+            link.close()
+
+    # --- status --------------------------------------------------------------------------------
+
+    def status(self) -> PairStatus:
+        lag = 0
+        if self.role is Role.STANDBY:
+            lag = int((self.clock() - self._last_frame) / self.tick)
+        return PairStatus(self.settings.letter, self.role.value, self.settings.partner,
+                          self._link is not None, self.last_takeover, lag, self.switchovers)
+
+
+def query(address: str, timeout: float = 3.0) -> dict[str, object]:
+    """The status of the station whose pair link listens at HOST:PORT (`main.py redundancy
+    status`): its hello. LinkError or OSError when it does not answer."""
+    from app.station.config import split_address
+
+    host, port = split_address(address)
+    with socket.create_connection((host, port), timeout=timeout) as conn:
+        conn.settimeout(timeout)
+        kind, payload = read_frame(conn)
+        send_frame(conn, HELLO, json.dumps({"letter": "?", "query": True}).encode())
+        if kind != HELLO:
+            raise LinkError("no hello from the station")
+        status = json.loads(payload).get("status")
+        if not isinstance(status, dict):
+            raise LinkError("the station's hello has no status")
+        return status

@@ -1,0 +1,201 @@
+"""Two stations of a hot-standby pair in one test run, on loopback, and the node they poll."""
+
+from __future__ import annotations
+
+import contextlib
+import socket
+import struct
+import threading
+import time
+from collections.abc import Callable, Iterator
+from pathlib import Path
+
+import pytest
+
+from app.authority import Source, Who
+from app.station.config import load_station
+from app.station.runtime import Runtime
+from netplc.program import parse
+from netplc.records import Record
+from netplc.simulator import Simulator
+from tests.app.conftest import write_station
+
+TICK_MS = 40
+# the node's link, the operator's word 04000 written to the node's 04100 every scan, a 10 s timer
+# (elapsed time mirrored) and a counter of the 0.4 s generator's rising edges (edge memory)
+PROGRAM = """\
+TNA $03760
+FON C:$02140 N:NODE S:1
+TNA $03760
+FON C:$02134 N:NWRITE S:4000 D:4100 R:2
+TNA $03760
+TIM C:$03000 N:100
+TNA $03752
+CTR C:$03010 N:255
+JMP 0
+"""
+STATION = """\
+name = "pair"
+NetPlcProgram = "pair.stl"
+NetSyncTime = {tick}
+[modbus_server]
+port = 0
+writable = [["04000", "04777"]]
+[[nodes]]
+node = 1
+endpoint = "tcp://127.0.0.1:{node}"
+timeout = 0.3
+retries = 0
+backoff = 0.05
+[redundancy]
+letter = "{letter}"
+listen = "127.0.0.1:{listen}"
+partner = "127.0.0.1:{partner}"
+arbiter = "{arbiter}"
+"""
+OPERATOR = Who("", Source.MODBUS, "test")
+
+
+def free_port() -> int:
+    with socket.socket() as s:
+        s.bind(("127.0.0.1", 0))
+        return s.getsockname()[1]
+
+
+def wait_for(condition: Callable[[], object], timeout: float = 3.0, what: str = "") -> None:
+    deadline = time.monotonic() + timeout
+    while not condition():
+        if time.monotonic() > deadline:
+            raise AssertionError(f"not within {timeout} s: {what}")
+        time.sleep(0.01)
+
+
+class Station:
+    """One station of the pair: its folder, the runtime while it runs, and its journal."""
+
+    def __init__(self, folder: Path) -> None:
+        self.folder = folder
+        self.runtime: Runtime | None = None
+        self.journal: list[Record] = []
+
+    def start(self) -> Runtime:
+        runtime = Runtime(load_station(self.folder))
+        runtime.subscribe(self.journal.append)
+        runtime.start()
+        self.runtime = runtime
+        return runtime
+
+    @property
+    def rt(self) -> Runtime:
+        assert self.runtime is not None
+        return self.runtime
+
+    @property
+    def role(self) -> str:
+        assert self.rt.pair is not None
+        return self.rt.pair.role.value
+
+    def word(self, addr: int) -> int:
+        assert self.rt.engine is not None
+        return self.rt.engine.snapshot.get_word(addr)
+
+    def write(self, addr: int, value: int) -> object:
+        assert self.rt.commands is not None
+        return self.rt.commands.write_word(OPERATOR, addr, value).result(3)
+
+    def kill(self) -> None:
+        """Dead at once: no more scans, the link cut with no word to the partner."""
+        rt = self.rt
+        assert rt.scan_thread is not None and rt.pair is not None
+        rt.scan_thread.stop()
+        rt.scan_thread = None
+        pair, rt.pair = rt.pair, None
+        pair.kill()
+        rt.stop()
+        self.runtime = None
+
+    def stop(self) -> None:
+        if self.runtime is not None:
+            self.runtime.stop()
+            self.runtime = None
+
+    def texts(self) -> list[str]:
+        return [r.text for r in self.journal if r.text]
+
+
+@pytest.fixture
+def node() -> Iterator[Simulator]:
+    sim = Simulator(parse("JMP 0\n", "node.stl"), tick=TICK_MS / 1000)
+    sim.start()
+    yield sim
+    sim.stop()
+
+
+def make_pair(tmp_path: Path, node: Simulator, arbiter: str = "none",
+              b_dials: int | None = None) -> tuple[Station, Station]:
+    """A and B of one station; B dials `b_dials` (a proxy's port) instead of A's link."""
+    ports = {"A": free_port(), "B": free_port()}
+    stations = []
+    for letter, other in (("A", "B"), ("B", "A")):
+        partner = b_dials if letter == "B" and b_dials else ports[other]
+        folder = write_station(tmp_path / letter, STATION.format(
+            tick=TICK_MS, node=node.port, letter=letter, listen=ports[letter], partner=partner,
+            arbiter=arbiter), {"pair.stl": PROGRAM})
+        stations.append(Station(folder))
+    return stations[0], stations[1]
+
+
+@pytest.fixture
+def pair(tmp_path: Path, node: Simulator) -> Iterator[tuple[Station, Station]]:
+    a, b = make_pair(tmp_path, node)
+    yield a, b
+    for st in (b, a):
+        st.stop()
+
+
+class Proxy:
+    """A TCP proxy between the pair that the test cuts: every connection and the listener."""
+
+    def __init__(self) -> None:
+        self.target = 0
+        self.server = socket.create_server(("127.0.0.1", 0))
+        self.port = self.server.getsockname()[1]
+        self.sockets: list[socket.socket] = []
+        threading.Thread(target=self._accept, daemon=True).start()
+
+    def _accept(self) -> None:
+        while True:
+            try:
+                conn, _ = self.server.accept()
+                upstream = socket.create_connection(("127.0.0.1", self.target))
+            except OSError:
+                return
+            self.sockets += [conn, upstream]
+            for one, other in ((conn, upstream), (upstream, conn)):
+                threading.Thread(target=self._pipe, args=(one, other), daemon=True).start()
+
+    @staticmethod
+    def _pipe(src: socket.socket, dst: socket.socket) -> None:
+        try:
+            while data := src.recv(65536):
+                dst.sendall(data)
+        except OSError:
+            return
+
+    def cut(self) -> None:
+        with contextlib.suppress(OSError):
+            self.server.shutdown(socket.SHUT_RDWR)  # wakes the accept (close alone does not)
+        self.server.close()
+        for s in self.sockets:
+            with contextlib.suppress(OSError):
+                s.shutdown(socket.SHUT_RDWR)
+            s.close()
+
+
+def modbus_write(port: int, register: int, value: int) -> int:
+    """FC06 to the station's Modbus server: 0 when applied, else the exception code."""
+    with socket.create_connection(("127.0.0.1", port), timeout=3) as s:
+        s.sendall(struct.pack(">HHHBBHH", 1, 0, 6, 1, 6, register, value))
+        answer = s.recv(64)
+    function = answer[7]
+    return answer[8] if function & 0x80 else 0
