@@ -28,7 +28,7 @@ _KIND_WORDS = {bool: "true/false", int: "integer", float: "number", str: "string
                dict: "table"}
 _TABLE_HEADS = {"": "Top level", "modbus_server": "[modbus_server]", "nodes": "[[nodes]]",
                 "simulators": "[[simulators]]", "operator": "[operator]", "opcua": "[opcua]",
-                "mqtt": "[mqtt]"}
+                "mqtt": "[mqtt]", "redundancy": "[redundancy]"}
 
 
 def _cell(text: str) -> str:

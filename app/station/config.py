@@ -868,7 +868,8 @@ def _redundancy(problems: list[str], fname: str, table: dict[str, Any] | None,
     most = max(2, FAILOVER_MAX_MS // sync)  # the declared bounds hold; the tick bounds it further
     failover = r.number("failover_after", min(3, most))
     if failover > most:
-        r.bad("failover_after", f"{failover} ticks of {sync} ms is more than {FAILOVER_MAX_MS} ms")
+        r.bad("failover_after", f"{failover} is outside 2-{most} (ticks of {sync} ms: a takeover within "
+                                f"about {FAILOVER_MAX_MS} ms)")
         failover = most
     arbiter = r.get("arbiter")
     r.finish()
