@@ -27,7 +27,7 @@ from collections.abc import Mapping
 from dataclasses import dataclass, field
 from functools import cached_property
 from operator import attrgetter
-from typing import Any, ClassVar, NamedTuple
+from typing import Any, ClassVar
 
 from app.scada.table import TagTable
 from hmi_forms.elements import props as p
@@ -43,8 +43,10 @@ ZONE_TYPES = {"low": 2, "normal": 0, "high": 2}
 MAX_SHOWN = 65536  # words remembered per conversion (`remembered`): every word a register can hold
 
 
-class Shown(NamedTuple):
-    """What an analog element shows of one word (`Scaled.shows` makes every one)."""
+@dataclass(frozen=True, slots=True, eq=False)
+class Shown:
+    """What an analog element shows of one word (`Scaled.shows` makes every one). Frozen: a view
+    reads it and cannot change it; in slots: a view reads its parts at every change."""
 
     hw: int | None  # None: no word read yet
     phy: float
@@ -171,6 +173,10 @@ class AnalogBase(Scaled):
     LabelInt: int = field(default=50, metadata=p.prop(p.integer(1, 100_000)))
 
     maximum: float | None = field(default=None, init=False)
+    # what each word shows, as `shows` made it, shared by every element with the same conversion
+    # (a form of a thousand gauges shows few distinct words); none are remembered for an element
+    # with Hysteresis, whose zone depends on the last one
+    remembered: dict[int, Shown] = field(default_factory=dict, init=False, repr=False)
     trend: Trend | None = field(default=None, init=False, repr=False)
     last_scan: int = field(default=-1, init=False)
 
@@ -180,6 +186,8 @@ class AnalogBase(Scaled):
             problems.append(("PhyHigh", f"{self.PhyHigh:g} must be above PhyLow {self.PhyLow:g}"))
         if self.Hysteresis < 0:
             problems.append(("Hysteresis", "must not be negative"))
+        key = (self.scaling, self.Precision, self.PhyLow, self.PhyHigh, self.Hysteresis)
+        self.remembered = SHOWN.setdefault(key, {})  # shared once the conversion is known
         return problems
 
     def __post_init__(self) -> None:
@@ -225,20 +233,16 @@ class AnalogBase(Scaled):
     def settle(self, hw: int) -> Shown:
         """A new word of a plain element read by its form's bank, while its data are good: what
         `refresh` would show (a plain element records nothing and keeps no maximum)."""
-        shown = self.shown = self.remembered.get(hw) or self._remember(hw)
+        try:  # (a miss is rare: a dict's get would cost every hit a call)
+            shown = self.remembered[hw]
+        except KeyError:
+            shown = self._remember(hw)
+        self.shown = shown
         self.stale = False
         return shown
 
-    @cached_property
-    def remembered(self) -> dict[int, Shown]:
-        """What each word shows, as `shows` made it, shared by every element with the same
-        conversion (a form of a thousand gauges shows few distinct words); none are remembered for
-        an element with Hysteresis, whose zone depends on the last one."""
-        key = (self.scaling, self.Precision, self.PhyLow, self.PhyHigh, self.Hysteresis)
-        return SHOWN.setdefault(key, {})
-
     def _remember(self, hw: int) -> Shown:
-        """`shows`, remembered (a `Shown` is a tuple, never false: `remembered.get(hw) or ...`)."""
+        """`shows`, remembered (a `Shown` is never false: `remembered.get(hw) or ...`)."""
         shown = self.shows(hw)
         remembered = self.remembered
         if len(remembered) >= MAX_SHOWN:

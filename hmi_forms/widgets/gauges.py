@@ -559,11 +559,14 @@ class GaugeFace(Face):
         """`Face.put`, with the composition of what the model shows looked up in one step."""
         if not self.fresh:
             self.load()
-        entry = self.entries.get(shown.hw)
-        if entry is None or entry[0] is not shown or self.style_of(self.model) != self.style:
+        try:
+            was, text, extra = self.entries[shown.hw]
+        except KeyError:
+            was = None
+        if was is not shown or self.style_of(self.model) != self.style:
             self.sync()
             return False
-        drawn = self._ops(shown.zone, entry[1], entry[2])
+        drawn = self._ops(shown.zone, text, extra)
         if drawn == self.drawn:
             return False
         self.drawn, self.painted = drawn, None
