@@ -12,6 +12,7 @@ import pytest
 from PySide6.QtCore import Qt
 from PySide6.QtWidgets import QPlainTextEdit
 
+from app import __version__
 from app.gui.main_window import MainWindow
 from app.gui.zoom import ACTUAL, FIT_WIDTH, FIT_WINDOW
 from app.station.config import load_station
@@ -292,7 +293,7 @@ def test_a_trend_starts_with_the_archives_history(qtbot, demo_copy: Path) -> Non
 
 
 def test_about_names_the_version(console: MainWindow) -> None:
-    assert "NetPlc Station 0.1.0" in console.about_text()
+    assert f"NetPlc Station {__version__}" in console.about_text()
 
 
 @pytest.fixture
