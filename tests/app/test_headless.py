@@ -31,6 +31,15 @@ def kinds(archive: Path) -> dict[str, list[tuple]]:
     return out
 
 
+def level_rose(archive: Path) -> bool:
+    """The archive holds two NSTOREs of the level, the later higher (committed while it runs)."""
+    try:
+        level = [r[5] for r in kinds(archive).get("data", []) if (r[1], r[2]) == (1, 1)]
+    except sqlite3.Error:  # no archive or no day table yet
+        return False
+    return len(level) >= 2 and level[-1] > level[0]
+
+
 def check_archive(archive: Path) -> dict[str, list[tuple]]:
     by_kind = kinds(archive)
     data = by_kind["data"]
@@ -72,7 +81,9 @@ def test_sigterm_mid_run_exits_0_with_everything_flushed(demo_copy: Path) -> Non
         while time.monotonic() < deadline:
             if "nodes 1/1 up" in proc.stdout.readline():
                 break
-        time.sleep(1.5)  # at least one NSTORE second after the link is up
+        archive = demo_copy / "archive" / "journal.sqlite"
+        while time.monotonic() < deadline and not level_rose(archive):  # NSTOREs, once a second
+            time.sleep(0.05)
         proc.send_signal(signal.SIGTERM)
         out, err = proc.communicate(timeout=20)
     finally:
