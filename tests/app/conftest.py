@@ -5,6 +5,7 @@ from __future__ import annotations
 import signal
 import subprocess
 import time
+from collections.abc import Callable
 from pathlib import Path
 
 import pytest
@@ -23,10 +24,11 @@ def copy_demo(dest: Path) -> Path:
     return dest
 
 
-def stop_once_up(proc: subprocess.Popen[str], settle: float = 0.0) -> tuple[str, str]:
+def stop_once_up(proc: subprocess.Popen[str], settle: float = 0.0,
+                 until: Callable[[], bool] | None = None) -> tuple[str, str]:
     """Wait (at most 30 s) for a `--no-gui` station's status line with its node up, let it run
-    `settle` s more, then stop it with SIGTERM as systemd does: its whole output (killed if it
-    hangs)."""
+    `settle` s more or until `until()` holds, then stop it with SIGTERM as systemd does: its whole
+    output (killed if it hangs)."""
     seen: list[str] = []
     try:
         assert proc.stdout is not None
@@ -36,6 +38,8 @@ def stop_once_up(proc: subprocess.Popen[str], settle: float = 0.0) -> tuple[str,
             if not seen[-1] or "nodes 1/1 up" in seen[-1]:  # up, or the station ended
                 break
         time.sleep(settle)
+        while until is not None and time.monotonic() < deadline and not until():
+            time.sleep(0.05)
         proc.send_signal(signal.SIGTERM)
         out, err = proc.communicate(timeout=30)
         return "".join(seen) + out, err
@@ -59,12 +63,26 @@ def demo_copy(tmp_path: Path) -> Path:
 
 @pytest.fixture(scope="session")
 def headless_archive(tmp_path_factory: pytest.TempPathFactory) -> tuple[Path, str]:
-    """The demo station run headless for 5 s (once per session): its archive and its output."""
+    """The demo station run headless for 5 s, once per run: its archive and its output. Under xdist
+    the first worker to need it runs it and the others wait for it and read what it left (the
+    tests only read the archive)."""
+    import fcntl
+    import os
+    import shutil
     import subprocess
     import sys
 
-    station = copy_demo(tmp_path_factory.mktemp("headless") / "station")
-    r = subprocess.run([sys.executable, "main.py", "--no-gui", str(station), "--duration", "5",
-                        "--status-every", "1"], cwd=REPO, capture_output=True, text=True, timeout=60)
-    assert r.returncode == 0, r.stderr
-    return station / "archive" / "journal.sqlite", r.stdout
+    shared = tmp_path_factory.getbasetemp()
+    if os.environ.get("PYTEST_XDIST_WORKER"):
+        shared = shared.parent  # the run's folder, above each worker's own
+    folder, out = shared / "headless", shared / "headless" / "stdout.txt"
+    with open(shared / "headless.lock", "w") as lock:
+        fcntl.flock(lock, fcntl.LOCK_EX)  # released when closed
+        if not out.exists():
+            shutil.rmtree(folder, ignore_errors=True)  # what a failed run of another worker left
+            station = copy_demo(folder / "station")
+            r = subprocess.run([sys.executable, "main.py", "--no-gui", str(station), "--duration", "5",
+                                "--status-every", "1"], cwd=REPO, capture_output=True, text=True, timeout=60)
+            assert r.returncode == 0, r.stderr
+            out.write_text(r.stdout, encoding="utf-8")
+    return folder / "station" / "archive" / "journal.sqlite", out.read_text(encoding="utf-8")

@@ -29,6 +29,15 @@ def kinds(archive: Path) -> dict[str, list[tuple]]:
     return out
 
 
+def level_rose(archive: Path) -> bool:
+    """The archive holds two NSTOREs of the level, the later higher (committed while it runs)."""
+    try:
+        level = [r[5] for r in kinds(archive).get("data", []) if (r[1], r[2]) == (1, 1)]
+    except sqlite3.Error:  # no archive or no day table yet
+        return False
+    return len(level) >= 2 and level[-1] > level[0]
+
+
 def check_archive(archive: Path) -> dict[str, list[tuple]]:
     by_kind = kinds(archive)
     data = by_kind["data"]
@@ -64,7 +73,8 @@ def test_a_start_raises_no_quality_alarm_before_the_first_answer(headless_archiv
 def test_sigterm_mid_run_exits_0_with_everything_flushed(demo_copy: Path) -> None:
     proc = subprocess.Popen([sys.executable, "main.py", "--no-gui", str(demo_copy), "--status-every", "0.5"],
                             cwd=REPO, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
-    out, err = stop_once_up(proc, settle=1.5)  # at least one NSTORE second after the link is up
+    archive = demo_copy / "archive" / "journal.sqlite"
+    out, err = stop_once_up(proc, until=lambda: level_rose(archive))  # NSTOREs, once a second
     assert proc.returncode == 0, err
     assert "SIGTERM: stopping" in out
     check_archive(demo_copy / "archive" / "journal.sqlite")
