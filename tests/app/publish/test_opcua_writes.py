@@ -48,10 +48,13 @@ async def write(client: object, name: str, variant: ua.Variant,
 
 
 def committed(runtime: Runtime, text: str) -> list[tuple[str, str]]:
-    """The operator records on disk holding `text`, as (source, text)."""
+    """The operator records on disk holding `text`, as (source, text); none while the day's table
+    is not yet written (refusals are journaled without waiting for the commit)."""
     table = time.strftime("%d_%m_%Y")
     con = sqlite3.connect(f"file:{runtime.station.Archive}?mode=ro", uri=True)
     try:
+        if not con.execute("SELECT 1 FROM sqlite_master WHERE name = ?", (table,)).fetchone():
+            return []
         return con.execute(f'SELECT source, text FROM "{table}" WHERE kind = \'operator\' AND text LIKE ?',
                            (f"%{text}%",)).fetchall()
     finally:
