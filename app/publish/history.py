@@ -40,7 +40,7 @@ import logging
 import sqlite3
 import struct
 import zlib
-from collections.abc import Callable, Collection, Mapping, Sequence
+from collections.abc import Callable, Collection, Mapping
 from concurrent.futures import ThreadPoolExecutor
 from dataclasses import dataclass
 from datetime import UTC, datetime
@@ -184,14 +184,15 @@ def _check(node: ua.NodeId, d: Domain, *more: object) -> int:
 # --- reading the archive (on the history thread) ----------------------------------------------
 
 Fetch = Callable[[dt.date, tuple[int, int], int], list[Row]]  # day, ids [lo, hi), limit -> rows
+Located = tuple[int, Row]  # a record and its day's ordinal (an id is unique within its day)
 
 
 def walk(archive: Archive, d: Domain, fetch: Fetch, after: Position | None, limit: int,
-         scan: int | None = None) -> tuple[list[Row], Position | None]:
+         scan: int | None = None) -> tuple[list[Located], Position | None]:
     """Up to `limit` records of the domain after `after`, in its order, with the position to
     resume after (None: nothing is left). `scan` bounds the ids examined (a window of the journal
     among data records); a read that reaches it resumes after the last id examined."""
-    out: list[Row] = []
+    out: list[Located] = []
     forward = d.forward
     after_day = after.day if after is not None and after.day else None
     for day in sorted(archive.days(), reverse=not forward):
@@ -216,21 +217,22 @@ def walk(archive: Archive, d: Domain, fetch: Fetch, after: Position | None, limi
                 lo, hi = (lo, lo + scan) if forward else (hi - scan, hi)
                 cut = Position(o, hi - 1 if forward else lo)
             scan -= hi - lo
-        out += fetch(day, (lo, hi), limit + 1 - len(out))
+        out += [(o, row) for row in fetch(day, (lo, hi), limit + 1 - len(out))]
         if len(out) > limit:
             del out[limit:]
-            return out, Position(o, out[-1].id) if out else (after or Position())
+            return out, _after(out) or after or Position()
         if cut is not None:
             return out, cut
     return out, None
 
 
+def _after(rows: list[Located]) -> Position | None:
+    """The position after the last of `rows` (None: there is none)."""
+    return Position(rows[-1][0], rows[-1][1].id) if rows else None
+
+
 def _times(d: Domain) -> tuple[int, int]:
     return (d.first if d.first is not None else -_FAR, d.last if d.last is not None else _FAR)
-
-
-def _day_of(archive: Archive, ts: float) -> int:
-    return dt.datetime.fromtimestamp(ts, archive.tz).date().toordinal()
 
 
 Sample = tuple[int, Row | None]  # time (ms), and the record (None: no bound there, Bad_BoundNotFound)
@@ -248,20 +250,20 @@ def read_raw(archive: Archive, key: SeriesKey, d: Domain, bounds: bool, after: P
         """The series' first record of [first, last] in that direction (a bound)."""
         near = Domain(first, last, forward, None, None, 1)
         rows, _ = walk(archive, near, fetch(None, forward), None, 1)
-        return rows[0] if rows else None
+        return rows[0][1] if rows else None
 
     both = bounds and d.start is not None and d.end is not None and d.start != d.end
     out: list[Sample] = []
     if after is None or not after.tail:
         rows, resume = walk(archive, d, fetch(_times(d), d.forward), after, limit)
-        if both and after is None and not (rows and round(rows[0].ts * 1000) == d.start):
+        if both and after is None and not (rows and round(rows[0][1].ts * 1000) == d.start):
             assert d.start is not None  # a record at the start is its own bound; else the one beyond
             bound = neighbour(None, d.start - 1, False) if d.forward else neighbour(d.start + 1, None, True)
             out.append(_sample(bound, d.start))
             if len(rows) == limit:  # the bound counts: the page's last record waits for the next
                 rows.pop()
-                resume = Position(_day_of(archive, rows[-1].ts), rows[-1].id) if rows else Position()
-        out += [_sample(r) for r in rows]
+                resume = _after(rows) or Position()
+        out += [_sample(r) for _, r in rows]
         if resume is not None or not both:
             return out, resume
         if len(out) >= limit:  # the far bound in an answer of its own
@@ -277,17 +279,16 @@ def _sample(row: Row | None, missing: int = 0) -> Sample:
     return (missing, None) if row is None else (round(row.ts * 1000), row)
 
 
-def read_journal(archive: Archive, d: Domain, after: Position | None, limit: int,
-                 wanted: Callable[[Row], bool]) -> tuple[list[Row], Position | None]:
-    """The journal's records of the domain after `after` that `wanted` keeps: of at most `limit`
-    records read, within at most SCAN_ROWS records examined."""
+def read_journal(archive: Archive, d: Domain, after: Position | None,
+                 limit: int) -> tuple[list[Located], Position | None]:
+    """The journal's records of the domain after `after`: at most `limit`, of at most SCAN_ROWS
+    records examined."""
     times = _times(d)
 
     def fetch(day: dt.date, ids: tuple[int, int], n: int) -> list[Row]:
         return archive.window(day, ids, kinds=JOURNAL, times=times, newest_first=not d.forward, limit=n)
 
-    rows, resume = walk(archive, d, fetch, after, limit, SCAN_ROWS)
-    return [r for r in rows if wanted(r)], resume
+    return walk(archive, d, fetch, after, limit, SCAN_ROWS)
 
 
 # --- values and events as a client receives them ----------------------------------------------
@@ -313,14 +314,15 @@ def data_value(series: Series, sample: Sample, stamps: ua.TimestampsToReturn) ->
                         SourceTimestamp=source, ServerTimestamp=server)
 
 
-def event_of(archive: Archive, row: Row, source: ua.NodeId) -> Event:
+def event_of(located: Located, source: ua.NodeId) -> Event:
     """A journal record as the event it was: BaseEventType's fields (a system record a
     SystemEventType), its EventId the record's day and id."""
+    day, row = located
     event = Event(source)
     when = datetime.fromtimestamp(row.ts, UTC)
     name, text, severity = _describe(row)
     for field, value, kind in (
-            ("EventId", struct.pack(">Iq", _day_of(archive, row.ts), row.id), ua.VariantType.ByteString),
+            ("EventId", struct.pack(">Iq", day, row.id), ua.VariantType.ByteString),
             ("EventType", ua.NodeId(EVENT_TYPES.get(row.kind, ua.ObjectIds.BaseEventType)),
              ua.VariantType.NodeId),
             ("SourceNode", source, ua.VariantType.NodeId), ("SourceName", name, ua.VariantType.String),
@@ -349,13 +351,14 @@ class StationHistory(HistoryManager):
     """The server's history manager, reading the station's archive."""
 
     def __init__(self, iserver: Any, archived: Archived | None, series: Mapping[ua.NodeId, Series],
-                 notifiers: Sequence[ua.NodeId]) -> None:
-        """`series`: the archived tags' variables; `notifiers`: the nodes whose event history is
-        the journal (the station object, the Server object)."""
+                 station: ua.NodeId) -> None:
+        """`series`: the archived tags' variables; `station`: the station object, the source of
+        the events, whose event history is the journal, as the Server object's is."""
         super().__init__(iserver)
         self.archived = archived
         self.series = dict(series)
-        self.notifiers = list(notifiers)
+        self.station = station
+        self.notifiers = [ua.NodeId(ua.ObjectIds.Server), station] if archived is not None else []
         self._executor = ThreadPoolExecutor(1, thread_name_prefix="opcua-history")
 
     async def stop(self) -> None:
@@ -403,7 +406,7 @@ class StationHistory(HistoryManager):
                 result, resume, n = await self._run(self._raw, series, d, details.ReturnBounds, after, limit,
                                                     params.TimestampsToReturn)
             else:
-                result, resume, n = await self._run(self._events, rv.NodeId, details.Filter, d, after, limit)
+                result, resume, n = await self._run(self._events, details.Filter, d, after, limit)
         except (sqlite3.Error, OSError) as e:
             logger.exception("history of %s not read from %s", rv.NodeId.to_string(),
                              self.archived.path if self.archived else "no archive")
@@ -431,19 +434,12 @@ class StationHistory(HistoryManager):
         values = [data_value(series, s, stamps) for s in samples]
         return ua.HistoryData(DataValues=values), resume, len(values)
 
-    def _events(self, node: ua.NodeId, flt: ua.EventFilter, d: Domain, after: Position | None,
+    def _events(self, flt: ua.EventFilter, d: Domain, after: Position | None,
                 limit: int) -> tuple[ua.HistoryEvent, Position | None, int]:
-        where = WhereClauseEvaluator(logger, self.iserver.aspace, flt.WhereClause)
-        events: list[Event] = []
         with self._open() as archive:
-            def wanted(row: Row) -> bool:
-                event = event_of(archive, row, node)
-                if not where.eval(event):
-                    return False
-                events.append(event)
-                return True
-
-            _, resume = read_journal(archive, d, after, limit, wanted)
+            rows, resume = read_journal(archive, d, after, limit)
+        where = WhereClauseEvaluator(logger, self.iserver.aspace, flt.WhereClause)
+        events = [event for event in (event_of(row, self.station) for row in rows) if where.eval(event)]
         fields = [ua.HistoryEventFieldList(EventFields=e.to_event_fields(flt.SelectClauses)) for e in events]
         return ua.HistoryEvent(Events=fields), resume, len(fields)
 

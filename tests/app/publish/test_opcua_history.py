@@ -230,6 +230,8 @@ def test_the_journal_as_events_of_the_station_and_the_server(station: tuple[Runt
     assert max(sizes) <= 10
     assert len(station_events) == 4 + MESSAGES
     assert [e["Message"] for e in server_events] == [e["Message"] for e in station_events]
+    # the source is the station, wherever its history is read
+    assert {e["SourceNode"] for e in station_events + server_events} == {ua.NodeId("Demo station", 1)}
     assert len({e["EventId"] for e in station_events}) == len(station_events)  # each once
     message, alarm, operator, record = station_events[:4]
     assert message["Message"].Text == "Уровень выше 90 %" and message["SourceName"] == "MSG3"
