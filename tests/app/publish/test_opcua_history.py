@@ -13,14 +13,18 @@ import asyncio
 import time
 from collections.abc import Iterator
 from datetime import UTC, datetime
+from pathlib import Path
 
 import pytest
 from asyncua import Client, ua
 from asyncua.common.events import get_filter_from_event_type
 
+from app.publish import history
 from app.scada.alarms import State
 from app.station.runtime import Runtime
 from netplc.records import Record
+from registrar.query import Archive
+from registrar.reading import SeriesKey
 from registrar.store import Store
 from tests.app.conftest import copy_demo
 from tests.app.publish.conftest import STATION_URI, demo_with, free_port
@@ -295,3 +299,44 @@ def test_what_is_not_archived_says_so(station: tuple[Runtime, str, float]) -> No
     assert out["user access"] == (read | history, read)
     assert ua.EventNotifier.HistoryRead in out["notifier"]
     assert out["capabilities"] == [True, True, False]
+
+
+def test_pages_across_midnight_and_the_scan_limit_give_every_record_once(
+        tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> None:
+    """The reading itself, without a server: a series and a journal spanning two days' tables, read
+    forward and backward in pages that end at a day's edge, with the journal's scan limit small."""
+    midnight = datetime(2026, 3, 5).timestamp()  # local midnight: the archive's tables change there
+    db = tmp_path / "journal.sqlite"
+    store = Store(db)
+    store.start()
+    for i in range(-10, 10):
+        store.put(Record(midnight + i, "data", grp=1, type=1, source="04010", value=float(i + 10)))
+        store.put(Record(midnight + i + 0.5, "message", grp=1, type=0, number=1, text=f"m{i}"))
+    store.close()
+    key = SeriesKey("data", 1, 1, "04010")
+    span = history.domain(utc((midnight - 20) * 1000), utc((midnight + 20) * 1000), 0)
+    backward = history.domain(utc((midnight + 20) * 1000), utc((midnight - 20) * 1000), 0)
+    assert span is not None and backward is not None
+    with Archive(db) as archive:
+        assert len(archive.days()) == 2
+        for d, order in ((span, 1), (backward, -1)):
+            for limit in (11, 5):  # 11: the first page (a bound and ten records) ends at the day's edge
+                got: list[float | None] = []
+                after = None
+                while True:
+                    samples, after = history.read_raw(archive, key, d, True, after, limit)
+                    got += [row.value if row is not None else None for _, row in samples]
+                    if after is None:
+                        break
+                assert got == [None, *[float(v) for v in range(20)][::order], None]  # no bound found
+            for limit, scan in ((10, history.SCAN_ROWS), (3, 7)):  # 10: a page ends at the day's edge
+                monkeypatch.setattr(history, "SCAN_ROWS", scan)  # 7: a few records examined a page
+                texts: list[str] = []
+                after, pages = None, 0
+                while True:
+                    rows, after = history.read_journal(archive, d, after, limit)
+                    texts += [row.text for _, row in rows if row.text]
+                    pages += 1
+                    if after is None:
+                        break
+                assert texts == [f"m{i}" for i in range(-10, 10)][::order] and pages >= 20 / limit
