@@ -64,8 +64,8 @@ from registrar.schema import day_bounds_in
 
 logger = logging.getLogger(__name__)
 
-MAX_VALUES = 10_000  # values of one node in one answer (HistoryServerCapabilities.MaxReturnDataValues)
-MAX_EVENTS = 10_000  # events of one node in one answer (MaxReturnEventValues)
+MAX_VALUES = 2_000  # values of one node in one answer (HistoryServerCapabilities.MaxReturnDataValues)
+MAX_EVENTS = 1_000  # events of one node in one answer (MaxReturnEventValues)
 SCAN_ROWS = 200_000  # archive records one answer of events examines at most (the journal among data)
 JOURNAL = ("message", "alarm", "operator", "system")  # the record kinds that are events
 UNSPECIFIED = datetime(1601, 1, 2, tzinfo=UTC)  # DateTime.MinValue (and anything before): no time given
