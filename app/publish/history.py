@@ -13,9 +13,9 @@ a record and keeps no aggregates).
 
 asyncua's HistoryManager stays the server's (its HistoryRead and HistoryUpdate services call it; it
 refuses every update) with its read side replaced here: its storage interface resumes a read at the
-timestamp of the first value not returned, which repeats the values sharing that timestamp and
-stops short of nothing (NumValuesPerNode truncates without a continuation point), and it checks no
-node and knows no bounds, TimestampsToReturn or ReleaseContinuationPoints. From asyncua come the
+timestamp of the first value not returned, which repeats the values sharing that timestamp; its
+NumValuesPerNode truncates without a continuation point; and it checks no node and knows no
+bounds, TimestampsToReturn or ReleaseContinuationPoints. From asyncua come the
 result structures, `Event.to_event_fields` for an EventFilter's select clauses and its
 WhereClauseEvaluator for the where clause.
 
@@ -29,7 +29,8 @@ exactly once (ids are unique and in time order). ReleaseContinuationPoints has n
 
 Reads run on a thread of their own, each on a fresh read-only connection, with at most MAX_VALUES
 values or MAX_EVENTS events per answer and at most SCAN_ROWS journal rows examined for one: the
-server's event loop never waits for SQLite, and a long range is read in pages.
+server's event loop never waits for SQLite, and since it encodes each answer (a few tens of
+milliseconds for MAX_VALUES), a long range is read in pages that keep it responsive.
 """
 
 from __future__ import annotations
@@ -66,6 +67,7 @@ logger = logging.getLogger(__name__)
 
 MAX_VALUES = 2_000  # values of one node in one answer (HistoryServerCapabilities.MaxReturnDataValues)
 MAX_EVENTS = 1_000  # events of one node in one answer (MaxReturnEventValues)
+MAX_NODES = 100  # nodes in one HistoryRead (OperationLimits.MaxNodesPerHistoryReadData, ...Events)
 SCAN_ROWS = 200_000  # archive records one answer of events examines at most (the journal among data)
 JOURNAL = ("message", "alarm", "operator", "system")  # the record kinds that are events
 UNSPECIFIED = datetime(1601, 1, 2, tzinfo=UTC)  # DateTime.MinValue (and anything before): no time given
@@ -371,6 +373,8 @@ class StationHistory(HistoryManager):
             raise ServiceError(_S.BadTimestampsToReturnInvalid)
         if not params.NodesToRead:
             raise ServiceError(_S.BadNothingToDo)
+        if len(params.NodesToRead) > MAX_NODES:
+            raise ServiceError(_S.BadTooManyOperations)
         return [await self._read(params, rv) for rv in params.NodesToRead]
 
     async def _read(self, params: ua.HistoryReadParameters,
@@ -468,4 +472,7 @@ async def install(server: Any, history: StationHistory) -> None:
         await server.get_node(nodeid).write_value(value)
     await server.get_node(ua.ObjectIds.Server_ServerCapabilities_MaxHistoryContinuationPoints).write_value(
         ua.Variant(0, ua.VariantType.UInt16))  # none kept: no limit
+    for limit in (ua.ObjectIds.Server_ServerCapabilities_OperationLimits_MaxNodesPerHistoryReadData,
+                  ua.ObjectIds.Server_ServerCapabilities_OperationLimits_MaxNodesPerHistoryReadEvents):
+        await server.get_node(limit).write_value(ua.Variant(MAX_NODES, _UINT32))
 

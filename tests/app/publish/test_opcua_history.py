@@ -282,7 +282,16 @@ def test_what_is_not_archived_says_so(station: tuple[Runtime, str, float]) -> No
             out["capabilities"] = [await client.get_node(n).read_value() for n in (
                 ua.ObjectIds.HistoryServerCapabilities_AccessHistoryDataCapability,
                 ua.ObjectIds.HistoryServerCapabilities_AccessHistoryEventsCapability,
-                ua.ObjectIds.HistoryServerCapabilities_InsertDataCapability)]
+                ua.ObjectIds.HistoryServerCapabilities_InsertDataCapability,
+                ua.ObjectIds.HistoryServerCapabilities_MaxReturnDataValues,
+                ua.ObjectIds.Server_ServerCapabilities_OperationLimits_MaxNodesPerHistoryReadData)]
+            params = ua.HistoryReadParameters(HistoryReadDetails=asked, ReleaseContinuationPoints=False,
+                                              TimestampsToReturn=ua.TimestampsToReturn.Both,
+                                              NodesToRead=[ua.HistoryReadValueId(NodeId=level.nodeid)] * 101)
+            try:
+                await client.uaclient.history_read(params)
+            except ua.UaStatusCodeError as e:
+                out["too many"] = e.code
             return out
         finally:
             await client.disconnect()
@@ -298,7 +307,8 @@ def test_what_is_not_archived_says_so(station: tuple[Runtime, str, float]) -> No
     history, read = 1 << ua.AccessLevel.HistoryRead, 1 << ua.AccessLevel.CurrentRead
     assert out["user access"] == (read | history, read)
     assert ua.EventNotifier.HistoryRead in out["notifier"]
-    assert out["capabilities"] == [True, True, False]
+    assert out["capabilities"] == [True, True, False, history.MAX_VALUES, history.MAX_NODES]
+    assert out["too many"] == ua.StatusCodes.BadTooManyOperations
 
 
 def test_pages_across_midnight_and_the_scan_limit_give_every_record_once(
