@@ -54,6 +54,7 @@ from asyncua.common.utils import ServiceError
 from asyncua.server.history import HistoryManager
 from asyncua.server.monitored_item_service import WhereClauseEvaluator
 
+from app.publish.conditions import TWO_STATES
 from app.publish.ua_types import SEVERITY, STATUS, python
 from app.scada.alarms import State
 from app.scada.quality import Quality
@@ -316,22 +317,48 @@ def data_value(series: Series, sample: Sample, stamps: ua.TimestampsToReturn) ->
                         SourceTimestamp=source, ServerTimestamp=server)
 
 
-def event_of(located: Located, source: ua.NodeId) -> Event:
+@dataclass(frozen=True)
+class AlarmSource:
+    """An alarm's condition as its live events name it (conditions.py), so that its history says
+    the same: the condition (ConditionId), its type, its source."""
+
+    condition: ua.NodeId
+    type_id: ua.NodeId
+    source: ua.NodeId
+    source_name: str
+
+
+# what an alarm's new state says of ActiveState and AckedState (the others say neither)
+ACTIVE_ACKED = {State.NORMAL: (False, True), State.UNACK: (True, False), State.ACKED: (True, True),
+                State.RTNUN: (False, False)}
+
+
+def event_of(located: Located, station: ua.NodeId, alarms: Mapping[str, AlarmSource]) -> Event:
     """A journal record as the event it was: BaseEventType's fields (a system record a
-    SystemEventType), its EventId the record's day and id."""
+    SystemEventType), its EventId the record's day and id. An alarm's transition is its
+    condition's event: the condition's type, source, ConditionName and ConditionId, and the
+    ActiveState and AckedState the new state says."""
     day, row = located
-    event = Event(source)
+    event = Event(station)
     when = datetime.fromtimestamp(row.ts, UTC)
     name, text, severity = _describe(row)
-    for field, value, kind in (
-            ("EventId", struct.pack(">Iq", day, row.id), ua.VariantType.ByteString),
-            ("EventType", ua.NodeId(EVENT_TYPES.get(row.kind, ua.ObjectIds.BaseEventType)),
-             ua.VariantType.NodeId),
-            ("SourceNode", source, ua.VariantType.NodeId), ("SourceName", name, ua.VariantType.String),
-            ("Time", when, ua.VariantType.DateTime), ("ReceiveTime", when, ua.VariantType.DateTime),
-            ("Message", ua.LocalizedText(text), ua.VariantType.LocalizedText),
-            ("Severity", severity, ua.VariantType.UInt16)):
-        event.add_property(field, value, kind)
+    kind = ua.NodeId(EVENT_TYPES.get(row.kind, ua.ObjectIds.BaseEventType))
+    _V = ua.VariantType
+    fields: dict[str, tuple[Any, ua.VariantType]] = {
+        "EventId": (struct.pack(">Iq", day, row.id), _V.ByteString), "EventType": (kind, _V.NodeId),
+        "SourceNode": (station, _V.NodeId), "SourceName": (name, _V.String), "Time": (when, _V.DateTime),
+        "ReceiveTime": (when, _V.DateTime), "Message": (ua.LocalizedText(text), _V.LocalizedText),
+        "Severity": (severity, _V.UInt16)}
+    alarm = alarms.get(row.source or "") if row.kind == "alarm" else None
+    if alarm is not None:
+        fields.update({"EventType": (alarm.type_id, _V.NodeId), "SourceNode": (alarm.source, _V.NodeId),
+                       "SourceName": (alarm.source_name, _V.String), "ConditionName": (row.source, _V.String),
+                       "NodeId": (alarm.condition, _V.NodeId)})  # NodeId: the ConditionId's field
+        for state, on in zip(("ActiveState", "AckedState"), ACTIVE_ACKED.get(State(row.type or 0), ())):
+            fields[state] = (ua.LocalizedText(TWO_STATES[state][0 if on else 1]), _V.LocalizedText)
+            fields[f"{state}/Id"] = (on, _V.Boolean)
+    for field, (value, variant) in fields.items():
+        event.add_property(field, value, variant)
     return event
 
 
@@ -340,10 +367,9 @@ def _describe(row: Row) -> tuple[str, str, int]:
     text = row.text or ""
     if row.kind == "message":
         return f"MSG{row.number}", text or f"message {row.number}", SEVERITY[alarm_priority(row.type or 0)]
-    if row.kind == "alarm":
-        change = f"{State(row.number or 0).word} -> {State(row.type or 0).word}"
-        return row.source or "", f"{row.source}: {change}" + (f": {text}" if text else ""), \
-            SEVERITY.get(row.grp or 3, 500)
+    if row.kind == "alarm":  # its text names the change, as the condition's event says it
+        change = f"{row.source} {State(row.number or 0).word} -> {State(row.type or 0).word}"
+        return row.source or "", text or change, SEVERITY.get(row.grp or 3, 500)
     return row.source or "", text, 100
 
 
@@ -353,13 +379,14 @@ class StationHistory(HistoryManager):
     """The server's history manager, reading the station's archive."""
 
     def __init__(self, iserver: Any, archived: Archived | None, series: Mapping[ua.NodeId, Series],
-                 station: ua.NodeId) -> None:
-        """`series`: the archived tags' variables; `station`: the station object, the source of
-        the events, whose event history is the journal, as the Server object's is."""
+                 station: ua.NodeId, alarms: Mapping[str, AlarmSource]) -> None:
+        """`series`: the archived tags' variables; `station`: the station object, whose event
+        history is the journal, as the Server object's is; `alarms`: the alarms' conditions."""
         super().__init__(iserver)
         self.archived = archived
         self.series = dict(series)
         self.station = station
+        self.alarms = dict(alarms)
         self.notifiers = [ua.NodeId(ua.ObjectIds.Server), station] if archived is not None else []
         self._executor = ThreadPoolExecutor(1, thread_name_prefix="opcua-history")
 
@@ -443,7 +470,8 @@ class StationHistory(HistoryManager):
         with self._open() as archive:
             rows, resume = read_journal(archive, d, after, limit)
         where = WhereClauseEvaluator(logger, self.iserver.aspace, flt.WhereClause)
-        events = [event for event in (event_of(row, self.station) for row in rows) if where.eval(event)]
+        events = [event for event in (event_of(row, self.station, self.alarms) for row in rows)
+                  if where.eval(event)]
         fields = [ua.HistoryEventFieldList(EventFields=e.to_event_fields(flt.SelectClauses)) for e in events]
         return ua.HistoryEvent(Events=fields), resume, len(fields)
 

@@ -64,7 +64,7 @@ from app.authority.logins import Logins
 from app.authority.users import UserError, Users
 from app.publish.conditions import Conditions
 from app.publish.feed import LatestReadings, Watch
-from app.publish.history import Archived, Series, StationHistory, install, series_of
+from app.publish.history import AlarmSource, Archived, Series, StationHistory, install, series_of
 from app.publish.methods import StationMethods, StepLock
 from app.publish.pki import TrustList, host_names, station_certificate, subject, thumbprint
 from app.publish.points import PointReader, PointWriter, Writable
@@ -422,8 +422,11 @@ class OpcUaServer:
         sources = {tag.name: nodeid for tag, nodeid in zip(self.tags, self.nodeids)}
         await self.conditions.build(server, idx, alarms, station, sources, plc, self.plc_state.nodeid)
         await self.methods.add(station, idx)
-        # after the event generator, which sets the station's EventNotifier
-        await install(server, StationHistory(server.iserver, self.archived, self.series, station.nodeid))
+        # after the conditions, which set the station's EventNotifier
+        alarm_sources = {alarm_id: AlarmSource(c.nodeid, c.type_id, c.source, c.source_name)
+                         for alarm_id, c in self.conditions.by_id.items()}
+        await install(server, StationHistory(server.iserver, self.archived, self.series, station.nodeid,
+                                             alarm_sources))
 
     async def _add_tags(self, server: Server, folder: ua.NodeId) -> None:
         """The tags' variables, of their standard types (ua_types.py), and then their properties in

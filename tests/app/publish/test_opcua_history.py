@@ -195,7 +195,13 @@ def test_the_journal_as_events_of_the_station_and_the_server(station: tuple[Runt
         try:
             base = client.get_node(ua.ObjectIds.BaseEventType)
             evfilter = await get_filter_from_event_type([base])
-            names = [c.BrowsePath[0].Name for c in evfilter.SelectClauses]
+            condition = ua.NodeId(ua.ObjectIds.ConditionType)
+            evfilter.SelectClauses += [  # an alarm's: its condition's fields
+                ua.SimpleAttributeOperand(TypeDefinitionId=condition, AttributeId=ua.AttributeIds.NodeId),
+                *(ua.SimpleAttributeOperand(TypeDefinitionId=condition, AttributeId=ua.AttributeIds.Value,
+                                            BrowsePath=[ua.QualifiedName(n, 0) for n in path.split("/")])
+                  for path in ("ConditionName", "ActiveState/Id", "AckedState/Id"))]
+            names = ["/".join(q.Name for q in c.BrowsePath) or "ConditionId" for c in evfilter.SelectClauses]
             asked = ua.ReadEventDetails(StartTime=utc((t - 61) * 1000), EndTime=utc(t * 1000),
                                         NumValuesPerNode=10, Filter=evfilter)
             pages: list[list[object]] = []
@@ -234,15 +240,21 @@ def test_the_journal_as_events_of_the_station_and_the_server(station: tuple[Runt
     assert max(sizes) <= 10
     assert len(station_events) == 4 + MESSAGES
     assert [e["Message"] for e in server_events] == [e["Message"] for e in station_events]
-    # the source is the station, wherever its history is read
-    assert {e["SourceNode"] for e in station_events + server_events} == {ua.NodeId("Demo station", 1)}
+    # the source is the station (an alarm's: its condition's), wherever its history is read
+    assert {e["SourceNode"] for e in station_events + server_events} == {
+        ua.NodeId("Demo station", 1), ua.NodeId("Tags.LEVEL", 1)}
     assert len({e["EventId"] for e in station_events}) == len(station_events)  # each once
     message, alarm, operator, record = station_events[:4]
     assert message["Message"].Text == "Уровень выше 90 %" and message["SourceName"] == "MSG3"
     assert message["EventType"] == ua.NodeId(ua.ObjectIds.BaseEventType) and message["Severity"] == 700
     assert message["Time"] == utc(round((t - 50) * 1000)) == message["ReceiveTime"]
-    assert alarm["SourceName"] == "LEVEL.H" and alarm["Severity"] == 700
-    assert alarm["Message"].Text == "LEVEL.H: normal -> active-unacknowledged"
+    # an alarm's transition is its condition's event, as the live one was
+    assert alarm["EventType"] == ua.NodeId(ua.ObjectIds.ExclusiveLevelAlarmType)
+    assert (alarm["SourceNode"], alarm["SourceName"]) == (ua.NodeId("Tags.LEVEL", 1), "LEVEL")
+    assert (alarm["ConditionName"], alarm["ConditionId"]) == ("LEVEL.H", ua.NodeId("Alarms.LEVEL.H", 1))
+    assert (alarm["ActiveState/Id"], alarm["AckedState/Id"], alarm["Severity"]) == (True, False, 700)
+    assert alarm["Message"].Text == "LEVEL.H normal -> active-unacknowledged"
+    assert message["ConditionName"] is None  # a message is no condition's
     assert operator["SourceName"] == "opcua:operator@127.0.0.1:5000"
     assert operator["Message"].Text == "Пуск: 0 -> 1"
     assert record["EventType"] == ua.NodeId(ua.ObjectIds.SystemEventType)
@@ -304,8 +316,8 @@ def test_what_is_not_archived_says_so(station: tuple[Runtime, str, float]) -> No
     assert out["last three"] == ([level_ts(t, k) for k in (N - 1, N - 2, N - 3)], None)
     assert out["later"] == ua.StatusCodes.GoodNoData
     assert out["historizing"] == (True, False)
-    history, read = 1 << ua.AccessLevel.HistoryRead, 1 << ua.AccessLevel.CurrentRead
-    assert out["user access"] == (read | history, read)
+    history_read, read = 1 << ua.AccessLevel.HistoryRead, 1 << ua.AccessLevel.CurrentRead
+    assert out["user access"] == (read | history_read, read)
     assert ua.EventNotifier.HistoryRead in out["notifier"]
     assert out["capabilities"] == [True, True, False, history.MAX_VALUES, history.MAX_NODES]
     assert out["too many"] == ua.StatusCodes.BadTooManyOperations
