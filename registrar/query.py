@@ -299,7 +299,10 @@ class Archive(ArchiveReader):
         if not self._has(day):
             return 1
         table = quoted(day)
-        lo, hi = self._con.execute(f"SELECT min(id), max(id) FROM {table}").fetchone()
+        # two subqueries: SQLite answers a lone min() or max() of the key from the B-tree's ends,
+        # but both in one SELECT by a scan of the table
+        lo, hi = self._con.execute(
+            f"SELECT (SELECT min(id) FROM {table}), (SELECT max(id) FROM {table})").fetchone()
         if lo is None:
             return 1
         hi += 1

@@ -13,9 +13,9 @@ a record and keeps no aggregates).
 
 asyncua's HistoryManager stays the server's (its HistoryRead and HistoryUpdate services call it; it
 refuses every update) with its read side replaced here: its storage interface resumes a read at the
-timestamp of the first value not returned, which repeats the values sharing that timestamp and
-stops short of nothing (NumValuesPerNode truncates without a continuation point), and it checks no
-node and knows no bounds, TimestampsToReturn or ReleaseContinuationPoints. From asyncua come the
+timestamp of the first value not returned, which repeats the values sharing that timestamp; its
+NumValuesPerNode truncates without a continuation point; and it checks no node and knows no
+bounds, TimestampsToReturn or ReleaseContinuationPoints. From asyncua come the
 result structures, `Event.to_event_fields` for an EventFilter's select clauses and its
 WhereClauseEvaluator for the where clause.
 
@@ -29,7 +29,8 @@ exactly once (ids are unique and in time order). ReleaseContinuationPoints has n
 
 Reads run on a thread of their own, each on a fresh read-only connection, with at most MAX_VALUES
 values or MAX_EVENTS events per answer and at most SCAN_ROWS journal rows examined for one: the
-server's event loop never waits for SQLite, and a long range is read in pages.
+server's event loop never waits for SQLite, and since it encodes each answer (a few tens of
+milliseconds for MAX_VALUES), a long range is read in pages that keep it responsive.
 """
 
 from __future__ import annotations
@@ -40,7 +41,7 @@ import logging
 import sqlite3
 import struct
 import zlib
-from collections.abc import Callable, Collection, Mapping, Sequence
+from collections.abc import Callable, Collection, Mapping
 from concurrent.futures import ThreadPoolExecutor
 from dataclasses import dataclass
 from datetime import UTC, datetime
@@ -53,6 +54,7 @@ from asyncua.common.utils import ServiceError
 from asyncua.server.history import HistoryManager
 from asyncua.server.monitored_item_service import WhereClauseEvaluator
 
+from app.publish.conditions import TWO_STATES
 from app.publish.ua_types import SEVERITY, STATUS, python
 from app.scada.alarms import State
 from app.scada.quality import Quality
@@ -64,8 +66,9 @@ from registrar.schema import day_bounds_in
 
 logger = logging.getLogger(__name__)
 
-MAX_VALUES = 10_000  # values of one node in one answer (HistoryServerCapabilities.MaxReturnDataValues)
-MAX_EVENTS = 10_000  # events of one node in one answer (MaxReturnEventValues)
+MAX_VALUES = 2_000  # values of one node in one answer (HistoryServerCapabilities.MaxReturnDataValues)
+MAX_EVENTS = 1_000  # events of one node in one answer (MaxReturnEventValues)
+MAX_NODES = 100  # nodes in one HistoryRead (OperationLimits.MaxNodesPerHistoryReadData, ...Events)
 SCAN_ROWS = 200_000  # archive records one answer of events examines at most (the journal among data)
 JOURNAL = ("message", "alarm", "operator", "system")  # the record kinds that are events
 UNSPECIFIED = datetime(1601, 1, 2, tzinfo=UTC)  # DateTime.MinValue (and anything before): no time given
@@ -184,14 +187,15 @@ def _check(node: ua.NodeId, d: Domain, *more: object) -> int:
 # --- reading the archive (on the history thread) ----------------------------------------------
 
 Fetch = Callable[[dt.date, tuple[int, int], int], list[Row]]  # day, ids [lo, hi), limit -> rows
+Located = tuple[int, Row]  # a record and its day's ordinal (an id is unique within its day)
 
 
 def walk(archive: Archive, d: Domain, fetch: Fetch, after: Position | None, limit: int,
-         scan: int | None = None) -> tuple[list[Row], Position | None]:
+         scan: int | None = None) -> tuple[list[Located], Position | None]:
     """Up to `limit` records of the domain after `after`, in its order, with the position to
     resume after (None: nothing is left). `scan` bounds the ids examined (a window of the journal
     among data records); a read that reaches it resumes after the last id examined."""
-    out: list[Row] = []
+    out: list[Located] = []
     forward = d.forward
     after_day = after.day if after is not None and after.day else None
     for day in sorted(archive.days(), reverse=not forward):
@@ -216,21 +220,22 @@ def walk(archive: Archive, d: Domain, fetch: Fetch, after: Position | None, limi
                 lo, hi = (lo, lo + scan) if forward else (hi - scan, hi)
                 cut = Position(o, hi - 1 if forward else lo)
             scan -= hi - lo
-        out += fetch(day, (lo, hi), limit + 1 - len(out))
+        out += [(o, row) for row in fetch(day, (lo, hi), limit + 1 - len(out))]
         if len(out) > limit:
             del out[limit:]
-            return out, Position(o, out[-1].id) if out else (after or Position())
+            return out, _after(out) or after or Position()
         if cut is not None:
             return out, cut
     return out, None
 
 
+def _after(rows: list[Located]) -> Position | None:
+    """The position after the last of `rows` (None: there is none)."""
+    return Position(rows[-1][0], rows[-1][1].id) if rows else None
+
+
 def _times(d: Domain) -> tuple[int, int]:
     return (d.first if d.first is not None else -_FAR, d.last if d.last is not None else _FAR)
-
-
-def _day_of(archive: Archive, ts: float) -> int:
-    return dt.datetime.fromtimestamp(ts, archive.tz).date().toordinal()
 
 
 Sample = tuple[int, Row | None]  # time (ms), and the record (None: no bound there, Bad_BoundNotFound)
@@ -248,20 +253,20 @@ def read_raw(archive: Archive, key: SeriesKey, d: Domain, bounds: bool, after: P
         """The series' first record of [first, last] in that direction (a bound)."""
         near = Domain(first, last, forward, None, None, 1)
         rows, _ = walk(archive, near, fetch(None, forward), None, 1)
-        return rows[0] if rows else None
+        return rows[0][1] if rows else None
 
     both = bounds and d.start is not None and d.end is not None and d.start != d.end
     out: list[Sample] = []
     if after is None or not after.tail:
         rows, resume = walk(archive, d, fetch(_times(d), d.forward), after, limit)
-        if both and after is None and not (rows and round(rows[0].ts * 1000) == d.start):
+        if both and after is None and not (rows and round(rows[0][1].ts * 1000) == d.start):
             assert d.start is not None  # a record at the start is its own bound; else the one beyond
             bound = neighbour(None, d.start - 1, False) if d.forward else neighbour(d.start + 1, None, True)
             out.append(_sample(bound, d.start))
             if len(rows) == limit:  # the bound counts: the page's last record waits for the next
                 rows.pop()
-                resume = Position(_day_of(archive, rows[-1].ts), rows[-1].id) if rows else Position()
-        out += [_sample(r) for r in rows]
+                resume = _after(rows) or Position()
+        out += [_sample(r) for _, r in rows]
         if resume is not None or not both:
             return out, resume
         if len(out) >= limit:  # the far bound in an answer of its own
@@ -277,17 +282,16 @@ def _sample(row: Row | None, missing: int = 0) -> Sample:
     return (missing, None) if row is None else (round(row.ts * 1000), row)
 
 
-def read_journal(archive: Archive, d: Domain, after: Position | None, limit: int,
-                 wanted: Callable[[Row], bool]) -> tuple[list[Row], Position | None]:
-    """The journal's records of the domain after `after` that `wanted` keeps: of at most `limit`
-    records read, within at most SCAN_ROWS records examined."""
+def read_journal(archive: Archive, d: Domain, after: Position | None,
+                 limit: int) -> tuple[list[Located], Position | None]:
+    """The journal's records of the domain after `after`: at most `limit`, of at most SCAN_ROWS
+    records examined."""
     times = _times(d)
 
     def fetch(day: dt.date, ids: tuple[int, int], n: int) -> list[Row]:
         return archive.window(day, ids, kinds=JOURNAL, times=times, newest_first=not d.forward, limit=n)
 
-    rows, resume = walk(archive, d, fetch, after, limit, SCAN_ROWS)
-    return [r for r in rows if wanted(r)], resume
+    return walk(archive, d, fetch, after, limit, SCAN_ROWS)
 
 
 # --- values and events as a client receives them ----------------------------------------------
@@ -313,21 +317,48 @@ def data_value(series: Series, sample: Sample, stamps: ua.TimestampsToReturn) ->
                         SourceTimestamp=source, ServerTimestamp=server)
 
 
-def event_of(archive: Archive, row: Row, source: ua.NodeId) -> Event:
+@dataclass(frozen=True)
+class AlarmSource:
+    """An alarm's condition as its live events name it (conditions.py), so that its history says
+    the same: the condition (ConditionId), its type, its source."""
+
+    condition: ua.NodeId
+    type_id: ua.NodeId
+    source: ua.NodeId
+    source_name: str
+
+
+# what an alarm's new state says of ActiveState and AckedState (the others say neither)
+ACTIVE_ACKED = {State.NORMAL: (False, True), State.UNACK: (True, False), State.ACKED: (True, True),
+                State.RTNUN: (False, False)}
+
+
+def event_of(located: Located, station: ua.NodeId, alarms: Mapping[str, AlarmSource]) -> Event:
     """A journal record as the event it was: BaseEventType's fields (a system record a
-    SystemEventType), its EventId the record's day and id."""
-    event = Event(source)
+    SystemEventType), its EventId the record's day and id. An alarm's transition is its
+    condition's event: the condition's type, source, ConditionName and ConditionId, and the
+    ActiveState and AckedState the new state says."""
+    day, row = located
+    event = Event(station)
     when = datetime.fromtimestamp(row.ts, UTC)
     name, text, severity = _describe(row)
-    for field, value, kind in (
-            ("EventId", struct.pack(">Iq", _day_of(archive, row.ts), row.id), ua.VariantType.ByteString),
-            ("EventType", ua.NodeId(EVENT_TYPES.get(row.kind, ua.ObjectIds.BaseEventType)),
-             ua.VariantType.NodeId),
-            ("SourceNode", source, ua.VariantType.NodeId), ("SourceName", name, ua.VariantType.String),
-            ("Time", when, ua.VariantType.DateTime), ("ReceiveTime", when, ua.VariantType.DateTime),
-            ("Message", ua.LocalizedText(text), ua.VariantType.LocalizedText),
-            ("Severity", severity, ua.VariantType.UInt16)):
-        event.add_property(field, value, kind)
+    kind = ua.NodeId(EVENT_TYPES.get(row.kind, ua.ObjectIds.BaseEventType))
+    _V = ua.VariantType
+    fields: dict[str, tuple[Any, ua.VariantType]] = {
+        "EventId": (struct.pack(">Iq", day, row.id), _V.ByteString), "EventType": (kind, _V.NodeId),
+        "SourceNode": (station, _V.NodeId), "SourceName": (name, _V.String), "Time": (when, _V.DateTime),
+        "ReceiveTime": (when, _V.DateTime), "Message": (ua.LocalizedText(text), _V.LocalizedText),
+        "Severity": (severity, _V.UInt16)}
+    alarm = alarms.get(row.source or "") if row.kind == "alarm" else None
+    if alarm is not None:
+        fields.update({"EventType": (alarm.type_id, _V.NodeId), "SourceNode": (alarm.source, _V.NodeId),
+                       "SourceName": (alarm.source_name, _V.String), "ConditionName": (row.source, _V.String),
+                       "NodeId": (alarm.condition, _V.NodeId)})  # NodeId: the ConditionId's field
+        for state, on in zip(("ActiveState", "AckedState"), ACTIVE_ACKED.get(State(row.type or 0), ())):
+            fields[state] = (ua.LocalizedText(TWO_STATES[state][0 if on else 1]), _V.LocalizedText)
+            fields[f"{state}/Id"] = (on, _V.Boolean)
+    for field, (value, variant) in fields.items():
+        event.add_property(field, value, variant)
     return event
 
 
@@ -336,10 +367,9 @@ def _describe(row: Row) -> tuple[str, str, int]:
     text = row.text or ""
     if row.kind == "message":
         return f"MSG{row.number}", text or f"message {row.number}", SEVERITY[alarm_priority(row.type or 0)]
-    if row.kind == "alarm":
-        change = f"{State(row.number or 0).word} -> {State(row.type or 0).word}"
-        return row.source or "", f"{row.source}: {change}" + (f": {text}" if text else ""), \
-            SEVERITY.get(row.grp or 3, 500)
+    if row.kind == "alarm":  # its text names the change, as the condition's event says it
+        change = f"{row.source} {State(row.number or 0).word} -> {State(row.type or 0).word}"
+        return row.source or "", text or change, SEVERITY.get(row.grp or 3, 500)
     return row.source or "", text, 100
 
 
@@ -349,13 +379,15 @@ class StationHistory(HistoryManager):
     """The server's history manager, reading the station's archive."""
 
     def __init__(self, iserver: Any, archived: Archived | None, series: Mapping[ua.NodeId, Series],
-                 notifiers: Sequence[ua.NodeId]) -> None:
-        """`series`: the archived tags' variables; `notifiers`: the nodes whose event history is
-        the journal (the station object, the Server object)."""
+                 station: ua.NodeId, alarms: Mapping[str, AlarmSource]) -> None:
+        """`series`: the archived tags' variables; `station`: the station object, whose event
+        history is the journal, as the Server object's is; `alarms`: the alarms' conditions."""
         super().__init__(iserver)
         self.archived = archived
         self.series = dict(series)
-        self.notifiers = list(notifiers)
+        self.station = station
+        self.alarms = dict(alarms)
+        self.notifiers = [ua.NodeId(ua.ObjectIds.Server), station] if archived is not None else []
         self._executor = ThreadPoolExecutor(1, thread_name_prefix="opcua-history")
 
     async def stop(self) -> None:
@@ -368,6 +400,8 @@ class StationHistory(HistoryManager):
             raise ServiceError(_S.BadTimestampsToReturnInvalid)
         if not params.NodesToRead:
             raise ServiceError(_S.BadNothingToDo)
+        if len(params.NodesToRead) > MAX_NODES:
+            raise ServiceError(_S.BadTooManyOperations)
         return [await self._read(params, rv) for rv in params.NodesToRead]
 
     async def _read(self, params: ua.HistoryReadParameters,
@@ -403,7 +437,7 @@ class StationHistory(HistoryManager):
                 result, resume, n = await self._run(self._raw, series, d, details.ReturnBounds, after, limit,
                                                     params.TimestampsToReturn)
             else:
-                result, resume, n = await self._run(self._events, rv.NodeId, details.Filter, d, after, limit)
+                result, resume, n = await self._run(self._events, details.Filter, d, after, limit)
         except (sqlite3.Error, OSError) as e:
             logger.exception("history of %s not read from %s", rv.NodeId.to_string(),
                              self.archived.path if self.archived else "no archive")
@@ -431,19 +465,13 @@ class StationHistory(HistoryManager):
         values = [data_value(series, s, stamps) for s in samples]
         return ua.HistoryData(DataValues=values), resume, len(values)
 
-    def _events(self, node: ua.NodeId, flt: ua.EventFilter, d: Domain, after: Position | None,
+    def _events(self, flt: ua.EventFilter, d: Domain, after: Position | None,
                 limit: int) -> tuple[ua.HistoryEvent, Position | None, int]:
-        where = WhereClauseEvaluator(logger, self.iserver.aspace, flt.WhereClause)
-        events: list[Event] = []
         with self._open() as archive:
-            def wanted(row: Row) -> bool:
-                event = event_of(archive, row, node)
-                if not where.eval(event):
-                    return False
-                events.append(event)
-                return True
-
-            _, resume = read_journal(archive, d, after, limit, wanted)
+            rows, resume = read_journal(archive, d, after, limit)
+        where = WhereClauseEvaluator(logger, self.iserver.aspace, flt.WhereClause)
+        events = [event for event in (event_of(row, self.station, self.alarms) for row in rows)
+                  if where.eval(event)]
         fields = [ua.HistoryEventFieldList(EventFields=e.to_event_fields(flt.SelectClauses)) for e in events]
         return ua.HistoryEvent(Events=fields), resume, len(fields)
 
@@ -472,4 +500,7 @@ async def install(server: Any, history: StationHistory) -> None:
         await server.get_node(nodeid).write_value(value)
     await server.get_node(ua.ObjectIds.Server_ServerCapabilities_MaxHistoryContinuationPoints).write_value(
         ua.Variant(0, ua.VariantType.UInt16))  # none kept: no limit
+    for limit in (ua.ObjectIds.Server_ServerCapabilities_OperationLimits_MaxNodesPerHistoryReadData,
+                  ua.ObjectIds.Server_ServerCapabilities_OperationLimits_MaxNodesPerHistoryReadEvents):
+        await server.get_node(limit).write_value(ua.Variant(MAX_NODES, _UINT32))
 

@@ -3,7 +3,10 @@
 asyncua runs on a thread and event loop of its own. Values come from the station's `Readings`
 (`Runtime.watch`, through `LatestReadings`: at most one update per tick, none while the loop
 lags); only the variables whose value or quality changed are written, each with the scan's wall
-time as source timestamp and a StatusCode from the tag's quality.
+time as source timestamp, the time it is written as server timestamp and a StatusCode from the
+tag's quality. A tag's variable is of Part 8's standard types with its ranges and units
+(ua_types.py), and its history, where the program archives it, is read from the station's archive
+(history.py, Part 11).
 
 Client writes are the station's commands (app/authority/): every session's Write service is taken
 before asyncua's own, and a write to a tag variable goes to the command layer with the session's
@@ -61,7 +64,7 @@ from app.authority.logins import Logins
 from app.authority.users import UserError, Users
 from app.publish.conditions import Conditions
 from app.publish.feed import LatestReadings, Watch
-from app.publish.history import Archived, Series, StationHistory, install, series_of
+from app.publish.history import AlarmSource, Archived, Series, StationHistory, install, series_of
 from app.publish.methods import StationMethods, StepLock
 from app.publish.pki import TrustList, host_names, station_certificate, subject, thumbprint
 from app.publish.points import PointReader, PointWriter, Writable
@@ -419,16 +422,17 @@ class OpcUaServer:
         sources = {tag.name: nodeid for tag, nodeid in zip(self.tags, self.nodeids)}
         await self.conditions.build(server, idx, alarms, station, sources, plc, self.plc_state.nodeid)
         await self.methods.add(station, idx)
-        # after the event generator, which sets the station's EventNotifier
-        notifiers = [ua.NodeId(ua.ObjectIds.Server), station.nodeid] if self.archived is not None else []
-        await install(server, StationHistory(server.iserver, self.archived, self.series, notifiers))
+        # after the conditions, which set the station's EventNotifier
+        alarm_sources = {alarm_id: AlarmSource(c.nodeid, c.type_id, c.source, c.source_name)
+                         for alarm_id, c in self.conditions.by_id.items()}
+        await install(server, StationHistory(server.iserver, self.archived, self.series, station.nodeid,
+                                             alarm_sources))
 
     async def _add_tags(self, server: Server, folder: ua.NodeId) -> None:
-        """The tags' variables, of their standard types with their properties (ua_types.py), added
-        as one batch of nodes. asyncua checks each new child against all of its parent's references
-        (quadratic: a minute for 10,000 tags); tag names are unique, so each tag is added to a
-        folder whose reference list is set aside meanwhile and put back with the new reference
-        appended."""
+        """The tags' variables, of their standard types (ua_types.py), and then their properties in
+        one batch. asyncua checks each new child against all of its parent's references (quadratic:
+        a minute for 10,000 tags); tag names are unique, so each variable is added to a folder whose
+        reference list is set aside meanwhile and put back with the new reference appended."""
         service = server.iserver.node_mgt_service
         folder_data = server.iserver.aspace.get(folder)
         references = folder_data.references

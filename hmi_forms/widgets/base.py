@@ -16,7 +16,7 @@ and input fields, and it is drawn identically for all element types: an operator
 from __future__ import annotations
 
 from collections.abc import Callable, Hashable
-from operator import attrgetter
+from operator import itemgetter
 from pathlib import Path
 from typing import ClassVar
 
@@ -152,7 +152,9 @@ class ElementWidget(QWidget):
         if model.Cursor in CURSORS:
             self.setCursor(CURSORS[model.Cursor])
         self._layers: dict[Hashable, QPixmap] = {}
-        self._style_of = attrgetter(*self.style_props())  # one call in C at every draw
+        # read from the model's attributes in one call in C at every draw and composition (an
+        # attrgetter would ask the model's class for each name first, at twice the cost)
+        self._style_of = itemgetter(*self.style_props())
         self._style = self.style()
         self._look = self.look()
         # the form and the rectangle on it, kept: asking Qt for them costs more than the repaint
@@ -208,7 +210,7 @@ class ElementWidget(QWidget):
         """The colours, frame and font: checked at every draw and composition, so that a change
         (a form designer sets a colour) rebuilds the cached pictures by itself. Other properties the
         pictures are drawn from are in `look`: after changing one, call `restyle`."""
-        return self._style_of(self.model)
+        return self._style_of(vars(self.model))
 
     def look(self) -> tuple[object, ...]:
         """Everything the cached layer is drawn from besides the state and the size: widgets
@@ -232,7 +234,7 @@ class ElementWidget(QWidget):
 
     def draw(self, p: QPainter, r: QRectF) -> None:
         """Draw the element into `r`, its own rectangle, with its top-left corner at the origin."""
-        if self._style_of(self.model) != self._style:
+        if self.style() != self._style:
             self.restyle()
         p.drawPixmap(ORIGIN, self.layer())
         self.paint_dynamic(p, r)
@@ -325,8 +327,8 @@ class Face:
     lives as long as its widget; what it read of the widget is read again at the first change
     after the widget moved, was resized or restyled (`forget`)."""
 
-    __slots__ = ("drawn", "fresh", "key", "layers", "marked", "model", "plain", "rect", "repaint", "style",
-                 "style_of", "widget", "x", "y")
+    __slots__ = ("attrs", "drawn", "fresh", "key", "layers", "marked", "model", "plain", "rect", "repaint",
+                 "style", "style_of", "widget", "x", "y")
 
     bank: ClassVar[type[Bank] | None] = None  # what reads the operand of a `plain` element it draws
 
@@ -340,7 +342,7 @@ class Face:
         widget = self.widget
         self.repaint, self.rect, self.x, self.y = widget._where or widget._locate()
         self.layers, self.key = widget._layers, widget.layer_key
-        self.style_of, self.style = widget._style_of, widget._style
+        self.style_of, self.style, self.attrs = widget._style_of, widget._style, vars(self.model)
         self.plain = type(widget).paint_dynamic is ElementWidget.paint_dynamic  # the layer is all of it
         self.marked = widget._stale
         self.fresh = True
@@ -390,7 +392,7 @@ class Face:
     def restyled(self) -> bool:
         """Whether the colours, frame or font changed since the face was read: the widget is then
         restyled, drawn with a painter once, and read again at the next change."""
-        if self.style_of(self.model) == self.style:
+        if self.style_of(self.attrs) == self.style:
             return False
         self.widget.restyle()
         return True

@@ -43,7 +43,7 @@ class DiscreteFace(Face):
         """`Face.put` in one step: the layer by the bit and the press (a plain element is simple)."""
         if not self.fresh:
             self.load()
-        if self.style_of(self.model) != self.style:
+        if self.style_of(self.attrs) != self.style:
             return super().put(shown)
         drawn = [(PIX, (self.x, self.y, self._layer()))]
         if drawn == self.drawn:

@@ -563,7 +563,7 @@ class GaugeFace(Face):
             was, text, extra = self.entries[shown.hw]
         except KeyError:
             was = None
-        if was is not shown or self.style_of(self.model) != self.style:
+        if was is not shown or self.style_of(self.attrs) != self.style:
             self.sync()
             return False
         drawn = self._ops(shown.zone, text, extra)

@@ -4,6 +4,7 @@ gauge settled from them ends up exactly where its own `update` would have put it
 from __future__ import annotations
 
 import random
+from dataclasses import FrozenInstanceError
 from pathlib import Path
 
 import pytest
@@ -106,12 +107,26 @@ def test_a_banked_gauge_takes_each_word_as_its_own_update_would(qtbot, tmp_path)
             assert isinstance(own, AnalogBase)
             own.update(s)
             assert (model.hw, model.phy, model.text, model.zone) == (own.hw, own.phy, own.text, own.zone)
+            assert model.shown is own.shown  # one path: what `shows` made of the word, for both
             assert not model.stale
     composed = view.grab().toImage()
     for _, w in view.pairs:
         w.face.forget()  # drawn with a painter, as before any composition
     view.update()
     assert view.grab().toImage() == composed
+
+
+def test_what_a_gauge_shows_is_its_models_alone(qtbot, tmp_path) -> None:
+    """The view reads what the model shows and cannot write it: the parts are read-only and the
+    whole is frozen."""
+    view = view_of(qtbot, tmp_path, [gauge("G", 0, "04010", PhyHigh=100)])
+    view.refresh(snap(words={0o4010: 900}))
+    [model] = banked(view)
+    assert (model.text, model.zone) == ("130.0", "high")
+    with pytest.raises(AttributeError):
+        model.text = "0.0"  # type: ignore[misc]
+    with pytest.raises(FrozenInstanceError):
+        model.shown.zone = "normal"  # type: ignore[misc]
 
 
 def test_a_banked_gauge_that_fails_is_reported_and_the_form_keeps_running(qtbot, tmp_path,

@@ -13,14 +13,18 @@ import asyncio
 import time
 from collections.abc import Iterator
 from datetime import UTC, datetime
+from pathlib import Path
 
 import pytest
 from asyncua import Client, ua
 from asyncua.common.events import get_filter_from_event_type
 
+from app.publish import history
 from app.scada.alarms import State
 from app.station.runtime import Runtime
 from netplc.records import Record
+from registrar.query import Archive
+from registrar.reading import SeriesKey
 from registrar.store import Store
 from tests.app.conftest import copy_demo
 from tests.app.publish.conftest import STATION_URI, demo_with, free_port
@@ -191,7 +195,13 @@ def test_the_journal_as_events_of_the_station_and_the_server(station: tuple[Runt
         try:
             base = client.get_node(ua.ObjectIds.BaseEventType)
             evfilter = await get_filter_from_event_type([base])
-            names = [c.BrowsePath[0].Name for c in evfilter.SelectClauses]
+            condition = ua.NodeId(ua.ObjectIds.ConditionType)
+            evfilter.SelectClauses += [  # an alarm's: its condition's fields
+                ua.SimpleAttributeOperand(TypeDefinitionId=condition, AttributeId=ua.AttributeIds.NodeId),
+                *(ua.SimpleAttributeOperand(TypeDefinitionId=condition, AttributeId=ua.AttributeIds.Value,
+                                            BrowsePath=[ua.QualifiedName(n, 0) for n in path.split("/")])
+                  for path in ("ConditionName", "ActiveState/Id", "AckedState/Id"))]
+            names = ["/".join(q.Name for q in c.BrowsePath) or "ConditionId" for c in evfilter.SelectClauses]
             asked = ua.ReadEventDetails(StartTime=utc((t - 61) * 1000), EndTime=utc(t * 1000),
                                         NumValuesPerNode=10, Filter=evfilter)
             pages: list[list[object]] = []
@@ -230,13 +240,21 @@ def test_the_journal_as_events_of_the_station_and_the_server(station: tuple[Runt
     assert max(sizes) <= 10
     assert len(station_events) == 4 + MESSAGES
     assert [e["Message"] for e in server_events] == [e["Message"] for e in station_events]
+    # the source is the station (an alarm's: its condition's), wherever its history is read
+    assert {e["SourceNode"] for e in station_events + server_events} == {
+        ua.NodeId("Demo station", 1), ua.NodeId("Tags.LEVEL", 1)}
     assert len({e["EventId"] for e in station_events}) == len(station_events)  # each once
     message, alarm, operator, record = station_events[:4]
     assert message["Message"].Text == "Уровень выше 90 %" and message["SourceName"] == "MSG3"
     assert message["EventType"] == ua.NodeId(ua.ObjectIds.BaseEventType) and message["Severity"] == 700
     assert message["Time"] == utc(round((t - 50) * 1000)) == message["ReceiveTime"]
-    assert alarm["SourceName"] == "LEVEL.H" and alarm["Severity"] == 700
-    assert alarm["Message"].Text == "LEVEL.H: normal -> active-unacknowledged"
+    # an alarm's transition is its condition's event, as the live one was
+    assert alarm["EventType"] == ua.NodeId(ua.ObjectIds.ExclusiveLevelAlarmType)
+    assert (alarm["SourceNode"], alarm["SourceName"]) == (ua.NodeId("Tags.LEVEL", 1), "LEVEL")
+    assert (alarm["ConditionName"], alarm["ConditionId"]) == ("LEVEL.H", ua.NodeId("Alarms.LEVEL.H", 1))
+    assert (alarm["ActiveState/Id"], alarm["AckedState/Id"], alarm["Severity"]) == (True, False, 700)
+    assert alarm["Message"].Text == "LEVEL.H normal -> active-unacknowledged"
+    assert message["ConditionName"] is None  # a message is no condition's
     assert operator["SourceName"] == "opcua:operator@127.0.0.1:5000"
     assert operator["Message"].Text == "Пуск: 0 -> 1"
     assert record["EventType"] == ua.NodeId(ua.ObjectIds.SystemEventType)
@@ -276,7 +294,16 @@ def test_what_is_not_archived_says_so(station: tuple[Runtime, str, float]) -> No
             out["capabilities"] = [await client.get_node(n).read_value() for n in (
                 ua.ObjectIds.HistoryServerCapabilities_AccessHistoryDataCapability,
                 ua.ObjectIds.HistoryServerCapabilities_AccessHistoryEventsCapability,
-                ua.ObjectIds.HistoryServerCapabilities_InsertDataCapability)]
+                ua.ObjectIds.HistoryServerCapabilities_InsertDataCapability,
+                ua.ObjectIds.HistoryServerCapabilities_MaxReturnDataValues,
+                ua.ObjectIds.Server_ServerCapabilities_OperationLimits_MaxNodesPerHistoryReadData)]
+            params = ua.HistoryReadParameters(HistoryReadDetails=asked, ReleaseContinuationPoints=False,
+                                              TimestampsToReturn=ua.TimestampsToReturn.Both,
+                                              NodesToRead=[ua.HistoryReadValueId(NodeId=level.nodeid)] * 101)
+            try:
+                await client.uaclient.history_read(params)
+            except ua.UaStatusCodeError as e:
+                out["too many"] = e.code
             return out
         finally:
             await client.disconnect()
@@ -289,7 +316,49 @@ def test_what_is_not_archived_says_so(station: tuple[Runtime, str, float]) -> No
     assert out["last three"] == ([level_ts(t, k) for k in (N - 1, N - 2, N - 3)], None)
     assert out["later"] == ua.StatusCodes.GoodNoData
     assert out["historizing"] == (True, False)
-    history, read = 1 << ua.AccessLevel.HistoryRead, 1 << ua.AccessLevel.CurrentRead
-    assert out["user access"] == (read | history, read)
+    history_read, read = 1 << ua.AccessLevel.HistoryRead, 1 << ua.AccessLevel.CurrentRead
+    assert out["user access"] == (read | history_read, read)
     assert ua.EventNotifier.HistoryRead in out["notifier"]
-    assert out["capabilities"] == [True, True, False]
+    assert out["capabilities"] == [True, True, False, history.MAX_VALUES, history.MAX_NODES]
+    assert out["too many"] == ua.StatusCodes.BadTooManyOperations
+
+
+def test_pages_across_midnight_and_the_scan_limit_give_every_record_once(
+        tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> None:
+    """The reading itself, without a server: a series and a journal spanning two days' tables, read
+    forward and backward in pages that end at a day's edge, with the journal's scan limit small."""
+    midnight = datetime(2026, 3, 5).timestamp()  # local midnight: the archive's tables change there
+    db = tmp_path / "journal.sqlite"
+    store = Store(db)
+    store.start()
+    for i in range(-10, 10):
+        store.put(Record(midnight + i, "data", grp=1, type=1, source="04010", value=float(i + 10)))
+        store.put(Record(midnight + i + 0.5, "message", grp=1, type=0, number=1, text=f"m{i}"))
+    store.close()
+    key = SeriesKey("data", 1, 1, "04010")
+    span = history.domain(utc((midnight - 20) * 1000), utc((midnight + 20) * 1000), 0)
+    backward = history.domain(utc((midnight + 20) * 1000), utc((midnight - 20) * 1000), 0)
+    assert span is not None and backward is not None
+    with Archive(db) as archive:
+        assert len(archive.days()) == 2
+        for d, order in ((span, 1), (backward, -1)):
+            for limit in (11, 5):  # 11: the first page (a bound and ten records) ends at the day's edge
+                got: list[float | None] = []
+                after = None
+                while True:
+                    samples, after = history.read_raw(archive, key, d, True, after, limit)
+                    got += [row.value if row is not None else None for _, row in samples]
+                    if after is None:
+                        break
+                assert got == [None, *[float(v) for v in range(20)][::order], None]  # no bound found
+            for limit, scan in ((10, history.SCAN_ROWS), (3, 7)):  # 10: a page ends at the day's edge
+                monkeypatch.setattr(history, "SCAN_ROWS", scan)  # 7: a few records examined a page
+                texts: list[str] = []
+                after, pages = None, 0
+                while True:
+                    rows, after = history.read_journal(archive, d, after, limit)
+                    texts += [row.text for _, row in rows if row.text]
+                    pages += 1
+                    if after is None:
+                        break
+                assert texts == [f"m{i}" for i in range(-10, 10)][::order] and pages >= 20 / limit
