@@ -24,9 +24,9 @@ from pathlib import Path
 from PySide6.QtWidgets import QApplication
 from scan import generate, pick_functions  # bench/scan.py: the 8 K-word program
 
+from app.gui.application import application
 from app.gui.monitor.source import LocalSource
 from app.gui.monitor.window import ProgramWindow
-from app.gui.style import apply_style
 from app.station.config import load_station
 from app.station.runtime import Runtime
 from netplc.engine import Engine
@@ -74,8 +74,7 @@ def main() -> None:
     ap.add_argument("--rounds", type=int, default=15)
     ap.add_argument("--seed", type=int, default=165)
     args = ap.parse_args()
-    app = QApplication.instance() or QApplication([])
-    apply_style(app)  # type: ignore[arg-type]
+    app = application()
     with tempfile.TemporaryDirectory() as tmp:
         runtime = Runtime(load_station(station(Path(tmp) / "st", args.seed)))
         runtime.start()

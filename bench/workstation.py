@@ -31,9 +31,9 @@ os.environ.setdefault("QT_QPA_PLATFORM", "offscreen")
 from PySide6.QtCore import QEvent, QObject
 from PySide6.QtWidgets import QApplication, QLabel, QMainWindow
 
+from app.gui.application import application
 from app.gui.main_window import MainWindow
 from app.gui.screenshots import copy_station
-from app.gui.style import apply_style
 from app.station.config import load_station
 from app.station.runtime import Runtime
 
@@ -110,8 +110,7 @@ def launched(mode: str) -> float:
 
 
 def child(mode: str, t0: float) -> None:
-    app = QApplication(sys.argv[:1])
-    apply_style(app)
+    app = application()
     if mode == "bare":
         bare_window(app)
         print(time.time() - t0)
@@ -145,8 +144,7 @@ def main(argv: list[str] | None = None) -> int:
         return 0
     cold, cold_bare = launched("form"), launched("bare")
     seconds = args.minutes * 60 if args.minutes else args.seconds
-    app = QApplication.instance() or QApplication(sys.argv[:1])
-    apply_style(app)
+    app = application()
     bare = bare_window(app)
     with tempfile.TemporaryDirectory() as tmp:
         headless = Runtime(load_station(copy_station(Path(tmp) / "headless")))

@@ -2,6 +2,7 @@
 bytecode caches, PostgreSQL clusters, and OPC UA servers that share one fill of the standard
 address space."""
 
+import gc
 import itertools
 import os
 import sys
@@ -50,6 +51,25 @@ def own_pg_cluster():
 def pg_url(pg_cluster) -> str:
     """A fresh, empty database in the session's cluster."""
     return pg_cluster.create_database(f"plant_{next(_databases)}")
+
+
+@pytest.fixture(autouse=True)
+def _collect_on_the_gui_thread(request: pytest.FixtureRequest):
+    """A test with Qt collects Python's garbage on the GUI thread, as our windows do
+    (app/gui/application.py), and leaves none of its Qt objects to be freed later by another
+    thread; the other tests keep Python's own collection."""
+    if "qapp" not in request.fixturenames:
+        yield
+        return
+    from app.gui.application import MainThreadCollector
+
+    app = request.getfixturevalue("qapp")
+    MainThreadCollector(parent=app)
+    yield
+    for collector in app.findChildren(MainThreadCollector):
+        collector.stop()
+        collector.setParent(None)
+    gc.collect()
 
 
 def pytest_runtest_setup(item: pytest.Item) -> None:

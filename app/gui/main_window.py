@@ -45,12 +45,12 @@ from app.authority.users import Session, Users
 from app.gui import i18n, words
 from app.gui.alarm_summary import AlarmSummary
 from app.gui.alarms import AlarmBanner, FixedLine, HealthStrip
+from app.gui.application import application
 from app.gui.bridge import Answers, RuntimeBridge
 from app.gui.journal import JournalDock
 from app.gui.login import LoginDialog
 from app.gui.rights import Rights
 from app.gui.status import StationStatusBar, station_problems
-from app.gui.style import apply_style
 from app.gui.trend_history import TrendHistory
 from app.gui.users_dialog import UsersDialog
 from app.gui.zoom import ACTUAL, FIT_WIDTH, FIT_WINDOW, ZoomArea, ZoomSettings
@@ -581,8 +581,7 @@ def _placeholder(text: str) -> QWidget:
 
 def run_workstation(station_path: str) -> int:
     """`python main.py [STATION]`: start the runtime, show the window, stop the runtime on close."""
-    app = QApplication.instance() or QApplication(sys.argv[:1])
-    apply_style(app)
+    app = application()
     try:
         station = load_station(station_path)
         i18n.install(app, station.Language)

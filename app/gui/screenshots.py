@@ -54,15 +54,13 @@ def main(argv: list[str] | None = None) -> int:
     ap.add_argument("--seconds", type=float, default=RUN_SECONDS, help="how long the station runs first")
     args = ap.parse_args(argv)
 
-    from PySide6.QtWidgets import QApplication
 
+    from app.gui.application import application
     from app.gui.main_window import MainWindow
-    from app.gui.style import apply_style
     from app.gui.viewer import ViewerWindow
     from app.station.runtime import Runtime
 
-    app = QApplication.instance() or QApplication(sys.argv[:1])
-    apply_style(app)
+    app = application()
     args.out.mkdir(parents=True, exist_ok=True)
     written: list[Path] = []
     with tempfile.TemporaryDirectory() as tmp:

@@ -28,7 +28,6 @@ import pyqtgraph as pg
 from PySide6.QtCore import QT_TRANSLATE_NOOP, Qt
 from PySide6.QtGui import QAction, QColor, QKeySequence
 from PySide6.QtWidgets import (
-    QApplication,
     QComboBox,
     QFileDialog,
     QFormLayout,
@@ -49,8 +48,8 @@ from PySide6.QtWidgets import (
 )
 
 from app.gui import i18n
+from app.gui.application import application
 from app.gui.series_loader import Series, SeriesLoader
-from app.gui.style import apply_style
 from app.scada.tag import Tag
 from app.station.config import DEMO_STATION, ConfigError, load_station, station_file
 from hmi_forms.elements import formats
@@ -532,8 +531,7 @@ def run_viewer(target: str | None) -> int:
     if isinstance(path, Path) and not path.is_file():
         print(f"{path}: no archive here (run the station first, or name an archive file)", file=sys.stderr)
         return 2
-    app = QApplication.instance() or QApplication(sys.argv[:1])
-    apply_style(app)
+    app = application()
     i18n.install(app)  # the viewer has no station file: the system locale decides
     window = ViewerWindow(path)
     window.show()

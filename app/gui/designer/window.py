@@ -13,7 +13,6 @@ from pathlib import Path
 from PySide6.QtCore import QPointF, QSize, Qt
 from PySide6.QtGui import QAction, QCloseEvent, QGuiApplication, QKeySequence, QShowEvent
 from PySide6.QtWidgets import (
-    QApplication,
     QDockWidget,
     QFileDialog,
     QInputDialog,
@@ -382,10 +381,9 @@ def run_designer(target: str, screenshot: str | None = None) -> int:
     except ValueError as e:
         print(e, file=sys.stderr)
         return 2
-    from app.gui.style import apply_style
+    from app.gui.application import application
 
-    app = QApplication.instance() or QApplication(sys.argv[:1])
-    apply_style(app)
+    app = application()
     try:
         window = DesignerWindow(context)
     except FormError as e:

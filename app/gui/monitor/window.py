@@ -10,11 +10,11 @@ from collections.abc import Callable
 from pathlib import Path
 
 from PySide6.QtGui import QCloseEvent
-from PySide6.QtWidgets import QApplication, QDialog, QMainWindow, QWidget
+from PySide6.QtWidgets import QDialog, QMainWindow, QWidget
 
+from app.gui.application import application
 from app.gui.monitor.source import LocalSource, OpcUaSource, RemoteSource, Source
 from app.gui.monitor.view import ProgramMonitor
-from app.gui.style import apply_style
 from app.scada.tag import Tag
 from app.station.config import load_station
 from app.station.load import load
@@ -90,8 +90,7 @@ def run_monitor(target: str, program: str | None = None, user: str | None = None
     station (the login dialog; with --user and stdin not a terminal, the password is its first
     line), over Modbus read-only. Exit 2 with the reason when it cannot start, 1 when the login is
     cancelled."""
-    app = QApplication.instance() or QApplication(sys.argv[:1])
-    apply_style(app)  # type: ignore[arg-type]
+    app = application()
     try:
         if target.startswith("opc.tcp://"):
             source: Source | None = station_source(target, program, user)
