@@ -1,6 +1,6 @@
 """The manual (docs/, mkdocs.yml): its reference pages are what docs/gen_reference.py writes from
 the code now, and the site builds with `mkdocs build --strict` (a broken link, a missing page or
-anchor fails).
+anchor fails); the README stays a short page whose links lead into the manual.
 
 The build is a test rather than a second step of `make test` so that it runs on the other core
 beside the suite (about 2 s of CPU) and in every run of pytest, CI's too.
@@ -11,6 +11,7 @@ from __future__ import annotations
 import importlib.util
 import json
 import os
+import re
 import subprocess
 import sys
 from pathlib import Path
@@ -72,3 +73,18 @@ def test_every_key_of_the_reference_is_one_the_parser_reads(tmp_path: Path) -> N
     _, problems = read_station(tmp_path)
     unknown = [p for p in problems if "unknown setting" in p]
     assert not unknown, "declared in KEYS but not read by the parser:\n" + "\n".join(unknown)
+
+
+def test_the_readme_is_a_short_page_whose_links_lead_into_the_manual() -> None:
+    """The README is the way in (what it is, the two commands, where each reader goes, the layout and
+    benchmark tables); what a reader needs beyond it is a page of the manual, so it stays short and
+    every link of it leads to a file that exists (mkdocs checks the manual's links, not these)."""
+    readme = (REPO / "README.md").read_text(encoding="utf-8")
+    prose = [line for line in readme.splitlines() if not line.startswith("|")]
+    assert len(prose) <= 150, f"README.md has {len(prose)} lines besides its tables: move details to docs/"
+    links = re.findall(r"\]\(([^)\s]+)\)", readme)
+    targets = {t.split("#")[0] for t in links if not t.startswith(("#", "http"))}
+    missing = sorted(t for t in targets if not (REPO / t).exists())
+    assert not missing, f"README.md links to what does not exist: {missing}"
+    assert "\n## Benchmarks\n" in readme and "--8<-- [start:benchmarks]" in readme, \
+        "docs/benchmarks.md includes the README's benchmark table by its snippet markers"

@@ -109,6 +109,6 @@ class Refusal:
 
 
 def policy_table() -> str:
-    """The policy as a Markdown table (the README and the manual print it from here)."""
+    """The policy as a Markdown table (docs/reference/roles.md prints it from here)."""
     rows = [f"| {a.value} | {POLICY[a]} |" for a in Action]
     return "\n".join(["| Action | Needs the role (or higher) |", "|---|---|", *rows])

@@ -66,7 +66,7 @@ class Role(StrEnum):
 HSB_STATUS = {Role.STARTING: 0, Role.PRIMARY: 5, Role.STANDBY: 4}
 DEFECT = 6
 # The pair's status words in NetPlc memory, beside the RTC (077700-077707), each station's own
-# (written after the mirrored memory is put), for a program and an HMI (README "Redundancy")
+# (written after the mirrored memory is put), for a program and an HMI (docs/integration/redundancy.md)
 HSB_NUM_PLC = 0o77710  # byte: 1 = A, 0 = B (HSBNumPLC)
 HSB_STATUS_BYTE = 0o77711  # byte: HSBStatus
 DGN_HSB = 0o77712  # word: b7 the partner's station differs, b9 the pair link is down, b15 a switchover

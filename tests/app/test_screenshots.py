@@ -1,4 +1,4 @@
-"""`python -m app.gui.screenshots`: the README's pictures come from the running demo station."""
+"""`python -m app.gui.screenshots`: the manual's pictures come from the running demo station."""
 
 from __future__ import annotations
 

@@ -1,6 +1,6 @@
-"""The function tutorial is true, in the README and in the manual: each `$ python -m netplc run ...`
+"""The function tutorial of the manual is true: each `$ python -m netplc run ...`
 line in its console blocks is run as a subprocess from the repository root, and its output must be
-the one shown (a command the two show alike runs once)."""
+the one shown (a command shown twice runs once)."""
 
 from __future__ import annotations
 
@@ -13,7 +13,7 @@ import pytest
 
 ROOT = Path(__file__).resolve().parents[2]
 PROMPT = "$ python -m netplc run "
-TUTORIALS = ("README.md", "docs/engineer/programs.md")
+TUTORIALS = ("docs/engineer/programs.md",)
 
 
 def tutorial_commands(name: str) -> list[tuple[str, list[str]]]:

@@ -158,9 +158,11 @@ def test_the_policy_table_prints_every_action():
     assert all(f"| {a.value} | {POLICY[a]} |" in table for a in Action)
 
 
-def test_the_readme_prints_the_policy_table_the_layer_uses():
-    readme = (Path(__file__).resolve().parents[3] / "README.md").read_text(encoding="utf-8")
-    assert policy_table() in readme, "README's policy table is stale: paste app.authority.policy_table()"
+def test_the_manual_prints_the_policy_table_the_layer_uses_and_the_readme_links_to_it():
+    repo = Path(__file__).resolve().parents[3]
+    roles = (repo / "docs" / "reference" / "roles.md").read_text(encoding="utf-8")
+    assert policy_table() in roles, "the manual's policy table is stale: run `make reference`"
+    assert "(docs/reference/roles.md)" in (repo / "README.md").read_text(encoding="utf-8")
 
 
 def test_user_administration_needs_the_admin_and_is_answered_after_the_commit():
