@@ -36,7 +36,7 @@ def test_a_listener_that_raises_stops_neither_quality_nor_the_hmi_nor_opc_ua(qtb
         qtbot.waitUntil(lambda: runtime.readings().snapshot.scan >= first.snapshot.scan + 5, timeout=10_000)
 
         async def opcua_scans() -> list[int]:
-            async with Client(url) as client:
+            async with Client(url, timeout=30) as client:
                 ns = await client.get_namespace_index("urn:netplc:station:Demo station")
                 scan = client.get_node(ua.NodeId("NetPlc.Tick", ns))
                 seen = [await scan.read_value()]

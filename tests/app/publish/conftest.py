@@ -230,7 +230,7 @@ def opcua_client(url: str, user: str | None = None, password: str = "") -> objec
     """An asyncua client of `url`, logged in as `user` (None: anonymous)."""
     from asyncua import Client
 
-    client = Client(url)
+    client = Client(url, timeout=30)  # s: a loaded machine connects slowly
     if user is not None:
         client.set_user(user)
         client.set_password(password)

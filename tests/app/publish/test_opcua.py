@@ -46,7 +46,7 @@ def test_browse_read_units_and_quality(station: tuple[Runtime, str]) -> None:
     _, url = station
 
     async def go() -> None:
-        async with Client(url) as client:
+        async with Client(url, timeout=30) as client:
             root = client.nodes.objects
             names = [(await n.read_browse_name()).Name for n in await root.get_children()]
             assert "Demo station" in names
@@ -87,7 +87,7 @@ def test_subscription_sees_changes_within_two_ticks(station: tuple[Runtime, str]
             received.append((runtime.engine.scan_counter, val))
 
     async def go() -> None:
-        async with Client(url) as client:
+        async with Client(url, timeout=30) as client:
             tick = client.get_node(ua.NodeId("NetPlc.Tick", await client.get_namespace_index(
                 "urn:netplc:station:Demo station")))
             sub = await client.create_subscription(50, Handler())
@@ -111,7 +111,7 @@ def test_quality_goes_bad_when_the_node_is_killed(station: tuple[Runtime, str]) 
             events.append(event)
 
     async def go() -> None:
-        async with Client(url) as client:
+        async with Client(url, timeout=30) as client:
             ns = await client.get_namespace_index("urn:netplc:station:Demo station")
             sub = await client.create_subscription(50, Handler())
             await sub.subscribe_events(client.get_node(ua.NodeId("Demo station", ns)),

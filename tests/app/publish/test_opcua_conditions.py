@@ -117,7 +117,7 @@ def test_events_arrive_at_the_server_object_and_the_station_with_the_a_and_c_fie
     alarm_id = "ALM_EVENTS.ALARM"
 
     async def go() -> tuple[Any, Any, int]:
-        async with Client(url) as client:
+        async with Client(url, timeout=30) as client:
             at_server, _, _ = await subscribe(client)
             at_station, _, _ = await subscribe(client, ua.NodeId("Demo station", await ns(client)))
             alarm_on(runtime, "ALM_EVENTS")
@@ -145,7 +145,7 @@ def test_the_conditions_are_instances_of_the_standard_types_with_stable_node_ids
     _, url, _ = station
 
     async def go() -> dict[str, Any]:
-        async with Client(url) as client:
+        async with Client(url, timeout=30) as client:
             idx = await ns(client)
             out: dict[str, Any] = {}
             for alarm_id in ("LEVEL.H", "TRIGGER.BAD", "NETPLC.STOPPED", "MSG3", "ALM_EVENTS.ALARM"):
@@ -252,7 +252,7 @@ def test_an_alarm_acknowledged_at_the_station_updates_its_condition(station: Sta
     alarm_id = "ALM_STATION.ALARM"
 
     async def go() -> tuple[Any, bool, str]:
-        async with Client(url) as client:
+        async with Client(url, timeout=30) as client:
             idx = await ns(client)
             events, _, _ = await subscribe(client, ua.NodeId("Demo station", idx))
             alarm_on(runtime, "ALM_STATION")
@@ -281,7 +281,7 @@ def test_condition_refresh_sends_the_retained_conditions_between_refresh_start_a
 
     async def go() -> dict[str, Any]:
         out: dict[str, Any] = {}
-        async with Client(url) as client:
+        async with Client(url, timeout=30) as client:
             live, _, _ = await subscribe(client)
             alarm_on(runtime, "ALM_REFRESH")
             out["first"] = await live.last(alarm_id, ActiveState__Id=True)
@@ -294,7 +294,7 @@ def test_condition_refresh_sends_the_retained_conditions_between_refresh_start_a
             await until(lambda: sum(e.EventType == end for e in events.events) == 2, "two RefreshEnd")
             out["events"] = list(events.events)
             out["wrong object"] = await call(client, ua.NodeId(_O.Server), refresh, sid)
-            async with Client(url) as other:
+            async with Client(url, timeout=30) as other:
                 out["foreign"] = await call(other, condition_type, refresh, sid)
             events.events.clear()
             out["refresh2"] = await call(client, condition_type, refresh2, sid,

@@ -88,7 +88,7 @@ def ms(dv: ua.DataValue) -> int:
 
 
 async def connect(url: str) -> tuple[Client, int]:
-    client = Client(url)
+    client = Client(url, timeout=30)  # s: a loaded machine connects slowly
     await client.connect()
     return client, await client.get_namespace_index(STATION_URI)
 

@@ -58,7 +58,7 @@ def test_tags_are_of_part_8_types_with_the_ranges_and_units_of_tags_csv(station:
 
     async def go() -> dict[str, dict[str, object]]:
         out: dict[str, dict[str, object]] = {}
-        async with Client(url) as client:
+        async with Client(url, timeout=30) as client:
             ns = await client.get_namespace_index(STATION_URI)
             for row in rows:
                 node = client.get_node(ua.NodeId(f"Tags.{row['name']}", ns))
@@ -100,7 +100,7 @@ def test_every_node_of_the_station_has_a_string_nodeid_and_a_plain_browse_name(
 
     async def go() -> tuple[list[str], ua.NodeId, ua.NodeId]:
         bad: list[str] = []
-        async with Client(url) as client:
+        async with Client(url, timeout=30) as client:
             ns = await client.get_namespace_index(STATION_URI)
 
             async def walk(node: Node) -> None:
@@ -130,7 +130,7 @@ def test_values_carry_source_and_server_timestamps(station: tuple[Runtime, str])
     _, url = station
 
     async def go() -> list[ua.DataValue]:
-        async with Client(url) as client:
+        async with Client(url, timeout=30) as client:
             ns = await client.get_namespace_index(STATION_URI)
             level = client.get_node(ua.NodeId("Tags.LEVEL", ns))
             deadline = time.monotonic() + 10
@@ -149,7 +149,7 @@ def test_build_info_and_application_name_name_netplc_station(station: tuple[Runt
     _, url = station
 
     async def go() -> tuple[ua.BuildInfo, list[ua.ApplicationDescription]]:
-        async with Client(url) as client:
+        async with Client(url, timeout=30) as client:
             info = await client.get_node(ua.ObjectIds.Server_ServerStatus_BuildInfo).read_value()
             return info, await client.find_servers()
 
@@ -166,7 +166,7 @@ def test_method_arguments_are_described(station: tuple[Runtime, str]) -> None:
     _, url = station
 
     async def go() -> tuple[ua.NodeId, list[ua.Argument], int]:
-        async with Client(url) as client:
+        async with Client(url, timeout=30) as client:
             ns = await client.get_namespace_index(STATION_URI)
             force = client.get_node(ua.NodeId("Station.Force", ns))
             args = await force.get_child("0:InputArguments")
