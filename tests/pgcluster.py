@@ -102,6 +102,7 @@ class PgCluster:
         return self.database_url(name)
 
     def remove(self) -> None:
+        """Stopped at once (SIGQUIT: no shutdown checkpoint, the data is thrown away) and deleted."""
         with contextlib.suppress(Exception):
-            self.stop()
+            self.stop(signal.SIGQUIT)
         shutil.rmtree(self.folder, ignore_errors=True)
