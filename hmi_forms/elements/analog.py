@@ -102,6 +102,32 @@ class Scaled(Element):
             if "PhyHigh" not in raw and alarms.h is not None:
                 self.PhyHigh = alarms.h
 
+    def disagreements(self, raw: Mapping[str, Any], tags: TagTable) -> list[tuple[str, str]]:
+        """Where the form's own conversion or unit (`raw`, checked) contradicts the tag the element
+        is bound to: the tag is the station's truth (alarms, journal, OPC UA read it), so an element
+        scaling otherwise shows a wrong number with the right unit. Warnings: the form still opens."""
+        tag = tags.by_name.get(self.tag)
+        if tag is None:
+            return []
+        out: list[tuple[str, str]] = []
+        lo, hi = tag.limits
+        truth = tag.scaling or p.Scaling(lo, hi, lo, hi)
+        own = self.scaling
+        span = abs(truth.PhyMax - truth.PhyMin) or 1.0
+        if any(k in raw for k in ("Device", "AppMin", "AppMax", "PhyMin", "PhyMax")) and any(
+                abs(own.to_phy(w) - truth.to_phy(w)) > 1e-6 * span for w in (truth.AppMin, truth.AppMax)):
+            key = "Device" if "Device" in raw else next(
+                (k for k in ("AppMin", "AppMax", "PhyMin", "PhyMax") if getattr(own, k) != getattr(truth, k)),
+                "AppMin")
+            word = truth.AppMax
+            out.append((key, f"{_ranges(own)} contradicts tag {tag.name}'s {_ranges(truth)}: word "
+                             f"{word:g} shows {self.format(own.to_phy(word))} here, "
+                             f"{self.format(truth.to_phy(word))} {tag.unit}".rstrip()
+                             + " (remove the element's own conversion to take the tag's)"))
+        if "Units" in raw and tag.unit and self.Units != tag.unit:
+            out.append(("Units", f'"{self.Units}" contradicts tag {tag.name}\'s unit "{tag.unit}"'))
+        return out
+
     def check(self, ctx: p.Context) -> list[tuple[str, str]]:
         inline = {k: getattr(self, k) for k in ("AppMin", "AppMax", "PhyMin", "PhyMax")}
         given = [k for k, v in inline.items() if v is not None]
@@ -142,6 +168,10 @@ class Scaled(Element):
     text = property(attrgetter("shown.text"))
     zone = property(attrgetter("shown.zone"))
     fraction = property(attrgetter("shown.fraction"))
+
+
+def _ranges(sc: p.Scaling) -> str:
+    return f"{sc.AppMin:g}..{sc.AppMax:g} -> {sc.PhyMin:g}..{sc.PhyMax:g}"
 
 
 def scaling_problems(ranges: dict[str, Any]) -> list[tuple[str, str]]:

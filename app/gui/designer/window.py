@@ -29,6 +29,7 @@ from app.gui.designer.preview import Preview, plan
 from app.gui.designer.problems import ProblemsPane
 from app.gui.designer.properties import PropertyPanel
 from app.gui.designer.station import Context, open_target
+from app.gui.designer.tag_browser import TagBrowser
 from hmi_forms.elements import ELEMENT_TYPES
 from hmi_forms.form import FormError
 from hmi_forms.form_doc import FormDoc, new_doc, read_doc
@@ -50,11 +51,13 @@ class DesignerWindow(QMainWindow):
         self.setCentralWidget(self.canvas)
         names = sorted(context.names)
         self.palette = Palette(self.add)
+        self.tag_browser = TagBrowser(context.tags, self.add_tag)
         self.properties = PropertyPanel(self.design, names)
         self.problems_label = QLabel()
         self.preview_label = QLabel()
         self.problems = ProblemsPane(self.design, self._problem_count)
         self._dock("Elements", self.palette, Qt.DockWidgetArea.LeftDockWidgetArea)
+        self._dock("Tags", self.tag_browser, Qt.DockWidgetArea.LeftDockWidgetArea)
         self._dock("Properties", self.properties, Qt.DockWidgetArea.RightDockWidgetArea)
         self.problems_dock = self._dock("Problems", self.problems, Qt.DockWidgetArea.BottomDockWidgetArea)
         self.statusBar().addWidget(self.problems_label)
@@ -77,6 +80,7 @@ class DesignerWindow(QMainWindow):
         station = self.context.station
         if station is not None:
             doc.station, doc.allow_outside = station.folder, station.allow_outside
+        doc.tags = self.context.tags
         archive = station.Archive if station is not None and station.Archive.is_file() else None
         return Design(doc, self.context.names, archive, self)
 
@@ -109,8 +113,11 @@ class DesignerWindow(QMainWindow):
         star = "" if self.design.undo.isClean() else "*"
         self.setWindowTitle(f"{self.design.doc.path.name}{star} - NetPlc form designer")
 
-    def _problem_count(self, n: int) -> None:
-        self.problems_label.setText(f"{n} problem(s): see Problems" if n else "No problems")
+    def _problem_count(self, n: int, warned: int = 0) -> None:
+        text = f"{n} problem(s): see Problems" if n else "No problems"
+        if warned:
+            text += self.tr(", {0} warning(s)").format(warned)
+        self.problems_label.setText(text)
 
     def _dock(self, title: str, widget: QWidget, area: Qt.DockWidgetArea) -> QDockWidget:
         dock = QDockWidget(title, self)
@@ -204,12 +211,20 @@ class DesignerWindow(QMainWindow):
         self._rebind_undo()
 
     def add(self, kind: str) -> None:
-        """Edit -> Add element: the new element near the top left of what the canvas shows, each
-        next one a little further down, so a series of adds does not pile up."""
+        """Edit -> Add element."""
+        self.design.add(kind, self._next_place())
+
+    def add_tag(self, name: str) -> None:
+        """A double-clicked tag of the tag browser: its element."""
+        self.design.add_tag(name, self._next_place())
+
+    def _next_place(self) -> QPointF:
+        """Near the top left of what the canvas shows, each next one a little further down, so a
+        series of adds does not pile up."""
         seen = self.canvas.mapToScene(self.canvas.viewport().rect()).boundingRect()
         n = len(self.design.doc.elements) % 10
         step = 2 * self.design.grid * (n + 1)
-        self.design.add(kind, QPointF(max(seen.left(), 0) + step, max(seen.top(), 0) + step))
+        return QPointF(max(seen.left(), 0) + step, max(seen.top(), 0) + step)
 
     def _rebind_undo(self) -> None:
         """Undo and Redo follow this form's stack and name the step they would take."""
