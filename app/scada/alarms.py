@@ -380,7 +380,9 @@ class AlarmSystem:
         keep = hyst[frozen] if frozen is not None else None
         if len(self._lim_idx):
             x = self._lim_sign * (phy[self._lim_tag] - self._lim_limit)
-            hyst[self._lim_idx] = (x >= 0) | (hyst[self._lim_idx] & (x >= -self._lim_db))
+            # the deadband keeps an alarm that is on (after its on delay) from returning; a condition
+            # still waiting out its on delay ends below the limit itself (not raised at 89.9 % of 90)
+            hyst[self._lim_idx] = (x >= 0) | (self._cond[self._lim_idx] & (x >= -self._lim_db))
         if len(self._disc_idx):
             hyst[self._disc_idx] = phy[self._disc_tag] == self._disc_when
         if len(self._q_idx):
