@@ -119,7 +119,8 @@ def test_an_on_delay_alarm_is_not_raised_when_its_condition_cleared_before_the_d
     r.level(89.9)
     assert r.scan(9) == [] and r.scan(11) == []
     r.level(87.5)
-    assert r.scan(12) == [] and r.scan(13) == [("LEVEL.H", "active-unacknowledged", "returned-unacknowledged")]
+    assert r.scan(12) == []
+    assert r.scan(13) == [("LEVEL.H", "active-unacknowledged", "returned-unacknowledged")]
 
 
 def test_high_high_and_low_low_are_alarms_of_their_own() -> None:
