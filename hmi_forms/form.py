@@ -288,8 +288,7 @@ class _Loader:
         if self.fatal > before:
             return None
         element = cls(**values)
-        if isinstance(element, Scaled):
-            element.take_tag(raw, self.ctx.tags)
+        element.take_tag(raw, self.ctx.tags)
         problems = element.check(self.ctx)
         for key, text in problems:
             self.problem(where, key, text)

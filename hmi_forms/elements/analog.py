@@ -27,13 +27,14 @@ from collections.abc import Mapping
 from dataclasses import dataclass, field
 from functools import cached_property
 from operator import attrgetter
-from typing import Any, ClassVar
+from typing import Any
 
 from app.scada.table import TagTable
+from app.scada.tag import Tag
 from hmi_forms.elements import props as p
 from hmi_forms.elements.base import Element, Reader, Writer, word_reader
 from hmi_forms.elements.trend import Trend
-from netplc.address import IO_BITS
+from netplc.address import IO_BITS, fmt_octal
 from netplc.memory import Snapshot
 
 logger = logging.getLogger(__name__)
@@ -72,20 +73,14 @@ class Scaled(Element):
     Units: str = field(default="", metadata=p.prop(p.text))
 
     scaling: p.Scaling = field(default=p.Scaling(0, 1, 0, 1), init=False)
-    tag: str = field(default="", init=False)  # the tag of tags.csv the element's address names
     shown: Shown = field(default=UNKNOWN, init=False)  # what its word shows now
 
-    ADDRESS_KEYS: ClassVar[tuple[str, ...]] = ("InAddr", "Address", "OutAddr")  # where a tag is named
-
-    def take_tag(self, raw: Mapping[str, Any], tags: TagTable) -> None:
+    def take_tag(self, raw: Mapping[str, Any], tags: TagTable) -> Tag | None:
         """Fill from the tag named by the element's address what the form's `raw` properties leave
         out (the loader calls it before `check`)."""
-        named = (raw.get(k) for k in self.ADDRESS_KEYS)
-        name = next((v for v in named if isinstance(v, str) and v in tags.by_name), None)
-        if name is None:
-            return
-        tag = tags.by_name[name]
-        self.tag = tag.name
+        tag = super().take_tag(raw, tags)
+        if tag is None:
+            return None
         ranges = ("Device", "AppMin", "AppMax", "PhyMin", "PhyMax")
         if not any(k in raw for k in ranges):
             lo, hi = tag.limits
@@ -101,6 +96,7 @@ class Scaled(Element):
                 self.PhyLow = alarms.l
             if "PhyHigh" not in raw and alarms.h is not None:
                 self.PhyHigh = alarms.h
+        return tag
 
     def disagreements(self, raw: Mapping[str, Any], tags: TagTable) -> list[tuple[str, str]]:
         """Where the form's own conversion or unit (`raw`, checked) contradicts the tag the element
@@ -351,9 +347,10 @@ class AnalogOutput(Scaled, Writer):
             return False, f"{entry.strip()} is out of range {self.format(lo)} … {self.format(hi)}{units}"
         hw = self.scaling.to_hw(phy)
         assert self.OutAddr is not None
-        if why := self.refused(f"{self.Name} \u2192 {self.format(self.scaling.to_phy(hw))}{units}"):
+        label = self.label or fmt_octal(self.OutAddr)
+        if why := self.refused(f"{label} \u2192 {self.format(self.scaling.to_phy(hw))}{units}"):
             return False, why
         if self.target is not None and (why := self.target.write_word(
-                self.OutAddr, hw, user=self.user, label=self.Name, at_least=self.Role)) is not None:
+                self.OutAddr, hw, user=self.user, label=self.label or None, at_least=self.Role)) is not None:
             return False, why
         return True, f"Set to {self.format(self.scaling.to_phy(hw))}{units}"

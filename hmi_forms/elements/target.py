@@ -73,14 +73,14 @@ class EngineTarget:
         tag = self._bits.get(addr)
         ticket = self.commands.write_bit(self.who(user), addr, value, label=_named(label, tag),
                                          at_least=at_least)
-        return self._told(ticket, label or fmt_octal(addr))
+        return self._told(ticket, _said(label, tag, addr))
 
     def write_word(self, addr: int, value: int, *, user: str, label: str | None = None,
                    at_least: str | None = None) -> str | None:
         tag = self._words.get(addr)
         ticket = self.commands.write_word(self.who(user), addr, value, label=_named(label, tag),
                                           at_least=at_least, describe=tag.change if tag else None)
-        return self._told(ticket, label or fmt_octal(addr))
+        return self._told(ticket, _said(label, tag, addr))
 
     def _told(self, ticket: Ticket, what: str) -> str | None:
         if self.on_answer is not None:
@@ -102,9 +102,16 @@ ONE_WORD = (TagType.WORD, TagType.INT16, TagType.BCD)
 
 
 def _named(label: str | None, tag: Tag | None) -> str | None:
+    """The element's label with the tag's name; without a label, the tag's description."""
     if tag is None:
         return label
-    return f"{label} {tag.name}" if label else tag.name
+    return f"{label or tag.description} {tag.name}".strip()
+
+
+def _said(label: str | None, tag: Tag | None, addr: int) -> str:
+    """What the operator is told a refusal was about: the element's label, else its tag's
+    description or name, else the address."""
+    return label or (tag.description or tag.name if tag is not None else "") or fmt_octal(addr)
 
 
 class NullTarget:

@@ -167,7 +167,7 @@ def test_an_element_asks_when_the_form_says_confirm_and_checks_its_role(qtbot, c
     model.Confirm = True
     console.ask = no = Answers(False)
     assert model.click() is False
-    assert no.asked == ["Confirm: Пуск \u2192 1?"]
+    assert no.asked == ["Confirm: Пуск \u2192 Пуск (1)?"]  # the state in the element's words
     qtbot.wait(300)
     assert engine.snapshot.get_hmi_bit(START_BIT) == 0
     console.ask = Answers(True)
