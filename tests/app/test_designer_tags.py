@@ -107,3 +107,25 @@ def test_check_and_the_problems_pane_warn_of_a_contradicting_conversion(
     flagged = [i.raw.get("Name") for i in w.design.items.values() if i.flagged]
     assert len(flagged) == 1
     assert "warning" in w.problems_label.text()
+
+
+def test_the_canvas_shows_the_tags_alarm_zones_and_unit_under_a_gauge(qtbot: QtBot, demo_copy: Path) -> None:
+    from PySide6.QtGui import QColor, QImage, QPainter
+    from PySide6.QtWidgets import QStyleOptionGraphicsItem
+
+    w = make_window(qtbot, demo_copy / "forms" / "02_analog.hmi")
+    raw = w.design.add_tag("TEMP")
+    item = w.design.items[id(raw)]
+    w.design.select([])  # no selection outline or handles over the band
+    image = QImage(int(raw["w"]), int(raw["h"]), QImage.Format.Format_ARGB32)
+    image.fill(QColor("#ffffff"))
+    painter = QPainter(image)
+    item.paint(painter, QStyleOptionGraphicsItem(), None)
+    painter.end()
+    y = image.height() - 3
+
+    def at(fraction: float) -> str:
+        return image.pixelColor(int(fraction * (image.width() - 1)), y).name()
+
+    # TEMP: -50..150 °C, H 120 (amber from 0.85), HH 140 (red from 0.95)
+    assert (at(0.5), at(0.9), at(0.98)) == ("#c8d2dc", "#f2a900", "#d32f2f")
