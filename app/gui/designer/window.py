@@ -114,7 +114,7 @@ class DesignerWindow(QMainWindow):
         self.setWindowTitle(f"{self.design.doc.path.name}{star} - NetPlc form designer")
 
     def _problem_count(self, n: int, warned: int = 0) -> None:
-        text = f"{n} problem(s): see Problems" if n else "No problems"
+        text = self.tr("{0} problem(s): see Problems").format(n) if n else self.tr("No problems")
         if warned:
             text += self.tr(", {0} warning(s)").format(warned)
         self.problems_label.setText(text)

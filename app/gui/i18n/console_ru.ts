@@ -89,10 +89,6 @@
         <translation>Состояние</translation>
     </message>
     <message>
-        <source>Value</source>
-        <translation>Значение</translation>
-    </message>
-    <message>
         <source>Text</source>
         <translation>Текст</translation>
     </message>
@@ -100,12 +96,35 @@
         <source>shelved by {0} until {1}: {2}</source>
         <translation>отложена ({0}) до {1}: {2}</translation>
     </message>
+    <message>
+        <source>Value at change</source>
+        <translation>Значение при изменении</translation>
+    </message>
+    <message>
+        <source>The value when the alarm last changed state, not the value now</source>
+        <translation>Значение в момент последнего изменения состояния аварии, а не текущее</translation>
+    </message>
 </context>
 <context>
     <name>DateTimeWidget</name>
     <message>
         <source>since start {0}</source>
         <translation>с пуска {0}</translation>
+    </message>
+</context>
+<context>
+    <name>DesignerWindow</name>
+    <message>
+        <source>, {0} warning(s)</source>
+        <translation>, предупреждений: {0}</translation>
+    </message>
+    <message>
+        <source>{0} problem(s): see Problems</source>
+        <translation>проблем: {0} (см. «Проблемы»)</translation>
+    </message>
+    <message>
+        <source>No problems</source>
+        <translation>Проблем нет</translation>
     </message>
 </context>
 <context>
@@ -363,6 +382,74 @@
     </message>
 </context>
 <context>
+    <name>Palette</name>
+    <message>
+        <source>pulses on OutAddr: scan mod Period = Phase (Fig. 2.4.3)</source>
+        <translation>импульсы на OutAddr: скан mod Period = Phase (рис. 2.4.3)</translation>
+    </message>
+    <message>
+        <source>a sync generator enabled by Ainput</source>
+        <translation>генератор синхронизации, разрешаемый Ainput</translation>
+    </message>
+    <message>
+        <source>a bit as text, image, lamp; a button when Enabled</source>
+        <translation>бит как текст, картинка, лампа; кнопка при Enabled</translation>
+    </message>
+    <message>
+        <source>a bit with colours per state</source>
+        <translation>бит с цветами по состояниям</translation>
+    </message>
+    <message>
+        <source>its state only while EnableAddr is 1</source>
+        <translation>состояние только пока EnableAddr = 1</translation>
+    </message>
+    <message>
+        <source>cycles ImageFirst..ImageLast while the bit is 1</source>
+        <translation>перебирает ImageFirst..ImageLast, пока бит = 1</translation>
+    </message>
+    <message>
+        <source>a tag's value with its unit: digital, bar, dial, graph</source>
+        <translation>значение тега с единицей: цифры, полоса, шкала, график</translation>
+    </message>
+    <message>
+        <source>the operator's setpoint, converted and written</source>
+        <translation>уставка оператора: пересчитывается и записывается</translation>
+    </message>
+    <message>
+        <source>a picture from the form's folder</source>
+        <translation>картинка из папки формы</translation>
+    </message>
+    <message>
+        <source>a caption</source>
+        <translation>надпись</translation>
+    </message>
+    <message>
+        <source>a bit trend, one sample per scan</source>
+        <translation>тренд бита, одна точка за скан</translation>
+    </message>
+    <message>
+        <source>the archive's records of a day</source>
+        <translation>записи архива за день</translation>
+    </message>
+    <message>
+        <source>time, date and the time since start</source>
+        <translation>время, дата и время с пуска</translation>
+    </message>
+    <message>
+        <source>{0}: {1}
+Drag onto the form, or double-click to add</source>
+        <translation>{0}: {1}
+Перетащите на форму или дважды щёлкните, чтобы добавить</translation>
+    </message>
+</context>
+<context>
+    <name>ProblemsPane</name>
+    <message>
+        <source>warning: {0}</source>
+        <translation>предупреждение: {0}</translation>
+    </message>
+</context>
+<context>
     <name>ShelveDialog</name>
     <message>
         <source>Shelve {0}</source>
@@ -383,6 +470,34 @@
     <message>
         <source>Reason</source>
         <translation>Причина</translation>
+    </message>
+    <message>
+        <source>Maintenance of the instrument</source>
+        <translation>Обслуживание прибора</translation>
+    </message>
+    <message>
+        <source>Instrument faulty, repair requested</source>
+        <translation>Прибор неисправен, ремонт заказан</translation>
+    </message>
+    <message>
+        <source>Nuisance: chattering alarm</source>
+        <translation>Ложная: дребезг аварии</translation>
+    </message>
+    <message>
+        <source>Start-up or shut-down of the unit</source>
+        <translation>Пуск или останов установки</translation>
+    </message>
+    <message>
+        <source>Known condition, under observation</source>
+        <translation>Известное состояние, под наблюдением</translation>
+    </message>
+    <message>
+        <source>Choose a usual reason…</source>
+        <translation>Выберите типовую причину…</translation>
+    </message>
+    <message>
+        <source>Give the reason for shelving: it is journaled with your name.</source>
+        <translation>Укажите причину отключения: она записывается в журнал с вашим именем.</translation>
     </message>
 </context>
 <context>
@@ -462,6 +577,25 @@
     <message>
         <source>no link to node {0} ({1})</source>
         <translation>нет связи с узлом {0} ({1})</translation>
+    </message>
+</context>
+<context>
+    <name>TagBrowser</name>
+    <message>
+        <source>Search tags: name, description, unit</source>
+        <translation>Поиск тегов: имя, описание, единица</translation>
+    </message>
+    <message>
+        <source>{0} ({1}{2}): no form element shows this type</source>
+        <translation>{0} ({1}{2}): ни один элемент формы не показывает этот тип</translation>
+    </message>
+    <message>
+        <source>{0} ({1}{2}): drag onto the form for a {3} bound to it</source>
+        <translation>{0} ({1}{2}): перетащите на форму, чтобы создать привязанный к нему {3}</translation>
+    </message>
+    <message>
+        <source>The station has no tags (tags.csv)</source>
+        <translation>У станции нет тегов (tags.csv)</translation>
     </message>
 </context>
 <context>
