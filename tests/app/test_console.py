@@ -365,7 +365,7 @@ def test_refusals_roles_and_alarms_speak_russian_too(qtbot, russian, demo_copy: 
         summary = window.summary
         heads = [summary.model.headerData(i, Qt.Orientation.Horizontal, Qt.ItemDataRole.DisplayRole)
                  for i in range(6)]
-        assert heads == ["Приоритет", "Время", "Авария", "Состояние", "Значение", "Текст"]
+        assert heads == ["Приоритет", "Время", "Авария", "Состояние", "Значение при изменении", "Текст"]
         assert summary.counts[1].text().startswith("P1 критическая: ")
         assert summary.shelve.text() == "Отложить…" and window.summary_dock.windowTitle().startswith("Аварии")
         shown = (State.UNACK, State.ACKED, State.RTNUN, State.SHELVED, State.SUPPRESSED, State.OUT_OF_SERVICE)
