@@ -59,11 +59,35 @@ def icon(kind: str) -> QIcon:
     return QIcon(pixmap)
 
 
-class Palette(QListWidget):
-    def __init__(self, add: Callable[[str], object], parent: QWidget | None = None) -> None:
+class DragList(QListWidget):
+    """A list whose entries are dragged onto the canvas as `mime`, each carrying its UserRole text
+    (an element type, a tag's name); a double-click calls `add` with it, if it may be dragged."""
+
+    def __init__(self, mime: str, add: Callable[[str], object], parent: QWidget | None = None) -> None:
         super().__init__(parent)
+        self.mime = mime
         self.setDragEnabled(True)
         self.setDragDropMode(QAbstractItemView.DragDropMode.DragOnly)
+        self.itemDoubleClicked.connect(lambda item: self._add(item, add))
+
+    @staticmethod
+    def _add(item: QListWidgetItem, add: Callable[[str], object]) -> None:
+        if item.flags() & Qt.ItemFlag.ItemIsDragEnabled:
+            add(item.data(Qt.ItemDataRole.UserRole))
+
+    def mimeTypes(self) -> list[str]:
+        return [self.mime]
+
+    def mimeData(self, items: list[QListWidgetItem]) -> QMimeData:
+        data = QMimeData()
+        if items:
+            data.setData(self.mime, items[0].data(Qt.ItemDataRole.UserRole).encode())
+        return data
+
+
+class Palette(DragList):
+    def __init__(self, add: Callable[[str], object], parent: QWidget | None = None) -> None:
+        super().__init__(ELEMENT_MIME, add, parent)
         self.setIconSize(QSize(ICON, ICON))
         self.setWordWrap(True)
         for kind in ELEMENT_TYPES:
@@ -73,13 +97,3 @@ class Palette(QListWidget):
             tip = self.tr("{0}: {1}\nDrag onto the form, or double-click to add")
             item.setToolTip(tip.format(kind, hint))
             self.addItem(item)
-        self.itemDoubleClicked.connect(lambda item: add(item.data(Qt.ItemDataRole.UserRole)))
-
-    def mimeTypes(self) -> list[str]:
-        return [ELEMENT_MIME]
-
-    def mimeData(self, items: list[QListWidgetItem]) -> QMimeData:
-        data = QMimeData()
-        if items:
-            data.setData(ELEMENT_MIME, items[0].data(Qt.ItemDataRole.UserRole).encode())
-        return data

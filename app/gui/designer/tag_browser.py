@@ -8,11 +8,9 @@ from __future__ import annotations
 
 from collections.abc import Callable
 
-from PySide6.QtCore import QMimeData, Qt
+from PySide6.QtCore import Qt
 from PySide6.QtWidgets import (
-    QAbstractItemView,
     QLineEdit,
-    QListWidget,
     QListWidgetItem,
     QVBoxLayout,
     QWidget,
@@ -20,6 +18,7 @@ from PySide6.QtWidgets import (
 
 from app.gui.designer.canvas import TAG_MIME
 from app.gui.designer.design import TAG_ELEMENTS
+from app.gui.designer.palette import DragList
 from app.scada.table import TagTable
 from app.scada.tag import Tag
 
@@ -28,28 +27,6 @@ def matches(tag: Tag, words: str) -> bool:
     """Every word of the search in the tag's name, description, unit or type (any case)."""
     text = f"{tag.name} {tag.description} {tag.unit} {tag.type}".casefold()
     return all(w in text for w in words.casefold().split())
-
-
-class TagList(QListWidget):
-    def __init__(self, add: Callable[[str], object], parent: QWidget | None = None) -> None:
-        super().__init__(parent)
-        self.setDragEnabled(True)
-        self.setDragDropMode(QAbstractItemView.DragDropMode.DragOnly)
-        self.itemDoubleClicked.connect(lambda item: self._add(item, add))
-
-    @staticmethod
-    def _add(item: QListWidgetItem, add: Callable[[str], object]) -> None:
-        if item.flags() & Qt.ItemFlag.ItemIsDragEnabled:
-            add(item.data(Qt.ItemDataRole.UserRole))
-
-    def mimeTypes(self) -> list[str]:
-        return [TAG_MIME]
-
-    def mimeData(self, items: list[QListWidgetItem]) -> QMimeData:
-        data = QMimeData()
-        if items:
-            data.setData(TAG_MIME, items[0].data(Qt.ItemDataRole.UserRole).encode())
-        return data
 
 
 class TagBrowser(QWidget):
@@ -61,7 +38,7 @@ class TagBrowser(QWidget):
         self.search = QLineEdit()
         self.search.setPlaceholderText(self.tr("Search tags: name, description, unit"))
         self.search.setClearButtonEnabled(True)
-        self.list = TagList(add)
+        self.list = DragList(TAG_MIME, add)
         layout = QVBoxLayout(self)
         layout.setContentsMargins(0, 0, 0, 0)
         layout.addWidget(self.search)
