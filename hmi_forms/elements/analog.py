@@ -331,6 +331,11 @@ class AnalogOutput(Scaled, Writer):
         self.shown = self.shows(hw)
         return True
 
+    def change(self, old: int, new: int) -> str:
+        """A write of its word as the journal says it: the physical values and unit ("20.0 -> 50.0 °C")."""
+        units = f" {self.Units}" if self.Units else ""
+        return f"{self.format(self.scaling.to_phy(old))} -> {self.format(self.scaling.to_phy(new))}{units}"
+
     def submit(self, entry: str) -> tuple[bool, str]:
         """Validate the operator's entry and write it; returns (accepted, message to show)."""
         lo, hi = self.scaling.phy_range
@@ -351,6 +356,7 @@ class AnalogOutput(Scaled, Writer):
         if why := self.refused(f"{label} \u2192 {self.format(self.scaling.to_phy(hw))}{units}"):
             return False, why
         if self.target is not None and (why := self.target.write_word(
-                self.OutAddr, hw, user=self.user, label=self.label or None, at_least=self.Role)) is not None:
+                self.OutAddr, hw, user=self.user, label=self.label or None, at_least=self.Role,
+                describe=self.change)) is not None:
             return False, why
         return True, f"Set to {self.format(self.scaling.to_phy(hw))}{units}"

@@ -32,13 +32,15 @@ logger = logging.getLogger(__name__)
 class Target(Protocol):
     """`write_*` return why the write was refused at once (a sentence for the operator: the role,
     a full queue), or None once it is sent; `at_least` is the element's Role, which may ask more
-    than the station's policy, never less."""
+    than the station's policy, never less; `describe(old, new)` says a word's change in physical
+    terms for the journal when no tag does (an element's own conversion)."""
 
     def write_bit(self, addr: int, value: int, *, user: str, label: str | None = None,
                   at_least: str | None = None) -> str | None: ...
 
     def write_word(self, addr: int, value: int, *, user: str, label: str | None = None,
-                   at_least: str | None = None) -> str | None: ...
+                   at_least: str | None = None,
+                   describe: Callable[[int, int], str] | None = None) -> str | None: ...
 
 
 class Effects(Protocol):
@@ -76,10 +78,11 @@ class EngineTarget:
         return self._told(ticket, _said(label, tag, addr))
 
     def write_word(self, addr: int, value: int, *, user: str, label: str | None = None,
-                   at_least: str | None = None) -> str | None:
+                   at_least: str | None = None,
+                   describe: Callable[[int, int], str] | None = None) -> str | None:
         tag = self._words.get(addr)
         ticket = self.commands.write_word(self.who(user), addr, value, label=_named(label, tag),
-                                          at_least=at_least, describe=tag.change if tag else None)
+                                          at_least=at_least, describe=tag.change if tag else describe)
         return self._told(ticket, _said(label, tag, addr))
 
     def _told(self, ticket: Ticket, what: str) -> str | None:
@@ -122,5 +125,6 @@ class NullTarget:
         return None
 
     def write_word(self, addr: int, value: int, *, user: str, label: str | None = None,
-                   at_least: str | None = None) -> str | None:
+                   at_least: str | None = None,
+                   describe: Callable[[int, int], str] | None = None) -> str | None:
         return None
