@@ -36,7 +36,10 @@ def test_a_new_gauge_on_temp_shows_the_tags_value(qtbot: QtBot, demo_copy: Path)
     assert not {"AppMin", "AppMax", "PhyMin", "PhyMax", "Device"} & set(raw)  # none of its own
     w.properties.commit("InAddr", "TEMP")
     raw = w.design.doc.elements[-1]
-    assert raw["InAddr"] == "TEMP"
+    assert raw["InAddr"] == "TEMP" and raw["Name"] == "Температура 1"  # named by the tag, one step
+    w.design.undo.undo()
+    assert "InAddr" not in raw and raw["Name"] == "AnalogBase"
+    w.design.undo.redo()
     item = w.design.items[id(raw)]
     assert item.problems == [] and item.model is not None
     w.design.show_snapshot(temperature(990))  # 148 °C by the tag (the bug showed 24.2 with 0..4095)

@@ -274,6 +274,17 @@ class Design(QObject):
                        f"Add {kind} of {tag.name}")
         return raw
 
+    def named_by_tag(self, raw: dict[str, Any], key: str, value: Any) -> dict[str, Any]:
+        """Binding an element that still has its type's name (`AnalogBase 2`) to a tag also names it
+        by the tag's description, as a tag dropped from the browser is: its face and the operator's
+        confirmations then say what it shows. {} for anything else."""
+        tag = self.doc.tags.get(value) if isinstance(value, str) else None
+        kind = raw.get("type")
+        stem = str(raw.get("Name", "")).rstrip("0123456789").rstrip()
+        if tag is None or key not in Element.ADDRESS_KEYS or stem not in ("", kind):
+            return {}
+        return {"Name": self.unique_name(tag.description or tag.name)}
+
     def delete(self, raws: list[dict[str, Any]]) -> None:
         if raws:
             self.undo.push(Remove(self, raws, f"Delete {len(raws)} element(s)"))

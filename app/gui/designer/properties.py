@@ -205,7 +205,8 @@ class PropertyPanel(QWidget):
         if isinstance(value, tuple):
             self._add_image(key, value[1], targets)
             return
-        self.design.set_props([(t, {key: value}) for t in targets], f"Set {key}")
+        named = self.design.named_by_tag(targets[0], key, value) if len(targets) == 1 else {}
+        self.design.set_props([(t, {key: value, **named}) for t in targets], f"Set {key}")
 
     def _images(self) -> list[Any]:
         """The form's images list (none while the section is not a list: a problem to fix first)."""
