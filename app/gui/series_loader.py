@@ -29,6 +29,8 @@ Window = tuple[float, float]  # [since, until): seconds since the epoch
 # the record each start of a station writes (app/station/runtime.py): a series breaks there
 RESTARTS = Filter(kinds=frozenset({"system"}), source="station", text="station starting")
 MAX_RESTARTS = 1000  # of one day
+DAY_S = 86_400
+MAX_ZOOM = 50  # a window narrower than a 50th of the day reads no more than 50 times the points
 
 
 def cut(ts: np.ndarray, values: np.ndarray, window: Window | None,
@@ -54,6 +56,14 @@ class SeriesLoader(Worker):
         super().__init__("series", (sqlite3.Error, OSError, ArchiveError), parent)
         self.points = points
 
+    def points_for(self, window: Window | None) -> int:
+        """As many points over the day as keep `points` within the window: the day is reduced in
+        equal time buckets, and a window of an hour would otherwise keep a 24th of them."""
+        if window is None:
+            return self.points
+        share = max((window[1] - window[0]) / DAY_S, 1 / MAX_ZOOM)
+        return round(self.points / min(share, 1.0))
+
     def request(self, path: str | Path, day: dt.date, key: SeriesKey,
                 topic: Hashable | None = None, window: Window | None = None) -> int:
         """Queue a read of `key` on `day` within `window` (superseding the last one of `topic`, if
@@ -66,6 +76,6 @@ class SeriesLoader(Worker):
         restarts = RESTARTS if key.station is None else replace(RESTARTS, stations=frozenset({key.station}))
         with Archive(path) as archive:
             ts, values = archive.series(day, grp=key.grp, type=key.type, source=key.source,
-                                        points=self.points, **of_station)
+                                        points=self.points_for(window), **of_station)
             starts = [r.ts for r in archive.records(day, restarts, 0, MAX_RESTARTS, newest_first=False)]
         return key, *cut(ts, values, window, starts)
