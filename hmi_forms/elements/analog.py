@@ -137,7 +137,8 @@ class Scaled(Element):
             return []
         missing = [k for k, v in inline.items() if v is None]
         if len(missing) == 4:
-            return [("Device", "missing: give a Device or AppMin, AppMax, PhyMin and PhyMax")]
+            return [("Device", "missing: name a tag as the address (its conversion is taken), or give a "
+                                "Device or AppMin, AppMax, PhyMin and PhyMax")]
         if missing:
             return [(k, "missing (needed with the other range properties)") for k in missing]
         problems = scaling_problems(inline)
