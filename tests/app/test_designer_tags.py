@@ -132,3 +132,22 @@ def test_the_canvas_shows_the_tags_alarm_zones_and_unit_under_a_gauge(qtbot: QtB
 
     # TEMP: -50..150 °C, H 120 (amber from 0.85), HH 140 (red from 0.95)
     assert (at(0.5), at(0.9), at(0.98)) == ("#c8d2dc", "#f2a900", "#d32f2f")
+
+
+def test_the_designer_speaks_russian(qtbot: QtBot, demo_copy: Path) -> None:
+    from PySide6.QtWidgets import QApplication
+
+    from app.gui import i18n
+
+    app = QApplication.instance()
+    assert isinstance(app, QApplication)
+    i18n.install(app, "ru")
+    try:
+        w = make_window(qtbot, demo_copy / "forms" / "02_analog.hmi")
+        assert [a.text() for a in w.menuBar().actions()] == ["&Файл", "&Правка", "&Упорядочить", "&Вид"]
+        assert w.tag_browser.search.placeholderText().startswith("Поиск тегов")
+        hints = [w.palette.item(i).text() for i in range(w.palette.count())]
+        assert "StaticText\nнадпись" in hints
+        assert w.windowTitle() == "02_analog.hmi — конструктор форм NetPlc"
+    finally:
+        i18n.uninstall(app)

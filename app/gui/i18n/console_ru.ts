@@ -126,6 +126,238 @@
         <source>No problems</source>
         <translation>Проблем нет</translation>
     </message>
+    <message>
+        <source>&amp;Arrange</source>
+        <translation>&amp;Упорядочить</translation>
+    </message>
+    <message>
+        <source>&amp;Copy</source>
+        <translation>&amp;Копировать</translation>
+    </message>
+    <message>
+        <source>&amp;Delete</source>
+        <translation>&amp;Удалить</translation>
+    </message>
+    <message>
+        <source>&amp;Edit</source>
+        <translation>&amp;Правка</translation>
+    </message>
+    <message>
+        <source>&amp;File</source>
+        <translation>&amp;Файл</translation>
+    </message>
+    <message>
+        <source>&amp;New form…</source>
+        <translation>&amp;Новая форма…</translation>
+    </message>
+    <message>
+        <source>&amp;Paste</source>
+        <translation>&amp;Вставить</translation>
+    </message>
+    <message>
+        <source>&amp;Preview live</source>
+        <translation>&amp;Живой просмотр</translation>
+    </message>
+    <message>
+        <source>&amp;Redo {0}</source>
+        <translation>&amp;Повторить {0}</translation>
+    </message>
+    <message>
+        <source>&amp;Redo</source>
+        <translation>&amp;Повторить</translation>
+    </message>
+    <message>
+        <source>&amp;Save</source>
+        <translation>&amp;Сохранить</translation>
+    </message>
+    <message>
+        <source>&amp;Undo {0}</source>
+        <translation>&amp;Отменить {0}</translation>
+    </message>
+    <message>
+        <source>&amp;Undo</source>
+        <translation>&amp;Отменить</translation>
+    </message>
+    <message>
+        <source>Actual size</source>
+        <translation>Реальный размер</translation>
+    </message>
+    <message>
+        <source>Add &amp;element</source>
+        <translation>Добавить &amp;элемент</translation>
+    </message>
+    <message>
+        <source>Cu&amp;t</source>
+        <translation>Вы&amp;резать</translation>
+    </message>
+    <message>
+        <source>Designer</source>
+        <translation>Конструктор</translation>
+    </message>
+    <message>
+        <source>Discard the unsaved changes of this form?</source>
+        <translation>Отбросить несохранённые изменения формы?</translation>
+    </message>
+    <message>
+        <source>Distribute horizontally</source>
+        <translation>Распределить по горизонтали</translation>
+    </message>
+    <message>
+        <source>Distribute vertically</source>
+        <translation>Распределить по вертикали</translation>
+    </message>
+    <message>
+        <source>Elements</source>
+        <translation>Элементы</translation>
+    </message>
+    <message>
+        <source>Form designer</source>
+        <translation>Конструктор форм</translation>
+    </message>
+    <message>
+        <source>Forms (*.hmi)</source>
+        <translation>Формы (*.hmi)</translation>
+    </message>
+    <message>
+        <source>Forms of the station</source>
+        <translation>Формы станции</translation>
+    </message>
+    <message>
+        <source>Grid size…</source>
+        <translation>Шаг сетки…</translation>
+    </message>
+    <message>
+        <source>Grid step, pixels:</source>
+        <translation>Шаг сетки, пикселей:</translation>
+    </message>
+    <message>
+        <source>Grid</source>
+        <translation>Сетка</translation>
+    </message>
+    <message>
+        <source>New form</source>
+        <translation>Новая форма</translation>
+    </message>
+    <message>
+        <source>No station with a Modbus server beside this form</source>
+        <translation>Рядом с формой нет станции с сервером Modbus</translation>
+    </message>
+    <message>
+        <source>Open form</source>
+        <translation>Открыть форму</translation>
+    </message>
+    <message>
+        <source>Problems</source>
+        <translation>Проблемы</translation>
+    </message>
+    <message>
+        <source>Properties</source>
+        <translation>Свойства</translation>
+    </message>
+    <message>
+        <source>Save &amp;as…</source>
+        <translation>Сохранить &amp;как…</translation>
+    </message>
+    <message>
+        <source>Save form as</source>
+        <translation>Сохранить форму как</translation>
+    </message>
+    <message>
+        <source>Saved {0}</source>
+        <translation>Сохранено: {0}</translation>
+    </message>
+    <message>
+        <source>Select &amp;all</source>
+        <translation>Выделить &amp;всё</translation>
+    </message>
+    <message>
+        <source>Show grid</source>
+        <translation>Показывать сетку</translation>
+    </message>
+    <message>
+        <source>Snap to &amp;grid</source>
+        <translation>Привязка к &amp;сетке</translation>
+    </message>
+    <message>
+        <source>Tags</source>
+        <translation>Теги</translation>
+    </message>
+    <message>
+        <source>The form was not saved: {0}</source>
+        <translation>Форма не сохранена: {0}</translation>
+    </message>
+    <message>
+        <source>Zoom in</source>
+        <translation>Увеличить</translation>
+    </message>
+    <message>
+        <source>Zoom out</source>
+        <translation>Уменьшить</translation>
+    </message>
+    <message>
+        <source>{0} - NetPlc form designer</source>
+        <translation>{0} — конструктор форм NetPlc</translation>
+    </message>
+    <message>
+        <source>{0} problem(s), see Problems: the station will not open the form. Save anyway?</source>
+        <translation>Проблем: {0} (см. «Проблемы»): станция не откроет эту форму. Всё равно сохранить?</translation>
+    </message>
+    <message>
+        <source>The station serves Modbus RTU on a serial port; the preview reads Modbus TCP</source>
+        <translation>Станция отдаёт Modbus RTU через последовательный порт, а просмотр читает Modbus TCP</translation>
+    </message>
+    <message>
+        <source>Align left</source>
+        <translation>Выровнять по левому краю</translation>
+    </message>
+    <message>
+        <source>Align right</source>
+        <translation>Выровнять по правому краю</translation>
+    </message>
+    <message>
+        <source>Align top</source>
+        <translation>Выровнять по верху</translation>
+    </message>
+    <message>
+        <source>Align bottom</source>
+        <translation>Выровнять по низу</translation>
+    </message>
+    <message>
+        <source>Centre horizontally</source>
+        <translation>Центрировать по горизонтали</translation>
+    </message>
+    <message>
+        <source>Centre vertically</source>
+        <translation>Центрировать по вертикали</translation>
+    </message>
+    <message>
+        <source>Bring to front</source>
+        <translation>На передний план</translation>
+    </message>
+    <message>
+        <source>Raise</source>
+        <translation>Поднять</translation>
+    </message>
+    <message>
+        <source>Lower</source>
+        <translation>Опустить</translation>
+    </message>
+    <message>
+        <source>Send to back</source>
+        <translation>На задний план</translation>
+    </message>
+    <message>
+        <source>&amp;Close</source>
+        <translation>&amp;Закрыть</translation>
+    </message>
+    <message>
+        <source>&amp;Open…</source>
+        <translation>&amp;Открыть…</translation>
+    </message>
+    <message>
+        <source>&amp;View</source>
+        <translation>&amp;Вид</translation>
+    </message>
 </context>
 <context>
     <name>DiscreteWidget</name>
