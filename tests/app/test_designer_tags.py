@@ -149,5 +149,9 @@ def test_the_designer_speaks_russian(qtbot: QtBot, demo_copy: Path) -> None:
         hints = [w.palette.item(i).text() for i in range(w.palette.count())]
         assert "StaticText\nнадпись" in hints
         assert w.windowTitle() == "02_analog.hmi — конструктор форм NetPlc"
+        assert w.properties.title.text() == "Форма 02_analog.hmi"
+        w.design.add("AnalogBase")
+        appearance = w.properties.editors["Appearance"]
+        assert appearance.combo.itemText(0) == "(по умолчанию)"  # type: ignore[attr-defined]
     finally:
         i18n.uninstall(app)

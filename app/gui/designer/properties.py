@@ -162,8 +162,8 @@ class PropertyPanel(QWidget):
         """Show the targets' current values (after an edit, an undo, a move)."""
         t = self.targets
         one = f'{t[0].get("type")} "{t[0].get("Name")}"'
-        self.title.setText(f"Form {self.design.doc.path.name}" if self.form_mode else
-                           one if len(t) == 1 else f"{len(t)} elements")
+        self.title.setText(self.tr("Form {0}").format(self.design.doc.path.name) if self.form_mode else
+                           one if len(t) == 1 else self.tr("{0} elements").format(len(t)))
         for key, editor in self.editors.items():
             values = [self._source(t, key).get(key, MISSING) for t in self.targets]
             mixed = any(v != values[0] for v in values[1:])

@@ -106,6 +106,24 @@
     </message>
 </context>
 <context>
+    <name>ColorEditor</name>
+    <message>
+        <source>Pick a colour</source>
+        <translation>Выбрать цвет</translation>
+    </message>
+    <message>
+        <source>Colour</source>
+        <translation>Цвет</translation>
+    </message>
+</context>
+<context>
+    <name>ComboEditor</name>
+    <message>
+        <source>(default)</source>
+        <translation>(по умолчанию)</translation>
+    </message>
+</context>
+<context>
     <name>DateTimeWidget</name>
     <message>
         <source>since start {0}</source>
@@ -364,6 +382,21 @@
     <message>
         <source>(indication off)</source>
         <translation>(индикация выключена)</translation>
+    </message>
+</context>
+<context>
+    <name>FontEditor</name>
+    <message>
+        <source>(default)</source>
+        <translation>(по умолчанию)</translation>
+    </message>
+    <message>
+        <source>Back to the default font</source>
+        <translation>Вернуть шрифт по умолчанию</translation>
+    </message>
+    <message>
+        <source>Font</source>
+        <translation>Шрифт</translation>
     </message>
 </context>
 <context>
@@ -675,10 +708,32 @@ Drag onto the form, or double-click to add</source>
     </message>
 </context>
 <context>
+    <name>Preview</name>
+    <message>
+        <source>Preview live: {0}</source>
+        <translation>Живой просмотр: {0}</translation>
+    </message>
+    <message>
+        <source>Preview: {0}</source>
+        <translation>Просмотр: {0}</translation>
+    </message>
+</context>
+<context>
     <name>ProblemsPane</name>
     <message>
         <source>warning: {0}</source>
         <translation>предупреждение: {0}</translation>
+    </message>
+</context>
+<context>
+    <name>PropertyPanel</name>
+    <message>
+        <source>Form {0}</source>
+        <translation>Форма {0}</translation>
+    </message>
+    <message>
+        <source>{0} elements</source>
+        <translation>элементов: {0}</translation>
     </message>
 </context>
 <context>
