@@ -172,7 +172,7 @@ class Element:
 
     def record(self, snap: Snapshot, kind: Kind, **fields: Any) -> None:
         if self.effects is not None:
-            self.effects.put(Record(snap.wall, kind, source=self.Name, **fields))
+            self.effects.put(Record(snap.wall, kind, source=self.label or self.Name, **fields))
 
 
 @dataclass(eq=False)

@@ -100,3 +100,15 @@ def test_a_setpoint_without_a_tag_journals_its_own_physical_values(tmp_path: Pat
     engine.scan()
     texts = [r.text for r in sink.records if r.kind == "operator"]
     assert texts == ["write 04030: 0.0 -> 130.0 °C (raw 1024 -> 3686 at 04030)"]
+
+
+def test_a_default_named_element_journals_by_its_tags_description(tmp_path: Path, tags) -> None:
+    from tests.hmi_forms.helpers import ListTarget
+
+    lamp = {"type": "DiscreteBase", "Name": "DiscreteBase 2", **BOX, "InAddr": "PUMP", "RegMessages": True,
+            "TextFalse": "стоп", "TextTrue": "работа"}
+    model = load_form(write_form(tmp_path, [lamp]), tags=tags).elements[0]
+    model.effects = effects = ListTarget()
+    model.update(snap())
+    model.update(snap(bits={0o40005: 1}))
+    assert [(r.source, r.text) for r in effects.records] == [("Насос", "работа")]
