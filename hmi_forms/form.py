@@ -75,6 +75,7 @@ class Form:
     images: list[Path | None] = field(default_factory=list)  # None: not shown (see props.Outside)
     elements: list[Element] = field(default_factory=list)
     problems: list[str] = field(default_factory=list)  # of a form that loads all the same
+    warnings: list[str] = field(default_factory=list)  # allowed, but contradicting the station's tags
 
 
 FORM_PROPS: dict[str, p.Parser] = {
@@ -118,6 +119,7 @@ class _Loader:
                  allow_outside: bool, tags: TagTable | None = None) -> None:
         self.path = path
         self.problems: list[str] = []
+        self.warnings: list[str] = []
         self.fatal = 0  # problems that stop the form from opening (the others only lose a picture)
         self.ctx = p.Context(symbols, path.parent, roots=(station,) if station else (),
                              allow_outside=allow_outside, tags=tags or TagTable())
@@ -126,6 +128,9 @@ class _Loader:
         head = f"{self.path}: {where}: {prop}" if prop else f"{self.path}: {where}"
         self.problems.append(f"{head}: {text}")
         self.fatal += fatal
+
+    def warn(self, where: str, prop: str, text: str) -> None:
+        self.warnings.append(f"{self.path}: {where}: {prop}: {text}")
 
     def load(self) -> Form:
         """The form of the file. A station's form is read only from inside the station folder,
@@ -156,6 +161,7 @@ class _Loader:
         if self.fatal:
             raise FormError(self.problems)
         form.problems = self.problems
+        form.warnings = self.warnings
         return form
 
     def form_settings(self, raw: Any) -> Form:
@@ -282,10 +288,13 @@ class _Loader:
         if self.fatal > before:
             return None
         element = cls(**values)
-        if isinstance(element, Scaled):
-            element.take_tag(raw, self.ctx.tags)
-        for key, text in element.check(self.ctx):
+        element.take_tag(raw, self.ctx.tags)
+        problems = element.check(self.ctx)
+        for key, text in problems:
             self.problem(where, key, text)
+        if isinstance(element, Scaled) and not problems:
+            for key, text in element.disagreements(raw, self.ctx.tags):
+                self.warn(where, key, text)
         return element
 
 

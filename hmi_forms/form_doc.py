@@ -16,6 +16,7 @@ from dataclasses import dataclass, field, fields
 from pathlib import Path
 from typing import Any
 
+from app.scada.table import TagTable
 from hmi_forms.elements import ELEMENT_TYPES, Element
 from hmi_forms.elements import props as p
 from hmi_forms.form import FormError, _Loader, parse_form
@@ -32,6 +33,7 @@ class FormDoc:
     data: dict[str, Any] = field(default_factory=dict)  # the file's JSON object
     station: Path | None = None  # the station folder: images may come from it as well as the form's
     allow_outside: bool = False  # the station lets paths leave its folder
+    tags: TagTable = field(default_factory=TagTable)  # the station's: their conversion, unit, limits
 
     @property
     def settings(self) -> dict[str, Any]:
@@ -67,11 +69,18 @@ def read_doc(path: str | Path) -> FormDoc:
 
 def problems(doc: FormDoc, symbols: dict[str, int]) -> list[str]:
     """What `check` would report for this document if it were saved now."""
+    return checked(doc, symbols)[0]
+
+
+def checked(doc: FormDoc, symbols: dict[str, int]) -> tuple[list[str], list[str]]:
+    """What `check` would report for this document if it were saved now: its problems, and its
+    warnings (an element whose conversion or unit contradicts its tag's)."""
+    loader = _Loader(doc.path, symbols, doc.station, doc.allow_outside, doc.tags)
     try:
-        _Loader(doc.path, symbols, doc.station, doc.allow_outside).build(json.loads(json.dumps(doc.data)))
+        loader.build(json.loads(json.dumps(doc.data)))
     except FormError as e:
-        return e.problems
-    return []
+        return e.problems, loader.warnings
+    return [], loader.warnings
 
 
 class Reader:
@@ -81,7 +90,7 @@ class Reader:
     def __init__(self, doc: FormDoc, symbols: dict[str, int]) -> None:
         self.path = doc.path
         self.symbols = symbols
-        self.loader = _Loader(doc.path, symbols, doc.station, doc.allow_outside)
+        self.loader = _Loader(doc.path, symbols, doc.station, doc.allow_outside, doc.tags)
         self.loader.ctx.devices = self.loader.devices(doc.data.get("devices", []))
         self.loader.ctx.images = self.loader.images(doc.data.get("images", []))
         self.ctx = self.loader.ctx

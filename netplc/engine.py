@@ -344,7 +344,7 @@ class Engine:
                 self._journal(user, fmt_octal(addr), old, new, addr, label)
             else:
                 self.sink.put(Record(self.wall_time(), "operator", source=user, number=addr, value=float(new),
-                                     text=f"write {label}: {describe(old, new)} "
+                                     text=f"write {label or fmt_octal(addr)}: {describe(old, new)} "
                                           f"(raw {old} -> {new} at {fmt_octal(addr)})"))
 
         return apply

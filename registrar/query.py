@@ -239,7 +239,7 @@ class Archive(ArchiveReader):
                     for r in chunk:
                         local = self.local_time(r[1] / 1000).isoformat(timespec="milliseconds")
                         tag = tags.get(r[at]) if r[2] == "data" and r[7] is not None else None
-                        phy = [] if tag is None else [
+                        phy = ["", "", ""] if tag is None else [  # every row the header's fields
                             tag.name, f"{tag.word_value(int(r[7])):.{tag.decimals}f}", tag.unit]
                         out.writerow([r[0], local, *r[1:], *phy])
                     n += len(chunk)

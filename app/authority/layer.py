@@ -34,6 +34,7 @@ from typing import TYPE_CHECKING
 from app.authority.policy import POLICY, ROLE_OF_SOURCE, ROLES, Action, Refusal, Source, needs, rank
 from app.authority.users import UserError
 from app.scada.forcing import forcing_tag, unforcing_tag
+from app.scada.station import STOPPED_BY_COMMAND
 from app.scada.tag import Tag, TagType
 from netplc.address import EMERGENCY_STOP, IO_BITS, fmt_octal
 from netplc.engine import BUSY, JOURNAL_FULL, Engine, RunState
@@ -418,8 +419,8 @@ class Commands:
         engine = self.engine
 
         def apply(_mem: Memory) -> None:
+            self._put(who, STOPPED_BY_COMMAND)  # first: NETPLC.STOPPED names who
             engine.stop()
-            self._put(who, "NetPlc stopped")
 
         return self._queue(who, Action.STOP, "NetPlc", apply)
 

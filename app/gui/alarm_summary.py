@@ -39,6 +39,7 @@ from PySide6.QtGui import QBrush, QColor
 from PySide6.QtWidgets import (
     QAbstractItemView,
     QApplication,
+    QComboBox,
     QDialog,
     QDialogButtonBox,
     QDoubleSpinBox,
@@ -73,7 +74,10 @@ COLOURS = {1: ("#c62828", "#ffffff"), 2: ("#ef6c00", "#ffffff"), 3: ("#fdd835", 
 QUIET = ("#eceff1", "#607d8b")  # shelved
 COLUMNS = (QT_TRANSLATE_NOOP("AlarmTableModel", "Priority"), QT_TRANSLATE_NOOP("AlarmTableModel", "Time"),
            QT_TRANSLATE_NOOP("AlarmTableModel", "Alarm"), QT_TRANSLATE_NOOP("AlarmTableModel", "State"),
-           QT_TRANSLATE_NOOP("AlarmTableModel", "Value"), QT_TRANSLATE_NOOP("AlarmTableModel", "Text"))
+           QT_TRANSLATE_NOOP("AlarmTableModel", "Value at change"),
+           QT_TRANSLATE_NOOP("AlarmTableModel", "Text"))
+VALUE_TIP = QT_TRANSLATE_NOOP("AlarmTableModel",
+                              "The value when the alarm last changed state, not the value now")
 
 Index = QModelIndex | QPersistentModelIndex
 
@@ -116,6 +120,8 @@ class AlarmTableModel(QAbstractTableModel):
     def headerData(self, section: int, orientation: Qt.Orientation, role: int = 0) -> Any:
         if orientation == Qt.Orientation.Horizontal and role == Qt.ItemDataRole.DisplayRole:
             return QCoreApplication.translate("AlarmTableModel", COLUMNS[section])
+        if orientation == Qt.Orientation.Horizontal and role == Qt.ItemDataRole.ToolTipRole and section == 4:
+            return QCoreApplication.translate("AlarmTableModel", VALUE_TIP)
         return None
 
     def data(self, index: Index, role: int = 0) -> Any:
@@ -127,7 +133,7 @@ class AlarmTableModel(QAbstractTableModel):
             if col == 1:
                 return stamp(row.since or row.changed)
             if col == 2:
-                return row.id
+                return row.label or row.id
             if col == 3:
                 if row.state is State.SHELVED and row.shelved_until is not None:
                     shelved = QCoreApplication.translate("AlarmTableModel", "shelved by {0} until {1}: {2}")
@@ -136,14 +142,24 @@ class AlarmTableModel(QAbstractTableModel):
             if col == 4:
                 return row.shown
             return row.text
+        if role == Qt.ItemDataRole.ToolTipRole and index.column() == 2:
+            return row.id  # the identity the journal and the publishers use
         if role in (Qt.ItemDataRole.BackgroundRole, Qt.ItemDataRole.ForegroundRole):
             back, fore = row_colours(row, self.blink_on)
             return QBrush(back if role == Qt.ItemDataRole.BackgroundRole else fore)
         return None
 
 
+SHELVE_REASONS = (QT_TRANSLATE_NOOP("ShelveDialog", "Maintenance of the instrument"),
+                  QT_TRANSLATE_NOOP("ShelveDialog", "Instrument faulty, repair requested"),
+                  QT_TRANSLATE_NOOP("ShelveDialog", "Nuisance: chattering alarm"),
+                  QT_TRANSLATE_NOOP("ShelveDialog", "Start-up or shut-down of the unit"),
+                  QT_TRANSLATE_NOOP("ShelveDialog", "Known condition, under observation"))
+
+
 class ShelveDialog(QDialog):
-    """Shelving needs a duration and a reason (ISA-18.2: a shelved alarm comes back by itself)."""
+    """Shelving needs a duration and a reason (ISA-18.2: a shelved alarm comes back by itself).
+    The reason is typed or taken from the presets; OK with none says so and keeps the dialog open."""
 
     def __init__(self, alarm: str, parent: QWidget | None = None) -> None:
         super().__init__(parent)
@@ -153,15 +169,39 @@ class ShelveDialog(QDialog):
         self.minutes.setRange(1, 7 * 24 * 60)
         self.minutes.setValue(60)
         self.minutes.setSuffix(self.tr(" min"))
+        self.presets = QComboBox()
+        self.presets.addItem(self.tr("Choose a usual reason…"), "")
+        for reason in SHELVE_REASONS:
+            text = self.tr(reason)
+            self.presets.addItem(text, text)
+        self.presets.activated.connect(self._preset)
         self.reason = QLineEdit()
         self.reason.setPlaceholderText(self.tr("why (required)"))
+        self.missing = QLabel(self.tr("Give the reason for shelving: it is journaled with your name."))
+        self.missing.setStyleSheet("color: #b00020")
+        self.missing.setWordWrap(True)
+        self.missing.hide()
+        self.reason.textChanged.connect(lambda _text: self.missing.hide())
         lay.addRow(self.tr("Duration"), self.minutes)
-        lay.addRow(self.tr("Reason"), self.reason)
+        lay.addRow(self.tr("Reason"), self.presets)
+        lay.addRow("", self.reason)
+        lay.addRow(self.missing)
         ok, cancel = QDialogButtonBox.StandardButton.Ok, QDialogButtonBox.StandardButton.Cancel
         buttons = QDialogButtonBox(ok | cancel)
         buttons.accepted.connect(self.accept)
         buttons.rejected.connect(self.reject)
         lay.addRow(buttons)
+
+    def _preset(self, index: int) -> None:
+        if text := self.presets.itemData(index):
+            self.reason.setText(text)
+
+    def accept(self) -> None:
+        if not self.reason.text().strip():
+            self.missing.show()
+            self.reason.setFocus()
+            return
+        super().accept()
 
 
 class Annunciator:
@@ -284,8 +324,8 @@ class AlarmSummary(QWidget):
     def _apply(self) -> None:
         typed = self.filter.text().strip().casefold().split()
         rows = [r for r in self.rows
-                if all(w in f"{r.id} {r.text} {r.state.word} {words.state(r.state)} {r.tag or ''}".casefold()
-                       for w in typed)]
+                if all(w in f"{r.id} {r.label} {r.text} {r.state.word} {words.state(r.state)} {r.tag or ''}"
+                       .casefold() for w in typed)]
         selected = set(self.selected())
         self.model.set_rows(rows)
         for i, r in enumerate(rows):

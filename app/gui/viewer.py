@@ -49,12 +49,23 @@ from PySide6.QtWidgets import (
 
 from app.gui import i18n
 from app.gui.application import application
+from app.gui.designer.station import find_station
 from app.gui.series_loader import Series, SeriesLoader
 from app.scada.tag import Tag
-from app.station.config import DEMO_STATION, ConfigError, load_station, station_file
+from app.station.config import DEMO_STATION, ConfigError, load_station, read_station, station_file
 from hmi_forms.elements import formats
-from hmi_forms.widgets.records import ARCHIVE_COLUMNS, Column, RecordsModel, records_view
+from hmi_forms.widgets.records import (
+    ARCHIVE_COLUMNS,
+    SOURCE,
+    VALUE,
+    Column,
+    RecordsModel,
+    format_value,
+    records_view,
+)
 from hmi_forms.widgets.worker import Worker
+from netplc.address import parse_octal
+from netplc.program import read_symbols
 from registrar.plant.url import is_url
 from registrar.query import Archive, Filter, SeriesKey
 from registrar.reading import ArchiveError, ArchiveReader, Row
@@ -75,13 +86,14 @@ STATION = Column("Station", lambda r: r.station or "", 100)  # shown for a plant
 PALETTE = ("#1f77b4", "#d62728", "#2ca02c", "#ff7f0e", "#9467bd", "#17becf", "#8c564b", "#e377c2")
 
 
-def series_label(key: SeriesKey, tag: Tag | None = None) -> str:
-    """How a series is named: by its tag (name, description, unit) where the archive has one."""
+def series_label(key: SeriesKey, tag: Tag | None = None, symbol: str = "") -> str:
+    """How a series is named: by its tag (name, description, unit) where the archive has one, else
+    by the symbol of symbols.csv its address has."""
     parts = [f"group {key.grp}" if key.grp is not None else "",
              f"type {key.type}" if key.type is not None else "", key.source or ""]
     raw = " / ".join(p for p in parts if p) or key.kind
     if tag is None:
-        return raw
+        return f"{symbol} ({raw})" if symbol else raw
     described = f"{tag.name} {tag.description}".strip() + (f", {tag.unit}" if tag.unit else "")
     return f"{described} ({raw})"
 
@@ -91,6 +103,19 @@ def physical(tag: Tag | None, values: np.ndarray) -> np.ndarray:
     if tag is None:
         return values
     return np.array([tag.word_value(int(v)) if np.isfinite(v) else np.nan for v in values], dtype=np.float64)
+
+
+def station_symbols(archive: Path | str) -> dict[int, str]:
+    """The symbols of the station an archive file belongs to (its station.toml in the archive's
+    folder or the two above), by address, to name the series and sources that have no tag.
+    {}: a plant archive, or no station or symbols beside it."""
+    if not isinstance(archive, Path):
+        return {}
+    toml = find_station(archive.resolve())
+    station = read_station(toml)[0] if toml is not None else None
+    if station is None or station.Symbols is None:
+        return {}
+    return {addr: name for name, addr in read_symbols(station.Symbols)[0].items()}
 
 
 @dataclass(frozen=True)
@@ -128,8 +153,11 @@ class PageReader:
 
 
 class ViewerWindow(QMainWindow):
-    def __init__(self, archive_path: Path | str | None = None, parent: QWidget | None = None) -> None:
+    def __init__(self, archive_path: Path | str | None = None, parent: QWidget | None = None,
+                 symbols: dict[int, str] | None = None) -> None:
+        """`symbols`: names by address for what has no tag (None: those of the archive's station)."""
         super().__init__(parent)
+        self.symbols = symbols
         self.setWindowTitle(self.tr("NetPlc Station — journal viewer"))
         self.archive: Archive | None = None
         self.archive_path: Path | str | None = None  # a file, or a plant archive's URL
@@ -137,6 +165,7 @@ class ViewerWindow(QMainWindow):
         self.total = 0
         self.curves: dict[SeriesKey, pg.PlotDataItem] = {}
         self.tags: dict[str, Tag] = {}  # the archive's tags by the source of their data series
+        self.tag_names: dict[str, Tag] = {}  # the same by name (an alarm's source is TAG.LIMIT)
         self.loading: dict[SeriesKey, int] = {}  # series asked for and not yet plotted: their token
         self.loader = SeriesLoader(SERIES_POINTS, self)
         self.loader.answered.connect(self._series_loaded)
@@ -230,7 +259,10 @@ class ViewerWindow(QMainWindow):
         self.tabs = QTabWidget()
         records = QWidget()
         rec_lay = QVBoxLayout(records)
-        self.model = RecordsModel((*ARCHIVE_COLUMNS, STATION), parent=self)
+        columns = [Column(SOURCE.title, self.source_text, SOURCE.width) if c is SOURCE
+                   else Column(VALUE.title, self.value_text, 110, right=True) if c is VALUE else c
+                   for c in ARCHIVE_COLUMNS]
+        self.model = RecordsModel((*columns, STATION), parent=self)
         self.table = records_view(self.model, row_height=22)
         rec_lay.addWidget(self.table, 1)
         pager = QHBoxLayout()
@@ -283,6 +315,9 @@ class ViewerWindow(QMainWindow):
         if not self.pager.closed:
             self.pager.submit(self.pages.close)  # the pages read the archive as it is now, too
         self.tags = archive.tags()
+        self.tag_names = {t.name: t for t in self.tags.values()}
+        if self.symbols is None:
+            self.symbols = station_symbols(path)
         self.path_label.setText(f"<small>{path}</small>")
         self.stations.blockSignals(True)
         self.stations.clear()
@@ -352,8 +387,45 @@ class ViewerWindow(QMainWindow):
         )
 
     def apply_filter(self) -> None:
+        """Read the records again under the filter, and the plotted series within its From/To."""
         self.offset = 0
         self._load_page()
+        for key in [*self.curves, *self.loading]:
+            self.show_series(key)
+
+    def window(self) -> tuple[float, float]:
+        """From/To of the filter, as the series are cut to them."""
+        flt = self.current_filter()
+        assert flt.since is not None and flt.until is not None
+        return flt.since, flt.until
+
+    # what the Records table shows of a record: a tag's name and physical value with its unit
+    def record_tag(self, r: Row) -> Tag | None:
+        if r.kind == "data":
+            return self.tags.get(r.source or "")
+        if r.kind == "alarm":
+            return self.tag_names.get((r.source or "").partition(".")[0])
+        return None
+
+    def source_text(self, r: Row) -> str:
+        source = r.source or ""
+        if r.kind != "data":
+            return source
+        tag = self.tags.get(source)
+        name = tag.name if tag is not None else self.symbol_of(source)
+        return f"{name} ({source})" if name else source
+
+    def value_text(self, r: Row) -> str:
+        tag = self.record_tag(r)
+        if tag is None or r.value is None:
+            return format_value(r.value)
+        return tag.format(tag.word_value(int(r.value)) if r.kind == "data" else r.value)
+
+    def symbol_of(self, source: str) -> str:
+        try:
+            return (self.symbols or {}).get(parse_octal(source), "")
+        except ValueError:
+            return ""
 
     def page(self, step: int | None) -> None:
         if step is None:
@@ -465,7 +537,7 @@ class ViewerWindow(QMainWindow):
         day = self.day
         if not shown or self.archive_path is None or day is None:
             return
-        self.loading[key] = self.loader.request(self.archive_path, day, key, topic=key)
+        self.loading[key] = self.loader.request(self.archive_path, day, key, topic=key, window=self.window())
         self.statusBar().showMessage(f"reading {self.label(key)}…")
 
     def _series_loaded(self, token: int, series: Series) -> None:
@@ -493,7 +565,8 @@ class ViewerWindow(QMainWindow):
         return self.tags.get(key.source or "") if key.kind == "data" else None
 
     def label(self, key: SeriesKey) -> str:
-        return series_label(key, self.tag_of(key))
+        symbol = self.symbol_of(key.source or "") if key.kind == "data" else ""
+        return series_label(key, self.tag_of(key), symbol)
 
     def check_series(self, row: int) -> None:
         """Tick a series in the list (what a click does), for scripts and tests."""

@@ -185,6 +185,7 @@ class AlarmRow:
     shelved_until: float | None = None
     shelved_by: str = ""
     reason: str = ""
+    label: str = ""  # what the alarm is about, for a person: its tag's description, else its text
 
     @property
     def acked(self) -> bool:
@@ -380,7 +381,9 @@ class AlarmSystem:
         keep = hyst[frozen] if frozen is not None else None
         if len(self._lim_idx):
             x = self._lim_sign * (phy[self._lim_tag] - self._lim_limit)
-            hyst[self._lim_idx] = (x >= 0) | (hyst[self._lim_idx] & (x >= -self._lim_db))
+            # the deadband keeps an alarm that is on (after its on delay) from returning; a condition
+            # still waiting out its on delay ends below the limit itself (not raised at 89.9 % of 90)
+            hyst[self._lim_idx] = (x >= 0) | (self._cond[self._lim_idx] & (x >= -self._lim_db))
         if len(self._disc_idx):
             hyst[self._disc_idx] = phy[self._disc_tag] == self._disc_when
         if len(self._q_idx):
@@ -632,8 +635,9 @@ class AlarmSystem:
         t = self._tag_of[i]
         tag = self.tags[t] if t >= 0 else None
         shown = "" if a.value is None else tag.format(a.value) if tag is not None else f"{a.value:g}"
+        label = (tag.description or tag.name) if tag is not None else a.defn.text
         return AlarmRow(a.id, a.defn.priority, state, a.since, a.changed, a.value, a.text,
-                        a.defn.tag, shown, a.shelved_until, a.shelved_by, a.reason)
+                        a.defn.tag, shown, a.shelved_until, a.shelved_by, a.reason, label)
 
     def rows(self) -> tuple[AlarmRow, ...]:
         """The summary: listed alarms (by priority, newest first), then the shelved ones."""

@@ -72,6 +72,7 @@ class StationAlarms:
         self.exchange: Exchange | None = None
         self._messages: list[int] = []
         self._since: dict[int, int] = {}  # node -> first scan of this run with its link known
+        self._stopped_by = ""  # who stopped NetPlc through the command layer (its record), while stopped
 
     def attach(self, engine: Engine, exchange: Exchange | None) -> None:
         """Evaluate after every scan of `engine`; start saving states."""
@@ -83,15 +84,18 @@ class StationAlarms:
         """The runtime's record observer: collects the NMSG numbers of the scan being run."""
         if record.kind == "message" and record.number is not None:
             self._messages.append(record.number)
+        elif record.kind == "operator" and record.text == STOPPED_BY_COMMAND:
+            self._stopped_by = record.source or ""
 
     def on_scan(self, snapshot: Snapshot) -> None:
         ex = self.exchange
         running = snapshot.state == RunState.RUNNING
         if not running:
             self._since.clear()  # after a stop, data is expected afresh from the next start
-        elif ex is not None:
-            for n in ex.configs:
-                if n not in self._since and ex.link_known(n):
+        else:
+            self._stopped_by = ""
+            for n in ex.configs if ex is not None else ():
+                if n not in self._since and ex.link_known(n):  # type: ignore[union-attr]
                     self._since[n] = snapshot.scan
         links = LinkView(running=running,
                          links={n: ex.link_up(n) for n in ex.configs} if ex is not None else {},
@@ -104,7 +108,7 @@ class StationAlarms:
             self.sink.put(record)
         messages, self._messages = self._messages, []
         self.system.evaluate(snapshot, snapshot.wall, self.quality, messages,
-                             "" if running else stop_reason(snapshot.state))
+                             "" if running else stop_reason(snapshot.state, self._stopped_by))
         if self._dirty and snapshot.time - self._published >= PUBLISH_EVERY:
             self._publish(snapshot.time)
 
@@ -174,13 +178,16 @@ class StationAlarms:
 
 
 
-def stop_reason(state: str) -> str:
+STOPPED_BY_COMMAND = "NetPlc stopped"  # the command layer's record of a Stop, naming who
+
+
+def stop_reason(state: str, by: str = "") -> str:
     """Why NetPlc is not running, from the snapshot's run state (Engine.state_text), with its
-    stop code."""
+    stop code; `by`: who stopped it through the command layer (the journal's name of them)."""
     if state == RunState.HALTED:
         return "halted by HLT"
     if state == f"{RunState.STOPPED}, code {EMERGENCY_STOP_CODE}":
         return f"emergency stop by bit {fmt_octal(EMERGENCY_STOP)} (code {EMERGENCY_STOP_CODE})"
     if state == RunState.STOPPED:
-        return "stopped by the operator or the watchdog (code 0)"
+        return f"stopped by {by} (code 0)" if by else "stopped by the operator or the watchdog (code 0)"
     return state

@@ -43,6 +43,7 @@ def check_station(path: str | Path) -> CheckReport:
                                f"{problem}")
     loaded = load(station)
     report.problems += loaded.problems + loaded.form_problems
+    report.warnings += [w for form in loaded.forms for w in form.warnings]
     report.notes += loaded.notes
     pair = station.redundancy
     if pair is not None and pair.arbiter == "none":

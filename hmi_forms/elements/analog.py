@@ -27,13 +27,14 @@ from collections.abc import Mapping
 from dataclasses import dataclass, field
 from functools import cached_property
 from operator import attrgetter
-from typing import Any, ClassVar
+from typing import Any
 
 from app.scada.table import TagTable
+from app.scada.tag import Tag
 from hmi_forms.elements import props as p
 from hmi_forms.elements.base import Element, Reader, Writer, word_reader
 from hmi_forms.elements.trend import Trend
-from netplc.address import IO_BITS
+from netplc.address import IO_BITS, fmt_octal
 from netplc.memory import Snapshot
 
 logger = logging.getLogger(__name__)
@@ -72,20 +73,14 @@ class Scaled(Element):
     Units: str = field(default="", metadata=p.prop(p.text))
 
     scaling: p.Scaling = field(default=p.Scaling(0, 1, 0, 1), init=False)
-    tag: str = field(default="", init=False)  # the tag of tags.csv the element's address names
     shown: Shown = field(default=UNKNOWN, init=False)  # what its word shows now
 
-    ADDRESS_KEYS: ClassVar[tuple[str, ...]] = ("InAddr", "Address", "OutAddr")  # where a tag is named
-
-    def take_tag(self, raw: Mapping[str, Any], tags: TagTable) -> None:
+    def take_tag(self, raw: Mapping[str, Any], tags: TagTable) -> Tag | None:
         """Fill from the tag named by the element's address what the form's `raw` properties leave
         out (the loader calls it before `check`)."""
-        named = (raw.get(k) for k in self.ADDRESS_KEYS)
-        name = next((v for v in named if isinstance(v, str) and v in tags.by_name), None)
-        if name is None:
-            return
-        tag = tags.by_name[name]
-        self.tag = tag.name
+        tag = super().take_tag(raw, tags)
+        if tag is None:
+            return None
         ranges = ("Device", "AppMin", "AppMax", "PhyMin", "PhyMax")
         if not any(k in raw for k in ranges):
             lo, hi = tag.limits
@@ -101,6 +96,33 @@ class Scaled(Element):
                 self.PhyLow = alarms.l
             if "PhyHigh" not in raw and alarms.h is not None:
                 self.PhyHigh = alarms.h
+        return tag
+
+    def disagreements(self, raw: Mapping[str, Any], tags: TagTable) -> list[tuple[str, str]]:
+        """Where the form's own conversion or unit (`raw`, checked) contradicts the tag the element
+        is bound to: the tag is the station's truth (alarms, journal, OPC UA read it), so an element
+        scaling otherwise shows a wrong number with the right unit. Warnings: the form still opens."""
+        tag = tags.by_name.get(self.tag)
+        if tag is None:
+            return []
+        out: list[tuple[str, str]] = []
+        lo, hi = tag.limits
+        truth = tag.scaling or p.Scaling(lo, hi, lo, hi)
+        own = self.scaling
+        span = abs(truth.PhyMax - truth.PhyMin) or 1.0
+        if any(k in raw for k in ("Device", "AppMin", "AppMax", "PhyMin", "PhyMax")) and any(
+                abs(own.to_phy(w) - truth.to_phy(w)) > 1e-6 * span for w in (truth.AppMin, truth.AppMax)):
+            key = "Device" if "Device" in raw else next(
+                (k for k in ("AppMin", "AppMax", "PhyMin", "PhyMax") if getattr(own, k) != getattr(truth, k)),
+                "AppMin")
+            word = truth.AppMax
+            out.append((key, f"{_ranges(own)} contradicts tag {tag.name}'s {_ranges(truth)}: word "
+                             f"{word:g} shows {self.format(own.to_phy(word))} here, "
+                             f"{self.format(truth.to_phy(word))} {tag.unit}".rstrip()
+                             + " (remove the element's own conversion to take the tag's)"))
+        if "Units" in raw and tag.unit and self.Units != tag.unit:
+            out.append(("Units", f'"{self.Units}" contradicts tag {tag.name}\'s unit "{tag.unit}"'))
+        return out
 
     def check(self, ctx: p.Context) -> list[tuple[str, str]]:
         inline = {k: getattr(self, k) for k in ("AppMin", "AppMax", "PhyMin", "PhyMax")}
@@ -115,7 +137,8 @@ class Scaled(Element):
             return []
         missing = [k for k, v in inline.items() if v is None]
         if len(missing) == 4:
-            return [("Device", "missing: give a Device or AppMin, AppMax, PhyMin and PhyMax")]
+            return [("Device", "missing: name a tag as the address (its conversion is taken), or give a "
+                                "Device or AppMin, AppMax, PhyMin and PhyMax")]
         if missing:
             return [(k, "missing (needed with the other range properties)") for k in missing]
         problems = scaling_problems(inline)
@@ -142,6 +165,10 @@ class Scaled(Element):
     text = property(attrgetter("shown.text"))
     zone = property(attrgetter("shown.zone"))
     fraction = property(attrgetter("shown.fraction"))
+
+
+def _ranges(sc: p.Scaling) -> str:
+    return f"{sc.AppMin:g}..{sc.AppMax:g} -> {sc.PhyMin:g}..{sc.PhyMax:g}"
 
 
 def scaling_problems(ranges: dict[str, Any]) -> list[tuple[str, str]]:
@@ -305,6 +332,11 @@ class AnalogOutput(Scaled, Writer):
         self.shown = self.shows(hw)
         return True
 
+    def change(self, old: int, new: int) -> str:
+        """A write of its word as the journal says it: the physical values and unit ("20.0 -> 50.0 °C")."""
+        units = f" {self.Units}" if self.Units else ""
+        return f"{self.format(self.scaling.to_phy(old))} -> {self.format(self.scaling.to_phy(new))}{units}"
+
     def submit(self, entry: str) -> tuple[bool, str]:
         """Validate the operator's entry and write it; returns (accepted, message to show)."""
         lo, hi = self.scaling.phy_range
@@ -321,9 +353,11 @@ class AnalogOutput(Scaled, Writer):
             return False, f"{entry.strip()} is out of range {self.format(lo)} … {self.format(hi)}{units}"
         hw = self.scaling.to_hw(phy)
         assert self.OutAddr is not None
-        if why := self.refused(f"{self.Name} \u2192 {self.format(self.scaling.to_phy(hw))}{units}"):
+        label = self.label or fmt_octal(self.OutAddr)
+        if why := self.refused(f"{label} \u2192 {self.format(self.scaling.to_phy(hw))}{units}"):
             return False, why
         if self.target is not None and (why := self.target.write_word(
-                self.OutAddr, hw, user=self.user, label=self.Name, at_least=self.Role)) is not None:
+                self.OutAddr, hw, user=self.user, label=self.label or None, at_least=self.Role,
+                describe=self.change)) is not None:
             return False, why
         return True, f"Set to {self.format(self.scaling.to_phy(hw))}{units}"

@@ -17,13 +17,15 @@ decided here once, for both:
 
 from __future__ import annotations
 
-from collections.abc import Callable
+from collections.abc import Callable, Mapping
 from dataclasses import dataclass, field
 from functools import cached_property
 from typing import Any, ClassVar
 
 from app.authority.policy import ROLES
 from app.scada.quality import Quality
+from app.scada.table import TagTable
+from app.scada.tag import Tag
 from hmi_forms.elements import props as p
 from hmi_forms.elements.target import Effects, Target
 from netplc.address import IO_BITS, BitRef, data_index
@@ -81,6 +83,30 @@ class Element:
     target: Target | None = field(default=None, init=False, repr=False)  # the operator's writes
     effects: Effects | None = field(default=None, init=False, repr=False)  # the runtime's copy only
     user: str = field(default="operator", init=False)
+    tag: str = field(default="", init=False)  # the tag of tags.csv the element's address names
+    described: str = field(default="", init=False)  # that tag's description
+
+    ADDRESS_KEYS: ClassVar[tuple[str, ...]] = ("InAddr", "Address", "OutAddr")  # where a tag is named
+
+    def take_tag(self, raw: Mapping[str, Any], tags: TagTable) -> Tag | None:
+        """The tag of tags.csv the element's address (in the form's `raw` properties) names, kept
+        by name and description (the loader calls it before `check`); None: no tag is named."""
+        named = (raw.get(k) for k in self.ADDRESS_KEYS)
+        name = next((v for v in named if isinstance(v, str) and v in tags.by_name), None)
+        if name is None:
+            return None
+        tag = tags.by_name[name]
+        self.tag, self.described = tag.name, tag.description
+        return tag
+
+    @property
+    def label(self) -> str:
+        """What a person reads for the element in a confirmation and in the journal: its Name, unless
+        that only repeats its type (the designer's "DiscreteBase 2"), then its tag's description or
+        name; "" when it has neither (the caller names its address)."""
+        if self.Name.rstrip("0123456789").rstrip() not in ("", self.TYPE):
+            return self.Name
+        return self.described or self.tag
 
     def check(self, ctx: p.Context) -> list[tuple[str, str]]:
         """Problems between properties, as (property, problem); resolves references to the context."""
@@ -146,7 +172,7 @@ class Element:
 
     def record(self, snap: Snapshot, kind: Kind, **fields: Any) -> None:
         if self.effects is not None:
-            self.effects.put(Record(snap.wall, kind, source=self.Name, **fields))
+            self.effects.put(Record(snap.wall, kind, source=self.label or self.Name, **fields))
 
 
 @dataclass(eq=False)

@@ -94,9 +94,11 @@ class DiscreteBase(Element, Writer):
         out = self.OutAddr or self.InAddr
         assert out is not None
         new = 0 if self.value else 1
-        if self.refused(f"{self.Name} \u2192 {new}"):
+        state = (self.TextTrue if new else self.TextFalse) or str(new)  # in the element's words
+        if self.refused(f"{self.label or out} \u2192 {state}"):
             return False
-        why = self.target.write_bit(out.hmi, new, user=self.user, label=self.Name, at_least=self.Role)
+        why = self.target.write_bit(out.hmi, new, user=self.user, label=self.label or None,
+                                    at_least=self.Role)
         return why is None
 
 

@@ -32,13 +32,15 @@ logger = logging.getLogger(__name__)
 class Target(Protocol):
     """`write_*` return why the write was refused at once (a sentence for the operator: the role,
     a full queue), or None once it is sent; `at_least` is the element's Role, which may ask more
-    than the station's policy, never less."""
+    than the station's policy, never less; `describe(old, new)` says a word's change in physical
+    terms for the journal when no tag does (an element's own conversion)."""
 
     def write_bit(self, addr: int, value: int, *, user: str, label: str | None = None,
                   at_least: str | None = None) -> str | None: ...
 
     def write_word(self, addr: int, value: int, *, user: str, label: str | None = None,
-                   at_least: str | None = None) -> str | None: ...
+                   at_least: str | None = None,
+                   describe: Callable[[int, int], str] | None = None) -> str | None: ...
 
 
 class Effects(Protocol):
@@ -73,14 +75,15 @@ class EngineTarget:
         tag = self._bits.get(addr)
         ticket = self.commands.write_bit(self.who(user), addr, value, label=_named(label, tag),
                                          at_least=at_least)
-        return self._told(ticket, label or fmt_octal(addr))
+        return self._told(ticket, _said(label, tag, addr))
 
     def write_word(self, addr: int, value: int, *, user: str, label: str | None = None,
-                   at_least: str | None = None) -> str | None:
+                   at_least: str | None = None,
+                   describe: Callable[[int, int], str] | None = None) -> str | None:
         tag = self._words.get(addr)
         ticket = self.commands.write_word(self.who(user), addr, value, label=_named(label, tag),
-                                          at_least=at_least, describe=tag.change if tag else None)
-        return self._told(ticket, label or fmt_octal(addr))
+                                          at_least=at_least, describe=tag.change if tag else describe)
+        return self._told(ticket, _said(label, tag, addr))
 
     def _told(self, ticket: Ticket, what: str) -> str | None:
         if self.on_answer is not None:
@@ -102,9 +105,16 @@ ONE_WORD = (TagType.WORD, TagType.INT16, TagType.BCD)
 
 
 def _named(label: str | None, tag: Tag | None) -> str | None:
+    """The element's label with the tag's name; without a label, the tag's description."""
     if tag is None:
         return label
-    return f"{label} {tag.name}" if label else tag.name
+    return f"{label or tag.description} {tag.name}".strip()
+
+
+def _said(label: str | None, tag: Tag | None, addr: int) -> str:
+    """What the operator is told a refusal was about: the element's label, else its tag's
+    description or name, else the address."""
+    return label or (tag.description or tag.name if tag is not None else "") or fmt_octal(addr)
 
 
 class NullTarget:
@@ -115,5 +125,6 @@ class NullTarget:
         return None
 
     def write_word(self, addr: int, value: int, *, user: str, label: str | None = None,
-                   at_least: str | None = None) -> str | None:
+                   at_least: str | None = None,
+                   describe: Callable[[int, int], str] | None = None) -> str | None:
         return None

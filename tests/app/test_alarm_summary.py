@@ -219,3 +219,26 @@ def test_an_operator_acknowledges_and_silences_from_the_summary(qtbot, station: 
     assert not summary.silence.isEnabled() and "Stop the sound" in summary.silence.toolTip()
     assert station.alarms.system.get("LEVEL.H").state is State.ACKED
     assert ("ivanov", "alarm sound silenced") in [(r.source, r.text) for r in station.sink.records]
+
+
+def test_the_alarm_column_says_what_and_the_shelve_dialog_insists_on_a_reason(qtbot,
+                                                                              station: Station) -> None:
+    from app.gui.alarm_summary import ShelveDialog
+
+    station.step(4000, 0, T0)
+    summary = station.summary("petrov")
+    qtbot.addWidget(summary)
+    model = summary.model
+    assert model.data(model.index(0, 2)) == "Уровень"  # the tag's description, not LEVEL.H
+    assert model.data(model.index(0, 2), Qt.ItemDataRole.ToolTipRole) == "LEVEL.H"
+    assert model.headerData(4, Qt.Orientation.Horizontal) == "Value at change"
+    assert "not the value now" in model.headerData(4, Qt.Orientation.Horizontal, Qt.ItemDataRole.ToolTipRole)
+    dialog = ShelveDialog("LEVEL.H", summary)
+    dialog.show()
+    dialog.accept()  # OK with no reason: said, and the dialog stays
+    assert dialog.isVisible() and dialog.result() != dialog.DialogCode.Accepted
+    assert dialog.missing.isVisibleTo(dialog)
+    dialog.presets.activated.emit(1)
+    assert dialog.reason.text() == "Maintenance of the instrument" and not dialog.missing.isVisibleTo(dialog)
+    dialog.accept()
+    assert dialog.result() == dialog.DialogCode.Accepted

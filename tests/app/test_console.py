@@ -167,7 +167,7 @@ def test_an_element_asks_when_the_form_says_confirm_and_checks_its_role(qtbot, c
     model.Confirm = True
     console.ask = no = Answers(False)
     assert model.click() is False
-    assert no.asked == ["Confirm: Пуск \u2192 1?"]
+    assert no.asked == ["Confirm: Пуск \u2192 Пуск (1)?"]  # the state in the element's words
     qtbot.wait(300)
     assert engine.snapshot.get_hmi_bit(START_BIT) == 0
     console.ask = Answers(True)
@@ -365,7 +365,7 @@ def test_refusals_roles_and_alarms_speak_russian_too(qtbot, russian, demo_copy: 
         summary = window.summary
         heads = [summary.model.headerData(i, Qt.Orientation.Horizontal, Qt.ItemDataRole.DisplayRole)
                  for i in range(6)]
-        assert heads == ["Приоритет", "Время", "Авария", "Состояние", "Значение", "Текст"]
+        assert heads == ["Приоритет", "Время", "Авария", "Состояние", "Значение при изменении", "Текст"]
         assert summary.counts[1].text().startswith("P1 критическая: ")
         assert summary.shelve.text() == "Отложить…" and window.summary_dock.windowTitle().startswith("Аварии")
         shown = (State.UNACK, State.ACKED, State.RTNUN, State.SHELVED, State.SUPPRESSED, State.OUT_OF_SERVICE)

@@ -128,7 +128,7 @@ def test_bad_values_are_refused_with_the_reason(window: DesignerWindow) -> None:
     assert not addr.reason.isHidden() and "not an octal address" in addr.reason.text()
     addr.line.editingFinished.emit()
     assert named(window, "Пуск") == raw and not window.design.undo.canUndo()
-    for key, text, reason in (("InAddr", "NO_SUCH", 'unknown symbol "NO_SUCH"'),
+    for key, text, reason in (("InAddr", "NO_SUCH", 'unknown tag or symbol "NO_SUCH"'),
                               ("h", "-5", "out of range"),
                               ("Name", "Время", "taken by another element")):
         editor = window.properties.editors[key]
@@ -152,8 +152,9 @@ def test_conversion_limits_and_sync_type_are_checked_together(qtbot: QtBot, demo
     assert isinstance(device, ComboEditor) and device.combo.findText("Temperature") > 0
     w.properties.commit("AppMin", 0)
     assert "either Device or AppMin" in w.properties.editors["AppMin"].reason.text()
-    w.properties.commit("Device", MISSING)
-    assert "Device: missing" in w.properties.editors["Device"].reason.text()
+    w.properties.commit("Device", MISSING)  # bound to tag LEVEL: takes the tag's conversion
+    assert "Device" not in named(w, "Уровень") and not w.properties.editors["Device"].reason.text()
+    assert w.design.items[id(named(w, "Уровень"))].model.scaling.AppMax == 4095
     w.properties.commit("SyncType", "PACE_1S")
     assert named(w, "Уровень")["SyncType"] == "PACE_1S"
     w.properties.commit("SyncType", "010000")

@@ -216,6 +216,7 @@ def test_watch_edit_force_unforce_and_step_from_the_view(qtbot, runtime: Runtime
     monitor.step_button.click()
     assert engine.scan_counter > before and monitor.view.snapshot is engine.snapshot
     assert any(t.startswith("step one scan") for _, t in operator_texts(runtime))
+    wait(qtbot, lambda: monitor.message.text() == "")  # the stale refusal goes with a successful step
 
 
 def test_find_go_to_label_and_follow_a_symbol(qtbot, runtime: Runtime) -> None:

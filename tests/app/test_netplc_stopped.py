@@ -118,3 +118,21 @@ def test_stop_reasons_name_the_stop_code() -> None:
     assert stop_reason("stopped, code 11") == "emergency stop by bit 03770 (code 11)"
     assert stop_reason("halted") == "halted by HLT"
     assert stop_reason("stopped, code 7") == "stopped, code 7"
+
+
+def test_netplc_stopped_names_who_stopped_it_through_the_command_layer(tmp_path: Path) -> None:
+    from app.scada.station import STOPPED_BY_COMMAND
+    from netplc.records import Record
+
+    st = Station(tmp_path)
+    st.engine.start()
+    st.scan(2)
+    st.alarms.observe(Record(T0, "operator", source="engineer", text=STOPPED_BY_COMMAND))  # Commands.stop
+    st.engine.stop()
+    st.scan(2)
+    assert st.alarms.system.get(STOPPED_ID).text == "NetPlc is not running: stopped by engineer (code 0)"
+    st.engine.start()
+    st.scan(2)
+    st.engine.stop()  # not through the layer (the watchdog): who is not known
+    st.scan(2)
+    assert "stopped by the operator or the watchdog" in st.alarms.system.get(STOPPED_ID).text

@@ -224,3 +224,65 @@ def test_a_dropped_plant_archive_connection_is_said_and_the_next_page_reconnects
     viewer.apply_filter()
     settled(qtbot, viewer)
     assert viewer.total == 202 and viewer.page_label.text() == "records 1–202 of 202"
+
+
+def restarted_archive(path: Path, t0: float) -> Path:
+    """LEVEL (a tag) and 04020 (a symbol of the demo, no tag) every second from t0 to t0+9, the
+    station stopped after t0+4 and started again at t0+6.5; an alarm of LEVEL at t0+2."""
+    from app.scada.table import TagTable
+    from app.scada.tag import Scaling, Tag, TagType
+    from netplc.records import Record
+    from registrar.store import Store
+
+    level = Tag("LEVEL", 0o4010, TagType.WORD, "%", Scaling(0, 4095, 0, 100), 1, "Уровень")
+    store = Store(path, wallclock=lambda: t0, tags=TagTable([level]))
+    store.put(Record(t0 - 0.5, "system", source="station", text="station starting: here"))
+    for i in (*range(5), *range(7, 10)):
+        store.put(Record(t0 + i, "data", 1, 1, "04010", value=float(i * 409.5)))
+        store.put(Record(t0 + i, "data", 1, 3, "04020", value=float(i)))
+    store.put(Record(t0 + 2, "alarm", grp=2, type=1, source="LEVEL.H", number=0, value=91.25))
+    store.put(Record(t0 + 4.5, "system", source="station", text="station stopped"))
+    store.put(Record(t0 + 6.5, "system", source="station", text="station starting: here"))
+    store.start()
+    store.close()
+    return path
+
+
+def test_series_honour_from_to_and_break_at_a_restart(qtbot, demo_copy: Path) -> None:
+    from PySide6.QtCore import QTime
+
+    t0 = dt.datetime.combine(dt.date.today(), dt.time(10, 0, 0)).timestamp()
+    path = restarted_archive(demo_copy / "archive" / "journal.sqlite", t0)
+    viewer = settled(qtbot, ViewerWindow(path))  # finds the demo's symbols.csv beside the archive
+    qtbot.addWidget(viewer)
+    labels = [viewer.series_list.item(i).text() for i in range(viewer.series_list.count())]
+    assert labels == ["LEVEL Уровень, % (group 1 / type 1 / 04010)", "LEVEL_AVG (group 1 / type 3 / 04020)"]
+    viewer.check_series(1)
+    qtbot.waitUntil(lambda: len(viewer.curves) == 1, timeout=WAIT)
+    xs, ys = next(iter(viewer.curves.values())).getData()
+    assert [str(y) for y in ys] == ["0.0", "1.0", "2.0", "3.0", "4.0", "nan", "7.0", "8.0", "9.0"]
+    assert xs[5] == t0 + 6.5  # no line across the restart
+    viewer.since.setTime(QTime(10, 0, 2))
+    viewer.until.setTime(QTime(10, 0, 7))  # whole seconds: up to 10:00:07.999
+    viewer.apply_filter()
+    qtbot.waitUntil(lambda: not viewer.loading and len(viewer.curves) == 1, timeout=WAIT)
+    xs, ys = next(iter(viewer.curves.values())).getData()
+    assert [str(y) for y in ys] == ["2.0", "3.0", "4.0", "nan", "7.0"]
+    assert xs.min() >= t0 + 2 and xs.max() < t0 + 8
+
+
+def test_records_show_tag_names_and_physical_values_with_units_and_csv_rows_are_whole(
+        qtbot, tmp_path: Path) -> None:
+    t0 = dt.datetime.combine(dt.date.today(), dt.time(10, 0, 0)).timestamp()
+    path = restarted_archive(tmp_path / "journal.sqlite", t0)
+    viewer = settled(qtbot, ViewerWindow(path, symbols={0o4020: "LEVEL_AVG"}))
+    qtbot.addWidget(viewer)
+    rows = [[viewer.model.index(r, c).data() for c in (1, 4, 6)] for r in range(viewer.model.rowCount())]
+    assert ["data", "LEVEL (04010)", "10.0 %"] in rows  # word 409 of 0..4095 -> 0..100 %
+    assert ["data", "LEVEL_AVG (04020)", "1"] in rows  # no tag: the symbol, the value as stored
+    assert ["alarm", "LEVEL.H", "91.2 %"] in rows
+    out = tmp_path / "all.csv"
+    viewer.export_csv(out)
+    with open(out, encoding="utf-8-sig", newline="") as f:
+        table = list(csv.reader(f))
+    assert len(table) > 10 and {len(r) for r in table} == {len(table[0])}

@@ -46,7 +46,7 @@ class ListTarget:
         self.writes.append(("bit", addr, value, user))
 
     def write_word(self, addr: int, value: int, *, user: str, label: str | None = None,
-                   at_least: str | None = None) -> None:
+                   at_least: str | None = None, describe: object = None) -> None:
         self.writes.append(("word", addr, value, user))
 
     def set_bit(self, addr: int, value: int) -> None:

@@ -90,7 +90,8 @@ def test_devices_and_conversions(tmp_path) -> None:
         'device "T": PhyMax: missing required property',
         'device "U": Gain: unknown property',
         'element "L": Device: unknown device "Levl" (U)',
-        'element "M": Device: missing: give a Device or AppMin, AppMax, PhyMin and PhyMax',
+        'element "M": Device: missing: name a tag as the address (its conversion is taken), or give a '
+        'Device or AppMin, AppMax, PhyMin and PhyMax',
         'element "N": PhyMax: equals PhyMin (5): the conversion is undefined',
         'element "O": PhyMin: give either Device or AppMin/AppMax/PhyMin/PhyMax, not both',
         'element "P": InAddr: 03777: 2-byte operand runs past bit 03777',

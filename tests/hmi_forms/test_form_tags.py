@@ -14,7 +14,7 @@ from hmi_forms.form import FormError, load_form
 from netplc.engine import Engine
 from netplc.program import parse
 from netplc.records import ListSink
-from tests.hmi_forms.helpers import engine_target, write_form
+from tests.hmi_forms.helpers import engine_target, snap, write_form
 
 TAGS = """\
 name,address,type,unit,app_min,app_max,phy_min,phy_max,decimals,description,h,l,priority
@@ -82,3 +82,33 @@ def test_an_operator_write_to_a_tag_is_journaled_in_physical_units_with_the_raw_
                                           "(raw 1024 -> 3686 at 04030)")
     assert texts[1][2] == "write Пуск START (040042): 0 -> 1"
     assert texts[2][2] == "write Other (04100): 0 -> 7"  # no tag: as before
+
+
+def test_a_setpoint_without_a_tag_journals_its_own_physical_values(tmp_path: Path) -> None:
+    """The designer's "AnalogOutput" with its own conversion: the record names no type and no raw
+    word alone, but the physical values and unit of the element's conversion."""
+    sink = ListSink()
+    engine = Engine(parse("JMP 0\n"), sink=sink)
+    engine.mem.set_word(0o4030, 1024)  # 0.0 °C
+    own = {"type": "AnalogOutput", "Name": "AnalogOutput", **BOX, "OutAddr": "04030", "AppMin": 0,
+           "AppMax": 4095, "PhyMin": -50, "PhyMax": 150, "Units": "°C"}
+    form = load_form(write_form(tmp_path, [own]))
+    setpoint = form.elements[0]
+    setpoint.bind(engine_target(engine), "ivanov")
+    setpoint.update(snap(words={0o4030: 1024}))
+    assert setpoint.submit("130")[0]
+    engine.scan()
+    texts = [r.text for r in sink.records if r.kind == "operator"]
+    assert texts == ["write 04030: 0.0 -> 130.0 °C (raw 1024 -> 3686 at 04030)"]
+
+
+def test_a_default_named_element_journals_by_its_tags_description(tmp_path: Path, tags) -> None:
+    from tests.hmi_forms.helpers import ListTarget
+
+    lamp = {"type": "DiscreteBase", "Name": "DiscreteBase 2", **BOX, "InAddr": "PUMP", "RegMessages": True,
+            "TextFalse": "стоп", "TextTrue": "работа"}
+    model = load_form(write_form(tmp_path, [lamp]), tags=tags).elements[0]
+    model.effects = effects = ListTarget()
+    model.update(snap())
+    model.update(snap(bits={0o40005: 1}))
+    assert [(r.source, r.text) for r in effects.records] == [("Насос", "работа")]

@@ -46,3 +46,28 @@ def test_the_guard_decides_before_anything_is_written(tmp_path: Path) -> None:
     answer[0] = None
     assert button.click() is True and setpoint.submit("50")[0]
     assert target.writes == [("bit", 0o40042, 1, "ivan"), ("word", 0o4030, 2048, "ivan")]
+
+
+def test_a_confirmation_names_the_tag_not_the_type_and_says_the_state(tmp_path: Path) -> None:
+    """The designer's "DiscreteBase" bound to a tag is asked about by the tag's description, the
+    new state in the element's words; the target is given the label the journal names."""
+    from app.scada.table import TagTable
+    from app.scada.tag import Scaling, Tag, TagType
+
+    tags = TagTable([Tag("PUMP", 0o40042, TagType.BIT, description="Насос"),
+                     Tag("SP", 0o4030, TagType.WORD, "°C", Scaling(0, 4095, -50, 150), 1, "Уставка")])
+    button = {**BUTTON, "Name": "DiscreteBase 2", "InAddr": "PUMP", "TextFalse": "Стоп", "TextTrue": "Пуск"}
+    setpoint = {"type": "AnalogOutput", "Name": "AnalogOutput", "x": 0, "y": 40, "w": 200, "h": 80,
+                "OutAddr": "SP"}
+    plain = {**BUTTON, "Name": "DiscreteBase 3", "InAddr": "040043", "y": 100}
+    models = load_form(write_form(tmp_path, [button, setpoint, plain]), tags=tags).elements
+    asked: list[str] = []
+    for model in models:
+        model.bind(ListTarget(), "ivan")
+        model.guard = lambda _element, what: asked.append(what) or "no"
+        model.update(snap())
+    models[0].click()
+    models[1].submit("20")
+    models[2].click()
+    assert asked == ["Насос \u2192 Пуск", "Уставка \u2192 20.0 °C", "040043 \u2192 1"]
+    assert [m.label for m in models] == ["Насос", "Уставка", ""]

@@ -1,6 +1,9 @@
-"""The canvas view: rubber-band and Ctrl+click selection, keyboard moves, drops from the palette."""
+"""The canvas view: rubber-band and Ctrl+click selection, keyboard moves, drops from the palette and
+the tag browser."""
 
 from __future__ import annotations
+
+import logging
 
 from PySide6.QtCore import Qt
 from PySide6.QtGui import QDragEnterEvent, QDragMoveEvent, QDropEvent, QKeyEvent, QPainter, QWheelEvent
@@ -9,7 +12,9 @@ from PySide6.QtWidgets import QGraphicsView, QWidget
 from app.gui.designer.design import Design
 from hmi_forms.elements import ELEMENT_TYPES
 
+logger = logging.getLogger(__name__)
 ELEMENT_MIME = "application/x-netplc-element-type"
+TAG_MIME = "application/x-netplc-tag"  # a tag's name, from the tag browser
 ARROWS = {Qt.Key.Key_Left: (-1, 0), Qt.Key.Key_Right: (1, 0), Qt.Key.Key_Up: (0, -1), Qt.Key.Key_Down: (0, 1)}
 
 
@@ -64,30 +69,44 @@ class Canvas(QGraphicsView):
             return
         super().wheelEvent(event)
 
-    def _element_drag(self, event: QDragEnterEvent | QDragMoveEvent | QDropEvent) -> str | None:
+    def _dragged(self, event: QDragEnterEvent | QDragMoveEvent | QDropEvent) -> tuple[str, str] | None:
+        """("element", type) from the palette or ("tag", name) from the tag browser; None: neither."""
         data = event.mimeData()
-        if not data.hasFormat(ELEMENT_MIME):
-            return None
-        kind = bytes(data.data(ELEMENT_MIME).data()).decode()
-        return kind if kind in ELEMENT_TYPES else None
+        if data.hasFormat(ELEMENT_MIME):
+            kind = bytes(data.data(ELEMENT_MIME).data()).decode()
+            return ("element", kind) if kind in ELEMENT_TYPES else None
+        if data.hasFormat(TAG_MIME):
+            name = bytes(data.data(TAG_MIME).data()).decode()
+            return ("tag", name) if name in self.design.doc.tags.by_name else None
+        return None
 
     def dragEnterEvent(self, event: QDragEnterEvent) -> None:
-        if self._element_drag(event):
+        if self._dragged(event):
             event.acceptProposedAction()
         else:
             super().dragEnterEvent(event)
 
     def dragMoveEvent(self, event: QDragMoveEvent) -> None:
-        if self._element_drag(event):
+        if self._dragged(event):
             event.acceptProposedAction()
         else:
             super().dragMoveEvent(event)
 
     def dropEvent(self, event: QDropEvent) -> None:
-        kind = self._element_drag(event)
-        if kind is None:
+        dragged = self._dragged(event)
+        if dragged is None:
             super().dropEvent(event)
             return
-        self.design.add(kind, self.mapToScene(event.position().toPoint()))
+        at = self.mapToScene(event.position().toPoint())
+        what, name = dragged
+        try:
+            if what == "tag":
+                self.design.add_tag(name, at)
+            else:
+                self.design.add(name, at)
+        except ValueError:  # a tag no element shows: the browser does not let it be dragged
+            logger.exception("designer: drop of %s %r refused", what, name)
+            event.ignore()
+            return
         event.acceptProposedAction()
         self.setFocus()

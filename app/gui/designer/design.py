@@ -19,8 +19,9 @@ from app.gui.designer.arrange import Z_ORDERS, aligned, box, distributed, number
 from app.gui.designer.commands import MISSING, NUDGE_ID, Insert, Remove, Reorder, SetProps
 from app.gui.designer.items import ElementItem
 from app.gui.designer.scene import FormScene
+from app.scada.tag import TagType
 from hmi_forms.elements import ELEMENT_TYPES, Element
-from hmi_forms.form_doc import FormDoc, Reader, image_files, problems
+from hmi_forms.form_doc import FormDoc, Reader, checked, image_files
 from hmi_forms.form_writer import save_form
 from hmi_forms.widgets.base import ElementWidget, Images
 from hmi_forms.widgets.form_view import FormView
@@ -36,9 +37,10 @@ NEW_PROPS: dict[str, dict[str, Any]] = {
     "DiscreteBase": STATES, "DiscreteColorLabel": STATES, "DiscreteControlledEnable": STATES,
     "DiscreteAnimation": {**STATES, "ImageFirst": -1, "ImageLast": -1},
     "StaticText": {"Text": "Text"},
-    "AnalogBase": {"AppMin": 0, "AppMax": 4095, "PhyMin": 0, "PhyMax": 100, "Appearance": "digital"},
-    "AnalogOutput": {"AppMin": 0, "AppMax": 4095, "PhyMin": 0, "PhyMax": 100},
+    "AnalogBase": {"Appearance": "digital"},  # no conversion of its own: its tag's (Scaled.take_tag)
 }
+# the element a tag dropped from the tag browser becomes (the types the elements' addresses take)
+TAG_ELEMENTS = {TagType.BIT: "DiscreteBase", TagType.WORD: "AnalogBase"}
 
 
 class Design(QObject):
@@ -102,8 +104,9 @@ class Design(QObject):
     def item(self, raw: dict[str, Any]) -> ElementItem:
         return self.items[id(raw)]
 
-    def problems(self) -> list[str]:
-        return problems(self.doc, self.symbols)
+    def checked(self) -> tuple[list[str], list[str]]:
+        """What `check` would report: the problems, and the warnings."""
+        return checked(self.doc, self.symbols)
 
     def image_files(self) -> list[str]:
         return image_files(self.doc.path.parent)
@@ -245,17 +248,42 @@ class Design(QObject):
                 raw["Image"] = files[0]
         return raw
 
-    def add(self, kind: str, at: QPointF | None = None) -> dict[str, Any]:
-        """Edit -> Add element: a new element of `kind`, selected (at `at`, else near the top left)."""
+    def add(self, kind: str, at: QPointF | None = None, props: dict[str, Any] | None = None,
+            text: str = "") -> dict[str, Any]:
+        """Edit -> Add element: a new element of `kind` (with `props`), selected (at `at`, else near
+        the top left)."""
         if kind not in ELEMENT_TYPES:
             raise ValueError(f"unknown element type {kind!r}")
         if at is None:
             n = len(self.doc.elements) % 20
             at = QPointF(16 + n * self.grid * 2, 16 + n * self.grid * 2)
-        raw = self.new_element(kind, at.x(), at.y())
-        self.undo.push(Insert(self, [raw], f"Add {kind}"))
+        raw = {**self.new_element(kind, at.x(), at.y()), **(props or {})}
+        self.undo.push(Insert(self, [raw], text or f"Add {kind}"))
         self.select([raw])
         return raw
+
+    def add_tag(self, name: str, at: QPointF | None = None) -> dict[str, Any]:
+        """A tag dropped from the tag browser: the element fitting its type, named by the tag's
+        description, bound by the tag's name and with nothing of its own that the tag gives
+        (conversion, unit, decimals, limits), so it shows the tag's truth."""
+        tag = self.doc.tags.get(name)
+        kind = TAG_ELEMENTS.get(tag.type) if tag is not None else None
+        if tag is None or kind is None:
+            raise ValueError(f"no element shows tag {name!r}")
+        raw = self.add(kind, at, {"Name": self.unique_name(tag.description or tag.name), "InAddr": tag.name},
+                       f"Add {kind} of {tag.name}")
+        return raw
+
+    def named_by_tag(self, raw: dict[str, Any], key: str, value: Any) -> dict[str, Any]:
+        """Binding an element that still has its type's name (`AnalogBase 2`) to a tag also names it
+        by the tag's description, as a tag dropped from the browser is: its face and the operator's
+        confirmations then say what it shows. {} for anything else."""
+        tag = self.doc.tags.get(value) if isinstance(value, str) else None
+        kind = raw.get("type")
+        stem = str(raw.get("Name", "")).rstrip("0123456789").rstrip()
+        if tag is None or key not in Element.ADDRESS_KEYS or stem not in ("", kind):
+            return {}
+        return {"Name": self.unique_name(tag.description or tag.name)}
 
     def delete(self, raws: list[dict[str, Any]]) -> None:
         if raws:

@@ -189,7 +189,7 @@ class ComboEditor(Editor):
         super().__init__(check, parent)
         self.combo = QComboBox()
         self.combo.setEditable(editable)
-        self.combo.addItem("(default)", MISSING)
+        self.combo.addItem(self.tr("(default)"), MISSING)
         for label, value in options:
             self.combo.addItem(label, value)
         self.row.addWidget(self.combo)
@@ -220,7 +220,7 @@ class ColorEditor(LineEditor):
         super().__init__("text", check, parent=parent)
         self.pick = QPushButton("…")
         self.pick.setFixedWidth(28)
-        self.pick.setToolTip("Pick a colour")
+        self.pick.setToolTip(self.tr("Pick a colour"))
         self.row.addWidget(self.pick)
         self.pick.clicked.connect(self._dialog)
 
@@ -233,7 +233,7 @@ class ColorEditor(LineEditor):
             self.pick.setStyleSheet("")
 
     def _dialog(self) -> None:
-        color = QColorDialog.getColor(QColor(self.line.text() or "#ffffff"), self, "Colour",
+        color = QColorDialog.getColor(QColor(self.line.text() or "#ffffff"), self, self.tr("Colour"),
                                       QColorDialog.ColorDialogOption.ShowAlphaChannel)
         if color.isValid():
             self.line.setText(color_text(color))
@@ -254,7 +254,7 @@ class FontEditor(Editor):
         self.button = QPushButton()
         self.clear = QPushButton("×")
         self.clear.setFixedWidth(28)
-        self.clear.setToolTip("Back to the default font")
+        self.clear.setToolTip(self.tr("Back to the default font"))
         self.row.addWidget(self.button, 1)
         self.row.addWidget(self.clear)
         self.value: Any = MISSING
@@ -270,7 +270,7 @@ class FontEditor(Editor):
             size = value.get("Size", p.Font.Size)
             self.button.setText(f'{value.get("Family", p.Font.Family)} {size:g} {style}'.strip())
         else:
-            self.button.setText("(default)")
+            self.button.setText(self.tr("(default)"))
         self.refuse(None)
 
     def _dialog(self) -> None:
@@ -282,7 +282,7 @@ class FontEditor(Editor):
         start.setPointSizeF(f.Size)
         start.setBold(f.Bold)
         start.setItalic(f.Italic)
-        ok, font = QFontDialog.getFont(start, self, "Font")
+        ok, font = QFontDialog.getFont(start, self, self.tr("Font"))
         if ok:
             self.submit(font_value(font))
 

@@ -5,7 +5,9 @@ first comes into view): a widget painted by
 its form is drawn straight into the canvas with `draw`, exactly as the form draws it; a widget made
 of child widgets (plots, input fields, the journal) is rendered once into a pixmap per change. The
 item adds only what a designer needs on top: selection outline and handles, a red outline while
-the element has problems, and resizing by its handles.
+the element has problems, resizing by its handles, and under an analog element its scale's band
+with the alarm zones of its tag (or its own PhyLow/PhyHigh) and its unit: what the engineer must
+see while placing it, before any value arrives.
 """
 
 from __future__ import annotations
@@ -17,7 +19,10 @@ from PySide6.QtCore import QPointF, QRectF, Qt
 from PySide6.QtGui import QBrush, QColor, QPainter, QPainterPath, QPen, QPixmap
 from PySide6.QtWidgets import QGraphicsItem, QGraphicsSceneMouseEvent, QStyleOptionGraphicsItem, QWidget
 
+from app.scada.table import TagAlarms
 from hmi_forms.elements import Element
+from hmi_forms.elements.analog import AnalogBase, Scaled
+from hmi_forms.widgets import theme
 from hmi_forms.widgets.base import ElementWidget, SelfPainted
 from netplc.memory import Snapshot
 
@@ -36,6 +41,29 @@ CURSORS = {"tl": Qt.CursorShape.SizeFDiagCursor, "br": Qt.CursorShape.SizeFDiagC
            "tr": Qt.CursorShape.SizeBDiagCursor, "bl": Qt.CursorShape.SizeBDiagCursor,
            "t": Qt.CursorShape.SizeVerCursor, "b": Qt.CursorShape.SizeVerCursor,
            "l": Qt.CursorShape.SizeHorCursor, "r": Qt.CursorShape.SizeHorCursor}
+
+
+BAND = 5.0  # the scale band's height
+
+
+def zones(model: Scaled, alarms: TagAlarms | None) -> list[tuple[float, float, QColor]]:
+    """The alarm zones on the element's scale as (from, to) fractions of PhyMin..PhyMax and a colour:
+    the tag's LL/L and H/HH limits (amber beyond L and H, red beyond LL and HH), else the element's
+    own PhyLow/PhyHigh."""
+    lo, hi = model.scaling.phy_range
+    if alarms is not None and alarms.limits():
+        marks = [(lo, alarms.ll, theme.ALARM), (lo, alarms.l, theme.WARN),
+                 (alarms.h, hi, theme.WARN), (alarms.hh, hi, theme.ALARM)]
+    elif isinstance(model, AnalogBase):
+        marks = [(lo, model.PhyLow, theme.WARN), (model.PhyHigh, hi, theme.ALARM)]
+    else:
+        marks = []
+    out = []
+    for a, b, color in marks:
+        if a is not None and b is not None:
+            fa, fb = model.scaling.fraction(a), model.scaling.fraction(b)
+            out.append((min(fa, fb), max(fa, fb), color))
+    return out
 
 
 def handle_points(r: QRectF) -> dict[str, QPointF]:
@@ -162,6 +190,8 @@ class ElementItem(QGraphicsItem):
             self.model = self.widget = None
         finally:
             p.restore()
+        if isinstance(self.model, Scaled) and not self.problems:
+            self._scale_band(p, r, self.model)
         if self.problems or self.flagged:
             p.setPen(QPen(PROBLEM, 1.5, Qt.PenStyle.DashLine))
             p.setBrush(Qt.BrushStyle.NoBrush)
@@ -177,6 +207,27 @@ class ElementItem(QGraphicsItem):
             p.setBrush(SELECTED)
             for point in handle_points(r).values():
                 p.drawRect(QRectF(point.x() - HANDLE / 2, point.y() - HANDLE / 2, HANDLE, HANDLE))
+
+    def _scale_band(self, p: QPainter, r: QRectF, model: Scaled) -> None:
+        """The scale as a band along the element's bottom edge, its alarm zones coloured, and the
+        unit (with the tag it comes from) above its right end."""
+        alarms = self.design.doc.tags.alarms.get(model.tag) if model.tag else None
+        band = QRectF(r.left(), r.bottom() - BAND, r.width(), BAND)
+        p.save()
+        p.setPen(Qt.PenStyle.NoPen)
+        p.fillRect(band, QColor("#c8d2dc"))
+        for f0, f1, color in zones(model, alarms):
+            p.fillRect(QRectF(band.left() + f0 * band.width(), band.top(), (f1 - f0) * band.width(),
+                              band.height()), color)
+        caption = " ".join(t for t in (model.tag, model.Units) if t)
+        if caption and r.height() > 3 * BAND:
+            font = p.font()
+            font.setPixelSize(10)
+            p.setFont(font)
+            p.setPen(theme.TEXT_DIM)
+            p.drawText(QRectF(r.left(), band.top() - 13, r.width() - 3, 13),
+                       int(Qt.AlignmentFlag.AlignRight | Qt.AlignmentFlag.AlignVCenter), caption)
+        p.restore()
 
     # --- moving and resizing ---------------------------------------------------------------------
 

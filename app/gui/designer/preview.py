@@ -171,12 +171,12 @@ class Preview(QObject):
         self.snapshot.emit(snap)
         if not self._up:
             self._up = True
-            self.status.emit(f"Preview live: {self.endpoint}")
+            self.status.emit(self.tr("Preview live: {0}").format(self.endpoint))
         self._next.start()
 
     def _failed(self, _token: int, why: str) -> None:
         if self.worker is None:
             return
         self._up = False
-        self.status.emit(f"Preview: {why}")
+        self.status.emit(self.tr("Preview: {0}").format(why))
         self._next.start()

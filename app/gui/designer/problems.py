@@ -11,7 +11,7 @@ from collections.abc import Callable
 from typing import Any
 
 from PySide6.QtCore import Qt, QTimer
-from PySide6.QtWidgets import QListWidget, QListWidgetItem, QWidget
+from PySide6.QtWidgets import QListWidget, QListWidgetItem, QStyle, QWidget
 
 from app.gui.designer.design import Design
 
@@ -31,12 +31,13 @@ def element_of(problem: str, elements: list[dict[str, Any]]) -> dict[str, Any] |
 
 
 class ProblemsPane(QListWidget):
-    def __init__(self, design: Design, on_count: Callable[[int], None],
+    def __init__(self, design: Design, on_count: Callable[[int, int], None],
                  parent: QWidget | None = None) -> None:
         super().__init__(parent)
         self.design = design
         self.on_count = on_count
         self.problems: list[str] = []
+        self.warnings: list[str] = []
         self.timer = QTimer(self)
         self.timer.setSingleShot(True)
         self.timer.setInterval(DELAY_MS)
@@ -52,17 +53,25 @@ class ProblemsPane(QListWidget):
         self.timer.start()
 
     def recheck(self) -> list[str]:
+        """List the problems, then the warnings (marked as such: the station opens the form all the
+        same); returns the problems."""
         self.timer.stop()
-        self.problems = self.design.problems()
+        self.problems, self.warnings = self.design.checked()
         prefix = f"{self.design.doc.path}: "
         self.clear()
-        for text in self.problems:
-            item = QListWidgetItem(text.removeprefix(prefix))
+        warning = self.tr("warning: {0}")
+        icon = self.style().standardIcon(QStyle.StandardPixmap.SP_MessageBoxWarning)
+        for text in self.problems + self.warnings:
+            shown = text.removeprefix(prefix)
+            item = QListWidgetItem(shown)
+            if text in self.warnings:
+                item.setText(warning.format(shown))
+                item.setIcon(icon)
             item.setData(Qt.ItemDataRole.UserRole, text)
             item.setToolTip(text)
             self.addItem(item)
-        self.on_count(len(self.problems))
-        self.design.flag([e for e in map(self._element, self.problems) if e is not None])
+        self.on_count(len(self.problems), len(self.warnings))
+        self.design.flag([e for e in map(self._element, self.problems + self.warnings) if e is not None])
         return self.problems
 
     def _element(self, problem: str) -> dict[str, Any] | None:

@@ -162,8 +162,8 @@ class PropertyPanel(QWidget):
         """Show the targets' current values (after an edit, an undo, a move)."""
         t = self.targets
         one = f'{t[0].get("type")} "{t[0].get("Name")}"'
-        self.title.setText(f"Form {self.design.doc.path.name}" if self.form_mode else
-                           one if len(t) == 1 else f"{len(t)} elements")
+        self.title.setText(self.tr("Form {0}").format(self.design.doc.path.name) if self.form_mode else
+                           one if len(t) == 1 else self.tr("{0} elements").format(len(t)))
         for key, editor in self.editors.items():
             values = [self._source(t, key).get(key, MISSING) for t in self.targets]
             mixed = any(v != values[0] for v in values[1:])
@@ -205,7 +205,8 @@ class PropertyPanel(QWidget):
         if isinstance(value, tuple):
             self._add_image(key, value[1], targets)
             return
-        self.design.set_props([(t, {key: value}) for t in targets], f"Set {key}")
+        named = self.design.named_by_tag(targets[0], key, value) if len(targets) == 1 else {}
+        self.design.set_props([(t, {key: value, **named}) for t in targets], f"Set {key}")
 
     def _images(self) -> list[Any]:
         """The form's images list (none while the section is not a list: a problem to fix first)."""

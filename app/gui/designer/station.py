@@ -10,6 +10,7 @@ from __future__ import annotations
 from dataclasses import dataclass, field
 from pathlib import Path
 
+from app.scada.table import TagTable, read_tags
 from app.station.config import STATION_FILE, Station, read_station
 from netplc.program import ProgramError, load_symbols
 
@@ -22,6 +23,7 @@ class Context:
     station: Station | None
     form: Path  # the form to open (may not exist yet: a new form)
     names: dict[str, int] = field(default_factory=dict)  # symbols and tags -> address
+    tags: TagTable = field(default_factory=TagTable)  # the good rows of the station's tags.csv
 
     @property
     def forms(self) -> list[Path]:
@@ -67,4 +69,15 @@ def open_target(target: str | Path) -> Context:
         folder = station.HMIload or station.folder / "forms"
         existing = sorted(folder.glob("*.hmi")) if folder.is_dir() else []
         form = existing[0] if existing else folder / NEW_FORM
-    return Context(station, form, names(station) if station is not None else {})
+    if station is None:
+        return Context(None, form)
+    found = names(station)
+    return Context(station, form, found, tags(station, found))
+
+
+def tags(station: Station, symbols: dict[str, int]) -> TagTable:
+    """The station's tags (their good rows: check reports the others), for the tag browser and for
+    elements to take their conversion, unit and limits from."""
+    if station.Tags is None or not station.Tags.is_file():
+        return TagTable()
+    return read_tags(station.Tags, symbols)[0]

@@ -10,7 +10,7 @@ from __future__ import annotations
 import sys
 from pathlib import Path
 
-from PySide6.QtCore import QPointF, QSize, Qt
+from PySide6.QtCore import QT_TRANSLATE_NOOP, QPointF, QSize, Qt
 from PySide6.QtGui import QAction, QCloseEvent, QGuiApplication, QKeySequence, QShowEvent
 from PySide6.QtWidgets import (
     QDockWidget,
@@ -22,6 +22,7 @@ from PySide6.QtWidgets import (
     QWidget,
 )
 
+from app.gui import i18n
 from app.gui.designer.canvas import Canvas
 from app.gui.designer.design import Design
 from app.gui.designer.palette import Palette
@@ -29,15 +30,26 @@ from app.gui.designer.preview import Preview, plan
 from app.gui.designer.problems import ProblemsPane
 from app.gui.designer.properties import PropertyPanel
 from app.gui.designer.station import Context, open_target
+from app.gui.designer.tag_browser import TagBrowser
 from hmi_forms.elements import ELEMENT_TYPES
 from hmi_forms.form import FormError
 from hmi_forms.form_doc import FormDoc, new_doc, read_doc
 
 SIZE = QSize(1366, 768)
-ALIGN = (("Align left", "left"), ("Align right", "right"), ("Align top", "top"), ("Align bottom", "bottom"),
-         ("Centre horizontally", "hcenter"), ("Centre vertically", "vcenter"))
-Z_ORDER = (("Bring to front", "front", "Ctrl+Shift+]"), ("Raise", "raise", "Ctrl+]"),
-           ("Lower", "lower", "Ctrl+["), ("Send to back", "back", "Ctrl+Shift+["))
+SAVE_ANYWAY = QT_TRANSLATE_NOOP(
+    "DesignerWindow", "{0} problem(s), see Problems: the station will not open the form. Save anyway?")
+RTU_PREVIEW = QT_TRANSLATE_NOOP(
+    "DesignerWindow", "The station serves Modbus RTU on a serial port; the preview reads Modbus TCP")
+ALIGN = ((QT_TRANSLATE_NOOP("DesignerWindow", "Align left"), "left"),
+         (QT_TRANSLATE_NOOP("DesignerWindow", "Align right"), "right"),
+         (QT_TRANSLATE_NOOP("DesignerWindow", "Align top"), "top"),
+         (QT_TRANSLATE_NOOP("DesignerWindow", "Align bottom"), "bottom"),
+         (QT_TRANSLATE_NOOP("DesignerWindow", "Centre horizontally"), "hcenter"),
+         (QT_TRANSLATE_NOOP("DesignerWindow", "Centre vertically"), "vcenter"))
+Z_ORDER = ((QT_TRANSLATE_NOOP("DesignerWindow", "Bring to front"), "front", "Ctrl+Shift+]"),
+           (QT_TRANSLATE_NOOP("DesignerWindow", "Raise"), "raise", "Ctrl+]"),
+           (QT_TRANSLATE_NOOP("DesignerWindow", "Lower"), "lower", "Ctrl+["),
+           (QT_TRANSLATE_NOOP("DesignerWindow", "Send to back"), "back", "Ctrl+Shift+["))
 
 
 class DesignerWindow(QMainWindow):
@@ -50,13 +62,17 @@ class DesignerWindow(QMainWindow):
         self.setCentralWidget(self.canvas)
         names = sorted(context.names)
         self.palette = Palette(self.add)
+        self.tag_browser = TagBrowser(context.tags, self.add_tag)
         self.properties = PropertyPanel(self.design, names)
         self.problems_label = QLabel()
         self.preview_label = QLabel()
         self.problems = ProblemsPane(self.design, self._problem_count)
-        self._dock("Elements", self.palette, Qt.DockWidgetArea.LeftDockWidgetArea)
-        self._dock("Properties", self.properties, Qt.DockWidgetArea.RightDockWidgetArea)
-        self.problems_dock = self._dock("Problems", self.problems, Qt.DockWidgetArea.BottomDockWidgetArea)
+        self._dock("Elements", self.tr("Elements"), self.palette, Qt.DockWidgetArea.LeftDockWidgetArea)
+        self._dock("Tags", self.tr("Tags"), self.tag_browser, Qt.DockWidgetArea.LeftDockWidgetArea)
+        self._dock("Properties", self.tr("Properties"), self.properties,
+                   Qt.DockWidgetArea.RightDockWidgetArea)
+        self.problems_dock = self._dock("Problems", self.tr("Problems"), self.problems,
+                                        Qt.DockWidgetArea.BottomDockWidgetArea)
         self.statusBar().addWidget(self.problems_label)
         self.statusBar().addPermanentWidget(self.preview_label)
         self._build_menus()
@@ -77,6 +93,7 @@ class DesignerWindow(QMainWindow):
         station = self.context.station
         if station is not None:
             doc.station, doc.allow_outside = station.folder, station.allow_outside
+        doc.tags = self.context.tags
         archive = station.Archive if station is not None and station.Archive.is_file() else None
         return Design(doc, self.context.names, archive, self)
 
@@ -107,14 +124,18 @@ class DesignerWindow(QMainWindow):
 
     def _title(self, *_: object) -> None:
         star = "" if self.design.undo.isClean() else "*"
-        self.setWindowTitle(f"{self.design.doc.path.name}{star} - NetPlc form designer")
+        name = f"{self.design.doc.path.name}{star}"
+        self.setWindowTitle(self.tr("{0} - NetPlc form designer").format(name))
 
-    def _problem_count(self, n: int) -> None:
-        self.problems_label.setText(f"{n} problem(s): see Problems" if n else "No problems")
+    def _problem_count(self, n: int, warned: int = 0) -> None:
+        text = self.tr("{0} problem(s): see Problems").format(n) if n else self.tr("No problems")
+        if warned:
+            text += self.tr(", {0} warning(s)").format(warned)
+        self.problems_label.setText(text)
 
-    def _dock(self, title: str, widget: QWidget, area: Qt.DockWidgetArea) -> QDockWidget:
+    def _dock(self, name: str, title: str, widget: QWidget, area: Qt.DockWidgetArea) -> QDockWidget:
         dock = QDockWidget(title, self)
-        dock.setObjectName(title)
+        dock.setObjectName(name)
         dock.setWidget(widget)
         dock.setFeatures(QDockWidget.DockWidgetFeature.DockWidgetMovable
                          | QDockWidget.DockWidgetFeature.DockWidgetFloatable)
@@ -136,65 +157,67 @@ class DesignerWindow(QMainWindow):
     def _build_menus(self) -> None:
         bar = self.menuBar()
         keys = QKeySequence.StandardKey
-        file = bar.addMenu("&File")
-        self._action(file, "&New form…", self.new_form, keys.New)
-        self._action(file, "&Open…", self.open_form, keys.Open)
+        file = bar.addMenu(self.tr("&File"))
+        self._action(file, self.tr("&New form…"), self.new_form, keys.New)
+        self._action(file, self.tr("&Open…"), self.open_form, keys.Open)
         if self.context.forms:
-            station = file.addMenu("Forms of the station")
+            station = file.addMenu(self.tr("Forms of the station"))
             for path in self.context.forms:
                 self._action(station, path.name,
                              lambda _=False, p=path: self._may_discard() and self.open_path(p))
-        self._action(file, "&Save", lambda: self.save(), keys.Save)
-        self._action(file, "Save &as…", self.save_as, keys.SaveAs)
+        self._action(file, self.tr("&Save"), lambda: self.save(), keys.Save)
+        self._action(file, self.tr("Save &as…"), self.save_as, keys.SaveAs)
         file.addSeparator()
-        self._action(file, "&Close", self.close, keys.Quit)
+        self._action(file, self.tr("&Close"), self.close, keys.Quit)
 
-        edit = bar.addMenu("&Edit")
+        edit = bar.addMenu(self.tr("&Edit"))
         self.edit_menu = edit
-        self.undo_action = self._action(edit, "&Undo", lambda: self.design.undo.undo(), keys.Undo)
-        self.redo_action = self._action(edit, "&Redo", lambda: self.design.undo.redo(), keys.Redo)
+        self.undo_action = self._action(edit, self.tr("&Undo"), lambda: self.design.undo.undo(), keys.Undo)
+        self.redo_action = self._action(edit, self.tr("&Redo"), lambda: self.design.undo.redo(), keys.Redo)
         edit.addSeparator()
-        self._action(edit, "Cu&t", self.cut, keys.Cut)
-        self._action(edit, "&Copy", self.copy, keys.Copy)
-        self._action(edit, "&Paste", self.paste, keys.Paste)
-        self._action(edit, "&Delete", lambda: self.design.delete(self.design.selected()), keys.Delete)
-        self._action(edit, "Select &all", self.select_all, keys.SelectAll)
+        self._action(edit, self.tr("Cu&t"), self.cut, keys.Cut)
+        self._action(edit, self.tr("&Copy"), self.copy, keys.Copy)
+        self._action(edit, self.tr("&Paste"), self.paste, keys.Paste)
+        self._action(edit, self.tr("&Delete"), lambda: self.design.delete(self.design.selected()),
+                     keys.Delete)
+        self._action(edit, self.tr("Select &all"), self.select_all, keys.SelectAll)
         edit.addSeparator()
-        add = edit.addMenu("Add &element")
+        add = edit.addMenu(self.tr("Add &element"))
         self.add_actions = {kind: self._action(add, kind, lambda _=False, k=kind: self.add(k))
                             for kind in ELEMENT_TYPES}
 
-        arrange = bar.addMenu("&Arrange")
+        arrange = bar.addMenu(self.tr("&Arrange"))
         for text, how in ALIGN:
-            self._action(arrange, text, lambda _=False, h=how: self.design.align(h))
+            self._action(arrange, self.tr(text), lambda _=False, h=how: self.design.align(h))
         arrange.addSeparator()
-        self._action(arrange, "Distribute horizontally", lambda: self.design.distribute("h"))
-        self._action(arrange, "Distribute vertically", lambda: self.design.distribute("v"))
+        self._action(arrange, self.tr("Distribute horizontally"), lambda: self.design.distribute("h"))
+        self._action(arrange, self.tr("Distribute vertically"), lambda: self.design.distribute("v"))
         arrange.addSeparator()
         for text, how, key in Z_ORDER:
-            self._action(arrange, text, lambda _=False, h=how: self.design.z_order(h), key)
+            self._action(arrange, self.tr(text), lambda _=False, h=how: self.design.z_order(h), key)
         arrange.addSeparator()
-        self.snap_action = self._action(arrange, "Snap to &grid", self._toggle_snap, "Ctrl+G", checkable=True)
+        self.snap_action = self._action(arrange, self.tr("Snap to &grid"), self._toggle_snap, "Ctrl+G",
+                                        checkable=True)
         self.snap_action.setChecked(True)
-        self.grid_action = self._action(arrange, "Show grid", self._toggle_grid, checkable=True)
+        self.grid_action = self._action(arrange, self.tr("Show grid"), self._toggle_grid, checkable=True)
         self.grid_action.setChecked(True)
-        self._action(arrange, "Grid size…", self._grid_size)
+        self._action(arrange, self.tr("Grid size…"), self._grid_size)
 
-        view = bar.addMenu("&View")
-        self.preview_action = self._action(view, "&Preview live", self.toggle_preview, "F6", checkable=True)
+        view = bar.addMenu(self.tr("&View"))
+        self.preview_action = self._action(view, self.tr("&Preview live"), self.toggle_preview, "F6",
+                                           checkable=True)
         station = self.context.station
         if station is None or not station.modbus_server.enabled:
             self.preview_action.setEnabled(False)
-            self.preview_action.setToolTip("No station with a Modbus server beside this form")
+            self.preview_action.setToolTip(self.tr("No station with a Modbus server beside this form"))
         elif station.modbus_server.serial is not None:
             self.preview_action.setEnabled(False)
-            self.preview_action.setToolTip("The station's Modbus server is RTU on a serial port; "
-                                           "the preview reads Modbus TCP")
+            self.preview_action.setToolTip(self.tr(RTU_PREVIEW))
         view.addSeparator()
-        self._action(view, "Zoom in", lambda: self.canvas.scale(1.25, 1.25), keys.ZoomIn)
-        self._action(view, "Zoom out", lambda: self.canvas.scale(0.8, 0.8), keys.ZoomOut)
-        self._action(view, "Actual size", self.canvas.resetTransform, "Ctrl+0")
-        tools = self.addToolBar("Designer")
+        self._action(view, self.tr("Zoom in"), lambda: self.canvas.scale(1.25, 1.25), keys.ZoomIn)
+        self._action(view, self.tr("Zoom out"), lambda: self.canvas.scale(0.8, 0.8), keys.ZoomOut)
+        self._action(view, self.tr("Actual size"), self.canvas.resetTransform, "Ctrl+0")
+        tools = self.addToolBar(self.tr("Designer"))
         tools.setObjectName("designer-tools")
         tools.addAction(self.undo_action)
         tools.addAction(self.redo_action)
@@ -204,12 +227,20 @@ class DesignerWindow(QMainWindow):
         self._rebind_undo()
 
     def add(self, kind: str) -> None:
-        """Edit -> Add element: the new element near the top left of what the canvas shows, each
-        next one a little further down, so a series of adds does not pile up."""
+        """Edit -> Add element."""
+        self.design.add(kind, self._next_place())
+
+    def add_tag(self, name: str) -> None:
+        """A double-clicked tag of the tag browser: its element."""
+        self.design.add_tag(name, self._next_place())
+
+    def _next_place(self) -> QPointF:
+        """Near the top left of what the canvas shows, each next one a little further down, so a
+        series of adds does not pile up."""
         seen = self.canvas.mapToScene(self.canvas.viewport().rect()).boundingRect()
         n = len(self.design.doc.elements) % 10
         step = 2 * self.design.grid * (n + 1)
-        self.design.add(kind, QPointF(max(seen.left(), 0) + step, max(seen.top(), 0) + step))
+        return QPointF(max(seen.left(), 0) + step, max(seen.top(), 0) + step)
 
     def _rebind_undo(self) -> None:
         """Undo and Redo follow this form's stack and name the step they would take."""
@@ -222,10 +253,10 @@ class DesignerWindow(QMainWindow):
         undo.redoTextChanged.connect(self._redo_text)
 
     def _undo_text(self, text: str) -> None:
-        self.undo_action.setText(f"&Undo {text}".strip())
+        self.undo_action.setText(self.tr("&Undo {0}").format(text).strip())
 
     def _redo_text(self, text: str) -> None:
-        self.redo_action.setText(f"&Redo {text}".strip())
+        self.redo_action.setText(self.tr("&Redo {0}").format(text).strip())
 
     def _toggle_snap(self, on: bool) -> None:
         self.design.snapping = on
@@ -235,7 +266,8 @@ class DesignerWindow(QMainWindow):
         self.design.scene.update()
 
     def _grid_size(self) -> None:
-        n, ok = QInputDialog.getInt(self, "Grid", "Grid step, pixels:", self.design.grid, 2, 100)
+        n, ok = QInputDialog.getInt(self, self.tr("Grid"), self.tr("Grid step, pixels:"), self.design.grid,
+                                    2, 100)
         if ok:
             self.design.grid = n
             self.design.scene.update()
@@ -264,13 +296,13 @@ class DesignerWindow(QMainWindow):
 
     def confirm(self, question: str) -> bool:
         """Ask the engineer (a test answers by replacing this method)."""
-        answer = QMessageBox.question(self, "Form designer", question)
+        answer = QMessageBox.question(self, self.tr("Form designer"), question)
         return answer == QMessageBox.StandardButton.Yes
 
     def warn(self, text: str) -> None:
         """Tell the engineer what went wrong (also on stderr, for a designer started from a shell)."""
         print(text, file=sys.stderr)
-        QMessageBox.warning(self, "Form designer", text)
+        QMessageBox.warning(self, self.tr("Form designer"), text)
 
     def save(self, path: Path | None = None) -> bool:
         """Save; the problems are worked out first and, when there are any, shown and confirmed."""
@@ -278,21 +310,20 @@ class DesignerWindow(QMainWindow):
         if found:
             self.problems_dock.show()
             self.problems_dock.raise_()
-            if not self.confirm(f"The form has {len(found)} problem(s), listed under Problems; the station "
-                                "will not open it as it is. Save anyway?"):
+            if not self.confirm(self.tr(SAVE_ANYWAY).format(len(found))):
                 return False
         try:
             saved = self.design.save(path)
         except OSError as e:
-            self.warn(f"The form was not saved: {e}")
+            self.warn(self.tr("The form was not saved: {0}").format(e))
             return False
         self._title()
-        self.statusBar().showMessage(f"Saved {saved}", 5000)
+        self.statusBar().showMessage(self.tr("Saved {0}").format(saved), 5000)
         return True
 
     def save_as(self) -> None:
-        name, _ = QFileDialog.getSaveFileName(self, "Save form as", str(self.design.doc.path),
-                                              "Forms (*.hmi)")
+        name, _ = QFileDialog.getSaveFileName(self, self.tr("Save form as"), str(self.design.doc.path),
+                                              self.tr("Forms (*.hmi)"))
         if name:
             self.save(Path(name))
 
@@ -300,10 +331,12 @@ class DesignerWindow(QMainWindow):
         return str(self.design.doc.path.parent)
 
     def _may_discard(self) -> bool:
-        return self.design.undo.isClean() or self.confirm("Discard the unsaved changes of this form?")
+        return self.design.undo.isClean() or self.confirm(
+            self.tr("Discard the unsaved changes of this form?"))
 
     def open_form(self) -> None:
-        name, _ = QFileDialog.getOpenFileName(self, "Open form", self._folder(), "Forms (*.hmi)")
+        name, _ = QFileDialog.getOpenFileName(self, self.tr("Open form"), self._folder(),
+                                              self.tr("Forms (*.hmi)"))
         if name and self._may_discard():
             self.open_path(Path(name))
 
@@ -317,7 +350,8 @@ class DesignerWindow(QMainWindow):
         return True
 
     def new_form(self) -> None:
-        name, _ = QFileDialog.getSaveFileName(self, "New form", self._folder(), "Forms (*.hmi)")
+        name, _ = QFileDialog.getSaveFileName(self, self.tr("New form"), self._folder(),
+                                              self.tr("Forms (*.hmi)"))
         if name and self._may_discard():
             self.set_document(new_doc(Path(name)))
 
@@ -384,6 +418,7 @@ def run_designer(target: str, screenshot: str | None = None) -> int:
     from app.gui.application import application
 
     app = application()
+    i18n.install(app, context.station.Language if context.station is not None else "")
     try:
         window = DesignerWindow(context)
     except FormError as e:

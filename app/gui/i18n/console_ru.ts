@@ -89,16 +89,38 @@
         <translation>Состояние</translation>
     </message>
     <message>
-        <source>Value</source>
-        <translation>Значение</translation>
-    </message>
-    <message>
         <source>Text</source>
         <translation>Текст</translation>
     </message>
     <message>
         <source>shelved by {0} until {1}: {2}</source>
         <translation>отложена ({0}) до {1}: {2}</translation>
+    </message>
+    <message>
+        <source>Value at change</source>
+        <translation>Значение при изменении</translation>
+    </message>
+    <message>
+        <source>The value when the alarm last changed state, not the value now</source>
+        <translation>Значение в момент последнего изменения состояния аварии, а не текущее</translation>
+    </message>
+</context>
+<context>
+    <name>ColorEditor</name>
+    <message>
+        <source>Pick a colour</source>
+        <translation>Выбрать цвет</translation>
+    </message>
+    <message>
+        <source>Colour</source>
+        <translation>Цвет</translation>
+    </message>
+</context>
+<context>
+    <name>ComboEditor</name>
+    <message>
+        <source>(default)</source>
+        <translation>(по умолчанию)</translation>
     </message>
 </context>
 <context>
@@ -109,10 +131,272 @@
     </message>
 </context>
 <context>
+    <name>DesignerWindow</name>
+    <message>
+        <source>, {0} warning(s)</source>
+        <translation>, предупреждений: {0}</translation>
+    </message>
+    <message>
+        <source>{0} problem(s): see Problems</source>
+        <translation>проблем: {0} (см. «Проблемы»)</translation>
+    </message>
+    <message>
+        <source>No problems</source>
+        <translation>Проблем нет</translation>
+    </message>
+    <message>
+        <source>&amp;Arrange</source>
+        <translation>&amp;Упорядочить</translation>
+    </message>
+    <message>
+        <source>&amp;Copy</source>
+        <translation>&amp;Копировать</translation>
+    </message>
+    <message>
+        <source>&amp;Delete</source>
+        <translation>&amp;Удалить</translation>
+    </message>
+    <message>
+        <source>&amp;Edit</source>
+        <translation>&amp;Правка</translation>
+    </message>
+    <message>
+        <source>&amp;File</source>
+        <translation>&amp;Файл</translation>
+    </message>
+    <message>
+        <source>&amp;New form…</source>
+        <translation>&amp;Новая форма…</translation>
+    </message>
+    <message>
+        <source>&amp;Paste</source>
+        <translation>&amp;Вставить</translation>
+    </message>
+    <message>
+        <source>&amp;Preview live</source>
+        <translation>&amp;Живой просмотр</translation>
+    </message>
+    <message>
+        <source>&amp;Redo {0}</source>
+        <translation>&amp;Повторить {0}</translation>
+    </message>
+    <message>
+        <source>&amp;Redo</source>
+        <translation>&amp;Повторить</translation>
+    </message>
+    <message>
+        <source>&amp;Save</source>
+        <translation>&amp;Сохранить</translation>
+    </message>
+    <message>
+        <source>&amp;Undo {0}</source>
+        <translation>&amp;Отменить {0}</translation>
+    </message>
+    <message>
+        <source>&amp;Undo</source>
+        <translation>&amp;Отменить</translation>
+    </message>
+    <message>
+        <source>Actual size</source>
+        <translation>Реальный размер</translation>
+    </message>
+    <message>
+        <source>Add &amp;element</source>
+        <translation>Добавить &amp;элемент</translation>
+    </message>
+    <message>
+        <source>Cu&amp;t</source>
+        <translation>Вы&amp;резать</translation>
+    </message>
+    <message>
+        <source>Designer</source>
+        <translation>Конструктор</translation>
+    </message>
+    <message>
+        <source>Discard the unsaved changes of this form?</source>
+        <translation>Отбросить несохранённые изменения формы?</translation>
+    </message>
+    <message>
+        <source>Distribute horizontally</source>
+        <translation>Распределить по горизонтали</translation>
+    </message>
+    <message>
+        <source>Distribute vertically</source>
+        <translation>Распределить по вертикали</translation>
+    </message>
+    <message>
+        <source>Elements</source>
+        <translation>Элементы</translation>
+    </message>
+    <message>
+        <source>Form designer</source>
+        <translation>Конструктор форм</translation>
+    </message>
+    <message>
+        <source>Forms (*.hmi)</source>
+        <translation>Формы (*.hmi)</translation>
+    </message>
+    <message>
+        <source>Forms of the station</source>
+        <translation>Формы станции</translation>
+    </message>
+    <message>
+        <source>Grid size…</source>
+        <translation>Шаг сетки…</translation>
+    </message>
+    <message>
+        <source>Grid step, pixels:</source>
+        <translation>Шаг сетки, пикселей:</translation>
+    </message>
+    <message>
+        <source>Grid</source>
+        <translation>Сетка</translation>
+    </message>
+    <message>
+        <source>New form</source>
+        <translation>Новая форма</translation>
+    </message>
+    <message>
+        <source>No station with a Modbus server beside this form</source>
+        <translation>Рядом с формой нет станции с сервером Modbus</translation>
+    </message>
+    <message>
+        <source>Open form</source>
+        <translation>Открыть форму</translation>
+    </message>
+    <message>
+        <source>Problems</source>
+        <translation>Проблемы</translation>
+    </message>
+    <message>
+        <source>Properties</source>
+        <translation>Свойства</translation>
+    </message>
+    <message>
+        <source>Save &amp;as…</source>
+        <translation>Сохранить &amp;как…</translation>
+    </message>
+    <message>
+        <source>Save form as</source>
+        <translation>Сохранить форму как</translation>
+    </message>
+    <message>
+        <source>Saved {0}</source>
+        <translation>Сохранено: {0}</translation>
+    </message>
+    <message>
+        <source>Select &amp;all</source>
+        <translation>Выделить &amp;всё</translation>
+    </message>
+    <message>
+        <source>Show grid</source>
+        <translation>Показывать сетку</translation>
+    </message>
+    <message>
+        <source>Snap to &amp;grid</source>
+        <translation>Привязка к &amp;сетке</translation>
+    </message>
+    <message>
+        <source>Tags</source>
+        <translation>Теги</translation>
+    </message>
+    <message>
+        <source>The form was not saved: {0}</source>
+        <translation>Форма не сохранена: {0}</translation>
+    </message>
+    <message>
+        <source>Zoom in</source>
+        <translation>Увеличить</translation>
+    </message>
+    <message>
+        <source>Zoom out</source>
+        <translation>Уменьшить</translation>
+    </message>
+    <message>
+        <source>{0} - NetPlc form designer</source>
+        <translation>{0} — конструктор форм NetPlc</translation>
+    </message>
+    <message>
+        <source>{0} problem(s), see Problems: the station will not open the form. Save anyway?</source>
+        <translation>Проблем: {0} (см. «Проблемы»): станция не откроет эту форму. Всё равно сохранить?</translation>
+    </message>
+    <message>
+        <source>The station serves Modbus RTU on a serial port; the preview reads Modbus TCP</source>
+        <translation>Станция отдаёт Modbus RTU через последовательный порт, а просмотр читает Modbus TCP</translation>
+    </message>
+    <message>
+        <source>Align left</source>
+        <translation>Выровнять по левому краю</translation>
+    </message>
+    <message>
+        <source>Align right</source>
+        <translation>Выровнять по правому краю</translation>
+    </message>
+    <message>
+        <source>Align top</source>
+        <translation>Выровнять по верху</translation>
+    </message>
+    <message>
+        <source>Align bottom</source>
+        <translation>Выровнять по низу</translation>
+    </message>
+    <message>
+        <source>Centre horizontally</source>
+        <translation>Центрировать по горизонтали</translation>
+    </message>
+    <message>
+        <source>Centre vertically</source>
+        <translation>Центрировать по вертикали</translation>
+    </message>
+    <message>
+        <source>Bring to front</source>
+        <translation>На передний план</translation>
+    </message>
+    <message>
+        <source>Raise</source>
+        <translation>Поднять</translation>
+    </message>
+    <message>
+        <source>Lower</source>
+        <translation>Опустить</translation>
+    </message>
+    <message>
+        <source>Send to back</source>
+        <translation>На задний план</translation>
+    </message>
+    <message>
+        <source>&amp;Close</source>
+        <translation>&amp;Закрыть</translation>
+    </message>
+    <message>
+        <source>&amp;Open…</source>
+        <translation>&amp;Открыть…</translation>
+    </message>
+    <message>
+        <source>&amp;View</source>
+        <translation>&amp;Вид</translation>
+    </message>
+</context>
+<context>
     <name>DiscreteWidget</name>
     <message>
         <source>(indication off)</source>
         <translation>(индикация выключена)</translation>
+    </message>
+</context>
+<context>
+    <name>FontEditor</name>
+    <message>
+        <source>(default)</source>
+        <translation>(по умолчанию)</translation>
+    </message>
+    <message>
+        <source>Back to the default font</source>
+        <translation>Вернуть шрифт по умолчанию</translation>
+    </message>
+    <message>
+        <source>Font</source>
+        <translation>Шрифт</translation>
     </message>
 </context>
 <context>
@@ -363,6 +647,96 @@
     </message>
 </context>
 <context>
+    <name>Palette</name>
+    <message>
+        <source>pulses on OutAddr: scan mod Period = Phase (Fig. 2.4.3)</source>
+        <translation>импульсы на OutAddr: скан mod Period = Phase (рис. 2.4.3)</translation>
+    </message>
+    <message>
+        <source>a sync generator enabled by Ainput</source>
+        <translation>генератор синхронизации, разрешаемый Ainput</translation>
+    </message>
+    <message>
+        <source>a bit as text, image, lamp; a button when Enabled</source>
+        <translation>бит как текст, картинка, лампа; кнопка при Enabled</translation>
+    </message>
+    <message>
+        <source>a bit with colours per state</source>
+        <translation>бит с цветами по состояниям</translation>
+    </message>
+    <message>
+        <source>its state only while EnableAddr is 1</source>
+        <translation>состояние только пока EnableAddr = 1</translation>
+    </message>
+    <message>
+        <source>cycles ImageFirst..ImageLast while the bit is 1</source>
+        <translation>перебирает ImageFirst..ImageLast, пока бит = 1</translation>
+    </message>
+    <message>
+        <source>a tag's value with its unit: digital, bar, dial, graph</source>
+        <translation>значение тега с единицей: цифры, полоса, шкала, график</translation>
+    </message>
+    <message>
+        <source>the operator's setpoint, converted and written</source>
+        <translation>уставка оператора: пересчитывается и записывается</translation>
+    </message>
+    <message>
+        <source>a picture from the form's folder</source>
+        <translation>картинка из папки формы</translation>
+    </message>
+    <message>
+        <source>a caption</source>
+        <translation>надпись</translation>
+    </message>
+    <message>
+        <source>a bit trend, one sample per scan</source>
+        <translation>тренд бита, одна точка за скан</translation>
+    </message>
+    <message>
+        <source>the archive's records of a day</source>
+        <translation>записи архива за день</translation>
+    </message>
+    <message>
+        <source>time, date and the time since start</source>
+        <translation>время, дата и время с пуска</translation>
+    </message>
+    <message>
+        <source>{0}: {1}
+Drag onto the form, or double-click to add</source>
+        <translation>{0}: {1}
+Перетащите на форму или дважды щёлкните, чтобы добавить</translation>
+    </message>
+</context>
+<context>
+    <name>Preview</name>
+    <message>
+        <source>Preview live: {0}</source>
+        <translation>Живой просмотр: {0}</translation>
+    </message>
+    <message>
+        <source>Preview: {0}</source>
+        <translation>Просмотр: {0}</translation>
+    </message>
+</context>
+<context>
+    <name>ProblemsPane</name>
+    <message>
+        <source>warning: {0}</source>
+        <translation>предупреждение: {0}</translation>
+    </message>
+</context>
+<context>
+    <name>PropertyPanel</name>
+    <message>
+        <source>Form {0}</source>
+        <translation>Форма {0}</translation>
+    </message>
+    <message>
+        <source>{0} elements</source>
+        <translation>элементов: {0}</translation>
+    </message>
+</context>
+<context>
     <name>ShelveDialog</name>
     <message>
         <source>Shelve {0}</source>
@@ -383,6 +757,34 @@
     <message>
         <source>Reason</source>
         <translation>Причина</translation>
+    </message>
+    <message>
+        <source>Maintenance of the instrument</source>
+        <translation>Обслуживание прибора</translation>
+    </message>
+    <message>
+        <source>Instrument faulty, repair requested</source>
+        <translation>Прибор неисправен, ремонт заказан</translation>
+    </message>
+    <message>
+        <source>Nuisance: chattering alarm</source>
+        <translation>Ложная: дребезг аварии</translation>
+    </message>
+    <message>
+        <source>Start-up or shut-down of the unit</source>
+        <translation>Пуск или останов установки</translation>
+    </message>
+    <message>
+        <source>Known condition, under observation</source>
+        <translation>Известное состояние, под наблюдением</translation>
+    </message>
+    <message>
+        <source>Choose a usual reason…</source>
+        <translation>Выберите типовую причину…</translation>
+    </message>
+    <message>
+        <source>Give the reason for shelving: it is journaled with your name.</source>
+        <translation>Укажите причину отключения: она записывается в журнал с вашим именем.</translation>
     </message>
 </context>
 <context>
@@ -462,6 +864,25 @@
     <message>
         <source>no link to node {0} ({1})</source>
         <translation>нет связи с узлом {0} ({1})</translation>
+    </message>
+</context>
+<context>
+    <name>TagBrowser</name>
+    <message>
+        <source>Search tags: name, description, unit</source>
+        <translation>Поиск тегов: имя, описание, единица</translation>
+    </message>
+    <message>
+        <source>{0} ({1}{2}): no form element shows this type</source>
+        <translation>{0} ({1}{2}): ни один элемент формы не показывает этот тип</translation>
+    </message>
+    <message>
+        <source>{0} ({1}{2}): drag onto the form for a {3} bound to it</source>
+        <translation>{0} ({1}{2}): перетащите на форму, чтобы создать привязанный к нему {3}</translation>
+    </message>
+    <message>
+        <source>The station has no tags (tags.csv)</source>
+        <translation>У станции нет тегов (tags.csv)</translation>
     </message>
 </context>
 <context>

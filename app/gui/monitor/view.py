@@ -547,8 +547,12 @@ class ProgramMonitor(QWidget):
         return self.answers.follow(what, ticket)
 
     def _answered(self, what: str, answer: Answer) -> None:
+        """A refusal is said until the next command is done (a successful step, write or force
+        leaves no stale error behind)."""
         if not answer.ok:
             self._say("Refused: " + words.answer(what, answer))
+        elif self.message.text():
+            self.message.clear()
 
     def _watch_menu(self, pos: QPoint) -> None:
         r = self.watch.rowAt(pos.y())

@@ -104,6 +104,25 @@ def test_a_condition_shorter_than_the_on_delay_raises_nothing() -> None:
         assert r.scan(k) == []
 
 
+def test_an_on_delay_alarm_is_not_raised_when_its_condition_cleared_before_the_delay_ended() -> None:
+    """LEVEL.H came on at 89.9 % (limit 90 %, deadband 2): the deadband held the pending condition,
+    not only the alarm that was on."""
+    r = Rig(TagAlarms(h=90, deadband=2, on_delay=2, off_delay=1))
+    r.level(90.5)
+    assert r.scan(0) == []  # the on delay starts
+    r.level(89.9)  # back below the limit, inside the deadband, before the delay ended
+    for k in range(1, 6):
+        assert r.scan(k) == []
+    assert r.state("LEVEL.H") is State.NORMAL
+    r.level(90.5)  # a condition that lasts raises the alarm after the delay; the deadband then holds it
+    assert r.scan(6) == [] and r.scan(8) == [("LEVEL.H", "normal", "active-unacknowledged")]
+    r.level(89.9)
+    assert r.scan(9) == [] and r.scan(11) == []
+    r.level(87.5)
+    assert r.scan(12) == []
+    assert r.scan(13) == [("LEVEL.H", "active-unacknowledged", "returned-unacknowledged")]
+
+
 def test_high_high_and_low_low_are_alarms_of_their_own() -> None:
     r = Rig(TagAlarms(hh=95, h=90, l=10, ll=5))
     r.level(97)
