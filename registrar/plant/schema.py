@@ -92,11 +92,14 @@ TAG_VALUES_SQL = f"""CREATE VIEW tag_values AS
     WHERE t.type IN ({", ".join(f"'{k}'" for k in ONE_WORD_TYPES)})"""
 
 
-def connect(url: str, *, read_only: bool = False, timeout: float = 5.0) -> psycopg.Connection:
-    """Autocommit: every write is inside an explicit `con.transaction()`."""
-    options = "-c default_transaction_read_only=on" if read_only else ""
+def connect(url: str, *, read_only: bool = False, timeout: float = 5.0, options: str = "",
+            **params: object) -> psycopg.Connection:
+    """Autocommit: every write is inside an explicit `con.transaction()`. `options`: the
+    session's server settings (`-c name=value`), `params`: more libpq connection parameters."""
+    if read_only:
+        options = f"{options} -c default_transaction_read_only=on".strip()
     return psycopg.connect(url, connect_timeout=max(1, round(timeout)), options=options,
-                           autocommit=True, application_name="netplc-station")
+                           autocommit=True, application_name="netplc-station", **params)
 
 
 def ensure_schema(con: psycopg.Connection) -> dt.tzinfo | None:

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import contextlib
+import dataclasses
 import socket
 import struct
 import threading
@@ -77,9 +78,14 @@ class Station:
         self.folder = folder
         self.runtime: Runtime | None = None
         self.journal: list[Record] = []
+        self.arbiter = ""  # the arbiter's URL as this station reaches it (a proxy's), "" as its folder says
 
     def start(self) -> Runtime:
-        runtime = Runtime(load_station(self.folder))
+        station = load_station(self.folder)
+        if self.arbiter and station.redundancy is not None:  # the folder's hash is unchanged
+            station = dataclasses.replace(station, redundancy=dataclasses.replace(
+                station.redundancy, arbiter=self.arbiter))
+        runtime = Runtime(station)
         runtime.subscribe(self.journal.append)
         runtime.start()
         self.runtime = runtime
