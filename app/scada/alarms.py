@@ -130,6 +130,7 @@ class Alarm:
     defn: AlarmDef
     active: bool = False  # as annunciated: a latched alarm stays active after its condition has gone
     acked: bool = True
+    acked_by: str = ""  # who acknowledged it, while it is acknowledged
     since: float = 0.0  # wall time of the last activation
     changed: float = 0.0  # wall time of the last transition
     value: float | None = None  # physical value at the last transition
@@ -197,8 +198,8 @@ def summary_order(row: AlarmRow) -> tuple[bool, int, float]:
     return shelved, row.priority, -(row.changed if shelved else row.since)
 
 
-PERSISTED = ("active", "acked", "since", "changed", "value", "shelved_until", "shelved_by", "reason",
-             "one_shot", "out_of_service", "oos_by", "suppressed", "detail", "comment", "comment_by")
+PERSISTED = ("active", "acked", "acked_by", "since", "changed", "value", "shelved_until", "shelved_by",
+             "reason", "one_shot", "out_of_service", "oos_by", "suppressed", "detail", "comment", "comment_by")
 UNSHELVED = {"shelved_until": None, "shelved_by": "", "reason": "", "one_shot": False}
 
 
@@ -336,6 +337,19 @@ class AlarmSystem:
             self._cond[i] = self._hyst[i] = cond
             if a.shelved_until is not None:
                 self._shelved.add(i)
+
+    def adopt(self, states: Mapping[str, Mapping[str, Any]]) -> None:
+        """The states of a hot-standby pair's primary (app/station/pair.py), taken as they are, so
+        the standby's alarms are the primary's, acknowledgements, shelving and out-of-service
+        included, and a takeover leaves nothing for an operator to do again. Kept and published as
+        any change; journaled by the primary alone, which made them."""
+        self.restore(states)
+        self._changed.update(i for alarm_id in states if (i := self.by_id.get(alarm_id)) is not None)
+        self._flush_changes()
+
+    def states(self) -> dict[str, dict[str, Any]]:
+        """Every alarm's state, as `on_change` hands each."""
+        return {a.id: self.state_of(i) for i, a in enumerate(self.alarms)}
 
     def state_of(self, i: int) -> dict[str, Any]:
         a = self.alarms[i]
@@ -481,6 +495,8 @@ class AlarmSystem:
         phy, raw = self._value(i)
         a.changed = now
         a.value = phy
+        if not a.acked:
+            a.acked_by = ""
         text = f"{a.id} {old.word} -> {new.word}: {a.text}"
         t = self._tag_of[i]
         if phy is not None and raw is not None:
@@ -523,7 +539,7 @@ class AlarmSystem:
         old = a.state
         latched = a.defn.latching and a.active and not self._cond[i]
         if old is State.UNACK or old is State.RTNUN:
-            a.acked = True
+            a.acked, a.acked_by = True, user
         elif not (old is State.ACKED and latched):
             return
         if latched:

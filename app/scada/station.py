@@ -72,6 +72,7 @@ class StationAlarms:
         self.exchange: Exchange | None = None
         self._messages: list[int] = []
         self._since: dict[int, int] = {}  # node -> first scan of this run with its link known
+        self._unsent: dict[str, dict[str, Any]] | None = None  # changed states for a pair's standby
 
     def attach(self, engine: Engine, exchange: Exchange | None) -> None:
         """Evaluate after every scan of `engine`; start saving states."""
@@ -116,6 +117,19 @@ class StationAlarms:
     def _changed(self, changes: dict[str, dict[str, Any]]) -> None:
         self.state.update(changes)
         self._dirty.update(changes)
+        if self._unsent is not None:
+            self._unsent.update(changes)
+
+    def changes_for_standby(self, whole: bool = False) -> dict[str, dict[str, Any]]:
+        """On the engine thread: the states changed since the last call (the first call starts
+        keeping them), or with `whole` every alarm's; what a pair's primary sends its standby."""
+        unsent, self._unsent = self._unsent or {}, {}
+        return self.system.states() if whole else unsent
+
+    def adopt(self, states: dict[str, dict[str, Any]]) -> None:
+        """On the engine thread: the primary's states, on its standby (AlarmSystem.adopt)."""
+        if states:
+            self.run_now(lambda: self.system.adopt(states))
 
     def _publish(self, now: float | None = None) -> None:
         for alarm_id in self._dirty:

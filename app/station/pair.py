@@ -27,7 +27,7 @@ import struct
 import threading
 import time
 from collections.abc import Callable
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from enum import StrEnum
 from typing import TYPE_CHECKING
 
@@ -154,6 +154,7 @@ class Pair:
         self.cause = 0  # the last switchover's cause code (HSB_SWITCH)
         self.led_scans = 0  # scans run as the primary: of two primaries, the one with more leads
         self._awaiting: list[tuple[int, Callable[[], None]]] = []  # (scan, callback): after_mirrored
+        self._whole_alarms = True  # the next capture holds every alarm's state (a new link's first)
 
     @property
     def tick(self) -> float:
@@ -280,10 +281,17 @@ class Pair:
         engine = self._engine
         assert engine is not None
         if engine.follower and self.mirror.complete:
-            with self._lock:
-                self.mirror.load_into(engine, mem)
+            self._load_mirror(engine, mem)
         engine.follower = False
         self._put_words(mem)
+
+    def _load_mirror(self, engine: Engine, mem: Memory) -> None:
+        """On the engine thread: the mirrored memory and engine state, and the alarm states."""
+        with self._lock:
+            self.mirror.load_into(engine, mem)
+            alarms = self.mirror.take_alarms()
+        if self.runtime.alarms is not None:
+            self.runtime.alarms.adopt(alarms)
 
     def _follow(self, _mem: Memory) -> None:
         engine = self._engine
@@ -357,6 +365,7 @@ class Pair:
                     old.close()
                 self._link = conn
                 self._last_frame = self.clock()
+                self._whole_alarms = True
             self._become(decide(self.role, self.settings.letter, Role(hello["role"]), self.led_scans,
                                 int(hello.get("led", 0))), f"partner {hello['letter']} is {hello['role']}")
             self.refused = ""
@@ -465,8 +474,8 @@ class Pair:
         assert engine is not None
         with self._lock:
             self._load_pending = False
-            if engine.follower and self.mirror.complete:
-                self.mirror.load_into(engine, mem)
+        if engine.follower and self.mirror.complete:
+            self._load_mirror(engine, mem)
         self._put_words(mem)
 
     def _put_words(self, mem: Memory) -> None:
@@ -491,8 +500,13 @@ class Pair:
             self.led_scans += 1
         if self.role is not Role.PRIMARY or self._link is None:
             return
-        cap = capture(engine, snapshot)
+        alarms = self.runtime.alarms
+        states = alarms.changes_for_standby(self._whole_alarms) if alarms is not None else {}
+        self._whole_alarms = False
+        cap = capture(engine, snapshot, states)
         with self._changed:
+            if self._capture is not None and self._capture.alarms:  # not sent yet: none is lost
+                cap = replace(cap, alarms={**self._capture.alarms, **cap.alarms})
             self._capture = cap
             if self._handing_over:
                 self._handover, self._handing_over = self._handing_over, ""

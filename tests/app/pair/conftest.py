@@ -39,7 +39,7 @@ STATION = """\
 name = "pair"
 NetPlcProgram = "pair.stl"
 NetSyncTime = {tick}
-[modbus_server]
+{top}[modbus_server]
 port = 0
 writable = [["04000", "04777"]]
 [[nodes]]
@@ -137,16 +137,17 @@ def node() -> Iterator[Simulator]:
     sim.stop()
 
 
-def make_pair(tmp_path: Path, node: Simulator, arbiter: str = "none",
-              b_dials: int | None = None) -> tuple[Station, Station]:
-    """A and B of one station; B dials `b_dials` (a proxy's port) instead of A's link."""
+def make_pair(tmp_path: Path, node: Simulator, arbiter: str = "none", b_dials: int | None = None,
+              top: str = "", files: dict[str, str] | None = None) -> tuple[Station, Station]:
+    """A and B of one station; B dials `b_dials` (a proxy's port) instead of A's link. `top`:
+    more top-level keys of station.toml, `files`: more files of the station folder."""
     ports = {"A": free_port(), "B": free_port()}
     stations = []
     for letter, other in (("A", "B"), ("B", "A")):
         partner = b_dials if letter == "B" and b_dials else ports[other]
         folder = write_station(tmp_path / letter, STATION.format(
             tick=TICK_MS, node=node.port, letter=letter, listen=ports[letter], partner=partner,
-            arbiter=arbiter), {"pair.stl": PROGRAM})
+            arbiter=arbiter, top=top), {"pair.stl": PROGRAM, **(files or {})})
         stations.append(Station(folder))
     return stations[0], stations[1]
 
