@@ -198,8 +198,9 @@ def summary_order(row: AlarmRow) -> tuple[bool, int, float]:
     return shelved, row.priority, -(row.changed if shelved else row.since)
 
 
-PERSISTED = ("active", "acked", "acked_by", "since", "changed", "value", "shelved_until", "shelved_by",
-             "reason", "one_shot", "out_of_service", "oos_by", "suppressed", "detail", "comment", "comment_by")
+PERSISTED = ("active", "acked", "acked_by", "since", "changed", "value", "shelved_until",
+             "shelved_by", "reason", "one_shot", "out_of_service", "oos_by", "suppressed", "detail",
+             "comment", "comment_by")
 UNSHELVED = {"shelved_until": None, "shelved_by": "", "reason": "", "one_shot": False}
 
 
