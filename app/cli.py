@@ -521,8 +521,10 @@ def run_migrate(source: str, url: str, station: str | None) -> int:
         bar = "#" * round(30 * done)
         print(f"\r[{bar:<30}] {sent:,} / {total:,} records", end="", file=sys.stderr, flush=True)
 
+    # one of a hot-standby pair: as its letter, so its records keep the keys its forwarder gives them
+    letter = owner.redundancy.letter if owner is not None and owner.redundancy is not None else ""
     try:
-        n = Forwarder(path, url, name).forward_all(progress)
+        n = Forwarder(path, url, name, letter=letter).forward_all(progress)
     except (ArchiveError, sqlite3.Error) as e:
         print(f"\n{path} -> {url}: {e}", file=sys.stderr)
         return 1

@@ -101,6 +101,9 @@ class StationAlarms:
                          forced=[a for f in snapshot.forces for a in f.operands])
         self.quality = self.quality_map.evaluate(snapshot, links)
         self.readings = Readings(snapshot, self.quality_map, links, self.quality)
+        if self.engine is not None and self.engine.follower:
+            self._messages.clear()  # a pair's standby: the primary's alarm states are adopted, and
+            return  # the primary journals the transitions and the series, which it forwards
         for record in self.series.evaluate(snapshot, links, snapshot.wall):
             self.sink.put(record)
         messages, self._messages = self._messages, []

@@ -273,7 +273,8 @@ class Runtime:
             from registrar.plant.forward import Forwarder  # psycopg only where a plant archive is named
 
             self.forwarder = Forwarder(st.Archive, st.plant_archive, st.name, keep_days=st.plant_keep_days,
-                                       sink=self.put, wallclock=self.wallclock)
+                                       sink=self.put, wallclock=self.wallclock,
+                                       letter=st.redundancy.letter if st.redundancy is not None else "")
             self.forwarder.start()  # never fails: PostgreSQL away is a lag, not a start error
         started = False
         try:
