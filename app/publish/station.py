@@ -40,7 +40,9 @@ def start_publishers(runtime: Runtime) -> list[Publisher]:
                              commands=runtime.commands, watch=runtime.watch, engine=runtime.engine,
                              exchange=runtime.exchange, alarms=alarms, journal=runtime.system,
                              step_lock=lambda: runtime.scan_thread.lock if runtime.scan_thread else None,
-                             archived=archived, language=st.Language)
+                             archived=archived, language=st.Language,
+                             pair_letter=st.redundancy.letter if st.redundancy is not None else "",
+                             service_level=runtime.service_level)
         try:
             server.start()
         except (OSError, RuntimeError) as e:

@@ -64,6 +64,9 @@ class Role(StrEnum):
 
 # HSBStatus of seed 000 by role: 0 after power-on, 4 standby, 5 master (6 defect: refused partner)
 HSB_STATUS = {Role.STARTING: 0, Role.PRIMARY: 5, Role.STANDBY: 4}
+# OPC UA ServiceLevel by role (Part 4 6.6.2.4.2: 0 maintenance, 1 no data, 2-199 degraded, 200-255
+# healthy): the standby serves reads but no writes, degraded; a client of the pair takes the highest
+SERVICE_LEVEL = {Role.STARTING: 1, Role.PRIMARY: 255, Role.STANDBY: 100}
 DEFECT = 6
 # The pair's status words in NetPlc memory, beside the RTC (077700-077707), each station's own
 # (written after the mirrored memory is put), for a program and an HMI (README "Redundancy")

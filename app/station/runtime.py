@@ -423,6 +423,15 @@ class Runtime:
             if self.started:
                 self.system(f"{text}; the node stays down until it does")
 
+    def service_level(self) -> int:
+        """OPC UA ServiceLevel: 255 alone; one of a pair, by its role (pair.SERVICE_LEVEL)."""
+        from app.station.pair import SERVICE_LEVEL, Role
+
+        pair = self.pair
+        if pair is not None:
+            return SERVICE_LEVEL[pair.role]
+        return SERVICE_LEVEL[Role.PRIMARY if self.station.redundancy is None else Role.STARTING]
+
     def role_of(self, name: str) -> str | None:
         """A user's role as users.json says now (read again when the file changed, so a role changed
         or a user removed counts at the next command); None when there is no such user."""

@@ -3,7 +3,6 @@
 from __future__ import annotations
 
 import contextlib
-import dataclasses
 import socket
 import struct
 import threading
@@ -14,6 +13,7 @@ from pathlib import Path
 import pytest
 
 from app.authority import Source, Who
+from app.station.config import Station as StationSettings
 from app.station.config import load_station
 from app.station.runtime import Runtime
 from netplc.program import parse
@@ -78,14 +78,12 @@ class Station:
         self.folder = folder
         self.runtime: Runtime | None = None
         self.journal: list[Record] = []
-        self.arbiter = ""  # the arbiter's URL as this station reaches it (a proxy's), "" as its folder says
+        # the settings as this station differs from its partner on one host (a port, the arbiter
+        # through a proxy), put after loading: the folder's hash, which the pair compares, is unchanged
+        self.adjust: Callable[[StationSettings], StationSettings] = lambda settings: settings
 
     def start(self) -> Runtime:
-        station = load_station(self.folder)
-        if self.arbiter and station.redundancy is not None:  # the folder's hash is unchanged
-            station = dataclasses.replace(station, redundancy=dataclasses.replace(
-                station.redundancy, arbiter=self.arbiter))
-        runtime = Runtime(station)
+        runtime = Runtime(self.adjust(load_station(self.folder)))
         runtime.subscribe(self.journal.append)
         runtime.start()
         self.runtime = runtime

@@ -6,6 +6,7 @@ from __future__ import annotations
 
 import time
 from collections.abc import Iterator
+from dataclasses import replace
 from pathlib import Path
 
 import pytest
@@ -67,7 +68,8 @@ def test_a_primary_that_loses_the_arbiter_and_its_partner_steps_down(
     port = int(pg_url.rsplit(":", 1)[1].split("/")[0])
     to_arbiter.target = port
     a, b = make_pair(tmp_path, node, pg_url, b_dials=proxy.port)
-    a.arbiter = pg_url.replace(f":{port}/", f":{to_arbiter.port}/")
+    via_proxy = pg_url.replace(f":{port}/", f":{to_arbiter.port}/")
+    a.adjust = lambda st: replace(st, redundancy=replace(st.redundancy, arbiter=via_proxy))  # type: ignore[arg-type]
     proxy.target = load_station(a.folder).redundancy.listen_address[1]  # type: ignore[union-attr]
     try:
         a.start()

@@ -1,0 +1,67 @@
+"""OPC UA clients told which station of the pair to use (Part 4 6.6.2, non-transparent
+redundancy): RedundancySupport Hot, ServerUriArray the partner's ApplicationUri, ServiceLevel
+high on the primary and low on the standby, turned over by a takeover; the tags' NodeIds are the
+same on both."""
+
+from __future__ import annotations
+
+import asyncio
+from dataclasses import replace
+from pathlib import Path
+from typing import Any
+
+from asyncua import Client, ua
+
+from netplc.simulator import Simulator
+from tests.app.pair.conftest import Station, free_port, make_pair, wait_for
+
+
+def serve_opcua(station: Station) -> str:
+    url = f"opc.tcp://127.0.0.1:{free_port()}/netplc/"
+    station.adjust = lambda st: replace(st, opcua=replace(st.opcua, enabled=True, endpoint=url))
+    return url
+
+
+async def redundancy(client: Client) -> dict[str, Any]:
+    node = await client.nodes.server.get_child(["0:ServerRedundancy"])
+    return {"level": await client.get_node(ua.ObjectIds.Server_ServiceLevel).read_value(),
+            "support": await (await node.get_child(["0:RedundancySupport"])).read_value(),
+            "uris": await (await node.get_child(["0:ServerUriArray"])).read_value(),
+            "type": (await node.read_type_definition()).Identifier,
+            "uri": (await client.get_endpoints())[0].Server.ApplicationUri,
+            "ns": await client.get_namespace_index("urn:netplc:station:pair")}
+
+
+def test_clients_are_told_the_primary_by_its_service_level(tmp_path: Path, node: Simulator) -> None:
+    a, b = make_pair(tmp_path, node)
+    a_url, b_url = serve_opcua(a), serve_opcua(b)
+
+    async def check() -> None:
+        async with Client(a_url) as on_a, Client(b_url) as on_b:
+            of_a, of_b = await redundancy(on_a), await redundancy(on_b)
+        assert (of_a["level"], of_b["level"]) == (255, 100)
+        assert of_a["support"] == of_b["support"] == ua.RedundancySupport.Hot
+        assert of_a["type"] == of_b["type"] == ua.ObjectIds.NonTransparentRedundancyType
+        assert (of_a["uri"], of_b["uri"]) == ("urn:netplc:station:pair:A", "urn:netplc:station:pair:B")
+        assert (of_a["uris"], of_b["uris"]) == ([of_b["uri"]], [of_a["uri"]])
+        assert of_a["ns"] == of_b["ns"]  # one namespace: a client's NodeIds hold on either
+
+    async def b_leads() -> None:
+        async with Client(b_url) as on_b:
+            service_level = on_b.get_node(ua.ObjectIds.Server_ServiceLevel)
+            for _ in range(500):
+                if await service_level.read_value() == 255:
+                    return
+                await asyncio.sleep(0.01)
+            raise AssertionError("B's ServiceLevel is not the primary's")
+
+    try:
+        a.start()
+        b.start()
+        asyncio.run(check())
+        a.kill()
+        wait_for(lambda: b.role == "primary", what="takeover")
+        asyncio.run(b_leads())
+    finally:
+        b.stop()
+        a.stop()
