@@ -60,7 +60,7 @@ def start_publishers(runtime: Runtime) -> list[Publisher]:
         publisher = SparkplugPublisher(st.mqtt, st.name, tags=tags, commands=runtime.commands,
                                        watch=runtime.watch, journal=runtime.system,
                                        bdseq_file=st.folder / BDSEQ_FILE, exchange=runtime.exchange,
-                                       quality_map=runtime.alarms.quality_map)
+                                       quality_map=runtime.alarms.quality_map, leads=runtime.leads)
         publisher.start()
         started.append(publisher)
         devices = ", ".join(d.id for d in publisher.layout.devices) or "none"

@@ -76,15 +76,17 @@ class Capture:
     ctr: dict[int, int]
     stop_code: int
     alarms: dict[str, dict[str, Any]] = field(default_factory=dict)  # changed states, by alarm
+    bdseq: int = -1  # the MQTT Sparkplug session's bdSeq (-1: no MQTT)
 
 
-def capture(engine: Engine, snapshot: Snapshot, alarms: dict[str, dict[str, Any]]) -> Capture:
+def capture(engine: Engine, snapshot: Snapshot, alarms: dict[str, dict[str, Any]],
+            bdseq: int = -1) -> Capture:
     """The scan's state; the timers and counters read only at the coils the program has (all
     2048 of each would cost the scan milliseconds)."""
     tim, ctr = engine.tim_ticks, engine.ctr_values
     tims, ctrs = _coils(engine)
     return Capture(snapshot, {c: tim[c] for c in tims if tim[c]}, {c: ctr[c] for c in ctrs if ctr[c]},
-                   engine.stop_code, alarms)
+                   engine.stop_code, alarms, bdseq)
 
 
 _COILS: dict[int, tuple[tuple[int, ...], tuple[int, ...]]] = {}  # by id of the program
@@ -120,7 +122,7 @@ class Encoder:
         if cap.alarms:
             header["alarms"] = cap.alarms
         extras = json.dumps({"state": cap.snapshot.state, "stop_code": cap.stop_code,
-                             "tim": cap.tim, "ctr": cap.ctr,
+                             "tim": cap.tim, "ctr": cap.ctr, "bdseq": cap.bdseq,
                              "forces": [[f.kind, fmt_octal(f.addr), f.value, f.user]
                                         for f in cap.snapshot.forces]})
         if extras != self._extras or self.last is None:
@@ -172,6 +174,7 @@ class Mirror:
     ctr: dict[int, int] = field(default_factory=dict)
     forces: tuple[Force, ...] = ()
     alarms: dict[str, dict[str, Any]] = field(default_factory=dict)  # states not yet put, by alarm
+    bdseq: int = -1  # the primary's MQTT Sparkplug bdSeq
 
     @property
     def complete(self) -> bool:
@@ -197,6 +200,7 @@ class Mirror:
                 self.state, self.stop_code = extras["state"], int(extras["stop_code"])
                 self.tim = {int(c): float(v) for c, v in extras["tim"].items()}
                 self.ctr = {int(c): int(v) for c, v in extras["ctr"].items()}
+                self.bdseq = int(extras.get("bdseq", -1))
                 self.forces = tuple(Force(kind, parse_octal(addr), int(value), user)
                                     for kind, addr, value, user in extras["forces"])
             alarms = header.get("alarms", {})

@@ -158,6 +158,7 @@ class Pair:
         self.led_scans = 0  # scans run as the primary: of two primaries, the one with more leads
         self._awaiting: list[tuple[int, Callable[[], None]]] = []  # (scan, callback): after_mirrored
         self._whole_alarms = True  # the next capture holds every alarm's state (a new link's first)
+        self._bdseq = -1  # the primary's MQTT bdSeq as last handed to this station's publisher
 
     @property
     def tick(self) -> float:
@@ -441,9 +442,13 @@ class Pair:
                 self._last_frame = self.clock()
                 post = not self._load_pending
                 self._load_pending = True
-                scan = self.mirror.scan
+                scan, bdseq = self.mirror.scan, self.mirror.bdseq
             if post and self._engine is not None:
                 self._engine.post(self._load)
+            sparkplug = self.runtime.sparkplug()
+            if sparkplug is not None and bdseq != self._bdseq:  # one edge node: the primary's session,
+                self._bdseq = bdseq  # whose bdSeq this station goes on from, before it could lead
+                sparkplug.follow(bdseq)
             send_frame(conn, ACK, struct.pack(">q", scan))
         elif kind == ACK and len(payload) == 8:
             self._mirrored(struct.unpack(">q", payload)[0])
@@ -506,7 +511,8 @@ class Pair:
         alarms = self.runtime.alarms
         states = alarms.changes_for_standby(self._whole_alarms) if alarms is not None else {}
         self._whole_alarms = False
-        cap = capture(engine, snapshot, states)
+        sparkplug = self.runtime.sparkplug()
+        cap = capture(engine, snapshot, states, sparkplug.bdseq if sparkplug is not None else -1)
         with self._changed:
             if self._capture is not None and self._capture.alarms:  # not sent yet: none is lost
                 cap = replace(cap, alarms={**self._capture.alarms, **cap.alarms})

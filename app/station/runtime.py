@@ -51,6 +51,7 @@ from registrar.retain import Retainer
 from registrar.store import Store, StoreStats
 
 if TYPE_CHECKING:
+    from app.publish.mqtt import SparkplugPublisher
     from app.station.pair import Pair
     from registrar.plant.forward import Forwarder
 
@@ -373,6 +374,18 @@ class Runtime:
             raise StartError([f"{st.path}: redundancy.listen: cannot listen on {st.redundancy.listen}: "
                               f"{_reason(e)}"]) from None
         self.pair = pair
+
+    def leads(self) -> bool:
+        """Does this station act now: alone, or the primary of its pair (MQTT publishes only then)."""
+        return self._standby() is None
+
+    def sparkplug(self) -> SparkplugPublisher | None:
+        """The station's MQTT Sparkplug edge node, if it publishes one (a pair mirrors its bdSeq)."""
+        if not self.station.mqtt.enabled:
+            return None
+        from app.publish.mqtt import SparkplugPublisher  # loaded already: the station publishes MQTT
+
+        return next((p for p in self.publishers if isinstance(p, SparkplugPublisher)), None)
 
     def _standby(self) -> str | None:
         """Why the command layer refuses a write or command now: this station is not the primary."""
