@@ -174,6 +174,9 @@ def _monitor_parser() -> argparse.ArgumentParser:
                                                         "folder for its program, symbols and tags")
     p.add_argument("--user", help="over OPC UA, the user to log in as (the dialog asks the password; when "
                                   "stdin is not a terminal, its first line is the password)")
+    p.add_argument("--partner", metavar="URL", default="",
+                   help="over OPC UA, the endpoint of the other station of a hot-standby pair: the monitor "
+                        "follows whichever leads (its certificate trusted by a monitor of it before)")
     return p
 
 
@@ -289,7 +292,7 @@ def main(argv: list[str] | None = None) -> int:
                 return 2
             from app.gui.monitor.window import run_monitor
 
-            return run_monitor(ns.target, ns.program, ns.user)
+            return run_monitor(ns.target, ns.program, ns.user, ns.partner)
         if command == "archive":
             ns = _archive_parser().parse_args(rest)
             if ns.action == "backup":

@@ -12,6 +12,8 @@ from typing import Any
 
 from asyncua import Client, ua
 
+from app.authority.users import Users
+from app.publish.client import StationClient
 from netplc.simulator import Simulator
 from tests.app.pair.conftest import Station, free_port, make_pair, wait_for
 
@@ -63,5 +65,34 @@ def test_clients_are_told_the_primary_by_its_service_level(tmp_path: Path, node:
         wait_for(lambda: b.role == "primary", what="takeover")
         asyncio.run(b_leads())
     finally:
+        b.stop()
+        a.stop()
+
+
+def test_a_monitor_given_both_endpoints_follows_the_primary(tmp_path: Path, node: Simulator) -> None:
+    """IntoStandBy: the station read leads no more (its ServiceLevel fell), the monitor logs in to
+    the other; the primary killed: the link is lost, it logs in to the other again."""
+    a, b = make_pair(tmp_path, node)
+    a_url, b_url = serve_opcua(a), serve_opcua(b)
+    for st in (a, b):
+        Users(st.folder).add("eng1", "engineer", "eng1")
+    client = StationClient(a_url, partner=b_url, folder=tmp_path / "config", period=0.05)
+    try:
+        a.start()
+        b.start()
+        client.discover().result(10)
+        client.open("eng1", "eng1").result(20)
+        wait_for(lambda: client.snapshot is not None, what="the monitor reads A")
+        assert a.rt.pair is not None and a.rt.pair.into_standby("IntoStandBy by test", wait=2)
+        wait_for(lambda: client.url == b_url and client.switches == 1, timeout=10, what="the monitor on B")
+        assert client.service_level == 255 and client.user == "eng1"
+        b.kill()
+        wait_for(lambda: a.role == "primary", what="A takes over")
+        wait_for(lambda: client.url == a_url and client.switches == 2 and not client.error, timeout=10,
+                 what="the monitor back on A")
+        scan = client.snapshot.scan if client.snapshot is not None else 0
+        wait_for(lambda: client.snapshot is not None and client.snapshot.scan > scan, what="it reads A on")
+    finally:
+        client.close()
         b.stop()
         a.stop()
