@@ -48,7 +48,7 @@ def test_clients_are_told_the_primary_and_a_monitor_follows_it(tmp_path: Path, n
         assert of_a["type"] == of_b["type"] == ua.ObjectIds.NonTransparentRedundancyType
         assert (of_a["uri"], of_b["uri"]) == ("urn:netplc:station:pair:A", "urn:netplc:station:pair:B")
         assert (of_a["uris"], of_b["uris"]) == ([of_b["uri"]], [of_a["uri"]])
-        assert of_a["ns"] == of_b["ns"] == 2  # one namespace after each ApplicationUri: NodeIds hold on either
+        assert of_a["ns"] == of_b["ns"] == 2  # after each ApplicationUri: NodeIds hold on either
 
     client = StationClient(a_url, partner=b_url, folder=tmp_path / "config", period=0.05)
     try:
