@@ -45,7 +45,7 @@ def alarm(station: Station, alarm_id: str) -> Alarm:
 
 def raise_alarm(station: Station, alarm_id: str) -> None:
     assert station.rt.engine is not None and station.rt.engine.write_bit(BITS[alarm_id], 1, user="test")
-    wait_for(lambda: alarm(station, alarm_id).state is State.UNACK, what=f"{alarm_id} active")
+    wait_for(lambda: alarm(station, alarm_id).state is State.UNACK, timeout=10, what=f"{alarm_id} active")
 
 
 def test_acknowledged_on_the_primary_acknowledged_on_the_new_primary(
@@ -60,7 +60,7 @@ def test_acknowledged_on_the_primary_acknowledged_on_the_new_primary(
     assert a.rt.commands.shelve(IVAN, "DOOR.ALARM", "door propped open for the fitters", 3600).result(3).ok
     assert a.rt.commands.out_of_service(OLGA, "FAN.ALARM").result(3).ok  # answered: B holds it
     a.kill()
-    wait_for(lambda: b.role == "primary", what="takeover")
+    wait_for(lambda: b.role == "primary", timeout=10, what="takeover")
     trip, door, fan = (alarm(b, alarm_id) for alarm_id in BITS)
     assert (trip.state, trip.acked_by) == (State.ACKED, "ivan")
     assert (door.state, door.shelved_by, door.reason) == (State.SHELVED, "ivan",
@@ -78,5 +78,5 @@ def test_a_standby_that_comes_late_gets_every_alarm_s_state(alarm_pair: tuple[St
     assert a.rt.commands.acknowledge(IVAN, "TRIP.ALARM").result(3).ok
     b.start()
     assert b.role == "standby"
-    wait_for(lambda: alarm(b, "TRIP.ALARM").acked_by == "ivan", what="B has A's acknowledgement")
+    wait_for(lambda: alarm(b, "TRIP.ALARM").acked_by == "ivan", timeout=10, what="B has A's acknowledgement")
     assert alarm(b, "TRIP.ALARM").state is State.ACKED
