@@ -47,16 +47,19 @@ PUBLISH_EVERY = 0.25  # s of engine time between two rebuilds of the summary dur
 class StationAlarms:
     def __init__(self, tags: Path | None, program: Program, messages: list[CatalogMessage], sink: RecordSink,
                  state_file: Path, symbols: dict[str, int] | None = None,
-                 regdata: Mapping[str, Sequence[tuple[int, int]]] | None = None) -> None:
+                 regdata: Mapping[str, Sequence[tuple[int, int]]] | None = None,
+                 no_standby: Callable[[], str] | None = None) -> None:
         """TagError (every problem of tags.csv) if the tags cannot be used. `regdata`: the forms'
-        RegData elements by name, with their operands (app/scada/series.py)."""
+        RegData elements by name, with their operands (app/scada/series.py); `no_standby`: one of a
+        hot-standby pair, why it has no standby now ("" while it has), for PAIR.NO_STANDBY."""
         self.table = load_tags(tags, symbols) if tags is not None else TagTable()
         self.quality_map = QualityMap(program, self.table.tags)
         self.sink = sink
         self.series = SeriesQuality(program, regdata or {})
         self.state = AlarmStateFile(state_file, sink)
         self.system = AlarmSystem(self.table, messages, sink=sink, saved=self.state.load(),
-                                  on_change=self._changed, station=True)
+                                  on_change=self._changed, station=True, pair=no_standby is not None)
+        self.no_standby = no_standby or (lambda: "")
         self.quality = np.zeros(len(self.table.tags), dtype=np.int8)  # of the last scan, by tag
         self.readings: Readings | None = None  # of the last scan; None before the first
         # The alarm summary, rebuilt on the engine thread after states changed, from the rows of
@@ -108,7 +111,7 @@ class StationAlarms:
             self.sink.put(record)
         messages, self._messages = self._messages, []
         self.system.evaluate(snapshot, snapshot.wall, self.quality, messages,
-                             "" if running else stop_reason(snapshot.state))
+                             "" if running else stop_reason(snapshot.state), self.no_standby())
         if self._dirty and snapshot.time - self._published >= PUBLISH_EVERY:
             self._publish(snapshot.time)
 

@@ -322,7 +322,8 @@ class Runtime:
         self.exchange.start()
         regdata = {el.Name: el.sources() for _, el in behaviour.elements if el.RegData}
         self.alarms = StationAlarms(st.Tags, self.program, list(self.catalog), self,
-                                    st.Archive.with_name(ALARM_STATE_FILE), self.symbols, regdata)
+                                    st.Archive.with_name(ALARM_STATE_FILE), self.symbols, regdata,
+                                    self._no_standby if st.redundancy is not None else None)
         self.subscribe(self.alarms.observe)
         self.alarms.attach(self.engine, self.exchange)
         self.commands = Commands(self.engine, self, role_of=self.role_of, tags=self.alarms.table.tags,
@@ -386,6 +387,16 @@ class Runtime:
         from app.publish.mqtt import SparkplugPublisher  # loaded already: the station publishes MQTT
 
         return next((p for p in self.publishers if isinstance(p, SparkplugPublisher)), None)
+
+    def _no_standby(self) -> str:
+        """Why this pair's primary has no standby now (PAIR.NO_STANDBY), "" while it has one."""
+        pair = self.pair
+        if pair is None or pair.role != "primary":
+            return ""
+        status = pair.status()
+        if pair.refused:
+            return pair.refused
+        return "" if status.link else f"pair link to {status.partner} down"
 
     def _standby(self) -> str | None:
         """Why the command layer refuses a write or command now: this station is not the primary."""

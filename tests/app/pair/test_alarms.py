@@ -11,7 +11,7 @@ import pytest
 
 from app.authority import Source, Who
 from app.authority.users import Users
-from app.scada.alarms import Alarm, State
+from app.scada.alarms import NO_STANDBY_ID, Alarm, State
 from netplc.simulator import Simulator
 from tests.app.pair.conftest import Station, make_pair, wait_for
 
@@ -67,7 +67,10 @@ def test_acknowledged_on_the_primary_acknowledged_on_the_new_primary(
                                                           "door propped open for the fitters")
     assert (fan.state, fan.oos_by) == (State.OUT_OF_SERVICE, "olga")
     assert b.rt.alarms is not None
-    assert [r.id for r in b.rt.alarms.summary if r.state is State.UNACK] == []  # nothing to do again
+    # nothing to do again, but one new alarm: B leads with no standby (in the banner, it sounds)
+    wait_for(lambda: alarm(b, NO_STANDBY_ID).state is State.UNACK, timeout=10, what="PAIR.NO_STANDBY")
+    assert [r.id for r in b.rt.alarms.summary if r.state is State.UNACK] == [NO_STANDBY_ID]
+    assert alarm(b, NO_STANDBY_ID).text.startswith("No standby: the pair runs on one station: pair link to")
 
 
 def test_a_standby_that_comes_late_gets_every_alarm_s_state(alarm_pair: tuple[Station, Station]) -> None:
@@ -80,3 +83,13 @@ def test_a_standby_that_comes_late_gets_every_alarm_s_state(alarm_pair: tuple[St
     assert b.role == "standby"
     wait_for(lambda: alarm(b, "TRIP.ALARM").acked_by == "ivan", timeout=10, what="B has A's acknowledgement")
     assert alarm(b, "TRIP.ALARM").state is State.ACKED
+
+
+def test_no_standby_is_an_alarm_of_the_primary_until_its_partner_is_back(
+        alarm_pair: tuple[Station, Station]) -> None:
+    a, b = alarm_pair
+    a.start()  # alone: it leads with no standby
+    wait_for(lambda: alarm(a, NO_STANDBY_ID).state is State.UNACK, timeout=10, what="A has no standby")
+    b.start()
+    wait_for(lambda: alarm(a, NO_STANDBY_ID).state is State.RTNUN, timeout=10, what="B is A's standby")
+    wait_for(lambda: alarm(b, NO_STANDBY_ID).state is State.RTNUN, timeout=10, what="and B shows A's")
