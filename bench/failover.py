@@ -10,7 +10,8 @@
    acknowledged writes lost (the new primary's word below the last acknowledged value). With
    `--plant` both forward to one plant archive (a throwaway PostgreSQL cluster of tests/pgcluster.py):
    at the end, records of the two local archives missing from it, and alarm transitions in it
-   twice (the same transition of the same alarm twice in a row: journaled by both stations).
+   twice in a row (the same transition of the same alarm: journaled by the old primary in a last
+   scan its standby did not hold yet when it was killed, and again by the new primary).
 
     .venv/bin/python bench/failover.py [--seconds S] [--kills N] [--plant]
 """
@@ -182,7 +183,7 @@ def kills(base: Path, node: Simulator, n: int, plant: str = "") -> None:
     if plant:
         missing, doubled, total = plant_check(plant, paths)
         print(f"plant archive: {total} records of the pair, {missing} of the local archives missing, "
-              f"{doubled} doubled")
+              f"{doubled} alarm transitions twice in a row")
 
 
 def plant_check(url: str, paths: dict[str, Path]) -> tuple[int, int, int]:
