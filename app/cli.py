@@ -174,6 +174,9 @@ def _monitor_parser() -> argparse.ArgumentParser:
                                                         "folder for its program, symbols and tags")
     p.add_argument("--user", help="over OPC UA, the user to log in as (the dialog asks the password; when "
                                   "stdin is not a terminal, its first line is the password)")
+    p.add_argument("--partner", metavar="URL", default="",
+                   help="over OPC UA, the endpoint of the other station of a hot-standby pair: the monitor "
+                        "follows whichever leads (its certificate trusted by a monitor of it before)")
     return p
 
 
@@ -289,7 +292,7 @@ def main(argv: list[str] | None = None) -> int:
                 return 2
             from app.gui.monitor.window import run_monitor
 
-            return run_monitor(ns.target, ns.program, ns.user)
+            return run_monitor(ns.target, ns.program, ns.user, ns.partner)
         if command == "archive":
             ns = _archive_parser().parse_args(rest)
             if ns.action == "backup":
@@ -521,8 +524,10 @@ def run_migrate(source: str, url: str, station: str | None) -> int:
         bar = "#" * round(30 * done)
         print(f"\r[{bar:<30}] {sent:,} / {total:,} records", end="", file=sys.stderr, flush=True)
 
+    # one of a hot-standby pair: as its letter, so its records keep the keys its forwarder gives them
+    letter = owner.redundancy.letter if owner is not None and owner.redundancy is not None else ""
     try:
-        n = Forwarder(path, url, name).forward_all(progress)
+        n = Forwarder(path, url, name, letter=letter).forward_all(progress)
     except (ArchiveError, sqlite3.Error) as e:
         print(f"\n{path} -> {url}: {e}", file=sys.stderr)
         return 1

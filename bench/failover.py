@@ -7,14 +7,19 @@
    an increasing word to whichever is primary, each write waiting for its answer. The primary is
    killed (no more scans, the link cut with no word) `--kills` times, the killed one restarted as
    the standby each time. Takeover time (kill to the standby's role primary) p50 and max, and
-   acknowledged writes lost (the new primary's word below the last acknowledged value).
+   acknowledged writes lost (the new primary's word below the last acknowledged value). With
+   `--plant` both forward to one plant archive (a throwaway PostgreSQL cluster of tests/pgcluster.py):
+   at the end, records of the two local archives missing from it, and alarm transitions in it
+   twice in a row (the same transition of the same alarm: journaled by the old primary in a last
+   scan its standby did not hold yet when it was killed, and again by the new primary).
 
-    .venv/bin/python bench/failover.py [--seconds S] [--kills N]
+    .venv/bin/python bench/failover.py [--seconds S] [--kills N] [--plant]
 """
 
 from __future__ import annotations
 
 import argparse
+import itertools
 import statistics
 import subprocess
 import sys
@@ -36,17 +41,24 @@ from tests.app.pair.conftest import PROGRAM, STATION, free_port  # noqa: E402
 
 TICK_MS = 20
 WHO = Who("", Source.MODBUS, "bench")
+TAGS = """name,address,type,unit,app_min,app_max,phy_min,phy_max,decimals,description,hh,h,l,ll,deadband,\
+on_delay,off_delay,alarm_when,priority,latching,suppress_by,quality_alarm
+GEN,03752,bit,,,,,,,Generator 0.4 s,,,,,,,,1,4,,,
+"""
 
 
-def folders(base: Path, node: int, ports: dict[str, int]) -> dict[str, Path]:
+def folders(base: Path, node: int, ports: dict[str, int], plant: str = "") -> dict[str, Path]:
     out = {}
+    # forwarding: the alarm of the 0.4 s generator's bit, journaled by the primary at every change
+    top = f'Archive = "{plant}"\nTags = "tags.csv"\n' if plant else ""
     for letter, other in (("A", "B"), ("B", "A")):
         folder = base / letter
         folder.mkdir(parents=True)
         (folder / "station.toml").write_text(STATION.format(
             tick=TICK_MS, node=node, letter=letter, listen=ports[letter], partner=ports[other],
-            arbiter="none"), encoding="utf-8")
+            arbiter="none", top=top), encoding="utf-8")
         (folder / "pair.stl").write_text(PROGRAM, encoding="utf-8")
+        (folder / "tags.csv").write_text(TAGS, encoding="utf-8")
         out[letter] = folder
     return out
 
@@ -100,9 +112,9 @@ def cost(base: Path, node: Simulator, seconds: float) -> None:
           f"(x{paired[1] / max(alone[1], 1e-9):.2f})")
 
 
-def kills(base: Path, node: Simulator, n: int) -> None:
+def kills(base: Path, node: Simulator, n: int, plant: str = "") -> None:
     ports = {"A": free_port(), "B": free_port()}
-    paths = folders(base / "kills", node.port, ports)
+    paths = folders(base / "kills", node.port, ports, plant)
     rts = {letter: Runtime(load_station(paths[letter])) for letter in "AB"}
     rts["A"].start()
     rts["B"].start()
@@ -168,21 +180,60 @@ def kills(base: Path, node: Simulator, n: int) -> None:
           f"p50 {statistics.median(took) * 1000:.0f} ms, max {max(took) * 1000:.0f} ms; "
           f"kills with an acknowledged write lost: {lost}; the standby's lag at the takeover: "
           f"max {max(lag)} scans")
+    if plant:
+        missing, doubled, total = plant_check(plant, paths)
+        print(f"plant archive: {total} records of the pair, {missing} of the local archives missing, "
+              f"{doubled} alarm transitions twice in a row")
 
+
+def plant_check(url: str, paths: dict[str, Path]) -> tuple[int, int, int]:
+    """Records of both local archives missing from the plant archive, records in it twice."""
+    import sqlite3
+
+    import psycopg
+
+    from registrar.plant.schema import PAIR_ID_BASE
+    from registrar.schema import DAY_GLOB
+
+    ours: set[int] = set()
+    for letter, folder in paths.items():
+        con = sqlite3.connect(load_station(folder).Archive)
+        for (name,) in con.execute("SELECT name FROM sqlite_master WHERE type = 'table' AND name GLOB ?",
+                                   (DAY_GLOB,)):
+            ours |= {i + PAIR_ID_BASE[letter] for (i,) in con.execute(f'SELECT id FROM "{name}"')}
+        con.close()
+    with psycopg.connect(url) as pg:
+        ids = {i for (i,) in pg.execute("SELECT id FROM records WHERE station = 'pair'")}
+        alarms = pg.execute("SELECT source, number, type FROM records WHERE station = 'pair' "
+                            "AND kind = 'alarm' ORDER BY ts, id").fetchall()
+    doubled = sum(1 for before, row in itertools.pairwise(alarms) if before == row)
+    return len(ours - ids), doubled, len(ids)
 
 def main() -> None:
     p = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     p.add_argument("--seconds", type=float, default=5.0)
     p.add_argument("--kills", type=int, default=20)
+    p.add_argument("--plant", action="store_true", help="forward to a throwaway PostgreSQL cluster")
     args = p.parse_args()
     node = Simulator(parse("JMP 0\n", "node.stl"), tick=TICK_MS / 1000)
     node.start()
+    cluster = None
     try:
+        url = ""
+        if args.plant:
+            from tests.pgcluster import PgCluster
+
+            cluster = PgCluster()
+            cluster.start()
+            url = cluster.create_database("failover")
         with tempfile.TemporaryDirectory() as d:
-            cost(Path(d), node, args.seconds)
-            kills(Path(d), node, args.kills)
+            if args.seconds:
+                cost(Path(d), node, args.seconds)
+            kills(Path(d), node, args.kills, url)
     finally:
         node.stop()
+        if cluster is not None:
+            cluster.remove()
 
 
 if __name__ == "__main__":

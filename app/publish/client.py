@@ -9,6 +9,12 @@ do is the station's answer (UserExecutable of each method, UserAccessLevel of ea
 read again every few seconds), and each action's answer is the station's StatusCode mapped back to
 the layer's `Reason`, so a view shows a refusal from here as it shows a local one.
 
+A hot-standby pair's monitor is given both endpoints (`partner`): it follows the primary on its
+own. Each read asks the Server's ServiceLevel too (Part 4 6.6.2: the primary 255, the standby
+100); when the station it reads stops leading, or its link is lost, it logs in to the other with
+the same user at once, and reads on. The partner's certificate must be known already (trusted in
+`known_stations.json` by a first monitor of it), as a password is sent to no station unasked.
+
 asyncua's client is asyncio: it runs on a thread of its own, callers get `concurrent.futures`
 futures, and `snapshot` is NetPlc's memory as last read, polled every `period` (the view's refresh
 period) and rebuilt only when something changed. A lost link is retried with a back-off.
@@ -62,6 +68,7 @@ TIMEOUT_S = 5.0
 CLOSE_S = 2.0  # a logout the station does not answer within this is left to its session timeout
 RIGHTS_EVERY_S = 2.0  # what the user may do is asked again this often (a role changed at the station)
 RETRY_S = (0.5, 1.0, 2.0, 5.0, 10.0)  # back-off of reconnections
+LEADS = 200  # a ServiceLevel from here up is a healthy server (Part 4 6.6.2.4.2): a pair's primary
 KNOWN_STATIONS = "known_stations.json"
 WRITE = 1 << ua.AccessLevel.CurrentWrite  # in a UserAccessLevel
 REASONS = {int(code): reason for reason, code in ANSWERS.items()}  # the station's codes, read back
@@ -183,13 +190,37 @@ def answer_of(code: int) -> Answer:
     return Answer(REASONS.get(code, Reason.FAILED), f"the station answered {name}: {doc}")
 
 
+async def _offer(url: str) -> Offer:
+    """What the station at `url` offers (GetEndpoints over a None channel, which stations serve
+    for discovery); LoginError when it does not answer, or offers only what sends a password in
+    clear off loopback."""
+    try:
+        endpoints = await Client(url, timeout=TIMEOUT_S).connect_and_get_server_endpoints()
+    except (OSError, TimeoutError, ua.UaError) as e:
+        raise LoginError(f"{url}: no answer ({_why(e)})") from None
+    offer = Offer(url, None)
+    for ep in endpoints:
+        if ep.SecurityPolicyUri == SecurityPolicyBasic256Sha256.URI and ep.ServerCertificate and \
+                ep.SecurityMode == ua.MessageSecurityMode.SignAndEncrypt:
+            offer = Offer(url, Certificate(bytes(ep.ServerCertificate)))
+    if offer.certificate is None and not is_loopback(url):
+        raise LoginError(f"{url} offers no Basic256Sha256 Sign&Encrypt endpoint: a password is not "
+                         "sent in clear to a station off loopback")
+    return offer
+
+
 class StationClient:
     """One logged-in session with a station, on a thread of its own: `discover()`, decide whether
     to trust the station's certificate (`KnownStations`), then `open()`, `close()` at the end."""
 
-    def __init__(self, url: str, *, folder: Path | None = None, period: float = 0.1) -> None:
-        """`folder` holds the monitor's own certificate and the known stations (config_dir())."""
+    def __init__(self, url: str, *, partner: str = "", folder: Path | None = None,
+                 period: float = 0.1) -> None:
+        """`folder` holds the monitor's own certificate and the known stations (config_dir());
+        `partner`: the endpoint of the other station of a hot-standby pair, followed to when it leads."""
         self.url = url
+        self.partner = partner
+        self.service_level = LEADS  # the Server's, as last read
+        self.switches = 0  # times the monitor followed the pair's primary to the other station
         self.offer: Offer | None = None
         self.user = ""
         self._password = ""
@@ -295,18 +326,7 @@ class StationClient:
         return ticket
 
     async def _discover(self) -> Offer:
-        try:
-            endpoints = await Client(self.url, timeout=TIMEOUT_S).connect_and_get_server_endpoints()
-        except (OSError, TimeoutError, ua.UaError) as e:
-            raise LoginError(f"{self.url}: no answer ({_why(e)})") from None
-        self.offer = Offer(self.url, None)
-        for ep in endpoints:
-            if ep.SecurityPolicyUri == SecurityPolicyBasic256Sha256.URI and ep.ServerCertificate and \
-                    ep.SecurityMode == ua.MessageSecurityMode.SignAndEncrypt:
-                self.offer = Offer(self.url, Certificate(bytes(ep.ServerCertificate)))
-        if self.offer.certificate is None and not is_loopback(self.url):
-            raise LoginError(f"{self.url} offers no Basic256Sha256 Sign&Encrypt endpoint: a password is not "
-                             "sent in clear to a station off loopback")
+        self.offer = await _offer(self.url)
         return self.offer
 
     async def _open(self) -> None:
@@ -350,7 +370,10 @@ class StationClient:
         try:
             await client.connect()
             spaces = await client.get_namespace_array()
-            station = next(((i, s) for i, s in enumerate(spaces) if s.startswith(STATION_URI)), None)
+            # the last: a pair's station has its ApplicationUri (the namespace's with its letter) at
+            # index 1, as every server has, and the namespace of its nodes, the same on both, after it
+            ours = [(i, s) for i, s in enumerate(spaces) if s.startswith(STATION_URI)]
+            station = ours[-1] if ours else None
             if station is None:
                 raise LoginError(f"{self.url} is not a NetPlc station (no {STATION_URI}... namespace)")
             self._ns, self.station = station[0], station[1].removeprefix(STATION_URI)
@@ -385,6 +408,9 @@ class StationClient:
                     await self._connect()
                     asked = time.monotonic()
                 await self._read()
+                if self.partner and self.service_level < LEADS and await self._follow("it leads no more"):
+                    asked = time.monotonic()
+                    continue
                 if time.monotonic() - asked >= RIGHTS_EVERY_S or not self._watched <= self.writable.keys():
                     asked = time.monotonic()
                     await self._ask_rights()
@@ -392,12 +418,45 @@ class StationClient:
             except (OSError, TimeoutError, ua.UaError, LoginError) as e:
                 if _why(e) != self.error:
                     logger.warning("%s: %s", self.url, _why(e))  # once per cause, not every try
+                if self.partner and failures == 0 and await self._follow(_why(e)):
+                    continue
                 await self._lost(_why(e), failures)
                 failures += 1
             except Exception as e:  # not the link's fault: logged whole, then tried again the same way
                 logger.exception("%s: reading the station failed", self.url)
                 await self._lost(f"{type(e).__name__}: {e}", failures)
                 failures += 1
+
+    async def _follow(self, why: str) -> bool:
+        """Log in to the pair's other station (its certificate known already); True once
+        logged in there, False when it cannot be (the link to this one is then retried)."""
+        try:
+            there = await _offer(self.partner)
+        except LoginError as e:
+            logger.warning("%s: the pair's other station: %s", self.url, e)
+            return False
+        if there.certificate is not None and \
+                KnownStations(self.folder).verdict(self.partner, there.certificate) != "known":
+            self.error = (f"{self.url}: {why}; the pair's other station {self.partner} is not trusted yet: "
+                          f"monitor it once to trust its certificate")
+            return False
+        old = self._client
+        self._client = None
+        if old is not None:
+            try:
+                await old.disconnect()
+            except Exception:  # no log: the station left may be gone; its session times out there
+                logger.debug("closing the session of the station left failed", exc_info=True)
+        self.url, self.partner, self.offer = self.partner, self.url, there
+        try:
+            await self._connect()
+        except (OSError, TimeoutError, ua.UaError, LoginError) as e:
+            logger.warning("%s: logging in failed: %s", self.url, _why(e))
+            return False
+        self.switches += 1
+        self.error = ""
+        logger.info("following the pair's primary to %s (%s)", self.url, why)
+        return True
 
     async def _lost(self, why: str, failures: int) -> None:
         """The session is given up (said in `error`) and a new one tried after a back-off."""
@@ -417,10 +476,13 @@ class StationClient:
         client = self._client
         assert client is not None
         names = ("NetPlc.Tick", "NetPlc.State", "NetPlc.Memory.Bits", "NetPlc.Memory.Data", "NetPlc.Forces")
-        values = await client.uaclient.read_attributes([self._node(n) for n in names], ua.AttributeIds.Value)
+        nodes = [self._node(n) for n in names] + [ua.NodeId(ua.ObjectIds.Server_ServiceLevel)]
+        *values, level = await client.uaclient.read_attributes(nodes, ua.AttributeIds.Value)
         for dv in values:
             if dv.StatusCode is not None and not dv.StatusCode.is_good():
                 raise ua.UaStatusCodeError(dv.StatusCode.value)
+        served = level.Value.Value if level.Value is not None else None
+        self.service_level = LEADS if served is None else int(served)
         raw = tuple(dv.Value.Value if dv.Value is not None else None for dv in values)
         self.reads += 1
         if raw == self._raw:

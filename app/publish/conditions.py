@@ -8,6 +8,7 @@ an Object in the station's Alarms folder with the stable NodeId `Alarms.<id>` an
     a bit's value            OffNormalAlarmType (NormalState: a NormalValue variable for a bit)
     a tag's bad quality      SystemOffNormalAlarmType
     NetPlc not running       SystemOffNormalAlarmType (InputNode NetPlc.State, normal "running")
+    a pair with no standby   SystemOffNormalAlarmType (PAIR.NO_STANDBY: no input variable)
     NMSG alarm messages      AlarmConditionType (raised by the program: no input variable)
 
 with the optional ShelvingState, SuppressedState, OutOfServiceState and the RemoveFromService and
@@ -98,7 +99,7 @@ from app.authority import Action, Commands, Reason, Ticket, Who
 from app.publish import condition_nodes as nodes
 from app.publish.methods import answered, arguments
 from app.publish.ua_types import SEVERITY
-from app.scada.alarms import ONE_SHOT_LIMIT, PRIORITIES, Alarm, Source
+from app.scada.alarms import ONE_SHOT_LIMIT, PRIORITIES, STOPPED_ID, Alarm, Source
 from netplc.records import Record
 
 logger = logging.getLogger(__name__)
@@ -229,7 +230,7 @@ class Conditions:
             d = alarm.defn
             key = d.id.rsplit(".", 1)[-1] if d.source is Source.LIMIT else ""
             normal: ua.Variant | None = None  # the input's value when normal, where it has one
-            if d.source is Source.STATION:
+            if d.id == STOPPED_ID:  # PAIR.NO_STANDBY, the other station alarm, has no input variable
                 normal = ua.Variant("running", _V.String)
             elif d.source is Source.DISCRETE and d.tag in sources and await _is_bit(server, sources[d.tag]):
                 normal = ua.Variant(not d.when, _V.Boolean)
@@ -251,7 +252,7 @@ class Conditions:
                 source, source_name, input_ = sources[d.tag], d.tag, sources[d.tag]
             else:
                 source, source_name = plc.nodeid, "NetPlc"
-                input_ = plc_state if d.source is Source.STATION else ua.NodeId()
+                input_ = plc_state if d.id == STOPPED_ID else ua.NodeId()
             c = Condition(copy.copy(alarm), ids[0], ua.NodeId(shape[0]), source, source_name, input_,
                           variables.get("NormalValue", ua.NodeId()), ua.NodeId(f"{root}.ShelvingState", idx),
                           variables, methods)

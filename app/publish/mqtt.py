@@ -21,6 +21,13 @@ timestamp is not older than the last one seen) the node publishes NDEATH, discon
 again at once, with the next bdSeq, and births when the host is online again. A STATE older than
 the last one seen (an old session's death delivered late) is ignored.
 
+A station of a hot-standby pair is one edge node with its partner (one group and edge node id,
+one client id): only the primary connects and publishes (`leads()`), the standby keeps no session.
+A station that stops leading publishes NDEATH and disconnects; one that starts leading connects
+and births with the next bdSeq of the pair's: the primary's bdSeq is mirrored to the standby
+(`follow`), so after a takeover a host application never takes the old primary's NDEATH (its will,
+sent late) for the new session's.
+
 Every other NCMD metric is a write of an edge node point, every DCMD metric a write of one of the
 device's points, through the station's command layer (app/authority/) by the MQTT source (a
 command names no user: it acts with `[mqtt] role`), checked for the metric's Sparkplug datatype
@@ -82,11 +89,13 @@ class MqttStatus:
 class SparkplugPublisher:
     def __init__(self, settings: MqttSettings, station: str, *, tags: Sequence[Tag], commands: Commands,
                  watch: Watch, journal: Callable[[str], None], bdseq_file: Path | None = None,
-                 quality_map: QualityMap | None = None, exchange: Exchange | None = None) -> None:
+                 quality_map: QualityMap | None = None, exchange: Exchange | None = None,
+                 leads: Callable[[], bool] = lambda: True) -> None:
         """`bdseq_file` keeps the bdSeq of the last connection across restarts (Sparkplug 3.0:
         each connection's bdSeq is the previous one's plus one), so a host application never
         takes the NDEATH of an old session for the new one's; None: it starts at 0. The exchange's
-        nodes are the devices, their points those `quality_map` says their NREADs fill."""
+        nodes are the devices, their points those `quality_map` says their NREADs fill. `leads()`:
+        does this station publish now (the primary of a pair, or a station alone)?"""
         self.settings = settings
         self.topics = spb.Topics(settings.group_id, settings.edge_node_id or station)
         self.tags = list(tags)
@@ -98,6 +107,8 @@ class SparkplugPublisher:
         self.watch = watch
         self.journal = journal
         self.status = MqttStatus()
+        self.leads = leads
+        self._online = False  # connecting or connected (a pair's standby: not)
         self.kinds = [spb.datatype(t) for t in self.tags]
         bands = dict(settings.deadband)
         self.deadband = np.array([bands.get(t.type.value, 0.0) for t in self.tags])
@@ -151,9 +162,10 @@ class SparkplugPublisher:
     # --- life cycle ----------------------------------------------------------------------------
 
     def start(self) -> None:
-        """Never fails for a broker that is away: the client keeps trying, the station runs on."""
-        self.client.connect_async(self.host, self.port, KEEPALIVE)
-        self.client.loop_start()
+        """Never fails for a broker that is away: the client keeps trying, the station runs on.
+        A pair's standby connects once it leads (the publisher's thread)."""
+        if self.leads():
+            self._go_online()
         self._thread = threading.Thread(target=self._run, name="mqtt-publish", daemon=True)
         self._thread.start()
         self._unwatch = self.watch(self.feed)
@@ -167,10 +179,38 @@ class SparkplugPublisher:
         self._wake.set()
         if self._thread is not None:
             self._thread.join(10)
+        if self._online:
+            self._go_offline()
+
+    def _go_online(self) -> None:
+        self._online = True
+        with self._lock:
+            self._set_will()
+        self.client.reconnect_delay_set(*BACKOFF)
+        self.client.connect_async(self.host, self.port, KEEPALIVE)
+        self.client.loop_start()
+
+    def _go_offline(self) -> None:
+        """NDEATH by the node itself (spec 3.0), then disconnect: a stop, or a pair's primary
+        that became the standby."""
+        self._online = False
+        self._session = False
+        self._leaving = True
         if self.status.connected:
             self._publish_death()
         self.client.disconnect()
         self.client.loop_stop()
+        self._leaving = False
+
+    def follow(self, bdseq: int) -> None:
+        """A pair's standby: the primary's session has `bdseq`; this station's next is the one
+        after it, kept as the last one made, so that it goes on from there after a restart too."""
+        with self._lock:
+            if self._online or not 0 <= bdseq <= 255:
+                return
+            self.bdseq = bdseq
+            self._store_bdseq()
+            self.bdseq = (bdseq + 1) % 256
 
     def _wakeup(self) -> None:
         self._wake.set()
@@ -340,6 +380,8 @@ class SparkplugPublisher:
                 time.sleep(wait)
             self._wake.clear()
             item = self.feed.take()
+            if not self._lead_or_follow():
+                continue
             if item is not None:
                 self._readings, self._latest = item, self.reader.read(item)
             reading = self._latest
@@ -352,6 +394,21 @@ class SparkplugPublisher:
             elif item is not None:
                 self._data(reading)
             last = time.monotonic()
+
+    def _lead_or_follow(self) -> bool:
+        """Connect when this station has come to lead its pair, end the session when it has come to
+        follow; True while it publishes."""
+        leads = self.leads()
+        if leads and not self._online:
+            self.journal(f"MQTT: this station leads its pair: connecting as {self.topics.node} "
+                         f"(bdSeq {self.bdseq})")
+            self._buffer.clear()  # what a standby saw was the primary's to publish
+            self._go_online()
+        elif not leads and self._online:
+            self.journal(f"MQTT: this station is the standby of its pair: NDEATH, session ended "
+                         f"(bdSeq {self.bdseq}); the primary publishes")
+            self._go_offline()
+        return leads
 
     def _leave(self) -> None:
         """The primary host is offline: NDEATH, disconnect, and connect again at once (the next

@@ -98,6 +98,7 @@ ANSWERS = {Reason.APPLIED: _S.Good, Reason.DENIED: _S.BadUserAccessDenied,  # by
            Reason.INVALID: _S.BadInvalidArgument, Reason.BUSY: _S.BadTooManyOperations,
            Reason.JOURNAL_FULL: _S.BadResourceUnavailable, Reason.NOT_RUNNING: _S.BadServerHalted,
            Reason.FAILED: _S.BadInternalError, Reason.STANDBY: _S.BadInvalidState}
+HEALTHY = 255  # ServiceLevel of a station alone (Part 4 6.6.2.4.2: 200-255 healthy)
 YIELD_EVERY = 500  # variable writes between two turns of the event loop
 READABLE_WITHIN = 2.0  # s at most an applied write waits for its value to be readable here
 MEMORY_BITS = "NetPlc's I/O bits 00000-03777, one byte each (0 or 1): byte n is bit n"
@@ -219,15 +220,20 @@ class OpcUaServer:
                  commands: Commands, watch: Watch, engine: Any, exchange: Any, alarms: Sequence[Alarm] = (),
                  journal: Callable[[str], None] = lambda _text: None,
                  step_lock: StepLock = lambda: None, archived: Archived | None = None,
-                 language: str = "") -> None:
+                 language: str = "", pair_letter: str = "",
+                 service_level: Callable[[], int] = lambda: HEALTHY) -> None:
         """`journal` takes the system records of the server's security (a certificate made or
         made private, a client certificate refused); `step_lock` gives the scan thread's lock, which
         the Step method needs; `archived` what the station archives, for Historical Access;
-        `language` the station's (a bit's TrueState and FalseState are in it)."""
+        `language` the station's (a bit's TrueState and FalseState are in it); `pair_letter` this
+        station's in a hot-standby pair ("" alone), `service_level` its ServiceLevel now."""
         self.endpoint = settings.endpoint
         self.settings = settings
         self.archived = archived
         self.language = language
+        self.pair_letter = pair_letter
+        self.service_level = service_level
+        self._level = -1  # the ServiceLevel the address space holds
         self.station = station
         self.folder = folder
         self.tags = list(tags)
@@ -313,14 +319,18 @@ class OpcUaServer:
         server.application_type = ua.ApplicationType.Server
         await server.set_build_info(build.product_uri, build.manufacturer, build.product, build.version,
                                     build.build_number, build.build_date)
-        uri = f"urn:netplc:station:{self.station}"
-        await server.set_application_uri(uri)
+        uri = f"urn:netplc:station:{self.station}"  # the namespace's: one for both stations of a pair
+        application = f"{uri}:{self.pair_letter}" if self.pair_letter else uri
+        await server.set_application_uri(application)
         if self.secure:
-            await self._secure(server, uri)
+            await self._secure(server, application)
         else:
             server.set_security_policy([ua.SecurityPolicyType.NoSecurity])
         self.server = server
         await self._build(server, uri)
+        if self.pair_letter:
+            await self._redundancy(server, uri)
+        await self._serve_level()
         self._intercept(server)
         await server.start()
         if self.secure:  # no await since the listener opened: no client is served before this
@@ -340,10 +350,36 @@ class OpcUaServer:
                 if item is not None:
                     await self._publish(item)
                     self._readable(item.snapshot.scan)
+                await self._serve_level()
                 self.status.skipped = self.feed.skipped
         finally:
             await _stop_clock(server)
             await server.stop()
+
+    async def _redundancy(self, server: Server, namespace: str) -> None:
+        """One of a hot-standby pair (Part 4 6.6.2, non-transparent redundancy, Hot; Part 5
+        NonTransparentRedundancyType): RedundancySupport Hot, ServerUriArray the partner's
+        ApplicationUri; the ServiceLevel says which of the two is the primary."""
+        node = server.get_node(ua.NodeId(ua.ObjectIds.Server_ServerRedundancy))
+        await node.delete_reference(ua.NodeId(ua.ObjectIds.ServerRedundancyType),
+                                    ua.ObjectIds.HasTypeDefinition, bidirectional=False)
+        await node.add_reference(ua.NodeId(ua.ObjectIds.NonTransparentRedundancyType),
+                                 ua.ObjectIds.HasTypeDefinition, bidirectional=False)
+        support = server.get_node(ua.NodeId(ua.ObjectIds.Server_ServerRedundancy_RedundancySupport))
+        await support.write_value(ua.Variant(ua.RedundancySupport.Hot.value, ua.VariantType.Int32))
+        partner = "B" if self.pair_letter == "A" else "A"
+        await node.add_property(ua.NodeId("ServerRedundancy.ServerUriArray", self.idx),
+                                ua.QualifiedName("ServerUriArray", 0), [f"{namespace}:{partner}"],
+                                ua.VariantType.String)
+
+    async def _serve_level(self) -> None:
+        """Server.ServiceLevel, written when it changed (Part 4 6.6.2.4.2: a client of a pair
+        chooses the server with the highest)."""
+        level = self.service_level()
+        if level != self._level:
+            self._level = level
+            node = self.server.get_node(ua.NodeId(ua.ObjectIds.Server_ServiceLevel))
+            await node.write_value(ua.Variant(level, ua.VariantType.Byte))
 
     async def _secure(self, server: Server, uri: str) -> None:
         """Basic256Sha256 Sign&Encrypt with the station's own certificate (pki.py)."""

@@ -40,7 +40,9 @@ def start_publishers(runtime: Runtime) -> list[Publisher]:
                              commands=runtime.commands, watch=runtime.watch, engine=runtime.engine,
                              exchange=runtime.exchange, alarms=alarms, journal=runtime.system,
                              step_lock=lambda: runtime.scan_thread.lock if runtime.scan_thread else None,
-                             archived=archived, language=st.Language)
+                             archived=archived, language=st.Language,
+                             pair_letter=st.redundancy.letter if st.redundancy is not None else "",
+                             service_level=runtime.service_level)
         try:
             server.start()
         except (OSError, RuntimeError) as e:
@@ -58,7 +60,7 @@ def start_publishers(runtime: Runtime) -> list[Publisher]:
         publisher = SparkplugPublisher(st.mqtt, st.name, tags=tags, commands=runtime.commands,
                                        watch=runtime.watch, journal=runtime.system,
                                        bdseq_file=st.folder / BDSEQ_FILE, exchange=runtime.exchange,
-                                       quality_map=runtime.alarms.quality_map)
+                                       quality_map=runtime.alarms.quality_map, leads=runtime.leads)
         publisher.start()
         started.append(publisher)
         devices = ", ".join(d.id for d in publisher.layout.devices) or "none"

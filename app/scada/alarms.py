@@ -56,6 +56,9 @@ LIMIT_WORDS = {"HH": "high-high", "H": "high", "L": "low", "LL": "low-low"}
 # NetPlc not running: the plant goes uncontrolled by the program and every value is frozen, so the
 # operator must know at once (high: it sounds), deliberate stop or not.
 STOPPED_ID, STOPPED_PRIORITY = "NETPLC.STOPPED", 2
+# One of a hot-standby pair leading with no standby on its link: the plant has lost its redundancy
+# (after a takeover, or with the partner down); the operator must know, and it sounds.
+NO_STANDBY_ID, NO_STANDBY_PRIORITY = "PAIR.NO_STANDBY", 2
 # A one-shot shelving ends when its alarm's condition returns to normal, and after this long at the
 # latest: nothing stays shelved for good because its condition never came and went (ISA-18.2 wants
 # shelving bounded; OPC UA Part 9 bounds a OneShotShelved alarm the same way).
@@ -88,7 +91,7 @@ class Source(StrEnum):
     DISCRETE = "discrete"
     MESSAGE = "message"
     QUALITY = "quality"
-    STATION = "station"  # NetPlc's run state: STOPPED_ID
+    STATION = "station"  # the station's own: NetPlc's run state (STOPPED_ID), its pair (NO_STANDBY_ID)
 
 
 class AlarmError(ValueError):
@@ -130,6 +133,7 @@ class Alarm:
     defn: AlarmDef
     active: bool = False  # as annunciated: a latched alarm stays active after its condition has gone
     acked: bool = True
+    acked_by: str = ""  # who acknowledged it, while it is acknowledged
     since: float = 0.0  # wall time of the last activation
     changed: float = 0.0  # wall time of the last transition
     value: float | None = None  # physical value at the last transition
@@ -198,8 +202,9 @@ def summary_order(row: AlarmRow) -> tuple[bool, int, float]:
     return shelved, row.priority, -(row.changed if shelved else row.since)
 
 
-PERSISTED = ("active", "acked", "since", "changed", "value", "shelved_until", "shelved_by", "reason",
-             "one_shot", "out_of_service", "oos_by", "suppressed", "detail", "comment", "comment_by")
+PERSISTED = ("active", "acked", "acked_by", "since", "changed", "value", "shelved_until",
+             "shelved_by", "reason", "one_shot", "out_of_service", "oos_by", "suppressed", "detail",
+             "comment", "comment_by")
 UNSHELVED = {"shelved_until": None, "shelved_by": "", "reason": "", "one_shot": False}
 
 
@@ -220,9 +225,9 @@ class Transition:
 
 
 def alarm_defs(table: TagTable, messages: Iterable[CatalogMessage] = (),
-               station: bool = False) -> list[AlarmDef]:
+               station: bool = False, pair: bool = False) -> list[AlarmDef]:
     """Every alarm of the tags and of the catalog's alarm and critical messages; with `station`,
-    NetPlc's own NETPLC.STOPPED too."""
+    NetPlc's own NETPLC.STOPPED too, with `pair` PAIR.NO_STANDBY."""
     out: list[AlarmDef] = []
     for tag in table.tags:
         spec = table.alarms.get(tag.name)
@@ -248,6 +253,9 @@ def alarm_defs(table: TagTable, messages: Iterable[CatalogMessage] = (),
                                 number=m.number))
     if station:
         out.append(AlarmDef(STOPPED_ID, Source.STATION, "NetPlc is not running", STOPPED_PRIORITY))
+    if pair:
+        out.append(AlarmDef(NO_STANDBY_ID, Source.STATION, "No standby: the pair runs on one station",
+                            NO_STANDBY_PRIORITY))
     return out
 
 
@@ -269,9 +277,10 @@ class AlarmSystem:
     def __init__(self, table: TagTable, messages: Iterable[CatalogMessage] = (), *,
                  sink: RecordSink | None = None, saved: Mapping[str, Mapping[str, Any]] | None = None,
                  on_change: Callable[[dict[str, dict[str, Any]]], None] | None = None,
-                 clock: Callable[[], float] = time.time, station: bool = False) -> None:
+                 clock: Callable[[], float] = time.time, station: bool = False, pair: bool = False) -> None:
         """`station`: the alarm system of a running station, with NETPLC.STOPPED (`evaluate`'s
-        `stopped` says why NetPlc is not running)."""
+        `stopped` says why NetPlc is not running); `pair`: one of a hot-standby pair, with
+        PAIR.NO_STANDBY (`evaluate`'s `no_standby` says why)."""
         self.table = table
         self.sink: RecordSink = sink or NullSink()
         self.on_change = on_change
@@ -279,17 +288,20 @@ class AlarmSystem:
         self.tags: list[Tag] = list(table.tags)
         self.reader = TagReader(self.tags)
         pos = {t.name: i for i, t in enumerate(self.tags)}
-        self.defs = alarm_defs(table, messages, station)
+        self.defs = alarm_defs(table, messages, station, pair)
         self.alarms = [Alarm(d) for d in self.defs]
         self.by_id = {a.id: i for i, a in enumerate(self.alarms)}
         n = len(self.defs)
         groups = {s: _Group() for s in Source}
         self._msg: dict[int, int] = {}
         self._stopped: int | None = None  # NETPLC.STOPPED
+        self._no_standby: int | None = None  # PAIR.NO_STANDBY
         for i, d in enumerate(self.defs):
             if d.tag is not None:
                 groups[d.source].idx.append(i)
                 groups[d.source].tag.append(pos[d.tag])
+            elif d.id == NO_STANDBY_ID:
+                self._no_standby = i
             elif d.source is Source.STATION:
                 self._stopped = i
             else:
@@ -338,6 +350,19 @@ class AlarmSystem:
             if a.shelved_until is not None:
                 self._shelved.add(i)
 
+    def adopt(self, states: Mapping[str, Mapping[str, Any]]) -> None:
+        """The states of a hot-standby pair's primary (app/station/pair.py), taken as they are, so
+        the standby's alarms are the primary's, acknowledgements, shelving and out-of-service
+        included, and a takeover leaves nothing for an operator to do again. Kept and published as
+        any change; journaled by the primary alone, which made them."""
+        self.restore(states)
+        self._changed.update(i for alarm_id in states if (i := self.by_id.get(alarm_id)) is not None)
+        self._flush_changes()
+
+    def states(self) -> dict[str, dict[str, Any]]:
+        """Every alarm's state, as `on_change` hands each."""
+        return {a.id: self.state_of(i) for i, a in enumerate(self.alarms)}
+
     def state_of(self, i: int) -> dict[str, Any]:
         a = self.alarms[i]
         out = {key: getattr(a, key) for key in PERSISTED}
@@ -357,11 +382,12 @@ class AlarmSystem:
 
     def evaluate(self, snapshot: MemoryView, now: float | None = None,
                  quality: np.ndarray | Sequence[int] | Mapping[str, int] | None = None,
-                 messages: Iterable[int] = (), stopped: str = "") -> list[Transition]:
+                 messages: Iterable[int] = (), stopped: str = "", no_standby: str = "") -> list[Transition]:
         """One scan: `quality` holds each tag's quality code in table order (as
         `QualityMap.evaluate` gives it) or by tag name (None, or a tag not named: good),
         `messages` the NMSG numbers journaled in the scan, `stopped` why NetPlc is not running
-        ("" while it runs). Returns the transitions, which are journaled as well."""
+        ("" while it runs), `no_standby` why a pair's primary has no standby ("" while it has).
+        Returns the transitions, which are journaled as well."""
         if now is None:
             now = getattr(snapshot, "wall", 0.0) or self.clock()
         out: list[Transition] = []
@@ -394,9 +420,10 @@ class AlarmSystem:
                 i = self._msg.get(number)
                 if i is not None:
                     hyst[i] = True
-        if self._stopped is not None:
-            self._stop_detail(self._stopped, stopped)
-            hyst[self._stopped] = bool(stopped)
+        for i, why in ((self._stopped, stopped), (self._no_standby, no_standby)):
+            if i is not None:
+                self._detail(i, why)
+                hyst[i] = bool(why)
         differs = (hyst != self._cond) | ~np.isnan(self._pending)
         if frozen is not None:
             hyst[frozen] = keep
@@ -416,11 +443,12 @@ class AlarmSystem:
         self._flush_changes()
         return out
 
-    def _stop_detail(self, i: int, stopped: str) -> None:
-        """NETPLC.STOPPED says why while NetPlc is not running, and keeps it after it runs again."""
+    def _detail(self, i: int, why: str) -> None:
+        """A station alarm (NETPLC.STOPPED, PAIR.NO_STANDBY) says why while it is active, and keeps
+        it after it has gone."""
         a = self.alarms[i]
-        if stopped and stopped != a.detail:
-            a.detail = stopped
+        if why and why != a.detail:
+            a.detail = why
             self._changed.add(i)
 
     def _debounce(self, i: int, cond: bool, now: float, out: list[Transition]) -> None:
@@ -484,6 +512,8 @@ class AlarmSystem:
         phy, raw = self._value(i)
         a.changed = now
         a.value = phy
+        if not a.acked:
+            a.acked_by = ""
         text = f"{a.id} {old.word} -> {new.word}: {a.text}"
         t = self._tag_of[i]
         if phy is not None and raw is not None:
@@ -526,7 +556,7 @@ class AlarmSystem:
         old = a.state
         latched = a.defn.latching and a.active and not self._cond[i]
         if old is State.UNACK or old is State.RTNUN:
-            a.acked = True
+            a.acked, a.acked_by = True, user
         elif not (old is State.ACKED and latched):
             return
         if latched:

@@ -47,16 +47,19 @@ PUBLISH_EVERY = 0.25  # s of engine time between two rebuilds of the summary dur
 class StationAlarms:
     def __init__(self, tags: Path | None, program: Program, messages: list[CatalogMessage], sink: RecordSink,
                  state_file: Path, symbols: dict[str, int] | None = None,
-                 regdata: Mapping[str, Sequence[tuple[int, int]]] | None = None) -> None:
+                 regdata: Mapping[str, Sequence[tuple[int, int]]] | None = None,
+                 no_standby: Callable[[], str] | None = None) -> None:
         """TagError (every problem of tags.csv) if the tags cannot be used. `regdata`: the forms'
-        RegData elements by name, with their operands (app/scada/series.py)."""
+        RegData elements by name, with their operands (app/scada/series.py); `no_standby`: one of a
+        hot-standby pair, why it has no standby now ("" while it has), for PAIR.NO_STANDBY."""
         self.table = load_tags(tags, symbols) if tags is not None else TagTable()
         self.quality_map = QualityMap(program, self.table.tags)
         self.sink = sink
         self.series = SeriesQuality(program, regdata or {})
         self.state = AlarmStateFile(state_file, sink)
         self.system = AlarmSystem(self.table, messages, sink=sink, saved=self.state.load(),
-                                  on_change=self._changed, station=True)
+                                  on_change=self._changed, station=True, pair=no_standby is not None)
+        self.no_standby = no_standby or (lambda: "")
         self.quality = np.zeros(len(self.table.tags), dtype=np.int8)  # of the last scan, by tag
         self.readings: Readings | None = None  # of the last scan; None before the first
         # The alarm summary, rebuilt on the engine thread after states changed, from the rows of
@@ -73,6 +76,7 @@ class StationAlarms:
         self._messages: list[int] = []
         self._since: dict[int, int] = {}  # node -> first scan of this run with its link known
         self._stopped_by = ""  # who stopped NetPlc through the command layer (its record), while stopped
+        self._unsent: dict[str, dict[str, Any]] | None = None  # changed states for a pair's standby
 
     def attach(self, engine: Engine, exchange: Exchange | None) -> None:
         """Evaluate after every scan of `engine`; start saving states."""
@@ -104,11 +108,15 @@ class StationAlarms:
                          forced=[a for f in snapshot.forces for a in f.operands])
         self.quality = self.quality_map.evaluate(snapshot, links)
         self.readings = Readings(snapshot, self.quality_map, links, self.quality)
+        if self.engine is not None and self.engine.follower:
+            self._messages.clear()  # a pair's standby: the primary's alarm states are adopted, and
+            return  # the primary journals the transitions and the series, which it forwards
         for record in self.series.evaluate(snapshot, links, snapshot.wall):
             self.sink.put(record)
         messages, self._messages = self._messages, []
         self.system.evaluate(snapshot, snapshot.wall, self.quality, messages,
-                             "" if running else stop_reason(snapshot.state, self._stopped_by))
+                             "" if running else stop_reason(snapshot.state, self._stopped_by),
+                             self.no_standby())
         if self._dirty and snapshot.time - self._published >= PUBLISH_EVERY:
             self._publish(snapshot.time)
 
@@ -120,6 +128,19 @@ class StationAlarms:
     def _changed(self, changes: dict[str, dict[str, Any]]) -> None:
         self.state.update(changes)
         self._dirty.update(changes)
+        if self._unsent is not None:
+            self._unsent.update(changes)
+
+    def changes_for_standby(self, whole: bool = False) -> dict[str, dict[str, Any]]:
+        """On the engine thread: the states changed since the last call (the first call starts
+        keeping them), or with `whole` every alarm's; what a pair's primary sends its standby."""
+        unsent, self._unsent = self._unsent or {}, {}
+        return self.system.states() if whole else unsent
+
+    def adopt(self, states: dict[str, dict[str, Any]]) -> None:
+        """On the engine thread: the primary's states, on its standby (AlarmSystem.adopt)."""
+        if states:
+            self.run_now(lambda: self.system.adopt(states))
 
     def _publish(self, now: float | None = None) -> None:
         for alarm_id in self._dirty:

@@ -3,9 +3,11 @@ puts it into its engine (docs/architecture.md section 11).
 
 The state is the engine's own: NetPlc memory (bits and data, which hold the edge memory too: a
 CTR's rising edge is RES 1 while its bit C is 0), the timers' and counters' current values, the
-forces, the run state and the scan number. A frame carries only what changed since the frame
-before it (memory as runs of the 64-byte blocks that differ); the first frame of a link is the
-whole state, so a standby that comes late or comes back catches up at once.
+forces, the run state and the scan number, and the alarm states the station keeps beside it
+(acknowledged by whom, shelved, out of service: app/scada/alarms.py). A frame carries only what
+changed since the frame before it (memory as runs of the 64-byte blocks that differ, the alarms
+whose state changed); the first frame of a link is the whole state, so a standby that comes late
+or comes back catches up at once.
 
 Frames on the link: a 4-byte big-endian length, then the version byte, the kind byte and the
 payload. A state payload is a 4-byte length of its JSON header, the header, then the memory runs
@@ -73,15 +75,18 @@ class Capture:
     tim: dict[int, float]
     ctr: dict[int, int]
     stop_code: int
+    alarms: dict[str, dict[str, Any]] = field(default_factory=dict)  # changed states, by alarm
+    bdseq: int = -1  # the MQTT Sparkplug session's bdSeq (-1: no MQTT)
 
 
-def capture(engine: Engine, snapshot: Snapshot) -> Capture:
+def capture(engine: Engine, snapshot: Snapshot, alarms: dict[str, dict[str, Any]],
+            bdseq: int = -1) -> Capture:
     """The scan's state; the timers and counters read only at the coils the program has (all
     2048 of each would cost the scan milliseconds)."""
     tim, ctr = engine.tim_ticks, engine.ctr_values
     tims, ctrs = _coils(engine)
     return Capture(snapshot, {c: tim[c] for c in tims if tim[c]}, {c: ctr[c] for c in ctrs if ctr[c]},
-                   engine.stop_code)
+                   engine.stop_code, alarms, bdseq)
 
 
 _COILS: dict[int, tuple[tuple[int, ...], tuple[int, ...]]] = {}  # by id of the program
@@ -114,8 +119,10 @@ class Encoder:
         now = image(cap.snapshot)
         runs = [(0, now)] if self.last is None else _delta(self.last, now)
         header: dict[str, Any] = {"scan": cap.snapshot.scan, "full": self.last is None}
+        if cap.alarms:
+            header["alarms"] = cap.alarms
         extras = json.dumps({"state": cap.snapshot.state, "stop_code": cap.stop_code,
-                             "tim": cap.tim, "ctr": cap.ctr,
+                             "tim": cap.tim, "ctr": cap.ctr, "bdseq": cap.bdseq,
                              "forces": [[f.kind, fmt_octal(f.addr), f.value, f.user]
                                         for f in cap.snapshot.forces]})
         if extras != self._extras or self.last is None:
@@ -166,6 +173,8 @@ class Mirror:
     tim: dict[int, float] = field(default_factory=dict)
     ctr: dict[int, int] = field(default_factory=dict)
     forces: tuple[Force, ...] = ()
+    alarms: dict[str, dict[str, Any]] = field(default_factory=dict)  # states not yet put, by alarm
+    bdseq: int = -1  # the primary's MQTT Sparkplug bdSeq
 
     @property
     def complete(self) -> bool:
@@ -191,8 +200,13 @@ class Mirror:
                 self.state, self.stop_code = extras["state"], int(extras["stop_code"])
                 self.tim = {int(c): float(v) for c, v in extras["tim"].items()}
                 self.ctr = {int(c): int(v) for c, v in extras["ctr"].items()}
+                self.bdseq = int(extras.get("bdseq", -1))
                 self.forces = tuple(Force(kind, parse_octal(addr), int(value), user)
                                     for kind, addr, value, user in extras["forces"])
+            alarms = header.get("alarms", {})
+            if not isinstance(alarms, dict):
+                raise TypeError("the alarms are no table")
+            self.alarms.update(alarms)
             self.scan = int(header["scan"])
         except (struct.error, ValueError, KeyError, TypeError) as e:
             raise LinkError(f"a state frame that cannot be read: {e}") from None
@@ -206,6 +220,11 @@ class Mirror:
         engine.state = _run_state(self.state)
         engine.stop_code = self.stop_code
         engine.scan_counter = self.scan
+
+    def take_alarms(self) -> dict[str, dict[str, Any]]:
+        """The alarm states received since the last call, for the standby's alarm system."""
+        alarms, self.alarms = self.alarms, {}
+        return alarms
 
 
 def _run_state(text: str) -> RunState:

@@ -27,7 +27,7 @@ import struct
 import threading
 import time
 from collections.abc import Callable
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from enum import StrEnum
 from typing import TYPE_CHECKING
 
@@ -64,6 +64,9 @@ class Role(StrEnum):
 
 # HSBStatus of seed 000 by role: 0 after power-on, 4 standby, 5 master (6 defect: refused partner)
 HSB_STATUS = {Role.STARTING: 0, Role.PRIMARY: 5, Role.STANDBY: 4}
+# OPC UA ServiceLevel by role (Part 4 6.6.2.4.2: 0 maintenance, 1 no data, 2-199 degraded, 200-255
+# healthy): the standby serves reads but no writes, degraded; a client of the pair takes the highest
+SERVICE_LEVEL = {Role.STARTING: 1, Role.PRIMARY: 255, Role.STANDBY: 100}
 DEFECT = 6
 # The pair's status words in NetPlc memory, beside the RTC (077700-077707), each station's own
 # (written after the mirrored memory is put), for a program and an HMI (docs/integration/redundancy.md)
@@ -154,6 +157,8 @@ class Pair:
         self.cause = 0  # the last switchover's cause code (HSB_SWITCH)
         self.led_scans = 0  # scans run as the primary: of two primaries, the one with more leads
         self._awaiting: list[tuple[int, Callable[[], None]]] = []  # (scan, callback): after_mirrored
+        self._whole_alarms = True  # the next capture holds every alarm's state (a new link's first)
+        self._bdseq = -1  # the primary's MQTT bdSeq as last handed to this station's publisher
 
     @property
     def tick(self) -> float:
@@ -280,10 +285,17 @@ class Pair:
         engine = self._engine
         assert engine is not None
         if engine.follower and self.mirror.complete:
-            with self._lock:
-                self.mirror.load_into(engine, mem)
+            self._load_mirror(engine, mem)
         engine.follower = False
         self._put_words(mem)
+
+    def _load_mirror(self, engine: Engine, mem: Memory) -> None:
+        """On the engine thread: the mirrored memory and engine state, and the alarm states."""
+        with self._lock:
+            self.mirror.load_into(engine, mem)
+            alarms = self.mirror.take_alarms()
+        if self.runtime.alarms is not None:
+            self.runtime.alarms.adopt(alarms)
 
     def _follow(self, _mem: Memory) -> None:
         engine = self._engine
@@ -357,6 +369,7 @@ class Pair:
                     old.close()
                 self._link = conn
                 self._last_frame = self.clock()
+                self._whole_alarms = True
             self._become(decide(self.role, self.settings.letter, Role(hello["role"]), self.led_scans,
                                 int(hello.get("led", 0))), f"partner {hello['letter']} is {hello['role']}")
             self.refused = ""
@@ -429,9 +442,13 @@ class Pair:
                 self._last_frame = self.clock()
                 post = not self._load_pending
                 self._load_pending = True
-                scan = self.mirror.scan
+                scan, bdseq = self.mirror.scan, self.mirror.bdseq
             if post and self._engine is not None:
                 self._engine.post(self._load)
+            sparkplug = self.runtime.sparkplug()
+            if sparkplug is not None and bdseq != self._bdseq:  # one edge node: the primary's session,
+                self._bdseq = bdseq  # whose bdSeq this station goes on from, before it could lead
+                sparkplug.follow(bdseq)
             send_frame(conn, ACK, struct.pack(">q", scan))
         elif kind == ACK and len(payload) == 8:
             self._mirrored(struct.unpack(">q", payload)[0])
@@ -465,8 +482,8 @@ class Pair:
         assert engine is not None
         with self._lock:
             self._load_pending = False
-            if engine.follower and self.mirror.complete:
-                self.mirror.load_into(engine, mem)
+        if engine.follower and self.mirror.complete:
+            self._load_mirror(engine, mem)
         self._put_words(mem)
 
     def _put_words(self, mem: Memory) -> None:
@@ -491,8 +508,14 @@ class Pair:
             self.led_scans += 1
         if self.role is not Role.PRIMARY or self._link is None:
             return
-        cap = capture(engine, snapshot)
+        alarms = self.runtime.alarms
+        states = alarms.changes_for_standby(self._whole_alarms) if alarms is not None else {}
+        self._whole_alarms = False
+        sparkplug = self.runtime.sparkplug()
+        cap = capture(engine, snapshot, states, sparkplug.bdseq if sparkplug is not None else -1)
         with self._changed:
+            if self._capture is not None and self._capture.alarms:  # not sent yet: none is lost
+                cap = replace(cap, alarms={**self._capture.alarms, **cap.alarms})
             self._capture = cap
             if self._handing_over:
                 self._handover, self._handing_over = self._handing_over, ""

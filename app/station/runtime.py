@@ -51,6 +51,7 @@ from registrar.retain import Retainer
 from registrar.store import Store, StoreStats
 
 if TYPE_CHECKING:
+    from app.publish.mqtt import SparkplugPublisher
     from app.station.pair import Pair
     from registrar.plant.forward import Forwarder
 
@@ -273,7 +274,8 @@ class Runtime:
             from registrar.plant.forward import Forwarder  # psycopg only where a plant archive is named
 
             self.forwarder = Forwarder(st.Archive, st.plant_archive, st.name, keep_days=st.plant_keep_days,
-                                       sink=self.put, wallclock=self.wallclock)
+                                       sink=self.put, wallclock=self.wallclock,
+                                       letter=st.redundancy.letter if st.redundancy is not None else "")
             self.forwarder.start()  # never fails: PostgreSQL away is a lag, not a start error
         started = False
         try:
@@ -320,7 +322,8 @@ class Runtime:
         self.exchange.start()
         regdata = {el.Name: el.sources() for _, el in behaviour.elements if el.RegData}
         self.alarms = StationAlarms(st.Tags, self.program, list(self.catalog), self,
-                                    st.Archive.with_name(ALARM_STATE_FILE), self.symbols, regdata)
+                                    st.Archive.with_name(ALARM_STATE_FILE), self.symbols, regdata,
+                                    self._no_standby if st.redundancy is not None else None)
         self.subscribe(self.alarms.observe)
         self.alarms.attach(self.engine, self.exchange)
         self.commands = Commands(self.engine, self, role_of=self.role_of, tags=self.alarms.table.tags,
@@ -373,6 +376,28 @@ class Runtime:
                               f"{_reason(e)}"]) from None
         self.pair = pair
 
+    def leads(self) -> bool:
+        """Does this station act now: alone, or the primary of its pair (MQTT publishes only then)."""
+        return self._standby() is None
+
+    def sparkplug(self) -> SparkplugPublisher | None:
+        """The station's MQTT Sparkplug edge node, if it publishes one (a pair mirrors its bdSeq)."""
+        if not self.station.mqtt.enabled:
+            return None
+        from app.publish.mqtt import SparkplugPublisher  # loaded already: the station publishes MQTT
+
+        return next((p for p in self.publishers if isinstance(p, SparkplugPublisher)), None)
+
+    def _no_standby(self) -> str:
+        """Why this pair's primary has no standby now (PAIR.NO_STANDBY), "" while it has one."""
+        pair = self.pair
+        if pair is None or pair.role != "primary":
+            return ""
+        status = pair.status()
+        if pair.refused:
+            return pair.refused
+        return "" if status.link else f"pair link to {status.partner} down"
+
     def _standby(self) -> str | None:
         """Why the command layer refuses a write or command now: this station is not the primary."""
         pair = self.pair
@@ -421,6 +446,15 @@ class Runtime:
         for text in unresolved_hosts(self.station):
             if self.started:
                 self.system(f"{text}; the node stays down until it does")
+
+    def service_level(self) -> int:
+        """OPC UA ServiceLevel: 255 alone; one of a pair, by its role (pair.SERVICE_LEVEL)."""
+        from app.station.pair import SERVICE_LEVEL, Role
+
+        pair = self.pair
+        if pair is not None:
+            return SERVICE_LEVEL[pair.role]
+        return SERVICE_LEVEL[Role.PRIMARY if self.station.redundancy is None else Role.STARTING]
 
     def role_of(self, name: str) -> str | None:
         """A user's role as users.json says now (read again when the file changed, so a role changed

@@ -8,6 +8,12 @@ all: PostgreSQL away, the network down, a SIGKILL in the middle of a batch (the 
 open transaction back) all end in a replay from the committed position, and the unique key
 (station, day, id) refuses anything sent twice. While the copy lags by more than a minute the
 station is told, once by a 'system' record and continuously by `stats.lag`.
+
+Each station of a hot-standby pair forwards its own archive, under the pair's one name, as its
+letter (schema.py: PAIR_ID_BASE, `forwarded_pair`): both run their forwarders whatever their
+role, so the records a primary committed before it died are forwarded when it comes back, and a
+standby journals no copy of the primary's records (its alarms are the primary's, adopted, not
+evaluated: app/scada/station.py), so nothing reaches the plant archive twice.
 """
 
 from __future__ import annotations
@@ -61,7 +67,9 @@ class Forwarder:
         interval: float = 0.5,
         batch: int = BATCH,
         lag_alarm: float = LAG_ALARM,
+        letter: str = "",
     ) -> None:
+        """`letter`: this station's in a hot-standby pair ("A", "B"), "" for a station alone."""
         self.local = Path(local)
         self.url = url
         self.station = station
@@ -71,6 +79,8 @@ class Forwarder:
         self.interval = interval
         self.batch = batch
         self.lag_alarm = lag_alarm
+        self.letter = letter
+        self.id_base = plant.PAIR_ID_BASE[letter] if letter else 0
         self._pg: psycopg.Connection | None = None
         self._sqlite: sqlite3.Connection | None = None
         self._tz: dt.tzinfo | None = None
@@ -201,8 +211,10 @@ class Forwarder:
             self._tz = plant.ensure_schema(con)
             self._published = False
             self._publish(con)
-            self._done = {d: n for d, n in con.execute(
-                "SELECT day, last_id FROM forwarded WHERE station = %s", (self.station,))}
+            self._done = {d: n for d, n in (con.execute(
+                "SELECT day, last_id FROM forwarded_pair WHERE station = %s AND letter = %s",
+                (self.station, self.letter)) if self.letter else con.execute(
+                "SELECT day, last_id FROM forwarded WHERE station = %s", (self.station,)))}
             self._known.clear()
             self._partitions = set(plant.partitions(con))
             self._retain(con)
@@ -308,8 +320,8 @@ class Forwarder:
             "WHERE id > ? ORDER BY id LIMIT ?", (done, self.batch)).fetchall()
         if not rows:
             return 0
-        station = self.station
-        out = [(station, day, *r) for r in rows]
+        station, base = self.station, self.id_base
+        out = [(station, day, r[0] + base, *r[1:]) for r in rows]
         last = rows[-1][0]
         try:
             self._send(con, day, out, last, plant.copy_rows)
@@ -339,8 +351,13 @@ class Forwarder:
                     plant.ensure_partitions(con, days, tz)
                 write(con, rows)
                 self._list_series(con, days)
-                con.execute("INSERT INTO forwarded VALUES (%s, %s, %s) ON CONFLICT (station, day) "
-                            "DO UPDATE SET last_id = excluded.last_id", (self.station, day, last))
+                if self.letter:
+                    con.execute("INSERT INTO forwarded_pair VALUES (%s, %s, %s, %s) ON CONFLICT "
+                                "(station, letter, day) DO UPDATE SET last_id = excluded.last_id",
+                                (self.station, self.letter, day, last))
+                else:
+                    con.execute("INSERT INTO forwarded VALUES (%s, %s, %s) ON CONFLICT (station, day) "
+                                "DO UPDATE SET last_id = excluded.last_id", (self.station, day, last))
         except psycopg.Error:
             self._known.clear()
             self._partitions.clear()

@@ -5,6 +5,12 @@ silent; only the one that holds this lease may act as primary (docs/architecture
 The lease is a session-level advisory lock (`pg_try_advisory_lock`) on a connection of its own:
 PostgreSQL releases it when that session ends, so a primary that dies, or loses the server for
 longer than its TCP keepalive, frees it for the standby without anyone's help.
+
+The order of the two ends matters when the network parts the primary from the server: the
+primary must give up before the server frees the lock for the standby. The lease's session asks
+the server to drop a silent client after LEASE_SERVER_DROP s (its TCP keepalive), while the
+primary's check gives up on an unanswered query after LEASE_CLIENT_GIVES_UP s (libpq's
+tcp_user_timeout): the primary steps down seconds before its partner may lead.
 """
 
 from __future__ import annotations
@@ -17,6 +23,13 @@ import psycopg
 from registrar.plant.schema import connect
 
 logger = logging.getLogger(__name__)
+
+LEASE_CLIENT_GIVES_UP = 1.0  # s: an unacknowledged query to the arbiter fails the check
+KEEPALIVE_IDLE, KEEPALIVE_INTERVAL, KEEPALIVE_COUNT = 2, 1, 2  # the server's probes of the client
+LEASE_SERVER_DROP = KEEPALIVE_IDLE + KEEPALIVE_INTERVAL * KEEPALIVE_COUNT  # s before the lock is freed
+_SERVER_KEEPALIVE = (f"-c tcp_keepalives_idle={KEEPALIVE_IDLE}"
+                     f" -c tcp_keepalives_interval={KEEPALIVE_INTERVAL}"
+                     f" -c tcp_keepalives_count={KEEPALIVE_COUNT}")
 
 
 def lease_key(station: str) -> int:
@@ -43,7 +56,8 @@ class Lease:
             return True
         try:
             if self._con is None or self._con.closed:
-                self._con = connect(self.url, timeout=self.timeout)
+                self._con = connect(self.url, timeout=self.timeout, options=_SERVER_KEEPALIVE,
+                                    tcp_user_timeout=round(LEASE_CLIENT_GIVES_UP * 1000))
             row = self._con.execute("SELECT pg_try_advisory_lock(%s)", (self.key,)).fetchone()
         except psycopg.Error as e:
             self._lost(e)

@@ -8,6 +8,11 @@ id) of each partition makes a replayed batch fail instead of doubling rows. `for
 last id copied per station and day, written in the same transaction as the rows, so a batch and
 its position are committed together or not at all.
 
+The two stations of a hot-standby pair forward under their one name, each its own archive: a
+record's id there is its local id plus its letter's base (PAIR_ID_BASE: A from 2^40, B from 2^41),
+so the two never collide and each keeps its own order, and each letter's position is a row of
+`forwarded_pair`. Queries order by time, so the pair's records read as one history.
+
 `tags` keeps every version of each station's tags (its tags.csv as the station's archive holds
 it), each valid from the change that made it to the next one, and the view `tag_values` gives
 every data record of a one-word tag by the version of its time: time, station, tag, the physical
@@ -37,6 +42,7 @@ from registrar.schema import (
 )
 
 PLANT = ""  # the `station` of the plant-wide meta rows
+PAIR_ID_BASE = {"A": 1 << 40, "B": 2 << 40}  # a pair's records: local id + its letter's base
 COPY_COLUMNS = ("station", "day", "id", "ts", "kind", "grp", "type", "source", "number", "value", "text")
 COPY_TYPES = ("text", "date", "int8", "int8", "text", "int8", "int8", "text", "int8", "float8", "text")
 LOCK_PARTITIONS = 7_165_001  # advisory lock key: one writer at a time creates or drops partitions
@@ -61,6 +67,8 @@ SCHEMA_SQL = (
         UNIQUE NULLS NOT DISTINCT (station, day, kind, grp, type, source))""",
     """CREATE TABLE IF NOT EXISTS forwarded (station text NOT NULL, day date NOT NULL,
         last_id bigint NOT NULL, PRIMARY KEY (station, day))""",
+    """CREATE TABLE IF NOT EXISTS forwarded_pair (station text NOT NULL, letter text NOT NULL,
+        day date NOT NULL, last_id bigint NOT NULL, PRIMARY KEY (station, letter, day))""",
     # A station's tags, one row per tag and version: a version converts the records from valid_from
     # (the first '-infinity') to valid_to (the current 'infinity'); `since` is when the station took
     # it up (its archive's `tags_since`; NULL: not known); `source` is the key of its data records.
@@ -92,11 +100,14 @@ TAG_VALUES_SQL = f"""CREATE VIEW tag_values AS
     WHERE t.type IN ({", ".join(f"'{k}'" for k in ONE_WORD_TYPES)})"""
 
 
-def connect(url: str, *, read_only: bool = False, timeout: float = 5.0) -> psycopg.Connection:
-    """Autocommit: every write is inside an explicit `con.transaction()`."""
-    options = "-c default_transaction_read_only=on" if read_only else ""
+def connect(url: str, *, read_only: bool = False, timeout: float = 5.0, options: str = "",
+            **params: object) -> psycopg.Connection:
+    """Autocommit: every write is inside an explicit `con.transaction()`. `options`: the
+    session's server settings (`-c name=value`), `params`: more libpq connection parameters."""
+    if read_only:
+        options = f"{options} -c default_transaction_read_only=on".strip()
     return psycopg.connect(url, connect_timeout=max(1, round(timeout)), options=options,
-                           autocommit=True, application_name="netplc-station")
+                           autocommit=True, application_name="netplc-station", **params)
 
 
 def ensure_schema(con: psycopg.Connection) -> dt.tzinfo | None:
@@ -160,6 +171,7 @@ def drop_days_before(con: psycopg.Connection, oldest: dt.date) -> list[str]:
             con.execute(f'DROP TABLE "{name}"')
             con.execute("DELETE FROM series WHERE day = %s", (name,))
         con.execute("DELETE FROM forwarded WHERE day < %s", (oldest,))
+        con.execute("DELETE FROM forwarded_pair WHERE day < %s", (oldest,))
     return [n for _d, n in old]
 
 

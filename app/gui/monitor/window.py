@@ -85,15 +85,16 @@ def remote_source(target: str, program: str | None = None) -> RemoteSource:
     return RemoteSource(host, int(port), program=listed, symbols=symbols, tags=tags)
 
 
-def run_monitor(target: str, program: str | None = None, user: str | None = None) -> int:
-    """`python main.py monitor TARGET [--program P] [--user NAME]`: over OPC UA as a user of the
-    station (the login dialog; with --user and stdin not a terminal, the password is its first
-    line), over Modbus read-only. Exit 2 with the reason when it cannot start, 1 when the login is
-    cancelled."""
+def run_monitor(target: str, program: str | None = None, user: str | None = None,
+                partner: str = "") -> int:
+    """`python main.py monitor TARGET [--program P] [--user NAME] [--partner URL]`: over OPC UA as a
+    user of the station (the login dialog; with --user and stdin not a terminal, the password is its
+    first line; with --partner it follows the pair's primary), over Modbus read-only. Exit 2 with
+    the reason when it cannot start, 1 when the login is cancelled."""
     app = application()
     try:
         if target.startswith("opc.tcp://"):
-            source: Source | None = station_source(target, program, user)
+            source: Source | None = station_source(target, program, user, partner)
             if source is None:
                 return 1
         else:
@@ -107,14 +108,16 @@ def run_monitor(target: str, program: str | None = None, user: str | None = None
     return app.exec()
 
 
-def station_source(url: str, program: str | None = None, user: str | None = None) -> OpcUaSource | None:
-    """A station over OPC UA, logged in through the login dialog; None when it was cancelled."""
+def station_source(url: str, program: str | None = None, user: str | None = None,
+                   partner: str = "") -> OpcUaSource | None:
+    """A station over OPC UA, logged in through the login dialog; None when it was cancelled.
+    `partner`: the other station of its hot-standby pair, followed to when it leads."""
     from app.gui.monitor.login import LoginDialog
     from app.publish.client import StationClient  # OPC UA loaded only for a station over OPC UA
 
     listed = listing(program) if program else None
     password = sys.stdin.readline().rstrip("\r\n") if user and not sys.stdin.isatty() else None
-    client = StationClient(url)
+    client = StationClient(url, partner=partner)
     dialog = LoginDialog(client, user or "", password)
     if dialog.exec() != QDialog.DialogCode.Accepted:
         client.close()

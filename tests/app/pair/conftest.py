@@ -13,6 +13,7 @@ from pathlib import Path
 import pytest
 
 from app.authority import Source, Who
+from app.station.config import Station as StationSettings
 from app.station.config import load_station
 from app.station.runtime import Runtime
 from netplc.program import parse
@@ -38,7 +39,7 @@ STATION = """\
 name = "pair"
 NetPlcProgram = "pair.stl"
 NetSyncTime = {tick}
-[modbus_server]
+{top}[modbus_server]
 port = 0
 writable = [["04000", "04777"]]
 [[nodes]]
@@ -77,9 +78,12 @@ class Station:
         self.folder = folder
         self.runtime: Runtime | None = None
         self.journal: list[Record] = []
+        # the settings as this station differs from its partner on one host (a port, the arbiter
+        # through a proxy), put after loading: the folder's hash, which the pair compares, is unchanged
+        self.adjust: Callable[[StationSettings], StationSettings] = lambda settings: settings
 
     def start(self) -> Runtime:
-        runtime = Runtime(load_station(self.folder))
+        runtime = Runtime(self.adjust(load_station(self.folder)))
         runtime.subscribe(self.journal.append)
         runtime.start()
         self.runtime = runtime
@@ -131,16 +135,17 @@ def node() -> Iterator[Simulator]:
     sim.stop()
 
 
-def make_pair(tmp_path: Path, node: Simulator, arbiter: str = "none",
-              b_dials: int | None = None) -> tuple[Station, Station]:
-    """A and B of one station; B dials `b_dials` (a proxy's port) instead of A's link."""
+def make_pair(tmp_path: Path, node: Simulator, arbiter: str = "none", b_dials: int | None = None,
+              top: str = "", files: dict[str, str] | None = None) -> tuple[Station, Station]:
+    """A and B of one station; B dials `b_dials` (a proxy's port) instead of A's link. `top`:
+    more top-level keys of station.toml, `files`: more files of the station folder."""
     ports = {"A": free_port(), "B": free_port()}
     stations = []
     for letter, other in (("A", "B"), ("B", "A")):
         partner = b_dials if letter == "B" and b_dials else ports[other]
         folder = write_station(tmp_path / letter, STATION.format(
             tick=TICK_MS, node=node.port, letter=letter, listen=ports[letter], partner=partner,
-            arbiter=arbiter), {"pair.stl": PROGRAM})
+            arbiter=arbiter, top=top), {"pair.stl": PROGRAM, **(files or {})})
         stations.append(Station(folder))
     return stations[0], stations[1]
 

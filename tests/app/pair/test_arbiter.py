@@ -7,13 +7,15 @@ from __future__ import annotations
 
 import time
 from collections.abc import Iterator
+from dataclasses import replace
 from pathlib import Path
 
 import pytest
 
 from app.station.config import load_station
 from netplc.simulator import Simulator
-from tests.app.pair.conftest import TICK_MS, Proxy, Station, make_pair, wait_for
+from registrar.plant.lease import LEASE_CLIENT_GIVES_UP, LEASE_SERVER_DROP, Lease
+from tests.app.pair.conftest import OPERATOR, TICK_MS, Proxy, Station, make_pair, wait_for
 
 
 @pytest.fixture
@@ -57,3 +59,50 @@ def test_without_an_arbiter_both_act(
     finally:
         b.stop()
         a.stop()
+
+
+def test_a_primary_that_loses_the_arbiter_and_its_partner_steps_down(
+        tmp_path: Path, node: Simulator, proxy: Proxy, pg_url: str) -> None:
+    """A reaches the arbiter through a proxy of its own: both cut, A is alone and cannot know
+    whether B leads, so it steps down; B, which still reaches the arbiter, takes the lease."""
+    to_arbiter = Proxy()
+    port = int(pg_url.rsplit(":", 1)[1].split("/")[0])
+    to_arbiter.target = port
+    a, b = make_pair(tmp_path, node, pg_url, b_dials=proxy.port)
+    via_proxy = pg_url.replace(f":{port}/", f":{to_arbiter.port}/")
+    a.adjust = lambda st: replace(st, redundancy=replace(st.redundancy, arbiter=via_proxy))  # type: ignore[arg-type]
+    proxy.target = load_station(a.folder).redundancy.listen_address[1]  # type: ignore[union-attr]
+    try:
+        a.start()
+        b.start()
+        assert (a.role, b.role) == ("primary", "standby")
+        to_arbiter.cut()
+        proxy.cut()
+        wait_for(lambda: a.role == "standby", timeout=10, what="A steps down")
+        wait_for(lambda: b.role == "primary", timeout=10, what="B takes the lease")
+        assert a.role == "standby"
+        wait_for(lambda: any("lost the arbiter" in t and "and the partner" in t for t in a.texts()),
+                 timeout=10, what="A journals why it stepped down")
+        assert a.rt.commands is not None
+        assert not a.rt.commands.write_word(OPERATOR, 0o4000, 5).result(3).ok  # A refuses
+    finally:
+        to_arbiter.cut()
+        b.stop()
+        a.stop()
+
+
+def test_the_lease_session_is_dropped_by_the_server_only_after_the_primary_gave_up(pg_url: str) -> None:
+    """A network that parts the primary from the arbiter: the primary's check fails first."""
+    lease = Lease(pg_url, "pair")
+    try:
+        assert lease.take()
+        assert lease._con is not None
+        settings = dict(lease._con.execute(
+            "SELECT name, setting FROM pg_settings WHERE name LIKE 'tcp_keepalives_%'").fetchall())
+        dropped = int(settings["tcp_keepalives_idle"]) + int(settings["tcp_keepalives_interval"]) \
+            * int(settings["tcp_keepalives_count"])
+        assert dropped == LEASE_SERVER_DROP > 2 * LEASE_CLIENT_GIVES_UP
+        gives_up = lease._con.info.get_parameters()["tcp_user_timeout"]
+        assert gives_up == str(round(LEASE_CLIENT_GIVES_UP * 1000))
+    finally:
+        lease.release()

@@ -36,3 +36,13 @@ def test_a_delta_before_the_whole_state_is_refused() -> None:
         Mirror().apply(encoder.frame(Capture(mem.snapshot(2), {}, {}, 0)))
     with pytest.raises(LinkError, match="cannot be read"):
         Mirror().apply(b"\x00\x00\x00\x05{nope")
+
+
+def test_alarm_states_reach_the_standby_once_however_frames_come() -> None:
+    mem, encoder, mirror = Memory(), Encoder(), Mirror()
+    acked = {"active": True, "acked": True, "acked_by": "ivan"}
+    mirror.apply(encoder.frame(Capture(mem.snapshot(1), {}, {}, 0, {"TRIP.ALARM": acked})))
+    mirror.apply(encoder.frame(Capture(mem.snapshot(2), {}, {}, 0, {"DOOR.ALARM": {"active": False}})))
+    mirror.apply(encoder.frame(Capture(mem.snapshot(3), {}, {}, 0)))
+    assert mirror.take_alarms() == {"TRIP.ALARM": acked, "DOOR.ALARM": {"active": False}}
+    assert mirror.take_alarms() == {}

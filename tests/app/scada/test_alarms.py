@@ -63,8 +63,10 @@ def test_a_limit_alarm_through_on_delay_ack_deadband_and_off_delay() -> None:
     assert r.scan(0.1) == []  # on delay: 1 s
     assert r.scan(1.0) == []
     assert r.scan(1.1) == [("LEVEL.H", "normal", "active-unacknowledged")]
+    assert r.system.get("LEVEL.H").acked_by == ""
     ack = r.system.acknowledge("LEVEL.H", "ivanov")
     assert [(t.old, t.new, t.user) for t in ack] == [(State.UNACK, State.ACKED, "ivanov")]
+    assert r.system.get("LEVEL.H").acked_by == "ivanov"  # kept with the state (a pair's standby too)
     r.level(88.5)  # below H but inside the deadband (90 - 2): still active
     assert r.scan(2.0) == []
     r.level(87)
@@ -85,6 +87,9 @@ def test_returned_unacknowledged_then_back_and_acknowledged() -> None:
     assert [(t.old.word, t.new.word) for t in r.system.acknowledge("LEVEL.H", "op")] == [
         ("returned-unacknowledged", "normal")]
     assert r.system.acknowledge("LEVEL.H", "op") == []  # nothing left to acknowledge
+    r.level(95)
+    r.scan(4)
+    assert r.system.get("LEVEL.H").acked_by == ""  # a new alarm: nobody has acknowledged it
 
 
 def test_the_deadband_keeps_a_noisy_value_from_chattering() -> None:
