@@ -149,9 +149,9 @@ def main(argv: list[str] | None = None) -> int:
     else:
         served = (f"Modbus RTU on {serial.device} ({serial.baudrate} baud, "
                   f"{serial.bytesize}{serial.parity}{serial.stopbits})")
-    print(f"simulated CPU-165 node: {args.program} every {args.tick} ms, {served} unit {args.unit} "
-          "(Ctrl-C stops)", flush=True)
-    try:
+    try:  # a Ctrl-C from here on, even while the line is printed, stops the node's threads
+        print(f"simulated CPU-165 node: {args.program} every {args.tick} ms, {served} unit {args.unit} "
+              "(Ctrl-C stops)", flush=True)
         threading.Event().wait()
     except KeyboardInterrupt:
         pass

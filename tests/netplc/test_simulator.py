@@ -69,4 +69,9 @@ def test_command_line_simulator(tmp_path: Path) -> None:
         c.close()
     finally:
         proc.send_signal(signal.SIGINT)
-        assert proc.wait(10) == 0
+        try:
+            assert proc.wait(60) == 0
+        finally:
+            if proc.poll() is None:
+                proc.kill()
+                proc.wait(10)
