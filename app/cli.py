@@ -19,6 +19,7 @@ from pathlib import Path
 from app import __version__, logs
 from app.logs import LEVELS
 from app.station.config import DEMO_STATION
+from netplc import interruptible
 from registrar.plant.url import is_url
 
 COMMANDS = ("view", "check", "simulate", "alarms-report", "design", "monitor", "archive", "users", "opcua",
@@ -415,7 +416,7 @@ def run_headless(station: str, duration: float | None, every: float) -> int:
         started = time.monotonic()
         while not done.is_set():
             left = every if duration is None else min(every, started + duration - time.monotonic())
-            if left <= 0 or done.wait(left):
+            if left <= 0 or interruptible.wait(done, left):
                 break
             print(runtime.status().line(), flush=True)
     finally:

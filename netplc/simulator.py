@@ -18,6 +18,7 @@ import sys
 import threading
 from collections.abc import Iterable
 
+from netplc import interruptible
 from netplc.engine import Engine
 from netplc.modbus import (
     ALL_MEMORY,
@@ -152,7 +153,7 @@ def main(argv: list[str] | None = None) -> int:
     try:  # a Ctrl-C from here on, even while the line is printed, stops the node's threads
         print(f"simulated CPU-165 node: {args.program} every {args.tick} ms, {served} unit {args.unit} "
               "(Ctrl-C stops)", flush=True)
-        threading.Event().wait()
+        interruptible.wait(threading.Event())
     except KeyboardInterrupt:
         pass
     finally:
