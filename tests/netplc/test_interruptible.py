@@ -13,8 +13,9 @@ def test_a_signal_to_another_thread_ends_the_main_threads_wait() -> None:
     done = threading.Event()
     previous = signal.signal(signal.SIGUSR1, lambda _signum, _frame: done.set())  # runs on the main thread
     try:
-        sender = threading.Thread(target=lambda: signal.pthread_kill(threading.get_ident(), signal.SIGUSR1))
-        sender.start()  # the signal goes to the sender's thread, not to the waiting one
+        # once the main thread waits, the signal goes to the sender's thread, not to the waiting one
+        sender = threading.Timer(0.1, lambda: signal.pthread_kill(threading.get_ident(), signal.SIGUSR1))
+        sender.start()
         assert interruptible.wait(done)  # for ever unless the handler runs: a plain done.wait() hangs
         sender.join()
     finally:
