@@ -63,7 +63,8 @@ def free_port() -> int:
         return s.getsockname()[1]
 
 
-def wait_for(condition: Callable[[], object], timeout: float = 3.0, what: str = "") -> None:
+def wait_for(condition: Callable[[], object], timeout: float = 15.0, what: str = "") -> None:
+    """`condition` within `timeout` (generous: a loaded CI machine; speed is for bench/)."""
     deadline = time.monotonic() + timeout
     while not condition():
         if time.monotonic() > deadline:

@@ -45,7 +45,7 @@ def alarm(station: Station, alarm_id: str) -> Alarm:
 
 def raise_alarm(station: Station, alarm_id: str) -> None:
     assert station.rt.engine is not None and station.rt.engine.write_bit(BITS[alarm_id], 1, user="test")
-    wait_for(lambda: alarm(station, alarm_id).state is State.UNACK, timeout=10, what=f"{alarm_id} active")
+    wait_for(lambda: alarm(station, alarm_id).state is State.UNACK, what=f"{alarm_id} active")
 
 
 def test_acknowledged_on_the_primary_acknowledged_on_the_new_primary(
@@ -60,7 +60,7 @@ def test_acknowledged_on_the_primary_acknowledged_on_the_new_primary(
     assert a.rt.commands.shelve(IVAN, "DOOR.ALARM", "door propped open for the fitters", 3600).result(3).ok
     assert a.rt.commands.out_of_service(OLGA, "FAN.ALARM").result(3).ok  # answered: B holds it
     a.kill()
-    wait_for(lambda: b.role == "primary", timeout=10, what="takeover")
+    wait_for(lambda: b.role == "primary", what="takeover")
     trip, door, fan = (alarm(b, alarm_id) for alarm_id in BITS)
     assert (trip.state, trip.acked_by) == (State.ACKED, "ivan")
     assert (door.state, door.shelved_by, door.reason) == (State.SHELVED, "ivan",
@@ -68,7 +68,7 @@ def test_acknowledged_on_the_primary_acknowledged_on_the_new_primary(
     assert (fan.state, fan.oos_by) == (State.OUT_OF_SERVICE, "olga")
     assert b.rt.alarms is not None
     # nothing to do again, but one new alarm: B leads with no standby (in the banner, it sounds)
-    wait_for(lambda: alarm(b, NO_STANDBY_ID).state is State.UNACK, timeout=10, what="PAIR.NO_STANDBY")
+    wait_for(lambda: alarm(b, NO_STANDBY_ID).state is State.UNACK, what="PAIR.NO_STANDBY")
     assert [r.id for r in b.rt.alarms.summary if r.state is State.UNACK] == [NO_STANDBY_ID]
     assert alarm(b, NO_STANDBY_ID).text.startswith("No standby: the pair runs on one station: pair link to")
 
@@ -81,7 +81,7 @@ def test_a_standby_that_comes_late_gets_every_alarm_s_state(alarm_pair: tuple[St
     assert a.rt.commands.acknowledge(IVAN, "TRIP.ALARM").result(3).ok
     b.start()
     assert b.role == "standby"
-    wait_for(lambda: alarm(b, "TRIP.ALARM").acked_by == "ivan", timeout=10, what="B has A's acknowledgement")
+    wait_for(lambda: alarm(b, "TRIP.ALARM").acked_by == "ivan", what="B has A's acknowledgement")
     assert alarm(b, "TRIP.ALARM").state is State.ACKED
 
 
@@ -89,7 +89,7 @@ def test_no_standby_is_an_alarm_of_the_primary_until_its_partner_is_back(
         alarm_pair: tuple[Station, Station]) -> None:
     a, b = alarm_pair
     a.start()  # alone: it leads with no standby
-    wait_for(lambda: alarm(a, NO_STANDBY_ID).state is State.UNACK, timeout=10, what="A has no standby")
+    wait_for(lambda: alarm(a, NO_STANDBY_ID).state is State.UNACK, what="A has no standby")
     b.start()
-    wait_for(lambda: alarm(a, NO_STANDBY_ID).state is State.RTNUN, timeout=10, what="B is A's standby")
-    wait_for(lambda: alarm(b, NO_STANDBY_ID).state is State.RTNUN, timeout=10, what="and B shows A's")
+    wait_for(lambda: alarm(a, NO_STANDBY_ID).state is State.RTNUN, what="B is A's standby")
+    wait_for(lambda: alarm(b, NO_STANDBY_ID).state is State.RTNUN, what="and B shows A's")

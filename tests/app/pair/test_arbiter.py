@@ -78,8 +78,8 @@ def test_a_primary_that_loses_the_arbiter_and_its_partner_steps_down(
         assert (a.role, b.role) == ("primary", "standby")
         to_arbiter.cut()
         proxy.cut()
-        wait_for(lambda: a.role == "standby", timeout=10, what="A steps down")
-        wait_for(lambda: b.role == "primary", timeout=10, what="B takes the lease")
+        wait_for(lambda: a.role == "standby", what="A steps down")
+        wait_for(lambda: b.role == "primary", what="B takes the lease")
         assert a.role == "standby"
         wait_for(lambda: any("lost the arbiter" in t and "and the partner" in t for t in a.texts()),
                  timeout=10, what="A journals why it stepped down")

@@ -47,10 +47,10 @@ def test_the_pair_forwards_to_one_plant_archive_nothing_lost_nothing_doubled(
         a.start()
         b.start()
         assert a.rt.engine is not None and a.rt.engine.write_bit(BITS[TRIP], 1, user="test")
-        wait_for(lambda: alarm(b, TRIP).state is State.UNACK, timeout=10, what="the alarm on both")
+        wait_for(lambda: alarm(b, TRIP).state is State.UNACK, what="the alarm on both")
         assert a.write(0o4000, 1111).ok
         a.kill()
-        wait_for(lambda: b.role == "primary", timeout=10, what="takeover")
+        wait_for(lambda: b.role == "primary", what="takeover")
         assert b.write(0o4000, 2222).ok
         a.start()  # back as the standby: forwards what it had not yet
         assert a.role == "standby"

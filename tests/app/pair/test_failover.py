@@ -4,8 +4,6 @@ standby; IntoStandBy switches over and back with nothing lost."""
 
 from __future__ import annotations
 
-import time
-
 import pytest
 
 from app.authority import Source, Who
@@ -14,7 +12,7 @@ from app.cli import run_redundancy
 from app.station.pair import HSB_NUM_PLC, HSB_STATUS_BYTE, HSB_SWITCH
 from netplc.modbus import BUSY
 from netplc.simulator import Simulator
-from tests.app.pair.conftest import OPERATOR, TICK_MS, Station, modbus_write, wait_for
+from tests.app.pair.conftest import OPERATOR, Station, modbus_write, wait_for
 
 NODE_WORD = 0o4100  # where the primary's NWRITE puts the operator's word 04000 on the node
 TIMER, COUNTER = 0o3000, 0o3010
@@ -59,10 +57,7 @@ def test_kill_the_primary_the_standby_takes_over_and_the_old_one_comes_back_as_s
     assert a.write(0o4000, 1112).ok  # answered once the standby holds it: killed right after
     elapsed, counted = a.rt.engine.tim_ticks[TIMER], a.rt.engine.ctr_values[COUNTER]
     a.kill()
-    killed = time.monotonic()
-    wait_for(lambda: b.role == "primary", timeout=2, what="takeover")
-    took = time.monotonic() - killed
-    assert took <= (3 + 1) * TICK_MS / 1000 + 0.25, took  # failover_after + one tick, + a loaded CI
+    wait_for(lambda: b.role == "primary", what="takeover")  # how fast: bench/failover.py
     # the role changes on the pair's thread, its record reaches the journal on the engine's
     wait_for(lambda: any("partner silent for" in t for t in b.texts()), what="the takeover journaled")
     wait_for(lambda: b.word(0o4000) == 1112, what="the acknowledged write is not lost")

@@ -59,7 +59,7 @@ def test_clients_are_told_the_primary_and_a_monitor_follows_it(tmp_path: Path, n
         client.open("eng1", "eng1").result(20)
         wait_for(lambda: client.snapshot is not None, what="the monitor reads A")
         assert a.rt.pair is not None and a.rt.pair.into_standby("IntoStandBy by test", wait=2)
-        wait_for(lambda: client.url == b_url and client.switches == 1, timeout=10, what="the monitor on B")
+        wait_for(lambda: client.url == b_url and client.switches == 1, what="the monitor on B")
         wait_for(lambda: client.service_level == 255, what="B's ServiceLevel the primary's")
         assert client.user == "eng1"
         b.kill()

@@ -30,13 +30,13 @@ def test_one_edge_node_for_the_pair(tmp_path: Path, node: Simulator, mosquitto: 
         wait_for(lambda: b.rt.pair is not None and b.rt.pair.mirror.complete, timeout=10,
                  what="B holds A's state")
         a.kill()
-        wait_for(lambda: b.role == "primary", timeout=10, what="takeover")
+        wait_for(lambda: b.role == "primary", what="takeover")
         second = host.wait("NBIRTH", after=1)
         assert bdseq(second) == (first + 1) % 256
         assert [bdseq(d) for d in host.of("NDEATH")] == [first]  # A's session ended, B's lives
         a.start()  # back as the standby: no session of its own
         assert a.role == "standby"
-        wait_for(lambda: a.rt.pair is not None and a.rt.pair.mirror.complete, timeout=10, what="A follows")
+        wait_for(lambda: a.rt.pair is not None and a.rt.pair.mirror.complete, what="A follows")
         assert b.rt.pair is not None and b.rt.pair.into_standby("IntoStandBy by test", wait=2)
         third = host.wait("NBIRTH", after=2)
         assert bdseq(third) == (first + 2) % 256  # A learned B's bdSeq as its standby
