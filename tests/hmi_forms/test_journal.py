@@ -106,7 +106,7 @@ def test_the_journal_reads_off_the_gui_thread_and_the_newest_request_wins(qtbot,
     widget.min_type.setCurrentIndex(2)  # alarms and worse: queued behind the slow read
     widget.min_type.setCurrentIndex(1)  # warnings and worse: supersedes it
     view.refresh(snap(scan=1))  # a tick: supersedes that, and still owes the new filter's count
-    assert time.monotonic() - started < 0.5  # the GUI thread never waited for the archive
+    assert time.monotonic() - started < 3  # the GUI thread never waited for the archive (10 s gate)
     assert widget.table.rows == [] and answers == []
     gate.set()
     qtbot.waitUntil(lambda: len(answers) == 1, timeout=WAIT)
