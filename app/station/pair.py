@@ -69,7 +69,7 @@ HSB_STATUS = {Role.STARTING: 0, Role.PRIMARY: 5, Role.STANDBY: 4}
 SERVICE_LEVEL = {Role.STARTING: 1, Role.PRIMARY: 255, Role.STANDBY: 100}
 DEFECT = 6
 # The pair's status words in NetPlc memory, beside the RTC (077700-077707), each station's own
-# (written after the mirrored memory is put), for a program and an HMI (docs/integration/redundancy.md)
+# (written after the mirrored memory is put), for a program and an HMI (docs/operations/redundancy.md)
 HSB_NUM_PLC = 0o77710  # byte: 1 = A, 0 = B (HSBNumPLC)
 HSB_STATUS_BYTE = 0o77711  # byte: HSBStatus
 DGN_HSB = 0o77712  # word: b7 the partner's station differs, b9 the pair link is down, b15 a switchover

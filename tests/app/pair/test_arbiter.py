@@ -1,7 +1,7 @@
 """No split brain (issue 26): the link between the pair is cut while both run (a proxy between
 them that the test stops); with the plant archive's PostgreSQL as the arbiter exactly one acts as
 primary, and both journal it. Without an arbiter both act, as the manual says
-(docs/integration/redundancy.md)."""
+(docs/operations/redundancy.md)."""
 
 from __future__ import annotations
 
