@@ -423,3 +423,22 @@ def test_only_an_admin_manages_users_and_it_is_journaled(qtbot, console: MainWin
                                    "password)"),
                          ("admin", "password of ivan changed"), ("admin", "user viewer removed"),
                          ("admin", "logged out")]
+
+
+def test_the_header_says_while_forces_are_active_and_the_element_shows_f(qtbot, console: MainWindow) -> None:
+    from app.authority import Source, Who
+    from hmi_forms.widgets import theme
+
+    runtime = console.runtime
+    model, widget = element(console, "Уставка температуры")
+    ticket = runtime.commands.force_tag(Who("engineer", Source.CONSOLE), "TEMP_SP", 20.0)
+    assert ticket.result(5).ok
+    qtbot.waitUntil(lambda: "1 forces active" in console.health.problems, timeout=5000)
+    assert console.health.problems[0] == "1 forces active" and console.health.isVisible()
+    qtbot.waitUntil(lambda: model.quality == "forced", timeout=5000)
+    assert widget.stale_mark.word == "forced"
+    image = widget.grab().toImage()
+    forced = theme.FORCED.rgb()
+    assert any(image.pixel(x, 1) == forced for x in range(image.width()))  # the orange frame, no hatch
+    assert runtime.commands.unforce_all(Who("engineer", Source.CONSOLE)).result(5).ok
+    qtbot.waitUntil(lambda: "1 forces active" not in console.health.problems, timeout=5000)

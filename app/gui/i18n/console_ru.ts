@@ -456,6 +456,10 @@
         <translation>действуют форсирования: форсирование &gt; программа &gt; объект (Станция -&gt; Программа)</translation>
     </message>
     <message>
+        <source>{0} forces active</source>
+        <translation>Действует форсирований: {0}</translation>
+    </message>
+    <message>
         <source>NetPlc program {0}</source>
         <translation>NetPlc: {0}</translation>
     </message>
@@ -715,8 +719,8 @@
         <translation>? NetPlc остановлен: показано последнее значение, ничего не меняется</translation>
     </message>
     <message>
-        <source>? forced: the value is forced by an engineer, not the plant's</source>
-        <translation>? форсировано: значение задано инженером, а не получено с объекта</translation>
+        <source>F forced: the value is forced by an engineer, not the plant's</source>
+        <translation>F форсировано: значение задано инженером, а не получено с объекта</translation>
     </message>
 </context>
 <context>

@@ -34,6 +34,7 @@ from PySide6.QtWidgets import (
     QListWidget,
     QListWidgetItem,
     QMenu,
+    QMessageBox,
     QPushButton,
     QSizePolicy,
     QSplitter,
@@ -43,7 +44,7 @@ from PySide6.QtWidgets import (
     QWidget,
 )
 
-from app.authority import Action, Answer, Refusal, Ticket
+from app.authority import Action, Answer, Refusal, Ticket, write_range
 from app.gui import words
 from app.gui.bridge import Answers
 from app.gui.monitor.listing import (
@@ -78,6 +79,23 @@ NO_LISTING = ("No program to list: give it with --program (the program, or the s
 READ_ONLY_LINE = ("Read-only over Modbus: Modbus has no users, so this monitor only watches. Write, force "
                   "and step as a user of the station: over its OPC UA endpoint (main.py monitor "
                   "opc.tcp://HOST:PORT/PATH) or at its own workstation. Its forces are unknown here.")
+
+
+def unforce_stays(value: str) -> str:
+    """What an unforce leaves behind, said before it is done: the station does not restore the
+    value from before the force (a PLC's convention: the live writers take over from it)."""
+    held = f"The memory keeps {value}, the forced value," if value else "The memory keeps the forced values"
+    return f"{held} until the program, a node or an operator writes it."
+
+
+def parse_force(text: str, tag: Tag) -> float:
+    """A physical value typed for a force; ValueError, in words, outside the tag's range."""
+    value = parse_phy(text, tag)
+    lo, hi = write_range(tag)
+    if not lo <= value <= hi:
+        raise ValueError(f"{tag.name} is not forced: {tag.format(value)} is outside its range "
+                         f"{tag.format(lo)} .. {tag.format(hi)}")
+    return value
 
 
 def forced_text(n: int | None) -> str:
@@ -275,6 +293,7 @@ class ProgramMonitor(QWidget):
         self.acting = source.acting
         self.granted: list[tuple[Control, Action, str]] = []  # controls enabled while the user may act
         self._rights = -1  # the source's `rights` the controls show
+        self.ask: Callable[[str, str], bool] = self._ask  # a force or unforce is confirmed (tests answer)
 
         self.find = QLineEdit()
         self.find.setPlaceholderText("Find (Enter: next)")
@@ -289,7 +308,7 @@ class ProgramMonitor(QWidget):
         self.step_button = QPushButton("Step one scan")
         self.step_button.clicked.connect(self.step)
         self.unforce_button = QPushButton("Unforce all")
-        self.unforce_button.clicked.connect(self.unforce_all)
+        self.unforce_button.clicked.connect(self.ask_unforce_all)
         self._grant(self.step_button, Action.STEP, "Step one scan")
         self._grant(self.unforce_button, Action.UNFORCE, "Unforce all")
         self.read_only = QLabel(READ_ONLY_LINE)
@@ -570,13 +589,59 @@ class ProgramMonitor(QWidget):
 
     # --- forcing and stepping ---------------------------------------------------------------------
 
+    def _ask(self, title: str, text: str) -> bool:
+        return QMessageBox.question(self, title, text) == QMessageBox.StandardButton.Yes
+
     def _force_actions(self, menu: QMenu, kind: Kind, addr: int, where: str) -> None:
-        self._add_force_actions(menu, where, lambda: self.force(kind, addr, None),
-                                lambda: self._ask_force(kind, addr, where), lambda: self.unforce(kind, addr))
+        self._add_force_actions(menu, where, lambda: self.confirm_force(kind, addr, None),
+                                lambda: self._ask_force(kind, addr, where),
+                                lambda: self.confirm_unforce(kind, addr))
 
     def _tag_force_actions(self, menu: QMenu, tag: Tag) -> None:
-        self._add_force_actions(menu, tag.name, lambda: self.force_tag(tag, None),
-                                lambda: self._ask_force_tag(tag), lambda: self.unforce_tag(tag))
+        self._add_force_actions(menu, tag.name, lambda: self.confirm_force_tag(tag, None),
+                                lambda: self._ask_force_tag(tag), lambda: self.confirm_unforce_tag(tag))
+
+    def _shown(self, tag: Tag | None, kind: Kind = "word", addr: int = 0) -> str:
+        """What the memory holds now, as the view shows it (in the tag's units)."""
+        snap = self.source.snapshot()
+        if snap is None:
+            return "its value"
+        return tag.format(tag.value(snap)) if tag is not None else str(Force(kind, addr, 0).read(snap))
+
+    def confirm_force(self, kind: Kind, addr: int, value: int | None) -> Ticket | None:
+        """Force after the engineer confirms: the program and the plant lose this memory."""
+        where = Force(kind, addr, 0).where
+        to = f"at its value {self._shown(None, kind, addr)} (bumpless)" if value is None else f"to {value}"
+        if not self.ask("Force", f"Force {where} {to}? The program and the nodes no longer change it "
+                                 "until it is unforced."):
+            return None
+        return self.force(kind, addr, value)
+
+    def confirm_force_tag(self, tag: Tag, phy: float | None) -> Ticket | None:
+        to = f"at its value {self._shown(tag)} (bumpless)" if phy is None else f"to {tag.format(phy)}"
+        if not self.ask("Force", f"Force {tag.name} {to}? The program and the nodes no longer change it "
+                                 "until it is unforced."):
+            return None
+        return self.force_tag(tag, phy)
+
+    def confirm_unforce(self, kind: Kind, addr: int) -> Ticket | None:
+        """Unforce after the engineer confirms, told that the forced value stays in memory."""
+        where = Force(kind, addr, 0).where
+        if not self.ask("Unforce", f"Unforce {where}? {unforce_stays(self._shown(None, kind, addr))}"):
+            return None
+        return self.unforce(kind, addr)
+
+    def confirm_unforce_tag(self, tag: Tag) -> Ticket | None:
+        if not self.ask("Unforce", f"Unforce {tag.name}? {unforce_stays(self._shown(tag))}"):
+            return None
+        return self.unforce_tag(tag)
+
+    def ask_unforce_all(self) -> Ticket | None:
+        """The Unforce all button: asks first, naming how many forces go."""
+        forces = self.source.forces() or ()
+        if not self.ask("Unforce all", f"Unforce all {len(forces)} forces? {unforce_stays('')}"):
+            return None
+        return self.unforce_all()
 
     def _add_force_actions(self, menu: QMenu, where: str, bumpless: Callable[[], None],
                            ask: Callable[[], None], release: Callable[[], None]) -> None:
@@ -587,12 +652,12 @@ class ProgramMonitor(QWidget):
             self._grant(menu.addAction(text, slot), act, text.rstrip("…"), keep=False)
 
     def _ask_force_tag(self, tag: Tag) -> None:
-        lo, hi = tag.phy_limits
+        lo, hi = write_range(tag)  # PhyMin..PhyMax where the tag scales, not what its word holds
         text, ok = QInputDialog.getText(self, "Force", f"Force {tag.name} to ({tag.unit or 'value'}, "
-                                                       f"{lo:g}..{hi:g}):")
+                                                       f"{tag.format(lo)} .. {tag.format(hi)}):")
         if ok:
             try:
-                self.force_tag(tag, parse_phy(text, tag))
+                self.confirm_force_tag(tag, parse_force(text, tag))
             except ValueError as e:
                 self._say(str(e))
 
@@ -607,7 +672,7 @@ class ProgramMonitor(QWidget):
         text, ok = QInputDialog.getText(self, "Force", f"Force {where} to (decimal, 0x1F or 1Fh):")
         if ok:
             try:
-                self.force(kind, addr, parse_value(text, kind))
+                self.confirm_force(kind, addr, parse_value(text, kind))
             except ValueError as e:
                 self._say(str(e))
 
