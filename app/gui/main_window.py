@@ -49,11 +49,12 @@ from app.gui.application import application
 from app.gui.bridge import Answers, RuntimeBridge
 from app.gui.journal import JournalDock
 from app.gui.login import LoginDialog
+from app.gui.placement import Placement, primary_size
 from app.gui.rights import Rights
 from app.gui.status import StationStatusBar, station_problems
 from app.gui.trend_history import TrendHistory
 from app.gui.users_dialog import UsersDialog
-from app.gui.zoom import ACTUAL, FIT_WIDTH, FIT_WINDOW, ZoomArea, ZoomSettings
+from app.gui.zoom import ACTUAL, FIT_WIDTH, FIT_WINDOW, ZoomArea
 from app.scada.alarms import AlarmRow
 from app.scada.readings import Readings
 from app.station.config import load_station
@@ -102,7 +103,8 @@ class MainWindow(QMainWindow):
         self.view_faults: list[str] = []  # form elements that failed to show: logged, in the health strip
         self.history: TrendHistory | None = None
         self.zooms: list[ZoomArea] = []
-        self.zoom_settings = ZoomSettings(station.Archive.parent / "workstation.ini")
+        # geometry, docks and zoom as kept for this screen size (app/gui/placement.py)
+        self.placement = Placement(station.Archive.parent / "workstation.ini", primary_size())
         self.viewers: list[QWidget] = []
 
         central = QWidget()
@@ -222,6 +224,10 @@ class MainWindow(QMainWindow):
         view = self.menuBar().addMenu(self.tr("&View"))
         view.addAction(self.journal.toggleViewAction())
         view.addAction(self.summary_dock.toggleViewAction())
+        full = QAction(self.tr("&Full screen"), self)
+        full.setShortcut(QKeySequence("F11"))
+        full.triggered.connect(lambda: self.showNormal() if self.isFullScreen() else self.showFullScreen())
+        view.addAction(full)
         view.addSeparator()
         for text, keys, act in (
                 (self.tr("Fit &width"), "Ctrl+1", lambda a: a.set_mode(FIT_WIDTH)),
@@ -257,7 +263,7 @@ class MainWindow(QMainWindow):
                                  if isinstance(model, (DiscreteBase, AnalogOutput)) and model.Enabled})
             self.history.attach(view)
             area = ZoomArea(view)
-            area.restore(self.zoom_settings.get(form.path))
+            area.restore(self.placement.zoom(form.path))
             area.zoomed.connect(lambda _label, a=area: self._zoomed(a))
             self.zooms.append(area)
             self.tabs.addTab(area, form.title)
@@ -279,7 +285,7 @@ class MainWindow(QMainWindow):
 
     def _zoomed(self, area: ZoomArea) -> None:
         """Remember the choice for this form, and show it."""
-        self.zoom_settings.put(area.form_view.form.path, area.choice)
+        self.placement.put_zoom(area.form_view.form.path, area.choice)
         if area is self.current_zoom():
             self.status.showMessage(self.tr("Zoom: ") + area.label(), 3000)
 
@@ -481,6 +487,7 @@ class MainWindow(QMainWindow):
             event.ignore()
             return
         self._activity.stop()
+        self.placement.save(self)
         for view in self.views:  # the guards refer back to the window: no cycle left for the GC
             for model in view.form.elements:
                 if isinstance(model, Writer):
@@ -579,8 +586,10 @@ def _placeholder(text: str) -> QWidget:
     return label
 
 
-def run_workstation(station_path: str) -> int:
-    """`python main.py [STATION]`: start the runtime, show the window, stop the runtime on close."""
+def run_workstation(station_path: str, fullscreen: bool = False) -> int:
+    """`python main.py [STATION] [--fullscreen]`: start the runtime, show the window (full screen
+    in the operator mode, else as kept for this screen size, maximized the first time), stop the
+    runtime on close."""
     app = application()
     try:
         station = load_station(station_path)
@@ -596,7 +605,7 @@ def run_workstation(station_path: str) -> int:
         QMessageBox.critical(None, "NetPlc Station", f"The station cannot start:\n\n{e}")
         return 2
     window = MainWindow(runtime)
-    window.show()
+    window.placement.show(window, fullscreen or station.operator.fullscreen)
     _quit_on_signals(app)
     try:
         return app.exec()

@@ -76,6 +76,7 @@ class OperatorSettings:
 
     default_user: str = ""  # a viewer shown as logged in while nobody is; "": logged out
     idle_logout: int = 0  # seconds without input before a user is logged out; 0: never
+    fullscreen: bool = False  # the operator mode: the workstation opens full screen, no window chrome
 
 
 LANGUAGES = ("ru", "en")
@@ -300,6 +301,9 @@ KEYS: dict[str, dict[str, Key]] = {
             "a user of role viewer shown while nobody is logged in; empty: logged out"),
         Key("idle_logout", int, _OPERATOR.idle_logout,
             "seconds without input before the user is logged out; 0: never", (0, 86_400)),
+        Key("fullscreen", bool, _OPERATOR.fullscreen,
+            "the operator mode: the workstation opens full screen, with no window chrome (also "
+            "`main.py STATION --fullscreen`)"),
     ),
     "opcua": _keys(
         Key("enabled", bool, _OPCUA.enabled, "run the OPC UA server"),
@@ -732,8 +736,9 @@ def _operator(problems: list[str], fname: str, table: dict[str, Any]) -> Operato
                        "`main.py users add NAME --role viewer|operator|engineer|admin`")
     default = r.get("default_user")
     idle = r.number("idle_logout")
+    fullscreen = r.get("fullscreen")
     r.finish()
-    return OperatorSettings(default.strip(), idle)
+    return OperatorSettings(default.strip(), idle, bool(fullscreen))
 
 
 def _ports_in_common(problems: list[str], fname: str, server: ModbusServerSettings,

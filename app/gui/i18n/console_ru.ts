@@ -238,6 +238,10 @@
         <translation>&amp;Вид</translation>
     </message>
     <message>
+        <source>&amp;Full screen</source>
+        <translation>&amp;Полный экран</translation>
+    </message>
+    <message>
         <source>Fit &amp;width</source>
         <translation>По &amp;ширине</translation>
     </message>
