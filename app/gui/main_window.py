@@ -47,6 +47,7 @@ from app.gui.alarm_summary import AlarmSummary
 from app.gui.alarms import AlarmBanner, FixedLine, HealthStrip
 from app.gui.application import application
 from app.gui.bridge import Answers, RuntimeBridge
+from app.gui.faceplate import Console, Faceplates
 from app.gui.journal import JournalDock
 from app.gui.login import LoginDialog
 from app.gui.placement import Placement, primary_size
@@ -143,6 +144,11 @@ class MainWindow(QMainWindow):
         self.setStatusBar(self.status)
         self._build_menu()
         self.form_problems = self._load_forms()
+        alarms = runtime.alarms
+        self.faceplates = Faceplates(  # a tag's faceplate from any element bound to it
+            Console(self.commands, lambda: self.who, self.answers, lambda title, text: self.ask(title, text),
+                    station.Archive, alarms.system.defs if alarms else (), self.summary),
+            alarms.table.tags if alarms else (), self.views, self)
 
         self.bridge.readings.connect(self._on_readings)
         self.summary.changed.connect(self._alarms_changed)
@@ -309,6 +315,7 @@ class MainWindow(QMainWindow):
         """One scan's memory and the quality of what every element shows, together."""
         for view in self.views:
             view.refresh(readings.snapshot, readings)
+        self.faceplates.show_readings(readings)
 
     def _alarms_changed(self) -> None:
         unacknowledged = self.summary.unacknowledged()
@@ -493,6 +500,7 @@ class MainWindow(QMainWindow):
                 if isinstance(model, Writer):
                     model.guard = None
         self._timer.stop()
+        self.faceplates.close()
         self.summary.stop()
         self.bridge.detach()
         self.journal.close_archive()

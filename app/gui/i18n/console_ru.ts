@@ -688,6 +688,14 @@
         <source>A message's type and worse; an alarm record by the priority of that severity (3 critical: priority 1, 2 alarm: 1-2, 1 warning: 1-3); a data record by its type</source>
         <translation>Тип сообщения и более тяжёлые; запись аварии — по приоритету этой тяжести (3 критическая: приоритет 1, 2 авария: 1-2, 1 предупреждение: 1-3); запись данных — по её типу</translation>
     </message>
+    <message>
+        <source>reading…</source>
+        <translation>чтение…</translation>
+    </message>
+    <message>
+        <source>archive unreadable: {0}</source>
+        <translation>архив не читается: {0}</translation>
+    </message>
 </context>
 <context>
     <name>_Header</name>
@@ -891,6 +899,113 @@
     <message>
         <source>{0}: {1} is no longer a user ({2} needed)</source>
         <translation>{0}: {1} больше не пользователь (нужна роль «{2}»)</translation>
+    </message>
+    <message>
+        <source>The memory keeps the forced values until the program, a node or an operator writes them.</source>
+        <translation>В памяти остаются форсированные значения, пока их не запишет программа, узел или оператор.</translation>
+    </message>
+    <message>
+        <source>The memory keeps {0}, the forced value, until the program, a node or an operator writes it.</source>
+        <translation>В памяти остаётся {0} — форсированное значение, пока его не запишет программа, узел или оператор.</translation>
+    </message>
+</context>
+<context>
+    <name>Faceplate</name>
+    <message>
+        <source>Faceplate: {0}</source>
+        <translation>Карточка: {0}</translation>
+    </message>
+    <message>
+        <source>No alarms on this tag</source>
+        <translation>У этого тега нет аварий</translation>
+    </message>
+    <message>
+        <source>Acknowledge</source>
+        <translation>Квитировать</translation>
+    </message>
+    <message>
+        <source>Shelve…</source>
+        <translation>Отложить…</translation>
+    </message>
+    <message>
+        <source>Set</source>
+        <translation>Задать</translation>
+    </message>
+    <message>
+        <source>empty: at its value</source>
+        <translation>пусто: текущим значением</translation>
+    </message>
+    <message>
+        <source>Force…</source>
+        <translation>Форсировать…</translation>
+    </message>
+    <message>
+        <source>Unforce…</source>
+        <translation>Снять форсирование…</translation>
+    </message>
+    <message>
+        <source>Set to ({0})</source>
+        <translation>Задать ({0})</translation>
+    </message>
+    <message>
+        <source>value</source>
+        <translation>значение</translation>
+    </message>
+    <message>
+        <source>Force</source>
+        <translation>Форсирование</translation>
+    </message>
+    <message>
+        <source>Close</source>
+        <translation>Закрыть</translation>
+    </message>
+    <message>
+        <source>F forced by {0}</source>
+        <translation>F форсировал {0}</translation>
+    </message>
+    <message>
+        <source>{0} is not a number</source>
+        <translation>{0} — не число</translation>
+    </message>
+    <message>
+        <source>Set {0}</source>
+        <translation>Задать {0}</translation>
+    </message>
+    <message>
+        <source>{0} is not forced: {1} is outside its range {2} .. {3}</source>
+        <translation>{0} не форсирован: {1} вне диапазона {2} .. {3}</translation>
+    </message>
+    <message>
+        <source>at its value (bumpless)</source>
+        <translation>текущим значением (безударно)</translation>
+    </message>
+    <message>
+        <source>to {0}</source>
+        <translation>значением {0}</translation>
+    </message>
+    <message>
+        <source>Force {0} {1}? The program and the nodes no longer change it until it is unforced.</source>
+        <translation>Форсировать {0} {1}? Программа и узлы не будут его менять, пока форсирование не снято.</translation>
+    </message>
+    <message>
+        <source>Force {0}</source>
+        <translation>Форсировать {0}</translation>
+    </message>
+    <message>
+        <source>Unforce</source>
+        <translation>Снятие форсирования</translation>
+    </message>
+    <message>
+        <source>Unforce {0}?</source>
+        <translation>Снять форсирование {0}?</translation>
+    </message>
+    <message>
+        <source>Unforce {0}</source>
+        <translation>Снять форсирование {0}</translation>
+    </message>
+    <message>
+        <source>No alarm of {0} to shelve</source>
+        <translation>У {0} нет аварий, которые можно отложить</translation>
     </message>
 </context>
 </TS>

@@ -81,13 +81,6 @@ READ_ONLY_LINE = ("Read-only over Modbus: Modbus has no users, so this monitor o
                   "opc.tcp://HOST:PORT/PATH) or at its own workstation. Its forces are unknown here.")
 
 
-def unforce_stays(value: str) -> str:
-    """What an unforce leaves behind, said before it is done: the station does not restore the
-    value from before the force (a PLC's convention: the live writers take over from it)."""
-    held = f"The memory keeps {value}, the forced value," if value else "The memory keeps the forced values"
-    return f"{held} until the program, a node or an operator writes it."
-
-
 def parse_force(text: str, tag: Tag) -> float:
     """A physical value typed for a force; ValueError, in words, outside the tag's range."""
     value = parse_phy(text, tag)
@@ -627,19 +620,19 @@ class ProgramMonitor(QWidget):
     def confirm_unforce(self, kind: Kind, addr: int) -> Ticket | None:
         """Unforce after the engineer confirms, told that the forced value stays in memory."""
         where = Force(kind, addr, 0).where
-        if not self.ask("Unforce", f"Unforce {where}? {unforce_stays(self._shown(None, kind, addr))}"):
+        if not self.ask("Unforce", f"Unforce {where}? {words.unforce_stays(self._shown(None, kind, addr))}"):
             return None
         return self.unforce(kind, addr)
 
     def confirm_unforce_tag(self, tag: Tag) -> Ticket | None:
-        if not self.ask("Unforce", f"Unforce {tag.name}? {unforce_stays(self._shown(tag))}"):
+        if not self.ask("Unforce", f"Unforce {tag.name}? {words.unforce_stays(self._shown(tag))}"):
             return None
         return self.unforce_tag(tag)
 
     def ask_unforce_all(self) -> Ticket | None:
         """The Unforce all button: asks first, naming how many forces go."""
         forces = self.source.forces() or ()
-        if not self.ask("Unforce all", f"Unforce all {len(forces)} forces? {unforce_stays('')}"):
+        if not self.ask("Unforce all", f"Unforce all {len(forces)} forces? {words.unforce_stays('')}"):
             return None
         return self.unforce_all()
 
