@@ -18,7 +18,6 @@ from PySide6.QtWidgets import (
     QDialog,
     QDialogButtonBox,
     QFrame,
-    QGridLayout,
     QHBoxLayout,
     QLabel,
     QPlainTextEdit,
@@ -154,22 +153,3 @@ class HealthStrip(QFrame):
         dialog.setAttribute(Qt.WidgetAttribute.WA_DeleteOnClose)
         dialog.show()
         return dialog
-
-
-class FixedLine(QFrame):
-    """A slot of fixed height in the header: a quiet line underneath, a strip (the alarm banner,
-    the health strip) over it while the strip is shown. Nothing below ever moves when an alarm
-    comes or goes (ISA-101: the screen does not move under the operator's hand)."""
-
-    def __init__(self, strip: QWidget, quiet: str, height: int, parent: QWidget | None = None) -> None:
-        super().__init__(parent)
-        self.setObjectName("fixedLine")
-        self.setFixedHeight(height)
-        lay = QGridLayout(self)
-        lay.setContentsMargins(0, 0, 0, 0)
-        self.quiet = QLabel(quiet)
-        self.quiet.setObjectName("quietLine")
-        self.quiet.setContentsMargins(12, 0, 12, 0)
-        lay.addWidget(self.quiet, 0, 0)
-        lay.addWidget(strip, 0, 0)  # added last: drawn over the quiet line while visible
-        self.strip = strip

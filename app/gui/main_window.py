@@ -17,7 +17,6 @@ from __future__ import annotations
 import logging
 import signal
 import sys
-import time
 from collections.abc import Callable
 from dataclasses import replace
 from importlib import metadata
@@ -28,13 +27,10 @@ from PySide6.QtGui import QAction, QCloseEvent, QKeySequence
 from PySide6.QtWidgets import (
     QApplication,
     QDockWidget,
-    QFrame,
-    QHBoxLayout,
     QLabel,
     QMainWindow,
     QMessageBox,
     QPlainTextEdit,
-    QPushButton,
     QTabWidget,
     QVBoxLayout,
     QWidget,
@@ -44,10 +40,12 @@ from app.authority import Action, Answer, Commands, Refusal, Source, Ticket, Who
 from app.authority.users import Session, Users
 from app.gui import i18n, words
 from app.gui.alarm_summary import AlarmSummary
-from app.gui.alarms import AlarmBanner, FixedLine, HealthStrip
+from app.gui.alarms import AlarmBanner, HealthStrip
 from app.gui.application import application
 from app.gui.bridge import Answers, RuntimeBridge
+from app.gui.docks import SMALL_SCREEN, DockStrip
 from app.gui.faceplate import Console, Faceplates
+from app.gui.header import HeaderLine
 from app.gui.journal import JournalDock
 from app.gui.login import LoginDialog
 from app.gui.placement import Placement, primary_size
@@ -60,7 +58,6 @@ from app.scada.alarms import AlarmRow
 from app.scada.readings import Readings
 from app.station.config import load_station
 from app.station.runtime import Runtime
-from hmi_forms.elements import formats
 from hmi_forms.elements.analog import AnalogOutput
 from hmi_forms.elements.base import Writer
 from hmi_forms.elements.discrete import DiscreteBase
@@ -76,9 +73,8 @@ logger = logging.getLogger(__name__)
 
 STATUS_MS = 500
 REFUSAL_MS = 10_000
-FRAME_HEIGHT = 380  # menu, header, banner, tabs, journal dock and status bar around a form
+FRAME_HEIGHT = 320  # menu, header line, tabs, journal dock and status bar around a form
 MIN_SIZE = (1024, 600)  # the window's minimum fits a 1366x768 screen, whatever the forms hold
-ALARM_LINE, HEALTH_LINE = 40, 28  # the header's fixed lines: their content changes, never their size
 JOURNAL_HEIGHT = 190
 
 
@@ -113,20 +109,17 @@ class MainWindow(QMainWindow):
         lay = QVBoxLayout(central)
         lay.setContentsMargins(0, 0, 0, 0)
         lay.setSpacing(0)
-        self.header = _Header(station.name)
-        self.header.login.clicked.connect(self.log_in_or_out)
         self.alarms = AlarmBanner()
         for button in (self.alarms.ack, self.alarms.ack_all):
             self.rights.add(button, Action.ACKNOWLEDGE, button.text())
         self.health = HealthStrip()
+        # station, alarm banner, health strip, user and clock: one line of a fixed height
+        self.header = HeaderLine(station.name, self.alarms, self.health, self.tr("No unacknowledged alarms"))
+        self.header.login.clicked.connect(self.log_in_or_out)
         self.tabs = QTabWidget()
         self.tabs.setObjectName("forms")
         self.tabs.setDocumentMode(True)
         lay.addWidget(self.header)
-        self.fixed_lines = (FixedLine(self.alarms, self.tr("No unacknowledged alarms"), ALARM_LINE),
-                            FixedLine(self.health, "", HEALTH_LINE))
-        for line in self.fixed_lines:
-            lay.addWidget(line)
         lay.addWidget(self.tabs, 1)
         self.setCentralWidget(central)
 
@@ -140,6 +133,7 @@ class MainWindow(QMainWindow):
         self.addDockWidget(Qt.DockWidgetArea.BottomDockWidgetArea, self.summary_dock)
         self.tabifyDockWidget(self.journal, self.summary_dock)
         self.summary_dock.raise_()
+        self.dock_strip = DockStrip(self, (self.journal, self.summary_dock), JOURNAL_HEIGHT)
         self.status = StationStatusBar()
         self.setStatusBar(self.status)
         self._build_menu()
@@ -161,6 +155,8 @@ class MainWindow(QMainWindow):
         self._timer.start()
         self.refresh_status()
         self._fit_to_forms()
+        if (collapsed := self.placement.docks_collapsed()) is not None:
+            self.dock_strip.set_collapsed(collapsed)
         self._user_changed()
         self._activity = _Activity(self.session, self)
 
@@ -234,6 +230,10 @@ class MainWindow(QMainWindow):
         full.setShortcut(QKeySequence("F11"))
         full.triggered.connect(lambda: self.showNormal() if self.isFullScreen() else self.showFullScreen())
         view.addAction(full)
+        collapse = QAction(self.tr("&Collapse docks"), self)
+        collapse.setShortcut(QKeySequence("F9"))
+        collapse.triggered.connect(self.dock_strip.toggle)
+        view.addAction(collapse)
         view.addSeparator()
         for text, keys, act in (
                 (self.tr("Fit &width"), "Ctrl+1", lambda a: a.set_mode(FIT_WIDTH)),
@@ -495,6 +495,7 @@ class MainWindow(QMainWindow):
             return
         self._activity.stop()
         self.placement.save(self)
+        self.placement.put_docks_collapsed(self.dock_strip.collapsed)
         for view in self.views:  # the guards refer back to the window: no cycle left for the GC
             for model in view.form.elements:
                 if isinstance(model, Writer):
@@ -533,41 +534,6 @@ class _Activity(QObject):
         if self.app is not None:
             self.app.removeEventFilter(self)
             self.app = None
-
-
-class _Header(QFrame):
-    """Station name, user on duty, date and time: the strip every SCADA screen starts with."""
-
-    def __init__(self, name: str) -> None:
-        super().__init__()
-        self.setObjectName("header")
-        lay = QHBoxLayout(self)
-        lay.setContentsMargins(14, 6, 14, 6)
-        title = QLabel(name)
-        title.setObjectName("headerTitle")
-        product = QLabel("NetPlc Station")
-        product.setObjectName("headerProduct")
-        self.user = QLabel()
-        self.user.setObjectName("headerUser")
-        self.login = QPushButton()
-        self.login.setObjectName("headerLogin")
-        self.clock = QLabel()
-        self.clock.setObjectName("headerClock")
-        lay.addWidget(product)
-        lay.addWidget(title)
-        lay.addStretch(1)
-        lay.addWidget(self.user)
-        lay.addWidget(self.login)
-        lay.addSpacing(18)
-        lay.addWidget(self.clock)
-        self.tick()
-
-    def show_user(self, name: str, role: str, *, logged_in: bool) -> None:
-        self.user.setText(f"{name} ({words.role(role)})" if name else self.tr("nobody logged in"))
-        self.login.setText(self.tr("Log out") if logged_in else self.tr("Log in…"))
-
-    def tick(self) -> None:
-        self.clock.setText(formats.date_time(time.time()))
 
 
 def version() -> str:
@@ -614,6 +580,10 @@ def run_workstation(station_path: str, fullscreen: bool = False) -> int:
         return 2
     window = MainWindow(runtime)
     window.placement.show(window, fullscreen or station.operator.fullscreen)
+    screen = window.screen()
+    if window.placement.docks_collapsed() is None and screen is not None \
+            and screen.size().height() < SMALL_SCREEN:
+        window.dock_strip.set_collapsed(True)  # the first start on a small screen: the picture first
     _quit_on_signals(app)
     try:
         return app.exec()

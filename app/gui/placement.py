@@ -43,6 +43,15 @@ class Placement:
         self.settings.setValue(f"{self.group}/zoom/{form.name}", choice)
         self.settings.sync()
 
+    def docks_collapsed(self) -> bool | None:
+        """Whether the docks were left collapsed on this screen size; None: never chosen here."""
+        value = self.settings.value(f"{self.group}/docks_collapsed")
+        return None if value is None else str(value).lower() == "true"
+
+    def put_docks_collapsed(self, collapsed: bool) -> None:
+        self.settings.setValue(f"{self.group}/docks_collapsed", collapsed)
+        self.settings.sync()
+
     def restore(self, window: QMainWindow) -> bool:
         """The geometry and docks kept for this screen size; False at the first start on it."""
         geometry = self.settings.value(f"{self.group}/geometry")

@@ -322,7 +322,7 @@ def test_the_console_speaks_russian_and_the_forms_keep_their_texts(qtbot, russia
         heads = [window.journal.model.headerData(i, Qt.Orientation.Horizontal) for i in range(3)]
         assert heads == ["Время", "Вид", "Группа"]
         assert window.alarms.ack.text() == "Квитировать"
-        assert window.fixed_lines[0].quiet.text() == "Нет неквитированных аварий"
+        assert window.header.quiet.text() == "Нет неквитированных аварий"
         window.refresh_status()
         assert window.status.state.text() == "NetPlc: работает"
         assert window.journal.windowTitle() == "Журнал — сегодня"

@@ -8,7 +8,7 @@ from pathlib import Path
 from PySide6.QtCore import QSize, Qt
 from PySide6.QtWidgets import QDockWidget, QLabel, QMainWindow
 
-from app.gui.placement import Placement
+from app.gui.placement import Placement, primary_size
 from app.gui.zoom import FIT_WIDTH, FIT_WINDOW
 from app.station.config import load_station
 from tests.app.conftest import write_station
@@ -57,3 +57,31 @@ def test_the_operator_mode_is_a_station_toml_key(tmp_path: Path) -> None:
     assert load_station(tmp_path).operator.fullscreen
     write_station(tmp_path, 'NetPlcLoad = false\n')
     assert not load_station(tmp_path).operator.fullscreen
+
+
+def test_the_docks_collapse_to_a_strip_and_the_forms_get_the_height(qtbot, demo_copy: Path) -> None:
+    from app.gui.main_window import MainWindow
+    from app.station.runtime import Runtime
+
+    runtime = Runtime(load_station(demo_copy))
+    runtime.start()
+    window = MainWindow(runtime)
+    try:
+        qtbot.addWidget(window)
+        window.resize(1366, 768)
+        window.show()
+        qtbot.waitUntil(lambda: window.tabs.height() > 300, timeout=5000)
+        open_height = window.tabs.height()
+        window.dock_strip.set_collapsed(True)
+        qtbot.waitUntil(lambda: window.tabs.height() > open_height + 100, timeout=5000)
+        assert window.summary_dock.isVisible() and not window.summary.isVisible()  # the strip stays
+        assert window.summary_dock.height() < 60
+        qtbot.mousePress(window.summary_dock, Qt.MouseButton.LeftButton)  # a click on the strip opens
+        qtbot.waitUntil(lambda: window.summary.isVisible(), timeout=5000)
+        window.dock_strip.set_collapsed(True)
+        window.close()
+        kept = Placement(runtime.station.Archive.parent / "workstation.ini", primary_size())
+        assert kept.docks_collapsed() is True  # and so it opens next time on this screen size
+    finally:
+        window.close()
+        runtime.stop()

@@ -238,6 +238,10 @@
         <translation>&amp;Вид</translation>
     </message>
     <message>
+        <source>&amp;Collapse docks</source>
+        <translation>&amp;Свернуть панели</translation>
+    </message>
+    <message>
         <source>&amp;Full screen</source>
         <translation>&amp;Полный экран</translation>
     </message>
@@ -698,7 +702,7 @@
     </message>
 </context>
 <context>
-    <name>_Header</name>
+    <name>HeaderLine</name>
     <message>
         <source>nobody logged in</source>
         <translation>никто не вошёл</translation>
