@@ -14,6 +14,7 @@ from __future__ import annotations
 import logging
 
 from PySide6.QtCore import Qt, QTimer, Signal
+from PySide6.QtGui import QMouseEvent
 from PySide6.QtWidgets import (
     QDialog,
     QDialogButtonBox,
@@ -39,6 +40,7 @@ class AlarmBanner(QFrame):
 
     acknowledged = Signal(object)  # AlarmRow
     acknowledged_all = Signal()
+    chosen = Signal(object)  # AlarmRow: double-clicked, to be shown on its form (app/gui/navigate.py)
 
     def __init__(self, parent: QWidget | None = None) -> None:
         super().__init__(parent)
@@ -101,6 +103,10 @@ class AlarmBanner(QFrame):
         self.setVisible(True)
         if not self._timer.isActive():
             self._timer.start()
+
+    def mouseDoubleClickEvent(self, event: QMouseEvent) -> None:
+        if self.alarms:
+            self.chosen.emit(self.alarms[0])
 
     def _toggle_blink(self) -> None:
         self._blink = not self._blink

@@ -48,6 +48,7 @@ from app.gui.faceplate import Console, Faceplates
 from app.gui.header import HeaderLine
 from app.gui.journal import JournalDock
 from app.gui.login import LoginDialog
+from app.gui.navigate import AlarmNavigator
 from app.gui.placement import Placement, primary_size
 from app.gui.rights import Rights
 from app.gui.status import StationStatusBar, station_problems
@@ -143,6 +144,10 @@ class MainWindow(QMainWindow):
             Console(self.commands, lambda: self.who, self.answers, lambda title, text: self.ask(title, text),
                     station.Archive, alarms.system.defs if alarms else (), self.summary),
             alarms.table.tags if alarms else (), self.views, self)
+        # a double-click on an alarm shows its tag's element; a tab marks its forms' alarms
+        self.navigator = AlarmNavigator(self.tabs, self.zooms, self.faceplates.bound,
+                                        alarms.system.defs if alarms else (), self)
+        self.navigator.follow(self.summary, self.alarms, self.journal)
 
         self.bridge.readings.connect(self._on_readings)
         self.summary.changed.connect(self._alarms_changed)
@@ -320,6 +325,7 @@ class MainWindow(QMainWindow):
     def _alarms_changed(self) -> None:
         unacknowledged = self.summary.unacknowledged()
         self.alarms.show_alarms(unacknowledged)
+        self.navigator.mark_tabs(unacknowledged)
         self.summary_dock.setWindowTitle(self.tr("Alarms — {0} unacknowledged").format(len(unacknowledged))
                                          if unacknowledged else self.tr("Alarms"))
 
