@@ -127,7 +127,7 @@ class MainWindow(QMainWindow):
         self.journal = JournalDock(station.Archive, self)
         self.addDockWidget(Qt.DockWidgetArea.BottomDockWidgetArea, self.journal)
         self.summary = AlarmSummary(runtime.alarms, self.commands, lambda: self.who, answers=self.answers,
-                                    sound=station.alarm_sound)
+                                    sound=station.alarm_sound, sounds=station.alarm_sounds)
         self.summary_dock = QDockWidget(self.tr("Alarms"), self)
         self.summary_dock.setObjectName("alarmSummaryDock")
         self.summary_dock.setWidget(self.summary)
