@@ -49,6 +49,7 @@ from app.gui.header import HeaderLine
 from app.gui.journal import JournalDock
 from app.gui.login import LoginDialog
 from app.gui.navigate import AlarmNavigator
+from app.gui.notice import Note, confirm
 from app.gui.placement import Placement, primary_size
 from app.gui.rights import Rights
 from app.gui.status import StationStatusBar, station_problems
@@ -123,6 +124,7 @@ class MainWindow(QMainWindow):
         lay.addWidget(self.header)
         lay.addWidget(self.tabs, 1)
         self.setCentralWidget(central)
+        self.note = Note(central)  # a refusal, whole, over the bottom of the forms
 
         self.journal = JournalDock(station.Archive, self)
         self.addDockWidget(Qt.DockWidgetArea.BottomDockWidgetArea, self.journal)
@@ -380,8 +382,7 @@ class MainWindow(QMainWindow):
 
     def ask(self, title: str, text: str) -> bool:
         """The second step of a command: the operator confirms it (tests answer for them)."""
-        answer = QMessageBox.question(self, title, text)
-        return answer == QMessageBox.StandardButton.Yes
+        return confirm(self, title, text)
 
     def _answered(self, what: str, answer: Answer) -> None:
         """A command the layer did not do says why, where the operator looks: the status bar, in
@@ -391,6 +392,7 @@ class MainWindow(QMainWindow):
 
     def refuse(self, text: str) -> None:
         self.status.showMessage(self.tr("Refused: ") + text, REFUSAL_MS)
+        self.note.say(self.tr("Refused: ") + text, REFUSAL_MS)  # whole, where the status bar cuts it
 
     def command(self, action: Action, what: str, send: Callable[[Who], Ticket], question: str = "",
                 then: Callable[[Answer], None] | None = None) -> Ticket | None:

@@ -107,6 +107,8 @@ def test_the_demo_opens_as_its_viewer_who_may_not_act(qtbot, console: MainWindow
     assert "Пуск: needs the operator role; viewer is viewer" in button.toolTip()  # it keeps its look
     qtbot.mouseClick(button, Qt.MouseButton.LeftButton)
     assert console.status.currentMessage() == "Refused: Пуск: needs the operator role; viewer is viewer"
+    assert console.note.isVisible() and console.note.text() == console.status.currentMessage()  # whole
+    assert console.note.width() <= console.width()
     setpoint, _ = element(console, "Уставка температуры")
     ok, why = setpoint.submit("50")
     assert not ok and why == "Уставка температуры: needs the operator role; viewer is viewer"

@@ -34,7 +34,6 @@ from PySide6.QtWidgets import (
     QListWidget,
     QListWidgetItem,
     QMenu,
-    QMessageBox,
     QPushButton,
     QSizePolicy,
     QSplitter,
@@ -59,6 +58,7 @@ from app.gui.monitor.listing import (
     parse_watch,
 )
 from app.gui.monitor.source import Acting, Source
+from app.gui.notice import confirm
 from app.gui.rights import Control
 from app.gui.status import IDLE, WARN, Pill
 from app.scada.forcing import tag_keys
@@ -583,7 +583,7 @@ class ProgramMonitor(QWidget):
     # --- forcing and stepping ---------------------------------------------------------------------
 
     def _ask(self, title: str, text: str) -> bool:
-        return QMessageBox.question(self, title, text) == QMessageBox.StandardButton.Yes
+        return confirm(self, title, text)
 
     def _force_actions(self, menu: QMenu, kind: Kind, addr: int, where: str) -> None:
         self._add_force_actions(menu, where, lambda: self.confirm_force(kind, addr, None),
