@@ -36,7 +36,8 @@ def test_a_journal_column_is_never_narrower_than_its_title(qtbot) -> None:
     qtbot.addWidget(view)
     bold = QFont(view.horizontalHeader().font())
     bold.setBold(True)
+    metrics = QFontMetrics(bold)
     for col, column in enumerate(JOURNAL_COLUMNS):
         if column.width:
             title = model.headerData(col, Qt.Orientation.Horizontal, Qt.ItemDataRole.DisplayRole)
-            assert view.horizontalHeader().sectionSize(col) > QFontMetrics(bold).horizontalAdvance(title), title
+            assert view.horizontalHeader().sectionSize(col) > metrics.horizontalAdvance(title), title
