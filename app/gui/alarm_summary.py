@@ -21,7 +21,6 @@ horn made audible (app/gui/annunciation.py); the station key `alarm_sound = fals
 from __future__ import annotations
 
 import logging
-import time
 from collections.abc import Callable
 from pathlib import Path
 from typing import Any
@@ -61,6 +60,7 @@ from app.gui.bridge import Answers
 from app.gui.rights import Rights
 from app.scada.alarms import PRIORITIES, AlarmRow, State
 from app.scada.station import StationAlarms
+from hmi_forms.elements import formats
 
 logger = logging.getLogger(__name__)
 
@@ -93,7 +93,8 @@ def row_colours(row: AlarmRow, blink_on: bool) -> tuple[QColor, QColor]:
 
 
 def stamp(ts: float) -> str:
-    return time.strftime("%d.%m %H:%M:%S", time.localtime(ts)) if ts else ""
+    """The console's one date format (its language's), with the time."""
+    return formats.date_time(ts) if ts else ""
 
 
 class AlarmTableModel(QAbstractTableModel):
@@ -224,7 +225,7 @@ class AlarmSummary(QWidget):
         self.table.verticalHeader().setVisible(False)
         self.table.verticalHeader().setDefaultSectionSize(22)
         header = self.table.horizontalHeader()
-        for col, width in enumerate((90, 110, 130, 170, 90)):
+        for col, width in enumerate((90, 150, 130, 170, 90)):
             self.table.setColumnWidth(col, width)
         header.setSectionResizeMode(len(COLUMNS) - 1, QHeaderView.ResizeMode.Stretch)
         lay.addWidget(self.table, 1)

@@ -391,8 +391,9 @@ def test_refusals_roles_and_alarms_speak_russian_too(qtbot, russian, demo_copy: 
 
 
 def test_the_language_comes_from_station_toml(demo_copy: Path) -> None:
+    assert load_station(demo_copy).Language == "ru"  # the demo's forms are Russian: so is its console
     toml = demo_copy / "station.toml"
-    toml.write_text(toml.read_text(encoding="utf-8").replace('# Language = "ru"', 'Language = "en"'),
+    toml.write_text(toml.read_text(encoding="utf-8").replace('Language = "ru"', 'Language = "en"'),
                     encoding="utf-8")
     assert load_station(demo_copy).Language == "en"
 
