@@ -13,7 +13,7 @@ from __future__ import annotations
 from collections.abc import Sequence
 
 from PySide6.QtCore import QEvent, QObject, Qt
-from PySide6.QtWidgets import QDockWidget, QMainWindow, QTabBar
+from PySide6.QtWidgets import QDockWidget, QLabel, QMainWindow, QTabBar
 
 SMALL_SCREEN = 900  # px high: below it the docks start collapsed
 
@@ -32,6 +32,7 @@ class DockStrip(QObject):
             inner = dock.widget()
             if inner is not None:
                 inner.setVisible(not collapsed)
+            dock.setTitleBarWidget(_strip(dock) if collapsed else None)
         self._tabs_follow()
         heights = [1 if collapsed else self.height] * len(self.docks)  # 1: as small as the title lets it
         self.window.resizeDocks(self.docks, heights, Qt.Orientation.Vertical)
@@ -56,3 +57,13 @@ class DockStrip(QObject):
             self.set_collapsed(False)
             return True
         return False
+
+
+def _strip(dock: QDockWidget) -> QLabel:
+    """A collapsed dock's title: its title (with its count), a line high, following the dock's."""
+    label = QLabel(dock.windowTitle())
+    label.setObjectName("dockStrip")
+    label.setStyleSheet("#dockStrip { background: #c3c9d2; color: #263445; font-weight: bold; "
+                        "padding: 3px 8px; }")
+    dock.windowTitleChanged.connect(label.setText)
+    return label

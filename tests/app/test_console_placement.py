@@ -76,6 +76,9 @@ def test_the_docks_collapse_to_a_strip_and_the_forms_get_the_height(qtbot, demo_
         qtbot.waitUntil(lambda: window.tabs.height() > open_height + 100, timeout=5000)
         assert window.summary_dock.isVisible() and not window.summary.isVisible()  # the strip stays
         assert window.summary_dock.height() < 60
+        analog = next(a for a in window.zooms if a.form_view.form.path.stem == "02_analog")
+        window.tabs.setCurrentWidget(analog)  # drawn for the 1366x768 operator screen: shown nearly 1:1
+        qtbot.waitUntil(lambda: analog.transform().m11() > 0.95, timeout=5000)
         qtbot.mousePress(window.summary_dock, Qt.MouseButton.LeftButton)  # a click on the strip opens
         qtbot.waitUntil(lambda: window.summary.isVisible(), timeout=5000)
         window.dock_strip.set_collapsed(True)
