@@ -95,10 +95,12 @@ class AlarmBanner(QFrame):
         first = self.alarms[0]
         when = formats.clock(first.since or first.changed)
         kind = words.priority(first.priority).upper()
-        self.text.setText(f"{when}   P{first.priority} {kind}   {first.text}   "
+        self.text.setText(f"{when}  P{first.priority} {kind}  {first.text}  "
                           f"[{first.id}, {words.state(first.state)}]")
         many = len(self.alarms) > 1
-        self.count.setText(self.tr("{0} unacknowledged").format(len(self.alarms)) if many else "")
+        # a badge: the banner shares the header's one line, and its alarm needs the width
+        self.count.setText(str(len(self.alarms)) if many else "")
+        self.count.setToolTip(self.tr("{0} unacknowledged").format(len(self.alarms)) if many else "")
         self.ack_all.setVisible(len(self.alarms) > 1)
         self.setVisible(True)
         if not self._timer.isActive():

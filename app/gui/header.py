@@ -23,7 +23,7 @@ from app.gui.alarms import AlarmBanner, HealthStrip
 from hmi_forms.elements import formats
 
 LINE = 44  # px: the one line, whatever it says
-HEALTH_SHARE = 0.35  # of the middle for the health strip while an alarm is shown beside it
+HEALTH_SHARE = 0.25  # of the middle for the health strip while an alarm is shown beside it
 
 
 class HeaderLine(QFrame):
@@ -90,7 +90,9 @@ class HeaderLine(QFrame):
         self.arrange()
 
     def show_user(self, name: str, role: str, *, logged_in: bool) -> None:
-        self.user.setText(f"{name} ({words.role(role)})" if name else self.tr("nobody logged in"))
+        """The name, its role beneath it in a smaller line: the banner keeps the width."""
+        self.user.setText(f"{name}\n{words.role(role)}" if name else self.tr("nobody logged in"))
+        self.user.setToolTip(f"{name} ({words.role(role)})" if name else "")
         self.login.setText(self.tr("Log out") if logged_in else self.tr("Log in…"))
 
     def tick(self) -> None:

@@ -16,15 +16,16 @@ QMainWindow, #central { background: #d9dde3; }
 #headerTitle { color: #ffffff; font-size: 13pt; font-weight: bold; }
 #headerLabel { color: #b8c4d4; }
 #headerClock { color: #ffffff; font-family: "DejaVu Sans Mono"; font-size: 10pt; }
-#headerUser { color: #ffffff; font-weight: bold; padding-right: 8px; }
+#headerUser { color: #ffffff; font-weight: bold; padding-right: 4px; }
 #headerLogin { padding: 3px 12px; }
 #alarmBanner { background: #b71c1c; border-bottom: 1px solid #7f0000; }
 #alarmBanner[blink="true"] { background: #d32f2f; }
 #alarmIcon { color: #ffeb3b; font-size: 16pt; }
 #alarmText { color: #ffffff; font-size: 11pt; font-weight: bold; }
-#alarmCount { color: #ffcdd2; padding: 0 10px; }
+#alarmCount { color: #b71c1c; background: #ffcdd2; font-weight: bold; border-radius: 9px; padding: 1px 7px;
+              margin: 0 6px; }
 #alarmAck { background: #ffffff; color: #b71c1c; font-weight: bold; border: 1px solid #7f0000;
-            border-radius: 3px; padding: 4px 14px; }
+            border-radius: 3px; padding: 4px 8px; }
 #alarmAck:hover { background: #ffebee; }
 #alarmAck:disabled { background: #e8b4b4; color: #7f3b3b; }
 #healthStrip { background: #ffe082; border-bottom: 1px solid #c79a00; }

@@ -246,9 +246,9 @@ KEYS: dict[str, dict[str, Key]] = {
         Key("alarm_sound_p1", str, None, "the sound file (WAV) of priority 1, played in a loop until "
             "acknowledged or silenced", said="the shipped one"),
         Key("alarm_sound_p2", str, None, "the sound file (WAV) of priority 2", said="the shipped one"),
-        Key("alarm_horn", str, None, "an HMI bit (`040060`, `02200`) the station sets to 1 while an "
-            "alarm of priority 1-2 sounds and to 0 once acknowledged or silenced: the program drives a "
-            "real horn from it", said="none"),
+        Key("alarm_horn", str, None, "an HMI bit (`03600`, `040060`) the station sets to 1 while an alarm "
+            "of priority 1-2 sounds and to 0 once acknowledged or silenced; the program only reads it, "
+            "to drive a real horn", said="none"),
         Key("allow_outside", bool, False, "station paths (and form images) may leave the station folder"),
         Key("Language", str, "", f"the console's language: {', '.join(LANGUAGES)}",
             said="the system locale"),

@@ -141,7 +141,7 @@ def test_the_banner_shows_the_highest_priority_unacknowledged_alarm(qtbot, stati
     qtbot.addWidget(banner)
     banner.show_alarms(summary.unacknowledged())
     assert "LEVEL.H" in banner.text.text() and "P2" in banner.text.text()
-    assert banner.count.text() == "2 unacknowledged"
+    assert banner.count.text() == "2" and banner.count.toolTip() == "2 unacknowledged"
 
 
 def test_priority_1_and_2_sound_until_acknowledged_or_silenced(qapp, tmp_path: Path) -> None:

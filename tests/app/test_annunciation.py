@@ -11,7 +11,7 @@ from app.gui.sounds import shipped
 from app.station.config import load_station
 from app.station.runtime import Runtime
 
-LEVEL, HORN = 0o4010, 0o2200
+LEVEL, HORN = 0o4010, 0o3600
 
 
 def test_the_horn_bit_sounds_with_a_high_alarm_until_silenced(qtbot, demo_copy: Path) -> None:
