@@ -103,7 +103,7 @@ def paint_stale(p: QPainter, r: QRectF) -> None:
     p.fillRect(r, QColor(221, 225, 230, 150))
     p.fillRect(r, QBrush(QColor(90, 96, 106, 110), Qt.BrushStyle.BDiagPattern))
     p.setRenderHint(QPainter.RenderHint.Antialiasing)
-    d = max(12.0, min(22.0, min(r.width(), r.height()) * 0.35))
+    d = max(16.0, min(22.0, min(r.width(), r.height()) * 0.35))  # its glyph >= 12 px
     badge = QRectF(r.right() - d - 2, r.top() + 2, d, d)
     p.setPen(QPen(QColor("#ffffff"), 1.5))
     p.setBrush(theme.STALE)
@@ -119,7 +119,7 @@ def paint_forced(p: QPainter, r: QRectF) -> None:
     p.setPen(QPen(theme.FORCED, 3))
     p.setBrush(Qt.BrushStyle.NoBrush)
     p.drawRect(r.adjusted(1.5, 1.5, -1.5, -1.5))
-    d = max(12.0, min(22.0, min(r.width(), r.height()) * 0.35))
+    d = max(16.0, min(22.0, min(r.width(), r.height()) * 0.35))  # its glyph >= 12 px
     badge = QRectF(r.right() - d - 2, r.top() + 2, d, d)
     p.setPen(Qt.PenStyle.NoPen)
     p.setBrush(theme.FORCED)

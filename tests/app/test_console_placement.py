@@ -88,3 +88,40 @@ def test_the_docks_collapse_to_a_strip_and_the_forms_get_the_height(qtbot, demo_
     finally:
         window.close()
         runtime.stop()
+
+
+def test_the_analog_form_at_the_operator_screen_has_no_text_under_12_px(qtbot, demo_copy: Path,
+                                                                         monkeypatch) -> None:
+    """The demo's analog form at 1366x768 in the operator mode (docks folded): shown at 1:1, its
+    smallest text (the gauges' names, the trend's axes, the clock's date) 12 px or more."""
+    from app.gui.main_window import MainWindow
+    from app.station.runtime import Runtime
+    from hmi_forms.widgets import theme
+
+    sizes: list[float] = []
+    real = theme.sized_font
+
+    def spy(size_px: float, bold: bool = False, family: str = theme.FAMILY):
+        sizes.append(size_px)
+        return real(size_px, bold, family)
+
+    monkeypatch.setattr(theme, "sized_font", spy)
+    runtime = Runtime(load_station(demo_copy))
+    runtime.start()
+    window = MainWindow(runtime)
+    try:
+        qtbot.addWidget(window)
+        window.resize(1366, 768)
+        window.dock_strip.set_collapsed(True)
+        window.show()
+        analog = next(a for a in window.zooms if a.form_view.form.path.stem == "02_analog")
+        qtbot.waitUntil(lambda: window.tabs.currentWidget() is not None, timeout=5000)
+        sizes.clear()
+        window.tabs.setCurrentWidget(analog)
+        qtbot.waitUntil(lambda: analog.transform().m11() > 0.99, timeout=5000)
+        qtbot.waitUntil(lambda: len(sizes) > 20, timeout=10_000)  # drawn
+        qtbot.wait(300)
+        assert min(sizes) * analog.transform().m11() >= 12.0
+    finally:
+        window.close()
+        runtime.stop()
