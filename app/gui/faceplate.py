@@ -179,10 +179,13 @@ class Faceplate(QDialog):
         entry = QHBoxLayout()
         entry.addWidget(self.entry, 1)
         entry.addWidget(self.set)
-        forcing = QHBoxLayout()
-        forcing.addWidget(self.force_entry, 1)
-        forcing.addWidget(self.force)
-        forcing.addWidget(self.unforce)
+        forcing = QVBoxLayout()  # the entry a line of its own: its hint is read whole in Russian too
+        forcing.addWidget(self.force_entry)
+        force_buttons = QHBoxLayout()
+        force_buttons.addStretch(1)
+        force_buttons.addWidget(self.force)
+        force_buttons.addWidget(self.unforce)
+        forcing.addLayout(force_buttons)
         form = QFormLayout()
         if settable:
             form.addRow(self.tr("Set to ({0})").format(tag.unit or self.tr("value")), entry)
