@@ -45,6 +45,9 @@ def _main_parser() -> argparse.ArgumentParser:
                    help="station folder or its station.toml (default: the demo station)")
     p.add_argument("--version", action="version", version=f"netplc-station {__version__}")
     p.add_argument("--no-gui", action="store_true", help="run headless, printing a status line")
+    p.add_argument("--fullscreen", action="store_true",
+                   help="the operator mode: the workstation full screen, no window chrome "
+                        "(also [operator] fullscreen in station.toml)")
     p.add_argument("--duration", type=float, metavar="S",
                    help="with --no-gui: stop after S seconds (default: until SIGINT/SIGTERM)")
     p.add_argument("--status-every", type=float, default=5.0, metavar="S",
@@ -323,7 +326,7 @@ def main(argv: list[str] | None = None) -> int:
     _log_to_station(ns.station, level)
     if ns.no_gui:
         return run_headless(ns.station, ns.duration, ns.status_every)
-    return run_gui(ns.station)
+    return run_gui(ns.station, ns.fullscreen)
 
 
 def _installed(extra: str, what: str) -> bool:
@@ -430,10 +433,10 @@ def run_headless(station: str, duration: float | None, every: float) -> int:
     return 0
 
 
-def run_gui(station: str) -> int:
+def run_gui(station: str, fullscreen: bool = False) -> int:
     from app.gui.main_window import run_workstation
 
-    return run_workstation(station)
+    return run_workstation(station, fullscreen)
 
 
 def run_viewer(archive: str | None) -> int:

@@ -353,7 +353,14 @@ class Commands:
         """Silence the horn: the alarms stay unacknowledged; journaled naming who."""
         if (denied := self._check(who, Action.SILENCE, "")) is not None:
             return denied
-        return self._queue(who, Action.SILENCE, "", lambda _m: self._put(who, "alarm sound silenced"))
+        alarms = self.alarms
+
+        def apply(_mem: Memory) -> None:
+            if alarms is not None:
+                alarms.silence(self.wall)  # the consoles' sound and the horn bit
+            self._put(who, "alarm sound silenced")
+
+        return self._queue(who, Action.SILENCE, "", apply)
 
     # --- forcing -------------------------------------------------------------------------------
 

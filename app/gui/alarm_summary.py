@@ -14,15 +14,15 @@ a state changes, and redraws only when its version moved, so a flood of transiti
 GUI one table reset per refresh, never one per transition. The table is a model/view pair:
 only the visible rows are drawn, whatever the length of the list.
 
-`Annunciator` sounds a new alarm of priority 1-2 until it is acknowledged or silenced; the
-station key `alarm_sound = false` turns sound off.
+The sound of a new alarm of priority 1-2 until it is acknowledged or silenced is the station's
+horn made audible (app/gui/annunciation.py); the station key `alarm_sound = false` turns it off.
 """
 
 from __future__ import annotations
 
 import logging
-import time
 from collections.abc import Callable
+from pathlib import Path
 from typing import Any
 
 from PySide6.QtCore import (
@@ -38,7 +38,6 @@ from PySide6.QtCore import (
 from PySide6.QtGui import QBrush, QColor
 from PySide6.QtWidgets import (
     QAbstractItemView,
-    QApplication,
     QComboBox,
     QDialog,
     QDialogButtonBox,
@@ -57,17 +56,18 @@ from PySide6.QtWidgets import (
 
 from app.authority import Action, Answer, Commands, Who
 from app.gui import words
+from app.gui.annunciation import Annunciation
 from app.gui.bridge import Answers
 from app.gui.rights import Rights
 from app.scada.alarms import PRIORITIES, AlarmRow, State
 from app.scada.station import StationAlarms
+from hmi_forms.elements import formats
 
 logger = logging.getLogger(__name__)
 
 REFRESH_MS = 250  # how often the summary looks for a new version
 BLINK_MS = 500
 BEEP_MS = 1000
-SOUNDING = (1, 2)  # priorities that sound until acknowledged or silenced
 # background and text per priority: critical red, high orange, medium yellow, low blue
 COLOURS = {1: ("#c62828", "#ffffff"), 2: ("#ef6c00", "#ffffff"), 3: ("#fdd835", "#263445"),
            4: ("#90caf9", "#263445")}
@@ -97,7 +97,8 @@ def row_colours(row: AlarmRow, blink_on: bool) -> tuple[QColor, QColor]:
 
 
 def stamp(ts: float) -> str:
-    return time.strftime("%d.%m %H:%M:%S", time.localtime(ts)) if ts else ""
+    """The console's one date format (its language's), with the time."""
+    return formats.date_time(ts) if ts else ""
 
 
 class AlarmTableModel(QAbstractTableModel):
@@ -204,29 +205,6 @@ class ShelveDialog(QDialog):
         super().accept()
 
 
-class Annunciator:
-    """Sounds while an unacknowledged alarm of priority 1-2 that came after the last silence is
-    listed. `QApplication.beep` works on every platform Qt runs on, offscreen included (silent)."""
-
-    def __init__(self, enabled: bool, beep: Callable[[], None] = QApplication.beep) -> None:
-        self.enabled = enabled
-        self.beep = beep
-        self.silenced_at = 0.0  # wall time of the last silence
-        self.sounding = False
-
-    def update(self, rows: list[AlarmRow]) -> None:
-        self.sounding = self.enabled and any(
-            r.state is State.UNACK and r.priority in SOUNDING and r.since > self.silenced_at for r in rows)
-
-    def silence(self, now: float | None = None) -> None:
-        self.silenced_at = time.time() if now is None else now
-        self.sounding = False
-
-    def tick(self) -> None:
-        if self.sounding:
-            self.beep()
-
-
 class AlarmSummary(QWidget):
     """The summary as a widget (the workstation docks it). It reads `alarms`; what the operator
     does goes to `commands` as `who()`, and each answer to `answers` (the window's status bar)."""
@@ -234,7 +212,9 @@ class AlarmSummary(QWidget):
     changed = Signal()  # the rows changed: the banner follows
 
     def __init__(self, alarms: StationAlarms | None, commands: Commands, who: Callable[[], Who], *,
-                 answers: Answers | None = None, sound: bool = True, parent: QWidget | None = None) -> None:
+                 answers: Answers | None = None, sound: bool = True,
+                 sounds: tuple[Path | None, Path | None] = (None, None),
+                 parent: QWidget | None = None) -> None:
         super().__init__(parent)
         self.setObjectName("alarmSummary")
         self.alarms = alarms
@@ -243,7 +223,7 @@ class AlarmSummary(QWidget):
         self.answers = answers or Answers()
         self.rows: list[AlarmRow] = []
         self._version = -1
-        self.annunciator = Annunciator(sound)
+        self.annunciator = Annunciation(alarms.horn if alarms is not None else None, sound, sounds)
         lay = QVBoxLayout(self)
         lay.setContentsMargins(4, 4, 4, 4)
         head = QHBoxLayout()
@@ -285,7 +265,7 @@ class AlarmSummary(QWidget):
         self.table.verticalHeader().setVisible(False)
         self.table.verticalHeader().setDefaultSectionSize(22)
         header = self.table.horizontalHeader()
-        for col, width in enumerate((90, 110, 130, 170, 90)):
+        for col, width in enumerate((90, 150, 130, 170, 90)):
             self.table.setColumnWidth(col, width)
         header.setSectionResizeMode(len(COLUMNS) - 1, QHeaderView.ResizeMode.Stretch)
         lay.addWidget(self.table, 1)
@@ -317,7 +297,7 @@ class AlarmSummary(QWidget):
             return
         self._version = alarms.version
         self.rows = list(alarms.summary)
-        self.annunciator.update(self.rows)
+        self.annunciator.update()
         self._apply()
         self.changed.emit()
 
@@ -396,3 +376,4 @@ class AlarmSummary(QWidget):
     def stop(self) -> None:
         for timer in (self._timer, self._blink, self._beep):
             timer.stop()
+        self.annunciator.stop()

@@ -14,11 +14,11 @@ from __future__ import annotations
 import logging
 
 from PySide6.QtCore import Qt, QTimer, Signal
+from PySide6.QtGui import QMouseEvent
 from PySide6.QtWidgets import (
     QDialog,
     QDialogButtonBox,
     QFrame,
-    QGridLayout,
     QHBoxLayout,
     QLabel,
     QPlainTextEdit,
@@ -40,6 +40,7 @@ class AlarmBanner(QFrame):
 
     acknowledged = Signal(object)  # AlarmRow
     acknowledged_all = Signal()
+    chosen = Signal(object)  # AlarmRow: double-clicked, to be shown on its form (app/gui/navigate.py)
 
     def __init__(self, parent: QWidget | None = None) -> None:
         super().__init__(parent)
@@ -94,14 +95,20 @@ class AlarmBanner(QFrame):
         first = self.alarms[0]
         when = formats.clock(first.since or first.changed)
         kind = words.priority(first.priority).upper()
-        self.text.setText(f"{when}   P{first.priority} {kind}   {first.text}   "
+        self.text.setText(f"{when}  P{first.priority} {kind}  {first.text}  "
                           f"[{first.id}, {words.state(first.state)}]")
         many = len(self.alarms) > 1
-        self.count.setText(self.tr("{0} unacknowledged").format(len(self.alarms)) if many else "")
+        # a badge: the banner shares the header's one line, and its alarm needs the width
+        self.count.setText(str(len(self.alarms)) if many else "")
+        self.count.setToolTip(self.tr("{0} unacknowledged").format(len(self.alarms)) if many else "")
         self.ack_all.setVisible(len(self.alarms) > 1)
         self.setVisible(True)
         if not self._timer.isActive():
             self._timer.start()
+
+    def mouseDoubleClickEvent(self, event: QMouseEvent) -> None:
+        if self.alarms:
+            self.chosen.emit(self.alarms[0])
 
     def _toggle_blink(self) -> None:
         self._blink = not self._blink
@@ -154,22 +161,3 @@ class HealthStrip(QFrame):
         dialog.setAttribute(Qt.WidgetAttribute.WA_DeleteOnClose)
         dialog.show()
         return dialog
-
-
-class FixedLine(QFrame):
-    """A slot of fixed height in the header: a quiet line underneath, a strip (the alarm banner,
-    the health strip) over it while the strip is shown. Nothing below ever moves when an alarm
-    comes or goes (ISA-101: the screen does not move under the operator's hand)."""
-
-    def __init__(self, strip: QWidget, quiet: str, height: int, parent: QWidget | None = None) -> None:
-        super().__init__(parent)
-        self.setObjectName("fixedLine")
-        self.setFixedHeight(height)
-        lay = QGridLayout(self)
-        lay.setContentsMargins(0, 0, 0, 0)
-        self.quiet = QLabel(quiet)
-        self.quiet.setObjectName("quietLine")
-        self.quiet.setContentsMargins(12, 0, 12, 0)
-        lay.addWidget(self.quiet, 0, 0)
-        lay.addWidget(strip, 0, 0)  # added last: drawn over the quiet line while visible
-        self.strip = strip

@@ -17,7 +17,6 @@ from __future__ import annotations
 import logging
 import signal
 import sys
-import time
 from collections.abc import Callable
 from dataclasses import replace
 from importlib import metadata
@@ -28,13 +27,10 @@ from PySide6.QtGui import QAction, QCloseEvent, QKeySequence
 from PySide6.QtWidgets import (
     QApplication,
     QDockWidget,
-    QFrame,
-    QHBoxLayout,
     QLabel,
     QMainWindow,
     QMessageBox,
     QPlainTextEdit,
-    QPushButton,
     QTabWidget,
     QVBoxLayout,
     QWidget,
@@ -44,21 +40,26 @@ from app.authority import Action, Answer, Commands, Refusal, Source, Ticket, Who
 from app.authority.users import Session, Users
 from app.gui import i18n, words
 from app.gui.alarm_summary import AlarmSummary
-from app.gui.alarms import AlarmBanner, FixedLine, HealthStrip
+from app.gui.alarms import AlarmBanner, HealthStrip
 from app.gui.application import application
 from app.gui.bridge import Answers, RuntimeBridge
+from app.gui.docks import SMALL_SCREEN, DockStrip
+from app.gui.faceplate import Console, Faceplates
+from app.gui.header import HeaderLine
 from app.gui.journal import JournalDock
 from app.gui.login import LoginDialog
+from app.gui.navigate import AlarmNavigator
+from app.gui.notice import Note, confirm
+from app.gui.placement import Placement, primary_size
 from app.gui.rights import Rights
 from app.gui.status import StationStatusBar, station_problems
 from app.gui.trend_history import TrendHistory
 from app.gui.users_dialog import UsersDialog
-from app.gui.zoom import ACTUAL, FIT_WIDTH, FIT_WINDOW, ZoomArea, ZoomSettings
+from app.gui.zoom import ACTUAL, FIT_WIDTH, FIT_WINDOW, ZoomArea
 from app.scada.alarms import AlarmRow
 from app.scada.readings import Readings
 from app.station.config import load_station
 from app.station.runtime import Runtime
-from hmi_forms.elements import formats
 from hmi_forms.elements.analog import AnalogOutput
 from hmi_forms.elements.base import Writer
 from hmi_forms.elements.discrete import DiscreteBase
@@ -74,9 +75,8 @@ logger = logging.getLogger(__name__)
 
 STATUS_MS = 500
 REFUSAL_MS = 10_000
-FRAME_HEIGHT = 380  # menu, header, banner, tabs, journal dock and status bar around a form
+FRAME_HEIGHT = 320  # menu, header line, tabs, journal dock and status bar around a form
 MIN_SIZE = (1024, 600)  # the window's minimum fits a 1366x768 screen, whatever the forms hold
-ALARM_LINE, HEALTH_LINE = 40, 28  # the header's fixed lines: their content changes, never their size
 JOURNAL_HEIGHT = 190
 
 
@@ -102,7 +102,8 @@ class MainWindow(QMainWindow):
         self.view_faults: list[str] = []  # form elements that failed to show: logged, in the health strip
         self.history: TrendHistory | None = None
         self.zooms: list[ZoomArea] = []
-        self.zoom_settings = ZoomSettings(station.Archive.parent / "workstation.ini")
+        # geometry, docks and zoom as kept for this screen size (app/gui/placement.py)
+        self.placement = Placement(station.Archive.parent / "workstation.ini", primary_size())
         self.viewers: list[QWidget] = []
 
         central = QWidget()
@@ -110,37 +111,45 @@ class MainWindow(QMainWindow):
         lay = QVBoxLayout(central)
         lay.setContentsMargins(0, 0, 0, 0)
         lay.setSpacing(0)
-        self.header = _Header(station.name)
-        self.header.login.clicked.connect(self.log_in_or_out)
         self.alarms = AlarmBanner()
         for button in (self.alarms.ack, self.alarms.ack_all):
             self.rights.add(button, Action.ACKNOWLEDGE, button.text())
         self.health = HealthStrip()
+        # station, alarm banner, health strip, user and clock: one line of a fixed height
+        self.header = HeaderLine(station.name, self.alarms, self.health, self.tr("No unacknowledged alarms"))
+        self.header.login.clicked.connect(self.log_in_or_out)
         self.tabs = QTabWidget()
         self.tabs.setObjectName("forms")
         self.tabs.setDocumentMode(True)
         lay.addWidget(self.header)
-        self.fixed_lines = (FixedLine(self.alarms, self.tr("No unacknowledged alarms"), ALARM_LINE),
-                            FixedLine(self.health, "", HEALTH_LINE))
-        for line in self.fixed_lines:
-            lay.addWidget(line)
         lay.addWidget(self.tabs, 1)
         self.setCentralWidget(central)
+        self.note = Note(central)  # a refusal, whole, over the bottom of the forms
 
         self.journal = JournalDock(station.Archive, self)
         self.addDockWidget(Qt.DockWidgetArea.BottomDockWidgetArea, self.journal)
         self.summary = AlarmSummary(runtime.alarms, self.commands, lambda: self.who, answers=self.answers,
-                                    sound=station.alarm_sound)
+                                    sound=station.alarm_sound, sounds=station.alarm_sounds)
         self.summary_dock = QDockWidget(self.tr("Alarms"), self)
         self.summary_dock.setObjectName("alarmSummaryDock")
         self.summary_dock.setWidget(self.summary)
         self.addDockWidget(Qt.DockWidgetArea.BottomDockWidgetArea, self.summary_dock)
         self.tabifyDockWidget(self.journal, self.summary_dock)
         self.summary_dock.raise_()
+        self.dock_strip = DockStrip(self, (self.journal, self.summary_dock), JOURNAL_HEIGHT)
         self.status = StationStatusBar()
         self.setStatusBar(self.status)
         self._build_menu()
         self.form_problems = self._load_forms()
+        alarms = runtime.alarms
+        self.faceplates = Faceplates(  # a tag's faceplate from any element bound to it
+            Console(self.commands, lambda: self.who, self.answers, lambda title, text: self.ask(title, text),
+                    station.Archive, alarms.system.defs if alarms else (), self.summary),
+            alarms.table.tags if alarms else (), self.views, self)
+        # a double-click on an alarm shows its tag's element; a tab marks its forms' alarms
+        self.navigator = AlarmNavigator(self.tabs, self.zooms, self.faceplates.bound,
+                                        alarms.system.defs if alarms else (), self)
+        self.navigator.follow(self.summary, self.alarms, self.journal)
 
         self.bridge.readings.connect(self._on_readings)
         self.summary.changed.connect(self._alarms_changed)
@@ -153,6 +162,8 @@ class MainWindow(QMainWindow):
         self._timer.start()
         self.refresh_status()
         self._fit_to_forms()
+        if (collapsed := self.placement.docks_collapsed()) is not None:
+            self.dock_strip.set_collapsed(collapsed)
         self._user_changed()
         self._activity = _Activity(self.session, self)
 
@@ -222,6 +233,14 @@ class MainWindow(QMainWindow):
         view = self.menuBar().addMenu(self.tr("&View"))
         view.addAction(self.journal.toggleViewAction())
         view.addAction(self.summary_dock.toggleViewAction())
+        full = QAction(self.tr("&Full screen"), self)
+        full.setShortcut(QKeySequence("F11"))
+        full.triggered.connect(lambda: self.showNormal() if self.isFullScreen() else self.showFullScreen())
+        view.addAction(full)
+        collapse = QAction(self.tr("&Collapse docks"), self)
+        collapse.setShortcut(QKeySequence("F9"))
+        collapse.triggered.connect(self.dock_strip.toggle)
+        view.addAction(collapse)
         view.addSeparator()
         for text, keys, act in (
                 (self.tr("Fit &width"), "Ctrl+1", lambda a: a.set_mode(FIT_WIDTH)),
@@ -257,7 +276,7 @@ class MainWindow(QMainWindow):
                                  if isinstance(model, (DiscreteBase, AnalogOutput)) and model.Enabled})
             self.history.attach(view)
             area = ZoomArea(view)
-            area.restore(self.zoom_settings.get(form.path))
+            area.restore(self.placement.zoom(form.path))
             area.zoomed.connect(lambda _label, a=area: self._zoomed(a))
             self.zooms.append(area)
             self.tabs.addTab(area, form.title)
@@ -279,7 +298,7 @@ class MainWindow(QMainWindow):
 
     def _zoomed(self, area: ZoomArea) -> None:
         """Remember the choice for this form, and show it."""
-        self.zoom_settings.put(area.form_view.form.path, area.choice)
+        self.placement.put_zoom(area.form_view.form.path, area.choice)
         if area is self.current_zoom():
             self.status.showMessage(self.tr("Zoom: ") + area.label(), 3000)
 
@@ -303,10 +322,12 @@ class MainWindow(QMainWindow):
         """One scan's memory and the quality of what every element shows, together."""
         for view in self.views:
             view.refresh(readings.snapshot, readings)
+        self.faceplates.show_readings(readings)
 
     def _alarms_changed(self) -> None:
         unacknowledged = self.summary.unacknowledged()
         self.alarms.show_alarms(unacknowledged)
+        self.navigator.mark_tabs(unacknowledged)
         self.summary_dock.setWindowTitle(self.tr("Alarms — {0} unacknowledged").format(len(unacknowledged))
                                          if unacknowledged else self.tr("Alarms"))
 
@@ -361,8 +382,7 @@ class MainWindow(QMainWindow):
 
     def ask(self, title: str, text: str) -> bool:
         """The second step of a command: the operator confirms it (tests answer for them)."""
-        answer = QMessageBox.question(self, title, text)
-        return answer == QMessageBox.StandardButton.Yes
+        return confirm(self, title, text)
 
     def _answered(self, what: str, answer: Answer) -> None:
         """A command the layer did not do says why, where the operator looks: the status bar, in
@@ -372,6 +392,7 @@ class MainWindow(QMainWindow):
 
     def refuse(self, text: str) -> None:
         self.status.showMessage(self.tr("Refused: ") + text, REFUSAL_MS)
+        self.note.say(self.tr("Refused: ") + text, REFUSAL_MS)  # whole, where the status bar cuts it
 
     def command(self, action: Action, what: str, send: Callable[[Who], Ticket], question: str = "",
                 then: Callable[[Answer], None] | None = None) -> Ticket | None:
@@ -481,11 +502,14 @@ class MainWindow(QMainWindow):
             event.ignore()
             return
         self._activity.stop()
+        self.placement.save(self)
+        self.placement.put_docks_collapsed(self.dock_strip.collapsed)
         for view in self.views:  # the guards refer back to the window: no cycle left for the GC
             for model in view.form.elements:
                 if isinstance(model, Writer):
                     model.guard = None
         self._timer.stop()
+        self.faceplates.close()
         self.summary.stop()
         self.bridge.detach()
         self.journal.close_archive()
@@ -520,41 +544,6 @@ class _Activity(QObject):
             self.app = None
 
 
-class _Header(QFrame):
-    """Station name, user on duty, date and time: the strip every SCADA screen starts with."""
-
-    def __init__(self, name: str) -> None:
-        super().__init__()
-        self.setObjectName("header")
-        lay = QHBoxLayout(self)
-        lay.setContentsMargins(14, 6, 14, 6)
-        title = QLabel(name)
-        title.setObjectName("headerTitle")
-        product = QLabel("NetPlc Station")
-        product.setObjectName("headerProduct")
-        self.user = QLabel()
-        self.user.setObjectName("headerUser")
-        self.login = QPushButton()
-        self.login.setObjectName("headerLogin")
-        self.clock = QLabel()
-        self.clock.setObjectName("headerClock")
-        lay.addWidget(product)
-        lay.addWidget(title)
-        lay.addStretch(1)
-        lay.addWidget(self.user)
-        lay.addWidget(self.login)
-        lay.addSpacing(18)
-        lay.addWidget(self.clock)
-        self.tick()
-
-    def show_user(self, name: str, role: str, *, logged_in: bool) -> None:
-        self.user.setText(f"{name} ({words.role(role)})" if name else self.tr("nobody logged in"))
-        self.login.setText(self.tr("Log out") if logged_in else self.tr("Log in…"))
-
-    def tick(self) -> None:
-        self.clock.setText(formats.date_time(time.time()))
-
-
 def version() -> str:
     """The installed package's version (pyproject.toml), or "dev" when run from a bare checkout."""
     try:
@@ -579,8 +568,10 @@ def _placeholder(text: str) -> QWidget:
     return label
 
 
-def run_workstation(station_path: str) -> int:
-    """`python main.py [STATION]`: start the runtime, show the window, stop the runtime on close."""
+def run_workstation(station_path: str, fullscreen: bool = False) -> int:
+    """`python main.py [STATION] [--fullscreen]`: start the runtime, show the window (full screen
+    in the operator mode, else as kept for this screen size, maximized the first time), stop the
+    runtime on close."""
     app = application()
     try:
         station = load_station(station_path)
@@ -596,7 +587,11 @@ def run_workstation(station_path: str) -> int:
         QMessageBox.critical(None, "NetPlc Station", f"The station cannot start:\n\n{e}")
         return 2
     window = MainWindow(runtime)
-    window.show()
+    window.placement.show(window, fullscreen or station.operator.fullscreen)
+    screen = window.screen()
+    if window.placement.docks_collapsed() is None and screen is not None \
+            and screen.size().height() < SMALL_SCREEN:
+        window.dock_strip.set_collapsed(True)  # the first start on a small screen: the picture first
     _quit_on_signals(app)
     try:
         return app.exec()

@@ -1,5 +1,8 @@
 """`python -m app.gui.screenshots DIR`: the workstation, the viewer and the designer on the demo station.
 
+The workstation's tabs and a tag's faceplate (over the analog form) are taken at 1366x768 and
+1920x1080, in English (`workstation-02-analog.png`) and in Russian (`...-ru.png`).
+
 The demo station runs for real (a copy in a temporary folder, the embedded node over TCP, its own
 archive) while a short script plays the operator: Пуск pressed a few times, a setpoint entered,
 the pump switched on, and the level driven over its alarm limit, so that the pictures show what an
@@ -27,6 +30,7 @@ if TYPE_CHECKING:
 
 SIZE = (1400, 900)  # the viewer's
 WINDOW_SIZES = ((1366, 768), (1920, 1080))  # the smallest screen the workstation must fit; a common one
+LANGUAGES = ("en", "ru")
 RUN_SECONDS = 24.0
 START_BIT = 0o40042
 PUMP, PUMP_IND = 0o2120, 0o2121
@@ -55,8 +59,8 @@ def main(argv: list[str] | None = None) -> int:
     args = ap.parse_args(argv)
 
 
+    from app.gui import i18n
     from app.gui.application import application
-    from app.gui.main_window import MainWindow
     from app.gui.viewer import ViewerWindow
     from app.station.runtime import Runtime
 
@@ -66,24 +70,14 @@ def main(argv: list[str] | None = None) -> int:
     with tempfile.TemporaryDirectory() as tmp:
         runtime = Runtime(load_station(copy_station(Path(tmp) / "station")))
         runtime.start()
-        window = MainWindow(runtime)
-        window.resize(*WINDOW_SIZES[0])
-        window.show()
         try:
-            _play_operator(runtime, lambda s: _pump_events(app, s), args.seconds)
-            for size in WINDOW_SIZES:
-                window.resize(*size)
-                suffix = "" if size == WINDOW_SIZES[0] else f"-{size[0]}x{size[1]}"
-                for i, view in enumerate(window.views):
-                    window.tabs.setCurrentIndex(i)
-                    _pump_events(app, 0.3)
-                    view.flush()
-                    path = args.out / f"workstation-{slug(view.form.path.stem)}{suffix}.png"
-                    window.grab().save(str(path))
-                    written.append(path)
+            for n, language in enumerate(LANGUAGES):
+                i18n.install(app, language)  # the window's texts are translated as it is made
+                written += _workstation(runtime, args.out, lambda s: _pump_events(app, s),
+                                        args.seconds if n == 0 else 0.0, "" if language == "en" else "-ru")
+            i18n.install(app, "en")
             written.append(_designer(runtime, args.out, lambda s: _pump_events(app, s)))
         finally:
-            window.close()
             runtime.stop()
         viewer = ViewerWindow(runtime.station.Archive)
         viewer.resize(*SIZE)
@@ -106,6 +100,49 @@ def main(argv: list[str] | None = None) -> int:
     for path in written:
         print(path)
     return 0
+
+
+def _workstation(runtime: Runtime, out: Path, wait: Callable[[float], None], seconds: float,
+                 language: str) -> list[Path]:
+    """Every tab, and TEMP's faceplate over the analog form, at each window size."""
+    from PySide6.QtGui import QPainter
+
+    from app.gui.main_window import MainWindow
+
+    window = MainWindow(runtime)
+    window.resize(*WINDOW_SIZES[0])
+    window.show()
+    written: list[Path] = []
+    try:
+        _play_operator(runtime, wait, seconds)
+        for size in WINDOW_SIZES:
+            window.resize(*size)
+            suffix = ("" if size == WINDOW_SIZES[0] else f"-{size[0]}x{size[1]}") + language
+            for i, view in enumerate(window.views):
+                window.tabs.setCurrentIndex(i)
+                wait(0.3)
+                view.flush()
+                path = out / f"workstation-{slug(view.form.path.stem)}{suffix}.png"
+                window.grab().save(str(path))
+                written.append(path)
+            analog = next(i for i, v in enumerate(window.views) if v.form.path.stem == "02_analog")
+            window.tabs.setCurrentIndex(analog)
+            plate = window.faceplates.show_tag(next(t for t in runtime.alarms.table.tags if t.name == "TEMP"))
+            wait(0.5)  # its hour of history is read in a thread
+            picture = window.grab()
+            p = QPainter(picture)
+            try:  # the dialog where a window manager would put it: over the middle of the window
+                p.drawPixmap((picture.width() - plate.width()) // 2, (picture.height() - plate.height()) // 2,
+                             plate.grab())
+            finally:
+                p.end()
+            path = out / f"faceplate-temp{suffix}.png"
+            picture.save(str(path))
+            written.append(path)
+            plate.close()
+    finally:
+        window.close()
+    return written
 
 
 def _designer(runtime: Runtime, out: Path, wait: Callable[[float], None]) -> Path:

@@ -90,9 +90,12 @@ STATES = (QT_TRANSLATE_NOOP("StationStatusBar", "running"), QT_TRANSLATE_NOOP("S
 
 
 def station_problems(s: RuntimeStatus) -> list[str]:
-    """What the health strip lists, in the console's language: a stopped program, dead links;
+    """What the health strip lists, in the console's language: forces in effect (a force left
+    behind after commissioning is the costliest thing to miss), a stopped program, dead links;
     archive and server failures as the runtime words them."""
     problems: list[str] = []
+    if s.forced:
+        problems.append(QCoreApplication.translate("StationStatusBar", "{0} forces active").format(s.forced))
     if s.state != "running":
         state = QCoreApplication.translate("StationStatusBar", s.state)
         problems.append(QCoreApplication.translate("StationStatusBar", "NetPlc program {0}").format(state))

@@ -12,26 +12,26 @@ from PySide6.QtWidgets import QApplication
 STYLE = """
 QMainWindow, #central { background: #d9dde3; }
 #header { background: #263445; border-bottom: 2px solid #3d7bd9; }
-#headerProduct { color: #8fb4ea; font-weight: bold; font-size: 11pt; padding-right: 10px; }
+
 #headerTitle { color: #ffffff; font-size: 13pt; font-weight: bold; }
 #headerLabel { color: #b8c4d4; }
-#headerClock { color: #ffffff; font-family: "DejaVu Sans Mono"; font-size: 12pt; }
-#headerUser { color: #ffffff; font-weight: bold; padding-right: 8px; }
+#headerClock { color: #ffffff; font-family: "DejaVu Sans Mono"; font-size: 10pt; }
+#headerUser { color: #ffffff; font-weight: bold; padding-right: 4px; }
 #headerLogin { padding: 3px 12px; }
 #alarmBanner { background: #b71c1c; border-bottom: 1px solid #7f0000; }
 #alarmBanner[blink="true"] { background: #d32f2f; }
 #alarmIcon { color: #ffeb3b; font-size: 16pt; }
 #alarmText { color: #ffffff; font-size: 11pt; font-weight: bold; }
-#alarmCount { color: #ffcdd2; padding: 0 10px; }
+#alarmCount { color: #b71c1c; background: #ffcdd2; font-weight: bold; border-radius: 9px; padding: 1px 7px;
+              margin: 0 6px; }
 #alarmAck { background: #ffffff; color: #b71c1c; font-weight: bold; border: 1px solid #7f0000;
-            border-radius: 3px; padding: 4px 14px; }
+            border-radius: 3px; padding: 4px 8px; }
 #alarmAck:hover { background: #ffebee; }
 #alarmAck:disabled { background: #e8b4b4; color: #7f3b3b; }
 #healthStrip { background: #ffe082; border-bottom: 1px solid #c79a00; }
 #healthText { color: #4e3b00; font-weight: bold; }
 #healthDetails { padding: 1px 10px; }
-#fixedLine { background: #cfd4db; border-bottom: 1px solid #b9c0ca; }
-#quietLine { color: #6b7684; }
+#quietLine { color: #9fb0c4; }
 QTabWidget#forms::pane { border: none; background: #d9dde3; }
 QTabBar::tab { background: #c3c9d2; color: #263445; padding: 7px 18px; margin-right: 1px;
                border-top-left-radius: 3px; border-top-right-radius: 3px; }

@@ -69,6 +69,17 @@ def refusal(why: Refusal) -> str:
         why.action, role(why.role), why.user, role(why.user_role))
 
 
+def unforce_stays(value: str) -> str:
+    """What an unforce leaves behind, said before it is done: the station does not restore the
+    value from before the force (a PLC's convention: the live writers take over from it)."""
+    if not value:
+        return QCoreApplication.translate("words", "The memory keeps the forced values until the program, a "
+                                                   "node or an operator writes them.")
+    return QCoreApplication.translate(
+        "words", "The memory keeps {0}, the forced value, until the program, a node or an operator writes it."
+    ).format(value)
+
+
 def answer(what: str, said: Answer) -> str:
     """Why the command layer did not do `what` (the view's words for what it asked): a refusal for
     the role in the console's language, any other reason in the layer's words."""

@@ -3,14 +3,12 @@
 Forms are drawn for one screen size (the demo's are 1000x760); a 1366x768 screen shows only their
 top. The form view is put in a graphics scene and the scene scaled, so every element, plot and
 entry field scales alike and clicks still land where they are drawn. The choice is remembered per
-form (`ZoomSettings`) and a fit is kept on every resize.
+form and screen size (app/gui/placement.py) and a fit is kept on every resize.
 """
 
 from __future__ import annotations
 
-from pathlib import Path
-
-from PySide6.QtCore import QRect, QSettings, Qt, Signal
+from PySide6.QtCore import QRect, Qt, Signal
 from PySide6.QtGui import QColor, QPainter, QResizeEvent, QTransform, QWheelEvent
 from PySide6.QtWidgets import QFrame, QGraphicsScene, QGraphicsView, QWidget
 
@@ -106,17 +104,3 @@ class ZoomArea(QGraphicsView):
             event.accept()
             return
         super().wheelEvent(event)
-
-
-class ZoomSettings:
-    """The zoom chosen per form, kept beside the station's archive (a folder the station writes)."""
-
-    def __init__(self, file: Path) -> None:
-        self.settings = QSettings(str(file), QSettings.Format.IniFormat)
-
-    def get(self, form: Path) -> str:
-        return str(self.settings.value(f"zoom/{form.name}", FIT_WINDOW))
-
-    def put(self, form: Path, choice: str) -> None:
-        self.settings.setValue(f"zoom/{form.name}", choice)
-        self.settings.sync()

@@ -27,6 +27,7 @@ from typing import Any
 import numpy as np
 
 from app.scada.alarms import AlarmRow, AlarmSystem, CatalogMessage, summary_order
+from app.scada.horn import Horn
 from app.scada.quality import LinkView, QualityMap
 from app.scada.readings import Readings
 from app.scada.series import SeriesQuality
@@ -48,10 +49,11 @@ class StationAlarms:
     def __init__(self, tags: Path | None, program: Program, messages: list[CatalogMessage], sink: RecordSink,
                  state_file: Path, symbols: dict[str, int] | None = None,
                  regdata: Mapping[str, Sequence[tuple[int, int]]] | None = None,
-                 no_standby: Callable[[], str] | None = None) -> None:
+                 no_standby: Callable[[], str] | None = None, horn: int | None = None) -> None:
         """TagError (every problem of tags.csv) if the tags cannot be used. `regdata`: the forms'
         RegData elements by name, with their operands (app/scada/series.py); `no_standby`: one of a
-        hot-standby pair, why it has no standby now ("" while it has), for PAIR.NO_STANDBY."""
+        hot-standby pair, why it has no standby now ("" while it has), for PAIR.NO_STANDBY; `horn`:
+        the HMI bit set while an alarm sounds (station.toml `alarm_horn`)."""
         self.table = load_tags(tags, symbols) if tags is not None else TagTable()
         self.quality_map = QualityMap(program, self.table.tags)
         self.sink = sink
@@ -72,6 +74,7 @@ class StationAlarms:
         self._dirty: set[str] = set()
         self._published = float("-inf")  # engine time of the last rebuild
         self.engine: Engine | None = None
+        self.horn = Horn(horn)  # what is to be heard, and the horn bit (app/scada/horn.py)
         self.exchange: Exchange | None = None
         self._messages: list[int] = []
         self._since: dict[int, int] = {}  # node -> first scan of this run with its link known
@@ -82,6 +85,8 @@ class StationAlarms:
         """Evaluate after every scan of `engine`; start saving states."""
         self.engine, self.exchange = engine, exchange
         engine.subscribe(self.on_scan)
+        self.horn.update(self.summary)  # alarms restored unacknowledged sound again
+        self._sound()
         self.state.start()
 
     def observe(self, record: Record) -> None:
@@ -152,6 +157,8 @@ class StationAlarms:
         self._dirty.clear()
         self.summary = tuple(sorted(self._rows.values(), key=summary_order))
         self.version += 1
+        if self.horn.update(self.summary):
+            self._sound()
         if now is not None:
             self._published = now
 
@@ -192,6 +199,15 @@ class StationAlarms:
     def set_out_of_service(self, alarm_id: str, user: str, out_of_service: bool = True) -> None:
         self.system.get(alarm_id)
         self._post(lambda: self.system.set_out_of_service(alarm_id, user, out_of_service))
+
+    def silence(self, now: float) -> None:
+        """On the engine thread (the command layer's Silence): what sounds now stops."""
+        self.horn.silence(now)
+        self._sound()
+
+    def _sound(self) -> None:
+        if self.engine is not None and self.horn.bit is not None:
+            self.engine.post(self.horn.write)
 
     def close(self) -> None:
         """After the scan thread has stopped: write the last states."""

@@ -16,6 +16,8 @@ from app.station.config import read_station
 from app.station.fingerprint import differing, fingerprint
 from app.station.load import load
 from app.station.runtime import unresolved_hosts
+from netplc.address import fmt_octal
+from netplc.program import COIL_BITS, Program
 from registrar.store import archive_problem
 
 
@@ -45,11 +47,22 @@ def check_station(path: str | Path) -> CheckReport:
     report.problems += loaded.problems + loaded.form_problems
     report.warnings += [w for form in loaded.forms for w in form.warnings]
     report.notes += loaded.notes
+    if station.alarm_horn is not None:
+        report.problems += horn_written(station.path, station.alarm_horn, loaded.program)
     pair = station.redundancy
     if pair is not None and pair.arbiter == "none":
         report.warnings.append(f"{station.path}: redundancy.arbiter: \"none\": when the link between "
                                f"the pair breaks while both run, both act as primary (split brain)")
     return report
+
+
+def horn_written(path: Path, horn: int, program: Program) -> list[str]:
+    """`alarm_horn` is the station's to set between two scans: a coil of the program on it would
+    fight the station, and the program's own use of the bit would be broken (an edge memory, say)."""
+    return [f"{path}: alarm_horn: {fmt_octal(horn)} is written by the program (line {ins.line}: "
+            f"{ins.text.strip()}): the station sets this bit, the program may only read it"
+            for ins in program.instrs
+            if ins.op in COIL_BITS and ins.c is not None and ins.c <= horn < ins.c + COIL_BITS[ins.op]]
 
 
 def check_pair(path: str | Path, partner: str | Path) -> CheckReport:

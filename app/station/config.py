@@ -16,7 +16,7 @@ from typing import Any
 
 from app.authority.policy import OPERATOR, ROLES
 from app.scada.tag import TagType
-from netplc.address import fmt_octal, is_data_byte, is_io_bit, parse_octal
+from netplc.address import fmt_octal, is_data_byte, is_io_bit, parse_hmi_bit, parse_octal
 from netplc.exchange import NODE_DEFAULTS, NodeConfig, shared_problems
 from netplc.modbus import Endpoint, line_problems
 from netplc.problems import Problems
@@ -76,6 +76,7 @@ class OperatorSettings:
 
     default_user: str = ""  # a viewer shown as logged in while nobody is; "": logged out
     idle_logout: int = 0  # seconds without input before a user is logged out; 0: never
+    fullscreen: bool = False  # the operator mode: the workstation opens full screen, no window chrome
 
 
 LANGUAGES = ("ru", "en")
@@ -168,6 +169,8 @@ class Station:
     plant_archive: str | None = None  # `Archive` given as a postgresql:// URL: forwarded there
     plant_keep_days: int = 0  # days the plant archive keeps (for every station in it); 0: all
     alarm_sound: bool = True  # a new alarm of priority 1-2 sounds until acknowledged or silenced
+    alarm_sounds: tuple[Path | None, Path | None] = (None, None)  # priority 1, 2; None: the shipped WAV
+    alarm_horn: int | None = None  # HMI bit set while an alarm sounds (app/scada/horn.py)
     opcua: OpcUaSettings = OpcUaSettings()
     mqtt: MqttSettings = MqttSettings()
     redundancy: RedundancySettings | None = None  # None: a station on its own
@@ -240,6 +243,12 @@ KEYS: dict[str, dict[str, Key]] = {
         Key("Tags", str, None, "tags.csv: the tags, their conversion and alarms"),
         Key("RetainForces", bool, False, "forces survive a restart (`<Retain>.forces.json`)"),
         Key("alarm_sound", bool, True, "a new alarm of priority 1-2 sounds until acknowledged or silenced"),
+        Key("alarm_sound_p1", str, None, "the sound file (WAV) of priority 1, played in a loop until "
+            "acknowledged or silenced", said="the shipped one"),
+        Key("alarm_sound_p2", str, None, "the sound file (WAV) of priority 2", said="the shipped one"),
+        Key("alarm_horn", str, None, "an HMI bit (`03600`, `040060`) the station sets to 1 while an alarm "
+            "of priority 1-2 sounds and to 0 once acknowledged or silenced; the program only reads it, "
+            "to drive a real horn", said="none"),
         Key("allow_outside", bool, False, "station paths (and form images) may leave the station folder"),
         Key("Language", str, "", f"the console's language: {', '.join(LANGUAGES)}",
             said="the system locale"),
@@ -300,6 +309,9 @@ KEYS: dict[str, dict[str, Key]] = {
             "a user of role viewer shown while nobody is logged in; empty: logged out"),
         Key("idle_logout", int, _OPERATOR.idle_logout,
             "seconds without input before the user is logged out; 0: never", (0, 86_400)),
+        Key("fullscreen", bool, _OPERATOR.fullscreen,
+            "the operator mode: the workstation opens full screen, with no window chrome (also "
+            "`main.py STATION --fullscreen`)"),
     ),
     "opcua": _keys(
         Key("enabled", bool, _OPCUA.enabled, "run the OPC UA server"),
@@ -482,6 +494,11 @@ def read_station(path: str | Path) -> tuple[Station | None, list[str]]:
     tags = top.path("Tags", base)
     retain_forces = top.get("RetainForces")
     alarm_sound = bool(top.get("alarm_sound"))
+    alarm_sounds = (top.path("alarm_sound_p1", base), top.path("alarm_sound_p2", base))
+    for key, sound in zip(("alarm_sound_p1", "alarm_sound_p2"), alarm_sounds, strict=True):
+        if sound is not None and not sound.is_file():
+            top.bad(key, f"{sound} is not a file")
+    alarm_horn = _horn_bit(top)
     server = _modbus_server(problems, fname, top.get("modbus_server"))
     nodes = _nodes(problems, fname, top.get("nodes"))
     simulators = _simulators(problems, fname, top.get("simulators"), base, top.allow_outside)
@@ -519,7 +536,7 @@ def read_station(path: str | Path) -> tuple[Station | None, list[str]]:
         nodes=tuple(nodes), simulators=tuple(runnable), operator=operator, Language=language, Tags=tags,
         allow_outside=top.allow_outside, RetainForces=bool(retain_forces), plant_archive=plant,
         plant_keep_days=plant_keep_days,
-        alarm_sound=alarm_sound, opcua=opcua,
+        alarm_sound=alarm_sound, alarm_sounds=alarm_sounds, alarm_horn=alarm_horn, opcua=opcua,
         mqtt=mqtt, redundancy=redundancy,
     )
     return station, problems
@@ -724,6 +741,18 @@ def _simulators(problems: list[str], fname: str, items: list[Any], base: Path,
     return sims
 
 
+def _horn_bit(top: _Reader) -> int | None:
+    """`alarm_horn`: an HMI bit address in octal, as the forms write them."""
+    text = top.get("alarm_horn")
+    if text is None:
+        return None
+    try:
+        return parse_hmi_bit(text).hmi
+    except ValueError as e:
+        top.bad("alarm_horn", f"{text!r} is not an HMI bit address: {e}")
+        return None
+
+
 def _operator(problems: list[str], fname: str, table: dict[str, Any]) -> OperatorSettings:
     r = _Reader(problems, fname, table, "operator")
     if "users" in table:
@@ -732,8 +761,9 @@ def _operator(problems: list[str], fname: str, table: dict[str, Any]) -> Operato
                        "`main.py users add NAME --role viewer|operator|engineer|admin`")
     default = r.get("default_user")
     idle = r.number("idle_logout")
+    fullscreen = r.get("fullscreen")
     r.finish()
-    return OperatorSettings(default.strip(), idle)
+    return OperatorSettings(default.strip(), idle, bool(fullscreen))
 
 
 def _ports_in_common(problems: list[str], fname: str, server: ModbusServerSettings,

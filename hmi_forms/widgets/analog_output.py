@@ -55,7 +55,7 @@ class AnalogOutputWidget(SelfPainted):
         row.addWidget(self.button)
         layout.addLayout(row)
         self.message = QLabel("")
-        self.message.setFont(theme.sized_font(11))
+        self.message.setFont(theme.sized_font(12))
         self.message.setWordWrap(True)
         layout.addWidget(self.message)
         layout.addStretch(1)

@@ -11,6 +11,8 @@ needs no painter state, and an unchanged composition is not repainted at all.
 Widgets only draw what their model computed, and never write it. The stale mark (grey wash,
 hatching and a "?" badge) is a child widget kept above everything else, so it also covers plots
 and input fields, and it is drawn identically for all element types: an operator learns it once.
+A forced value is not bad data, and must not look like it: its mark is an orange frame with an "F"
+badge and no hatching (`paint_forced`), so a commissioning force left behind is seen at a glance.
 """
 
 from __future__ import annotations
@@ -85,7 +87,7 @@ QUALITY_TIPS = {
         "quality", "? comm-fail: the node that fills this value is down; the last value is shown"),
     "not running": QT_TRANSLATE_NOOP(
         "quality", "? not running: NetPlc is stopped; the last value is shown, nothing changes"),
-    "forced": QT_TRANSLATE_NOOP("quality", "? forced: the value is forced by an engineer, not the plant's"),
+    "forced": QT_TRANSLATE_NOOP("quality", "F forced: the value is forced by an engineer, not the plant's"),
 }
 
 
@@ -101,7 +103,7 @@ def paint_stale(p: QPainter, r: QRectF) -> None:
     p.fillRect(r, QColor(221, 225, 230, 150))
     p.fillRect(r, QBrush(QColor(90, 96, 106, 110), Qt.BrushStyle.BDiagPattern))
     p.setRenderHint(QPainter.RenderHint.Antialiasing)
-    d = max(12.0, min(22.0, min(r.width(), r.height()) * 0.35))
+    d = max(16.0, min(22.0, min(r.width(), r.height()) * 0.35))  # its glyph >= 12 px
     badge = QRectF(r.right() - d - 2, r.top() + 2, d, d)
     p.setPen(QPen(QColor("#ffffff"), 1.5))
     p.setBrush(theme.STALE)
@@ -110,19 +112,51 @@ def paint_stale(p: QPainter, r: QRectF) -> None:
     p.drawText(badge, Qt.AlignmentFlag.AlignCenter, "?")
 
 
+def paint_forced(p: QPainter, r: QRectF) -> None:
+    """An orange frame and an "F" badge, the value left readable: forced is not bad quality."""
+    p.setRenderHint(QPainter.RenderHint.Antialiasing)
+    p.fillRect(r, QColor(theme.FORCED.red(), theme.FORCED.green(), theme.FORCED.blue(), 40))
+    p.setPen(QPen(theme.FORCED, 3))
+    p.setBrush(Qt.BrushStyle.NoBrush)
+    p.drawRect(r.adjusted(1.5, 1.5, -1.5, -1.5))
+    d = max(16.0, min(22.0, min(r.width(), r.height()) * 0.35))  # its glyph >= 12 px
+    badge = QRectF(r.right() - d - 2, r.top() + 2, d, d)
+    p.setPen(Qt.PenStyle.NoPen)
+    p.setBrush(theme.FORCED)
+    p.drawRect(badge)
+    p.setPen(QColor("#ffffff"))
+    p.setFont(theme.sized_font(d * 0.75, bold=True))
+    p.drawText(badge, Qt.AlignmentFlag.AlignCenter, "F")
+
+
+def paint_quality(p: QPainter, r: QRectF, word: str) -> None:
+    """The mark of what is not good about the value shown: forced, or stale (any other word)."""
+    if word == "forced":
+        paint_forced(p, r)
+    else:
+        paint_stale(p, r)
+
+
 class StaleMark(QWidget):
-    """The stale mark as a child on top of elements made of child widgets (plots, input fields)."""
+    """The quality mark as a child on top of elements made of child widgets (plots, input fields)."""
 
     def __init__(self, parent: QWidget) -> None:
         super().__init__(parent)
         self.setAttribute(Qt.WidgetAttribute.WA_TransparentForMouseEvents)
-        self.setToolTip(quality_tip("stale"))
+        self.word = "stale"
+        self.setToolTip(quality_tip(self.word))
         self.hide()
+
+    def show_word(self, word: str) -> None:
+        if word != self.word:
+            self.word = word
+            self.update()
+        self.setToolTip(quality_tip(word))
 
     def paintEvent(self, event: QPaintEvent) -> None:
         p = QPainter(self)
         try:
-            paint_stale(p, QRectF(self.rect()))
+            paint_quality(p, QRectF(self.rect()), self.word)
         finally:
             p.end()
 
@@ -239,7 +273,7 @@ class ElementWidget(QWidget):
         p.drawPixmap(ORIGIN, self.layer())
         self.paint_dynamic(p, r)
         if self.model.stale:
-            paint_stale(p, r)
+            paint_quality(p, r, self.model.quality)
 
     def layer(self) -> QPixmap:
         key = self.layer_key()
@@ -418,7 +452,7 @@ class SelfPainted(ElementWidget):
             self.stale_mark.setVisible(self.model.stale)
             self.stale_mark.raise_()
         if self.model.stale:
-            self.stale_mark.setToolTip(quality_tip(self.model.quality or "stale"))
+            self.stale_mark.show_word(self.model.quality or "stale")
         self.update(self.changed_rect())
 
     def changed_rect(self) -> QRect:

@@ -105,7 +105,7 @@ class GaugeWidget(ElementWidget):
     # --- geometry shared by the static layer and the pointer ----------------------------------
 
     def _name_height(self) -> float:
-        return max(11.0, min(18.0, self.height() * 0.11)) if self.model.Name else 0.0
+        return max(15.5, min(18.0, self.height() * 0.11)) if self.model.Name else 0.0  # text >= 12 px
 
     def _layout(self) -> None:
         if not self._laid_out:

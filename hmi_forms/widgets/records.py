@@ -21,7 +21,7 @@ from PySide6.QtCore import (
     QPersistentModelIndex,
     Qt,
 )
-from PySide6.QtGui import QColor
+from PySide6.QtGui import QColor, QFont, QFontMetrics
 from PySide6.QtWidgets import QAbstractItemView, QHeaderView, QTableView
 
 from app.scada.alarms import State
@@ -46,6 +46,7 @@ def format_value(value: float | None) -> str:
 
 
 STATES = frozenset(int(s) for s in State)
+HEADER_PADDING = 18  # px beside a column title: its margins and the sort mark
 
 
 def type_name(row: Row) -> str:
@@ -176,9 +177,13 @@ def records_view(model: RecordsModel, row_height: int) -> QTableView:
     view.verticalHeader().setDefaultSectionSize(row_height)
     header = view.horizontalHeader()
     header.setSectionResizeMode(QHeaderView.ResizeMode.Interactive)
+    bold = QFont(header.font())
+    bold.setBold(True)  # the style sheet's headers are bold: room for the title, in any language
+    metrics = QFontMetrics(bold)
     for col, column in enumerate(model.columns):
         if column.width:
-            header.resizeSection(col, column.width)
+            title = str(model.headerData(col, Qt.Orientation.Horizontal, Qt.ItemDataRole.DisplayRole) or "")
+            header.resizeSection(col, max(column.width, metrics.horizontalAdvance(title) + HEADER_PADDING))
         else:
             header.setSectionResizeMode(col, QHeaderView.ResizeMode.Stretch)
     return view

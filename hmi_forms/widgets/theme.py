@@ -25,6 +25,7 @@ ON = QColor("#2e7d32")  # a bit at 1
 WARN = QColor("#f2a900")
 ALARM = QColor("#d32f2f")
 STALE = QColor("#7a808a")
+FORCED = QColor("#e65100")  # an engineer's force: orange, never the grey of stale data
 FAMILY = "DejaVu Sans"
 MONO = "DejaVu Sans Mono"
 

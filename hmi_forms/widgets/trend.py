@@ -44,6 +44,7 @@ def _pen_color(color: Color | None) -> QColor:
 # seconds between the clock-time axis's labels: the first that leaves LABEL_GAP px per label
 STEPS = (1, 2, 5, 10, 15, 30, 60, 120, 300, 600, 900, 1800, 3600, 7200, 10800, 21600, 43200, 86400)
 LABEL_GAP = 64
+TICK_PX = 12  # the axes' labels: an operator reads them from a step back
 LABELS_KEPT = 4096  # label pixmaps of all trends of the process, started afresh when full
 _labels: dict[tuple[str, str, int, float], QPixmap] = {}
 
@@ -206,7 +207,7 @@ class TrendWidget(SelfPainted):
         super().__init__(model, images, parent)
         self.trend: Trend = model.trend  # type: ignore[assignment]
         self.header = max(16, min(22, round(model.h * 0.14)))
-        axes = {"bottom": ClockAxis(theme.sized_font(10)), "left": KeptAxis(orientation="left")}
+        axes = {"bottom": ClockAxis(theme.sized_font(TICK_PX)), "left": KeptAxis(orientation="left")}
         plot = pg.PlotWidget(self, background=theme.qcolor(model.BackColor, QColor("#fff")), axisItems=axes)
         self.axis: ClockAxis = plot.getPlotItem().getAxis("bottom")
         plot.setGeometry(1, self.header, model.w - 2, model.h - self.header - 1)
@@ -216,7 +217,7 @@ class TrendWidget(SelfPainted):
         item.setMenuEnabled(False)
         item.hideButtons()
         item.showGrid(x=True, y=isinstance(model, AnalogBase), alpha=0.25)
-        tick_font = theme.sized_font(10)
+        tick_font = theme.sized_font(TICK_PX)
         for name in ("left", "bottom"):
             axis = item.getAxis(name)
             axis.setPen(pg.mkPen(theme.BORDER))

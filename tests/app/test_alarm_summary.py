@@ -14,9 +14,12 @@ from PySide6.QtCore import Qt
 
 from app.authority import Commands, Reason, Source, Who
 from app.gui.alarm_health import HealthDialog, health_text
-from app.gui.alarm_summary import AlarmSummary, Annunciator, row_colours
+from app.gui.alarm_summary import AlarmSummary, row_colours
 from app.gui.alarms import AlarmBanner
+from app.gui.annunciation import Annunciation, QSoundEffect
+from app.gui.sounds import shipped
 from app.scada.alarms import AlarmRow, State
+from app.scada.horn import Horn
 from app.scada.station import StationAlarms
 from hmi_forms.widgets.records import type_name
 from netplc.engine import Engine, FakeClock
@@ -138,30 +141,54 @@ def test_the_banner_shows_the_highest_priority_unacknowledged_alarm(qtbot, stati
     qtbot.addWidget(banner)
     banner.show_alarms(summary.unacknowledged())
     assert "LEVEL.H" in banner.text.text() and "P2" in banner.text.text()
-    assert banner.count.text() == "2 unacknowledged"
+    assert banner.count.text() == "2" and banner.count.toolTip() == "2 unacknowledged"
 
 
-def test_priority_1_and_2_sound_until_acknowledged_or_silenced() -> None:
+def test_priority_1_and_2_sound_until_acknowledged_or_silenced(qapp, tmp_path: Path) -> None:
+    """The station's horn, and the console's sound of it: the file of the priority that sounds,
+    in a loop (or a beep a second where Qt Multimedia is not installed)."""
     beeps: list[int] = []
-    horn = Annunciator(True, lambda: beeps.append(1))
+    horn = Horn()
+    mine = tmp_path / "klaxon.wav"
+    sound = Annunciation(horn, True, (mine, None), lambda: beeps.append(1))
     high = AlarmRow("LEVEL.H", 2, State.UNACK, T0, T0, 97.0, "high")
     medium = AlarmRow("TEMP.H", 3, State.UNACK, T0, T0, 130.0, "high")
-    horn.update([medium])
-    horn.tick()
-    assert not horn.sounding and beeps == []
-    horn.update([high, medium])
-    horn.tick()
-    assert horn.sounding and beeps == [1]
+    assert not horn.update([medium])
+    sound.tick()
+    assert not sound.sounding and sound.playing is None and beeps == []
+    assert horn.update([high, medium]) and horn.priority == 2
+    sound.tick()
+    assert sound.sounding and sound.playing == shipped(2)  # the shipped WAV of priority 2
+    assert beeps == ([1] if QSoundEffect is None else [])
     horn.silence(T0 + 1)
     horn.update([high])
-    assert not horn.sounding  # silenced: only a newer alarm sounds again
+    sound.tick()
+    assert not horn.sounding and sound.playing is None  # silenced: only a newer alarm sounds again
     horn.update([AlarmRow("LEVEL.HH", 1, State.UNACK, T0 + 2, T0 + 2, 99.0, "hh")])
-    assert horn.sounding
+    sound.tick()
+    assert horn.priority == 1 and sound.playing == mine  # station.toml's alarm_sound_p1
     horn.update([AlarmRow("LEVEL.HH", 1, State.ACKED, T0 + 2, T0 + 3, 99.0, "hh")])
-    assert not horn.sounding  # acknowledged
-    off = Annunciator(False, lambda: beeps.append(1))
-    off.update([high])
-    assert not off.sounding  # the station key alarm_sound = false
+    sound.tick()
+    assert not horn.sounding and sound.playing is None  # acknowledged
+    horn.update([AlarmRow("X", 1, State.UNACK, T0 + 4, T0 + 4, None, "x")])
+    off = Annunciation(horn, False, beep=lambda: beeps.append(1))
+    off.tick()
+    assert horn.sounding and not off.sounding and off.playing is None  # alarm_sound = false
+    assert all(shipped(p).stat().st_size > 1000 for p in (1, 2))
+
+
+def test_the_horn_bit_follows_the_alarms_and_the_silence(tmp_path: Path) -> None:
+    """`alarm_horn`: the bit the program reads to drive a real horn, set while anything sounds."""
+    from netplc.memory import Memory
+
+    mem = Memory()
+    horn = Horn(bit=0o40060)
+    horn.update([AlarmRow("LEVEL.H", 2, State.UNACK, T0, T0, 97.0, "high")])
+    horn.write(mem)
+    assert mem.get_hmi_bit(0o40060) == 1
+    horn.silence(T0 + 1)
+    horn.write(mem)
+    assert mem.get_hmi_bit(0o40060) == 0
 
 
 def test_journals_name_an_alarm_records_new_state() -> None:

@@ -108,3 +108,15 @@ def test_tags_csv_problems_are_reported_by_check(tmp_path: Path) -> None:
     plant(st / "station.toml", 'Tags = "tags.csv"', 'Tags = "no_tags.csv"')
     r = run_check(st)
     assert f"{st / 'station.toml'}: Tags: file {st / 'no_tags.csv'} does not exist" in r.stdout
+
+
+def test_a_horn_bit_the_program_writes_is_a_problem(tmp_path: Path) -> None:
+    from app.station.check import check_station
+
+    station = copy_demo(tmp_path / "st")
+    toml = station / "station.toml"
+    toml.write_text(toml.read_text(encoding="utf-8").replace('alarm_horn = "03600"', 'alarm_horn = "02200"'),
+                    encoding="utf-8")
+    problems = check_station(station).problems
+    assert any("alarm_horn: 02200 is written by the program (line " in p and "may only read it" in p
+               for p in problems), problems

@@ -101,12 +101,14 @@ class Answers:
 
 def test_the_demo_opens_as_its_viewer_who_may_not_act(qtbot, console: MainWindow) -> None:
     engine = console.runtime.engine
-    assert console.user == "viewer" and "viewer (viewer)" in console.header.user.text()
+    assert console.user == "viewer" and console.header.user.text() == "viewer\nviewer"
     model, button = element(console, "Пуск")
     qtbot.waitUntil(lambda: model.value is not None, timeout=5000)
     assert "Пуск: needs the operator role; viewer is viewer" in button.toolTip()  # it keeps its look
     qtbot.mouseClick(button, Qt.MouseButton.LeftButton)
     assert console.status.currentMessage() == "Refused: Пуск: needs the operator role; viewer is viewer"
+    assert console.note.isVisible() and console.note.text() == console.status.currentMessage()  # whole
+    assert console.note.width() <= console.width()
     setpoint, _ = element(console, "Уставка температуры")
     ok, why = setpoint.submit("50")
     assert not ok and why == "Уставка температуры: needs the operator role; viewer is viewer"
@@ -322,7 +324,7 @@ def test_the_console_speaks_russian_and_the_forms_keep_their_texts(qtbot, russia
         heads = [window.journal.model.headerData(i, Qt.Orientation.Horizontal) for i in range(3)]
         assert heads == ["Время", "Вид", "Группа"]
         assert window.alarms.ack.text() == "Квитировать"
-        assert window.fixed_lines[0].quiet.text() == "Нет неквитированных аварий"
+        assert window.header.quiet.text() == "Нет неквитированных аварий"
         window.refresh_status()
         assert window.status.state.text() == "NetPlc: работает"
         assert window.journal.windowTitle() == "Журнал — сегодня"
@@ -352,7 +354,7 @@ def test_refusals_roles_and_alarms_speak_russian_too(qtbot, russian, demo_copy: 
     window = MainWindow(runtime)
     qtbot.addWidget(window)
     try:
-        assert "viewer (наблюдатель)" in window.header.user.text()
+        assert window.header.user.text() == "viewer\nнаблюдатель"
         model, button = element(window, "Пуск")
         qtbot.waitUntil(lambda: model.value is not None, timeout=5000)
         qtbot.mouseClick(button, Qt.MouseButton.LeftButton)
@@ -389,8 +391,9 @@ def test_refusals_roles_and_alarms_speak_russian_too(qtbot, russian, demo_copy: 
 
 
 def test_the_language_comes_from_station_toml(demo_copy: Path) -> None:
+    assert load_station(demo_copy).Language == "ru"  # the demo's forms are Russian: so is its console
     toml = demo_copy / "station.toml"
-    toml.write_text(toml.read_text(encoding="utf-8").replace('# Language = "ru"', 'Language = "en"'),
+    toml.write_text(toml.read_text(encoding="utf-8").replace('Language = "ru"', 'Language = "en"'),
                     encoding="utf-8")
     assert load_station(demo_copy).Language == "en"
 
@@ -423,3 +426,22 @@ def test_only_an_admin_manages_users_and_it_is_journaled(qtbot, console: MainWin
                                    "password)"),
                          ("admin", "password of ivan changed"), ("admin", "user viewer removed"),
                          ("admin", "logged out")]
+
+
+def test_the_header_says_while_forces_are_active_and_the_element_shows_f(qtbot, console: MainWindow) -> None:
+    from app.authority import Source, Who
+    from hmi_forms.widgets import theme
+
+    runtime = console.runtime
+    model, widget = element(console, "Уставка температуры")
+    ticket = runtime.commands.force_tag(Who("engineer", Source.CONSOLE), "TEMP_SP", 20.0)
+    assert ticket.result(5).ok
+    qtbot.waitUntil(lambda: "1 forces active" in console.health.problems, timeout=5000)
+    assert console.health.problems[0] == "1 forces active" and console.health.isVisible()
+    qtbot.waitUntil(lambda: model.quality == "forced", timeout=5000)
+    assert widget.stale_mark.word == "forced"
+    image = widget.grab().toImage()
+    forced = theme.FORCED.rgb()
+    assert any(image.pixel(x, 1) == forced for x in range(image.width()))  # the orange frame, no hatch
+    assert runtime.commands.unforce_all(Who("engineer", Source.CONSOLE)).result(5).ok
+    qtbot.waitUntil(lambda: "1 forces active" not in console.health.problems, timeout=5000)

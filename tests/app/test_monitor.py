@@ -17,7 +17,7 @@ from app.authority import Who
 from app.authority.users import Users
 from app.gui.monitor.listing import Listing, fmt_value, parse_value, parse_watch
 from app.gui.monitor.source import READ_ONLY, LocalSource, RemoteSource
-from app.gui.monitor.view import ON, ProgramMonitor
+from app.gui.monitor.view import ON, ProgramMonitor, parse_force
 from app.gui.monitor.window import ProgramWindow, remote_source
 from app.station.config import load_station
 from app.station.runtime import Runtime
@@ -203,6 +203,11 @@ def test_watch_edit_force_unforce_and_step_from_the_view(qtbot, runtime: Runtime
     monitor.watch.item(0, 1).setText("9")  # a write loses to the force
     wait(qtbot, lambda: monitor.watch.item(0, 4).text() == "F 7 (program view:eng1)")
     assert engine.snapshot.get_word(0o4000) == 7
+    asked: list[str] = []
+    monitor.ask = lambda title, text: asked.append(text) is None and len(asked) > 1  # no, then yes
+    monitor.unforce_button.click()
+    assert asked[0].startswith("Unforce all 2 forces? The memory keeps the forced values")
+    assert monitor.forced_pill.text() == "F: 2 forced"  # answered no: nothing sent
     monitor.unforce_button.click()
     wait(qtbot, lambda: monitor.forced_pill.text() == "F: 0 forced")
     texts = operator_texts(runtime)
@@ -436,7 +441,16 @@ def test_the_watch_table_forces_a_tag_in_physical_units(qtbot, tmp_path: Path) -
         assert monitor.watch.item(0, 1).text() == "130.0 °C" and monitor.watch.item(0, 2).text() == "028Ah"
         assert monitor.watch.item(1, 4).text() == "F 0.00 m3/h (program view:eng1)"
         monitor.watch.item(0, 1).setText("10")  # an operator write loses to the force
-        monitor.unforce_tag(monitor.watch_items[1].tag)  # type: ignore[arg-type]
+        asked: list[str] = []
+        monitor.ask = lambda title, text: asked.append(text) is None
+        temp_sp = monitor.watch_items[0].tag
+        assert temp_sp is not None
+        with pytest.raises(ValueError, match=r"TEMP_SP is not forced: 1000\.0 °C is outside its range "
+                                             r"0\.0 °C \.\. 200\.0 °C"):
+            parse_force("1000", temp_sp)  # the tag's PhyMin..PhyMax, not the word's 0..13107 °C
+        monitor.confirm_unforce_tag(monitor.watch_items[1].tag)  # type: ignore[arg-type]
+        assert asked == ["Unforce FLOW? The memory keeps 0.00 m3/h, the forced value, until the program, "
+                         "a node or an operator writes it."]
         wait(qtbot, lambda: monitor.forced_pill.text() == "F: 1 forced")
         monitor.watch.item(1, 1).setText("12,5")  # a write of both words, once unforced
         wait(qtbot, lambda: monitor.watch.item(1, 1).text() == "12.50 m3/h")

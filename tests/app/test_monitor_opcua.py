@@ -146,6 +146,7 @@ def test_an_engineer_forces_steps_and_the_station_journals_the_engineer(
     wait(qtbot, lambda: monitor.watch.item(1, 1).text() == "130.0 °C")
     texts = remote.operator("eng1")
     assert "force 02000: 0 -> 1" in texts and "force TEMP_SP: 0.0 -> 130.0 °C (raw 028Ah)" in texts
+    monitor.ask = lambda title, text: True  # the engineer confirms Unforce all
     monitor.unforce_button.click()
     wait(qtbot, lambda: monitor.forced_pill.text() == "F: 0 forced")
     assert engine.forces.count == 0

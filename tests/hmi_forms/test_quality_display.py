@@ -8,11 +8,13 @@ import math
 from pathlib import Path
 
 import pytest
+from PySide6.QtGui import QColor, QImage
 
 from app.scada.quality import LinkView, Quality, QualityMap
 from app.scada.readings import Readings
 from hmi_forms.elements.target import NullTarget
 from hmi_forms.form import load_form
+from hmi_forms.widgets import theme
 from hmi_forms.widgets.form_view import FormView
 from netplc.memory import Memory
 from netplc.program import parse
@@ -91,7 +93,43 @@ def test_a_forced_value_is_shown_as_it_is_and_marked(view: FormView) -> None:
     view.refresh(snap, r)
     local, widget = models(view)["local"]
     assert local.quality == Quality.FORCED.word and local.text == "100.0"
-    assert widget.toolTip().startswith("? forced")
+    assert widget.toolTip().startswith("F forced")
+
+
+def colour_count(image: QImage, colour: QColor) -> int:
+    """Pixels of (nearly) `colour`, sampled every 2 px."""
+    return sum(_near(QColor(image.pixel(x, y)), colour)
+               for x in range(0, image.width(), 2) for y in range(0, image.height(), 2))
+
+
+def _near(a: QColor, b: QColor) -> bool:
+    return abs(a.red() - b.red()) + abs(a.green() - b.green()) + abs(a.blue() - b.blue()) < 30
+
+
+@pytest.mark.parametrize("name", ["local", "setpoint"])  # drawn by the form; with child widgets
+def test_a_forced_element_has_its_own_mark_not_the_stale_hatch(view: FormView, name: str) -> None:
+    """The same element at the same value, forced and then stale: orange frame and "F" against
+    the grey hatch; the two pictures differ and only the forced one has the force colour."""
+    mem = Memory()
+    addr = 0o4100 if name == "local" else 0o4012
+    mem.set_word(addr, 4095)
+    model, widget = models(view)[name]
+    view.refresh(*reversed(readings(mem, 1, LinkView(links={0: True}, forced=[addr]))))
+    assert model.quality == Quality.FORCED.word
+    forced = grab_element(view, widget)
+    view.refresh(*reversed(readings(mem, 2, LinkView(running=False))))
+    assert model.quality == Quality.NOT_RUNNING.word
+    stale = grab_element(view, widget)
+    assert differs(forced, stale) > 200
+    assert colour_count(forced, theme.FORCED) > 100
+    assert colour_count(stale, theme.FORCED) == 0
+
+
+def grab_element(view: FormView, widget) -> QImage:
+    """The element as the operator sees it: the form's pixels where it is (the form paints most
+    elements itself; those with child widgets paint over it)."""
+    view.repaint()
+    return view.grab(widget.geometry()).toImage()
 
 
 def test_a_value_that_arrived_while_marked_is_shown_once_the_data_are_good_again(view: FormView) -> None:

@@ -522,6 +522,14 @@
         <translation>&amp;Вид</translation>
     </message>
     <message>
+        <source>&amp;Collapse docks</source>
+        <translation>&amp;Свернуть панели</translation>
+    </message>
+    <message>
+        <source>&amp;Full screen</source>
+        <translation>&amp;Полный экран</translation>
+    </message>
+    <message>
         <source>Fit &amp;width</source>
         <translation>По &amp;ширине</translation>
     </message>
@@ -858,6 +866,10 @@ Drag onto the form, or double-click to add</source>
         <translation>действуют форсирования: форсирование &gt; программа &gt; объект (Станция -&gt; Программа)</translation>
     </message>
     <message>
+        <source>{0} forces active</source>
+        <translation>Действует форсирований: {0}</translation>
+    </message>
+    <message>
         <source>NetPlc program {0}</source>
         <translation>NetPlc: {0}</translation>
     </message>
@@ -1101,9 +1113,17 @@ Drag onto the form, or double-click to add</source>
         <source>A message's type and worse; an alarm record by the priority of that severity (3 critical: priority 1, 2 alarm: 1-2, 1 warning: 1-3); a data record by its type</source>
         <translation>Тип сообщения и более тяжёлые; запись аварии — по приоритету этой тяжести (3 критическая: приоритет 1, 2 авария: 1-2, 1 предупреждение: 1-3); запись данных — по её типу</translation>
     </message>
+    <message>
+        <source>reading…</source>
+        <translation>чтение…</translation>
+    </message>
+    <message>
+        <source>archive unreadable: {0}</source>
+        <translation>архив не читается: {0}</translation>
+    </message>
 </context>
 <context>
-    <name>_Header</name>
+    <name>HeaderLine</name>
     <message>
         <source>nobody logged in</source>
         <translation>никто не вошёл</translation>
@@ -1136,8 +1156,8 @@ Drag onto the form, or double-click to add</source>
         <translation>? NetPlc остановлен: показано последнее значение, ничего не меняется</translation>
     </message>
     <message>
-        <source>? forced: the value is forced by an engineer, not the plant's</source>
-        <translation>? форсировано: значение задано инженером, а не получено с объекта</translation>
+        <source>F forced: the value is forced by an engineer, not the plant's</source>
+        <translation>F форсировано: значение задано инженером, а не получено с объекта</translation>
     </message>
 </context>
 <context>
@@ -1304,6 +1324,271 @@ Drag onto the form, or double-click to add</source>
     <message>
         <source>{0}: {1} is no longer a user ({2} needed)</source>
         <translation>{0}: {1} больше не пользователь (нужна роль «{2}»)</translation>
+    </message>
+    <message>
+        <source>The memory keeps the forced values until the program, a node or an operator writes them.</source>
+        <translation>В памяти остаются форсированные значения, пока их не запишет программа, узел или оператор.</translation>
+    </message>
+    <message>
+        <source>The memory keeps {0}, the forced value, until the program, a node or an operator writes it.</source>
+        <translation>В памяти остаётся {0} — форсированное значение, пока его не запишет программа, узел или оператор.</translation>
+    </message>
+</context>
+<context>
+    <name>Faceplate</name>
+    <message>
+        <source>Faceplate: {0}</source>
+        <translation>Карточка: {0}</translation>
+    </message>
+    <message>
+        <source>No alarms on this tag</source>
+        <translation>У этого тега нет аварий</translation>
+    </message>
+    <message>
+        <source>Acknowledge</source>
+        <translation>Квитировать</translation>
+    </message>
+    <message>
+        <source>Shelve…</source>
+        <translation>Отложить…</translation>
+    </message>
+    <message>
+        <source>Set</source>
+        <translation>Задать</translation>
+    </message>
+    <message>
+        <source>empty: at its value</source>
+        <translation>пусто: текущим значением</translation>
+    </message>
+    <message>
+        <source>Force…</source>
+        <translation>Форсировать…</translation>
+    </message>
+    <message>
+        <source>Unforce…</source>
+        <translation>Снять форсирование…</translation>
+    </message>
+    <message>
+        <source>Set to ({0})</source>
+        <translation>Задать ({0})</translation>
+    </message>
+    <message>
+        <source>value</source>
+        <translation>значение</translation>
+    </message>
+    <message>
+        <source>Force</source>
+        <translation>Форсирование</translation>
+    </message>
+    <message>
+        <source>Close</source>
+        <translation>Закрыть</translation>
+    </message>
+    <message>
+        <source>F forced by {0}</source>
+        <translation>F форсировал {0}</translation>
+    </message>
+    <message>
+        <source>{0} is not a number</source>
+        <translation>{0} — не число</translation>
+    </message>
+    <message>
+        <source>Set {0}</source>
+        <translation>Задать {0}</translation>
+    </message>
+    <message>
+        <source>{0} is not forced: {1} is outside its range {2} .. {3}</source>
+        <translation>{0} не форсирован: {1} вне диапазона {2} .. {3}</translation>
+    </message>
+    <message>
+        <source>at its value (bumpless)</source>
+        <translation>текущим значением (безударно)</translation>
+    </message>
+    <message>
+        <source>to {0}</source>
+        <translation>значением {0}</translation>
+    </message>
+    <message>
+        <source>Force {0} {1}? The program and the nodes no longer change it until it is unforced.</source>
+        <translation>Форсировать {0} {1}? Программа и узлы не будут его менять, пока форсирование не снято.</translation>
+    </message>
+    <message>
+        <source>Force {0}</source>
+        <translation>Форсировать {0}</translation>
+    </message>
+    <message>
+        <source>Unforce</source>
+        <translation>Снятие форсирования</translation>
+    </message>
+    <message>
+        <source>Unforce {0}?</source>
+        <translation>Снять форсирование {0}?</translation>
+    </message>
+    <message>
+        <source>Unforce {0}</source>
+        <translation>Снять форсирование {0}</translation>
+    </message>
+    <message>
+        <source>No alarm of {0} to shelve</source>
+        <translation>У {0} нет аварий, которые можно отложить</translation>
+    </message>
+</context>
+<context>
+    <name>ProgramMonitor</name>
+    <message>
+        <source>No program to list: give it with --program (the program, or the station folder for its symbols and tags too), or over Modbus name the station folder (main.py monitor STATION); watch addresses, symbols or tags in the table on the right.</source>
+        <translation>Нет программы для листинга: укажите её через --program (программу или папку станции, чтобы были и её символы и теги), а по Modbus — папку станции (main.py monitor СТАНЦИЯ); адреса, символы и теги можно наблюдать в таблице справа.</translation>
+    </message>
+    <message>
+        <source>Read-only over Modbus: Modbus has no users, so this monitor only watches. Write, force and step as a user of the station: over its OPC UA endpoint (main.py monitor opc.tcp://HOST:PORT/PATH) or at its own workstation. Its forces are unknown here.</source>
+        <translation>Только просмотр по Modbus: у Modbus нет пользователей, поэтому монитор только наблюдает. Запись, форсирование и шаг — как пользователь станции: через её OPC UA (main.py monitor opc.tcp://ХОСТ:ПОРТ/ПУТЬ) или на её рабочем месте. Её форсирования здесь неизвестны.</translation>
+    </message>
+    <message>
+        <source>Force {0} {1}? The program and the nodes no longer change it until it is unforced.</source>
+        <translation>Форсировать {0} {1}? Программа и узлы не будут его менять, пока форсирование не снято.</translation>
+    </message>
+    <message>
+        <source>F: unknown over Modbus</source>
+        <translation>Ф: неизвестно по Modbus</translation>
+    </message>
+    <message>
+        <source>F: {0} forced</source>
+        <translation>Ф: форсировано {0}</translation>
+    </message>
+    <message>
+        <source>Find (Enter: next)</source>
+        <translation>Найти (Enter: далее)</translation>
+    </message>
+    <message>
+        <source>Go to label…</source>
+        <translation>К метке…</translation>
+    </message>
+    <message>
+        <source>Step one scan</source>
+        <translation>Один цикл</translation>
+    </message>
+    <message>
+        <source>Unforce all</source>
+        <translation>Снять все форсирования</translation>
+    </message>
+    <message>
+        <source>Words:</source>
+        <translation>Слова:</translation>
+    </message>
+    <message>
+        <source>Address / symbol</source>
+        <translation>Адрес / символ</translation>
+    </message>
+    <message>
+        <source>Value</source>
+        <translation>Значение</translation>
+    </message>
+    <message>
+        <source>Forced</source>
+        <translation>Форсировано</translation>
+    </message>
+    <message>
+        <source>Uses: click a line to follow its operand</source>
+        <translation>Использования: щёлкните строку, чтобы проследить её операнд</translation>
+    </message>
+    <message>
+        <source>Watch: type an address (04000, 040042, 02000:w, 04001:b), a symbol or a tag</source>
+        <translation>Наблюдение: введите адрес (04000, 040042, 02000:w, 04001:b), символ или тег</translation>
+    </message>
+    <message>
+        <source>the station's forces are not in the Modbus map: see them at its own workstation</source>
+        <translation>форсирований станции нет в карте Modbus: смотрите их на её рабочем месте</translation>
+    </message>
+    <message>
+        <source>forces in effect: force &gt; program &gt; live</source>
+        <translation>действуют форсирования: форсирование &gt; программа &gt; объект</translation>
+    </message>
+    <message>
+        <source>nothing forced</source>
+        <translation>ничего не форсировано</translation>
+    </message>
+    <message>
+        <source>Refused: </source>
+        <translation>Отказано: </translation>
+    </message>
+    <message>
+        <source>Remove from watch</source>
+        <translation>Убрать из наблюдения</translation>
+    </message>
+    <message>
+        <source>its value</source>
+        <translation>его значение</translation>
+    </message>
+    <message>
+        <source>at its value {0} (bumpless)</source>
+        <translation>текущим значением {0} (безударно)</translation>
+    </message>
+    <message>
+        <source>to {0}</source>
+        <translation>значением {0}</translation>
+    </message>
+    <message>
+        <source>Force</source>
+        <translation>Форсирование</translation>
+    </message>
+    <message>
+        <source>Unforce</source>
+        <translation>Снятие форсирования</translation>
+    </message>
+    <message>
+        <source>Unforce {0}?</source>
+        <translation>Снять форсирование {0}?</translation>
+    </message>
+    <message>
+        <source>Unforce all {0} forces?</source>
+        <translation>Снять все форсирования ({0})?</translation>
+    </message>
+    <message>
+        <source>Force {0} at its value (bumpless)</source>
+        <translation>Форсировать {0} текущим значением (безударно)</translation>
+    </message>
+    <message>
+        <source>Force {0} to…</source>
+        <translation>Форсировать {0} значением…</translation>
+    </message>
+    <message>
+        <source>Unforce {0}</source>
+        <translation>Снять форсирование {0}</translation>
+    </message>
+    <message>
+        <source>Force {0} to ({1}, {2} .. {3}):</source>
+        <translation>Форсировать {0} значением ({1}, {2} .. {3}):</translation>
+    </message>
+    <message>
+        <source>value</source>
+        <translation>значение</translation>
+    </message>
+    <message>
+        <source>Force {0} to (decimal, 0x1F or 1Fh):</source>
+        <translation>Форсировать {0} значением (десятичное, 0x1F или 1Fh):</translation>
+    </message>
+    <message>
+        <source>Uses of {0} ({1}): {2} lines</source>
+        <translation>Использования {0} ({1}): строк {2}</translation>
+    </message>
+    <message>
+        <source>Follow uses of {0} {1}</source>
+        <translation>Использования {0} {1}</translation>
+    </message>
+    <message>
+        <source>Watch {0}</source>
+        <translation>Наблюдать {0}</translation>
+    </message>
+</context>
+<context>
+    <name>ProgramWindow</name>
+    <message>
+        <source>Program — {0}</source>
+        <translation>Программа — {0}</translation>
+    </message>
+    <message>
+        <source> (read-only)</source>
+        <translation> (только просмотр)</translation>
     </message>
 </context>
 </TS>

@@ -21,7 +21,7 @@ from __future__ import annotations
 import logging
 from collections.abc import Callable
 
-from PySide6.QtCore import QPoint, QRect, Qt, QTimer, Signal
+from PySide6.QtCore import QT_TRANSLATE_NOOP, QCoreApplication, QPoint, QRect, Qt, QTimer, Signal
 from PySide6.QtGui import QColor, QContextMenuEvent, QFont, QFontMetrics, QMouseEvent, QPainter, QPaintEvent
 from PySide6.QtWidgets import (
     QAbstractScrollArea,
@@ -43,7 +43,7 @@ from PySide6.QtWidgets import (
     QWidget,
 )
 
-from app.authority import Action, Answer, Refusal, Ticket
+from app.authority import Action, Answer, Refusal, Ticket, write_range
 from app.gui import words
 from app.gui.bridge import Answers
 from app.gui.monitor.listing import (
@@ -58,6 +58,7 @@ from app.gui.monitor.listing import (
     parse_watch,
 )
 from app.gui.monitor.source import Acting, Source
+from app.gui.notice import confirm
 from app.gui.rights import Control
 from app.gui.status import IDLE, WARN, Pill
 from app.scada.forcing import tag_keys
@@ -72,17 +73,39 @@ logger = logging.getLogger(__name__)
 REFRESH_MS = 100  # at most 10 refreshes per second
 ON, OFF, FORCED = QColor("#2e7d32"), QColor("#b0b7c0"), QColor("#e65100")
 VALUE_CHARS = 34  # the values column (timers, counters, FON operands) before the source text
-NO_LISTING = ("No program to list: give it with --program (the program, or the station folder for its "
-              "symbols and tags too), or over Modbus name the station folder (main.py monitor STATION); "
-              "watch addresses, symbols or tags in the table on the right.")
-READ_ONLY_LINE = ("Read-only over Modbus: Modbus has no users, so this monitor only watches. Write, force "
-                  "and step as a user of the station: over its OPC UA endpoint (main.py monitor "
-                  "opc.tcp://HOST:PORT/PATH) or at its own workstation. Its forces are unknown here.")
+NO_LISTING = QT_TRANSLATE_NOOP(
+    "ProgramMonitor", "No program to list: give it with --program (the program, or the station folder for "
+    "its symbols and tags too), or over Modbus name the station folder (main.py monitor STATION); watch "
+    "addresses, symbols or tags in the table on the right.")
+READ_ONLY_LINE = QT_TRANSLATE_NOOP(
+    "ProgramMonitor", "Read-only over Modbus: Modbus has no users, so this monitor only watches. Write, "
+    "force and step as a user of the station: over its OPC UA endpoint (main.py monitor "
+    "opc.tcp://HOST:PORT/PATH) or at its own workstation. Its forces are unknown here.")
+
+FORCE_QUESTION = QT_TRANSLATE_NOOP(
+    "ProgramMonitor", "Force {0} {1}? The program and the nodes no longer change it until it is unforced.")
+
+
+def tr(text: str) -> str:
+    """The Program view's words in the console's language (context ProgramMonitor)."""
+    return QCoreApplication.translate("ProgramMonitor", text)
+
+
+def parse_force(text: str, tag: Tag) -> float:
+    """A physical value typed for a force; ValueError, in words, outside the tag's range."""
+    value = parse_phy(text, tag)
+    lo, hi = write_range(tag)
+    if not lo <= value <= hi:
+        raise ValueError(f"{tag.name} is not forced: {tag.format(value)} is outside its range "
+                         f"{tag.format(lo)} .. {tag.format(hi)}")
+    return value
 
 
 def forced_text(n: int | None) -> str:
     """The forces count; None: the source cannot see them (over Modbus)."""
-    return "F: unknown over Modbus" if n is None else f"F: {n} forced"
+    if n is None:
+        return QCoreApplication.translate("ProgramMonitor", "F: unknown over Modbus")
+    return QCoreApplication.translate("ProgramMonitor", "F: {0} forced").format(n)
 
 
 class ListingView(QAbstractScrollArea):
@@ -175,7 +198,7 @@ class ListingView(QAbstractScrollArea):
         if not len(self.listing):
             p.setPen(QColor("#6b7685"))
             flags = Qt.AlignmentFlag.AlignLeft | Qt.AlignmentFlag.AlignTop | Qt.TextFlag.TextWordWrap
-            text = f"{self.source.state()}\n\n{NO_LISTING}"  # what the monitor does: the whole line
+            text = f"{self.source.state()}\n\n{tr(NO_LISTING)}"  # what the monitor does: the whole line
             p.drawText(self.viewport().rect().adjusted(12, 12, -12, -12), int(flags), text)
         first = rows.start
         instrs = self.listing.program.instrs
@@ -275,24 +298,25 @@ class ProgramMonitor(QWidget):
         self.acting = source.acting
         self.granted: list[tuple[Control, Action, str]] = []  # controls enabled while the user may act
         self._rights = -1  # the source's `rights` the controls show
+        self.ask: Callable[[str, str], bool] = self._ask  # a force or unforce is confirmed (tests answer)
 
         self.find = QLineEdit()
-        self.find.setPlaceholderText("Find (Enter: next)")
+        self.find.setPlaceholderText(self.tr("Find (Enter: next)"))
         self.find.returnPressed.connect(self.find_next)
         self.labels = QComboBox()
-        self.labels.addItem("Go to label…")
+        self.labels.addItem(self.tr("Go to label…"))
         self.labels.addItems(sorted(self.listing.labels))
         self.labels.activated.connect(self._label_chosen)
         self.formats = QComboBox()
         self.formats.addItems(list(FORMATS))
         self.formats.currentTextChanged.connect(self._format_changed)
-        self.step_button = QPushButton("Step one scan")
+        self.step_button = QPushButton(self.tr("Step one scan"))
         self.step_button.clicked.connect(self.step)
-        self.unforce_button = QPushButton("Unforce all")
-        self.unforce_button.clicked.connect(self.unforce_all)
-        self._grant(self.step_button, Action.STEP, "Step one scan")
-        self._grant(self.unforce_button, Action.UNFORCE, "Unforce all")
-        self.read_only = QLabel(READ_ONLY_LINE)
+        self.unforce_button = QPushButton(self.tr("Unforce all"))
+        self.unforce_button.clicked.connect(self.ask_unforce_all)
+        self._grant(self.step_button, Action.STEP, self.tr("Step one scan"))
+        self._grant(self.unforce_button, Action.UNFORCE, self.tr("Unforce all"))
+        self.read_only = QLabel(tr(READ_ONLY_LINE))
         self.read_only.setObjectName("monitorReadOnly")
         self.read_only.setStyleSheet("background: #fff4d6; color: #5d4200; padding: 4px 6px;")
         self.read_only.setWordWrap(True)
@@ -311,7 +335,7 @@ class ProgramMonitor(QWidget):
         bar.setContentsMargins(6, 4, 6, 4)
         bar.addWidget(self.find, 2)
         bar.addWidget(self.labels, 1)
-        bar.addWidget(QLabel("Words:"))
+        bar.addWidget(QLabel(self.tr("Words:")))
         bar.addWidget(self.formats)
         bar.addWidget(self.step_button)
         bar.addWidget(self.unforce_button)
@@ -322,21 +346,22 @@ class ProgramMonitor(QWidget):
         self.view.row_clicked.connect(self._row_clicked)
         self.watch = QTableWidget(0, 5)
         self.watch.setObjectName("watch")
-        self.watch.setHorizontalHeaderLabels(["Address / symbol", "Value", "Hex", "BCD", "Forced"])
+        self.watch.setHorizontalHeaderLabels(
+            [self.tr("Address / symbol"), self.tr("Value"), "Hex", "BCD", self.tr("Forced")])
         self.watch.horizontalHeader().setSectionResizeMode(0, QHeaderView.ResizeMode.Stretch)
         self.watch.verticalHeader().setVisible(False)
         self.watch.itemChanged.connect(self._watch_edited)
         self.watch.setContextMenuPolicy(Qt.ContextMenuPolicy.CustomContextMenu)
         self.watch.customContextMenuRequested.connect(self._watch_menu)
-        self.uses_title = QLabel("Uses: click a line to follow its operand")
+        self.uses_title = QLabel(self.tr("Uses: click a line to follow its operand"))
         self.uses = QListWidget()
         self.uses.itemActivated.connect(self._use_chosen)
         self.uses.itemClicked.connect(self._use_chosen)
         side = QWidget()
         side_lay = QVBoxLayout(side)
         side_lay.setContentsMargins(0, 0, 0, 0)
-        side_lay.addWidget(QLabel("Watch: type an address (04000, 040042, 02000:w, 04001:b), a symbol or "
-                                  "a tag"))
+        side_lay.addWidget(QLabel(self.tr("Watch: type an address (04000, 040042, 02000:w, 04001:b), a "
+                                          "symbol or a tag")))
         side_lay.addWidget(self.watch, 3)
         side_lay.addWidget(self.message)
         side_lay.addWidget(self.uses_title)
@@ -386,8 +411,9 @@ class ProgramMonitor(QWidget):
         self._refresh_watch(snap, {f.key: f for f in known})
 
     def show_forced(self, n: int | None) -> None:
-        why = ("the station's forces are not in the Modbus map: see them at its own workstation" if n is None
-               else "forces in effect: force > program > live" if n else "nothing forced")
+        unknown = self.tr("the station's forces are not in the Modbus map: see them at its own workstation")
+        why = (unknown if n is None else self.tr("forces in effect: force > program > live") if n
+               else self.tr("nothing forced"))
         self.forced_pill.show_value(forced_text(n), WARN if n is None or n else IDLE, why)
 
     def _refresh_watch(self, snap: Snapshot, forces: dict[tuple[Kind, int], Force]) -> None:
@@ -550,7 +576,7 @@ class ProgramMonitor(QWidget):
         """A refusal is said until the next command is done (a successful step, write or force
         leaves no stale error behind)."""
         if not answer.ok:
-            self._say("Refused: " + words.answer(what, answer))
+            self._say(self.tr("Refused: ") + words.answer(what, answer))
         elif self.message.text():
             self.message.clear()
 
@@ -565,7 +591,7 @@ class ProgramMonitor(QWidget):
         else:
             self._tag_force_actions(menu, item.tag)
         menu.addSeparator()
-        menu.addAction("Remove from watch", lambda: self.remove_watch(r))
+        menu.addAction(self.tr("Remove from watch"), lambda: self.remove_watch(r))
         menu.exec(self.watch.viewport().mapToGlobal(pos))
 
     def remove_watch(self, r: int) -> None:
@@ -574,29 +600,80 @@ class ProgramMonitor(QWidget):
 
     # --- forcing and stepping ---------------------------------------------------------------------
 
+    def _ask(self, title: str, text: str) -> bool:
+        return confirm(self, title, text)
+
     def _force_actions(self, menu: QMenu, kind: Kind, addr: int, where: str) -> None:
-        self._add_force_actions(menu, where, lambda: self.force(kind, addr, None),
-                                lambda: self._ask_force(kind, addr, where), lambda: self.unforce(kind, addr))
+        self._add_force_actions(menu, where, lambda: self.confirm_force(kind, addr, None),
+                                lambda: self._ask_force(kind, addr, where),
+                                lambda: self.confirm_unforce(kind, addr))
 
     def _tag_force_actions(self, menu: QMenu, tag: Tag) -> None:
-        self._add_force_actions(menu, tag.name, lambda: self.force_tag(tag, None),
-                                lambda: self._ask_force_tag(tag), lambda: self.unforce_tag(tag))
+        self._add_force_actions(menu, tag.name, lambda: self.confirm_force_tag(tag, None),
+                                lambda: self._ask_force_tag(tag), lambda: self.confirm_unforce_tag(tag))
+
+    def _shown(self, tag: Tag | None, kind: Kind = "word", addr: int = 0) -> str:
+        """What the memory holds now, as the view shows it (in the tag's units)."""
+        snap = self.source.snapshot()
+        if snap is None:
+            return self.tr("its value")
+        return tag.format(tag.value(snap)) if tag is not None else str(Force(kind, addr, 0).read(snap))
+
+    def confirm_force(self, kind: Kind, addr: int, value: int | None) -> Ticket | None:
+        """Force after the engineer confirms: the program and the plant lose this memory."""
+        where = Force(kind, addr, 0).where
+        to = (self.tr("at its value {0} (bumpless)").format(self._shown(None, kind, addr)) if value is None
+              else self.tr("to {0}").format(value))
+        if not self.ask(self.tr("Force"), tr(FORCE_QUESTION).format(where, to)):
+            return None
+        return self.force(kind, addr, value)
+
+    def confirm_force_tag(self, tag: Tag, phy: float | None) -> Ticket | None:
+        to = (self.tr("at its value {0} (bumpless)").format(self._shown(tag)) if phy is None
+              else self.tr("to {0}").format(tag.format(phy)))
+        if not self.ask(self.tr("Force"), tr(FORCE_QUESTION).format(tag.name, to)):
+            return None
+        return self.force_tag(tag, phy)
+
+    def confirm_unforce(self, kind: Kind, addr: int) -> Ticket | None:
+        """Unforce after the engineer confirms, told that the forced value stays in memory."""
+        where = Force(kind, addr, 0).where
+        if not self.ask(self.tr("Unforce"), self.tr("Unforce {0}?").format(where) + " "
+                        + words.unforce_stays(self._shown(None, kind, addr))):
+            return None
+        return self.unforce(kind, addr)
+
+    def confirm_unforce_tag(self, tag: Tag) -> Ticket | None:
+        stays = words.unforce_stays(self._shown(tag))
+        if not self.ask(self.tr("Unforce"), self.tr("Unforce {0}?").format(tag.name) + " " + stays):
+            return None
+        return self.unforce_tag(tag)
+
+    def ask_unforce_all(self) -> Ticket | None:
+        """The Unforce all button: asks first, naming how many forces go."""
+        forces = self.source.forces() or ()
+        if not self.ask(self.tr("Unforce all"), self.tr("Unforce all {0} forces?").format(len(forces)) + " "
+                        + words.unforce_stays("")):
+            return None
+        return self.unforce_all()
 
     def _add_force_actions(self, menu: QMenu, where: str, bumpless: Callable[[], None],
                            ask: Callable[[], None], release: Callable[[], None]) -> None:
         menu.setToolTipsVisible(True)  # a greyed action says which role it needs, or that all are read-only
-        for text, slot, act in ((f"Force {where} at its value (bumpless)", bumpless, Action.FORCE),
-                                (f"Force {where} to…", ask, Action.FORCE),
-                                (f"Unforce {where}", release, Action.UNFORCE)):
+        bumpless_text = self.tr("Force {0} at its value (bumpless)").format(where)
+        for text, slot, act in ((bumpless_text, bumpless, Action.FORCE),
+                                (self.tr("Force {0} to…").format(where), ask, Action.FORCE),
+                                (self.tr("Unforce {0}").format(where), release, Action.UNFORCE)):
             self._grant(menu.addAction(text, slot), act, text.rstrip("…"), keep=False)
 
     def _ask_force_tag(self, tag: Tag) -> None:
-        lo, hi = tag.phy_limits
-        text, ok = QInputDialog.getText(self, "Force", f"Force {tag.name} to ({tag.unit or 'value'}, "
-                                                       f"{lo:g}..{hi:g}):")
+        lo, hi = write_range(tag)  # PhyMin..PhyMax where the tag scales, not what its word holds
+        question = self.tr("Force {0} to ({1}, {2} .. {3}):").format(
+            tag.name, tag.unit or self.tr("value"), tag.format(lo), tag.format(hi))
+        text, ok = QInputDialog.getText(self, self.tr("Force"), question)
         if ok:
             try:
-                self.force_tag(tag, parse_phy(text, tag))
+                self.confirm_force_tag(tag, parse_force(text, tag))
             except ValueError as e:
                 self._say(str(e))
 
@@ -608,10 +685,11 @@ class ProgramMonitor(QWidget):
         return self._sent(f"unforce {tag.name}", self._acts().unforce_tag(tag, self.user()))
 
     def _ask_force(self, kind: Kind, addr: int, where: str) -> None:
-        text, ok = QInputDialog.getText(self, "Force", f"Force {where} to (decimal, 0x1F or 1Fh):")
+        question = self.tr("Force {0} to (decimal, 0x1F or 1Fh):").format(where)
+        text, ok = QInputDialog.getText(self, self.tr("Force"), question)
         if ok:
             try:
-                self.force(kind, addr, parse_value(text, kind))
+                self.confirm_force(kind, addr, parse_value(text, kind))
             except ValueError as e:
                 self._say(str(e))
 
@@ -624,11 +702,11 @@ class ProgramMonitor(QWidget):
         return self._sent(f"unforce {where}", self._acts().unforce(kind, addr, self.user()))
 
     def unforce_all(self) -> Ticket:
-        return self._sent("Unforce all", self._acts().unforce_all(self.user()))
+        return self._sent(self.tr("Unforce all"), self._acts().unforce_all(self.user()))
 
     def step(self) -> Ticket:
         """Step one scan (NetPlc stopped) and show its result at once."""
-        ticket = self._sent("Step one scan", self._acts().step(self.user()))
+        ticket = self._sent(self.tr("Step one scan"), self._acts().step(self.user()))
         self.refresh()
         return ticket
 
@@ -667,8 +745,8 @@ class ProgramMonitor(QWidget):
         """List the lines using `addr` (a symbol's uses) and mark them in the listing."""
         rows = self.listing.uses(addr)
         names = [n for n, a in self.listing.program.symbols.items() if a == addr]
-        self.uses_title.setText(f"Uses of {' / '.join(names) or fmt_octal(addr)} ({fmt_octal(addr)}): "
-                                f"{len(rows)} lines")
+        self.uses_title.setText(self.tr("Uses of {0} ({1}): {2} lines").format(
+            " / ".join(names) or fmt_octal(addr), fmt_octal(addr), len(rows)))
         self.uses.clear()
         for row in rows:
             r = self.listing.rows[row]
@@ -690,8 +768,9 @@ class ProgramMonitor(QWidget):
         for op in self.listing.operands[index]:
             name = op.kind if op.kind == "bit" else f"{op.role} word"
             text = fmt_octal(op.addr) + ("" if op.kind == "bit" else ":w")
-            menu.addAction(f"Follow uses of {name} {fmt_octal(op.addr)}", lambda a=op.addr: self.follow(a))
-            menu.addAction(f"Watch {text}", lambda t=text: self.add_watch(t))
+            menu.addAction(self.tr("Follow uses of {0} {1}").format(name, fmt_octal(op.addr)),
+                           lambda a=op.addr: self.follow(a))
+            menu.addAction(self.tr("Watch {0}").format(text), lambda t=text: self.add_watch(t))
             self._force_actions(menu, op.kind, op.addr, text)
             menu.addSeparator()
         menu.exec(where)

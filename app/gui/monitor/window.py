@@ -29,7 +29,8 @@ class ProgramWindow(QMainWindow):
     def __init__(self, source: Source, user: Callable[[], str], parent: QWidget | None = None) -> None:
         super().__init__(parent)
         self.source = source
-        self.setWindowTitle(f"Program — {source.title}" + ("" if source.acting else " (read-only)"))
+        self.setWindowTitle(self.tr("Program — {0}").format(source.title)
+                            + ("" if source.acting else self.tr(" (read-only)")))
         self.monitor = ProgramMonitor(source, user)
         self.setCentralWidget(self.monitor)
         self.monitor.said.connect(self.statusBar().showMessage)

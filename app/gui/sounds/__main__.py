@@ -1,0 +1,5 @@
+"""`python -m app.gui.sounds`: write the shipped alarm sounds again."""
+
+from app.gui.sounds import main
+
+main()
