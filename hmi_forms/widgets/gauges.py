@@ -596,7 +596,9 @@ class GaugeFace(Face):
         None where a painter must draw."""
         zone = shown.zone
         text = (shown.text or "---") + self.units
-        if not self.slot.fits(text):
+        slot = self.slot
+        # past its area, a text is repainted with its whole element, not with the area alone
+        if not slot.fits(text) or (self.part is not None and not slot.inside(text)):
             return None
         value = (text, self.inks[zone])
         kind = self.kind

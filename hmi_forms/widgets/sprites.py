@@ -89,6 +89,8 @@ class Glyphs:
         self.ascent = math.ceil(self.metrics.ascent())
         self.size = (0, math.ceil(self.metrics.height()) + 2 * PAD)
         self.advances: dict[str, float] = {}
+        self.advances64: dict[str, int] = {}  # the same in 64ths of a pixel, as Qt keeps them
+        self.widths: dict[str, int] = {}
         self.alone: set[str] = set()  # characters whose advance is the same beside every other here
         self.kerned: set[str] = set()  # characters whose advance changes beside one of them
         self.pixmaps = SPRITES.family(("glyphs", font.key(), dpr))  # (char, ink, fx, fy) -> Sprite
@@ -101,6 +103,8 @@ class Glyphs:
                 return False
             adv = self.metrics.horizontalAdvance
             own = self.advances[c] = adv(c)
+            self.advances64[c] = round(own * 64)
+            self.widths[c] = math.ceil(own) + 2 * PAD + 1  # of its pixmaps
             if any(adv(c + k) != own + self.advances[k] or adv(k + c) != own + self.advances[k]
                    for k in (*self.alone, c) if k != c) or adv(c + c) != 2 * own:
                 self.kerned.add(c)
@@ -118,8 +122,8 @@ class Glyphs:
         key = (c, ink.key, fx, fy)
         sprite = self.pixmaps.get(key)
         if sprite is None:
-            width = math.ceil(self.advances[c]) + 2 * PAD + 1
-            pix = blank(QSize(width, self.size[1] + 1), self.dpr, None)
+            width = self.widths[c]
+            pix = blank(QSize(width, self.size[1] + 1), self.dpr, None)  # (`TextSlot.draw` cuts it)
             p = QPainter(pix)
             try:  # a painter left open on a pixmap crashes Qt when the pixmap goes
                 p.setRenderHint(QPainter.RenderHint.Antialiasing)
@@ -140,9 +144,12 @@ class TextSlot:
     `drawText(box, align, text)` gives.
 
     `area` (by default the box with a margin for glyphs that overhang it) inside `bounds` (the
-    element's rectangle: a glyph never needs a clip) is what a new text repaints: filled with
-    `back`, the flat colour of that area, when the ink has one. A text wider than the area, or
-    one whose characters the font kerns, is drawn whole by the painter (`fits` says which)."""
+    element's rectangle) is what a new text repaints: filled with `back`, the flat colour of that
+    area, when the ink has one and the text lies inside it (`inside`). A text wider than the area
+    (a small gauge's readout of a wide range) is drawn from glyphs too, over what is there, cut
+    where drawText cuts a text wider than its box (the box, its edges rounded to whole pixels)
+    and where the form's clip cuts the element (`bounds`); without `bounds`, or when the font
+    kerns its characters, a text is drawn whole by the painter (`fits` says which)."""
 
     def __init__(self, box: QRectF, font: QFont, align: Qt.AlignmentFlag, dpr: float = 1.0,
                  area: QRectF | None = None, bounds: QRectF | None = None) -> None:
@@ -169,6 +176,18 @@ class TextSlot:
         else:
             span = right - box.left()
         self.span = span - 2
+        # where glyphs are cut (left, top, right, bottom; None: nowhere): at the element's sides,
+        # as the form clips an element, and, for a text wider or taller than its box, at the box
+        # as drawText clips it (its edges rounded half up to whole pixels, as Qt rounds a clip)
+        self.sides: tuple[int, ...] | None = None
+        self.cut: tuple[int, ...] | None = None
+        if bounds is not None:
+            self.sides = sides = (math.ceil(bounds.left()), math.ceil(bounds.top()),
+                                  math.floor(bounds.right()), math.floor(bounds.bottom()))
+            edges = [math.floor(v + 0.5) for v in (box.left(), box.top(), box.right(), box.bottom())]
+            self.cut = (max(sides[0], edges[0]), max(sides[1], edges[1]), min(sides[2], edges[2]),
+                        min(sides[3], edges[3]))
+        self.tall = self.metrics.height() > box.height()  # drawText clips every text to the box
 
     @property
     def rect(self) -> QRect:
@@ -176,10 +195,25 @@ class TextSlot:
         return QRect(self.at, self.size)
 
     def fits(self, text: str) -> bool:
-        """Whether `text` is drawn from glyphs: not kerned, and not wider than the area (a value far
-        out of its range is drawn whole by the painter instead)."""
+        """Whether `text` is drawn from glyphs: not kerned, and inside the area or cut at the
+        element's sides (without those a text wider than the area is drawn whole instead)."""
         glyphs = self.glyphs
-        return (glyphs.alone.issuperset(text) or glyphs.learn(text)) and glyphs.width(text) <= self.span
+        if not (glyphs.alone.issuperset(text) or glyphs.learn(text)):
+            return False
+        return self.sides is not None or glyphs.width(text) <= self.span
+
+    def inside(self, text: str) -> bool:
+        """Whether a text that `fits` lies inside the area (what a new text alone repaints)."""
+        return self.glyphs.width(text) <= self.span
+
+    def _left(self, width: float) -> float:
+        """Where drawText starts a line of `width` in the box."""
+        box, align = self.box, self.align
+        if align & Qt.AlignmentFlag.AlignRight:
+            return box.right() - width
+        if align & Qt.AlignmentFlag.AlignHCenter:
+            return box.left() + (box.width() - width) / 2
+        return box.left()
 
     def draw(self, p: QPainter, text: str, ink: Ink, x: int = 0, y: int = 0) -> None:
         """The text with the slot's box moved by (x, y) whole pixels (a form draws its elements
@@ -190,24 +224,32 @@ class TextSlot:
             p.drawText(self.box.translated(x, y), self.align, text)  # drawn whole, as drawText would
             return
         glyphs = self.glyphs
-        if ink.back is not None:
+        width = glyphs.width(text)
+        if ink.back is not None and width <= self.span:  # the flat colour under the text, opaque
             p.fillRect(x + self.at.x(), y + self.at.y(), self.size.width(), self.size.height(), ink.back)
-        box, align, advances, glyph = self.box, self.align, glyphs.advances, glyphs.glyph
-        if align & Qt.AlignmentFlag.AlignRight:
-            left = box.right() - glyphs.width(text)
-        elif align & Qt.AlignmentFlag.AlignHCenter:
-            left = box.left() + (box.width() - glyphs.width(text)) / 2
-        else:
-            left = box.left()
-        base = self.base + y
-        row = math.floor(base)
-        fy = int((base - row) * 64)  # as Qt turns a position into 64ths (QFixed::fromReal)
-        ox = left + x
+        advances, glyph = glyphs.advances64, glyphs.glyph
+        left = self._left(width)
+        clip = self.cut if width > self.box.width() or self.tall else self.sides
+        far = 1 << 30
+        x0, y0, x1, y1 = (-far, -far, far, far) if clip is None else (clip[0] + x, clip[1] + y,
+                                                                       clip[2] + x, clip[3] + y)
+        dpr, height = glyphs.dpr, glyphs.size[1] + 1
+        # positions in 64ths of a pixel, as Qt lays a line out: the start made whole 64ths once
+        # (QFixed::fromReal), then advanced by each glyph's advance, itself whole 64ths
+        row, fy = divmod(int((self.base + y) * 64), 64)
+        at = int((left + x) * 64)
         for c in text:
-            column = math.floor(ox)
-            dx, dy, pix = glyph(c, ink, int((ox - column) * 64), fy)
-            p.drawPixmap(column + dx, row + dy, pix)
-            ox += advances[c]
+            column, fx = divmod(at, 64)
+            dx, dy, pix = glyph(c, ink, fx, fy)
+            gx, gy = column + dx, row + dy
+            right, bottom = gx + glyphs.widths[c], gy + height
+            if x0 <= gx and right <= x1 and y0 <= gy and bottom <= y1:
+                p.drawPixmap(gx, gy, pix)
+            elif gx < x1 and x0 < right and gy < y1 and y0 < bottom:  # cut as a clip would cut it
+                a, b, t, u = max(x0, gx), min(x1, right), max(y0, gy), min(y1, bottom)
+                p.drawPixmap(a, t, pix, round((a - gx) * dpr), round((t - gy) * dpr), round((b - a) * dpr),
+                             round((u - t) * dpr))
+            at += advances[c]
 
 
 def draw_text(p: QPainter, slot: TextSlot, x: int, y: int, text: str, ink: Ink) -> None:

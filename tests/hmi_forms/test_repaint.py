@@ -206,6 +206,26 @@ def test_a_text_drawn_from_glyphs_is_pixel_for_pixel_the_drawn_text(qtbot) -> No
                         pictures.append(picture)
                     assert pictures[0] == pictures[1] == pictures[2], (font.key(), box, text)
     assert fitted > 100  # of 162: most from glyphs
+    for align in (theme.RIGHT, Qt.AlignmentFlag.AlignCenter):  # wider than its element: cut at its sides
+        box, bounds = QRectF(16.3, 4.6, 30.2, 18), QRectF(10, 0, 40, 30)
+        slot = TextSlot(box, theme.sized_font(12, bold=True, family=mono), align, bounds=bounds)
+        assert slot.fits("-1234.5 %") and not slot.inside("-1234.5 %")
+        pictures = []
+        for how in ("drawn, clipped", "from glyphs"):
+            picture = QImage(90, 40, QImage.Format.Format_ARGB32)
+            picture.fill(QColor("#ffffff"))
+            p = QPainter(picture)
+            p.setRenderHint(QPainter.RenderHint.Antialiasing)
+            if how == "drawn, clipped":
+                p.setClipRect(bounds.toRect())
+                p.setFont(slot.font)
+                p.setPen(theme.TEXT)
+                p.drawText(box, align, "-1234.5 %")
+            else:
+                slot.draw(p, "-1234.5 %", Ink(theme.TEXT))
+            p.end()
+            pictures.append(picture)
+        assert pictures[0] == pictures[1]
     assert all(len(key[0]) == 1 for key in slot.glyphs.pixmaps)  # pictures of characters, not of texts
 
 
@@ -292,7 +312,7 @@ def test_a_3000_element_bench_form_fits_the_form_limits(tmp_path) -> None:
     assert sum(e.TYPE == "Graph" for e in plots.elements) == 100
 
 
-def test_a_text_too_wide_for_its_cached_box_is_drawn_whole(qtbot, tmp_path) -> None:
+def test_a_text_too_wide_for_its_area_is_drawn_whole(qtbot, tmp_path) -> None:
     """A word far beyond AppMax gives a value wider than the scale's: it must not be cut."""
     doc = [{"type": "AnalogBase", "Name": "B", "x": 0, "y": 0, "w": 160, "h": 64, "InAddr": "04010",
             "Device": "Level", "Appearance": "hbar", "Units": "%"}]
@@ -303,9 +323,9 @@ def test_a_text_too_wide_for_its_cached_box_is_drawn_whole(qtbot, tmp_path) -> N
     assert view.pairs[0][0].text == "1600.4"
     picture = view.grab().toImage()
     value = slot._value
-    assert not value.fits("1600.4 %")  # not drawn from glyphs...
+    assert value.fits("1600.4 %") and not value.inside("1600.4 %")  # from glyphs, past the area...
     start = round(value.box.right() - value.metrics.horizontalAdvance("1600.4 %"))
-    assert start < value.at.x() - 2  # ...since it starts left of what the pixmaps cover
+    assert start < value.at.x() - 2  # ...since it starts left of the area
     left_of_cache = [(x, y) for x in range(start, value.at.x()) for y in range(2, 22)]
     assert any(picture.pixelColor(x, y).lightness() < 120 for x, y in left_of_cache)  # drawn all the same
 
