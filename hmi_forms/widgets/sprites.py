@@ -87,6 +87,7 @@ class Glyphs:
         self.font, self.dpr = font, dpr
         self.metrics = QFontMetricsF(font)
         self.ascent = math.ceil(self.metrics.ascent())
+        self.below = math.ceil(self.metrics.height()) + PAD + 1 - self.ascent  # pixmap rows below the base
         self.size = (0, math.ceil(self.metrics.height()) + 2 * PAD)
         self.advances: dict[str, float] = {}
         self.advances64: dict[str, int] = {}  # the same in 64ths of a pixel, as Qt keeps them
@@ -158,6 +159,7 @@ class TextSlot:
             area = area.intersected(bounds)
         left, top = math.ceil(area.left()), math.ceil(area.top())
         self.at = QPoint(left, top)
+        self.left, self.top = left, top
         self.size = QSize(max(1, math.floor(area.right()) - left), max(1, math.floor(area.bottom()) - top))
         self.box = box
         self.font = font
@@ -188,6 +190,14 @@ class TextSlot:
             self.cut = (max(sides[0], edges[0]), max(sides[1], edges[1]), min(sides[2], edges[2]),
                         min(sides[3], edges[3]))
         self.tall = self.metrics.height() > box.height()  # drawText clips every text to the box
+        if align & Qt.AlignmentFlag.AlignRight:  # a line of width w starts at anchor - pull * w
+            self.anchor, self.pull = box.right(), 1.0
+        elif align & Qt.AlignmentFlag.AlignHCenter:
+            self.anchor, self.pull = box.left() + box.width() / 2, 0.5
+        else:
+            self.anchor, self.pull = box.left(), 0.0
+        self.row, self.fy = divmod(int(self.base * 64), 64)  # the baseline in pixels and 64ths
+        self.span64, self.box64 = self.span * 64, box.width() * 64
 
     @property
     def rect(self) -> QRect:
@@ -208,50 +218,56 @@ class TextSlot:
 
     def _left(self, width: float) -> float:
         """Where drawText starts a line of `width` in the box."""
-        box, align = self.box, self.align
-        if align & Qt.AlignmentFlag.AlignRight:
-            return box.right() - width
-        if align & Qt.AlignmentFlag.AlignHCenter:
-            return box.left() + (box.width() - width) / 2
-        return box.left()
+        return self.anchor - self.pull * width
 
     def draw(self, p: QPainter, text: str, ink: Ink, x: int = 0, y: int = 0) -> None:
         """The text with the slot's box moved by (x, y) whole pixels (a form draws its elements
         at their places)."""
-        if not self.fits(text):
-            p.setFont(self.font)
-            p.setPen(ink.fore)
-            p.drawText(self.box.translated(x, y), self.align, text)  # drawn whole, as drawText would
+        if self.fits(text):
+            self.paint(p, text, ink, x, y)
             return
+        p.setFont(self.font)
+        p.setPen(ink.fore)
+        p.drawText(self.box.translated(x, y), self.align, text)  # drawn whole, as drawText would
+
+    def paint(self, p: QPainter, text: str, ink: Ink, x: int = 0, y: int = 0) -> None:
+        """`draw` of a text that `fits`, glyph by glyph. Positions are in 64ths of a pixel, as Qt
+        lays a line out in the element: its start made whole 64ths once (QFixed::fromReal), then
+        advanced by each glyph's advance, itself whole 64ths."""
         glyphs = self.glyphs
-        width = glyphs.width(text)
-        if ink.back is not None and width <= self.span:  # the flat colour under the text, opaque
-            p.fillRect(x + self.at.x(), y + self.at.y(), self.size.width(), self.size.height(), ink.back)
-        advances, glyph = glyphs.advances64, glyphs.glyph
-        left = self._left(width)
-        clip = self.cut if width > self.box.width() or self.tall else self.sides
-        far = 1 << 30
-        x0, y0, x1, y1 = (-far, -far, far, far) if clip is None else (clip[0] + x, clip[1] + y,
-                                                                       clip[2] + x, clip[3] + y)
+        advances = glyphs.advances64
+        width = sum(map(advances.__getitem__, text))
+        if ink.back is not None and width <= self.span64:  # the flat colour under the text, opaque
+            p.fillRect(x + self.left, y + self.top, self.size.width(), self.size.height(), ink.back)
+        at = int(self._left(width / 64) * 64) + (x << 6)
+        gy, fy = self.row + y, self.fy
+        clip = self.cut if width > self.box64 or self.tall else self.sides
+        get, glyph, key = glyphs.pixmaps.get, glyphs.glyph, ink.key
+        if clip is None or (clip[0] + x <= (at >> 6) - PAD and (at + width >> 6) + PAD + 2 <= clip[2] + x and
+                            clip[1] + y <= gy - PAD - glyphs.ascent and gy + glyphs.below <= clip[3] + y):
+            for c in text:  # (the usual case: nothing to cut)
+                fx = at & 63
+                dx, dy, pix = get((c, key, fx, fy)) or glyph(c, ink, fx, fy)
+                p.drawPixmap((at >> 6) + dx, gy + dy, pix)
+                at += advances[c]
+            return
+        x0, y0, x1, y1 = clip[0] + x, clip[1] + y, clip[2] + x, clip[3] + y
         dpr, height = glyphs.dpr, glyphs.size[1] + 1
-        # positions in 64ths of a pixel, as Qt lays a line out: the start made whole 64ths once
-        # (QFixed::fromReal), then advanced by each glyph's advance, itself whole 64ths
-        row, fy = divmod(int((self.base + y) * 64), 64)
-        at = int((left + x) * 64)
         for c in text:
-            column, fx = divmod(at, 64)
-            dx, dy, pix = glyph(c, ink, fx, fy)
-            gx, gy = column + dx, row + dy
-            right, bottom = gx + glyphs.widths[c], gy + height
-            if x0 <= gx and right <= x1 and y0 <= gy and bottom <= y1:
-                p.drawPixmap(gx, gy, pix)
-            elif gx < x1 and x0 < right and gy < y1 and y0 < bottom:  # cut as a clip would cut it
-                a, b, t, u = max(x0, gx), min(x1, right), max(y0, gy), min(y1, bottom)
-                p.drawPixmap(a, t, pix, round((a - gx) * dpr), round((t - gy) * dpr), round((b - a) * dpr),
+            fx = at & 63
+            dx, dy, pix = get((c, key, fx, fy)) or glyph(c, ink, fx, fy)
+            gx, top = (at >> 6) + dx, gy + dy
+            right, bottom = gx + glyphs.widths[c], top + height
+            if x0 <= gx and right <= x1 and y0 <= top and bottom <= y1:
+                p.drawPixmap(gx, top, pix)
+            elif gx < x1 and x0 < right and top < y1 and y0 < bottom:  # cut as a clip would cut it
+                a, b, t, u = max(x0, gx), min(x1, right), max(y0, top), min(y1, bottom)
+                p.drawPixmap(a, t, pix, round((a - gx) * dpr), round((t - top) * dpr), round((b - a) * dpr),
                              round((u - t) * dpr))
             at += advances[c]
 
 
 def draw_text(p: QPainter, slot: TextSlot, x: int, y: int, text: str, ink: Ink) -> None:
-    """A form's composition step (`base.Op`) for a value's text at the element's place (x, y)."""
-    slot.draw(p, text, ink, x, y)
+    """A form's composition step (`base.Op`) for a value's text at the element's place (x, y): a
+    text the gauge found `fits`."""
+    slot.paint(p, text, ink, x, y)
