@@ -262,8 +262,11 @@ class TextSlot:
                 p.drawPixmap(gx, top, pix)
             elif gx < x1 and x0 < right and top < y1 and y0 < bottom:  # cut as a clip would cut it
                 a, b, t, u = max(x0, gx), min(x1, right), max(y0, top), min(y1, bottom)
-                p.drawPixmap(a, t, pix, round((a - gx) * dpr), round((t - top) * dpr), round((b - a) * dpr),
-                             round((u - t) * dpr))
+                if dpr == 1.0:
+                    p.drawPixmap(a, t, pix, a - gx, t - top, b - a, u - t)
+                else:
+                    p.drawPixmap(a, t, pix, round((a - gx) * dpr), round((t - top) * dpr),
+                                 round((b - a) * dpr), round((u - t) * dpr))
             at += advances[c]
 
 
