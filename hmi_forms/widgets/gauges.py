@@ -559,14 +559,14 @@ class GaugeFace(Face):
         """`Face.put`, with the composition of what the model shows looked up in one step."""
         if not self.fresh:
             self.load()
-        try:
-            was, text, extra = self.entries[shown.hw]
-        except KeyError:
-            was = None
-        if was is not shown or self.style_of(self.attrs) != self.style:
+        if not self.contained or self.style_of(self.attrs) != self.style:
             self.sync()
             return False
-        drawn = self._ops(shown.zone, text, extra)
+        entry = self._entry(shown)  # a word not shown lately: its parts, then drawn as one that was
+        if entry is None:
+            self.sync()
+            return False
+        drawn = self._ops(shown.zone, entry[1], entry[2])
         if drawn == self.drawn:
             return False
         self.drawn, self.painted = drawn, None
@@ -580,16 +580,21 @@ class GaugeFace(Face):
         if m.stale or not self.contained or marked or self.restyled():
             return None
         shown = m.shown
-        entry = self.entries.get(shown.hw)
+        entry = self._entry(shown)
+        return None if entry is None else self._ops(shown.zone, entry[1], entry[2])
+
+    def _entry(self, shown: Shown) -> Entry | None:
+        """What `shown` is drawn with, from `entries` or made now; None where a painter must draw."""
+        entries = self.entries
+        entry = entries.get(shown.hw)
         if entry is None or entry[0] is not shown:
             parts = self._parts(shown)
             if parts is None:
                 return None
-            entries = self.entries
             if len(entries) >= MAX_ENTRIES:  # bounded: a plant's words over their range do not recur
                 entries.clear()
             entry = entries[shown.hw] = (shown, *parts)
-        return self._ops(shown.zone, entry[1], entry[2])
+        return entry
 
     def _parts(self, shown: Shown) -> tuple[tuple[str, Ink], object] | None:
         """The value's text and ink, and the needle's sprite or the bar's fill (width, colour);
