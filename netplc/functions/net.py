@@ -30,8 +30,8 @@ def node(mem: Memory, fon: Fon) -> Step:
 @register(301, "NREAD", s="O", d="M", r="D")
 @built
 def nread(mem: Memory, fon: Fon) -> Step:
-    """Read R bytes at the node's address S into local D. Built once: a program at a fast tick
-    runs every NREAD on every scan, most of them finding their request still in flight."""
+    """Read R bytes at the node's address S into local D."""
+    # built once: at a fast tick every NREAD runs every scan, most finding their request in flight
     key, remote, local, length = fon.index, fon.s or 0, fon.d or 0, fon.r or 0
     link, bits = fon.c + 1, mem.bits
 
