@@ -88,7 +88,7 @@ class Glyphs:
         self.metrics = QFontMetricsF(font)
         self.ascent = math.ceil(self.metrics.ascent())
         self.below = math.ceil(self.metrics.height()) + PAD + 1 - self.ascent  # pixmap rows below the base
-        self.size = (0, math.ceil(self.metrics.height()) + 2 * PAD)
+        self.height = math.ceil(self.metrics.height()) + 2 * PAD + 1  # of its pixmaps
         self.advances: dict[str, float] = {}
         self.advances64: dict[str, int] = {}  # the same in 64ths of a pixel, as Qt keeps them
         self.widths: dict[str, int] = {}
@@ -124,7 +124,7 @@ class Glyphs:
         sprite = self.pixmaps.get(key)
         if sprite is None:
             width = self.widths[c]
-            pix = blank(QSize(width, self.size[1] + 1), self.dpr, None)  # (`TextSlot.draw` cuts it)
+            pix = blank(QSize(width, self.height), self.dpr, None)  # (`TextSlot.draw` cuts it)
             p = QPainter(pix)
             try:  # a painter left open on a pixmap crashes Qt when the pixmap goes
                 p.setRenderHint(QPainter.RenderHint.Antialiasing)
@@ -252,7 +252,7 @@ class TextSlot:
                 at += advances[c]
             return
         x0, y0, x1, y1 = clip[0] + x, clip[1] + y, clip[2] + x, clip[3] + y
-        dpr, height = glyphs.dpr, glyphs.size[1] + 1
+        dpr, height = glyphs.dpr, glyphs.height
         for c in text:
             fx = at & 63
             dx, dy, pix = get((c, key, fx, fy)) or glyph(c, ink, fx, fy)
