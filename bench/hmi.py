@@ -5,10 +5,19 @@ A generated form of N elements (`--elements`, default 300) laid out in a square 
 dials, two discrete colour labels, one digital readout and one bar, every one bound to a value that
 changes on every tick. One tick = what the workstation does with a snapshot: FormView.refresh
 (models, change detection, repaint scheduling) and the paint that follows (processEvents). The
-yardstick is N plain QLabels on the same grid, each given a new text per tick with setText and
-painted the same way. Ticks of the two alternate, so both see the same machine load. Prints per
-tick the mean, median, p95 and worst of the form, the yardstick beside it and the ratio of the
-medians, and the resident memory after warm-up and after all ticks (flat = no growth).
+yardstick is N plain QLabels on the same grid, each given per tick the text the element's model
+makes of the same word with setText, and painted the same way: the least a changing number costs
+in Qt, so a form at or below it costs nothing for its dials, bars and colours.
+
+The values are a plant's (`--workload full`, the default): each word anywhere in 0..65535 (a
+transmitter's full range, shown scaled to 0..10000 with one decimal), every word a new value at
+every tick, so a cache of pictures per value never warms up and the memory figures show whether
+every cache is bounded. `--workload demo` is the old one: 1,001 values of 0..1000 (scaled to
+0..100), which a per-value cache holds after a few hundred ticks.
+
+Ticks of the form and the yardstick alternate, so both see the same machine load. Prints per tick
+the mean, median, p95 and worst of the form, the yardstick beside it and the ratio of the medians,
+and the resident memory after warm-up and after all ticks (flat = no growth).
 
 `--readings` refreshes as the workstation does, with the runtime's Readings of each scan: the
 words come from NREADs of one node (64 words each, link up), so every element's data quality is
@@ -26,6 +35,7 @@ trend buffers and mapped to the same time window, redrawn in the same ticks: the
 can cost in Qt, so a plot with its axes at or below it costs nothing for being a pyqtgraph plot.
 
     QT_QPA_PLATFORM=offscreen python bench/hmi.py [--elements N] [--ticks T] [--plots] [--readings]
+        [--workload full|demo]
 """
 
 from __future__ import annotations
@@ -115,8 +125,16 @@ def places(n: int, plots: bool) -> tuple[int, int, list[tuple[str, int, int, int
     return cols, (tile + cols - 1) // cols, out
 
 
-def generate(folder: Path, n: int, plots: bool) -> Path:
+# (AppMax, PhyMax, the word of element i at a tick) of each workload
+WORKLOADS = {
+    "full": (65535, 10000, lambda tick, i: (tick * 40503 + i * 9973) & 0xFFFF),
+    "demo": (1000, 100, lambda tick, i: (tick * 7 + i * 13) % 1001),
+}
+
+
+def generate(folder: Path, n: int, plots: bool, workload: str = "full") -> Path:
     cols, rows, placed = places(n, plots)
+    app_max, phy_max, _ = WORKLOADS[workload]
     elements = []
     for i, (kind, x, y, span) in enumerate(placed):
         word, bit = f"0{word_addr(i):o}", f"0{bit_addr(i):o}"
@@ -129,9 +147,9 @@ def generate(folder: Path, n: int, plots: bool) -> Path:
             elements.append({"type": "Graph", "Name": f"G{i}", **place, "Address": bit, "Elements": 100})
         else:
             elements.append({"type": "AnalogBase", "Name": f"A{i}", **place, "InAddr": word,
-                             "Device": "Raw", "Units": "%", "Appearance": kind, "PhyHigh": 90})
+                             "Device": "Raw", "Units": "%", "Appearance": kind, "PhyHigh": 0.9 * phy_max})
     doc = {"form": {"title": "bench", "width": cols * TILE, "height": rows * TILE},
-           "devices": [{"Name": "Raw", "AppMin": 0, "AppMax": 1000, "PhyMin": 0, "PhyMax": 100}],
+           "devices": [{"Name": "Raw", "AppMin": 0, "AppMax": app_max, "PhyMin": 0, "PhyMax": phy_max}],
            "elements": elements}
     path = folder / "bench.hmi"
     path.write_text(json.dumps(doc))
@@ -151,11 +169,11 @@ def station(n: int) -> QualityMap:
     return QualityMap(parse("\n".join([*lines, "JMP 0", ""])), [])
 
 
-def drive(mem: Memory, n: int, tick: int) -> None:
-    """Every element's value changes on every tick: words step by at least 0.7 % of the range,
-    bits toggle."""
+def drive(mem: Memory, n: int, tick: int, workload: str = "full") -> None:
+    """Every element's value changes on every tick (words as `WORKLOADS` says), bits toggle."""
+    word = WORKLOADS[workload][2]
     for i in range(n):
-        mem.set_word(word_addr(i), (tick * 7 + i * 13) % 1001)
+        mem.set_word(word_addr(i), word(tick, i))
     for i in range(min(n, 0o1700)):
         mem.set_bit(0o2000 + i, (tick + i) % 2)
 
@@ -216,17 +234,20 @@ def main() -> None:
     parser.add_argument("--ticks", type=int, default=1000, help="ticks measured (default 1000)")
     parser.add_argument("--plots", action="store_true", help="every sixth element a trend plot, not a bar")
     parser.add_argument("--readings", action="store_true", help="judge data quality as the workstation does")
+    parser.add_argument("--workload", choices=sorted(WORKLOADS), default="full",
+                        help="full: words over 0..65535, a new value each tick (default); demo: 1,001 values")
     args = parser.parse_args()
     n, ticks = args.elements, args.ticks
     app = QApplication.instance() or QApplication([])
     with tempfile.TemporaryDirectory() as tmp:
-        form = load_form(generate(Path(tmp), n, args.plots))
+        form = load_form(generate(Path(tmp), n, args.plots, args.workload))
     clock = FakeClock()  # 100 ms ticks for the plot redraw pacing, however fast the replay runs
     view = FormView(form, NullTarget(), clock=clock)
     view.show()
     window, plain, lines = yardstick(n, view.trends)
     window.show()
     mem = Memory()
+    scale = WORKLOADS[args.workload][1] / WORKLOADS[args.workload][0]
     qmap, links = station(n), LinkView(links={0: True})
     app.processEvents()
     # allocated up front, so that the measurement itself does not grow the memory it measures
@@ -237,7 +258,7 @@ def main() -> None:
     warm = min(200, ticks // 10)
     rss_warm = (0.0, 0.0)
     for tick in range(ticks):
-        drive(mem, n, tick)
+        drive(mem, n, tick, args.workload)
         snap = mem.snapshot(tick, tick * 0.1, 1.8e9 + tick * 0.1)
         readings = Readings(snap, qmap, links, qmap.evaluate(snap, links)) if args.readings else None
         clock.advance(0.1)
@@ -254,7 +275,7 @@ def main() -> None:
             redraws.append(tick)
         t0 = time.perf_counter()
         for i, label in plain:  # the text a model would make of the same word
-            label.setText(f"{snap.get_word(word_addr(i)) / 10:.1f}")
+            label.setText(f"{snap.get_word(word_addr(i)) * scale:.1f}")
         if redrew:
             for line in lines:
                 line.redraw(snap.wall)
@@ -268,7 +289,8 @@ def main() -> None:
     refresh = statistics.mean(models[warm:])
     what = f"plots redrawn together every {REDRAW_INTERVAL:g} s, " if args.plots else ""
     what += f"quality judged against {len(qmap.feeds)} NREADs, " if args.readings else ""
-    print(f"hmi form update, {n} elements all changing every tick, {form.width}x{form.height} px: "
+    print(f"hmi form update, {n} elements all changing every tick ({args.workload} workload), "
+          f"{form.width}x{form.height} px: "
           f"{mean:.2f} ms mean, {median:.2f} ms median, {p95:.2f} ms p95, {worst:.2f} ms worst over "
           f"{ticks - warm} ticks (of it refresh {refresh:.2f} ms, paint {mean - refresh:.2f} ms); {what}"
           f"target <= {TICK_MS / 2:g} ms")

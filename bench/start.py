@@ -3,9 +3,13 @@
 Each run is a fresh `python` process doing what `python main.py --no-gui STATION` does (import,
 read station.toml, load messages and program, start the archive, Modbus server and scan thread)
 and stopping at the first finished scan. Runs alternate between a cold start (no compiled-program
-cache beside the archive) and a warm one (the cache of the previous start), and with the
-yardsticks measured in the same run: `python -c pass` (the interpreter alone) and a process that
-only imports the packages. Target (issue 16): first scan <= 0.5 s after the process starts.
+cache beside the archive) and a warm one (the cache of the previous start), interleaved with the
+yardsticks: `python -c pass` (the interpreter alone) and a process that imports exactly the
+modules the station's start loaded, in the order it loaded them, and does nothing else. That is
+fair: it is the least any start of this station can cost, so start / imports says what the
+station adds to its imports (issue 28: warm start <= 1.3x), and a module the configuration does
+not use (Qt, pymodbus, the form code) would count against neither. Each row: median and worst.
+Target (issue 16): first scan <= 0.5 s after the process starts.
 
     .venv/bin/python bench/start.py [--runs N]
 """
@@ -53,6 +57,16 @@ while runtime.engine.stats.count < 1:
 t["first_scan"] = time.time()
 runtime.stop()
 print(json.dumps(t))
+print(json.dumps(list(sys.modules)))
+"""
+
+# the yardstick: the modules a start loaded, imported in the same order, nothing else
+IMPORTS = """
+import importlib, json, sys
+sys.path.insert(0, sys.argv[2])
+for name in json.loads(open(sys.argv[1], encoding="utf-8").read()):
+    if name not in sys.modules:
+        importlib.import_module(name)
 """
 
 
@@ -64,12 +78,15 @@ def make_station(folder: Path) -> int:
     return len(text.splitlines())
 
 
-def timed(args: list[str]) -> tuple[float, dict[str, float]]:
+def timed(args: list[str]) -> tuple[float, dict]:
     """Seconds from just before the process is created to its end, and what it printed."""
     t0 = time.time()
     r = subprocess.run([sys.executable, *args], capture_output=True, text=True, check=True, cwd=ROOT)
     end = time.time()
-    phases = {k: v - t0 for k, v in json.loads(r.stdout).items()} if r.stdout.strip() else {}
+    lines = r.stdout.splitlines()
+    phases = {k: v - t0 for k, v in json.loads(lines[0]).items()} if lines else {}
+    if len(lines) > 1:
+        phases["modules"] = lines[1]
     return end - t0, phases
 
 
@@ -105,6 +122,10 @@ def phases_in_process(station: Path) -> str:
     return ", ".join(f"{k} {v:.0f} ms" for k, v in figures.items()) + f" ({len(source):,} chars of Python)"
 
 
+def spread(values: list[float]) -> str:
+    return f"median {statistics.median(values):.0f}, worst {max(values):.0f}"
+
+
 def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--runs", type=int, default=5)
@@ -115,36 +136,40 @@ def main() -> None:
         print(f"station: {lines}-line program of 8192 words (bench/scan.py, seed 165), archive, "
               f"Modbus server; {args.runs} runs of each, interleaved")
         cache = station / "archive" / "compiled"
-        names = ("python -c pass", "import app.station.runtime", "cold", "warm")
+        needed = station / "modules.json"  # what a start loaded, for the imports yardstick
+        timed(["-c", CHILD, str(station), str(ROOT)])  # a first start: the cache and the module list
+        needed.write_text(timed(["-c", CHILD, str(station), str(ROOT)])[1]["modules"], encoding="utf-8")
+        names = ("python -c pass", "imports", "cold", "warm")
         rows: dict[str, list[float]] = {k: [] for k in names}
-        parts: dict[str, list[dict[str, float]]] = {"cold": [], "warm": []}
+        parts: dict[str, list[dict]] = {"cold": [], "warm": []}
         for _ in range(args.runs):
-            rows["python -c pass"].append(timed(["-c", "pass"])[0])
-            imports = ["-c", "import app.station.config, app.station.runtime"]
-            rows["import app.station.runtime"].append(timed(imports)[0])
+            rows["python -c pass"].append(timed(["-c", "pass"])[0] * 1e3)
+            rows["imports"].append(timed(["-c", IMPORTS, str(needed), str(ROOT)])[0] * 1e3)
             for kind in ("cold", "warm"):
                 if kind == "cold":
                     shutil.rmtree(cache, ignore_errors=True)
                 _, phases = timed(["-c", CHILD, str(station), str(ROOT)])
-                rows[kind].append(phases["first_scan"])
+                rows[kind].append(phases["first_scan"] * 1e3)
                 parts[kind].append(phases)
-        med = {k: statistics.median(v) * 1e3 for k, v in rows.items()}
+        count = len(json.loads(needed.read_text(encoding="utf-8")))
+        print(f"  yardsticks: python -c pass {spread(rows['python -c pass'])} ms; importing the {count} "
+              f"modules a start loads {spread(rows['imports'])} ms")
         for kind in ("cold", "warm"):
-            p = {k: statistics.median(ph[k] for ph in parts[kind]) * 1e3 for k in parts[kind][0]}
-            print(f"  {kind} start: first scan {med[kind]:.0f} ms after the process was created "
-                  f"(min {min(rows[kind]) * 1e3:.0f}, max {max(rows[kind]) * 1e3:.0f}): interpreter up "
-                  f"{p['main']:.0f}, imports {p['imported'] - p['main']:.0f}, station + messages + program "
-                  f"{p['loaded'] - p['imported']:.0f}, archive + engine (compile) + server "
+            p = {k: statistics.median(ph[k] for ph in parts[kind]) * 1e3
+                 for k in parts[kind][0] if k != "modules"}
+            ratios = [s / i for s, i in zip(rows[kind], rows["imports"], strict=True)]
+            print(f"  {kind} start: first scan {spread(rows[kind])} ms after the process was created, "
+                  f"{statistics.median(ratios):.2f}x the imports (worst run {max(ratios):.2f}x); medians: "
+                  f"interpreter up {p['main']:.0f}, imports {p['imported'] - p['main']:.0f}, "
+                  f"station + messages + program {p['loaded'] - p['imported']:.0f}, "
+                  f"archive + engine (compile) + server "
                   f"{p['started'] - p['loaded']:.0f}, first scan {p['first_scan'] - p['started']:.0f} ms")
-        print(f"  yardsticks: python -c pass {med['python -c pass']:.0f} ms, importing the packages "
-              f"{med['import app.station.runtime']:.0f} ms")
-        bare, imports = med["python -c pass"], med["import app.station.runtime"]
-        print(f"  warm start = {med['warm'] / bare:.1f}x python -c pass, "
-              f"{med['warm'] / imports:.2f}x the imports alone; cold start "
-              f"{med['cold'] / bare:.1f}x / {med['cold'] / imports:.2f}x")
         print(f"  in process: {phases_in_process(station)}")
-        ok = med["cold"] <= 500 and med["warm"] <= 500
-        print(f"target first scan <= 500 ms (cold and warm): {'met' if ok else 'NOT met'}")
+        worst = max(s / i for s, i in zip(rows["warm"], rows["imports"], strict=True))
+        fast = max(statistics.median(rows["cold"]), statistics.median(rows["warm"])) <= 500
+        print(f"target warm start <= 1.3x the imports in every run: {'met' if worst <= 1.3 else 'NOT met'} "
+              f"(worst {worst:.2f}x); first scan <= 500 ms (median, cold and warm): "
+              f"{'met' if fast else 'NOT met'}")
 
 
 if __name__ == "__main__":

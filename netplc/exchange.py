@@ -268,7 +268,7 @@ class _Node:
         self.idle = max(config.timeout, PROBE_IDLE)
         self.active = time.monotonic()  # when the last request or probe ended
         self.busy = False  # a request or probe is being served
-        self.blocks: dict[tuple[int, int], Block] = {}  # (remote, length) -> where it is
+        self.blocks: dict[tuple[int, int], tuple[Block, str]] = {}  # (remote, length) -> where it is
         # the answers since the last normal one, all exceptions: how many, to which requests, which codes
         self.refusals = 0
         self.refused: set[int] = set()  # request keys (PROBE's too)
@@ -318,15 +318,16 @@ class _Node:
         now = time.monotonic()
         if now < self.retry_at:
             return None, self.stats.last_error or "link down"
-        where = describe(self.config.profile, req.remote)
         length = req.length if req.payload is None else len(req.payload)
-        block = self.blocks.get((req.remote, length))
-        if block is None:  # an instruction asks for the same block every scan: map it once
+        located = self.blocks.get((req.remote, length))
+        if located is None:  # an instruction asks for the same block every scan: map it once
+            where = describe(self.config.profile, req.remote)
             try:
-                block = locate(self.config.profile, self.config.table, req.remote, length)
+                located = locate(self.config.profile, self.config.table, req.remote, length), where
             except MapError as e:
                 return None, f"{where}: {e}"
-            self.blocks[req.remote, length] = block
+            self.blocks[req.remote, length] = located
+        block, where = located
         if req.payload is None:
             data, error = await self.transact(lambda: self.read(block), where, req.key)
         else:

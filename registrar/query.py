@@ -22,9 +22,8 @@ from dataclasses import replace
 from pathlib import Path
 from urllib.parse import quote
 
-import numpy as np
-
 from app.scada.tag import Tag
+from netplc.lazy import lazy
 from registrar.plant.url import is_url
 from registrar.reading import (
     EXPORT_CHUNK,
@@ -51,6 +50,8 @@ from registrar.schema import (
     text_index,
     zone,
 )
+
+np = lazy("numpy")  # loaded at first use: only a station with tags or forms needs it
 
 PROBE_ROWS = 20_000  # newest rows tried first for a page (a couple of milliseconds)
 INDEX_ROWS = 50_000  # up to this many index matches are fetched and sorted rather than scanned

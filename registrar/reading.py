@@ -10,9 +10,10 @@ import datetime as dt
 from dataclasses import dataclass
 from typing import NamedTuple
 
-import numpy as np
-
 from app.scada.tag import Tag
+from netplc.lazy import lazy
+
+np = lazy("numpy")  # loaded at first use: only a station with tags or forms needs it
 
 EXPORT_CHUNK = 10_000
 

@@ -216,3 +216,20 @@ def test_the_soft_plc_knows_nothing_of_the_station() -> None:
     above = sorted(f"{m} imports {d}" for m, deps in graph().items() if under(m, ("netplc",))
                    for d in deps if under(d, ("app", "registrar", "hmi_forms")))
     assert above == []
+
+
+def test_a_headless_station_imports_only_what_its_configuration_uses(tmp_path: Path) -> None:
+    """Issue 28: `main.py --no-gui` of a station with a program, an archive and the Modbus server
+    (no forms, no serial line, no OPC UA, MQTT or plant archive) imports no Qt, no form code and
+    none of pymodbus, asyncua, paho or psycopg: `-X importtime` lists every module it loaded."""
+    (tmp_path / "station.toml").write_text('NetPlcProgram = "p.stl"\nArchive = "archive/journal.sqlite"\n'
+                                           "[modbus_server]\nport = 0\n", encoding="utf-8")
+    (tmp_path / "p.stl").write_text("JMP 0\n", encoding="utf-8")
+    r = subprocess.run([sys.executable, "-X", "importtime", "main.py", "--no-gui", str(tmp_path),
+                        "--duration", "0.2"], cwd=REPO, capture_output=True, text=True, timeout=60)
+    assert r.returncode == 0, r.stderr[-2000:]
+    loaded = {line.rsplit("|", 1)[1].strip() for line in r.stderr.splitlines()
+              if line.startswith("import time:") and line.count("|") == 2}
+    assert "app.station.runtime" in loaded  # what importtime lists is the station's start
+    unused = (*QT, "hmi_forms", "pymodbus", "asyncua", "paho", "psycopg", "google.protobuf")
+    assert sorted(m for m in loaded if under(m, unused)) == []

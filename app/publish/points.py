@@ -13,13 +13,14 @@ import fnmatch
 from collections.abc import Iterable, Sequence
 from dataclasses import dataclass
 
-import numpy as np
-
 from app.authority import Action, Commands, Reason, Ticket, Who
 from app.scada.quality import Operands, QualityMap
 from app.scada.readings import Readings
 from app.scada.tag import SIZES, Tag, TagReader, TagType, check_address
 from netplc.address import IO_BITS, AddressError
+from netplc.lazy import lazy
+
+np = lazy("numpy")  # loaded at first use: only a station with tags or forms needs it
 
 
 def symbol_tags(symbols: dict[str, int]) -> list[Tag]:

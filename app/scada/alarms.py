@@ -42,13 +42,14 @@ from dataclasses import dataclass, field
 from enum import IntEnum, StrEnum
 from typing import Any, Protocol
 
-import numpy as np
-
-from app.scada.quality import ALARMED_CODES, HELD_CODES
+from app.scada.quality import code_flags
 from app.scada.table import TagTable
 from app.scada.tag import Tag, TagReader
+from netplc.lazy import lazy
 from netplc.memory import MemoryView
 from netplc.records import NullSink, Record, RecordSink
+
+np = lazy("numpy")  # loaded at first use: only a station with tags or forms needs it
 
 PRIORITIES = {1: "critical", 2: "high", 3: "medium", 4: "low"}
 MESSAGE_PRIORITY = {3: 1, 2: 2}  # NMSG type 3 critical -> priority 1, type 2 alarm -> priority 2
@@ -398,8 +399,9 @@ class AlarmSystem:
         if isinstance(quality, Mapping):
             quality = [quality.get(t.name, 0) for t in self.tags]
         codes = np.asarray(quality, dtype=np.intp) if quality is not None else None
-        alarmed = ALARMED_CODES[codes] if codes is not None else None
-        held = HELD_CODES[codes] if codes is not None else None
+        alarmed_codes, held_codes = code_flags()
+        alarmed = alarmed_codes[codes] if codes is not None else None
+        held = held_codes[codes] if codes is not None else None
         frozen = None
         if held is not None and held.any():  # process alarms while held, quality ones unless alarmed
             frozen = np.concatenate((self._proc_idx[held[self._proc_tag]],

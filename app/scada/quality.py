@@ -35,17 +35,19 @@ operand addresses of the scan, which the runtime fills from the snapshot's force
 
 from __future__ import annotations
 
+import functools
 from collections.abc import Collection, Mapping, Sequence
 from dataclasses import dataclass
 from enum import IntEnum
 
-import numpy as np
-
 from app.scada.tag import Tag, span
 from netplc.address import IO_BITS
 from netplc.exchange import NODE, NREAD, NWRITE, _fon_nodes
+from netplc.lazy import lazy
 from netplc.memory import MemoryView
 from netplc.program import Instr, Program
+
+np = lazy("numpy")  # loaded at first use: only a station with tags or forms needs it
 
 STALE_TICKS = 2  # scans of lateness tolerated beyond the normal one-scan answer
 NORMAL_AGE = 1  # scans from a request to its data in memory, normally
@@ -84,8 +86,13 @@ class Quality(IntEnum):
 
 _WORDS = {Quality.GOOD: "good", Quality.INITIAL: "initial", Quality.STALE: "stale",
           Quality.COMM_FAIL: "comm-fail", Quality.NOT_RUNNING: "not running", Quality.FORCED: "forced"}
-ALARMED_CODES = np.array([q.alarmed for q in Quality], dtype=bool)  # indexed by quality code
-HELD_CODES = np.array([q.held for q in Quality], dtype=bool)
+
+
+@functools.cache
+def code_flags() -> tuple[np.ndarray, np.ndarray]:
+    """Alarmed and held, indexed by quality code: made at first use (numpy loads with tags)."""
+    return (np.array([q.alarmed for q in Quality], dtype=bool),
+            np.array([q.held for q in Quality], dtype=bool))
 
 
 MAX_SPANS = 65536  # operand spans whose feeding NREADs are kept (QualityMap.feeding)

@@ -14,10 +14,11 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass, replace
 
-import numpy as np
-
 from app.scada.quality import LinkView, Operands, Quality, QualityMap
+from netplc.lazy import lazy
 from netplc.memory import Snapshot
+
+np = lazy("numpy")  # loaded at first use: only a station with tags or forms needs it
 
 
 @dataclass(frozen=True, slots=True)

@@ -15,14 +15,15 @@ from __future__ import annotations
 from collections.abc import Mapping, Sequence
 from dataclasses import replace
 
-import numpy as np
-
-from app.scada.quality import HELD_CODES, LinkView, Quality, QualityMap
+from app.scada.quality import LinkView, Quality, QualityMap, code_flags
 from app.scada.tag import Tag, TagType
 from netplc.address import fmt_octal, parse_octal
+from netplc.lazy import lazy
 from netplc.memory import MemoryView
 from netplc.program import Program
 from netplc.records import Record
+
+np = lazy("numpy")  # loaded at first use: only a station with tags or forms needs it
 
 NSTORE = 304
 GAP_WORDS = tuple(q.word for q in Quality if q.held)  # a data record with one of these is no point
@@ -70,7 +71,8 @@ class SeriesQuality:
         per_operand = self.map.evaluate(view, links)
         codes = np.zeros(len(self.sources), dtype=np.int8)
         np.maximum.at(codes, self._owner, per_operand)  # the worst of the series' operands
-        turned = np.flatnonzero(HELD_CODES[codes] & ~HELD_CODES[self.codes]).tolist()
+        held = code_flags()[1]
+        turned = np.flatnonzero(held[codes] & ~held[self.codes]).tolist()
         self.codes = codes
         out = []
         for i in turned:

@@ -24,8 +24,6 @@ from collections.abc import Callable, Mapping, Sequence
 from pathlib import Path
 from typing import Any
 
-import numpy as np
-
 from app.scada.alarms import AlarmRow, AlarmSystem, CatalogMessage, summary_order
 from app.scada.horn import Horn
 from app.scada.quality import LinkView, QualityMap
@@ -35,10 +33,13 @@ from app.scada.table import TagTable, load_tags
 from netplc.address import EMERGENCY_STOP, fmt_octal
 from netplc.engine import Engine, RunState
 from netplc.exchange import Exchange
+from netplc.lazy import lazy
 from netplc.memory import Snapshot
 from netplc.program import Program
 from netplc.records import Record, RecordSink
 from registrar.alarm_state import AlarmStateFile
+
+np = lazy("numpy")  # loaded at first use: only a station with tags or forms needs it
 
 STATE_FILE = "alarms.sqlite"  # next to the archive
 EMERGENCY_STOP_CODE = 11  # the engine's stop code for the emergency-stop bit

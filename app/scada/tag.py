@@ -16,8 +16,6 @@ from dataclasses import dataclass
 from enum import StrEnum
 from operator import itemgetter
 
-import numpy as np
-
 from netplc.address import (
     IO_BITS,
     check_operand,
@@ -25,7 +23,10 @@ from netplc.address import (
     parse_hmi_bit,
 )
 from netplc.functions._util import bcd_to_bin
+from netplc.lazy import lazy
 from netplc.memory import MemoryView
+
+np = lazy("numpy")  # loaded at first use: only a station with tags or forms needs it
 
 
 @dataclass(frozen=True, slots=True)

@@ -15,17 +15,20 @@ from __future__ import annotations
 
 from dataclasses import dataclass, field
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 from app.authority.policy import VIEWER
 from app.authority.users import USERS_FILE, Users, UsersFileError
 from app.scada.table import TagTable, read_tags
 from app.station.config import Station
 from app.station.extras import station_problems
-from hmi_forms.form import Form, load_forms
 from netplc.exchange import check_program_nodes
 from netplc.program import Program, ProgramError, load_symbols, parse, parse_file, read_symbols
 from netplc.textfile import MISSING, TextFileError, confine, file_problem, read_text
 from registrar.catalog import Catalog, CatalogError
+
+if TYPE_CHECKING:
+    from hmi_forms.form import Form
 
 RECOVERY_ROUNDS = 5
 
@@ -84,6 +87,8 @@ def load_station_forms(station: Station, symbols: dict[str, int],
     and the problems of those that did not load. Their addresses may name `tags`."""
     if station.HMIload is None:
         return [], []
+    from hmi_forms.form import load_forms  # the form code loads only for a station that has forms
+
     return load_forms(station.HMIload, symbols, station=station.folder, allow_outside=station.allow_outside,
                       tags=tags)
 

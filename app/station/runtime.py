@@ -37,8 +37,6 @@ from app.scada.station import StationAlarms
 from app.station.config import Station
 from app.station.load import load, load_station_forms
 from app.station.lock import StationLock, StationRunning
-from hmi_forms.behaviour import FormBehaviour
-from hmi_forms.form import Form
 from netplc.engine import Engine
 from netplc.exchange import Exchange, NodeConfig
 from netplc.forcing import Force, load_forces, save_forces
@@ -53,6 +51,7 @@ from registrar.store import Store, StoreStats
 if TYPE_CHECKING:
     from app.publish.mqtt import SparkplugPublisher
     from app.station.pair import Pair
+    from hmi_forms.form import Form
     from registrar.plant.forward import Forwarder
 
 logger = logging.getLogger(__name__)
@@ -302,11 +301,15 @@ class Runtime:
         self.retainer = Retainer(st.Retain, self.engine, self)
         self.restored = self.retainer.restore()
         self._restore_forces()
-        behaviour = FormBehaviour(self.forms, self.engine.mem, self, self.problem)
-        behaviour.attach(self.engine)
-        if self.forms:
+        regdata: dict[str, tuple[tuple[int, int], ...]] = {}
+        if self.forms:  # the form code loads only for a station that has forms
+            from hmi_forms.behaviour import FormBehaviour
+
+            behaviour = FormBehaviour(self.forms, self.engine.mem, self, self.problem)
+            behaviour.attach(self.engine)
             self.system(f"forms loaded: {len(self.forms)}, of their elements {len(behaviour.elements)} act "
                         "on the station (sync generators, RegData/RegMessages), with or without a window")
+            regdata = {el.Name: el.sources() for _, el in behaviour.elements if el.RegData}
         for i, (sim, program) in enumerate(zip(st.simulators, self.node_programs, strict=True)):
             simulator = Simulator(program, host=sim.host, port=sim.port, unit=sim.unit,
                                   tick=sim.tick_ms / 1000)
@@ -320,7 +323,6 @@ class Runtime:
         self.exchange = Exchange(self.nodes, self)
         self.exchange.attach(self.engine)
         self.exchange.start()
-        regdata = {el.Name: el.sources() for _, el in behaviour.elements if el.RegData}
         self.alarms = StationAlarms(st.Tags, self.program, list(self.catalog), self,
                                     st.Archive.with_name(ALARM_STATE_FILE), self.symbols, regdata,
                                     self._no_standby if st.redundancy is not None else None,

@@ -41,7 +41,7 @@ logger = logging.getLogger(__name__)
 
 APPEARANCES = ("digital", "hbar", "dial", "semidial", "graph", "tank")  # tank: an extension
 ZONE_TYPES = {"low": 2, "normal": 0, "high": 2}
-MAX_SHOWN = 65536  # words remembered per conversion (`remembered`): every word a register can hold
+MAX_SHOWN = 4096  # words remembered per conversion (`remembered`), then forgotten: memory stays flat
 
 
 @dataclass(frozen=True, slots=True, eq=False)

@@ -14,13 +14,14 @@ from collections.abc import Callable, Iterable, Sequence
 from operator import itemgetter
 from typing import Any, Protocol
 
-import numpy as np
-
 from app.scada.quality import Operands, Quality, QualityMap
 from app.scada.readings import Readings
 from hmi_forms.elements.base import Element
 from netplc.address import DATA_SIZE, IO_BITS, data_index
+from netplc.lazy import lazy
 from netplc.memory import Snapshot
+
+np = lazy("numpy")  # loaded at first use: only a station with tags or forms needs it
 
 UNKNOWN = -1  # no value: taken again at the next snapshot, whatever it holds
 

@@ -8,7 +8,11 @@ scan, so the trends of a form share one clock-time axis and join the archive's h
 
 from __future__ import annotations
 
-import numpy as np
+import math
+
+from netplc.lazy import lazy
+
+np = lazy("numpy")  # loaded at first use: only a station with tags or forms needs it
 
 
 class Trend:
@@ -18,7 +22,7 @@ class Trend:
         self.t = np.full(size, np.nan)  # wall-clock seconds of each sample
         self.count = 0  # samples ever added
 
-    def add(self, value: float, t: float = np.nan) -> None:
+    def add(self, value: float, t: float = math.nan) -> None:
         i = self.count % self.size
         self.buf[i] = value
         self.t[i] = t

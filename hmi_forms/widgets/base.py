@@ -30,7 +30,8 @@ from hmi_forms.elements import Element
 from hmi_forms.elements.bank import Bank
 from hmi_forms.widgets import theme
 
-Op = tuple[Callable[..., None], tuple[object, ...]]  # an unbound QPainter method and its arguments:
+Op = tuple[Callable[..., None], tuple[object, ...]]  # an unbound QPainter method (or a function of the
+# painter: sprites.draw_text) and its arguments:
 PIX, FILL = QPainter.drawPixmap, QPainter.fillRect  # (x, y, pixmap) and (x, y, w, h, colour)
 STYLE = ("BackColor", "ForeColor", "BorderStyle", "Font")  # checked at every draw (`style`)
 ORIGIN = QPoint(0, 0)

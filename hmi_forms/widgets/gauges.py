@@ -31,7 +31,7 @@ from hmi_forms.elements.analog import AnalogBase, Shown
 from hmi_forms.elements.bank import WordBank
 from hmi_forms.widgets import theme
 from hmi_forms.widgets.base import FILL, PIX, STYLE, ElementWidget, Face, Images, Op
-from hmi_forms.widgets.sprites import SPRITES, Ink, Sprite, TextSlot, blank
+from hmi_forms.widgets.sprites import SPRITES, Ink, Sprite, TextSlot, blank, draw_text
 
 
 def nice_step(span: float, max_ticks: int) -> float:
@@ -60,7 +60,6 @@ def scale_ticks(lo: float, hi: float, max_major: int) -> tuple[list[float], list
 SMALL_DIAL = 45.0  # radius in px below which a dial drops its labels and enlarges the readout
 SPRITE_DIAL = 64.0  # radius in px up to which needles are cached pixmaps (larger: drawn each time)
 PART_AREA = 150 * 150  # px²: from this size on, a change of text alone repaints only its box
-MERGED_AREA = 64 * 64  # px² up to which a dial's value text and needle are one pixmap (one copy a tick)
 SEMI_END_LABEL = 12.0  # degrees: a semidial's end labels stand this far above its baseline
 HUB = QColor("#33393f")
 WHITE = QColor("#ffffff")
@@ -69,9 +68,10 @@ BOXED = {None: Ink(theme.TEXT, WHITE), "normal": Ink(theme.TEXT, WHITE), "low": 
          "high": Ink(WHITE, theme.ALARM)}
 BARE = {None: Ink(theme.TEXT), "normal": Ink(theme.TEXT), "low": Ink(theme.WARN.darker(115)),
         "high": Ink(theme.ALARM.darker(115))}
-# what a gauge draws for what its model shows: that `Shown`, the text's sprite, and the needle's
+# what a gauge draws for what its model shows: that `Shown`, its text and ink, and the needle's
 # sprite or the bar fill's (width, colour) or None (`GaugeFace.entries`)
-Entry = tuple[Shown, Sprite, object]
+Entry = tuple[Shown, tuple[str, Ink], object]
+MAX_ENTRIES = 1024  # entries kept per family of alike gauges: words recur in a demo, not in a plant
 
 
 class GaugeWidget(ElementWidget):
@@ -508,8 +508,8 @@ class GaugeFace(Face):
     one step (`entries`), the same for every gauge drawn from the same sprites with the same
     conversion."""
 
-    __slots__ = ("bar", "contained", "entries", "inks", "kind", "merged", "needles", "painted", "part",
-                 "slot", "tall", "text_op", "texts", "travel", "units")
+    __slots__ = ("bar", "contained", "entries", "inks", "kind", "needles", "painted", "part",
+                 "slot", "tall", "text_op", "travel", "units")
 
     bank = WordBank
 
@@ -521,7 +521,7 @@ class GaugeFace(Face):
         assert widget._value is not None
         m = widget.model
         kind = self.kind = m.Appearance
-        self.slot, self.texts = widget._value, widget._value.sprites
+        self.slot = widget._value
         self.inks, self.units = (BARE, widget._units) if kind == "hbar" else (BOXED, "")
         self.needles, self.travel, self.contained = widget._needles, widget._travel, widget._contained
         self.bar, self.tall = widget._bar, widget._digital[0].height() > 30
@@ -529,8 +529,8 @@ class GaugeFace(Face):
         self.part = None if part is None else part.translated(self.rect.topLeft()).intersected(self.rect)
         self.painted: tuple[object, ...] | None = None  # what a painter drew last (`GaugeWidget.shown`)
         self.text_op: Op | None = None
-        self.merged: dict[Hashable, Sprite] = SPRITES.family(("merged", id(self.texts), id(self.needles)))
-        family = ("entries", kind, id(self.texts), id(self.needles), self.travel, self.bar, self.units,
+        family = ("entries", kind, id(self.slot.glyphs), self.slot.span, id(self.needles), self.travel,
+                  self.bar, self.units,
                   self.part is None, id(m.remembered))
         # emptied with the sprites; none for a dial that pokes out of its element (a painter draws it)
         self.entries: dict[int | None, Entry] = SPRITES.family(family) if self.contained else {}
@@ -559,14 +559,14 @@ class GaugeFace(Face):
         """`Face.put`, with the composition of what the model shows looked up in one step."""
         if not self.fresh:
             self.load()
-        try:
-            was, text, extra = self.entries[shown.hw]
-        except KeyError:
-            was = None
-        if was is not shown or self.style_of(self.attrs) != self.style:
+        if not self.contained or self.style_of(self.attrs) != self.style:
             self.sync()
             return False
-        drawn = self._ops(shown.zone, text, extra)
+        entry = self._entry(shown)  # a word not shown lately: its parts, then drawn as one that was
+        if entry is None:
+            self.sync()
+            return False
+        drawn = self._ops(shown.zone, entry[1], entry[2])
         if drawn == self.drawn:
             return False
         self.drawn, self.painted = drawn, None
@@ -580,71 +580,49 @@ class GaugeFace(Face):
         if m.stale or not self.contained or marked or self.restyled():
             return None
         shown = m.shown
-        entry = self.entries.get(shown.hw)
+        entry = self._entry(shown)
+        return None if entry is None else self._ops(shown.zone, entry[1], entry[2])
+
+    def _entry(self, shown: Shown) -> Entry | None:
+        """What `shown` is drawn with, from `entries` or made now; None where a painter must draw."""
+        entries = self.entries
+        entry = entries.get(shown.hw)
         if entry is None or entry[0] is not shown:
             parts = self._parts(shown)
             if parts is None:
                 return None
-            entry = self.entries[shown.hw] = (shown, *parts)
-        return self._ops(shown.zone, entry[1], entry[2])
+            if len(entries) >= MAX_ENTRIES:  # bounded: a plant's words over their range do not recur
+                entries.clear()
+            entry = entries[shown.hw] = (shown, *parts)
+        return entry
 
-    def _parts(self, shown: Shown) -> tuple[Sprite, object] | None:
-        """The value's text sprite and the needle's sprite or the bar's fill (width, colour);
+    def _parts(self, shown: Shown) -> tuple[tuple[str, Ink], object] | None:
+        """The value's text and ink, and the needle's sprite or the bar's fill (width, colour);
         None where a painter must draw."""
         zone = shown.zone
-        ink = self.inks[zone]
         text = (shown.text or "---") + self.units
-        sprite = self.texts.get((text, ink.key)) or self.slot.sprite(text, ink)
-        if sprite is None:
+        slot = self.slot
+        # past its area, a text is repainted with its whole element, not with the area alone
+        if not slot.fits(text) or (self.part is not None and not slot.inside(text)):
             return None
+        value = (text, self.inks[zone])
         kind = self.kind
         if shown.hw is None or kind == "digital":
-            return sprite, None
+            return value, None
         if kind == "hbar":
             fill = theme.ZONE_COLORS.get(zone or "") or theme.ACCENT
-            return sprite, (round(self.bar[3] * shown.fraction), fill)
+            return value, (round(self.bar[3] * shown.fraction), fill)
         if self.needles is None:
             return None
         pointer = round(shown.fraction * self.travel)
-        needle = self.needles.get(pointer) or self.widget._needle_sprite(pointer)
-        if self.part is not None:  # a large dial: its text alone is repainted
-            return sprite, needle
-        merged = self.merged.get((text, ink.key, pointer))
-        if merged is None:
-            merged = self._merge(sprite, needle)
-            if merged is None:
-                return sprite, needle
-            SPRITES.put(self.merged, (text, ink.key, pointer), merged)
-        return merged, None
+        return value, self.needles.get(pointer) or self.widget._needle_sprite(pointer)
 
-    def _merge(self, text: Sprite, needle: Sprite) -> Sprite | None:
-        """The value's text with the needle over it in one pixmap, when small: a tick of a form
-        of small dials then copies one pixmap per dial instead of two. The pixels are those of the
-        two drawn in turn: the text is opaque, and where it is not, the needle is blended later
-        over what it would have been blended over."""
-        a = QRect(text[0], text[1], text[2].width(), text[2].height())  # (the sprites' dpr: 1 here)
-        b = QRect(needle[0], needle[1], needle[2].width(), needle[2].height())
-        dpr = text[2].devicePixelRatio()
-        if dpr != 1.0 or needle[2].devicePixelRatio() != 1.0:
-            return None
-        union = a.united(b)
-        if union.width() * union.height() > MERGED_AREA:
-            return None
-        pix = blank(union.size(), dpr, None)
-        p = QPainter(pix)
-        try:  # a painter left open on a pixmap crashes Qt when the pixmap goes
-            p.drawPixmap(a.x() - union.x(), a.y() - union.y(), text[2])
-            p.drawPixmap(b.x() - union.x(), b.y() - union.y(), needle[2])
-        finally:
-            p.end()
-        return union.x(), union.y(), pix
-
-    def _ops(self, zone: str | None, text: Sprite, extra: object) -> list[Op]:
+    def _ops(self, zone: str | None, text: tuple[str, Ink], extra: object) -> list[Op]:
         """The composition at the element's place: its zone's layer, the text, the needle or fill."""
         x, y = self.x, self.y
         layer = self.layers.get(zone)  # (not `or`: the truth of a QPixmap is a call into Qt)
         drawn: list[Op] = [(PIX, (x, y, self.widget.layer() if layer is None else layer))]
-        value = self.text_op = (PIX, (x + text[0], y + text[1], text[2]))
+        value = self.text_op = (draw_text, (self.slot, x, y, *text))
         if extra is None:
             drawn.append(value)
         elif self.kind == "hbar":

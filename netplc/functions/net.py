@@ -9,22 +9,37 @@ netplc run`, tests of other functions) there is no link, so C+1 = 0.
 
 from __future__ import annotations
 
+from netplc.functions._util import Step, built
 from netplc.functions.registry import Fon, FonContext, register
+from netplc.memory import Memory
 
 
 @register(300, "NODE", s="D", limits=(("S", 0, 255),))
-def node(ctx: FonContext, fon: Fon) -> None:
+@built
+def node(mem: Memory, fon: Fon) -> Step:
     """Select the node of the following NREAD/NWRITE (kept until the next NODE, across scans).
     Nodes are numbered 0...255 (the manual's range): another number is a load error."""
-    ctx.node = fon.s or 0
+    number = fon.s or 0
+
+    def step(ctx: FonContext) -> None:
+        ctx.node = number
+
+    return step
 
 
 @register(301, "NREAD", s="O", d="M", r="D")
-def nread(ctx: FonContext, fon: Fon) -> None:
+@built
+def nread(mem: Memory, fon: Fon) -> Step:
     """Read R bytes at the node's address S into local D."""
-    ex = ctx.exchange
-    up = ex is not None and ex.request_read(fon.index, ctx.node, fon.s or 0, fon.d or 0, fon.r or 0)
-    ctx.mem.bits[fon.c + 1] = 1 if up else 0
+    # built once: at a fast tick every NREAD runs every scan, most finding their request in flight
+    key, remote, local, length = fon.index, fon.s or 0, fon.d or 0, fon.r or 0
+    link, bits = fon.c + 1, mem.bits
+
+    def step(ctx: FonContext) -> None:
+        ex = ctx.exchange
+        bits[link] = 1 if ex is not None and ex.request_read(key, ctx.node, remote, local, length) else 0
+
+    return step
 
 
 @register(302, "NWRITE", s="M", d="O", r="D")

@@ -21,7 +21,6 @@ from netplc.modbus.pdu import (
     ProtocolError,
     take_frames,
 )
-from netplc.modbus.pymodbus_client import PymodbusClient
 
 
 class ModbusClient(Protocol):
@@ -49,6 +48,8 @@ def open_client(endpoint: Endpoint, timeout: float, lean: bool = True) -> Modbus
     goes with each request, so the nodes of one RS-485 line can share one client."""
     if endpoint.scheme == "tcp" and lean:
         return LeanTcpClient(endpoint, timeout)
+    from netplc.modbus.pymodbus_client import PymodbusClient  # pymodbus loads only for the nodes it serves
+
     return PymodbusClient(endpoint, timeout)
 
 

@@ -20,23 +20,25 @@ by `fault`, and the port is reopened every second until it works again.
 from __future__ import annotations
 
 import contextlib
+import functools
 import logging
 import threading
 from collections.abc import Callable
-from typing import Protocol
+from typing import TYPE_CHECKING, Protocol
 
 import serial
-from pymodbus.pdu import DecodePDU
 
 from netplc.modbus.endpoint import Endpoint
 from netplc.modbus.pdu import ServeHandler, answer
+
+if TYPE_CHECKING:
+    from pymodbus.pdu import DecodePDU
 
 BROADCAST = 0
 MAX_FRAME = 256  # an RTU frame's longest: unit, 253 bytes of PDU, CRC
 MIN_FRAME = 4  # unit, function code, CRC
 WRITE_WAIT = 5.0  # s a write may wait for its scan and journal record before it goes unanswered
 REOPEN = 1.0  # s between attempts to reopen a failed serial port
-_REQUESTS, _ANSWERS = DecodePDU(is_server=True), DecodePDU(is_server=False)
 _READS = frozenset((1, 2, 3, 4))
 
 
@@ -48,6 +50,15 @@ def crc16(data: bytes | bytearray) -> bytes:
         for _ in range(8):
             crc = (crc >> 1) ^ 0xA001 if crc & 1 else crc >> 1
     return crc.to_bytes(2, "little")
+
+
+@functools.cache
+def _decoder(requests: bool) -> DecodePDU:
+    """pymodbus's decoder of requests (or answers), made at first use: pymodbus loads only for a
+    serial line, not for every station that imports the stack."""
+    from pymodbus.pdu import DecodePDU
+
+    return DecodePDU(is_server=requests)
 
 
 def _length(decoder: DecodePDU, buf: bytes | bytearray) -> int | None:
@@ -65,7 +76,7 @@ def request_length(buf: bytes | bytearray) -> int | None:
     function code does not tell it."""
     if len(buf) < 2:
         return 0
-    return _length(_REQUESTS, buf)
+    return _length(_decoder(True), buf)
 
 
 def take_frames(buf: bytearray, silent: bool = False) -> tuple[list[bytes], int]:
@@ -76,7 +87,7 @@ def take_frames(buf: bytearray, silent: bool = False) -> tuple[list[bytes], int]
     pos, skipped, end = 0, 0, len(buf)
     while end - pos >= MIN_FRAME:
         head = buf[pos : pos + MAX_FRAME]
-        sizes = ((_length(_REQUESTS, head), 1), (_length(_ANSWERS, head), -1))
+        sizes = ((_length(_decoder(True), head), 1), (_length(_decoder(False), head), -1))
         known = any(size is not None for size, _ in sizes)
         waiting = not known and head[1] != 0  # a code no table knows: its CRC, or the silence, ends it
         found = 0

@@ -173,29 +173,95 @@ def test_elements_that_look_alike_share_their_layers(qtbot, tmp_path) -> None:
     assert two.toImage().pixelColor(50, 2) == QColor("#2e7d32")
 
 
-def test_a_text_from_the_cache_is_pixel_for_pixel_the_drawn_text(qtbot) -> None:
-    font = theme.sized_font(15, bold=True, family=theme.MONO)
-    box = QRectF(10.4, 6.7, 61.3, 21.2)
-    for ink, align in ((Ink(theme.TEXT, QColor("#ffffff")), Qt.AlignmentFlag.AlignCenter),
-                       (Ink(theme.TEXT), theme.RIGHT)):
-        area = box.adjusted(2, 2, -2, -2) if ink.back is not None else None
-        slot = TextSlot(box, font, align, area=area)
+def test_a_text_drawn_from_glyphs_is_pixel_for_pixel_the_drawn_text(qtbot) -> None:
+    """Digits drawn from cached glyphs against drawText of the whole text, in boxes at whole and
+    fractional places (where Qt rounds each glyph's position), on a flat colour and on none."""
+    texts = ("-12.5", "1234.5", "9876.0", "---", "10000.0", "0.1 %")
+    fitted = 0
+    mono = theme.MONO
+    for font in (theme.sized_font(15, bold=True, family=mono), theme.sized_font(11, bold=True, family=mono),
+                 theme.sized_font(12)):
+        for box in (QRectF(10.4, 6.7, 61.3, 21.2), QRectF(10, 6, 61, 21), QRectF(3.5, 2.25, 70.1, 17.9)):
+            for ink, align in ((Ink(theme.TEXT, QColor("#ffffff")), Qt.AlignmentFlag.AlignCenter),
+                               (Ink(theme.TEXT), theme.RIGHT),
+                               (Ink(QColor("#ffffff"), theme.ALARM), theme.RIGHT)):
+                area = box.adjusted(2, 2, -2, -2) if ink.back is not None else None
+                slot = TextSlot(box, font, align, area=area)
+                for text in texts:
+                    # one wider than the area is drawn whole (the same pixels: compared all the same)
+                    fitted += slot.fits(text) or slot.glyphs.width(text) <= slot.span
+                    pictures = []
+                    for how in ("drawn", "from glyphs rendered now", "from cached glyphs"):
+                        picture = QImage(90, 40, QImage.Format.Format_ARGB32)
+                        picture.fill(ink.back or QColor("#ffffff"))
+                        p = QPainter(picture)
+                        p.setRenderHint(QPainter.RenderHint.Antialiasing)
+                        if how == "drawn":
+                            p.setFont(font)
+                            p.setPen(ink.fore)
+                            p.drawText(box, align, text)
+                        else:
+                            slot.draw(p, text, ink)
+                        p.end()
+                        pictures.append(picture)
+                    assert pictures[0] == pictures[1] == pictures[2], (font.key(), box, text)
+    assert fitted > 100  # of 162: most from glyphs
+    for align in (theme.RIGHT, Qt.AlignmentFlag.AlignCenter):  # wider than its element: cut at its sides
+        box, bounds = QRectF(16.3, 4.6, 30.2, 18), QRectF(10, 0, 40, 30)
+        slot = TextSlot(box, theme.sized_font(12, bold=True, family=mono), align, bounds=bounds)
+        assert slot.fits("-1234.5 %") and not slot.inside("-1234.5 %")
         pictures = []
-        for how in ("drawn", "rendered into the cache", "from the cache"):
+        for how in ("drawn, clipped", "from glyphs"):
             picture = QImage(90, 40, QImage.Format.Format_ARGB32)
             picture.fill(QColor("#ffffff"))
             p = QPainter(picture)
             p.setRenderHint(QPainter.RenderHint.Antialiasing)
-            if how == "drawn":
-                p.setFont(font)
-                p.setPen(ink.fore)
-                p.drawText(box, align, "-12.5")
+            if how == "drawn, clipped":
+                p.setClipRect(bounds.toRect())
+                p.setFont(slot.font)
+                p.setPen(theme.TEXT)
+                p.drawText(box, align, "-1234.5 %")
             else:
-                slot.draw(p, "-12.5", ink)
+                slot.draw(p, "-1234.5 %", Ink(theme.TEXT))
             p.end()
             pictures.append(picture)
-        assert pictures[0] == pictures[1] == pictures[2]
-        assert len(slot.sprites) == 1
+        assert pictures[0] == pictures[1]
+    assert all(len(key[0]) == 1 for key in slot.glyphs.pixmaps)  # pictures of characters, not of texts
+
+
+def test_the_picture_caches_stay_bounded_whatever_the_values(qtbot, tmp_path) -> None:
+    """A plant's words over their whole range: what the gauges cache is bounded by characters,
+    inks and pixels, never by the values (MAX_SHOWN, MAX_ENTRIES, the glyphs)."""
+    from hmi_forms.elements.analog import MAX_SHOWN
+    from hmi_forms.widgets.sprites import SPRITES
+
+    wide = {**LEVEL, "Name": "Wide", "AppMax": 65535, "PhyMax": 10000}
+    doc = [{**dial("D", 0, "04010", Device="Wide", Precision=1)},
+           {**dial("R", 150, "04012", Device="Wide", Precision=1), "Appearance": "digital", "h": 60},
+           {**dial("B", 300, "04014", Device="Wide", Precision=1), "Appearance": "hbar", "h": 60,
+            "Units": "%"}]
+    path = tmp_path / "t.hmi"
+    path.write_text(json.dumps({"form": {"title": "t", "width": 600, "height": 300}, "devices": [wide],
+                                "elements": doc}), encoding="utf-8")
+    view = FormView(load_form(path), NullTarget())
+    view.show()
+    qtbot.addWidget(view)
+
+    def feed(first: int, count: int) -> int:
+        for k in range(first, first + count):
+            hw = k * 40503 & 0xFFFF
+            view.refresh(snap(scan=k, words={0o4010: hw, 0o4012: hw ^ 0x5555, 0o4014: hw ^ 0xAAAA}))
+            settle()
+        return SPRITES.bytes  # what the pictures hold (entries and remembered words: counted below)
+
+    warm = feed(1, 1500)
+    assert feed(1501, 1500) <= warm * 1.05  # the next 1,500 values are drawn from what the first cached
+    for widget in view.painted:
+        model = widget.model
+        assert len(model.remembered) <= MAX_SHOWN
+        assert len(widget.face.entries) <= gauges.MAX_ENTRIES
+        assert all(len(key[0]) == 1 for key in widget._value.glyphs.pixmaps)
+    assert view.errors == []
 
 
 def test_the_sprite_cache_starts_afresh_past_its_budget(qtbot) -> None:
@@ -246,7 +312,7 @@ def test_a_3000_element_bench_form_fits_the_form_limits(tmp_path) -> None:
     assert sum(e.TYPE == "Graph" for e in plots.elements) == 100
 
 
-def test_a_text_too_wide_for_its_cached_box_is_drawn_whole(qtbot, tmp_path) -> None:
+def test_a_text_too_wide_for_its_area_is_drawn_whole(qtbot, tmp_path) -> None:
     """A word far beyond AppMax gives a value wider than the scale's: it must not be cut."""
     doc = [{"type": "AnalogBase", "Name": "B", "x": 0, "y": 0, "w": 160, "h": 64, "InAddr": "04010",
             "Device": "Level", "Appearance": "hbar", "Units": "%"}]
@@ -257,9 +323,9 @@ def test_a_text_too_wide_for_its_cached_box_is_drawn_whole(qtbot, tmp_path) -> N
     assert view.pairs[0][0].text == "1600.4"
     picture = view.grab().toImage()
     value = slot._value
-    assert all(text != "1600.4 %" for text, _ in value.sprites)  # not cached...
+    assert value.fits("1600.4 %") and not value.inside("1600.4 %")  # from glyphs, past the area...
     start = round(value.box.right() - value.metrics.horizontalAdvance("1600.4 %"))
-    assert start < value.at.x() - 2  # ...since it starts left of what the pixmaps cover
+    assert start < value.at.x() - 2  # ...since it starts left of the area
     left_of_cache = [(x, y) for x in range(start, value.at.x()) for y in range(2, 22)]
     assert any(picture.pixelColor(x, y).lightness() < 120 for x, y in left_of_cache)  # drawn all the same
 
