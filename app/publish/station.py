@@ -28,6 +28,7 @@ def start_publishers(runtime: Runtime) -> list[Publisher]:
     tags = published_tags(runtime.tags.tags, runtime.symbols)
     started: list[Publisher] = []
     if st.opcua.enabled:
+        from app.publish.files import StationFiles
         from app.publish.history import Archived
         from app.publish.opcua import OpcUaServer  # asyncua loads only for a station that serves OPC UA
 
@@ -40,7 +41,7 @@ def start_publishers(runtime: Runtime) -> list[Publisher]:
                              commands=runtime.commands, watch=runtime.watch, engine=runtime.engine,
                              exchange=runtime.exchange, alarms=alarms, journal=runtime.system,
                              step_lock=lambda: runtime.scan_thread.lock if runtime.scan_thread else None,
-                             archived=archived, language=st.Language)
+                             archived=archived, language=st.Language, files=StationFiles(st))
         try:
             server.start()
         except (OSError, RuntimeError) as e:
@@ -73,6 +74,7 @@ class _Unsubscribing:
 
     def __init__(self, server: Any, runtime: Runtime) -> None:
         self.server, self.runtime = server, runtime
+        self.seats = server.seats  # the sessions logged in (seats.py): the station's status lists them
 
     def stop(self) -> None:
         self.runtime.unsubscribe(self.server.on_record)

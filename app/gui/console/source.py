@@ -1,0 +1,156 @@
+"""A remote station as the data source of the console's views: the same `readings` signal the local
+workstation's `RuntimeBridge` gives (one scan's memory with the quality of everything in it), so
+a form view refreshes from either without knowing which one it has; besides it the station's
+files (its forms to show), its alarms and the link's state.
+
+The session runs on its own thread (`ConsoleClient`, asyncua); each change there pokes this
+object, which takes the newest state on the GUI thread (coalesced: a GUI that lags skips to the
+newest, as the bridge does). Quality is judged here as the station judges it, from the station's
+program and tags (its files), NetPlc's run state and the nodes' links as the station reads them;
+while the link to the station is down every operand is "station unreachable", its own quality,
+so nothing looks live that is not.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import logging
+import threading
+from dataclasses import dataclass
+
+import numpy as np
+from PySide6.QtCore import QObject, Signal
+
+from app.publish.console import ConsoleClient, Files
+from app.scada.alarms import AlarmRow
+from app.scada.quality import LinkView, Operands, Quality, QualityMap
+from app.scada.readings import Reading, Readings
+from app.scada.table import TagTable, read_tags
+from hmi_forms.form import Form, load_forms
+from netplc.memory import Snapshot
+from netplc.program import Program, ProgramError, parse, parse_file, read_symbols
+
+logger = logging.getLogger(__name__)
+
+
+@dataclass(frozen=True)
+class Unreachable(Readings):
+    """The last scan the console had, every operand of it "station unreachable"."""
+
+    def address(self, address: int, nbytes: int = 2) -> Quality:
+        return Quality.UNREACHABLE
+
+    def quality(self, name: str) -> Quality:
+        return Quality.UNREACHABLE
+
+    def judge(self, operands: Operands) -> np.ndarray:
+        return np.full(len(operands.member), Quality.UNREACHABLE, dtype=np.int8)
+
+    def tag(self, name: str) -> Reading:
+        return dataclasses.replace(super().tag(name), quality=Quality.UNREACHABLE)
+
+    def live(self, snapshot: Snapshot) -> Snapshot:
+        return snapshot
+
+
+@dataclass
+class Loaded:
+    """The station's parts as the console loads them from its files."""
+
+    files: Files
+    symbols: dict[str, int]
+    tags: TagTable
+    program: Program
+    forms: list[Form]
+    problems: list[str]
+
+
+def load_files(files: Files) -> Loaded:
+    """The forms, tags, symbols and program of the station's files, and what did not load."""
+    problems: list[str] = []
+    symbols: dict[str, int] = {}
+    if (path := files.part("symbols")) is not None:
+        symbols, errors = read_symbols(path)
+        problems += [str(e) for e in errors]
+    tags = TagTable()
+    if (path := files.part("tags")) is not None:
+        tags, errors_ = read_tags(path, symbols)
+        problems += errors_
+    program = parse("", source="<no program>")
+    if (path := files.part("program")) is not None:
+        try:
+            program = parse_file(path, symbols)
+        except ProgramError as e:
+            problems += e.problems
+    forms: list[Form] = []
+    if (path := files.part("forms")) is not None:
+        forms, form_problems = load_forms(path, symbols, station=files.folder, tags=tags)
+        problems += form_problems
+    else:
+        problems.append("the station serves no forms (no HMIload, or it lies outside the station folder)")
+    return Loaded(files, symbols, tags, program, forms, problems)
+
+
+class StationSource(QObject):
+    """`readings` as the bridge gives them; `loaded` when the station's files changed; `alarms`
+    the station's alarm rows; `link` "" while the station answers, else why not."""
+
+    readings = Signal(object)  # Readings (Unreachable while the link is down)
+    loaded = Signal(object)  # Loaded
+    alarms = Signal(object)  # tuple[AlarmRow, ...]
+    link = Signal(str)
+    _poke = Signal()  # from the client's thread
+
+    def __init__(self, client: ConsoleClient, parent: QObject | None = None) -> None:
+        super().__init__(parent)
+        self.client = client
+        self.current: Loaded | None = None
+        self.quality_map: QualityMap | None = None
+        self._snapshot: Snapshot | None = None
+        self._files: Files | None = None
+        self._alarms: tuple[AlarmRow, ...] | None = None
+        self._error: str | None = None
+        self._waiting = False
+        self._lock = threading.Lock()
+        self._poke.connect(self._deliver)
+        client.changed = self._changed
+        self._changed()  # what the client has already (it logged in before this was made)
+
+    def _changed(self) -> None:
+        with self._lock:
+            if self._waiting:
+                return
+            self._waiting = True
+        self._poke.emit()
+
+    def _deliver(self) -> None:
+        with self._lock:
+            self._waiting = False
+        client = self.client
+        files, error, snapshot, alarms = client.files, client.error, client.snapshot, client.alarms
+        if files is not None and files is not self._files:
+            self._files = files
+            self.current = load_files(files)
+            self.quality_map = QualityMap(self.current.program, self.current.tags.tags)
+            self.loaded.emit(self.current)
+            self._snapshot = None  # the new views are shown the scan they have not seen
+        if error != self._error:
+            self._error = error
+            self.link.emit(error)
+            if error and self._snapshot is not None and self.quality_map is not None:
+                last = dataclasses.replace(self._snapshot)  # a new scan to the views: judged again
+                self.readings.emit(Unreachable(last, self.quality_map, LinkView(), np.zeros(0, np.int8)))
+        if not error and snapshot is not None and snapshot is not self._snapshot and \
+                self.quality_map is not None:
+            self._snapshot = snapshot
+            links = LinkView(running=snapshot.state == "running", links=dict(client.links),
+                             forced=[a for f in snapshot.forces for a in f.operands])
+            self.readings.emit(Readings(snapshot, self.quality_map, links,
+                                        self.quality_map.evaluate(snapshot, links)))
+        if alarms != self._alarms:
+            self._alarms = alarms
+            self.alarms.emit(alarms)
+
+    def stop(self) -> None:
+        self.client.changed = lambda: None
+        self.client.close()

@@ -1,0 +1,188 @@
+"""The remote console (`main.py console opc.tcp://HOST:PORT/PATH`): the operator's forms and alarm
+banner of a station running elsewhere, with no NetPlc, exchange or archive of its own.
+
+Its views are the workstation's own (the form view in its zoom area, the alarm banner, the health
+strip, the header); what differs is where their data comes from: a `StationSource` (source.py)
+instead of the in-process runtime's bridge. Everything it does is done by the user logged in at
+the station, through the station's command layer: a form's write is the station's WriteBit or
+WriteWord method, an acknowledgement its Acknowledge; the station checks the role, journals with
+the user's name and answers, and a refusal is said in the status bar naming the role it needs.
+Forms come from the station (its Files): a form saved there is shown here at the next poll.
+"""
+
+from __future__ import annotations
+
+import logging
+import sys
+
+from PySide6.QtCore import QTimer
+from PySide6.QtGui import QCloseEvent
+from PySide6.QtWidgets import QDialog, QMainWindow, QStatusBar, QTabWidget, QVBoxLayout, QWidget
+
+from app.authority import Answer, Source, Ticket, Who
+from app.gui import i18n, words
+from app.gui.alarms import AlarmBanner, FixedLine, HealthStrip
+from app.gui.application import application
+from app.gui.bridge import Answers
+from app.gui.console.source import Loaded, StationSource
+from app.gui.main_window import ALARM_LINE, HEALTH_LINE, REFUSAL_MS, _Header, _placeholder, _problems_page
+from app.gui.zoom import ZoomArea
+from app.publish.console import ConsoleClient
+from app.scada.alarms import AlarmRow, summary_order
+from app.scada.readings import Readings
+from hmi_forms.elements.target import EngineTarget
+from hmi_forms.widgets.form_view import FormView
+from netplc.problems import Problems
+
+logger = logging.getLogger(__name__)
+
+STATUS_MS = 1000
+
+
+class RemoteTarget(EngineTarget):
+    """The station's command layer, reached over its endpoint, as the form elements' Target: the
+    station names a tag's write with the tag and journals it with the console's user."""
+
+    def __init__(self, client: ConsoleClient, answers: Answers) -> None:
+        # no local layer: the station's checks, names and journals each write
+        self.client = client
+        self.who = lambda user: Who(user, Source.OPCUA)
+        self.on_answer = answers.follow
+        self.say = words.answer
+
+    def bit(self, who: Who, addr: int, value: int, label: str | None, at_least: str | None) -> Ticket:
+        return self.client.write_bit(addr, value, label, at_least)
+
+    def word(self, who: Who, addr: int, value: int, label: str | None, at_least: str | None) -> Ticket:
+        return self.client.write_word(addr, value, label, at_least)
+
+
+class ConsoleWindow(QMainWindow):
+    def __init__(self, source: StationSource, parent: QWidget | None = None) -> None:
+        super().__init__(parent)
+        self.source = source
+        client = self.client = source.client
+        self.setWindowTitle(f"NetPlc console — {client.station or client.url}")
+        self.answers = Answers()
+        self.answers.answered.connect(self._answered)
+        self.target = RemoteTarget(client, self.answers)
+        self.views: list[FormView] = []
+        self.unacknowledged: list[AlarmRow] = []
+        central = QWidget()
+        lay = QVBoxLayout(central)
+        lay.setContentsMargins(0, 0, 0, 0)
+        lay.setSpacing(0)
+        self.header = _Header(client.station or client.url)
+        self.header.login.setVisible(False)  # the console's user is the one it logged in as
+        self.banner = AlarmBanner()
+        self.health = HealthStrip()
+        self.tabs = QTabWidget()
+        self.tabs.setObjectName("forms")
+        self.tabs.setDocumentMode(True)
+        lay.addWidget(self.header)
+        for line in (FixedLine(self.banner, self.tr("No unacknowledged alarms"), ALARM_LINE),
+                     FixedLine(self.health, "", HEALTH_LINE)):
+            lay.addWidget(line)
+        lay.addWidget(self.tabs, 1)
+        self.setCentralWidget(central)
+        self.status = QStatusBar()
+        self.setStatusBar(self.status)
+        self.resize(1024, 700)
+        self.banner.acknowledged.connect(self.acknowledge)
+        self.banner.acknowledged_all.connect(self.acknowledge_all)
+        source.loaded.connect(self._load)
+        source.readings.connect(self._on_readings)
+        source.alarms.connect(self._on_alarms)
+        source.link.connect(self._on_link)
+        self._timer = QTimer(self)
+        self._timer.timeout.connect(self._tick)
+        self._timer.start(STATUS_MS)
+        if source.current is not None:
+            self._load(source.current)
+        self._tick()
+
+    def _load(self, loaded: Loaded) -> None:
+        """The station's forms (again, when its files changed), in place of the ones shown."""
+        current = self.tabs.currentIndex()
+        self.views = []
+        while self.tabs.count():
+            page = self.tabs.widget(0)
+            self.tabs.removeTab(0)
+            page.deleteLater()
+        for form in loaded.forms:
+            view = FormView(form, self.target, user=self.client.user)
+            self.views.append(view)
+            self.tabs.addTab(ZoomArea(view), form.title)
+        if loaded.problems:
+            self.tabs.addTab(_problems_page(loaded.problems), self.tr("Form problems"))
+        if not loaded.forms and not loaded.problems:
+            self.tabs.addTab(_placeholder(self.tr("The station serves no forms.")), self.tr("No forms"))
+        self.tabs.setCurrentIndex(max(0, min(current, self.tabs.count() - 1)))
+
+    def _on_readings(self, readings: Readings) -> None:
+        for view in self.views:
+            view.refresh(readings.snapshot, readings)
+
+    def _on_alarms(self, rows: tuple[AlarmRow, ...]) -> None:
+        self.unacknowledged = sorted((r for r in rows if not r.acked), key=summary_order)
+        self.banner.show_alarms(self.unacknowledged)
+
+    def _on_link(self, error: str) -> None:
+        self.health.show_problems([self.tr("station unreachable: {0}; reconnecting").format(error)]
+                                  if error else [])
+        self._tick()
+
+    def _tick(self) -> None:
+        self.header.tick()
+        role = words.role(self.client.role) if self.client.role else ""
+        self.header.user.setText(f"{self.client.user} ({role})" if role else self.client.user)
+        if not self.status.currentMessage():  # a refusal stays its time
+            self.status.showMessage(self.client.state(), STATUS_MS + 200)
+
+    def acknowledge(self, alarm: AlarmRow) -> Ticket:
+        return self.answers.follow(self.tr("Acknowledge"), self.client.acknowledge(alarm.id))
+
+    def acknowledge_all(self) -> Ticket:
+        return self.answers.follow(self.tr("Acknowledge all"), self.client.acknowledge_all())
+
+    def _answered(self, what: str, answer: Answer) -> None:
+        if not answer.ok:
+            self.status.showMessage(self.tr("Refused: ") + words.answer(what, answer), REFUSAL_MS)
+
+    def closeEvent(self, event: QCloseEvent) -> None:
+        self._timer.stop()
+        self.source.stop()
+        super().closeEvent(event)
+
+
+def open_console(url: str, user: str | None = None, password: str | None = None) -> ConsoleWindow | None:
+    """Log in to the station at `url` (the login dialog; trust on first use) and open its console;
+    None when the login was cancelled, Problems when the station refused it."""
+    from app.gui.monitor.login import LoginDialog
+
+    client = ConsoleClient(url)
+    dialog = LoginDialog(client, user or "", password)
+    if dialog.exec() != QDialog.DialogCode.Accepted:
+        client.close()
+        if dialog.error:
+            raise Problems([dialog.error])
+        return None
+    if client.files is not None:
+        i18n.install(application(), str(client.files.manifest.get("language", "")))
+    return ConsoleWindow(StationSource(client))
+
+
+def run_console(url: str, user: str | None = None) -> int:
+    """`python main.py console opc.tcp://... [--user NAME]` (with --user and stdin not a terminal,
+    the password is stdin's first line). Exit 2 when the station refused, 1 when cancelled."""
+    app = application()
+    password = sys.stdin.readline().rstrip("\r\n") if user and not sys.stdin.isatty() else None
+    try:
+        window = open_console(url, user, password)
+    except Problems as e:
+        print("\n".join(e.problems), file=sys.stderr)
+        return 2
+    if window is None:
+        return 1
+    window.show()
+    return app.exec()

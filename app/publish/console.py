@@ -1,0 +1,171 @@
+"""A remote console's session with its station (`main.py console opc.tcp://...`): the Program
+view's `StationClient` (login, trust on first use, memory, back-off, commands as the user) and what
+a console adds, all of it standard OPC UA that any client could do the same way:
+
+- the station's files (files.py): the manifest read with every poll; a file whose SHA-256 is not
+  in the console's cache is read through its FileType object, and the station's folder as of that
+  manifest is put together under the console's config directory (`stations/<host:port>/<hash>/`),
+  which the console then loads like a station's own: a form saved at the station reaches the
+  console at its next poll;
+- the alarms: the conditions of the station's Alarms folder (browsed once per session), their
+  ISA-18.2 state word, severity and text read with every poll, so a console that reconnects shows
+  the station's alarms as they are now (the refresh a ConditionRefresh gives an event client);
+- the nodes' links (Nodes.<n>.Up), so the console judges its elements' quality as the station does;
+- the user's role at the station (Station.Role), so a refusal names the role it needed;
+- writes of a form's raw address through the station's WriteBit and WriteWord methods.
+"""
+
+from __future__ import annotations
+
+import hashlib
+import json
+import logging
+import shutil
+from dataclasses import dataclass
+from datetime import datetime
+from pathlib import Path
+from urllib.parse import urlsplit
+
+from asyncua import ua
+from asyncua.client.ua_file import UaFile
+
+from app.authority import Action, Answer, Reason, Refusal, Ticket
+from app.authority.policy import needs
+from app.publish.client import StationClient, config_dir
+from app.publish.ua_types import SEVERITY
+from app.scada.alarms import AlarmRow, State
+from netplc.address import fmt_octal
+
+logger = logging.getLogger(__name__)
+
+STATES = {state.word: state for state in State}
+PRIORITY_OF = {severity: priority for priority, severity in SEVERITY.items()}
+FIELDS = ("State", "Severity", "Text", "Time")  # read of each condition
+
+
+@dataclass(frozen=True)
+class Files:
+    """The station's files as of one manifest, put together in `folder`."""
+
+    folder: Path
+    manifest: dict[str, object]
+
+    def part(self, name: str) -> Path | None:
+        rel = dict(self.manifest.get("parts", {})).get(name)  # type: ignore[call-overload]
+        return self.folder / rel if rel else None
+
+
+class ConsoleClient(StationClient):
+    def __init__(self, url: str, *, folder: Path | None = None, period: float = 0.1) -> None:
+        super().__init__(url, folder=folder, period=period)
+        self.files: Files | None = None  # as last put together
+        self.alarms: tuple[AlarmRow, ...] = ()
+        self.links: dict[int, bool] = {}
+        self.role = ""
+        self._manifest = ""
+        self._browsed: object = None  # the session the alarms and nodes were browsed in
+        self._alarm_ids: list[str] = []
+        self._nodes: list[int] = []
+        base = (folder or config_dir()) / "console"
+        self._cache = base / "cache"
+        self._stations = base / "stations" / urlsplit(url).netloc.replace(":", "_")
+
+    # --- from any thread ----------------------------------------------------------------------
+
+    def write_bit(self, addr: int, value: int, label: str | None, at_least: str | None) -> Ticket:
+        return self._said(self.call("WriteBit", fmt_octal(addr), value, label or "", at_least or ""),
+                          Action.WRITE, label or fmt_octal(addr), at_least)
+
+    def write_word(self, addr: int, value: int, label: str | None, at_least: str | None) -> Ticket:
+        return self._said(self.call("WriteWord", fmt_octal(addr), value, label or "", at_least or ""),
+                          Action.WRITE, label or fmt_octal(addr), at_least)
+
+    def acknowledge(self, alarm_id: str) -> Ticket:
+        return self._said(self.call("Acknowledge", alarm_id), Action.ACKNOWLEDGE, alarm_id)
+
+    def acknowledge_all(self) -> Ticket:
+        return self._said(self.call("AcknowledgeAll"), Action.ACKNOWLEDGE, Action.ACKNOWLEDGE.value)
+
+    def _said(self, sent: Ticket, action: Action, what: str, at_least: str | None = None) -> Ticket:
+        """The station's answer, a refusal for the role in its parts (the role it needs, the user's)."""
+        ticket: Ticket = Ticket()
+
+        def done(answer: Ticket) -> None:
+            a: Answer = answer.result()
+            if a.reason is Reason.DENIED:
+                a = Answer(a.reason, a.text, Refusal(what, needs(action, at_least), self.user, self.role))
+            ticket.set_result(a)
+
+        sent.add_done_callback(done)
+        return ticket
+
+    # --- on the client's loop -------------------------------------------------------------------
+
+    async def _read(self) -> None:
+        client = self._client
+        assert client is not None
+        if self._browsed is not client:
+            await self._browse()
+            self._browsed = client
+        nodes = [self._node("Files.Manifest"), self._node("Station.Role")]
+        nodes += [self._node(f"Nodes.{n}.Up") for n in self._nodes]
+        nodes += [self._node(f"Alarms.{a}.{f}") for a in self._alarm_ids for f in FIELDS]
+        values = [dv.Value.Value if dv.Value is not None else None
+                  for dv in await client.uaclient.read_attributes(nodes, ua.AttributeIds.Value)]
+        manifest, self.role = str(values[0] or "{}"), str(values[1] or "")
+        self.links = {n: bool(up) for n, up in zip(self._nodes, values[2:])}
+        rest = values[2 + len(self._nodes):]
+        self.alarms = tuple(self._row(a, rest[k * len(FIELDS):(k + 1) * len(FIELDS)])
+                            for k, a in enumerate(self._alarm_ids))
+        if manifest != self._manifest:
+            self.files = await self._fetch(manifest)
+            self._manifest = manifest
+        await super()._read()  # the memory last: its change tells the console, which reads the rest
+
+    async def _browse(self) -> None:
+        client = self._client
+        assert client is not None
+        alarms = await client.get_node(self._node("Alarms")).get_children()
+        self._alarm_ids = [str(n.nodeid.Identifier).removeprefix("Alarms.") for n in alarms]
+        nodes = await client.get_node(self._node("Nodes")).get_children()
+        self._nodes = sorted(int(str(n.nodeid.Identifier).removeprefix("Nodes.")) for n in nodes)
+
+    @staticmethod
+    def _row(alarm_id: str, values: list[object]) -> AlarmRow:
+        state, severity, text, when = values
+        changed = when.timestamp() if isinstance(when, datetime) else 0.0
+        priority = PRIORITY_OF.get(int(severity or 0), 4)
+        return AlarmRow(alarm_id, priority, STATES.get(str(state), State.NORMAL), changed, changed, None,
+                        str(text or ""))
+
+    async def _fetch(self, text: str) -> Files:
+        """The files of `text` (a manifest), each read from the station unless cached by its hash."""
+        client = self._client
+        assert client is not None
+        manifest = json.loads(text)
+        files: dict[str, str] = manifest.get("files", {})
+        self._cache.mkdir(parents=True, exist_ok=True)
+        for rel, sha in files.items():
+            cached = self._cache / sha
+            if cached.exists():
+                continue
+            async with UaFile(client.get_node(self._node(f"Files.{rel}")), "r") as f:
+                content: bytes = await f.read()
+            if hashlib.sha256(content).hexdigest() != sha:
+                raise ua.UaError(f"{rel}: the station sent other content than its manifest's hash "
+                                 "(changed while read): read again at the next poll")
+            partial = cached.with_suffix(".part")
+            partial.write_bytes(content)
+            partial.replace(cached)
+        folder = self._stations / hashlib.sha256(text.encode()).hexdigest()[:16]
+        if not folder.exists():
+            made = folder.with_suffix(".part")
+            shutil.rmtree(made, ignore_errors=True)
+            for rel, sha in files.items():
+                target = made / rel
+                target.parent.mkdir(parents=True, exist_ok=True)
+                shutil.copyfile(self._cache / sha, target)
+            made.mkdir(parents=True, exist_ok=True)
+            made.replace(folder)
+        logger.info("%s: station files as of manifest %s in %s", self.url, folder.name, folder)
+        return Files(folder, manifest)
