@@ -1,0 +1,167 @@
+"""Remote consoles (`main.py console opc.tcp://...`): the demo station running headless with its
+OPC UA endpoint on a free loopback port, consoles attached in-process (offscreen) as different
+users of it, each a real asyncua client of the real endpoint, their views really rendered. What a
+console does is the station's command as its user; what it shows is the station's."""
+
+from __future__ import annotations
+
+import json
+from collections.abc import Callable, Iterator
+from pathlib import Path
+
+import pytest
+
+from app.authority import Answer
+from app.gui.console.source import StationSource
+from app.gui.console.window import ConsoleWindow
+from app.publish.console import ConsoleClient
+from app.scada.quality import Quality
+from app.scada.readings import Readings
+from app.station.config import load_station
+from app.station.runtime import Runtime
+from netplc.records import Record
+from tests.app.publish.conftest import demo_with, free_port
+
+WAIT = 30_000  # ms: a loaded CI machine; every wait ends on its event
+
+
+class Station:
+    """The demo station serving OPC UA on loopback (users viewer, operator, engineer: their password
+    their name), restartable on the same port."""
+
+    def __init__(self, folder: Path) -> None:
+        self.port = free_port()
+        self.url = f"opc.tcp://127.0.0.1:{self.port}/netplc/"
+        self.folder = folder / "st"
+        self.records: list[Record] = []
+        self.runtime = demo_with(self.folder, f'[opcua]\nenabled = true\nendpoint = "{self.url}"\n',
+                                 self.records)
+
+    def stop(self) -> None:
+        self.runtime.stop()
+
+    def restart(self) -> None:
+        self.runtime = Runtime(load_station(self.folder))
+        self.runtime.subscribe(self.records.append)
+        self.runtime.start()
+
+
+@pytest.fixture(scope="module")
+def station(tmp_path_factory: pytest.TempPathFactory) -> Iterator[Station]:
+    st = Station(tmp_path_factory.mktemp("consoles"))
+    try:
+        yield st
+    finally:
+        st.stop()
+
+
+Attach = Callable[[Station, str], ConsoleWindow]
+
+
+@pytest.fixture
+def attach(qtbot, tmp_path: Path) -> Iterator[Attach]:
+    """Consoles logged in as users of a station, each with its own config folder; closed after."""
+    windows: list[ConsoleWindow] = []
+
+    def open_(station: Station, user: str) -> ConsoleWindow:
+        client = ConsoleClient(station.url, folder=tmp_path / user, period=0.05)
+        try:
+            client.discover().result(20)
+            client.open(user, user).result(30)
+        except Exception:
+            client.close()
+            raise
+        window = ConsoleWindow(StationSource(client))
+        windows.append(window)
+        window.show()
+        qtbot.waitUntil(lambda: bool(window.views) and window.views[0].form is not None, timeout=WAIT)
+        return window
+
+    try:
+        yield open_
+    finally:
+        for window in windows:
+            window.close()
+            window.deleteLater()
+
+
+def qualities(window: ConsoleWindow) -> set[str]:
+    """What the elements that show a value of the plant say of it ("" for good)."""
+    return {model.quality for view in window.views for model in view.form.elements if model.sources()}
+
+
+def readings_of(window: ConsoleWindow) -> list[Readings]:
+    seen: list[Readings] = []
+    window.source.readings.connect(seen.append)
+    return seen
+
+
+def test_an_acknowledge_shows_on_the_other_console_and_in_the_journal_a_viewer_is_refused_by_role(
+        qtbot, station: Station, attach: Attach) -> None:
+    operator, viewer = attach(station, "operator"), attach(station, "viewer")
+    station.runtime.simulator_answers(0, False)  # node 0's cable pulled: TRIGGER's quality alarm comes
+    try:
+        for console in (operator, viewer):
+            qtbot.waitUntil(lambda c=console: any(r.id == "TRIGGER.BAD" for r in c.unacknowledged), timeout=WAIT)
+        alarm = next(r for r in viewer.unacknowledged if r.id == "TRIGGER.BAD")
+        refused: Answer = viewer.acknowledge(alarm).result(20)
+        assert str(refused.refusal) == "TRIGGER.BAD: needs the operator role; viewer is viewer"
+        qtbot.waitUntil(lambda: "needs the operator role; viewer is viewer" in viewer.status.currentMessage(),
+                        timeout=WAIT)
+        assert operator.acknowledge(alarm).result(20).ok
+        qtbot.waitUntil(lambda: all(r.id != "TRIGGER.BAD" for r in viewer.unacknowledged), timeout=WAIT)
+        acked = [r.text or "" for r in station.records if r.kind == "alarm" and r.source == "TRIGGER.BAD"
+                 and "acknowledged; by opcua:operator@127.0.0.1:" in (r.text or "")]
+        assert acked, "the acknowledgement journaled with the operator's name"
+    finally:
+        station.runtime.simulator_answers(0, True)
+    lines = station.runtime.status().consoles
+    assert any(line.startswith("operator@127.0.0.1:") for line in lines)
+    assert any(line.startswith("viewer@127.0.0.1:") for line in lines)
+    assert any("OPC UA: opcua:viewer@127.0.0.1:" in (r.text or "") and "connected" in (r.text or "")
+               for r in station.records)
+
+
+def test_a_setpoint_written_on_one_console_shows_on_the_other(qtbot, station: Station, attach: Attach) -> None:
+    writer, watcher = attach(station, "operator"), attach(station, "viewer")
+    seen = readings_of(watcher)
+    address = station.runtime.symbols["SETPOINT"]
+    raw = 1234 if station.runtime.readings().tag("TEMP_SP").raw != 1234 else 2345
+    assert writer.target.write_word(address, raw, user="operator", label="Уставка") is None  # sent
+    qtbot.waitUntil(lambda: bool(seen) and seen[-1].tag("TEMP_SP").raw == raw, timeout=WAIT)
+    assert seen[-1].tag("TEMP_SP").quality is Quality.GOOD
+    written = [r for r in station.records if r.kind == "operator" and "TEMP_SP" in (r.text or "")]
+    assert written and (written[-1].source or "").startswith("opcua:operator@")
+    refused = watcher.target.write_word(address, 7, user="viewer", label="Уставка")
+    qtbot.waitUntil(lambda: "needs the operator role; viewer is viewer" in watcher.status.currentMessage(),
+                    timeout=WAIT)
+    assert refused is None  # answered later, by the station
+
+
+def test_a_form_changed_at_the_station_reaches_the_console(qtbot, station: Station, attach: Attach) -> None:
+    console = attach(station, "viewer")
+    form = station.folder / "forms" / "03_sync.hmi"
+    doc = json.loads(form.read_text(encoding="utf-8"))
+    doc["form"]["title"] = "Changed at the station"
+    form.write_text(json.dumps(doc, ensure_ascii=False), encoding="utf-8")
+    qtbot.waitUntil(lambda: "Changed at the station" in [console.tabs.tabText(i) for i in range(console.tabs.count())],
+                    timeout=WAIT)
+    assert len(console.views) == 3
+
+
+def test_a_console_shows_the_station_unreachable_and_reconnects_by_itself(
+        qtbot, tmp_path: Path, attach: Attach) -> None:
+    station = Station(tmp_path)
+    try:
+        console = attach(station, "operator")
+        qtbot.waitUntil(lambda: qualities(console) == {""}, timeout=WAIT)
+        before = {r.id: r.state for r in console.source.client.alarms}
+        station.stop()
+        qtbot.waitUntil(lambda: qualities(console) == {Quality.UNREACHABLE.word}, timeout=WAIT)
+        assert console.health.isVisible() and "station unreachable" in console.health.problems[0]
+        station.restart()
+        qtbot.waitUntil(lambda: qualities(console) == {""} and not console.client.error, timeout=WAIT)
+        assert not console.health.isVisible()
+        assert {r.id: r.state for r in console.source.client.alarms} == before
+    finally:
+        station.stop()
