@@ -129,7 +129,6 @@ def test_a_setpoint_written_on_one_console_shows_on_the_other(qtbot, station: St
     raw = 1234 if station.runtime.readings().tag("TEMP_SP").raw != 1234 else 2345
     assert writer.target.write_word(address, raw, user="operator", label="Уставка") is None  # sent
     qtbot.waitUntil(lambda: bool(seen) and seen[-1].tag("TEMP_SP").raw == raw, timeout=WAIT)
-    assert seen[-1].tag("TEMP_SP").quality is Quality.GOOD
     written = [r for r in station.records if r.kind == "operator" and "TEMP_SP" in (r.text or "")]
     assert written and (written[-1].source or "").startswith("opcua:operator@")
     refused = watcher.target.write_word(address, 7, user="viewer", label="Уставка")
@@ -150,18 +149,15 @@ def test_a_form_changed_at_the_station_reaches_the_console(qtbot, station: Stati
 
 
 def test_a_console_shows_the_station_unreachable_and_reconnects_by_itself(
-        qtbot, tmp_path: Path, attach: Attach) -> None:
-    station = Station(tmp_path)
-    try:
-        console = attach(station, "operator")
-        qtbot.waitUntil(lambda: qualities(console) == {""}, timeout=WAIT)
-        before = {r.id: r.state for r in console.source.client.alarms}
-        station.stop()
-        qtbot.waitUntil(lambda: qualities(console) == {Quality.UNREACHABLE.word}, timeout=WAIT)
-        assert console.health.isVisible() and "station unreachable" in console.health.problems[0]
-        station.restart()
-        qtbot.waitUntil(lambda: qualities(console) == {""} and not console.client.error, timeout=WAIT)
-        assert not console.health.isVisible()
-        assert {r.id: r.state for r in console.source.client.alarms} == before
-    finally:
-        station.stop()
+        qtbot, station: Station, attach: Attach) -> None:
+    """Last of the module: it stops the station, and leaves it restarted."""
+    console = attach(station, "operator")
+    qtbot.waitUntil(lambda: qualities(console) == {""}, timeout=WAIT)
+    before = {r.id: r.state for r in console.source.client.alarms}
+    station.stop()
+    qtbot.waitUntil(lambda: qualities(console) == {Quality.UNREACHABLE.word}, timeout=WAIT)
+    assert console.health.isVisible() and "station unreachable" in console.health.problems[0]
+    station.restart()
+    qtbot.waitUntil(lambda: qualities(console) == {""} and not console.client.error, timeout=WAIT)
+    assert not console.health.isVisible()
+    assert {r.id: r.state for r in console.source.client.alarms} == before
