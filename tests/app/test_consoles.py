@@ -102,7 +102,8 @@ def test_an_acknowledge_shows_on_the_other_console_and_in_the_journal_a_viewer_i
     station.runtime.simulator_answers(0, False)  # node 0's cable pulled: TRIGGER's quality alarm comes
     try:
         for console in (operator, viewer):
-            qtbot.waitUntil(lambda c=console: any(r.id == "TRIGGER.BAD" for r in c.unacknowledged), timeout=WAIT)
+            qtbot.waitUntil(lambda c=console: any(r.id == "TRIGGER.BAD" for r in c.unacknowledged),
+                            timeout=WAIT)
         alarm = next(r for r in viewer.unacknowledged if r.id == "TRIGGER.BAD")
         refused: Answer = viewer.acknowledge(alarm).result(20)
         assert str(refused.refusal) == "TRIGGER.BAD: needs the operator role; viewer is viewer"
@@ -122,7 +123,8 @@ def test_an_acknowledge_shows_on_the_other_console_and_in_the_journal_a_viewer_i
                for r in station.records)
 
 
-def test_a_setpoint_written_on_one_console_shows_on_the_other(qtbot, station: Station, attach: Attach) -> None:
+def test_a_setpoint_written_on_one_console_shows_on_the_other(
+        qtbot, station: Station, attach: Attach) -> None:
     writer, watcher = attach(station, "operator"), attach(station, "viewer")
     seen = readings_of(watcher)
     address = station.runtime.symbols["SETPOINT"]
@@ -143,7 +145,7 @@ def test_a_form_changed_at_the_station_reaches_the_console(qtbot, station: Stati
     doc = json.loads(form.read_text(encoding="utf-8"))
     doc["form"]["title"] = "Changed at the station"
     form.write_text(json.dumps(doc, ensure_ascii=False), encoding="utf-8")
-    qtbot.waitUntil(lambda: "Changed at the station" in [console.tabs.tabText(i) for i in range(console.tabs.count())],
+    qtbot.waitUntil(lambda: "Changed at the station" in map(console.tabs.tabText, range(console.tabs.count())),
                     timeout=WAIT)
     assert len(console.views) == 3
 

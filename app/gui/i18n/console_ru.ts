@@ -1,6 +1,41 @@
 <?xml version='1.0' encoding='utf-8'?>
 <TS version="2.1" language="ru_RU">
 <context>
+    <name>ConsoleWindow</name>
+    <message>
+        <source>No unacknowledged alarms</source>
+        <translation>Нет неквитированных аварий</translation>
+    </message>
+    <message>
+        <source>station unreachable: {0}; reconnecting</source>
+        <translation>станция недоступна: {0}; переподключение</translation>
+    </message>
+    <message>
+        <source>Refused: </source>
+        <translation>Отказано: </translation>
+    </message>
+    <message>
+        <source>Acknowledge</source>
+        <translation>Квитировать</translation>
+    </message>
+    <message>
+        <source>Acknowledge all</source>
+        <translation>Квитировать все</translation>
+    </message>
+    <message>
+        <source>The station serves no forms.</source>
+        <translation>Станция не передаёт мнемосхем.</translation>
+    </message>
+    <message>
+        <source>Form problems</source>
+        <translation>Ошибки форм</translation>
+    </message>
+    <message>
+        <source>No forms</source>
+        <translation>Нет форм</translation>
+    </message>
+</context>
+<context>
     <name>AlarmBanner</name>
     <message>
         <source>Acknowledge</source>
@@ -718,6 +753,10 @@
         <source>? forced: the value is forced by an engineer, not the plant's</source>
         <translation>? форсировано: значение задано инженером, а не получено с объекта</translation>
     </message>
+    <message>
+        <source>? station unreachable: the console's link to the station is lost; the last value is shown</source>
+        <translation>? станция недоступна: связь пульта со станцией потеряна; показано последнее значение</translation>
+    </message>
 </context>
 <context>
     <name>records</name>
@@ -871,6 +910,10 @@
     <message>
         <source>forced</source>
         <translation>форсировано</translation>
+    </message>
+    <message>
+        <source>station unreachable</source>
+        <translation>станция недоступна</translation>
     </message>
     <message>
         <source>{0}: nobody is logged in ({1} needed)</source>
