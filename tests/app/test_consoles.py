@@ -145,8 +145,8 @@ def test_a_form_changed_at_the_station_reaches_the_console(qtbot, station: Stati
     doc = json.loads(form.read_text(encoding="utf-8"))
     doc["form"]["title"] = "Changed at the station"
     form.write_text(json.dumps(doc, ensure_ascii=False), encoding="utf-8")
-    qtbot.waitUntil(lambda: "Changed at the station" in map(console.tabs.tabText, range(console.tabs.count())),
-                    timeout=WAIT)
+    tabs = console.tabs
+    qtbot.waitUntil(lambda: "Changed at the station" in map(tabs.tabText, range(tabs.count())), timeout=WAIT)
     assert len(console.views) == 3
 
 
