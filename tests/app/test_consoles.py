@@ -133,10 +133,9 @@ def test_a_setpoint_written_on_one_console_shows_on_the_other(
     qtbot.waitUntil(lambda: bool(seen) and seen[-1].tag("TEMP_SP").raw == raw, timeout=WAIT)
     written = [r for r in station.records if r.kind == "operator" and "TEMP_SP" in (r.text or "")]
     assert written and (written[-1].source or "").startswith("opcua:operator@")
-    refused = watcher.target.write_word(address, 7, user="viewer", label="Уставка")
+    watcher.target.write_word(address, 7, user="viewer", label="Уставка")  # refused by the station
     qtbot.waitUntil(lambda: "needs the operator role; viewer is viewer" in watcher.status.currentMessage(),
                     timeout=WAIT)
-    assert refused is None  # answered later, by the station
 
 
 def test_a_form_changed_at_the_station_reaches_the_console(qtbot, station: Station, attach: Attach) -> None:
