@@ -2,14 +2,15 @@
 view's `StationClient` (login, trust on first use, memory, back-off, commands as the user) and what
 a console adds, all of it standard OPC UA that any client could do the same way:
 
-- the station's files (files.py): the manifest read with every poll; a file whose SHA-256 is not
+- the station's files (files.py): the manifest read every SLOW_S; a file whose SHA-256 is not
   in the console's cache is read through its FileType object, and the station's folder as of that
   manifest is put together under the console's config directory (`stations/<host:port>/<hash>/`),
   which the console then loads like a station's own: a form saved at the station reaches the
-  console at its next poll;
+  console within a second or two;
 - the alarms: the conditions of the station's Alarms folder (browsed once per session), their
-  ISA-18.2 state word, severity and text read with every poll, so a console that reconnects shows
-  the station's alarms as they are now (the refresh a ConditionRefresh gives an event client);
+  ISA-18.2 state word, severity and text read every SLOW_S (with the manifest, links and role), so
+  a console that reconnects shows the station's alarms as they are now (the refresh a
+  ConditionRefresh gives an event client);
 - the nodes' links (Nodes.<n>.Up), so the console judges its elements' quality as the station does;
 - the user's role at the station (Station.Role), so a refusal names the role it needed;
 - writes of a form's raw address through the station's WriteBit and WriteWord methods.
@@ -21,6 +22,7 @@ import hashlib
 import json
 import logging
 import shutil
+import time
 from dataclasses import dataclass
 from datetime import datetime
 from pathlib import Path
@@ -41,6 +43,7 @@ logger = logging.getLogger(__name__)
 STATES = {state.word: state for state in State}
 PRIORITY_OF = {severity: priority for priority, severity in SEVERITY.items()}
 FIELDS = ("State", "Severity", "Text", "Time")  # read of each condition
+SLOW_S = 0.5  # the manifest, the alarms, the links and the role are read this often (memory every poll)
 
 
 @dataclass(frozen=True)
@@ -69,6 +72,7 @@ class ConsoleClient(StationClient):
         base = (folder or config_dir()) / "console"
         self._cache = base / "cache"
         self._stations = base / "stations" / urlsplit(url).netloc.replace(":", "_")
+        self._slow = 0.0  # when the slow part was read last
 
     # --- from any thread ----------------------------------------------------------------------
 
@@ -106,7 +110,16 @@ class ConsoleClient(StationClient):
         assert client is not None
         if self._browsed is not client:
             await self._browse()
-            self._browsed = client
+            self._browsed, self._slow = client, 0.0
+        if time.monotonic() - self._slow >= SLOW_S:
+            await self._read_slow()
+            self._slow = time.monotonic()
+            self.changed()  # the alarms may have changed where the memory did not
+        await super()._read()  # the memory last: its change tells the console, which reads the rest
+
+    async def _read_slow(self) -> None:
+        client = self._client
+        assert client is not None
         nodes = [self._node("Files.Manifest"), self._node("Station.Role")]
         nodes += [self._node(f"Nodes.{n}.Up") for n in self._nodes]
         nodes += [self._node(f"Alarms.{a}.{f}") for a in self._alarm_ids for f in FIELDS]
@@ -120,7 +133,6 @@ class ConsoleClient(StationClient):
         if manifest != self._manifest:
             self.files = await self._fetch(manifest)
             self._manifest = manifest
-        await super()._read()  # the memory last: its change tells the console, which reads the rest
 
     async def _browse(self) -> None:
         client = self._client
