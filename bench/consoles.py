@@ -6,8 +6,9 @@ OPC UA on a free loopback port; the consoles run in this process (offscreen Qt a
 a `ConsoleWindow` logged in as "operator" showing the demo's analog form, polling every 100 ms
 (the demo's tick). The station's CPU is its process's (utime + stime from /proc) over each phase's
 wall time, in % of one core. Latency is from the scan (its wall time, the memory variables' source
-timestamp) to the next paint of the console's form after the readings of that scan reached it,
-over every console and scan of the 8-console phase. The local workstation's cost on the same form
+timestamp) to the paint of the console's form that shows it (the paint after the newest readings;
+a scan that changed nothing on the form paints nothing), over every console and paint of the
+8-console phase. The local workstation's cost on the same form
 is measured as bench/workstation.py does: this process with a headless runtime alone, then with
 the window shown on it; the window's share is the difference.
 
@@ -88,8 +89,7 @@ class Latency(QObject):
         area.viewport().installEventFilter(self)
 
     def _readings(self, readings: Readings) -> None:
-        if self.pending is None:
-            self.pending = readings.snapshot.wall
+        self.pending = readings.snapshot.wall  # the paint shows the newest (no change: no paint)
 
     def eventFilter(self, watched: QObject, event: QEvent) -> bool:
         if event.type() == QEvent.Type.Paint and self.pending is not None:
