@@ -21,6 +21,7 @@ from __future__ import annotations
 import hashlib
 import json
 import logging
+import os
 import shutil
 import time
 from dataclasses import dataclass
@@ -73,6 +74,7 @@ class ConsoleClient(StationClient):
         self._cache = base / "cache"
         self._stations = base / "stations" / urlsplit(url).netloc.replace(":", "_")
         self._slow = 0.0  # when the slow part was read last
+        self._own = f"{os.getpid()}-{id(self):x}"  # this client's partial files, apart from other consoles'
 
     # --- from any thread ----------------------------------------------------------------------
 
@@ -166,18 +168,21 @@ class ConsoleClient(StationClient):
             if hashlib.sha256(content).hexdigest() != sha:
                 raise ua.UaError(f"{rel}: the station sent other content than its manifest's hash "
                                  "(changed while read): read again at the next poll")
-            partial = cached.with_suffix(".part")
+            partial = self._cache / f"{sha}.{self._own}.part"  # consoles may share the cache
             partial.write_bytes(content)
             partial.replace(cached)
         folder = self._stations / hashlib.sha256(text.encode()).hexdigest()[:16]
         if not folder.exists():
-            made = folder.with_suffix(".part")
+            made = self._stations / f"{folder.name}.{self._own}.part"
             shutil.rmtree(made, ignore_errors=True)
             for rel, sha in files.items():
                 target = made / rel
                 target.parent.mkdir(parents=True, exist_ok=True)
                 shutil.copyfile(self._cache / sha, target)
             made.mkdir(parents=True, exist_ok=True)
-            made.replace(folder)
+            if folder.is_dir():  # another console put the same files together meanwhile: theirs is ours
+                shutil.rmtree(made, ignore_errors=True)
+            else:
+                made.replace(folder)
         logger.info("%s: station files as of manifest %s in %s", self.url, folder.name, folder)
         return Files(folder, manifest)

@@ -624,6 +624,6 @@ class Runtime:
             problems=tuple(problems),
             forced=engine.forces.count if engine else 0,
             pair=pair.line() if pair is not None else "",
-            consoles=tuple(seat.line() for p in self.publishers for seat in getattr(p, "seats", None).seats()
-                           if hasattr(p, "seats")),
+            consoles=tuple(seat.line() for p in self.publishers if hasattr(p, "seats")
+                           for seat in p.seats.seats()),
         )

@@ -14,6 +14,8 @@ import pytest
 from app.authority import Answer
 from app.gui.console.source import StationSource
 from app.gui.console.window import ConsoleWindow
+from app.gui.status import StationStatusBar
+from app.publish.client import LoginError
 from app.publish.console import ConsoleClient
 from app.scada.quality import Quality
 from app.scada.readings import Readings
@@ -147,6 +149,30 @@ def test_a_form_changed_at_the_station_reaches_the_console(qtbot, station: Stati
     tabs = console.tabs
     qtbot.waitUntil(lambda: "Changed at the station" in map(tabs.tabText, range(tabs.count())), timeout=WAIT)
     assert len(console.views) == 3
+
+
+def test_the_station_lists_its_consoles_and_refuses_one_beyond_max_consoles(
+        qtbot, station: Station, attach: Attach, tmp_path: Path) -> None:
+    attach(station, "operator")
+    seats = next(p.seats for p in station.runtime.publishers if hasattr(p, "seats"))
+    bar = StationStatusBar()
+    qtbot.addWidget(bar)
+    bar.show_status(station.runtime.status())
+    assert bar.consoles.text() == f"Consoles {len(seats.seats())}"
+    assert any(line.startswith("operator@127.0.0.1:") for line in bar.consoles.toolTip().splitlines())
+    limit, seats.limit = seats.limit, len(seats.seats())  # as if [opcua] max_consoles said so
+    try:
+        one_more = ConsoleClient(station.url, folder=tmp_path / "one-more")
+        try:
+            one_more.discover().result(20)
+            with pytest.raises(LoginError, match="BadTooManySessions"):
+                one_more.open("viewer", "viewer").result(30)
+        finally:
+            one_more.close()
+    finally:
+        seats.limit = limit
+    assert any(r.kind == "operator" and "max_consoles" in (r.text or "") and "viewer" in (r.source or "")
+               for r in station.records)
 
 
 def test_a_console_shows_the_station_unreachable_and_reconnects_by_itself(

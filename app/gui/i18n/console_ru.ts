@@ -423,6 +423,10 @@
 <context>
     <name>StationStatusBar</name>
     <message>
+        <source>Consoles {0}</source>
+        <translation>Пульты {0}</translation>
+    </message>
+    <message>
         <source>NetPlc: {0}</source>
         <translation>NetPlc: {0}</translation>
     </message>
