@@ -21,6 +21,7 @@ from app.scada.quality import Quality
 from app.scada.readings import Readings
 from app.station.config import load_station
 from app.station.runtime import Runtime
+from hmi_forms.elements.base import Writer
 from netplc.records import Record
 from tests.app.publish.conftest import demo_with, free_port
 
@@ -138,6 +139,10 @@ def test_a_setpoint_written_on_one_console_shows_on_the_other(
     watcher.target.write_word(address, 7, user="viewer", label="Уставка")  # refused by the station
     qtbot.waitUntil(lambda: "needs the operator role; viewer is viewer" in watcher.status.currentMessage(),
                     timeout=WAIT)
+    element = next(m for v in writer.views for m in v.form.elements if isinstance(m, Writer))
+    element.Confirm = True  # a command that cannot be taken back: the console asks first
+    writer.ask = lambda title, text: False
+    assert element.refused("Уставка = 100") == "cancelled"
 
 
 def test_a_form_changed_at_the_station_reaches_the_console(qtbot, station: Station, attach: Attach) -> None:

@@ -17,7 +17,7 @@ import sys
 
 from PySide6.QtCore import QTimer
 from PySide6.QtGui import QCloseEvent
-from PySide6.QtWidgets import QDialog, QMainWindow, QStatusBar, QTabWidget, QVBoxLayout, QWidget
+from PySide6.QtWidgets import QDialog, QMainWindow, QMessageBox, QStatusBar, QTabWidget, QVBoxLayout, QWidget
 
 from app.authority import Answer, Source, Ticket, Who
 from app.gui import i18n, words
@@ -30,6 +30,7 @@ from app.gui.zoom import ZoomArea
 from app.publish.console import ConsoleClient
 from app.scada.alarms import AlarmRow, summary_order
 from app.scada.readings import Readings
+from hmi_forms.elements.base import Writer
 from hmi_forms.elements.target import EngineTarget
 from hmi_forms.widgets.form_view import FormView
 from netplc.problems import Problems
@@ -110,7 +111,7 @@ class ConsoleWindow(QMainWindow):
             self.tabs.removeTab(0)
             page.deleteLater()
         for form in loaded.forms:
-            view = FormView(form, self.target, user=self.client.user)
+            view = FormView(form, self.target, user=self.client.user, guard=self._guard)
             self.views.append(view)
             self.tabs.addTab(ZoomArea(view), form.title)
         if loaded.problems:
@@ -118,6 +119,16 @@ class ConsoleWindow(QMainWindow):
         if not loaded.forms and not loaded.problems:
             self.tabs.addTab(_placeholder(self.tr("The station serves no forms.")), self.tr("No forms"))
         self.tabs.setCurrentIndex(max(0, min(current, self.tabs.count() - 1)))
+
+    def ask(self, title: str, text: str) -> bool:
+        """The second step of a command: the operator confirms it (tests answer for them)."""
+        return QMessageBox.question(self, title, text) == QMessageBox.StandardButton.Yes
+
+    def _guard(self, element: Writer, what: str) -> str | None:
+        """Before a form element writes: its Confirm (the station checks the role when it is sent)."""
+        if element.Confirm and not self.ask(self.tr("Confirm"), what + "?"):
+            return self.tr("cancelled")
+        return None
 
     def _on_readings(self, readings: Readings) -> None:
         for view in self.views:

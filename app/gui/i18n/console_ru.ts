@@ -3,6 +3,14 @@
 <context>
     <name>ConsoleWindow</name>
     <message>
+        <source>Confirm</source>
+        <translation>Подтверждение</translation>
+    </message>
+    <message>
+        <source>cancelled</source>
+        <translation>отменено</translation>
+    </message>
+    <message>
         <source>No unacknowledged alarms</source>
         <translation>Нет неквитированных аварий</translation>
     </message>
