@@ -13,20 +13,25 @@ a console adds, all of it standard OPC UA that any client could do the same way:
   ConditionRefresh gives an event client);
 - the nodes' links (Nodes.<n>.Up), so the console judges its elements' quality as the station does;
 - the user's role at the station (Station.Role), so a refusal names the role it needed;
-- writes of a form's raw address through the station's WriteBit and WriteWord methods.
+- writes of a form's raw address through the station's WriteBit and WriteWord methods;
+- the journal: the station object's event history (HistoryReadEvents, Part 11), newest first.
 """
 
 from __future__ import annotations
 
+import datetime as dt
 import hashlib
 import json
 import logging
 import os
 import shutil
+import struct
 import time
+from concurrent.futures import Future
 from dataclasses import dataclass
-from datetime import datetime
+from datetime import UTC
 from pathlib import Path
+from typing import Any
 from urllib.parse import urlsplit
 
 from asyncua import ua
@@ -34,10 +39,11 @@ from asyncua.client.ua_file import UaFile
 
 from app.authority import Action, Answer, Reason, Refusal, Ticket
 from app.authority.policy import needs
-from app.publish.client import StationClient, config_dir
+from app.publish.client import StationClient, _why, config_dir
 from app.publish.ua_types import SEVERITY
 from app.scada.alarms import AlarmRow, State
 from netplc.address import fmt_octal
+from registrar.reading import Row
 
 logger = logging.getLogger(__name__)
 
@@ -92,6 +98,10 @@ class ConsoleClient(StationClient):
     def acknowledge_all(self) -> Ticket:
         return self._said(self.call("AcknowledgeAll"), Action.ACKNOWLEDGE, Action.ACKNOWLEDGE.value)
 
+    def journal(self, day: dt.date, limit: int) -> Future[list[Row]]:
+        """The newest `limit` records of `day` (this machine's day) in the station's journal."""
+        return self._submit(self._journal(day, limit))
+
     def _said(self, sent: Ticket, action: Action, what: str, at_least: str | None = None) -> Ticket:
         """The station's answer, a refusal for the role in its parts (the role it needs, the user's)."""
         ticket: Ticket = Ticket()
@@ -136,6 +146,19 @@ class ConsoleClient(StationClient):
             self.files = await self._fetch(manifest)
             self._manifest = manifest
 
+    async def _journal(self, day: dt.date, limit: int) -> list[Row]:
+        client = self._client
+        if client is None:
+            raise ConnectionError(f"not connected: {self.error or 'logging in'}")
+        start = dt.datetime.combine(day, dt.time.min).astimezone(UTC)
+        end = start + dt.timedelta(days=1)
+        station = client.get_node(self._node(self.station))
+        try:  # an end before the start: newest first
+            events = await station.read_event_history(end, start, limit)
+        except ua.UaError as e:
+            raise ConnectionError(f"{self.url}: {_why(e)}") from None
+        return [_record(e) for e in events]
+
     async def _browse(self) -> None:
         client = self._client
         assert client is not None
@@ -147,7 +170,7 @@ class ConsoleClient(StationClient):
     @staticmethod
     def _row(alarm_id: str, values: list[object]) -> AlarmRow:
         state, severity, text, when = values
-        changed = when.timestamp() if isinstance(when, datetime) else 0.0
+        changed = when.timestamp() if isinstance(when, dt.datetime) else 0.0
         priority = PRIORITY_OF.get(int(severity or 0), 4)
         return AlarmRow(alarm_id, priority, STATES.get(str(state), State.NORMAL), changed, changed, None,
                         str(text or ""))
@@ -186,3 +209,22 @@ class ConsoleClient(StationClient):
                 made.replace(folder)
         logger.info("%s: station files as of manifest %s in %s", self.url, folder.name, folder)
         return Files(folder, manifest)
+
+
+def _record(event: Any) -> Row:
+    """A journal event as the record it was: its id from its EventId (history.py: day and id), its
+    kind from its type and source (a system record is a SystemEventType, an alarm's transition its
+    condition's type, a message's source MSGn, the rest operator actions)."""
+    _day, rid = struct.unpack(">Iq", event.EventId) if len(event.EventId or b"") == 12 else (0, 0)
+    when = event.Time if event.Time.tzinfo is not None else event.Time.replace(tzinfo=UTC)
+    source = str(event.SourceName or "")
+    kind = event.EventType.Identifier
+    if kind == ua.ObjectIds.SystemEventType:
+        kind = "system"
+    elif kind != ua.ObjectIds.BaseEventType:
+        kind = "alarm"
+    else:
+        kind = "message" if source.startswith("MSG") and source[3:].isdigit() else "operator"
+    message = event.Message.Text if isinstance(event.Message, ua.LocalizedText) else str(event.Message or "")
+    return Row(rid, when.timestamp(), kind, PRIORITY_OF.get(int(event.Severity or 0)), None, source,
+               int(source[3:]) if kind == "message" else None, None, message)

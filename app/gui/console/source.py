@@ -14,6 +14,7 @@ so nothing looks live that is not.
 from __future__ import annotations
 
 import dataclasses
+import datetime as dt
 import logging
 import threading
 from dataclasses import dataclass
@@ -27,10 +28,14 @@ from app.scada.quality import LinkView, Operands, Quality, QualityMap
 from app.scada.readings import Reading, Readings
 from app.scada.table import TagTable, read_tags
 from hmi_forms.form import Form, load_forms
+from hmi_forms.widgets.journal import Page
 from netplc.memory import Snapshot
 from netplc.program import Program, ProgramError, parse, parse_file, read_symbols
+from registrar.query import Filter
 
 logger = logging.getLogger(__name__)
+
+JOURNAL_WAIT_S = 10.0  # a page of the journal the station does not give within this is "unreadable"
 
 
 @dataclass(frozen=True)
@@ -89,6 +94,27 @@ def load_files(files: Files) -> Loaded:
     else:
         problems.append("the station serves no forms (no HMIload, or it lies outside the station folder)")
     return Loaded(files, symbols, tags, program, forms, problems)
+
+
+class RemoteJournal:
+    """The station's journal as the journal dock reads it (app/gui/journal.py), on the dock's worker
+    thread: the station object's event history of the day, newest first. A station that does not
+    answer is the dock's "archive unreadable" with the reason (an OSError, as a local file's)."""
+
+    def __init__(self, client: ConsoleClient) -> None:
+        self.client = client
+
+    def page(self, day: dt.date, flt: Filter, limit: int, count: bool) -> Page | None:
+        try:
+            rows = self.client.journal(day, limit).result(JOURNAL_WAIT_S)
+        except (ConnectionError, TimeoutError) as e:
+            raise OSError(f"the station's journal: {e or type(e).__name__}") from None
+        kinds = flt.kinds
+        shown = [r for r in rows if kinds is None or r.kind in kinds]
+        return Page(day, shown, len(shown) if len(rows) < limit else None)
+
+    def close(self) -> None:
+        pass  # the session is the console's: closed with it
 
 
 class StationSource(QObject):

@@ -2,7 +2,7 @@
 banner of a station running elsewhere, with no NetPlc, exchange or archive of its own.
 
 Its views are the workstation's own (the form view in its zoom area, the alarm banner, the health
-strip, the header); what differs is where their data comes from: a `StationSource` (source.py)
+strip, the journal dock, the header); what differs is where their data comes from: a `StationSource` (source.py)
 instead of the in-process runtime's bridge. Everything it does is done by the user logged in at
 the station, through the station's command layer: a form's write is the station's WriteBit or
 WriteWord method, an acknowledgement its Acknowledge; the station checks the role, journals with
@@ -15,7 +15,7 @@ from __future__ import annotations
 import logging
 import sys
 
-from PySide6.QtCore import QTimer
+from PySide6.QtCore import Qt, QTimer
 from PySide6.QtGui import QCloseEvent
 from PySide6.QtWidgets import QDialog, QMainWindow, QMessageBox, QStatusBar, QTabWidget, QVBoxLayout, QWidget
 
@@ -24,7 +24,8 @@ from app.gui import i18n, words
 from app.gui.alarms import AlarmBanner, FixedLine, HealthStrip
 from app.gui.application import application
 from app.gui.bridge import Answers
-from app.gui.console.source import Loaded, StationSource
+from app.gui.console.source import Loaded, RemoteJournal, StationSource
+from app.gui.journal import JournalDock
 from app.gui.main_window import ALARM_LINE, HEALTH_LINE, REFUSAL_MS, _Header, _placeholder, _problems_page
 from app.gui.zoom import ZoomArea
 from app.publish.console import ConsoleClient
@@ -86,6 +87,8 @@ class ConsoleWindow(QMainWindow):
             lay.addWidget(line)
         lay.addWidget(self.tabs, 1)
         self.setCentralWidget(central)
+        self.journal = JournalDock(RemoteJournal(client), self)
+        self.addDockWidget(Qt.DockWidgetArea.BottomDockWidgetArea, self.journal)
         self.status = QStatusBar()
         self.setStatusBar(self.status)
         self.resize(1024, 700)
@@ -162,6 +165,7 @@ class ConsoleWindow(QMainWindow):
 
     def closeEvent(self, event: QCloseEvent) -> None:
         self._timer.stop()
+        self.journal.close_archive()
         self.source.stop()
         super().closeEvent(event)
 
