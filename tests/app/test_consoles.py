@@ -6,6 +6,8 @@ console does is the station's command as its user; what it shows is the station'
 from __future__ import annotations
 
 import json
+import subprocess
+import sys
 from collections.abc import Callable, Iterator
 from pathlib import Path
 
@@ -23,6 +25,7 @@ from app.station.config import load_station
 from app.station.runtime import Runtime
 from hmi_forms.elements.base import Writer
 from netplc.records import Record
+from tests.app.conftest import REPO
 from tests.app.publish.conftest import demo_with, free_port
 
 WAIT = 30_000  # ms: a loaded CI machine; every wait ends on its event
@@ -197,3 +200,9 @@ def test_a_console_shows_the_station_unreachable_and_reconnects_by_itself(
     qtbot.waitUntil(lambda: qualities(console) == {""} and not console.client.error, timeout=WAIT)
     assert not console.health.isVisible()
     assert {r.id: r.state for r in console.source.client.alarms} == before
+
+
+def test_the_console_command_wants_an_opc_tcp_url() -> None:
+    run = subprocess.run([sys.executable, str(REPO / "main.py"), "console", "http://10.0.0.10/"],
+                         capture_output=True, text=True, timeout=60, cwd=REPO)
+    assert run.returncode == 2 and run.stderr == "http://10.0.0.10/: not an opc.tcp:// URL\n"

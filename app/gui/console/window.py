@@ -2,8 +2,9 @@
 banner of a station running elsewhere, with no NetPlc, exchange or archive of its own.
 
 Its views are the workstation's own (the form view in its zoom area, the alarm banner, the health
-strip, the journal dock, the header); what differs is where their data comes from: a `StationSource` (source.py)
-instead of the in-process runtime's bridge. Everything it does is done by the user logged in at
+strip, the journal dock, the header); what differs is where their data comes from: a
+`StationSource` and a `RemoteJournal` (source.py) instead of the in-process runtime's bridge and
+the archive's file. Everything it does is done by the user logged in at
 the station, through the station's command layer: a form's write is the station's WriteBit or
 WriteWord method, an acknowledgement its Acknowledge; the station checks the role, journals with
 the user's name and answers, and a refusal is said in the status bar naming the role it needs.
@@ -26,7 +27,15 @@ from app.gui.application import application
 from app.gui.bridge import Answers
 from app.gui.console.source import Loaded, RemoteJournal, StationSource
 from app.gui.journal import JournalDock
-from app.gui.main_window import ALARM_LINE, HEALTH_LINE, REFUSAL_MS, _Header, _placeholder, _problems_page
+from app.gui.main_window import (
+    ALARM_LINE,
+    HEALTH_LINE,
+    REFUSAL_MS,
+    _Header,
+    _placeholder,
+    _problems_page,
+    _quit_on_signals,
+)
 from app.gui.zoom import ZoomArea
 from app.publish.console import ConsoleClient
 from app.scada.alarms import AlarmRow, summary_order
@@ -200,4 +209,5 @@ def run_console(url: str, user: str | None = None) -> int:
     if window is None:
         return 1
     window.show()
+    _quit_on_signals(app)  # Ctrl+C or SIGTERM log out of the station before the console ends
     return app.exec()
