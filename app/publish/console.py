@@ -37,8 +37,8 @@ from urllib.parse import urlsplit
 from asyncua import ua
 from asyncua.client.ua_file import UaFile
 
-from app.authority import Action, Answer, Reason, Refusal, Ticket
-from app.authority.policy import needs
+from app.authority import Action, Answer, Reason, Refusal, Ticket, Who
+from app.authority.policy import ROLES, needs, rank
 from app.publish.client import StationClient, _why, config_dir
 from app.publish.ua_types import SEVERITY
 from app.scada.alarms import AlarmRow, State
@@ -85,24 +85,29 @@ class ConsoleClient(StationClient):
     # --- from any thread ----------------------------------------------------------------------
 
     def write_bit(self, addr: int, value: int, label: str | None, at_least: str | None) -> Ticket:
-        return self._said(self.call("WriteBit", fmt_octal(addr), value, label or "", at_least or ""),
+        return self.said(self.call("WriteBit", fmt_octal(addr), value, label or "", at_least or ""),
                           Action.WRITE, label or fmt_octal(addr), at_least)
 
     def write_word(self, addr: int, value: int, label: str | None, at_least: str | None) -> Ticket:
-        return self._said(self.call("WriteWord", fmt_octal(addr), value, label or "", at_least or ""),
+        return self.said(self.call("WriteWord", fmt_octal(addr), value, label or "", at_least or ""),
                           Action.WRITE, label or fmt_octal(addr), at_least)
 
-    def acknowledge(self, alarm_id: str) -> Ticket:
-        return self._said(self.call("Acknowledge", alarm_id), Action.ACKNOWLEDGE, alarm_id)
-
-    def acknowledge_all(self) -> Ticket:
-        return self._said(self.call("AcknowledgeAll"), Action.ACKNOWLEDGE, Action.ACKNOWLEDGE.value)
+    def denial(self, action: Action, at_least: str | None = None, what: str | None = None) -> Refusal | None:
+        """Why the user may not do `action` (needing at least `at_least`): the station's answers
+        (UserExecutable of its method for the action, and the user's role for a form element's
+        higher Role); None when it may, or until the station answered."""
+        need = needs(action, at_least)
+        role = self.role
+        allowed = self.may(action) is not False
+        if allowed and at_least is not None and role in ROLES:  # a form element asking more than the policy
+            allowed = rank(role) >= rank(need)
+        return None if allowed else Refusal(what or action.value, need, self.user, role)
 
     def journal(self, day: dt.date, limit: int) -> Future[list[Row]]:
         """The newest `limit` records of `day` (this machine's day) in the station's journal."""
         return self._submit(self._journal(day, limit))
 
-    def _said(self, sent: Ticket, action: Action, what: str, at_least: str | None = None) -> Ticket:
+    def said(self, sent: Ticket, action: Action, what: str, at_least: str | None = None) -> Ticket:
         """The station's answer, a refusal for the role in its parts (the role it needs, the user's)."""
         ticket: Ticket = Ticket()
 
@@ -209,6 +214,40 @@ class ConsoleClient(StationClient):
                 made.replace(folder)
         logger.info("%s: station files as of manifest %s in %s", self.url, folder.name, folder)
         return Files(folder, manifest)
+
+
+class StationCommands:
+    """The station's command layer as a console's views call it (the alarm summary, the banner,
+    the rights of their buttons): the layer's methods and answers, each sent as the station's
+    method with the console's user; `who` is the console's and not sent (the session is who)."""
+
+    def __init__(self, client: ConsoleClient) -> None:
+        self.client = client
+
+    def denial(self, who: Who, action: Action, at_least: str | None = None,
+               what: str | None = None) -> Refusal | None:
+        return self.client.denial(action, at_least, what)
+
+    def may(self, who: Who, action: Action, at_least: str | None = None) -> bool:
+        return self.denial(who, action, at_least) is None
+
+    def acknowledge(self, who: Who, alarm_id: str, comment: str = "") -> Ticket:
+        return self._sent(Action.ACKNOWLEDGE, alarm_id, "Acknowledge", alarm_id)
+
+    def acknowledge_all(self, who: Who) -> Ticket:
+        return self._sent(Action.ACKNOWLEDGE, Action.ACKNOWLEDGE.value, "AcknowledgeAll")
+
+    def shelve(self, who: Who, alarm_id: str, reason: str, duration: float, once: bool = False) -> Ticket:
+        return self._sent(Action.SHELVE, alarm_id, "Shelve", alarm_id, reason, float(duration))
+
+    def unshelve(self, who: Who, alarm_id: str) -> Ticket:
+        return self._sent(Action.UNSHELVE, alarm_id, "Unshelve", alarm_id)
+
+    def silence(self, who: Who) -> Ticket:
+        return self._sent(Action.SILENCE, Action.SILENCE.value, "Silence")
+
+    def _sent(self, action: Action, what: str, method: str, *args: object) -> Ticket:
+        return self.client.said(self.client.call(method, *args), action, what)
 
 
 def _record(event: Any) -> Row:

@@ -65,6 +65,7 @@ METHODS = (
                                      ("Seconds", "how long it stays shelved", _DOUBLE)),
            "Shelve an alarm for a while (ISA-18.2): it neither sounds nor shows until then"),
     Method("Unshelve", Action.UNSHELVE, (ALARM,), "Return a shelved alarm to the summary"),
+    Method("Silence", Action.SILENCE, description="Silence the horn; the alarms stay unacknowledged"),
     # what a remote console's form elements write (a raw NetPlc address, as the local workstation's do)
     Method("WriteBit", Action.WRITE, (ADDRESS, ("Value", "0 or 1", _INT32), LABEL, ROLE),
            "Write an I/O or HMI bit as an operator's form element does"),
@@ -125,6 +126,8 @@ class StationMethods:
             return self._tag(who, method, args)
         if method.name == "AcknowledgeAll":
             return commands.acknowledge_all(who)
+        if method.name == "Silence":
+            return commands.silence(who)
         if method.name in ("Acknowledge", "Shelve", "Unshelve"):
             return self._alarm(who, method, args)
         if method.name in ("WriteBit", "WriteWord"):

@@ -19,6 +19,7 @@ from app.gui.console.window import ConsoleWindow
 from app.gui.status import StationStatusBar
 from app.publish.client import LoginError
 from app.publish.console import ConsoleClient
+from app.scada.alarms import State
 from app.scada.quality import Quality
 from app.scada.readings import Readings
 from app.station.config import load_station
@@ -120,6 +121,13 @@ def test_an_acknowledge_shows_on_the_other_console_and_in_the_journal_a_viewer_i
         acked = [r.text or "" for r in station.records if r.kind == "alarm" and r.source == "TRIGGER.BAD"
                  and "acknowledged; by opcua:operator@127.0.0.1:" in (r.text or "")]
         assert acked, "the acknowledgement journaled with the operator's name"
+        qtbot.waitUntil(lambda: not viewer.banner.ack.isEnabled(), timeout=WAIT)  # as the station answers
+        assert "needs the operator role; viewer is viewer" in viewer.summary.ack.toolTip()
+        assert operator.commands.shelve(operator.who, "TRIGGER.BAD", "cable work", 600).result(20).ok
+        rows = viewer.summary
+        qtbot.waitUntil(lambda: any(r.id == "TRIGGER.BAD" and r.state is State.SHELVED for r in rows.rows),
+                        timeout=WAIT)
+        assert operator.commands.unshelve(operator.who, "TRIGGER.BAD").result(20).ok
         journal = viewer.journal  # the station's journal, read over OPC UA, names the operator too
         qtbot.waitUntil(lambda: any(r.kind == "alarm" and "TRIGGER.BAD" in (r.text or "") and
                                     "by opcua:operator@" in (r.text or "") for r in journal.model.rows),

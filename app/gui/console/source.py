@@ -23,7 +23,7 @@ import numpy as np
 from PySide6.QtCore import QObject, Signal
 
 from app.publish.console import ConsoleClient, Files
-from app.scada.alarms import AlarmRow
+from app.scada.alarms import AlarmRow, summary_order
 from app.scada.quality import LinkView, Operands, Quality, QualityMap
 from app.scada.readings import Reading, Readings
 from app.scada.table import TagTable, read_tags
@@ -117,6 +117,19 @@ class RemoteJournal:
         pass  # the session is the console's: closed with it
 
 
+class RemoteAlarms:
+    """The station's alarms as the alarm summary reads the local alarm system's (`version`,
+    `summary` in the summary's order)."""
+
+    def __init__(self) -> None:
+        self.version = 0
+        self.summary: list[AlarmRow] = []
+
+    def show(self, rows: tuple[AlarmRow, ...]) -> None:
+        self.summary = sorted(rows, key=summary_order)
+        self.version += 1
+
+
 class StationSource(QObject):
     """`readings` as the bridge gives them; `loaded` when the station's files changed; `alarms`
     the station's alarm rows; `link` "" while the station answers, else why not."""
@@ -131,6 +144,7 @@ class StationSource(QObject):
         super().__init__(parent)
         self.client = client
         self.current: Loaded | None = None
+        self.station_alarms = RemoteAlarms()
         self.quality_map: QualityMap | None = None
         self._snapshot: Snapshot | None = None
         self._files: Files | None = None
@@ -175,6 +189,7 @@ class StationSource(QObject):
                                         self.quality_map.evaluate(snapshot, links)))
         if alarms != self._alarms:
             self._alarms = alarms
+            self.station_alarms.show(alarms)
             self.alarms.emit(alarms)
 
     def stop(self) -> None:

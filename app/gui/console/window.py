@@ -18,10 +18,20 @@ import sys
 
 from PySide6.QtCore import Qt, QTimer
 from PySide6.QtGui import QCloseEvent
-from PySide6.QtWidgets import QDialog, QMainWindow, QMessageBox, QStatusBar, QTabWidget, QVBoxLayout, QWidget
+from PySide6.QtWidgets import (
+    QDialog,
+    QDockWidget,
+    QMainWindow,
+    QMessageBox,
+    QStatusBar,
+    QTabWidget,
+    QVBoxLayout,
+    QWidget,
+)
 
-from app.authority import Answer, Source, Ticket, Who
+from app.authority import Action, Answer, Source, Ticket, Who
 from app.gui import i18n, words
+from app.gui.alarm_summary import AlarmSummary
 from app.gui.alarms import AlarmBanner, FixedLine, HealthStrip
 from app.gui.application import application
 from app.gui.bridge import Answers
@@ -36,9 +46,10 @@ from app.gui.main_window import (
     _problems_page,
     _quit_on_signals,
 )
+from app.gui.rights import Rights
 from app.gui.zoom import ZoomArea
-from app.publish.console import ConsoleClient
-from app.scada.alarms import AlarmRow, summary_order
+from app.publish.console import ConsoleClient, StationCommands
+from app.scada.alarms import AlarmRow
 from app.scada.readings import Readings
 from hmi_forms.elements.base import Writer
 from hmi_forms.elements.target import EngineTarget
@@ -77,6 +88,8 @@ class ConsoleWindow(QMainWindow):
         self.answers = Answers()
         self.answers.answered.connect(self._answered)
         self.target = RemoteTarget(client, self.answers)
+        self.commands = StationCommands(client)
+        self.rights = Rights(self.commands, lambda: self.who)  # type: ignore[arg-type]
         self.views: list[FormView] = []
         self.unacknowledged: list[AlarmRow] = []
         central = QWidget()
@@ -86,6 +99,8 @@ class ConsoleWindow(QMainWindow):
         self.header = _Header(client.station or client.url)
         self.header.login.setVisible(False)  # the console's user is the one it logged in as
         self.banner = AlarmBanner()
+        for button in (self.banner.ack, self.banner.ack_all):
+            self.rights.add(button, Action.ACKNOWLEDGE, button.text())
         self.health = HealthStrip()
         self.tabs = QTabWidget()
         self.tabs.setObjectName("forms")
@@ -98,14 +113,22 @@ class ConsoleWindow(QMainWindow):
         self.setCentralWidget(central)
         self.journal = JournalDock(RemoteJournal(client), self)
         self.addDockWidget(Qt.DockWidgetArea.BottomDockWidgetArea, self.journal)
+        self.summary = AlarmSummary(source.station_alarms, self.commands,  # type: ignore[arg-type]
+                                    lambda: self.who, answers=self.answers)
+        self.summary_dock = QDockWidget(self.tr("Alarms"), self)
+        self.summary_dock.setObjectName("alarmSummaryDock")
+        self.summary_dock.setWidget(self.summary)
+        self.addDockWidget(Qt.DockWidgetArea.BottomDockWidgetArea, self.summary_dock)
+        self.tabifyDockWidget(self.journal, self.summary_dock)
+        self.summary_dock.raise_()
         self.status = QStatusBar()
         self.setStatusBar(self.status)
         self.resize(1024, 700)
         self.banner.acknowledged.connect(self.acknowledge)
-        self.banner.acknowledged_all.connect(self.acknowledge_all)
+        self.banner.acknowledged_all.connect(self.summary.acknowledge_all)
+        self.summary.changed.connect(self._alarms_changed)
         source.loaded.connect(self._load)
         source.readings.connect(self._on_readings)
-        source.alarms.connect(self._on_alarms)
         source.link.connect(self._on_link)
         self._timer = QTimer(self)
         self._timer.timeout.connect(self._tick)
@@ -146,9 +169,16 @@ class ConsoleWindow(QMainWindow):
         for view in self.views:
             view.refresh(readings.snapshot, readings)
 
-    def _on_alarms(self, rows: tuple[AlarmRow, ...]) -> None:
-        self.unacknowledged = sorted((r for r in rows if not r.acked), key=summary_order)
-        self.banner.show_alarms(self.unacknowledged)
+    @property
+    def who(self) -> Who:
+        """The console's user, as the journal at the station names it (the session is who acts)."""
+        return Who(self.client.user, Source.OPCUA)
+
+    def _alarms_changed(self) -> None:
+        waiting = self.unacknowledged = self.summary.unacknowledged()
+        self.banner.show_alarms(waiting)
+        self.summary_dock.setWindowTitle(self.tr("Alarms — {0} unacknowledged").format(len(waiting))
+                                         if waiting else self.tr("Alarms"))
 
     def _on_link(self, error: str) -> None:
         self.health.show_problems([self.tr("station unreachable: {0}; reconnecting").format(error)]
@@ -159,14 +189,13 @@ class ConsoleWindow(QMainWindow):
         self.header.tick()
         role = words.role(self.client.role) if self.client.role else ""
         self.header.user.setText(f"{self.client.user} ({role})" if role else self.client.user)
+        self.rights.update()
+        self.summary.rights.update()
         if not self.status.currentMessage():  # a refusal stays its time
             self.status.showMessage(self.client.state(), STATUS_MS + 200)
 
     def acknowledge(self, alarm: AlarmRow) -> Ticket:
-        return self.answers.follow(self.tr("Acknowledge"), self.client.acknowledge(alarm.id))
-
-    def acknowledge_all(self) -> Ticket:
-        return self.answers.follow(self.tr("Acknowledge all"), self.client.acknowledge_all())
+        return self.answers.follow(self.tr("Acknowledge"), self.commands.acknowledge(self.who, alarm.id))
 
     def _answered(self, what: str, answer: Answer) -> None:
         if not answer.ok:
@@ -174,6 +203,7 @@ class ConsoleWindow(QMainWindow):
 
     def closeEvent(self, event: QCloseEvent) -> None:
         self._timer.stop()
+        self.summary.stop()
         self.journal.close_archive()
         self.source.stop()
         super().closeEvent(event)

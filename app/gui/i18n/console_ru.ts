@@ -3,6 +3,14 @@
 <context>
     <name>ConsoleWindow</name>
     <message>
+        <source>Alarms</source>
+        <translation>Аварии</translation>
+    </message>
+    <message>
+        <source>Alarms — {0} unacknowledged</source>
+        <translation>Аварии — неквитированных: {0}</translation>
+    </message>
+    <message>
         <source>Confirm</source>
         <translation>Подтверждение</translation>
     </message>
