@@ -154,6 +154,12 @@ def test_a_setpoint_written_on_one_console_shows_on_the_other(
     watcher.target.write_word(address, 7, user="viewer", label="Уставка")  # refused by the station
     qtbot.waitUntil(lambda: "needs the operator role; viewer is viewer" in watcher.status.currentMessage(),
                     timeout=WAIT)
+    program = writer.open_program()  # the Program view on the console's session, as the station lets it
+    assert program is not None and program.source.client is writer.client
+    step = program.monitor.step_button
+    qtbot.waitUntil(lambda: "the station does not let operator do this" in step.toolTip(), timeout=WAIT)
+    program.close()
+    assert writer.client.error == "" and writer.client.snapshot is not None  # its session goes on
     element = next(m for v in writer.views for m in v.form.elements if isinstance(m, Writer))
     element.Confirm = True  # a command that cannot be taken back: the console asks first
     writer.ask = lambda title, text: False

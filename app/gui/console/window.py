@@ -17,7 +17,7 @@ import logging
 import sys
 
 from PySide6.QtCore import Qt, QTimer
-from PySide6.QtGui import QCloseEvent
+from PySide6.QtGui import QAction, QCloseEvent, QKeySequence
 from PySide6.QtWidgets import (
     QDialog,
     QDockWidget,
@@ -46,6 +46,8 @@ from app.gui.main_window import (
     _problems_page,
     _quit_on_signals,
 )
+from app.gui.monitor.source import OpcUaSource
+from app.gui.monitor.window import ProgramWindow
 from app.gui.rights import Rights
 from app.gui.zoom import ZoomArea
 from app.publish.console import ConsoleClient, StationCommands
@@ -79,6 +81,14 @@ class RemoteTarget(EngineTarget):
         return self.client.write_word(addr, value, label, at_least)
 
 
+class SharedSession(OpcUaSource):
+    """The Program view on the console's own session with the station: closed with the console,
+    not with the view."""
+
+    def close(self) -> None:
+        pass
+
+
 class ConsoleWindow(QMainWindow):
     def __init__(self, source: StationSource, parent: QWidget | None = None) -> None:
         super().__init__(parent)
@@ -91,6 +101,7 @@ class ConsoleWindow(QMainWindow):
         self.commands = StationCommands(client)
         self.rights = Rights(self.commands, lambda: self.who)  # type: ignore[arg-type]
         self.views: list[FormView] = []
+        self.programs: list[ProgramWindow] = []  # the Program views opened from here
         self.unacknowledged: list[AlarmRow] = []
         central = QWidget()
         lay = QVBoxLayout(central)
@@ -123,6 +134,14 @@ class ConsoleWindow(QMainWindow):
         self.summary_dock.raise_()
         self.status = QStatusBar()
         self.setStatusBar(self.status)
+        station = self.menuBar().addMenu(self.tr("&Station"))
+        program = QAction(self.tr("&Program…"), self)  # the listing live, the watch table, forcing
+        program.setShortcut(QKeySequence("Ctrl+Shift+P"))
+        program.triggered.connect(self.open_program)
+        station.addAction(program)
+        view = self.menuBar().addMenu(self.tr("&View"))
+        view.addAction(self.journal.toggleViewAction())
+        view.addAction(self.summary_dock.toggleViewAction())
         self.resize(1024, 700)
         self.banner.acknowledged.connect(self.acknowledge)
         self.banner.acknowledged_all.connect(self.summary.acknowledge_all)
@@ -154,6 +173,20 @@ class ConsoleWindow(QMainWindow):
         if not loaded.forms and not loaded.problems:
             self.tabs.addTab(_placeholder(self.tr("The station serves no forms.")), self.tr("No forms"))
         self.tabs.setCurrentIndex(max(0, min(current, self.tabs.count() - 1)))
+
+    def open_program(self) -> ProgramWindow | None:
+        """Station -> Program: the station's program live, over this console's session, with what
+        the user may do there as the station answers (forcing and single scans for an engineer)."""
+        loaded = self.source.current
+        if loaded is None:
+            self.status.showMessage(self.tr("The station's files are not loaded yet"), REFUSAL_MS)
+            return None
+        source = SharedSession(self.client, program=loaded.program, symbols=loaded.symbols,
+                               tags=loaded.tags.by_name)
+        window = ProgramWindow(source, lambda: self.client.user)
+        window.show()
+        self.programs.append(window)
+        return window
 
     def ask(self, title: str, text: str) -> bool:
         """The second step of a command: the operator confirms it (tests answer for them)."""
@@ -203,6 +236,8 @@ class ConsoleWindow(QMainWindow):
 
     def closeEvent(self, event: QCloseEvent) -> None:
         self._timer.stop()
+        for program in self.programs:
+            program.close()
         self.summary.stop()
         self.journal.close_archive()
         self.source.stop()

@@ -3,6 +3,22 @@
 <context>
     <name>ConsoleWindow</name>
     <message>
+        <source>&amp;Station</source>
+        <translation>&amp;Станция</translation>
+    </message>
+    <message>
+        <source>&amp;Program…</source>
+        <translation>&amp;Программа…</translation>
+    </message>
+    <message>
+        <source>&amp;View</source>
+        <translation>&amp;Вид</translation>
+    </message>
+    <message>
+        <source>The station's files are not loaded yet</source>
+        <translation>Файлы станции ещё не загружены</translation>
+    </message>
+    <message>
         <source>Alarms</source>
         <translation>Аварии</translation>
     </message>
