@@ -72,6 +72,7 @@ class ConsoleClient(StationClient):
         self.alarms: tuple[AlarmRow, ...] = ()
         self.links: dict[int, bool] = {}
         self.role = ""
+        self.journal_events: object = None  # Station.JournalEvents as last read: it changes, the journal did
         self._manifest = ""
         self._browsed: object = None  # the session the alarms and nodes were browsed in
         self._alarm_ids: list[str] = []
@@ -103,9 +104,11 @@ class ConsoleClient(StationClient):
             allowed = rank(role) >= rank(need)
         return None if allowed else Refusal(what or action.value, need, self.user, role)
 
-    def journal(self, day: dt.date, limit: int) -> Future[list[Row]]:
-        """The newest `limit` records of `day` (this machine's day) in the station's journal."""
-        return self._submit(self._journal(day, limit))
+    def journal(self, day: dt.date, limit: int, since: float | None = None) -> Future[list[Row]]:
+        """The newest `limit` records of `day` (this machine's day) in the station's journal, newest
+        first; with `since` (a record's time) only those from then on, oldest first (the station
+        reads the few rows after it, not the day's newest page again)."""
+        return self._submit(self._journal(day, limit, since))
 
     def said(self, sent: Ticket, action: Action, what: str, at_least: str | None = None) -> Ticket:
         """The station's answer, a refusal for the role in its parts (the role it needs, the user's)."""
@@ -137,29 +140,32 @@ class ConsoleClient(StationClient):
     async def _read_slow(self) -> None:
         client = self._client
         assert client is not None
-        nodes = [self._node("Files.Manifest"), self._node("Station.Role")]
+        nodes = [self._node(n) for n in ("Files.Manifest", "Station.Role", "Station.JournalEvents")]
         nodes += [self._node(f"Nodes.{n}.Up") for n in self._nodes]
         nodes += [self._node(f"Alarms.{a}.{f}") for a in self._alarm_ids for f in FIELDS]
         values = [dv.Value.Value if dv.Value is not None else None
                   for dv in await client.uaclient.read_attributes(nodes, ua.AttributeIds.Value)]
-        manifest, self.role = str(values[0] or "{}"), str(values[1] or "")
-        self.links = {n: bool(up) for n, up in zip(self._nodes, values[2:])}
-        rest = values[2 + len(self._nodes):]
+        manifest, self.role, self.journal_events = str(values[0] or "{}"), str(values[1] or ""), values[2]
+        self.links = {n: bool(up) for n, up in zip(self._nodes, values[3:])}
+        rest = values[3 + len(self._nodes):]
         self.alarms = tuple(self._row(a, rest[k * len(FIELDS):(k + 1) * len(FIELDS)])
                             for k, a in enumerate(self._alarm_ids))
         if manifest != self._manifest:
             self.files = await self._fetch(manifest)
             self._manifest = manifest
 
-    async def _journal(self, day: dt.date, limit: int) -> list[Row]:
+    async def _journal(self, day: dt.date, limit: int, since: float | None) -> list[Row]:
         client = self._client
         if client is None:
             raise ConnectionError(f"not connected: {self.error or 'logging in'}")
-        start = dt.datetime.combine(day, dt.time.min).astimezone(UTC)
-        end = start + dt.timedelta(days=1)
+        first = dt.datetime.combine(day, dt.time.min).astimezone(UTC)
+        end = first + dt.timedelta(days=1)
         station = client.get_node(self._node(self.station))
-        try:  # an end before the start: newest first
-            events = await station.read_event_history(end, start, limit)
+        try:  # an end before the start reads newest first
+            if since is None:
+                events = await station.read_event_history(end, first, limit)
+            else:
+                events = await station.read_event_history(dt.datetime.fromtimestamp(since, UTC), end, limit)
         except ua.UaError as e:
             raise ConnectionError(f"{self.url}: {_why(e)}") from None
         return [_record(e) for e in events]

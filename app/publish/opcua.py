@@ -65,7 +65,7 @@ from app.authority.users import UserError, Users
 from app.publish.conditions import Conditions
 from app.publish.feed import LatestReadings, Watch
 from app.publish.files import StationFiles
-from app.publish.history import AlarmSource, Archived, Series, StationHistory, install, series_of
+from app.publish.history import JOURNAL, AlarmSource, Archived, Series, StationHistory, install, series_of
 from app.publish.methods import StationMethods, StepLock
 from app.publish.pki import TrustList, host_names, station_certificate, subject, thumbprint
 from app.publish.points import PointReader, PointWriter, Writable
@@ -254,6 +254,8 @@ class OpcUaServer:
         self.feed = LatestReadings(self._wake)
         self._unwatch: Callable[[], None] | None = None
         self._published = -1  # the scan whose values the address space holds
+        self._events = 0  # the journal's events since the start (Station.JournalEvents)
+        self._events_shown = 0
         self._waiting: list[tuple[int, asyncio.Future[None]]] = []  # writes waiting to be readable
         self._loop: asyncio.AbstractEventLoop | None = None
         self._ready = threading.Event()
@@ -292,7 +294,9 @@ class OpcUaServer:
 
     def on_record(self, record: Record) -> None:
         """The runtime's record observer: an alarm's transition becomes its condition's state and
-        event."""
+        event; every event of the journal counts in Station.JournalEvents."""
+        if record.kind in JOURNAL:
+            self._events += 1
         if record.kind == "alarm" and self._ready.is_set():
             self.conditions.post(record)
 
@@ -432,6 +436,13 @@ class OpcUaServer:
         await self.methods.add(station, idx)
         if self.files is not None:
             await self.files.build(server, station, idx)
+        events = ua.Variant(0, ua.VariantType.UInt64)
+        self.journal_events = await station.add_variable(ua.NodeId("Station.JournalEvents", idx),
+                                                         name("JournalEvents"), events)
+        await self.journal_events.write_attribute(ua.AttributeIds.Description, ua.DataValue(ua.Variant(
+            ua.LocalizedText("events journaled since the station started (messages, alarm transitions, "
+                             "operator actions, system records): a console reads the journal's history "
+                             "when it changes"))))
         role = await station.add_variable(ua.NodeId("Station.Role", idx), name("Role"), "")
         self.role_node = role.nodeid
         await role.write_attribute(ua.AttributeIds.Description, ua.DataValue(ua.Variant(ua.LocalizedText(
@@ -530,6 +541,9 @@ class OpcUaServer:
         await self.plc_state.write_value(reading.state)
         await self.plc_scan_ms.write_value(float(self.engine.stats.last_ms))
         await self.plc_tick.write_value(ua.Variant(reading.scan, ua.VariantType.UInt64))
+        if self._events != self._events_shown:
+            self._events_shown = self._events
+            await self.journal_events.write_value(ua.Variant(self._events_shown, ua.VariantType.UInt64))
         for n, stats in (self.exchange.stats.items() if self.exchange is not None else ()):
             vars_ = self.node_vars.get(n)
             if vars_ is None:

@@ -32,6 +32,7 @@ from hmi_forms.widgets.journal import Page
 from netplc.memory import Snapshot
 from netplc.program import Program, ProgramError, parse, parse_file, read_symbols
 from registrar.query import Filter
+from registrar.reading import Row
 
 logger = logging.getLogger(__name__)
 
@@ -103,15 +104,36 @@ class RemoteJournal:
 
     def __init__(self, client: ConsoleClient) -> None:
         self.client = client
+        self._day: dt.date | None = None
+        self._rows: list[Row] = []  # the day's newest records as last read, newest first
+        self._seen: object = None  # the station's count of journal events the rows hold
+        self._misses = 0
 
     def page(self, day: dt.date, flt: Filter, limit: int, count: bool) -> Page | None:
+        """The day's newest page: read whole once, then only what came since its newest record,
+        and only when the station's count of journal events changed (an event counts before its
+        record is committed: it is looked for again at the next pages, three times at most)."""
+        head = self.client.journal_events
         try:
-            rows = self.client.journal(day, limit).result(JOURNAL_WAIT_S)
+            if day != self._day or not self._rows:
+                self._rows = self.client.journal(day, limit).result(JOURNAL_WAIT_S)
+                self._day, self._seen, self._misses = day, head, 0
+            elif head != self._seen:
+                newest = self._rows[0]
+                new = [r for r in self.client.journal(day, limit, newest.ts).result(JOURNAL_WAIT_S)
+                       if r.id > newest.id]
+                self._rows = (new[::-1] + self._rows)[:limit]
+                self._misses = 0 if new else self._misses + 1
+                if isinstance(head, int) and isinstance(self._seen, int) and new:
+                    self._seen = min(head, self._seen + len(new))
+                if self._misses >= 3 or not isinstance(head, int) or not isinstance(self._seen, int):
+                    self._seen, self._misses = head, 0
         except (ConnectionError, TimeoutError) as e:
+            self._rows = []  # read whole again once the station answers: it may have restarted
             raise OSError(f"the station's journal: {e or type(e).__name__}") from None
         kinds = flt.kinds
-        shown = [r for r in rows if kinds is None or r.kind in kinds]
-        return Page(day, shown, len(shown) if len(rows) < limit else None)
+        shown = [r for r in self._rows if kinds is None or r.kind in kinds]
+        return Page(day, shown, len(shown) if len(self._rows) < limit else None)
 
     def close(self) -> None:
         pass  # the session is the console's: closed with it
