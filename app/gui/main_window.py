@@ -19,11 +19,11 @@ import signal
 import sys
 import time
 from collections.abc import Callable
-from dataclasses import replace
+from dataclasses import dataclass, replace
 from importlib import metadata
 from typing import TYPE_CHECKING
 
-from PySide6.QtCore import QEvent, QObject, QSize, Qt, QTimer
+from PySide6.QtCore import QCoreApplication, QEvent, QObject, QSize, Qt, QTimer
 from PySide6.QtGui import QAction, QCloseEvent, QKeySequence
 from PySide6.QtWidgets import (
     QApplication,
@@ -105,38 +105,17 @@ class MainWindow(QMainWindow):
         self.zoom_settings = ZoomSettings(station.Archive.parent / "workstation.ini")
         self.viewers: list[QWidget] = []
 
-        central = QWidget()
-        central.setObjectName("central")
-        lay = QVBoxLayout(central)
-        lay.setContentsMargins(0, 0, 0, 0)
-        lay.setSpacing(0)
-        self.header = _Header(station.name)
+        frame = station_frame(self, station.name)
+        self.header, self.alarms, self.health = frame.header, frame.alarms, frame.health
+        self.tabs, self.fixed_lines = frame.tabs, frame.fixed_lines
         self.header.login.clicked.connect(self.log_in_or_out)
-        self.alarms = AlarmBanner()
         for button in (self.alarms.ack, self.alarms.ack_all):
             self.rights.add(button, Action.ACKNOWLEDGE, button.text())
-        self.health = HealthStrip()
-        self.tabs = QTabWidget()
-        self.tabs.setObjectName("forms")
-        self.tabs.setDocumentMode(True)
-        lay.addWidget(self.header)
-        self.fixed_lines = (FixedLine(self.alarms, self.tr("No unacknowledged alarms"), ALARM_LINE),
-                            FixedLine(self.health, "", HEALTH_LINE))
-        for line in self.fixed_lines:
-            lay.addWidget(line)
-        lay.addWidget(self.tabs, 1)
-        self.setCentralWidget(central)
 
         self.journal = JournalDock(station.Archive, self)
-        self.addDockWidget(Qt.DockWidgetArea.BottomDockWidgetArea, self.journal)
         self.summary = AlarmSummary(runtime.alarms, self.commands, lambda: self.who, answers=self.answers,
                                     sound=station.alarm_sound)
-        self.summary_dock = QDockWidget(self.tr("Alarms"), self)
-        self.summary_dock.setObjectName("alarmSummaryDock")
-        self.summary_dock.setWidget(self.summary)
-        self.addDockWidget(Qt.DockWidgetArea.BottomDockWidgetArea, self.summary_dock)
-        self.tabifyDockWidget(self.journal, self.summary_dock)
-        self.summary_dock.raise_()
+        self.summary_dock = bottom_docks(self, self.journal, self.summary)
         self.status = StationStatusBar()
         self.setStatusBar(self.status)
         self._build_menu()
@@ -494,6 +473,51 @@ class MainWindow(QMainWindow):
         for viewer in self.viewers:
             viewer.close()
         super().closeEvent(event)
+
+
+@dataclass
+class Frame:
+    """What the workstation and a remote console (app/gui/console/) show around the forms: the
+    header, the alarm banner and the health strip on their fixed lines, the forms' tabs."""
+
+    header: _Header
+    alarms: AlarmBanner
+    health: HealthStrip
+    tabs: QTabWidget
+    fixed_lines: tuple[FixedLine, FixedLine]
+
+
+def bottom_docks(window: QMainWindow, journal: JournalDock, summary: AlarmSummary) -> QDockWidget:
+    """The journal and the alarm summary docked below the forms, tabbed, the summary on top; its dock."""
+    window.addDockWidget(Qt.DockWidgetArea.BottomDockWidgetArea, journal)
+    dock = QDockWidget(QCoreApplication.translate("MainWindow", "Alarms"), window)
+    dock.setObjectName("alarmSummaryDock")
+    dock.setWidget(summary)
+    window.addDockWidget(Qt.DockWidgetArea.BottomDockWidgetArea, dock)
+    window.tabifyDockWidget(journal, dock)
+    dock.raise_()
+    return dock
+
+
+def station_frame(window: QMainWindow, title: str) -> Frame:
+    """The frame as `window`'s central widget."""
+    central = QWidget()
+    central.setObjectName("central")
+    lay = QVBoxLayout(central)
+    lay.setContentsMargins(0, 0, 0, 0)
+    lay.setSpacing(0)
+    alarms, health = AlarmBanner(), HealthStrip()
+    frame = Frame(_Header(title), alarms, health, QTabWidget(), (
+        FixedLine(alarms, QCoreApplication.translate("MainWindow", "No unacknowledged alarms"), ALARM_LINE),
+        FixedLine(health, "", HEALTH_LINE)))
+    frame.tabs.setObjectName("forms")
+    frame.tabs.setDocumentMode(True)
+    lay.addWidget(frame.header)
+    for line in frame.fixed_lines:
+        lay.addWidget(line)
+    lay.addWidget(frame.tabs, 1)
+    window.setCentralWidget(central)
+    return frame
 
 
 class _Activity(QObject):

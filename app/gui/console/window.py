@@ -16,36 +16,31 @@ from __future__ import annotations
 import logging
 import sys
 
-from PySide6.QtCore import Qt, QTimer
+from PySide6.QtCore import QTimer
 from PySide6.QtGui import QAction, QCloseEvent, QKeySequence
 from PySide6.QtWidgets import (
-    QDialog,
-    QDockWidget,
     QMainWindow,
     QMessageBox,
     QStatusBar,
-    QTabWidget,
-    QVBoxLayout,
     QWidget,
 )
 
 from app.authority import Action, Answer, Source, Ticket, Who
 from app.gui import i18n, words
 from app.gui.alarm_summary import AlarmSummary
-from app.gui.alarms import AlarmBanner, FixedLine, HealthStrip
 from app.gui.application import application
 from app.gui.bridge import Answers
 from app.gui.console.source import Loaded, RemoteJournal, StationSource
 from app.gui.journal import JournalDock
 from app.gui.main_window import (
-    ALARM_LINE,
-    HEALTH_LINE,
     REFUSAL_MS,
-    _Header,
     _placeholder,
     _problems_page,
     _quit_on_signals,
+    bottom_docks,
+    station_frame,
 )
+from app.gui.monitor.login import logged_in
 from app.gui.monitor.source import OpcUaSource
 from app.gui.monitor.window import ProgramWindow
 from app.gui.rights import Rights
@@ -103,35 +98,16 @@ class ConsoleWindow(QMainWindow):
         self.views: list[FormView] = []
         self.programs: list[ProgramWindow] = []  # the Program views opened from here
         self.unacknowledged: list[AlarmRow] = []
-        central = QWidget()
-        lay = QVBoxLayout(central)
-        lay.setContentsMargins(0, 0, 0, 0)
-        lay.setSpacing(0)
-        self.header = _Header(client.station or client.url)
+        frame = station_frame(self, client.station or client.url)
+        self.header, self.banner, self.health = frame.header, frame.alarms, frame.health
+        self.tabs = frame.tabs
         self.header.login.setVisible(False)  # the console's user is the one it logged in as
-        self.banner = AlarmBanner()
         for button in (self.banner.ack, self.banner.ack_all):
             self.rights.add(button, Action.ACKNOWLEDGE, button.text())
-        self.health = HealthStrip()
-        self.tabs = QTabWidget()
-        self.tabs.setObjectName("forms")
-        self.tabs.setDocumentMode(True)
-        lay.addWidget(self.header)
-        for line in (FixedLine(self.banner, self.tr("No unacknowledged alarms"), ALARM_LINE),
-                     FixedLine(self.health, "", HEALTH_LINE)):
-            lay.addWidget(line)
-        lay.addWidget(self.tabs, 1)
-        self.setCentralWidget(central)
         self.journal = JournalDock(RemoteJournal(client), self)
-        self.addDockWidget(Qt.DockWidgetArea.BottomDockWidgetArea, self.journal)
         self.summary = AlarmSummary(source.station_alarms, self.commands,  # type: ignore[arg-type]
                                     lambda: self.who, answers=self.answers)
-        self.summary_dock = QDockWidget(self.tr("Alarms"), self)
-        self.summary_dock.setObjectName("alarmSummaryDock")
-        self.summary_dock.setWidget(self.summary)
-        self.addDockWidget(Qt.DockWidgetArea.BottomDockWidgetArea, self.summary_dock)
-        self.tabifyDockWidget(self.journal, self.summary_dock)
-        self.summary_dock.raise_()
+        self.summary_dock = bottom_docks(self, self.journal, self.summary)
         self.status = QStatusBar()
         self.setStatusBar(self.status)
         station = self.menuBar().addMenu(self.tr("&Station"))
@@ -247,14 +223,8 @@ class ConsoleWindow(QMainWindow):
 def open_console(url: str, user: str | None = None, password: str | None = None) -> ConsoleWindow | None:
     """Log in to the station at `url` (the login dialog; trust on first use) and open its console;
     None when the login was cancelled, Problems when the station refused it."""
-    from app.gui.monitor.login import LoginDialog
-
     client = ConsoleClient(url)
-    dialog = LoginDialog(client, user or "", password)
-    if dialog.exec() != QDialog.DialogCode.Accepted:
-        client.close()
-        if dialog.error:
-            raise Problems([dialog.error])
+    if not logged_in(client, user, password):
         return None
     if client.files is not None:
         i18n.install(application(), str(client.files.manifest.get("language", "")))
