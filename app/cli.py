@@ -22,8 +22,8 @@ from app.station.config import DEMO_STATION
 from netplc import interruptible
 from registrar.plant.url import is_url
 
-COMMANDS = ("view", "check", "simulate", "alarms-report", "design", "monitor", "archive", "users", "opcua",
-            "redundancy")
+COMMANDS = ("view", "check", "simulate", "alarms-report", "design", "monitor", "console", "archive", "users",
+            "opcua", "redundancy")
 
 
 def _main_parser() -> argparse.ArgumentParser:
@@ -35,6 +35,7 @@ def _main_parser() -> argparse.ArgumentParser:
                "station), simulate PROGRAM.stl (a simulated CPU-165 node), alarms-report ARCHIVE --day "
                "DD_MM_YYYY (alarm-system health), design [FORM.hmi | STATION] (the form designer), "
                "monitor opc.tcp://HOST:PORT/PATH | STATION_OR_HOST:PORT (the program monitor of a running "
+               "station), console opc.tcp://HOST:PORT/PATH (a remote operator console of a running "
                "station), archive migrate "
                "ARCHIVE.sqlite postgresql://... (copy an archive into the plant archive), "
                "users (the station's users and roles), opcua trust STATION THUMBPRINT (trust an OPC UA "
@@ -184,6 +185,18 @@ def _monitor_parser() -> argparse.ArgumentParser:
     return p
 
 
+def _console_parser() -> argparse.ArgumentParser:
+    p = argparse.ArgumentParser(prog="python main.py console",
+                                description="A remote operator console of a running station: its forms, "
+                                            "alarms and commands over the station's OPC UA endpoint, as a "
+                                            "user of that station (a login dialog); no NetPlc, exchange or "
+                                            "archive of its own.")
+    p.add_argument("url", help="opc.tcp://HOST:PORT/PATH of the station's OPC UA endpoint")
+    p.add_argument("--user", help="the user to log in as (the dialog asks the password; when stdin is not "
+                                  "a terminal, its first line is the password)")
+    return p
+
+
 def _users_parser() -> argparse.ArgumentParser:
     from app.authority.policy import ROLES
 
@@ -297,6 +310,16 @@ def main(argv: list[str] | None = None) -> int:
             from app.gui.monitor.window import run_monitor
 
             return run_monitor(ns.target, ns.program, ns.user, ns.partner)
+        if command == "console":
+            ns = _console_parser().parse_args(rest)
+            if not ns.url.startswith("opc.tcp://"):
+                print(f"{ns.url}: not an opc.tcp:// URL", file=sys.stderr)
+                return 2
+            if not _installed("opcua", "the console"):
+                return 2
+            from app.gui.console.window import run_console
+
+            return run_console(ns.url, ns.user)
         if command == "archive":
             ns = _archive_parser().parse_args(rest)
             if ns.action == "backup":

@@ -6,6 +6,9 @@ thread (hmi_forms/widgets/worker.py), with the MessageJournal element's reader: 
 page of 500 rows and the day's count, which on a busy day or a slow disk takes longer than a
 frame, and a window waiting for them stops repainting. The newest request wins, so a slow read
 never piles refreshes up behind it; an unreadable archive is said in the dock's summary.
+
+The archive is the dock's reader: the local station's file (`JournalReader`), or at a remote console
+the station's journal over OPC UA (app/gui/console/source.py `RemoteJournal`, the same `page`).
 """
 
 from __future__ import annotations
@@ -15,6 +18,7 @@ import logging
 import sqlite3
 from functools import partial
 from pathlib import Path
+from typing import Protocol
 
 from PySide6.QtCore import Qt, QTimer
 from PySide6.QtWidgets import QCheckBox, QDockWidget, QHBoxLayout, QLabel, QVBoxLayout, QWidget
@@ -32,13 +36,19 @@ REFRESH_MS = 1500
 PAGE = "page"  # the worker's one topic: a newer refresh supersedes an older one still waiting
 
 
+class Reader(Protocol):
+    def page(self, day: dt.date, flt: Filter, limit: int, count: bool) -> Page | None: ...
+
+    def close(self) -> None: ...
+
+
 class JournalDock(QDockWidget):
-    def __init__(self, archive_path: Path, parent: QWidget | None = None) -> None:
+    def __init__(self, archive: Path | Reader, parent: QWidget | None = None) -> None:
+        """`archive`: the station's archive file, or a reader of the station's journal."""
         super().__init__(parent)
         self.setWindowTitle(self.tr("Journal — today"))
         self.setObjectName("journalDock")
-        self.archive_path = archive_path
-        self.reader = JournalReader(archive_path)
+        self.reader = JournalReader(archive) if isinstance(archive, Path) else archive
         self.worker = Worker("journal dock", (sqlite3.Error, OSError), self, on_close=self.reader.close)
         self.worker.answered.connect(self._shown)
         self.worker.failed.connect(self._failed)

@@ -18,11 +18,11 @@ import logging
 import signal
 import sys
 from collections.abc import Callable
-from dataclasses import replace
+from dataclasses import dataclass, replace
 from importlib import metadata
 from typing import TYPE_CHECKING
 
-from PySide6.QtCore import QEvent, QObject, QSize, Qt, QTimer
+from PySide6.QtCore import QCoreApplication, QEvent, QObject, QSize, Qt, QTimer
 from PySide6.QtGui import QAction, QCloseEvent, QKeySequence
 from PySide6.QtWidgets import (
     QApplication,
@@ -106,36 +106,17 @@ class MainWindow(QMainWindow):
         self.placement = Placement(station.Archive.parent / "workstation.ini", primary_size())
         self.viewers: list[QWidget] = []
 
-        central = QWidget()
-        central.setObjectName("central")
-        lay = QVBoxLayout(central)
-        lay.setContentsMargins(0, 0, 0, 0)
-        lay.setSpacing(0)
-        self.alarms = AlarmBanner()
+        frame = station_frame(self, station.name)
+        self.header, self.alarms, self.health = frame.header, frame.alarms, frame.health
+        self.tabs, self.note = frame.tabs, frame.note
+        self.header.login.clicked.connect(self.log_in_or_out)
         for button in (self.alarms.ack, self.alarms.ack_all):
             self.rights.add(button, Action.ACKNOWLEDGE, button.text())
-        self.health = HealthStrip()
-        # station, alarm banner, health strip, user and clock: one line of a fixed height
-        self.header = HeaderLine(station.name, self.alarms, self.health, self.tr("No unacknowledged alarms"))
-        self.header.login.clicked.connect(self.log_in_or_out)
-        self.tabs = QTabWidget()
-        self.tabs.setObjectName("forms")
-        self.tabs.setDocumentMode(True)
-        lay.addWidget(self.header)
-        lay.addWidget(self.tabs, 1)
-        self.setCentralWidget(central)
-        self.note = Note(central)  # a refusal, whole, over the bottom of the forms
 
         self.journal = JournalDock(station.Archive, self)
-        self.addDockWidget(Qt.DockWidgetArea.BottomDockWidgetArea, self.journal)
         self.summary = AlarmSummary(runtime.alarms, self.commands, lambda: self.who, answers=self.answers,
                                     sound=station.alarm_sound, sounds=station.alarm_sounds)
-        self.summary_dock = QDockWidget(self.tr("Alarms"), self)
-        self.summary_dock.setObjectName("alarmSummaryDock")
-        self.summary_dock.setWidget(self.summary)
-        self.addDockWidget(Qt.DockWidgetArea.BottomDockWidgetArea, self.summary_dock)
-        self.tabifyDockWidget(self.journal, self.summary_dock)
-        self.summary_dock.raise_()
+        self.summary_dock = bottom_docks(self, self.journal, self.summary)
         self.dock_strip = DockStrip(self, (self.journal, self.summary_dock), JOURNAL_HEIGHT)
         self.status = StationStatusBar()
         self.setStatusBar(self.status)
@@ -518,6 +499,51 @@ class MainWindow(QMainWindow):
         for viewer in self.viewers:
             viewer.close()
         super().closeEvent(event)
+
+
+@dataclass
+class Frame:
+    """What the workstation and a remote console (app/gui/console/) show around the forms: the
+    one header line (station, alarm banner, health strip, user, clock), the forms' tabs, and the
+    note that shows a refusal whole over them."""
+
+    header: HeaderLine
+    alarms: AlarmBanner
+    health: HealthStrip
+    tabs: QTabWidget
+    note: Note
+
+
+def bottom_docks(window: QMainWindow, journal: JournalDock, summary: AlarmSummary) -> QDockWidget:
+    """The journal and the alarm summary docked below the forms, tabbed, the summary on top; its dock."""
+    window.addDockWidget(Qt.DockWidgetArea.BottomDockWidgetArea, journal)
+    dock = QDockWidget(QCoreApplication.translate("MainWindow", "Alarms"), window)
+    dock.setObjectName("alarmSummaryDock")
+    dock.setWidget(summary)
+    window.addDockWidget(Qt.DockWidgetArea.BottomDockWidgetArea, dock)
+    window.tabifyDockWidget(journal, dock)
+    dock.raise_()
+    return dock
+
+
+def station_frame(window: QMainWindow, title: str) -> Frame:
+    """The frame as `window`'s central widget."""
+    central = QWidget()
+    central.setObjectName("central")
+    lay = QVBoxLayout(central)
+    lay.setContentsMargins(0, 0, 0, 0)
+    lay.setSpacing(0)
+    alarms, health = AlarmBanner(), HealthStrip()
+    # station, alarm banner, health strip, user and clock: one line of a fixed height
+    header = HeaderLine(title, alarms, health,
+                        QCoreApplication.translate("MainWindow", "No unacknowledged alarms"))
+    tabs = QTabWidget()
+    tabs.setObjectName("forms")
+    tabs.setDocumentMode(True)
+    lay.addWidget(header)
+    lay.addWidget(tabs, 1)
+    window.setCentralWidget(central)
+    return Frame(header, alarms, health, tabs, Note(central))
 
 
 class _Activity(QObject):

@@ -46,7 +46,9 @@ class StationStatusBar(QStatusBar):
         self.records = Pill()
         self.server = Pill()
         self.forced = Pill()  # "F: n forced", always shown (netplc/forcing.py)
-        for pill in (self.state, self.forced, self.scan, self.tick, self.nodes, self.records, self.server):
+        self.consoles = Pill()  # the OPC UA sessions logged in (remote consoles...), while there are any
+        for pill in (self.state, self.forced, self.scan, self.tick, self.nodes, self.records, self.server,
+                     self.consoles):
             self.addPermanentWidget(pill)
 
     def show_status(self, s: RuntimeStatus) -> None:
@@ -82,6 +84,8 @@ class StationStatusBar(QStatusBar):
                                    fault or self.tr("NetPlc memory served over Modbus RTU"))
         else:
             self.server.show_value(self.tr("Modbus off"), IDLE)
+        self.consoles.setVisible(bool(s.consoles))
+        self.consoles.show_value(self.tr("Consoles {0}").format(len(s.consoles)), OK, "\n".join(s.consoles))
 
 
 # the engine's state texts, for the translation sources (the status bar translates them as shown)

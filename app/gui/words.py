@@ -33,6 +33,7 @@ SOURCES = (
     QT_TRANSLATE_NOOP("words", "good"), QT_TRANSLATE_NOOP("words", "initial"),
     QT_TRANSLATE_NOOP("words", "stale"), QT_TRANSLATE_NOOP("words", "comm-fail"),
     QT_TRANSLATE_NOOP("words", "not running"), QT_TRANSLATE_NOOP("words", "forced"),
+    QT_TRANSLATE_NOOP("words", "station unreachable"),
 )
 
 

@@ -38,7 +38,7 @@ import logging
 import os
 import socket
 import time
-from collections.abc import Coroutine
+from collections.abc import Callable, Coroutine
 from concurrent.futures import Future
 from dataclasses import dataclass
 from pathlib import Path
@@ -239,6 +239,8 @@ class StationClient:
         self._raw: tuple[object, ...] = ()
         self._loop = LoopThread(f"monitor-{urlsplit(self.url).netloc}")
         self._task: asyncio.Task[None] | None = None
+        # called on the client's thread when the snapshot or the link's state changed
+        self.changed: Callable[[], None] = lambda: None
 
     # --- from any thread ----------------------------------------------------------------------
 
@@ -411,6 +413,9 @@ class StationClient:
                 if self.partner and self.service_level < LEADS and await self._follow("it leads no more"):
                     asked = time.monotonic()
                     continue
+                if self.error:
+                    self.error = ""
+                    self.changed()
                 if time.monotonic() - asked >= RIGHTS_EVERY_S or not self._watched <= self.writable.keys():
                     asked = time.monotonic()
                     await self._ask_rights()
@@ -461,6 +466,7 @@ class StationClient:
     async def _lost(self, why: str, failures: int) -> None:
         """The session is given up (said in `error`) and a new one tried after a back-off."""
         self.error = why
+        self.changed()
         client, self._client = self._client, None
         if client is not None:
             try:
@@ -493,6 +499,7 @@ class StationClient:
         self.snapshot = Snapshot(tuple(bits or b""), bytes(data or b""), int(tick or 0), time.monotonic(),
                                  when.timestamp() if when is not None else time.time(), str(state or ""),
                                  self._forces(str(forces or "[]")))
+        self.changed()
 
     def _forces(self, text: str) -> tuple[Force, ...]:
         try:

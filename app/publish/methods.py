@@ -1,5 +1,6 @@
 """The station's OPC UA methods: run, stop and step NetPlc, force and unforce an address or a tag,
-for a remote Program view (`main.py monitor opc.tcp://...`) acting as a logged-in user of the station.
+for a remote Program view (`main.py monitor opc.tcp://...`) acting as a logged-in user of the station;
+acknowledge and shelve alarms and write a form's bit or word, for a remote console (`main.py console`).
 
 Each call is the station's command (app/authority/) with the session's user and peer: the layer
 checks the role, journals it and answers once applied and committed; the call's StatusCode is the
@@ -19,7 +20,8 @@ from typing import Any
 
 from asyncua import Node, ua
 
-from app.authority import Action, Commands, Reason, Ticket, Who
+from app.authority import Action, Commands, Reason, Source, Ticket, Who
+from hmi_forms.elements.target import EngineTarget
 from netplc.address import AddressError, parse_octal
 from netplc.forcing import KINDS
 
@@ -37,6 +39,9 @@ class Method:
 _STRING, _INT32, _DOUBLE = ua.ObjectIds.String, ua.ObjectIds.Int32, ua.ObjectIds.Double
 KIND, ADDRESS, TAG = ("Kind", "bit, byte or word", _STRING), ("Address", "octal, as 04010", _STRING), \
     ("Name", "the tag's name, as in tags.csv", _STRING)
+LABEL = ("Label", "the form element's words for what it writes (journaled); empty: none", _STRING)
+ROLE = ("Role", "the form element's Role: it may ask more than the station's policy, never less; "
+                "empty: the policy's", _STRING)
 ALARM = ("AlarmId", "the alarm's identity, as the Alarms folder names it (LEVEL.H, MSG3)", _STRING)
 METHODS = (
     Method("Run", Action.RUN, description="Run NetPlc's program"),
@@ -60,6 +65,12 @@ METHODS = (
                                      ("Seconds", "how long it stays shelved", _DOUBLE)),
            "Shelve an alarm for a while (ISA-18.2): it neither sounds nor shows until then"),
     Method("Unshelve", Action.UNSHELVE, (ALARM,), "Return a shelved alarm to the summary"),
+    Method("Silence", Action.SILENCE, description="Silence the horn; the alarms stay unacknowledged"),
+    # what a remote console's form elements write (a raw NetPlc address, as the local workstation's do)
+    Method("WriteBit", Action.WRITE, (ADDRESS, ("Value", "0 or 1", _INT32), LABEL, ROLE),
+           "Write an I/O or HMI bit as an operator's form element does"),
+    Method("WriteWord", Action.WRITE, (ADDRESS, ("Value", "the raw word, 0..65535", _INT32), LABEL, ROLE),
+           "Write a data word as an operator's form element does"),
 )
 
 
@@ -69,6 +80,7 @@ class StationMethods:
         self.step_lock = step_lock
         self.answers = answers
         self.by_node: dict[ua.NodeId, Method] = {}
+        self.target = EngineTarget(commands, lambda _user: Who("", Source.OPCUA))  # `who` is passed
 
     async def add(self, parent: Node, idx: int) -> None:
         for method in METHODS:
@@ -114,8 +126,12 @@ class StationMethods:
             return self._tag(who, method, args)
         if method.name == "AcknowledgeAll":
             return commands.acknowledge_all(who)
+        if method.name == "Silence":
+            return commands.silence(who)
         if method.name in ("Acknowledge", "Shelve", "Unshelve"):
             return self._alarm(who, method, args)
+        if method.name in ("WriteBit", "WriteWord"):
+            return self._write(who, method, args)
         kind, address = args[0], args[1]
         target = f"{kind} {address}"
         try:
@@ -146,6 +162,20 @@ class StationMethods:
             return commands.refuse(who, method.action, alarm, Reason.INVALID,
                                    "Shelve takes a String reason and a number of seconds")
         return commands.shelve(who, alarm, reason, float(seconds))
+
+    def _write(self, who: Who, method: Method, args: list[object]) -> Ticket:
+        address, value, label, role = args
+        try:
+            addr = parse_octal(str(address))
+            top = 1 if method.name == "WriteBit" else 0xFFFF
+            if not isinstance(value, int) or isinstance(value, bool) or not 0 <= value <= top:
+                raise ValueError(f"{value!r} is not a whole number 0..{top}")
+            if not isinstance(label, (str, type(None))) or not isinstance(role, (str, type(None))):
+                raise ValueError("Label and Role are Strings")
+        except (AddressError, ValueError) as e:
+            return self.commands.refuse(who, method.action, str(address), Reason.INVALID, str(e))
+        write = self.target.bit if method.name == "WriteBit" else self.target.word
+        return write(who, addr, value, label or None, role or None)
 
     def _tag(self, who: Who, method: Method, args: list[object]) -> Ticket:
         commands, name = self.commands, args[0]

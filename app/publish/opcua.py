@@ -64,10 +64,12 @@ from app.authority.logins import Logins
 from app.authority.users import UserError, Users
 from app.publish.conditions import Conditions
 from app.publish.feed import LatestReadings, Watch
-from app.publish.history import AlarmSource, Archived, Series, StationHistory, install, series_of
+from app.publish.files import StationFiles
+from app.publish.history import JOURNAL, AlarmSource, Archived, Series, StationHistory, install, series_of
 from app.publish.methods import StationMethods, StepLock
 from app.publish.pki import TrustList, host_names, station_certificate, subject, thumbprint
 from app.publish.points import PointReader, PointWriter, Writable
+from app.publish.seats import Seats
 from app.publish.ua_types import (
     CODES,
     HISTORY_READ,
@@ -221,12 +223,14 @@ class OpcUaServer:
                  journal: Callable[[str], None] = lambda _text: None,
                  step_lock: StepLock = lambda: None, archived: Archived | None = None,
                  language: str = "", pair_letter: str = "",
-                 service_level: Callable[[], int] = lambda: HEALTHY) -> None:
+                 service_level: Callable[[], int] = lambda: HEALTHY,
+                 files: StationFiles | None = None) -> None:
         """`journal` takes the system records of the server's security (a certificate made or
         made private, a client certificate refused); `step_lock` gives the scan thread's lock, which
         the Step method needs; `archived` what the station archives, for Historical Access;
         `language` the station's (a bit's TrueState and FalseState are in it); `pair_letter` this
-        station's in a hot-standby pair ("" alone), `service_level` its ServiceLevel now."""
+        station's in a hot-standby pair ("" alone), `service_level` its ServiceLevel now; `files`
+        what the station serves its consoles (files.py)."""
         self.endpoint = settings.endpoint
         self.settings = settings
         self.archived = archived
@@ -252,9 +256,13 @@ class OpcUaServer:
         self.secure = not is_loopback(self.endpoint)
         self.trust = TrustList(folder)
         self.users = _Users(Logins(lambda: Users(folder), commands, Source.OPCUA), folder, not self.secure)
+        self.files = files
+        self.seats = Seats(settings.max_consoles, commands, journal)
         self.feed = LatestReadings(self._wake)
         self._unwatch: Callable[[], None] | None = None
         self._published = -1  # the scan whose values the address space holds
+        self._events = 0  # the journal's events since the start (Station.JournalEvents)
+        self._events_shown = 0
         self._waiting: list[tuple[int, asyncio.Future[None]]] = []  # writes waiting to be readable
         self._loop: asyncio.AbstractEventLoop | None = None
         self._ready = threading.Event()
@@ -293,7 +301,9 @@ class OpcUaServer:
 
     def on_record(self, record: Record) -> None:
         """The runtime's record observer: an alarm's transition becomes its condition's state and
-        event."""
+        event; every event of the journal counts in Station.JournalEvents."""
+        if record.kind in JOURNAL:
+            self._events += 1
         if record.kind == "alarm" and self._ready.is_set():
             self.conditions.post(record)
 
@@ -337,6 +347,7 @@ class OpcUaServer:
             assert server.bserver is not None
             server.bserver.set_policies([
                 _Trusting(server.iserver.certificate, server.iserver.private_key, self._trusted)])
+        files = asyncio.get_running_loop().create_task(self.files.run()) if self.files is not None else None
         try:
             self._ready.set()
             while not self._stop.is_set():
@@ -353,6 +364,8 @@ class OpcUaServer:
                 await self._serve_level()
                 self.status.skipped = self.feed.skipped
         finally:
+            if files is not None:
+                files.cancel()
             await _stop_clock(server)
             await server.stop()
 
@@ -458,6 +471,20 @@ class OpcUaServer:
         sources = {tag.name: nodeid for tag, nodeid in zip(self.tags, self.nodeids)}
         await self.conditions.build(server, idx, alarms, station, sources, plc, self.plc_state.nodeid)
         await self.methods.add(station, idx)
+        if self.files is not None:
+            await self.files.build(server, station, idx)
+        events = ua.Variant(0, ua.VariantType.UInt64)
+        self.journal_events = await station.add_variable(ua.NodeId("Station.JournalEvents", idx),
+                                                         name("JournalEvents"), events)
+        await self.journal_events.write_attribute(ua.AttributeIds.Description, ua.DataValue(ua.Variant(
+            ua.LocalizedText("events journaled since the station started (messages, alarm transitions, "
+                             "operator actions, system records): a console reads the journal's history "
+                             "when it changes"))))
+        role = await station.add_variable(ua.NodeId("Station.Role", idx), name("Role"), "")
+        self.role_node = role.nodeid
+        await role.write_attribute(ua.AttributeIds.Description, ua.DataValue(ua.Variant(ua.LocalizedText(
+            "the role of the session's user at this station (a console names it in a refusal); empty: "
+            "none"))))
         # after the conditions, which set the station's EventNotifier
         alarm_sources = {alarm_id: AlarmSource(c.nodeid, c.type_id, c.source, c.source_name)
                          for alarm_id, c in self.conditions.by_id.items()}
@@ -551,6 +578,9 @@ class OpcUaServer:
         await self.plc_state.write_value(reading.state)
         await self.plc_scan_ms.write_value(float(self.engine.stats.last_ms))
         await self.plc_tick.write_value(ua.Variant(reading.scan, ua.VariantType.UInt64))
+        if self._events != self._events_shown:
+            self._events_shown = self._events
+            await self.journal_events.write_value(ua.Variant(self._events_shown, ua.VariantType.UInt64))
         for n, stats in (self.exchange.stats.items() if self.exchange is not None else ()):
             vars_ = self.node_vars.get(n)
             if vars_ is None:
@@ -606,10 +636,20 @@ class OpcUaServer:
 
             def activate_session(params: Any, peer_certificate: bytes | None) -> Any:
                 users.peer = _peer(session.name)
+                token = params.UserIdentityToken
+                who = Who(getattr(token, "UserName", None) or "", Source.OPCUA, users.peer)
                 try:
-                    return activate(params, peer_certificate)
+                    if session not in self.seats.sessions():
+                        self.seats.check(who)
+                    result = activate(params, peer_certificate)
                 finally:
                     users.peer = ""
+                self.seats.take(session, _who(session))
+                return result
+
+            async def close_session(delete_subs: bool = True) -> None:
+                self.seats.leave(session)
+                await close(delete_subs)
 
             async def write(params: ua.WriteParameters) -> list[ua.StatusCode]:
                 return await self._write(_who(session), params)
@@ -617,8 +657,9 @@ class OpcUaServer:
             async def call(requests: list[ua.CallMethodRequest]) -> list[ua.CallMethodResult]:
                 return await self._call(session, requests, service)
 
-            service = session.call
+            service, close = session.call, session.close_session
             session.activate_session = activate_session
+            session.close_session = close_session
             session.write = write
             session.call = call
             return session
@@ -629,13 +670,17 @@ class OpcUaServer:
 
     def _user_access_level(self, event: ServerItemCallback, _service: object) -> None:
         """A tag's UserAccessLevel and a station method's UserExecutable as the policy answers
-        for the session's user (every user may read a tag and its history)."""
+        for the session's user (every user may read a tag and its history), and Station.Role."""
         if not event.is_external:
             return
         may: bool | None = None
         reads, results = event.request_params.NodesToRead, event.response_params
         user = event.user.name if event.user is not None and event.user.name else ""
         for n, rv in enumerate(reads):
+            if rv.NodeId == self.role_node and rv.AttributeId == ua.AttributeIds.Value:
+                role = self.commands.role(Who(user, Source.OPCUA)) or ""
+                results[n] = ua.DataValue(ua.Variant(role, ua.VariantType.String))
+                continue
             if rv.AttributeId == ua.AttributeIds.UserExecutable:
                 who = Who(user, Source.OPCUA)
                 executable = self.methods.executable(who, rv.NodeId)

@@ -41,6 +41,7 @@ QUALITY_CODES = {
     Quality.STALE: STALE,  # each of these three: the last value the plant gave, no longer current,
     Quality.COMM_FAIL: STALE,  # which is STALE as the spec uses it (what a host makes of the
     Quality.NOT_RUNNING: STALE,  # metrics of an edge node or device that died)
+    Quality.UNREACHABLE: STALE,  # (a console's own, never published: the station is what publishes)
     Quality.INITIAL: BAD,  # nothing read yet: no value (is_null) and BAD, never a stale or good one
 }
 NULL_QUALITIES = frozenset({Quality.INITIAL})  # published without a value: there is none yet

@@ -28,6 +28,7 @@ def start_publishers(runtime: Runtime) -> list[Publisher]:
     tags = published_tags(runtime.tags.tags, runtime.symbols)
     started: list[Publisher] = []
     if st.opcua.enabled:
+        from app.publish.files import StationFiles
         from app.publish.history import Archived
         from app.publish.opcua import OpcUaServer  # asyncua loads only for a station that serves OPC UA
 
@@ -42,7 +43,7 @@ def start_publishers(runtime: Runtime) -> list[Publisher]:
                              step_lock=lambda: runtime.scan_thread.lock if runtime.scan_thread else None,
                              archived=archived, language=st.Language,
                              pair_letter=st.redundancy.letter if st.redundancy is not None else "",
-                             service_level=runtime.service_level)
+                             service_level=runtime.service_level, files=StationFiles(st))
         try:
             server.start()
         except (OSError, RuntimeError) as e:
@@ -75,6 +76,7 @@ class _Unsubscribing:
 
     def __init__(self, server: Any, runtime: Runtime) -> None:
         self.server, self.runtime = server, runtime
+        self.seats = server.seats  # the sessions logged in (seats.py): the station's status lists them
 
     def stop(self) -> None:
         self.runtime.unsubscribe(self.server.on_record)

@@ -44,7 +44,8 @@ STATUS = {Quality.GOOD: ua.StatusCodes.Good, Quality.INITIAL: ua.StatusCodes.Bad
           Quality.STALE: ua.StatusCodes.UncertainLastUsableValue,
           Quality.COMM_FAIL: ua.StatusCodes.BadCommunicationError,
           Quality.NOT_RUNNING: ua.StatusCodes.BadOutOfService,
-          Quality.FORCED: ua.StatusCodes.GoodLocalOverride}
+          Quality.FORCED: ua.StatusCodes.GoodLocalOverride,
+          Quality.UNREACHABLE: ua.StatusCodes.BadNoCommunication}
 CODES = [ua.StatusCode(STATUS[q]) for q in Quality]  # by quality code
 SEVERITY = {1: 900, 2: 700, 3: 500, 4: 300}  # alarm priority -> OPC UA severity 1-1000
 

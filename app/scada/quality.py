@@ -19,7 +19,9 @@ block's data in scans, NetPlc's run state and forcing give each address its qual
   it (every start would otherwise raise one per tag before the first answer), and process alarms
   wait for the first real value (`Quality.held`). It turns into good when the data lands, into
   comm-fail when the first attempt fails, into stale when the data is late;
-- good: anything else, including what the program computes itself while it runs.
+- good: anything else, including what the program computes itself while it runs;
+- station unreachable: only at a remote console (app/gui/console/), whose link to the station is
+  lost: what it shows is the last it knew, not the plant's now.
 
 Qualities are ordered so that the worst of several blocks (a tag spanning two NREADs) is the
 highest; an address no NREAD fills is good while NetPlc runs.
@@ -60,6 +62,7 @@ class Quality(IntEnum):
     COMM_FAIL = 3
     NOT_RUNNING = 4
     FORCED = 5
+    UNREACHABLE = 6  # a remote console's: the link to the station is lost (never the station's own)
 
     @property
     def word(self) -> str:
@@ -69,7 +72,7 @@ class Quality(IntEnum):
     @property
     def bad(self) -> bool:
         """The value cannot be trusted (forced is shown, but it is not bad: someone chose it)."""
-        return self in (Quality.STALE, Quality.COMM_FAIL, Quality.NOT_RUNNING)
+        return self in (Quality.STALE, Quality.COMM_FAIL, Quality.NOT_RUNNING, Quality.UNREACHABLE)
 
     @property
     def alarmed(self) -> bool:
@@ -85,7 +88,8 @@ class Quality(IntEnum):
 
 
 _WORDS = {Quality.GOOD: "good", Quality.INITIAL: "initial", Quality.STALE: "stale",
-          Quality.COMM_FAIL: "comm-fail", Quality.NOT_RUNNING: "not running", Quality.FORCED: "forced"}
+          Quality.COMM_FAIL: "comm-fail", Quality.NOT_RUNNING: "not running", Quality.FORCED: "forced",
+          Quality.UNREACHABLE: "station unreachable"}
 
 
 @functools.cache

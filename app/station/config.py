@@ -92,6 +92,7 @@ class OpcUaSettings:
     # host names and addresses the server's certificate names besides the host's own (clients
     # check that the name they connect to is one of them): a DNS alias, a NAT address
     certificate_names: tuple[str, ...] = ()
+    max_consoles: int = 16  # client sessions at once (consoles, monitors, other clients); more are refused
 
 
 @dataclass(frozen=True)
@@ -318,6 +319,8 @@ KEYS: dict[str, dict[str, Key]] = {
         Key("endpoint", str, _OPCUA.endpoint, "its `opc.tcp://` address"),
         Key("writable", list, [], "tag names or patterns (`TEMP_*`) clients may write"),
         Key("certificate_names", list, [], "names and addresses its certificate holds besides the host's"),
+        Key("max_consoles", int, _OPCUA.max_consoles,
+            "client sessions at once (consoles, monitors, other clients); one more is refused", (1, 1000)),
     ),
     "mqtt": _keys(
         Key("enabled", bool, _MQTT.enabled, "run the Sparkplug B publisher"),
@@ -842,11 +845,12 @@ def _opcua(problems: list[str], fname: str, table: dict[str, Any]) -> OpcUaSetti
     endpoint = r.get("endpoint")
     writable = _names(r, "writable")
     certificate_names = _host_names(r, "certificate_names")
+    max_consoles = r.number("max_consoles")
     r.finish()
     if not endpoint.startswith("opc.tcp://"):
         r.bad("endpoint", f"{endpoint!r} is not an opc.tcp:// address")
         endpoint = d.endpoint
-    return OpcUaSettings(enabled, endpoint, writable, certificate_names)
+    return OpcUaSettings(enabled, endpoint, writable, certificate_names, max_consoles)
 
 
 def _mqtt(problems: list[str], fname: str, table: dict[str, Any], base: Path,

@@ -92,6 +92,7 @@ class RuntimeStatus:
     problems: tuple[str, ...] = field(default=())  # what an operator must see (disk, server, ...)
     forced: int = 0  # forces in effect: the always-visible "F: n forced"
     pair: str = ""  # one of a hot-standby pair: its role and link (PairStatus.line), else ""
+    consoles: tuple[str, ...] = ()  # the OPC UA sessions logged in: user@host:port since when
 
     @property
     def nodes_up(self) -> int:
@@ -111,6 +112,8 @@ class RuntimeStatus:
                 f"nodes {self.nodes_up}/{len(self.nodes)} up [{nodes}] | records {self.records_written}")
         if self.pair:
             text += f" | {self.pair}"
+        if self.consoles:
+            text += f" | consoles: {', '.join(self.consoles)}"
         if self.problems:
             text += " | " + "; ".join(self.problems)
         return text
@@ -658,4 +661,6 @@ class Runtime:
             problems=tuple(problems),
             forced=engine.forces.count if engine else 0,
             pair=pair.line() if pair is not None else "",
+            consoles=tuple(seat.line() for p in self.publishers if hasattr(p, "seats")
+                           for seat in p.seats.seats()),
         )

@@ -73,17 +73,25 @@ class EngineTarget:
     def write_bit(self, addr: int, value: int, *, user: str, label: str | None = None,
                   at_least: str | None = None) -> str | None:
         tag = self._bits.get(addr)
-        ticket = self.commands.write_bit(self.who(user), addr, value, label=_named(label, tag),
-                                         at_least=at_least)
-        return self._told(ticket, _said(label, tag, addr))
+        return self._told(self.bit(self.who(user), addr, value, label, at_least), _said(label, tag, addr))
 
     def write_word(self, addr: int, value: int, *, user: str, label: str | None = None,
                    at_least: str | None = None,
                    describe: Callable[[int, int], str] | None = None) -> str | None:
         tag = self._words.get(addr)
-        ticket = self.commands.write_word(self.who(user), addr, value, label=_named(label, tag),
-                                          at_least=at_least, describe=tag.change if tag else describe)
-        return self._told(ticket, _said(label, tag, addr))
+        return self._told(self.word(self.who(user), addr, value, label, at_least, describe),
+                          _said(label, tag, addr))
+
+    def bit(self, who: Who, addr: int, value: int, label: str | None, at_least: str | None) -> Ticket:
+        """The command of a form's bit write, as `who` (a remote console's too: app/publish/methods.py)."""
+        return self.commands.write_bit(who, addr, value, label=_named(label, self._bits.get(addr)),
+                                       at_least=at_least)
+
+    def word(self, who: Who, addr: int, value: int, label: str | None, at_least: str | None,
+             describe: Callable[[int, int], str] | None = None) -> Ticket:
+        tag = self._words.get(addr)
+        return self.commands.write_word(who, addr, value, label=_named(label, tag), at_least=at_least,
+                                        describe=tag.change if tag else describe)
 
     def _told(self, ticket: Ticket, what: str) -> str | None:
         if self.on_answer is not None:

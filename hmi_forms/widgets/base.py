@@ -89,6 +89,9 @@ QUALITY_TIPS = {
     "not running": QT_TRANSLATE_NOOP(
         "quality", "? not running: NetPlc is stopped; the last value is shown, nothing changes"),
     "forced": QT_TRANSLATE_NOOP("quality", "F forced: the value is forced by an engineer, not the plant's"),
+    "station unreachable": QT_TRANSLATE_NOOP(
+        "quality", "? station unreachable: the console's link to the station is lost; "
+                   "the last value is shown"),
 }
 
 

@@ -1,6 +1,73 @@
 <?xml version='1.0' encoding='utf-8'?>
 <TS version="2.1" language="ru_RU">
 <context>
+    <name>ConsoleWindow</name>
+    <message>
+        <source>&amp;Station</source>
+        <translation>&amp;Станция</translation>
+    </message>
+    <message>
+        <source>&amp;Program…</source>
+        <translation>&amp;Программа…</translation>
+    </message>
+    <message>
+        <source>&amp;View</source>
+        <translation>&amp;Вид</translation>
+    </message>
+    <message>
+        <source>The station's files are not loaded yet</source>
+        <translation>Файлы станции ещё не загружены</translation>
+    </message>
+    <message>
+        <source>Alarms</source>
+        <translation>Аварии</translation>
+    </message>
+    <message>
+        <source>Alarms — {0} unacknowledged</source>
+        <translation>Аварии — неквитированных: {0}</translation>
+    </message>
+    <message>
+        <source>Confirm</source>
+        <translation>Подтверждение</translation>
+    </message>
+    <message>
+        <source>cancelled</source>
+        <translation>отменено</translation>
+    </message>
+    <message>
+        <source>No unacknowledged alarms</source>
+        <translation>Нет неквитированных аварий</translation>
+    </message>
+    <message>
+        <source>station unreachable: {0}; reconnecting</source>
+        <translation>станция недоступна: {0}; переподключение</translation>
+    </message>
+    <message>
+        <source>Refused: </source>
+        <translation>Отказано: </translation>
+    </message>
+    <message>
+        <source>Acknowledge</source>
+        <translation>Квитировать</translation>
+    </message>
+    <message>
+        <source>Acknowledge all</source>
+        <translation>Квитировать все</translation>
+    </message>
+    <message>
+        <source>The station serves no forms.</source>
+        <translation>Станция не передаёт мнемосхем.</translation>
+    </message>
+    <message>
+        <source>Form problems</source>
+        <translation>Ошибки форм</translation>
+    </message>
+    <message>
+        <source>No forms</source>
+        <translation>Нет форм</translation>
+    </message>
+</context>
+<context>
     <name>AlarmBanner</name>
     <message>
         <source>Acknowledge</source>
@@ -798,6 +865,10 @@ Drag onto the form, or double-click to add</source>
 <context>
     <name>StationStatusBar</name>
     <message>
+        <source>Consoles {0}</source>
+        <translation>Пульты {0}</translation>
+    </message>
+    <message>
         <source>NetPlc: {0}</source>
         <translation>NetPlc: {0}</translation>
     </message>
@@ -1159,6 +1230,10 @@ Drag onto the form, or double-click to add</source>
         <source>F forced: the value is forced by an engineer, not the plant's</source>
         <translation>F форсировано: значение задано инженером, а не получено с объекта</translation>
     </message>
+    <message>
+        <source>? station unreachable: the console's link to the station is lost; the last value is shown</source>
+        <translation>? станция недоступна: связь пульта со станцией потеряна; показано последнее значение</translation>
+    </message>
 </context>
 <context>
     <name>records</name>
@@ -1312,6 +1387,10 @@ Drag onto the form, or double-click to add</source>
     <message>
         <source>forced</source>
         <translation>форсировано</translation>
+    </message>
+    <message>
+        <source>station unreachable</source>
+        <translation>станция недоступна</translation>
     </message>
     <message>
         <source>{0}: nobody is logged in ({1} needed)</source>

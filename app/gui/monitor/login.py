@@ -28,6 +28,7 @@ from PySide6.QtWidgets import (
 
 from app.publish.client import Certificate, KnownStations, LoginError, Offer, StationClient
 from hmi_forms.widgets.worker import Worker
+from netplc.problems import Problems
 
 logger = logging.getLogger(__name__)
 
@@ -150,3 +151,15 @@ class LoginDialog(QDialog):
     def _give_up(self, why: str) -> None:
         self.error = why
         self.reject()
+
+
+def logged_in(client: StationClient, user: str | None = None, password: str | None = None) -> bool:
+    """The login dialog for `client`: True once logged in, False when cancelled (the client
+    closed); Problems with the station's refusal when it logged in by itself and was refused."""
+    dialog = LoginDialog(client, user or "", password)
+    if dialog.exec() == QDialog.DialogCode.Accepted:
+        return True
+    client.close()
+    if dialog.error:
+        raise Problems([dialog.error])
+    return False

@@ -10,7 +10,7 @@ from collections.abc import Callable
 from pathlib import Path
 
 from PySide6.QtGui import QCloseEvent
-from PySide6.QtWidgets import QDialog, QMainWindow, QWidget
+from PySide6.QtWidgets import QMainWindow, QWidget
 
 from app.gui.application import application
 from app.gui.monitor.source import LocalSource, OpcUaSource, RemoteSource, Source
@@ -113,17 +113,13 @@ def station_source(url: str, program: str | None = None, user: str | None = None
                    partner: str = "") -> OpcUaSource | None:
     """A station over OPC UA, logged in through the login dialog; None when it was cancelled.
     `partner`: the other station of its hot-standby pair, followed to when it leads."""
-    from app.gui.monitor.login import LoginDialog
+    from app.gui.monitor.login import logged_in
     from app.publish.client import StationClient  # OPC UA loaded only for a station over OPC UA
 
     listed = listing(program) if program else None
     password = sys.stdin.readline().rstrip("\r\n") if user and not sys.stdin.isatty() else None
     client = StationClient(url, partner=partner)
-    dialog = LoginDialog(client, user or "", password)
-    if dialog.exec() != QDialog.DialogCode.Accepted:
-        client.close()
-        if dialog.error:
-            raise Problems([dialog.error])
+    if not logged_in(client, user, password):
         return None
     if listed is None:
         return OpcUaSource(client)

@@ -1,0 +1,248 @@
+"""The remote console (`main.py console opc.tcp://HOST:PORT/PATH`): the operator's forms and alarm
+banner of a station running elsewhere, with no NetPlc, exchange or archive of its own.
+
+Its views are the workstation's own (the form view in its zoom area, the alarm banner, the health
+strip, the journal dock, the header); what differs is where their data comes from: a
+`StationSource` and a `RemoteJournal` (source.py) instead of the in-process runtime's bridge and
+the archive's file. Everything it does is done by the user logged in at
+the station, through the station's command layer: a form's write is the station's WriteBit or
+WriteWord method, an acknowledgement its Acknowledge; the station checks the role, journals with
+the user's name and answers, and a refusal is said in the status bar naming the role it needs.
+Forms come from the station (its Files): a form saved there is shown here at the next poll.
+"""
+
+from __future__ import annotations
+
+import logging
+import sys
+
+from PySide6.QtCore import QTimer
+from PySide6.QtGui import QAction, QCloseEvent, QKeySequence
+from PySide6.QtWidgets import (
+    QMainWindow,
+    QMessageBox,
+    QStatusBar,
+    QWidget,
+)
+
+from app.authority import Action, Answer, Source, Ticket, Who
+from app.gui import i18n, words
+from app.gui.alarm_summary import AlarmSummary
+from app.gui.application import application
+from app.gui.bridge import Answers
+from app.gui.console.source import Loaded, RemoteJournal, StationSource
+from app.gui.journal import JournalDock
+from app.gui.main_window import (
+    REFUSAL_MS,
+    _placeholder,
+    _problems_page,
+    _quit_on_signals,
+    bottom_docks,
+    station_frame,
+)
+from app.gui.monitor.login import logged_in
+from app.gui.monitor.source import OpcUaSource
+from app.gui.monitor.window import ProgramWindow
+from app.gui.rights import Rights
+from app.gui.zoom import ZoomArea
+from app.publish.console import ConsoleClient, StationCommands
+from app.scada.alarms import AlarmRow
+from app.scada.readings import Readings
+from hmi_forms.elements.base import Writer
+from hmi_forms.elements.target import EngineTarget
+from hmi_forms.widgets.form_view import FormView
+from netplc.problems import Problems
+
+logger = logging.getLogger(__name__)
+
+STATUS_MS = 1000
+
+
+class RemoteTarget(EngineTarget):
+    """The station's command layer, reached over its endpoint, as the form elements' Target: the
+    station names a tag's write with the tag and journals it with the console's user."""
+
+    def __init__(self, client: ConsoleClient, answers: Answers) -> None:
+        # no local layer: the station's checks, names and journals each write
+        self.client = client
+        self.who = lambda user: Who(user, Source.OPCUA)
+        self.on_answer = answers.follow
+        self.say = words.answer
+
+    def bit(self, who: Who, addr: int, value: int, label: str | None, at_least: str | None) -> Ticket:
+        return self.client.write_bit(addr, value, label, at_least)
+
+    def word(self, who: Who, addr: int, value: int, label: str | None, at_least: str | None) -> Ticket:
+        return self.client.write_word(addr, value, label, at_least)
+
+
+class SharedSession(OpcUaSource):
+    """The Program view on the console's own session with the station: closed with the console,
+    not with the view."""
+
+    def close(self) -> None:
+        pass
+
+
+class ConsoleWindow(QMainWindow):
+    def __init__(self, source: StationSource, parent: QWidget | None = None) -> None:
+        super().__init__(parent)
+        self.source = source
+        client = self.client = source.client
+        self.setWindowTitle(f"NetPlc console — {client.station or client.url}")
+        self.answers = Answers()
+        self.answers.answered.connect(self._answered)
+        self.target = RemoteTarget(client, self.answers)
+        self.commands = StationCommands(client)
+        self.rights = Rights(self.commands, lambda: self.who)  # type: ignore[arg-type]
+        self.views: list[FormView] = []
+        self.programs: list[ProgramWindow] = []  # the Program views opened from here
+        self.unacknowledged: list[AlarmRow] = []
+        frame = station_frame(self, client.station or client.url)
+        self.header, self.banner, self.health = frame.header, frame.alarms, frame.health
+        self.tabs = frame.tabs
+        self.header.login.setVisible(False)  # the console's user is the one it logged in as
+        for button in (self.banner.ack, self.banner.ack_all):
+            self.rights.add(button, Action.ACKNOWLEDGE, button.text())
+        self.journal = JournalDock(RemoteJournal(client), self)
+        self.summary = AlarmSummary(source.station_alarms, self.commands,  # type: ignore[arg-type]
+                                    lambda: self.who, answers=self.answers)
+        self.summary_dock = bottom_docks(self, self.journal, self.summary)
+        self.status = QStatusBar()
+        self.setStatusBar(self.status)
+        station = self.menuBar().addMenu(self.tr("&Station"))
+        program = QAction(self.tr("&Program…"), self)  # the listing live, the watch table, forcing
+        program.setShortcut(QKeySequence("Ctrl+Shift+P"))
+        program.triggered.connect(self.open_program)
+        station.addAction(program)
+        view = self.menuBar().addMenu(self.tr("&View"))
+        view.addAction(self.journal.toggleViewAction())
+        view.addAction(self.summary_dock.toggleViewAction())
+        self.resize(1024, 700)
+        self.banner.acknowledged.connect(self.acknowledge)
+        self.banner.acknowledged_all.connect(self.summary.acknowledge_all)
+        self.summary.changed.connect(self._alarms_changed)
+        source.loaded.connect(self._load)
+        source.readings.connect(self._on_readings)
+        source.link.connect(self._on_link)
+        self._timer = QTimer(self)
+        self._timer.timeout.connect(self._tick)
+        self._timer.start(STATUS_MS)
+        if source.current is not None:
+            self._load(source.current)
+        self._tick()
+
+    def _load(self, loaded: Loaded) -> None:
+        """The station's forms (again, when its files changed), in place of the ones shown."""
+        current = self.tabs.currentIndex()
+        self.views = []
+        while self.tabs.count():
+            page = self.tabs.widget(0)
+            self.tabs.removeTab(0)
+            page.deleteLater()
+        for form in loaded.forms:
+            view = FormView(form, self.target, user=self.client.user, guard=self._guard)
+            self.views.append(view)
+            self.tabs.addTab(ZoomArea(view), form.title)
+        if loaded.problems:
+            self.tabs.addTab(_problems_page(loaded.problems), self.tr("Form problems"))
+        if not loaded.forms and not loaded.problems:
+            self.tabs.addTab(_placeholder(self.tr("The station serves no forms.")), self.tr("No forms"))
+        self.tabs.setCurrentIndex(max(0, min(current, self.tabs.count() - 1)))
+
+    def open_program(self) -> ProgramWindow | None:
+        """Station -> Program: the station's program live, over this console's session, with what
+        the user may do there as the station answers (forcing and single scans for an engineer)."""
+        loaded = self.source.current
+        if loaded is None:
+            self.status.showMessage(self.tr("The station's files are not loaded yet"), REFUSAL_MS)
+            return None
+        source = SharedSession(self.client, program=loaded.program, symbols=loaded.symbols,
+                               tags=loaded.tags.by_name)
+        window = ProgramWindow(source, lambda: self.client.user)
+        window.show()
+        self.programs.append(window)
+        return window
+
+    def ask(self, title: str, text: str) -> bool:
+        """The second step of a command: the operator confirms it (tests answer for them)."""
+        return QMessageBox.question(self, title, text) == QMessageBox.StandardButton.Yes
+
+    def _guard(self, element: Writer, what: str) -> str | None:
+        """Before a form element writes: its Confirm (the station checks the role when it is sent)."""
+        if element.Confirm and not self.ask(self.tr("Confirm"), what + "?"):
+            return self.tr("cancelled")
+        return None
+
+    def _on_readings(self, readings: Readings) -> None:
+        for view in self.views:
+            view.refresh(readings.snapshot, readings)
+
+    @property
+    def who(self) -> Who:
+        """The console's user, as the journal at the station names it (the session is who acts)."""
+        return Who(self.client.user, Source.OPCUA)
+
+    def _alarms_changed(self) -> None:
+        waiting = self.unacknowledged = self.summary.unacknowledged()
+        self.banner.show_alarms(waiting)
+        self.summary_dock.setWindowTitle(self.tr("Alarms — {0} unacknowledged").format(len(waiting))
+                                         if waiting else self.tr("Alarms"))
+
+    def _on_link(self, error: str) -> None:
+        self.health.show_problems([self.tr("station unreachable: {0}; reconnecting").format(error)]
+                                  if error else [])
+        self._tick()
+
+    def _tick(self) -> None:
+        self.header.tick()
+        role = words.role(self.client.role) if self.client.role else ""
+        self.header.user.setText(f"{self.client.user} ({role})" if role else self.client.user)
+        self.rights.update()
+        self.summary.rights.update()
+        if not self.status.currentMessage():  # a refusal stays its time
+            self.status.showMessage(self.client.state(), STATUS_MS + 200)
+
+    def acknowledge(self, alarm: AlarmRow) -> Ticket:
+        return self.answers.follow(self.tr("Acknowledge"), self.commands.acknowledge(self.who, alarm.id))
+
+    def _answered(self, what: str, answer: Answer) -> None:
+        if not answer.ok:
+            self.status.showMessage(self.tr("Refused: ") + words.answer(what, answer), REFUSAL_MS)
+
+    def closeEvent(self, event: QCloseEvent) -> None:
+        self._timer.stop()
+        for program in self.programs:
+            program.close()
+        self.summary.stop()
+        self.journal.close_archive()
+        self.source.stop()
+        super().closeEvent(event)
+
+
+def open_console(url: str, user: str | None = None, password: str | None = None) -> ConsoleWindow | None:
+    """Log in to the station at `url` (the login dialog; trust on first use) and open its console;
+    None when the login was cancelled, Problems when the station refused it."""
+    client = ConsoleClient(url)
+    if not logged_in(client, user, password):
+        return None
+    if client.files is not None:
+        i18n.install(application(), str(client.files.manifest.get("language", "")))
+    return ConsoleWindow(StationSource(client))
+
+
+def run_console(url: str, user: str | None = None) -> int:
+    """`python main.py console opc.tcp://... [--user NAME]` (with --user and stdin not a terminal,
+    the password is stdin's first line). Exit 2 when the station refused, 1 when cancelled."""
+    app = application()
+    password = sys.stdin.readline().rstrip("\r\n") if user and not sys.stdin.isatty() else None
+    try:
+        window = open_console(url, user, password)
+    except Problems as e:
+        print("\n".join(e.problems), file=sys.stderr)
+        return 2
+    if window is None:
+        return 1
+    window.show()
+    _quit_on_signals(app)  # Ctrl+C or SIGTERM log out of the station before the console ends
+    return app.exec()

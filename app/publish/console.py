@@ -1,0 +1,275 @@
+"""A remote console's session with its station (`main.py console opc.tcp://...`): the Program
+view's `StationClient` (login, trust on first use, memory, back-off, commands as the user) and what
+a console adds, all of it standard OPC UA that any client could do the same way:
+
+- the station's files (files.py): the manifest read every SLOW_S; a file whose SHA-256 is not
+  in the console's cache is read through its FileType object, and the station's folder as of that
+  manifest is put together under the console's config directory (`stations/<host:port>/<hash>/`),
+  which the console then loads like a station's own: a form saved at the station reaches the
+  console within a second or two;
+- the alarms: the conditions of the station's Alarms folder (browsed once per session), their
+  ISA-18.2 state word, severity and text read every SLOW_S (with the manifest, links and role), so
+  a console that reconnects shows the station's alarms as they are now (the refresh a
+  ConditionRefresh gives an event client);
+- the nodes' links (Nodes.<n>.Up), so the console judges its elements' quality as the station does;
+- the user's role at the station (Station.Role), so a refusal names the role it needed;
+- writes of a form's raw address through the station's WriteBit and WriteWord methods;
+- the journal: the station object's event history (HistoryReadEvents, Part 11), newest first.
+"""
+
+from __future__ import annotations
+
+import datetime as dt
+import hashlib
+import json
+import logging
+import os
+import shutil
+import struct
+import time
+from concurrent.futures import Future
+from dataclasses import dataclass
+from datetime import UTC
+from pathlib import Path
+from typing import Any
+from urllib.parse import urlsplit
+
+from asyncua import ua
+from asyncua.client.ua_file import UaFile
+
+from app.authority import Action, Answer, Reason, Refusal, Ticket, Who
+from app.authority.policy import ROLES, needs, rank
+from app.publish.client import StationClient, _why, config_dir
+from app.publish.ua_types import SEVERITY
+from app.scada.alarms import AlarmRow, State
+from netplc.address import fmt_octal
+from registrar.reading import Row
+
+logger = logging.getLogger(__name__)
+
+STATES = {state.word: state for state in State}
+PRIORITY_OF = {severity: priority for priority, severity in SEVERITY.items()}
+FIELDS = ("State", "Severity", "Text", "Time")  # read of each condition
+SLOW_S = 0.5  # the manifest, the alarms, the links and the role are read this often (memory every poll)
+
+
+@dataclass(frozen=True)
+class Files:
+    """The station's files as of one manifest, put together in `folder`."""
+
+    folder: Path
+    manifest: dict[str, object]
+
+    def part(self, name: str) -> Path | None:
+        rel = dict(self.manifest.get("parts", {})).get(name)  # type: ignore[call-overload]
+        return self.folder / rel if rel else None
+
+
+class ConsoleClient(StationClient):
+    def __init__(self, url: str, *, folder: Path | None = None, period: float = 0.1) -> None:
+        super().__init__(url, folder=folder, period=period)
+        self.files: Files | None = None  # as last put together
+        self.alarms: tuple[AlarmRow, ...] = ()
+        self.links: dict[int, bool] = {}
+        self.role = ""
+        self.journal_events: object = None  # Station.JournalEvents as last read: it changes, the journal did
+        self._manifest = ""
+        self._browsed: object = None  # the session the alarms and nodes were browsed in
+        self._alarm_ids: list[str] = []
+        self._nodes: list[int] = []
+        base = (folder or config_dir()) / "console"
+        self._cache = base / "cache"
+        self._stations = base / "stations" / urlsplit(url).netloc.replace(":", "_")
+        self._slow = 0.0  # when the slow part was read last
+        self._own = f"{os.getpid()}-{id(self):x}"  # this client's partial files, apart from other consoles'
+
+    # --- from any thread ----------------------------------------------------------------------
+
+    def write_bit(self, addr: int, value: int, label: str | None, at_least: str | None) -> Ticket:
+        return self.said(self.call("WriteBit", fmt_octal(addr), value, label or "", at_least or ""),
+                          Action.WRITE, label or fmt_octal(addr), at_least)
+
+    def write_word(self, addr: int, value: int, label: str | None, at_least: str | None) -> Ticket:
+        return self.said(self.call("WriteWord", fmt_octal(addr), value, label or "", at_least or ""),
+                          Action.WRITE, label or fmt_octal(addr), at_least)
+
+    def denial(self, action: Action, at_least: str | None = None, what: str | None = None) -> Refusal | None:
+        """Why the user may not do `action` (needing at least `at_least`): the station's answers
+        (UserExecutable of its method for the action, and the user's role for a form element's
+        higher Role); None when it may, or until the station answered."""
+        need = needs(action, at_least)
+        role = self.role
+        allowed = self.may(action) is not False
+        if allowed and at_least is not None and role in ROLES:  # a form element asking more than the policy
+            allowed = rank(role) >= rank(need)
+        return None if allowed else Refusal(what or action.value, need, self.user, role)
+
+    def journal(self, day: dt.date, limit: int, since: float | None = None) -> Future[list[Row]]:
+        """The newest `limit` records of `day` (this machine's day) in the station's journal, newest
+        first; with `since` (a record's time) only those from then on, oldest first (the station
+        reads the few rows after it, not the day's newest page again)."""
+        return self._submit(self._journal(day, limit, since))
+
+    def said(self, sent: Ticket, action: Action, what: str, at_least: str | None = None) -> Ticket:
+        """The station's answer, a refusal for the role in its parts (the role it needs, the user's)."""
+        ticket: Ticket = Ticket()
+
+        def done(answer: Ticket) -> None:
+            a: Answer = answer.result()
+            if a.reason is Reason.DENIED:
+                a = Answer(a.reason, a.text, Refusal(what, needs(action, at_least), self.user, self.role))
+            ticket.set_result(a)
+
+        sent.add_done_callback(done)
+        return ticket
+
+    # --- on the client's loop -------------------------------------------------------------------
+
+    async def _read(self) -> None:
+        client = self._client
+        assert client is not None
+        if self._browsed is not client:
+            await self._browse()
+            self._browsed, self._slow = client, 0.0
+        if time.monotonic() - self._slow >= SLOW_S:
+            await self._read_slow()
+            self._slow = time.monotonic()
+            self.changed()  # the alarms may have changed where the memory did not
+        await super()._read()  # the memory last: its change tells the console, which reads the rest
+
+    async def _read_slow(self) -> None:
+        client = self._client
+        assert client is not None
+        nodes = [self._node(n) for n in ("Files.Manifest", "Station.Role", "Station.JournalEvents")]
+        nodes += [self._node(f"Nodes.{n}.Up") for n in self._nodes]
+        nodes += [self._node(f"Alarms.{a}.{f}") for a in self._alarm_ids for f in FIELDS]
+        values = [dv.Value.Value if dv.Value is not None else None
+                  for dv in await client.uaclient.read_attributes(nodes, ua.AttributeIds.Value)]
+        manifest, self.role, self.journal_events = str(values[0] or "{}"), str(values[1] or ""), values[2]
+        self.links = {n: bool(up) for n, up in zip(self._nodes, values[3:])}
+        rest = values[3 + len(self._nodes):]
+        self.alarms = tuple(self._row(a, rest[k * len(FIELDS):(k + 1) * len(FIELDS)])
+                            for k, a in enumerate(self._alarm_ids))
+        if manifest != self._manifest:
+            self.files = await self._fetch(manifest)
+            self._manifest = manifest
+
+    async def _journal(self, day: dt.date, limit: int, since: float | None) -> list[Row]:
+        client = self._client
+        if client is None:
+            raise ConnectionError(f"not connected: {self.error or 'logging in'}")
+        first = dt.datetime.combine(day, dt.time.min).astimezone(UTC)
+        end = first + dt.timedelta(days=1)
+        station = client.get_node(self._node(self.station))
+        try:  # an end before the start reads newest first
+            if since is None:
+                events = await station.read_event_history(end, first, limit)
+            else:
+                events = await station.read_event_history(dt.datetime.fromtimestamp(since, UTC), end, limit)
+        except ua.UaError as e:
+            raise ConnectionError(f"{self.url}: {_why(e)}") from None
+        return [_record(e) for e in events]
+
+    async def _browse(self) -> None:
+        client = self._client
+        assert client is not None
+        alarms = await client.get_node(self._node("Alarms")).get_children()
+        self._alarm_ids = [str(n.nodeid.Identifier).removeprefix("Alarms.") for n in alarms]
+        nodes = await client.get_node(self._node("Nodes")).get_children()
+        self._nodes = sorted(int(str(n.nodeid.Identifier).removeprefix("Nodes.")) for n in nodes)
+
+    @staticmethod
+    def _row(alarm_id: str, values: list[object]) -> AlarmRow:
+        state, severity, text, when = values
+        changed = when.timestamp() if isinstance(when, dt.datetime) else 0.0
+        priority = PRIORITY_OF.get(int(severity or 0), 4)
+        return AlarmRow(alarm_id, priority, STATES.get(str(state), State.NORMAL), changed, changed, None,
+                        str(text or ""))
+
+    async def _fetch(self, text: str) -> Files:
+        """The files of `text` (a manifest), each read from the station unless cached by its hash."""
+        client = self._client
+        assert client is not None
+        manifest = json.loads(text)
+        files: dict[str, str] = manifest.get("files", {})
+        self._cache.mkdir(parents=True, exist_ok=True)
+        for rel, sha in files.items():
+            cached = self._cache / sha
+            if cached.exists():
+                continue
+            async with UaFile(client.get_node(self._node(f"Files.{rel}")), "r") as f:
+                content: bytes = await f.read()
+            if hashlib.sha256(content).hexdigest() != sha:
+                raise ua.UaError(f"{rel}: the station sent other content than its manifest's hash "
+                                 "(changed while read): read again at the next poll")
+            partial = self._cache / f"{sha}.{self._own}.part"  # consoles may share the cache
+            partial.write_bytes(content)
+            partial.replace(cached)
+        folder = self._stations / hashlib.sha256(text.encode()).hexdigest()[:16]
+        if not folder.exists():
+            made = self._stations / f"{folder.name}.{self._own}.part"
+            shutil.rmtree(made, ignore_errors=True)
+            for rel, sha in files.items():
+                target = made / rel
+                target.parent.mkdir(parents=True, exist_ok=True)
+                shutil.copyfile(self._cache / sha, target)
+            made.mkdir(parents=True, exist_ok=True)
+            if folder.is_dir():  # another console put the same files together meanwhile: theirs is ours
+                shutil.rmtree(made, ignore_errors=True)
+            else:
+                made.replace(folder)
+        logger.info("%s: station files as of manifest %s in %s", self.url, folder.name, folder)
+        return Files(folder, manifest)
+
+
+class StationCommands:
+    """The station's command layer as a console's views call it (the alarm summary, the banner,
+    the rights of their buttons): the layer's methods and answers, each sent as the station's
+    method with the console's user; `who` is the console's and not sent (the session is who)."""
+
+    def __init__(self, client: ConsoleClient) -> None:
+        self.client = client
+
+    def denial(self, who: Who, action: Action, at_least: str | None = None,
+               what: str | None = None) -> Refusal | None:
+        return self.client.denial(action, at_least, what)
+
+    def may(self, who: Who, action: Action, at_least: str | None = None) -> bool:
+        return self.denial(who, action, at_least) is None
+
+    def acknowledge(self, who: Who, alarm_id: str, comment: str = "") -> Ticket:
+        return self._sent(Action.ACKNOWLEDGE, alarm_id, "Acknowledge", alarm_id)
+
+    def acknowledge_all(self, who: Who) -> Ticket:
+        return self._sent(Action.ACKNOWLEDGE, Action.ACKNOWLEDGE.value, "AcknowledgeAll")
+
+    def shelve(self, who: Who, alarm_id: str, reason: str, duration: float, once: bool = False) -> Ticket:
+        return self._sent(Action.SHELVE, alarm_id, "Shelve", alarm_id, reason, float(duration))
+
+    def unshelve(self, who: Who, alarm_id: str) -> Ticket:
+        return self._sent(Action.UNSHELVE, alarm_id, "Unshelve", alarm_id)
+
+    def silence(self, who: Who) -> Ticket:
+        return self._sent(Action.SILENCE, Action.SILENCE.value, "Silence")
+
+    def _sent(self, action: Action, what: str, method: str, *args: object) -> Ticket:
+        return self.client.said(self.client.call(method, *args), action, what)
+
+
+def _record(event: Any) -> Row:
+    """A journal event as the record it was: its id from its EventId (history.py: day and id), its
+    kind from its type and source (a system record is a SystemEventType, an alarm's transition its
+    condition's type, a message's source MSGn, the rest operator actions)."""
+    _day, rid = struct.unpack(">Iq", event.EventId) if len(event.EventId or b"") == 12 else (0, 0)
+    when = event.Time if event.Time.tzinfo is not None else event.Time.replace(tzinfo=UTC)
+    source = str(event.SourceName or "")
+    kind = event.EventType.Identifier
+    if kind == ua.ObjectIds.SystemEventType:
+        kind = "system"
+    elif kind != ua.ObjectIds.BaseEventType:
+        kind = "alarm"
+    else:
+        kind = "message" if source.startswith("MSG") and source[3:].isdigit() else "operator"
+    message = event.Message.Text if isinstance(event.Message, ua.LocalizedText) else str(event.Message or "")
+    return Row(rid, when.timestamp(), kind, PRIORITY_OF.get(int(event.Severity or 0)), None, source,
+               int(source[3:]) if kind == "message" else None, None, message)

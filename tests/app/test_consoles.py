@@ -1,0 +1,227 @@
+"""Remote consoles (`main.py console opc.tcp://...`): the demo station running headless with its
+OPC UA endpoint on a free loopback port, consoles attached in-process (offscreen) as different
+users of it, each a real asyncua client of the real endpoint, their views really rendered. What a
+console does is the station's command as its user; what it shows is the station's."""
+
+from __future__ import annotations
+
+import json
+import subprocess
+import sys
+from collections.abc import Callable, Iterator
+from pathlib import Path
+
+import pytest
+
+from app.authority import Answer
+from app.gui.console.source import StationSource
+from app.gui.console.window import ConsoleWindow
+from app.gui.status import StationStatusBar
+from app.publish.client import LoginError
+from app.publish.console import ConsoleClient
+from app.scada.alarms import State
+from app.scada.quality import Quality
+from app.scada.readings import Readings
+from app.station.config import load_station
+from app.station.runtime import Runtime
+from hmi_forms.elements.base import Writer
+from netplc.records import Record
+from tests.app.conftest import REPO
+from tests.app.publish.conftest import demo_with, free_port
+
+WAIT = 30_000  # ms: a loaded CI machine; every wait ends on its event
+
+
+class Station:
+    """The demo station serving OPC UA on loopback (users viewer, operator, engineer: their password
+    their name), restartable on the same port."""
+
+    def __init__(self, folder: Path) -> None:
+        self.port = free_port()
+        self.url = f"opc.tcp://127.0.0.1:{self.port}/netplc/"
+        self.folder = folder / "st"
+        self.records: list[Record] = []
+        self.runtime = demo_with(self.folder, f'[opcua]\nenabled = true\nendpoint = "{self.url}"\n',
+                                 self.records)
+
+    def stop(self) -> None:
+        self.runtime.stop()
+
+    def restart(self) -> None:
+        self.runtime = Runtime(load_station(self.folder))
+        self.runtime.subscribe(self.records.append)
+        self.runtime.start()
+
+
+@pytest.fixture(scope="module")
+def station(tmp_path_factory: pytest.TempPathFactory) -> Iterator[Station]:
+    st = Station(tmp_path_factory.mktemp("consoles"))
+    try:
+        yield st
+    finally:
+        st.stop()
+
+
+Attach = Callable[[Station, str], ConsoleWindow]
+
+
+@pytest.fixture
+def attach(qtbot, tmp_path: Path) -> Iterator[Attach]:
+    """Consoles logged in as users of a station, each with its own config folder; closed after."""
+    windows: list[ConsoleWindow] = []
+
+    def open_(station: Station, user: str) -> ConsoleWindow:
+        client = ConsoleClient(station.url, folder=tmp_path / user, period=0.05)
+        try:
+            client.discover().result(20)
+            client.open(user, user).result(30)
+        except Exception:
+            client.close()
+            raise
+        window = ConsoleWindow(StationSource(client))
+        windows.append(window)
+        window.show()
+        qtbot.waitUntil(lambda: bool(window.views) and window.views[0].form is not None, timeout=WAIT)
+        return window
+
+    try:
+        yield open_
+    finally:
+        for window in windows:
+            window.close()
+            window.deleteLater()
+
+
+def qualities(window: ConsoleWindow) -> set[str]:
+    """What the elements that show a value of the plant say of it ("" for good)."""
+    return {model.quality for view in window.views for model in view.form.elements if model.sources()}
+
+
+def shown(window: ConsoleWindow) -> dict[str, State]:
+    """The alarms the console lists, by identity: those not normal."""
+    return {r.id: r.state for r in window.source.client.alarms if r.state is not State.NORMAL}
+
+
+def readings_of(window: ConsoleWindow) -> list[Readings]:
+    seen: list[Readings] = []
+    window.source.readings.connect(seen.append)
+    return seen
+
+
+def test_an_acknowledge_shows_on_the_other_console_and_in_the_journal_a_viewer_is_refused_by_role(
+        qtbot, station: Station, attach: Attach) -> None:
+    operator, viewer = attach(station, "operator"), attach(station, "viewer")
+    station.runtime.simulator_answers(0, False)  # node 0's cable pulled: TRIGGER's quality alarm comes
+    try:
+        for console in (operator, viewer):
+            qtbot.waitUntil(lambda c=console: any(r.id == "TRIGGER.BAD" for r in c.unacknowledged),
+                            timeout=WAIT)
+        alarm = next(r for r in viewer.unacknowledged if r.id == "TRIGGER.BAD")
+        refused: Answer = viewer.acknowledge(alarm).result(20)
+        assert str(refused.refusal) == "TRIGGER.BAD: needs the operator role; viewer is viewer"
+        qtbot.waitUntil(lambda: "needs the operator role; viewer is viewer" in viewer.status.currentMessage(),
+                        timeout=WAIT)
+        assert operator.acknowledge(alarm).result(20).ok
+        qtbot.waitUntil(lambda: all(r.id != "TRIGGER.BAD" for r in viewer.unacknowledged), timeout=WAIT)
+        acked = [r.text or "" for r in station.records if r.kind == "alarm" and r.source == "TRIGGER.BAD"
+                 and "acknowledged; by opcua:operator@127.0.0.1:" in (r.text or "")]
+        assert acked, "the acknowledgement journaled with the operator's name"
+        qtbot.waitUntil(lambda: not viewer.banner.ack.isEnabled(), timeout=WAIT)  # as the station answers
+        assert "needs the operator role; viewer is viewer" in viewer.summary.ack.toolTip()
+        assert operator.commands.shelve(operator.who, "TRIGGER.BAD", "cable work", 600).result(20).ok
+        rows = viewer.summary
+        qtbot.waitUntil(lambda: any(r.id == "TRIGGER.BAD" and r.state is State.SHELVED for r in rows.rows),
+                        timeout=WAIT)
+        assert operator.commands.unshelve(operator.who, "TRIGGER.BAD").result(20).ok
+        journal = viewer.journal  # the station's journal, read over OPC UA, names the operator too
+        qtbot.waitUntil(lambda: any(r.kind == "alarm" and "TRIGGER.BAD" in (r.text or "") and
+                                    "by opcua:operator@" in (r.text or "") for r in journal.model.rows),
+                        timeout=WAIT)
+    finally:
+        station.runtime.simulator_answers(0, True)
+    lines = station.runtime.status().consoles
+    assert any(line.startswith("operator@127.0.0.1:") for line in lines)
+    assert any(line.startswith("viewer@127.0.0.1:") for line in lines)
+    assert any("OPC UA: opcua:viewer@127.0.0.1:" in (r.text or "") and "connected" in (r.text or "")
+               for r in station.records)
+
+
+def test_a_setpoint_written_on_one_console_shows_on_the_other(
+        qtbot, station: Station, attach: Attach) -> None:
+    writer, watcher = attach(station, "operator"), attach(station, "viewer")
+    seen = readings_of(watcher)
+    address = station.runtime.symbols["SETPOINT"]
+    raw = 1234 if station.runtime.readings().tag("TEMP_SP").raw != 1234 else 2345
+    assert writer.target.write_word(address, raw, user="operator", label="Уставка") is None  # sent
+    qtbot.waitUntil(lambda: bool(seen) and seen[-1].tag("TEMP_SP").raw == raw, timeout=WAIT)
+    written = [r for r in station.records if r.kind == "operator" and "TEMP_SP" in (r.text or "")]
+    assert written and (written[-1].source or "").startswith("opcua:operator@")
+    watcher.target.write_word(address, 7, user="viewer", label="Уставка")  # refused by the station
+    qtbot.waitUntil(lambda: "needs the operator role; viewer is viewer" in watcher.status.currentMessage(),
+                    timeout=WAIT)
+    program = writer.open_program()  # the Program view on the console's session, as the station lets it
+    assert program is not None and program.source.client is writer.client
+    step = program.monitor.step_button
+    qtbot.waitUntil(lambda: "the station does not let operator do this" in step.toolTip(), timeout=WAIT)
+    program.close()
+    assert writer.client.error == "" and writer.client.snapshot is not None  # its session goes on
+    element = next(m for v in writer.views for m in v.form.elements if isinstance(m, Writer))
+    element.Confirm = True  # a command that cannot be taken back: the console asks first
+    writer.ask = lambda title, text: False
+    assert element.refused("Уставка = 100") == "cancelled"
+
+
+def test_a_form_changed_at_the_station_reaches_the_console(qtbot, station: Station, attach: Attach) -> None:
+    console = attach(station, "viewer")
+    form = station.folder / "forms" / "03_sync.hmi"
+    doc = json.loads(form.read_text(encoding="utf-8"))
+    doc["form"]["title"] = "Changed at the station"
+    form.write_text(json.dumps(doc, ensure_ascii=False), encoding="utf-8")
+    tabs = console.tabs
+    qtbot.waitUntil(lambda: "Changed at the station" in map(tabs.tabText, range(tabs.count())), timeout=WAIT)
+    assert len(console.views) == 3
+
+
+def test_the_station_lists_its_consoles_and_refuses_one_beyond_max_consoles(
+        qtbot, station: Station, attach: Attach, tmp_path: Path) -> None:
+    attach(station, "operator")
+    seats = next(p.seats for p in station.runtime.publishers if hasattr(p, "seats"))
+    bar = StationStatusBar()
+    qtbot.addWidget(bar)
+    bar.show_status(station.runtime.status())
+    assert bar.consoles.text() == f"Consoles {len(seats.seats())}"
+    assert any(line.startswith("operator@127.0.0.1:") for line in bar.consoles.toolTip().splitlines())
+    limit, seats.limit = seats.limit, len(seats.seats())  # as if [opcua] max_consoles said so
+    try:
+        one_more = ConsoleClient(station.url, folder=tmp_path / "one-more")
+        try:
+            one_more.discover().result(20)
+            with pytest.raises(LoginError, match="BadTooManySessions"):
+                one_more.open("viewer", "viewer").result(30)
+        finally:
+            one_more.close()
+    finally:
+        seats.limit = limit
+    assert any(r.kind == "operator" and "max_consoles" in (r.text or "") and "viewer" in (r.source or "")
+               for r in station.records)
+
+
+def test_a_console_shows_the_station_unreachable_and_reconnects_by_itself(
+        qtbot, station: Station, attach: Attach) -> None:
+    """Last of the module: it stops the station, and leaves it restarted."""
+    console = attach(station, "operator")
+    qtbot.waitUntil(lambda: qualities(console) == {""}, timeout=WAIT)
+    station.stop()
+    qtbot.waitUntil(lambda: qualities(console) == {Quality.UNREACHABLE.word}, timeout=WAIT)
+    assert console.health.isVisible() and "station unreachable" in console.health.problems[0]
+    station.restart()
+    qtbot.waitUntil(lambda: qualities(console) == {""} and not console.client.error, timeout=WAIT)
+    assert not console.health.isVisible()
+    qtbot.waitUntil(lambda: shown(console) == {r.id: r.state for r in station.runtime.alarms.summary},
+                    timeout=WAIT)  # the station's alarms as they are now
+
+
+def test_the_console_command_wants_an_opc_tcp_url() -> None:
+    run = subprocess.run([sys.executable, str(REPO / "main.py"), "console", "http://10.0.0.10/"],
+                         capture_output=True, text=True, timeout=60, cwd=REPO)
+    assert run.returncode == 2 and run.stderr == "http://10.0.0.10/: not an opc.tcp:// URL\n"
