@@ -21,6 +21,7 @@ horn made audible (app/gui/annunciation.py); the station key `alarm_sound = fals
 from __future__ import annotations
 
 import logging
+import time
 from collections.abc import Callable
 from pathlib import Path
 from typing import Any
@@ -365,6 +366,9 @@ class AlarmSummary(QWidget):
 
     def _silenced(self, answer: Answer) -> None:
         if answer.ok:
+            silenced = getattr(self.alarms, "silenced", None)  # a remote station's rows keep their own horn
+            if silenced is not None:
+                silenced(time.time())
             self.annunciator.silence()
             self.rights.update()
 

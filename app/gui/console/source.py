@@ -24,6 +24,7 @@ from PySide6.QtCore import QObject, Signal
 
 from app.publish.console import ConsoleClient, Files
 from app.scada.alarms import AlarmRow, summary_order
+from app.scada.horn import Horn
 from app.scada.quality import LinkView, Operands, Quality, QualityMap
 from app.scada.readings import Reading, Readings
 from app.scada.table import TagTable, read_tags
@@ -146,10 +147,16 @@ class RemoteAlarms:
     def __init__(self) -> None:
         self.version = 0
         self.summary: list[AlarmRow] = []
+        self.horn = Horn()  # what sounds, worked out from the station's rows as the station does
 
     def show(self, rows: tuple[AlarmRow, ...]) -> None:
         self.summary = sorted(rows, key=summary_order)
+        self.horn.update(self.summary)
         self.version += 1
+
+    def silenced(self, now: float) -> None:
+        """The station took this console's silence: what sounds now stops here too."""
+        self.horn.silence(now)
 
 
 class StationSource(QObject):

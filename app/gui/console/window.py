@@ -15,6 +15,7 @@ from __future__ import annotations
 
 import logging
 import sys
+from collections.abc import Callable
 
 from PySide6.QtCore import QTimer
 from PySide6.QtGui import QAction, QCloseEvent, QKeySequence
@@ -68,11 +69,14 @@ class RemoteTarget(EngineTarget):
         self.who = lambda user: Who(user, Source.OPCUA)
         self.on_answer = answers.follow
         self.say = words.answer
+        self._bits: dict = {}  # the station names a write by its tag: the view says the element's label
+        self._words: dict = {}
 
     def bit(self, who: Who, addr: int, value: int, label: str | None, at_least: str | None) -> Ticket:
         return self.client.write_bit(addr, value, label, at_least)
 
-    def word(self, who: Who, addr: int, value: int, label: str | None, at_least: str | None) -> Ticket:
+    def word(self, who: Who, addr: int, value: int, label: str | None, at_least: str | None,
+             describe: Callable[[int, int], str] | None = None) -> Ticket:
         return self.client.write_word(addr, value, label, at_least)
 
 

@@ -732,7 +732,7 @@
         <translation>генератор синхронизации, разрешаемый Ainput</translation>
     </message>
     <message>
-        <source>a bit as text, image, lamp; a button when Enabled</source>
+        <source>a bit as text, image and lamp; a button when Enabled</source>
         <translation>бит как текст, картинка, лампа; кнопка при Enabled</translation>
     </message>
     <message>

@@ -89,7 +89,8 @@ def test_tags_are_of_part_8_types_with_the_ranges_and_units_of_tags_csv(station:
     assert nodes["TEMP"]["EngineeringUnits"].UnitId == CELSIUS
     trigger = nodes["TRIGGER"]
     assert trigger["type"] == ua.ObjectIds.TwoStateDiscreteType
-    assert (trigger["TrueState"].Text, trigger["FalseState"].Text) == ("On", "Off")
+    # in the station's language (the demo's is Russian): "On" and "Off" in an English one
+    assert (trigger["TrueState"].Text, trigger["FalseState"].Text) == ("Вкл", "Выкл")
 
 
 def test_every_node_of_the_station_has_a_string_nodeid_and_a_plain_browse_name(
