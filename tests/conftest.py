@@ -57,7 +57,7 @@ def pg_url(pg_cluster) -> str:
 def _collect_on_the_gui_thread(request: pytest.FixtureRequest):
     """A test with Qt collects Python's garbage on the GUI thread, as our windows do
     (app/gui/application.py), and leaves none of its Qt objects to be freed later by another
-    thread; the other tests keep Python's own collection."""
+    thread, nor its translation; the other tests keep Python's own collection."""
     if "qapp" not in request.fixturenames:
         yield
         return
@@ -66,6 +66,9 @@ def _collect_on_the_gui_thread(request: pytest.FixtureRequest):
     app = request.getfixturevalue("qapp")
     MainThreadCollector(parent=app)
     yield
+    from app.gui import i18n
+
+    i18n.uninstall(app)  # a window that installed its station's language leaves none to the next test
     for collector in app.findChildren(MainThreadCollector):
         collector.stop()
         collector.setParent(None)

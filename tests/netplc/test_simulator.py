@@ -51,17 +51,19 @@ def test_main_reports_bad_arguments(tmp_path: Path, capsys: pytest.CaptureFixtur
 def test_command_line_simulator(tmp_path: Path) -> None:
     program = tmp_path / "node.stl"
     program.write_text("v = $04000\nTNA $03760\nFON C:$03000 N:MOV S:$04002 D:v\nJMP 0\n", encoding="utf-8")
-    proc = subprocess.Popen(
-        [sys.executable, "-m", "netplc.simulator", str(program),
-         "--port", "0", "--tick", "10", "--unit", "3"],
-        cwd=ROOT, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True,
-        env={**os.environ, "PYTHONUNBUFFERED": "1"},
-    )
+    errors = tmp_path / "stderr.txt"
+    with open(errors, "wb") as err:  # a file, not a pipe nobody reads: a full pipe would block it
+        proc = subprocess.Popen(
+            [sys.executable, "-m", "netplc.simulator", str(program),
+             "--port", "0", "--tick", "10", "--unit", "3"],
+            cwd=ROOT, stdout=subprocess.PIPE, stderr=err, text=True,
+            env={**os.environ, "PYTHONUNBUFFERED": "1", "PYTHONFAULTHANDLER": "1"},
+        )
     try:
         assert proc.stdout is not None
         line = proc.stdout.readline()
         m = re.search(r"Modbus TCP on 127\.0\.0\.1:(\d+) unit 3", line)
-        assert m, line + (proc.stderr.read() if proc.poll() is not None and proc.stderr else "")
+        assert m, line + (errors.read_text() if proc.poll() is not None else "")
         c = ModbusTcpClient("127.0.0.1", port=int(m.group(1)), timeout=2)
         assert c.connect()
         assert not c.write_register(1025, 4242, device_id=3).isError()
@@ -70,8 +72,13 @@ def test_command_line_simulator(tmp_path: Path) -> None:
     finally:
         proc.send_signal(signal.SIGINT)
         try:
-            assert proc.wait(60) == 0
+            code = proc.wait(60)
+        except subprocess.TimeoutExpired:
+            proc.send_signal(signal.SIGABRT)  # PYTHONFAULTHANDLER: every thread's stack to stderr
+            proc.wait(10)
+            pytest.fail("the simulator did not stop on Ctrl-C:\n" + errors.read_text(errors="replace"))
         finally:
             if proc.poll() is None:
                 proc.kill()
                 proc.wait(10)
+    assert code == 0, errors.read_text(errors="replace")
