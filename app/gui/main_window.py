@@ -491,7 +491,7 @@ class MainWindow(QMainWindow):
 
         alarms = self.runtime.alarms
         window = TrendWindow(self.bridge, alarms.table.tags if alarms else (), self.runtime.station.Archive,
-                             lambda: self.user)
+                             lambda: self.user, self)  # a window of its own, owned by this one
         window.show()
         self.viewers.append(window)
         return window

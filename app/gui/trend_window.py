@@ -371,8 +371,9 @@ class TrendWindow(QWidget):
             self.curves[name].setData(ts, vs)
             va, vb = value_at(ts, vs, a), value_at(ts, vs, b)
             s = stats(ts, vs, x0, x1)
-            cells = [pen.heading(), _num(va), _num(vb), _num(vb - va),
-                     *((_num(s.min), _num(s.max), _num(s.mean)) if s else ("", "", ""))]
+            d = pen.tag.decimals
+            cells = [pen.heading(), _num(va, d), _num(vb, d), _num(vb - va, d),
+                     *((_num(s.min, d), _num(s.max, d), _num(s.mean, d)) if s else ("", "", ""))]
             for col, text in enumerate(cells):
                 item = QTableWidgetItem(text)
                 if col == 0:
@@ -470,5 +471,6 @@ def _clock(t: float) -> str:
     return dt.datetime.fromtimestamp(t).strftime("%H:%M:%S") if t > 0 else ""
 
 
-def _num(v: float) -> str:
-    return "" if math.isnan(v) else f"{v:.6g}"
+def _num(v: float, decimals: int) -> str:
+    """With the tag's decimals, as its value is shown everywhere else."""
+    return "" if math.isnan(v) else f"{v:.{decimals}f}"

@@ -72,11 +72,11 @@ def test_two_tags_picked_give_pens_cursors_and_statistics_of_the_archive(
     trend.set_cursors(t0 + 60 * 2 + 5, t0 + 60 * 7 + 5)
     trend.dirty = True
     trend.redraw()
-    assert [trend.cell("LEVEL", c) for c in ("A", "B", "B − A")] == ["20", "70", "50"]
-    assert [trend.cell("TEMP", c) for c in ("A", "B", "B − A")] == ["-42", "-22", "20"]
+    assert [trend.cell("LEVEL", c) for c in ("A", "B", "B − A")] == ["20.0", "70.0", "50.0"]
+    assert [trend.cell("TEMP", c) for c in ("A", "B", "B − A")] == ["-42.0", "-22.0", "20.0"]
     assert "B − A 300.0 s" in trend.cursor_text.text()
-    assert [trend.cell("LEVEL", c) for c in ("Min", "Max", "Mean")] == ["0", "90", "45"]
-    assert [trend.cell("TEMP", c) for c in ("Min", "Max", "Mean")] == ["-50", "-14", "-32"]
+    assert [trend.cell("LEVEL", c) for c in ("Min", "Max", "Mean")] == ["0.0", "90.0", "45.0"]
+    assert [trend.cell("TEMP", c) for c in ("Min", "Max", "Mean")] == ["-50.0", "-14.0", "-32.0"]
     assert not trend.grab().isNull()
 
     out = tmp_path / "trend.csv"
