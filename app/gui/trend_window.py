@@ -4,10 +4,12 @@ values, with two cursors, the statistics of the range shown, saved per user, exp
 A pen is a tag: its archive series is the NSTORE of the tag's address (the raw word, converted
 with the tag's scaling, as the faceplate reads it), each day of the range shown read once, in the
 series loader's worker thread (app/gui/series_loader.py), so panning back a week never stops the
-window; the live values come from the runtime bridge's readings (good or forced ones only). The
-plot and the table are redrawn twice a second, not at every scan. The cursors' table gives each
-pen's value at A and at B (the last sample at or before), B − A, and the minimum, maximum and mean
-of the samples in the visible range; the CSV export holds those samples.
+window; a range zoomed into (under six hours, within a day, not live) is read again at its own
+detail, so zooming shows the samples rather than the day's reduction. The live values come from
+the runtime bridge's readings (good or forced ones only). The plot and the table are redrawn
+twice a second, not at every scan. The cursors' table gives each pen's value at A and at B (the
+last sample at or before), B − A, and the minimum, maximum and mean of the samples in the visible
+range; the CSV export holds those samples.
 """
 
 from __future__ import annotations
@@ -43,7 +45,7 @@ from PySide6.QtWidgets import (
 
 from app.gui.bridge import RuntimeBridge
 from app.gui.designer.tag_browser import matches
-from app.gui.series_loader import Series, SeriesLoader
+from app.gui.series_loader import DAY_S, Series, SeriesLoader, Window
 from app.scada.quality import Quality
 from app.scada.readings import Readings
 from app.scada.tag import Tag
@@ -65,6 +67,8 @@ logger = logging.getLogger(__name__)
 
 POINTS = 4000  # read of a day: a plot a few thousand pixels wide
 MAX_DAYS = 31  # read for one range shown: a month back at most
+DETAIL_BELOW = DAY_S / 4  # a range shorter than this, within one day, is read again at its own detail
+DETAIL_MS = 300  # after the last pan or zoom step
 REDRAW_MS = 500
 LIVE_POINTS = 36_000  # live samples kept per pen: an hour at ten a second
 COLUMNS = 7  # pen, A, B, B − A, min, max, mean
@@ -78,6 +82,7 @@ class PenData:
         self.colour = colour
         self.days: dict[dt.date, tuple[np.ndarray, np.ndarray]] = {}
         self.asked: set[dt.date] = set()
+        self.detail: tuple[Window, np.ndarray, np.ndarray] | None = None  # the range zoomed into
         self.live_t: list[float] = []
         self.live_v: list[float] = []
 
@@ -87,6 +92,12 @@ class PenData:
         parts = [self.days[d] for d in sorted(self.days)]
         ts = np.concatenate([p[0] for p in parts]) if parts else np.empty(0)
         vs = np.concatenate([p[1] for p in parts]) if parts else np.empty(0)
+        if self.detail is not None:  # the day's reduction replaced by the range's own points
+            (w0, w1), dts, dvs = self.detail
+            outside = (ts < w0) | (ts >= w1)
+            ts, vs = np.concatenate([ts[outside], dts]), np.concatenate([vs[outside], dvs])
+            order = np.argsort(ts, kind="stable")
+            ts, vs = ts[order], vs[order]
         old = ts < live_from
         return (np.concatenate([ts[old], np.asarray(self.live_t, dtype=np.float64)]),
                 np.concatenate([vs[old], np.asarray(self.live_v, dtype=np.float64)]))
@@ -107,7 +118,7 @@ class TrendWindow(QWidget):
         self.user = user
         self.book = TrendBook(archive.parent)
         self.pens: dict[str, PenData] = {}
-        self.asked: dict[int, tuple[PenData, dt.date]] = {}
+        self.asked: dict[int, tuple[PenData, dt.date, Window | None]] = {}
         self.dirty = True
         self.loader = SeriesLoader(POINTS, self)
         self.loader.answered.connect(self._loaded)
@@ -180,6 +191,10 @@ class TrendWindow(QWidget):
         view = self.plot.getViewBox()
         view.sigRangeChangedManually.connect(lambda *_: self.live.setChecked(False))
         view.sigXRangeChanged.connect(lambda *_: self._range_changed())
+        self.settled = QTimer(self)
+        self.settled.setSingleShot(True)
+        self.settled.setInterval(DETAIL_MS)
+        self.settled.timeout.connect(self._want_detail)
 
         self.cursor_text = QLabel()
         self.cursor_text.setObjectName("trendCursors")
@@ -281,7 +296,25 @@ class TrendWindow(QWidget):
 
     def _range_changed(self) -> None:
         self._want_history()
+        if not self.live.isChecked():  # live, the recent part comes from the readings
+            self.settled.start()
         self._touch()
+
+    def _want_detail(self) -> None:
+        """A range zoomed into, within one day: its own points rather than the day's reduction (the
+        loader reads up to 50 times the day's points for it, the last request of a pen superseding
+        the one before)."""
+        x0, x1 = self.visible()
+        day = dt.date.fromtimestamp(max(x0, 0.0))
+        if self.live.isChecked() or x1 - x0 > DETAIL_BELOW or dt.date.fromtimestamp(max(x1, 0.0)) != day \
+                or not self.archive.exists():
+            return
+        for pen in self.pens.values():
+            key = SeriesKey("data", None, None, fmt_octal(pen.tag.address))
+            token = self.loader.request(self.archive, day, key, ("detail", pen.tag.name), (x0, x1))
+            # the request it supersedes is answered no more
+            self.asked = {t: a for t, a in self.asked.items() if a[0] is not pen or a[2] is None}
+            self.asked[token] = (pen, day, (x0, x1))
 
     def _want_history(self) -> None:
         """Ask the archive for each day of the range shown that no pen has read yet."""
@@ -296,20 +329,25 @@ class TrendWindow(QWidget):
             for day in days:
                 if day not in pen.asked:
                     pen.asked.add(day)
-                    self.asked[self.loader.request(self.archive, day, key)] = (pen, day)
+                    self.asked[self.loader.request(self.archive, day, key)] = (pen, day, None)
 
     def _loaded(self, token: int, series: Series) -> None:
-        pen, day = self.asked.pop(token, (None, None))
+        pen, day, window = self.asked.pop(token, (None, None, None))
         if pen is None or day is None or self.pens.get(pen.tag.name) is not pen:
             return  # removed while it loaded
         _key, ts, raw = series
-        pen.days[day] = (ts, raw if pen.tag.scaling is None else pen.tag.scaling.to_phy(raw))
+        values = raw if pen.tag.scaling is None else pen.tag.scaling.to_phy(raw)
+        if window is None:
+            pen.days[day] = (ts, values)
+        else:
+            pen.detail = (window, ts, values)
         self._touch()
 
     def _failed(self, token: int, why: str) -> None:
-        pen, day = self.asked.pop(token, (None, None))  # logged by the loader
+        pen, day, window = self.asked.pop(token, (None, None, None))  # logged by the loader
         if pen is not None and day is not None:
-            pen.asked.discard(day)
+            if window is None:
+                pen.asked.discard(day)
             self.message.setText(self.tr("The archive of {0} could not be read: {1}").format(day, why))
 
     def loading(self) -> bool:
@@ -462,6 +500,7 @@ class TrendWindow(QWidget):
     def closeEvent(self, event: object) -> None:
         if self.timer.isActive():  # closed once: by the operator, then with the workstation
             self.timer.stop()
+            self.settled.stop()
             self.bridge.readings.disconnect(self.show_readings)
             self.loader.close()
         super().closeEvent(event)  # type: ignore[arg-type]

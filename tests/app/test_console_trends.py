@@ -115,3 +115,37 @@ def test_a_saved_trend_reopens_with_its_pens_for_the_same_user_only(qtbot, stati
     other = window.open_trends()
     assert other.saved.count() == 0 and not other.open_trend("Печь")
     assert "Печь" in other.message.text()
+
+
+def test_a_range_zoomed_into_is_read_at_its_own_detail(qtbot, demo_copy: Path) -> None:
+    """A day of LEVEL every half second (7200 samples, more than a day's read keeps): zoomed into
+    20 s, every sample of them is drawn, not the day's bucket extremes."""
+    t0 = float(int(time.time()) - 7200)
+    store = Store(demo_copy / "archive" / "journal.sqlite", wallclock=lambda: t0)
+    for i in range(7200):
+        store.put(Record(t0 + 0.5 * i, "data", 1, 1, "04010", value=float(i % 4096)))
+    store.start()
+    store.close()
+    runtime = Runtime(load_station(demo_copy))
+    runtime.start()
+    window = MainWindow(runtime)
+    qtbot.addWidget(window)
+    try:
+        trend = window.open_trends()
+        trend.add_pen("LEVEL")
+        a, b = t0 + 600 - 0.25, t0 + 620 - 0.25  # 600 s .. 619.5 s: samples 1200 .. 1239
+        trend.set_range(a, b)
+
+        def inside() -> int:
+            ts, _ = trend.pens["LEVEL"].samples()
+            return int(((ts >= a) & (ts < b)).sum())
+
+        qtbot.waitUntil(lambda: trend.pens["LEVEL"].detail is not None and not trend.loading(), timeout=WAIT)
+        assert inside() == 40
+        trend.dirty = True
+        trend.redraw()
+        assert trend.cell("LEVEL", "Min") == f"{1200 / 4095 * 100:.1f}"
+        assert trend.cell("LEVEL", "Max") == f"{1239 / 4095 * 100:.1f}"
+    finally:
+        window.close()
+        runtime.stop()
