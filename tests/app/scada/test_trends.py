@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import math
+import re
 from pathlib import Path
 
 import numpy as np
@@ -20,7 +21,7 @@ def test_trends_are_kept_per_user_and_a_broken_file_is_named(tmp_path: Path) -> 
     assert book.get("operator", "Печь") == SavedTrend("Печь", [Pen("TEMP", "#d62728")], 600.0)
     assert book.get("engineer", "Печь") is None
     book.path.write_text("{not json", encoding="utf-8")
-    with pytest.raises(TrendFileError, match=str(tmp_path / "trends.json").replace(".", r"\.")):
+    with pytest.raises(TrendFileError, match=re.escape(str(tmp_path / "trends.json"))):
         book.names("operator")
 
 
