@@ -10,6 +10,7 @@ from collections.abc import Iterator
 from pathlib import Path
 
 import pytest
+from PySide6.QtCore import Qt
 
 from app.gui.main_window import MainWindow
 from app.gui.trend_window import TrendWindow
@@ -55,7 +56,8 @@ def test_two_tags_picked_give_pens_cursors_and_statistics_of_the_archive(
     trend = window.open_trends()
     assert isinstance(trend, TrendWindow)
     trend.search.setText("уровень")  # the picker searches descriptions too
-    assert [trend.tag_list.item(i).data(256) for i in range(trend.tag_list.count())] == ["LEVEL"]
+    listed = [trend.tag_list.item(i).data(Qt.ItemDataRole.UserRole) for i in range(trend.tag_list.count())]
+    assert listed == ["LEVEL"]
     trend.tag_list.setCurrentRow(0)
     trend._add_current()
     trend.add_pen("TEMP")
