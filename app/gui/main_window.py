@@ -180,6 +180,9 @@ class MainWindow(QMainWindow):
         viewer = QAction(self.tr("Open journal &viewer…"), self)
         viewer.setShortcut(QKeySequence("Ctrl+J"))
         viewer.triggered.connect(self.open_viewer)
+        trends = QAction(self.tr("Run-time &trends…"), self)  # app/gui/trend_window.py
+        trends.setShortcut(QKeySequence("Ctrl+T"))
+        trends.triggered.connect(self.open_trends)
         self.act_quit = quit_ = QAction(self.tr("&Quit…"), self)
         quit_.setShortcut(QKeySequence("Ctrl+Q"))  # on every platform; it asks before anything stops
         quit_.triggered.connect(self.request_quit)
@@ -198,6 +201,7 @@ class MainWindow(QMainWindow):
         station.addAction(self.act_users)
         station.addSeparator()
         station.addAction(viewer)
+        station.addAction(trends)
         for i, sim in enumerate(self.runtime.station.simulators):  # the demo's bad-quality case
             answers = QAction(self.tr("Simulated node {0} answers").format(sim.node), self)
             answers.setCheckable(True)
@@ -462,6 +466,16 @@ class MainWindow(QMainWindow):
         viewer = ViewerWindow(self.runtime.station.Archive)
         viewer.show()
         self.viewers.append(viewer)
+
+    def open_trends(self) -> QWidget:
+        from app.gui.trend_window import TrendWindow
+
+        alarms = self.runtime.alarms
+        window = TrendWindow(self.bridge, alarms.table.tags if alarms else (), self.runtime.station.Archive,
+                             lambda: self.user, self)  # a window of its own, owned by this one
+        window.show()
+        self.viewers.append(window)
+        return window
 
     def open_health(self) -> None:
         from app.gui.alarm_health import HealthDialog

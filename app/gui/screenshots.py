@@ -1,7 +1,8 @@
 """`python -m app.gui.screenshots DIR`: the workstation, the viewer and the designer on the demo station.
 
-The workstation's tabs and a tag's faceplate (over the analog form) are taken at 1366x768 and
-1920x1080, in English (`workstation-02-analog.png`) and in Russian (`...-ru.png`).
+The workstation's tabs, a tag's faceplate (over the analog form) and the run-time trend of LEVEL
+and TEMP are taken at 1366x768 and 1920x1080, in English (`workstation-02-analog.png`) and in
+Russian (`...-ru.png`).
 
 The demo station runs for real (a copy in a temporary folder, the embedded node over TCP, its own
 archive) while a short script plays the operator: Пуск pressed a few times, a setpoint entered,
@@ -26,6 +27,7 @@ from app.station.config import DEMO_STATION, load_station
 if TYPE_CHECKING:
     from PySide6.QtCore import QCoreApplication
 
+    from app.gui.main_window import MainWindow
     from app.station.runtime import Runtime
 
 SIZE = (1400, 900)  # the viewer's
@@ -140,9 +142,28 @@ def _workstation(runtime: Runtime, out: Path, wait: Callable[[float], None], sec
             picture.save(str(path))
             written.append(path)
             plate.close()
+            written.append(_trend(window, out / f"trend-level-temp{suffix}.png", size, wait))
     finally:
         window.close()
     return written
+
+
+def _trend(window: MainWindow, path: Path, size: tuple[int, int], wait: Callable[[float], None]) -> Path:
+    """The run-time trend of LEVEL and TEMP zoomed into the last minute, the cursors on them."""
+    trend = window.open_trends()
+    trend.resize(*size)
+    for name in ("LEVEL", "TEMP"):
+        trend.add_pen(name)
+    deadline = time.monotonic() + 30
+    while (trend.loading() or not all(p.live_t for p in trend.pens.values())) and time.monotonic() < deadline:
+        wait(0.05)  # the archive is read in a thread, the live values come with the scans
+    now = time.time()
+    trend.set_range(now - 60, now)
+    trend.set_cursors(now - 25, now - 2)
+    wait(0.6)
+    trend.grab().save(str(path))
+    trend.close()
+    return path
 
 
 def _designer(runtime: Runtime, out: Path, wait: Callable[[float], None]) -> Path:

@@ -14,7 +14,7 @@ def test_screenshots_of_every_form_and_the_viewer(qtbot, tmp_path: Path) -> None
     assert main([str(tmp_path), "--seconds", "1.5"]) == 0
     names = sorted(p.name for p in tmp_path.glob("*.png"))
     forms = sorted(p.stem for p in (DEMO_STATION / "forms").glob("*.hmi"))
-    shots = [f"workstation-{f.replace('_', '-')}" for f in forms] + ["faceplate-temp"]
+    shots = [f"workstation-{f.replace('_', '-')}" for f in forms] + ["faceplate-temp", "trend-level-temp"]
     assert names == sorted([*(f"{s}{size}{language}.png" for s in shots for size in ("", "-1920x1080")
                               for language in ("", "-ru")),
                             "designer-02-analog.png", "viewer-records.png", "viewer-series.png"])

@@ -549,6 +549,10 @@
 <context>
     <name>MainWindow</name>
     <message>
+        <source>Run-time &amp;trends…</source>
+        <translation>&amp;Тренды…</translation>
+    </message>
+    <message>
         <source>No unacknowledged alarms</source>
         <translation>Нет неквитированных аварий</translation>
     </message>
@@ -1668,6 +1672,137 @@ Drag onto the form, or double-click to add</source>
     <message>
         <source> (read-only)</source>
         <translation> (только просмотр)</translation>
+    </message>
+</context>
+<context>
+    <name>TrendWindow</name>
+    <message>
+        <source>Run-time trend</source>
+        <translation>Тренд</translation>
+    </message>
+    <message>
+        <source>Search tags: name, description, unit</source>
+        <translation>Поиск тегов: имя, описание, единица</translation>
+    </message>
+    <message>
+        <source>Add to the trend</source>
+        <translation>Добавить в тренд</translation>
+    </message>
+    <message>
+        <source>Live</source>
+        <translation>Реальное время</translation>
+    </message>
+    <message>
+        <source>Follow the live values; panning or zooming the plot stops following</source>
+        <translation>Следовать за текущими значениями; сдвиг или масштабирование графика прекращает слежение</translation>
+    </message>
+    <message>
+        <source>The trends saved by the user on duty</source>
+        <translation>Тренды, сохранённые текущим пользователем</translation>
+    </message>
+    <message>
+        <source>Open</source>
+        <translation>Открыть</translation>
+    </message>
+    <message>
+        <source>Save as…</source>
+        <translation>Сохранить как…</translation>
+    </message>
+    <message>
+        <source>Remove pen</source>
+        <translation>Убрать перо</translation>
+    </message>
+    <message>
+        <source>Export PNG…</source>
+        <translation>Экспорт PNG…</translation>
+    </message>
+    <message>
+        <source>PNG image (*.png)</source>
+        <translation>Изображение PNG (*.png)</translation>
+    </message>
+    <message>
+        <source>Export CSV…</source>
+        <translation>Экспорт CSV…</translation>
+    </message>
+    <message>
+        <source>CSV (*.csv)</source>
+        <translation>CSV (*.csv)</translation>
+    </message>
+    <message>
+        <source>Span</source>
+        <translation>Интервал</translation>
+    </message>
+    <message>
+        <source>Pen</source>
+        <translation>Перо</translation>
+    </message>
+    <message>
+        <source>Min</source>
+        <translation>Мин</translation>
+    </message>
+    <message>
+        <source>Max</source>
+        <translation>Макс</translation>
+    </message>
+    <message>
+        <source>Mean</source>
+        <translation>Среднее</translation>
+    </message>
+    <message>
+        <source>{0} min</source>
+        <translation>{0} мин</translation>
+    </message>
+    <message>
+        <source>{0} h</source>
+        <translation>{0} ч</translation>
+    </message>
+    <message>
+        <source>Double-click to add {0} to the trend</source>
+        <translation>Двойной щелчок добавляет {0} в тренд</translation>
+    </message>
+    <message>
+        <source>{0}: no such tag in this station</source>
+        <translation>{0}: такого тега в станции нет</translation>
+    </message>
+    <message>
+        <source>The archive of {0} could not be read: {1}</source>
+        <translation>Архив за {0} не прочитан: {1}</translation>
+    </message>
+    <message>
+        <source>A {0}   B {1}   B − A {2} s</source>
+        <translation>A {0}   B {1}   B − A {2} с</translation>
+    </message>
+    <message>
+        <source>The trend was not saved: {0}</source>
+        <translation>Тренд не сохранён: {0}</translation>
+    </message>
+    <message>
+        <source>Run-time trend: {0}</source>
+        <translation>Тренд: {0}</translation>
+    </message>
+    <message>
+        <source>Save trend</source>
+        <translation>Сохранить тренд</translation>
+    </message>
+    <message>
+        <source>Name of the trend</source>
+        <translation>Имя тренда</translation>
+    </message>
+    <message>
+        <source>No trend {0} of this user</source>
+        <translation>У этого пользователя нет тренда {0}</translation>
+    </message>
+    <message>
+        <source>Export</source>
+        <translation>Экспорт</translation>
+    </message>
+    <message>
+        <source>{0} could not be written</source>
+        <translation>{0} не записан</translation>
+    </message>
+    <message>
+        <source>{0} could not be written: {1}</source>
+        <translation>{0} не записан: {1}</translation>
     </message>
 </context>
 </TS>
