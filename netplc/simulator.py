@@ -14,6 +14,7 @@ the network, it does not ask it.
 from __future__ import annotations
 
 import argparse
+import signal
 import sys
 import threading
 from collections.abc import Iterable
@@ -137,27 +138,34 @@ def main(argv: list[str] | None = None) -> int:
     except OSError as e:
         print(f"simulate: {e}", file=sys.stderr)
         return 2
+    # Ctrl-C and SIGTERM stop the node, also where it was started with SIGINT ignored (a job a
+    # script put in the background inherits that, and so did the suite's simulators)
+    stop = threading.Event()
+    previous = {s: signal.signal(s, lambda *_: stop.set()) for s in (signal.SIGINT, signal.SIGTERM)}
     sim = Simulator(program, args.host, args.port, args.unit, args.tick / 1000.0, sink=ConsoleSink(),
                     serial=serial)
     where = f"{args.host}:{args.port}" if serial is None else serial.device
     try:
-        sim.start()
-    except OSError as e:
-        print(f"simulate: cannot {'listen on' if serial is None else 'open'} {where}: {e}", file=sys.stderr)
-        return 1
-    if serial is None:
-        served = f"Modbus TCP on {args.host}:{sim.port}"
-    else:
-        served = (f"Modbus RTU on {serial.device} ({serial.baudrate} baud, "
-                  f"{serial.bytesize}{serial.parity}{serial.stopbits})")
-    try:  # a Ctrl-C from here on, even while the line is printed, stops the node's threads
-        print(f"simulated CPU-165 node: {args.program} every {args.tick} ms, {served} unit {args.unit} "
-              "(Ctrl-C stops)", flush=True)
-        interruptible.wait(threading.Event())
-    except KeyboardInterrupt:
-        pass
+        try:
+            sim.start()
+        except OSError as e:
+            print(f"simulate: cannot {'listen on' if serial is None else 'open'} {where}: {e}",
+                  file=sys.stderr)
+            return 1
+        if serial is None:
+            served = f"Modbus TCP on {args.host}:{sim.port}"
+        else:
+            served = (f"Modbus RTU on {serial.device} ({serial.baudrate} baud, "
+                      f"{serial.bytesize}{serial.parity}{serial.stopbits})")
+        try:
+            print(f"simulated CPU-165 node: {args.program} every {args.tick} ms, {served} unit {args.unit} "
+                  "(Ctrl-C stops)", flush=True)
+            interruptible.wait(stop)
+        finally:
+            sim.stop()
     finally:
-        sim.stop()
+        for sig, handler in previous.items():
+            signal.signal(sig, handler)
     return 0
 
 

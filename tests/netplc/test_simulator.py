@@ -53,9 +53,11 @@ def test_command_line_simulator(tmp_path: Path) -> None:
     program.write_text("v = $04000\nTNA $03760\nFON C:$03000 N:MOV S:$04002 D:v\nJMP 0\n", encoding="utf-8")
     errors = tmp_path / "stderr.txt"
     with open(errors, "wb") as err:  # a file, not a pipe nobody reads: a full pipe would block it
+        # started as a script's background job is: with SIGINT ignored (`trap "" INT`), which Ctrl-C
+        # must stop all the same
         proc = subprocess.Popen(
-            [sys.executable, "-m", "netplc.simulator", str(program),
-             "--port", "0", "--tick", "10", "--unit", "3"],
+            ["sh", "-c", 'trap "" INT; exec "$@"', "sh", sys.executable, "-m", "netplc.simulator",
+             str(program), "--port", "0", "--tick", "10", "--unit", "3"],
             cwd=ROOT, stdout=subprocess.PIPE, stderr=err, text=True,
             env={**os.environ, "PYTHONUNBUFFERED": "1", "PYTHONFAULTHANDLER": "1"},
         )
