@@ -4,7 +4,7 @@ VENV := .venv
 PY := $(VENV)/bin/python
 STAMP := $(VENV)/.installed
 
-.PHONY: run test lint bench screenshots translations dist docs reference clean
+.PHONY: run test lint bench screenshots translations dist docs reference durations clean
 
 $(STAMP): pyproject.toml
 	test -x $(PY) || $(PYTHON) -m venv $(VENV)
@@ -42,6 +42,10 @@ docs: $(STAMP)
 
 reference: $(STAMP)
 	$(PY) -m docs.gen_reference
+
+# the test files' times of the last `make test`, kept for a clean clone's first run (tests/conftest.py)
+durations:
+	$(PY) -c "import json, pathlib; d = json.loads(pathlib.Path('.pytest_cache/v/netplc/file_durations').read_text()); pathlib.Path('tests/file_durations.json').write_text(json.dumps({k: round(v, 1) for k, v in sorted(d.items()) if pathlib.Path(k).exists()}, indent=0) + chr(10))"
 
 screenshots: $(STAMP) $(QM)
 	QT_QPA_PLATFORM=offscreen $(PY) -m app.gui.screenshots docs/screenshots

@@ -4,8 +4,10 @@ address space."""
 
 import gc
 import itertools
+import json
 import os
 import sys
+from pathlib import Path
 
 import pytest
 
@@ -88,6 +90,9 @@ def pytest_runtest_setup(item: pytest.Item) -> None:
 # one running a long file alone at the end. Tests of a file stay together, in their order.
 
 DURATIONS = "netplc/file_durations"
+# a clean clone (CI) has no cache yet: the times of a full run, kept in the repository, order it
+# (refresh them with `make durations` after adding long tests)
+KEPT = Path(__file__).with_name("file_durations.json")
 _spent: dict[str, float] = {}
 
 
@@ -98,6 +103,8 @@ def _file(nodeid: str) -> str:
 def pytest_collection_modifyitems(config: pytest.Config, items: list[pytest.Item]) -> None:
     cache = getattr(config, "cache", None)  # None under -p no:cacheprovider
     last: dict[str, float] = cache.get(DURATIONS, {}) if cache is not None else {}
+    if not last and KEPT.exists():
+        last = json.loads(KEPT.read_text(encoding="utf-8"))
     if not last:
         return
     unknown = max(last.values())  # a new file may be long: it goes among the first
