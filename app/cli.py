@@ -179,10 +179,15 @@ def _monitor_parser() -> argparse.ArgumentParser:
                                                         "folder for its program, symbols and tags")
     p.add_argument("--user", help="over OPC UA, the user to log in as (the dialog asks the password; when "
                                   "stdin is not a terminal, its first line is the password)")
-    p.add_argument("--partner", metavar="URL", default="",
-                   help="over OPC UA, the endpoint of the other station of a hot-standby pair: the monitor "
-                        "follows whichever leads (its certificate trusted by a monitor of it before)")
+    _partner_option(p, "over OPC UA, ", "monitor")
     return p
+
+
+def _partner_option(p: argparse.ArgumentParser, over: str, what: str) -> None:
+    """--partner of a client of a hot-standby pair: it follows the station that leads."""
+    p.add_argument("--partner", metavar="URL", default="",
+                   help=f"{over}the endpoint of the other station of a hot-standby pair: the {what} follows "
+                        "whichever leads (its certificate trusted by a console or monitor of it before)")
 
 
 def _console_parser() -> argparse.ArgumentParser:
@@ -194,6 +199,7 @@ def _console_parser() -> argparse.ArgumentParser:
     p.add_argument("url", help="opc.tcp://HOST:PORT/PATH of the station's OPC UA endpoint")
     p.add_argument("--user", help="the user to log in as (the dialog asks the password; when stdin is not "
                                   "a terminal, its first line is the password)")
+    _partner_option(p, "", "console")
     return p
 
 
@@ -319,7 +325,7 @@ def main(argv: list[str] | None = None) -> int:
                 return 2
             from app.gui.console.window import run_console
 
-            return run_console(ns.url, ns.user)
+            return run_console(ns.url, ns.user, ns.partner)
         if command == "archive":
             ns = _archive_parser().parse_args(rest)
             if ns.action == "backup":

@@ -36,7 +36,7 @@ class HeaderLine(QFrame):
         lay = QHBoxLayout(self)
         lay.setContentsMargins(12, 0, 10, 0)
         lay.setSpacing(8)
-        title = QLabel(name)
+        title = self.title = QLabel(name)  # a console of a pair says here which station it is on
         title.setObjectName("headerTitle")
         title.setToolTip("NetPlc Station")
         self.quiet = QLabel(quiet)

@@ -221,6 +221,8 @@ class StationClient:
         self.partner = partner
         self.service_level = LEADS  # the Server's, as last read
         self.switches = 0  # times the monitor followed the pair's primary to the other station
+        self.switched = ""  # the last of those, in words for the user ("" before any)
+        self.server = ""  # the ApplicationUri of the station logged in to: a pair's ends in its letter
         self.offer: Offer | None = None
         self.user = ""
         self._password = ""
@@ -299,8 +301,14 @@ class StationClient:
         snap = self.snapshot
         if snap is None:
             return f"logging in to {self.url} as {self.user}…"
-        return (f"{self.user} at {self.station or self.url}: NetPlc {snap.state}, scan {snap.scan}, "
-                f"{self.reads} reads")
+        return (f"{self.user} at {self.where()}: NetPlc {snap.state}, scan {snap.scan}, "
+                f"{self.reads} reads" + (f"; {self.switched}" if self.switched else ""))
+
+    def where(self) -> str:
+        """The station logged in to, with its letter when it is one of a pair ("pair B")."""
+        letter = self.server.removeprefix(f"{STATION_URI}{self.station}:") if self.station else ""
+        name = self.station or self.url
+        return f"{name} {letter}" if letter and letter != self.server else name
 
     # --- on the client's loop -------------------------------------------------------------------
 
@@ -379,6 +387,7 @@ class StationClient:
             if station is None:
                 raise LoginError(f"{self.url} is not a NetPlc station (no {STATION_URI}... namespace)")
             self._ns, self.station = station[0], station[1].removeprefix(STATION_URI)
+            self.server = spaces[1] if len(spaces) > 1 else ""
             self._client = client
             await self._ask_rights()
             await self._read()
@@ -445,6 +454,9 @@ class StationClient:
             self.error = (f"{self.url}: {why}; the pair's other station {self.partner} is not trusted yet: "
                           f"monitor it once to trust its certificate")
             return False
+        left = self.where()
+        self.error = f"{why}; switching to the pair's other station {self.partner}"
+        self.changed()  # shown while it switches: nothing looks live from the station left
         old = self._client
         self._client = None
         if old is not None:
@@ -460,7 +472,9 @@ class StationClient:
             return False
         self.switches += 1
         self.error = ""
+        self.switched = f"switched from {left} at {time.strftime('%H:%M:%S')} ({why})"
         logger.info("following the pair's primary to %s (%s)", self.url, why)
+        self.changed()
         return True
 
     async def _lost(self, why: str, failures: int) -> None:

@@ -66,8 +66,11 @@ class Files:
 
 
 class ConsoleClient(StationClient):
-    def __init__(self, url: str, *, folder: Path | None = None, period: float = 0.1) -> None:
-        super().__init__(url, folder=folder, period=period)
+    def __init__(self, url: str, *, partner: str = "", folder: Path | None = None,
+                 period: float = 0.1) -> None:
+        """`partner`: the other station of a hot-standby pair; the console follows the one that leads
+        (StationClient), and reads the forms, alarms and journal there again (a new session)."""
+        super().__init__(url, partner=partner, folder=folder, period=period)
         self.files: Files | None = None  # as last put together
         self.alarms: tuple[AlarmRow, ...] = ()
         self.links: dict[int, bool] = {}

@@ -52,6 +52,7 @@ def write_station(folder: Path, toml: str, files: dict[str, str] | None = None) 
     folder.mkdir(parents=True, exist_ok=True)
     (folder / "station.toml").write_text(toml, encoding="utf-8")
     for name, text in (files or {}).items():
+        (folder / name).parent.mkdir(parents=True, exist_ok=True)
         (folder / name).write_text(text, encoding="utf-8")
     return folder
 

@@ -109,6 +109,7 @@ class RemoteJournal:
         self._rows: list[Row] = []  # the day's newest records as last read, newest first
         self._seen: object = None  # the station's count of journal events the rows hold
         self._misses = 0
+        self._switches = client.switches  # the pair's other station keeps a journal of its own
 
     def page(self, day: dt.date, flt: Filter, limit: int, count: bool) -> Page | None:
         """The day's newest page: read whole once, then only what came since its newest record,
@@ -116,9 +117,10 @@ class RemoteJournal:
         record is committed: it is looked for again at the next pages, three times at most)."""
         head = self.client.journal_events
         try:
-            if day != self._day or not self._rows:
+            if day != self._day or not self._rows or self.client.switches != self._switches:
+                switches = self.client.switches
                 self._rows = self.client.journal(day, limit).result(JOURNAL_WAIT_S)
-                self._day, self._seen, self._misses = day, head, 0
+                self._day, self._seen, self._misses, self._switches = day, head, 0, switches
             elif head != self._seen:
                 newest = self._rows[0]
                 new = [r for r in self.client.journal(day, limit, newest.ts).result(JOURNAL_WAIT_S)

@@ -200,6 +200,12 @@ class ConsoleWindow(QMainWindow):
 
     def _tick(self) -> None:
         self.header.tick()
+        where = self.client.where()  # a console of a pair: the station it follows to, and when it did
+        if self.header.title.text() != where:
+            self.header.title.setText(where)
+            self.setWindowTitle(f"NetPlc console — {where}")
+        self.header.title.setToolTip(f"{self.client.url}; {self.client.switched}" if self.client.switched
+                                     else self.client.url)
         role = words.role(self.client.role) if self.client.role else ""
         self.header.user.setText(f"{self.client.user} ({role})" if role else self.client.user)
         self.rights.update()
@@ -224,10 +230,12 @@ class ConsoleWindow(QMainWindow):
         super().closeEvent(event)
 
 
-def open_console(url: str, user: str | None = None, password: str | None = None) -> ConsoleWindow | None:
+def open_console(url: str, user: str | None = None, password: str | None = None,
+                 partner: str = "") -> ConsoleWindow | None:
     """Log in to the station at `url` (the login dialog; trust on first use) and open its console;
-    None when the login was cancelled, Problems when the station refused it."""
-    client = ConsoleClient(url)
+    None when the login was cancelled, Problems when the station refused it. `partner`: the other
+    station of its hot-standby pair, followed to whenever it leads."""
+    client = ConsoleClient(url, partner=partner)
     if not logged_in(client, user, password):
         return None
     if client.files is not None:
@@ -235,13 +243,14 @@ def open_console(url: str, user: str | None = None, password: str | None = None)
     return ConsoleWindow(StationSource(client))
 
 
-def run_console(url: str, user: str | None = None) -> int:
-    """`python main.py console opc.tcp://... [--user NAME]` (with --user and stdin not a terminal,
-    the password is stdin's first line). Exit 2 when the station refused, 1 when cancelled."""
+def run_console(url: str, user: str | None = None, partner: str = "") -> int:
+    """`python main.py console opc.tcp://... [--user NAME] [--partner URL]` (with --user and stdin
+    not a terminal, the password is stdin's first line). Exit 2 when the station refused, 1 when
+    cancelled."""
     app = application()
     password = sys.stdin.readline().rstrip("\r\n") if user and not sys.stdin.isatty() else None
     try:
-        window = open_console(url, user, password)
+        window = open_console(url, user, password, partner)
     except Problems as e:
         print("\n".join(e.problems), file=sys.stderr)
         return 2

@@ -8,6 +8,7 @@ import struct
 import threading
 import time
 from collections.abc import Callable, Iterator
+from dataclasses import replace
 from pathlib import Path
 
 import pytest
@@ -126,6 +127,13 @@ class Station:
 
     def texts(self) -> list[str]:
         return [r.text for r in self.journal if r.text]
+
+
+def serve_opcua(station: Station) -> str:
+    """The station's OPC UA endpoint on a free loopback port (the folder's hash unchanged)."""
+    url = f"opc.tcp://127.0.0.1:{free_port()}/netplc/"
+    station.adjust = lambda st: replace(st, opcua=replace(st.opcua, enabled=True, endpoint=url))
+    return url
 
 
 @pytest.fixture

@@ -6,7 +6,6 @@ Program view given both endpoints follows the primary by itself, through IntoSta
 from __future__ import annotations
 
 import asyncio
-from dataclasses import replace
 from pathlib import Path
 from typing import Any
 
@@ -15,13 +14,7 @@ from asyncua import Client, ua
 from app.authority.users import Users
 from app.publish.client import StationClient
 from netplc.simulator import Simulator
-from tests.app.pair.conftest import Station, free_port, make_pair, wait_for
-
-
-def serve_opcua(station: Station) -> str:
-    url = f"opc.tcp://127.0.0.1:{free_port()}/netplc/"
-    station.adjust = lambda st: replace(st, opcua=replace(st.opcua, enabled=True, endpoint=url))
-    return url
+from tests.app.pair.conftest import make_pair, serve_opcua, wait_for
 
 
 async def redundancy(client: Client) -> dict[str, Any]:
