@@ -4,10 +4,11 @@ banner of a station running elsewhere, with no NetPlc, exchange or archive of it
 Its views are the workstation's own (the form view in its zoom area, the alarm banner, the health
 strip, the journal dock, the header); what differs is where their data comes from: a
 `StationSource` and a `RemoteJournal` (source.py) instead of the in-process runtime's bridge and
-the archive's file, and a `StationSeries` (series.py) behind the trends' history. Everything it does is done by the user logged in at
-the station, through the station's command layer: a form's write is the station's WriteBit or
-WriteWord method, an acknowledgement its Acknowledge; the station checks the role, journals with
-the user's name and answers, and a refusal is said in the status bar naming the role it needs.
+the archive's file, and a `StationSeries` (series.py) behind the trends' history. Everything it
+does is done by the user logged in at the station, through the station's command layer: a form's
+write is the station's WriteBit or WriteWord method, an acknowledgement its Acknowledge; the
+station checks the role, journals with the user's name and answers, and a refusal is said in the
+status bar naming the role it needs.
 Forms come from the station (its Files): a form saved there is shown here at the next poll.
 """
 
