@@ -79,7 +79,7 @@ class TrendHistory(QObject):
         self.loader = source
         source.setParent(self)
         self.loader.answered.connect(self._loaded)
-        self.loader.failed.connect(lambda token, _why: self._asked.pop(token, None))  # logged by the loader
+        self.loader.failed.connect(self._failed)
         self._asked: dict[int, tuple[TrendWidget, bool]] = {}
         self._days: dict[TrendWidget, dt.date] = {}
         self._found: dict[TrendWidget, SeriesKey] = {}
@@ -103,6 +103,13 @@ class TrendHistory(QObject):
             if trend in self._found and self._found[trend] != key:
                 continue
             self._asked[self.loader.read(day, key)] = (trend, raw)
+
+    def _failed(self, token: int, _why: str) -> None:
+        """Logged by the loader; the day is read again when next wanted (a station back, a file
+        readable again)."""
+        asked = self._asked.pop(token, None)
+        if asked is not None:
+            self._days.pop(asked[0], None)
 
     def _loaded(self, token: int, series: Series) -> None:
         key, ts, values = series

@@ -35,7 +35,8 @@ class StationSeries(Worker):
         self.archived = {t.address: t.name for t in tags.tags if t.type in ARCHIVED_TYPES}
 
     def available(self) -> bool:
-        return True  # a station unreachable is answered as a failure, said once in the log
+        """The link up: a trend asked while it is down asks again when the view next wants."""
+        return not self.client.error
 
     def keys(self, model: AnalogBase) -> list[tuple[SeriesKey, bool]]:
         name = self.archived.get(model.InAddr) if model.InAddr is not None else None
