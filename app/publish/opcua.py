@@ -668,11 +668,12 @@ class OpcUaServer:
         iserver.create_session = create_session
         iserver.register_server = _no_registrations  # no session is needed, over any channel
         server.subscribe_server_callback(CallbackType.PostRead, self._user_access_level)
-        server.subscribe_server_callback(CallbackType.PostRead, index_ranges)
 
     def _user_access_level(self, event: ServerItemCallback, _service: object) -> None:
         """A tag's UserAccessLevel and a station method's UserExecutable as the policy answers
-        for the session's user (every user may read a tag and its history), and Station.Role."""
+        for the session's user (every user may read a tag and its history), and Station.Role;
+        a Value read with an IndexRange its part (asyncua keeps one PostRead callback: this one)."""
+        index_ranges(event, _service)
         if not event.is_external:
             return
         may: bool | None = None
