@@ -53,7 +53,7 @@ from app.gui.notice import Note, confirm
 from app.gui.placement import Placement, primary_size
 from app.gui.rights import Rights
 from app.gui.status import StationStatusBar, station_problems
-from app.gui.trend_history import TrendHistory
+from app.gui.trend_history import ArchiveSeries, TrendHistory
 from app.gui.users_dialog import UsersDialog
 from app.gui.zoom import ACTUAL, FIT_WIDTH, FIT_WINDOW, ZoomArea
 from app.scada.alarms import AlarmRow
@@ -251,7 +251,7 @@ class MainWindow(QMainWindow):
         forms, problems = self.runtime.open_forms()  # the views' own models: they only show
         target = EngineTarget(self.commands, lambda user: Who(user, Source.CONSOLE),
                               on_answer=self.answers.follow, say=words.answer)
-        self.history = TrendHistory(station.Archive, self)
+        self.history = TrendHistory(ArchiveSeries(station.Archive), self)
         for form in forms:
             view = FormView(form, target, archive_path=station.Archive, user=self.user,
                             started=self.runtime.started_clock, guard=self._guard,

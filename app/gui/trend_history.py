@@ -1,6 +1,8 @@
-"""Trend history from the archive: at start a trend is filled with what the archive holds of it,
-and scrolling back past its live samples reads the day scrolled to, in the viewer's worker thread
-(app/gui/series_loader.py), so the window never waits for the disk.
+"""Trend history: at start a trend is filled with what the archive holds of it, and scrolling back
+past its live samples reads the day scrolled to, in a worker thread, so the window never waits for
+the disk or the network. The views have one code path; what differs is the `SeriesSource` behind
+it: the station's own archive file (`ArchiveSeries`, app/gui/series_loader.py) at the local
+workstation, the station's Historical Access at a remote console (app/gui/console/series.py).
 
 A trend's series is found by what wrote it: an element with RegData journals its physical value
 under its own name; otherwise an NSTORE of the trend's address (source = the octal address) holds
@@ -11,8 +13,9 @@ from __future__ import annotations
 
 import datetime as dt
 from pathlib import Path
+from typing import Protocol
 
-from PySide6.QtCore import QObject
+from PySide6.QtCore import QObject, SignalInstance
 
 from app.gui.series_loader import Series, SeriesLoader
 from hmi_forms.elements.analog import AnalogBase
@@ -32,13 +35,51 @@ def series_keys(model: AnalogBase) -> list[tuple[SeriesKey, bool]]:
     return keys
 
 
+class SeriesSource(Protocol):
+    """Where a trend's history is read (a Worker: `answered` carries a token and a Series)."""
+
+    answered: SignalInstance
+    failed: SignalInstance
+
+    def available(self) -> bool: ...
+
+    def keys(self, model: AnalogBase) -> list[tuple[SeriesKey, bool]]:
+        """Where the source may hold this trend's series, with whether the values are raw words."""
+        ...
+
+    def read(self, day: dt.date, key: SeriesKey) -> int:
+        """Queue a read of `key` on `day`; the token of its answer."""
+        ...
+
+    def setParent(self, parent: QObject) -> None: ...
+
+    def close(self) -> None: ...
+
+
+class ArchiveSeries(SeriesLoader):
+    """The station's own archive file (the local workstation)."""
+
+    def __init__(self, path: Path) -> None:
+        super().__init__(POINTS)
+        self.path = path
+
+    def available(self) -> bool:
+        return self.path.exists()
+
+    def keys(self, model: AnalogBase) -> list[tuple[SeriesKey, bool]]:
+        return series_keys(model)
+
+    def read(self, day: dt.date, key: SeriesKey) -> int:
+        return self.request(self.path, day, key)
+
+
 class TrendHistory(QObject):
-    def __init__(self, archive: Path, parent: QObject | None = None) -> None:
+    def __init__(self, source: SeriesSource, parent: QObject | None = None) -> None:
         super().__init__(parent)
-        self.archive = archive
-        self.loader = SeriesLoader(POINTS, self)
+        self.loader = source
+        source.setParent(self)
         self.loader.answered.connect(self._loaded)
-        self.loader.failed.connect(lambda token, _why: self._asked.pop(token, None))  # logged by the loader
+        self.loader.failed.connect(self._failed)
         self._asked: dict[int, tuple[TrendWidget, bool]] = {}
         self._days: dict[TrendWidget, dt.date] = {}
         self._found: dict[TrendWidget, SeriesKey] = {}
@@ -54,14 +95,21 @@ class TrendHistory(QObject):
             self._request(trend, dt.date.fromtimestamp(t0))
 
     def _request(self, trend: TrendWidget, day: dt.date) -> None:
-        if self._days.get(trend) == day or not self.archive.exists():
+        if self._days.get(trend) == day or not self.loader.available():
             return
         self._days[trend] = day
         assert isinstance(trend.model, AnalogBase)
-        for key, raw in series_keys(trend.model):
+        for key, raw in self.loader.keys(trend.model):
             if trend in self._found and self._found[trend] != key:
                 continue
-            self._asked[self.loader.request(self.archive, day, key)] = (trend, raw)
+            self._asked[self.loader.read(day, key)] = (trend, raw)
+
+    def _failed(self, token: int, _why: str) -> None:
+        """Logged by the loader; the day is read again when next wanted (a station back, a file
+        readable again)."""
+        asked = self._asked.pop(token, None)
+        if asked is not None:
+            self._days.pop(asked[0], None)
 
     def _loaded(self, token: int, series: Series) -> None:
         key, ts, values = series

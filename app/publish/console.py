@@ -14,7 +14,9 @@ a console adds, all of it standard OPC UA that any client could do the same way:
 - the nodes' links (Nodes.<n>.Up), so the console judges its elements' quality as the station does;
 - the user's role at the station (Station.Role), so a refusal names the role it needed;
 - writes of a form's raw address through the station's WriteBit and WriteWord methods;
-- the journal: the station object's event history (HistoryReadEvents, Part 11), newest first.
+- the journal: the station object's event history (HistoryReadEvents, Part 11), newest first;
+- a trend's history: its tag's raw history (HistoryReadRawModified, Part 11), page after page
+  with the station's continuation points.
 """
 
 from __future__ import annotations
@@ -113,6 +115,11 @@ class ConsoleClient(StationClient):
         reads the few rows after it, not the day's newest page again)."""
         return self._submit(self._journal(day, limit, since))
 
+    def history(self, tag: str, start: dt.datetime, end: dt.datetime) -> Future[list[ua.DataValue]]:
+        """The archived values of the station's tag `tag` from `start` (included) to `end` (not),
+        oldest first, in physical units with the StatusCode of their quality."""
+        return self._submit(self._history(tag, start, end))
+
     def said(self, sent: Ticket, action: Action, what: str, at_least: str | None = None) -> Ticket:
         """The station's answer, a refusal for the role in its parts (the role it needs, the user's)."""
         ticket: Ticket = Ticket()
@@ -172,6 +179,15 @@ class ConsoleClient(StationClient):
         except ua.UaError as e:
             raise ConnectionError(f"{self.url}: {_why(e)}") from None
         return [_record(e) for e in events]
+
+    async def _history(self, tag: str, start: dt.datetime, end: dt.datetime) -> list[ua.DataValue]:
+        client = self._client
+        if client is None:
+            raise ConnectionError(f"not connected: {self.error or 'logging in'}")
+        try:  # asyncua reads on while the station answers a continuation point
+            return await client.get_node(self._node(f"Tags.{tag}")).read_raw_history(start, end, 0, False)
+        except ua.UaError as e:
+            raise ConnectionError(f"{self.url}: {tag}: {_why(e)}") from None
 
     async def _browse(self) -> None:
         client = self._client

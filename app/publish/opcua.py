@@ -66,6 +66,7 @@ from app.publish.conditions import Conditions
 from app.publish.feed import LatestReadings, Watch
 from app.publish.files import StationFiles
 from app.publish.history import JOURNAL, AlarmSource, Archived, Series, StationHistory, install, series_of
+from app.publish.index_range import index_ranges
 from app.publish.methods import StationMethods, StepLock
 from app.publish.pki import TrustList, host_names, station_certificate, subject, thumbprint
 from app.publish.points import PointReader, PointWriter, Writable
@@ -525,8 +526,8 @@ class OpcUaServer:
 
     async def _add_memory(self, plc: Node, idx: int) -> None:
         """NetPlc's memory and forces, read-only, for a remote Program view (`main.py monitor
-        opc.tcp://...`), which needs raw memory, not only tags. asyncua's Read ignores IndexRange:
-        a client reads each whole (20 KB in all)."""
+        opc.tcp://...`), which needs raw memory, not only tags. A Read's IndexRange is answered
+        that part (index_range.py); a client that gives none reads each whole (20 KB in all)."""
         memory = await plc.add_object(ua.NodeId("NetPlc.Memory", idx), ua.QualifiedName("Memory", idx))
         nodes = []
         for parent, name, initial, description in ((memory, "Bits", bytes(IO_BITS), MEMORY_BITS),
@@ -670,7 +671,9 @@ class OpcUaServer:
 
     def _user_access_level(self, event: ServerItemCallback, _service: object) -> None:
         """A tag's UserAccessLevel and a station method's UserExecutable as the policy answers
-        for the session's user (every user may read a tag and its history), and Station.Role."""
+        for the session's user (every user may read a tag and its history), and Station.Role;
+        a Value read with an IndexRange its part (asyncua keeps one PostRead callback: this one)."""
+        index_ranges(event, _service)
         if not event.is_external:
             return
         may: bool | None = None

@@ -5,9 +5,12 @@ console does is the station's command as its user; what it shows is the station'
 
 from __future__ import annotations
 
+import datetime as dt
 import json
+import math
 import subprocess
 import sys
+import time
 from collections.abc import Callable, Iterator
 from pathlib import Path
 
@@ -24,9 +27,11 @@ from app.scada.quality import Quality
 from app.scada.readings import Readings
 from app.station.config import load_station
 from app.station.runtime import Runtime
+from hmi_forms.elements.analog import AnalogBase
 from hmi_forms.elements.base import Writer
 from netplc.records import Record
-from tests.app.conftest import REPO
+from registrar.store import Store
+from tests.app.conftest import REPO, copy_demo
 from tests.app.publish.conftest import demo_with, free_port
 
 WAIT = 30_000  # ms: a loaded CI machine; every wait ends on its event
@@ -225,3 +230,42 @@ def test_the_console_command_wants_an_opc_tcp_url() -> None:
     run = subprocess.run([sys.executable, str(REPO / "main.py"), "console", "http://10.0.0.10/"],
                          capture_output=True, text=True, timeout=60, cwd=REPO)
     assert run.returncode == 2 and run.stderr == "http://10.0.0.10/: not an opc.tcp:// URL\n"
+
+
+@pytest.fixture(scope="module")
+def archived(tmp_path_factory: pytest.TempPathFactory) -> Iterator[tuple[Station, list[float]]]:
+    """A station whose archive holds LEVEL's NSTORE series of the minute before it started: raw
+    words 0, 40, 80, ... (0 %, ~1 %, ~2 % ...), one a gap."""
+    folder = tmp_path_factory.mktemp("archived")
+    station = copy_demo(folder / "st")
+    t = time.time()
+    store = Store(station / "archive" / "journal.sqlite")
+    store.start()
+    times = [t - 60 + 0.5 * k for k in range(100)]
+    for k, ts in enumerate(times):
+        store.put(Record(ts, "data", grp=1, type=1, source="04010", value=None if k == 50 else 40 * k,
+                         text="comm-fail" if k == 50 else None))
+    store.close()
+    st = Station(folder)
+    try:
+        yield st, times
+    finally:
+        st.stop()
+
+
+def test_a_consoles_trend_shows_the_stations_archived_values_of_a_stored_tag(
+        qtbot, archived: tuple[Station, list[float]], attach: Attach) -> None:
+    station, times = archived
+    if dt.date.fromtimestamp(times[0]) != dt.date.today():
+        pytest.skip("the archived minute is of yesterday (a run at midnight)")
+    window = attach(station, "viewer")
+    trend = next(t for view in window.views for t in view.trends  # the analog form's LEVEL graph
+                 if isinstance(t.model, AnalogBase))
+    qtbot.waitUntil(lambda: len(trend.hist_times) >= len(times), timeout=WAIT)
+    shown = dict(zip(trend.hist_times.tolist(), trend.hist_values.tolist()))
+    for k, ts in enumerate(times):
+        value = next(v for s, v in shown.items() if abs(s - ts) < 1e-3)
+        if k == 50:
+            assert math.isnan(value)  # the gap
+        else:
+            assert value == pytest.approx(40 * k * 100 / 4095, abs=0.01)  # LEVEL in %

@@ -4,10 +4,11 @@ banner of a station running elsewhere, with no NetPlc, exchange or archive of it
 Its views are the workstation's own (the form view in its zoom area, the alarm banner, the health
 strip, the journal dock, the header); what differs is where their data comes from: a
 `StationSource` and a `RemoteJournal` (source.py) instead of the in-process runtime's bridge and
-the archive's file. Everything it does is done by the user logged in at
-the station, through the station's command layer: a form's write is the station's WriteBit or
-WriteWord method, an acknowledgement its Acknowledge; the station checks the role, journals with
-the user's name and answers, and a refusal is said in the status bar naming the role it needs.
+the archive's file, and a `StationSeries` (series.py) behind the trends' history. Everything it
+does is done by the user logged in at the station, through the station's command layer: a form's
+write is the station's WriteBit or WriteWord method, an acknowledgement its Acknowledge; the
+station checks the role, journals with the user's name and answers, and a refusal is said in the
+status bar naming the role it needs.
 Forms come from the station (its Files): a form saved there is shown here at the next poll.
 """
 
@@ -31,6 +32,7 @@ from app.gui import i18n, words
 from app.gui.alarm_summary import AlarmSummary
 from app.gui.application import application
 from app.gui.bridge import Answers
+from app.gui.console.series import StationSeries
 from app.gui.console.source import Loaded, RemoteJournal, StationSource
 from app.gui.journal import JournalDock
 from app.gui.main_window import (
@@ -45,6 +47,7 @@ from app.gui.monitor.login import logged_in
 from app.gui.monitor.source import OpcUaSource
 from app.gui.monitor.window import ProgramWindow
 from app.gui.rights import Rights
+from app.gui.trend_history import TrendHistory
 from app.gui.zoom import ZoomArea
 from app.publish.console import ConsoleClient, StationCommands
 from app.scada.alarms import AlarmRow
@@ -100,6 +103,7 @@ class ConsoleWindow(QMainWindow):
         self.commands = StationCommands(client)
         self.rights = Rights(self.commands, lambda: self.who)  # type: ignore[arg-type]
         self.views: list[FormView] = []
+        self.history: TrendHistory | None = None  # of the forms shown
         self.programs: list[ProgramWindow] = []  # the Program views opened from here
         self.unacknowledged: list[AlarmRow] = []
         frame = station_frame(self, client.station or client.url)
@@ -140,6 +144,10 @@ class ConsoleWindow(QMainWindow):
         """The station's forms (again, when its files changed), in place of the ones shown."""
         current = self.tabs.currentIndex()
         self.views = []
+        if self.history is not None:
+            self.history.close()
+            self.history.deleteLater()
+        self.history = TrendHistory(StationSeries(self.client, loaded.tags), self)
         while self.tabs.count():
             page = self.tabs.widget(0)
             self.tabs.removeTab(0)
@@ -147,6 +155,7 @@ class ConsoleWindow(QMainWindow):
         for form in loaded.forms:
             view = FormView(form, self.target, user=self.client.user, guard=self._guard)
             self.views.append(view)
+            self.history.attach(view)
             self.tabs.addTab(ZoomArea(view), form.title)
         if loaded.problems:
             self.tabs.addTab(_problems_page(loaded.problems), self.tr("Form problems"))
@@ -226,6 +235,8 @@ class ConsoleWindow(QMainWindow):
             program.close()
         self.summary.stop()
         self.journal.close_archive()
+        if self.history is not None:
+            self.history.close()
         self.source.stop()
         super().closeEvent(event)
 

@@ -176,3 +176,30 @@ def test_method_arguments_are_described(station: tuple[Runtime, str]) -> None:
     nodeid, args, rank = run(go())
     assert nodeid == ua.NodeId("Station.Force.InputArguments", 1)
     assert [a.Name for a in args] == ["Kind", "Address", "Value"] and rank == ua.ValueRank.OneDimension
+
+
+def test_a_read_with_an_index_range_is_answered_that_part_of_the_memory(station: tuple[Runtime, str]) -> None:
+    """Part 4 7.27: a Read's IndexRange selects a part of an array or ByteString (asyncua's own
+    Read service ignores it); a range past the end is Bad_IndexRangeNoData, a malformed one
+    Bad_IndexRangeInvalid, and a read without one still gets the whole value."""
+    _, url = station
+
+    async def go() -> list[ua.DataValue]:
+        async with Client(url, timeout=30) as client:
+            ns = await client.get_namespace_index(STATION_URI)
+            data, bits = ua.NodeId("NetPlc.Memory.Data", ns), ua.NodeId("NetPlc.Memory.Bits", ns)
+            params = ua.ReadParameters()
+            params.NodesToRead = [ua.ReadValueId(NodeId=node, AttributeId=ua.AttributeIds.Value, IndexRange=r)
+                                  for node, r in ((data, ""), (data, "16:31"), (data, "16383:20000"),
+                                                  (bits, "5"), (data, "20000:20001"), (data, "7:7"),
+                                                  (data, "x"))]
+            return await client.uaclient.read(params)
+
+    whole, part, tail, bit, past, equal, bad = run(go())
+    memory = whole.Value.Value
+    assert len(memory) == 16 * 1024
+    assert part.Value.Value == memory[16:32]  # one Read: one snapshot of the memory
+    assert len(tail.Value.Value) == 1
+    assert len(bit.Value.Value) == 1 and part.SourceTimestamp is not None
+    assert past.StatusCode.value == ua.StatusCodes.BadIndexRangeNoData
+    assert equal.StatusCode.value == bad.StatusCode.value == ua.StatusCodes.BadIndexRangeInvalid
