@@ -3,11 +3,20 @@
 1. The cost: station A runs alone for `--seconds`, then with B (a `main.py --no-gui` child, so
    A's process CPU is A's own) attached as its standby; A's mean scan time (the scan and its
    listeners, the mirror's capture among them) and A's process CPU per second, and their ratios.
-2. Takeovers: A and B in this process on loopback with a simulated node; a writer thread writes
-   an increasing word to whichever is primary, each write waiting for its answer. The primary is
-   killed (no more scans, the link cut with no word) `--kills` times, the killed one restarted as
-   the standby each time. Takeover time (kill to the standby's role primary) p50 and max, and
-   acknowledged writes lost (the new primary's word below the last acknowledged value). With
+2. Takeovers: A and B as processes of their own (`--serve`: the station loaded from its folder,
+   made from tests/app/pair's template, and run as `main.py --no-gui` runs it, its Modbus and
+   OPC UA ports put after loading since two stations on one host cannot share them) polling a
+   simulated node. Two real clients write: a Modbus TCP client (netplc's LeanTcpClient) to
+   register 1024 (word 04000) and an asyncua client logged in as an operator to the tag OPW
+   (word 04002), each the values 1, 2, 3... once each, to whichever station accepts (exception 6
+   / Bad_InvalidState: the standby), keeping the values acknowledged. The primary's process is
+   SIGKILLed `--kills` times, restarted as the standby each time, the next kill once the pair is
+   whole again. Takeover time: the kill to each client's first write acknowledged by the new
+   primary, and to the new primary's journal record of its takeover. Every applied write is a
+   record of the station's journal (value and word): lost = acknowledged and journaled by
+   neither station, or the new primary's word, read before the first write to it, below the last
+   value acknowledged; applied twice = one value journaled twice. The standby's lag (its
+   HSB_LAG byte, read over Modbus) just before each kill. With
    `--plant` both forward to one plant archive (a throwaway PostgreSQL cluster of tests/pgcluster.py):
    at the end, records of the two local archives missing from it, and alarm transitions in it
    twice in a row (the same transition of the same alarm: journaled by the old primary in a last
@@ -19,38 +28,53 @@
 from __future__ import annotations
 
 import argparse
+import asyncio
+import contextlib
 import itertools
+import os
+import signal
+import sqlite3
 import statistics
 import subprocess
 import sys
 import tempfile
 import threading
 import time
+from collections import Counter
+from collections.abc import Callable
+from dataclasses import dataclass, field, replace
 from pathlib import Path
 
 ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT))
 
-from app.authority import Source, Who  # noqa: E402
+from app.authority.users import Users  # noqa: E402
 from app.station.config import load_station  # noqa: E402
+from app.station.pair import HSB_NUM_PLC  # noqa: E402
 from app.station.runtime import Runtime  # noqa: E402
-from netplc.address import IO_BITS  # noqa: E402
+from netplc.modbus import BUSY  # noqa: E402
+from netplc.modbus.client import LeanTcpClient  # noqa: E402
+from netplc.modbus.endpoint import Endpoint  # noqa: E402
+from netplc.modbus.pdu import DeviceError, LinkError  # noqa: E402
 from netplc.program import parse  # noqa: E402
 from netplc.simulator import Simulator  # noqa: E402
+from registrar.schema import DAY_GLOB  # noqa: E402
 from tests.app.pair.conftest import PROGRAM, STATION, free_port  # noqa: E402
 
 TICK_MS = 20
-WHO = Who("", Source.MODBUS, "bench")
+NAME = "pair"  # the station's name (tests/app/pair's template): its OPC UA namespace
 TAGS = """name,address,type,unit,app_min,app_max,phy_min,phy_max,decimals,description,hh,h,l,ll,deadband,\
 on_delay,off_delay,alarm_when,priority,latching,suppress_by,quality_alarm
 GEN,03752,bit,,,,,,,Generator 0.4 s,,,,,,,,1,4,,,
+OPW,04002,word,,0,65535,0,65535,0,The OPC UA writer's word,,,,,,,,,,,,
 """
 
 
 def folders(base: Path, node: int, ports: dict[str, int], plant: str = "") -> dict[str, Path]:
     out = {}
     # forwarding: the alarm of the 0.4 s generator's bit, journaled by the primary at every change
-    top = f'Archive = "{plant}"\nTags = "tags.csv"\n' if plant else ""
+    # and the OPC UA writer's tag
+    top = (f'Archive = "{plant}"\n' if plant else "") + 'Tags = "tags.csv"\n'
     for letter, other in (("A", "B"), ("B", "A")):
         folder = base / letter
         folder.mkdir(parents=True)
@@ -112,74 +136,272 @@ def cost(base: Path, node: Simulator, seconds: float) -> None:
           f"(x{paired[1] / max(alone[1], 1e-9):.2f})")
 
 
+MODBUS_WORD, OPCUA_WORD = 0o4000, 0o4002  # each writer's own word (register 1024, the tag OPW)
+HSB_LAG_REGISTER = 0o77716 // 2  # the standby's lag in scans, the low byte (little-endian word)
+
+
+def serve(folder: Path, modbus_port: int, opcua_url: str) -> None:
+    """A station of the pair as a process of its own, until SIGTERM (or SIGKILL). The station's
+    Modbus and OPC UA ports are put after loading (as tests/app/pair does): two stations on one
+    host cannot listen on the same ports, and station.toml's ports count in the hash the pair
+    compares (on two hosts both folders would be the same file)."""
+    station = load_station(folder)
+    station = replace(station, modbus_server=replace(station.modbus_server, port=modbus_port),
+                      opcua=replace(station.opcua, enabled=True, endpoint=opcua_url, writable=("OPW",)))
+    runtime = Runtime(station)
+    done = threading.Event()
+    signal.signal(signal.SIGTERM, lambda _signum, _frame: done.set())
+    runtime.start()
+    try:
+        done.wait()
+    finally:
+        runtime.stop()
+
+
+@dataclass
+class Writer:
+    """A client writing 1, 2, 3... to its own word of whichever station answers writes; each
+    value is tried once (an unanswered one is not sent again: a retry would be the client's
+    double). `acked`: (value, station index, monotonic time of the answer). `behind`: takeovers
+    where the new primary's word, read before the first write to it, was below the last value
+    acknowledged (an acknowledged write lost with the old primary)."""
+
+    name: str
+    acked: list[tuple[int, int, float]] = field(default_factory=list)
+    behind: int = 0
+    errors: int = 0
+
+    def last(self) -> int:
+        return self.acked[-1][0] if self.acked else 0
+
+
+async def modbus_writer(w: Writer, ports: list[int], stop: threading.Event) -> None:
+    clients = [LeanTcpClient(Endpoint("tcp", "127.0.0.1", p), timeout=1.0) for p in ports]
+    at, value, checked = 0, 0, -1
+    register = MODBUS_WORD // 2
+    while not stop.is_set():
+        client = clients[at]
+        try:
+            if not client.connected:
+                await client.connect()
+            if checked != at:  # the first write to this station: has it the last acknowledged value?
+                (word,) = await client.read(1, "holding", register, 1)
+            value += 1
+            await client.write(1, "holding", register, [value])
+        except DeviceError as e:  # 6: the standby (or busy): the other answers writes
+            if e.code != BUSY:
+                raise
+            at = 1 - at
+            await asyncio.sleep(0.002)
+            continue
+        except LinkError:  # killed (or not up yet): the other one
+            client.close()
+            at = 1 - at
+            await asyncio.sleep(0.002)
+            continue
+        if checked != at:
+            w.behind += word < w.last()
+            checked = at
+        w.acked.append((value, at, time.monotonic()))
+    for client in clients:
+        client.close()
+
+
+async def opcua_writer(w: Writer, urls: list[str], stop: threading.Event) -> None:
+    """Logged in as an operator to both stations (a client of a Hot pair keeps a session to
+    each, Part 4 6.6.2), writing to the one that accepts; Bad_InvalidState: the standby."""
+    from asyncua import Client, ua
+
+    errors = (OSError, TimeoutError, ConnectionError, ua.UaError)
+    clients: list[Client | None] = [None, None]
+
+    async def drop(i: int) -> None:
+        client, clients[i] = clients[i], None
+        if client is not None:
+            with contextlib.suppress(*errors):
+                await asyncio.wait_for(client.disconnect(), 1)
+
+    async def session(i: int) -> Client:
+        client = clients[i]
+        if client is None:
+            client = Client(urls[i], timeout=2)
+            client.set_user("op1")
+            client.set_password("op1")
+            await client.connect()
+            clients[i] = client
+        return client
+
+    at, value, checked = 0, 0, -1
+    while not stop.is_set():
+        if clients[1 - at] is None:  # the partner's session, ready for a takeover
+            try:
+                await session(1 - at)
+            except errors:
+                await drop(1 - at)
+        try:
+            client = await session(at)
+            ns = await client.get_namespace_index(f"urn:netplc:station:{NAME}")
+            node = client.get_node(ua.NodeId("Tags.OPW", ns))
+            word = await node.read_value()
+            kind = (await node.read_data_value()).Value.VariantType
+            until = time.monotonic() + 1  # then back to see to the partner's session
+            while not stop.is_set() and time.monotonic() < until:
+                value += 1
+                await node.write_value(ua.DataValue(ua.Variant(value, kind)))
+                if checked != at:
+                    w.behind += word < w.last()
+                    checked = at
+                w.acked.append((value, at, time.monotonic()))
+        except ua.uaerrors.BadInvalidState:  # the standby
+            at = 1 - at
+            await asyncio.sleep(0.002)
+        except errors:  # killed, or not up yet
+            w.errors += 1
+            await drop(at)
+            at = 1 - at
+            await asyncio.sleep(0.002)
+    for i in (0, 1):
+        await drop(i)
+
+
+def hsb(port: int) -> tuple[int, bool, int] | None:
+    """The station's HSBStatus (4 standby, 5 primary), whether its pair link is up, and its lag
+    in scans, read over Modbus (registers 16356-16359: the words 077710-077716); None: no answer."""
+    async def read() -> list[int]:
+        client = LeanTcpClient(Endpoint("tcp", "127.0.0.1", port), timeout=1.0)
+        await client.connect()
+        try:
+            return await client.read(1, "holding", HSB_NUM_PLC // 2, 4)
+        finally:
+            client.close()
+
+    try:
+        words = asyncio.run(read())
+    except (LinkError, DeviceError):
+        return None
+    return words[0] >> 8, not words[1] & 1 << 9, words[3] & 0xFF
+
+
+def wait_until(condition: Callable[[], object], timeout: float, what: str) -> None:
+    deadline = time.monotonic() + timeout
+    while not condition():
+        if time.monotonic() > deadline:
+            raise SystemExit(f"not within {timeout} s: {what}")
+        time.sleep(0.01)
+
+
+def applied(folder: Path, since_ms: int) -> dict[int, Counter[int]]:
+    """The writes each word's journal says were applied, from the station's local archive: by
+    word, how many times each value was written (a write applied twice is counted twice)."""
+    out: dict[int, Counter[int]] = {MODBUS_WORD: Counter(), OPCUA_WORD: Counter()}
+    con = sqlite3.connect(load_station(folder).Archive)
+    try:
+        for (name,) in con.execute("SELECT name FROM sqlite_master WHERE type = 'table' AND name GLOB ?",
+                                   (DAY_GLOB,)):
+            for number, value in con.execute(
+                    f"SELECT number, value FROM \"{name}\" WHERE kind = 'operator' AND ts >= ? AND "
+                    "text LIKE 'write %' AND number IN (?, ?)", (since_ms, MODBUS_WORD, OPCUA_WORD)):
+                out[number][int(value)] += 1
+    finally:
+        con.close()
+    return out
+
+
+def takeovers(folder: Path) -> list[int]:
+    """ts (ms) of the station's journal records of its takeovers (standby -> primary)."""
+    con = sqlite3.connect(load_station(folder).Archive)
+    try:
+        return [ts for (name,) in con.execute(
+                    "SELECT name FROM sqlite_master WHERE type = 'table' AND name GLOB ?", (DAY_GLOB,))
+                for (ts,) in con.execute(f"SELECT ts FROM \"{name}\" WHERE text LIKE '%standby -> primary%'")]
+    finally:
+        con.close()
+
+
 def kills(base: Path, node: Simulator, n: int, plant: str = "") -> None:
     ports = {"A": free_port(), "B": free_port()}
     paths = folders(base / "kills", node.port, ports, plant)
-    rts = {letter: Runtime(load_station(paths[letter])) for letter in "AB"}
-    rts["A"].start()
-    rts["B"].start()
-    acked: dict[int, int] = {}  # the last value each runtime acknowledged, by its id
+    modbus = [free_port(), free_port()]
+    urls = [f"opc.tcp://127.0.0.1:{free_port()}/netplc/" for _ in "AB"]
+    for folder in paths.values():
+        Users(folder).add("op1", "operator", "op1")
+    procs: dict[int, subprocess.Popen[bytes]] = {}
+
+    def start(i: int) -> None:
+        procs[i] = subprocess.Popen(
+            [sys.executable, __file__, "--serve", str(paths["AB"[i]]), "--modbus-port", str(modbus[i]),
+             "--opcua", urls[i]], cwd=ROOT, stdout=subprocess.DEVNULL)
+
+    def role(i: int) -> int | None:
+        status = hsb(modbus[i])
+        return None if status is None else status[0]
+
+    since = int(time.time() * 1000)
+    start(0)
+    wait_until(lambda: role(0) == 5, 60, "A the primary")
+    start(1)
+    writers = [Writer("Modbus"), Writer("OPC UA")]
     stop = threading.Event()
-
-    def primary() -> Runtime | None:
-        return next((rt for rt in rts.values() if rt.pair is not None and rt.pair.role == "primary"), None)
-
-    def writer() -> None:
-        value = 0
-        while not stop.is_set():
-            rt = primary()
-            if rt is None or rt.commands is None:
-                time.sleep(0.005)
-                continue
-            value = (value + 1) & 0xFFFF
-            try:
-                if rt.commands.write_word(WHO, 0o4000, value).result(1).ok:
-                    acked[id(rt)] = value
-            except TimeoutError:  # asked of a station killed before it applied it: not acknowledged
-                continue
-
-    thread = threading.Thread(target=writer, daemon=True)
-    thread.start()
-    took: list[float] = []
+    threads = [threading.Thread(target=asyncio.run, args=(modbus_writer(writers[0], modbus, stop),)),
+               threading.Thread(target=asyncio.run, args=(opcua_writer(writers[1], urls, stop),))]
+    took: dict[str, list[float]] = {"Modbus": [], "OPC UA": [], "journal": []}
     lag: list[int] = []
-    lost = 0
+    killings: list[tuple[float, str]] = []  # the wall time of each kill, the letter taking over
     try:
+        for t in threads:
+            t.start()
         for _ in range(n):
-            time.sleep(0.3)
-            dead = primary()
-            assert dead is not None
-            letter = dead.station.redundancy.letter  # type: ignore[union-attr]
-            other = rts["B" if letter == "A" else "A"]
-            assert dead.scan_thread is not None and dead.pair is not None
-            dead.scan_thread.stop()
-            dead.scan_thread = None
-            pair, dead.pair = dead.pair, None
-            killed = time.monotonic()
-            pair.kill()
-            while other.pair is None or other.pair.role != "primary":
-                time.sleep(0.001)
-            took.append(time.monotonic() - killed)
-            dead.stop()  # its last commits answer the writes of its last scans
-            last = acked.get(id(dead), 0)
-            lag.append(other.pair.status().lag)
-            image = other.pair.mirror.image  # the state the new primary led from
-            if image[IO_BITS] | image[IO_BITS + 1] << 8 < last:
-                lost += 1
-            rts[letter] = Runtime(load_station(paths[letter]))
-            rts[letter].start()
-            back = rts[letter].pair
-            while back is None or back.role != "standby" or not back.mirror.complete:
-                time.sleep(0.005)  # the next kill once the pair is whole again
+            # the pair whole: the standby hears the primary, both writers acknowledged on the primary
+            wait_until(lambda: 5 in (role(0), role(1)), 60, "a primary")
+            at = 0 if role(0) == 5 else 1
+            standby = modbus[1 - at]
+            wait_until(lambda: (s := hsb(standby)) is not None and s[0] == 4 and s[1], 60,  # noqa: B023
+                       "the pair whole")
+            time.sleep(0.5)
+            wait_until(lambda: all(w.acked and w.acked[-1][1] == at for w in writers), 60,  # noqa: B023
+                       "both writers on the primary")
+            status = hsb(modbus[1 - at])
+            lag.append(status[2] if status is not None else -1)
+            procs[at].send_signal(signal.SIGKILL)
+            killed, killed_wall = time.monotonic(), time.time()
+            procs[at].wait()
+            for w in writers:
+                wait_until(lambda w=w, dead=at: w.acked[-1][1] != dead, 60,
+                           f"{w.name} writes to the new primary")
+                took[w.name].append(next(t for _v, i, t in w.acked if i != at and t > killed) - killed)
+            killings.append((killed_wall, "AB"[1 - at]))
+            start(at)  # the old primary back, as the standby
     finally:
         stop.set()
-        thread.join(5)
-        for rt in rts.values():
-            rt.stop()
+        for t in threads:
+            t.join(30)
+        for p in procs.values():
+            p.terminate()
+            p.wait(30)
+    counts = [applied(paths[letter], since) for letter in "AB"]
+    led = 0  # kills after which the survivor journaled no takeover: it led already (a takeover of its
+    for killed_wall, letter in killings:  # own while the primary stalled, between the check and the kill)
+        after = [ts / 1000 - killed_wall for ts in takeovers(paths[letter]) if ts >= killed_wall * 1000 - 1]
+        if after and min(after) < 10:
+            took["journal"].append(min(after))
+        else:
+            led += 1
     failover = 3 * TICK_MS
-    print(f"{n} kills at NetSyncTime {TICK_MS} ms (failover_after 3 = {failover} ms): takeover "
-          f"p50 {statistics.median(took) * 1000:.0f} ms, max {max(took) * 1000:.0f} ms; "
-          f"kills with an acknowledged write lost: {lost}; the standby's lag at the takeover: "
-          f"max {max(lag)} scans")
+    print(f"{n} SIGKILLs of the primary process at NetSyncTime {TICK_MS} ms (failover_after 3 = "
+          f"{failover} ms), load average {os.getloadavg()[0]:.1f}:")
+    for what, times in took.items():
+        ms = [t * 1000 for t in times]
+        until = "the journal record" if what == "journal" else f"the first {what} write acknowledged"
+        print(f"  takeover, kill to {until}: p50 {statistics.median(ms):.0f} ms, max {max(ms):.0f} ms")
+    for w, word in zip(writers, (MODBUS_WORD, OPCUA_WORD), strict=True):
+        times = counts[0][word] + counts[1][word]
+        values = [v for v, _i, _t in w.acked]
+        lost = sum(1 for v in values if not times[v])
+        twice = sum(1 for c in times.values() if c > 1)
+        print(f"  {w.name}: {len(values)} writes acknowledged, lost {lost} (+ {w.behind} takeovers with the "
+              f"new primary's word below the last acknowledged), applied twice {twice}")
+    print(f"  the standby's lag at the kill: max {max(lag)} scans; kills with no takeover journaled by "
+          f"the survivor (it had taken over already): {led}")
     if plant:
         missing, doubled, total = plant_check(plant, paths)
         print(f"plant archive: {total} records of the pair, {missing} of the local archives missing, "
@@ -214,7 +436,13 @@ def main() -> None:
     p.add_argument("--seconds", type=float, default=5.0)
     p.add_argument("--kills", type=int, default=20)
     p.add_argument("--plant", action="store_true", help="forward to a throwaway PostgreSQL cluster")
+    p.add_argument("--serve", type=Path, help=argparse.SUPPRESS)  # a station of the pair (a child)
+    p.add_argument("--modbus-port", type=int, help=argparse.SUPPRESS)
+    p.add_argument("--opcua", help=argparse.SUPPRESS)
     args = p.parse_args()
+    if args.serve is not None:
+        serve(args.serve, args.modbus_port, args.opcua)
+        return
     node = Simulator(parse("JMP 0\n", "node.stl"), tick=TICK_MS / 1000)
     node.start()
     cluster = None
