@@ -329,7 +329,7 @@ class Runtime:
         self.alarms = StationAlarms(st.Tags, self.program, list(self.catalog), self,
                                     st.Archive.with_name(ALARM_STATE_FILE), self.symbols, regdata,
                                     self._no_standby if st.redundancy is not None else None,
-                                    horn=st.alarm_horn)
+                                    horn=st.alarm_horn, language=st.Language)
         self.subscribe(self.alarms.observe)
         self.alarms.attach(self.engine, self.exchange)
         self.commands = Commands(self.engine, self, role_of=self.role_of, tags=self.alarms.table.tags,

@@ -1,0 +1,88 @@
+"""The words of the Qt-free layers in the station's `Language`: alarm texts, their transitions,
+why NetPlc is not running. These layers cannot use Qt's tr(), and their texts are built once, on
+the engine thread, then travel as they are to the journal, OPC UA, MQTT and every console; so they
+are built in the station's language from this catalogue, never translated after. Alarm identities
+(LEVEL.HH) and journal kinds are keys, not prose, and stay as they are."""
+
+from __future__ import annotations
+
+import os
+from dataclasses import dataclass
+
+TEXTS: dict[str, dict[str, str]] = {
+    "en": {
+        "HH": "high-high", "H": "high", "L": "low", "LL": "low-low",
+        "limit": "{label}: {word} ({key} {limit})",
+        "bad quality": "{label}: bad quality",
+        "not running": "NetPlc is not running",
+        "no standby": "No standby: the pair runs on one station",
+        "normal": "normal", "active-unacknowledged": "active-unacknowledged",
+        "active-acknowledged": "active-acknowledged", "returned-unacknowledged": "returned-unacknowledged",
+        "shelved": "shelved", "suppressed": "suppressed", "out-of-service": "out-of-service",
+        "not a number": "not a number", "raw": "raw", "by": "by {user}",
+        "acknowledged": "acknowledged", "reset": "reset", "comment": "comment: {text}",
+        "unshelved": "unshelved", "suppressed by design": "suppressed by design",
+        "suppression ended": "suppression ended", "shelving ran out": "shelving by {user} ran out",
+        "one-shot ended": "one-shot shelving by {user} ended: returned to normal",
+        "shelved once": "shelved once, until it returns to normal (at most until {stamp})",
+        "shelved for": "shelved for {duration:g} s until {stamp}",
+        "taken out of service": "taken out of service", "returned to service": "returned to service",
+        "halted": "halted by HLT",
+        "emergency stop": "emergency stop by bit {bit} (code {code})",
+        "stopped by": "stopped by {user} (code 0)",
+        "stopped": "stopped by the operator or the watchdog (code 0)",
+    },
+    "ru": {
+        "HH": "верхний аварийный", "H": "верхний предупредительный", "L": "нижний предупредительный",
+        "LL": "нижний аварийный",
+        "limit": "{label}: {word} ({key} {limit})",
+        "bad quality": "{label}: недостоверное значение",
+        "not running": "NetPlc не работает",
+        "no standby": "Нет резерва: пара работает на одной станции",
+        "normal": "норма", "active-unacknowledged": "активна, не квитирована",
+        "active-acknowledged": "активна, квитирована", "returned-unacknowledged": "ушла, не квитирована",
+        "shelved": "отложена", "suppressed": "подавлена", "out-of-service": "выведена из работы",
+        "not a number": "не число", "raw": "код", "by": "оператор {user}",
+        "acknowledged": "квитирована", "reset": "сброшена", "comment": "комментарий: {text}",
+        "unshelved": "возвращена из отложенных", "suppressed by design": "подавлена по проекту",
+        "suppression ended": "подавление снято", "shelving ran out": "срок откладывания ({user}) истёк",
+        "one-shot ended": "разовое откладывание ({user}) окончено: вернулась в норму",
+        "shelved once": "отложена до возврата в норму (не дольше чем до {stamp})",
+        "shelved for": "отложена на {duration:g} с до {stamp}",
+        "taken out of service": "выведена из работы", "returned to service": "введена в работу",
+        "halted": "остановлена командой HLT",
+        "emergency stop": "аварийный останов битом {bit} (код {code})",
+        "stopped by": "остановлена: {user} (код 0)",
+        "stopped": "остановлена оператором или сторожевым таймером (код 0)",
+    },
+}
+STAMPS = {"en": "%Y-%m-%d %H:%M:%S", "ru": "%d.%m.%Y %H:%M:%S"}  # the console's date formats
+
+
+def system_language() -> str:
+    """The language of the system locale, as the console's own default (app/gui/i18n) chooses it."""
+    for name in ("LC_ALL", "LC_MESSAGES", "LANG"):
+        value = os.environ.get(name, "")
+        if value:
+            return "ru" if value.lower().startswith("ru") else "en"
+    return "en"
+
+
+@dataclass(frozen=True)
+class Words:
+    """The catalogue of one language: `words("limit", label=..., ...)` is its text, filled in."""
+
+    language: str
+
+    def __call__(self, name: str, /, **values: object) -> str:
+        return TEXTS[self.language][name].format(**values)
+
+    @property
+    def stamp(self) -> str:
+        """The strftime format of a date and time in this language."""
+        return STAMPS[self.language]
+
+
+def words(language: str = "") -> Words:
+    """The station's `Language` ("" follows the system locale)."""
+    return Words(language if language in TEXTS else system_language())
