@@ -9,6 +9,8 @@ from __future__ import annotations
 import os
 from dataclasses import dataclass
 
+from hmi_forms.elements.formats import DATES, TIME
+
 TEXTS: dict[str, dict[str, str]] = {
     "en": {
         "HH": "high-high", "H": "high", "L": "low", "LL": "low-low",
@@ -56,7 +58,6 @@ TEXTS: dict[str, dict[str, str]] = {
         "stopped": "остановлена оператором или сторожевым таймером (код 0)",
     },
 }
-STAMPS = {"en": "%Y-%m-%d %H:%M:%S", "ru": "%d.%m.%Y %H:%M:%S"}  # the console's date formats
 
 
 def system_language() -> str:
@@ -80,7 +81,7 @@ class Words:
     @property
     def stamp(self) -> str:
         """The strftime format of a date and time in this language."""
-        return STAMPS[self.language]
+        return f"{DATES[self.language]} {TIME}"
 
 
 def words(language: str = "") -> Words:
