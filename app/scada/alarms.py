@@ -440,8 +440,8 @@ class AlarmSystem:
         for i in self._suppressible:
             on = bool(snapshot.get_hmi_bit(self.defs[i].suppress_by or 0))
             if on != self.alarms[i].suppressed:
-                self._overlay(i, now, out, None, self.say("suppressed by design" if on else "suppression ended"),
-                              suppressed=on)
+                note = self.say("suppressed by design" if on else "suppression ended")
+                self._overlay(i, now, out, None, note, suppressed=on)
         for i in sorted(self._shelved):
             a = self.alarms[i]
             if a.shelved_until is not None and now >= a.shelved_until:
@@ -526,7 +526,9 @@ class AlarmSystem:
         if phy is not None and raw is not None:
             tag = self.tags[t]
             shown = tag.format(phy) if not math.isnan(phy) else say("not a number")
-            text += f"; {tag.name} = {shown}" + (f" ({say('raw')} {raw:g})" if tag.scaling is not None else "")
+            text += f"; {tag.name} = {shown}"
+            if tag.scaling is not None:
+                text += f" ({say('raw')} {raw:g})"
         if note:
             text += f"; {note}"
         if user:

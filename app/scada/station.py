@@ -125,7 +125,8 @@ class StationAlarms:
             self.sink.put(record)
         messages, self._messages = self._messages, []
         self.system.evaluate(snapshot, snapshot.wall, self.quality, messages,
-                             "" if running else stop_reason(snapshot.state, self._stopped_by, self.system.say),
+                             "" if running else stop_reason(snapshot.state, self._stopped_by,
+                                                                   self.system.say),
                              self.no_standby())
         if self._dirty and snapshot.time - self._published >= PUBLISH_EVERY:
             self._publish(snapshot.time)

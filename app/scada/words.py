@@ -1,8 +1,9 @@
 """The words of the Qt-free layers in the station's `Language`: alarm texts, their transitions,
-why NetPlc is not running. These layers cannot use Qt's tr(), and their texts are built once, on
-the engine thread, then travel as they are to the journal, OPC UA, MQTT and every console; so they
-are built in the station's language from this catalogue, never translated after. Alarm identities
-(LEVEL.HH) and journal kinds are keys, not prose, and stay as they are."""
+why NetPlc is not running, the station's 'system' records. These layers cannot use Qt's tr(),
+and their texts are built once, on the engine thread, then travel as they are to the journal,
+OPC UA, MQTT and every console; so they are built in the station's language from this
+catalogue, never translated after. Alarm identities (LEVEL.HH) and journal kinds are keys, not
+prose, and stay as they are. The log stays English (ENGLISH), for whoever supports the station."""
 
 from __future__ import annotations
 
@@ -33,6 +34,20 @@ TEXTS: dict[str, dict[str, str]] = {
         "emergency stop": "emergency stop by bit {bit} (code {code})",
         "stopped by": "stopped by {user} (code 0)",
         "stopped": "stopped by the operator or the watchdog (code 0)",
+        # the station's 'system' records (app/station/runtime.py)
+        "cannot start": "station cannot start: {problem}",
+        "starting": "station starting: {path}",
+        "form not loaded": "form not loaded: {problem}",
+        "forms loaded": "forms loaded: {forms}, of their elements {elements} act on the station (sync "
+                        "generators, RegData/RegMessages), with or without a window",
+        "program loaded": "program loaded: {source} ({instrs} instructions, {words} words)",
+        "started": "station started: NetSyncTime {sync} ms, retentive memory from {restored}",
+        "forces restored": "{n} retained forces restored from {file} (RetainForces = true)",
+        "forces not saved": "retained forces not saved: {file}: {error}",
+        "stays down": "{text}; the node stays down until it does",
+        "station stopped": "station stopped",
+        "node answers": "simulated node {node} answers again",
+        "node silent": "simulated node {node} stopped answering",
     },
     "ru": {
         "HH": "верхний аварийный", "H": "верхний предупредительный", "L": "нижний предупредительный",
@@ -56,6 +71,19 @@ TEXTS: dict[str, dict[str, str]] = {
         "emergency stop": "аварийный останов битом {bit} (код {code})",
         "stopped by": "остановлена: {user} (код 0)",
         "stopped": "остановлена оператором или сторожевым таймером (код 0)",
+        "cannot start": "станция не может запуститься: {problem}",
+        "starting": "станция запускается: {path}",
+        "form not loaded": "мнемосхема не загружена: {problem}",
+        "forms loaded": "мнемосхемы загружены: {forms}, из их элементов {elements} действуют на станции "
+                        "(генераторы синхронизации, RegData/RegMessages), с окном и без",
+        "program loaded": "программа загружена: {source} (инструкций: {instrs}, слов: {words})",
+        "started": "станция запущена: NetSyncTime {sync} мс, сохраняемая память из {restored}",
+        "forces restored": "восстановлено сохранённых фиксаций: {n}, из {file} (RetainForces = true)",
+        "forces not saved": "сохранённые фиксации не записаны: {file}: {error}",
+        "stays down": "{text}; узел считается отключённым, пока имя не разрешится",
+        "station stopped": "станция остановлена",
+        "node answers": "имитируемый узел {node} снова отвечает",
+        "node silent": "имитируемый узел {node} перестал отвечать",
     },
 }
 
@@ -87,3 +115,6 @@ class Words:
 def words(language: str = "") -> Words:
     """The station's `Language` ("" follows the system locale)."""
     return Words(language if language in TEXTS else system_language())
+
+
+ENGLISH = Words("en")  # of the log, read by whoever supports the station

@@ -25,7 +25,8 @@ T0 = 1_800_000_000.0
 def english_words() -> set[str]:
     """The catalogue's English words that its Russian texts do not share (NetPlc, HLT, HH...)."""
     def of(table: dict[str, str]) -> set[str]:
-        return {w for text in table.values() for w in re.findall(r"[A-Za-z]{2,}", re.sub(r"\{[^}]*\}", "", text))}
+        bare = (re.sub(r"\{[^}]*\}", "", text) for text in table.values())
+        return {w for text in bare for w in re.findall(r"[A-Za-z]{2,}", text)}
     return of(TEXTS["en"]) - of(TEXTS["ru"])
 
 
