@@ -10,8 +10,6 @@ from __future__ import annotations
 import os
 from dataclasses import dataclass
 
-from hmi_forms.elements.formats import DATES, TIME
-
 TEXTS: dict[str, dict[str, str]] = {
     "en": {
         "HH": "high-high", "H": "high", "L": "low", "LL": "low-low",
@@ -108,7 +106,10 @@ class Words:
 
     @property
     def stamp(self) -> str:
-        """The strftime format of a date and time in this language."""
+        """The strftime format of a date and time in this language, the console's (imported when
+        asked: a headless station loads no form code, tests/test_boundaries.py)."""
+        from hmi_forms.elements.formats import DATES, TIME
+
         return f"{DATES[self.language]} {TIME}"
 
 
