@@ -20,14 +20,17 @@ from pathlib import Path
 import numpy as np
 from PySide6.QtCore import QObject
 
+from app.scada.words import TEXTS, Words
 from hmi_forms.widgets.worker import Worker
 from registrar.query import Archive, SeriesKey
 from registrar.reading import ArchiveError, Filter
 
 Series = tuple[SeriesKey, np.ndarray, np.ndarray]  # key, times (s), values
 Window = tuple[float, float]  # [since, until): seconds since the epoch
-# the record each start of a station writes (app/station/runtime.py): a series breaks there
-RESTARTS = Filter(kinds=frozenset({"system"}), source="station", text="station starting")
+# the record each start of a station writes (app/station/runtime.py), in any of its languages (the
+# station's `Language` may have changed within a day): a series breaks there
+RESTARTS = tuple(Filter(kinds=frozenset({"system"}), source="station",
+                        text=Words(language)("starting", path="")) for language in TEXTS)
 MAX_RESTARTS = 1000  # of one day
 DAY_S = 86_400
 MAX_ZOOM = 50  # a window narrower than a 50th of the day reads no more than 50 times the points
@@ -73,9 +76,11 @@ class SeriesLoader(Worker):
     def _load(self, path: str | Path, day: dt.date, key: SeriesKey, window: Window | None) -> Series:
         """`path`: a file, or a plant archive's URL (kept a str: Path would fold its //)."""
         of_station = {"station": key.station} if key.station is not None else {}
-        restarts = RESTARTS if key.station is None else replace(RESTARTS, stations=frozenset({key.station}))
+        restarts = RESTARTS if key.station is None else \
+            tuple(replace(r, stations=frozenset({key.station})) for r in RESTARTS)
         with Archive(path) as archive:
             ts, values = archive.series(day, grp=key.grp, type=key.type, source=key.source,
                                         points=self.points_for(window), **of_station)
-            starts = [r.ts for r in archive.records(day, restarts, 0, MAX_RESTARTS, newest_first=False)]
+            starts = sorted(r.ts for f in restarts
+                            for r in archive.records(day, f, 0, MAX_RESTARTS, newest_first=False))
         return key, *cut(ts, values, window, starts)

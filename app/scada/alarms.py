@@ -45,6 +45,7 @@ from typing import Any, Protocol
 from app.scada.quality import code_flags
 from app.scada.table import TagTable
 from app.scada.tag import Tag, TagReader
+from app.scada.words import Words, words
 from netplc.lazy import lazy
 from netplc.memory import MemoryView
 from netplc.records import NullSink, Record, RecordSink
@@ -53,7 +54,6 @@ np = lazy("numpy")  # loaded at first use: only a station with tags or forms nee
 
 PRIORITIES = {1: "critical", 2: "high", 3: "medium", 4: "low"}
 MESSAGE_PRIORITY = {3: 1, 2: 2}  # NMSG type 3 critical -> priority 1, type 2 alarm -> priority 2
-LIMIT_WORDS = {"HH": "high-high", "H": "high", "L": "low", "LL": "low-low"}
 # NetPlc not running: the plant goes uncontrolled by the program and every value is frozen, so the
 # operator must know at once (high: it sounds), deliberate stop or not.
 STOPPED_ID, STOPPED_PRIORITY = "NETPLC.STOPPED", 2
@@ -226,9 +226,10 @@ class Transition:
 
 
 def alarm_defs(table: TagTable, messages: Iterable[CatalogMessage] = (),
-               station: bool = False, pair: bool = False) -> list[AlarmDef]:
+               station: bool = False, pair: bool = False, say: Words | None = None) -> list[AlarmDef]:
     """Every alarm of the tags and of the catalog's alarm and critical messages; with `station`,
-    NetPlc's own NETPLC.STOPPED too, with `pair` PAIR.NO_STANDBY."""
+    NetPlc's own NETPLC.STOPPED too, with `pair` PAIR.NO_STANDBY; texts in the language of `say`."""
+    say = say or words()
     out: list[AlarmDef] = []
     for tag in table.tags:
         spec = table.alarms.get(tag.name)
@@ -239,23 +240,23 @@ def alarm_defs(table: TagTable, messages: Iterable[CatalogMessage] = (),
                   "on_delay": spec.on_delay, "off_delay": spec.off_delay, "latching": spec.latching,
                   "suppress_by": spec.suppress_by}
         for key, limit in spec.limits():
-            text = f"{label}: {LIMIT_WORDS[key]} ({key} {tag.format(limit)})"
+            text = say("limit", label=label, word=say(key), key=key, limit=tag.format(limit))
             out.append(AlarmDef(f"{tag.name}.{key}", Source.LIMIT, text, limit=limit,
                                 high=key in ("HH", "H"), **common))
         if spec.alarm_when is not None:
             out.append(AlarmDef(f"{tag.name}.ALARM", Source.DISCRETE, f"{label} = {spec.alarm_when}",
                                 when=spec.alarm_when, **common))
         if spec.quality_alarm:
-            out.append(AlarmDef(f"{tag.name}.BAD", Source.QUALITY, f"{label}: bad quality",
+            out.append(AlarmDef(f"{tag.name}.BAD", Source.QUALITY, say("bad quality", label=label),
                                 spec.priority, tag=tag.name))
     for m in messages:
         if m.type in MESSAGE_PRIORITY:
             out.append(AlarmDef(f"MSG{m.number}", Source.MESSAGE, m.text, MESSAGE_PRIORITY[m.type],
                                 number=m.number))
     if station:
-        out.append(AlarmDef(STOPPED_ID, Source.STATION, "NetPlc is not running", STOPPED_PRIORITY))
+        out.append(AlarmDef(STOPPED_ID, Source.STATION, say("not running"), STOPPED_PRIORITY))
     if pair:
-        out.append(AlarmDef(NO_STANDBY_ID, Source.STATION, "No standby: the pair runs on one station",
+        out.append(AlarmDef(NO_STANDBY_ID, Source.STATION, say("no standby"),
                             NO_STANDBY_PRIORITY))
     return out
 
@@ -278,10 +279,12 @@ class AlarmSystem:
     def __init__(self, table: TagTable, messages: Iterable[CatalogMessage] = (), *,
                  sink: RecordSink | None = None, saved: Mapping[str, Mapping[str, Any]] | None = None,
                  on_change: Callable[[dict[str, dict[str, Any]]], None] | None = None,
-                 clock: Callable[[], float] = time.time, station: bool = False, pair: bool = False) -> None:
+                 clock: Callable[[], float] = time.time, station: bool = False, pair: bool = False,
+                 language: str = "") -> None:
         """`station`: the alarm system of a running station, with NETPLC.STOPPED (`evaluate`'s
         `stopped` says why NetPlc is not running); `pair`: one of a hot-standby pair, with
-        PAIR.NO_STANDBY (`evaluate`'s `no_standby` says why)."""
+        PAIR.NO_STANDBY (`evaluate`'s `no_standby` says why); `language`: the station's `Language`, in
+        which every text and transition is built (app/scada/words.py)."""
         self.table = table
         self.sink: RecordSink = sink or NullSink()
         self.on_change = on_change
@@ -289,7 +292,8 @@ class AlarmSystem:
         self.tags: list[Tag] = list(table.tags)
         self.reader = TagReader(self.tags)
         pos = {t.name: i for i, t in enumerate(self.tags)}
-        self.defs = alarm_defs(table, messages, station, pair)
+        self.say = words(language)
+        self.defs = alarm_defs(table, messages, station, pair, self.say)
         self.alarms = [Alarm(d) for d in self.defs]
         self.by_id = {a.id: i for i, a in enumerate(self.alarms)}
         n = len(self.defs)
@@ -436,12 +440,12 @@ class AlarmSystem:
         for i in self._suppressible:
             on = bool(snapshot.get_hmi_bit(self.defs[i].suppress_by or 0))
             if on != self.alarms[i].suppressed:
-                self._overlay(i, now, out, None, "suppressed by design" if on else "suppression ended",
-                              suppressed=on)
+                note = self.say("suppressed by design" if on else "suppression ended")
+                self._overlay(i, now, out, None, note, suppressed=on)
         for i in sorted(self._shelved):
             a = self.alarms[i]
             if a.shelved_until is not None and now >= a.shelved_until:
-                self._overlay(i, now, out, None, f"shelving by {a.shelved_by} ran out", **UNSHELVED)
+                self._overlay(i, now, out, None, self.say("shelving ran out", user=a.shelved_by), **UNSHELVED)
         self._flush_changes()
         return out
 
@@ -475,7 +479,7 @@ class AlarmSystem:
             a.active = False
         self._emit(i, old, now, out)
         if a.one_shot and not cond:
-            self._overlay(i, now, out, None, f"one-shot shelving by {a.shelved_by} ended: returned to normal",
+            self._overlay(i, now, out, None, self.say("one-shot ended", user=a.shelved_by),
                           **UNSHELVED)
 
     def _overlay(self, i: int, now: float, out: list[Transition], user: str | None, note: str,
@@ -516,16 +520,19 @@ class AlarmSystem:
         a.value = phy
         if not a.acked:
             a.acked_by = ""
-        text = f"{a.id} {old.word} -> {new.word}: {a.text}"
+        say = self.say
+        text = f"{a.id} {say(old.word)} -> {say(new.word)}: {a.text}"
         t = self._tag_of[i]
         if phy is not None and raw is not None:
             tag = self.tags[t]
-            shown = tag.format(phy) if not math.isnan(phy) else "not a number"
-            text += f"; {tag.name} = {shown}" + (f" (raw {raw:g})" if tag.scaling is not None else "")
+            shown = tag.format(phy) if not math.isnan(phy) else say("not a number")
+            text += f"; {tag.name} = {shown}"
+            if tag.scaling is not None:
+                text += f" ({say('raw')} {raw:g})"
         if note:
             text += f"; {note}"
         if user:
-            text += f"; by {user}"
+            text += f"; {say('by', user=user)}"
         tr = Transition(now, a.id, old, new, a.defn.priority,
                         None if phy is None or math.isnan(phy) else phy, user, text)
         out.append(tr)
@@ -563,7 +570,7 @@ class AlarmSystem:
             return
         if latched:
             a.active = False
-        note = "acknowledged" if old is not State.ACKED else "reset"
+        note = self.say("acknowledged" if old is not State.ACKED else "reset")
         if comment:
             a.comment, a.comment_by = comment, user
             note += f": {comment}"
@@ -588,9 +595,9 @@ class AlarmSystem:
         i = self.check_shelve(alarm_id, user, reason, duration)
         when = self.clock() if now is None else now
         until = when + duration
-        stamp = time.strftime("%Y-%m-%d %H:%M:%S", time.localtime(until))
-        how = f"shelved once, until it returns to normal (at most until {stamp})" if once else \
-            f"shelved for {duration:g} s until {stamp}"
+        stamp = time.strftime(self.say.stamp, time.localtime(until))
+        how = self.say("shelved once", stamp=stamp) if once else \
+            self.say("shelved for", duration=duration, stamp=stamp)
         return self._act(lambda out: self._overlay(
             i, when, out, user, f"{how}: {reason}", shelved_until=until, shelved_by=user, reason=reason,
             one_shot=once))
@@ -612,7 +619,7 @@ class AlarmSystem:
         if self.alarms[i].shelved_until is None:
             return []
         when = self.clock() if now is None else now
-        return self._act(lambda out: self._overlay(i, when, out, user, "unshelved", **UNSHELVED))
+        return self._act(lambda out: self._overlay(i, when, out, user, self.say("unshelved"), **UNSHELVED))
 
     def comment(self, alarm_id: str, user: str, text: str, now: float | None = None) -> list[Transition]:
         """An operator's comment on an alarm: journaled as a record of the alarm (its state stays),
@@ -623,7 +630,7 @@ class AlarmSystem:
 
         def run(out: list[Transition]) -> None:
             a.comment, a.comment_by = text, user
-            self._emit(i, a.state, when, out, user, f"comment: {text}", always=True)
+            self._emit(i, a.state, when, out, user, self.say("comment", text=text), always=True)
 
         return self._act(run)
 
@@ -642,7 +649,7 @@ class AlarmSystem:
         if self.alarms[i].out_of_service == out_of_service:
             return []
         when = self.clock() if now is None else now
-        note = "taken out of service" if out_of_service else "returned to service"
+        note = self.say("taken out of service" if out_of_service else "returned to service")
         return self._act(lambda out: self._overlay(i, when, out, user, note, out_of_service=out_of_service,
                                                    oos_by=user if out_of_service else ""))
 

@@ -30,6 +30,7 @@ from app.scada.quality import LinkView, QualityMap
 from app.scada.readings import Readings
 from app.scada.series import SeriesQuality
 from app.scada.table import TagTable, load_tags
+from app.scada.words import Words, words
 from netplc.address import EMERGENCY_STOP, fmt_octal
 from netplc.engine import Engine, RunState
 from netplc.exchange import Exchange
@@ -50,18 +51,21 @@ class StationAlarms:
     def __init__(self, tags: Path | None, program: Program, messages: list[CatalogMessage], sink: RecordSink,
                  state_file: Path, symbols: dict[str, int] | None = None,
                  regdata: Mapping[str, Sequence[tuple[int, int]]] | None = None,
-                 no_standby: Callable[[], str] | None = None, horn: int | None = None) -> None:
+                 no_standby: Callable[[], str] | None = None, horn: int | None = None,
+                 language: str = "") -> None:
         """TagError (every problem of tags.csv) if the tags cannot be used. `regdata`: the forms'
         RegData elements by name, with their operands (app/scada/series.py); `no_standby`: one of a
         hot-standby pair, why it has no standby now ("" while it has), for PAIR.NO_STANDBY; `horn`:
-        the HMI bit set while an alarm sounds (station.toml `alarm_horn`)."""
+        the HMI bit set while an alarm sounds (station.toml `alarm_horn`); `language`: the station's
+        `Language`, of every alarm text."""
         self.table = load_tags(tags, symbols) if tags is not None else TagTable()
         self.quality_map = QualityMap(program, self.table.tags)
         self.sink = sink
         self.series = SeriesQuality(program, regdata or {})
         self.state = AlarmStateFile(state_file, sink)
         self.system = AlarmSystem(self.table, messages, sink=sink, saved=self.state.load(),
-                                  on_change=self._changed, station=True, pair=no_standby is not None)
+                                  on_change=self._changed, station=True, pair=no_standby is not None,
+                                  language=language)
         self.no_standby = no_standby or (lambda: "")
         self.quality = np.zeros(len(self.table.tags), dtype=np.int8)  # of the last scan, by tag
         self.readings: Readings | None = None  # of the last scan; None before the first
@@ -121,7 +125,8 @@ class StationAlarms:
             self.sink.put(record)
         messages, self._messages = self._messages, []
         self.system.evaluate(snapshot, snapshot.wall, self.quality, messages,
-                             "" if running else stop_reason(snapshot.state, self._stopped_by),
+                             "" if running else stop_reason(snapshot.state, self._stopped_by,
+                                                                   self.system.say),
                              self.no_standby())
         if self._dirty and snapshot.time - self._published >= PUBLISH_EVERY:
             self._publish(snapshot.time)
@@ -219,13 +224,15 @@ class StationAlarms:
 STOPPED_BY_COMMAND = "NetPlc stopped"  # the command layer's record of a Stop, naming who
 
 
-def stop_reason(state: str, by: str = "") -> str:
+def stop_reason(state: str, by: str = "", say: Words | None = None) -> str:
     """Why NetPlc is not running, from the snapshot's run state (Engine.state_text), with its
-    stop code; `by`: who stopped it through the command layer (the journal's name of them)."""
+    stop code; `by`: who stopped it through the command layer (the journal's name of them);
+    in the language of `say`."""
+    say = say or words()
     if state == RunState.HALTED:
-        return "halted by HLT"
+        return say("halted")
     if state == f"{RunState.STOPPED}, code {EMERGENCY_STOP_CODE}":
-        return f"emergency stop by bit {fmt_octal(EMERGENCY_STOP)} (code {EMERGENCY_STOP_CODE})"
+        return say("emergency stop", bit=fmt_octal(EMERGENCY_STOP), code=EMERGENCY_STOP_CODE)
     if state == RunState.STOPPED:
-        return f"stopped by {by} (code 0)" if by else "stopped by the operator or the watchdog (code 0)"
+        return say("stopped by", user=by) if by else say("stopped")
     return state

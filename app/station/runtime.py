@@ -34,6 +34,7 @@ from app.scada.alarms import Alarm
 from app.scada.readings import Readings
 from app.scada.station import STATE_FILE as ALARM_STATE_FILE
 from app.scada.station import StationAlarms
+from app.scada.words import ENGLISH, words
 from app.station.config import Station
 from app.station.load import load, load_station_forms
 from app.station.lock import StationLock, StationRunning
@@ -250,6 +251,14 @@ class Runtime:
         logger.log(level, "%s", text)
         self.put(Record(self.wallclock(), "system", source="station", text=text))
 
+    def say(self, name: str, level: int = logging.INFO, **values: object) -> None:
+        """A 'system' record of the catalogue (app/scada/words.py: `name` and its `values`) in the
+        station's `Language`, and the same in English in the log (at `level`), which is read by
+        whoever supports the station, not only by its operators."""
+        logger.log(level, "%s", ENGLISH(name, **values))
+        self.put(Record(self.wallclock(), "system", source="station",
+                        text=words(self.station.Language)(name, **values)))
+
     # --- start and stop ------------------------------------------------------------------------
 
     def start(self) -> None:
@@ -285,7 +294,7 @@ class Runtime:
             started = True
         except StartError as e:
             for problem in e.problems:
-                self.system(f"station cannot start: {problem}")
+                self.say("cannot start", problem=problem)
             raise
         finally:
             if not started:  # whatever ended the start, Ctrl+C too: what did start stops again
@@ -293,12 +302,12 @@ class Runtime:
 
     def _start_parts(self) -> None:
         st = self.station
-        self.system(f"station starting: {st.path}")
+        self.say("starting", path=st.path)
         self.engine = Engine(self.program, sink=self, tick=st.tick, wallclock=self.wallclock,
                              code_cache=st.Archive.parent / CODE_CACHE)
         self.started_clock = self.engine.now  # engine-clock time of the start (DateTime elements)
         for problem in self.form_problems:
-            self.system(f"form not loaded: {problem}")
+            self.say("form not loaded", problem=problem)
         if not st.NetPlcLoad:
             self.engine.stop()
         self.retainer = Retainer(st.Retain, self.engine, self)
@@ -310,8 +319,7 @@ class Runtime:
 
             behaviour = FormBehaviour(self.forms, self.engine.mem, self, self.problem)
             behaviour.attach(self.engine)
-            self.system(f"forms loaded: {len(self.forms)}, of their elements {len(behaviour.elements)} act "
-                        "on the station (sync generators, RegData/RegMessages), with or without a window")
+            self.say("forms loaded", forms=len(self.forms), elements=len(behaviour.elements))
             regdata = {el.Name: el.sources() for _, el in behaviour.elements if el.RegData}
         for i, (sim, program) in enumerate(zip(st.simulators, self.node_programs, strict=True)):
             simulator = Simulator(program, host=sim.host, port=sim.port, unit=sim.unit,
@@ -329,7 +337,7 @@ class Runtime:
         self.alarms = StationAlarms(st.Tags, self.program, list(self.catalog), self,
                                     st.Archive.with_name(ALARM_STATE_FILE), self.symbols, regdata,
                                     self._no_standby if st.redundancy is not None else None,
-                                    horn=st.alarm_horn)
+                                    horn=st.alarm_horn, language=st.Language)
         self.subscribe(self.alarms.observe)
         self.alarms.attach(self.engine, self.exchange)
         self.commands = Commands(self.engine, self, role_of=self.role_of, tags=self.alarms.table.tags,
@@ -350,19 +358,19 @@ class Runtime:
                 self.problem(f"Modbus server not started: {st.path}: modbus_server.port: cannot listen on "
                               f"{server.host}:{server.port}: {_reason(e)}")
             if modbus.fault:  # a serial port not there yet, or not ours to open: tried again
-                self.system(f"Modbus server not started yet: {st.path}: modbus_server.port: {modbus.fault}; "
-                            f"retrying every {REOPEN:g} s", logging.WARNING)
+                self.system(f"Modbus server not started yet: {st.path}: "
+                            f"modbus_server.port: {modbus.fault}; retrying every {REOPEN:g} s",
+                            logging.WARNING)
         self.publishers = start_publishers(self)
-        self.system(f"program loaded: {self.program.source} ({len(self.program.instrs)} instructions, "
-                    f"{self.program.words} words)")
+        self.say("program loaded", source=self.program.source, instrs=len(self.program.instrs),
+                    words=self.program.words)
         self.retainer.start()  # before the first scan: its writers wait for its saves
         if st.redundancy is not None:
             self._start_pair()
         self.scan_thread = ScanThread(self.engine, st.tick, on_error=self._scan_error)
         self.scan_thread.start()
         self.started = True
-        self.system(f"station started: NetSyncTime {st.NetSyncTime} ms, "
-                    f"retentive memory from {self.restored}")
+        self.say("started", sync=st.NetSyncTime, restored=self.restored)
         threading.Thread(target=self._report_unresolved, name="resolve", daemon=True).start()
 
     def _start_pair(self) -> None:
@@ -429,7 +437,7 @@ class Runtime:
             self.problem(f"retained force not restored: {problem}")
         self.engine.forces.restore(forces, user="station (RetainForces)")
         if forces:
-            self.system(f"{len(forces)} retained forces restored from {st.forces_file} (RetainForces = true)")
+            self.say("forces restored", n=len(forces), file=st.forces_file)
         self.engine.subscribe(self._save_forces)
 
     def _save_forces(self, _snapshot: object) -> None:
@@ -442,8 +450,8 @@ class Runtime:
         try:
             save_forces(self.station.forces_file, listing)
         except OSError as e:
-            self.system(f"retained forces not saved: {self.station.forces_file}: {e.strerror or e}",
-                        logging.WARNING)
+            self.say("forces not saved", logging.WARNING, file=self.station.forces_file,
+                     error=e.strerror or e)
 
     def _report_unresolved(self) -> None:
         """Journal each node host name that does not resolve, by its key. The station starts all the
@@ -451,7 +459,7 @@ class Runtime:
         (shown down meanwhile); `check` reports the name as a problem, for the typo it may be."""
         for text in unresolved_hosts(self.station):
             if self.started:
-                self.system(f"{text}; the node stays down until it does")
+                self.say("stays down", text=text)
 
     def service_level(self) -> int:
         """OPC UA ServiceLevel: 255 alone; one of a pair, by its role (pair.SERVICE_LEVEL)."""
@@ -532,7 +540,7 @@ class Runtime:
         self.silent.clear()
         if self.store is not None:
             if self.started:
-                self.system("station stopped")
+                self.say("station stopped")
             store, self.store = self.store, None
             store.close()  # flushes every queued record
             self._final_store = store.stats
@@ -559,7 +567,7 @@ class Runtime:
             new.engine.mem.load(old.engine.snapshot)  # the plant goes on where it stopped
             new.start()
             self.simulators[index] = new
-        self.system(f"simulated node {sim.node} {'answers again' if answering else 'stopped answering'}")
+        self.say("node answers" if answering else "node silent", node=sim.node)
 
     def watch(self, callback: Callable[[Readings], None], name: str | None = None) -> Callable[[], None]:
         """The station's public feed: `callback(readings)` on the engine thread after every scan,

@@ -129,7 +129,7 @@ def test_an_acknowledge_shows_on_the_other_console_and_in_the_journal_a_viewer_i
         assert operator.acknowledge(alarm).result(20).ok
         qtbot.waitUntil(lambda: all(r.id != "TRIGGER.BAD" for r in viewer.unacknowledged), timeout=WAIT)
         acked = [r.text or "" for r in station.records if r.kind == "alarm" and r.source == "TRIGGER.BAD"
-                 and "acknowledged; by opcua:operator@127.0.0.1:" in (r.text or "")]
+                 and "квитирована; оператор opcua:operator@127.0.0.1:" in (r.text or "")]
         assert acked, "the acknowledgement journaled with the operator's name"
         qtbot.waitUntil(lambda: not viewer.banner.ack.isEnabled(), timeout=WAIT)  # as the station answers
         assert "needs the operator role; viewer is viewer" in viewer.summary.ack.toolTip()
@@ -140,7 +140,7 @@ def test_an_acknowledge_shows_on_the_other_console_and_in_the_journal_a_viewer_i
         assert operator.commands.unshelve(operator.who, "TRIGGER.BAD").result(20).ok
         journal = viewer.journal  # the station's journal, read over OPC UA, names the operator too
         qtbot.waitUntil(lambda: any(r.kind == "alarm" and "TRIGGER.BAD" in (r.text or "") and
-                                    "by opcua:operator@" in (r.text or "") for r in journal.model.rows),
+                                    "оператор opcua:operator@" in (r.text or "") for r in journal.model.rows),
                         timeout=WAIT)
     finally:
         station.runtime.simulator_answers(0, True)

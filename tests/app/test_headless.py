@@ -48,8 +48,9 @@ def check_archive(archive: Path) -> dict[str, list[tuple]]:
     assert (5, "NetPlc запущен") in messages
     assert (6, "Связь с узлом 0 установлена") in messages
     system = [r[6] for r in by_kind["system"]]
-    assert any(t.startswith("station started") for t in system)
-    assert system[-1] == "station stopped"  # the last record written: everything before it is flushed
+    assert any(t.startswith("станция запускается: ") for t in system)  # the demo speaks Russian
+    assert any(t.startswith("станция запущена: NetSyncTime") for t in system)
+    assert system[-1] == "станция остановлена"  # the last record written: everything before it is flushed
     assert any("link up" in t for t in system)
     return by_kind
 

@@ -46,7 +46,7 @@ def test_viewer_shows_rows_plots_and_exports(qtbot, headless_archive: tuple[Path
     kinds = {viewer.model.index(r, 1).data() for r in range(viewer.model.rowCount())}
     assert kinds >= {"data", "message", "system"}
     shown = texts(viewer)
-    assert "NetPlc запущен" in shown and shown[-1] == "station stopped"  # oldest first
+    assert "NetPlc запущен" in shown and shown[-1] == "станция остановлена"  # oldest first
 
     viewer.kind.setCurrentText("message")
     viewer.apply_filter()

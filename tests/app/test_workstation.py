@@ -105,8 +105,8 @@ def test_an_alarm_is_shown_and_its_acknowledgement_journaled(qtbot, workstation:
     assert not banner.alarms and not banner.isVisible()
     qtbot.waitUntil(lambda: not workstation.summary.unacknowledged(), timeout=3000)
     runtime.stop()  # flushes the archive
-    acks = [r for r in archive_rows(runtime, "alarm") if r[0] == "MSG3" and "by engineer" in r[2]]
-    assert len(acks) == 1 and "acknowledged" in acks[0][2] and high in acks[0][2]  # one, naming it
+    acks = [r for r in archive_rows(runtime, "alarm") if r[0] == "MSG3" and "оператор engineer" in r[2]]
+    assert len(acks) == 1 and "квитирована" in acks[0][2] and high in acks[0][2]  # one, naming it
     messages = archive_rows(runtime, "message")
     assert (None, 3, "Уровень выше 90 %") in messages
 

@@ -242,9 +242,10 @@ def test_an_operator_acknowledges_and_shelves_a_viewer_is_refused_and_the_summar
         f"refused acknowledge {alarm_id}: needs the operator role; viewer is viewer",
         f"refused shelve {alarm_id}: needs the operator role; viewer is viewer"]
     acts = [r.text for r in records if r.kind == "alarm" and r.source == alarm_id]
-    assert all("by opcua:operator@127.0.0.1:" in t for t in acts[1:])
-    assert ["acknowledged: seen" in t for t in acts[1:]] == [True, False, False, False]
-    assert "TimedShelve over OPC UA" in acts[2] and "shelved once" in acts[3] and "unshelved" in acts[4]
+    assert all("оператор opcua:operator@127.0.0.1:" in t for t in acts[1:])  # the demo speaks Russian
+    assert ["квитирована: seen" in t for t in acts[1:]] == [True, False, False, False]
+    assert "TimedShelve over OPC UA" in acts[2] and "отложена до возврата" in acts[3]
+    assert "возвращена из отложенных" in acts[4]
 
 
 def test_an_alarm_acknowledged_at_the_station_updates_its_condition(station: Station) -> None:
@@ -266,7 +267,7 @@ def test_an_alarm_acknowledged_at_the_station_updates_its_condition(station: Sta
 
     event, acked, word = run(go())
     assert acked is True and word == "active-acknowledged" and event.Retain is True
-    assert event.Message.Text.endswith("acknowledged; by operator")
+    assert event.Message.Text.endswith("квитирована; оператор operator")
 
 
 def test_condition_refresh_sends_the_retained_conditions_between_refresh_start_and_end(
@@ -372,5 +373,5 @@ def test_comments_and_out_of_service_through_the_condition(station: Station) -> 
     assert out["disabled"] == _S.BadConditionAlreadyDisabled
     assert (out["enable"], out["back"]) == (_S.Good, State.NORMAL)
     assert out["enabled"] == _S.BadConditionAlreadyEnabled
-    assert any(r.kind == "alarm" and r.source == commented and "comment: technician called" in r.text
+    assert any(r.kind == "alarm" and r.source == commented and "комментарий: technician called" in r.text
                for r in records)
