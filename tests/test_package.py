@@ -77,6 +77,7 @@ def run(venv: Path, *args: str) -> subprocess.CompletedProcess[str]:
 def installed_env(venv: Path) -> dict[str, str]:
     """No PYTHONPATH: the package must come from the venv, not from this checkout."""
     env = {k: v for k, v in os.environ.items() if k != "PYTHONPATH"}
+    env["PYTHONFAULTHANDLER"] = "1"  # a station that hangs shows where (tests/app/conftest.py stop_once_up)
     env["PATH"] = f"{venv / 'bin'}{os.pathsep}{env.get('PATH', '')}"
     return env
 

@@ -28,7 +28,7 @@ def stop_once_up(proc: subprocess.Popen[str], settle: float = 0.0,
                  until: Callable[[], bool] | None = None) -> tuple[str, str]:
     """Wait (at most 30 s) for a `--no-gui` station's status line with its node up, let it run
     `settle` s more or until `until()` holds, then stop it with SIGTERM as systemd does: its whole
-    output (killed if it hangs)."""
+    output (killed if it hangs, its threads' stacks in the error where PYTHONFAULTHANDLER is set)."""
     seen: list[str] = []
     try:
         assert proc.stdout is not None
@@ -41,7 +41,13 @@ def stop_once_up(proc: subprocess.Popen[str], settle: float = 0.0,
         while until is not None and time.monotonic() < deadline and not until():
             time.sleep(0.05)
         proc.send_signal(signal.SIGTERM)
-        out, err = proc.communicate(timeout=30)
+        try:
+            out, err = proc.communicate(timeout=60)
+        except subprocess.TimeoutExpired:  # with PYTHONFAULTHANDLER set, SIGABRT prints every stack
+            proc.send_signal(signal.SIGABRT)
+            out, err = proc.communicate(timeout=10)
+            said = "".join(seen) + out + err
+            raise AssertionError(f"the station did not stop on SIGTERM:\n{said}") from None
         return "".join(seen) + out, err
     finally:
         if proc.poll() is None:
