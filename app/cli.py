@@ -12,7 +12,6 @@ import argparse
 import signal
 import sqlite3
 import sys
-import threading
 import time
 from pathlib import Path
 
@@ -426,7 +425,7 @@ def run_headless(station: str, duration: float | None, every: float) -> int:
     runtime = _open_runtime(station)
     if runtime is None:
         return 2
-    done = threading.Event()
+    done = interruptible.Flag()  # raised by the signal handler: no lock (netplc/interruptible.py)
     notifier = Notifier()
     service: Service | None = None
 

@@ -1,26 +1,41 @@
-"""Waiting on the main thread without deafening it to Ctrl-C and SIGTERM.
+"""Waiting on the main thread for a signal, without deafening it and without a lock.
 
 A signal may be delivered to any thread of the process; Python runs its handler (the
-KeyboardInterrupt of Ctrl-C, the station's SIGTERM handler) on the main thread, at its next
+KeyboardInterrupt of Ctrl-C, a station's SIGTERM handler) on the main thread, at its next
 bytecode. A main thread blocked in a lock without a timeout (`Event().wait()`) never gets there
-when the signal went to a scan or network thread: the simulator then ignored Ctrl-C for good (seen
-under load in the suite). Waiting in short slices bounds the delay to one slice.
+when the signal went to a scan or network thread: the simulator then ignored Ctrl-C for good.
+And a handler must take no lock the main thread may hold when the handler interrupts it:
+`Event.set()` in a handler deadlocked the headless station when the signal came while the main
+thread was inside that Event's `wait()` (seen in the suite). So the handler raises a `Flag` (a
+plain attribute) and the main thread sleeps in short slices, looking at it between them.
 """
 
 from __future__ import annotations
 
-import threading
 import time
 
-SLICE = 0.2  # s: the longest a signal waits for the main thread
+SLICE = 0.1  # s: the longest a signal waits for the main thread
 
 
-def wait(event: threading.Event, seconds: float | None = None) -> bool:
-    """`event.wait(seconds)` (None: for ever) in slices of SLICE; True once the event is set."""
+class Flag:
+    """Raised by a signal handler, read by the main thread: no lock on either side."""
+
+    def __init__(self) -> None:
+        self.raised = False
+
+    def set(self) -> None:
+        self.raised = True
+
+    def is_set(self) -> bool:
+        return self.raised
+
+
+def wait(flag: Flag, seconds: float | None = None) -> bool:
+    """Until `flag` is raised (True) or `seconds` passed (None: for ever; False)."""
     end = None if seconds is None else time.monotonic() + seconds
-    while not event.is_set():
+    while not flag.raised:
         left = SLICE if end is None else min(SLICE, end - time.monotonic())
         if left <= 0:
             return False
-        event.wait(left)
+        time.sleep(left)
     return True

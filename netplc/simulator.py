@@ -16,7 +16,6 @@ from __future__ import annotations
 import argparse
 import signal
 import sys
-import threading
 from collections.abc import Iterable
 
 from netplc import interruptible
@@ -140,7 +139,7 @@ def main(argv: list[str] | None = None) -> int:
         return 2
     # Ctrl-C and SIGTERM stop the node, also where it was started with SIGINT ignored (a job a
     # script put in the background inherits that, and so did the suite's simulators)
-    stop = threading.Event()
+    stop = interruptible.Flag()  # raised by the signal handlers: no lock (netplc/interruptible.py)
     previous = {s: signal.signal(s, lambda *_: stop.set()) for s in (signal.SIGINT, signal.SIGTERM)}
     sim = Simulator(program, args.host, args.port, args.unit, args.tick / 1000.0, sink=ConsoleSink(),
                     serial=serial)
