@@ -193,3 +193,15 @@ def test_a_second_station_on_the_same_folder_is_refused(tmp_path: Path) -> None:
     again = Runtime(load_station(folder))  # the lock goes with the stop
     again.start()
     again.stop()
+
+
+def test_the_unit_does_not_restart_a_station_whose_configuration_was_refused(tmp_path: Path) -> None:
+    """A refused configuration exits 2 (named on stderr); restarting it every RestartSec would only
+    repeat the refusal in the journal, so the unit names that status in RestartPreventExitStatus."""
+    from app.cli import run_headless
+
+    unit = (REPO / "resources/systemd/netplc-station.service").read_text(encoding="utf-8")
+    keys = dict(line.split("=", 1) for line in unit.splitlines() if "=" in line and not line.startswith("#"))
+    folder = write_station(tmp_path / "station", 'NetPlcProgram = "missing.stl"\nNetSyncTime = 20\n', {})
+    status = run_headless(str(folder), 1, 60)
+    assert keys["Restart"] == "on-failure" and keys["RestartPreventExitStatus"] == str(status) == "2"
