@@ -105,7 +105,7 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--port", type=int, default=502, help="TCP port (default 502; 0 = any free port)")
     p.add_argument("--serial", metavar="ENDPOINT",
                    help="answer as a Modbus RTU slave on this serial port instead of TCP: "
-                        "rtu:///dev/ttyUSB0?baudrate=19200&parity=N (COM3 on Windows: rtu://COM3)")
+                        "rtu:///dev/ttyUSB0?baudrate=19200&parity=E (COM3 on Windows: rtu://COM3)")
     p.add_argument("--unit", type=int, default=1, help="Modbus unit id to answer (default 1)")
     p.add_argument("--tick", type=int, default=100, help="scan tick in ms (default 100)")
     return p

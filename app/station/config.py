@@ -213,7 +213,8 @@ _MQTT, _OPERATOR = MqttSettings(), OperatorSettings()
 # what each node setting means; its kind and default are NodeConfig's own (netplc/exchange.py)
 _NODE_MEANINGS = {
     "name": "what the station calls the node (its Sparkplug device id); empty: Node<n>",
-    "endpoint": "`tcp://host:port` or `rtu:///dev/ttyS0?baudrate=19200&parity=N`; empty: its simulator's",
+    "endpoint": "`tcp://host:port` or `rtu:///dev/ttyS0?baudrate=19200&parity=E` (even parity by default); "
+                "empty: its simulator's",
     "unit": "Modbus unit id: 0-255 over TCP, 1-247 over RTU",
     "profile": "`cpu165` (a NetPlc node) or `modbus` (any Modbus device)",
     "timeout": "seconds per attempt (0.01-60)",

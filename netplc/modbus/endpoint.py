@@ -17,14 +17,16 @@ BYTESIZES = (5, 6, 7, 8)
 
 @dataclass(frozen=True, slots=True)
 class Endpoint:
-    """`tcp://host:port` or `rtu:///dev/ttyX?baudrate=19200&parity=N&bytesize=8&stopbits=1`."""
+    """`tcp://host:port` or `rtu:///dev/ttyX?baudrate=19200&parity=E&bytesize=8&stopbits=1`; the serial
+    defaults are the Modbus serial line's (even parity; 2 stop bits with no parity), the same as the
+    station's own RTU server, so that a node and a server left at their defaults talk."""
 
     scheme: str  # "tcp" | "rtu"
     host: str = ""
     port: int = 502
     device: str = ""
     baudrate: int = 19200
-    parity: str = "N"
+    parity: str = "E"
     bytesize: int = 8
     stopbits: int = 1
 
@@ -36,7 +38,7 @@ class Endpoint:
 
 def parse_endpoint(text: str) -> Endpoint:
     """Parse an endpoint; ValueError says what is wrong with it and shows the expected form."""
-    forms = "expected tcp://host:port, rtu:///dev/ttyX?baudrate=19200&parity=N or rtu://COM3?baudrate=..."
+    forms = "expected tcp://host:port, rtu:///dev/ttyX?baudrate=19200&parity=E or rtu://COM3?baudrate=..."
     try:
         url = urlsplit(text.strip())
         port = url.port
@@ -70,6 +72,8 @@ def parse_endpoint(text: str) -> Endpoint:
             else:
                 raise ValueError(f"endpoint {text!r}: unknown option {key!r} "
                                  "(baudrate, parity, bytesize, stopbits)")
+        if options.get("parity") == "N":
+            options.setdefault("stopbits", 2)
         endpoint = Endpoint("rtu", device=device, **options)
         if problems := line_problems(endpoint):
             raise ValueError(f"endpoint {text!r}: {problems[0][1]}")

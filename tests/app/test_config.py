@@ -192,8 +192,8 @@ endpoint = "rtu:///dev/ttyX?baudrate=19200"
         "nodes[0].backoff_max: 0 s is outside 0.01-3600 s",
         "nodes[1].backoff: 3 s is more than backoff_max 1 s",
         "nodes[2].endpoint: endpoint 'tcp://bad..name:502': 'bad..name' is not a valid host name",
-        "nodes[4].endpoint: rtu:///dev/ttyX?baudrate=19200&parity=N and node 4's "
-        "rtu:///dev/ttyX?baudrate=9600&parity=N share /dev/ttyX with different line settings",
+        "nodes[4].endpoint: rtu:///dev/ttyX?baudrate=19200&parity=E and node 4's "
+        "rtu:///dev/ttyX?baudrate=9600&parity=E share /dev/ttyX with different line settings",
     ]
 
 

@@ -220,3 +220,15 @@ def test_modbus_profile_and_device_exceptions(node0: Simulator) -> None:
                                                    "(illegal data address)")
     finally:
         st.stop()
+
+
+def test_a_serial_node_left_at_its_defaults_talks_to_the_stations_rtu_server_at_its_defaults() -> None:
+    """The Modbus serial line's defaults on both ends: even parity, 1 stop bit; no parity, 2."""
+    from app.station.config import KEYS
+
+    server = {name: key.default for name, key in KEYS["modbus_server"].items()}
+    node = NodeConfig(1, "rtu:///dev/ttyUSB0").parsed
+    assert (node.baudrate, node.parity, node.bytesize, node.stopbits) == \
+        (server["baudrate"], server["parity"], 8, 1)
+    assert NodeConfig(1, "rtu:///dev/ttyUSB0?parity=N").parsed.stopbits == 2
+    assert NodeConfig(1, "rtu:///dev/ttyUSB0?parity=N&stopbits=1").parsed.stopbits == 1

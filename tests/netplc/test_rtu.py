@@ -121,7 +121,7 @@ def test_two_nodes_share_the_line_and_a_silent_one_only_fails_itself(rtu_node: R
         "FON C:$02114 N:NREAD S:4000 D:$04010 R:2\n"
         "JMP 0\n"
     )
-    line = f"rtu://{rtu_node.port}?baudrate=19200"
+    line = f"rtu://{rtu_node.port}?baudrate=19200&parity=N"  # a pty takes no parity setting
     nodes = [NodeConfig(1, line, unit=UNIT, timeout=0.2, retries=0),
              NodeConfig(2, line, unit=UNIT + 1, timeout=0.2, retries=0)]  # nobody answers unit 6
     st = Station(program, nodes)
