@@ -334,7 +334,7 @@ KEYS: dict[str, dict[str, Key]] = {
         Key("deadband", dict, {}, "per tag type, in physical units: `{ float32 = 0.5, word = 2 }`"),
         Key("publish_period", int, _MQTT.publish_period, "ms between NDATA messages at least; 0: every tick",
             (0, 3_600_000)),
-        Key("writable", list, [], "tag names or patterns an NCMD may write"),
+        Key("writable", list, [], "tag names or patterns an NCMD or a DCMD may write"),
         Key("buffer", int, _MQTT.buffer, "NDATA/DDATA messages kept while no Sparkplug session is up",
             (0, 10_000_000)),
         Key("primary_host", str, _MQTT.primary_host,
