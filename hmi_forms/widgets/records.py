@@ -101,7 +101,8 @@ JOURNAL_COLUMNS = (
     Column("Group", GROUP.text, 50),
     Column("Type", type_name, 64),
     Column("Source", SOURCE.text, 110),
-    Column("Text", lambda r: r.text or ("" if r.number is None else f"message {r.number}")),
+    Column("Text", lambda r: r.text or ("" if r.number is None else QCoreApplication.translate(
+        "records", "message {0}").format(r.number))),
     Column("Value", VALUE.text, 60),
 )
 """A form's journal: seconds are enough, and a message without text is named by its number."""
