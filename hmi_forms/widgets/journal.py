@@ -18,7 +18,7 @@ from dataclasses import dataclass
 from functools import partial
 from pathlib import Path
 
-from PySide6.QtCore import QT_TRANSLATE_NOOP, QCoreApplication, QDate
+from PySide6.QtCore import QT_TRANSLATE_NOOP, QCoreApplication, QDate, Qt
 from PySide6.QtGui import QColor
 from PySide6.QtWidgets import (
     QComboBox,
@@ -127,11 +127,11 @@ class JournalWidget(SelfPainted):
         for w in (self.date, today, self.kind, self.min_type, self.group):
             bar.addWidget(w)
         bar.addStretch(1)
-        bar.addWidget(self.status)
         layout.addLayout(bar)
         self.table = RecordsModel(JOURNAL_COLUMNS, PALETTE)
         self.view = records_view(self.table, row_height=20)
         layout.addWidget(self.view, 1)
+        layout.addWidget(self.status, 0, Qt.AlignmentFlag.AlignRight)  # under the table: the bar for filters
         self.stale_mark.raise_()
         self.reload()
 
@@ -175,11 +175,10 @@ class JournalWidget(SelfPainted):
         self.table.set_rows(page.rows)
         if page.total is not None:
             self._count = False
-            n, total, day = len(page.rows), page.total, formats.date(page.day)
-            self.status.setText(
-                QCoreApplication.translate("JournalWidget", "{0} of {1} records, {2}").format(n, total, day)
-                if total > n else
-                QCoreApplication.translate("JournalWidget", "{0} records, {1}").format(total, day))
+            n, total = len(page.rows), page.total  # of the day the picker beside it shows
+            shown = QCoreApplication.translate("JournalWidget", "{0} of {1} records").format(n, total)
+            self.status.setText(shown if total > n else
+                                QCoreApplication.translate("JournalWidget", "{0} records").format(total))
 
     def _failed(self, _token: int, why: str) -> None:
         self.status.setText(QCoreApplication.translate("JournalWidget", "archive unreadable: {0}").format(

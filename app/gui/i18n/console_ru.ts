@@ -1902,16 +1902,16 @@ Drag onto the form, or double-click to add</source>
         <translation>архива ещё нет</translation>
     </message>
     <message>
-        <source>{0} of {1} records, {2}</source>
-        <translation>записей {0} из {1}, {2}</translation>
-    </message>
-    <message>
-        <source>{0} records, {1}</source>
-        <translation>записей: {0}, {1}</translation>
-    </message>
-    <message>
         <source>archive unreadable: {0}</source>
         <translation>архив не читается: {0}</translation>
+    </message>
+    <message>
+        <source>{0} of {1} records</source>
+        <translation>записей: {0} из {1}</translation>
+    </message>
+    <message>
+        <source>{0} records</source>
+        <translation>записей: {0}</translation>
     </message>
 </context>
 <context>
