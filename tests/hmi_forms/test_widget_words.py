@@ -13,7 +13,7 @@ from hmi_forms.elements.analog import DISABLED, NOT_A_NUMBER, OUT_OF_RANGE, SET_
 from hmi_forms.widgets.analog_output import SENTENCES
 from hmi_forms.widgets.form_view import FormView
 from tests.hmi_forms.helpers import engine_target
-from tests.hmi_forms.test_widgets import engine, one
+from tests.hmi_forms.test_widgets import differs, engine, image, one
 
 ENGLISH = re.compile(r"\b(?!NetPlc\b)[A-Za-z]{3,}\b")  # a word of three latin letters or more
 
@@ -59,3 +59,20 @@ def test_the_journal_element_says_its_filters_and_status_in_russian(qtbot, tmp_p
     assert heads == ["Время", "Вид", "Группа", "Тип", "Источник", "Текст", "Значение"]
     assert ENGLISH.findall(" ".join(texts + heads)) == []
     widget.close_archive()
+
+
+def test_a_shared_picture_is_drawn_again_in_the_next_language(qtbot, tmp_path, qapp) -> None:
+    """A generator's picture ("0: period 5, phase 0") is shared by every widget that looks the same;
+    one drawn in English is not shown in a console switched to Russian (the screenshots do that)."""
+    from app.gui import i18n
+
+    form = one(tmp_path, "SyncGenerator", w=220, h=80, OutAddr="02001", InAddr="02000", Period0=5)
+    pictures = []
+    for language in ("en", "ru"):
+        i18n.install(qapp, language)
+        view = FormView(form, engine_target(engine()[0]))
+        qtbot.addWidget(view)
+        view.show()
+        pictures.append(image(view, qtbot))
+    i18n.uninstall(qapp)
+    assert differs(*pictures) > 20
