@@ -231,9 +231,12 @@ def _users_parser() -> argparse.ArgumentParser:
 
 def run_users(argv: list[str]) -> int:
     from app.authority.users import UserError, Users
-    from app.station.config import station_file
+    from app.scada.words import words
+    from app.station.config import read_station, station_file
 
     ns = _users_parser().parse_args(argv)
+    station = read_station(ns.station)[0]
+    say = words(station.Language if station is not None else "")
     try:
         users = Users(station_file(ns.station).parent)
         if ns.action == "list":
@@ -241,13 +244,13 @@ def run_users(argv: list[str]) -> int:
                 print(f"{user.name}\t{user.role}")
         elif ns.action == "remove":
             users.remove(ns.name)
-            print(f"user {ns.name} removed")
+            print(say("user removed", user=ns.name))
         elif ns.action == "add":
             users.add(ns.name, ns.role, _password())
-            print(f"user {ns.name} added as {ns.role}")
+            print(say("user added", user=ns.name, role=ns.role))
         else:
             users.passwd(ns.name, _password())
-            print(f"password of {ns.name} changed")
+            print(say("password changed", user=ns.name))
     except UserError as e:
         print(f"users: {e}", file=sys.stderr)
         return 1

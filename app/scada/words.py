@@ -97,6 +97,8 @@ TEXTS: dict[str, dict[str, str]] = {
         "status letter": "letter", "status role": "role", "status partner": "partner", "status link": "link",
         "status last_takeover": "last takeover", "status lag": "lag", "status switchovers": "switchovers",
         "link is up": "up", "link is down": "DOWN",
+        "user added": "user {user} added as {role}", "user removed": "user {user} removed",
+        "password changed": "password of {user} changed",
     },
     "ru": {
         "HH": "верхний аварийный", "H": "верхний предупредительный", "L": "нижний предупредительный",
@@ -181,6 +183,9 @@ TEXTS: dict[str, dict[str, str]] = {
         "status last_takeover": "последний переход", "status lag": "отставание",
         "status switchovers": "переключений",
         "link is up": "есть", "link is down": "НЕТ",
+        "user added": "пользователь {user} добавлен, роль {role}",
+        "user removed": "пользователь {user} удалён",
+        "password changed": "пароль пользователя {user} изменён",
     },
 }
 
