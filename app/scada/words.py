@@ -82,7 +82,6 @@ TEXTS: dict[str, dict[str, str]] = {
         "note users default": "users {file}: {n}, {name!r} at the workstation until someone logs in",
         "note forms": "forms in {folder}: {n} loaded",
         "note pair": "pair: {ours} and {theirs} hold the same station",
-        "check archive": "{path}: Archive: {archive}: cannot open the archive: {problem}",
         "check split brain": '{path}: redundancy.arbiter: "none": when the link between the pair breaks '
                              "while both run, both act as primary (split brain)",
         "check horn": "{path}: alarm_horn: {bit} is written by the program (line {line}: {text}): the "
@@ -166,7 +165,6 @@ TEXTS: dict[str, dict[str, str]] = {
         "note users default": "пользователи {file}: {n}, {name!r} за рабочим местом, пока никто не вошёл",
         "note forms": "мнемосхемы в {folder}: загружено {n}",
         "note pair": "пара: в {ours} и {theirs} одна и та же станция",
-        "check archive": "{path}: Archive: {archive}: архив не открывается: {problem}",
         "check split brain": '{path}: redundancy.arbiter: "none": если связь между станциями пары '
                              "прервётся, когда обе работают, обе станут основными (split brain)",
         "check horn": "{path}: alarm_horn: бит {bit} пишет программа (строка {line}: {text}): этот бит "

@@ -48,8 +48,8 @@ def check_station(path: str | Path) -> CheckReport:
     report.notes.append(say("note station", path=station.path))
     report.problems += unresolved_hosts(station)
     if problem := archive_problem(station.Archive):
-        report.problems.append(say("check archive", path=station.path, archive=station.Archive,
-                                   problem=problem))
+        report.problems.append(f"{station.path}: Archive: {station.Archive}: cannot open the archive: "
+                               f"{problem}")  # the start's words, as it refuses
     loaded = load(station)
     report.problems += loaded.problems + loaded.form_problems
     report.warnings += [w for form in loaded.forms for w in form.warnings]

@@ -137,7 +137,8 @@ def test_check_says_its_own_words_in_the_station_language_naming_file_and_line(t
     line = next(i for i, text in enumerate((st / "netplc.stl").read_text(encoding="utf-8").splitlines(), 1)
                 if text.startswith("YON $02200"))
     if language == "ru":
-        assert f"{toml}: Archive: {st / 'archive' / 'journal.sqlite'}: архив не открывается: " in r.stdout
+        # the archive's problem in the start's own words (a start refuses with the same)
+        assert f"{toml}: Archive: {st / 'archive' / 'journal.sqlite'}: cannot open the archive: " in r.stdout
         assert f"{toml}: alarm_horn: бит 02200 пишет программа (строка {line}: " in r.stdout
         assert "найдено проблем: 2" in r.stderr
     else:
