@@ -117,27 +117,32 @@ def _redundancy_parser() -> argparse.ArgumentParser:
 
 
 def run_redundancy(target: str) -> int:
+    from app.scada.words import words
     from app.station.config import read_station
     from app.station.mirror import LinkError
     from app.station.pair import query
 
-    address = target
+    address, say = target, words()  # the station's language where its folder is named
     if Path(target).exists():
         station, problems = read_station(target)
+        if station is not None:
+            say = words(station.Language)
         if station is None or station.redundancy is None:
-            print("\n".join(problems) or f"{target}: no [redundancy] in its station.toml", file=sys.stderr)
+            print("\n".join(problems) or say("no redundancy", target=target), file=sys.stderr)
             return 1
         address = station.redundancy.listen
     try:
         status = query(address)
     except (OSError, LinkError, ValueError) as e:
-        print(f"{address}: no answer from the station's pair link: {e}", file=sys.stderr)
+        print(say("no pair answer", address=address, error=e), file=sys.stderr)
         return 1
     for key in ("letter", "role", "partner", "link", "last_takeover", "lag", "switchovers"):
         value = status.get(key)
         if key == "link":
-            value = "up" if value else "DOWN"
-        print(f"{key.replace('_', ' ')}: {value if value not in ('', None) else '-'}")
+            value = say("link is up" if value else "link is down")
+        elif key == "role" and value in ("starting", "primary", "standby"):
+            value = say(f"role {value}")
+        print(f"{say(f'status {key}')}: {value if value not in ('', None) else '-'}")
     return 0
 
 
@@ -226,9 +231,12 @@ def _users_parser() -> argparse.ArgumentParser:
 
 def run_users(argv: list[str]) -> int:
     from app.authority.users import UserError, Users
-    from app.station.config import station_file
+    from app.scada.words import words
+    from app.station.config import read_station, station_file
 
     ns = _users_parser().parse_args(argv)
+    station = read_station(ns.station)[0]
+    say = words(station.Language if station is not None else "")
     try:
         users = Users(station_file(ns.station).parent)
         if ns.action == "list":
@@ -236,13 +244,13 @@ def run_users(argv: list[str]) -> int:
                 print(f"{user.name}\t{user.role}")
         elif ns.action == "remove":
             users.remove(ns.name)
-            print(f"user {ns.name} removed")
+            print(say("user removed", user=ns.name))
         elif ns.action == "add":
             users.add(ns.name, ns.role, _password())
-            print(f"user {ns.name} added as {ns.role}")
+            print(say("user added", user=ns.name, role=ns.role))
         else:
             users.passwd(ns.name, _password())
-            print(f"password of {ns.name} changed")
+            print(say("password changed", user=ns.name))
     except UserError as e:
         print(f"users: {e}", file=sys.stderr)
         return 1
@@ -371,15 +379,16 @@ def run_check(station: str, partner: str | None = None) -> int:
     from app.station.check import check_pair, check_station
 
     report = check_station(station) if partner is None else check_pair(station, partner)
+    say = report.words
     for problem in report.problems:
         print(problem)
     for warning in report.warnings:
-        print(f"warning: {warning}")
+        print(say("warning", text=warning))
     if report.ok:
         for note in report.notes:
-            print(f"ok: {note}")
+            print(say("ok", text=note))
         return 0
-    print(f"{len(report.problems)} problem(s) found", file=sys.stderr)
+    print(say("problems found", n=len(report.problems)), file=sys.stderr)
     return 1
 
 

@@ -68,6 +68,17 @@ if TYPE_CHECKING:
 NODE, NREAD, NWRITE = 300, 301, 302
 PROBE_IDLE = 1.0  # seconds without a request before a node's link is probed
 T = TypeVar("T")
+# the exchange's records (English; the station says them in its Language, app/scada/words.py)
+LINK_WORDS = {
+    "link up": "node {node} ({endpoint}): link up",
+    "link down": "node {node} ({endpoint}): link down",
+    "link down because": "node {node} ({endpoint}): link down: {error}",
+}
+Say = Callable[..., str]  # `say(name, **values)`: a record's text
+
+
+def english(name: str, /, **values: object) -> str:
+    return LINK_WORDS[name].format(**values)
 
 logger = logging.getLogger(__name__)
 
@@ -449,6 +460,7 @@ class Exchange:
             raise ValueError(f"node {cfg.node}: {key}: {text}")
         self.configs: dict[int, NodeConfig] = {cfg.node: cfg for cfg in nodes}
         self.sink: RecordSink = sink or NullSink()
+        self.words: Say = english  # the station's words for its records (app/scada/words.py)
         self.engine: Engine | None = None
         self.stats: dict[int, NodeStats] = {
             n: NodeStats(n, str(cfg.parsed)) for n, cfg in self.configs.items()
@@ -583,9 +595,9 @@ class Exchange:
 
     def link_changed(self, node: _Node, up: bool, error: str) -> None:
         n = node.config.node
-        text = f"node {n} ({node.stats.endpoint}): link {'up' if up else 'down'}"
-        self.sink.put(Record(time.time(), "system", source=f"node {n}", number=n,
-                             value=1.0 if up else 0.0, text=f"{text}: {error}" if error else text))
+        name = "link up" if up else "link down because" if error else "link down"
+        self.sink.put(Record(time.time(), "system", source=f"node {n}", number=n, value=1.0 if up else 0.0,
+                             text=self.words(name, node=n, endpoint=node.stats.endpoint, error=error)))
         present = self._present
 
         def apply(mem: Memory) -> None:

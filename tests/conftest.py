@@ -77,6 +77,18 @@ def _collect_on_the_gui_thread(request: pytest.FixtureRequest):
     gc.collect()
 
 
+@pytest.fixture
+def russian(qapp):
+    """The console's Russian installed for the test (and removed after it)."""
+    from app.gui import i18n
+
+    assert i18n.install(qapp, "ru") == "ru"
+    try:
+        yield
+    finally:
+        i18n.uninstall(qapp)
+
+
 def pytest_runtest_setup(item: pytest.Item) -> None:
     if "asyncua" in sys.modules:  # OPC UA servers may start: see tests/opcua_address_space.py
         from tests.opcua_address_space import fill_once

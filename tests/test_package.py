@@ -110,7 +110,7 @@ def test_the_wheel_installs_netplc_station_with_the_demo_and_the_translations(tm
     finally:
         out, err = stop_once_up(station)
     assert r.returncode == 0, r.stdout + r.stderr
-    assert f"ok: station {demo / 'station.toml'}" in r.stdout
+    assert f"норма: станция {demo / 'station.toml'}" in r.stdout  # the demo's Language is ru
     assert station.returncode == 0, err
     lines = out.splitlines()
     assert lines[0].startswith("station Demo station started"), out

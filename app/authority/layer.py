@@ -119,7 +119,7 @@ class Commands:
                  hand_over: Callable[[str], str | None] | None = None) -> None:
         self.engine = engine
         self.standby = standby  # why this station of a pair takes no commands now (names the primary)
-        self.hand_over = hand_over  # IntoStandBy: None when done, else why not; None: no pair
+        self.hand_over = hand_over  # IntoStandBy by a user: None when done, else why not; None: no pair
         self.sink = sink
         self.role_of = role_of
         self.tags = {t.name: t for t in tags}
@@ -463,7 +463,7 @@ class Commands:
         if self.hand_over is None:
             return self.refuse(who, Action.INTO_STANDBY, "station", Reason.INVALID,
                                "the station is not one of a hot-standby pair ([redundancy])")
-        if (why := self.hand_over(f"IntoStandBy by {who.name}")) is not None:
+        if (why := self.hand_over(who.name)) is not None:
             return self.refuse(who, Action.INTO_STANDBY, "station", Reason.INVALID, why)
         self._put(who, "IntoStandBy: the primary role goes to the partner")
         return self._answer_after_commit()

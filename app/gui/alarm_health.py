@@ -17,6 +17,7 @@ from PySide6.QtCore import QCoreApplication, QDate
 from PySide6.QtGui import QFont
 from PySide6.QtWidgets import QDateEdit, QDialog, QHBoxLayout, QLabel, QPlainTextEdit, QVBoxLayout, QWidget
 
+from hmi_forms.elements import formats
 from hmi_forms.widgets.worker import Worker
 from registrar.health import alarm_health
 from registrar.query import Archive
@@ -52,7 +53,7 @@ class HealthDialog(QDialog):
         bar.addWidget(QLabel(self.tr("Day:")))
         self.day = QDateEdit(QDate.currentDate())
         self.day.setCalendarPopup(True)
-        self.day.setDisplayFormat("dd.MM.yyyy")
+        self.day.setDisplayFormat(formats.qt_date())
         self.day.dateChanged.connect(self.show_day)
         bar.addWidget(self.day)
         bar.addStretch(1)

@@ -63,6 +63,7 @@ from app.gui.rights import Rights
 from app.scada.alarms import PRIORITIES, AlarmRow, State
 from app.scada.station import StationAlarms
 from hmi_forms.elements import formats
+from hmi_forms.widgets.records import cell_width, title_width
 
 logger = logging.getLogger(__name__)
 
@@ -73,6 +74,7 @@ BEEP_MS = 1000
 COLOURS = {1: ("#c62828", "#ffffff"), 2: ("#ef6c00", "#ffffff"), 3: ("#fdd835", "#263445"),
            4: ("#90caf9", "#263445")}
 QUIET = ("#eceff1", "#607d8b")  # shelved
+WIDTHS = (90, 150, 130, 170, 90)  # px at least, of the columns before the text
 COLUMNS = (QT_TRANSLATE_NOOP("AlarmTableModel", "Priority"), QT_TRANSLATE_NOOP("AlarmTableModel", "Time"),
            QT_TRANSLATE_NOOP("AlarmTableModel", "Alarm"), QT_TRANSLATE_NOOP("AlarmTableModel", "State"),
            QT_TRANSLATE_NOOP("AlarmTableModel", "Value at change"),
@@ -137,12 +139,13 @@ class AlarmTableModel(QAbstractTableModel):
             if col == 2:
                 return row.label or row.id
             if col == 3:
-                if row.state is State.SHELVED and row.shelved_until is not None:
-                    shelved = QCoreApplication.translate("AlarmTableModel", "shelved by {0} until {1}: {2}")
-                    return shelved.format(row.shelved_by, stamp(row.shelved_until), row.reason)
                 return words.state(row.state)
             if col == 4:
                 return row.shown
+            if row.state is State.SHELVED and row.shelved_until is not None:  # wrapped, read whole
+                note = QCoreApplication.translate("AlarmTableModel", "shelved by {0} until {1}: {2}")
+                shelved = note.format(row.shelved_by, stamp(row.shelved_until), row.reason)
+                return f"{row.text}\n{shelved}"
             return row.text
         if role == Qt.ItemDataRole.ToolTipRole and index.column() == 2:
             return row.id  # the identity the journal and the publishers use
@@ -266,9 +269,11 @@ class AlarmSummary(QWidget):
         self.table.verticalHeader().setVisible(False)
         self.table.verticalHeader().setDefaultSectionSize(22)
         header = self.table.horizontalHeader()
-        for col, width in enumerate((90, 150, 130, 170, 90)):
+        for col, width in enumerate(WIDTHS):
             self.table.setColumnWidth(col, width)
         header.setSectionResizeMode(len(COLUMNS) - 1, QHeaderView.ResizeMode.Stretch)
+        header.sectionResized.connect(lambda col, _old, _new: col == len(COLUMNS) - 1 and self._fit_rows())
+        self._fit()
         lay.addWidget(self.table, 1)
         self.ack.clicked.connect(self.acknowledge_selected)
         self.ack_all.clicked.connect(self.acknowledge_all)
@@ -302,6 +307,26 @@ class AlarmSummary(QWidget):
         self._apply()
         self.changed.emit()
 
+    def _fit(self) -> None:
+        """Widen a column whose title or cells need more room (a longer language, a longer value):
+        titles, priorities and states are read whole, whichever come; the text takes what is left."""
+        header, table = self.table.horizontalHeader(), self.table
+        least = {0: max(cell_width(table, f"{p} {words.priority(p)}") for p in PRIORITIES),
+                 3: max(cell_width(table, words.state(s)) for s in State)}
+        for col in range(len(COLUMNS) - 1):
+            title = self.model.headerData(col, Qt.Orientation.Horizontal, Qt.ItemDataRole.DisplayRole)
+            need = max(title_width(header, title), table.sizeHintForColumn(col), least.get(col, 0))
+            if need > table.columnWidth(col):
+                table.setColumnWidth(col, need)
+        self._fit_rows()
+
+    def _fit_rows(self) -> None:
+        """A shelved alarm's row is as high as its text and shelving note need, wrapped to the
+        text column (a reason can be long); the others keep one line."""
+        for i, row in enumerate(self.model.rows):
+            if row.state is State.SHELVED:
+                self.table.resizeRowToContents(i)
+
     def _apply(self) -> None:
         typed = self.filter.text().strip().casefold().split()
         rows = [r for r in self.rows
@@ -309,6 +334,7 @@ class AlarmSummary(QWidget):
                        .casefold() for w in typed)]
         selected = set(self.selected())
         self.model.set_rows(rows)
+        self._fit()
         for i, r in enumerate(rows):
             if r.id in selected:
                 self.table.selectRow(i)

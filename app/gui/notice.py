@@ -48,6 +48,7 @@ class Note(QLabel):
         self.timer.start(ms)
 
     def _place(self) -> None:
+        self.ensurePolished()  # the style sheet's padding counts in the height, from the first note on
         parent = self.parentWidget()
         assert parent is not None
         width = max(100, parent.width() - 2 * MARGIN)

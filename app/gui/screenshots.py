@@ -1,8 +1,8 @@
 """`python -m app.gui.screenshots DIR`: the workstation, the viewer and the designer on the demo station.
 
-The workstation's tabs, a tag's faceplate (over the analog form) and the run-time trend of LEVEL
-and TEMP are taken at 1366x768 and 1920x1080, in English (`workstation-02-analog.png`) and in
-Russian (`...-ru.png`).
+The workstation's tabs, a tag's faceplate (over the analog form), the run-time trend of LEVEL
+and TEMP and the designer are taken at 1366x768 and 1920x1080, in English
+(`workstation-02-analog.png`, `designer-02-analog-1920x1080.png`) and in Russian (`...-ru.png`).
 
 The demo station runs for real (a copy in a temporary folder, the embedded node over TCP, its own
 archive) while a short script plays the operator: Пуск pressed a few times, a setpoint entered,
@@ -75,10 +75,11 @@ def main(argv: list[str] | None = None) -> int:
         try:
             for n, language in enumerate(LANGUAGES):
                 i18n.install(app, language)  # the window's texts are translated as it is made
+                suffix = "" if language == "en" else "-ru"
                 written += _workstation(runtime, args.out, lambda s: _pump_events(app, s),
-                                        args.seconds if n == 0 else 0.0, "" if language == "en" else "-ru")
+                                        args.seconds if n == 0 else 0.0, suffix)
+                written += _designer(runtime, args.out, lambda s: _pump_events(app, s), suffix)
             i18n.install(app, "en")
-            written.append(_designer(runtime, args.out, lambda s: _pump_events(app, s)))
         finally:
             runtime.stop()
         viewer = ViewerWindow(runtime.station.Archive)
@@ -166,23 +167,33 @@ def _trend(window: MainWindow, path: Path, size: tuple[int, int], wait: Callable
     return path
 
 
-def _designer(runtime: Runtime, out: Path, wait: Callable[[float], None]) -> Path:
-    """The form designer on the analog form, previewing the running station live, a gauge selected."""
+def _designer(runtime: Runtime, out: Path, wait: Callable[[float], None], language: str) -> list[Path]:
+    """The form designer on the analog form at each window size, previewing the running station
+    live, a gauge selected."""
     from app.gui.designer.station import open_target
     from app.gui.designer.window import DesignerWindow
 
     window = DesignerWindow(open_target(runtime.station.path.parent / "forms" / "02_analog.hmi"))
+    window.resize(*WINDOW_SIZES[0])
     window.show()
-    window.canvas.home()
-    window.design.select([e for e in window.design.doc.elements if e.get("Name") == "Уровень"])
-    window.start_preview("127.0.0.1", runtime.modbus.port if runtime.modbus is not None else None)
-    wait(2.0)
-    window.problems.recheck()
-    path = out / "designer-02-analog.png"
-    window.grab().save(str(path))
-    window.stop_preview()
-    window.close()
-    return path
+    written: list[Path] = []
+    try:
+        window.design.select([e for e in window.design.doc.elements if e.get("Name") == "Уровень"])
+        window.start_preview("127.0.0.1", runtime.modbus.port if runtime.modbus is not None else None)
+        wait(2.0)
+        for size in WINDOW_SIZES:
+            window.resize(*size)
+            window.canvas.home()
+            wait(0.3)
+            window.problems.recheck()
+            suffix = ("" if size == WINDOW_SIZES[0] else f"-{size[0]}x{size[1]}") + language
+            path = out / f"designer-02-analog{suffix}.png"
+            window.grab().save(str(path))
+            written.append(path)
+        window.stop_preview()
+    finally:
+        window.close()
+    return written
 
 
 def _play_operator(runtime: Runtime, wait: Callable[[float], None], seconds: float) -> None:

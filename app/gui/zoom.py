@@ -8,11 +8,14 @@ form and screen size (app/gui/placement.py) and a fit is kept on every resize.
 
 from __future__ import annotations
 
-from PySide6.QtCore import QRect, Qt, Signal
+from PySide6.QtCore import QT_TRANSLATE_NOOP, QCoreApplication, QRect, Qt, Signal
 from PySide6.QtGui import QColor, QPainter, QResizeEvent, QTransform, QWheelEvent
 from PySide6.QtWidgets import QFrame, QGraphicsScene, QGraphicsView, QWidget
 
-FIT_WIDTH, FIT_WINDOW, ACTUAL = "fit width", "fit window", "100 %"
+# the modes are keys (the settings keep them); the status bar says them translated
+FIT_WIDTH = QT_TRANSLATE_NOOP("ZoomArea", "fit width")
+FIT_WINDOW = QT_TRANSLATE_NOOP("ZoomArea", "fit window")
+ACTUAL = "100 %"
 MODES = (FIT_WIDTH, FIT_WINDOW, ACTUAL)
 STEP = 1.15  # one notch of Ctrl+wheel, or Ctrl++ / Ctrl+-
 LIMITS = (0.25, 4.0)
@@ -64,7 +67,9 @@ class ZoomArea(QGraphicsView):
         return self.mode or f"{self.factor:.3f}"
 
     def label(self) -> str:
-        return self.mode or f"{self.factor * 100:.0f} %"
+        if self.mode:
+            return QCoreApplication.translate("ZoomArea", self.mode)
+        return f"{self.factor * 100:.0f} %"
 
     def _apply(self) -> None:
         w, h = self.form_view.width(), self.form_view.height()

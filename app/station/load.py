@@ -20,6 +20,7 @@ from typing import TYPE_CHECKING
 from app.authority.policy import VIEWER
 from app.authority.users import USERS_FILE, Users, UsersFileError
 from app.scada.table import TagTable, read_tags
+from app.scada.words import Phrase, phrase
 from app.station.config import Station
 from app.station.extras import station_problems
 from netplc.exchange import check_program_nodes
@@ -43,7 +44,7 @@ class Loaded:
     forms: list[Form] = field(default_factory=list)
     problems: list[str] = field(default_factory=list)  # each one stops a start
     form_problems: list[str] = field(default_factory=list)  # forms that did not load
-    notes: list[str] = field(default_factory=list)  # what was found good, for check's summary
+    notes: list[Phrase] = field(default_factory=list)  # what was found good, for check's summary
 
 
 def load(station: Station) -> Loaded:
@@ -59,25 +60,25 @@ def load(station: Station) -> Loaded:
             out.problems += e.problems
             continue
         out.node_programs.append(p)
-        out.notes.append(f"node {sim.node} simulator program {sim.program.name}: "
-                         f"{len(p.instrs)} instructions")
+        out.notes.append(phrase("note simulator", node=sim.node, program=sim.program.name,
+                                instrs=len(p.instrs)))
     if station.Messages is not None:
         try:
             out.catalog = Catalog.load(station.Messages)
-            out.notes.append(f"messages {station.Messages.name}: {len(out.catalog)} texts")
+            out.notes.append(phrase("note messages", file=station.Messages.name, n=len(out.catalog)))
         except CatalogError as e:
             out.problems += e.problems
     if station.Tags is not None:
         out.tags, problems = read_tags(station.Tags, out.symbols)
         out.problems += problems
-        out.notes.append(f"tags {station.Tags.name}: {len(out.tags.tags)} tags, "
-                         f"{len(out.tags.alarms)} with alarms")
+        out.notes.append(phrase("note tags", file=station.Tags.name, n=len(out.tags.tags),
+                                alarms=len(out.tags.alarms)))
     _users(station, out)
     _state_files(station, out)
     out.problems += station_problems(station)  # OPC UA, MQTT or the plant archive without its extra
     out.forms, out.form_problems = load_station_forms(station, out.symbols, out.tags)
     if station.HMIload is not None:
-        out.notes.append(f"forms in {station.HMIload}: {len(out.forms)} loaded")
+        out.notes.append(phrase("note forms", folder=station.HMIload, n=len(out.forms)))
     return out
 
 
@@ -126,8 +127,8 @@ def _users(station: Station, out: Loaded) -> None:
         out.problems.append(f"{key}: {name!r} is of role {user.role}: the default user acts for whoever "
                             "is at the workstation without logging in, so it must be a viewer")
     elif users.users:
-        out.notes.append(f"users {USERS_FILE}: {len(users.users)}"
-                         + (f", {name!r} at the workstation until someone logs in" if name else ""))
+        out.notes.append(phrase("note users", file=USERS_FILE, n=len(users.users)) if not name else
+                         phrase("note users default", file=USERS_FILE, n=len(users.users), name=name))
 
 
 def _state_files(station: Station, out: Loaded) -> None:
@@ -151,7 +152,7 @@ def _program(station: Station, out: Loaded) -> Program | None:
         out.problems += e.problems
         return _recovered(path, out.symbols, {d.line for d in e.errors})
     out.program = program
-    out.notes.append(f"program {path.name}: {len(program.instrs)} instructions, {program.words} words")
+    out.notes.append(phrase("note program", file=path.name, instrs=len(program.instrs), words=program.words))
     return program
 
 

@@ -42,6 +42,10 @@ class LinkError(ConnectionError):
     """The pair link broke, or the partner sent what is no frame of ours."""
 
 
+class LinkClosed(LinkError):
+    """The partner closed the link: how a link usually ends, said in the station's words."""
+
+
 def send_frame(sock: socket.socket, kind: int, payload: bytes) -> None:
     sock.sendall(_HEAD.pack(len(payload) + 2, VERSION, kind) + payload)
 
@@ -61,7 +65,7 @@ def _receive(sock: socket.socket, n: int) -> bytes:
     while len(out) < n:
         chunk = sock.recv(n - len(out))
         if not chunk:
-            raise LinkError("the partner closed the pair link")
+            raise LinkClosed("the partner closed the pair link")
         out += chunk
     return bytes(out)
 

@@ -31,6 +31,7 @@ from dataclasses import dataclass, replace
 from enum import StrEnum
 from typing import TYPE_CHECKING
 
+from app.scada.words import Phrase, phrase, words
 from app.station.config import RedundancySettings
 from app.station.fingerprint import differing
 from app.station.mirror import (
@@ -40,6 +41,7 @@ from app.station.mirror import (
     STATE,
     Capture,
     Encoder,
+    LinkClosed,
     LinkError,
     Mirror,
     capture,
@@ -60,6 +62,11 @@ class Role(StrEnum):
     STARTING = "starting"
     PRIMARY = "primary"
     STANDBY = "standby"
+
+
+def said_role(role: Role) -> Phrase:
+    """A role as the records name it, in the station's language."""
+    return phrase(f"role {role.value}")
 
 
 # HSBStatus of seed 000 by role: 0 after power-on, 4 standby, 5 master (6 defect: refused partner)
@@ -191,7 +198,7 @@ class Pair:
         self._spawn(self._watch, "pair watch")
         window = max(self.failover + 2 * self.tick, START_WINDOW)
         if not self._decided.wait(window):
-            self._become(Role.PRIMARY, f"no partner answered within {window * 1000:.0f} ms of the start")
+            self._become(Role.PRIMARY, phrase("no partner", ms=window * 1000))
 
     def _spawn(self, target: Callable[[], None], name: str) -> None:
         thread = threading.Thread(target=target, name=name, daemon=True)
@@ -231,7 +238,7 @@ class Pair:
             return "the station is starting as one of a pair: it takes commands once it is the primary"
         return f"this station ({self.settings.letter}) is the standby: the primary is {self.partner_name}"
 
-    def _may_lead(self, cause: str, patience: float = 0.0) -> bool:
+    def _may_lead(self, cause: Phrase, patience: float = 0.0) -> bool:
         """Without an arbiter, always; with one, once this station holds its lease (`patience`:
         seconds to keep trying, for a lease the partner is releasing as it hands over). A
         refusal is journaled once per cause."""
@@ -243,17 +250,17 @@ class Pair:
             if self.clock() >= deadline or self._stopping.is_set():
                 if lease.last_error != self._waiting:  # once per cause, not per silent tick
                     self._waiting = lease.last_error
-                    self.runtime.system(f"pair {self.settings.letter}: stays {self.role.value} ({cause}): "
-                                        f"the arbiter decides: {lease.last_error}", logging.WARNING)
+                    self.runtime.say("pair stays", logging.WARNING, letter=self.settings.letter,
+                                     role=said_role(self.role), cause=cause, error=lease.last_error)
                 return False
             self._stopping.wait(self.tick / 4)
         self._waiting = ""
         return True
 
-    def _become(self, role: Role, cause: str, patience: float = 0.0, code: int = 0) -> None:
+    def _become(self, role: Role, cause: Phrase, patience: float = 0.0, code: int = 0) -> None:
         if role is Role.PRIMARY and self.role is not Role.PRIMARY and not self._may_lead(cause, patience):
             if self.role is Role.STARTING:
-                role, cause = Role.STANDBY, f"{cause}; the partner holds the arbiter's lease"
+                role, cause = Role.STANDBY, phrase("lease held", cause=cause)
             else:
                 return
         if role is not Role.PRIMARY and self.lease is not None:
@@ -272,13 +279,15 @@ class Pair:
         if role is Role.PRIMARY:
             if old is Role.STANDBY:
                 self.switchovers += 1
-            self.last_takeover = f"{time.strftime('%Y-%m-%d %H:%M:%S')}: {cause}"
+            said = words(self.runtime.station.Language)
+            self.last_takeover = f"{time.strftime(said.stamp)}: {said.say(cause)}"
             engine.post(self._lead)
         else:
             engine.post(self._follow)
         self._decided.set()
         level = logging.WARNING if old is not Role.STARTING else logging.INFO
-        self.runtime.system(f"pair {self.settings.letter}: {old} -> {role}: {cause}", level)
+        self.runtime.say("pair role", level, letter=self.settings.letter, old=said_role(old),
+                         new=said_role(role), cause=cause)
 
     def _lead(self, mem: Memory) -> None:
         """On the engine thread: the newest mirrored state, then the program runs on from it."""
@@ -305,7 +314,8 @@ class Pair:
     def into_standby(self, cause: str, wait: float = 0.0) -> bool:
         """Hand the primary role to the standby (IntoStandBy) at the end of the next scan: that
         scan's state is the last frame, then the handover. False when this station is no primary
-        with a standby on the link. `wait`: seconds to wait for the handover to be sent."""
+        with a standby on the link. `wait`: seconds to wait for the handover to be sent. `cause`
+        is said in the station's language: the partner, whose Language is ours, journals it."""
         with self._changed:
             if self.role is not Role.PRIMARY or self._link is None:
                 return False
@@ -371,14 +381,16 @@ class Pair:
                 self._last_frame = self.clock()
                 self._whole_alarms = True
             self._become(decide(self.role, self.settings.letter, Role(hello["role"]), self.led_scans,
-                                int(hello.get("led", 0))), f"partner {hello['letter']} is {hello['role']}")
+                                int(hello.get("led", 0))),
+                         phrase("partner is", letter=hello["letter"], role=said_role(Role(hello["role"]))))
             self.refused = ""
             paired = True
             self._run_link(conn)
         except (OSError, LinkError, ValueError) as e:
             if paired and not self._stopping.is_set():
-                self.runtime.system(f"pair {self.settings.letter}: link to the partner lost "
-                                    f"({self.role.value}): {e or type(e).__name__}", logging.WARNING)
+                self.runtime.say("pair link lost", logging.WARNING, letter=self.settings.letter,
+                                 role=said_role(self.role), error=phrase("link closed")
+                                 if isinstance(e, LinkClosed) else e or type(e).__name__)
             elif not self._stopping.is_set():
                 logger.info("pair link ended: %s", e)
         finally:
@@ -397,17 +409,16 @@ class Pair:
         """The partner holds the same station, and the other letter; else refused, journaled."""
         theirs = hello.get("files")
         differ = differing(self.files, theirs if isinstance(theirs, dict) else {})
-        why = ""
         if hello["letter"] == self.settings.letter:
-            why = f"the partner is {self.settings.letter} as well"
+            why = phrase("same letter", letter=self.settings.letter)
         elif differ:
-            why = f"the partner's station differs: {', '.join(differ)}"
-        if not why:
+            why = phrase("station differs", files=", ".join(differ))
+        else:
             return True
-        text = f"pair {self.settings.letter}: partner refused: {why}"
+        text = words(self.runtime.station.Language)("pair refused", letter=self.settings.letter, why=why)
         if text != self.refused:
             self.refused = text
-            self.runtime.system(text, logging.WARNING)
+            self.runtime.say("pair refused", logging.WARNING, letter=self.settings.letter, why=why)
         return False
 
     def _run_link(self, conn: socket.socket) -> None:
@@ -454,7 +465,7 @@ class Pair:
             self._mirrored(struct.unpack(">q", payload)[0])
         elif kind == HANDOVER:
             cause = json.loads(payload).get("cause", "IntoStandBy")
-            self._become(Role.PRIMARY, f"handed over by the partner: {cause}", patience=self.failover,
+            self._become(Role.PRIMARY, phrase("handed over", cause=cause), patience=self.failover,
                          code=HANDED_OVER)
 
     def after_mirrored(self, callback: Callable[[], None]) -> None:
@@ -526,8 +537,8 @@ class Pair:
                 self._last_frame = self.clock()
             self._changed.notify_all()
         if self._handover:
-            self.runtime.system(f"pair {self.settings.letter}: primary -> standby: {self._handover}",
-                                logging.WARNING)
+            self.runtime.say("pair handover", logging.WARNING, letter=self.settings.letter,
+                             cause=self._handover)
 
     def _watch(self) -> None:
         """The standby's watch on the primary's silence; the primary's on its lease: one that
@@ -536,14 +547,14 @@ class Pair:
             lease = self.lease
             if self.role is Role.PRIMARY and lease is not None and not lease.alive() \
                     and not lease.take() and self._link is None:
-                self._become(Role.STANDBY, f"lost the arbiter ({lease.last_error}) and the partner",
+                self._become(Role.STANDBY, phrase("lost both", error=lease.last_error),
                              code=STEPPED_DOWN)
             if self.role is not Role.STANDBY:
                 continue
             silent = self.clock() - self._last_frame
             if silent >= self.failover:
                 self._drop_link()
-                self._become(Role.PRIMARY, f"partner silent for {silent * 1000:.0f} ms", code=SILENT)
+                self._become(Role.PRIMARY, phrase("partner silent", ms=silent * 1000), code=SILENT)
 
     def _drop_link(self) -> None:
         with self._changed:

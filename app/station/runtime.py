@@ -34,7 +34,7 @@ from app.scada.alarms import Alarm
 from app.scada.readings import Readings
 from app.scada.station import STATE_FILE as ALARM_STATE_FILE
 from app.scada.station import StationAlarms
-from app.scada.words import ENGLISH, words
+from app.scada.words import ENGLISH, phrase, words
 from app.station.config import Station
 from app.station.load import load, load_station_forms
 from app.station.lock import StationLock, StationRunning
@@ -332,6 +332,7 @@ class Runtime:
             self.simulators.append(simulator)
             self._fill_endpoint(sim.node, f"tcp://{sim.host}:{simulator.port}")
         self.exchange = Exchange(self.nodes, self)
+        self.exchange.words = words(st.Language)
         self.exchange.attach(self.engine)
         self.exchange.start()
         self.alarms = StationAlarms(st.Tags, self.program, list(self.catalog), self,
@@ -370,7 +371,7 @@ class Runtime:
         self.scan_thread = ScanThread(self.engine, st.tick, on_error=self._scan_error)
         self.scan_thread.start()
         self.started = True
-        self.say("started", sync=st.NetSyncTime, restored=self.restored)
+        self.say("started", sync=st.NetSyncTime, restored=phrase(f"retained {self.restored}"))
         threading.Thread(target=self._report_unresolved, name="resolve", daemon=True).start()
 
     def _start_pair(self) -> None:
@@ -419,10 +420,10 @@ class Runtime:
             return None if self.station.redundancy is None else "the station is joining its pair"
         return pair.refusal()
 
-    def _hand_over(self, cause: str) -> str | None:
-        """IntoStandBy, for the command layer: None once asked for, else why not."""
+    def _hand_over(self, user: str) -> str | None:
+        """IntoStandBy by `user`, for the command layer: None once asked for, else why not."""
         pair = self.pair
-        if pair is None or not pair.into_standby(cause):
+        if pair is None or not pair.into_standby(words(self.station.Language)("into standby", user=user)):
             return "no standby on the pair link to hand over to"
         return None
 
@@ -510,7 +511,7 @@ class Runtime:
         """Stop everything in the reverse order of start; safe to call twice or after a failed start.
         The primary of a pair hands over to its standby first."""
         if self.pair is not None:
-            self.pair.into_standby("the primary is stopping", wait=1.0)
+            self.pair.into_standby(words(self.station.Language)("primary stopping"), wait=1.0)
             self.pair.stop()
             self.pair = None
         if self.scan_thread is not None:

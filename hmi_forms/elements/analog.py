@@ -33,6 +33,7 @@ from app.scada.table import TagTable
 from app.scada.tag import Tag
 from hmi_forms.elements import props as p
 from hmi_forms.elements.base import Element, Reader, Writer, word_reader
+from hmi_forms.elements.sentence import Sentence
 from hmi_forms.elements.trend import Trend
 from netplc.address import IO_BITS, fmt_octal
 from netplc.memory import Snapshot
@@ -41,6 +42,11 @@ logger = logging.getLogger(__name__)
 
 APPEARANCES = ("digital", "hbar", "dial", "semidial", "graph", "tank")  # tank: an extension
 ZONE_TYPES = {"low": 2, "normal": 0, "high": 2}
+# what an AnalogOutput says of an entry (the widget lists them for the translations)
+DISABLED = "Input is disabled for this element"
+NOT_A_NUMBER = '"{0}" is not a number'
+OUT_OF_RANGE = "{0} is out of range {1} … {2}{3}"
+SET_TO = "Set to {0}{1}"
 MAX_SHOWN = 4096  # words remembered per conversion (`remembered`), then forgotten: memory stays flat
 
 
@@ -342,15 +348,15 @@ class AnalogOutput(Scaled, Writer):
         lo, hi = self.scaling.phy_range
         units = f" {self.Units}" if self.Units else ""
         if not self.Enabled:
-            return False, "Input is disabled for this element"
+            return False, Sentence(DISABLED)
         try:
             phy = float(entry.strip().replace(",", "."))
         except ValueError:
-            return False, f'"{entry.strip()}" is not a number'
+            return False, Sentence(NOT_A_NUMBER, entry.strip())
         if not math.isfinite(phy):
-            return False, f'"{entry.strip()}" is not a number'
+            return False, Sentence(NOT_A_NUMBER, entry.strip())
         if not lo <= phy <= hi:
-            return False, f"{entry.strip()} is out of range {self.format(lo)} … {self.format(hi)}{units}"
+            return False, Sentence(OUT_OF_RANGE, entry.strip(), self.format(lo), self.format(hi), units)
         hw = self.scaling.to_hw(phy)
         assert self.OutAddr is not None
         label = self.label or fmt_octal(self.OutAddr)
@@ -360,4 +366,4 @@ class AnalogOutput(Scaled, Writer):
                 self.OutAddr, hw, user=self.user, label=self.label or None, at_least=self.Role,
                 describe=self.change)) is not None:
             return False, why
-        return True, f"Set to {self.format(self.scaling.to_phy(hw))}{units}"
+        return True, Sentence(SET_TO, self.format(self.scaling.to_phy(hw)), units)

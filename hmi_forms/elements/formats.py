@@ -13,12 +13,18 @@ import datetime as dt
 
 TIME = "%H:%M:%S"
 DATES = {"ru": "%d.%m.%Y", "en": "%Y-%m-%d"}
-_date = DATES["ru"]
+QT_DATES = {"ru": "dd.MM.yyyy", "en": "yyyy-MM-dd"}  # the same, for Qt's date pickers
+_language = "ru"
 
 
 def set_language(language: str) -> None:
-    global _date
-    _date = DATES.get(language, DATES["ru"])
+    global _language
+    _language = language if language in DATES else "ru"
+
+
+def qt_date() -> str:
+    """The date picker's format: its dates read as the journal's beside it."""
+    return QT_DATES[_language]
 
 
 def clock(ts: float, tz: dt.tzinfo | None = None) -> str:
@@ -33,7 +39,7 @@ def clock_ms(ts: float, tz: dt.tzinfo | None = None) -> str:
 def date(day: dt.date | float) -> str:
     if isinstance(day, float | int):
         day = dt.date.fromtimestamp(day)
-    return day.strftime(_date)
+    return day.strftime(DATES[_language])
 
 
 def date_time(ts: float) -> str:

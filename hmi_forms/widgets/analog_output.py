@@ -9,16 +9,30 @@ hardware word).
 
 from __future__ import annotations
 
-from PySide6.QtCore import Qt
+from PySide6.QtCore import QT_TRANSLATE_NOOP, QCoreApplication, Qt
 from PySide6.QtWidgets import QHBoxLayout, QLabel, QLineEdit, QPushButton, QVBoxLayout, QWidget
 
 from hmi_forms.elements.analog import AnalogOutput
+from hmi_forms.elements.sentence import Sentence
 from hmi_forms.widgets import theme
 from hmi_forms.widgets.base import Images, SelfPainted
 
 OK_STYLE = f"color: {theme.ON.name()};"
 BAD_STYLE = f"color: {theme.ALARM.name()}; font-weight: bold;"
 EDIT_BAD = f"QLineEdit {{ border: 2px solid {theme.ALARM.name()}; background: #fdecea; }}"
+SENTENCES = (  # the model's (hmi_forms/elements/analog.py), for the translations
+    QT_TRANSLATE_NOOP("AnalogOutput", "Input is disabled for this element"),
+    QT_TRANSLATE_NOOP("AnalogOutput", '"{0}" is not a number'),
+    QT_TRANSLATE_NOOP("AnalogOutput", "{0} is out of range {1} … {2}{3}"),
+    QT_TRANSLATE_NOOP("AnalogOutput", "Set to {0}{1}"),
+)
+
+
+def said(text: str) -> str:
+    """The model's sentence in the console's language; a refusal comes translated already."""
+    if isinstance(text, Sentence):
+        return QCoreApplication.translate("AnalogOutput", text.source).format(*text.values)
+    return text
 
 
 class AnalogOutputWidget(SelfPainted):
@@ -48,7 +62,7 @@ class AnalogOutputWidget(SelfPainted):
         self.edit.setEnabled(model.Enabled)
         self.edit.returnPressed.connect(self.submit)
         self.edit.textEdited.connect(self._clear_mark)
-        self.button = QPushButton("Set")
+        self.button = QPushButton(QCoreApplication.translate("AnalogOutput", "Set"))
         self.button.setEnabled(model.Enabled)
         self.button.clicked.connect(self.submit)
         row.addWidget(self.edit, 1)
@@ -60,8 +74,9 @@ class AnalogOutputWidget(SelfPainted):
         layout.addWidget(self.message)
         layout.addStretch(1)
         self.stale_mark.raise_()
-        self.setToolTip(f"{model.Name}: writes word {oct(model.OutAddr or 0)[2:].rjust(5, '0')}; "
-                        f"range {model.format(lo)} … {model.format(hi)}{units}")
+        word = oct(model.OutAddr or 0)[2:].rjust(5, "0")
+        tip = QCoreApplication.translate("AnalogOutput", "{0}: writes word {1}; range {2} … {3}{4}")
+        self.setToolTip(tip.format(model.Name, word, model.format(lo), model.format(hi), units))
 
     def sync(self) -> None:
         units = f" {self.model.Units}" if self.model.Units else ""
@@ -70,7 +85,7 @@ class AnalogOutputWidget(SelfPainted):
 
     def submit(self) -> None:
         ok, text = self.model.submit(self.edit.text())
-        self.message.setText(text)
+        self.message.setText(said(text))
         self.message.setStyleSheet(OK_STYLE if ok else BAD_STYLE)
         self.edit.setStyleSheet("" if ok else EDIT_BAD)
         if ok:

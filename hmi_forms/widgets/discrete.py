@@ -80,7 +80,8 @@ class DiscreteWidget(ElementWidget):
         self.has_lamp = not isinstance(model, DiscreteColorLabel) and not has_images
         if model.Enabled and model.Cursor == "Default":
             self.setCursor(Qt.CursorShape.PointingHandCursor)
-        self.setToolTip(f"{model.Name}: {model.InAddr}" + (" (click to toggle)" if model.Enabled else ""))
+        self.setToolTip(f"{model.Name}: {model.InAddr}" + (QCoreApplication.translate(
+            "DiscreteWidget", " (click to toggle)") if model.Enabled else ""))
 
     def back_color(self) -> QColor | None:
         if isinstance(self.model, DiscreteColorLabel):

@@ -12,7 +12,7 @@ from __future__ import annotations
 import math
 from collections.abc import Callable, Hashable
 
-from PySide6.QtCore import QPointF, QRect, QRectF, Qt
+from PySide6.QtCore import QCoreApplication, QPointF, QRect, QRectF, Qt
 from PySide6.QtGui import (
     QColor,
     QFont,
@@ -98,9 +98,11 @@ class GaugeWidget(ElementWidget):
         self._bar: tuple[int, int, int, float] = (0, 0, 0, 0.0)  # the fill's left, top, height and travel
         self._needles: dict[Hashable, Sprite] | None = None  # the needle by position (None: drawn each time)
         self._contained = True  # the dial lies inside the element (its sprites need no clip)
-        self.setToolTip(f"{model.Name}: word {oct(model.InAddr or 0)[2:].rjust(5, '0')}, "
-                        f"{model.format(lo)} … {model.format(hi)}{self._units}"
-                        + ("; double-click resets the maximum" if model.KeepMaxValue else ""))
+        self.setToolTip(QCoreApplication.translate("AnalogWidget", "{0}: word {1}, {2} … {3}{4}").format(
+            model.Name, oct(model.InAddr or 0)[2:].rjust(5, "0"), model.format(lo), model.format(hi),
+            self._units)
+            + (QCoreApplication.translate("AnalogWidget", "; double-click resets the maximum")
+               if model.KeepMaxValue else ""))
 
     # --- geometry shared by the static layer and the pointer ----------------------------------
 
@@ -490,7 +492,7 @@ class GaugeWidget(ElementWidget):
             p.setFont(theme.sized_font(max(8.0, size * 0.38)))
             p.setPen(fg if m.zone else theme.ALARM)
             p.drawText(box.adjusted(6, 2, 0, 0), Qt.AlignmentFlag.AlignLeft | Qt.AlignmentFlag.AlignTop,
-                       f"max {m.format(m.maximum)}")
+                       QCoreApplication.translate("AnalogWidget", "max {0}").format(m.format(m.maximum)))
 
     def mouseDoubleClickEvent(self, event: QMouseEvent) -> None:
         if self.model.KeepMaxValue:

@@ -18,7 +18,7 @@ from dataclasses import dataclass
 from functools import partial
 from pathlib import Path
 
-from PySide6.QtCore import QDate
+from PySide6.QtCore import QT_TRANSLATE_NOOP, QCoreApplication, QDate, Qt
 from PySide6.QtGui import QColor
 from PySide6.QtWidgets import (
     QComboBox,
@@ -41,7 +41,10 @@ from registrar.query import Archive, Filter, Row
 
 logger = logging.getLogger(__name__)
 
-MIN_TYPES = (("all types", None), ("warnings and worse", 1), ("alarms and worse", 2), ("critical", 3))
+MIN_TYPES = ((QT_TRANSLATE_NOOP("JournalWidget", "all types"), None),
+             (QT_TRANSLATE_NOOP("JournalWidget", "warnings and worse"), 1),
+             (QT_TRANSLATE_NOOP("JournalWidget", "alarms and worse"), 2),
+             (QT_TRANSLATE_NOOP("JournalWidget", "critical"), 3))
 PALETTE = Palette(back={1: QColor("#fff4d6"), 2: QColor("#fde0dc"), 3: theme.ALARM},
                   fore={2: QColor("#8e1b1b"), 3: QColor("#ffffff")})
 PAGE = "page"  # the worker's one topic: a newer page request supersedes the older ones
@@ -97,26 +100,26 @@ class JournalWidget(SelfPainted):
         bar = QHBoxLayout()
         self.date = QDateEdit(QDate.currentDate())
         self.date.setCalendarPopup(True)
-        self.date.setDisplayFormat("dd.MM.yyyy")
+        self.date.setDisplayFormat(formats.qt_date())
         self.date.dateChanged.connect(self._day_chosen)
-        today = QPushButton("Today")
+        today = QPushButton(QCoreApplication.translate("JournalWidget", "Today"))
         today.clicked.connect(lambda: self.date.setDate(QDate.currentDate()))
         self.kind = QComboBox()
-        self.kind.addItem("all kinds", KINDS)
+        self.kind.addItem(QCoreApplication.translate("JournalWidget", "all kinds"), KINDS)
         for k in KINDS:
-            self.kind.addItem(k, (k,))
-        self.kind.addItem("as configured", model.Kinds)
+            self.kind.addItem(QCoreApplication.translate("records", k), (k,))
+        self.kind.addItem(QCoreApplication.translate("JournalWidget", "as configured"), model.Kinds)
         self.kind.setCurrentIndex(self.kind.count() - 1)
         self.kind.currentIndexChanged.connect(self._filter_changed)
         self.min_type = QComboBox()
         for text, value in MIN_TYPES:
-            self.min_type.addItem(text, value)
+            self.min_type.addItem(QCoreApplication.translate("JournalWidget", text), value)
         self.min_type.setCurrentIndex([v for _, v in MIN_TYPES].index(model.MinType))
         self.min_type.currentIndexChanged.connect(self._filter_changed)
         self.group = QSpinBox()
         self.group.setRange(-1, 65535)
-        self.group.setSpecialValueText("all groups")
-        self.group.setPrefix("group ")
+        self.group.setSpecialValueText(QCoreApplication.translate("JournalWidget", "all groups"))
+        self.group.setPrefix(QCoreApplication.translate("JournalWidget", "group "))
         self.group.setValue(-1 if model.Group is None else model.Group)
         self.group.valueChanged.connect(self._filter_changed)
         self.status = QLabel("")
@@ -124,11 +127,11 @@ class JournalWidget(SelfPainted):
         for w in (self.date, today, self.kind, self.min_type, self.group):
             bar.addWidget(w)
         bar.addStretch(1)
-        bar.addWidget(self.status)
         layout.addLayout(bar)
         self.table = RecordsModel(JOURNAL_COLUMNS, PALETTE)
         self.view = records_view(self.table, row_height=20)
         layout.addWidget(self.view, 1)
+        layout.addWidget(self.status, 0, Qt.AlignmentFlag.AlignRight)  # under the table: the bar for filters
         self.stale_mark.raise_()
         self.reload()
 
@@ -150,7 +153,7 @@ class JournalWidget(SelfPainted):
     def reload(self, count: bool = True) -> None:
         """Ask for the chosen day's page; counting a whole day is left to changes of day or filter."""
         if self.reader is None:
-            self.status.setText("no archive configured")
+            self.status.setText(QCoreApplication.translate("JournalWidget", "no archive configured"))
             return
         if self.worker.closed:
             return  # the window is closing
@@ -166,17 +169,20 @@ class JournalWidget(SelfPainted):
 
     def _shown(self, _token: int, page: Page | None) -> None:
         if page is None:
-            self.status.setText("no archive yet")
+            self.status.setText(QCoreApplication.translate("JournalWidget", "no archive yet"))
             self.table.set_rows([])
             return
         self.table.set_rows(page.rows)
         if page.total is not None:
             self._count = False
-            n, total, day = len(page.rows), page.total, formats.date(page.day)
-            self.status.setText(f"{n} of {total} records, {day}" if total > n else f"{total} records, {day}")
+            n, total = len(page.rows), page.total  # of the day the picker beside it shows
+            shown = QCoreApplication.translate("JournalWidget", "{0} of {1} records").format(n, total)
+            self.status.setText(shown if total > n else
+                                QCoreApplication.translate("JournalWidget", "{0} records").format(total))
 
     def _failed(self, _token: int, why: str) -> None:
-        self.status.setText(f"archive unreadable: {why}")
+        self.status.setText(QCoreApplication.translate("JournalWidget", "archive unreadable: {0}").format(
+            why))
 
     def close_archive(self) -> None:
         """Stop reading (the window closes): the worker and the archive close."""

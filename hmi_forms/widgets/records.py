@@ -47,6 +47,7 @@ def format_value(value: float | None) -> str:
 
 STATES = frozenset(int(s) for s in State)
 HEADER_PADDING = 18  # px beside a column title: its margins and the sort mark
+CELL_PADDING = 10  # px beside a cell's text: the item's margins
 
 
 def type_name(row: Row) -> str:
@@ -79,14 +80,15 @@ class Column:
     text: Callable[[Row], str]
     width: int = 0  # 0: the column takes the spare width
     right: bool = False
+    fits: tuple[str, ...] = ()  # words the column shows whole, in the console's language ("records")
 
 
 TIME = Column("Time", clock_ms, 96)
 KINDS = (QT_TRANSLATE_NOOP("records", "data"), QT_TRANSLATE_NOOP("records", "message"),
          QT_TRANSLATE_NOOP("records", "operator"), QT_TRANSLATE_NOOP("records", "system"))
-KIND = Column("Kind", lambda r: QCoreApplication.translate("records", r.kind), 76)
+KIND = Column("Kind", lambda r: QCoreApplication.translate("records", r.kind), 76, fits=(*KINDS, "alarm"))
 GROUP = Column("Group", lambda r: "" if r.grp is None else str(r.grp), 64, right=True)
-TYPE = Column("Type", type_name, 64, right=True)
+TYPE = Column("Type", type_name, 64, right=True, fits=tuple(TYPE_NAMES.values()))
 SOURCE = Column("Source", lambda r: r.source or "", 120)
 NUMBER = Column("No.", number, 64, right=True)
 VALUE = Column("Value", lambda r: format_value(r.value), 84, right=True)
@@ -97,11 +99,12 @@ ARCHIVE_COLUMNS = (TIME, KIND, GROUP, TYPE, SOURCE, NUMBER, VALUE, TEXT)
 
 JOURNAL_COLUMNS = (
     Column("Time", lambda r: formats.clock(r.ts), 70),
-    Column("Kind", KIND.text, 70),
+    Column("Kind", KIND.text, 70, fits=KIND.fits),
     Column("Group", GROUP.text, 50),
-    Column("Type", type_name, 64),
+    Column("Type", type_name, 64, fits=TYPE.fits),
     Column("Source", SOURCE.text, 110),
-    Column("Text", lambda r: r.text or ("" if r.number is None else f"message {r.number}")),
+    Column("Text", lambda r: r.text or ("" if r.number is None else QCoreApplication.translate(
+        "records", "message {0}").format(r.number))),
     Column("Value", VALUE.text, 60),
 )
 """A form's journal: seconds are enough, and a message without text is named by its number."""
@@ -154,7 +157,7 @@ class RecordsModel(QAbstractTableModel):
         if not index.isValid():
             return None
         row = self.rows[index.row()]
-        if role == Qt.ItemDataRole.DisplayRole:
+        if role in (Qt.ItemDataRole.DisplayRole, Qt.ItemDataRole.ToolTipRole):  # the tip: a cut text whole
             return self.columns[index.column()].text(row)
         message = row.kind == "message"
         if role == Qt.ItemDataRole.BackgroundRole:
@@ -164,6 +167,17 @@ class RecordsModel(QAbstractTableModel):
         if role == Qt.ItemDataRole.TextAlignmentRole and self.columns[index.column()].right:
             return int(Qt.AlignmentFlag.AlignRight | Qt.AlignmentFlag.AlignVCenter)
         return None
+
+
+def title_width(header: QHeaderView, title: str) -> int:
+    """The room a column's title needs: the style sheet's headers are bold, in any language."""
+    bold = QFont(header.font())
+    bold.setBold(True)
+    return QFontMetrics(bold).horizontalAdvance(title) + HEADER_PADDING
+
+
+def cell_width(view: QTableView, text: str) -> int:
+    return view.fontMetrics().horizontalAdvance(text) + CELL_PADDING
 
 
 def records_view(model: RecordsModel, row_height: int) -> QTableView:
@@ -177,13 +191,11 @@ def records_view(model: RecordsModel, row_height: int) -> QTableView:
     view.verticalHeader().setDefaultSectionSize(row_height)
     header = view.horizontalHeader()
     header.setSectionResizeMode(QHeaderView.ResizeMode.Interactive)
-    bold = QFont(header.font())
-    bold.setBold(True)  # the style sheet's headers are bold: room for the title, in any language
-    metrics = QFontMetrics(bold)
     for col, column in enumerate(model.columns):
         if column.width:
             title = str(model.headerData(col, Qt.Orientation.Horizontal, Qt.ItemDataRole.DisplayRole) or "")
-            header.resizeSection(col, max(column.width, metrics.horizontalAdvance(title) + HEADER_PADDING))
+            words = (cell_width(view, QCoreApplication.translate("records", w)) for w in column.fits)
+            header.resizeSection(col, max(column.width, title_width(header, title), *words))
         else:
             header.setSectionResizeMode(col, QHeaderView.ResizeMode.Stretch)
     return view

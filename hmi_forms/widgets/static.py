@@ -98,9 +98,10 @@ class SyncWidget(ElementWidget):
                 p.fillRect(row.adjusted(-2, 1, 2, -1), QColor("#dbe4f3"))
             p.setPen(theme.TEXT if i == m.pair else theme.TEXT_DIM)
             p.drawText(row, theme.LEFT,
-                       f"{i}: period {period}, phase {phase}")
+                       QCoreApplication.translate("SyncWidget", "{0}: period {1}, phase {2}").format(
+                           i, period, phase))
         if isinstance(m, SyncTimer) and not m.enabled:
             p.setPen(theme.TEXT_DIM)
             p.setFont(theme.sized_font(h * 0.55, bold=True))
             p.drawText(QRectF(6, 2, r.width() - 18 - d, h), theme.RIGHT,
-                       "disabled")
+                       QCoreApplication.translate("SyncWidget", "disabled"))

@@ -126,7 +126,7 @@ def test_shelve_needs_a_reason_and_comes_back_by_itself(qtbot, station: Station)
     row = summary.model.rows[0]
     assert row.state is State.SHELVED and row.shelved_by == "petrov" and row.reason == "датчик на поверке"
     assert summary.counts[2].text() == "P2 high: 0"  # shelved alarms are not counted as listed
-    assert "shelved by petrov" in summary.model.data(summary.model.index(0, 3))
+    assert "shelved by petrov" in summary.model.data(summary.model.index(0, 5))  # the widest column
     station.step(4000, 0, T0 + 10 * 60 + 1)  # the shelving has run out, the level is still high
     summary.refresh()
     assert summary.model.rows[0].state is State.UNACK

@@ -20,7 +20,7 @@ def run_check(station: Path) -> subprocess.CompletedProcess[str]:
 def test_the_demo_station_is_clean() -> None:
     r = run_check(DEMO)
     assert r.returncode == 0, r.stdout + r.stderr
-    assert "ok: program netplc.stl" in r.stdout
+    assert "норма: программа netplc.stl: инструкций" in r.stdout  # the demo's Language is ru
 
 
 def plant(path: Path, old: str, new: str) -> None:
@@ -73,7 +73,7 @@ def test_every_planted_error_is_found(tmp_path: Path) -> None:
     ]
     for e in expected:
         assert e in out, f"{e!r} not in:\n{out}"
-    assert f"{len(out.splitlines())} problem(s) found" in r.stderr
+    assert f"найдено проблем: {len(out.splitlines())}" in r.stderr
 
 
 def test_check_reports_exactly_what_a_start_refuses(tmp_path: Path) -> None:
@@ -118,5 +118,30 @@ def test_a_horn_bit_the_program_writes_is_a_problem(tmp_path: Path) -> None:
     toml.write_text(toml.read_text(encoding="utf-8").replace('alarm_horn = "03600"', 'alarm_horn = "02200"'),
                     encoding="utf-8")
     problems = check_station(station).problems
-    assert any("alarm_horn: 02200 is written by the program (line " in p and "may only read it" in p
+    assert any("alarm_horn: бит 02200 пишет программа (строка " in p and "может только читать" in p
                for p in problems), problems
+
+
+@pytest.mark.parametrize("language", ["ru", "en"])
+def test_check_says_its_own_words_in_the_station_language_naming_file_and_line(tmp_path: Path,
+                                                                             language: str) -> None:
+    """The summary, what was found good and check's own problems in the station's `Language`, each
+    problem still naming its file, key and line."""
+    st = copy_demo(tmp_path / "st")
+    plant(st / "station.toml", 'Language = "ru"', f'Language = "{language}"')
+    plant(st / "station.toml", 'alarm_horn = "03600"', 'alarm_horn = "02200"')
+    (st / "archive" / "journal.sqlite").mkdir(parents=True)  # a folder where the archive should be
+    r = run_check(st)
+    assert r.returncode == 1
+    toml = st / "station.toml"
+    line = next(i for i, text in enumerate((st / "netplc.stl").read_text(encoding="utf-8").splitlines(), 1)
+                if text.startswith("YON $02200"))
+    if language == "ru":
+        # the archive's problem in the start's own words (a start refuses with the same)
+        assert f"{toml}: Archive: {st / 'archive' / 'journal.sqlite'}: cannot open the archive: " in r.stdout
+        assert f"{toml}: alarm_horn: бит 02200 пишет программа (строка {line}: " in r.stdout
+        assert "найдено проблем: 2" in r.stderr
+    else:
+        assert f"{toml}: Archive: {st / 'archive' / 'journal.sqlite'}: cannot open the archive: " in r.stdout
+        assert f"{toml}: alarm_horn: 02200 is written by the program (line {line}: " in r.stdout
+        assert "2 problem(s) found" in r.stderr

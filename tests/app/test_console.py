@@ -298,17 +298,6 @@ def test_about_names_the_version(console: MainWindow) -> None:
     assert f"NetPlc Station {__version__}" in console.about_text()
 
 
-@pytest.fixture
-def russian(qapp) -> Iterator[None]:
-    from app.gui import i18n
-
-    assert i18n.install(qapp, "ru") == "ru"
-    try:
-        yield
-    finally:
-        i18n.uninstall(qapp)
-
-
 def test_the_console_speaks_russian_and_the_forms_keep_their_texts(qtbot, russian, demo_copy: Path) -> None:
     from app.gui import i18n
 

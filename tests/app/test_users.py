@@ -138,3 +138,15 @@ def test_the_users_command(tmp_path: Path) -> None:
     assert users("passwd", "ivan", password="new").returncode == 0
     assert Users(tmp_path).verify("ivan", "new") is not None
     assert users("remove", "ivan").returncode == 0 and users("list").stdout == ""
+
+
+def test_the_users_command_speaks_the_station_language(tmp_path: Path) -> None:
+    (tmp_path / "station.toml").write_text('NetPlcLoad = false\nLanguage = "ru"\n', encoding="utf-8")
+
+    def users(*args: str) -> str:
+        return subprocess.run([sys.executable, "main.py", "users", "--station", str(tmp_path), *args],
+                              input="pw\n", cwd=REPO, capture_output=True, text=True, timeout=60).stdout
+
+    assert users("add", "ivan", "--role", "engineer") == "пользователь ivan добавлен, роль engineer\n"
+    assert users("passwd", "ivan") == "пароль пользователя ivan изменён\n"
+    assert users("remove", "ivan") == "пользователь ivan удалён\n"

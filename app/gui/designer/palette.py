@@ -3,6 +3,7 @@ onto the canvas or double-clicked."""
 
 from __future__ import annotations
 
+import re
 from collections.abc import Callable
 
 from PySide6.QtCore import QT_TRANSLATE_NOOP, QMimeData, QRectF, QSize, Qt
@@ -59,6 +60,12 @@ def icon(kind: str) -> QIcon:
     return QIcon(pixmap)
 
 
+def breakable(name: str) -> str:
+    """A type name that may wrap between its words (DiscreteControlled|Enable) where the dock is
+    narrow: a zero-width space before each capital but the first."""
+    return re.sub(r"(?<=[a-z])(?=[A-Z])", "\u200b", name)
+
+
 class DragList(QListWidget):
     """A list whose entries are dragged onto the canvas as `mime`, each carrying its UserRole text
     (an element type, a tag's name); a double-click calls `add` with it, if it may be dragged."""
@@ -68,6 +75,11 @@ class DragList(QListWidget):
         self.mime = mime
         self.setDragEnabled(True)
         self.setDragDropMode(QAbstractItemView.DragDropMode.DragOnly)
+        # entries wrapped to the dock's width, a long type name anywhere: nothing cut at the right
+        self.setWordWrap(True)
+        self.setHorizontalScrollBarPolicy(Qt.ScrollBarPolicy.ScrollBarAlwaysOff)
+        self.setResizeMode(QListWidget.ResizeMode.Adjust)
+        self.setTextElideMode(Qt.TextElideMode.ElideNone)
         self.itemDoubleClicked.connect(lambda item: self._add(item, add))
 
     @staticmethod
@@ -89,10 +101,9 @@ class Palette(DragList):
     def __init__(self, add: Callable[[str], object], parent: QWidget | None = None) -> None:
         super().__init__(ELEMENT_MIME, add, parent)
         self.setIconSize(QSize(ICON, ICON))
-        self.setWordWrap(True)
         for kind in ELEMENT_TYPES:
             hint = self.tr(HINTS[kind])
-            item = QListWidgetItem(icon(kind), f"{kind}\n{hint}")
+            item = QListWidgetItem(icon(kind), f"{breakable(kind)}\n{hint}")
             item.setData(Qt.ItemDataRole.UserRole, kind)
             tip = self.tr("{0}: {1}\nDrag onto the form, or double-click to add")
             item.setToolTip(tip.format(kind, hint))

@@ -18,6 +18,7 @@ import PySide6
 from PySide6.QtCore import QCoreApplication, QLibraryInfo, QLocale, QTranslator
 
 from hmi_forms.elements import formats
+from hmi_forms.widgets.base import SHARED_LAYERS
 
 logger = logging.getLogger(__name__)
 HERE = Path(__file__).resolve().parent
@@ -62,8 +63,10 @@ def install(app: QCoreApplication, language: str = "") -> str:
 
 
 def uninstall(app: QCoreApplication) -> None:
-    """Back to the source texts and the default formats."""
+    """Back to the source texts and the default formats; the form elements' shared pictures, which
+    hold their words ("period", "disabled"), are drawn again in the next language."""
     for old in app.findChildren(QTranslator):
         app.removeTranslator(old)
         old.deleteLater()
     formats.set_language("")
+    SHARED_LAYERS.clear()

@@ -450,6 +450,10 @@
         <source>(indication off)</source>
         <translation>(индикация выключена)</translation>
     </message>
+    <message>
+        <source> (click to toggle)</source>
+        <translation> (щелчок переключает)</translation>
+    </message>
 </context>
 <context>
     <name>FontEditor</name>
@@ -1305,6 +1309,10 @@ Drag onto the form, or double-click to add</source>
         <source>system</source>
         <translation>система</translation>
     </message>
+    <message>
+        <source>message {0}</source>
+        <translation>сообщение {0}</translation>
+    </message>
 </context>
 <context>
     <name>words</name>
@@ -1803,6 +1811,129 @@ Drag onto the form, or double-click to add</source>
     <message>
         <source>{0} could not be written: {1}</source>
         <translation>{0} не записан: {1}</translation>
+    </message>
+</context>
+<context>
+    <name>AnalogOutput</name>
+    <message>
+        <source>Input is disabled for this element</source>
+        <translation>Ввод для этого элемента отключён</translation>
+    </message>
+    <message>
+        <source>"{0}" is not a number</source>
+        <translation>«{0}» — не число</translation>
+    </message>
+    <message>
+        <source>{0} is out of range {1} … {2}{3}</source>
+        <translation>{0} вне диапазона {1} … {2}{3}</translation>
+    </message>
+    <message>
+        <source>Set to {0}{1}</source>
+        <translation>Задано {0}{1}</translation>
+    </message>
+    <message>
+        <source>Set</source>
+        <translation>Задать</translation>
+    </message>
+    <message>
+        <source>{0}: writes word {1}; range {2} … {3}{4}</source>
+        <translation>{0}: пишет слово {1}; диапазон {2} … {3}{4}</translation>
+    </message>
+</context>
+<context>
+    <name>AnalogWidget</name>
+    <message>
+        <source>{0}: word {1}, {2} … {3}{4}</source>
+        <translation>{0}: слово {1}, {2} … {3}{4}</translation>
+    </message>
+    <message>
+        <source>; double-click resets the maximum</source>
+        <translation>; двойной щелчок сбрасывает максимум</translation>
+    </message>
+    <message>
+        <source>max {0}</source>
+        <translation>макс. {0}</translation>
+    </message>
+</context>
+<context>
+    <name>JournalWidget</name>
+    <message>
+        <source>all types</source>
+        <translation>все типы</translation>
+    </message>
+    <message>
+        <source>warnings and worse</source>
+        <translation>предупреждения и выше</translation>
+    </message>
+    <message>
+        <source>alarms and worse</source>
+        <translation>аварии и выше</translation>
+    </message>
+    <message>
+        <source>critical</source>
+        <translation>критические</translation>
+    </message>
+    <message>
+        <source>Today</source>
+        <translation>Сегодня</translation>
+    </message>
+    <message>
+        <source>all kinds</source>
+        <translation>все виды</translation>
+    </message>
+    <message>
+        <source>as configured</source>
+        <translation>как настроено</translation>
+    </message>
+    <message>
+        <source>all groups</source>
+        <translation>все группы</translation>
+    </message>
+    <message>
+        <source>group </source>
+        <translation>группа </translation>
+    </message>
+    <message>
+        <source>no archive configured</source>
+        <translation>архив не задан</translation>
+    </message>
+    <message>
+        <source>no archive yet</source>
+        <translation>архива ещё нет</translation>
+    </message>
+    <message>
+        <source>archive unreadable: {0}</source>
+        <translation>архив не читается: {0}</translation>
+    </message>
+    <message>
+        <source>{0} of {1} records</source>
+        <translation>записей: {0} из {1}</translation>
+    </message>
+    <message>
+        <source>{0} records</source>
+        <translation>записей: {0}</translation>
+    </message>
+</context>
+<context>
+    <name>SyncWidget</name>
+    <message>
+        <source>{0}: period {1}, phase {2}</source>
+        <translation>{0}: период {1}, фаза {2}</translation>
+    </message>
+    <message>
+        <source>disabled</source>
+        <translation>отключён</translation>
+    </message>
+</context>
+<context>
+    <name>ZoomArea</name>
+    <message>
+        <source>fit width</source>
+        <translation>по ширине</translation>
+    </message>
+    <message>
+        <source>fit window</source>
+        <translation>по окну</translation>
     </message>
 </context>
 </TS>
