@@ -19,6 +19,7 @@ import hashlib
 import logging
 import marshal
 import os
+import tempfile
 from pathlib import Path
 
 from netplc import address, problems, textfile
@@ -94,16 +95,20 @@ class ParseCache:
         rows = [tuple(getattr(i, f) for f in _FIELDS) for i in program.instrs]
         payload = marshal.dumps((program.symbols, program.words, rows))
         path = self._path(key)
-        tmp = path.with_suffix(".tmp")
+        tmp: Path | None = None
         try:
             self.folder.mkdir(parents=True, exist_ok=True)
-            tmp.write_bytes(key + hashlib.sha256(payload).digest() + payload)
+            fd, name = tempfile.mkstemp(prefix=PREFIX, suffix=".tmp", dir=self.folder)  # one per writer
+            tmp = Path(name)
+            with os.fdopen(fd, "wb") as f:
+                f.write(key + hashlib.sha256(payload).digest() + payload)
             os.replace(tmp, path)
             self._bound()
         except OSError as e:  # each start parses then: slower, never wrong
             logger.warning("parsed program not kept in %s: %s", self.folder, e)
-            with contextlib.suppress(OSError):
-                tmp.unlink(missing_ok=True)
+            if tmp is not None:
+                with contextlib.suppress(OSError):
+                    tmp.unlink(missing_ok=True)
 
     def _bound(self) -> None:
         entries = []
