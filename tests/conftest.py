@@ -80,8 +80,8 @@ def _collect_on_the_gui_thread(request: pytest.FixtureRequest):
 def pytest_collection_finish(session: pytest.Session) -> None:
     """What collection left alive (every imported module, class and test item: most of a worker's
     objects) lives to the end of the run, so it leaves the collector's generations: each Qt test
-    ends on a full collection (above), which otherwise walks all of them again, a fifth of the
-    suite's CPU. Objects the tests make are collected as before."""
+    ends on a full collection (above), which otherwise walks all of them again: a fifth of the Qt
+    tests' CPU. Objects the tests make are collected as before."""
     gc.collect()
     gc.freeze()
 
