@@ -2,8 +2,8 @@
 
 Each run is a fresh `python` process doing what `python main.py --no-gui STATION` does (import,
 read station.toml, load messages and program, start the archive, Modbus server and scan thread)
-and stopping at the first finished scan. Runs alternate between a cold start (no compiled-program
-cache beside the archive) and a warm one (the cache of the previous start), interleaved with the
+and stopping at the first finished scan. Runs alternate between a cold start (no compiled or parsed
+program kept beside the archive) and a warm one (those of the previous start), interleaved with the
 yardsticks: `python -c pass` (the interpreter alone) and a process that imports exactly the
 modules the station's start loaded, in the order it loaded them, and does nothing else. That is
 fair: it is the least any start of this station can cost, so start / imports says what the
@@ -95,6 +95,7 @@ def phases_in_process(station: Path) -> str:
     from netplc import compiler
     from netplc.codecache import CodeCache
     from netplc.engine import Engine, FakeClock
+    from netplc.parsecache import ParseCache, parse_file_cached
     from netplc.program import parse_file
 
     def best(fn) -> float:
@@ -111,8 +112,11 @@ def phases_in_process(station: Path) -> str:
     source = compiler.generate_source(program, inline)
     cache = station / "phases-cache"
     Engine(program, clock=FakeClock(), code_cache=cache)
+    parsed = ParseCache(station / "phases-parsed")
+    parse_file_cached(station / "program.stl", {}, parsed)
     figures = {
         "parse": best(lambda: parse_file(station / "program.stl")),
+        "parse, from the cache": best(lambda: parse_file_cached(station / "program.stl", {}, parsed)),
         "generate Python": best(lambda: compiler.generate_source(program, inline)),
         "compile()": best(lambda: compile(source, "<bench>", "exec")),
         "engine, compiled": best(lambda: Engine(program, clock=FakeClock())),
@@ -135,7 +139,7 @@ def main() -> None:
         lines = make_station(station)
         print(f"station: {lines}-line program of 8192 words (bench/scan.py, seed 165), archive, "
               f"Modbus server; {args.runs} runs of each, interleaved")
-        cache = station / "archive" / "compiled"
+        caches = [station / "archive" / "compiled", station / "archive" / "parsed"]
         needed = station / "modules.json"  # what a start loaded, for the imports yardstick
         timed(["-c", CHILD, str(station), str(ROOT)])  # a first start: the cache and the module list
         needed.write_text(timed(["-c", CHILD, str(station), str(ROOT)])[1]["modules"], encoding="utf-8")
@@ -147,7 +151,8 @@ def main() -> None:
             rows["imports"].append(timed(["-c", IMPORTS, str(needed), str(ROOT)])[0] * 1e3)
             for kind in ("cold", "warm"):
                 if kind == "cold":
-                    shutil.rmtree(cache, ignore_errors=True)
+                    for cache in caches:
+                        shutil.rmtree(cache, ignore_errors=True)
                 _, phases = timed(["-c", CHILD, str(station), str(ROOT)])
                 rows[kind].append(phases["first_scan"] * 1e3)
                 parts[kind].append(phases)
@@ -161,7 +166,7 @@ def main() -> None:
             print(f"  {kind} start: first scan {spread(rows[kind])} ms after the process was created, "
                   f"{statistics.median(ratios):.2f}x the imports (worst run {max(ratios):.2f}x); medians: "
                   f"interpreter up {p['main']:.0f}, imports {p['imported'] - p['main']:.0f}, "
-                  f"station + messages + program {p['loaded'] - p['imported']:.0f}, "
+                  f"station + messages + program (parse) {p['loaded'] - p['imported']:.0f}, "
                   f"archive + engine (compile) + server "
                   f"{p['started'] - p['loaded']:.0f}, first scan {p['first_scan'] - p['started']:.0f} ms")
         print(f"  in process: {phases_in_process(station)}")

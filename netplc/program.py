@@ -160,11 +160,15 @@ def _is_hmi_bit(addr: int) -> bool:
 
 def parse_file(path: str | Path, symbols: dict[str, int] | None = None) -> Program:
     path = Path(path)
+    return parse(read_program_text(path), source=str(path), symbols=symbols)
+
+
+def read_program_text(path: Path) -> str:
+    """The program file's text; a file that cannot be read is a ProgramError naming it."""
     try:
-        text = read_text(path, "program")
+        return read_text(path, "program")
     except TextFileError as e:
         raise ProgramError([Diagnostic(str(path), e.line, 0, e.problem)]) from None
-    return parse(text, source=str(path), symbols=symbols)
 
 
 def load_program(path: str | Path, symbols_path: str | Path | None = None) -> Program:

@@ -3,7 +3,7 @@
 A backup is taken while the station runs and is a station folder itself: the station's files
 (station.toml, programs, symbols, messages, tags, forms and their pictures, users.json, the OPC UA
 certificates and trust list: every file of the folder but the log, the lock and what the station
-derives, such as the compiled program) at their places, and what the station writes while it
+derives, such as the compiled and parsed program) at their places, and what the station writes while it
 runs, each copied so that it is whole and of one moment: the retentive memory (the newest
 complete save, as a restart would take it), the retained forces, the alarm states and the
 journal (SQLite's online backup API, registrar/backup.py; last, so that the journal holds at
@@ -33,7 +33,7 @@ from app.logs import LOG_DIR
 from app.scada.station import STATE_FILE as ALARM_STATE_FILE
 from app.station.config import STATION_FILE, Station, read_station
 from app.station.lock import LOCK_FILE, StationLock
-from app.station.runtime import CODE_CACHE
+from app.station.runtime import CODE_CACHE, PARSE_CACHE
 from registrar.backup import Copied, copy_database
 from registrar.retain import newest_save, save_files
 
@@ -74,8 +74,9 @@ def _beside(role: str, path: Path) -> list[Path]:
 
 def _derived(station: Station) -> set[Path]:
     """What a backup leaves out of the folder: the state files (copied their own way) and what
-    goes with them, the log, the lock and the compiled program (made again at start)."""
-    out = {station.folder / LOG_DIR, station.folder / LOCK_FILE, station.Archive.parent / CODE_CACHE}
+    goes with them, the log, the lock and the compiled and parsed program (made again at start)."""
+    archive = station.Archive.parent
+    out = {station.folder / LOG_DIR, station.folder / LOCK_FILE, archive / CODE_CACHE, archive / PARSE_CACHE}
     for role, path in state_files(station).items():
         out.update([path, *_beside(role, path)])
     return out

@@ -24,6 +24,7 @@ from app.scada.words import Phrase, phrase
 from app.station.config import Station
 from app.station.extras import station_problems
 from netplc.exchange import check_program_nodes
+from netplc.parsecache import ParseCache, parse_file_cached
 from netplc.program import Program, ProgramError, load_symbols, parse, parse_file, read_symbols
 from netplc.textfile import MISSING, TextFileError, confine, file_problem, read_text
 from registrar.catalog import Catalog, CatalogError
@@ -47,15 +48,18 @@ class Loaded:
     notes: list[Phrase] = field(default_factory=list)  # what was found good, for check's summary
 
 
-def load(station: Station) -> Loaded:
+def load(station: Station, parse_cache: Path | None = None) -> Loaded:
+    """What the station reads; with `parse_cache` (a start's, not `check`'s: check writes nothing),
+    the parsed programs are kept in that folder for the next start (netplc/parsecache.py)."""
     out = Loaded()
     out.symbols = _symbols(station.Symbols, out)
-    program = _program(station, out)
+    cache = ParseCache(parse_cache) if parse_cache is not None else None
+    program = _program(station, out, cache)
     if program is not None:
         out.problems += [str(d) for d in check_program_nodes(program, station.nodes)]
     for sim in station.simulators:
         try:
-            p = parse_file(sim.program, load_symbols(sim.symbols) if sim.symbols else {})
+            p = _parse(sim.program, load_symbols(sim.symbols) if sim.symbols else {}, cache)
         except ProgramError as e:
             out.problems += e.problems
             continue
@@ -140,14 +144,18 @@ def _state_files(station: Station, out: Loaded) -> None:
             out.problems.append(f"{station.path}: {key}: {path} {why}")
 
 
-def _program(station: Station, out: Loaded) -> Program | None:
+def _parse(path: Path, symbols: dict[str, int], cache: ParseCache | None) -> Program:
+    return parse_file(path, symbols) if cache is None else parse_file_cached(path, symbols, cache)
+
+
+def _program(station: Station, out: Loaded, cache: ParseCache | None) -> Program | None:
     """The program (none when NetPlcLoad is false); with errors, the program without its bad lines
     (line numbers kept) for the checks that need a whole program, and `out.program` stays empty."""
     path = station.NetPlcProgram
     if not station.NetPlcLoad or path is None:
         return None
     try:
-        program = parse_file(path, out.symbols)
+        program = _parse(path, out.symbols, cache)
     except ProgramError as e:
         out.problems += e.problems
         return _recovered(path, out.symbols, {d.line for d in e.errors})

@@ -59,6 +59,7 @@ logger = logging.getLogger(__name__)
 RecordObserver = Callable[[Record], None]
 RESOLVE_TIMEOUT = 5.0  # seconds for the host names of all TCP nodes to resolve
 CODE_CACHE = "compiled"  # beside the archive: the compiled program, for a fast next start
+PARSE_CACHE = "parsed"  # beside it: the parsed programs (the station's and its simulated nodes')
 
 
 class StartError(Problems):
@@ -160,7 +161,7 @@ class Runtime:
     def __init__(self, station: Station, *, wallclock: Callable[[], float] = time.time) -> None:
         self.station = station
         self.wallclock = wallclock
-        loaded = load(station)
+        loaded = load(station, parse_cache=station.Archive.parent / PARSE_CACHE)
         if loaded.problems:
             raise StartError(loaded.problems)
         self.symbols, self.catalog, self.program = loaded.symbols, loaded.catalog, loaded.program
