@@ -11,11 +11,10 @@ import struct
 from typing import Protocol
 
 from netplc.modbus.endpoint import Endpoint
-from netplc.modbus.map import BIT_TABLES, MapError, Table, bits_from_bytes, bytes_from_bits
+from netplc.modbus.frames import read_pdu, write_pdu
+from netplc.modbus.map import BIT_TABLES, Table, bits_from_bytes
 from netplc.modbus.pdu import (
-    ADDRESS_REQUEST,
     MBAP,
-    READ_CODES,
     DeviceError,
     LinkError,
     ProtocolError,
@@ -180,7 +179,7 @@ class LeanTcpClient:
     async def read_bytes(self, unit: int, table: Table, address: int, count: int) -> bytes:
         """The answer's data as the wire carries it: registers big-endian, coils packed."""
         what = f"read {table} {address}+{count}"
-        reply = await self._transact(unit, ADDRESS_REQUEST.pack(READ_CODES[table], address, count), what)
+        reply = await self._transact(unit, read_pdu(table, address, count), what)
         size = (count + 7) // 8 if table in BIT_TABLES else 2 * count
         if len(reply) != size + 2 or reply[1] != size:
             raise ProtocolError(f"{what}: answer of {len(reply)} bytes ({reply[:8].hex(' ')}), "
@@ -195,14 +194,7 @@ class LeanTcpClient:
 
     async def write(self, unit: int, table: Table, address: int, values: list[int]) -> None:
         what = f"write {table} {address}+{len(values)}"
-        n = len(values)
-        if table == "coils":
-            data = bytes_from_bits(values)
-            request = struct.pack(">BHHB", 15, address, n, len(data)) + data
-        elif table == "holding":
-            request = struct.pack(f">BHHB{n}H", 16, address, n, 2 * n, *values)
-        else:
-            raise MapError(f"{table} is a read-only table")
+        request = write_pdu(table, address, values)
         reply = await self._transact(unit, request, what)
         if reply != request[:5]:
             raise ProtocolError(f"{what}: the answer {reply.hex(' ')} does not echo {request[:5].hex(' ')}")
