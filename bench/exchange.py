@@ -158,23 +158,33 @@ def measure(ports: list[int], tick: float, seconds: float, child: int, lean: boo
 
 
 def blocking_yardstick(ports: list[int], seconds: float) -> tuple[float, float]:
-    """(reads/s, CPU us per read) of the simplest client there is: one thread, blocking sockets,
-    the same 64-byte reads round-robin over the nodes, the answer's data kept as bytes."""
+    """(reads/s, CPU us per read) of the simplest client there is doing the exchange's work: one
+    thread, blocking sockets, each node's 64-byte read round-robin, the answer checked as the
+    exchange checks it (transaction id, unit, function, byte count) and its data byte-swapped into
+    the same place of a NetPlc memory."""
     import socket
-    import struct
 
+    from netplc.memory import Memory
+    from netplc.modbus import Frame, answer_data, locate
+
+    block = locate("cpu165", "holding", 0o4000, BLOCK)
+    frame = Frame.read(1, block.table, block.address, block.count)
+    mem = Memory()
     socks = [socket.create_connection(("127.0.0.1", p)) for p in ports]
     for sock in socks:
         sock.setsockopt(socket.IPPROTO_TCP, socket.TCP_NODELAY, 1)
-    request = struct.pack(">HHHBBHH", 1, 0, 6, 1, 3, 0o4000 // 2, BLOCK // 2)
-    size = 9 + BLOCK
-    reads, cpu0, t0 = 0, time.process_time(), time.monotonic()
+    locals_ = [local_block(i) for i in range(len(ports))]
+    size = 9 + 2 * block.count
+    reads, tid, cpu0, t0 = 0, 0, time.process_time(), time.monotonic()
     while time.monotonic() - t0 < seconds:
-        for sock in socks:
-            sock.sendall(request)
-            data = b""
+        for sock, local in zip(socks, locals_, strict=True):
+            tid = tid % 0xFFFF + 1
+            sock.sendall(frame.stamped(tid))
+            data = sock.recv(size)
             while len(data) < size:
                 data += sock.recv(size - len(data))
+            assert data[0] << 8 | data[1] == tid
+            mem.write(local, block.decode_wire(answer_data(frame, data, 0, size)))
             reads += 1
     wall, cpu = time.monotonic() - t0, time.process_time() - cpu0
     for sock in socks:

@@ -17,13 +17,13 @@ from netplc.modbus import (
     WRITABLE_TABLES,
     Block,
     DeviceError,
+    Frame,
     LinkError,
     MapError,
     describe,
     exception_text,
     locate,
 )
-from netplc.modbus.frames import Frame
 
 if TYPE_CHECKING:
     from netplc.exchange import NodeConfig
@@ -192,6 +192,8 @@ class LinkState:
 
     def answered(self) -> None:
         """A normal answer: the link is up, the back-off and the run of exceptions start over."""
+        if self.stats.up and not self.refusals and self.delay == self.config.backoff:
+            return  # the usual case: nothing to start over
         self.delay = self.config.backoff
         self.refusals, self.repeated = 0, False
         self.refused.clear()

@@ -33,8 +33,17 @@ from concurrent.futures import Future, ThreadPoolExecutor
 from typing import TYPE_CHECKING
 
 from netplc.links import LinkState, NodeStats, Outcomes, Request, Steps
-from netplc.modbus import DeviceError, LinkError, MapError
-from netplc.modbus.frames import Frame, FrameError, answer_data, frame_size, tid_at
+from netplc.modbus import (
+    Block,
+    DeviceError,
+    Frame,
+    FrameError,
+    LinkError,
+    MapError,
+    answer_data,
+    frame_size,
+    tid_at,
+)
 
 if TYPE_CHECKING:
     from netplc.exchange import NodeConfig
@@ -59,9 +68,11 @@ class TcpNode(LinkState):
         self.sock: socket.socket | None = None
         self.connecting = False  # the socket is being connected (or its address resolved)
         self.attempt_id = 0  # tells a late address resolution from the one awaited
+        self.addresses: list[Address] = []  # the host's further addresses, tried in turn
         self.queue: deque[Request] = deque()
         self.req: Request | None = None  # the request being served
-        self.run: Steps | None = None
+        self.run: Steps | None = None  # None while a one-frame read is served without steps
+        self.read_block: Block | None = None  # that read's block
         self.where = ""
         self.attempt = 0
         self.frame: Frame | None = None  # the transaction in flight
@@ -84,19 +95,29 @@ class TcpNode(LinkState):
         queue = self.queue
         while self.req is None and queue:
             req = queue.popleft()
-            if req is not self.probe and time.monotonic() < self.retry_at:
+            if req is not self.probe and self.hub.now < self.retry_at:
                 self.finish(req, None, self.stats.last_error or "link down")
+                continue
+            self.attempt = 0
+            plan = req.plan
+            if plan is not None and len(plan[2]) == 1:  # the hot path: a one-frame read built before
+                self.req, self.read_block, self.where, self.frame = req, plan[0], plan[1], plan[2][0]
+                self.transmit()
                 continue
             steps, where = self.steps(req)
             if steps is None:
                 self.finish(req, None, where)
                 continue
-            self.req, self.run, self.where, self.attempt = req, steps, where, 0
+            self.req, self.run, self.where = req, steps, where
             self.advance(None)
 
     def advance(self, answer: bytes | None) -> None:
         """Hand an answer's data to the request's steps: send the next frame, or finish."""
-        assert self.run is not None
+        if self.run is None:  # a one-frame read: its answer is the block
+            assert answer is not None and self.read_block is not None
+            self.answered()
+            self.end(self.read_block.decode_wire(answer), "")
+            return
         try:
             frame = self.run.send(answer)  # type: ignore[arg-type]
         except StopIteration as done:
@@ -116,12 +137,13 @@ class TcpNode(LinkState):
     def end(self, data: bytes | None, error: str) -> None:
         """The request is done: its outcome goes to the exchange, the next one starts."""
         req = self.req
-        self.req = self.run = self.frame = None
+        self.req = self.run = self.frame = self.read_block = None
         self.deadline = 0.0
-        self.active = now = time.monotonic()
+        self.active = now = self.hub.now
         if req is not None:
             self.finish(req, data, error)
-        self.next()
+        if self.queue:
+            self.next()
         if self.req is None:
             self.hub.arm(self, max(now + self.idle, self.retry_at))
 
@@ -163,7 +185,7 @@ class TcpNode(LinkState):
         assert frame is not None
         self.tid = tid = self.tid % 0xFFFF + 1
         adu = frame.stamped(tid)
-        self.deadline = deadline = time.monotonic() + self.timeout
+        self.deadline = deadline = self.hub.now + self.timeout
         if deadline < self.timer:
             self.hub.arm(self, deadline)
         try:
@@ -180,7 +202,7 @@ class TcpNode(LinkState):
     def connect(self) -> None:
         self.connecting = True
         self.attempt_id += 1
-        self.deadline = time.monotonic() + self.timeout
+        self.deadline = self.hub.now + self.timeout
         self.hub.arm(self, self.deadline)
         host, port = self.endpoint.host, self.endpoint.port
         try:
@@ -188,10 +210,12 @@ class TcpNode(LinkState):
         except ValueError:  # a name: resolved on the hub's helper thread, never on this one
             self.hub.resolve(self, self.attempt_id)
             return
-        self.dial((socket.AF_INET6 if ip.version == 6 else socket.AF_INET, (host, port)))
+        self.dial([(socket.AF_INET6 if ip.version == 6 else socket.AF_INET, (host, port))])
 
-    def dial(self, address: Address) -> None:
-        family, sockaddr = address
+    def dial(self, addresses: list[Address]) -> None:
+        """Connect to the first of the addresses; a refusal tries the next, as asyncio does."""
+        family, sockaddr = addresses[0]
+        self.addresses = addresses[1:]
         sock = socket.socket(family, socket.SOCK_STREAM)
         sock.setblocking(False)
         sock.setsockopt(socket.IPPROTO_TCP, socket.TCP_NODELAY, 1)
@@ -203,24 +227,32 @@ class TcpNode(LinkState):
         self.sock = sock
         self.hub.selector.register(sock, WRITE, self)  # writable once connected (or refused)
 
-    def resolved(self, attempt_id: int, address: Address | None, error: str) -> None:
+    def resolved(self, attempt_id: int, addresses: list[Address], error: str) -> None:
         if attempt_id != self.attempt_id or not self.connecting or self.sock is not None:
             return  # an attempt that has timed out already
-        if address is None:
-            self.cannot_connect(error)
+        if addresses:
+            self.dial(addresses)
         else:
-            self.dial(address)
+            self.cannot_connect(error)
 
     def cannot_connect(self, why: str) -> None:
+        if self.addresses:  # refused at one address: the next one
+            self.close_socket()
+            self.dial(self.addresses)
+            return
         self.retry(LinkError(f"cannot connect to {self.endpoint}: {why}"))
 
     def close(self) -> None:
-        sock, self.sock = self.sock, None
+        self.close_socket()
         self.connecting = False
         self.attempt_id += 1
+        self.addresses = []
         self.buf = self.rest = b""
         self.frame = None
         self.deadline = 0.0
+
+    def close_socket(self) -> None:
+        sock, self.sock = self.sock, None
         if sock is not None:
             self.hub.selector.unregister(sock)
             sock.close()
@@ -265,8 +297,8 @@ class TcpNode(LinkState):
             self.lost("connection lost")
             return
         buf = self.buf + data if self.buf else data
-        at = 0
-        while True:
+        at, end = 0, len(buf)
+        while at < end:
             try:
                 size = frame_size(buf, at)
             except FrameError as e:
@@ -305,7 +337,7 @@ class TcpNode(LinkState):
             if now + 1e-3 < self.deadline:  # the timer was set for an earlier transaction
                 self.hub.arm(self, self.deadline)
             elif self.connecting:
-                self.cannot_connect("timed out")
+                self.retry(LinkError(f"cannot connect to {self.endpoint}: timed out"))
             else:
                 what = self.frame.what if self.frame is not None else "request"
                 self.retry(LinkError(f"{what}: no answer within {self.timeout:g} s"))
@@ -328,6 +360,7 @@ class TcpHub:
         self.outbox: deque[Request] = deque()  # engine thread -> this thread
         self.inbox: deque[Callable[[], None]] = deque()  # helper threads -> this thread
         self.timers: list[tuple[float, int, TcpNode]] = []  # (when, sequence number, node)
+        self.now = time.monotonic()  # as of the last wake-up of the thread: a read asks no clock
         self._seq = itertools.count()
         self._woken = False
         self._stopping = False
@@ -386,11 +419,11 @@ class TcpHub:
 
         def done(f: Future[list[tuple]]) -> None:
             try:
-                family, _, _, _, sockaddr = f.result()[0]
-                outcome: tuple[Address | None, str] = (family, sockaddr[:2]), ""
+                found: list[Address] = [(family, sockaddr[:2]) for family, _, _, _, sockaddr in f.result()]
+                error = ""
             except OSError as e:
-                outcome = None, str(e)
-            self.call(lambda: node.resolved(attempt_id, *outcome))
+                found, error = [], str(e)
+            self.call(lambda: node.resolved(attempt_id, found, error))
 
         future.add_done_callback(done)
 
@@ -399,13 +432,15 @@ class TcpHub:
             while not self._stopping:
                 timers = self.timers
                 timeout = max(0.0, timers[0][0] - time.monotonic()) if timers else None
-                for key, events in self.selector.select(timeout):
+                ready = self.selector.select(timeout)
+                self.now = time.monotonic()
+                for key, events in ready:
                     node = key.data
                     if node is None:
                         self._woke()
                     elif node.sock is not None and node.sock is key.fileobj:
                         self._guard(node, node.ready, events)
-                now = time.monotonic()
+                now = self.now
                 while timers and timers[0][0] <= now:
                     when, _, node = heapq.heappop(timers)
                     if when == node.timer:  # else superseded by an earlier one
