@@ -1,5 +1,7 @@
-"""One client per node: the connection NODE/NREAD/NWRITE talk through (`open_client`), our lean
-Modbus TCP client for the exchange's hot path, and pymodbus's (serial RTU, and TCP for comparison).
+"""Asyncio Modbus clients (`open_client`): our lean TCP client, for the Program view's and the
+designer's reads of a station, and pymodbus's, through which the exchange reaches serial RTU lines
+(and TCP nodes when bench/exchange.py compares it). The exchange's own TCP nodes do not use these:
+they are served by its selector thread (netplc/tcp_exchange.py).
 
 Retries and reconnect back-off belong to the exchange (netplc/exchange.py), not to a client.
 """
@@ -114,14 +116,12 @@ class _Answers(asyncio.Protocol):
 
 
 class LeanTcpClient:
-    """A Modbus TCP client of our own for the exchange's hot path: one request at a time per
-    connection, an MBAP frame in and out, no per-request objects beyond the bytes and a future,
-    and the answer's data handed over as bytes (no list of ints). pymodbus's client spends most
-    of NetPlc's CPU at a few thousand block reads per second (bench/exchange.py shows both); this
-    one also fails a request the moment its connection drops.
+    """A Modbus TCP client of our own for asyncio callers: one request at a time per connection, an
+    MBAP frame in and out, no per-request objects beyond the bytes and a future, and the answer's
+    data handed over as bytes (no list of ints); it fails a request the moment its connection drops.
 
-    It has one waiter slot: the exchange holds its line's lock around every transaction, and a
-    second transaction started while one is in flight is refused (RuntimeError), never mixed up.
+    It has one waiter slot: a second transaction started while one is in flight is refused
+    (RuntimeError), never mixed up.
     Every answer is checked against its request (unit id, function code, byte count, the echo of
     a write); one that does not match is a ProtocolError."""
 
