@@ -42,7 +42,6 @@ from netplc.modbus import (
     MapError,
     answer_data,
     frame_size,
-    tid_at,
 )
 
 if TYPE_CHECKING:
@@ -144,7 +143,7 @@ class TcpNode(LinkState):
             self.finish(req, data, error)
         if self.queue:
             self.next()
-        if self.req is None:
+        if self.req is None and self.timer > now + self.idle:  # the probe's turn: already due earlier?
             self.hub.arm(self, max(now + self.idle, self.retry_at))
 
     def finish(self, req: Request, data: bytes | None, error: str) -> None:
@@ -184,7 +183,9 @@ class TcpNode(LinkState):
         frame = self.frame
         assert frame is not None
         self.tid = tid = self.tid % 0xFFFF + 1
-        adu = frame.stamped(tid)
+        adu = frame.adu  # as Frame.stamped, inline: this is once per read
+        adu[0] = tid >> 8
+        adu[1] = tid & 0xFF
         self.deadline = deadline = self.hub.now + self.timeout
         if deadline < self.timer:
             self.hub.arm(self, deadline)
@@ -307,7 +308,7 @@ class TcpNode(LinkState):
             if not size:
                 break
             frame = self.frame
-            if frame is not None and tid_at(buf, at) == self.tid:  # else a late answer: dropped
+            if frame is not None and buf[at] << 8 | buf[at + 1] == self.tid:  # else a late answer: dropped
                 try:
                     answer = answer_data(frame, buf, at, size)
                 except DeviceError as e:  # an answer, and the connection is sound: not retried
@@ -438,14 +439,23 @@ class TcpHub:
                     node = key.data
                     if node is None:
                         self._woke()
-                    elif node.sock is not None and node.sock is key.fileobj:
-                        self._guard(node, node.ready, events)
+                    elif node.sock is key.fileobj:  # else closed and perhaps made again meanwhile
+                        try:
+                            if events == READ and not node.connecting:
+                                node.receive(key.fileobj)
+                            else:
+                                node.ready(events)
+                        except Exception as e:  # a bug must not end the thread, nor show the link up
+                            self._crashed(node, e)
                 now = self.now
                 while timers and timers[0][0] <= now:
                     when, _, node = heapq.heappop(timers)
                     if when == node.timer:  # else superseded by an earlier one
                         node.timer = math.inf
-                        self._guard(node, node.tick, now)
+                        try:
+                            node.tick(now)
+                        except Exception as e:
+                            self._crashed(node, e)
         finally:
             for node in self.nodes.values():
                 node.close()
@@ -456,11 +466,8 @@ class TcpHub:
                 self._resolver.shutdown(wait=False, cancel_futures=True)
 
     def _woke(self) -> None:
-        try:
-            while self._wake_r.recv(4096):
-                pass
-        except BlockingIOError:
-            pass
+        with contextlib.suppress(BlockingIOError):
+            self._wake_r.recv(4096)  # what is left wakes the selector once more: harmless
         self._woken = False  # first: a request queued from now on wakes the thread again
         inbox, outbox, nodes = self.inbox, self.outbox, self.nodes
         while inbox:
@@ -469,12 +476,14 @@ class TcpHub:
         while outbox:
             req = outbox.popleft()
             node = nodes[req.node]
-            self._guard(node, node.submit, req)
+            try:
+                node.queue.append(req)
+                if node.req is None:
+                    node.next()
+            except Exception as e:  # a bug must not end the thread, nor show the link up
+                self._crashed(node, e)
 
     @staticmethod
-    def _guard(node: TcpNode, fn: Callable[..., None], *args: object) -> None:
-        try:
-            fn(*args)
-        except Exception as e:  # a bug must not end the thread, nor show the link up
-            logger.exception("node %d: request failed inside the exchange", node.config.node)
-            node.crashed(e)
+    def _crashed(node: TcpNode, error: Exception) -> None:
+        logger.exception("node %d: request failed inside the exchange", node.config.node)
+        node.crashed(error)

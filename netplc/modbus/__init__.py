@@ -11,7 +11,7 @@ every minor release.
 
 from netplc.modbus.client import LeanTcpClient, ModbusClient, open_client
 from netplc.modbus.endpoint import Endpoint, line_problems, parse_endpoint
-from netplc.modbus.frames import Frame, FrameError, answer_data, frame_size, tid_at
+from netplc.modbus.frames import Frame, FrameError, answer_data, frame_size
 from netplc.modbus.loop import LoopThread
 from netplc.modbus.map import (
     MAX_READ_BITS,
@@ -86,5 +86,4 @@ __all__ = [
     "locate",
     "open_client",
     "parse_endpoint",
-    "tid_at",
 ]

@@ -86,10 +86,6 @@ def frame_size(buf: bytearray, at: int) -> int:
     return size if len(buf) - at >= size else 0
 
 
-def tid_at(buf: bytearray, at: int) -> int:
-    return buf[at] << 8 | buf[at + 1]
-
-
 def answer_data(frame: Frame, buf: bytearray, at: int, size: int) -> bytes:
     """The data of the answer to `frame` lying at `buf[at:at + size]` (a complete frame with the
     request's transaction id): registers big-endian and coils packed, as the wire carries them;

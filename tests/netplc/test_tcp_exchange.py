@@ -15,7 +15,7 @@ from hypothesis import HealthCheck, example, given, settings
 from hypothesis import strategies as st
 
 from netplc.exchange import NodeConfig
-from netplc.modbus import TABLES, DeviceError, Frame, FrameError, LoopThread, answer_data, frame_size, tid_at
+from netplc.modbus import TABLES, DeviceError, Frame, FrameError, LoopThread, answer_data, frame_size
 from netplc.program import parse
 from netplc.simulator import Simulator
 from tests.netplc.test_exchange import Station, wait_until
@@ -72,7 +72,7 @@ def test_a_right_answer_gives_its_data(tid: int, unit: int, table: str, address:
                                        draw: st.DataObject) -> None:
     frame = Frame.read(unit, table, address, count)  # type: ignore[arg-type]
     request = bytes(frame.stamped(tid))
-    assert tid_at(request, 0) == tid and request[6] == unit
+    assert request[0] << 8 | request[1] == tid and request[6] == unit
     data = draw.draw(st.binary(min_size=frame.nbytes, max_size=frame.nbytes))
     answer = MBAP.pack(tid, 0, len(data) + 3, unit) + bytes((frame.fc, len(data))) + data
     buf = bytearray(b"\x00" * 3 + answer + answer[:5])  # a frame in the middle of a stream
