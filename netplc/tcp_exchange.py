@@ -363,7 +363,8 @@ class TcpHub:
         self.timers: list[tuple[float, int, TcpNode]] = []  # (when, sequence number, node)
         self.now = time.monotonic()  # as of the last wake-up of the thread: a read asks no clock
         self._seq = itertools.count()
-        self._woken = False
+        self._woken = False  # a wake-up byte is on its way
+        self._waiting = False  # the thread is in (or about to enter) select
         self._stopping = False
         self._wake_r, self._wake_w = socket.socketpair()
         self._wake_r.setblocking(False)
@@ -388,9 +389,10 @@ class TcpHub:
     # --- from other threads ----------------------------------------------------------------------
 
     def submit(self, req: Request) -> None:
-        """Engine thread: a request for one of the nodes; the thread is woken once per batch."""
+        """Engine thread: a request for one of the nodes. The thread is woken once per batch, and
+        only while it waits: busy, it takes the outbox before it waits again."""
         self.outbox.append(req)
-        if not self._woken:
+        if self._waiting and not self._woken:
             self._woken = True
             self._wake()
 
@@ -433,7 +435,11 @@ class TcpHub:
             while not self._stopping:
                 timers = self.timers
                 timeout = max(0.0, timers[0][0] - time.monotonic()) if timers else None
+                self._waiting = True  # first, then look: a request queued after the look wakes us
+                if self.outbox or self.inbox:
+                    timeout = 0.0
                 ready = self.selector.select(timeout)
+                self._waiting = False
                 self.now = time.monotonic()
                 for key, events in ready:
                     node = key.data
@@ -447,6 +453,8 @@ class TcpHub:
                                 node.ready(events)
                         except Exception as e:  # a bug must not end the thread, nor show the link up
                             self._crashed(node, e)
+                if self.outbox or self.inbox:
+                    self._drain()
                 now = self.now
                 while timers and timers[0][0] <= now:
                     when, _, node = heapq.heappop(timers)
@@ -468,7 +476,9 @@ class TcpHub:
     def _woke(self) -> None:
         with contextlib.suppress(BlockingIOError):
             self._wake_r.recv(4096)  # what is left wakes the selector once more: harmless
-        self._woken = False  # first: a request queued from now on wakes the thread again
+        self._woken = False  # a request queued from now on wakes the thread again (if it waits)
+
+    def _drain(self) -> None:
         inbox, outbox, nodes = self.inbox, self.outbox, self.nodes
         while inbox:
             fn = inbox.popleft()
