@@ -7,7 +7,6 @@ from __future__ import annotations
 import logging
 import socket
 import struct
-import threading
 from collections.abc import Iterator
 
 import pytest
@@ -19,6 +18,7 @@ from netplc.modbus import TABLES, DeviceError, Frame, FrameError, LoopThread, an
 from netplc.program import parse
 from netplc.simulator import Simulator
 from tests.netplc.test_exchange import Station, wait_until
+from tests.netplc.test_exchange_malformed import BadNode
 
 MBAP = struct.Struct(">HHHB")
 
@@ -97,59 +97,32 @@ def test_a_write_answer_must_echo_the_request() -> None:
 # --- over real TCP -------------------------------------------------------------------------------
 
 
-class ScriptedNode:
+class ScriptedNode(BadNode):
     """A Modbus TCP 'device' on 127.0.0.1 answering right, or with the bytes `garbage` (once per
     connection, then silence, as a confused device would), or by `split` TCP segments."""
 
     def __init__(self) -> None:
         self.garbage: bytes | None = None
         self.split = False
-        self.listener = socket.create_server(("127.0.0.1", 0))
-        self.port = self.listener.getsockname()[1]
-        self.connections = 0
-        threading.Thread(target=self.serve, daemon=True).start()
+        self.spoke: set[socket.socket] = set()  # connections that had their garbage
+        super().__init__(lambda unit, pdu: (unit, pdu))
 
-    def serve(self) -> None:
-        while True:
-            try:
-                conn, _ = self.listener.accept()
-            except OSError:
-                return
-            self.connections += 1
-            threading.Thread(target=self.answer, args=(conn,), daemon=True).start()
-
-    def answer(self, conn: socket.socket) -> None:
-        conn.setsockopt(socket.IPPROTO_TCP, socket.TCP_NODELAY, 1)
-        buf, spoke = b"", False
-        with conn:
-            while True:
-                try:
-                    data = conn.recv(4096)
-                except OSError:
-                    return
-                if not data:
-                    return
-                buf += data
-                while len(buf) >= 7 and len(buf) >= 6 + MBAP.unpack_from(buf)[2]:
-                    size = 6 + MBAP.unpack_from(buf)[2]
-                    request, buf = buf[:size], buf[size:]
-                    garbage = self.garbage
-                    if garbage is not None:
-                        if not spoke:
-                            spoke = True
-                            conn.sendall(garbage)
-                        continue
-                    out = answer_of(request)
-                    if self.split:  # a stale answer first, then the right one in two segments
-                        stale = bytearray(out)
-                        stale[1] ^= 0x80
-                        conn.sendall(bytes(stale) + out[:5])
-                        conn.sendall(out[5:])
-                    else:
-                        conn.sendall(out)
-
-    def close(self) -> None:
-        self.listener.close()
+    def respond(self, conn: socket.socket, tid: int, unit: int, pdu: bytes) -> None:
+        garbage = self.garbage
+        if garbage is not None:
+            if conn not in self.spoke:
+                self.spoke.add(conn)
+                conn.sendall(garbage)
+            return
+        out = answer_of(MBAP.pack(tid, 0, len(pdu) + 1, unit) + pdu)
+        if self.split:  # a stale answer first, then the right one in two segments
+            conn.setsockopt(socket.IPPROTO_TCP, socket.TCP_NODELAY, 1)
+            stale = bytearray(out)
+            stale[1] ^= 0x80
+            conn.sendall(bytes(stale) + out[:5])
+            conn.sendall(out[5:])
+        else:
+            conn.sendall(out)
 
 
 READ = "TNA $03760\nFON C:$02100 N:NODE S:1\nTNA $03760\nFON C:$02104 N:NREAD S:4000 D:$04000 R:4\nJMP 0\n"
