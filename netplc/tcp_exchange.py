@@ -397,6 +397,9 @@ class TcpHub:
             self._wake()
 
     def call(self, fn: Callable[[], None]) -> None:
+        """Any thread: run `fn` on the thread (a name looked up); nothing once it has stopped."""
+        if self._stopping:
+            return
         self.inbox.append(fn)
         self._woken = True
         self._wake()
