@@ -443,6 +443,11 @@ class Exchange:
         stats = self.stats.get(node)
         return stats is not None and stats.up
 
+    @property
+    def in_flight(self) -> int:
+        """Requests handed to the nodes whose outcome has not reached memory yet."""
+        return len(self._inflight)
+
     def link_known(self, node: int) -> bool:
         """The node has had its first exchange attempt (up or down is known, not assumed)."""
         stats = self.stats.get(node)

@@ -50,6 +50,7 @@ if TYPE_CHECKING:
 logger = logging.getLogger(__name__)
 
 READ, WRITE = selectors.EVENT_READ, selectors.EVENT_WRITE
+CRASHED = "node %d: request failed inside the exchange"
 CONNECTING = (0, errno.EINPROGRESS, errno.EWOULDBLOCK, errno.EAGAIN)
 Address = tuple[int, tuple[str, int]]  # socket family, (host, port)
 
@@ -455,7 +456,8 @@ class TcpHub:
                             else:
                                 node.ready(events)
                         except Exception as e:  # a bug must not end the thread, nor show the link up
-                            self._crashed(node, e)
+                            logger.exception(CRASHED, node.config.node)
+                            node.crashed(e)
                 if self.outbox or self.inbox:
                     self._drain()
                 now = self.now
@@ -466,7 +468,8 @@ class TcpHub:
                         try:
                             node.tick(now)
                         except Exception as e:
-                            self._crashed(node, e)
+                            logger.exception(CRASHED, node.config.node)
+                            node.crashed(e)
         finally:
             for node in self.nodes.values():
                 node.close()
@@ -494,9 +497,5 @@ class TcpHub:
                 if node.req is None:
                     node.next()
             except Exception as e:  # a bug must not end the thread, nor show the link up
-                self._crashed(node, e)
-
-    @staticmethod
-    def _crashed(node: TcpNode, error: Exception) -> None:
-        logger.exception("node %d: request failed inside the exchange", node.config.node)
-        node.crashed(error)
+                logger.exception(CRASHED, node.config.node)
+                node.crashed(e)
