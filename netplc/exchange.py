@@ -1,14 +1,15 @@
 """Exchange with the PLC network: NODE / NREAD / NWRITE block requests over Modbus
 (docs/architecture.md sections 1 and 7).
 
-The scan never waits for the network. NREAD/NWRITE hand a block request to the node's asyncio task
-(on the exchange's own event-loop thread) and return at once with the node's link state; while a
-request of an instruction is in flight, the instruction asks for nothing more. The task's result
-comes back through `engine.post`, so it is applied to memory at the start of a later scan, by the
-engine thread, like every other write. Link-state changes reach the presence list 077740-077777
-the same way.
+The scan never waits for the network. NREAD/NWRITE hand a block request to the exchange's thread
+(Modbus TCP nodes: the selector thread of netplc/tcp_exchange.py; serial lines and pymodbus's
+client: a task per node on an asyncio loop thread) and return at once with the node's link state;
+while a request of an instruction is in flight, the instruction asks for nothing more. The results
+come back through `engine.post`, so they are applied to memory at the start of a later scan, by
+the engine thread, like every other write. Link-state changes reach the presence list
+077740-077777 the same way.
 
-Each node has its own task, connection, timeout, retries and reconnect back-off, so a dead or slow
+Each node has its own connection, timeout, retries and reconnect back-off, so a dead or slow
 node only ever delays its own requests (the nodes of one RS-485 line share its connection, one
 transaction at a time, as they share the wire). While a node is backing off, its requests fail at once
 (the instruction's output shows the link is down) and the first request after the back-off tries
@@ -35,39 +36,36 @@ import asyncio
 import logging
 import time
 from collections import deque
-from collections.abc import Awaitable, Callable, Iterable, Mapping
+from collections.abc import Callable, Iterable, Mapping
 from dataclasses import dataclass, field, fields
-from typing import TYPE_CHECKING, Any, TypeVar
+from typing import TYPE_CHECKING, Any
 
 from netplc.address import PRESENCE_LIST, PRESENCE_NODES, AddressError, check_operand
+from netplc.links import PROBE_IDLE as PROBE_IDLE  # where the probe's idle time is read
+from netplc.links import LinkState, NodeStats, Request
 from netplc.memory import Memory
 from netplc.modbus import (
-    ILLEGAL_VALUE,
     PROFILES,
     TABLES,
     WRITABLE_TABLES,
-    Block,
     DeviceError,
     Endpoint,
     LinkError,
     LoopThread,
     MapError,
-    describe,
-    exception_text,
     locate,
     open_client,
     parse_endpoint,
 )
 from netplc.program import Diagnostic, Program
 from netplc.records import NullSink, Record, RecordSink
+from netplc.tcp_exchange import TcpHub, TcpNode
 
 if TYPE_CHECKING:
     from netplc.engine import Engine
     from netplc.program import Instr
 
 NODE, NREAD, NWRITE = 300, 301, 302
-PROBE_IDLE = 1.0  # seconds without a request before a node's link is probed
-T = TypeVar("T")
 # the exchange's records (English; the station says them in its Language, app/scada/words.py)
 LINK_WORDS = {
     "link up": "node {node} ({endpoint}): link up",
@@ -215,40 +213,10 @@ def shared_problems(nodes: Iterable[NodeConfig]) -> list[tuple[NodeConfig, Probl
     return found
 
 
-@dataclass
-class NodeStats:
-    """What the status bar shows of a node."""
-
-    node: int
-    endpoint: str
-    up: bool = False
-    reads: int = 0  # completed block reads
-    writes: int = 0  # completed block writes
-    errors: int = 0  # failed block requests
-    last_error: str = ""
-    probes: int = 0  # liveness probes sent while NetPlc asked the node nothing
-    changed: float = 0.0  # monotonic time of the last link-state change
-    age: int = 0  # scans from the request of the last completed read to its data in memory
-    age_max: int = 0
-
-
-@dataclass
-class _Request:
-    key: int  # the FON instruction index
-    remote: int
-    local: int = 0
-    length: int = 0
-    payload: bytes | None = None  # None: a read
-    scan: int = 0  # the scan that asked
-
-
-PROBE = _Request(key=-1, remote=0)  # the queue item of a liveness probe
-
-
 class _Line:
-    """One connection: a TCP node's own, or a serial RS-485 line shared by the nodes on it, whose
-    transactions the lock keeps one at a time (a silent slave holds its line for the timeout, as it
-    would on the wire, but never another line)."""
+    """One asyncio connection: a serial RS-485 line shared by the nodes on it, whose transactions
+    the lock keeps one at a time (a silent slave holds its line for the timeout, as it would on the
+    wire, but never another line), or a TCP node's own through pymodbus's client."""
 
     def __init__(self, endpoint: Endpoint, timeout: float, lean: bool) -> None:
         self.client = open_client(endpoint, timeout, lean)
@@ -263,28 +231,16 @@ class _Line:
             self.client.close()
 
 
-class _Node:
-    """A node's task state: lives on the exchange loop, except `stats.up`, read by the scan."""
+class _Node(LinkState):
+    """A node served by an asyncio task on the exchange's loop thread (serial lines, pymodbus's
+    TCP client): the same link state and request steps as the TCP hot path's."""
 
     def __init__(self, config: NodeConfig, exchange: Exchange, stats: NodeStats, line: _Line) -> None:
-        self.config = config
-        self.exchange = exchange
-        self.stats = stats
+        super().__init__(config, exchange, stats)
         self.line = line
         self.client = line.client
-        self.queue: asyncio.Queue[_Request] = asyncio.Queue()
-        self.delay = config.backoff
-        self.retry_at = 0.0  # monotonic time before which requests fail without trying
-        self.reported = False
-        self.idle = max(config.timeout, PROBE_IDLE)
-        self.active = time.monotonic()  # when the last request or probe ended
+        self.queue: asyncio.Queue[Request] = asyncio.Queue()
         self.busy = False  # a request or probe is being served
-        self.blocks: dict[tuple[int, int], tuple[Block, str]] = {}  # (remote, length) -> where it is
-        # the answers since the last normal one, all exceptions: how many, to which requests, which codes
-        self.refusals = 0
-        self.refused: set[int] = set()  # request keys (PROBE's too)
-        self.repeated = False  # a request of the run was refused twice: the node refuses them all
-        self.codes: set[int] = set()
 
     async def run(self) -> None:
         watch = asyncio.get_running_loop().create_task(self.watch(), name=f"node {self.config.node} probe")
@@ -293,15 +249,15 @@ class _Node:
                 req = await self.queue.get()
                 self.busy = True
                 try:
-                    data, error = await (self.probe() if req is PROBE else self.serve(req))
+                    req.data, req.error = await self.serve(req)
                 except Exception as e:  # a bug must not end the node's task, nor show the link up
                     logger.exception("node %d: request failed inside the exchange", self.config.node)
                     self.line.failed()
-                    data, error = None, f"internal error: {e!r}"
-                    self.down(error)
+                    req.data, req.error = None, f"internal error: {e!r}"
+                    self.down(req.error)
                 self.active, self.busy = time.monotonic(), False
-                if req is not PROBE:
-                    self.exchange.complete(self, req, data, error)
+                if req is not self.probe:
+                    self.exchange.complete(self, req)
         finally:
             watch.cancel()
             self.client.close()
@@ -317,142 +273,86 @@ class _Node:
                 await asyncio.sleep(due - now)
             else:
                 self.active = now
-                self.queue.put_nowait(PROBE)
+                self.stats.probes += 1
+                self.queue.put_nowait(self.probe)
 
-    async def probe(self) -> tuple[None, str]:
-        self.stats.probes += 1
-        unit, table = self.config.unit, self.config.table
-        _, error = await self.transact(lambda: self.client.read(unit, table, 0, 1), "probe", PROBE.key)
-        return None, error
-
-    async def serve(self, req: _Request) -> tuple[bytes | None, str]:
-        now = time.monotonic()
-        if now < self.retry_at:
+    async def serve(self, req: Request) -> tuple[bytes | None, str]:
+        if req is not self.probe and time.monotonic() < self.retry_at:
             return None, self.stats.last_error or "link down"
-        length = req.length if req.payload is None else len(req.payload)
-        located = self.blocks.get((req.remote, length))
-        if located is None:  # an instruction asks for the same block every scan: map it once
-            where = describe(self.config.profile, req.remote)
-            try:
-                located = locate(self.config.profile, self.config.table, req.remote, length), where
-            except MapError as e:
-                return None, f"{where}: {e}"
-            self.blocks[req.remote, length] = located
-        block, where = located
-        if req.payload is None:
-            data, error = await self.transact(lambda: self.read(block), where, req.key)
-        else:
-            payload = req.payload
-            data, error = await self.transact(lambda: self.write(block, payload), where, req.key)
-        return data, error
-
-    async def transact(self, call: Callable[[], Awaitable[T]], where: str, key: int) -> tuple[T | None, str]:
-        """`call()` (request `key`) with the node's retries; its outcome sets the link state and the
-        back-off. Returns (result, "") or (None, what went wrong)."""
+        steps, where = self.steps(req)
+        if steps is None:
+            return None, where
         try:
-            result = await self.attempts(call)
-        except DeviceError as e:  # the device answered, with an exception
-            if key == PROBE.key and e.code <= ILLEGAL_VALUE:  # no register 0 there: an answer
-                self.answered()
-            elif self.only_exceptions(key, e.code):
-                self.down(self.exceptions())
-            else:
-                self.link(True, "")
-            return None, f"{where}: {e}"
-        except MapError as e:  # the block does not fit the node's table: nothing was sent
-            self.link(True, "")
-            return None, f"{where}: {e}"
-        except LinkError as e:  # no answer, or one that is not the request's (ProtocolError)
-            self.down(str(e))
-            return None, str(e)
+            result = await self.attempts(req)
+        except (DeviceError, MapError, LinkError) as e:
+            return None, self.failed(e, where, req.key)
         self.answered()
         return result, ""
 
-    def answered(self) -> None:
-        """A normal answer: the link is up, the back-off and the run of exceptions start over."""
-        self.delay = self.config.backoff
-        self.refusals, self.repeated = 0, False
-        self.refused.clear()
-        self.codes.clear()
-        self.link(True, "")
-
-    def only_exceptions(self, key: int, code: int) -> bool:
-        """Count an exception in answer to request `key`: does the node now answer only those?"""
-        self.refusals += 1
-        self.repeated = self.repeated or key in self.refused
-        self.refused.add(key)
-        self.codes.add(code)
-        return self.repeated and self.refusals >= self.config.retries + 1
-
-    def exceptions(self) -> str:
-        codes = sorted(self.codes)
-        if len(codes) == 1:
-            return f"answers only exception {exception_text(codes[0])}"
-        return f"answers only exceptions {', '.join(exception_text(c) for c in codes)}"
-
-    def down(self, error: str) -> None:
-        """Every attempt failed: the link is down and the node backs off."""
-        self.retry_at = time.monotonic() + self.delay
-        self.delay = min(2 * self.delay, self.config.backoff_max)
-        self.link(False, error)
-
-    async def attempts(self, call: Callable[[], Awaitable[T]]) -> T:
+    async def attempts(self, req: Request) -> bytes:
+        """The request's steps, started over after a failed attempt while the node's retries last."""
         for attempt in range(self.config.retries + 1):
             try:
                 if not self.line.serial:  # a TCP node's connection is its own: nothing to share
-                    if not self.client.connected:
-                        await self.client.connect()
-                    return await call()
+                    return await self.drive(req)
                 async with self.line.lock:
-                    if not self.client.connected:
-                        await self.client.connect()
-                    return await call()
+                    return await self.drive(req)
             except LinkError:
                 self.line.failed()
                 if attempt == self.config.retries:
                     raise
         raise AssertionError("unreachable")
 
-    async def read(self, block: Block) -> bytes:
-        spans = block.spans(write=False)
-        unit, table, client = self.config.unit, block.table, self.client
-        if len(spans) == 1:
-            return block.decode_wire(await client.read_bytes(unit, table, *spans[0]))
-        return block.decode_wire(b"".join([await client.read_bytes(unit, table, a, n) for a, n in spans]))
+    async def drive(self, req: Request) -> bytes:
+        if not self.client.connected:
+            await self.client.connect()
+        steps, _ = self.steps(req)
+        assert steps is not None
+        answer = None
+        unit, client = self.config.unit, self.client
+        try:
+            while True:
+                frame = steps.send(answer)  # type: ignore[arg-type]
+                if frame.values is None:
+                    answer = await client.read_bytes(unit, frame.table, frame.address, frame.count)
+                else:
+                    await client.write(unit, frame.table, frame.address, frame.values)
+                    answer = b""
+        except StopIteration as done:
+            return done.value
 
-    async def write(self, block: Block, payload: bytes) -> bytes:
-        if block.table not in WRITABLE_TABLES:
-            raise MapError(f"{block.table} is a read-only table")
-        first = last = 0
-        unit, table = self.config.unit, block.table
-        if block.skip:  # odd edges: keep the neighbouring bytes of the edge registers
-            first = (await self.client.read(unit, table, block.address, 1))[0]
-        if block.odd_end:
-            last = (await self.client.read(unit, table, block.address + block.count - 1, 1))[0]
-        values = block.encode(payload, first, last)
-        offset = 0
-        for address, count in block.spans(write=True):
-            await self.client.write(self.config.unit, block.table, address, values[offset : offset + count])
-            offset += count
-        return b""
 
-    def link(self, up: bool, error: str) -> None:
-        stats = self.stats
-        if error:
-            stats.last_error = error
-        if stats.up == up and self.reported:
-            return
-        self.reported = True  # the first outcome is reported either way: a node down from the start too
-        stats.up = up
-        stats.changed = time.monotonic()
-        self.exchange.link_changed(self, up, error)
+class _LoopLinks:
+    """The asyncio nodes' side of the hand-over from the engine thread: one wake-up of the loop per
+    batch of requests, not one per request."""
+
+    def __init__(self) -> None:
+        self.thread = LoopThread("netplc-exchange")
+        self.nodes: dict[int, _Node] = {}
+        self.outbox: deque[Request] = deque()
+        self.wake = False
+
+    def submit(self, req: Request) -> None:
+        self.outbox.append(req)
+        if not self.wake:
+            self.wake = True
+            self.thread.call(self.dispatch)
+
+    def dispatch(self) -> None:
+        self.wake = False  # first: a request appended from now on schedules another wake-up
+        outbox, nodes = self.outbox, self.nodes
+        while outbox:
+            req = outbox.popleft()
+            nodes[req.node].queue.put_nowait(req)
 
 
 class Exchange:
-    """Implements `NetLink` for the engine: block requests to configured nodes over Modbus."""
+    """Implements `NetLink` for the engine: block requests to configured nodes over Modbus. Modbus
+    TCP nodes are served by the hot path (netplc/tcp_exchange.py), serial lines and pymodbus's
+    client by asyncio tasks."""
 
     def __init__(self, nodes: list[NodeConfig], sink: RecordSink | None = None, *, lean: bool = True) -> None:
-        self.lean = lean  # our lean Modbus TCP client; False: pymodbus's (bench/exchange.py compares)
+        self.lean = lean  # our own Modbus TCP hot path; False: pymodbus's client (bench/exchange.py compares)
         for cfg in nodes:
             if cfg.parsed is None:
                 raise ValueError(f"node {cfg.node}: no endpoint")
@@ -465,16 +365,20 @@ class Exchange:
         self.stats: dict[int, NodeStats] = {
             n: NodeStats(n, str(cfg.parsed)) for n, cfg in self.configs.items()
         }
-        self._nodes: dict[int, _Node] = {}
-        # Touched by the engine thread only: instruction keys with a request in flight, and the
-        # nodes whose link is up as of this scan (changes arrive with the presence-list update).
+        self._hub: TcpHub | None = None
+        self._loop: _LoopLinks | None = None
+        # node -> how the engine thread hands it a request (the TCP hub's or the loop's submit)
+        self._targets: dict[int, Callable[[Request], None]] = {}
+        # Touched by the engine thread only: instruction keys with a request in flight, the nodes
+        # whose link is up as of this scan (changes arrive with the presence-list update), and
+        # each NREAD's request, made once and sent again whenever the instruction asks anew.
         self._inflight: set[int] = set()
         self._present: set[int] = set()
+        self._reads: dict[int, Request] = {}
         # NREAD key -> the scan at the start of which its data last landed (data age for quality)
         self.refreshed: dict[int, int] = {}
-        self._outbox: deque[tuple[_Node, _Request]] = deque()  # engine thread -> exchange loop
-        self._wake = False
-        self._thread = LoopThread("netplc-exchange")
+        self._done: deque[Request] = deque()  # finished requests, applied at the start of a scan
+        self._applying = False  # an `_apply` is posted to the engine and has not started
 
     # --- wiring ----------------------------------------------------------------------------------
 
@@ -487,27 +391,44 @@ class Exchange:
         if self.engine is None:
             raise RuntimeError("Exchange.attach(engine) must come before start()")
         self._post_reset()
-        self._thread.start()
-        self._thread.run(self._spawn())
-
-    async def _spawn(self) -> None:
         lines: dict[str, _Line] = {}
         for n, cfg in self.configs.items():
             ep = cfg.parsed
+            assert ep is not None
+            if ep.scheme == "tcp" and self.lean:
+                hub = self._hub = self._hub or TcpHub()
+                hub.add(TcpNode(cfg, self, self.stats[n], hub))
+                self._targets[n] = hub.submit
+                continue
+            links = self._loop = self._loop or _LoopLinks()
             if ep.scheme == "rtu":  # the nodes of one serial port share its line
                 if ep.device not in lines:
-                    timeout = max(c.timeout for c in self.configs.values() if c.parsed.device == ep.device)
+                    timeout = max(c.timeout for c in self.configs.values()
+                                  if c.parsed is not None and c.parsed.device == ep.device)
                     lines[ep.device] = _Line(ep, timeout, self.lean)
                 line = lines[ep.device]
             else:
                 line = _Line(ep, cfg.timeout, self.lean)
-            node = _Node(cfg, self, self.stats[n], line)
-            self._nodes[n] = node
+            links.nodes[n] = _Node(cfg, self, self.stats[n], line)
+            self._targets[n] = links.submit
+        if self._hub is not None:
+            self._hub.start()
+        if self._loop is not None:
+            self._loop.thread.start()
+            self._loop.thread.run(self._spawn(self._loop))
+
+    @staticmethod
+    async def _spawn(links: _LoopLinks) -> None:
+        for n, node in links.nodes.items():
             asyncio.get_running_loop().create_task(node.run(), name=f"node {n}")
 
     def stop(self) -> None:
-        self._thread.stop()
-        self._nodes.clear()
+        hub, loop, self._hub, self._loop = self._hub, self._loop, None, None
+        self._targets.clear()
+        if hub is not None:
+            hub.stop()
+        if loop is not None:
+            loop.thread.stop()
         for stats in self.stats.values():
             stats.up = False
         if self.engine is not None:
@@ -515,17 +436,17 @@ class Exchange:
 
     def _post_reset(self) -> None:
         """No link and nothing in flight as of the next scan (requests of a stopped run never complete)."""
-        inflight, present, nodes = self._inflight, self._present, list(self.configs)
-        self._outbox.clear()
-        self._wake = False
+        inflight, present, nodes, done = self._inflight, self._present, list(self.configs), self._done
 
         def reset(mem: Memory) -> None:
             inflight.clear()
             present.clear()
+            done.clear()
             for n in nodes:
                 if n < PRESENCE_NODES:
                     mem.set_byte(PRESENCE_LIST + n, 0)
 
+        assert self.engine is not None
         self.engine.post(reset)
 
     # --- NetLink (called by NREAD/NWRITE on the engine thread) -----------------------------------
@@ -534,66 +455,76 @@ class Exchange:
         stats = self.stats.get(node)
         return stats is not None and stats.up
 
+    @property
+    def in_flight(self) -> int:
+        """Requests handed to the nodes whose outcome has not reached memory yet."""
+        return len(self._inflight)
+
     def link_known(self, node: int) -> bool:
         """The node has had its first exchange attempt (up or down is known, not assumed)."""
         stats = self.stats.get(node)
         return stats is not None and stats.changed > 0
 
     def request_read(self, key: int, node: int, remote: int, local: int, length: int) -> bool:
-        if key in self._inflight:  # the usual case at a fast tick: nothing to build
+        if key in self._inflight:  # the usual case at a fast tick: nothing to do
             return node in self._present
-        return self._request(node, _Request(key, remote, local, length))
+        req = self._reads.get(key)
+        if req is None or (req.node, req.remote, req.local, req.length) != (node, remote, local, length):
+            req = self._reads[key] = Request(key, node, remote, local, length)
+        return self._request(req)
 
     def request_write(self, key: int, node: int, remote: int, payload: bytes) -> bool:
-        return self._request(node, _Request(key, remote, payload=bytes(payload)))
+        if key in self._inflight:
+            return node in self._present
+        return self._request(Request(key, node, remote, payload=bytes(payload)))
 
-    def _request(self, node: int, req: _Request) -> bool:
-        target = self._nodes.get(node)
-        if target is None:
+    def _request(self, req: Request) -> bool:
+        submit = self._targets.get(req.node)
+        if submit is None:
             return False
-        if req.key not in self._inflight:
-            self._inflight.add(req.key)
-            req.scan = self.engine.scan_counter if self.engine is not None else 0
-            self._outbox.append((target, req))
-            if not self._wake:  # one wake-up of the loop per batch, not one per request
-                self._wake = True
-                self._thread.call(self._dispatch)
-        return node in self._present
-
-    def _dispatch(self) -> None:
-        """Exchange loop: hand the requests of the scan(s) since the last wake-up to their nodes."""
-        self._wake = False  # first: a request appended from now on schedules another wake-up
-        outbox = self._outbox
-        while outbox:
-            target, req = outbox.popleft()
-            target.queue.put_nowait(req)
+        self._inflight.add(req.key)
+        req.scan = self.engine.scan_counter if self.engine is not None else 0
+        submit(req)
+        return req.node in self._present
 
     # --- back on the engine thread ---------------------------------------------------------------
 
-    def complete(self, node: _Node, req: _Request, data: bytes | None, error: str) -> None:
-        """A request is done (exchange loop): count it and apply its result at the next scan."""
+    def complete(self, node: LinkState, req: Request) -> None:
+        """A request is done (exchange thread): count it; its result is applied at the next scan,
+        with every other result that is done by then, by one function posted to the engine."""
         stats = node.stats
-        if error:
+        if req.error:
             stats.errors += 1
-            stats.last_error = error
+            stats.last_error = req.error
         elif req.payload is None:
             stats.reads += 1
         else:
             stats.writes += 1
-        inflight, engine, refreshed = self._inflight, self.engine, self.refreshed
+        self._done.append(req)
+        if not self._applying:
+            self._applying = True
+            assert self.engine is not None
+            self.engine.post(self._apply)
 
-        def apply(mem: Memory) -> None:
+    def _apply(self, mem: Memory) -> None:
+        self._applying = False  # first: a request done from now on posts another `_apply`
+        done, inflight, refreshed, stats = self._done, self._inflight, self.refreshed, self.stats
+        assert self.engine is not None
+        scan = self.engine.scan_counter
+        while done:
+            req = done.popleft()
             inflight.discard(req.key)
+            data = req.data
             if data:
-                stats.age = engine.scan_counter - req.scan
-                stats.age_max = max(stats.age_max, stats.age)
+                node = stats[req.node]
+                node.age = age = scan - req.scan
+                if age > node.age_max:
+                    node.age_max = age
                 mem.write(req.local, data)
                 if req.payload is None:
-                    refreshed[req.key] = engine.scan_counter
+                    refreshed[req.key] = scan
 
-        self.engine.post(apply)
-
-    def link_changed(self, node: _Node, up: bool, error: str) -> None:
+    def link_changed(self, node: LinkState, up: bool, error: str) -> None:
         n = node.config.node
         name = "link up" if up else "link down because" if error else "link down"
         self.sink.put(Record(time.time(), "system", source=f"node {n}", number=n, value=1.0 if up else 0.0,
@@ -608,6 +539,7 @@ class Exchange:
             if n < PRESENCE_NODES:
                 mem.set_byte(PRESENCE_LIST + n, 0xFF if up else 0x00)
 
+        assert self.engine is not None
         self.engine.post(apply)
 
 

@@ -1,5 +1,6 @@
 """The Modbus stack: endpoints, the lean TCP client and the pymodbus one, our Modbus TCP server,
-RTU framing, and the CPU-165 Modbus map (how NetPlc memory looks as coils and registers).
+RTU framing, the exchange's TCP frames encoded once (`frames.py`), and the CPU-165 Modbus map (how
+NetPlc memory looks as coils and registers).
 
 It is the wire and nothing more: what NODE/NREAD/NWRITE mean is `netplc/exchange.py`, what a
 simulated CPU-165 node is is `netplc/simulator.py`; both reach the wire through this package. What
@@ -10,6 +11,7 @@ every minor release.
 
 from netplc.modbus.client import LeanTcpClient, ModbusClient, open_client
 from netplc.modbus.endpoint import Endpoint, line_problems, parse_endpoint
+from netplc.modbus.frames import Frame, FrameError, answer_data, frame_size
 from netplc.modbus.loop import LoopThread
 from netplc.modbus.map import (
     MAX_READ_BITS,
@@ -62,6 +64,8 @@ __all__ = [
     "DeviceError",
     "Done",
     "Endpoint",
+    "Frame",
+    "FrameError",
     "LeanTcpClient",
     "LinkError",
     "LoopThread",
@@ -73,9 +77,11 @@ __all__ = [
     "ServeHandler",
     "ServerLimits",
     "Table",
+    "answer_data",
     "bytes_from_words",
     "describe",
     "exception_text",
+    "frame_size",
     "line_problems",
     "locate",
     "open_client",

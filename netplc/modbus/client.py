@@ -1,5 +1,7 @@
-"""One client per node: the connection NODE/NREAD/NWRITE talk through (`open_client`), our lean
-Modbus TCP client for the exchange's hot path, and pymodbus's (serial RTU, and TCP for comparison).
+"""Asyncio Modbus clients (`open_client`): our lean TCP client, for the Program view's and the
+designer's reads of a station, and pymodbus's, through which the exchange reaches serial RTU lines
+(and TCP nodes when bench/exchange.py compares it). The exchange's own TCP nodes do not use these:
+they are served by its selector thread (netplc/tcp_exchange.py).
 
 Retries and reconnect back-off belong to the exchange (netplc/exchange.py), not to a client.
 """
@@ -11,11 +13,10 @@ import struct
 from typing import Protocol
 
 from netplc.modbus.endpoint import Endpoint
-from netplc.modbus.map import BIT_TABLES, MapError, Table, bits_from_bytes, bytes_from_bits
+from netplc.modbus.frames import read_pdu, write_pdu
+from netplc.modbus.map import BIT_TABLES, Table, bits_from_bytes
 from netplc.modbus.pdu import (
-    ADDRESS_REQUEST,
     MBAP,
-    READ_CODES,
     DeviceError,
     LinkError,
     ProtocolError,
@@ -115,14 +116,12 @@ class _Answers(asyncio.Protocol):
 
 
 class LeanTcpClient:
-    """A Modbus TCP client of our own for the exchange's hot path: one request at a time per
-    connection, an MBAP frame in and out, no per-request objects beyond the bytes and a future,
-    and the answer's data handed over as bytes (no list of ints). pymodbus's client spends most
-    of NetPlc's CPU at a few thousand block reads per second (bench/exchange.py shows both); this
-    one also fails a request the moment its connection drops.
+    """A Modbus TCP client of our own for asyncio callers: one request at a time per connection, an
+    MBAP frame in and out, no per-request objects beyond the bytes and a future, and the answer's
+    data handed over as bytes (no list of ints); it fails a request the moment its connection drops.
 
-    It has one waiter slot: the exchange holds its line's lock around every transaction, and a
-    second transaction started while one is in flight is refused (RuntimeError), never mixed up.
+    It has one waiter slot: a second transaction started while one is in flight is refused
+    (RuntimeError), never mixed up.
     Every answer is checked against its request (unit id, function code, byte count, the echo of
     a write); one that does not match is a ProtocolError."""
 
@@ -180,7 +179,7 @@ class LeanTcpClient:
     async def read_bytes(self, unit: int, table: Table, address: int, count: int) -> bytes:
         """The answer's data as the wire carries it: registers big-endian, coils packed."""
         what = f"read {table} {address}+{count}"
-        reply = await self._transact(unit, ADDRESS_REQUEST.pack(READ_CODES[table], address, count), what)
+        reply = await self._transact(unit, read_pdu(table, address, count), what)
         size = (count + 7) // 8 if table in BIT_TABLES else 2 * count
         if len(reply) != size + 2 or reply[1] != size:
             raise ProtocolError(f"{what}: answer of {len(reply)} bytes ({reply[:8].hex(' ')}), "
@@ -195,14 +194,7 @@ class LeanTcpClient:
 
     async def write(self, unit: int, table: Table, address: int, values: list[int]) -> None:
         what = f"write {table} {address}+{len(values)}"
-        n = len(values)
-        if table == "coils":
-            data = bytes_from_bits(values)
-            request = struct.pack(">BHHB", 15, address, n, len(data)) + data
-        elif table == "holding":
-            request = struct.pack(f">BHHB{n}H", 16, address, n, 2 * n, *values)
-        else:
-            raise MapError(f"{table} is a read-only table")
+        request = write_pdu(table, address, values)
         reply = await self._transact(unit, request, what)
         if reply != request[:5]:
             raise ProtocolError(f"{what}: the answer {reply.hex(' ')} does not echo {request[:5].hex(' ')}")

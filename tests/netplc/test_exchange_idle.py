@@ -40,6 +40,7 @@ def test_a_node_that_dies_while_the_program_is_stopped_shows_down_and_comes_back
 
         st.engine.post(lambda _m: st.engine.stop())
         wait_until(lambda: snap().state == "stopped")
+        wait_until(lambda: st.exchange.in_flight == 0)  # the last scan's requests are answered
         reads = stats.reads
         node0.server.stop()  # node 0 switched off while NetPlc asks it nothing
         took = wait_until(lambda: snap().get_byte(0o77740) == 0, timeout=PROBE_IDLE + 3)

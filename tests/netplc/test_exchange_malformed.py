@@ -70,8 +70,11 @@ class BadNode:
                     tid, _, length, unit = MBAP.unpack_from(buf)
                     pdu, buf = buf[7 : 6 + length], buf[6 + length :]
                     self.requests += 1
-                    got_unit, answer = self.reply(unit, pdu)
-                    conn.sendall(MBAP.pack(tid, 0, len(answer) + 1, got_unit) + answer)
+                    self.respond(conn, tid, unit, pdu)
+
+    def respond(self, conn: socket.socket, tid: int, unit: int, pdu: bytes) -> None:
+        got_unit, answer = self.reply(unit, pdu)
+        conn.sendall(MBAP.pack(tid, 0, len(answer) + 1, got_unit) + answer)
 
     def close(self) -> None:
         self.listener.close()
