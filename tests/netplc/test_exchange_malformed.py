@@ -169,8 +169,8 @@ class BadRtuDevice:
 def test_a_malformed_rtu_answer_is_a_failed_attempt(reply: Reply) -> None:
     device = BadRtuDevice(reply)
     try:
-        st = Station(READ, [NodeConfig(1, f"rtu://{device.port}?baudrate=115200", timeout=0.3, retries=1,
-                                       backoff=0.1, backoff_max=0.2)])
+        line = f"rtu://{device.port}?baudrate=115200&parity=N"  # a pty takes no parity setting
+        st = Station(READ, [NodeConfig(1, line, timeout=0.3, retries=1, backoff=0.1, backoff_max=0.2)])
         st.start()
         try:
             wait_until(lambda: st.exchange.stats[1].errors >= 2, timeout=5)
