@@ -44,6 +44,7 @@ from app.authority.policy import ROLES, needs, rank
 from app.publish.client import StationClient, _why, config_dir
 from app.publish.ua_types import SEVERITY
 from app.scada.alarms import AlarmRow, State
+from app.scada.horn import AlarmSource
 from netplc.address import fmt_octal
 from registrar.reading import Row
 
@@ -246,8 +247,11 @@ class StationCommands:
     the rights of their buttons): the layer's methods and answers, each sent as the station's
     method with the console's user; `who` is the console's and not sent (the session is who)."""
 
-    def __init__(self, client: ConsoleClient) -> None:
+    def __init__(self, client: ConsoleClient, alarms: AlarmSource) -> None:
+        """`alarms`: the console's copy of the station's alarms, whose horn a Silence the station
+        took stops at once (as the layer does the station's own)."""
         self.client = client
+        self.alarms = alarms
 
     def denial(self, who: Who, action: Action, at_least: str | None = None,
                what: str | None = None) -> Refusal | None:
@@ -269,7 +273,14 @@ class StationCommands:
         return self._sent(Action.UNSHELVE, alarm_id, "Unshelve", alarm_id)
 
     def silence(self, who: Who) -> Ticket:
-        return self._sent(Action.SILENCE, Action.SILENCE.value, "Silence")
+        ticket = self._sent(Action.SILENCE, Action.SILENCE.value, "Silence")
+        ticket.add_done_callback(self._silenced)
+        return ticket
+
+    def _silenced(self, ticket: Ticket) -> None:
+        """On the client's thread, before the view hears the answer."""
+        if ticket.result().ok:
+            self.alarms.silence(time.time())
 
     def _sent(self, action: Action, what: str, method: str, *args: object) -> Ticket:
         return self.client.said(self.client.call(method, *args), action, what)

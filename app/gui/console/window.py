@@ -53,7 +53,7 @@ from app.publish.console import ConsoleClient, StationCommands
 from app.scada.alarms import AlarmRow
 from app.scada.readings import Readings
 from hmi_forms.elements.base import Writer
-from hmi_forms.elements.target import EngineTarget
+from hmi_forms.elements.target import CommandTarget
 from hmi_forms.widgets.form_view import FormView
 from netplc.problems import Problems
 
@@ -62,18 +62,14 @@ logger = logging.getLogger(__name__)
 STATUS_MS = 1000
 
 
-class RemoteTarget(EngineTarget):
+class RemoteTarget(CommandTarget):
     """The station's command layer, reached over its endpoint, as the form elements' Target: the
-    station names a tag's write with the tag and journals it with the console's user."""
+    station names a tag's write with the tag and journals it with the console's user (so no tags
+    here: the view says the element's label)."""
 
     def __init__(self, client: ConsoleClient, answers: Answers) -> None:
-        # no local layer: the station's checks, names and journals each write
+        super().__init__(lambda user: Who(user, Source.OPCUA), (), answers.follow, words.answer)
         self.client = client
-        self.who = lambda user: Who(user, Source.OPCUA)
-        self.on_answer = answers.follow
-        self.say = words.answer
-        self._bits: dict = {}  # the station names a write by its tag: the view says the element's label
-        self._words: dict = {}
 
     def bit(self, who: Who, addr: int, value: int, label: str | None, at_least: str | None) -> Ticket:
         return self.client.write_bit(addr, value, label, at_least)
@@ -100,7 +96,7 @@ class ConsoleWindow(QMainWindow):
         self.answers = Answers()
         self.answers.answered.connect(self._answered)
         self.target = RemoteTarget(client, self.answers)
-        self.commands = StationCommands(client)
+        self.commands = StationCommands(client, source.station_alarms)
         self.rights = Rights(self.commands, lambda: self.who)  # type: ignore[arg-type]
         self.views: list[FormView] = []
         self.history: TrendHistory | None = None  # of the forms shown
