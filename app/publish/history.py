@@ -17,7 +17,7 @@ timestamp of the first value not returned, which repeats the values sharing that
 NumValuesPerNode truncates without a continuation point; and it checks no node and knows no
 bounds, TimestampsToReturn or ReleaseContinuationPoints. From asyncua come the
 result structures, `Event.to_event_fields` for an EventFilter's select clauses and its
-WhereClauseEvaluator for the where clause.
+WhereClauseEvaluator for the where clause (with the Like operator it lacks: `Where`).
 
 The time domain is Part 11's (4.4, 6.5.3): the start is included and the end is not, so contiguous
 reads see every value once; an end before the start, or an end with a count alone, reads backward;
@@ -38,6 +38,7 @@ from __future__ import annotations
 import asyncio
 import datetime as dt
 import logging
+import re
 import sqlite3
 import struct
 import zlib
@@ -45,6 +46,7 @@ from collections.abc import Callable, Collection, Mapping
 from concurrent.futures import ThreadPoolExecutor
 from dataclasses import dataclass
 from datetime import UTC, datetime
+from functools import lru_cache
 from pathlib import Path
 from typing import Any
 
@@ -373,6 +375,42 @@ def _describe(row: Row) -> tuple[str, str, int]:
     return row.source or "", text, 100
 
 
+# --- the where clause ----------------------------------------------------------------------------
+
+@lru_cache(maxsize=64)
+def like_pattern(pattern: str) -> re.Pattern[str]:
+    """Part 4's Like pattern (7.7.3, its table of special characters) as a regular expression:
+    `%` any text, `_` one character, `[...]` one of, `[^...]` none of, `\\` the next literally."""
+    out, i = [], 0
+    while i < len(pattern):
+        c = pattern[i]
+        if c == "\\" and i + 1 < len(pattern):
+            out.append(re.escape(pattern[i + 1]))
+            i += 2
+            continue
+        if c == "[" and (end := pattern.find("]", i + 2 if pattern[i + 1:i + 2] == "^" else i + 1)) > 0:
+            inner = pattern[i + 1:end]
+            negate = inner.startswith("^")
+            body = "".join("\\" + ch if ch in "\\]^[" else ch for ch in inner[negate:])
+            out.append(f"[{'^' if negate else ''}{body}]")
+            i = end + 1
+            continue
+        out.append(".*" if c == "%" else "." if c == "_" else re.escape(c))
+        i += 1
+    return re.compile("".join(out), re.DOTALL)
+
+
+class Where(WhereClauseEvaluator):
+    """asyncua's where-clause evaluator with the Like operator it leaves unimplemented, so that a
+    client filters the journal's events by their Message (a console's viewer: "text contains")."""
+
+    def _like_operator(self, string: object, pattern: object) -> bool:
+        text = string.Text if isinstance(string, ua.LocalizedText) else string
+        if not isinstance(text, str) or not isinstance(pattern, str):
+            return False
+        return like_pattern(pattern).fullmatch(text) is not None
+
+
 # --- the service --------------------------------------------------------------------------------
 
 class StationHistory(HistoryManager):
@@ -469,7 +507,7 @@ class StationHistory(HistoryManager):
                 limit: int) -> tuple[ua.HistoryEvent, Position | None, int]:
         with self._open() as archive:
             rows, resume = read_journal(archive, d, after, limit)
-        where = WhereClauseEvaluator(logger, self.iserver.aspace, flt.WhereClause)
+        where = Where(logger, self.iserver.aspace, flt.WhereClause)
         events = [event for event in (event_of(row, self.station, self.alarms) for row in rows)
                   if where.eval(event)]
         fields = [ua.HistoryEventFieldList(EventFields=e.to_event_fields(flt.SelectClauses)) for e in events]
