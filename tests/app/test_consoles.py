@@ -213,6 +213,27 @@ def test_the_station_lists_its_consoles_and_refuses_one_beyond_max_consoles(
                for r in station.records)
 
 
+def test_a_silence_the_station_took_stops_the_consoles_sound_at_once(
+        qtbot, station: Station, attach: Attach) -> None:
+    console = attach(station, "operator")
+    summary, horn = console.summary, console.source.station_alarms.horn
+    node = station.runtime.simulators[0].engine
+    node.write_word(0o4010, 3950)  # LEVEL 96 %: LEVEL.HH, priority 2, sounds until silenced
+    try:
+        qtbot.waitUntil(lambda: horn.sounding, timeout=WAIT)
+        summary.annunciator.tick()
+        assert summary.annunciator.sounding
+        summary.silence_sound()  # the station's Silence as the console's user
+        qtbot.waitUntil(lambda: not summary.annunciator.sounding and not horn.sounding, timeout=WAIT)
+        assert any(r.kind == "operator" and "opcua:operator@" in (r.source or "") for r in station.records
+                   if "silenced" in (r.text or "") or "звук" in (r.text or ""))
+        console.source.station_alarms.show(console.client.alarms)  # the rows again: silenced stays quiet
+        summary.annunciator.tick()
+        assert not summary.annunciator.sounding and not horn.sounding
+    finally:
+        node.write_word(0o4010, 0)
+
+
 def test_a_console_shows_the_station_unreachable_and_reconnects_by_itself(
         qtbot, station: Station, attach: Attach) -> None:
     """Last of the module: it stops the station, and leaves it restarted."""
