@@ -128,12 +128,17 @@ def where_clause(flt: Filter, mark: str = "?") -> tuple[str, list[object]]:
         conds.append(f"ts < {mark}")
         args.append(round(flt.until * 1000))
     if flt.text:
-        # SQLite folds case for ASCII only; the usual spellings of a Cyrillic word are tried too.
-        variants = sorted({flt.text, flt.text.lower(), flt.text.upper(), flt.text.capitalize()})
+        variants = spellings(flt.text)
         likes = " OR ".join(f"text LIKE {mark} ESCAPE '\\'" for _ in variants)
         conds.append(f"text IS NOT NULL AND ({likes})")
         args.extend(f"%{_escape_like(v)}%" for v in variants)
     return (" WHERE " + " AND ".join(conds)) if conds else "", args
+
+
+def spellings(text: str) -> list[str]:
+    """What "text contains" looks for: SQLite folds case for ASCII only (and a Like of OPC UA for
+    none), so the usual spellings of a Cyrillic word are tried too."""
+    return sorted({text, text.lower(), text.upper(), text.capitalize()})
 
 
 def alarm_priority(message_type: int) -> int:

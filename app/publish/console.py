@@ -45,11 +45,12 @@ from asyncua.common.events import Event
 from app.authority import Action, Answer, Reason, Refusal, Ticket, Who
 from app.authority.policy import ROLES, needs, rank
 from app.publish.client import StationClient, _why, config_dir
+from app.publish.history import journal_where
 from app.publish.ua_types import SEVERITY
 from app.scada.alarms import AlarmRow, State
 from app.scada.horn import AlarmSource
 from netplc.address import fmt_octal
-from registrar.reading import Row
+from registrar.reading import Filter, Row
 
 logger = logging.getLogger(__name__)
 
@@ -131,11 +132,11 @@ class ConsoleClient(StationClient):
         oldest first, in physical units with the StatusCode of their quality."""
         return self._submit(self._history(tag, start, end))
 
-    def events(self, start: dt.datetime, end: dt.datetime, where: ua.ContentFilter,
-               limit: int) -> Future[list[Row]]:
-        """The station's journal events from `start` (included) to `end` (not) that pass `where`
-        (evaluated by the station), oldest first, `limit` at most, as the records they were."""
-        return self._submit(self._events(start, end, where, limit))
+    def events(self, start: dt.datetime, end: dt.datetime, flt: Filter, limit: int) -> Future[list[Row]]:
+        """The station's journal events from `start` (included) to `end` (not) that pass what the
+        station evaluates of `flt` (history.py `journal_where`), oldest first, `limit` at most, as
+        the records they were."""
+        return self._submit(self._events(start, end, journal_where(flt), limit))
 
     def historizing(self, tags: list[str]) -> Future[set[str]]:
         """Which of the station's tags `tags` it keeps the history of (their Historizing)."""

@@ -10,10 +10,11 @@ path whether the archive is a file at hand or a station's over OPC UA. Qt-free.
   views convert once, as from a file. A value not good is a gap (NaN).
 - Records are the journal's events (HistoryReadEvents on the station object): the time range is
   the read's domain, and the station evaluates the rest of the filter as the where clause
-  (`where`): a minimum type as a minimum Severity, an exact source as SourceName, "text contains"
-  as Like on the Message in the spellings the local archive tries. Kinds are told apart from the
-  events' types on the console; a message's group is not in its event (`unfiltered`). Data
-  records are the series': the Records page of a station holds its journal only.
+  (app/publish/history.py `journal_where`): a minimum type as a minimum Severity, an exact source
+  as SourceName, "text contains" as Like on the Message in the spellings the local archive tries.
+  Kinds are told apart from the events' types on the console; a message's group is not in its
+  event (`unfiltered`). Data records are the series': the Records page of a station holds its
+  journal only.
 - Days are those from the journal's first event to today (the station has no call that lists its
   archive's days): a day without records reads as empty.
 
@@ -28,82 +29,22 @@ import datetime as dt
 import math
 from dataclasses import dataclass, field
 from pathlib import Path
+from typing import Any
 
 import numpy as np
-from asyncua import ua
 
 from app.publish.console import ConsoleClient
 from app.publish.history import ARCHIVED_TYPES, JOURNAL
-from app.publish.ua_types import SEVERITY
 from app.scada.table import TagTable
 from app.scada.tag import Tag
 from netplc.address import fmt_octal
-from registrar.reading import ArchiveReader, Filter, Row, SeriesKey, alarm_priority, thinned
+from registrar.reading import ArchiveReader, Filter, Row, SeriesKey, thinned
 from registrar.schema import COLUMNS
 
 READ_S = 60.0  # an answer (all its pages) the station does not give within this is a failed read
 MAX_RECORDS = 100_000  # of one day and filter: what the viewer pages through
 MAX_DAYS = 366  # listed back from today
 FIRST = dt.datetime(1601, 1, 2, tzinfo=dt.UTC)  # before any record: the journal's first event from here
-_BASE = ua.NodeId(ua.ObjectIds.BaseEventType)
-_V = ua.VariantType
-
-
-def _field(name: str) -> ua.SimpleAttributeOperand:
-    return ua.SimpleAttributeOperand(TypeDefinitionId=_BASE, BrowsePath=[ua.QualifiedName(name, 0)],
-                                     AttributeId=ua.AttributeIds.Value)
-
-
-def _literal(value: object, kind: ua.VariantType) -> ua.LiteralOperand:
-    return ua.LiteralOperand(Value=ua.Variant(value, kind))
-
-
-Spec = tuple[ua.FilterOperator, list]  # an element: its operator and operands (a Spec: a sub-element)
-
-
-def _all(op: ua.FilterOperator, specs: list[Spec]) -> Spec:
-    """`specs` joined pairwise by `op` (And, Or), as the binary operators of Part 4 take them."""
-    return specs[0] if len(specs) == 1 else (op, [specs[0], _all(op, specs[1:])])
-
-
-def _elements(spec: Spec, out: list[ua.ContentFilterElement]) -> int:
-    """`spec` and what it refers to into `out`, each element before its operands (the first the root)."""
-    at = len(out)
-    out.append(ua.ContentFilterElement())
-    op, operands = spec
-    out[at] = ua.ContentFilterElement(FilterOperator=op, FilterOperands=[
-        ua.ElementOperand(Index=_elements(o, out)) if isinstance(o, tuple) else o for o in operands])
-    return at
-
-
-def like(text: str) -> str:
-    """"Contains `text`" as a Like pattern (Part 4 7.7.3: its special characters escaped)."""
-    return "%" + "".join("\\" + c if c in "%_[]\\" else c for c in text) + "%"
-
-
-def _severity(op: ua.FilterOperator, message_type: int) -> Spec:
-    """The events' Severity against a message type's (history.py: an alarm's by its priority)."""
-    return op, [_field("Severity"), _literal(SEVERITY[alarm_priority(message_type)], _V.UInt16)]
-
-
-def where(flt: Filter) -> ua.ContentFilter:
-    """The part of `flt` the station evaluates on its events."""
-    specs: list[Spec] = []
-    if flt.min_type is not None:  # a message's type and worse, an alarm's priority and higher
-        specs.append(_severity(ua.FilterOperator.GreaterThanOrEqual, flt.min_type))
-    if flt.type is not None:
-        specs.append(_severity(ua.FilterOperator.Equals, flt.type))
-    if flt.source is not None:
-        specs.append((ua.FilterOperator.Equals, [_field("SourceName"), _literal(flt.source, _V.String)]))
-    if flt.text:  # the spellings the local archive tries (registrar/reading.py where_clause)
-        spellings = sorted({flt.text, flt.text.lower(), flt.text.upper(), flt.text.capitalize()})
-        specs.append(_all(ua.FilterOperator.Or, [
-            (ua.FilterOperator.Like, [_field("Message"), _literal(like(s), _V.String)])
-            for s in spellings]))
-    out: list[ua.ContentFilterElement] = []
-    if specs:
-        _elements(_all(ua.FilterOperator.And, specs), out)
-    return ua.ContentFilter(Elements=out)
 
 
 def _day_range(day: dt.date, flt: Filter) -> tuple[dt.datetime, dt.datetime]:
@@ -157,7 +98,7 @@ class StationArchive(ArchiveReader):
 
     def days(self) -> list[dt.date]:
         first = self.client.events(FIRST, dt.datetime.now(dt.UTC) + dt.timedelta(days=1),
-                                   ua.ContentFilter(), 1).result(READ_S)
+                                   Filter(), 1).result(READ_S)
         today = dt.date.today()
         oldest = max(first[0].time.date(), today - dt.timedelta(days=MAX_DAYS - 1)) if first else today
         return [today - dt.timedelta(days=k) for k in range((today - oldest).days + 1)]
@@ -174,7 +115,7 @@ class StationArchive(ArchiveReader):
         if flt.kinds is None or set(flt.kinds) & set(JOURNAL):
             start, end = _day_range(day, flt)
             if start < end:
-                rows = [r for r in self.client.events(start, end, where(flt), MAX_RECORDS).result(READ_S)
+                rows = [r for r in self.client.events(start, end, flt, MAX_RECORDS).result(READ_S)
                         if flt.kinds is None or r.kind in flt.kinds]
         self._read = (day, flt, rows)
         return rows
@@ -219,8 +160,9 @@ class StationArchive(ArchiveReader):
         return thinned(ts[order], words[order], points)
 
 
-def _word(tag: Tag, value: ua.DataValue) -> float:
-    """The archive's word of a value the station answered in physical units (NaN: not good)."""
+def _word(tag: Tag, value: Any) -> float:
+    """The archive's word of a value (a DataValue) the station answered in physical units (NaN:
+    not good)."""
     if not value.StatusCode.is_good() or value.Value is None or value.Value.Value is None:
         return math.nan
     return float(int.from_bytes(tag.encode(tag.to_raw(float(value.Value.Value))), "little"))

@@ -129,7 +129,7 @@ class ConsoleWindow(QMainWindow):
         trends.setShortcut(QKeySequence("Ctrl+T"))
         trends.triggered.connect(self.open_trends)
         station.addAction(trends)
-        viewer = QAction(self.tr("Journal &viewer…"), self)  # the station's archive, queried
+        viewer = QAction(self.tr("Open journal &viewer…"), self)  # the station's archive, queried
         viewer.setShortcut(QKeySequence("Ctrl+J"))
         viewer.triggered.connect(self.open_viewer)
         station.addAction(viewer)
