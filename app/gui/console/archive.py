@@ -58,7 +58,7 @@ def _day_range(day: dt.date, flt: Filter) -> tuple[dt.datetime, dt.datetime]:
     return dt.datetime.fromtimestamp(t0, dt.UTC), dt.datetime.fromtimestamp(max(t0, t1), dt.UTC)
 
 
-@dataclass
+@dataclass(eq=False)  # one console's archive is itself, whatever its tags
 class StationArchiveSource:
     """A station's archive as `registrar.query.Archive` opens it at a console (an `ArchiveSource`):
     its session and its tags (as its files give them); the tags it historizes asked once."""
