@@ -203,7 +203,7 @@ class ConsoleWindow(QMainWindow):
         return window
 
     def open_viewer(self) -> ViewerWindow | None:
-        """Station -> Journal viewer: the offline viewer's records and series, read from the
+        """Station -> Open journal viewer: the offline viewer's records and series, read from the
         station's archive (its event and value history) rather than a file."""
         if self.archive is None:
             self.status.showMessage(self.tr("The station's files are not loaded yet"), REFUSAL_MS)
