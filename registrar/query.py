@@ -28,6 +28,7 @@ from registrar.plant.url import is_url
 from registrar.reading import (
     EXPORT_CHUNK,
     ArchiveReader,
+    ArchiveSource,
     Filter,
     Row,
     SeriesKey,
@@ -64,9 +65,12 @@ _SELECT = "SELECT " + ", ".join(COLUMNS)
 
 class Archive(ArchiveReader):
     """A station's SQLite archive, or the plant archive when given a postgresql:// URL (the same
-    methods, see registrar/plant/query.py)."""
+    methods, see registrar/plant/query.py), or what an `ArchiveSource` opens (a station's archive
+    at a remote console)."""
 
-    def __new__(cls, target: str | Path) -> ArchiveReader:  # type: ignore[misc]
+    def __new__(cls, target: str | Path | ArchiveSource) -> ArchiveReader:  # type: ignore[misc]
+        if cls is Archive and not isinstance(target, str | Path):
+            return target.open()
         if cls is Archive and is_url(target):
             from registrar.plant.query import PgArchive  # psycopg only where a plant archive is read
 
@@ -389,6 +393,14 @@ class Archive(ArchiveReader):
     def _has(self, day: dt.date) -> bool:
         return self._con.execute("SELECT 1 FROM sqlite_master WHERE type = 'table' AND name = ?",
                                  (table_name(day),)).fetchone() is not None
+
+
+def available(target: str | Path | ArchiveSource) -> bool:
+    """Whether an archive is there to read now: a file that exists, a plant archive's URL (its
+    reads say when it is out of reach), a source that says so."""
+    if isinstance(target, str | Path):
+        return is_url(target) or Path(target).exists()
+    return target.available()
 
 
 def _open_ro(uri: str) -> sqlite3.Connection:

@@ -8,7 +8,7 @@ from __future__ import annotations
 
 import datetime as dt
 from dataclasses import dataclass
-from typing import NamedTuple
+from typing import NamedTuple, Protocol
 
 from app.scada.tag import Tag
 from netplc.lazy import lazy
@@ -66,9 +66,11 @@ class SeriesKey(NamedTuple):
 
 
 class ArchiveReader:
-    """What every archive reader answers besides its queries: its zone, its stations, local times."""
+    """What every archive reader answers besides its queries: its zone, its stations, local times,
+    and the fields of a `Filter` it cannot apply (`unfiltered`: the viewer offers them not)."""
 
     tz: dt.tzinfo | None = None
+    unfiltered: frozenset[str] = frozenset()
 
     def stations(self) -> list[str]:
         """The stations that write to the archive: a station's own archive names none."""
@@ -89,6 +91,16 @@ class ArchiveReader:
 
     def __exit__(self, *exc: object) -> None:
         self.close()
+
+
+class ArchiveSource(Protocol):
+    """An archive reached otherwise than by a file or a URL: a station's Historical Access at a
+    remote console (app/gui/console/archive.py). `registrar.query.Archive` opens it with `open`;
+    `available` is False while it cannot be read (a station out of reach)."""
+
+    def open(self) -> ArchiveReader: ...
+
+    def available(self) -> bool: ...
 
 
 def where_clause(flt: Filter, mark: str = "?") -> tuple[str, list[object]]:
@@ -116,12 +128,17 @@ def where_clause(flt: Filter, mark: str = "?") -> tuple[str, list[object]]:
         conds.append(f"ts < {mark}")
         args.append(round(flt.until * 1000))
     if flt.text:
-        # SQLite folds case for ASCII only; the usual spellings of a Cyrillic word are tried too.
-        variants = sorted({flt.text, flt.text.lower(), flt.text.upper(), flt.text.capitalize()})
+        variants = spellings(flt.text)
         likes = " OR ".join(f"text LIKE {mark} ESCAPE '\\'" for _ in variants)
         conds.append(f"text IS NOT NULL AND ({likes})")
         args.extend(f"%{_escape_like(v)}%" for v in variants)
     return (" WHERE " + " AND ".join(conds)) if conds else "", args
+
+
+def spellings(text: str) -> list[str]:
+    """What "text contains" looks for: SQLite folds case for ASCII only (and a Like of OPC UA for
+    none), so the usual spellings of a Cyrillic word are tried too."""
+    return sorted({text, text.lower(), text.upper(), text.capitalize()})
 
 
 def alarm_priority(message_type: int) -> int:

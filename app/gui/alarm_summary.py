@@ -9,10 +9,11 @@ alarm and the user (or refuses it, journaled throttled); its answer comes back t
 A button the user may not use is disabled, its tooltip naming the role. The header counts the
 listed alarms per priority.
 
-The summary only reads `StationAlarms.summary`, an immutable tuple the engine thread rebuilds when
-a state changes, and redraws only when its version moved, so a flood of transitions costs the
-GUI one table reset per refresh, never one per transition. The table is a model/view pair:
-only the visible rows are drawn, whatever the length of the list.
+The summary only reads its `AlarmSource`'s summary (the station's: `StationAlarms.summary`, an
+immutable tuple the engine thread rebuilds when a state changes), and redraws only when its
+version moved, so a flood of transitions costs the GUI one table reset per refresh, never one per
+transition. The table is a model/view pair: only the visible rows are drawn, whatever the length
+of the list.
 
 The sound of a new alarm of priority 1-2 until it is acknowledged or silenced is the station's
 horn made audible (app/gui/annunciation.py); the station key `alarm_sound = false` turns it off.
@@ -21,7 +22,6 @@ horn made audible (app/gui/annunciation.py); the station key `alarm_sound = fals
 from __future__ import annotations
 
 import logging
-import time
 from collections.abc import Callable
 from pathlib import Path
 from typing import Any
@@ -61,7 +61,7 @@ from app.gui.annunciation import Annunciation
 from app.gui.bridge import Answers
 from app.gui.rights import Rights
 from app.scada.alarms import PRIORITIES, AlarmRow, State
-from app.scada.station import StationAlarms
+from app.scada.horn import AlarmSource
 from hmi_forms.elements import formats
 from hmi_forms.widgets.records import cell_width, title_width
 
@@ -215,7 +215,7 @@ class AlarmSummary(QWidget):
 
     changed = Signal()  # the rows changed: the banner follows
 
-    def __init__(self, alarms: StationAlarms | None, commands: Commands, who: Callable[[], Who], *,
+    def __init__(self, alarms: AlarmSource | None, commands: Commands, who: Callable[[], Who], *,
                  answers: Answers | None = None, sound: bool = True,
                  sounds: tuple[Path | None, Path | None] = (None, None),
                  parent: QWidget | None = None) -> None:
@@ -391,10 +391,7 @@ class AlarmSummary(QWidget):
         self.answers.follow(self.tr("Silence"), self.commands.silence(self.who()), self._silenced)
 
     def _silenced(self, answer: Answer) -> None:
-        if answer.ok:
-            silenced = getattr(self.alarms, "silenced", None)  # a remote station's rows keep their own horn
-            if silenced is not None:
-                silenced(time.time())
+        if answer.ok:  # the layer has silenced the source's horn (app/scada/horn.py AlarmSource)
             self.annunciator.silence()
             self.rights.update()
 

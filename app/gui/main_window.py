@@ -58,6 +58,7 @@ from app.gui.users_dialog import UsersDialog
 from app.gui.zoom import ACTUAL, FIT_WIDTH, FIT_WINDOW, ZoomArea
 from app.scada.alarms import AlarmRow
 from app.scada.readings import Readings
+from app.scada.trends import TrendBook
 from app.station.config import load_station
 from app.station.runtime import Runtime
 from hmi_forms.elements.analog import AnalogOutput
@@ -471,8 +472,9 @@ class MainWindow(QMainWindow):
         from app.gui.trend_window import TrendWindow
 
         alarms = self.runtime.alarms
-        window = TrendWindow(self.bridge, alarms.table.tags if alarms else (), self.runtime.station.Archive,
-                             lambda: self.user, self)  # a window of its own, owned by this one
+        archive = self.runtime.station.Archive
+        window = TrendWindow(self.bridge.readings, alarms.table.tags if alarms else (), archive,
+                             TrendBook(archive.parent), lambda: self.user, self)  # a window of its own
         window.show()
         self.viewers.append(window)
         return window

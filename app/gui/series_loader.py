@@ -23,7 +23,7 @@ from PySide6.QtCore import QObject
 from app.scada.words import TEXTS, Words
 from hmi_forms.widgets.worker import Worker
 from registrar.query import Archive, SeriesKey
-from registrar.reading import ArchiveError, Filter
+from registrar.reading import ArchiveError, ArchiveSource, Filter
 
 Series = tuple[SeriesKey, np.ndarray, np.ndarray]  # key, times (s), values
 Window = tuple[float, float]  # [since, until): seconds since the epoch
@@ -67,14 +67,16 @@ class SeriesLoader(Worker):
         share = max((window[1] - window[0]) / DAY_S, 1 / MAX_ZOOM)
         return round(self.points / min(share, 1.0))
 
-    def request(self, path: str | Path, day: dt.date, key: SeriesKey,
+    def request(self, path: str | Path | ArchiveSource, day: dt.date, key: SeriesKey,
                 topic: Hashable | None = None, window: Window | None = None) -> int:
         """Queue a read of `key` on `day` within `window` (superseding the last one of `topic`, if
         given); the token that its `answered` or `failed` will carry."""
         return self.submit(partial(self._load, path, day, key, window), topic)
 
-    def _load(self, path: str | Path, day: dt.date, key: SeriesKey, window: Window | None) -> Series:
-        """`path`: a file, or a plant archive's URL (kept a str: Path would fold its //)."""
+    def _load(self, path: str | Path | ArchiveSource, day: dt.date, key: SeriesKey,
+              window: Window | None) -> Series:
+        """`path`: a file, a plant archive's URL (kept a str: Path would fold its //), or a
+        station's archive at a console."""
         of_station = {"station": key.station} if key.station is not None else {}
         restarts = RESTARTS if key.station is None else \
             tuple(replace(r, stations=frozenset({key.station})) for r in RESTARTS)

@@ -1,8 +1,9 @@
 """Trend history: at start a trend is filled with what the archive holds of it, and scrolling back
 past its live samples reads the day scrolled to, in a worker thread, so the window never waits for
-the disk or the network. The views have one code path; what differs is the `SeriesSource` behind
-it: the station's own archive file (`ArchiveSeries`, app/gui/series_loader.py) at the local
-workstation, the station's Historical Access at a remote console (app/gui/console/series.py).
+the disk or the network. The views have one code path; what differs is the archive `ArchiveSeries`
+reads (app/gui/series_loader.py, through `registrar.query.Archive`): the station's own archive
+file at the local workstation, the station's Historical Access at a remote console
+(app/gui/console/archive.py).
 
 A trend's series is found by what wrote it: an element with RegData journals its physical value
 under its own name; otherwise an NSTORE of the trend's address (source = the octal address) holds
@@ -13,16 +14,16 @@ from __future__ import annotations
 
 import datetime as dt
 from pathlib import Path
-from typing import Protocol
 
-from PySide6.QtCore import QObject, SignalInstance
+from PySide6.QtCore import QObject
 
 from app.gui.series_loader import Series, SeriesLoader
 from hmi_forms.elements.analog import AnalogBase
 from hmi_forms.widgets.form_view import FormView
 from hmi_forms.widgets.trend import TrendWidget
 from netplc.address import fmt_octal
-from registrar.query import SeriesKey
+from registrar.query import SeriesKey, available
+from registrar.reading import ArchiveSource
 
 POINTS = 4000  # per day read: enough for a plot a few thousand pixels wide
 
@@ -35,36 +36,16 @@ def series_keys(model: AnalogBase) -> list[tuple[SeriesKey, bool]]:
     return keys
 
 
-class SeriesSource(Protocol):
-    """Where a trend's history is read (a Worker: `answered` carries a token and a Series)."""
-
-    answered: SignalInstance
-    failed: SignalInstance
-
-    def available(self) -> bool: ...
-
-    def keys(self, model: AnalogBase) -> list[tuple[SeriesKey, bool]]:
-        """Where the source may hold this trend's series, with whether the values are raw words."""
-        ...
-
-    def read(self, day: dt.date, key: SeriesKey) -> int:
-        """Queue a read of `key` on `day`; the token of its answer."""
-        ...
-
-    def setParent(self, parent: QObject) -> None: ...
-
-    def close(self) -> None: ...
-
-
 class ArchiveSeries(SeriesLoader):
-    """The station's own archive file (the local workstation)."""
+    """The station's archive: its file at the local workstation, its Historical Access at a remote
+    console (an `ArchiveSource`, app/gui/console/archive.py)."""
 
-    def __init__(self, path: Path) -> None:
+    def __init__(self, path: Path | ArchiveSource) -> None:
         super().__init__(POINTS)
         self.path = path
 
     def available(self) -> bool:
-        return self.path.exists()
+        return available(self.path)
 
     def keys(self, model: AnalogBase) -> list[tuple[SeriesKey, bool]]:
         return series_keys(model)
@@ -74,7 +55,7 @@ class ArchiveSeries(SeriesLoader):
 
 
 class TrendHistory(QObject):
-    def __init__(self, source: SeriesSource, parent: QObject | None = None) -> None:
+    def __init__(self, source: ArchiveSeries, parent: QObject | None = None) -> None:
         super().__init__(parent)
         self.loader = source
         source.setParent(self)

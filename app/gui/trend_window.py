@@ -5,8 +5,10 @@ A pen is a tag: its archive series is the NSTORE of the tag's address (the raw w
 with the tag's scaling, as the faceplate reads it), each day of the range shown read once, in the
 series loader's worker thread (app/gui/series_loader.py), so panning back a week never stops the
 window; a range zoomed into (under six hours, within a day, not live) is read again at its own
-detail, so zooming shows the samples rather than the day's reduction. The live values come from
-the runtime bridge's readings (good or forced ones only). The plot and the table are redrawn
+detail, so zooming shows the samples rather than the day's reduction. The archive is the
+station's file at the workstation, its Historical Access at a remote console (app/gui/console/
+archive.py), read the same way. The live values come from each scan's readings, the runtime
+bridge's or a remote station's (good or forced ones only). The plot and the table are redrawn
 twice a second, not at every scan. The cursors' table gives each pen's value at A and at B (the
 last sample at or before), B − A, and the minimum, maximum and mean of the samples in the visible
 range; the CSV export holds those samples.
@@ -24,7 +26,7 @@ from pathlib import Path
 
 import numpy as np
 import pyqtgraph as pg
-from PySide6.QtCore import Qt, QTimer
+from PySide6.QtCore import Qt, QTimer, SignalInstance
 from PySide6.QtWidgets import (
     QCheckBox,
     QComboBox,
@@ -43,7 +45,6 @@ from PySide6.QtWidgets import (
     QWidget,
 )
 
-from app.gui.bridge import RuntimeBridge
 from app.gui.designer.tag_browser import matches
 from app.gui.series_loader import DAY_S, Series, SeriesLoader, Window
 from app.scada.quality import Quality
@@ -61,7 +62,8 @@ from app.scada.trends import (
     value_at,
 )
 from netplc.address import fmt_octal
-from registrar.query import SeriesKey
+from registrar.query import SeriesKey, available
+from registrar.reading import ArchiveSource
 
 logger = logging.getLogger(__name__)
 
@@ -107,16 +109,19 @@ class PenData:
 
 
 class TrendWindow(QWidget):
-    def __init__(self, bridge: RuntimeBridge, tags: Sequence[Tag], archive: Path,
-                 user: Callable[[], str], parent: QWidget | None = None) -> None:
+    def __init__(self, readings: SignalInstance, tags: Sequence[Tag], archive: Path | ArchiveSource,
+                 book: TrendBook, user: Callable[[], str], parent: QWidget | None = None) -> None:
+        """`readings`: each scan's `Readings` (the runtime bridge's, a remote station's);
+        `archive`: the station's (its file, or its Historical Access at a console); `book`: where
+        the user's named trends are kept."""
         super().__init__(parent, Qt.WindowType.Window)
         self.setObjectName("trendWindow")
         self.setWindowTitle(self.tr("Run-time trend"))
-        self.bridge = bridge
+        self.readings = readings
         self.tags = {t.name: t for t in tags}
         self.archive = archive
         self.user = user
-        self.book = TrendBook(archive.parent)
+        self.book = book
         self.pens: dict[str, PenData] = {}
         self.asked: dict[int, tuple[PenData, dt.date, Window | None]] = {}
         self.dirty = True
@@ -230,7 +235,7 @@ class TrendWindow(QWidget):
         self.show_matching()
         self.list_saved()
         self.follow_live()
-        bridge.readings.connect(self.show_readings)
+        readings.connect(self.show_readings)
         self.timer = QTimer(self)
         self.timer.setInterval(REDRAW_MS)
         self.timer.timeout.connect(self.redraw)
@@ -307,7 +312,7 @@ class TrendWindow(QWidget):
         x0, x1 = self.visible()
         day = dt.date.fromtimestamp(max(x0, 0.0))
         if self.live.isChecked() or x1 - x0 > DETAIL_BELOW or dt.date.fromtimestamp(max(x1, 0.0)) != day \
-                or not self.archive.exists():
+                or not available(self.archive):
             return
         for pen in self.pens.values():
             key = SeriesKey("data", None, None, fmt_octal(pen.tag.address))
@@ -318,7 +323,7 @@ class TrendWindow(QWidget):
 
     def _want_history(self) -> None:
         """Ask the archive for each day of the range shown that no pen has read yet."""
-        if not self.archive.exists():
+        if not available(self.archive):
             return
         x0, x1 = self.plot.getViewBox().viewRange()[0]
         first = dt.date.fromtimestamp(max(x0, x1 - MAX_DAYS * 86_400.0, 0.0))
@@ -501,7 +506,7 @@ class TrendWindow(QWidget):
         if self.timer.isActive():  # closed once: by the operator, then with the workstation
             self.timer.stop()
             self.settled.stop()
-            self.bridge.readings.disconnect(self.show_readings)
+            self.readings.disconnect(self.show_readings)
             self.loader.close()
         super().closeEvent(event)  # type: ignore[arg-type]
 

@@ -1,9 +1,11 @@
 """The offline journal viewer: an archive opened read-only, without a running station.
 
 It needs only the archive file (the message texts are stored in it), so an archive copied from a
-plant PC opens on any machine. Records are paged from SQLite rather than loaded whole, so a day
-of a million records opens as fast as a day of ten. Given a postgresql:// URL it opens the plant
-archive read-only instead: a list of stations to tick, and series of several stations on one plot.
+plant PC opens on any machine; at a remote console it reads the station's archive over its
+Historical Access instead (app/gui/console/archive.py), through the same views. Records are paged
+from SQLite rather than loaded whole, so a day of a million records opens as fast as a day of ten.
+Given a postgresql:// URL it opens the plant archive read-only instead: a list of stations to
+tick, and series of several stations on one plot.
 Days and From/To are read in the zone the archive was written in (stored in its meta).
 
 A page and its count are read in the viewer's worker thread (hmi_forms/widgets/worker.py), as the
@@ -68,7 +70,7 @@ from netplc.address import parse_octal
 from netplc.program import read_symbols
 from registrar.plant.url import is_url
 from registrar.query import Archive, Filter, SeriesKey
-from registrar.reading import ArchiveError, ArchiveReader, Row
+from registrar.reading import ArchiveError, ArchiveReader, ArchiveSource, Row
 
 logger = logging.getLogger(__name__)
 
@@ -105,10 +107,10 @@ def physical(tag: Tag | None, values: np.ndarray) -> np.ndarray:
     return np.array([tag.word_value(int(v)) if np.isfinite(v) else np.nan for v in values], dtype=np.float64)
 
 
-def station_symbols(archive: Path | str) -> dict[int, str]:
+def station_symbols(archive: Path | str | ArchiveSource) -> dict[int, str]:
     """The symbols of the station an archive file belongs to (its station.toml in the archive's
     folder or the two above), by address, to name the series and sources that have no tag.
-    {}: a plant archive, or no station or symbols beside it."""
+    {}: a plant archive or a station's at a console, or no station or symbols beside it."""
     if not isinstance(archive, Path):
         return {}
     toml = find_station(archive.resolve())
@@ -131,10 +133,10 @@ class PageReader:
     again after a failed read (a plant archive's dropped connection) or a reload."""
 
     def __init__(self) -> None:
-        self.target: Path | str | None = None
+        self.target: Path | str | ArchiveSource | None = None
         self.archive: ArchiveReader | None = None
 
-    def page(self, target: Path | str, day: dt.date, flt: Filter, offset: int) -> Page:
+    def page(self, target: Path | str | ArchiveSource, day: dt.date, flt: Filter, offset: int) -> Page:
         if self.archive is None or self.target != target:
             self.close()
             self.archive, self.target = Archive(target), target
@@ -153,14 +155,14 @@ class PageReader:
 
 
 class ViewerWindow(QMainWindow):
-    def __init__(self, archive_path: Path | str | None = None, parent: QWidget | None = None,
+    def __init__(self, archive_path: Path | str | ArchiveSource | None = None, parent: QWidget | None = None,
                  symbols: dict[int, str] | None = None) -> None:
         """`symbols`: names by address for what has no tag (None: those of the archive's station)."""
         super().__init__(parent)
         self.symbols = symbols
         self.setWindowTitle(self.tr("NetPlc Station — journal viewer"))
         self.archive: Archive | None = None
-        self.archive_path: Path | str | None = None  # a file, or a plant archive's URL
+        self.archive_path: Path | str | ArchiveSource | None = None  # a file, a URL, a station's
         self.offset = 0
         self.total = 0
         self.curves: dict[SeriesKey, pg.PlotDataItem] = {}
@@ -301,7 +303,7 @@ class ViewerWindow(QMainWindow):
 
     # --- archive and day -----------------------------------------------------------------------
 
-    def open_archive(self, path: Path | str) -> bool:
+    def open_archive(self, path: Path | str | ArchiveSource) -> bool:
         try:
             archive = Archive(path)
             days = archive.days()
@@ -319,6 +321,9 @@ class ViewerWindow(QMainWindow):
         if self.symbols is None:
             self.symbols = station_symbols(path)
         self.path_label.setText(f"<small>{path}</small>")
+        self.group.setEnabled("grp" not in archive.unfiltered)
+        self.group.setToolTip("" if self.group.isEnabled() else
+                              self.tr("the records of this archive carry no group"))
         self.stations.blockSignals(True)
         self.stations.clear()
         for name in stations:

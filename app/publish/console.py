@@ -16,7 +16,9 @@ a console adds, all of it standard OPC UA that any client could do the same way:
 - writes of a form's raw address through the station's WriteBit and WriteWord methods;
 - the journal: the station object's event history (HistoryReadEvents, Part 11), newest first;
 - a trend's history: its tag's raw history (HistoryReadRawModified, Part 11), page after page
-  with the station's continuation points.
+  with the station's continuation points;
+- the viewer's queries: the journal's events of a time range under a where clause the station
+  evaluates (a message's severity, its source, its text by Like), and which tags are historized.
 """
 
 from __future__ import annotations
@@ -38,20 +40,24 @@ from urllib.parse import urlsplit
 
 from asyncua import ua
 from asyncua.client.ua_file import UaFile
+from asyncua.common.events import Event
 
 from app.authority import Action, Answer, Reason, Refusal, Ticket, Who
 from app.authority.policy import ROLES, needs, rank
 from app.publish.client import StationClient, _why, config_dir
+from app.publish.history import journal_where
 from app.publish.ua_types import SEVERITY
 from app.scada.alarms import AlarmRow, State
+from app.scada.horn import AlarmSource
 from netplc.address import fmt_octal
-from registrar.reading import Row
+from registrar.reading import Filter, Row
 
 logger = logging.getLogger(__name__)
 
 STATES = {state.word: state for state in State}
 PRIORITY_OF = {severity: priority for priority, severity in SEVERITY.items()}
 FIELDS = ("State", "Severity", "Text", "Time")  # read of each condition
+EVENT_FIELDS = ("EventId", "EventType", "SourceName", "Time", "Message", "Severity")  # what `_record` reads
 SLOW_S = 0.5  # the manifest, the alarms, the links and the role are read this often (memory every poll)
 
 
@@ -88,6 +94,12 @@ class ConsoleClient(StationClient):
         self._slow = 0.0  # when the slow part was read last
         self._own = f"{os.getpid()}-{id(self):x}"  # this client's partial files, apart from other consoles'
 
+    @property
+    def keep(self) -> Path:
+        """This console's own folder for its station: the station's files as served, and what the
+        console keeps of its own (its users' named trends)."""
+        return self._stations
+
     # --- from any thread ----------------------------------------------------------------------
 
     def write_bit(self, addr: int, value: int, label: str | None, at_least: str | None) -> Ticket:
@@ -119,6 +131,16 @@ class ConsoleClient(StationClient):
         """The archived values of the station's tag `tag` from `start` (included) to `end` (not),
         oldest first, in physical units with the StatusCode of their quality."""
         return self._submit(self._history(tag, start, end))
+
+    def events(self, start: dt.datetime, end: dt.datetime, flt: Filter, limit: int) -> Future[list[Row]]:
+        """The station's journal events from `start` (included) to `end` (not) that pass what the
+        station evaluates of `flt` (history.py `journal_where`), oldest first, `limit` at most, as
+        the records they were."""
+        return self._submit(self._events(start, end, journal_where(flt), limit))
+
+    def historizing(self, tags: list[str]) -> Future[set[str]]:
+        """Which of the station's tags `tags` it keeps the history of (their Historizing)."""
+        return self._submit(self._historizing(tags))
 
     def said(self, sent: Ticket, action: Action, what: str, at_least: str | None = None) -> Ticket:
         """The station's answer, a refusal for the role in its parts (the role it needs, the user's)."""
@@ -189,6 +211,51 @@ class ConsoleClient(StationClient):
         except ua.UaError as e:
             raise ConnectionError(f"{self.url}: {tag}: {_why(e)}") from None
 
+    async def _events(self, start: dt.datetime, end: dt.datetime, where: ua.ContentFilter,
+                      limit: int) -> list[Row]:
+        """Answer after answer, with the station's continuation points (released when `limit` is
+        reached first)."""
+        client = self._client
+        if client is None:
+            raise ConnectionError(f"not connected: {self.error or 'logging in'}")
+        select = [ua.SimpleAttributeOperand(TypeDefinitionId=ua.NodeId(ua.ObjectIds.BaseEventType),
+                                            BrowsePath=[ua.QualifiedName(name, 0)],
+                                            AttributeId=ua.AttributeIds.Value) for name in EVENT_FIELDS]
+        details = ua.ReadEventDetails(StartTime=start, EndTime=end, NumValuesPerNode=0,
+                                      Filter=ua.EventFilter(SelectClauses=select, WhereClause=where))
+        value = ua.HistoryReadValueId(NodeId=self._node(self.station))
+        rows: list[Row] = []
+        try:
+            while True:
+                params = ua.HistoryReadParameters(HistoryReadDetails=details,  # (asyncua's default: release)
+                                                  TimestampsToReturn=ua.TimestampsToReturn.Both,
+                                                  ReleaseContinuationPoints=False, NodesToRead=[value])
+                result = (await client.uaclient.history_read(params))[0]
+                result.StatusCode.check()
+                rows += [_record(Event.from_event_fields(select, e.EventFields))
+                         for e in result.HistoryData.Events]
+                value.ContinuationPoint = result.ContinuationPoint
+                if not value.ContinuationPoint:
+                    return rows
+                if len(rows) >= limit:
+                    params.ReleaseContinuationPoints = True
+                    await client.uaclient.history_read(params)
+                    return rows[:limit]
+        except ua.UaError as e:
+            raise ConnectionError(f"{self.url}: {_why(e)}") from None
+
+    async def _historizing(self, tags: list[str]) -> set[str]:
+        client = self._client
+        if client is None:
+            raise ConnectionError(f"not connected: {self.error or 'logging in'}")
+        try:
+            values = await client.uaclient.read_attributes([self._node(f"Tags.{t}") for t in tags],
+                                                          ua.AttributeIds.Historizing)
+        except ua.UaError as e:
+            raise ConnectionError(f"{self.url}: {_why(e)}") from None
+        return {t for t, dv in zip(tags, values, strict=True)
+                if dv.StatusCode.is_good() and dv.Value is not None and dv.Value.Value is True}
+
     async def _browse(self) -> None:
         client = self._client
         assert client is not None
@@ -246,8 +313,11 @@ class StationCommands:
     the rights of their buttons): the layer's methods and answers, each sent as the station's
     method with the console's user; `who` is the console's and not sent (the session is who)."""
 
-    def __init__(self, client: ConsoleClient) -> None:
+    def __init__(self, client: ConsoleClient, alarms: AlarmSource) -> None:
+        """`alarms`: the console's copy of the station's alarms, whose horn a Silence the station
+        took stops at once (as the layer does the station's own)."""
         self.client = client
+        self.alarms = alarms
 
     def denial(self, who: Who, action: Action, at_least: str | None = None,
                what: str | None = None) -> Refusal | None:
@@ -269,7 +339,14 @@ class StationCommands:
         return self._sent(Action.UNSHELVE, alarm_id, "Unshelve", alarm_id)
 
     def silence(self, who: Who) -> Ticket:
-        return self._sent(Action.SILENCE, Action.SILENCE.value, "Silence")
+        ticket = self._sent(Action.SILENCE, Action.SILENCE.value, "Silence")
+        ticket.add_done_callback(self._silenced)
+        return ticket
+
+    def _silenced(self, ticket: Ticket) -> None:
+        """On the client's thread, before the view hears the answer."""
+        if ticket.result().ok:
+            self.alarms.silence(time.time())
 
     def _sent(self, action: Action, what: str, method: str, *args: object) -> Ticket:
         return self.client.said(self.client.call(method, *args), action, what)

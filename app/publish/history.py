@@ -17,7 +17,7 @@ timestamp of the first value not returned, which repeats the values sharing that
 NumValuesPerNode truncates without a continuation point; and it checks no node and knows no
 bounds, TimestampsToReturn or ReleaseContinuationPoints. From asyncua come the
 result structures, `Event.to_event_fields` for an EventFilter's select clauses and its
-WhereClauseEvaluator for the where clause.
+WhereClauseEvaluator for the where clause (with the Like operator it lacks: `Where`).
 
 The time domain is Part 11's (4.4, 6.5.3): the start is included and the end is not, so contiguous
 reads see every value once; an end before the start, or an end with a count alone, reads backward;
@@ -38,6 +38,7 @@ from __future__ import annotations
 import asyncio
 import datetime as dt
 import logging
+import re
 import sqlite3
 import struct
 import zlib
@@ -45,6 +46,7 @@ from collections.abc import Callable, Collection, Mapping
 from concurrent.futures import ThreadPoolExecutor
 from dataclasses import dataclass
 from datetime import UTC, datetime
+from functools import lru_cache
 from pathlib import Path
 from typing import Any
 
@@ -61,7 +63,7 @@ from app.scada.quality import Quality
 from app.scada.tag import Tag, TagType
 from netplc.address import fmt_octal
 from registrar.query import Archive
-from registrar.reading import Row, SeriesKey, alarm_priority
+from registrar.reading import Filter, Row, SeriesKey, alarm_priority, spellings
 from registrar.schema import day_bounds_in
 
 logger = logging.getLogger(__name__)
@@ -71,6 +73,8 @@ MAX_EVENTS = 1_000  # events of one node in one answer (MaxReturnEventValues)
 MAX_NODES = 100  # nodes in one HistoryRead (OperationLimits.MaxNodesPerHistoryReadData, ...Events)
 SCAN_ROWS = 200_000  # archive records one answer of events examines at most (the journal among data)
 JOURNAL = ("message", "alarm", "operator", "system")  # the record kinds that are events
+_BASE_EVENT = ua.NodeId(ua.ObjectIds.BaseEventType)
+_V = ua.VariantType
 UNSPECIFIED = datetime(1601, 1, 2, tzinfo=UTC)  # DateTime.MinValue (and anything before): no time given
 ARCHIVED_TYPES = (TagType.WORD, TagType.INT16, TagType.BCD)  # what NSTORE stores: one word
 _POINT = struct.Struct(">BIqBII")  # version, day ordinal, id, tail, taken, check
@@ -343,7 +347,6 @@ def event_of(located: Located, station: ua.NodeId, alarms: Mapping[str, AlarmSou
     when = datetime.fromtimestamp(row.ts, UTC)
     name, text, severity = _describe(row)
     kind = ua.NodeId(EVENT_TYPES.get(row.kind, ua.ObjectIds.BaseEventType))
-    _V = ua.VariantType
     fields: dict[str, tuple[Any, ua.VariantType]] = {
         "EventId": (struct.pack(">Iq", day, row.id), _V.ByteString), "EventType": (kind, _V.NodeId),
         "SourceNode": (station, _V.NodeId), "SourceName": (name, _V.String), "Time": (when, _V.DateTime),
@@ -371,6 +374,101 @@ def _describe(row: Row) -> tuple[str, str, int]:
         change = f"{row.source} {State(row.number or 0).word} -> {State(row.type or 0).word}"
         return row.source or "", text or change, SEVERITY.get(row.grp or 3, 500)
     return row.source or "", text, 100
+
+
+# --- the where clause ----------------------------------------------------------------------------
+
+@lru_cache(maxsize=64)
+def like_pattern(pattern: str) -> re.Pattern[str]:
+    """Part 4's Like pattern (7.7.3, its table of special characters) as a regular expression:
+    `%` any text, `_` one character, `[...]` one of, `[^...]` none of, `\\` the next literally."""
+    out, i = [], 0
+    while i < len(pattern):
+        c = pattern[i]
+        if c == "\\" and i + 1 < len(pattern):
+            out.append(re.escape(pattern[i + 1]))
+            i += 2
+            continue
+        if c == "[" and (end := pattern.find("]", i + 2 if pattern[i + 1:i + 2] == "^" else i + 1)) > 0:
+            inner = pattern[i + 1:end]
+            negate = inner.startswith("^")
+            body = "".join("\\" + ch if ch in "\\]^[" else ch for ch in inner[negate:])
+            out.append(f"[{'^' if negate else ''}{body}]")
+            i = end + 1
+            continue
+        out.append(".*" if c == "%" else "." if c == "_" else re.escape(c))
+        i += 1
+    return re.compile("".join(out), re.DOTALL)
+
+
+class Where(WhereClauseEvaluator):
+    """asyncua's where-clause evaluator with the Like operator it leaves unimplemented, so that a
+    client filters the journal's events by their Message (a console's viewer: "text contains")."""
+
+    def _like_operator(self, string: object, pattern: object) -> bool:
+        text = string.Text if isinstance(string, ua.LocalizedText) else string
+        if not isinstance(text, str) or not isinstance(pattern, str):
+            return False
+        return like_pattern(pattern).fullmatch(text) is not None
+
+
+def _field(name: str) -> ua.SimpleAttributeOperand:
+    return ua.SimpleAttributeOperand(TypeDefinitionId=_BASE_EVENT, BrowsePath=[ua.QualifiedName(name, 0)],
+                                     AttributeId=ua.AttributeIds.Value)
+
+
+def _literal(value: object, kind: ua.VariantType) -> ua.LiteralOperand:
+    return ua.LiteralOperand(Value=ua.Variant(value, kind))
+
+
+Spec = tuple[ua.FilterOperator, list]  # an element: its operator and operands (a Spec: a sub-element)
+
+
+def _all(op: ua.FilterOperator, specs: list[Spec]) -> Spec:
+    """`specs` joined pairwise by `op` (And, Or), as the binary operators of Part 4 take them."""
+    return specs[0] if len(specs) == 1 else (op, [specs[0], _all(op, specs[1:])])
+
+
+def _elements(spec: Spec, out: list[ua.ContentFilterElement]) -> int:
+    """`spec` and what it refers to into `out`, each element before its operands (the first the root)."""
+    op, operands = spec
+    at, element = len(out), ua.ContentFilterElement(FilterOperator=op)
+    out.append(element)
+    element.FilterOperands = [ua.ElementOperand(Index=_elements(o, out)) if isinstance(o, tuple) else o
+                              for o in operands]
+    return at
+
+
+def like(text: str) -> str:
+    """"Contains `text`" as a Like pattern (Part 4 7.7.3: its special characters escaped)."""
+    return "%" + "".join("\\" + c if c in "%_[]\\" else c for c in text) + "%"
+
+
+def _severity(op: ua.FilterOperator, message_type: int) -> Spec:
+    """The events' Severity against a message type's (`_describe`: an alarm's by its priority)."""
+    return op, [_field("Severity"), _literal(SEVERITY[alarm_priority(message_type)], _V.UInt16)]
+
+
+def journal_where(flt: Filter) -> ua.ContentFilter:
+    """The part of a journal's `Filter` a station evaluates on its events (a console's viewer,
+    app/gui/console/archive.py): a type as a Severity (`_describe`), a source as the SourceName,
+    a text as Like on the Message. Its From/To is the read's time range; a kind is told from the
+    events' types by the client, and a group is in no event."""
+    specs: list[Spec] = []
+    if flt.min_type is not None:  # a message's type and worse, an alarm's priority and higher
+        specs.append(_severity(ua.FilterOperator.GreaterThanOrEqual, flt.min_type))
+    if flt.type is not None:
+        specs.append(_severity(ua.FilterOperator.Equals, flt.type))
+    if flt.source is not None:
+        specs.append((ua.FilterOperator.Equals, [_field("SourceName"), _literal(flt.source, _V.String)]))
+    if flt.text:  # in the spellings the local archive tries
+        specs.append(_all(ua.FilterOperator.Or, [
+            (ua.FilterOperator.Like, [_field("Message"), _literal(like(s), _V.String)])
+            for s in spellings(flt.text)]))
+    out: list[ua.ContentFilterElement] = []
+    if specs:
+        _elements(_all(ua.FilterOperator.And, specs), out)
+    return ua.ContentFilter(Elements=out)
 
 
 # --- the service --------------------------------------------------------------------------------
@@ -469,7 +567,7 @@ class StationHistory(HistoryManager):
                 limit: int) -> tuple[ua.HistoryEvent, Position | None, int]:
         with self._open() as archive:
             rows, resume = read_journal(archive, d, after, limit)
-        where = WhereClauseEvaluator(logger, self.iserver.aspace, flt.WhereClause)
+        where = Where(logger, self.iserver.aspace, flt.WhereClause)
         events = [event for event in (event_of(row, self.station, self.alarms) for row in rows)
                   if where.eval(event)]
         fields = [ua.HistoryEventFieldList(EventFields=e.to_event_fields(flt.SelectClauses)) for e in events]

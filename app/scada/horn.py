@@ -14,6 +14,7 @@ from __future__ import annotations
 
 from collections.abc import Sequence
 from dataclasses import dataclass
+from typing import Protocol
 
 from app.scada.alarms import AlarmRow, State
 from netplc.memory import Memory
@@ -47,3 +48,18 @@ class Horn:
         """Set the horn bit to what sounds (the engine runs it between two scans)."""
         if self.bit is not None:
             mem.set_hmi_bit(self.bit, 1 if self.sounding else 0)
+
+
+class AlarmSource(Protocol):
+    """An alarm system as the alarm views read it (the summary, the banner, the sound): its rows in
+    the summary's order, their `version`, and its horn. `silence(now)` is where the command
+    layer's Silence lands: the station's own alarm system on its engine thread
+    (app/scada/station.py), a remote console's copy of the station's alarms once the station
+    answered the console's Silence (app/gui/console/source.py), so that the console's sound stops
+    at once as the station's does. No view silences a horn itself."""
+
+    version: int
+    summary: Sequence[AlarmRow]
+    horn: Horn
+
+    def silence(self, now: float) -> None: ...

@@ -16,7 +16,7 @@ from __future__ import annotations
 
 import dataclasses
 import logging
-from collections.abc import Callable
+from collections.abc import Callable, Iterable
 from typing import TYPE_CHECKING, Protocol
 
 from app.scada.tag import Tag, TagType
@@ -51,22 +51,22 @@ class Effects(Protocol):
     def put(self, record: Record) -> None: ...
 
 
-class EngineTarget:
-    """The station's command layer as the operator's Target. A write to a tag's address is
-    journaled with the tag's name and, for a word, its physical values and unit besides the raw
-    ones (`write Уставка температуры TEMP_SP: 0.0 -> 130.0 °C (raw ...)`). `who(user)` says who
-    writes from where (the console's user); `on_answer(what, ticket)` is given every ticket, `what`
-    the element's label, so the view says a refusal, at once or when the layer answers later;
-    `say(what, answer)` words a refusal for the element (the console's language)."""
+class CommandTarget:
+    """A command layer as the operator's Target: what both the station's own layer
+    (`EngineTarget`) and a remote console's (the station's methods, app/gui/console/window.py)
+    share. The refusal names what the operator acted on (the element's label, else its tag's
+    description or name, else the address); `who(user)` says who writes from where;
+    `on_answer(what, ticket)` is given every ticket, so the view says a refusal, at once or when
+    the layer answers later; `say(what, answer)` words a refusal (the console's language).
+    `bit` and `word` send the command, each source's own way."""
 
-    def __init__(self, commands: Commands, who: Callable[[str], Who],
+    def __init__(self, who: Callable[[str], Who], tags: Iterable[Tag] = (),
                  on_answer: Callable[[str, Ticket], object] | None = None,
                  say: Callable[[str, Answer], str] | None = None) -> None:
-        self.commands = commands
         self.who = who
         self.on_answer = on_answer
         self.say = say or said
-        tags = commands.tags.values()
+        tags = tuple(tags)
         self._bits = {t.address: t for t in tags if t.type is TagType.BIT}
         self._words = {t.address: t for t in tags if t.type in ONE_WORD}
 
@@ -83,6 +83,33 @@ class EngineTarget:
                           _said(label, tag, addr))
 
     def bit(self, who: Who, addr: int, value: int, label: str | None, at_least: str | None) -> Ticket:
+        raise NotImplementedError
+
+    def word(self, who: Who, addr: int, value: int, label: str | None, at_least: str | None,
+             describe: Callable[[int, int], str] | None = None) -> Ticket:
+        raise NotImplementedError
+
+    def _told(self, ticket: Ticket, what: str) -> str | None:
+        if self.on_answer is not None:
+            self.on_answer(what, ticket)
+        if not ticket.done():
+            return None
+        answer: Answer = ticket.result()
+        return None if answer.ok else self.say(what, answer)
+
+
+class EngineTarget(CommandTarget):
+    """The station's command layer as the operator's Target. A write to a tag's address is
+    journaled with the tag's name and, for a word, its physical values and unit besides the raw
+    ones (`write Уставка температуры TEMP_SP: 0.0 -> 130.0 °C (raw ...)`)."""
+
+    def __init__(self, commands: Commands, who: Callable[[str], Who],
+                 on_answer: Callable[[str, Ticket], object] | None = None,
+                 say: Callable[[str, Answer], str] | None = None) -> None:
+        super().__init__(who, commands.tags.values(), on_answer, say)
+        self.commands = commands
+
+    def bit(self, who: Who, addr: int, value: int, label: str | None, at_least: str | None) -> Ticket:
         """The command of a form's bit write, as `who` (a remote console's too: app/publish/methods.py)."""
         return self.commands.write_bit(who, addr, value, label=_named(label, self._bits.get(addr)),
                                        at_least=at_least)
@@ -92,14 +119,6 @@ class EngineTarget:
         tag = self._words.get(addr)
         return self.commands.write_word(who, addr, value, label=_named(label, tag), at_least=at_least,
                                         describe=tag.change if tag else describe)
-
-    def _told(self, ticket: Ticket, what: str) -> str | None:
-        if self.on_answer is not None:
-            self.on_answer(what, ticket)
-        if not ticket.done():
-            return None
-        answer: Answer = ticket.result()
-        return None if answer.ok else self.say(what, answer)
 
 
 def said(what: str, answer: Answer) -> str:

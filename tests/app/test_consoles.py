@@ -14,7 +14,9 @@ import time
 from collections.abc import Callable, Iterator
 from pathlib import Path
 
+import numpy as np
 import pytest
+from PySide6.QtCore import Qt, QTime
 
 from app.authority import Answer
 from app.gui.console.source import StationSource
@@ -211,6 +213,27 @@ def test_the_station_lists_its_consoles_and_refuses_one_beyond_max_consoles(
                for r in station.records)
 
 
+def test_a_silence_the_station_took_stops_the_consoles_sound_at_once(
+        qtbot, station: Station, attach: Attach) -> None:
+    console = attach(station, "operator")
+    summary, horn = console.summary, console.source.station_alarms.horn
+    node = station.runtime.simulators[0].engine
+    node.write_word(0o4010, 3950)  # LEVEL 96 %: LEVEL.HH, priority 2, sounds until silenced
+    try:
+        qtbot.waitUntil(lambda: horn.sounding, timeout=WAIT)
+        summary.annunciator.tick()
+        assert summary.annunciator.sounding
+        summary.silence_sound()  # the station's Silence as the console's user
+        qtbot.waitUntil(lambda: not summary.annunciator.sounding and not horn.sounding, timeout=WAIT)
+        assert any(r.kind == "operator" and "opcua:operator@" in (r.source or "") for r in station.records
+                   if "silenced" in (r.text or "") or "звук" in (r.text or ""))
+        console.source.station_alarms.show(console.client.alarms)  # the rows again: silenced stays quiet
+        summary.annunciator.tick()
+        assert not summary.annunciator.sounding and not horn.sounding
+    finally:
+        node.write_word(0o4010, 0)
+
+
 def test_a_console_shows_the_station_unreachable_and_reconnects_by_itself(
         qtbot, station: Station, attach: Attach) -> None:
     """Last of the module: it stops the station, and leaves it restarted."""
@@ -235,16 +258,22 @@ def test_the_console_command_wants_an_opc_tcp_url() -> None:
 @pytest.fixture(scope="module")
 def archived(tmp_path_factory: pytest.TempPathFactory) -> Iterator[tuple[Station, list[float]]]:
     """A station whose archive holds LEVEL's NSTORE series of the minute before it started: raw
-    words 0, 40, 80, ... (0 %, ~1 %, ~2 % ...), one a gap."""
+    words 0, 40, 80, ... (0 %, ~1 %, ~2 % ...), one a gap; and in that minute two messages, an
+    alarm ("Насос 2 остановлен", type 2) and an info one (type 0), and an operator's record."""
     folder = tmp_path_factory.mktemp("archived")
     station = copy_demo(folder / "st")
     t = time.time()
     store = Store(station / "archive" / "journal.sqlite")
     store.start()
     times = [t - 60 + 0.5 * k for k in range(100)]
-    for k, ts in enumerate(times):
+    journal = {10: Record(times[10], "message", grp=1, type=2, number=901, text="Насос 2 остановлен"),
+               20: Record(times[20], "message", grp=1, type=0, number=902, text="Насос 2 в работе"),
+               30: Record(times[30], "operator", source="olga@10.0.0.21", text="write Уставка: 1 -> 2")}
+    for k, ts in enumerate(times):  # in time order, as a station writes
         store.put(Record(ts, "data", grp=1, type=1, source="04010", value=None if k == 50 else 40 * k,
                          text="comm-fail" if k == 50 else None))
+        if k in journal:
+            store.put(journal[k])
     store.close()
     st = Station(folder)
     try:
@@ -269,3 +298,80 @@ def test_a_consoles_trend_shows_the_stations_archived_values_of_a_stored_tag(
             assert math.isnan(value)  # the gap
         else:
             assert value == pytest.approx(40 * k * 100 / 4095, abs=0.01)  # LEVEL in %
+
+
+def test_the_consoles_trend_window_draws_a_stored_tag_from_the_stations_history(
+        qtbot, archived: tuple[Station, list[float]], attach: Attach, tmp_path: Path) -> None:
+    station, times = archived
+    console = attach(station, "operator")
+    trend = console.open_trends()
+    assert trend is not None
+    trend.search.setText("уровень")  # the station's tags, searched as at the workstation
+    assert [trend.tag_list.item(i).data(Qt.ItemDataRole.UserRole) for i in range(trend.tag_list.count())] \
+        == ["LEVEL"]
+    pen = trend.add_pen("LEVEL")
+    assert pen is not None
+    trend.set_range(times[0] - 5, times[-1] + 5)
+    qtbot.waitUntil(lambda: not trend.loading() and any(len(ts) for ts, _ in pen.days.values()), timeout=WAIT)
+    ts, values = pen.samples()
+    shown = dict(zip(ts.tolist(), values.tolist()))
+    for k in (0, 1, 49, 51, 99):  # the station's physical values, back to the archive's words, converted
+        value = next(v for s, v in shown.items() if abs(s - times[k]) < 1e-3)
+        assert value == pytest.approx(40 * k * 100 / 4095, abs=0.01)
+    assert math.isnan(next(v for s, v in shown.items() if abs(s - times[50]) < 1e-3))  # the gap
+    trend.set_cursors(times[10], times[90])
+    trend.dirty = True
+    trend.redraw()
+    assert trend.cell("LEVEL", "B − A") == f"{40 * 80 * 100 / 4095:.1f}"
+    qtbot.waitUntil(lambda: len(pen.live_t) >= 2, timeout=WAIT)  # the station's live values go on
+    trend.save_as("Уровни")  # kept in the console's own folder for the station, per user
+    assert console.client.keep.joinpath("trends.json").is_file()
+    trend.export_csv(tmp_path / "trend.csv")
+    assert len((tmp_path / "trend.csv").read_text(encoding="utf-8").splitlines()) > 90
+    trend.export_png(tmp_path / "trend.png")
+    assert (tmp_path / "trend.png").stat().st_size > 0
+    trend.close()
+    again = console.open_trends()
+    assert again is not None and again.open_trend("Уровни") and list(again.pens) == ["LEVEL"]
+
+
+def test_the_consoles_viewer_queries_the_stations_journal_and_series(
+        qtbot, archived: tuple[Station, list[float]], attach: Attach, tmp_path: Path) -> None:
+    station, times = archived
+    console = attach(station, "viewer")
+    viewer = console.open_viewer()
+    assert viewer is not None and viewer.day == dt.date.fromtimestamp(times[0])
+
+    def texts() -> list[str]:
+        qtbot.waitUntil(lambda: viewer.paging is None, timeout=WAIT)
+        return [r.text or "" for r in viewer.model.rows]
+
+    assert {"Насос 2 остановлен", "Насос 2 в работе", "write Уставка: 1 -> 2"} <= set(texts())
+    assert not viewer.group.isEnabled()  # a message's group is not in its event
+    viewer.text.setText("НАСОС")  # contains, in the spellings the local archive tries: by the station
+    viewer.apply_filter()
+    assert texts() == ["Насос 2 остановлен", "Насос 2 в работе"]
+    viewer.type.setCurrentIndex(3)  # 2 alarm and above
+    viewer.apply_filter()
+    assert texts() == ["Насос 2 остановлен"] and viewer.page_label.text() == "records 1–1 of 1"
+    viewer.text.clear()
+    viewer.type.setCurrentIndex(0)
+    viewer.kind.setCurrentText("operator")
+    viewer.apply_filter()
+    assert texts() == ["write Уставка: 1 -> 2"]
+    viewer.kind.setCurrentText("all")
+    for edit, k in ((viewer.since, 15), (viewer.until, 40)):
+        edit.setTime(QTime.fromString(dt.datetime.fromtimestamp(times[k]).strftime("%H:%M:%S"), "HH:mm:ss"))
+    viewer.apply_filter()
+    assert "Насос 2 остановлен" not in texts() and "Насос 2 в работе" in texts()
+    assert viewer.export_csv(tmp_path / "journal.csv") == len(texts())
+    viewer.since.setTime(QTime(0, 0))
+    viewer.until.setTime(viewer.until.maximumTime())
+    labels = [viewer.series_list.item(i).text() for i in range(viewer.series_list.count())]
+    level = next(i for i, label in enumerate(labels) if label.startswith("LEVEL"))
+    assert labels[level] == "LEVEL Уровень, % (04010)"
+    viewer.check_series(level)
+    qtbot.waitUntil(lambda: not viewer.loading and len(viewer.curves) == 1, timeout=WAIT)
+    xs, ys = next(iter(viewer.curves.values())).getData()
+    assert len(xs) >= 100 and np.nanmax(ys) == pytest.approx(40 * 99 * 100 / 4095, abs=0.01)
+    assert np.isnan(ys).any()  # the gap

@@ -143,22 +143,26 @@ class RemoteJournal:
 
 
 class RemoteAlarms:
-    """The station's alarms as the alarm summary reads the local alarm system's (`version`,
-    `summary` in the summary's order)."""
+    """The station's alarms as the alarm views read the local alarm system's (an `AlarmSource`:
+    `version`, `summary` in the summary's order, the horn)."""
 
     def __init__(self) -> None:
         self.version = 0
         self.summary: list[AlarmRow] = []
         self.horn = Horn()  # what sounds, worked out from the station's rows as the station does
+        self._horn = threading.Lock()  # a Silence lands on the client's thread, the rows on the GUI's
 
     def show(self, rows: tuple[AlarmRow, ...]) -> None:
         self.summary = sorted(rows, key=summary_order)
-        self.horn.update(self.summary)
+        with self._horn:
+            self.horn.update(self.summary)
         self.version += 1
 
-    def silenced(self, now: float) -> None:
-        """The station took this console's silence: what sounds now stops here too."""
-        self.horn.silence(now)
+    def silence(self, now: float) -> None:
+        """The station took this console's Silence (StationCommands): what sounds now stops here
+        too, as it did at the station."""
+        with self._horn:
+            self.horn.silence(now)
 
 
 class StationSource(QObject):

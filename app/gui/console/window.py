@@ -4,7 +4,8 @@ banner of a station running elsewhere, with no NetPlc, exchange or archive of it
 Its views are the workstation's own (the form view in its zoom area, the alarm banner, the health
 strip, the journal dock, the header); what differs is where their data comes from: a
 `StationSource` and a `RemoteJournal` (source.py) instead of the in-process runtime's bridge and
-the archive's file, and a `StationSeries` (series.py) behind the trends' history. Everything it
+the archive's file, and a `StationArchiveSource` (archive.py) as the archive that the trends'
+history, the run-time trend window and the journal viewer read. Everything it
 does is done by the user logged in at the station, through the station's command layer: a form's
 write is the station's WriteBit or WriteWord method, an acknowledgement its Acknowledge; the
 station checks the role, journals with the user's name and answers, and a refusal is said in the
@@ -32,7 +33,7 @@ from app.gui import i18n, words
 from app.gui.alarm_summary import AlarmSummary
 from app.gui.application import application
 from app.gui.bridge import Answers
-from app.gui.console.series import StationSeries
+from app.gui.console.archive import StationArchiveSource
 from app.gui.console.source import Loaded, RemoteJournal, StationSource
 from app.gui.journal import JournalDock
 from app.gui.main_window import (
@@ -47,13 +48,16 @@ from app.gui.monitor.login import logged_in
 from app.gui.monitor.source import OpcUaSource
 from app.gui.monitor.window import ProgramWindow
 from app.gui.rights import Rights
-from app.gui.trend_history import TrendHistory
+from app.gui.trend_history import ArchiveSeries, TrendHistory
+from app.gui.trend_window import TrendWindow
+from app.gui.viewer import ViewerWindow
 from app.gui.zoom import ZoomArea
 from app.publish.console import ConsoleClient, StationCommands
 from app.scada.alarms import AlarmRow
 from app.scada.readings import Readings
+from app.scada.trends import TrendBook
 from hmi_forms.elements.base import Writer
-from hmi_forms.elements.target import EngineTarget
+from hmi_forms.elements.target import CommandTarget
 from hmi_forms.widgets.form_view import FormView
 from netplc.problems import Problems
 
@@ -62,18 +66,14 @@ logger = logging.getLogger(__name__)
 STATUS_MS = 1000
 
 
-class RemoteTarget(EngineTarget):
+class RemoteTarget(CommandTarget):
     """The station's command layer, reached over its endpoint, as the form elements' Target: the
-    station names a tag's write with the tag and journals it with the console's user."""
+    station names a tag's write with the tag and journals it with the console's user (so no tags
+    here: the view says the element's label)."""
 
     def __init__(self, client: ConsoleClient, answers: Answers) -> None:
-        # no local layer: the station's checks, names and journals each write
+        super().__init__(lambda user: Who(user, Source.OPCUA), (), answers.follow, words.answer)
         self.client = client
-        self.who = lambda user: Who(user, Source.OPCUA)
-        self.on_answer = answers.follow
-        self.say = words.answer
-        self._bits: dict = {}  # the station names a write by its tag: the view says the element's label
-        self._words: dict = {}
 
     def bit(self, who: Who, addr: int, value: int, label: str | None, at_least: str | None) -> Ticket:
         return self.client.write_bit(addr, value, label, at_least)
@@ -100,11 +100,13 @@ class ConsoleWindow(QMainWindow):
         self.answers = Answers()
         self.answers.answered.connect(self._answered)
         self.target = RemoteTarget(client, self.answers)
-        self.commands = StationCommands(client)
+        self.commands = StationCommands(client, source.station_alarms)
         self.rights = Rights(self.commands, lambda: self.who)  # type: ignore[arg-type]
         self.views: list[FormView] = []
         self.history: TrendHistory | None = None  # of the forms shown
+        self.archive: StationArchiveSource | None = None  # the station's, with its tags as loaded
         self.programs: list[ProgramWindow] = []  # the Program views opened from here
+        self.windows: list[QWidget] = []  # the trend windows and viewers opened from here
         self.unacknowledged: list[AlarmRow] = []
         frame = station_frame(self, client.station or client.url)
         self.header, self.banner, self.health = frame.header, frame.alarms, frame.health
@@ -123,6 +125,14 @@ class ConsoleWindow(QMainWindow):
         program.setShortcut(QKeySequence("Ctrl+Shift+P"))
         program.triggered.connect(self.open_program)
         station.addAction(program)
+        trends = QAction(self.tr("Run-time &trends…"), self)  # the station's tags, live and archived
+        trends.setShortcut(QKeySequence("Ctrl+T"))
+        trends.triggered.connect(self.open_trends)
+        station.addAction(trends)
+        viewer = QAction(self.tr("Open journal &viewer…"), self)  # the station's archive, queried
+        viewer.setShortcut(QKeySequence("Ctrl+J"))
+        viewer.triggered.connect(self.open_viewer)
+        station.addAction(viewer)
         view = self.menuBar().addMenu(self.tr("&View"))
         view.addAction(self.journal.toggleViewAction())
         view.addAction(self.summary_dock.toggleViewAction())
@@ -147,7 +157,8 @@ class ConsoleWindow(QMainWindow):
         if self.history is not None:
             self.history.close()
             self.history.deleteLater()
-        self.history = TrendHistory(StationSeries(self.client, loaded.tags), self)
+        self.archive = StationArchiveSource(self.client, loaded.tags)
+        self.history = TrendHistory(ArchiveSeries(self.archive), self)
         while self.tabs.count():
             page = self.tabs.widget(0)
             self.tabs.removeTab(0)
@@ -175,6 +186,32 @@ class ConsoleWindow(QMainWindow):
         window = ProgramWindow(source, lambda: self.client.user)
         window.show()
         self.programs.append(window)
+        return window
+
+    def open_trends(self) -> TrendWindow | None:
+        """Station -> Run-time trends: the station's tags picked into pens, their history read from
+        the station, their live values from this console's readings; the user's named trends kept
+        in this console's folder for the station (the console has no archive)."""
+        loaded, archive = self.source.current, self.archive
+        if loaded is None or archive is None:
+            self.status.showMessage(self.tr("The station's files are not loaded yet"), REFUSAL_MS)
+            return None
+        window = TrendWindow(self.source.readings, loaded.tags.tags, archive, TrendBook(self.client.keep),
+                             lambda: self.client.user, self)
+        window.show()
+        self.windows.append(window)
+        return window
+
+    def open_viewer(self) -> ViewerWindow | None:
+        """Station -> Open journal viewer: the offline viewer's records and series, read from the
+        station's archive (its event and value history) rather than a file."""
+        if self.archive is None:
+            self.status.showMessage(self.tr("The station's files are not loaded yet"), REFUSAL_MS)
+            return None
+        symbols = self.source.current.symbols if self.source.current is not None else {}
+        window = ViewerWindow(self.archive, symbols={a: n for n, a in symbols.items()})
+        window.show()
+        self.windows.append(window)
         return window
 
     def ask(self, title: str, text: str) -> bool:
@@ -231,8 +268,8 @@ class ConsoleWindow(QMainWindow):
 
     def closeEvent(self, event: QCloseEvent) -> None:
         self._timer.stop()
-        for program in self.programs:
-            program.close()
+        for window in (*self.programs, *self.windows):
+            window.close()
         self.summary.stop()
         self.journal.close_archive()
         if self.history is not None:

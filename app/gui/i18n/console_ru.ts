@@ -3,6 +3,14 @@
 <context>
     <name>ConsoleWindow</name>
     <message>
+        <source>Run-time &amp;trends…</source>
+        <translation>&amp;Тренды…</translation>
+    </message>
+    <message>
+        <source>Open journal &amp;viewer…</source>
+        <translation>Открыть &amp;просмотр журнала…</translation>
+    </message>
+    <message>
         <source>&amp;Station</source>
         <translation>&amp;Станция</translation>
     </message>
@@ -1060,6 +1068,10 @@ Drag onto the form, or double-click to add</source>
 </context>
 <context>
     <name>ViewerWindow</name>
+    <message>
+        <source>the records of this archive carry no group</source>
+        <translation>записи этого архива не содержат группы</translation>
+    </message>
     <message>
         <source>any</source>
         <translation>любой</translation>

@@ -264,6 +264,53 @@ def test_the_journal_as_events_of_the_station_and_the_server(station: tuple[Runt
     assert not_events == ua.StatusCodes.BadHistoryOperationUnsupported
 
 
+def test_the_journal_filtered_by_a_like_of_its_message_and_a_severity(
+        station: tuple[Runtime, str, float]) -> None:
+    """Part 4's Like (7.7.3): % any text, _ one character, [..] one of; with And, a Severity."""
+    _, url, t = station
+
+    def operand(name: str) -> ua.SimpleAttributeOperand:
+        return ua.SimpleAttributeOperand(TypeDefinitionId=ua.NodeId(ua.ObjectIds.BaseEventType),
+                                         BrowsePath=[ua.QualifiedName(name, 0)],
+                                         AttributeId=ua.AttributeIds.Value)
+
+    def element(op: ua.FilterOperator, *operands: object) -> ua.ContentFilterElement:
+        return ua.ContentFilterElement(FilterOperator=op, FilterOperands=list(operands))
+
+    def like(pattern: str) -> ua.ContentFilterElement:
+        return element(ua.FilterOperator.Like, operand("Message"),
+                       ua.LiteralOperand(Value=ua.Variant(pattern, ua.VariantType.String)))
+
+    severe = element(ua.FilterOperator.GreaterThanOrEqual, operand("Severity"),
+                     ua.LiteralOperand(Value=ua.Variant(700, ua.VariantType.UInt16)))
+    both = element(ua.FilterOperator.And, ua.ElementOperand(Index=1), ua.ElementOperand(Index=2))
+
+    async def go() -> list[list[str]]:
+        client, ns = await connect(url)
+        try:
+            texts = []
+            wheres = ([like("Уровень в норме 1_")], [like("%норме [23]")], [both, like("Уровень%"), severe])
+            for where in wheres:
+                flt = ua.EventFilter(SelectClauses=[operand("Message")],
+                                     WhereClause=ua.ContentFilter(Elements=where))
+                asked = ua.ReadEventDetails(StartTime=utc((t - 61) * 1000), EndTime=utc(t * 1000), Filter=flt)
+                params = ua.HistoryReadParameters(
+                    HistoryReadDetails=asked, TimestampsToReturn=ua.TimestampsToReturn.Both,
+                    ReleaseContinuationPoints=False,
+                    NodesToRead=[ua.HistoryReadValueId(NodeId=ua.NodeId("Demo station", ns))])
+                result = (await client.uaclient.history_read(params))[0]
+                result.StatusCode.check()
+                texts.append([e.EventFields[0].Value.Text for e in result.HistoryData.Events])
+            return texts
+        finally:
+            await client.disconnect()
+
+    teens, two_three, high = run(go())
+    assert teens == [f"Уровень в норме {i}" for i in range(10, 20)]
+    assert two_three == ["Уровень в норме 2", "Уровень в норме 3"]
+    assert high == ["Уровень выше 90 %"]  # severity 700; "в норме" ones are info
+
+
 def test_what_is_not_archived_says_so(station: tuple[Runtime, str, float]) -> None:
     _, url, t = station
 
