@@ -91,6 +91,7 @@ class Axes:
         self.key: tuple[object, ...] = ()
         self.pixmap = QPixmap()
         self.plot = QRectF()  # where the curves go
+        self.labels: list[tuple[str, QRectF]] = []  # the texts drawn, each where it is
 
     def value_ticks(self, lo: float, hi: float, height: float) -> list[tuple[float, str]]:
         if self.fixed is not None:
@@ -133,6 +134,11 @@ class Axes:
         grid, line = QColor(theme.BORDER), m.height()
         grid.setAlpha(GRID_ALPHA)
         p.setFont(self.font)
+        self.labels = []
+
+        def text_at(left: float, top: float, text: str) -> None:
+            self.labels.append((text, QRectF(left, top, m.horizontalAdvance(text), line)))
+            p.drawText(QPointF(left, top + m.ascent()), text)
         # the value axis: grid, ticks and labels, right-aligned against the axis, never cut
         for v, text in self.value_ticks(scale.lo, scale.hi, r.height()):
             y = round(self.y_of(v, scale)) + 0.5
@@ -142,9 +148,9 @@ class Axes:
             p.drawLine(QPointF(r.left(), y), QPointF(r.left() + TICK_LEN, y))
             top = min(max(y - line / 2, 0), r.bottom() - line / 2)
             p.setPen(theme.TEXT_DIM)
-            p.drawText(QRectF(0, top, r.left() - 4, line), theme.RIGHT, text)
+            text_at(r.left() - 4 - m.horizontalAdvance(text), top, text)
         if self.unit:
-            p.drawText(QRectF(0, r.bottom() + 1, r.left() - 4, line), theme.RIGHT, self.unit)
+            text_at(r.left() - 4 - m.horizontalAdvance(self.unit), r.bottom() + 1, self.unit)
         # the time axis: seconds before now (live) or clock times, each label centred on its tick
         per_second = r.width() / max(scale.t1 - scale.t0, 1e-9)
         if scale.live:
@@ -165,7 +171,7 @@ class Axes:
             left = min(x - w / 2, width - w - 1)  # the newest label (now) ends at the right end
             if left >= r.left():
                 p.setPen(theme.TEXT_DIM)
-                p.drawText(QPointF(left, r.bottom() + 1 + m.ascent()), text)
+                text_at(left, r.bottom() + 1, text)
         # the limits, dashed in their zone's colour
         for limit, color in self.limits:
             if scale.lo <= limit <= scale.hi:
