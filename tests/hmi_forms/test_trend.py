@@ -7,8 +7,9 @@ import math
 from pathlib import Path
 
 import pytest
-from PySide6.QtCore import QPoint, Qt
-from PySide6.QtGui import QColor, QImage
+from PySide6.QtCore import QPoint, QPointF, Qt
+from PySide6.QtGui import QColor, QImage, QWheelEvent
+from PySide6.QtWidgets import QApplication
 
 from app.station.config import DEMO_STATION
 from hmi_forms.elements.analog import AnalogBase
@@ -157,3 +158,30 @@ def test_no_axis_label_of_the_demo_forms_is_cut(qtbot) -> None:
             assert where.top() >= 0 and where.bottom() <= image.height(), text
             assert where.right() <= r.left() or where.top() >= r.bottom(), text  # beside or under the plot
             assert inked(image, where.left(), where.top(), where.width(), where.height()) > 3, text
+
+
+def test_the_wheel_zooms_about_the_mouse_and_the_mouse_reads_a_sample(qtbot, view: FormView) -> None:
+    bit, temp = view.trends
+    wall = fill(bit, lambda k: float(k % 20 < 10))
+    fill(temp, lambda k: 20.0 + k)
+    view.redraw_trends(wall)
+    r = temp.axes.plot
+    at = QPointF(r.center().x(), r.center().y())
+    before, under = temp.window(), temp.plot.time_at(at.x())
+    wheel = QWheelEvent(at, temp.plot.mapToGlobal(at), QPoint(), QPoint(0, 120), Qt.MouseButton.NoButton,
+                        Qt.KeyboardModifier.NoModifier, Qt.ScrollPhase.NoScrollPhase, False)
+    QApplication.sendEvent(temp.plot, wheel)
+    t0, t1 = temp.window()
+    assert not view.live and bit.window() == (t0, t1)
+    assert t1 - t0 == pytest.approx((before[1] - before[0]) * 0.8)  # one notch in
+    assert temp.plot.time_at(at.x()) == pytest.approx(under)  # about the time under the mouse
+    plain = temp.plot.grab().toImage()
+    qtbot.mouseMove(temp.plot, at.toPoint())
+    qtbot.waitUntil(lambda: temp.plot.mouse is not None, timeout=5000)
+    read = temp.plot.grab().toImage()
+    t, _ = temp.value_at(temp.plot.time_at(temp.plot.mouse.x()))
+    x = round(r.left() + (t - t0) * r.width() / (t1 - t0))
+    bottom = round(r.bottom())
+    dots = [QColor(read.pixel(x, y)) == theme.TEXT_DIM for y in range(bottom - 8, bottom)]
+    assert any(dots) and not all(dots)  # the dotted line at the sample
+    assert inked(read, r.left(), r.top(), r.width(), 16) > inked(plain, r.left(), r.top(), r.width(), 16) + 20
