@@ -8,6 +8,12 @@ sampled after a warm-up and at the end. Yardsticks from the same run: the headle
 for the same time (what the window adds is the difference), and a bare QMainWindow with a label
 shown (what the first drawn form costs beyond Qt's own start).
 
+Then each of the demo's forms is shown in turn (`--form-seconds` each) and every turn of the event
+loop is timed: one turn holds a tick's refresh of the forms, or the paint that follows it, or the
+trends' redraw once a second, so the longest turn is the longest the console stalls (target: no
+turn over 50 ms, half a tick). On a loaded machine a turn's wall time is mostly waiting for a
+core, so the GUI thread's CPU time in each turn is printed beside it: the work the console did.
+
 The start is measured twice: in this process (station loaded, started, window built and drawn),
 and from launching a fresh Python process to its first drawn form (imports included, as the
 operator waits for them), beside a fresh process that shows a bare QMainWindow.
@@ -20,6 +26,7 @@ from __future__ import annotations
 import argparse
 import os
 import resource
+import statistics
 import subprocess
 import sys
 import tempfile
@@ -46,10 +53,15 @@ def rss_mb() -> float:
         return int(f.read().split()[1]) * resource.getpagesize() / 1e6
 
 
-def pump(app: QApplication, seconds: float) -> None:
+def pump(app: QApplication, seconds: float, turns: list[tuple[float, float]] | None = None) -> None:
+    """Run the event loop for `seconds`; each of its turns, wall time and the GUI thread's CPU time
+    (ms), goes to `turns`."""
     end = time.monotonic() + seconds
     while time.monotonic() < end:
+        t0, c0 = time.perf_counter(), time.thread_time()
         app.processEvents()
+        if turns is not None:
+            turns.append(((time.perf_counter() - t0) * 1000, (time.thread_time() - c0) * 1000))
         time.sleep(0.005)
 
 
@@ -137,6 +149,7 @@ def main(argv: list[str] | None = None) -> int:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--seconds", type=float, default=60.0, help="length of each measured run (default 60)")
     ap.add_argument("--minutes", type=float, help="the long run: length in minutes (10 for the acceptance)")
+    ap.add_argument("--form-seconds", type=float, default=20.0, help="each form shown this long (default 20)")
     ap.add_argument("--child", nargs=2, metavar=("MODE", "T0"), help=argparse.SUPPRESS)
     args = ap.parse_args(argv)
     if args.child:
@@ -161,6 +174,13 @@ def main(argv: list[str] | None = None) -> int:
             cpu = cpu_over(app, seconds, samples)
             mem1 = samples[-1]
             status = runtime.status()
+            forms = []
+            for i in range(window.tabs.count()):
+                window.tabs.setCurrentIndex(i)
+                pump(app, 1.0)
+                turns: list[tuple[float, float]] = []
+                pump(app, args.form_seconds, turns)
+                forms.append((window.tabs.tabText(i), turns))
         finally:
             window.close()
             runtime.stop()
@@ -174,6 +194,13 @@ def main(argv: list[str] | None = None) -> int:
     print(f"resident memory after {WARMUP:.0f} s warm-up {mem0:.1f} MB, after the run {mem1:.1f} MB "
           f"({mem1 - mem0:+.1f} MB); at each tenth of the run: "
           + " ".join(f"{m:.1f}" for m in samples))
+    for name, turns in forms:
+        walls, cpus = [w for w, _ in turns], [c for _, c in turns]
+        print(f"form {name!r} shown {args.form_seconds:.0f} s, {len(turns)} turns of the event loop: "
+              f"longest {max(walls):.1f} ms wall ({sum(w > 50 for w in walls)} over 50 ms), p99 "
+              f"{statistics.quantiles(walls, n=100)[-1]:.1f} ms; GUI thread CPU in a turn: longest "
+              f"{max(cpus):.1f} ms ({sum(c > 50 for c in cpus)} over 50 ms), p99 "
+              f"{statistics.quantiles(cpus, n=100)[-1]:.1f} ms")
     return 0
 
 

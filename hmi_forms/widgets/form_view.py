@@ -126,12 +126,8 @@ class FormView(QWidget):
         self.history_wanted: Callable[[TrendWidget, float, float], None] | None = None
         self._next_flush = clock()
         for w in self.trends:  # one time axis for the form: panning one pans them all
-            if w is not self.trends[0]:
-                w.plot.getPlotItem().setXLink(self.trends[0].plot.getPlotItem())
-            w.view_box.sigRangeChangedManually.connect(self.pause)
+            w.moved = self.move_trends
             w.pause_button.clicked.connect(self.toggle_live)
-        if self.trends:
-            self.trends[0].view_box.sigXRangeChanged.connect(self._range_changed)
 
     @staticmethod
     def element_widget(model: Element, images: Images, archive: Path | None) -> ElementWidget:
@@ -194,7 +190,7 @@ class FormView(QWidget):
         now = self.clock()
         if self.trends and now >= self._next_flush:  # all plots of the form in the same tick
             self._next_flush = max(self._next_flush + REDRAW_INTERVAL, now)
-            self._redraw(snapshot.wall)
+            self.redraw_trends(snapshot.wall)
 
     def schedule(self, part: QRect) -> None:
         """Repaint `part` of the form: at once, or with the rest of a refresh."""
@@ -203,17 +199,14 @@ class FormView(QWidget):
         else:
             self._dirty.append(part)
 
-    def _redraw(self, wall: float) -> None:
-        if self.live:
-            for trend in self.trends:  # now at the views' x 0: they stay, the curves move
-                trend.place(wall, live=True)
+    def redraw_trends(self, wall: float) -> None:
+        """Draw every trend of the form at `wall`: live, ending then (once per REDRAW_INTERVAL)."""
         for trend in self.trends:
             trend.flush()
-        if self.live:
-            span = max(t.span for t in self.trends)
-            self.trends[0].show_window(wall - span, wall)  # the others are linked to it
-        for trend in self.trends:  # now: pyqtgraph would move a view in its paint, and paint twice
-            trend.view_box.updateMatrix()
+        if self.live:  # the samples kept, to two digits: the axes' labels stay as the period jitters
+            span = float(f"{max(t.span for t in self.trends):.2g}")
+            for trend in self.trends:
+                trend.show_window(wall - span, wall)
 
     def pause(self) -> None:
         """Stop following the clock (the operator pans, zooms or reads a value)."""
@@ -221,14 +214,13 @@ class FormView(QWidget):
             self.live = False
             for trend in self.trends:
                 trend.set_live(False)
-                trend.place(trend.origin, live=False)
 
     def resume(self) -> None:
         self.live = True
         for trend in self.trends:
             trend.set_live(True)
         if self._last is not None:
-            self._redraw(self._last.wall)
+            self.redraw_trends(self._last.wall)
 
     def toggle_live(self) -> None:
         if self.live:
@@ -236,16 +228,19 @@ class FormView(QWidget):
         else:
             self.resume()
 
-    def _range_changed(self, _box: object, x_range: tuple[float, float]) -> None:
-        """Scrolled back past the live samples: each trend asks for its history there."""
+    def move_trends(self, t0: float, t1: float) -> None:
+        """The operator dragged or wheeled in a trend: all trends of the form pause and show the
+        times t0..t1; scrolled back past the live samples, each asks for its history there."""
+        self.pause()
+        for trend in self.trends:
+            trend.show_window(t0, t1)
         if self.history_wanted is None:
             return
-        x_range = (x_range[0] + self.trends[0].origin, x_range[1] + self.trends[0].origin)
         for trend in self.trends:
             t = trend.trend.times()
             first = t[0] if len(t) and not np.isnan(t[0]) else float("inf")
-            if x_range[0] < first:
-                self.history_wanted(trend, x_range[0], x_range[1])
+            if t0 < first:
+                self.history_wanted(trend, t0, t1)
 
     def _fault(self, model: Element, error: Exception, what: str) -> None:
         """Mark the element stale; log and report the fault the first time (it recurs at every
@@ -266,7 +261,7 @@ class FormView(QWidget):
         for _, widget in self.pairs:
             widget.flush()
         if self.trends and self._last is not None and self.live:
-            self._redraw(self._last.wall)
+            self.redraw_trends(self._last.wall)
 
     def save_png(self, path: str | Path) -> bool:
         self.flush()

@@ -1,29 +1,31 @@
-"""Trends with pyqtgraph: the Graph element (a bit) and AnalogBase with Appearance "graph".
+"""Form trends: the Graph element (a bit) and AnalogBase with Appearance "graph", drawn with QPainter.
 
-Following docs/architecture.md section 9: the plot and its curves are created once per widget and
-fed with `setData` (bare PlotCurveItems: PlotDataItem's per-call bookkeeping cost five times the
-data itself); the y range is fixed (no autorange per frame) and the axes are cached as pixmaps.
-The x axis is time: the form (FormView) redraws all its trends in the same tick, on the same
-time, so two trends of one form never disagree about when something happened. Live, the axis is a
-fixed scale of seconds before now (the curves move under it, the axis, grid and view never
-change, so a redraw paints the curve alone: half the cost of the hand-drawn polylines of
-bench/hmi.py, where a clock-time axis moving under every plot cost twice theirs, issue 28);
-paused, it shows clock time. The operator may pause a trend (its button, or by dragging or wheeling in it: the
-form's trends are linked and all pause), pan and zoom in time, read the value under the mouse,
-and scroll back into the archive's history, drawn lighter behind the live samples.
+A form redraws all its trends once a second, in the same tick and on the same time (FormView), so
+two trends of one form never disagree about when something happened. Live, the time axis is a
+fixed scale of seconds before now; paused, it shows clock times. The operator may pause the trends
+(the button, or by dragging or wheeling in one: the form's trends follow together), pan and zoom
+in time, read the value under the mouse, and scroll back into the archive's history, drawn lighter
+behind the live samples.
+
+Why not a pyqtgraph plot, as before: each of its redraws went through a graphics scene, a view
+box, two axis items and a curve item in Python, and a form of 50 trends stalled the console for
+two to three times what the same curves cost drawn by hand (issue 28). Here a redraw is what a
+hand-drawn polyline costs and no more: the samples are copied once into a QPolygonF (through its
+buffer, no point objects) in data coordinates (seconds, value), the painter's transform puts them
+on the screen, and the axes are one cached pixmap (trend_axes.py) drawn anew only when their
+labels change. Samples taken while the data were bad (NaN) break the line.
 """
 
 from __future__ import annotations
 
 import math
-import time
-from collections.abc import Hashable
+from collections.abc import Callable, Hashable
 
 import numpy as np
-import pyqtgraph as pg
 from PySide6.QtCore import QCoreApplication, QPointF, QRect, QRectF, Qt
-from PySide6.QtGui import QColor, QFont, QFontMetrics, QPainter, QPen, QPixmap
-from PySide6.QtWidgets import QGraphicsItem, QStyleOptionGraphicsItem, QToolButton, QWidget
+from PySide6.QtGui import QColor, QMouseEvent, QPainter, QPaintEvent, QPen, QPolygonF, QTransform, QWheelEvent
+from PySide6.QtWidgets import QToolButton, QWidget
+from shiboken6 import VoidPtr
 
 from hmi_forms.elements import formats
 from hmi_forms.elements.analog import AnalogBase
@@ -32,172 +34,170 @@ from hmi_forms.elements.props import Color
 from hmi_forms.elements.trend import Trend
 from hmi_forms.widgets import theme
 from hmi_forms.widgets.base import Images, SelfPainted
+from hmi_forms.widgets.trend_axes import Axes, Scale
 
 REDRAW_INTERVAL = 1.0  # seconds between redraws of a form's plots (samples are kept every scan)
 PAUSE, LIVE = "\u275a\u275a", "\u25b6"
+ZOOM = 0.8  # the time shown after one notch of the wheel, as a share of what it was
+SHORTEST, LONGEST = 1.0, 31 * 86400.0  # seconds a zoom may show
 
 
 def _pen_color(color: Color | None) -> QColor:
     return theme.qcolor(color, theme.ACCENT)
 
 
-# seconds between the clock-time axis's labels: the first that leaves LABEL_GAP px per label
-STEPS = (1, 2, 5, 10, 15, 30, 60, 120, 300, 600, 900, 1800, 3600, 7200, 10800, 21600, 43200, 86400)
-LABEL_GAP = 64
-TICK_PX = 12  # the axes' labels: an operator reads them from a step back
-LABELS_KEPT = 4096  # label pixmaps of all trends of the process, started afresh when full
-_labels: dict[tuple[str, str, int, float], QPixmap] = {}
+def polygon(n: int) -> tuple[QPolygonF, np.ndarray]:
+    """A polygon of n points and its points as an (n, 2) array over the same memory."""
+    poly = QPolygonF()
+    poly.resize(n)
+    return poly, np.frombuffer(VoidPtr(poly.data(), n * 16, True), dtype=np.float64).reshape(n, 2)
 
 
-def _label(text: str, font: QFont, color: QColor, ratio: float) -> QPixmap:
-    """The pixmap of one axis label, shared by every trend that shows the same text."""
-    key = (text, font.key(), color.rgba(), ratio)
-    pixmap = _labels.get(key)
-    if pixmap is None:
-        if len(_labels) >= LABELS_KEPT:
-            _labels.clear()
-        metrics = QFontMetrics(font)
-        pixmap = QPixmap(round(metrics.horizontalAdvance(text) * ratio) + 1, round(metrics.height() * ratio))
-        pixmap.setDevicePixelRatio(ratio)
-        pixmap.fill(Qt.GlobalColor.transparent)
-        p = QPainter(pixmap)
-        p.setFont(font)
-        p.setPen(color)
-        p.drawText(0, metrics.ascent(), text)
-        p.end()
-        _labels[key] = pixmap
-    return pixmap
+def fill(xy: np.ndarray, t: np.ndarray, v: np.ndarray, steps: bool) -> None:
+    """Write the samples (t, v) as points: `steps`, each value held until the next sample's time
+    (2n - 1 points), else one point a sample."""
+    if steps:
+        xy[0::2, 0], xy[1::2, 0], xy[0::2, 1], xy[1::2, 1] = t, t[1:], v, v[:-1]
+    else:
+        xy[:, 0], xy[:, 1] = t, v
 
 
-def round_ticks(x0: float, x1: float, pixels: float, offset: float = 0.0) -> tuple[int, list[float]]:
-    """Round times in [x0, x1], multiples of a step from STEPS after `offset` is added (the zone's
-    offset for clock times), at least LABEL_GAP px apart."""
-    per_second = pixels / max(x1 - x0, 1e-9)
-    step = next((s for s in STEPS if s * per_second >= LABEL_GAP), STEPS[-1])
-    while step * per_second < LABEL_GAP:  # zoomed out past the longest step: multiples of it
-        step *= 2
-    first = math.ceil((x0 + offset) / step) * step - offset
-    return step, [first + k * step for k in range(int((x1 - first) // step) + 1)]
+class Curve:
+    """The polylines through a trend's samples, in data coordinates (seconds from the trend's
+    base, value), broken where a sample is NaN. Without a gap it is one polygon, kept and written
+    over at each redraw; `steps`: each value held until the next sample (a bit), else straight
+    lines between samples."""
 
+    def __init__(self, steps: bool) -> None:
+        self.steps = steps
+        self.lines: list[QPolygonF] = []
+        self._kept: tuple[QPolygonF, np.ndarray] | None = None
 
-def clock_label(t: float, step: int) -> str:
-    if step >= 86400:
-        return formats.date(t)
-    return time.strftime(formats.TIME if step < 60 else "%H:%M", time.localtime(t))
-
-
-def ago_label(x: float, step: int) -> str:
-    """`x` seconds from now (0 or less) in the unit of `step`."""
-    for unit, text in ((3600, "%1 h"), (60, "%1 min"), (1, "%1 s")):
-        if step >= unit and step % unit == 0:
-            return QCoreApplication.translate("TrendWidget", text).replace("%1", f"{x / unit:g}")
-    return ""  # not reached: every step is a whole number of seconds
-
-
-class KeptAxis(pg.AxisItem):
-    """An axis that keeps its bounding rectangle until it or its view is resized or moved: Qt asks
-    for it several times in every paint of the plot, and pyqtgraph maps it afresh each time
-    (with the grid, the rectangle of the view), a fifth of the plot's paint."""
-
-    _bounds: QRectF | None = None  # a class default: pyqtgraph resizes the axis in its __init__
-
-    def boundingRect(self) -> QRectF:
-        if self._bounds is None:
-            self._bounds = super().boundingRect()
-        return self._bounds
-
-    def _forget(self) -> None:
-        if self._bounds is not None:
-            self.prepareGeometryChange()
-            self._bounds = None
-
-    def resizeEvent(self, ev: object = None) -> None:
-        self._forget()
-        super().resizeEvent(ev)
-
-    def linkedViewChanged(self, view: object, newRange: object = None) -> None:
-        self._forget()
-        super().linkedViewChanged(view, newRange)
-
-    def setGrid(self, grid: int | float | bool) -> None:
-        self._forget()
-        super().setGrid(grid)
-
-
-class ClockAxis(KeptAxis):
-    """The time axis under a trend, in seconds from `origin` (the view's x 0): live, the seconds
-    before now ("-10 s"), which never change, so the axis and its grid are painted once and kept
-    as a pixmap; paused, clock times. Ticks on round seconds (minutes, hours, days as zoomed),
-    each label a pixmap shared by all trends of the process (pyqtgraph's DateAxisItem lays out
-    every label at each change)."""
-
-    def __init__(self, font: QFont) -> None:
-        super().__init__(orientation="bottom")
-        self.enableAutoSIPrefix(False)  # else every change of the range sets the axis's HTML label
-        self.setHeight(QFontMetrics(font).height() + self.style["tickTextOffset"][1])
-        self.setCacheMode(QGraphicsItem.CacheMode.DeviceCoordinateCache)
-        self.origin = 0.0
-        self.clock = False
-
-    def place(self, origin: float, clock: bool) -> None:
-        """Clock times from `origin`, or seconds before it: repainted only if its labels change."""
-        if clock != self.clock or (clock and origin != self.origin):
-            self.update()
-        self.origin, self.clock = origin, clock
-
-    def paint(self, p: QPainter, _opt: QStyleOptionGraphicsItem, _widget: QWidget | None = None) -> None:
-        view = self.linkedView()
-        if view is None:
-            return
-        bounds = self.mapRectFromParent(self.geometry())
-        grid = self.grid is not False
-        top = view.mapRectToItem(self, view.boundingRect()).top() if grid else bounds.top() - 4
-        x0, x1 = self.range
-        scale = bounds.width() / max(x1 - x0, 1e-9)
-        if self.clock:
-            start = x0 + self.origin
-            zone = time.localtime(start).tm_gmtoff if abs(start) < 1e11 else 0
-            step, ticks = round_ticks(start, x1 + self.origin, bounds.width(), zone)
-            ticks = [t - self.origin for t in ticks]
+    def set(self, t: np.ndarray, v: np.ndarray, gaps: bool) -> None:
+        if not len(t):
+            self.lines = []
+        elif not gaps:
+            n = 2 * len(t) - 1 if self.steps else len(t)
+            if self._kept is None or len(self._kept[1]) != n:
+                self._kept = polygon(n)
+            fill(self._kept[1], t, v, self.steps)
+            self.lines = [self._kept[0]]
         else:
-            step, ticks = round_ticks(x0, x1, bounds.width())
-        pen = QPen(self.pen())
-        p.setPen(pen)
-        p.drawLine(bounds.topLeft(), bounds.topRight())
-        if grid:
-            color = pen.color()
-            color.setAlpha(self.grid)
-            pen.setColor(color)
-            p.setPen(pen)
-        font, color = self.style["tickFont"], self.textPen().color()
-        ratio = p.device().devicePixelRatioF() if p.device() is not None else 1.0
-        y = bounds.top() + self.style["tickTextOffset"][1]
-        for t in ticks:
-            x = bounds.left() + (t - x0) * scale
-            p.drawLine(QPointF(x, top), QPointF(x, bounds.top()))
-            text = clock_label(t + self.origin, step) if self.clock else ago_label(t, step)
-            label = _label(text, font, color, ratio)
-            w = label.width() / ratio
-            left = min(x - w / 2, bounds.right() - w)  # the newest label (now) ends at the right end
-            if bounds.left() <= left:
-                p.drawPixmap(QPointF(left, y), label)
+            self.lines = [self._run(t, v, a, b) for a, b in runs(np.isnan(t) | np.isnan(v))]
+
+    def _run(self, t: np.ndarray, v: np.ndarray, a: int, b: int) -> QPolygonF:
+        """Samples a..b-1, all known: a bit's last value is held until the bad sample's time."""
+        if not self.steps:
+            poly, xy = polygon(b - a)
+            fill(xy, t[a:b], v[a:b], False)
+            return poly
+        held = b < len(t) and not math.isnan(t[b])
+        poly, xy = polygon(2 * (b - a) - 1 + held)
+        fill(xy[: 2 * (b - a) - 1], t[a:b], v[a:b], True)
+        if held:
+            xy[-1] = (t[b], v[b - 1])
+        return poly
 
 
-class FixedCurve(pg.PlotCurveItem):
-    """A curve whose extent is set from outside: pyqtgraph would otherwise measure the data (with
-    pixel padding) after every setData, for nothing, since the view never rescales to it."""
+def runs(bad: np.ndarray) -> list[tuple[int, int]]:
+    """The runs [a, b) of samples that are not `bad`."""
+    edges = np.flatnonzero(np.diff(np.concatenate(([1], bad.view(np.int8), [1]))))
+    return list(zip(edges[::2].tolist(), edges[1::2].tolist(), strict=True))
 
-    def __init__(self, extent: QRectF, **opts: object) -> None:
-        super().__init__(**opts)
-        self.extent = extent
 
-    def set_extent(self, extent: QRectF) -> None:
-        if extent != self.extent:
-            self.prepareGeometryChange()
-            self.extent = extent
+class TrendPlot(QWidget):
+    """The plot area of a trend: the cached axes, the curves through the painter's transform, and
+    the value under the mouse. Dragging pans and wheeling zooms in time (through `owner.moved`)."""
 
-    def boundingRect(self) -> QRectF:
-        return self.extent
+    def __init__(self, owner: TrendWidget) -> None:
+        super().__init__(owner)
+        self.owner = owner
+        self.setAttribute(Qt.WidgetAttribute.WA_OpaquePaintEvent)
+        self.setMouseTracking(True)
+        self.mouse: QPointF | None = None  # where the mouse is, for the value under it
+        self._drag: tuple[float, Scale] | None = None
+
+    def paintEvent(self, _event: QPaintEvent) -> None:
+        owner = self.owner
+        p = QPainter(self)
+        try:  # a painter left active after an error would crash Qt
+            axes, scale = owner.axes, owner.scale
+            axes.update(self.width(), self.height(), self.devicePixelRatioF(), scale)
+            p.drawPixmap(0, 0, axes.pixmap)
+            r = axes.plot
+            p.setClipRect(r)
+            sx = r.width() / max(scale.t1 - scale.t0, 1e-9)
+            sy = -r.height() / (scale.hi - scale.lo)
+            onto = QTransform(sx, 0, 0, sy, r.left() - (scale.t0 - (owner.base or 0.0)) * sx,
+                              r.bottom() - scale.lo * sy)
+            for pen, curve in ((owner.faded, owner.history), (owner.pen, owner.curve)):
+                if curve.lines:
+                    p.setPen(pen)
+                    for dx, dy in owner.stamps:  # a wide line: a thin one at each pixel of its width
+                        p.setTransform(onto * QTransform.fromTranslate(dx, dy) if dx or dy else onto)
+                        for poly in curve.lines:
+                            p.drawPolyline(poly)
+            p.resetTransform()
+            if self.mouse is not None and r.contains(self.mouse):
+                self._cursor(p, r, scale)
+        finally:
+            p.end()
+
+    def _cursor(self, p: QPainter, r: QRectF, scale: Scale) -> None:
+        """The sample nearest to the mouse: a dotted line at it, its time and value beside."""
+        found = self.owner.value_at(self.time_at(self.mouse.x()))
+        if found is None:
+            return
+        t, y = found
+        x = r.left() + (t - scale.t0) * r.width() / max(scale.t1 - scale.t0, 1e-9)
+        p.setPen(QPen(theme.TEXT_DIM, 1, Qt.PenStyle.DotLine))
+        p.drawLine(QPointF(x, r.top()), QPointF(x, r.bottom()))
+        text = f"{formats.clock(t)}  {self.owner.show_value(y)}"
+        m = self.owner.axes.metrics
+        w, h = m.horizontalAdvance(text) + 8, m.height() + 2
+        box = QRectF(x - w if x > r.center().x() else x, r.top(), w, h)
+        p.fillRect(box, QColor(255, 255, 255, 220))
+        p.setPen(theme.TEXT)
+        p.setFont(self.owner.axes.font)
+        p.drawText(box, Qt.AlignmentFlag.AlignCenter, text)
+
+    def time_at(self, x: float) -> float:
+        r, s = self.owner.axes.plot, self.owner.scale
+        return s.t0 + (x - r.left()) * (s.t1 - s.t0) / max(r.width(), 1.0)
+
+    def mousePressEvent(self, event: QMouseEvent) -> None:
+        if event.button() != Qt.MouseButton.LeftButton:
+            event.ignore()
+            return
+        self._drag = (event.position().x(), self.owner.scale)
+
+    def mouseMoveEvent(self, event: QMouseEvent) -> None:
+        self.mouse = event.position()
+        if self._drag is not None:
+            x, s = self._drag
+            shift = (x - self.mouse.x()) * (s.t1 - s.t0) / max(self.owner.axes.plot.width(), 1.0)
+            if shift:
+                self.owner.moved(s.t0 + shift, s.t1 + shift)
+        self.update()
+
+    def mouseReleaseEvent(self, _event: QMouseEvent) -> None:
+        self._drag = None
+
+    def mouseDoubleClickEvent(self, event: QMouseEvent) -> None:
+        event.ignore()  # the element's (a faceplate opens on it)
+
+    def leaveEvent(self, _event: object) -> None:
+        self.mouse = None
+        self.update()
+
+    def wheelEvent(self, event: QWheelEvent) -> None:
+        """Zoom in time about the time under the mouse."""
+        s = self.owner.scale
+        factor = ZOOM ** (event.angleDelta().y() / 120)
+        span = min(max((s.t1 - s.t0) * factor, SHORTEST), LONGEST)
+        at = self.time_at(event.position().x())
+        share = (at - s.t0) / max(s.t1 - s.t0, 1e-9)
+        self.owner.moved(at - share * span, at + (1 - share) * span)
 
 
 class TrendWidget(SelfPainted):
@@ -207,68 +207,45 @@ class TrendWidget(SelfPainted):
         super().__init__(model, images, parent)
         self.trend: Trend = model.trend  # type: ignore[assignment]
         self.header = max(16, min(22, round(model.h * 0.14)))
-        axes = {"bottom": ClockAxis(theme.sized_font(TICK_PX)), "left": KeptAxis(orientation="left")}
-        plot = pg.PlotWidget(self, background=theme.qcolor(model.BackColor, QColor("#fff")), axisItems=axes)
-        self.axis: ClockAxis = plot.getPlotItem().getAxis("bottom")
-        plot.setGeometry(1, self.header, model.w - 2, model.h - self.header - 1)
-        plot.setFrameShape(plot.Shape.NoFrame)
-        item = plot.getPlotItem()
-        item.setMouseEnabled(x=True, y=False)  # pan and zoom in time; the y range is the scale's
-        item.setMenuEnabled(False)
-        item.hideButtons()
-        item.showGrid(x=True, y=isinstance(model, AnalogBase), alpha=0.25)
-        tick_font = theme.sized_font(TICK_PX)
-        for name in ("left", "bottom"):
-            axis = item.getAxis(name)
-            axis.setPen(pg.mkPen(theme.BORDER))
-            axis.setTextPen(pg.mkPen(theme.TEXT_DIM))
-            axis.setStyle(tickFont=tick_font, tickLength=-4)
         color = _pen_color(model.Colors)
-        pen = pg.mkPen(color, width=model.LineWidth)
-        faded = QColor(color)
-        faded.setAlpha(110)
+        back = theme.qcolor(model.BackColor, QColor("#fff"))
+        share = 0.43  # the history's colour: the pen's, this much over the background (opaque)
+        faded = QColor.fromRgbF(*(share * c + (1 - share) * b for c, b in zip(
+            color.getRgbF()[:3], back.getRgbF()[:3], strict=True)))
+        self.pen, self.faded = QPen(color, 1), QPen(faded, 1)
+        for pen in (self.pen, self.faded):
+            pen.setCosmetic(True)  # one pixel wide whatever the transform
+        # LineWidth px drawn as a thin line at each pixel of a LineWidth-square: Qt strokes a wide
+        # line as a filled outline, 20-30 times the cost of a thin one (a 2 px trend took 9 ms)
+        offsets = range(-((model.LineWidth - 1) // 2), model.LineWidth // 2 + 1)
+        self.stamps = [(dx, dy) for dx in offsets for dy in offsets]
         if isinstance(model, Graph):
             self.lo, self.hi = -0.15, 1.15
-            item.setYRange(self.lo, self.hi, padding=0)
-            item.getAxis("left").setTicks([[(0, "0"), (1, "1")]])
-            item.getAxis("left").setWidth(18)
-            step = {"stepMode": "left"}
+            self.axes = Axes(back, [(0.0, "0"), (1.0, "1")], "", [])
         else:
-            self.lo, self.hi = model.scaling.phy_range
-            item.setYRange(self.lo, self.hi, padding=0.04)
-            item.getAxis("left").setWidth(38)
-            for limit, zone in ((model.PhyLow, theme.WARN), (model.PhyHigh, theme.ALARM)):
-                if limit is not None:
-                    dash = pg.mkPen(zone, style=Qt.PenStyle.DashLine)
-                    item.addItem(pg.InfiniteLine(limit, angle=0, pen=dash))
-            step = {}
-        self.history = FixedCurve(QRectF(), pen=pg.mkPen(faded, width=model.LineWidth), connect="finite",
-                                  **step)
-        self.curve = FixedCurve(QRectF(), pen=pen, connect="finite", **step)
-        item.addItem(self.history)
-        item.addItem(self.curve)
-        self.cursor = pg.InfiniteLine(angle=90, pen=pg.mkPen(theme.TEXT_DIM, style=Qt.PenStyle.DotLine))
-        self.cursor_label = pg.TextItem(color=theme.TEXT, fill=pg.mkBrush(255, 255, 255, 220), anchor=(0, 0))
-        for extra in (self.cursor, self.cursor_label):
-            extra.setVisible(False)
-            item.addItem(extra, ignoreBounds=True)
-        item.getAxis("left").setCacheMode(QGraphicsItem.CacheMode.DeviceCoordinateCache)
-        plot.scene().sigMouseMoved.connect(self._mouse_moved)
-        self.plot = plot
-        self.view_box = item.getViewBox()
+            lo, hi = model.scaling.phy_range
+            pad = (hi - lo) * 0.04 if hi > lo else 1.0
+            self.lo, self.hi = lo - pad, hi + pad
+            zones = ((model.PhyLow, theme.WARN), (model.PhyHigh, theme.ALARM))
+            limits = [(limit, zone) for limit, zone in zones if limit is not None]
+            self.axes = Axes(back, None, model.Units, limits)
+        self.plot = TrendPlot(self)
+        self.plot.setGeometry(1, self.header, model.w - 2, model.h - self.header - 1)
         self.pause_button = QToolButton(self)
         self.pause_button.setObjectName("trendPause")
         self.pause_button.setAutoRaise(True)
         self.pause_button.setGeometry(model.w - self.header - 2, 1, self.header, self.header - 2)
         self.pause_button.setText(PAUSE)
+        self.shown = -1  # trend.count when last drawn
+        self.base: float | None = None  # the time at x 0 of the curves' data: the first sample's
+        self.span = self.trend.size * 0.1  # seconds of the live window, measured at each redraw
+        self.scale = Scale(-self.span, 0.0, self.lo, self.hi, True)
+        self.live = True
         self.set_live(True)
         self.stale_mark.raise_()
-        self.shown = -1  # trend.count when last drawn
-        self.origin = 0.0  # the time at the view's x 0
-        self._drawn_at = 0.0  # the origin of the live curve's data
-        self.history.setVisible(False)
-        self.span = self.trend.size * 0.1  # seconds of the live window, measured at each redraw
+        self.curve, self.history = Curve(isinstance(model, Graph)), Curve(isinstance(model, Graph))
         self.hist_times = self.hist_values = np.empty(0)
+        self.moved: Callable[[float, float], None] = self.show_window  # the form links its trends here
         self._header_shown: tuple[object, ...] = ()
 
     def sync(self) -> None:
@@ -281,38 +258,38 @@ class TrendWidget(SelfPainted):
     def changed_rect(self) -> QRect:
         return QRect(0, 0, self.width(), self.header)  # the plot is redrawn by the form
 
+    def _base(self, t: np.ndarray) -> float:
+        if self.base is None and len(t) and not math.isnan(t[0]):
+            self.base = float(t[0])
+        return self.base or 0.0
+
     def flush(self) -> None:
-        if self.trend.count == self.shown and self.origin == self._drawn_at:
+        """The samples taken since the last redraw into the curve (drawn at the next paint)."""
+        if self.trend.count == self.shown:
             return
         t, y = self.trend.times(), self.trend.values()
-        known = t[~np.isnan(t)]
-        if len(known) > 2:  # the samples the element keeps, at their mean period
-            self.span = self.trend.size * max(float(known[-1] - known[0]) / (len(known) - 1), 0.001)
-        if len(t):
-            x = t - self.origin
-            self.curve.setData(x, y)
-            self.curve.set_extent(QRectF(x[0], self.lo, max(x[-1] - x[0], 1e-3), self.hi - self.lo))
-        self.shown, self._drawn_at = self.trend.count, self.origin
-
-    def place(self, origin: float, live: bool) -> None:
-        """Put time `origin` at the view's x 0: the curves move (at the next flush), the view does
-        not (live, the axis says seconds before it; paused, the clock times)."""
-        if origin != self.origin:
-            self.origin = origin
-            if self.history.isVisible():  # long: moved, not set again (the live samples are, at flush)
-                self.history.setPos(-origin, 0)
-        self.axis.place(origin, not live)
+        period = float(t[-1] - t[0]) / (len(t) - 1) if len(t) > 2 else math.nan
+        if period > 0:  # the samples the element keeps, at their mean period (NaN: not known)
+            self.span = self.trend.size * period
+        self.curve.set(t - self._base(t), y, self.trend.gaps > 0)
+        self.shown = self.trend.count
+        self.plot.update()
 
     def show_window(self, t0: float, t1: float) -> None:
-        """Show the times t0..t1 (the view of each trend linked to this one follows)."""
-        self.view_box.setXRange(t0 - self.origin, t1 - self.origin, padding=0)
+        """Show the times t0..t1 (the form shows the same on each of its trends)."""
+        scale = Scale(t0, t1, self.lo, self.hi, self.live)
+        if scale != self.scale:
+            self.scale = scale
+            self.plot.update()
 
     def window(self) -> tuple[float, float]:
         """The times shown."""
-        x0, x1 = self.view_box.viewRange()[0]
-        return x0 + self.origin, x1 + self.origin
+        return self.scale.t0, self.scale.t1
 
     def set_live(self, live: bool) -> None:
+        """Live: the time axis counts seconds before now; paused: clock times."""
+        self.live = live
+        self.show_window(*self.window())
         self.pause_button.setText(PAUSE if live else LIVE)
         self.pause_button.setToolTip(
             QCoreApplication.translate("TrendWidget", "Pause (dragging or wheeling in the plot also pauses)")
@@ -321,12 +298,8 @@ class TrendWidget(SelfPainted):
     def set_history(self, times: np.ndarray, values: np.ndarray) -> None:
         """The archive's samples of this trend, drawn lighter behind the live ones."""
         self.hist_times, self.hist_values = times, values
-        self.history.setData(times, values)
-        self.history.setPos(-self.origin, 0)
-        self.history.setVisible(len(times) > 0)
-        if len(times):
-            self.history.set_extent(QRectF(times[0], self.lo, max(times[-1] - times[0], 1e-3),
-                                           self.hi - self.lo))
+        self.history.set(times - self._base(times), values, gaps=True)
+        self.plot.update()
 
     def value_at(self, x: float) -> tuple[float, float] | None:
         """The sample nearest to time `x`, live or from the history: (time, value)."""
@@ -340,22 +313,13 @@ class TrendWidget(SelfPainted):
                 best = (float(t[j]), float(y[j]))
         return best
 
-    def _mouse_moved(self, pos: QPointF) -> None:
-        inside = self.view_box.sceneBoundingRect().contains(pos)
-        found = self.value_at(self.view_box.mapSceneToView(pos).x() + self.origin) if inside else None
-        self.cursor.setVisible(found is not None)
-        self.cursor_label.setVisible(found is not None)
-        if found is None:
-            return
-        t, y = found
-        value = "---" if math.isnan(y) else (str(int(y)) if isinstance(self.model, Graph)
-                                             else f"{self.model.format(y)} {self.model.Units}".rstrip())
-        x = t - self.origin
-        self.cursor.setPos(x)
-        self.cursor_label.setText(f"{formats.clock(t)}  {value}")
-        (x0, x1), (_, y1) = self.view_box.viewRange()
-        self.cursor_label.setAnchor((1, 0) if x > (x0 + x1) / 2 else (0, 0))
-        self.cursor_label.setPos(x, y1)
+    def show_value(self, y: float) -> str:
+        """A sample as the cursor tells it."""
+        if math.isnan(y):
+            return "---"
+        if isinstance(self.model, Graph):
+            return str(int(y))
+        return f"{self.model.format(y)} {self.model.Units}".rstrip()
 
     def look(self) -> tuple[object, ...]:
         """The header's name, address and lamp colour are in the cached layer (paint_static)."""

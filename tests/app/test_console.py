@@ -9,7 +9,7 @@ from collections.abc import Iterator
 from pathlib import Path
 
 import pytest
-from PySide6.QtCore import Qt
+from PySide6.QtCore import QPoint, Qt
 from PySide6.QtWidgets import QPlainTextEdit
 
 from app import __version__
@@ -232,18 +232,15 @@ def test_the_zoom_is_remembered_per_form(qtbot, console: MainWindow) -> None:
 
 
 def test_the_trends_of_a_form_share_one_time_axis(qtbot, console: MainWindow) -> None:
-    from hmi_forms.widgets.trend import ClockAxis, ago_label, clock_label
+    from hmi_forms.widgets.trend_axes import ago_label, clock_label
 
     view = console.views[0]
     first, second = view.trends[:2]
     qtbot.waitUntil(lambda: first.trend.count > 15 and second.trend.count > 15, timeout=10_000)
     view.flush()
-    axis = first.plot.getPlotItem().getAxis("bottom")
-    assert isinstance(axis, ClockAxis) and not axis.clock  # live: seconds before now
-    assert first.view_box.viewRange()[0] == pytest.approx(second.view_box.viewRange()[0], abs=1e-9)
-    x0, x1 = first.view_box.viewRange()[0]
-    assert abs(x1) < 1e-9 and x0 < -10  # live, the view stays: the curves move under it
+    assert first.scale.live and second.scale.live  # live: seconds before now
     t0, t1 = first.window()
+    assert second.window() == (t0, t1)
     assert abs(t1 - view._last.wall) < 0.01 and t1 - t0 > 10  # ending now
     assert first.shown == first.trend.count and second.shown == second.trend.count  # redrawn together
     t, v = first.trend.times()[-3], first.trend.values()[-3]
@@ -251,14 +248,19 @@ def test_the_trends_of_a_form_share_one_time_axis(qtbot, console: MainWindow) ->
     assert ago_label(-10, 5) == "-10 s" and ago_label(-120, 60) == "-2 min"
     assert clock_label(t, 1) == formats.clock(t)
 
-    second.view_box.setXRange(x0 - 30, x1 - 30, padding=0)
-    second.view_box.sigRangeChangedManually.emit([True, False])  # as a drag does
-    assert not view.live and first.pause_button.text() == "\u25b6" and axis.clock  # paused: clock times
-    assert first.view_box.viewRange()[0] == pytest.approx(second.view_box.viewRange()[0], abs=1e-9)  # linked
-    qtbot.wait(1200)
-    assert first.window()[1] < view._last.wall - 20  # paused: it stays where it was put
+    area = second.axes.plot  # drag the second trend's curves 100 px to the right: back in time
+    start = QPoint(round(area.center().x()) - 50, round(area.center().y()))
+    qtbot.mousePress(second.plot, Qt.MouseButton.LeftButton, pos=start)
+    qtbot.mouseMove(second.plot, start + QPoint(100, 0))
+    qtbot.mouseRelease(second.plot, Qt.MouseButton.LeftButton, pos=start + QPoint(100, 0))
+    assert not view.live and first.pause_button.text() == "\u25b6" and not first.scale.live  # clock times
+    moved = second.window()
+    assert first.window() == moved and moved[1] < t1 - 1  # linked
+    count = first.trend.count
+    qtbot.waitUntil(lambda: first.trend.count > count + 12, timeout=10_000)
+    assert first.window() == moved  # paused: it stays where it was put
     first.pause_button.click()
-    assert view.live and not axis.clock
+    assert view.live and first.scale.live
     assert abs(first.window()[1] - view._last.wall) < 0.01
 
 
