@@ -85,6 +85,9 @@ class StationAlarms:
         self._since: dict[int, int] = {}  # node -> first scan of this run with its link known
         self._stopped_by = ""  # who stopped NetPlc through the command layer (its record), while stopped
         self._unsent: dict[str, dict[str, Any]] | None = None  # changed states for a pair's standby
+        # told the ids of the alarms whose states a pair's standby adopted (on the engine thread):
+        # those changes are journaled by the primary alone, so a record observer never sees them
+        self.adopted: list[Callable[[list[str]], None]] = []
 
     def attach(self, engine: Engine, exchange: Exchange | None) -> None:
         """Evaluate after every scan of `engine`; start saving states."""
@@ -152,6 +155,9 @@ class StationAlarms:
         """On the engine thread: the primary's states, on its standby (AlarmSystem.adopt)."""
         if states:
             self.run_now(lambda: self.system.adopt(states))
+            ids = [alarm_id for alarm_id in states if alarm_id in self.system.by_id]
+            for observer in list(self.adopted):
+                observer(ids)
 
     def _publish(self, now: float | None = None) -> None:
         for alarm_id in self._dirty:

@@ -4,16 +4,21 @@ out-of-service likewise, and a standby that comes late gets every alarm's state 
 
 from __future__ import annotations
 
+import asyncio
 from collections.abc import Iterator
 from pathlib import Path
+from typing import Any
 
 import pytest
+from asyncua import Client, ua
 
 from app.authority import Source, Who
 from app.authority.users import Users
 from app.scada.alarms import NO_STANDBY_ID, Alarm, State
 from netplc.simulator import Simulator
-from tests.app.pair.conftest import Station, make_pair, wait_for
+from tests.app.pair.conftest import Station, make_pair, serve_opcua, wait_for
+from tests.app.publish.conftest import opcua_client
+from tests.app.publish.test_opcua_conditions import call, eid, subscribe, text, until
 
 TAGS = """\
 name,address,type,unit,app_min,app_max,phy_min,phy_max,decimals,description,hh,h,l,ll,deadband,on_delay,off_delay,alarm_when,priority,latching,suppress_by,quality_alarm
@@ -22,6 +27,7 @@ DOOR,02601,bit,,,,,,,Door open,,,,,,,,1,3,,,
 FAN,02602,bit,,,,,,,Fan fault,,,,,,,,1,3,,,
 """
 BITS = {"TRIP.ALARM": 0o2600, "DOOR.ALARM": 0o2601, "FAN.ALARM": 0o2602}
+TRIP = "TRIP.ALARM"
 IVAN = Who("ivan", Source.CONSOLE, "test")
 OLGA = Who("olga", Source.CONSOLE, "test")  # an engineer: out of service is hers
 
@@ -93,3 +99,49 @@ def test_no_standby_is_an_alarm_of_the_primary_until_its_partner_is_back(
     b.start()
     wait_for(lambda: alarm(a, NO_STANDBY_ID).state is State.RTNUN, what="B is A's standby")
     wait_for(lambda: alarm(b, NO_STANDBY_ID).state is State.RTNUN, what="and B shows A's")
+
+
+def test_the_conditions_show_the_adopted_states_and_take_the_acknowledgement_after_a_takeover(
+        alarm_pair: tuple[Station, Station]) -> None:
+    """The standby journals no transition of the primary's alarms, yet its OPC UA conditions show
+    them (it answers reads), and so do the new primary's after a kill: ConditionRefresh there
+    reports the alarm active and unacknowledged, and its Acknowledge works."""
+    a, b = alarm_pair
+    a_url, b_url = serve_opcua(a), serve_opcua(b)
+    refresh, end = ua.NodeId(ua.ObjectIds.ConditionType_ConditionRefresh), ua.NodeId(ua.ObjectIds.RefreshEndEventType)
+
+    async def refreshed(client: Client) -> Any:
+        """TRIP's condition as a ConditionRefresh of a new subscription reports it."""
+        events, sub, _ = await subscribe(client)
+        assert await call(client, ua.NodeId(ua.ObjectIds.ConditionType), refresh,
+                          ua.Variant(sub.subscription_id, ua.VariantType.UInt32)) == ua.StatusCodes.Good
+        await until(lambda: any(e.EventType == end for e in events.events), "RefreshEnd")
+        return next(e for e in events.events if getattr(e, "ConditionName", None) == TRIP)
+
+    async def on_b() -> tuple[Any, Any, int]:
+        async with opcua_client(b_url, "ivan", "ivan-secret") as client:
+            before = await refreshed(client)  # B still the standby
+            a.kill()
+            await until(lambda: b.role == "primary", "B takes over")
+        async with opcua_client(b_url, "ivan", "ivan-secret") as client:  # the client logs in anew
+            after = await refreshed(client)
+            cond = ua.NodeId(f"Alarms.{TRIP}", await client.get_namespace_index("urn:netplc:station:pair"))
+            acked = await call(client, cond, ua.ObjectIds.AcknowledgeableConditionType_Acknowledge,
+                               eid(after.EventId), text("seen after the takeover"))
+        return before, after, acked
+
+    try:
+        a.start()
+        b.start()
+        raise_alarm(a, TRIP)
+        wait_for(lambda: alarm(b, TRIP).state is State.UNACK, what="B holds A's alarm")
+        before, after, acked = asyncio.run(on_b())
+        wait_for(lambda: alarm(b, TRIP).state is State.ACKED, what="acknowledged on B")
+        assert alarm(b, TRIP).acked_by.startswith("opcua:ivan@")
+    finally:
+        b.stop()
+        a.stop()
+    for event in (before, after):
+        assert (getattr(event, "ActiveState/Id"), getattr(event, "AckedState/Id")) == (True, False)
+        assert (event.Severity, event.Retain) == (700, True)  # priority 2
+    assert acked == ua.StatusCodes.Good
