@@ -35,7 +35,7 @@ from netplc.address import EMERGENCY_STOP, fmt_octal
 from netplc.engine import Engine, RunState
 from netplc.exchange import Exchange
 from netplc.lazy import lazy
-from netplc.memory import Snapshot
+from netplc.memory import Memory, Snapshot
 from netplc.program import Program
 from netplc.records import Record, RecordSink
 from registrar.alarm_state import AlarmStateFile
@@ -217,9 +217,24 @@ class StationAlarms:
         self.horn.silence(now)
         self._sound()
 
+    def follow_horn(self, silenced_at: float) -> None:
+        """On the engine thread of a pair's standby: the primary's last silence, so its horn
+        sounds for what the primary's does, and goes on so after a takeover (nothing to silence
+        again)."""
+        if silenced_at != self.horn.silenced_at:
+            self.horn.silenced_at = silenced_at
+            self.horn.update(self.summary)
+
     def _sound(self) -> None:
-        if self.engine is not None and self.horn.bit is not None:
-            self.engine.post(self.horn.write)
+        engine = self.engine
+        if engine is not None and self.horn.bit is not None:
+            engine.post(self._write_horn)
+
+    def _write_horn(self, mem: Memory) -> None:
+        """The horn bit, on a station that leads: a pair's standby holds the primary's memory, its
+        horn bit included, which its own adopted states must not overwrite."""
+        if self.engine is None or not self.engine.follower:
+            self.horn.write(mem)
 
     def close(self) -> None:
         """After the scan thread has stopped: write the last states."""

@@ -293,8 +293,9 @@ class Pair:
         """On the engine thread: the mirrored memory and engine state, and the alarm states."""
         with self._lock:
             self.mirror.load_into(engine, mem)
-            alarms = self.mirror.take_alarms()
+            alarms, silenced = self.mirror.take_alarms(), self.mirror.silenced
         if self.runtime.alarms is not None:
+            self.runtime.alarms.follow_horn(silenced)
             self.runtime.alarms.adopt(alarms)
 
     def _follow(self, _mem: Memory) -> None:
@@ -512,7 +513,8 @@ class Pair:
         states = alarms.changes_for_standby(self._whole_alarms) if alarms is not None else {}
         self._whole_alarms = False
         sparkplug = self.runtime.sparkplug()
-        cap = capture(engine, snapshot, states, sparkplug.bdseq if sparkplug is not None else -1)
+        cap = capture(engine, snapshot, states, sparkplug.bdseq if sparkplug is not None else -1,
+                      alarms.horn.silenced_at if alarms is not None else 0.0)
         with self._changed:
             if self._capture is not None and self._capture.alarms:  # not sent yet: none is lost
                 cap = replace(cap, alarms={**self._capture.alarms, **cap.alarms})

@@ -105,6 +105,10 @@ class Station:
         assert self.rt.engine is not None
         return self.rt.engine.snapshot.get_word(addr)
 
+    def bit(self, addr: int) -> int:
+        assert self.rt.engine is not None
+        return self.rt.engine.snapshot.get_hmi_bit(addr)
+
     def write(self, addr: int, value: int) -> object:
         assert self.rt.commands is not None
         return self.rt.commands.write_word(OPERATOR, addr, value).result(3)

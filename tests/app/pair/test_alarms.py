@@ -15,6 +15,7 @@ from asyncua import Client, ua
 from app.authority import Source, Who
 from app.authority.users import Users
 from app.scada.alarms import NO_STANDBY_ID, Alarm, State
+from app.scada.horn import Horn
 from netplc.simulator import Simulator
 from tests.app.pair.conftest import Station, make_pair, serve_opcua, wait_for
 from tests.app.publish.conftest import opcua_client
@@ -145,3 +146,39 @@ def test_the_conditions_show_the_adopted_states_and_take_the_acknowledgement_aft
         assert (getattr(event, "ActiveState/Id"), getattr(event, "AckedState/Id")) == (True, False)
         assert (event.Severity, event.Retain) == (700, True)  # priority 2
     assert acked == ua.StatusCodes.Good
+
+
+def test_the_standby_s_horn_bit_is_the_primary_s_and_a_silence_holds_after_a_takeover(
+        tmp_path: Path, node: Simulator) -> None:
+    """The standby mirrors the primary's memory, the horn bit (`alarm_horn`) included: its own
+    adopted alarm states never set it; the primary's silence is mirrored, so after a takeover
+    the silenced horn stays silent."""
+    horn = 0o3600
+    a, b = make_pair(tmp_path, node, top=f'Tags = "tags.csv"\nalarm_horn = "0{horn:o}"\n',
+                     files={"tags.csv": TAGS})
+    for st in (a, b):
+        Users(st.folder).add("ivan", "operator", "ivan-secret")
+    try:
+        a.start()
+        b.start()
+        raise_alarm(a, TRIP)  # priority 2: it sounds
+        wait_for(lambda: alarm(b, TRIP).state is State.UNACK, what="B holds A's alarm")
+        wait_for(lambda: a.bit(horn) == 1 and b.bit(horn) == 1, what="the horn bit on both")
+        assert a.rt.commands is not None and a.rt.commands.silence(IVAN).result(3).ok
+        wait_for(lambda: a.bit(horn) == 0 and b.bit(horn) == 0, what="silenced on both")
+        assert b.rt.alarms is not None and not b.rt.alarms.horn.sounding
+        scan = b.rt.engine.snapshot.scan if b.rt.engine is not None else 0
+        wait_for(lambda: b.rt.engine is not None and b.rt.engine.snapshot.scan > scan + 10,
+                 what="B's scans go on")
+        assert b.bit(horn) == 0  # no scan of B's own set it
+        silenced = b.rt.alarms.horn.silenced_at
+        assert a.rt.alarms is not None and silenced == a.rt.alarms.horn.silenced_at > 0
+        a.kill()
+        wait_for(lambda: b.role == "primary", what="takeover")
+        # B sounds for its own new alarm, PAIR.NO_STANDBY, and not again for the silenced TRIP
+        wait_for(lambda: b.bit(horn) == 1, what="B's horn for PAIR.NO_STANDBY")
+        assert b.rt.alarms.horn.silenced_at == silenced
+        assert not Horn(silenced_at=silenced).update([r for r in b.rt.alarms.summary if r.id != NO_STANDBY_ID])
+    finally:
+        b.stop()
+        a.stop()
