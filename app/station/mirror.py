@@ -4,10 +4,10 @@ puts it into its engine (docs/architecture.md section 11).
 The state is the engine's own: NetPlc memory (bits and data, which hold the edge memory too: a
 CTR's rising edge is RES 1 while its bit C is 0), the timers' and counters' current values, the
 forces, the run state and the scan number, and the alarm states the station keeps beside it
-(acknowledged by whom, shelved, out of service: app/scada/alarms.py) with its horn's last silence. A frame carries only what
-changed since the frame before it (memory as runs of the 64-byte blocks that differ, the alarms
-whose state changed); the first frame of a link is the whole state, so a standby that comes late
-or comes back catches up at once.
+(acknowledged by whom, shelved, out of service: app/scada/alarms.py) with its horn's last silence.
+A frame carries only what changed since the frame before it (memory as runs of the 64-byte
+blocks that differ, the alarms whose state changed); the first frame of a link is the whole
+state, so a standby that comes late or comes back catches up at once.
 
 Frames on the link: a 4-byte big-endian length, then the version byte, the kind byte and the
 payload. A state payload is a 4-byte length of its JSON header, the header, then the memory runs
@@ -29,7 +29,8 @@ from netplc.forcing import Force
 from netplc.memory import Memory, Snapshot
 
 VERSION = 1
-HELLO, STATE, HANDOVER, ACK = 1, 2, 3, 4  # frame kinds (ACK: the standby holds scan n)
+# frame kinds (ACK: the standby holds scan n; TAKEN: the standby took over, leading from scan n)
+HELLO, STATE, HANDOVER, ACK, TAKEN = 1, 2, 3, 4, 5
 BLOCK = 64  # bytes compared at a time for a delta
 STRETCH = 2048  # bytes compared first: only a stretch that differs is compared block by block
 IMAGE = IO_BITS + DATA_SIZE

@@ -108,8 +108,9 @@ def test_the_conditions_show_the_adopted_states_and_take_the_acknowledgement_aft
     them (it answers reads), and so do the new primary's after a kill: ConditionRefresh there
     reports the alarm active and unacknowledged, and its Acknowledge works."""
     a, b = alarm_pair
-    a_url, b_url = serve_opcua(a), serve_opcua(b)
-    refresh, end = ua.NodeId(ua.ObjectIds.ConditionType_ConditionRefresh), ua.NodeId(ua.ObjectIds.RefreshEndEventType)
+    b_url = serve_opcua(b)  # B's server: A's is not asked
+    refresh = ua.NodeId(ua.ObjectIds.ConditionType_ConditionRefresh)
+    end = ua.NodeId(ua.ObjectIds.RefreshEndEventType)
 
     async def refreshed(client: Client) -> Any:
         """TRIP's condition as a ConditionRefresh of a new subscription reports it."""
@@ -178,7 +179,8 @@ def test_the_standby_s_horn_bit_is_the_primary_s_and_a_silence_holds_after_a_tak
         # B sounds for its own new alarm, PAIR.NO_STANDBY, and not again for the silenced TRIP
         wait_for(lambda: b.bit(horn) == 1, what="B's horn for PAIR.NO_STANDBY")
         assert b.rt.alarms.horn.silenced_at == silenced
-        assert not Horn(silenced_at=silenced).update([r for r in b.rt.alarms.summary if r.id != NO_STANDBY_ID])
+        others = [r for r in b.rt.alarms.summary if r.id != NO_STANDBY_ID]
+        assert not Horn(silenced_at=silenced).update(others)
     finally:
         b.stop()
         a.stop()
