@@ -17,10 +17,12 @@
    neither station, or the new primary's word, read before the first write to it, below the last
    value acknowledged; applied twice = one value journaled twice. The standby's lag (its
    HSB_LAG byte, read over Modbus) just before each kill. With
-   `--plant` both forward to one plant archive (a throwaway PostgreSQL cluster of tests/pgcluster.py):
-   at the end, records of the two local archives missing from it, and alarm transitions in it
-   twice in a row (the same transition of the same alarm: journaled by the old primary in a last
-   scan its standby did not hold yet when it was killed, and again by the new primary).
+   `--plant` both forward to one plant archive (a throwaway PostgreSQL cluster of tests/pgcluster.py,
+   on 127.0.0.1): at the end, records of the two local archives missing from it, and alarm
+   transitions in it twice in a row (the same transition of the same alarm: one record of an
+   event made by both stations, or one missing between two). Takeovers of a live primary (its
+   standby heard nothing for failover_after: the primary journals TAKEN and follows) and
+   flip-backs (two primaries meeting, one giving way) are counted from the journals.
 
     .venv/bin/python bench/failover.py [--seconds S] [--kills N] [--plant]
 """
@@ -307,15 +309,20 @@ def applied(folder: Path, since_ms: int) -> dict[int, Counter[int]]:
     return out
 
 
-def takeovers(folder: Path) -> list[int]:
-    """ts (ms) of the station's journal records of its takeovers (standby -> primary)."""
+def journaled(folder: Path, like: str) -> list[int]:
+    """ts (ms) of the station's journal records whose text is LIKE `like`."""
     con = sqlite3.connect(load_station(folder).Archive)
     try:
         return [ts for (name,) in con.execute(
                     "SELECT name FROM sqlite_master WHERE type = 'table' AND name GLOB ?", (DAY_GLOB,))
-                for (ts,) in con.execute(f"SELECT ts FROM \"{name}\" WHERE text LIKE '%standby -> primary%'")]
+                for (ts,) in con.execute(f"SELECT ts FROM \"{name}\" WHERE text LIKE ?", (like,))]
     finally:
         con.close()
+
+
+def takeovers(folder: Path) -> list[int]:
+    """ts (ms) of the station's journal records of its takeovers (standby -> primary)."""
+    return journaled(folder, "%standby -> primary%")
 
 
 def kills(base: Path, node: Simulator, n: int, plant: str = "") -> None:
@@ -386,9 +393,13 @@ def kills(base: Path, node: Simulator, n: int, plant: str = "") -> None:
             took["journal"].append(min(after))
         else:
             led += 1
-    failover = 3 * TICK_MS
-    print(f"{n} SIGKILLs of the primary process at NetSyncTime {TICK_MS} ms (failover_after 3 = "
-          f"{failover} ms), load average {os.getloadavg()[0]:.1f}:")
+    pair = load_station(paths["A"]).redundancy
+    assert pair is not None
+    told = sum(len(journaled(paths[x], "%the partner took over from scan%")) for x in "AB")
+    flips = sum(len(journaled(paths[x], "%primary -> standby: partner % is primary%")) for x in "AB")
+    print(f"{n} SIGKILLs of the primary process at NetSyncTime {TICK_MS} ms (failover_after "
+          f"{pair.failover_after} = {pair.failover_after * TICK_MS} ms), "
+          f"load average {os.getloadavg()[0]:.1f}:")
     for what, times in took.items():
         ms = [t * 1000 for t in times]
         until = "the journal record" if what == "journal" else f"the first {what} write acknowledged"
@@ -401,11 +412,12 @@ def kills(base: Path, node: Simulator, n: int, plant: str = "") -> None:
         print(f"  {w.name}: {len(values)} writes acknowledged, lost {lost} (+ {w.behind} takeovers with the "
               f"new primary's word below the last acknowledged), applied twice {twice}")
     print(f"  the standby's lag at the kill: max {max(lag)} scans; kills with no takeover journaled by "
-          f"the survivor (it had taken over already): {led}")
+          f"the survivor (it had taken over already): {led}; takeovers of a live primary (told, it "
+          f"followed): {told}; flip-backs (two primaries meeting): {flips}")
     if plant:
         missing, doubled, total = plant_check(plant, paths)
         print(f"plant archive: {total} records of the pair, {missing} of the local archives missing, "
-              f"{doubled} alarm transitions twice in a row")
+              f"{doubled} alarm transitions twice in a row (doubled, or one missing between)")
 
 
 def plant_check(url: str, paths: dict[str, Path]) -> tuple[int, int, int]:
@@ -430,6 +442,7 @@ def plant_check(url: str, paths: dict[str, Path]) -> tuple[int, int, int]:
                             "AND kind = 'alarm' ORDER BY ts, id").fetchall()
     doubled = sum(1 for before, row in itertools.pairwise(alarms) if before == row)
     return len(ours - ids), doubled, len(ids)
+
 
 def main() -> None:
     p = argparse.ArgumentParser(description=__doc__.splitlines()[0])

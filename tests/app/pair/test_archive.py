@@ -6,6 +6,7 @@ reach the plant archive once it comes back; nothing is lost."""
 from __future__ import annotations
 
 import sqlite3
+import threading
 from dataclasses import replace
 from pathlib import Path
 
@@ -15,6 +16,7 @@ import pytest
 from app.cli import main
 from app.scada.alarms import State
 from app.station.config import load_station
+from app.station.pair import query
 from netplc.simulator import Simulator
 from registrar.plant.schema import PAIR_ID_BASE
 from registrar.schema import DAY_GLOB
@@ -148,3 +150,33 @@ def test_a_primary_told_that_its_standby_took_over_follows_and_answers_nothing_i
         b.stop()
         a.stop()
     assert (raised(a), raised(b)) == (0, 1)
+
+
+def test_a_status_query_answers_no_write_that_waits_for_the_standby(
+        tmp_path: Path, node: Simulator, proxy: Proxy) -> None:
+    """The end of a connection to the pair link that is not the link (`redundancy status`) is no
+    word about the standby: a write waiting for it stays unanswered."""
+    a, b = make_pair(tmp_path, node, b_dials=proxy.port)
+    proxy.target = load_station(a.folder).redundancy.listen_address[1]  # type: ignore[union-attr]
+    b.adjust = lambda st: replace(st, redundancy=replace(st.redundancy, failover_after=PATIENT))
+    try:
+        a.start()
+        b.start()
+        proxy.hold()  # A's frames lost on their way: B acknowledges nothing more
+        assert a.rt.commands is not None and a.rt.pair is not None
+        ticket = a.rt.commands.write_word(OPERATOR, 0o4000, 99)
+        wait_for(lambda: a.word(0o4000) == 99, what="A applies the write")
+        links = sum(t.name == "pair link" for t in threading.enumerate())
+        assert query(f"127.0.0.1:{a.rt.pair.port}")["role"] == "primary"
+        wait_for(lambda: sum(t.name == "pair link" for t in threading.enumerate()) == links,
+                 what="the query's connection ended on A")
+        # a commit and a retentive save asked for now end after any the write's answer waited for
+        committed, saved = threading.Event(), threading.Event()
+        assert a.rt.store is not None and a.rt.retainer is not None
+        a.rt.store.after_commit(committed.set)
+        a.rt.retainer.after_save(saved.set)
+        wait_for(lambda: committed.is_set() and saved.is_set(), what="A's commit and save")
+        assert not ticket.done()
+    finally:
+        b.stop()
+        a.stop()
