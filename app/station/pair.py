@@ -660,8 +660,11 @@ class Pair:
                 continue
             silent = self.clock() - self._last_frame
             if silent >= self.failover:
+                cause = f"partner silent for {silent * 1000:.0f} ms"
+                if not self._may_lead(cause):  # the arbiter first: a primary it keeps is told nothing
+                    continue
                 self._tell_taken()
-                self._become(Role.PRIMARY, f"partner silent for {silent * 1000:.0f} ms", code=SILENT)
+                self._become(Role.PRIMARY, cause, code=SILENT)
 
     def _tell_taken(self) -> None:
         """End the link on a takeover, telling the partner, if it still lives, the scan this
