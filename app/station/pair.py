@@ -19,6 +19,7 @@ newest mirrored state is put into its engine and the program runs on from it in 
 
 from __future__ import annotations
 
+import contextlib
 import json
 import logging
 import select
@@ -166,9 +167,7 @@ class Pair:
         self._held: list[tuple[int, list[Record]]] = []
         self._taken = False  # told TAKEN: until the engine follows, the scan's records are dropped
         self._told: socket.socket | None = None  # the link this station took over on: drained, closed
-        self._send_lock = threading.Lock()  # frames on the link from its thread and from the watch
-        self._wake_r, self._wake_w = socket.socketpair()  # a new capture wakes the link's thread
-        self._wake_w.setblocking(False)
+        self._send_lock = threading.Lock()  # frames on the link: its sender, its reader, the watch
         self._whole_alarms = True  # the next capture holds every alarm's state (a new link's first)
         self._bdseq = -1  # the primary's MQTT bdSeq as last handed to this station's publisher
 
@@ -224,8 +223,6 @@ class Pair:
         self._threads.clear()
         if self._engine is not None:
             self._engine.unsubscribe(self._on_scan)
-        self._wake_r.close()
-        self._wake_w.close()
 
     def kill(self) -> None:
         """End the link at once with no word to the partner, as a dying station's would (tests,
@@ -405,6 +402,7 @@ class Pair:
                 if self._link is conn:
                     self._link = None
                 alone = self._link is None  # else a new link's standby acknowledges what waits
+                self._changed.notify_all()  # the link's sender ends
             self._handed.set()
             if conn is self._told:  # taken over on it: what the partner sends after TAKEN is
                 _drain(conn)  # read, so that it reads TAKEN rather than a reset
@@ -434,34 +432,48 @@ class Pair:
         return False
 
     def _run_link(self, conn: socket.socket) -> None:
-        """Send while primary, receive while standby; the role may turn over on a handover. The
-        primary reads the standby's acknowledgements as they come (its records and its writers
-        wait for them), woken by a new capture or by the link."""
-        encoder = Encoder()
+        """This thread reads every frame of the link whatever the role (the standby the primary's
+        state, the primary its standby's acknowledgements as they come: its records and its
+        writers wait for them); a thread of its own sends the primary's frames. The role may turn
+        over on a handover."""
+        threading.Thread(target=self._send_frames, args=(conn,), name="pair send", daemon=True).start()
         while not self._stopping.is_set():
-            if self.role is Role.PRIMARY or self._handover:
-                readable = select.select([conn, self._wake_r], [], [], self.tick)[0]
-                if self._wake_r in readable:
-                    _drain(self._wake_r, wait=0.0)
+            # the primary: a standby with nothing to acknowledge is no end
+            if self.role is Role.PRIMARY and not select.select([conn], [], [], self.tick)[0]:
+                if self._link is not conn:
+                    return
+                continue
+            # the standby: a read that times out ends the link; the watch decided on a takeover first
+            if self._received(*read_frame(conn), conn):
+                return
+
+    def _send_frames(self, conn: socket.socket) -> None:
+        """The primary's frames on `conn`, each capture as the engine's listener hands it over
+        (the engine thread never waits for the link), until the link ends."""
+        encoder = Encoder()
+        try:
+            while not self._stopping.is_set():
                 with self._changed:
-                    cap, self._capture = self._capture, None
-                    handover, self._handover = self._handover, ""
+                    self._changed.wait_for(lambda: self._capture is not None or bool(self._handover)
+                                           or self._stopping.is_set() or self._link is not conn, self.tick)
                     if self._link is not conn:
                         return
+                    if self.role is not Role.PRIMARY and not self._handover:
+                        encoder.last = None  # if this station leads again, its first frame is whole
+                        continue
+                    cap, self._capture = self._capture, None
+                    handover, self._handover = self._handover, ""
                 if cap is not None:
                     self._send(conn, STATE, encoder.frame(cap))
-                while select.select([conn], [], [], 0)[0]:  # the standby's acknowledgements
-                    if self._received(*read_frame(conn), conn):
-                        return
                 if handover:
                     if self.lease is not None:
                         self.lease.release()  # for the partner to take
                     self._send(conn, HANDOVER, json.dumps({"cause": handover}).encode())
                     self._handed.set()
-            else:  # a read that times out ends the link: the watch decides on a takeover
-                encoder.last = None  # if this station leads again, its first frame is whole
-                if self._received(*read_frame(conn), conn):
-                    return
+        except OSError as e:  # the link's reading thread ends it and says why
+            logger.info("pair link: a frame not sent: %s", e)
+            with contextlib.suppress(OSError):
+                conn.shutdown(socket.SHUT_RDWR)
 
     def _send(self, conn: socket.socket, kind: int, payload: bytes) -> None:
         with self._send_lock:
@@ -639,10 +651,6 @@ class Pair:
                 self.cause = HANDED_OVER
                 self._last_frame = self.clock()
             self._changed.notify_all()
-        try:
-            self._wake_w.send(b"\0")
-        except OSError:  # BlockingIOError: woken already; or closed: the pair is stopping
-            logger.debug("pair link's thread not woken")
         if self._handover:
             self.runtime.system(f"pair {self.settings.letter}: primary -> standby: {self._handover}",
                                 logging.WARNING)
@@ -705,13 +713,12 @@ class Pair:
 
 
 def _drain(conn: socket.socket, wait: float = 1.0) -> None:
-    """Read and drop what `conn` holds, until its end or `wait` seconds with nothing more (0: what
-    is there now)."""
+    """Read and drop what `conn` holds, until its end or `wait` seconds with nothing more."""
     try:
         conn.settimeout(wait)
         while conn.recv(65536):
             pass
-    except (TimeoutError, BlockingIOError):
+    except TimeoutError:
         return
     except OSError as e:
         logger.debug("pair link drained: %s", e)
