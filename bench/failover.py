@@ -33,6 +33,7 @@ import argparse
 import asyncio
 import contextlib
 import itertools
+import logging
 import os
 import signal
 import sqlite3
@@ -147,6 +148,9 @@ def serve(folder: Path, modbus_port: int, opcua_url: str) -> None:
     Modbus and OPC UA ports are put after loading (as tests/app/pair does): two stations on one
     host cannot listen on the same ports, and station.toml's ports count in the hash the pair
     compares (on two hosts both folders would be the same file)."""
+    # the pair's own words in the bench's output: a link that does not come up says why
+    logging.basicConfig(level=logging.WARNING, format=f"{folder.name} %(asctime)s %(name)s: %(message)s")
+    logging.getLogger("app.station.pair").setLevel(logging.INFO)
     station = load_station(folder)
     station = replace(station, modbus_server=replace(station.modbus_server, port=modbus_port),
                       opcua=replace(station.opcua, enabled=True, endpoint=opcua_url, writable=("OPW",)))
