@@ -363,11 +363,16 @@ def kills(base: Path, node: Simulator, n: int, plant: str = "") -> None:
             t.start()
         for _ in range(n):
             # the pair whole: the standby hears the primary, both writers acknowledged on the primary
-            wait_until(lambda: 5 in (role(0), role(1)), 60, "a primary")
+            wait_until(lambda: 5 in (role(0), role(1)), 180, "a primary")
             at = 0 if role(0) == 5 else 1
             standby = modbus[1 - at]
-            wait_until(lambda: (s := hsb(standby)) is not None and s[0] == 4 and s[1], 60,  # noqa: B023
-                       "the pair whole")
+            # 180 s: a restarted station's process starts in a minute and more at load average 30
+            try:
+                wait_until(lambda: (s := hsb(standby)) is not None and s[0] == 4 and s[1], 180,  # noqa: B023
+                           "the pair whole")
+            except SystemExit:
+                print(f"HSB of A and B (status, link up, lag): {hsb(modbus[0])}, {hsb(modbus[1])}")
+                raise
             time.sleep(0.5)
             wait_until(lambda: all(w.acked and w.acked[-1][1] == at for w in writers), 60,  # noqa: B023
                        "both writers on the primary")
