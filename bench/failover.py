@@ -349,7 +349,7 @@ def kills(base: Path, node: Simulator, n: int, plant: str = "") -> None:
 
     since = int(time.time() * 1000)
     start(0)
-    wait_until(lambda: role(0) == 5, 60, "A the primary")
+    wait_until(lambda: role(0) == 5, 180, "A the primary")
     start(1)
     writers = [Writer("Modbus"), Writer("OPC UA")]
     stop = threading.Event()
@@ -366,7 +366,7 @@ def kills(base: Path, node: Simulator, n: int, plant: str = "") -> None:
             wait_until(lambda: 5 in (role(0), role(1)), 180, "a primary")
             at = 0 if role(0) == 5 else 1
             standby = modbus[1 - at]
-            # 180 s: a restarted station's process starts in a minute and more at load average 30
+            # 180 s: a station's process starts in a minute and more at load average 30
             try:
                 wait_until(lambda: (s := hsb(standby)) is not None and s[0] == 4 and s[1], 180,  # noqa: B023
                            "the pair whole")
@@ -374,7 +374,7 @@ def kills(base: Path, node: Simulator, n: int, plant: str = "") -> None:
                 print(f"HSB of A and B (status, link up, lag): {hsb(modbus[0])}, {hsb(modbus[1])}")
                 raise
             time.sleep(0.5)
-            wait_until(lambda: all(w.acked and w.acked[-1][1] == at for w in writers), 60,  # noqa: B023
+            wait_until(lambda: all(w.acked and w.acked[-1][1] == at for w in writers), 180,  # noqa: B023
                        "both writers on the primary")
             status = hsb(modbus[1 - at])
             lag.append(status[2] if status is not None else -1)
