@@ -392,7 +392,7 @@ class Pair:
             paired = True
             self._run_link(conn)
         except (OSError, LinkError, ValueError) as e:
-            if paired and not self._stopping.is_set():
+            if paired and not self._stopping.is_set() and conn is not self._told:  # told: journaled
                 self.runtime.system(f"pair {self.settings.letter}: link to the partner lost "
                                     f"({self.role.value}): {e or type(e).__name__}", logging.WARNING)
             elif not self._stopping.is_set():
