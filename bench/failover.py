@@ -359,6 +359,7 @@ def kills(base: Path, node: Simulator, n: int, plant: str = "") -> None:
     lag: list[int] = []
     killings: list[tuple[float, str]] = []  # the wall time of each kill, the letter taking over
     stopped = ""  # why the kills ended early (a station too slow to start on an overloaded machine)
+    dead: int | None = None  # a station killed and not restarted yet
     try:
         for t in threads:
             t.start()
@@ -381,6 +382,7 @@ def kills(base: Path, node: Simulator, n: int, plant: str = "") -> None:
                 status = hsb(modbus[1 - at])
                 lag.append(status[2] if status is not None else -1)
                 procs[at].send_signal(signal.SIGKILL)
+                dead = at
                 killed, killed_wall = time.monotonic(), time.time()
                 procs[at].wait()
                 for w in writers:
@@ -389,8 +391,13 @@ def kills(base: Path, node: Simulator, n: int, plant: str = "") -> None:
                     took[w.name].append(next(t for _v, i, t in w.acked if i != at and t > killed) - killed)
                 killings.append((killed_wall, "AB"[1 - at]))
                 start(at)  # the old primary back, as the standby
-            except SystemExit as e:  # the figures of the kills done so far, and why no more
-                stopped = f" (stopped after {len(killings)}: {e})"
+                dead = None
+            except (SystemExit, KeyboardInterrupt) as e:  # the figures of the kills done so far, and why
+                stopped = f" (stopped after {len(killings)}: {e or 'interrupted'})"
+                if dead is not None:  # back, to forward what it committed before it was killed
+                    start(dead)
+                    with contextlib.suppress(SystemExit):
+                        wait_until(lambda: role(dead) is not None, 180, "the killed station back")  # noqa: B023
                 break
     finally:
         stop.set()
