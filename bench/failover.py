@@ -348,9 +348,6 @@ def kills(base: Path, node: Simulator, n: int, plant: str = "") -> None:
         return None if status is None else status[0]
 
     since = int(time.time() * 1000)
-    start(0)
-    wait_until(lambda: role(0) == 5, 180, "A the primary")
-    start(1)
     writers = [Writer("Modbus"), Writer("OPC UA")]
     stop = threading.Event()
     threads = [threading.Thread(target=asyncio.run, args=(modbus_writer(writers[0], modbus, stop),)),
@@ -360,7 +357,10 @@ def kills(base: Path, node: Simulator, n: int, plant: str = "") -> None:
     killings: list[tuple[float, str]] = []  # the wall time of each kill, the letter taking over
     stopped = ""  # why the kills ended early (a station too slow to start on an overloaded machine)
     dead: int | None = None  # a station killed and not restarted yet
-    try:
+    try:  # the stations are stopped whatever happens (a first start too slow included)
+        start(0)
+        wait_until(lambda: role(0) == 5, 180, "A the primary")
+        start(1)
         for t in threads:
             t.start()
         for _ in range(n):
@@ -402,7 +402,8 @@ def kills(base: Path, node: Simulator, n: int, plant: str = "") -> None:
     finally:
         stop.set()
         for t in threads:
-            t.join(30)
+            if t.is_alive():
+                t.join(30)
         for p in procs.values():
             p.terminate()
             p.wait(30)
