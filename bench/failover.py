@@ -17,10 +17,12 @@
    neither station, or the new primary's word, read before the first write to it, below the last
    value acknowledged; applied twice = one value journaled twice. The standby's lag (its
    HSB_LAG byte, read over Modbus) just before each kill. With
-   `--plant` both forward to one plant archive (a throwaway PostgreSQL cluster of tests/pgcluster.py):
-   at the end, records of the two local archives missing from it, and alarm transitions in it
-   twice in a row (the same transition of the same alarm: journaled by the old primary in a last
-   scan its standby did not hold yet when it was killed, and again by the new primary).
+   `--plant` both forward to one plant archive (a throwaway PostgreSQL cluster of tests/pgcluster.py,
+   on 127.0.0.1): at the end, records of the two local archives missing from it, and alarm
+   transitions in it twice in a row (the same transition of the same alarm: one record of an
+   event made by both stations, or one missing between two). Takeovers of a live primary (its
+   standby heard nothing for failover_after: the primary journals TAKEN and follows) and
+   flip-backs (two primaries meeting, one giving way) are counted from the journals.
 
     .venv/bin/python bench/failover.py [--seconds S] [--kills N] [--plant]
 """
@@ -31,6 +33,7 @@ import argparse
 import asyncio
 import contextlib
 import itertools
+import logging
 import os
 import signal
 import sqlite3
@@ -145,6 +148,9 @@ def serve(folder: Path, modbus_port: int, opcua_url: str) -> None:
     Modbus and OPC UA ports are put after loading (as tests/app/pair does): two stations on one
     host cannot listen on the same ports, and station.toml's ports count in the hash the pair
     compares (on two hosts both folders would be the same file)."""
+    # the pair's own words in the bench's output: a link that does not come up says why
+    logging.basicConfig(level=logging.WARNING, format=f"{folder.name} %(asctime)s %(name)s: %(message)s")
+    logging.getLogger("app.station.pair").setLevel(logging.INFO)
     station = load_station(folder)
     station = replace(station, modbus_server=replace(station.modbus_server, port=modbus_port),
                       opcua=replace(station.opcua, enabled=True, endpoint=opcua_url, writable=("OPW",)))
@@ -307,15 +313,20 @@ def applied(folder: Path, since_ms: int) -> dict[int, Counter[int]]:
     return out
 
 
-def takeovers(folder: Path) -> list[int]:
-    """ts (ms) of the station's journal records of its takeovers (standby -> primary)."""
+def journaled(folder: Path, like: str) -> list[int]:
+    """ts (ms) of the station's journal records whose text is LIKE `like`."""
     con = sqlite3.connect(load_station(folder).Archive)
     try:
         return [ts for (name,) in con.execute(
                     "SELECT name FROM sqlite_master WHERE type = 'table' AND name GLOB ?", (DAY_GLOB,))
-                for (ts,) in con.execute(f"SELECT ts FROM \"{name}\" WHERE text LIKE '%standby -> primary%'")]
+                for (ts,) in con.execute(f"SELECT ts FROM \"{name}\" WHERE text LIKE ?", (like,))]
     finally:
         con.close()
+
+
+def takeovers(folder: Path) -> list[int]:
+    """ts (ms) of the station's journal records of its takeovers (standby -> primary)."""
+    return journaled(folder, "%standby -> primary%")
 
 
 def kills(base: Path, node: Simulator, n: int, plant: str = "") -> None:
@@ -337,9 +348,6 @@ def kills(base: Path, node: Simulator, n: int, plant: str = "") -> None:
         return None if status is None else status[0]
 
     since = int(time.time() * 1000)
-    start(0)
-    wait_until(lambda: role(0) == 5, 60, "A the primary")
-    start(1)
     writers = [Writer("Modbus"), Writer("OPC UA")]
     stop = threading.Event()
     threads = [threading.Thread(target=asyncio.run, args=(modbus_writer(writers[0], modbus, stop),)),
@@ -347,34 +355,55 @@ def kills(base: Path, node: Simulator, n: int, plant: str = "") -> None:
     took: dict[str, list[float]] = {"Modbus": [], "OPC UA": [], "journal": []}
     lag: list[int] = []
     killings: list[tuple[float, str]] = []  # the wall time of each kill, the letter taking over
-    try:
+    stopped = ""  # why the kills ended early (a station too slow to start on an overloaded machine)
+    dead: int | None = None  # a station killed and not restarted yet
+    try:  # the stations are stopped whatever happens (a first start too slow included)
+        start(0)
+        wait_until(lambda: role(0) == 5, 180, "A the primary")
+        start(1)
         for t in threads:
             t.start()
         for _ in range(n):
-            # the pair whole: the standby hears the primary, both writers acknowledged on the primary
-            wait_until(lambda: 5 in (role(0), role(1)), 60, "a primary")
-            at = 0 if role(0) == 5 else 1
-            standby = modbus[1 - at]
-            wait_until(lambda: (s := hsb(standby)) is not None and s[0] == 4 and s[1], 60,  # noqa: B023
-                       "the pair whole")
-            time.sleep(0.5)
-            wait_until(lambda: all(w.acked and w.acked[-1][1] == at for w in writers), 60,  # noqa: B023
-                       "both writers on the primary")
-            status = hsb(modbus[1 - at])
-            lag.append(status[2] if status is not None else -1)
-            procs[at].send_signal(signal.SIGKILL)
-            killed, killed_wall = time.monotonic(), time.time()
-            procs[at].wait()
-            for w in writers:
-                wait_until(lambda w=w, dead=at: w.acked[-1][1] != dead, 60,
-                           f"{w.name} writes to the new primary")
-                took[w.name].append(next(t for _v, i, t in w.acked if i != at and t > killed) - killed)
-            killings.append((killed_wall, "AB"[1 - at]))
-            start(at)  # the old primary back, as the standby
+            try:
+                # the pair whole: the standby hears the primary, both writers acknowledged on the primary
+                wait_until(lambda: 5 in (role(0), role(1)), 180, "a primary")
+                at = 0 if role(0) == 5 else 1
+                standby = modbus[1 - at]
+                # 180 s: a station's process starts in a minute and more at load average 30
+                try:
+                    wait_until(lambda: (s := hsb(standby)) is not None and s[0] == 4 and s[1], 180,  # noqa: B023
+                               "the pair whole")
+                except SystemExit:
+                    print(f"HSB of A and B (status, link up, lag): {hsb(modbus[0])}, {hsb(modbus[1])}")
+                    raise
+                time.sleep(0.5)
+                wait_until(lambda: all(w.acked and w.acked[-1][1] == at for w in writers), 180,  # noqa: B023
+                           "both writers on the primary")
+                status = hsb(modbus[1 - at])
+                lag.append(status[2] if status is not None else -1)
+                procs[at].send_signal(signal.SIGKILL)
+                dead = at
+                killed, killed_wall = time.monotonic(), time.time()
+                procs[at].wait()
+                for w in writers:
+                    wait_until(lambda w=w, dead=at: w.acked[-1][1] != dead, 180,
+                               f"{w.name} writes to the new primary")
+                    took[w.name].append(next(t for _v, i, t in w.acked if i != at and t > killed) - killed)
+                killings.append((killed_wall, "AB"[1 - at]))
+                start(at)  # the old primary back, as the standby
+                dead = None
+            except (SystemExit, KeyboardInterrupt) as e:  # the figures of the kills done so far, and why
+                stopped = f" (stopped after {len(killings)}: {e or 'interrupted'})"
+                if dead is not None:  # back, to forward what it committed before it was killed
+                    start(dead)
+                    with contextlib.suppress(SystemExit):
+                        wait_until(lambda: role(dead) is not None, 180, "the killed station back")  # noqa: B023
+                break
     finally:
         stop.set()
         for t in threads:
-            t.join(30)
+            if t.is_alive():
+                t.join(30)
         for p in procs.values():
             p.terminate()
             p.wait(30)
@@ -386,9 +415,13 @@ def kills(base: Path, node: Simulator, n: int, plant: str = "") -> None:
             took["journal"].append(min(after))
         else:
             led += 1
-    failover = 3 * TICK_MS
-    print(f"{n} SIGKILLs of the primary process at NetSyncTime {TICK_MS} ms (failover_after 3 = "
-          f"{failover} ms), load average {os.getloadavg()[0]:.1f}:")
+    pair = load_station(paths["A"]).redundancy
+    assert pair is not None
+    told = sum(len(journaled(paths[x], "%the partner took over from scan%")) for x in "AB")
+    flips = sum(len(journaled(paths[x], "%primary -> standby: partner % is primary%")) for x in "AB")
+    print(f"{len(killings)} SIGKILLs{stopped} of the primary process at NetSyncTime {TICK_MS} ms "
+          f"(failover_after {pair.failover_after} = {pair.failover_after * TICK_MS} ms), "
+          f"load average {os.getloadavg()[0]:.1f}:")
     for what, times in took.items():
         ms = [t * 1000 for t in times]
         until = "the journal record" if what == "journal" else f"the first {what} write acknowledged"
@@ -401,11 +434,12 @@ def kills(base: Path, node: Simulator, n: int, plant: str = "") -> None:
         print(f"  {w.name}: {len(values)} writes acknowledged, lost {lost} (+ {w.behind} takeovers with the "
               f"new primary's word below the last acknowledged), applied twice {twice}")
     print(f"  the standby's lag at the kill: max {max(lag)} scans; kills with no takeover journaled by "
-          f"the survivor (it had taken over already): {led}")
+          f"the survivor (it had taken over already): {led}; takeovers of a live primary (told, it "
+          f"followed): {told}; flip-backs (two primaries meeting): {flips}")
     if plant:
         missing, doubled, total = plant_check(plant, paths)
         print(f"plant archive: {total} records of the pair, {missing} of the local archives missing, "
-              f"{doubled} alarm transitions twice in a row")
+              f"{doubled} alarm transitions twice in a row (doubled, or one missing between)")
 
 
 def plant_check(url: str, paths: dict[str, Path]) -> tuple[int, int, int]:
@@ -430,6 +464,7 @@ def plant_check(url: str, paths: dict[str, Path]) -> tuple[int, int, int]:
                             "AND kind = 'alarm' ORDER BY ts, id").fetchall()
     doubled = sum(1 for before, row in itertools.pairwise(alarms) if before == row)
     return len(ours - ids), doubled, len(ids)
+
 
 def main() -> None:
     p = argparse.ArgumentParser(description=__doc__.splitlines()[0])

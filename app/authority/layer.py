@@ -357,7 +357,7 @@ class Commands:
 
         def apply(_mem: Memory) -> None:
             if alarms is not None:
-                alarms.silence(self.wall)  # the consoles' sound and the horn bit
+                alarms.silence(self.wall())  # the consoles' sound and the horn bit
             self._put(who, "alarm sound silenced")
 
         return self._queue(who, Action.SILENCE, "", apply)

@@ -19,7 +19,9 @@ the station object (HasNotifier), which has the sources as event sources (HasEve
 
 The station's alarm model stays the one truth (app/scada/alarms.py): a condition is what the last
 transition of its alarm left, copied on the engine thread as the transition is journaled (`post`),
-so its fields and its event agree with the journal record, whichever seat acted. Its fields:
+so its fields and its event agree with the journal record, whichever seat acted; on a hot-standby
+pair's standby, what the primary's states it adopted left (`adopt`: no transition of its own), so
+the new primary's conditions are its alarms' states from its first scan on. Its fields:
 ActiveState = active (a latched alarm stays active until acknowledged), AckedState = acknowledged,
 EnabledState = in service (out of service is disabled and OutOfServiceState), SuppressedState =
 suppressed by design, ShelvingState Unshelved / TimedShelved / OneShotShelved with UnshelveTime
@@ -211,7 +213,7 @@ class Conditions:
         self.notifiers: list[ua.NodeId] = []
         self.server: Server | None = None
         self._loop: asyncio.AbstractEventLoop | None = None
-        self._queue: asyncio.Queue[tuple[Alarm, Record]] | None = None
+        self._queue: asyncio.Queue[tuple[Alarm, Record | None]] | None = None
         self._worker: asyncio.Task[None] | None = None
         self._lock = asyncio.Lock()  # events and refreshes one at a time, in order
         self._refreshing: set[int] = set()  # subscriptions being refreshed
@@ -264,7 +266,7 @@ class Conditions:
         await self._references(server, station, plc)
         for c in self.by_id.values():
             a = c.alarm
-            await self._show(c, f"{a.id} {a.state.word}: {a.text}", a.changed or time.time())
+            await self._show(c, _stated(a), a.changed or time.time())
         self._worker = asyncio.get_running_loop().create_task(self._work())
 
     async def _references(self, server: Server, station: Node, plc: Node) -> None:
@@ -288,7 +290,18 @@ class Conditions:
     def post(self, record: Record) -> None:
         """The runtime's record observer, on the thread that journals the transition (the engine's):
         the alarm as this transition left it, handed to the server's loop."""
-        alarm, loop, queue = self.alarms.get(record.source or ""), self._loop, self._queue
+        self._hand(record.source or "", record)
+
+    def adopt(self, alarm_ids: Sequence[str]) -> None:
+        """On the engine thread: alarms whose states a pair's standby took from its primary
+        (StationAlarms.adopt), which journals no transition for them: each condition shows its
+        alarm's state as it is now, with an event (its message the state, as at the start), so a
+        client of the standby, and of it once it leads, sees the primary's alarms."""
+        for alarm_id in alarm_ids:
+            self._hand(alarm_id, None)
+
+    def _hand(self, alarm_id: str, record: Record | None) -> None:
+        alarm, loop, queue = self.alarms.get(alarm_id), self._loop, self._queue
         if alarm is None or loop is None or queue is None:
             return
         view = copy.copy(alarm)
@@ -306,11 +319,15 @@ class Conditions:
             try:
                 c = self.by_id[alarm.id]
                 c.alarm = alarm
+                if record is None:  # adopted from a pair's primary: no transition of this station's
+                    text, ts = _stated(alarm), alarm.changed or time.time()
+                else:
+                    text, ts = record.text or "", record.ts
                 async with self._lock:
-                    event = await self._show(c, record.text or "", record.ts)
+                    event = await self._show(c, text, ts)
                     await self._send(event, list(self._subscriptions()))
             except Exception:  # the next transition is shown all the same
-                logger.exception("condition %s not updated", record.source)
+                logger.exception("condition %s not updated", alarm.id)
             await asyncio.sleep(0)
 
     async def _show(self, c: Condition, text: str, ts: float) -> Notification:
@@ -553,6 +570,11 @@ def _maybe(value: Any, kind: ua.VariantType) -> ua.Variant:
     if value is None:
         value = {_V.LocalizedText: ua.LocalizedText(), _V.NodeId: ua.NodeId()}.get(kind)
     return NULL if value is None else ua.Variant(value, kind)
+
+
+def _stated(a: Alarm) -> str:
+    """The Message of a condition shown with no transition of its own (at the start, adopted)."""
+    return f"{a.id} {a.state.word}: {a.text}"
 
 
 def _bracket(event_type: int) -> Notification:

@@ -308,6 +308,12 @@ class OpcUaServer:
         if record.kind == "alarm" and self._ready.is_set():
             self.conditions.post(record)
 
+    def on_adopted(self, alarm_ids: list[str]) -> None:
+        """StationAlarms' observer of the states a pair's standby adopted (no record): their
+        conditions show them."""
+        if self._ready.is_set():
+            self.conditions.adopt(alarm_ids)
+
     # --- the server's own loop -----------------------------------------------------------------
 
     def _run(self) -> None:

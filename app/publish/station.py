@@ -50,6 +50,7 @@ def start_publishers(runtime: Runtime) -> list[Publisher]:
             runtime.problem(f"OPC UA server not started: {st.path}: opcua.endpoint: {e}")
         else:
             runtime.subscribe(server.on_record)
+            runtime.alarms.adopted.append(server.on_adopted)
             started.append(_Unsubscribing(server, runtime))
             security = "Basic256Sha256 Sign&Encrypt, trusted clients" if server.secure else \
                 "no security, loopback"
@@ -72,7 +73,8 @@ def start_publishers(runtime: Runtime) -> list[Publisher]:
 
 
 class _Unsubscribing:
-    """The OPC UA server with its record observer (alarm events), removed when it stops."""
+    """The OPC UA server with its record observer (alarm events) and its observer of adopted alarm
+    states, removed when it stops."""
 
     def __init__(self, server: Any, runtime: Runtime) -> None:
         self.server, self.runtime = server, runtime
@@ -80,4 +82,7 @@ class _Unsubscribing:
 
     def stop(self) -> None:
         self.runtime.unsubscribe(self.server.on_record)
+        alarms = self.runtime.alarms
+        if alarms is not None and self.server.on_adopted in alarms.adopted:
+            alarms.adopted.remove(self.server.on_adopted)
         self.server.stop()

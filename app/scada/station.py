@@ -35,7 +35,7 @@ from netplc.address import EMERGENCY_STOP, fmt_octal
 from netplc.engine import Engine, RunState
 from netplc.exchange import Exchange
 from netplc.lazy import lazy
-from netplc.memory import Snapshot
+from netplc.memory import Memory, Snapshot
 from netplc.program import Program
 from netplc.records import Record, RecordSink
 from registrar.alarm_state import AlarmStateFile
@@ -85,6 +85,9 @@ class StationAlarms:
         self._since: dict[int, int] = {}  # node -> first scan of this run with its link known
         self._stopped_by = ""  # who stopped NetPlc through the command layer (its record), while stopped
         self._unsent: dict[str, dict[str, Any]] | None = None  # changed states for a pair's standby
+        # told the ids of the alarms whose states a pair's standby adopted (on the engine thread):
+        # those changes are journaled by the primary alone, so a record observer never sees them
+        self.adopted: list[Callable[[list[str]], None]] = []
 
     def attach(self, engine: Engine, exchange: Exchange | None) -> None:
         """Evaluate after every scan of `engine`; start saving states."""
@@ -152,6 +155,9 @@ class StationAlarms:
         """On the engine thread: the primary's states, on its standby (AlarmSystem.adopt)."""
         if states:
             self.run_now(lambda: self.system.adopt(states))
+            ids = [alarm_id for alarm_id in states if alarm_id in self.system.by_id]
+            for observer in list(self.adopted):
+                observer(ids)
 
     def _publish(self, now: float | None = None) -> None:
         for alarm_id in self._dirty:
@@ -211,9 +217,24 @@ class StationAlarms:
         self.horn.silence(now)
         self._sound()
 
+    def follow_horn(self, silenced_at: float) -> None:
+        """On the engine thread of a pair's standby: the primary's last silence, so its horn
+        sounds for what the primary's does, and goes on so after a takeover (nothing to silence
+        again)."""
+        if silenced_at != self.horn.silenced_at:
+            self.horn.silenced_at = silenced_at
+            self.horn.update(self.summary)
+
     def _sound(self) -> None:
-        if self.engine is not None and self.horn.bit is not None:
-            self.engine.post(self.horn.write)
+        engine = self.engine
+        if engine is not None and self.horn.bit is not None:
+            engine.post(self._write_horn)
+
+    def _write_horn(self, mem: Memory) -> None:
+        """The horn bit, on a station that leads: a pair's standby holds the primary's memory, its
+        horn bit included, which its own adopted states must not overwrite."""
+        if self.engine is None or not self.engine.follower:
+            self.horn.write(mem)
 
     def close(self) -> None:
         """After the scan thread has stopped: write the last states."""

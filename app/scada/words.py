@@ -68,6 +68,8 @@ TEXTS: dict[str, dict[str, str]] = {
         "handed over": "handed over by the partner: {cause}",
         "lost both": "lost the arbiter ({error}) and the partner",
         "partner silent": "partner silent for {ms:.0f} ms",
+        "taken over": "the partner took over from scan {scan} (it heard nothing for {ms:.0f} ms); {dropped} "
+                      "records of the later scans are the partner's to make",
         "into standby": "IntoStandBy by {user}",
         "primary stopping": "the primary is stopping",
         "link closed": "the partner closed the pair link",
@@ -151,6 +153,8 @@ TEXTS: dict[str, dict[str, str]] = {
         "handed over": "передано партнёром: {cause}",
         "lost both": "потеряны арбитр ({error}) и партнёр",
         "partner silent": "партнёр молчит {ms:.0f} мс",
+        "taken over": "партнёр взял управление со скана {scan} (не слышал эту станцию {ms:.0f} мс); записи "
+                      "последующих сканов, {dropped}, сделает партнёр",
         "into standby": "IntoStandBy: {user}",
         "primary stopping": "основная останавливается",
         "link closed": "партнёр закрыл связь пары",

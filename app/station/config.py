@@ -117,6 +117,10 @@ class MqttSettings:
 
 LETTERS = ("A", "B")  # HSBNumPLC of seed 000: 1 = A, 0 = B
 FAILOVER_MAX_MS = 1000  # a takeover within about a second: failover_after is bounded by it
+# failover_after's default, in ms: a loaded PC (load average 14 on 2 cores) stalls a scan or the
+# pair link's thread by a tenth of a second and more, which a few ticks of silence took for a dead
+# primary; half a second keeps a takeover within the second
+FAILOVER_DEFAULT_MS = 500
 
 
 @dataclass(frozen=True)
@@ -127,6 +131,7 @@ class RedundancySettings:
     partner: str  # HOST:PORT of the partner's pair link
     listen: str = "127.0.0.1:0"  # HOST:PORT of this station's pair link (0: a free port, tests)
     failover_after: int = 3  # NetSyncTime ticks of silence from the primary before a takeover
+    # (loaded: the ticks of FAILOVER_DEFAULT_MS unless station.toml says)
     arbiter: str = "none"  # "none", or the plant archive's postgresql:// URL (a lease)
 
     @property
@@ -302,7 +307,8 @@ KEYS: dict[str, dict[str, Key]] = {
         Key("partner", str, "", "the partner's pair link, `host:port` (required)"),
         Key("listen", str, "127.0.0.1:0", "this station's pair link, `host:port`"),
         Key("failover_after", int, 3, "NetSyncTime ticks of the primary's silence before the standby "
-            "takes over, within about a second", (2, 6_000), said="3, fewer where 3 ticks pass 1 s"),
+            "takes over, within about a second", (2, 6_000),
+            said="the ticks of 0.5 s: 3 at least, 1 s at most"),
         Key("arbiter", str, "none", "`postgresql://...` (a lease in the plant archive's PostgreSQL) or "
             "`none` (a cut pair link makes both primary)"),
     ),
@@ -901,7 +907,7 @@ def _redundancy(problems: list[str], fname: str, table: dict[str, Any] | None,
     partner = r.get("partner", required=True)
     listen = r.get("listen")
     most = max(2, FAILOVER_MAX_MS // sync)  # the declared bounds hold; the tick bounds it further
-    failover = r.number("failover_after", min(3, most))
+    failover = r.number("failover_after", min(max(3, -(-FAILOVER_DEFAULT_MS // sync)), most))
     if failover > most:
         r.bad("failover_after", f"{failover} is outside 2-{most} (ticks of {sync} ms: a takeover within "
                                 f"about {FAILOVER_MAX_MS} ms)")

@@ -4,10 +4,10 @@ puts it into its engine (docs/architecture.md section 11).
 The state is the engine's own: NetPlc memory (bits and data, which hold the edge memory too: a
 CTR's rising edge is RES 1 while its bit C is 0), the timers' and counters' current values, the
 forces, the run state and the scan number, and the alarm states the station keeps beside it
-(acknowledged by whom, shelved, out of service: app/scada/alarms.py). A frame carries only what
-changed since the frame before it (memory as runs of the 64-byte blocks that differ, the alarms
-whose state changed); the first frame of a link is the whole state, so a standby that comes late
-or comes back catches up at once.
+(acknowledged by whom, shelved, out of service: app/scada/alarms.py) with its horn's last silence.
+A frame carries only what changed since the frame before it (memory as runs of the 64-byte
+blocks that differ, the alarms whose state changed); the first frame of a link is the whole
+state, so a standby that comes late or comes back catches up at once.
 
 Frames on the link: a 4-byte big-endian length, then the version byte, the kind byte and the
 payload. A state payload is a 4-byte length of its JSON header, the header, then the memory runs
@@ -29,7 +29,8 @@ from netplc.forcing import Force
 from netplc.memory import Memory, Snapshot
 
 VERSION = 1
-HELLO, STATE, HANDOVER, ACK = 1, 2, 3, 4  # frame kinds (ACK: the standby holds scan n)
+# frame kinds (ACK: the standby holds scan n; TAKEN: the standby took over, leading from scan n)
+HELLO, STATE, HANDOVER, ACK, TAKEN = 1, 2, 3, 4, 5
 BLOCK = 64  # bytes compared at a time for a delta
 STRETCH = 2048  # bytes compared first: only a stretch that differs is compared block by block
 IMAGE = IO_BITS + DATA_SIZE
@@ -81,16 +82,17 @@ class Capture:
     stop_code: int
     alarms: dict[str, dict[str, Any]] = field(default_factory=dict)  # changed states, by alarm
     bdseq: int = -1  # the MQTT Sparkplug session's bdSeq (-1: no MQTT)
+    silenced: float = 0.0  # the wall time of the horn's last silence (app/scada/horn.py)
 
 
 def capture(engine: Engine, snapshot: Snapshot, alarms: dict[str, dict[str, Any]],
-            bdseq: int = -1) -> Capture:
+            bdseq: int = -1, silenced: float = 0.0) -> Capture:
     """The scan's state; the timers and counters read only at the coils the program has (all
     2048 of each would cost the scan milliseconds)."""
     tim, ctr = engine.tim_ticks, engine.ctr_values
     tims, ctrs = _coils(engine)
     return Capture(snapshot, {c: tim[c] for c in tims if tim[c]}, {c: ctr[c] for c in ctrs if ctr[c]},
-                   engine.stop_code, alarms, bdseq)
+                   engine.stop_code, alarms, bdseq, silenced)
 
 
 _COILS: dict[int, tuple[tuple[int, ...], tuple[int, ...]]] = {}  # by id of the program
@@ -126,7 +128,7 @@ class Encoder:
         if cap.alarms:
             header["alarms"] = cap.alarms
         extras = json.dumps({"state": cap.snapshot.state, "stop_code": cap.stop_code,
-                             "tim": cap.tim, "ctr": cap.ctr, "bdseq": cap.bdseq,
+                             "tim": cap.tim, "ctr": cap.ctr, "bdseq": cap.bdseq, "silenced": cap.silenced,
                              "forces": [[f.kind, fmt_octal(f.addr), f.value, f.user]
                                         for f in cap.snapshot.forces]})
         if extras != self._extras or self.last is None:
@@ -179,6 +181,7 @@ class Mirror:
     forces: tuple[Force, ...] = ()
     alarms: dict[str, dict[str, Any]] = field(default_factory=dict)  # states not yet put, by alarm
     bdseq: int = -1  # the primary's MQTT Sparkplug bdSeq
+    silenced: float = 0.0  # when the primary's horn was last silenced
 
     @property
     def complete(self) -> bool:
@@ -205,6 +208,7 @@ class Mirror:
                 self.tim = {int(c): float(v) for c, v in extras["tim"].items()}
                 self.ctr = {int(c): int(v) for c, v in extras["ctr"].items()}
                 self.bdseq = int(extras.get("bdseq", -1))
+                self.silenced = float(extras.get("silenced", 0.0))
                 self.forces = tuple(Force(kind, parse_octal(addr), int(value), user)
                                     for kind, addr, value, user in extras["forces"])
             alarms = header.get("alarms", {})

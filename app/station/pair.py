@@ -19,6 +19,7 @@ newest mirrored state is put into its engine and the program runs on from it in 
 
 from __future__ import annotations
 
+import contextlib
 import json
 import logging
 import select
@@ -39,6 +40,7 @@ from app.station.mirror import (
     HANDOVER,
     HELLO,
     STATE,
+    TAKEN,
     Capture,
     Encoder,
     LinkClosed,
@@ -50,6 +52,7 @@ from app.station.mirror import (
 )
 from netplc.engine import Engine
 from netplc.memory import Memory, Snapshot
+from netplc.records import Record
 
 if TYPE_CHECKING:
     from app.station.runtime import Runtime
@@ -83,8 +86,9 @@ DGN_HSB = 0o77712  # word: b7 the partner's station differs, b9 the pair link is
 HSB_SWITCH = 0o77714  # word: low byte the last switchover's cause, high byte the switchovers
 HSB_LAG = 0o77716  # byte: the standby's lag in the primary's scans (255 at most)
 START_WINDOW = 0.5  # s at least a starting station waits for a partner before it leads alone
-# switchover causes (the low byte of HSB_SWITCH), after seed 000's hardware codes
-SILENT, HANDED_OVER, STEPPED_DOWN = 50, 51, 52
+# switchover causes (the low byte of HSB_SWITCH), after seed 000's hardware codes; TAKEN_OVER: a
+# primary told by its standby that it took over (it had heard no frame for failover_after)
+SILENT, HANDED_OVER, STEPPED_DOWN, TAKEN_OVER = 50, 51, 52, 53
 
 
 def decide(mine: Role, letter: str, theirs: Role, my_scans: int = 0, their_scans: int = 0) -> Role:
@@ -164,6 +168,13 @@ class Pair:
         self.cause = 0  # the last switchover's cause code (HSB_SWITCH)
         self.led_scans = 0  # scans run as the primary: of two primaries, the one with more leads
         self._awaiting: list[tuple[int, Callable[[], None]]] = []  # (scan, callback): after_mirrored
+        # The primary's records, archived once the standby holds their scan (`hold`): those of the
+        # scan running now, then those of the scans sent and not yet acknowledged, by scan
+        self._records: list[Record] = []
+        self._held: list[tuple[int, list[Record]]] = []
+        self._taken = False  # told TAKEN: until the engine follows, the scan's records are dropped
+        self._told: socket.socket | None = None  # the link this station took over on: drained, closed
+        self._send_lock = threading.Lock()  # frames on the link: its sender, its reader, the watch
         self._whole_alarms = True  # the next capture holds every alarm's state (a new link's first)
         self._bdseq = -1  # the primary's MQTT bdSeq as last handed to this station's publisher
 
@@ -223,9 +234,12 @@ class Pair:
     def kill(self) -> None:
         """End the link at once with no word to the partner, as a dying station's would (tests,
         bench/failover.py): the partner learns of it only by the silence, and the writers waiting
-        for the standby are never answered, as by a dead process."""
+        for the standby are never answered and the records of the scans it does not hold never
+        archived, as by a dead process."""
         with self._lock:
             self._awaiting.clear()
+            self._records, self._held = [], []
+            self._taken = True  # what comes before the stop is dropped as well
         self.stop()
 
     # --- the role ------------------------------------------------------------------------------
@@ -302,8 +316,9 @@ class Pair:
         """On the engine thread: the mirrored memory and engine state, and the alarm states."""
         with self._lock:
             self.mirror.load_into(engine, mem)
-            alarms = self.mirror.take_alarms()
+            alarms, silenced = self.mirror.take_alarms(), self.mirror.silenced
         if self.runtime.alarms is not None:
+            self.runtime.alarms.follow_horn(silenced)
             self.runtime.alarms.adopt(alarms)
 
     def _follow(self, _mem: Memory) -> None:
@@ -363,7 +378,8 @@ class Pair:
         """One link, from hello to its end (a status query answered and closed, or the pair's)."""
         paired = False
         try:
-            conn.settimeout(max(self.failover, 1.0))
+            # longer than failover_after: the watch takes over first and tells the partner (TAKEN)
+            conn.settimeout(self.failover + 1.0)
             send_frame(conn, HELLO, json.dumps(self._hello()).encode())
             kind, payload = read_frame(conn)
             hello = json.loads(payload) if kind == HELLO else None
@@ -387,7 +403,7 @@ class Pair:
             paired = True
             self._run_link(conn)
         except (OSError, LinkError, ValueError) as e:
-            if paired and not self._stopping.is_set():
+            if paired and not self._stopping.is_set() and conn is not self._told:  # told: journaled
                 self.runtime.say("pair link lost", logging.WARNING, letter=self.settings.letter,
                                  role=said_role(self.role), error=phrase("link closed")
                                  if isinstance(e, LinkClosed) else e or type(e).__name__)
@@ -397,9 +413,14 @@ class Pair:
             with self._changed:
                 if self._link is conn:
                     self._link = None
+                alone = self._link is None  # else a new link's standby acknowledges what waits
+                self._changed.notify_all()  # the link's sender ends
             self._handed.set()
+            if conn is self._told:  # taken over on it: what the partner sends after TAKEN is
+                _drain(conn)  # read, so that it reads TAKEN rather than a reset
             conn.close()
-            self._mirrored(None)  # no standby to wait for: the primary's own commit stands
+            if alone:
+                self._mirrored(None)  # no standby to wait for: the primary's own commit stands
 
     def _hello(self) -> dict[str, object]:
         return {"letter": self.settings.letter, "role": self.role.value, "led": self.led_scans,
@@ -422,33 +443,59 @@ class Pair:
         return False
 
     def _run_link(self, conn: socket.socket) -> None:
-        """Send while primary, receive while standby; the role may turn over on a handover."""
-        encoder = Encoder()
+        """This thread reads every frame of the link whatever the role (the standby the primary's
+        state, the primary its standby's acknowledgements as they come: its records and its
+        writers wait for them); a thread of its own sends the primary's frames. The role may turn
+        over on a handover."""
+        threading.Thread(target=self._send_frames, args=(conn,), name="pair send", daemon=True).start()
         while not self._stopping.is_set():
-            if self.role is Role.PRIMARY or self._handover:
+            # the primary: a standby with nothing to acknowledge is no end
+            if self.role is Role.PRIMARY and not select.select([conn], [], [], self.tick)[0]:
+                if self._link is not conn:
+                    return
+                continue
+            # the standby: a read that times out ends the link; the watch decided on a takeover first
+            if self._received(*read_frame(conn), conn):
+                return
+
+    def _send_frames(self, conn: socket.socket) -> None:
+        """The primary's frames on `conn`, each capture as the engine's listener hands it over
+        (the engine thread never waits for the link), until the link ends."""
+        encoder = Encoder()
+        try:
+            while not self._stopping.is_set():
                 with self._changed:
-                    self._changed.wait_for(lambda: self._capture is not None or self._stopping.is_set()
-                                           or self._link is not conn, self.tick)
-                    cap, self._capture = self._capture, None
-                    handover, self._handover = self._handover, ""
+                    self._changed.wait_for(lambda: self._capture is not None or bool(self._handover)
+                                           or self._stopping.is_set() or self._link is not conn, self.tick)
                     if self._link is not conn:
                         return
+                    if self.role is not Role.PRIMARY and not self._handover:
+                        encoder.last = None  # if this station leads again, its first frame is whole
+                        continue
+                    cap, self._capture = self._capture, None
+                    handover, self._handover = self._handover, ""
                 if cap is not None:
-                    send_frame(conn, STATE, encoder.frame(cap))
-                while select.select([conn], [], [], 0)[0]:  # the standby's acknowledgements
-                    self._received(*read_frame(conn), conn)
+                    self._send(conn, STATE, encoder.frame(cap))
                 if handover:
                     if self.lease is not None:
                         self.lease.release()  # for the partner to take
-                    send_frame(conn, HANDOVER, json.dumps({"cause": handover}).encode())
+                    self._send(conn, HANDOVER, json.dumps({"cause": handover}).encode())
                     self._handed.set()
-            else:  # a read that times out ends the link: the watch decides on a takeover
-                encoder.last = None  # if this station leads again, its first frame is whole
-                self._received(*read_frame(conn), conn)
+        except OSError as e:  # the link's reading thread ends it and says why
+            logger.info("pair link: a frame not sent: %s", e)
+            with contextlib.suppress(OSError):
+                conn.shutdown(socket.SHUT_RDWR)
 
-    def _received(self, kind: int, payload: bytes, conn: socket.socket) -> None:
+    def _send(self, conn: socket.socket, kind: int, payload: bytes) -> None:
+        with self._send_lock:
+            send_frame(conn, kind, payload)
+
+    def _received(self, kind: int, payload: bytes, conn: socket.socket) -> bool:
+        """One frame from the partner; True when the link ends with it (TAKEN)."""
         if kind == STATE:
             with self._lock:
+                if self._link is not conn:  # taken over: the mirror stays the scan TAKEN named
+                    return False
                 self.mirror.apply(payload)
                 self._last_frame = self.clock()
                 post = not self._load_pending
@@ -460,13 +507,76 @@ class Pair:
             if sparkplug is not None and bdseq != self._bdseq:  # one edge node: the primary's session,
                 self._bdseq = bdseq  # whose bdSeq this station goes on from, before it could lead
                 sparkplug.follow(bdseq)
-            send_frame(conn, ACK, struct.pack(">q", scan))
+            self._send(conn, ACK, struct.pack(">q", scan))
         elif kind == ACK and len(payload) == 8:
             self._mirrored(struct.unpack(">q", payload)[0])
         elif kind == HANDOVER:
             cause = json.loads(payload).get("cause", "IntoStandBy")
             self._become(Role.PRIMARY, phrase("handed over", cause=cause), patience=self.failover,
                          code=HANDED_OVER)
+        elif kind == TAKEN and len(payload) == 8:
+            self._taken_over(struct.unpack(">q", payload)[0], conn)
+            return True
+        return False
+
+    def _taken_over(self, scan: int, conn: socket.socket) -> None:
+        """The standby took over from `scan` (it heard no frame of this primary's for
+        failover_after: a stalled scan, a loaded PC) while this station lives: it follows at once
+        rather than lead beside the partner. What the partner holds stands (its writers are
+        answered, its records archived); what it does not, the partner runs again: the writers
+        of those scans are not answered (as by a dead primary), their records not archived."""
+        engine = self._engine
+        assert engine is not None
+        with self._changed:
+            if self._link is conn:
+                self._link = None
+            if self.role is not Role.PRIMARY:
+                return
+            self.role = Role.STANDBY
+            engine.follower = True  # the scan running now evaluates no alarm, and no write follows
+            self._taken = True  # until the next scan: its records are the partner's to make
+            self.switchovers += 1
+            self.cause = TAKEN_OVER
+            self._last_frame = self.clock()
+            ready = [cb for at, cb in self._awaiting if at <= scan]
+            self._awaiting = []
+            keep = [records for at, records in self._held if at <= scan]
+            dropped = sum(len(records) for at, records in self._held if at > scan) + len(self._records)
+            self._held, self._records = [], []
+            self._changed.notify_all()
+        if self.lease is not None:
+            self.lease.release()
+        engine.post(self._followed)
+        for records in keep:
+            self._archive(records)
+        for callback in ready:
+            callback()
+        self.runtime.say("pair handover", logging.WARNING, letter=self.settings.letter,
+                         cause=phrase("taken over", scan=scan, ms=self.failover * 1000, dropped=dropped))
+
+    def _followed(self, _mem: Memory) -> None:
+        """On the engine thread, the scan after a TAKEN: the records from now on are this station's."""
+        with self._lock:
+            self._taken = False
+
+    def hold(self, record: Record) -> bool:
+        """The runtime's record, kept back while this station is the primary with a standby until
+        the standby holds the scan that made it (a record of a scan the standby never got would
+        be made again by the standby taking over from the scan before: twice in the plant
+        archive). False: archive it now. A 'system' record (this station's own) is never held."""
+        if record.kind == "system":
+            return False
+        with self._lock:
+            if self._taken:
+                return True  # a scan the new primary runs again
+            if self.role is not Role.PRIMARY or self._link is None:
+                return False
+            self._records.append(record)
+            return True
+
+    def _archive(self, records: list[Record]) -> None:
+        for record in records:
+            self.runtime.archive(record)
 
     def after_mirrored(self, callback: Callable[[], None]) -> None:
         """`callback()` once the standby holds the scan running now (its acknowledgement of that
@@ -480,10 +590,18 @@ class Pair:
         callback()
 
     def _mirrored(self, scan: int | None) -> None:
-        """The standby holds `scan` (or None: it is gone): the callbacks waiting for it."""
+        """The standby holds `scan` (or None: it is gone): the records of the scans it holds are
+        archived, then the callbacks waiting for them called (a writer is answered once its
+        record is committed, Runtime.after_commit)."""
         with self._lock:
             ready = [cb for at, cb in self._awaiting if scan is None or at <= scan]
             self._awaiting = [] if scan is None else [(at, cb) for at, cb in self._awaiting if at > scan]
+            records = [r for at, held in self._held if scan is None or at <= scan for r in held]
+            self._held = [] if scan is None else [(at, held) for at, held in self._held if at > scan]
+            if scan is None:
+                records += self._records
+                self._records = []
+        self._archive(records)
         for callback in ready:
             callback()
 
@@ -517,13 +635,20 @@ class Pair:
         self._put_words(engine.mem)  # for the next scan's program and snapshot
         if self.role is Role.PRIMARY:
             self.led_scans += 1
+        with self._lock:  # this scan's records wait for the standby to hold it
+            records, self._records = self._records, []
+            if records and self.role is Role.PRIMARY and self._link is not None:
+                self._held.append((snapshot.scan, records))
+                records = []
+        self._archive(records)  # no standby (any more): at once
         if self.role is not Role.PRIMARY or self._link is None:
             return
         alarms = self.runtime.alarms
         states = alarms.changes_for_standby(self._whole_alarms) if alarms is not None else {}
         self._whole_alarms = False
         sparkplug = self.runtime.sparkplug()
-        cap = capture(engine, snapshot, states, sparkplug.bdseq if sparkplug is not None else -1)
+        cap = capture(engine, snapshot, states, sparkplug.bdseq if sparkplug is not None else -1,
+                      alarms.horn.silenced_at if alarms is not None else 0.0)
         with self._changed:
             if self._capture is not None and self._capture.alarms:  # not sent yet: none is lost
                 cap = replace(cap, alarms={**self._capture.alarms, **cap.alarms})
@@ -553,8 +678,28 @@ class Pair:
                 continue
             silent = self.clock() - self._last_frame
             if silent >= self.failover:
-                self._drop_link()
-                self._become(Role.PRIMARY, phrase("partner silent", ms=silent * 1000), code=SILENT)
+                cause = phrase("partner silent", ms=silent * 1000)
+                if not self._may_lead(cause):  # the arbiter first: a primary it keeps is told nothing
+                    continue
+                self._tell_taken()
+                self._become(Role.PRIMARY, cause, code=SILENT)
+
+    def _tell_taken(self) -> None:
+        """End the link on a takeover, telling the partner, if it still lives, the scan this
+        station leads from (TAKEN): it follows then rather than lead beside this station. The link's
+        thread reads on until the partner closes (or a second), so the partner reads TAKEN."""
+        with self._changed:
+            link, self._link = self._link, None
+            scan = self.mirror.scan
+            self._told = link
+            self._changed.notify_all()
+        if link is None:
+            return
+        try:
+            self._send(link, TAKEN, struct.pack(">q", scan))
+            link.shutdown(socket.SHUT_WR)
+        except OSError as e:  # the partner is gone: nobody to tell
+            logger.info("pair link: TAKEN not sent: %s", e)
 
     def _drop_link(self) -> None:
         with self._changed:
@@ -575,6 +720,18 @@ class Pair:
             lag = int((self.clock() - self._last_frame) / self.tick)
         return PairStatus(self.settings.letter, self.role.value, self.settings.partner,
                           self._link is not None, self.last_takeover, lag, self.switchovers)
+
+
+def _drain(conn: socket.socket, wait: float = 1.0) -> None:
+    """Read and drop what `conn` holds, until its end or `wait` seconds with nothing more."""
+    try:
+        conn.settimeout(wait)
+        while conn.recv(65536):
+            pass
+    except TimeoutError:
+        return
+    except OSError as e:
+        logger.debug("pair link drained: %s", e)
 
 
 def query(address: str, timeout: float = 3.0) -> dict[str, object]:

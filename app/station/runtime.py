@@ -198,27 +198,41 @@ class Runtime:
     # --- records -------------------------------------------------------------------------------
 
     def put(self, record: Record) -> None:
-        """The sink every part writes to: the registrar, then whoever watches (alarm banner)."""
+        """The sink every part writes to: the registrar, then whoever watches (alarm banner). The
+        primary of a pair archives a record once its standby holds the scan that made it
+        (`Pair.hold`); the watchers see it at once."""
         alarms = self.alarms
         if record.kind == "data" and alarms is not None:
             record = alarms.stamp(record)  # a value that is not good keeps its quality in the archive
-        if self.store is not None:
-            self.store.put(record)
+        pair = self.pair
+        if pair is None or not pair.hold(record):
+            self.archive(record)
         for observer in list(self._observers):
             observer(record)
 
+    def archive(self, record: Record) -> None:
+        """`record` to the registrar (a pair's primary: once its standby holds the record's scan)."""
+        if self.store is not None:
+            self.store.put(record)
+
     def after_commit(self, callback: Callable[[], None]) -> None:
-        """`callback()` once every record put so far is on disk, and so is the retentive memory of
-        the scan that put them (registrar/retain.py), and a pair's standby holds that scan: the
-        engine answers an outside writer then, so an acknowledged write survives a crash both in
-        the journal and in memory, and a takeover."""
+        """`callback()` once a pair's standby holds the scan running now (app/station/pair.py),
+        then once every record put so far is on disk (a pair's primary archives them once the
+        standby holds their scan), and so is the retentive memory of the scan that put them
+        (registrar/retain.py): the engine answers an outside writer then, so an acknowledged
+        write survives a crash both in the journal and in memory, and a takeover."""
+        pair = self.pair
+        if pair is not None:
+            pair.after_mirrored(lambda: self._after_local_commit(callback))
+        else:
+            self._after_local_commit(callback)
+
+    def _after_local_commit(self, callback: Callable[[], None]) -> None:
         parts: list[Callable[[Callable[[], None]], None]] = []
         if self.store is not None:
             parts.append(self.store.after_commit)
         if self.retainer is not None:
             parts.append(self.retainer.after_save)
-        if self.pair is not None:  # and the standby of a pair holds the scan (app/station/pair.py)
-            parts.append(self.pair.after_mirrored)
         if not parts:
             callback()
             return

@@ -105,6 +105,10 @@ class Station:
         assert self.rt.engine is not None
         return self.rt.engine.snapshot.get_word(addr)
 
+    def bit(self, addr: int) -> int:
+        assert self.rt.engine is not None
+        return self.rt.engine.snapshot.get_hmi_bit(addr)
+
     def write(self, addr: int, value: int) -> object:
         assert self.rt.commands is not None
         return self.rt.commands.write_word(OPERATOR, addr, value).result(3)
@@ -168,14 +172,20 @@ def pair(tmp_path: Path, node: Simulator) -> Iterator[tuple[Station, Station]]:
 
 
 class Proxy:
-    """A TCP proxy between the pair that the test cuts: every connection and the listener."""
+    """A TCP proxy between the pair that the test cuts (every connection and the listener), or
+    whose connections so far it holds from the dialler (`hold`: what the listening side sends
+    on them is lost on its way, its end still passes; new connections pass)."""
 
     def __init__(self) -> None:
         self.target = 0
         self.server = socket.create_server(("127.0.0.1", 0))
         self.port = self.server.getsockname()[1]
         self.sockets: list[socket.socket] = []
+        self.held: set[socket.socket] = set()  # upstream sockets whose data is dropped
         threading.Thread(target=self._accept, daemon=True).start()
+
+    def hold(self) -> None:
+        self.held.update(self.sockets[1::2])
 
     def _accept(self) -> None:
         while True:
@@ -188,11 +198,12 @@ class Proxy:
             for one, other in ((conn, upstream), (upstream, conn)):
                 threading.Thread(target=self._pipe, args=(one, other), daemon=True).start()
 
-    @staticmethod
-    def _pipe(src: socket.socket, dst: socket.socket) -> None:
+    def _pipe(self, src: socket.socket, dst: socket.socket) -> None:
         try:
             while data := src.recv(65536):
-                dst.sendall(data)
+                if src not in self.held:
+                    dst.sendall(data)
+            dst.shutdown(socket.SHUT_WR)  # the end passes
         except OSError:
             return
 
@@ -204,6 +215,13 @@ class Proxy:
             with contextlib.suppress(OSError):
                 s.shutdown(socket.SHUT_RDWR)
             s.close()
+
+
+@pytest.fixture
+def proxy() -> Iterator[Proxy]:
+    p = Proxy()
+    yield p
+    p.cut()
 
 
 def modbus_write(port: int, register: int, value: int) -> int:

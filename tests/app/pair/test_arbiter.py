@@ -6,23 +6,13 @@ primary, and both journal it. Without an arbiter both act, as the manual says
 from __future__ import annotations
 
 import time
-from collections.abc import Iterator
 from dataclasses import replace
 from pathlib import Path
-
-import pytest
 
 from app.station.config import load_station
 from netplc.simulator import Simulator
 from registrar.plant.lease import LEASE_CLIENT_GIVES_UP, LEASE_SERVER_DROP, Lease
-from tests.app.pair.conftest import OPERATOR, TICK_MS, Proxy, Station, make_pair, wait_for
-
-
-@pytest.fixture
-def proxy() -> Iterator[Proxy]:
-    p = Proxy()
-    yield p
-    p.cut()
+from tests.app.pair.conftest import OPERATOR, Proxy, Station, make_pair, wait_for
 
 
 def cut_pair(tmp_path: Path, node: Simulator, proxy: Proxy, arbiter: str) -> tuple[Station, Station]:
@@ -32,7 +22,8 @@ def cut_pair(tmp_path: Path, node: Simulator, proxy: Proxy, arbiter: str) -> tup
     b.start()
     assert (a.role, b.role) == ("primary", "standby")
     proxy.cut()
-    time.sleep(6 * TICK_MS / 1000)  # twice failover_after: a standby that may lead has led by now
+    assert b.rt.pair is not None
+    time.sleep(2 * b.rt.pair.failover)  # twice failover_after: a standby that may lead has led by now
     return a, b
 
 

@@ -6,6 +6,8 @@ reach the plant archive once it comes back; nothing is lost."""
 from __future__ import annotations
 
 import sqlite3
+import threading
+from dataclasses import replace
 from pathlib import Path
 
 import psycopg
@@ -14,10 +16,11 @@ import pytest
 from app.cli import main
 from app.scada.alarms import State
 from app.station.config import load_station
+from app.station.pair import query
 from netplc.simulator import Simulator
 from registrar.plant.schema import PAIR_ID_BASE
 from registrar.schema import DAY_GLOB
-from tests.app.pair.conftest import Station, make_pair, wait_for
+from tests.app.pair.conftest import OPERATOR, TICK_MS, Proxy, Station, make_pair, wait_for
 from tests.app.pair.test_alarms import BITS, TAGS, alarm
 
 TRIP = "TRIP.ALARM"
@@ -71,3 +74,109 @@ def test_the_pair_forwards_to_one_plant_archive_nothing_lost_nothing_doubled(
     for st in (a, b):  # `archive migrate` of either folder sends them as its letter: nothing new
         assert main(["archive", "migrate", str(st.folder), pg_url]) == 0
         assert "0 records copied" in capsys.readouterr().out
+
+
+# TRIP raised 1 s after its bit: time for the bit to reach the standby before the test holds the
+# link, so that the transition is made in a scan the standby never gets, and made again by it; the
+# standby waits 2.5 s before it takes over (put after loading, beyond the 1 s that station.toml
+# allows: a slow machine still raises TRIP on A first)
+DELAYED = TAGS.replace("TRIP,02600,bit,,,,,,,Pump trip,,,,,,,,1,2,,,",
+                       "TRIP,02600,bit,,,,,,,Pump trip,,,,,,1.0,,1,2,,,")
+PATIENT = 2500 // TICK_MS
+RAISED = f"{TRIP} normal -> active-unacknowledged"
+
+
+def held_transition(tmp_path: Path, node: Simulator, proxy: Proxy, top: str = "") -> tuple[Station, Station]:
+    """A and B started, B dialling through `proxy`; TRIP's bit set on A and mirrored to B, then
+    the link held from A to B: A raises TRIP in a scan B never gets."""
+    a, b = make_pair(tmp_path, node, b_dials=proxy.port, top=f'Tags = "tags.csv"\n{top}',
+                     files={"tags.csv": DELAYED})
+    proxy.target = load_station(a.folder).redundancy.listen_address[1]  # type: ignore[union-attr]
+    b.adjust = lambda st: replace(st, redundancy=replace(st.redundancy, failover_after=PATIENT))
+    a.start()
+    b.start()
+    assert a.rt.engine is not None and a.rt.engine.write_bit(BITS[TRIP], 1, user="test")
+    wait_for(lambda: b.rt.engine is not None and b.rt.engine.snapshot.get_bit(BITS[TRIP]), what="bit on B")
+    proxy.hold()
+    assert alarm(a, TRIP).state is State.NORMAL, "raised before the link was held: the machine is too slow"
+    wait_for(lambda: alarm(a, TRIP).state is State.UNACK, what="A raises TRIP")
+    return a, b
+
+
+def raised(station: Station) -> int:
+    return sum(RAISED in text for _id, _kind, text in local_records(station))
+
+
+def test_a_transition_of_a_scan_the_standby_never_got_is_archived_once(
+        tmp_path: Path, node: Simulator, proxy: Proxy, pg_url: str) -> None:
+    """The primary dies with the frame of its last scan on its way: the standby, taking over
+    from the scan before, raises the alarm again; the primary had archived it only once the
+    standby held that scan, so the plant archive has it once (ids of two letters never collide,
+    so its unique key could not have refused the second)."""
+    a, b = held_transition(tmp_path, node, proxy, f'Archive = "{pg_url}"\n')
+    try:
+        a.kill()
+        wait_for(lambda: b.role == "primary", what="takeover")
+        wait_for(lambda: alarm(b, TRIP).state is State.UNACK, what="B raises TRIP")
+    finally:
+        b.stop()
+        a.stop()
+    assert (raised(a), raised(b)) == (0, 1)
+    with psycopg.connect(pg_url) as con:
+        texts = [t for (t,) in con.execute("SELECT coalesce(text, '') FROM records WHERE station = 'pair'")]
+    assert sum(RAISED in t for t in texts) == 1
+
+
+def test_a_primary_told_that_its_standby_took_over_follows_and_answers_nothing_it_does_not_hold(
+        tmp_path: Path, node: Simulator, proxy: Proxy) -> None:
+    """A live primary whose frames stopped reaching its standby (a loaded PC) is told by the
+    standby that took over, and follows: no flip-back. A write it applied in a scan the standby
+    never got is not acknowledged (the new primary never had it), and its record of the alarm
+    raised in such a scan is not archived: the new primary raises it once."""
+    a, b = held_transition(tmp_path, node, proxy)
+    try:
+        assert a.rt.commands is not None
+        ticket = a.rt.commands.write_word(OPERATOR, 0o4000, 4321)  # applied by A, never held by B
+        wait_for(lambda: a.word(0o4000) == 4321, what="A applies the write")
+        wait_for(lambda: b.role == "primary" and a.role == "standby", what="B takes over, A follows")
+        wait_for(lambda: alarm(b, TRIP).state is State.UNACK, what="B raises TRIP")
+        wait_for(lambda: b.rt.pair is not None and b.rt.pair.status().link, what="A is B's standby")
+        assert not ticket.done() or not ticket.result().ok
+        assert b.word(0o4000) != 4321
+        assert b.write(0o4000, 1357).ok  # B leads, with A its standby
+        wait_for(lambda: a.word(0o4000) == 1357, what="A follows B")
+        assert any("the partner took over from scan" in t for t in a.texts())
+    finally:
+        b.stop()
+        a.stop()
+    assert (raised(a), raised(b)) == (0, 1)
+
+
+def test_a_status_query_answers_no_write_that_waits_for_the_standby(
+        tmp_path: Path, node: Simulator, proxy: Proxy) -> None:
+    """The end of a connection to the pair link that is not the link (`redundancy status`) is no
+    word about the standby: a write waiting for it stays unanswered."""
+    a, b = make_pair(tmp_path, node, b_dials=proxy.port)
+    proxy.target = load_station(a.folder).redundancy.listen_address[1]  # type: ignore[union-attr]
+    b.adjust = lambda st: replace(st, redundancy=replace(st.redundancy, failover_after=PATIENT))
+    try:
+        a.start()
+        b.start()
+        proxy.hold()  # A's frames lost on their way: B acknowledges nothing more
+        assert a.rt.commands is not None and a.rt.pair is not None
+        ticket = a.rt.commands.write_word(OPERATOR, 0o4000, 99)
+        wait_for(lambda: a.word(0o4000) == 99, what="A applies the write")
+        links = sum(t.name == "pair link" for t in threading.enumerate())
+        assert query(f"127.0.0.1:{a.rt.pair.port}")["role"] == "primary"
+        wait_for(lambda: sum(t.name == "pair link" for t in threading.enumerate()) == links,
+                 what="the query's connection ended on A")
+        # a commit and a retentive save asked for now end after any the write's answer waited for
+        committed, saved = threading.Event(), threading.Event()
+        assert a.rt.store is not None and a.rt.retainer is not None
+        a.rt.store.after_commit(committed.set)
+        a.rt.retainer.after_save(saved.set)
+        wait_for(lambda: committed.is_set() and saved.is_set(), what="A's commit and save")
+        assert not ticket.done()
+    finally:
+        b.stop()
+        a.stop()

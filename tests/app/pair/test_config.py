@@ -34,7 +34,7 @@ def test_redundancy_keys_are_read_with_their_defaults(tmp_path: Path) -> None:
     pair = station.redundancy
     assert (pair.letter, pair.listen_address, pair.partner_address) == ("A", ("127.0.0.1", 7001),
                                                                         ("127.0.0.1", 7002))
-    assert (pair.failover_after, pair.arbiter) == (3, "none")
+    assert (pair.failover_after, pair.arbiter) == (10, "none")  # the ticks of 0.5 s (NetSyncTime 50)
 
 
 def test_bad_redundancy_keys_are_named(tmp_path: Path) -> None:

@@ -17,7 +17,7 @@ from app.scada.alarms import State
 from app.scada.readings import Readings
 from app.station.config import Station as StationSettings
 from netplc.simulator import Simulator
-from tests.app.pair.conftest import make_pair, serve_opcua, wait_for
+from tests.app.pair.conftest import TICK_MS, make_pair, serve_opcua, wait_for
 from tests.app.pair.test_alarms import TAGS, raise_alarm
 from tests.app.test_consoles import WAIT, qualities, shown
 
@@ -29,7 +29,7 @@ FORM = json.dumps({"form": {"title": "Pair", "width": 300, "height": 200}, "elem
 
 def slower_failover(settings: StationSettings) -> StationSettings:
     assert settings.redundancy is not None
-    return replace(settings, redundancy=replace(settings.redundancy, failover_after=10))
+    return replace(settings, redundancy=replace(settings.redundancy, failover_after=1000 // TICK_MS))  # 1 s
 
 
 def test_a_console_follows_the_primary_through_a_switchover_and_a_kill(
