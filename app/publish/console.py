@@ -123,9 +123,9 @@ class ConsoleClient(StationClient):
             else:
                 self._wants[key] = ranges
         if self._loop.loop is not None and self._client is not None:
-            self._submit(self._follow()).add_done_callback(self._followed)  # at once: a form switched to
+            self._submit(self._watch_wanted()).add_done_callback(self._watched)  # at once: a form shown
 
-    def _followed(self, done: Future[None]) -> None:
+    def _watched(self, done: Future[None]) -> None:
         error = None if done.cancelled() else done.exception()
         if error is not None:  # the link's: the next poll finds it lost, and watches them once back
             logger.warning("%s: watching the parts of the memory the views want: %s", self.url, _why(error))
@@ -192,9 +192,9 @@ class ConsoleClient(StationClient):
             tick = await client.get_node(self._node("NetPlc.NetSyncTimeMs")).read_value()
             await self.memory.open(client, float(tick or 100))
             self.service_level = self.memory.service_level if self.memory.service_level is not None else LEADS
-        await self._follow()
+        await self._watch_wanted()
 
-    async def _follow(self) -> None:
+    async def _watch_wanted(self) -> None:
         """Watch what the views want now (reading the parts newly wanted first)."""
         if self._following is None:
             self._following = asyncio.Lock()
