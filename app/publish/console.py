@@ -123,9 +123,9 @@ class ConsoleClient(StationClient):
             else:
                 self._wants[key] = ranges
         if self._loop.loop is not None and self._client is not None:
-            self._submit(self._watch_wanted()).add_done_callback(self._watched)  # at once: a form shown
+            self._submit(self._watch_wanted()).add_done_callback(self._watch_done)  # at once: a form shown
 
-    def _watched(self, done: Future[None]) -> None:
+    def _watch_done(self, done: Future[None]) -> None:
         error = None if done.cancelled() else done.exception()
         if error is not None:  # the link's: the next poll finds it lost, and watches them once back
             logger.warning("%s: watching the parts of the memory the views want: %s", self.url, _why(error))
