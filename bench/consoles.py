@@ -120,12 +120,21 @@ def console_process(url: str, folder: Path, form: int) -> int:
     and print what was measured as a JSON line; end at "quit"."""
     from app.gui.console.source import StationSource
     from app.gui.console.window import ConsoleWindow
+    from app.publish.client import LoginError
     from app.publish.console import ConsoleClient
 
     app = application()
     client = ConsoleClient(url, folder=folder, period=0.1)
     client.discover().result(60)
-    client.open("operator", "operator").result(60)
+    for attempt in range(3):  # a loaded machine: asyncua's health probe may give up on a login
+        try:
+            client.open("operator", "operator").result(60)
+            break
+        except LoginError as e:
+            print(f"login {attempt + 1} failed: {e}", file=sys.stderr)
+            time.sleep(2.0)
+    else:
+        raise RuntimeError(f"{url}: no login in 3 attempts")
     window = ConsoleWindow(StationSource(client))
     window.resize(*SIZE)
     window.show()

@@ -63,7 +63,13 @@ class RangedItems(MonitoredItemService):
     """A subscription's monitored items, each value cut to its item's IndexRange before asyncua
     compares it with the last one reported: a change elsewhere in the array reports nothing, and
     only the part is copied and sent. A range that is no NumericRange is refused at creation
-    (Bad_IndexRangeInvalid), one past the end reports Bad_IndexRangeNoData, as a Read would."""
+    (Bad_IndexRangeInvalid), one past the end reports Bad_IndexRangeNoData, as a Read would.
+    A part the same as the one sampled last is not handed to asyncua at all (which would copy it
+    deeply to find so), unless the item's filter reports a new timestamp too."""
+
+    def __init__(self, isub: InternalSubscription, aspace: object) -> None:
+        super().__init__(isub, aspace)  # type: ignore[arg-type]
+        self._parts: dict[int, tuple[object, object]] = {}  # by item: its part and status last sampled
 
     async def _create_data_change_monitored_item(
             self, params: ua.MonitoredItemCreateRequest) -> ua.MonitoredItemCreateResult:
@@ -78,9 +84,24 @@ class RangedItems(MonitoredItemService):
             mid = self._monitored_datachange.get(handle)
             item = self._monitored_items.get(mid) if mid is not None else None
             read = item.read_value_id if item is not None else None
-            if read is not None and read.IndexRange and read.AttributeId == ua.AttributeIds.Value:
+            if item is not None and read is not None and read.IndexRange and \
+                    read.AttributeId == ua.AttributeIds.Value:
                 value = part(value, read.IndexRange)
+                sampled = (value.Value.Value if value.Value is not None else None, value.StatusCode)
+                stamped = item.filter is not None and \
+                    getattr(item.filter, "Trigger", None) == ua.DataChangeTrigger.StatusValueTimestamp
+                if not stamped and self._parts.get(mid) == sampled:  # type: ignore[arg-type]
+                    return
+                self._parts[mid] = sampled  # type: ignore[index]
         await super().datachange_callback(handle, value, error)
+
+    async def _set_monitoring_mode(self, mode: ua.MonitoringMode, mid: int) -> ua.StatusCode:
+        self._parts.pop(mid, None)  # enabled again: its part is sampled anew, as asyncua samples others
+        return await super()._set_monitoring_mode(mode, mid)
+
+    def _delete_monitored_items(self, mid: int) -> ua.StatusCode:
+        self._parts.pop(mid, None)
+        return super()._delete_monitored_items(mid)
 
 
 def ranged(subscription: InternalSubscription) -> None:
