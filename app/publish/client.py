@@ -366,7 +366,10 @@ class StationClient:
 
     async def _connect(self) -> None:
         assert self.offer is not None
-        client = Client(self.url, timeout=TIMEOUT_S)
+        # asyncua probes the link every `watchdog_intervall` and gives it that long to answer (1 s by
+        # default, which a loaded PC misses: a session dropped for nothing); a lost link is found by
+        # the reads here, a closed one at once
+        client = Client(self.url, timeout=TIMEOUT_S, watchdog_intervall=TIMEOUT_S)
         client.name = f"NetPlc monitor ({self.user})"
         certificate = self.offer.certificate
         if certificate is not None:

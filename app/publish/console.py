@@ -11,6 +11,9 @@ a console adds, all of it standard OPC UA that any client could do the same way:
   ISA-18.2 state word, severity and text read every SLOW_S (with the manifest, links and role), so
   a console that reconnects shows the station's alarms as they are now (the refresh a
   ConditionRefresh gives an event client);
+- NetPlc's memory, only the parts its views want (`want`: the open form's operands; the whole of it
+  while a Program view is open, or until a view said what it wants), watched as monitored items
+  with an IndexRange (memory_items.py): the station pushes a part when it changed;
 - the nodes' links (Nodes.<n>.Up), so the console judges its elements' quality as the station does;
 - the user's role at the station (Station.Role), so a refusal names the role it needed;
 - writes of a form's raw address through the station's WriteBit and WriteWord methods;
@@ -23,6 +26,7 @@ a console adds, all of it standard OPC UA that any client could do the same way:
 
 from __future__ import annotations
 
+import asyncio
 import datetime as dt
 import hashlib
 import json
@@ -30,6 +34,7 @@ import logging
 import os
 import shutil
 import struct
+import threading
 import time
 from concurrent.futures import Future
 from dataclasses import dataclass
@@ -44,12 +49,14 @@ from asyncua.common.events import Event
 
 from app.authority import Action, Answer, Reason, Refusal, Ticket, Who
 from app.authority.policy import ROLES, needs, rank
-from app.publish.client import StationClient, _why, config_dir
+from app.publish.client import LEADS, StationClient, _why, config_dir
 from app.publish.history import journal_where
+from app.publish.memory_items import WHOLE, MemoryItems, Ranges
 from app.publish.ua_types import SEVERITY
 from app.scada.alarms import AlarmRow, State
 from app.scada.horn import AlarmSource
 from netplc.address import fmt_octal
+from netplc.memory import Snapshot
 from registrar.reading import Filter, Row
 
 logger = logging.getLogger(__name__)
@@ -58,7 +65,7 @@ STATES = {state.word: state for state in State}
 PRIORITY_OF = {severity: priority for priority, severity in SEVERITY.items()}
 FIELDS = ("State", "Severity", "Text", "Time")  # read of each condition
 EVENT_FIELDS = ("EventId", "EventType", "SourceName", "Time", "Message", "Severity")  # what `_record` reads
-SLOW_S = 0.5  # the manifest, the alarms, the links and the role are read this often (memory every poll)
+SLOW_S = 0.5  # the manifest, the alarms, the links and the role are read this often (memory: pushed)
 
 
 @dataclass(frozen=True)
@@ -93,6 +100,15 @@ class ConsoleClient(StationClient):
         self._stations = base / "stations" / urlsplit(url).netloc.replace(":", "_")
         self._slow = 0.0  # when the slow part was read last
         self._own = f"{os.getpid()}-{id(self):x}"  # this client's partial files, apart from other consoles'
+        self.memory = MemoryItems(self._node)
+        self.memory.on_batch = self._pushed
+        # the memory as last pushed and the parts of it that hold the station's values, together
+        self.shown: tuple[Snapshot, Ranges] | None = None
+        self._wants: dict[str, Ranges] = {}  # by the view that wants them
+        self._wants_lock = threading.Lock()
+        self._following: asyncio.Lock | None = None  # one change of the watched parts at a time
+        self._forces_text = ""
+        self._forces_parsed: tuple = ()
 
     @property
     def keep(self) -> Path:
@@ -109,6 +125,33 @@ class ConsoleClient(StationClient):
     def write_word(self, addr: int, value: int, label: str | None, at_least: str | None) -> Ticket:
         return self.said(self.call("WriteWord", fmt_octal(addr), value, label or "", at_least or ""),
                           Action.WRITE, label or fmt_octal(addr), at_least)
+
+    def want(self, key: str, ranges: Ranges | None) -> None:
+        """The view `key` reads `ranges` of the memory from now on (None: it reads none any more).
+        The console watches what all its views want together; the whole memory while nobody said."""
+        with self._wants_lock:
+            if ranges is None:
+                self._wants.pop(key, None)
+            else:
+                self._wants[key] = ranges
+        if self._loop.loop is not None and self._client is not None:
+            self._submit(self._watch_wanted()).add_done_callback(self._watch_done)  # at once: a form shown
+
+    def _watch_done(self, done: Future[None]) -> None:
+        error = None if done.cancelled() else done.exception()
+        if error is not None:  # the link's: the next poll finds it lost, and watches them once back
+            logger.warning("%s: watching the parts of the memory the views want: %s", self.url, _why(error))
+
+    @property
+    def wanted(self) -> Ranges:
+        with self._wants_lock:
+            wants = list(self._wants.values())
+        if not wants:
+            return WHOLE
+        out = Ranges()
+        for ranges in wants:
+            out = out | ranges
+        return out
 
     def denial(self, action: Action, at_least: str | None = None, what: str | None = None) -> Refusal | None:
         """Why the user may not do `action` (needing at least `at_least`): the station's answers
@@ -167,7 +210,33 @@ class ConsoleClient(StationClient):
             await self._read_slow()
             self._slow = time.monotonic()
             self.changed()  # the alarms may have changed where the memory did not
-        await super()._read()  # the memory last: its change tells the console, which reads the rest
+        if self.memory.client is not client:  # a new session: a subscription of its own
+            tick = await client.get_node(self._node("NetPlc.NetSyncTimeMs")).read_value()
+            await self.memory.open(client, float(tick or 100))
+            self.service_level = self.memory.service_level if self.memory.service_level is not None else LEADS
+        await self._watch_wanted()
+
+    async def _watch_wanted(self) -> None:
+        """Watch what the views want now (reading the parts newly wanted first)."""
+        if self._following is None:
+            self._following = asyncio.Lock()
+        async with self._following:
+            if self.memory.client is self._client and self._client is not None:
+                await self.memory.follow(self.wanted)
+
+    def _pushed(self) -> None:
+        """The station pushed a change (or a part newly watched was read): the memory shown anew."""
+        m = self.memory
+        if m.forces != self._forces_text:
+            self._forces_text, self._forces_parsed = m.forces, self._forces(m.forces)
+        snapshot = Snapshot(tuple(m.bits), bytes(m.data), m.tick, time.monotonic(), m.wall, m.state,
+                            self._forces_parsed)
+        self.shown = (snapshot, m.covered)
+        self.snapshot = snapshot
+        if m.service_level is not None:
+            self.service_level = m.service_level
+        self.reads = m.batches
+        self.changed()
 
     async def _read_slow(self) -> None:
         client = self._client

@@ -66,7 +66,7 @@ from app.publish.conditions import Conditions
 from app.publish.feed import LatestReadings, Watch
 from app.publish.files import StationFiles
 from app.publish.history import JOURNAL, AlarmSource, Archived, Series, StationHistory, install, series_of
-from app.publish.index_range import index_ranges
+from app.publish.index_range import index_ranges, ranged
 from app.publish.methods import StationMethods, StepLock
 from app.publish.pki import TrustList, host_names, station_certificate, subject, thumbprint
 from app.publish.points import PointReader, PointWriter, Writable
@@ -532,8 +532,9 @@ class OpcUaServer:
 
     async def _add_memory(self, plc: Node, idx: int) -> None:
         """NetPlc's memory and forces, read-only, for a remote Program view (`main.py monitor
-        opc.tcp://...`), which needs raw memory, not only tags. A Read's IndexRange is answered
-        that part (index_range.py); a client that gives none reads each whole (20 KB in all)."""
+        opc.tcp://...`) and the consoles' forms, which need raw memory, not only tags. A Read's
+        or a monitored item's IndexRange is answered that part (index_range.py); a client that
+        gives none reads each whole (20 KB in all)."""
         memory = await plc.add_object(ua.NodeId("NetPlc.Memory", idx), ua.QualifiedName("Memory", idx))
         nodes = []
         for parent, name, initial, description in ((memory, "Bits", bytes(IO_BITS), MEMORY_BITS),
@@ -584,7 +585,9 @@ class OpcUaServer:
         await self._publish_memory(readings.snapshot, when, now)  # before the tick that says which scan
         await self.plc_state.write_value(reading.state)
         await self.plc_scan_ms.write_value(float(self.engine.stats.last_ms))
-        await self.plc_tick.write_value(ua.Variant(reading.scan, ua.VariantType.UInt64))
+        await write(self.plc_tick.nodeid, value_attr,  # the scan's time: a console's latency counts from it
+                    ua.DataValue(ua.Variant(reading.scan, ua.VariantType.UInt64), SourceTimestamp=when,
+                                 ServerTimestamp=now))
         if self._events != self._events_shown:
             self._events_shown = self._events
             await self.journal_events.write_value(ua.Variant(self._events_shown, ua.VariantType.UInt64))
@@ -625,7 +628,8 @@ class OpcUaServer:
     def _intercept(self, server: Server) -> None:
         """Every client session's Write goes through `_write` instead of asyncua's attribute
         service (the session knows the user and the peer; that service knows neither), and the
-        login sees its peer; a Read of UserAccessLevel is answered for the session's user."""
+        login sees its peer; a Read of UserAccessLevel is answered for the session's user; the
+        monitored items of its subscriptions honour their IndexRange (index_range.py)."""
         iserver = server.iserver
         create = iserver.create_session
         users = self.users
@@ -664,11 +668,18 @@ class OpcUaServer:
             async def call(requests: list[ua.CallMethodRequest]) -> list[ua.CallMethodResult]:
                 return await self._call(session, requests, service)
 
-            service, close = session.call, session.close_session
+            async def create_subscription(params: ua.CreateSubscriptionParameters, callback: Any,
+                                          request_callback: Any = None) -> ua.CreateSubscriptionResult:
+                result = await subscribe(params, callback, request_callback)
+                ranged(session.subscription_service.subscriptions[result.SubscriptionId])
+                return result
+
+            service, close, subscribe = session.call, session.close_session, session.create_subscription
             session.activate_session = activate_session
             session.close_session = close_session
             session.write = write
             session.call = call
+            session.create_subscription = create_subscription  # monitored items honour IndexRange
             return session
 
         iserver.create_session = create_session

@@ -24,6 +24,8 @@ from app.gui.console.window import ConsoleWindow
 from app.gui.status import StationStatusBar
 from app.publish.client import LoginError
 from app.publish.console import ConsoleClient
+from app.publish.index_range import numeric_range
+from app.publish.memory_items import WHOLE, Ranges
 from app.scada.alarms import State
 from app.scada.quality import Quality
 from app.scada.readings import Readings
@@ -31,12 +33,15 @@ from app.station.config import load_station
 from app.station.runtime import Runtime
 from hmi_forms.elements.analog import AnalogBase
 from hmi_forms.elements.base import Writer
+from hmi_forms.widgets.form_view import FormView
+from netplc.address import DATA_SIZE, IO_BITS
 from netplc.records import Record
 from registrar.store import Store
 from tests.app.conftest import REPO, copy_demo
 from tests.app.publish.conftest import demo_with, free_port
 
 WAIT = 30_000  # ms: a loaded CI machine; every wait ends on its event
+ANALOG = 1  # the demo's analog form (02_analog.hmi), the second tab
 
 
 class Station:
@@ -99,9 +104,11 @@ def attach(qtbot, tmp_path: Path) -> Iterator[Attach]:
             window.deleteLater()
 
 
-def qualities(window: ConsoleWindow) -> set[str]:
-    """What the elements that show a value of the plant say of it ("" for good)."""
-    return {model.quality for view in window.views for model in view.form.elements if model.sources()}
+def qualities(window: ConsoleWindow, views: list[FormView] | None = None) -> set[str]:
+    """What the elements that show a value of the plant say of it ("" for good), on every form or
+    on `views`."""
+    return {model.quality for view in (window.views if views is None else views)
+            for model in view.form.elements if model.sources()}
 
 
 def shown(window: ConsoleWindow) -> dict[str, State]:
@@ -156,11 +163,13 @@ def test_an_acknowledge_shows_on_the_other_console_and_in_the_journal_a_viewer_i
 def test_a_setpoint_written_on_one_console_shows_on_the_other(
         qtbot, station: Station, attach: Attach) -> None:
     writer, watcher = attach(station, "operator"), attach(station, "viewer")
+    watcher.tabs.setCurrentIndex(ANALOG)  # the form that shows the setpoint: the console watches it
     seen = readings_of(watcher)
     address = station.runtime.symbols["SETPOINT"]
     raw = 1234 if station.runtime.readings().tag("TEMP_SP").raw != 1234 else 2345
     assert writer.target.write_word(address, raw, user="operator", label="Уставка") is None  # sent
-    qtbot.waitUntil(lambda: bool(seen) and seen[-1].tag("TEMP_SP").raw == raw, timeout=WAIT)
+    qtbot.waitUntil(lambda: bool(seen) and seen[-1].tag("TEMP_SP").raw == raw and
+                    watcher.source.covered.covers(watcher.reads[ANALOG]), timeout=WAIT)
     written = [r for r in station.records if r.kind == "operator" and "TEMP_SP" in (r.text or "")]
     assert written and (written[-1].source or "").startswith("opcua:operator@")
     watcher.target.write_word(address, 7, user="viewer", label="Уставка")  # refused by the station
@@ -176,6 +185,46 @@ def test_a_setpoint_written_on_one_console_shows_on_the_other(
     element.Confirm = True  # a command that cannot be taken back: the console asks first
     writer.ask = lambda title, text: False
     assert element.refused("Уставка = 100") == "cancelled"
+
+
+def watched(station: Station, window: ConsoleWindow) -> Ranges:
+    """The parts of the memory the station reports to the console's subscription, as the station's
+    monitored items of it say (asyncua's server keeps them by subscription)."""
+    server = next(p for p in station.runtime.publishers if hasattr(p, "seats")).server.server
+    memory = window.client.memory
+    subscription = server.iserver.subscription_service.subscriptions[memory._subscription.subscription_id]
+    bits: list[tuple[int, int]] = []
+    data: list[tuple[int, int]] = []
+    for item in subscription.monitored_item_srv._monitored_items.values():
+        read = item.read_value_id
+        name = str(read.NodeId.Identifier)
+        if name in ("NetPlc.Memory.Bits", "NetPlc.Memory.Data"):
+            is_bits = name.endswith("Bits")
+            span = numeric_range(read.IndexRange) or (0, (IO_BITS if is_bits else DATA_SIZE) - 1)
+            (bits if is_bits else data).append(span)
+    return Ranges(tuple(sorted(bits)), tuple(sorted(data)))
+
+
+def test_a_console_watches_only_what_the_form_shown_reads_and_all_of_it_for_the_program_view(
+        qtbot, station: Station, attach: Attach) -> None:
+    console = attach(station, "engineer")
+    console.tabs.setCurrentIndex(ANALOG)
+    analog = console.reads[ANALOG]
+    assert 0 < analog.size < 64 and len(analog.bits + analog.data) <= 4  # a few words, a few items
+    qtbot.waitUntil(lambda: watched(station, console) == analog, timeout=WAIT)
+    level = station.runtime.symbols["LEVEL"]  # node 0's simulation moves it: what the console shows
+    qtbot.waitUntil(lambda: console.source.covered.covers(analog) and console.client.snapshot is not None
+                    and console.client.snapshot.get_word(level) != 0, timeout=WAIT)
+    console.tabs.setCurrentIndex(0)  # another form: another set, the one before no more
+    qtbot.waitUntil(lambda: watched(station, console) == console.reads[0], timeout=WAIT)
+    assert console.reads[0] != analog
+    program = console.open_program()
+    assert program is not None
+    try:
+        qtbot.waitUntil(lambda: watched(station, console) == WHOLE, timeout=WAIT)  # it reads any address
+    finally:
+        program.close()
+    qtbot.waitUntil(lambda: watched(station, console) == console.reads[0], timeout=WAIT)
 
 
 def test_a_form_changed_at_the_station_reaches_the_console(qtbot, station: Station, attach: Attach) -> None:
@@ -243,8 +292,12 @@ def test_a_console_shows_the_station_unreachable_and_reconnects_by_itself(
     qtbot.waitUntil(lambda: qualities(console) == {Quality.UNREACHABLE.word}, timeout=WAIT)
     assert console.health.isVisible() and "station unreachable" in console.health.problems[0]
     station.restart()
-    qtbot.waitUntil(lambda: qualities(console) == {""} and not console.client.error, timeout=WAIT)
+    shown_view = console.views[console.tabs.currentIndex()]  # refreshed while shown; others once shown
+    qtbot.waitUntil(lambda: qualities(console, [shown_view]) == {""} and not console.client.error,
+                    timeout=WAIT)
     assert not console.health.isVisible()
+    console.tabs.setCurrentIndex(ANALOG)
+    qtbot.waitUntil(lambda: qualities(console, [console.views[ANALOG]]) == {""}, timeout=WAIT)
     qtbot.waitUntil(lambda: shown(console) == {r.id: r.state for r in station.runtime.alarms.summary},
                     timeout=WAIT)  # the station's alarms as they are now
 

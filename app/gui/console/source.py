@@ -23,6 +23,7 @@ import numpy as np
 from PySide6.QtCore import QObject, Signal
 
 from app.publish.console import ConsoleClient, Files
+from app.publish.memory_items import NOTHING, Ranges
 from app.scada.alarms import AlarmRow, summary_order
 from app.scada.horn import Horn
 from app.scada.quality import LinkView, Operands, Quality, QualityMap
@@ -167,7 +168,9 @@ class RemoteAlarms:
 
 class StationSource(QObject):
     """`readings` as the bridge gives them; `loaded` when the station's files changed; `alarms`
-    the station's alarm rows; `link` "" while the station answers, else why not."""
+    the station's alarm rows; `link` "" while the station answers, else why not. `covered`: the
+    parts of the memory that hold the station's values in the readings last given (the console
+    watches only what its views want: a view is shown readings that cover what it reads)."""
 
     readings = Signal(object)  # Readings (Unreachable while the link is down)
     loaded = Signal(object)  # Loaded
@@ -182,6 +185,7 @@ class StationSource(QObject):
         self.station_alarms = RemoteAlarms()
         self.quality_map: QualityMap | None = None
         self._snapshot: Snapshot | None = None
+        self.covered: Ranges = NOTHING
         self._files: Files | None = None
         self._alarms: tuple[AlarmRow, ...] | None = None
         self._error: str | None = None
@@ -202,7 +206,8 @@ class StationSource(QObject):
         with self._lock:
             self._waiting = False
         client = self.client
-        files, error, snapshot, alarms = client.files, client.error, client.snapshot, client.alarms
+        files, error, shown, alarms = client.files, client.error, client.shown, client.alarms
+        snapshot, covered = shown if shown is not None else (None, NOTHING)
         if files is not None and files is not self._files:
             self._files = files
             self.current = load_files(files)
@@ -217,7 +222,7 @@ class StationSource(QObject):
                 self.readings.emit(Unreachable(last, self.quality_map, LinkView(), np.zeros(0, np.int8)))
         if not error and snapshot is not None and snapshot is not self._snapshot and \
                 self.quality_map is not None:
-            self._snapshot = snapshot
+            self._snapshot, self.covered = snapshot, covered
             links = LinkView(running=snapshot.state == "running", links=dict(client.links),
                              forced=[a for f in snapshot.forces for a in f.operands])
             self.readings.emit(Readings(snapshot, self.quality_map, links,

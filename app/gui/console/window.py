@@ -11,6 +11,10 @@ write is the station's WriteBit or WriteWord method, an acknowledgement its Ackn
 station checks the role, journals with the user's name and answers, and a refusal is said in the
 status bar naming the role it needs.
 Forms come from the station (its Files): a form saved there is shown here at the next poll.
+Of NetPlc's memory the console watches what the form shown reads (its elements' operands), and the
+whole of it while a Program view is open; the form shown is refreshed from readings that cover it,
+a form not shown is not refreshed (it is, from the first readings that cover it, once shown), but
+for "station unreachable", which every form shows at once.
 """
 
 from __future__ import annotations
@@ -18,6 +22,7 @@ from __future__ import annotations
 import logging
 import sys
 from collections.abc import Callable
+from typing import Any
 
 from PySide6.QtCore import QTimer
 from PySide6.QtGui import QAction, QCloseEvent, QKeySequence
@@ -34,7 +39,7 @@ from app.gui.alarm_summary import AlarmSummary
 from app.gui.application import application
 from app.gui.bridge import Answers
 from app.gui.console.archive import StationArchiveSource
-from app.gui.console.source import Loaded, RemoteJournal, StationSource
+from app.gui.console.source import Loaded, RemoteJournal, StationSource, Unreachable
 from app.gui.journal import JournalDock
 from app.gui.main_window import (
     REFUSAL_MS,
@@ -53,10 +58,12 @@ from app.gui.trend_window import TrendWindow
 from app.gui.viewer import ViewerWindow
 from app.gui.zoom import ZoomArea
 from app.publish.console import ConsoleClient, StationCommands
+from app.publish.memory_items import NOTHING, WHOLE, Ranges, ranges_of
 from app.scada.alarms import AlarmRow
 from app.scada.readings import Readings
 from app.scada.trends import TrendBook
 from hmi_forms.elements.base import Writer
+from hmi_forms.elements.reads import operands
 from hmi_forms.elements.target import CommandTarget
 from hmi_forms.widgets.form_view import FormView
 from netplc.problems import Problems
@@ -85,10 +92,16 @@ class RemoteTarget(CommandTarget):
 
 class SharedSession(OpcUaSource):
     """The Program view on the console's own session with the station: closed with the console,
-    not with the view."""
+    not with the view. It reads any address: the console watches the whole memory while it is open."""
+
+    def __init__(self, client: ConsoleClient, **listing: Any) -> None:
+        super().__init__(client, **listing)
+        self.console = client
+        self.key = f"program-{id(self):x}"
+        client.want(self.key, WHOLE)
 
     def close(self) -> None:
-        pass
+        self.console.want(self.key, None)
 
 
 class ConsoleWindow(QMainWindow):
@@ -103,6 +116,8 @@ class ConsoleWindow(QMainWindow):
         self.commands = StationCommands(client, source.station_alarms)
         self.rights = Rights(self.commands, lambda: self.who)  # type: ignore[arg-type]
         self.views: list[FormView] = []
+        self.reads: list[Ranges] = []  # the parts of the memory each view reads
+        self.readings: Readings | None = None  # the last given
         self.history: TrendHistory | None = None  # of the forms shown
         self.archive: StationArchiveSource | None = None  # the station's, with its tags as loaded
         self.programs: list[ProgramWindow] = []  # the Program views opened from here
@@ -142,6 +157,7 @@ class ConsoleWindow(QMainWindow):
         self.summary.changed.connect(self._alarms_changed)
         source.loaded.connect(self._load)
         source.readings.connect(self._on_readings)
+        self.tabs.currentChanged.connect(self._shown_changed)
         source.link.connect(self._on_link)
         self._timer = QTimer(self)
         self._timer.timeout.connect(self._tick)
@@ -153,7 +169,7 @@ class ConsoleWindow(QMainWindow):
     def _load(self, loaded: Loaded) -> None:
         """The station's forms (again, when its files changed), in place of the ones shown."""
         current = self.tabs.currentIndex()
-        self.views = []
+        self.views, self.reads = [], []
         if self.history is not None:
             self.history.close()
             self.history.deleteLater()
@@ -166,6 +182,7 @@ class ConsoleWindow(QMainWindow):
         for form in loaded.forms:
             view = FormView(form, self.target, user=self.client.user, guard=self._guard)
             self.views.append(view)
+            self.reads.append(ranges_of(operands(form.elements)))
             self.history.attach(view)
             self.tabs.addTab(ZoomArea(view), form.title)
         if loaded.problems:
@@ -173,6 +190,7 @@ class ConsoleWindow(QMainWindow):
         if not loaded.forms and not loaded.problems:
             self.tabs.addTab(_placeholder(self.tr("The station serves no forms.")), self.tr("No forms"))
         self.tabs.setCurrentIndex(max(0, min(current, self.tabs.count() - 1)))
+        self._shown_changed()
 
     def open_program(self) -> ProgramWindow | None:
         """Station -> Program: the station's program live, over this console's session, with what
@@ -224,8 +242,27 @@ class ConsoleWindow(QMainWindow):
             return self.tr("cancelled")
         return None
 
+    def _shown(self) -> tuple[FormView | None, Ranges]:
+        """The form view shown and the parts of the memory it reads."""
+        i = self.tabs.currentIndex()
+        return (self.views[i], self.reads[i]) if 0 <= i < len(self.views) else (None, NOTHING)
+
+    def _shown_changed(self) -> None:
+        """Another tab: the console watches what its form reads, and shows it the last readings
+        if they cover it already."""
+        _, reads = self._shown()
+        self.client.want("form", reads)
+        if self.readings is not None:
+            self._on_readings(self.readings)
+
     def _on_readings(self, readings: Readings) -> None:
-        for view in self.views:
+        self.readings = readings
+        if isinstance(readings, Unreachable):  # every element says so, shown or not
+            for view in self.views:
+                view.refresh(readings.snapshot, readings)
+            return
+        view, reads = self._shown()
+        if view is not None and self.source.covered.covers(reads):
             view.refresh(readings.snapshot, readings)
 
     @property

@@ -203,3 +203,43 @@ def test_a_read_with_an_index_range_is_answered_that_part_of_the_memory(station:
     assert len(bit.Value.Value) == 1 and part.SourceTimestamp is not None
     assert past.StatusCode.value == ua.StatusCodes.BadIndexRangeNoData
     assert equal.StatusCode.value == bad.StatusCode.value == ua.StatusCodes.BadIndexRangeInvalid
+
+
+def _item(node: ua.NodeId, handle: int, index_range: str = "") -> ua.MonitoredItemCreateRequest:
+    params = ua.MonitoringParameters(ClientHandle=handle, SamplingInterval=0, QueueSize=1, DiscardOldest=True)
+    return ua.MonitoredItemCreateRequest(
+        ItemToMonitor=ua.ReadValueId(NodeId=node, AttributeId=ua.AttributeIds.Value, IndexRange=index_range),
+        MonitoringMode=ua.MonitoringMode.Reporting, RequestedParameters=params)
+
+
+def test_a_monitored_item_with_an_index_range_reports_that_part_when_it_changes(
+        station: tuple[Runtime, str]) -> None:
+    """Part 4 7.27 on CreateMonitoredItems: an item on a part of the memory is sent that part only,
+    and only when that part changed (not at each scan that changed something elsewhere); a range
+    that is no NumericRange is refused with Bad_IndexRangeInvalid."""
+    _, url = station
+    seen: dict[int, list[bytes]] = {1: [], 2: [], 3: []}
+
+    class Handler:
+        def datachange_notification(self, node: Node, value: object, data: object) -> None:
+            seen[data.monitored_item.ClientHandle].append(value)  # type: ignore[attr-defined]
+
+    async def go() -> list[object]:
+        async with Client(url, timeout=30) as client:
+            ns = await client.get_namespace_index(STATION_URI)
+            data, tick = ua.NodeId("NetPlc.Memory.Data", ns), ua.NodeId("NetPlc.Tick", ns)
+            sub = await client.create_subscription(50, Handler())
+            # LEVEL (04010: index 8), moved by node 0's simulation; 01750-... of bank 0, unused
+            made = await sub.create_monitored_items([_item(data, 1, "8:9"), _item(data, 2, "1000:1099"),
+                                                     _item(tick, 3), _item(data, 4, "9:8")])
+            deadline = time.monotonic() + 30
+            while len(seen[3]) < 15 or len(set(seen[1])) < 2:
+                assert time.monotonic() < deadline, f"{len(seen[3])} ticks, LEVEL {seen[1]} within 30 s"
+                await asyncio.sleep(0.05)
+            await sub.delete()
+            return made
+
+    made = run(go())
+    assert made[3] == ua.StatusCode(ua.StatusCodes.BadIndexRangeInvalid)
+    assert all(len(v) == 2 for v in seen[1]) and len(seen[1]) < len(seen[3])
+    assert seen[2] == [bytes(100)]  # once, at creation: nothing changed there since
