@@ -26,7 +26,7 @@ from pathlib import Path
 
 import numpy as np
 import pyqtgraph as pg
-from PySide6.QtCore import Qt, QTimer, SignalInstance
+from PySide6.QtCore import Qt, QTimer, Signal, SignalInstance
 from PySide6.QtWidgets import (
     QCheckBox,
     QComboBox,
@@ -109,6 +109,10 @@ class PenData:
 
 
 class TrendWindow(QWidget):
+    # the tags whose live values the window shows now (none once closed): a source that reads only
+    # what its views show (a remote console) watches them too
+    watching = Signal(list)
+
     def __init__(self, readings: SignalInstance, tags: Sequence[Tag], archive: Path | ArchiveSource,
                  book: TrendBook, user: Callable[[], str], parent: QWidget | None = None) -> None:
         """`readings`: each scan's `Readings` (the runtime bridge's, a remote station's);
@@ -276,6 +280,7 @@ class TrendWindow(QWidget):
         self._axis_units()
         self._want_history()
         self._touch()
+        self.watching.emit([p.tag for p in self.pens.values()])
         return pen
 
     def remove_pen(self, name: str) -> None:
@@ -283,6 +288,7 @@ class TrendWindow(QWidget):
             self.plot.removeItem(self.curves.pop(name))
             self._axis_units()
             self._touch()
+            self.watching.emit([p.tag for p in self.pens.values()])
 
     def _remove_current(self) -> None:
         row = self.table.currentRow()
@@ -508,6 +514,7 @@ class TrendWindow(QWidget):
             self.settled.stop()
             self.readings.disconnect(self.show_readings)
             self.loader.close()
+            self.watching.emit([])
         super().closeEvent(event)  # type: ignore[arg-type]
 
 

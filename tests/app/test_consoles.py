@@ -25,7 +25,7 @@ from app.gui.status import StationStatusBar
 from app.publish.client import LoginError
 from app.publish.console import ConsoleClient
 from app.publish.index_range import numeric_range
-from app.publish.memory_items import WHOLE, Ranges
+from app.publish.memory_items import WHOLE, Ranges, ranges_of
 from app.scada.alarms import State
 from app.scada.quality import Quality
 from app.scada.readings import Readings
@@ -364,6 +364,8 @@ def test_the_consoles_trend_window_draws_a_stored_tag_from_the_stations_history(
         == ["LEVEL"]
     pen = trend.add_pen("LEVEL")
     assert pen is not None
+    level = ranges_of([(station.runtime.symbols["LEVEL"], 2)])  # watched for its live values
+    qtbot.waitUntil(lambda: watched(station, console).covers(level), timeout=WAIT)
     trend.set_range(times[0] - 5, times[-1] + 5)
     qtbot.waitUntil(lambda: not trend.loading() and any(len(ts) for ts, _ in pen.days.values()), timeout=WAIT)
     ts, values = pen.samples()
@@ -384,6 +386,8 @@ def test_the_consoles_trend_window_draws_a_stored_tag_from_the_stations_history(
     trend.export_png(tmp_path / "trend.png")
     assert (tmp_path / "trend.png").stat().st_size > 0
     trend.close()
+    shown = console.reads[console.tabs.currentIndex()]
+    assert console.client.wanted == shown  # the window's want went with it
     again = console.open_trends()
     assert again is not None and again.open_trend("Уровни") and list(again.pens) == ["LEVEL"]
 
