@@ -5,9 +5,13 @@ A generated form of N elements (`--elements`, default 300) laid out in a square 
 dials, two discrete colour labels, one digital readout and one bar, every one bound to a value that
 changes on every tick. One tick = what the workstation does with a snapshot: FormView.refresh
 (models, change detection, repaint scheduling) and the paint that follows (processEvents). The
-yardstick is N plain QLabels on the same grid, each given per tick the text the element's model
-makes of the same word with setText, and painted the same way: the least a changing number costs
-in Qt, so a form at or below it costs nothing for its dials, bars and colours.
+yardstick is N plain QLabels, one in each element's rectangle, given per tick with setText the
+text the element shows of the same operand (a gauge's value as its model formats it, with " %"
+where a bar writes its units beside it; a lamp's ON or OFF), in the font and alignment the element
+draws that text with, and painted the same way. So both do the same work for the operator: the
+same number of texts, the same characters at the same size in boxes of the same size, all
+changing every tick; the labels draw nothing else and keep no picture. That is the least a
+changing text costs in Qt, so a form at or below it costs nothing for its dials, bars and colours.
 
 The values are a plant's (`--workload full`, the default): each word anywhere in 0..65535 (a
 transmitter's full range, shown scaled to 0..10000 with one decimal), every word a new value at
@@ -60,17 +64,19 @@ os.environ.setdefault("QT_QPA_PLATFORM", "offscreen")
 
 import numpy as np
 from PySide6.QtCore import Qt
-from PySide6.QtGui import QPainter, QPaintEvent, QPen, QPolygonF
+from PySide6.QtGui import QFont, QPainter, QPaintEvent, QPen, QPolygonF
 from PySide6.QtWidgets import QApplication, QLabel, QWidget
 
 from app.scada.quality import LinkView, QualityMap
 from app.scada.readings import Readings
 from hmi_forms.elements.target import NullTarget
 from hmi_forms.form import load_form
+from hmi_forms.widgets import theme
 from hmi_forms.widgets.form_view import FormView
+from hmi_forms.widgets.gauges import GaugeWidget
 from hmi_forms.widgets.trend import REDRAW_INTERVAL, TrendWidget, polygon
 from netplc.engine import FakeClock
-from netplc.memory import Memory
+from netplc.memory import Memory, Snapshot
 from netplc.program import parse
 
 TILE = 64
@@ -210,24 +216,54 @@ class Polyline(QWidget):
         p.end()
 
 
-def yardstick(n: int, plots: list[TrendWidget]) -> tuple[QWidget, list[tuple[int, QLabel]], list[Polyline]]:
-    """The form's yardstick on the same grid: a plain QLabel for each element that is not a plot,
-    a Polyline for each plot."""
-    cols, rows, placed = places(n, bool(plots))
+Plain = tuple[QLabel, str, int]  # a yardstick label, the kind of element it stands for, its operand
+
+
+def text_look(widget: QWidget) -> tuple[QFont, Qt.AlignmentFlag]:
+    """The font and alignment an element draws the text it shows with."""
+    if isinstance(widget, GaugeWidget):
+        widget._layout()
+        assert widget._value is not None
+        return widget._value.font, widget._value.align
+    model = widget.model  # a lamp
+    return theme.qfont(model.Font, bold=model.Enabled), theme.alignment(model.TextAlign) | theme.WRAP
+
+
+def yardstick(n: int, view: FormView) -> tuple[QWidget, list[Plain], list[Polyline]]:
+    """The form's yardstick on the same grid: for each element that is not a plot a plain QLabel
+    in its rectangle, with the font and alignment of its text; a Polyline for each plot."""
+    cols, rows, placed = places(n, bool(view.trends))
     window = QWidget()
     window.setFixedSize(cols * TILE, rows * TILE)
-    texts, lines = [], []
-    for i, (kind, x, y, span) in enumerate(placed):
+    texts: list[Plain] = []
+    lines: list[Polyline] = []
+    for i, ((kind, x, y, span), (_, element)) in enumerate(zip(placed, view.pairs, strict=True)):
         if kind == "graph":  # the plot's drawing area, under its header
-            plot = plots[len(lines)]
+            plot = view.trends[len(lines)]
             widget: QWidget = Polyline(plot, window)
             lines.append(widget)
             widget.setGeometry(plot.plot.geometry().translated(x, y))
         else:
-            widget = QLabel("---", window)
-            texts.append((i, widget))
+            label = widget = QLabel("---", window)
+            font, align = text_look(element)
+            label.setFont(font)
+            label.setAlignment(align)
+            texts.append((label, kind, bit_addr(i) if kind == "label" else word_addr(i)))
             widget.setGeometry(x, y, span * TILE, TILE)
     return window, texts, lines
+
+
+def show_texts(plain: list[Plain], snap: Snapshot, workload: str) -> None:
+    """A yardstick tick: each label given the text its element shows of the snapshot (a gauge's
+    value converted as `Scaling.to_phy` does, PhyMin and AppMin 0: the same number, the same text)."""
+    app_max, phy_max, _ = WORKLOADS[workload]
+    for label, kind, addr in plain:
+        if kind == "label":
+            label.setText("ON" if snap.get_bit(addr) else "OFF")
+        elif kind == "hbar":
+            label.setText(f"{snap.get_word(addr) * phy_max / app_max:.1f} %")
+        else:
+            label.setText(f"{snap.get_word(addr) * phy_max / app_max:.1f}")
 
 
 def stats(values: array) -> tuple[float, float, float, float]:
@@ -251,10 +287,9 @@ def main() -> None:
     clock = FakeClock()  # stands still: the bench redraws the plots itself, every REDRAW_INTERVAL
     view = FormView(form, NullTarget(), clock=clock)
     view.show()
-    window, plain, lines = yardstick(n, view.trends)
+    window, plain, lines = yardstick(n, view)
     window.show()
     mem = Memory()
-    scale = WORKLOADS[args.workload][1] / WORKLOADS[args.workload][0]
     qmap, links = station(n), LinkView(links={0: True})
     app.processEvents()
     # allocated up front, so that the measurement itself does not grow the memory it measures
@@ -278,8 +313,7 @@ def main() -> None:
         times[tick] = (t2 - t0) * 1000
         models[tick] = (t1 - t0) * 1000
         t0 = time.perf_counter()
-        for i, label in plain:  # the text a model would make of the same word
-            label.setText(f"{snap.get_word(word_addr(i)) * scale:.1f}")
+        show_texts(plain, snap, args.workload)
         app.processEvents()
         yard[tick] = (time.perf_counter() - t0) * 1000
         if lines and tick % every == 0:  # the plots, then their yardstick (in the plots' new window)

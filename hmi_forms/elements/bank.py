@@ -10,7 +10,7 @@ and what draws it is handed what it shows now.
 
 from __future__ import annotations
 
-from collections.abc import Callable, Iterable, Sequence
+from collections.abc import Callable, Sequence
 from operator import itemgetter
 from typing import Any, Protocol
 
@@ -116,6 +116,8 @@ class Banked:
         self.sources = [m.sources()[0] for m in self.models]  # a plain element shows one operand
         self.bank = kind([address for address, _ in self.sources])
         self.puts = [f.put for f in self.faces]
+        kinds = {type(m) for m in self.models}  # many settled at once (`Element.settler`)
+        self.settle = (kinds.pop() if len(kinds) == 1 else Element).settler(self.models)
         self.fault = fault
         self.marked = np.zeros(len(self.models), dtype=bool)  # shown with a quality mark
         self.judged_by: QualityMap | None = None
@@ -131,16 +133,20 @@ class Banked:
         else:
             codes = self._judge(readings)
             general = np.flatnonzero((codes != Quality.GOOD) | self.marked)
-        new: Iterable[tuple[int, int]] = zip(positions, values)
         if len(general):
             apart = set(general.tolist())
-            new = [(i, v) for i, v in new if i not in apart]
+            kept = [(i, v) for i, v in zip(positions, values) if i not in apart]
+            positions, values = [i for i, _ in kept], [v for _, v in kept]
             for i in apart:
                 self._update(i, snap, None if codes is None else Quality(int(codes[i])))
+        try:
+            shown = self.settle(positions, values) if positions else []
+        except Exception:  # no log: settled one by one below, each fault reported with its element
+            shown = None
         models, puts, repaint = self.models, self.puts, []
-        for i, value in new:
+        for k, i in enumerate(positions):
             try:
-                if puts[i](models[i].settle(value)):
+                if puts[i](models[i].settle(values[k]) if shown is None else shown[k]):
                     repaint.append(i)
             except Exception as e:  # no log: the view's fault handler logs and shows it
                 self._failed(i, e)

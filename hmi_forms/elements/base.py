@@ -17,7 +17,7 @@ decided here once, for both:
 
 from __future__ import annotations
 
-from collections.abc import Callable, Mapping
+from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass, field
 from functools import cached_property
 from typing import Any, ClassVar
@@ -133,6 +133,13 @@ class Element:
         """Take a new value of its operand, read by its form's bank while its data are good, as
         `update` would, for a `plain` element; what it shows now (what its face draws)."""
         raise NotImplementedError(f"{self.TYPE} reads its own operands")
+
+    @classmethod
+    def settler(cls, models: Sequence[Element]) -> Callable[[list[int], list[int]], list[object]]:
+        """`settle` of many plain elements of its kind at once, as the form's bank calls it:
+        (positions in `models`, their new values) -> what each shows now. One by one, unless a
+        kind does better."""
+        return lambda positions, values: [models[i].settle(v) for i, v in zip(positions, values)]
 
     def failed(self) -> None:
         """Updating or drawing it raised: marked stale until its next good value."""

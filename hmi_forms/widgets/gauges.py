@@ -92,7 +92,7 @@ class GaugeWidget(ElementWidget):
         self._units = f" {model.Units}" if model.Units else ""
         self._fill = QRect()  # the bar's fill at zero length
         self._track = QRectF()  # the bar's track
-        self._value: TextSlot | None = None  # where the value text goes, drawn from cached pixmaps
+        self._value: TextSlot | None = None  # where the value text goes, drawn as a glyph run
         self._part: QRect | None = None  # what a new text alone repaints (None: the whole element)
         self._paint_value: Callable[[QPainter], None] = self._paint_needle  # by Appearance
         self._bar: tuple[int, int, int, float] = (0, 0, 0, 0.0)  # the fill's left, top, height and travel
@@ -117,7 +117,7 @@ class GaugeWidget(ElementWidget):
             self._digital = self._compute_digital_geometry()
             appearance = self.model.Appearance
             dpr = self.devicePixelRatioF()
-            bounds = QRectF(self.rect())  # the sprites never reach past the element
+            bounds = QRectF(self.rect())  # the value and needle never reach past the element
             if appearance == "hbar":
                 self._paint_value = self._paint_bar_value
                 track = self._track = self._bar_geometry()
@@ -132,14 +132,14 @@ class GaugeWidget(ElementWidget):
                 widest = QFontMetricsF(font).horizontalAdvance("0" * self.digits + self._units) + 6
                 area = box.adjusted(-3, -3, 3, 3)
                 area.setLeft(max(area.left(), area.right() - widest))
-                self._value = TextSlot(box, font, theme.RIGHT, dpr, area, bounds)
+                self._value = TextSlot(box, font, theme.RIGHT, area, bounds)
             elif appearance == "digital":
                 self._paint_value = self._paint_digital_value
                 box, size, units_w = self._digital
                 text = box.adjusted(6, 0, -6 - units_w, 0)  # the units keep 8 px clear on its right
                 fill = QRectF(box.left() + 2, box.top() + 2, text.right() + 6 - box.left(), box.height() - 4)
                 font = theme.sized_font(size, bold=True, family=theme.MONO)
-                self._value = TextSlot(text, font, theme.RIGHT, dpr, fill, bounds)
+                self._value = TextSlot(text, font, theme.RIGHT, fill, bounds)
             else:
                 self._paint_value = self._paint_needle
                 c, r, start, sweep = self._dial
@@ -148,7 +148,7 @@ class GaugeWidget(ElementWidget):
                                           QPointF(-0.12 * r, 0), QPointF(0, -0.045 * r)])
                 box, size = self._box
                 self._value = TextSlot(box, theme.sized_font(size, bold=True, family=theme.MONO),
-                                       Qt.AlignmentFlag.AlignCenter, dpr, box.adjusted(2, 2, -2, -2), bounds)
+                                       Qt.AlignmentFlag.AlignCenter, box.adjusted(2, 2, -2, -2), bounds)
                 key = (c.toTuple(), r, start, sweep, self._travel, dpr)
                 self._needles = SPRITES.family(key) if r <= SPRITE_DIAL else None
                 # a dial squeezed below its least radius pokes out: its needle needs the clip (a

@@ -1,23 +1,21 @@
-"""Pixmaps of what a form draws again and again: glyphs of value texts and dial needles.
+"""What a form draws again and again, kept apart from the values: value texts and dial needles.
 
-A value is drawn from pictures that do not depend on the value: its text glyph by glyph, each
-glyph a pixmap cached by character, colours and the fraction of a pixel it starts at (a font's
-advances are whole 64ths of a pixel, so a character has at most 64 x 64 of those), and a needle
-by the pixel its tip travels to. So what the caches hold is bounded by the characters, colours
-and sizes a form uses, whatever the values: a plant's words over their whole range cost no more
-memory than a demo's few. Copying a few small pixmaps costs less than laying out a text, and the
-pixels are the same: each glyph is drawn into its pixmap at the same fraction of a pixel it has
-on the form, so Qt rounds and antialiases it there exactly as it would drawing the whole text.
-Pixmaps of all families are shared by the whole process and bounded in bytes.
+A value is drawn from parts that do not depend on the value. Its text is one glyph run
+(`QPainter.drawGlyphRun`): the font's glyph indexes at the places Qt's own text layout gives them,
+drawn from Qt's glyph cache; that is the call `drawText` ends in after laying the text out, so the
+pixels are drawText's, without a layout per text (the costly part) and without a picture per
+value. What is kept for texts is bounded by the characters and advances of the fonts a form uses.
+A needle is a pixmap by the pixel its tip travels to. So whatever the values, the caches stay
+bounded: a plant's words over their whole range cost no more memory than a demo's few. Pixmaps
+of all families are shared by the whole process and bounded in bytes.
 """
-
 from __future__ import annotations
 
 import math
 from collections.abc import Hashable
 
 from PySide6.QtCore import QPoint, QPointF, QRect, QRectF, QSize, Qt
-from PySide6.QtGui import QColor, QFont, QFontMetricsF, QPainter, QPixmap
+from PySide6.QtGui import QColor, QFont, QFontMetricsF, QGlyphRun, QPainter, QPixmap, QRawFont
 
 BUDGET = 64 * 2**20  # bytes of cached pixmaps in all
 
@@ -77,39 +75,45 @@ class Ink:
         self.key = fore.rgba() << 33 | (0 if back is None else 1 << 32 | back.rgba())  # one int: fast to hash
 
 
-PAD = 3  # px around a glyph's pixmap for what overhangs its advance (bold, antialiasing)
+PAD = 3  # px around a glyph's advance that its ink may reach (bold, antialiasing): past a clip, it is cut
+MAX_RUNS = 4096  # layouts kept per font (`Glyphs.layout`), by the advances of a text, not its characters
+MAX_PLANS = 64  # places kept per text slot (`TextSlot._plan`), by width and the slot's offset
 
 
 class Glyphs:
-    """The glyphs of one font at one device pixel ratio: advances, kerning checks and pixmaps."""
+    """The glyphs of one font: advances, kerning checks, glyph indexes and the layouts of texts
+    (the same at every device pixel ratio: Qt's glyph cache renders them for the device)."""
 
-    def __init__(self, font: QFont, dpr: float) -> None:
-        self.font, self.dpr = font, dpr
+    def __init__(self, font: QFont) -> None:
+        self.font = font
         self.metrics = QFontMetricsF(font)
+        self.raw = QRawFont.fromFont(font)
         self.ascent = math.ceil(self.metrics.ascent())
-        self.below = math.ceil(self.metrics.height()) + PAD + 1 - self.ascent  # pixmap rows below the base
-        self.height = math.ceil(self.metrics.height()) + 2 * PAD + 1  # of its pixmaps
+        self.below = math.ceil(self.metrics.height()) + PAD + 1 - self.ascent  # ink rows below the base
         self.advances: dict[str, float] = {}
         self.advances64: dict[str, int] = {}  # the same in 64ths of a pixel, as Qt keeps them
-        self.widths: dict[str, int] = {}
+        self.indexes: dict[str, int] = {}  # glyph index in the font
         self.alone: set[str] = set()  # characters whose advance is the same beside every other here
-        self.kerned: set[str] = set()  # characters whose advance changes beside one of them
-        self.pixmaps = SPRITES.family(("glyphs", font.key(), dpr))  # (char, ink, fx, fy) -> Sprite
+        self.kerned: set[str] = set()  # kerned, or not in the font itself (drawText takes another font)
+        self.layouts: dict[tuple[int, ...], tuple[int, list[QPointF]]] = {}  # `layout`
 
     def learn(self, text: str) -> bool:
-        """Whether `text` can be drawn glyph by glyph: no two of its characters kerned together
-        (drawText would move them); each new character is checked once against those known."""
+        """Whether `text` can be drawn as a glyph run: each character a glyph of the font itself
+        and no two kerned together (drawText would move them); each new character is checked once
+        against those known."""
         for c in set(text) - self.alone:
             if c in self.kerned:
                 return False
+            found = self.raw.glyphIndexesForString(c)
             adv = self.metrics.horizontalAdvance
             own = self.advances[c] = adv(c)
-            self.advances64[c] = round(own * 64)
-            self.widths[c] = math.ceil(own) + 2 * PAD + 1  # of its pixmaps
-            if any(adv(c + k) != own + self.advances[k] or adv(k + c) != own + self.advances[k]
-                   for k in (*self.alone, c) if k != c) or adv(c + c) != 2 * own:
+            if len(found) != 1 or not found[0] or any(
+                    adv(c + k) != own + self.advances[k] or adv(k + c) != own + self.advances[k]
+                    for k in (*self.alone, c) if k != c) or adv(c + c) != 2 * own:
                 self.kerned.add(c)
                 return False
+            self.indexes[c] = found[0]
+            self.advances64[c] = round(own * 64)
             self.alone.add(c)
         return True
 
@@ -117,43 +121,39 @@ class Glyphs:
         advances = self.advances
         return sum([advances[c] for c in text])
 
-    def glyph(self, c: str, ink: Ink, fx: int, fy: int) -> Sprite:
-        """The glyph of `c` in `ink` whose origin lies (fx, fy) 64ths of a pixel right of and below
-        a whole pixel (Qt places glyphs in 64ths too): its pixmap's corner relative to that pixel."""
-        key = (c, ink.key, fx, fy)
-        sprite = self.pixmaps.get(key)
-        if sprite is None:
-            width = self.widths[c]
-            pix = blank(QSize(width, self.height), self.dpr, None)  # (`TextSlot.draw` cuts it)
-            p = QPainter(pix)
-            try:  # a painter left open on a pixmap crashes Qt when the pixmap goes
-                p.setRenderHint(QPainter.RenderHint.Antialiasing)
-                p.setFont(self.font)
-                p.setPen(ink.fore)
-                p.drawText(QPointF(PAD + fx / 64, PAD + self.ascent + fy / 64), c)
-            finally:
-                p.end()
-            sprite = SPRITES.put(self.pixmaps, key, (-PAD, -PAD - self.ascent, pix))
-        return sprite
+    def layout(self, text: str) -> tuple[int, list[QPointF]]:
+        """The width of `text` and its glyphs' places from its start, in 64ths of a pixel as Qt
+        lays a line out: advanced by each glyph's advance, itself whole 64ths. Kept by the
+        advances (the digits of a value share theirs), so a few layouts serve every value."""
+        key = tuple(map(self.advances64.__getitem__, text))
+        found = self.layouts.get(key)
+        if found is None:
+            at, places = 0, []
+            for step in key:
+                places.append(QPointF(at / 64, 0))
+                at += step
+            if len(self.layouts) >= MAX_RUNS:
+                self.layouts.clear()
+            found = self.layouts[key] = (at, places)
+        return found
 
 
-GLYPHS: dict[tuple[str, float], Glyphs] = {}  # by font key and device pixel ratio
+GLYPHS: dict[str, Glyphs] = {}  # by font key
 
 
 class TextSlot:
-    """A text box drawn glyph by glyph from cached pixmaps, pixel for pixel what
-    `drawText(box, align, text)` gives.
+    """A text box drawn as a glyph run, pixel for pixel what `drawText(box, align, text)` gives.
 
     `area` (by default the box with a margin for glyphs that overhang it) inside `bounds` (the
     element's rectangle) is what a new text repaints: filled with `back`, the flat colour of that
     area, when the ink has one and the text lies inside it (`inside`). A text wider than the area
-    (a small gauge's readout of a wide range) is drawn from glyphs too, over what is there, cut
+    (a small gauge's readout of a wide range) is drawn as a glyph run too, over what is there, cut
     where drawText cuts a text wider than its box (the box, its edges rounded to whole pixels)
     and where the form's clip cuts the element (`bounds`); without `bounds`, or when the font
     kerns its characters, a text is drawn whole by the painter (`fits` says which)."""
 
-    def __init__(self, box: QRectF, font: QFont, align: Qt.AlignmentFlag, dpr: float = 1.0,
-                 area: QRectF | None = None, bounds: QRectF | None = None) -> None:
+    def __init__(self, box: QRectF, font: QFont, align: Qt.AlignmentFlag, area: QRectF | None = None,
+                 bounds: QRectF | None = None) -> None:
         area = box.adjusted(-3, -3, 3, 3) if area is None else area
         if bounds is not None:
             area = area.intersected(bounds)
@@ -164,8 +164,8 @@ class TextSlot:
         self.box = box
         self.font = font
         self.align = align
-        key = (font.key(), dpr)
-        glyphs = self.glyphs = GLYPHS.get(key) or GLYPHS.setdefault(key, Glyphs(font, dpr))
+        key = font.key()
+        glyphs = self.glyphs = GLYPHS.get(key) or GLYPHS.setdefault(key, Glyphs(font))
         self.metrics = glyphs.metrics
         # where drawText puts the baseline of one line in this box: the same for every text
         self.base = self.metrics.boundingRect(box, int(align.value), "0").top() + self.metrics.ascent()
@@ -198,6 +198,10 @@ class TextSlot:
             self.anchor, self.pull = box.left(), 0.0
         self.row, self.fy = divmod(int(self.base * 64), 64)  # the baseline in pixels and 64ths
         self.span64, self.box64 = self.span * 64, box.width() * 64
+        self.plans: dict[tuple[int, int, int], tuple[QPointF, QRect | None]] = {}  # `_plan`
+        self.run = QGlyphRun()  # the text shown last, laid out
+        self.run.setRawFont(glyphs.raw)
+        self.text, self.places = "", glyphs.layout("")[1]
 
     @property
     def rect(self) -> QRect:
@@ -231,43 +235,52 @@ class TextSlot:
         p.drawText(self.box.translated(x, y), self.align, text)  # drawn whole, as drawText would
 
     def paint(self, p: QPainter, text: str, ink: Ink, x: int = 0, y: int = 0) -> None:
-        """`draw` of a text that `fits`, glyph by glyph. Positions are in 64ths of a pixel, as Qt
-        lays a line out in the element: its start made whole 64ths once (QFixed::fromReal), then
-        advanced by each glyph's advance, itself whole 64ths."""
-        glyphs = self.glyphs
-        advances = glyphs.advances64
-        width = sum(map(advances.__getitem__, text))
+        """`draw` of a text that `fits`, as one glyph run (the slot's own: refilled only with a
+        new text, its places only with new advances)."""
+        width, places = self.glyphs.layout(text)
+        plan = self.plans.get((width, x, y)) or self._plan(width, x, y)
+        origin, cut = plan
         if ink.back is not None and width <= self.span64:  # the flat colour under the text, opaque
             p.fillRect(x + self.left, y + self.top, self.size.width(), self.size.height(), ink.back)
+        run = self.run
+        if text != self.text:
+            self.text = text
+            run.setGlyphIndexes(list(map(self.glyphs.indexes.__getitem__, text)))
+            if places is not self.places:
+                self.places = places
+                run.setPositions(places)
+        p.setPen(ink.fore)
+        if cut is None:  # (the usual case: nothing to cut)
+            p.drawGlyphRun(origin, run)
+        elif p.hasClipping():  # drawn with a painter, clipped to its element already
+            p.save()
+            p.setClipRect(cut, Qt.ClipOperation.IntersectClip)
+            p.drawGlyphRun(origin, run)
+            p.restore()
+        else:
+            p.setClipRect(cut)
+            p.drawGlyphRun(origin, run)
+            p.setClipping(False)
+
+    def _plan(self, width: int, x: int, y: int) -> tuple[QPointF, QRect | None]:
+        """Where a text of `width` 64ths starts with the box moved by (x, y), and where it is cut
+        (None: nowhere). Its start is made whole 64ths once, as Qt makes it (QFixed::fromReal);
+        where its glyphs may reach past the element's sides or past the box drawText clips a too
+        wide text to, it is clipped there as drawText would be. Kept per width and place: a
+        slot shows texts of a few widths at one or two places."""
+        glyphs = self.glyphs
         at = int(self._left(width / 64) * 64) + (x << 6)
-        gy, fy = self.row + y, self.fy
+        gy = self.row + y
         clip = self.cut if width > self.box64 or self.tall else self.sides
-        get, glyph, key = glyphs.pixmaps.get, glyphs.glyph, ink.key
-        if clip is None or (clip[0] + x <= (at >> 6) - PAD and (at + width >> 6) + PAD + 2 <= clip[2] + x and
-                            clip[1] + y <= gy - PAD - glyphs.ascent and gy + glyphs.below <= clip[3] + y):
-            for c in text:  # (the usual case: nothing to cut)
-                fx = at & 63
-                dx, dy, pix = get((c, key, fx, fy)) or glyph(c, ink, fx, fy)
-                p.drawPixmap((at >> 6) + dx, gy + dy, pix)
-                at += advances[c]
-            return
-        x0, y0, x1, y1 = clip[0] + x, clip[1] + y, clip[2] + x, clip[3] + y
-        dpr, height = glyphs.dpr, glyphs.height
-        for c in text:
-            fx = at & 63
-            dx, dy, pix = get((c, key, fx, fy)) or glyph(c, ink, fx, fy)
-            gx, top = (at >> 6) + dx, gy + dy
-            right, bottom = gx + glyphs.widths[c], top + height
-            if x0 <= gx and right <= x1 and y0 <= top and bottom <= y1:
-                p.drawPixmap(gx, top, pix)
-            elif gx < x1 and x0 < right and top < y1 and y0 < bottom:  # cut as a clip would cut it
-                a, b, t, u = max(x0, gx), min(x1, right), max(y0, top), min(y1, bottom)
-                if dpr == 1.0:
-                    p.drawPixmap(a, t, pix, a - gx, t - top, b - a, u - t)
-                else:
-                    p.drawPixmap(a, t, pix, round((a - gx) * dpr), round((t - top) * dpr),
-                                 round((b - a) * dpr), round((u - t) * dpr))
-            at += advances[c]
+        cut = None
+        if clip is not None and not (
+                clip[0] + x <= (at >> 6) - PAD and (at + width >> 6) + PAD + 2 <= clip[2] + x and
+                clip[1] + y <= gy - PAD - glyphs.ascent and gy + glyphs.below <= clip[3] + y):
+            cut = QRect(clip[0] + x, clip[1] + y, clip[2] - clip[0], clip[3] - clip[1])
+        if len(self.plans) >= MAX_PLANS:
+            self.plans.clear()
+        plan = self.plans[(width, x, y)] = (QPointF(at / 64, gy + self.fy / 64), cut)
+        return plan
 
 
 def draw_text(p: QPainter, slot: TextSlot, x: int, y: int, text: str, ink: Ink) -> None:
