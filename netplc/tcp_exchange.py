@@ -382,10 +382,13 @@ class TcpHub:
         self._thread.start()
 
     def stop(self, timeout: float = 5.0) -> None:
+        """The thread may see `_stopping` and end before the wake-up is sent: the sending end is
+        closed here, after the join, never by the thread."""
         self._stopping = True
         self._wake()
         if self._thread.is_alive():
             self._thread.join(timeout)
+        self._wake_w.close()
 
     # --- from other threads ----------------------------------------------------------------------
 
@@ -406,8 +409,14 @@ class TcpHub:
         self._wake()
 
     def _wake(self) -> None:
-        with contextlib.suppress(BlockingIOError):  # the pipe is full of wake-ups already
+        try:
             self._wake_w.send(b"\0")
+        except BlockingIOError:  # the pipe is full of wake-ups already
+            pass
+        except OSError:
+            if not self._stopping:
+                raise
+            # stopped meanwhile (a name looked up as the hub stops): nobody left to wake
 
     # --- on the thread ---------------------------------------------------------------------------
 
@@ -475,7 +484,6 @@ class TcpHub:
                 node.close()
             self.selector.close()
             self._wake_r.close()
-            self._wake_w.close()
             if self._resolver is not None:
                 self._resolver.shutdown(wait=False, cancel_futures=True)
 

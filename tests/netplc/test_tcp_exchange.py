@@ -267,3 +267,19 @@ def test_a_standby_engine_sends_no_writes() -> None:
     finally:
         st.stop()
         sim.stop()
+
+
+def test_a_stop_the_thread_saw_before_its_wake_up_was_sent_ends_cleanly() -> None:
+    """The thread may see the stop flag and end before `stop` sends its wake-up (a busy thread, a
+    loaded PC): the wake-up must still find its socket, and a late call from a helper thread is
+    dropped (CI once failed with EBADF here)."""
+    from netplc.tcp_exchange import TcpHub
+
+    hub = TcpHub()
+    hub.start()
+    hub._stopping = True  # as `stop` does first, and the thread sees it before the wake-up
+    hub._wake()
+    hub._thread.join(5)
+    assert not hub._thread.is_alive()
+    hub.stop()
+    hub.call(lambda: None)
