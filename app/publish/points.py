@@ -16,7 +16,7 @@ from dataclasses import dataclass
 from app.authority import Action, Commands, Reason, Ticket, Who
 from app.scada.quality import Operands, QualityMap
 from app.scada.readings import Readings
-from app.scada.tag import SIZES, Tag, TagReader, TagType, check_address
+from app.scada.tag import Tag, TagReader, TagType, check_address
 from netplc.address import IO_BITS, AddressError
 from netplc.lazy import lazy
 
@@ -86,7 +86,7 @@ class PointReader:
             try:
                 self._judge = np.array([qm.position(t.name) for t in self.tags], dtype=np.intp)
             except KeyError:
-                self._judge = qm.operands([(t.address, SIZES[t.type]) for t in self.tags])
+                self._judge = qm.operands([t.operand for t in self.tags])
         if isinstance(self._judge, Operands):
             return readings.judge(self._judge)
         return readings.codes[self._judge]

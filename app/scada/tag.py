@@ -211,6 +211,12 @@ class Tag:
         text = f"{phy:.{self.decimals}f}"
         return f"{text} {self.unit}" if self.unit else text
 
+    @property
+    def operand(self) -> tuple[int, int]:
+        """(address, bytes), bytes 0 for a bit: the tag as an element's `sources()` names an operand,
+        for the readers that judge or watch operands (quality, a console's watched memory)."""
+        return self.address, SIZES[self.type]
+
     def footprint(self) -> tuple[int, int]:
         """[first, last) in the HMI bit space (I/O bit n = n, data bit = byte*8+bit) that the tag
         occupies: what `quality.py` overlaps with the blocks NREADs fill."""

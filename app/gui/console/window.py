@@ -61,7 +61,6 @@ from app.publish.console import ConsoleClient, StationCommands
 from app.publish.memory_items import NOTHING, WHOLE, Ranges, ranges_of
 from app.scada.alarms import AlarmRow
 from app.scada.readings import Readings
-from app.scada.tag import SIZES
 from app.scada.trends import TrendBook
 from hmi_forms.elements.base import Writer
 from hmi_forms.elements.reads import operands
@@ -219,7 +218,7 @@ class ConsoleWindow(QMainWindow):
                              lambda: self.client.user, self)
         key = f"trends {id(window)}"  # each window its own want, dropped when it closes
         window.watching.connect(lambda tags: self.client.want(
-            key, ranges_of((t.address, SIZES[t.type]) for t in tags) if tags else None))
+            key, ranges_of(t.operand for t in tags) if tags else None))
         window.show()
         self.windows.append(window)
         return window
