@@ -18,7 +18,7 @@ from app.authority.policy import OPERATOR, ROLES
 from app.scada.tag import TagType
 from netplc.address import fmt_octal, is_data_byte, is_io_bit, parse_hmi_bit, parse_octal
 from netplc.exchange import NODE_DEFAULTS, NodeConfig, shared_problems
-from netplc.modbus import Endpoint, line_problems
+from netplc.modbus import Endpoint, default_stopbits, line_problems
 from netplc.problems import Problems
 from netplc.textfile import TextFileError, file_problem, read_text, resolve
 from registrar.plant.url import is_url, url_problem
@@ -650,7 +650,7 @@ def _serial_port(r: _Reader) -> Endpoint | None:
         return None
     baudrate = r.get("baudrate")
     parity = r.get("parity").upper()
-    stopbits = r.get("stopbits", 2 if parity == "N" else 1)
+    stopbits = r.get("stopbits", default_stopbits(parity))
     serial = Endpoint("rtu", device=device, baudrate=baudrate, parity=parity, stopbits=stopbits)
     found = line_problems(serial)
     for key, text in found:

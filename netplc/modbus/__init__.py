@@ -10,7 +10,7 @@ every minor release.
 """
 
 from netplc.modbus.client import LeanTcpClient, ModbusClient, open_client
-from netplc.modbus.endpoint import Endpoint, line_problems, parse_endpoint
+from netplc.modbus.endpoint import Endpoint, default_stopbits, line_problems, parse_endpoint
 from netplc.modbus.frames import Frame, FrameError, answer_data, frame_size
 from netplc.modbus.loop import LoopThread
 from netplc.modbus.map import (
@@ -79,6 +79,7 @@ __all__ = [
     "Table",
     "answer_data",
     "bytes_from_words",
+    "default_stopbits",
     "describe",
     "exception_text",
     "frame_size",

@@ -72,13 +72,18 @@ def parse_endpoint(text: str) -> Endpoint:
             else:
                 raise ValueError(f"endpoint {text!r}: unknown option {key!r} "
                                  "(baudrate, parity, bytesize, stopbits)")
-        if options.get("parity") == "N":
-            options.setdefault("stopbits", 2)
+        if "parity" in options:  # else the defaults, even parity and 1 stop bit, keep the rule
+            options.setdefault("stopbits", default_stopbits(options["parity"]))
         endpoint = Endpoint("rtu", device=device, **options)
         if problems := line_problems(endpoint):
             raise ValueError(f"endpoint {text!r}: {problems[0][1]}")
         return endpoint
     raise ValueError(f"endpoint {text!r}: unknown scheme {url.scheme!r} ({forms})")
+
+
+def default_stopbits(parity: str) -> int:
+    """The Modbus serial line's rule, 11 bits a character: 1 stop bit after a parity bit, 2 without."""
+    return 2 if parity == "N" else 1
 
 
 def line_problems(endpoint: Endpoint) -> list[tuple[str, str]]:
