@@ -22,6 +22,13 @@ from netplc.modbus.endpoint import Endpoint
 from netplc.modbus.map import BIT_TABLES, MapError, Table, bytes_from_bits
 from netplc.modbus.pdu import MBAP, READ_CODES, READ_TABLES, DeviceError, LinkError, ProtocolError
 
+try:  # pyserial sets a POSIX port up through termios, whose error is not an OSError
+    from termios import error as _termios_error
+
+    PORT_ERRORS: tuple[type[Exception], ...] = (_termios_error,)
+except ImportError:  # Windows: pyserial's SerialException is an OSError
+    PORT_ERRORS = ()
+
 # pymodbus logs every refused connect and every timeout; the exchange reports link changes itself
 # (node statistics and 'system' records), so a dead node must not flood the log.
 logging.getLogger("pymodbus").setLevel(logging.CRITICAL)
@@ -50,9 +57,18 @@ class PymodbusClient:
         return self._client is not None and self._client.connected
 
     async def connect(self) -> None:
+        """A port that the system will not open or set up as asked (no such device, a setting the
+        driver refuses: termios says EINVAL for parity on a pty) is a link fault with the
+        system's reason, not an internal error of the exchange."""
         self.close()
         self._client = self._make()
-        if not await self._client.connect():
+        try:
+            connected = await self._client.connect()
+        except (OSError, ValueError, *PORT_ERRORS) as e:
+            self.close()
+            reason = OSError(*e.args) if isinstance(e, PORT_ERRORS) else e  # "[Errno 22] Invalid argument"
+            raise LinkError(f"cannot open {self.endpoint}: {reason}") from e
+        if not connected:
             self.close()
             raise LinkError(f"cannot connect to {self.endpoint}")
 

@@ -138,6 +138,24 @@ def test_two_nodes_share_the_line_and_a_silent_one_only_fails_itself(rtu_node: R
         st.stop()
 
 
+def test_a_port_that_refuses_its_settings_is_a_link_fault_with_the_reason(
+        rtu_node: RtuNode, caplog: pytest.LogCaptureFixture) -> None:
+    """A pty takes no parity: termios refuses the line's default even parity (EINVAL). The node
+    is down with the system's reason, as for an absent port, and the exchange logs no error of
+    its own."""
+    program = "TNA $03760\nFON C:$02100 N:NODE S:0\nFON C:$02104 N:NREAD S:4000 D:$04000 R:2\nJMP 0\n"
+    st = Station(program, [NodeConfig(0, f"rtu://{rtu_node.port}", unit=UNIT, timeout=0.2, retries=0)])
+    st.start()
+    try:
+        wait_until(lambda: st.exchange.stats[0].errors >= 1)
+        error = st.exchange.stats[0].last_error
+        assert error.startswith(f"cannot open rtu://{rtu_node.port}?baudrate=19200&parity=E: [Errno 22] ")
+        assert "internal error" not in error and st.engine.snapshot.get_bit(0o2105) == 0
+        assert not [r for r in caplog.records if r.levelname == "ERROR"]
+    finally:
+        st.stop()
+
+
 def test_nodes_on_one_port_need_the_same_line_settings() -> None:
     with pytest.raises(ValueError, match=r"node 2: .* share /dev/ttyS7 with different line settings"):
         Station("JMP 0\n", [NodeConfig(1, "rtu:///dev/ttyS7?baudrate=9600"),
