@@ -77,6 +77,27 @@ def _collect_on_the_gui_thread(request: pytest.FixtureRequest):
     gc.collect()
 
 
+@pytest.fixture(autouse=True)
+def _no_log_handler_outlives_its_test():
+    """A test that runs a `main.py` command in this process (app.cli.main) has the station's log
+    configured onto the stderr pytest captured for that test (app/logs.py), which is closed when
+    the test ends: a later warning from a thread of another test would then fail to write
+    ("--- Logging error ---") instead of reaching the report. The station's handlers (pytest's own
+    come and go by phase) and the excepthooks go with their test."""
+    import logging
+    import threading
+
+    root = logging.getLogger()
+    handlers, level = list(root.handlers), root.level
+    hooks = sys.excepthook, threading.excepthook
+    yield
+    for handler in [h for h in root.handlers if getattr(h, "_netplc", False) and h not in handlers]:
+        root.removeHandler(handler)
+        handler.close()
+    root.setLevel(level)
+    sys.excepthook, threading.excepthook = hooks
+
+
 @pytest.fixture
 def russian(qapp):
     """The console's Russian installed for the test (and removed after it)."""
