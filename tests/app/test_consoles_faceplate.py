@@ -20,7 +20,7 @@ from netplc.records import Record
 from registrar.store import Store
 from tests.app.conftest import copy_demo
 from tests.app.test_console import Answers, element
-from tests.app.test_consoles import ANALOG, WAIT, Attach, Station, attach, watched  # noqa: F401 - attach
+from tests.app.test_consoles import ANALOG, WAIT, Attach, Station, attach, serving, watched  # noqa: F401
 
 TEMP_RAW = 0o4012  # TEMP's word (0..1000 raw = -50..150 °C)
 SETPOINT = 0o4030  # TEMP_SP's word (0..4095 raw = -50..150 °C)
@@ -38,11 +38,8 @@ def station(tmp_path_factory: pytest.TempPathFactory) -> Iterator[tuple[Station,
     for ts in times:
         store.put(Record(ts, "data", grp=1, type=2, source="04012", value=500))
     store.close()
-    st = Station(folder)
-    try:
+    with serving(folder) as st:
         yield st, times
-    finally:
-        st.stop()
 
 
 def open_plate(qtbot, window: ConsoleWindow, name: str) -> Faceplate:
