@@ -11,6 +11,12 @@ setpoint entry, acknowledge and shelve of its alarms, and for whoever may force,
 unforce. Each action is a command of the station's command layer as the user on duty, greyed
 with the role it needs when the layer would refuse it, its refusal said in the faceplate; forces
 are confirmed as in the Program view, the unforce question saying that the forced value stays.
+
+The same faceplate opens from the same elements at the local workstation and at a remote console
+(`main.py console`); what differs is the seat's `Console`: the in-process runtime's readings, the
+archive file and the station's layer, or a station over OPC UA (the readings of the tag's part of
+the memory, watched while the faceplate is open; its Historical Access; its WriteTag, ForceTag
+and UnforceTag methods, which the station checks and journals with the console's user).
 """
 
 from __future__ import annotations
@@ -39,7 +45,7 @@ from PySide6.QtWidgets import (
     QWidget,
 )
 
-from app.authority import Action, Answer, Commands, Ticket, Who, write_range
+from app.authority import Action, Answer, Ticket, Who, write_range
 from app.gui import words
 from app.gui.alarm_summary import AlarmSummary, ShelveDialog
 from app.gui.bridge import Answers
@@ -50,17 +56,20 @@ from app.scada.quality import Quality
 from app.scada.readings import Readings
 from app.scada.tag import Tag, TagType
 from hmi_forms.elements.base import Element, Writer
+from hmi_forms.elements.target import CommandTarget
 from hmi_forms.widgets.base import ElementWidget
 from hmi_forms.widgets.form_view import FormView
 from hmi_forms.widgets.trend import TrendWidget
 from netplc.address import fmt_octal
-from registrar.query import SeriesKey
+from registrar.query import SeriesKey, available
+from registrar.reading import ArchiveSource
 
 logger = logging.getLogger(__name__)
 
 HOUR = 3600.0
 LIVE_POINTS = 7200  # live samples kept: an hour at two a second
 TREND_POINTS = 1200  # read from the archive for the hour shown
+Operand = tuple[int, int]  # (address, bytes): a tag's `operand`
 
 
 def tag_of(model: Element, tags: Sequence[Tag]) -> Tag | None:
@@ -88,18 +97,34 @@ def _tag_at(operands: Sequence[tuple[int, int]], tags: Sequence[Tag]) -> Tag | N
     return None
 
 
+def _reads_all(_key: str, _operand: Operand | None) -> None:
+    """The in-process runtime's readings hold all of the memory: nothing to ask for."""
+
+
+def _holds_all(_operand: Operand) -> bool:
+    return True
+
+
 @dataclass
 class Console:
-    """What a faceplate needs of the workstation: its commands as the user on duty, where their
-    answers come back, how it asks, the archive, the alarms of the station."""
+    """What a faceplate needs of the seat it opens at, the local workstation or a remote console
+    (one faceplate for both: only these differ): the station's command layer as the seat reaches
+    it (`CommandTarget`: the station's own layer, or its methods over OPC UA), who is on duty,
+    where the answers come back, how it asks, the station's archive (its file, or an
+    `ArchiveSource`: a station's Historical Access), the station's alarms (their definitions and
+    the seat's summary of their states). `watch(key, operand)` asks the seat's data source for a
+    part of the memory while a faceplate shows it (None: no more), `covers(operand)` says whether
+    the readings it gives now hold it (a remote console reads only what its views want)."""
 
-    commands: Commands
+    target: CommandTarget
     who: Callable[[], Who]
     answers: Answers
     ask: Callable[[str, str], bool]
-    archive: Path
+    archive: Path | ArchiveSource
     defs: Sequence[AlarmDef]
     summary: AlarmSummary
+    watch: Callable[[str, Operand | None], None] = _reads_all
+    covers: Callable[[Operand], bool] = _holds_all
 
 
 class Faceplate(QDialog):
@@ -214,9 +239,12 @@ class Faceplate(QDialog):
                        (self.unforce, None, Action.UNFORCE), (self.ack, None, Action.ACKNOWLEDGE),
                        (self.shelve, None, Action.SHELVE))
         self.show_rights()
+        self.watching = f"faceplate:{tag.name}"  # the part of the memory it shows, while open
+        console.watch(self.watching, tag.operand)
+        self.finished.connect(self._release)
         self.loader = SeriesLoader(TREND_POINTS, self)
         self.loader.answered.connect(self._history)
-        if console.archive.exists():
+        if available(console.archive):
             now, key = dt.datetime.now(), SeriesKey("data", None, None, fmt_octal(tag.address))
             for day in sorted({(now - dt.timedelta(hours=1)).date(), now.date()}):
                 self.loader.request(console.archive, day, key)
@@ -228,13 +256,15 @@ class Faceplate(QDialog):
         tooltip of what is greyed."""
         who = self.console.who()
         for button, entry, action in self.grants:
-            why = self.console.commands.denial(who, action, what=button.text().rstrip("…"))
+            why = self.console.target.denial(who, action, what=button.text().rstrip("…"))
             button.setEnabled(why is None)
             button.setToolTip("" if why is None else words.refusal(why))
             if entry is not None:
                 entry.setEnabled(why is None)
 
     def show_readings(self, readings: Readings) -> None:
+        if not self.console.covers(self.tag.operand):  # not yet read for it
+            return
         self.readings = readings
         reading = readings.tag(self.tag.name)
         self.value.setText(self.tag.format(reading.value) if not math.isnan(reading.value) else "?")
@@ -304,7 +334,7 @@ class Faceplate(QDialog):
         if value is None:
             return None
         what = self.tr("Set {0}").format(self.tag.name)
-        return self._follow(what, self.console.commands.write_tag(self.console.who(), self.tag.name, value),
+        return self._follow(what, self.console.target.write_tag(self.console.who(), self.tag, value),
                             lambda a: self.entry.clear() if a.ok else None)
 
     def force_value(self) -> Ticket | None:
@@ -326,7 +356,7 @@ class Faceplate(QDialog):
                 tag.name, to)):
             return None
         return self._follow(self.tr("Force {0}").format(tag.name),
-                            self.console.commands.force_tag(self.console.who(), tag.name, phy))
+                            self.console.target.force_tag(self.console.who(), tag, phy))
 
     def unforce_value(self) -> Ticket | None:
         shown = self.value.text()
@@ -334,7 +364,7 @@ class Faceplate(QDialog):
                                 + words.unforce_stays(shown if shown != "?" else "")):
             return None
         return self._follow(self.tr("Unforce {0}").format(self.tag.name),
-                            self.console.commands.unforce_tag(self.console.who(), self.tag.name))
+                            self.console.target.unforce_tag(self.console.who(), self.tag))
 
     def unacknowledged(self) -> list[AlarmRow]:
         return [r for r in self.console.summary.rows if r.id in self.alarm_rows and not r.acked]
@@ -355,8 +385,13 @@ class Faceplate(QDialog):
         dialog.open()
         return dialog
 
-    def closeEvent(self, event: object) -> None:
+    def _release(self) -> None:
+        """Closed (or done with Escape): its reads stop, and so does the watch of its tag."""
         self.loader.close()
+        self.console.watch(self.watching, None)
+
+    def closeEvent(self, event: object) -> None:
+        self._release()
         super().closeEvent(event)  # type: ignore[arg-type]
 
 

@@ -93,6 +93,8 @@ class MainWindow(QMainWindow):
         self.session = Session(Users(station.folder), default=station.operator.default_user,
                                idle=station.operator.idle_logout)
         self.answers = Answers()  # every command's answer, on the GUI thread
+        self.target = EngineTarget(self.commands, lambda user: Who(user, Source.CONSOLE),  # the views'
+                                   on_answer=self.answers.follow, say=words.answer)
         self.answers.answered.connect(self._answered)
         self.rights = Rights(self.commands, lambda: self.who)
         # the form elements that write, with their own tooltip
@@ -125,7 +127,7 @@ class MainWindow(QMainWindow):
         self.form_problems = self._load_forms()
         alarms = runtime.alarms
         self.faceplates = Faceplates(  # a tag's faceplate from any element bound to it
-            Console(self.commands, lambda: self.who, self.answers, lambda title, text: self.ask(title, text),
+            Console(self.target, lambda: self.who, self.answers, lambda title, text: self.ask(title, text),
                     station.Archive, alarms.system.defs if alarms else (), self.summary),
             alarms.table.tags if alarms else (), self.views, self)
         # a double-click on an alarm shows its tag's element; a tab marks its forms' alarms
@@ -250,11 +252,9 @@ class MainWindow(QMainWindow):
                              self.tr("No forms"))
             return []
         forms, problems = self.runtime.open_forms()  # the views' own models: they only show
-        target = EngineTarget(self.commands, lambda user: Who(user, Source.CONSOLE),
-                              on_answer=self.answers.follow, say=words.answer)
         self.history = TrendHistory(ArchiveSeries(station.Archive), self)
         for form in forms:
-            view = FormView(form, target, archive_path=station.Archive, user=self.user,
+            view = FormView(form, self.target, archive_path=station.Archive, user=self.user,
                             started=self.runtime.started_clock, guard=self._guard,
                             report=self.view_faults.append)
             self.views.append(view)

@@ -1,6 +1,7 @@
 """The station's OPC UA methods: run, stop and step NetPlc, force and unforce an address or a tag,
 for a remote Program view (`main.py monitor opc.tcp://...`) acting as a logged-in user of the station;
-acknowledge and shelve alarms and write a form's bit or word, for a remote console (`main.py console`).
+acknowledge and shelve alarms, write a form's bit or word and a faceplate's tag, for a remote
+console (`main.py console`).
 
 Each call is the station's command (app/authority/) with the session's user and peer: the layer
 checks the role, journals it and answers once applied and committed; the call's StatusCode is the
@@ -71,6 +72,10 @@ METHODS = (
            "Write an I/O or HMI bit as an operator's form element does"),
     Method("WriteWord", Action.WRITE, (ADDRESS, ("Value", "the raw word, 0..65535", _INT32), LABEL, ROLE),
            "Write a data word as an operator's form element does"),
+    # what a remote console's faceplate writes: the tag, in its units, checked against its range
+    Method("WriteTag", Action.WRITE, (TAG, ("Value", "in the tag's physical units (a bit tag: 0 or 1)",
+                                            _DOUBLE)),
+           "Write a tag's physical value as an operator's faceplate does"),
 )
 
 
@@ -122,7 +127,7 @@ class StationMethods:
             return commands.into_standby(who)
         if method.name == "UnforceAll":
             return commands.unforce_all(who)
-        if method.name in ("ForceTag", "UnforceTag"):
+        if method.name in ("ForceTag", "UnforceTag", "WriteTag"):
             return self._tag(who, method, args)
         if method.name == "AcknowledgeAll":
             return commands.acknowledge_all(who)
@@ -184,6 +189,8 @@ class StationMethods:
         if method.name == "UnforceTag":
             return commands.unforce_tag(who, name)
         value = args[1]
+        if method.name == "WriteTag":  # the layer checks the value's type and the tag's range
+            return commands.write_tag(who, name, value)
         if value is not None and (not isinstance(value, (int, float)) or isinstance(value, bool)):
             return commands.refuse(who, method.action, name, Reason.INVALID, f"{value!r} is not a number")
         return commands.force_tag(who, name, None if value is None else float(value))

@@ -24,7 +24,7 @@ from netplc.address import fmt_octal
 from netplc.records import Record
 
 if TYPE_CHECKING:
-    from app.authority import Answer, Commands, Ticket, Who
+    from app.authority import Action, Answer, Commands, Refusal, Ticket, Who
 
 logger = logging.getLogger(__name__)
 
@@ -58,7 +58,9 @@ class CommandTarget:
     description or name, else the address); `who(user)` says who writes from where;
     `on_answer(what, ticket)` is given every ticket, so the view says a refusal, at once or when
     the layer answers later; `say(what, answer)` words a refusal (the console's language).
-    `bit` and `word` send the command, each source's own way."""
+    `bit` and `word` send the command, each source's own way; so do a tag's faceplate's commands
+    (`write_tag`, `force_tag`, `unforce_tag`, in the tag's units, and `denial`, what the layer
+    would refuse `who`), which the faceplate follows itself (app/gui/faceplate.py)."""
 
     def __init__(self, who: Callable[[str], Who], tags: Iterable[Tag] = (),
                  on_answer: Callable[[str, Ticket], object] | None = None,
@@ -87,6 +89,19 @@ class CommandTarget:
 
     def word(self, who: Who, addr: int, value: int, label: str | None, at_least: str | None,
              describe: Callable[[int, int], str] | None = None) -> Ticket:
+        raise NotImplementedError
+
+    def denial(self, who: Who, action: Action, what: str | None = None) -> Refusal | None:
+        raise NotImplementedError
+
+    def write_tag(self, who: Who, tag: Tag, value: float) -> Ticket:
+        raise NotImplementedError
+
+    def force_tag(self, who: Who, tag: Tag, phy: float | None) -> Ticket:
+        """`phy` None: at its present value (bumpless)."""
+        raise NotImplementedError
+
+    def unforce_tag(self, who: Who, tag: Tag) -> Ticket:
         raise NotImplementedError
 
     def _told(self, ticket: Ticket, what: str) -> str | None:
@@ -119,6 +134,18 @@ class EngineTarget(CommandTarget):
         tag = self._words.get(addr)
         return self.commands.write_word(who, addr, value, label=_named(label, tag), at_least=at_least,
                                         describe=tag.change if tag else describe)
+
+    def denial(self, who: Who, action: Action, what: str | None = None) -> Refusal | None:
+        return self.commands.denial(who, action, what=what)
+
+    def write_tag(self, who: Who, tag: Tag, value: float) -> Ticket:
+        return self.commands.write_tag(who, tag.name, value)
+
+    def force_tag(self, who: Who, tag: Tag, phy: float | None) -> Ticket:
+        return self.commands.force_tag(who, tag.name, phy)
+
+    def unforce_tag(self, who: Who, tag: Tag) -> Ticket:
+        return self.commands.unforce_tag(who, tag.name)
 
 
 def said(what: str, answer: Answer) -> str:

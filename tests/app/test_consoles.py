@@ -12,6 +12,7 @@ import subprocess
 import sys
 import time
 from collections.abc import Callable, Iterator
+from contextlib import contextmanager
 from pathlib import Path
 
 import numpy as np
@@ -65,13 +66,20 @@ class Station:
         self.runtime.start()
 
 
-@pytest.fixture(scope="module")
-def station(tmp_path_factory: pytest.TempPathFactory) -> Iterator[Station]:
-    st = Station(tmp_path_factory.mktemp("consoles"))
+@contextmanager
+def serving(folder: Path) -> Iterator[Station]:
+    """The station of `folder` (the demo copied to `folder/st`, unless there already) while in it."""
+    st = Station(folder)
     try:
         yield st
     finally:
         st.stop()
+
+
+@pytest.fixture(scope="module")
+def station(tmp_path_factory: pytest.TempPathFactory) -> Iterator[Station]:
+    with serving(tmp_path_factory.mktemp("consoles")) as st:
+        yield st
 
 
 Attach = Callable[[Station, str], ConsoleWindow]
@@ -328,11 +336,8 @@ def archived(tmp_path_factory: pytest.TempPathFactory) -> Iterator[tuple[Station
         if k in journal:
             store.put(journal[k])
     store.close()
-    st = Station(folder)
-    try:
+    with serving(folder) as st:
         yield st, times
-    finally:
-        st.stop()
 
 
 def test_a_consoles_trend_shows_the_stations_archived_values_of_a_stored_tag(

@@ -1,13 +1,14 @@
 """The remote console (`main.py console opc.tcp://HOST:PORT/PATH`): the operator's forms and alarm
 banner of a station running elsewhere, with no NetPlc, exchange or archive of its own.
 
-Its views are the workstation's own (the form view in its zoom area, the alarm banner, the health
-strip, the journal dock, the header); what differs is where their data comes from: a
-`StationSource` and a `RemoteJournal` (source.py) instead of the in-process runtime's bridge and
-the archive's file, and a `StationArchiveSource` (archive.py) as the archive that the trends'
-history, the run-time trend window and the journal viewer read. Everything it
-does is done by the user logged in at the station, through the station's command layer: a form's
-write is the station's WriteBit or WriteWord method, an acknowledgement its Acknowledge; the
+Its views are the workstation's own (the form view in its zoom area, a tag's faceplate from its
+elements, the alarm banner, the health strip, the journal dock, the header); what differs is
+where their data comes from: a `StationSource` and a `RemoteJournal` (source.py) instead of the
+in-process runtime's bridge and the archive's file, and a `StationArchiveSource` (archive.py) as
+the archive that the trends' history, the faceplates' hour, the run-time trend window and the
+journal viewer read. Everything it does is done by the user logged in at the station, through the
+station's command layer: a form's write is the station's WriteBit or WriteWord method, a
+faceplate's its WriteTag, ForceTag or UnforceTag, an acknowledgement its Acknowledge; the
 station checks the role, journals with the user's name and answers, and a refusal is said in the
 status bar naming the role it needs.
 Forms come from the station (its Files): a form saved there is shown here at the next poll.
@@ -33,13 +34,14 @@ from PySide6.QtWidgets import (
     QWidget,
 )
 
-from app.authority import Action, Answer, Source, Ticket, Who
+from app.authority import Action, Answer, Refusal, Source, Ticket, Who
 from app.gui import i18n, words
 from app.gui.alarm_summary import AlarmSummary
 from app.gui.application import application
 from app.gui.bridge import Answers
 from app.gui.console.archive import StationArchiveSource
 from app.gui.console.source import Loaded, RemoteJournal, StationSource, Unreachable
+from app.gui.faceplate import Console, Faceplates
 from app.gui.journal import JournalDock
 from app.gui.main_window import (
     REFUSAL_MS,
@@ -59,9 +61,11 @@ from app.gui.viewer import ViewerWindow
 from app.gui.zoom import ZoomArea
 from app.publish.console import ConsoleClient, StationCommands
 from app.publish.memory_items import NOTHING, WHOLE, Ranges, ranges_of
-from app.scada.alarms import AlarmRow
+from app.scada.alarms import AlarmRow, alarm_defs
 from app.scada.readings import Readings
+from app.scada.tag import Tag
 from app.scada.trends import TrendBook
+from app.scada.words import words as words_of
 from hmi_forms.elements.base import Writer
 from hmi_forms.elements.reads import operands
 from hmi_forms.elements.target import CommandTarget
@@ -74,9 +78,10 @@ STATUS_MS = 1000
 
 
 class RemoteTarget(CommandTarget):
-    """The station's command layer, reached over its endpoint, as the form elements' Target: the
-    station names a tag's write with the tag and journals it with the console's user (so no tags
-    here: the view says the element's label)."""
+    """The station's command layer, reached over its endpoint, as the form elements' Target and
+    the faceplates': the station names a tag's write with the tag and journals it with the
+    console's user (so no tags here: the view says the element's label); a faceplate's commands
+    are the station's WriteTag, ForceTag and UnforceTag."""
 
     def __init__(self, client: ConsoleClient, answers: Answers) -> None:
         super().__init__(lambda user: Who(user, Source.OPCUA), (), answers.follow, words.answer)
@@ -88,6 +93,23 @@ class RemoteTarget(CommandTarget):
     def word(self, who: Who, addr: int, value: int, label: str | None, at_least: str | None,
              describe: Callable[[int, int], str] | None = None) -> Ticket:
         return self.client.write_word(addr, value, label, at_least)
+
+    def denial(self, who: Who, action: Action, what: str | None = None) -> Refusal | None:
+        return self.client.denial(action, None, what)
+
+    def write_tag(self, who: Who, tag: Tag, value: float) -> Ticket:
+        return self._tag(Action.WRITE, tag, "WriteTag", float(value))
+
+    def force_tag(self, who: Who, tag: Tag, phy: float | None) -> Ticket:
+        return self._tag(Action.FORCE, tag, "ForceTag", phy)
+
+    def unforce_tag(self, who: Who, tag: Tag) -> Ticket:
+        return self._tag(Action.UNFORCE, tag, "UnforceTag")
+
+    def _tag(self, action: Action, tag: Tag, method: str, *args: object) -> Ticket:
+        """The station's method of a tag's command (a Null value: none given)."""
+        client = self.client
+        return client.said(client.call(method, tag.name, *args), action, tag.name)
 
 
 class SharedSession(OpcUaSource):
@@ -123,6 +145,7 @@ class ConsoleWindow(QMainWindow):
         self.programs: list[ProgramWindow] = []  # the Program views opened from here
         self.windows: list[QWidget] = []  # the trend windows and viewers opened from here
         self.unacknowledged: list[AlarmRow] = []
+        self.faceplates: Faceplates | None = None  # of the forms shown
         frame = station_frame(self, client.station or client.url)
         self.header, self.banner, self.health = frame.header, frame.alarms, frame.health
         self.tabs = frame.tabs
@@ -185,12 +208,35 @@ class ConsoleWindow(QMainWindow):
             self.reads.append(ranges_of(operands(form.elements)))
             self.history.attach(view)
             self.tabs.addTab(ZoomArea(view), form.title)
+        self._faceplates(loaded)
         if loaded.problems:
             self.tabs.addTab(_problems_page(loaded.problems), self.tr("Form problems"))
         if not loaded.forms and not loaded.problems:
             self.tabs.addTab(_placeholder(self.tr("The station serves no forms.")), self.tr("No forms"))
         self.tabs.setCurrentIndex(max(0, min(current, self.tabs.count() - 1)))
         self._shown_changed()
+
+    def _faceplates(self, loaded: Loaded) -> None:
+        """The faceplates of the station's tags on these forms, as the workstation's: the station's
+        commands (RemoteTarget), its archive, its alarms' states as this console lists them; the
+        tag's part of the memory watched while one is open."""
+        if self.faceplates is not None:
+            self.faceplates.close()
+            self.faceplates.deleteLater()
+        assert self.archive is not None
+        language = str(loaded.files.manifest.get("language", ""))
+        defs = alarm_defs(loaded.tags, say=words_of(language))
+        console = Console(self.target, lambda: self.who, self.answers,
+                          lambda title, text: self.ask(title, text), self.archive, defs, self.summary,
+                          watch=self._watch, covers=self._covers)
+        self.faceplates = Faceplates(console, loaded.tags.tags, self.views, self)
+
+    def _watch(self, key: str, operand: tuple[int, int] | None) -> None:
+        self.client.want(key, None if operand is None else ranges_of([operand]))
+
+    def _covers(self, operand: tuple[int, int]) -> bool:
+        """Readings hold the operand: the station's value, or "station unreachable" for all."""
+        return bool(self.client.error) or self.source.covered.covers(ranges_of([operand]))
 
     def open_program(self) -> ProgramWindow | None:
         """Station -> Program: the station's program live, over this console's session, with what
@@ -260,6 +306,8 @@ class ConsoleWindow(QMainWindow):
 
     def _on_readings(self, readings: Readings) -> None:
         self.readings = readings
+        if self.faceplates is not None:  # each shows the readings that hold its tag
+            self.faceplates.show_readings(readings)
         if isinstance(readings, Unreachable):  # every element says so, shown or not
             for view in self.views:
                 view.refresh(readings.snapshot, readings)
@@ -308,6 +356,8 @@ class ConsoleWindow(QMainWindow):
 
     def closeEvent(self, event: QCloseEvent) -> None:
         self._timer.stop()
+        if self.faceplates is not None:
+            self.faceplates.close()
         for window in (*self.programs, *self.windows):
             window.close()
         self.summary.stop()

@@ -169,7 +169,10 @@ def test_memory_and_forces_are_read_only_variables_of_the_station(station: tuple
     assert out["write"] == ua.StatusCodes.BadNotWritable
 
 
-def test_a_tag_is_forced_in_its_units_and_an_address_at_its_value(station: tuple[Runtime, str, list]) -> None:
+def test_a_tag_is_forced_and_written_in_its_units_and_an_address_forced_at_its_value(
+        station: tuple[Runtime, str, list]) -> None:
+    """ForceTag and UnforceTag (the Program view, a faceplate), WriteTag (a remote console's
+    faceplate): the layer's commands of a tag, its range and the role checked."""
     runtime, url, records = station
     engine = runtime.engine
     assert engine is not None
@@ -186,19 +189,31 @@ def test_a_tag_is_forced_in_its_units_and_an_address_at_its_value(station: tuple
                                 ua.Variant("hot", ua.VariantType.String))]
             forced = engine.forces.count
             codes += [await call(client, "UnforceTag", ua.Variant("TEMP_SP", ua.VariantType.String)), forced]
+        name = ua.Variant("TEMP_SP", ua.VariantType.String)
         async with opcua_client(url, "operator", "operator") as client:
-            codes.append(await call(client, "ForceTag", ua.Variant("TEMP_SP", ua.VariantType.String),
-                                    ua.Variant(1.0, ua.VariantType.Double)))
+            codes.append(await call(client, "ForceTag", name, ua.Variant(1.0, ua.VariantType.Double)))
+            codes += [await call(client, "WriteTag", name, ua.Variant(100.0, ua.VariantType.Double)),
+                      await call(client, "WriteTag", name, ua.Variant(900.0, ua.VariantType.Double)),
+                      await call(client, "WriteTag", name, ua.Variant("hot", ua.VariantType.String)),
+                      await call(client, "WriteTag", ua.Variant("NOPE", ua.VariantType.String),
+                                 ua.Variant(1.0, ua.VariantType.Double))]
+        async with opcua_client(url, "viewer", "viewer") as client:
+            codes.append(await call(client, "WriteTag", name, ua.Variant(50.0, ua.VariantType.Double)))
         return codes
 
     good = ua.StatusCodes.Good
     assert run(go()) == [good, good, ua.StatusCodes.BadNodeIdUnknown, ua.StatusCodes.BadInvalidArgument, good,
-                         len(tag_keys(temp)) + 1, ua.StatusCodes.BadUserAccessDenied]
+                         len(tag_keys(temp)) + 1, ua.StatusCodes.BadUserAccessDenied,
+                         good, ua.StatusCodes.BadOutOfRange, ua.StatusCodes.BadTypeMismatch,
+                         ua.StatusCodes.BadNodeIdUnknown, ua.StatusCodes.BadUserAccessDenied]
     texts = [r.text for r in records if r.kind == "operator" and (r.source or "").startswith("opcua:")]
     assert any(t.startswith("force TEMP_SP: ") and "-> 55.5" in t for t in texts)
     assert any(t.startswith("force 02120: ") and t.endswith("(bumpless)") for t in texts)
     assert any(t.startswith("unforce TEMP_SP") for t in texts)
     assert engine.forces.count == 1  # the bit stays forced
+    written = [r for r in records if r.kind == "operator" and (r.text or "").startswith("write ")]
+    assert len(written) == 1 and (written[0].source or "").startswith("opcua:operator@")
+    assert "TEMP_SP" in (written[0].text or "") and "-> 100.0 °C" in (written[0].text or "")  # applied
 
 
 def alarm(alarm_id: str) -> ua.Variant:
@@ -248,3 +263,4 @@ def test_a_viewer_may_not_acknowledge_or_shelve_an_operator_may(station: tuple[R
         f"refused shelve {STOPPED_ID}: needs the operator role; viewer is viewer"]
     acts = [r.text for r in records if r.kind == "alarm" and "operator" in (r.text or "")]
     assert acts  # the transitions name the operator, as at the workstation
+
