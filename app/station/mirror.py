@@ -4,7 +4,8 @@ puts it into its engine (docs/architecture.md section 11).
 The state is the engine's own: NetPlc memory (bits and data, which hold the edge memory too: a
 CTR's rising edge is RES 1 while its bit C is 0), the timers' and counters' current values, the
 forces, the run state and the scan number, and the alarm states the station keeps beside it
-(acknowledged by whom, shelved, out of service: app/scada/alarms.py) with its horn's last silence.
+(acknowledged by whom, shelved, out of service: app/scada/alarms.py) with its horn's last silence,
+and the scan's records, which the standby keeps until the primary has them on disk.
 A frame carries only what changed since the frame before it (memory as runs of the 64-byte
 blocks that differ, the alarms whose state changed); the first frame of a link is the whole
 state, so a standby that comes late or comes back catches up at once.

@@ -13,7 +13,8 @@ Each station of a hot-standby pair forwards its own archive, under the pair's on
 letter (schema.py: PAIR_ID_BASE, `forwarded_pair`): both run their forwarders whatever their
 role, so the records a primary committed before it died are forwarded when it comes back, and a
 standby journals no copy of the primary's records (its alarms are the primary's, adopted, not
-evaluated: app/scada/station.py), so nothing reaches the plant archive twice.
+evaluated: app/scada/station.py) but those a takeover leaves it, which both may hold: those have
+a pid (app/station/pair.py), sent as their id, so the plant archive keeps one.
 """
 
 from __future__ import annotations
