@@ -37,6 +37,7 @@ BLOCK = 64  # bytes compared at a time for a delta
 STRETCH = 2048  # bytes compared first: only a stretch that differs is compared block by block
 IMAGE = IO_BITS + DATA_SIZE
 MAX_FRAME = IMAGE + (1 << 20)  # a whole state and its header, with room to spare
+PENDING_SCANS = 10_000  # scans with records the standby keeps for a primary that has none on disk
 _HEAD = struct.Struct(">IBB")
 _RUN = struct.Struct(">IH")
 
@@ -238,6 +239,8 @@ class Mirror:
             if "committed" in header:
                 committed = int(header["committed"])
                 self.pending = [(at, held) for at, held in self.pending if at > committed]
+            if len(self.pending) > PENDING_SCANS:  # a primary whose disk fails for long: its oldest
+                del self.pending[: len(self.pending) - PENDING_SCANS]  # are lost only if it dies too
             self.scan = scan
         except (struct.error, ValueError, KeyError, TypeError) as e:
             raise LinkError(f"a state frame that cannot be read: {e}") from None
