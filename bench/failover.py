@@ -18,11 +18,14 @@
    value acknowledged; applied twice = one value journaled twice. The standby's lag (its
    HSB_LAG byte, read over Modbus) just before each kill. With
    `--plant` both forward to one plant archive (a throwaway PostgreSQL cluster of tests/pgcluster.py,
-   on 127.0.0.1): at the end, records of the two local archives missing from it, and alarm
-   transitions in it twice in a row (the same transition of the same alarm: one record of an
-   event made by both stations, or one missing between two). Takeovers of a live primary (its
-   standby heard nothing for failover_after: the primary journals TAKEN and follows) and
-   flip-backs (two primaries meeting, one giving way) are counted from the journals.
+   on 127.0.0.1): at the end (the station killed last back as the standby first, so that it
+   forwards what it committed before its kill), records of the two local archives missing from
+   it (a record both hold, one a new primary archived for its partner, is one: its pid), records
+   in it twice, alarm transitions in it twice in a row (the same transition of the same alarm:
+   one record of an event made by both stations, or one missing between two), and writes applied
+   that neither station journaled (a break in a word's chain of "old -> new"). Takeovers of a
+   live primary (its standby heard nothing for failover_after: the primary journals TAKEN and
+   follows) and flip-backs (two primaries meeting, one giving way) are counted from the journals.
 
     .venv/bin/python bench/failover.py [--seconds S] [--kills N] [--plant]
 """

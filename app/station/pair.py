@@ -15,6 +15,11 @@ no partner within its start window (failover_after ticks and two more, 0.5 s at 
 The standby takes over when the primary's frames have stopped for failover_after ticks: the
 newest mirrored state is put into its engine and the program runs on from it in the next scan
 (timers keep their elapsed time, edges their memory, NWRITEs resume from the mirrored words).
+
+The primary archives a scan's records once the standby holds that scan; they ride in its frame
+too, each with its pid, and the standby keeps them until the primary says they are on its disk:
+taking over, it archives what it kept, so a primary that died first loses none, and a copy both
+archived is one record in the plant archive, keyed by the pid.
 """
 
 from __future__ import annotations
