@@ -588,8 +588,10 @@ class Pair:
                 return False
             # its identity in both archives: the standby keeps it until this station has it on
             # disk, and archives it if it takes over before (`_lead`)
-            self._last_pid = max(round(record.ts * 1000) << PID_SHIFT, self._last_pid + 1)
-            self._records.append(replace(record, pid=self._last_pid))
+            self._last_pid = pid = max(round(record.ts * 1000) << PID_SHIFT, self._last_pid + 1)
+            r = record  # made whole rather than by dataclasses.replace: half the cost per record
+            self._records.append(Record(r.ts, r.kind, r.grp, r.type, r.source, r.number, r.value, r.text,
+                                        pid))
             return True
 
     def _archive(self, records: list[Record]) -> None:
