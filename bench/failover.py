@@ -18,11 +18,14 @@
    value acknowledged; applied twice = one value journaled twice. The standby's lag (its
    HSB_LAG byte, read over Modbus) just before each kill. With
    `--plant` both forward to one plant archive (a throwaway PostgreSQL cluster of tests/pgcluster.py,
-   on 127.0.0.1): at the end, records of the two local archives missing from it, and alarm
-   transitions in it twice in a row (the same transition of the same alarm: one record of an
-   event made by both stations, or one missing between two). Takeovers of a live primary (its
-   standby heard nothing for failover_after: the primary journals TAKEN and follows) and
-   flip-backs (two primaries meeting, one giving way) are counted from the journals.
+   on 127.0.0.1): at the end (the station killed last back as the standby first, so that it
+   forwards what it committed before its kill), records of the two local archives missing from
+   it (a record both hold, one a new primary archived for its partner, is one: its pid), records
+   in it twice, alarm transitions in it twice in a row (the same transition of the same alarm:
+   one record of an event made by both stations, or one missing between two), and writes applied
+   that neither station journaled (a break in a word's chain of "old -> new"). Takeovers of a
+   live primary (its standby heard nothing for failover_after: the primary journals TAKEN and
+   follows) and flip-backs (two primaries meeting, one giving way) are counted from the journals.
 
     .venv/bin/python bench/failover.py [--seconds S] [--kills N] [--plant]
 """
@@ -35,6 +38,7 @@ import contextlib
 import itertools
 import logging
 import os
+import re
 import signal
 import sqlite3
 import statistics
@@ -296,20 +300,26 @@ def wait_until(condition: Callable[[], object], timeout: float, what: str) -> No
         time.sleep(0.01)
 
 
-def applied(folder: Path, since_ms: int) -> dict[int, Counter[int]]:
-    """The writes each word's journal says were applied, from the station's local archive: by
-    word, how many times each value was written (a write applied twice is counted twice)."""
+def applied(folders: dict[str, Path], since_ms: int) -> dict[int, Counter[int]]:
+    """The writes each word's journal says were applied, from the stations' local archives: by
+    word, how many times each value was written (a write applied twice is counted twice; a record
+    both stations hold, one a new primary archived for its partner, has one pid in both: once)."""
     out: dict[int, Counter[int]] = {MODBUS_WORD: Counter(), OPCUA_WORD: Counter()}
-    con = sqlite3.connect(load_station(folder).Archive)
-    try:
-        for (name,) in con.execute("SELECT name FROM sqlite_master WHERE type = 'table' AND name GLOB ?",
-                                   (DAY_GLOB,)):
-            for number, value in con.execute(
-                    f"SELECT number, value FROM \"{name}\" WHERE kind = 'operator' AND ts >= ? AND "
-                    "text LIKE 'write %' AND number IN (?, ?)", (since_ms, MODBUS_WORD, OPCUA_WORD)):
-                out[number][int(value)] += 1
-    finally:
-        con.close()
+    seen: set[object] = set()
+    for letter, folder in folders.items():
+        con = sqlite3.connect(load_station(folder).Archive)
+        try:
+            for (name,) in con.execute("SELECT name FROM sqlite_master WHERE type = 'table' AND name GLOB ?",
+                                       (DAY_GLOB,)):
+                for number, value, key, pid in con.execute(
+                        f"SELECT number, value, id, pid FROM \"{name}\" WHERE kind = 'operator' AND ts >= ? "
+                        "AND text LIKE 'write %' AND number IN (?, ?)", (since_ms, MODBUS_WORD, OPCUA_WORD)):
+                    identity = pid if pid is not None else (letter, name, key)
+                    if identity not in seen:
+                        seen.add(identity)
+                        out[number][int(value)] += 1
+        finally:
+            con.close()
     return out
 
 
@@ -357,6 +367,7 @@ def kills(base: Path, node: Simulator, n: int, plant: str = "") -> None:
     killings: list[tuple[float, str]] = []  # the wall time of each kill, the letter taking over
     stopped = ""  # why the kills ended early (a station too slow to start on an overloaded machine)
     dead: int | None = None  # a station killed and not restarted yet
+    restarted = 1  # the station started last: B, or the one killed last
     try:  # the stations are stopped whatever happens (a first start too slow included)
         start(0)
         wait_until(lambda: role(0) == 5, 180, "A the primary")
@@ -391,7 +402,7 @@ def kills(base: Path, node: Simulator, n: int, plant: str = "") -> None:
                     took[w.name].append(next(t for _v, i, t in w.acked if i != at and t > killed) - killed)
                 killings.append((killed_wall, "AB"[1 - at]))
                 start(at)  # the old primary back, as the standby
-                dead = None
+                dead, restarted = None, at
             except (SystemExit, KeyboardInterrupt) as e:  # the figures of the kills done so far, and why
                 stopped = f" (stopped after {len(killings)}: {e or 'interrupted'})"
                 if dead is not None:  # back, to forward what it committed before it was killed
@@ -399,6 +410,11 @@ def kills(base: Path, node: Simulator, n: int, plant: str = "") -> None:
                     with contextlib.suppress(SystemExit):
                         wait_until(lambda: role(dead) is not None, 180, "the killed station back")  # noqa: B023
                 break
+        else:  # the last one killed back, up as the standby, before the stop: it forwards its tail
+            # then, and at its stop (a SIGTERM while it starts ends it before it forwards anything)
+            with contextlib.suppress(SystemExit):
+                wait_until(lambda i=restarted: (s := hsb(modbus[i])) is not None and s[0] == 4 and s[1], 180,
+                           "the killed station back as the standby")
     finally:
         stop.set()
         for t in threads:
@@ -407,7 +423,7 @@ def kills(base: Path, node: Simulator, n: int, plant: str = "") -> None:
         for p in procs.values():
             p.terminate()
             p.wait(30)
-    counts = [applied(paths[letter], since) for letter in "AB"]
+    counts = applied(paths, since)
     led = 0  # kills after which the survivor journaled no takeover: it led already (a takeover of its
     for killed_wall, letter in killings:  # own while the primary stalled, between the check and the kill)
         after = [ts / 1000 - killed_wall for ts in takeovers(paths[letter]) if ts >= killed_wall * 1000 - 1]
@@ -427,7 +443,7 @@ def kills(base: Path, node: Simulator, n: int, plant: str = "") -> None:
         until = "the journal record" if what == "journal" else f"the first {what} write acknowledged"
         print(f"  takeover, kill to {until}: p50 {statistics.median(ms):.0f} ms, max {max(ms):.0f} ms")
     for w, word in zip(writers, (MODBUS_WORD, OPCUA_WORD), strict=True):
-        times = counts[0][word] + counts[1][word]
+        times = counts[word]
         values = [v for v, _i, _t in w.acked]
         lost = sum(1 for v in values if not times[v])
         twice = sum(1 for c in times.values() if c > 1)
@@ -437,13 +453,26 @@ def kills(base: Path, node: Simulator, n: int, plant: str = "") -> None:
           f"the survivor (it had taken over already): {led}; takeovers of a live primary (told, it "
           f"followed): {told}; flip-backs (two primaries meeting): {flips}")
     if plant:
-        missing, doubled, total = plant_check(plant, paths)
-        print(f"plant archive: {total} records of the pair, {missing} of the local archives missing, "
-              f"{doubled} alarm transitions twice in a row (doubled, or one missing between)")
+        c = plant_check(plant, paths)
+        print(f"plant archive: {c.total} records of the pair, {c.missing} of the local archives missing, "
+              f"{c.copies} records twice, {c.twice_in_a_row} alarm transitions twice in a row (doubled, "
+              f"or one missing between), {c.unjournaled} writes applied and journaled by neither station")
 
 
-def plant_check(url: str, paths: dict[str, Path]) -> tuple[int, int, int]:
-    """Records of both local archives missing from the plant archive, records in it twice."""
+@dataclass
+class PlantCheck:
+    total: int  # records of the pair in the plant archive
+    missing: int  # records of the local archives not in it
+    twice_in_a_row: int  # alarm transitions twice in a row (one doubled, or one missing between)
+    copies: int  # records in it more than once (the same time, kind, source, number, value, text)
+    unjournaled: int  # writes applied that no record says (a break in a word's chain of old -> new)
+
+
+def plant_check(url: str, paths: dict[str, Path]) -> PlantCheck:
+    """Records of both local archives missing from the plant archive, and records in it twice;
+    writes applied and journaled by neither station: each writer writes 1, 2, 3... to its word,
+    so its records' "old -> new" values chain up, and a break is an applied write whose record
+    was lost (one the old primary applied, its standby held, and neither archived)."""
     import sqlite3
 
     import psycopg
@@ -451,19 +480,31 @@ def plant_check(url: str, paths: dict[str, Path]) -> tuple[int, int, int]:
     from registrar.plant.schema import PAIR_ID_BASE
     from registrar.schema import DAY_GLOB
 
-    ours: set[int] = set()
+    ours: set[int] = set()  # a record both stations hold (a takeover's) has one pid in both
     for letter, folder in paths.items():
         con = sqlite3.connect(load_station(folder).Archive)
         for (name,) in con.execute("SELECT name FROM sqlite_master WHERE type = 'table' AND name GLOB ?",
                                    (DAY_GLOB,)):
-            ours |= {i + PAIR_ID_BASE[letter] for (i,) in con.execute(f'SELECT id FROM "{name}"')}
+            ours |= {i + PAIR_ID_BASE[letter] if pid is None else pid
+                     for i, pid in con.execute(f'SELECT id, pid FROM "{name}"')}
         con.close()
     with psycopg.connect(url) as pg:
         ids = {i for (i,) in pg.execute("SELECT id FROM records WHERE station = 'pair'")}
         alarms = pg.execute("SELECT source, number, type FROM records WHERE station = 'pair' "
                             "AND kind = 'alarm' ORDER BY ts, id").fetchall()
+        copies = pg.execute("SELECT coalesce(sum(n - 1), 0) FROM (SELECT count(*) AS n FROM records "
+                            "WHERE station = 'pair' GROUP BY ts, kind, source, number, value, text) c"
+                            ).fetchone()[0]
+        writes = pg.execute("SELECT number, text FROM records WHERE station = 'pair' AND kind = 'operator' "
+                            "AND text LIKE 'write %%' AND number IN (%s, %s)",
+                            (MODBUS_WORD, OPCUA_WORD)).fetchall()
     doubled = sum(1 for before, row in itertools.pairwise(alarms) if before == row)
-    return len(ours - ids), doubled, len(ids)
+    breaks = 0
+    for word in (MODBUS_WORD, OPCUA_WORD):
+        chain = sorted((int(new), int(old)) for number, text in writes if number == word
+                       and (m := re.search(r": (\d+) -> (\d+)", text)) for old, new in [m.groups()])
+        breaks += sum(1 for (before, _), (_, old) in itertools.pairwise(chain) if old != before)
+    return PlantCheck(len(ids), len(ours - ids), doubled, int(copies), breaks)
 
 
 def main() -> None:

@@ -23,6 +23,9 @@ class Record:
     number: int | None = None  # message number for NMSG
     value: float | None = None
     text: str | None = None  # None for NMSG: the registrar resolves it from the catalog
+    # the record's identity in a hot-standby pair (app/station/pair.py gives it to a record its
+    # standby may archive too): the same in both stations' archives, so the plant archive keeps one
+    pid: int | None = None
 
 
 class RecordSink(Protocol):

@@ -33,8 +33,16 @@ DAY_COLUMNS_SQL = """(
     source TEXT,
     number INTEGER,
     value  REAL,
-    text   TEXT
+    text   TEXT,
+    pid    INTEGER
 )"""
+# `pid`: a hot-standby pair's identity of a record its standby may archive too (netplc/records.py
+# Record.pid), which the plant archive keys it by; NULL for every other record
+
+
+def has_pid(con: sqlite3.Connection, table: str) -> bool:
+    """Whether a day table has the `pid` column (a day written before it had none)."""
+    return any(row[1] == "pid" for row in con.execute(f'PRAGMA table_info("{table}")'))
 
 # Two indexes, both cheap while writing. The key index: its low-cardinality keys receive rows in
 # id order, so each insert lands on the last page of its key range. It serves series (all four

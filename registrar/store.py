@@ -42,6 +42,7 @@ from registrar.schema import (
     aux_fill_sql,
     aux_sql,
     fts_table,
+    has_pid,
     index_sql,
     local_day_bounds,
     local_zone_key,
@@ -59,9 +60,9 @@ RETRY_MAX = 5.0  # seconds between attempts while the disk keeps failing
 BUSY_TIMEOUT_MS = 1000
 SQLITE_HEADER = b"SQLite format 3\x00"  # the first 16 bytes of every SQLite database file
 
-Row = tuple[int, str, int | None, int | None, str | None, int | None, float | None, str | None]
+Row = tuple[int, str, int | None, int | None, str | None, int | None, float | None, str | None, int | None]
 _TS = operator.attrgetter("ts")
-_REST = operator.attrgetter("kind", "grp", "type", "source", "number", "value", "text")
+_REST = operator.attrgetter("kind", "grp", "type", "source", "number", "value", "text", "pid")
 _KIND, _KEY = operator.itemgetter(1), operator.itemgetter(1, 2, 3, 4)
 
 
@@ -74,7 +75,8 @@ _INT64 = range(-(2**63), 2**63)
 def _well_formed(r: object) -> bool:
     return (isinstance(r, Record) and isinstance(r.ts, int | float) and math.isfinite(r.ts)
             and abs(r.ts) < 1e12 and isinstance(r.kind, str)
-            and all(v is None or (isinstance(v, int) and v in _INT64) for v in (r.grp, r.type, r.number))
+            and all(v is None or (isinstance(v, int) and v in _INT64)
+                    for v in (r.grp, r.type, r.number, r.pid))
             and all(v is None or isinstance(v, str) for v in (r.source, r.text))
             and (r.value is None or isinstance(r.value, float)
                  or (isinstance(r.value, int) and r.value in _INT64)))
@@ -196,16 +198,19 @@ class Store:
         if len(queue) >= BATCH_MAX:
             self._wake.set()
 
-    def after_commit(self, callback: Callable[[], None]) -> None:
+    def after_commit(self, callback: Callable[[], None], wake: bool = True) -> None:
         """Call `callback()` in the writer thread once every record put before this call is
         committed (durable through a crash of the process): a Modbus write is answered only then.
         The writer is woken at once, so the wait is one commit rather than a flush interval, and
-        the barriers of one moment share that commit. A record dropped by a full queue is never
-        committed, so writers check `room()` before they produce records that must not be lost."""
+        the barriers of one moment share that commit; `wake` False: no commit of its own, the
+        next one's (a pair's primary telling its standby what it has on disk, app/station/pair.py).
+        A record dropped by a full queue is never committed, so writers check `room()` before
+        they produce records that must not be lost."""
         with self._lock:
             self._barriers += 1
             self._queue.append(_Barrier(callback))  # type: ignore[arg-type]
-        self._wake.set()
+        if wake:
+            self._wake.set()
 
     def room(self) -> int:
         """Records the queue takes before it drops."""
@@ -414,8 +419,8 @@ class Store:
             self._ensure_table(con, table, rows)
             last = con.execute(f'SELECT max(id) FROM "{table}"').fetchone()[0] or 0
             con.executemany(
-                f'INSERT INTO "{table}" (ts, kind, grp, type, source, number, value, text) '
-                "VALUES (?, ?, ?, ?, ?, ?, ?, ?)", rows)
+                f'INSERT INTO "{table}" (ts, kind, grp, type, source, number, value, text, pid) '
+                "VALUES (?, ?, ?, ?, ?, ?, ?, ?, ?)", rows)
             for sql in aux_fill_sql(table):  # the text index and the per-minute summary
                 con.execute(sql, (last,))
         con.execute("COMMIT")
@@ -466,7 +471,7 @@ class Store:
 
     def _resolve(self, row: Row) -> Row:
         """An NMSG record gets its catalog text (and group and type if it named none)."""
-        ms, kind, grp, typ, source, number, value, text = row
+        ms, kind, grp, typ, source, number, value, text, pid = row
         if number is None:
             return row
         if text is None:
@@ -475,12 +480,14 @@ class Store:
         if message is not None:
             grp = message.grp if grp is None else grp
             typ = message.type if typ is None else typ
-        return (ms, kind, grp, typ, source, number, value, text)
+        return (ms, kind, grp, typ, source, number, value, text, pid)
 
     def _ensure_table(self, con: sqlite3.Connection, table: str, rows: list[Row]) -> None:
         known = self._known.get(table)
         if known is None:
             con.execute(f'CREATE TABLE IF NOT EXISTS "{table}" {DAY_COLUMNS_SQL}')
+            if not has_pid(con, table):  # a day table of an archive from before the column
+                con.execute(f'ALTER TABLE "{table}" ADD COLUMN pid INTEGER')
             for sql in index_sql(table):
                 con.execute(sql)
             older = con.execute("SELECT 1 FROM sqlite_master WHERE name = ?",

@@ -4,7 +4,8 @@ puts it into its engine (docs/architecture.md section 11).
 The state is the engine's own: NetPlc memory (bits and data, which hold the edge memory too: a
 CTR's rising edge is RES 1 while its bit C is 0), the timers' and counters' current values, the
 forces, the run state and the scan number, and the alarm states the station keeps beside it
-(acknowledged by whom, shelved, out of service: app/scada/alarms.py) with its horn's last silence.
+(acknowledged by whom, shelved, out of service: app/scada/alarms.py) with its horn's last silence,
+and the scan's records, which the standby keeps until the primary has them on disk.
 A frame carries only what changed since the frame before it (memory as runs of the 64-byte
 blocks that differ, the alarms whose state changed); the first frame of a link is the whole
 state, so a standby that comes late or comes back catches up at once.
@@ -27,6 +28,7 @@ from netplc.address import DATA_SIZE, IO_BITS, fmt_octal, parse_octal
 from netplc.engine import Engine, RunState
 from netplc.forcing import Force
 from netplc.memory import Memory, Snapshot
+from netplc.records import Record
 
 VERSION = 1
 # frame kinds (ACK: the standby holds scan n; TAKEN: the standby took over, leading from scan n)
@@ -35,6 +37,7 @@ BLOCK = 64  # bytes compared at a time for a delta
 STRETCH = 2048  # bytes compared first: only a stretch that differs is compared block by block
 IMAGE = IO_BITS + DATA_SIZE
 MAX_FRAME = IMAGE + (1 << 20)  # a whole state and its header, with room to spare
+PENDING_SCANS = 10_000  # scans with records the standby keeps for a primary that has none on disk
 _HEAD = struct.Struct(">IBB")
 _RUN = struct.Struct(">IH")
 
@@ -83,16 +86,19 @@ class Capture:
     alarms: dict[str, dict[str, Any]] = field(default_factory=dict)  # changed states, by alarm
     bdseq: int = -1  # the MQTT Sparkplug session's bdSeq (-1: no MQTT)
     silenced: float = 0.0  # the wall time of the horn's last silence (app/scada/horn.py)
+    records: tuple[Record, ...] = ()  # the scan's records (with their pid), for the standby to keep
+    committed: int = -1  # the last scan whose records the primary has on disk (-1: none yet)
 
 
 def capture(engine: Engine, snapshot: Snapshot, alarms: dict[str, dict[str, Any]],
-            bdseq: int = -1, silenced: float = 0.0) -> Capture:
+            bdseq: int = -1, silenced: float = 0.0, records: tuple[Record, ...] = (),
+            committed: int = -1) -> Capture:
     """The scan's state; the timers and counters read only at the coils the program has (all
     2048 of each would cost the scan milliseconds)."""
     tim, ctr = engine.tim_ticks, engine.ctr_values
     tims, ctrs = _coils(engine)
     return Capture(snapshot, {c: tim[c] for c in tims if tim[c]}, {c: ctr[c] for c in ctrs if ctr[c]},
-                   engine.stop_code, alarms, bdseq, silenced)
+                   engine.stop_code, alarms, bdseq, silenced, records, committed)
 
 
 _COILS: dict[int, tuple[tuple[int, ...], tuple[int, ...]]] = {}  # by id of the program
@@ -127,6 +133,11 @@ class Encoder:
         header: dict[str, Any] = {"scan": cap.snapshot.scan, "full": self.last is None}
         if cap.alarms:
             header["alarms"] = cap.alarms
+        if cap.records:
+            header["records"] = [[r.pid, r.ts, r.kind, r.grp, r.type, r.source, r.number, r.value, r.text]
+                                 for r in cap.records]
+        if cap.committed >= 0:
+            header["committed"] = cap.committed
         extras = json.dumps({"state": cap.snapshot.state, "stop_code": cap.stop_code,
                              "tim": cap.tim, "ctr": cap.ctr, "bdseq": cap.bdseq, "silenced": cap.silenced,
                              "forces": [[f.kind, fmt_octal(f.addr), f.value, f.user]
@@ -182,6 +193,10 @@ class Mirror:
     alarms: dict[str, dict[str, Any]] = field(default_factory=dict)  # states not yet put, by alarm
     bdseq: int = -1  # the primary's MQTT Sparkplug bdSeq
     silenced: float = 0.0  # when the primary's horn was last silenced
+    # the primary's records of the scans it may not have on disk yet, by scan: what this station
+    # archives if it takes over (app/station/pair.py), and the highest pid the primary gave
+    pending: list[tuple[int, list[Record]]] = field(default_factory=list)
+    last_pid: int = 0
 
     @property
     def complete(self) -> bool:
@@ -215,7 +230,18 @@ class Mirror:
             if not isinstance(alarms, dict):
                 raise TypeError("the alarms are no table")
             self.alarms.update(alarms)
-            self.scan = int(header["scan"])
+            scan = int(header["scan"])
+            records = [Record(ts, kind, grp, typ, source, number, value, text, pid)
+                       for pid, ts, kind, grp, typ, source, number, value, text in header.get("records", ())]
+            if records:
+                self.pending.append((scan, records))
+                self.last_pid = max(self.last_pid, *(r.pid or 0 for r in records))
+            if "committed" in header:
+                committed = int(header["committed"])
+                self.pending = [(at, held) for at, held in self.pending if at > committed]
+            if len(self.pending) > PENDING_SCANS:  # a primary whose disk fails for long: its oldest
+                del self.pending[: len(self.pending) - PENDING_SCANS]  # are lost only if it dies too
+            self.scan = scan
         except (struct.error, ValueError, KeyError, TypeError) as e:
             raise LinkError(f"a state frame that cannot be read: {e}") from None
 
@@ -228,6 +254,12 @@ class Mirror:
         engine.state = _run_state(self.state)
         engine.stop_code = self.stop_code
         engine.scan_counter = self.scan
+
+    def take_pending(self) -> list[Record]:
+        """The primary's records that it may not have on disk: this station, taking over, archives
+        them (their pids make a copy the old primary committed too one record in the plant)."""
+        pending, self.pending = self.pending, []
+        return [r for _scan, records in pending for r in records]
 
     def take_alarms(self) -> dict[str, dict[str, Any]]:
         """The alarm states received since the last call, for the standby's alarm system."""

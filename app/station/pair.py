@@ -15,6 +15,11 @@ no partner within its start window (failover_after ticks and two more, 0.5 s at 
 The standby takes over when the primary's frames have stopped for failover_after ticks: the
 newest mirrored state is put into its engine and the program runs on from it in the next scan
 (timers keep their elapsed time, edges their memory, NWRITEs resume from the mirrored words).
+
+The primary archives a scan's records once the standby holds that scan; they ride in its frame
+too, each with its pid, and the standby keeps them until the primary says they are on its disk:
+taking over, it archives what it kept, so a primary that died first loses none, and a copy both
+archived is one record in the plant archive, keyed by the pid.
 """
 
 from __future__ import annotations
@@ -89,6 +94,10 @@ START_WINDOW = 0.5  # s at least a starting station waits for a partner before i
 # switchover causes (the low byte of HSB_SWITCH), after seed 000's hardware codes; TAKEN_OVER: a
 # primary told by its standby that it took over (it had heard no frame for failover_after)
 SILENT, HANDED_OVER, STEPPED_DOWN, TAKEN_OVER = 50, 51, 52, 53
+# a held record's pid (its identity in both stations' archives and the plant archive): its time in
+# ms shifted by this, or the last pid + 1 if that is higher, so pids only grow across the pair's
+# takeovers and restarts, far above the ids of a letter (registrar/plant/schema.py PAIR_ID_BASE)
+PID_SHIFT = 12
 
 
 def decide(mine: Role, letter: str, theirs: Role, my_scans: int = 0, their_scans: int = 0) -> Role:
@@ -172,6 +181,8 @@ class Pair:
         # scan running now, then those of the scans sent and not yet acknowledged, by scan
         self._records: list[Record] = []
         self._held: list[tuple[int, list[Record]]] = []
+        self._last_pid = 0  # the last pid given to a held record (`hold`), or seen in the mirror
+        self._on_disk = -1  # the last scan whose held records are committed to the local archive
         self._taken = False  # told TAKEN: until the engine follows, the scan's records are dropped
         self._told: socket.socket | None = None  # the link this station took over on: drained, closed
         self._send_lock = threading.Lock()  # frames on the link: its sender, its reader, the watch
@@ -309,6 +320,10 @@ class Pair:
         assert engine is not None
         if engine.follower and self.mirror.complete:
             self._load_mirror(engine, mem)
+            with self._lock:  # what the old primary may not have on disk: archived here, under its pids
+                pending = self.mirror.take_pending()
+                self._last_pid = max(self._last_pid, self.mirror.last_pid)
+            self._archive(pending)
         engine.follower = False
         self._put_words(mem)
 
@@ -571,7 +586,12 @@ class Pair:
                 return True  # a scan the new primary runs again
             if self.role is not Role.PRIMARY or self._link is None:
                 return False
-            self._records.append(record)
+            # its identity in both archives: the standby keeps it until this station has it on
+            # disk, and archives it if it takes over before (`_lead`)
+            self._last_pid = pid = max(round(record.ts * 1000) << PID_SHIFT, self._last_pid + 1)
+            r = record  # made whole rather than by dataclasses.replace: half the cost per record
+            self._records.append(Record(r.ts, r.kind, r.grp, r.type, r.source, r.number, r.value, r.text,
+                                        pid))
             return True
 
     def _archive(self, records: list[Record]) -> None:
@@ -602,8 +622,16 @@ class Pair:
                 records += self._records
                 self._records = []
         self._archive(records)
+        if records and scan is not None:  # the standby is told in a frame once they are on disk
+            self.runtime.after_archived(lambda: self._committed(scan))
         for callback in ready:
             callback()
+
+    def _committed(self, scan: int) -> None:
+        """The records of the scans up to `scan` are on this station's disk: the next frame says
+        so, and the standby forgets them (Mirror.pending)."""
+        with self._lock:
+            self._on_disk = max(self._on_disk, scan)
 
     def _load(self, mem: Memory) -> None:
         """On the engine thread: the newest mirrored state, while this station follows."""
@@ -637,9 +665,11 @@ class Pair:
             self.led_scans += 1
         with self._lock:  # this scan's records wait for the standby to hold it
             records, self._records = self._records, []
+            mirrored: tuple[Record, ...] = ()
             if records and self.role is Role.PRIMARY and self._link is not None:
                 self._held.append((snapshot.scan, records))
-                records = []
+                mirrored, records = tuple(records), []
+            on_disk = self._on_disk
         self._archive(records)  # no standby (any more): at once
         if self.role is not Role.PRIMARY or self._link is None:
             return
@@ -648,10 +678,12 @@ class Pair:
         self._whole_alarms = False
         sparkplug = self.runtime.sparkplug()
         cap = capture(engine, snapshot, states, sparkplug.bdseq if sparkplug is not None else -1,
-                      alarms.horn.silenced_at if alarms is not None else 0.0)
+                      alarms.horn.silenced_at if alarms is not None else 0.0, mirrored, on_disk)
         with self._changed:
-            if self._capture is not None and self._capture.alarms:  # not sent yet: none is lost
-                cap = replace(cap, alarms={**self._capture.alarms, **cap.alarms})
+            unsent = self._capture
+            if unsent is not None and (unsent.alarms or unsent.records):  # not sent yet: none is lost
+                cap = replace(cap, alarms={**unsent.alarms, **cap.alarms},
+                              records=unsent.records + cap.records)
             self._capture = cap
             if self._handing_over:
                 self._handover, self._handing_over = self._handing_over, ""

@@ -227,6 +227,15 @@ class Runtime:
         else:
             self._after_local_commit(callback)
 
+    def after_archived(self, callback: Callable[[], None]) -> None:
+        """`callback()` once the records archived so far are committed to the local archive, by
+        the commit that comes anyway (none of its own): a pair's primary tells its standby the
+        scans whose records it has on disk (app/station/pair.py)."""
+        if self.store is not None:
+            self.store.after_commit(callback, wake=False)
+        else:
+            callback()
+
     def _after_local_commit(self, callback: Callable[[], None]) -> None:
         parts: list[Callable[[Callable[[], None]], None]] = []
         if self.store is not None:

@@ -13,7 +13,8 @@ Each station of a hot-standby pair forwards its own archive, under the pair's on
 letter (schema.py: PAIR_ID_BASE, `forwarded_pair`): both run their forwarders whatever their
 role, so the records a primary committed before it died are forwarded when it comes back, and a
 standby journals no copy of the primary's records (its alarms are the primary's, adopted, not
-evaluated: app/scada/station.py), so nothing reaches the plant archive twice.
+evaluated: app/scada/station.py) but those a takeover leaves it, which both may hold: those have
+a pid (app/station/pair.py), sent as their id, so the plant archive keeps one.
 """
 
 from __future__ import annotations
@@ -34,7 +35,7 @@ import psycopg
 from netplc.records import Record
 from registrar.plant import schema as plant
 from registrar.reading import ArchiveError
-from registrar.schema import DAY_GLOB, KEYED_TAG_ROWS_SQL, parse_table_name, table_name
+from registrar.schema import DAY_GLOB, KEYED_TAG_ROWS_SQL, has_pid, parse_table_name, table_name
 
 logger = logging.getLogger(__name__)
 
@@ -86,6 +87,7 @@ class Forwarder:
         self._tz: dt.tzinfo | None = None
         self._done: dict[dt.date, int] = {}  # local day -> last id in the plant archive
         self._known: set[tuple] = set()  # (partition, series key) already listed in `series`
+        self._pid: dict[str, bool] = {}  # local day table -> whether it has the pid column
         self._partitions: set[dt.date] = set()
         self._wake = threading.Event()
         self._stopping = threading.Event()
@@ -315,13 +317,17 @@ class Forwarder:
             return 0
         day, name, _hi = days[0]
         done = self._done.get(day, 0)
+        pid = self._pid.get(name)
+        if pid is None:
+            pid = self._pid[name] = has_pid(local, name)
         rows = local.execute(
-            f'SELECT id, ts, kind, grp, type, source, number, value, text FROM "{name}" '
-            "WHERE id > ? ORDER BY id LIMIT ?", (done, self.batch)).fetchall()
+            f'SELECT id, ts, kind, grp, type, source, number, value, text, {"pid" if pid else "NULL"} '
+            f'FROM "{name}" WHERE id > ? ORDER BY id LIMIT ?', (done, self.batch)).fetchall()
         if not rows:
             return 0
         station, base = self.station, self.id_base
-        out = [(station, day, r[0] + base, *r[1:]) for r in rows]
+        # a pair's record that both stations may hold is keyed by its pid, the same in both
+        out = [(station, day, r[0] + base if r[9] is None else r[9], *r[1:9]) for r in rows]
         last = rows[-1][0]
         try:
             self._send(con, day, out, last, plant.copy_rows)

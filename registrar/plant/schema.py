@@ -11,7 +11,9 @@ its position are committed together or not at all.
 The two stations of a hot-standby pair forward under their one name, each its own archive: a
 record's id there is its local id plus its letter's base (PAIR_ID_BASE: A from 2^40, B from 2^41),
 so the two never collide and each keeps its own order, and each letter's position is a row of
-`forwarded_pair`. Queries order by time, so the pair's records read as one history.
+`forwarded_pair`. A record both stations may hold (kept by the standby for a takeover) is keyed by
+its pid instead (app/station/pair.py: its ms << 12, far above the letters' ids), the same in
+both. Queries order by time, so the pair's records read as one history.
 
 `tags` keeps every version of each station's tags (its tags.csv as the station's archive holds
 it), each valid from the change that made it to the next one, and the view `tag_values` gives

@@ -60,6 +60,22 @@ def test_messages_get_their_catalog_text_and_unknown_numbers_are_kept(db):
     ]
 
 
+def test_a_day_table_from_before_the_pid_column_gets_it_and_a_pair_record_keeps_its_pid(db):
+    day = table_name(dt.date.fromtimestamp(1_790_000_000.0))
+    db.parent.mkdir(parents=True, exist_ok=True)
+    con = sqlite3.connect(db)
+    con.execute(f'CREATE TABLE "{day}" (id INTEGER PRIMARY KEY, ts INTEGER NOT NULL, kind TEXT NOT NULL, '
+                "grp INTEGER, type INTEGER, source TEXT, number INTEGER, value REAL, text TEXT)")
+    con.execute(f'INSERT INTO "{day}" (ts, kind, text) VALUES (1790000000000, \'system\', \'before\')')
+    con.commit()
+    con.close()
+    store = Store(db)
+    store.start()
+    store.put(Record(1_790_000_000.5, "alarm", source="TRIP.ALARM", text="raised", pid=7 << 50))
+    store.close()
+    assert rows(db, day, "text, pid") == [("before", None), ("raised", 7 << 50)]
+
+
 def test_schema_reads_sensibly_with_the_catalog_copied_in(db):
     store = Store(db, catalog=CATALOG)
     store.start()
@@ -70,7 +86,7 @@ def test_schema_reads_sensibly_with_the_catalog_copied_in(db):
     columns = [(c[1], c[2]) for c in con.execute(f'PRAGMA table_info("{day}")')]
     assert columns == [("id", "INTEGER"), ("ts", "INTEGER"), ("kind", "TEXT"), ("grp", "INTEGER"),
                        ("type", "INTEGER"), ("source", "TEXT"), ("number", "INTEGER"), ("value", "REAL"),
-                       ("text", "TEXT")]
+                       ("text", "TEXT"), ("pid", "INTEGER")]
     assert con.execute("SELECT * FROM messages").fetchall() == [(3, 1, 2, "Уровень выше 90 %")]
     meta = dict(con.execute("SELECT key, value FROM meta"))
     assert meta["ts_unit"].startswith("milliseconds") and meta["schema_version"] == "2"

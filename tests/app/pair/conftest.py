@@ -174,7 +174,8 @@ def pair(tmp_path: Path, node: Simulator) -> Iterator[tuple[Station, Station]]:
 class Proxy:
     """A TCP proxy between the pair that the test cuts (every connection and the listener), or
     whose connections so far it holds from the dialler (`hold`: what the listening side sends
-    on them is lost on its way, its end still passes; new connections pass)."""
+    on them is lost on its way, its end still passes; new connections pass), or, `back`, from
+    the listening side (what the dialler sends is lost)."""
 
     def __init__(self) -> None:
         self.target = 0
@@ -184,8 +185,8 @@ class Proxy:
         self.held: set[socket.socket] = set()  # upstream sockets whose data is dropped
         threading.Thread(target=self._accept, daemon=True).start()
 
-    def hold(self) -> None:
-        self.held.update(self.sockets[1::2])
+    def hold(self, back: bool = False) -> None:
+        self.held.update(self.sockets[0::2] if back else self.sockets[1::2])
 
     def _accept(self) -> None:
         while True:

@@ -27,7 +27,8 @@ TRIP = "TRIP.ALARM"
 
 
 def local_records(station: Station) -> list[tuple[int, str, str]]:
-    """(id as forwarded, kind, text) of every record of the station's local archive."""
+    """(id as forwarded: its pid, else its id with its letter's base; kind, text) of every record
+    of the station's local archive."""
     letter = station.folder.name
     path = load_station(station.folder).Archive
     con = sqlite3.connect(f"file:{path}?mode=ro", uri=True)
@@ -35,8 +36,8 @@ def local_records(station: Station) -> list[tuple[int, str, str]]:
         out = []
         for (name,) in con.execute("SELECT name FROM sqlite_master WHERE type = 'table' AND name GLOB ?",
                                    (DAY_GLOB,)):
-            out += [(i + PAIR_ID_BASE[letter], kind, text or "")
-                    for i, kind, text in con.execute(f'SELECT id, kind, text FROM "{name}"')]
+            out += [(i + PAIR_ID_BASE[letter] if pid is None else pid, kind, text or "")
+                    for i, kind, text, pid in con.execute(f'SELECT id, kind, text, pid FROM "{name}"')]
         return out
     finally:
         con.close()
@@ -64,8 +65,9 @@ def test_the_pair_forwards_to_one_plant_archive_nothing_lost_nothing_doubled(
     with psycopg.connect(pg_url) as con:
         plant = con.execute("SELECT id, kind, coalesce(text, '') FROM records "
                             "WHERE station = 'pair'").fetchall()
-    ours = local_records(a) + local_records(b)
+    ours = set(local_records(a) + local_records(b))  # a record both hold has one pid
     assert sorted(plant) == sorted(ours)  # every record of both archives, once, no id of two
+    assert len({i for i, _kind, _text in ours}) == len(ours)
     texts = [text for _id, _kind, text in plant]
     assert sum(f"{TRIP} normal -> active-unacknowledged" in t for t in texts) == 1  # not the standby's too
     for done in ("write 04000: 0 -> 1111", "write 04000: 1111 -> 2222", "the primary is B"):
@@ -180,3 +182,89 @@ def test_a_status_query_answers_no_write_that_waits_for_the_standby(
     finally:
         b.stop()
         a.stop()
+
+
+def whole_pair(tmp_path: Path, node: Simulator, pg_url: str,
+               proxy: Proxy | None = None) -> tuple[Station, Station]:
+    """A and B started, forwarding to the plant archive (B dialling through `proxy`, if given),
+    the pair whole."""
+    a, b = make_pair(tmp_path, node, b_dials=proxy.port if proxy else None,
+                     top=f'Archive = "{pg_url}"\nTags = "tags.csv"\n', files={"tags.csv": TAGS})
+    if proxy is not None:
+        proxy.target = load_station(a.folder).redundancy.listen_address[1]  # type: ignore[union-attr]
+    a.start()
+    b.start()
+    wait_for(lambda: a.rt.pair is not None and a.rt.pair.status().link, what="the pair whole")
+    return a, b
+
+
+def raised_in_plant(pg_url: str) -> int:
+    with psycopg.connect(pg_url) as con:
+        return sum(RAISED in t for (t,) in con.execute(
+            "SELECT coalesce(text, '') FROM records WHERE station = 'pair'"))
+
+
+def test_a_transition_of_a_scan_the_standby_acknowledged_survives_a_primary_that_never_read_that(
+        tmp_path: Path, node: Simulator, proxy: Proxy, pg_url: str) -> None:
+    """The standby acknowledged the scan that raised TRIP; the primary died before it read that
+    acknowledgement, so it had not archived the transition, and the new primary, holding the
+    raised state, raises nothing again. The standby keeps the primary's records of the scans it
+    holds until the primary says they are on its disk, and archives them when it takes over."""
+    a, b = whole_pair(tmp_path, node, pg_url, proxy)
+    try:
+        proxy.hold(back=True)  # B's acknowledgements lost on their way: A archives nothing more
+        assert a.rt.engine is not None and a.rt.engine.write_bit(BITS[TRIP], 1, user="test")
+        wait_for(lambda: alarm(b, TRIP).state is State.UNACK, what="B holds the scan that raised TRIP")
+        a.kill()
+        wait_for(lambda: b.role == "primary", what="takeover")
+    finally:
+        b.stop()
+        a.stop()
+    assert (raised(a), raised(b)) == (0, 1)
+    assert raised_in_plant(pg_url) == 1
+
+
+def test_a_transition_the_primary_archived_but_had_not_on_disk_when_it_died_survives(
+        tmp_path: Path, node: Simulator, pg_url: str) -> None:
+    """The primary read the acknowledgement and handed TRIP's transition to its archive, which
+    had not committed it when the primary died (here: its archive locked by another writer, as a
+    slow disk would keep it): the standby, told of no commit, archives it when it takes over."""
+    a, b = whole_pair(tmp_path, node, pg_url)
+    lock = sqlite3.connect(load_station(a.folder).Archive, timeout=10)
+    try:
+        lock.execute("BEGIN IMMEDIATE")  # A's archive commits nothing more
+        assert a.rt.engine is not None and a.rt.engine.write_bit(BITS[TRIP], 1, user="test")
+        wait_for(lambda: alarm(b, TRIP).state is State.UNACK, what="B holds the scan that raised TRIP")
+        assert a.rt.pair is not None
+        pair = a.rt.pair  # its records wait for B's acknowledgement, then go to its archive
+        wait_for(lambda: not pair._held, what="A hands the transition to its archive")
+        a.kill()  # its archive's queue dies with it
+        lock.rollback()
+        wait_for(lambda: b.role == "primary", what="takeover")
+    finally:
+        lock.close()
+        b.stop()
+        a.stop()
+    assert (raised(a), raised(b)) == (0, 1)
+    assert raised_in_plant(pg_url) == 1
+
+
+def test_a_record_both_stations_archive_is_one_record_of_the_plant_archive(
+        tmp_path: Path, node: Simulator, proxy: Proxy, pg_url: str) -> None:
+    """IntoStandBy while the standby's acknowledgements are late: the new primary archives the
+    transition its partner may not have on disk, and the old primary archives it too once the
+    link ends; with one identity (its pid) the plant archive refuses the second copy."""
+    a, b = whole_pair(tmp_path, node, pg_url, proxy)
+    try:
+        proxy.hold(back=True)
+        assert a.rt.engine is not None and a.rt.engine.write_bit(BITS[TRIP], 1, user="test")
+        wait_for(lambda: alarm(b, TRIP).state is State.UNACK, what="B holds the scan that raised TRIP")
+        assert a.rt.pair is not None and a.rt.pair.into_standby("test", wait=5)
+        wait_for(lambda: b.role == "primary", what="the handover")
+        proxy.held.clear()  # B's frames reach A again (else A, hearing none, would take over)
+        a.stop()  # the link ends: A archives what waited for B's acknowledgement
+    finally:
+        b.stop()
+        a.stop()
+    assert (raised(a), raised(b)) == (1, 1)
+    assert raised_in_plant(pg_url) == 1

@@ -10,6 +10,7 @@ import pytest
 from app.station.mirror import Capture, Encoder, LinkError, Mirror
 from netplc.forcing import Force
 from netplc.memory import Memory
+from netplc.records import Record
 
 
 def test_every_frame_leaves_the_standby_with_the_primary_s_state() -> None:
@@ -46,3 +47,16 @@ def test_alarm_states_reach_the_standby_once_however_frames_come() -> None:
     mirror.apply(encoder.frame(Capture(mem.snapshot(3), {}, {}, 0)))
     assert mirror.take_alarms() == {"TRIP.ALARM": acked, "DOOR.ALARM": {"active": False}}
     assert mirror.take_alarms() == {}
+
+
+def test_the_standby_keeps_the_primary_s_records_until_it_says_they_are_on_its_disk() -> None:
+    mem, encoder, mirror = Memory(), Encoder(), Mirror()
+    raised = Record(1_790_000_000.25, "alarm", 2, 3, "TRIP.ALARM", 1, 1.0, "raised", pid=7 << 50)
+    wrote = Record(1_790_000_000.3, "operator", source="ivan", number=0o4000, value=5, text="write",
+                   pid=(7 << 50) + 1)
+    mirror.apply(encoder.frame(Capture(mem.snapshot(1), {}, {}, 0, records=(raised,))))
+    mirror.apply(encoder.frame(Capture(mem.snapshot(2), {}, {}, 0, records=(wrote,), committed=0)))
+    assert (mirror.pending, mirror.last_pid) == ([(1, [raised]), (2, [wrote])], (7 << 50) + 1)
+    mirror.apply(encoder.frame(Capture(mem.snapshot(3), {}, {}, 0, committed=1)))
+    assert mirror.take_pending() == [wrote]  # what a takeover now archives, the same records
+    assert mirror.take_pending() == []
