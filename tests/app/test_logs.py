@@ -36,7 +36,8 @@ def test_a_running_station_logs_into_its_folder(tmp_path):
 
 def test_a_library_logging_each_request_logs_its_warnings_only_unless_debug():
     code = ("import logging, app.logs as l; l.configure('{}')\n"
-            "a = logging.getLogger('asyncua.server.uaprocessor'); a.info('Read request'); a.warning('lost')\n")
+            "a = logging.getLogger('asyncua.server.uaprocessor')\n"
+            "a.info('Read request'); a.warning('lost')\n")
     quiet = subprocess.run([sys.executable, "-c", code.format("WARNING")], cwd=REPO, capture_output=True,
                            text=True, timeout=60)
     loud = subprocess.run([sys.executable, "-c", code.format("DEBUG")], cwd=REPO, capture_output=True,
