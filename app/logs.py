@@ -26,6 +26,10 @@ BACKUPS = 4
 LEVELS = ("DEBUG", "INFO", "WARNING", "ERROR", "CRITICAL")
 FORMAT = "%(asctime)s %(levelname)s %(threadName)s %(name)s: %(message)s"
 JOURNAL_FORMAT = "%(levelname)s %(threadName)s %(name)s: %(message)s"
+# libraries that log every request they serve at INFO (asyncua: each Read, Browse and Publish of
+# every client): a line per request of every console fills the file and costs the server a record
+# each; their warnings stay, their INFO only with DEBUG
+CHATTY = ("asyncua",)
 PRIORITIES = {logging.DEBUG: 7, logging.INFO: 6, logging.WARNING: 4, logging.ERROR: 3, logging.CRITICAL: 2}
 
 logger = logging.getLogger(__name__)
@@ -33,7 +37,8 @@ _file_handler: logging.Handler | None = None
 
 
 def configure(level: str = "WARNING") -> None:
-    """Log to stderr at `level`; uncaught exceptions of every thread are logged."""
+    """Log to stderr at `level`; uncaught exceptions of every thread are logged; the CHATTY
+    libraries' INFO only at DEBUG."""
     root = logging.getLogger()
     root.setLevel(logging.DEBUG if level == "DEBUG" else logging.INFO)
     for handler in [h for h in root.handlers if getattr(h, "_netplc", False)]:
@@ -43,6 +48,8 @@ def configure(level: str = "WARNING") -> None:
     console.setFormatter(_JournalFormatter(JOURNAL_FORMAT) if _to_journal() else logging.Formatter(FORMAT))
     console._netplc = True  # type: ignore[attr-defined]
     root.addHandler(console)
+    for name in CHATTY:
+        logging.getLogger(name).setLevel(logging.DEBUG if level == "DEBUG" else logging.WARNING)
     sys.excepthook = _uncaught
     threading.excepthook = _uncaught_in_thread
 

@@ -2,20 +2,23 @@
 view's `StationClient` (login, trust on first use, memory, back-off, commands as the user) and what
 a console adds, all of it standard OPC UA that any client could do the same way:
 
-- the station's files (files.py): the manifest read every SLOW_S; a file whose SHA-256 is not
-  in the console's cache is read through its FileType object, and the station's folder as of that
-  manifest is put together under the console's config directory (`stations/<host:port>/<hash>/`),
-  which the console then loads like a station's own: a form saved at the station reaches the
-  console within a second or two;
+- the station's files (files.py): the manifest watched (pushed when it changes); a file whose
+  SHA-256 is not in the console's cache is read through its FileType object, and the station's
+  folder as of that manifest is put together under the console's config directory
+  (`stations/<host:port>/<hash>/`), which the console then loads like a station's own: a form
+  saved at the station reaches the console within a second or two;
 - the alarms: the conditions of the station's Alarms folder (browsed once per session), their
-  ISA-18.2 state word, severity and text read every SLOW_S (with the manifest, links and role), so
-  a console that reconnects shows the station's alarms as they are now (the refresh a
-  ConditionRefresh gives an event client);
+  ISA-18.2 state word, severity, text and time watched as monitored items of the memory's
+  subscription (with the manifest, the nodes' links and the journal's count), so the station
+  pushes what changed, when it changed, in the notification that carries the scan; each new
+  session reads them all first, so a console that reconnects shows the station's alarms as they
+  are now (the refresh a ConditionRefresh gives an event client);
 - NetPlc's memory, only the parts its views want (`want`: the open form's operands; the whole of it
   while a Program view is open, or until a view said what it wants), watched as monitored items
   with an IndexRange (memory_items.py): the station pushes a part when it changed;
 - the nodes' links (Nodes.<n>.Up), so the console judges its elements' quality as the station does;
-- the user's role at the station (Station.Role), so a refusal names the role it needed;
+- the user's role at the station (Station.Role, read with the user's rights every few seconds),
+  so a refusal names the role it needed;
 - writes of a form's raw address through the station's WriteBit and WriteWord methods;
 - the journal: the station object's event history (HistoryReadEvents, Part 11), newest first;
 - a trend's history: its tag's raw history (HistoryReadRawModified, Part 11), page after page
@@ -36,6 +39,7 @@ import shutil
 import struct
 import threading
 import time
+from collections.abc import Callable
 from concurrent.futures import Future
 from dataclasses import dataclass
 from datetime import UTC
@@ -44,6 +48,7 @@ from typing import Any
 from urllib.parse import urlsplit
 
 from asyncua import ua
+from asyncua.client.ua_client import UaClientState
 from asyncua.client.ua_file import UaFile
 from asyncua.common.events import Event
 
@@ -65,7 +70,6 @@ STATES = {state.word: state for state in State}
 PRIORITY_OF = {severity: priority for priority, severity in SEVERITY.items()}
 FIELDS = ("State", "Severity", "Text", "Time")  # read of each condition
 EVENT_FIELDS = ("EventId", "EventType", "SourceName", "Time", "Message", "Severity")  # what `_record` reads
-SLOW_S = 0.5  # the manifest, the alarms, the links and the role are read this often (memory: pushed)
 
 
 @dataclass(frozen=True)
@@ -91,14 +95,14 @@ class ConsoleClient(StationClient):
         self.links: dict[int, bool] = {}
         self.role = ""
         self.journal_events: object = None  # Station.JournalEvents as last read: it changes, the journal did
-        self._manifest = ""
-        self._browsed: object = None  # the session the alarms and nodes were browsed in
+        self._manifest = ""  # the manifest whose files are put together in `files`
         self._alarm_ids: list[str] = []
         self._nodes: list[int] = []
+        self._pushed_values: dict[str, object] = {}  # by variable, as the station pushed them
+        self._fresh = False  # one of them changed since they were taken
         base = (folder or config_dir()) / "console"
         self._cache = base / "cache"
         self._stations = base / "stations" / urlsplit(url).netloc.replace(":", "_")
-        self._slow = 0.0  # when the slow part was read last
         self._own = f"{os.getpid()}-{id(self):x}"  # this client's partial files, apart from other consoles'
         self.memory = MemoryItems(self._node)
         self.memory.on_batch = self._pushed
@@ -201,20 +205,54 @@ class ConsoleClient(StationClient):
     # --- on the client's loop -------------------------------------------------------------------
 
     async def _read(self) -> None:
+        """Each period: the link (the station pushes the rest: nothing to read), a new session's
+        subscription, the files of a manifest pushed, the parts of the memory the views want."""
         client = self._client
         assert client is not None
-        if self._browsed is not client:
-            await self._browse()
-            self._browsed, self._slow = client, 0.0
-        if time.monotonic() - self._slow >= SLOW_S:
-            await self._read_slow()
-            self._slow = time.monotonic()
-            self.changed()  # the alarms may have changed where the memory did not
+        if client.uaclient.state is not UaClientState.CONNECTED:  # asyncua found the link lost
+            raise ConnectionError(f"the link is lost ({client.uaclient.state.value})")
         if self.memory.client is not client:  # a new session: a subscription of its own
             tick = await client.get_node(self._node("NetPlc.NetSyncTimeMs")).read_value()
             await self.memory.open(client, float(tick or 100))
+            await self._browse()
+            self._pushed_values = {}
+            await self.memory.values([(self._node(n), self._setter(n)) for n in self._watched_names()])
+            self._take()
             self.service_level = self.memory.service_level if self.memory.service_level is not None else LEADS
+        manifest = str(self._pushed_values.get("Files.Manifest") or "{}")
+        if manifest != self._manifest:
+            self.files = await self._fetch(manifest)
+            self._manifest = manifest
+            self.changed()
         await self._watch_wanted()
+
+    def _watched_names(self) -> list[str]:
+        """The station's variables a console watches besides the memory."""
+        return ["Files.Manifest", "Station.JournalEvents", *(f"Nodes.{n}.Up" for n in self._nodes),
+                *(f"Alarms.{a}.{f}" for a in self._alarm_ids for f in FIELDS)]
+
+    def _setter(self, name: str) -> Callable[[ua.DataValue], None]:
+        def apply(dv: ua.DataValue) -> None:
+            self._pushed_values[name] = dv.Value.Value if dv.Value is not None else None
+            self._fresh = True
+        return apply
+
+    def _take(self) -> None:
+        """The links, the alarms and the journal's count as the station pushed them last."""
+        self._fresh = False
+        values = self._pushed_values
+        self.journal_events = values.get("Station.JournalEvents")
+        self.links = {n: bool(values.get(f"Nodes.{n}.Up")) for n in self._nodes}
+        self.alarms = tuple(self._row(a, [values.get(f"Alarms.{a}.{f}") for f in FIELDS])
+                            for a in self._alarm_ids)
+
+    async def _ask_rights(self) -> None:
+        """The user's rights, and the user's role with them (a role changed at the station)."""
+        await super()._ask_rights()
+        client = self._client
+        if client is not None:
+            (dv,) = await client.uaclient.read_attributes([self._node("Station.Role")], ua.AttributeIds.Value)
+            self.role = str(dv.Value.Value or "") if dv.Value is not None else ""
 
     async def _watch_wanted(self) -> None:
         """Watch what the views want now (reading the parts newly wanted first)."""
@@ -227,6 +265,8 @@ class ConsoleClient(StationClient):
     def _pushed(self) -> None:
         """The station pushed a change (or a part newly watched was read): the memory shown anew."""
         m = self.memory
+        if self._fresh:
+            self._take()
         if m.forces != self._forces_text:
             self._forces_text, self._forces_parsed = m.forces, self._forces(m.forces)
         snapshot = Snapshot(tuple(m.bits), bytes(m.data), m.tick, time.monotonic(), m.wall, m.state,
@@ -238,38 +278,15 @@ class ConsoleClient(StationClient):
         self.reads = m.batches
         self.changed()
 
-    async def _read_slow(self) -> None:
-        client = self._client
-        assert client is not None
-        nodes = [self._node(n) for n in ("Files.Manifest", "Station.Role", "Station.JournalEvents")]
-        nodes += [self._node(f"Nodes.{n}.Up") for n in self._nodes]
-        nodes += [self._node(f"Alarms.{a}.{f}") for a in self._alarm_ids for f in FIELDS]
-        values = [dv.Value.Value if dv.Value is not None else None
-                  for dv in await client.uaclient.read_attributes(nodes, ua.AttributeIds.Value)]
-        manifest, self.role, self.journal_events = str(values[0] or "{}"), str(values[1] or ""), values[2]
-        self.links = {n: bool(up) for n, up in zip(self._nodes, values[3:])}
-        rest = values[3 + len(self._nodes):]
-        self.alarms = tuple(self._row(a, rest[k * len(FIELDS):(k + 1) * len(FIELDS)])
-                            for k, a in enumerate(self._alarm_ids))
-        if manifest != self._manifest:
-            self.files = await self._fetch(manifest)
-            self._manifest = manifest
-
     async def _journal(self, day: dt.date, limit: int, since: float | None) -> list[Row]:
-        client = self._client
-        if client is None:
-            raise ConnectionError(f"not connected: {self.error or 'logging in'}")
+        """The day's events with no where clause: the select clauses are the few fields a record
+        needs, not those asyncua's read_event_history builds by browsing the event types at each
+        read (some fifty Browse requests a page, each a console's cost at the station)."""
         first = dt.datetime.combine(day, dt.time.min).astimezone(UTC)
         end = first + dt.timedelta(days=1)
-        station = client.get_node(self._node(self.station))
-        try:  # an end before the start reads newest first
-            if since is None:
-                events = await station.read_event_history(end, first, limit)
-            else:
-                events = await station.read_event_history(dt.datetime.fromtimestamp(since, UTC), end, limit)
-        except ua.UaError as e:
-            raise ConnectionError(f"{self.url}: {_why(e)}") from None
-        return [_record(e) for e in events]
+        if since is None:  # an end before the start reads newest first
+            return await self._events(end, first, ua.ContentFilter(), limit)
+        return await self._events(dt.datetime.fromtimestamp(since, UTC), end, ua.ContentFilter(), limit)
 
     async def _history(self, tag: str, start: dt.datetime, end: dt.datetime) -> list[ua.DataValue]:
         client = self._client
@@ -282,15 +299,15 @@ class ConsoleClient(StationClient):
 
     async def _events(self, start: dt.datetime, end: dt.datetime, where: ua.ContentFilter,
                       limit: int) -> list[Row]:
-        """Answer after answer, with the station's continuation points (released when `limit` is
-        reached first)."""
+        """Answer after answer, with the station's continuation points, `limit` at most (the station
+        is asked no more; a continuation point left is released)."""
         client = self._client
         if client is None:
             raise ConnectionError(f"not connected: {self.error or 'logging in'}")
         select = [ua.SimpleAttributeOperand(TypeDefinitionId=ua.NodeId(ua.ObjectIds.BaseEventType),
                                             BrowsePath=[ua.QualifiedName(name, 0)],
                                             AttributeId=ua.AttributeIds.Value) for name in EVENT_FIELDS]
-        details = ua.ReadEventDetails(StartTime=start, EndTime=end, NumValuesPerNode=0,
+        details = ua.ReadEventDetails(StartTime=start, EndTime=end, NumValuesPerNode=limit,
                                       Filter=ua.EventFilter(SelectClauses=select, WhereClause=where))
         value = ua.HistoryReadValueId(NodeId=self._node(self.station))
         rows: list[Row] = []

@@ -10,22 +10,31 @@ Bad_IndexRangeNoData, one that is no range (or more dimensions than the value ha
 Bad_IndexRangeInvalid. Applied after the read (a PostRead callback), so the value's status and
 timestamps stay the server's; on a monitored item, to each value sampled before it is compared with
 the last one reported (`RangedItems`, installed in each session's subscriptions by opcua.py).
+
+The same items keep the value sampled last as it is when it cannot change in place (a number, a
+string, a ByteString...): asyncua deep-copies every value of every item of every subscription, the
+better part of what each scan costs the station per console.
 """
 
 from __future__ import annotations
 
+import copy
+import datetime as dt
 import re
 from dataclasses import replace
+from functools import lru_cache
 
 from asyncua import ua
 from asyncua.common.callback import ServerItemCallback
 from asyncua.server.internal_subscription import InternalSubscription
-from asyncua.server.monitored_item_service import MonitoredItemService
+from asyncua.server.monitored_item_service import MonitoredItemData, MonitoredItemService, MonitoredItemValues
 
 _RANGE = re.compile(r"(\d+)(?::(\d+))?")
 _S = ua.StatusCodes
+FIXED = (bool, int, float, str, bytes, dt.datetime, type(None))  # values nobody changes in place
 
 
+@lru_cache(maxsize=1024)
 def numeric_range(text: str) -> tuple[int, int] | None:
     """The first and last index of `text`, None when it is not a one-dimensional NumericRange."""
     m = _RANGE.fullmatch(text)
@@ -59,17 +68,34 @@ def index_ranges(event: ServerItemCallback, _service: object) -> None:
             results[n] = part(results[n], rv.IndexRange)
 
 
+class Sampled(MonitoredItemValues):
+    """An item's values as last sampled: one that cannot change in place is kept as it is (the
+    address space replaces a DataValue, never changes one), others deep-copied as asyncua does."""
+
+    def set_current_datavalue(self, cur_val: ua.DataValue) -> None:
+        value = cur_val.Value.Value if cur_val.Value is not None else None
+        self.old_dvalue = self.current_dvalue
+        self.current_dvalue = cur_val if isinstance(value, FIXED) else copy.deepcopy(cur_val)
+
+
 class RangedItems(MonitoredItemService):
     """A subscription's monitored items, each value cut to its item's IndexRange before asyncua
     compares it with the last one reported: a change elsewhere in the array reports nothing, and
     only the part is copied and sent. A range that is no NumericRange is refused at creation
     (Bad_IndexRangeInvalid), one past the end reports Bad_IndexRangeNoData, as a Read would.
     A part the same as the one sampled last is not handed to asyncua at all (which would copy it
-    deeply to find so), unless the item's filter reports a new timestamp too."""
+    deeply to find so), unless the item's filter reports a new timestamp too. Every item keeps its
+    values `Sampled`."""
 
     def __init__(self, isub: InternalSubscription, aspace: object) -> None:
         super().__init__(isub, aspace)  # type: ignore[arg-type]
         self._parts: dict[int, tuple[object, object]] = {}  # by item: its part and status last sampled
+
+    def _make_monitored_item_common(self, params: ua.MonitoredItemCreateRequest
+                                    ) -> tuple[ua.MonitoredItemCreateResult, MonitoredItemData]:
+        result, item = super()._make_monitored_item_common(params)
+        item.mvalue = Sampled()
+        return result, item
 
     async def _create_data_change_monitored_item(
             self, params: ua.MonitoredItemCreateRequest) -> ua.MonitoredItemCreateResult:

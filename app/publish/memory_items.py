@@ -121,14 +121,20 @@ class MemoryItems:
         scan's variables; no part of the memory yet (`follow`)."""
         self.client, self._items, self._apply, self.covered = client, {}, {}, NOTHING
         period = max(PUBLISH_MIN_MS, tick_ms / 2)
-        self._subscription = subscription = await client.create_subscription(period, self)
+        self._subscription = await client.create_subscription(period, self)
         scalars: list[tuple[ua.NodeId, Callable[[ua.DataValue], None]]] = [
             (self.node("NetPlc.Tick"), self._tick), (self.node("NetPlc.State"), self._state),
             (self.node("NetPlc.Forces"), self._forces),
             (ua.NodeId(ua.ObjectIds.Server_ServiceLevel), self._level)]
-        for dv, (_, apply) in zip(await self._read([(n, "") for n, _ in scalars]), scalars):
+        await self.values(scalars)
+
+    async def values(self, items: list[tuple[ua.NodeId, Callable[[ua.DataValue], None]]]) -> None:
+        """Watch the variables of `items` whole in the same subscription, each applied its value
+        read now and then each change the station pushes (before `on_batch`)."""
+        assert self._subscription is not None, "open() first"
+        for dv, (_, apply) in zip(await self._read([(n, "") for n, _ in items]), items):
             apply(dv)
-        await self._watch(subscription, [(n, "", apply) for n, apply in scalars])
+        await self._watch(self._subscription, [(n, "", apply) for n, apply in items])
 
     async def follow(self, wanted: Ranges) -> bool:
         """Watch the parts of `wanted` and no others; True when what is watched changed."""

@@ -34,6 +34,18 @@ def test_a_running_station_logs_into_its_folder(tmp_path):
     assert "station started" in log and "station stopped" in log
 
 
+def test_a_library_logging_each_request_logs_its_warnings_only_unless_debug():
+    code = ("import logging, app.logs as l; l.configure('{}')\n"
+            "a = logging.getLogger('asyncua.server.uaprocessor')\n"
+            "a.info('Read request'); a.warning('lost')\n")
+    quiet = subprocess.run([sys.executable, "-c", code.format("WARNING")], cwd=REPO, capture_output=True,
+                           text=True, timeout=60)
+    loud = subprocess.run([sys.executable, "-c", code.format("DEBUG")], cwd=REPO, capture_output=True,
+                          text=True, timeout=60)
+    assert "lost" in quiet.stderr and "Read request" not in quiet.stderr
+    assert "Read request" in loud.stderr
+
+
 def test_an_uncaught_exception_in_a_thread_is_logged_with_its_traceback():
     code = ("import threading, app.logs as l; l.configure('WARNING')\n"
             "t = threading.Thread(target=lambda: 1 / 0, name='worker'); t.start(); t.join()\n")
