@@ -53,6 +53,7 @@ from hmi_forms.widgets.trend import REDRAW_INTERVAL, TrendWidget
 from netplc.memory import Snapshot
 
 logger = logging.getLogger(__name__)
+Text = tuple[TextSlot, int, int, str, Ink]  # a composed text's arguments (`sprites.draw_text`)
 BATCH = 100  # changed elements from which a refresh that changed most of the form repaints it whole
 
 
@@ -314,7 +315,7 @@ class FormView(QWidget):
         elements do not overlap (`_apart`) and each draws only inside its own rectangle (a text
         is cut at its element's sides, or its ink lies inside them: a slot with `sides`), so
         this is pixel for pixel the order element by element."""
-        texts: list[tuple[Face, tuple[TextSlot, int, int, str, Ink]]] = []
+        texts: list[tuple[Face, Text]] = []
         over: list[tuple[Face, Op]] = []  # drawn after the texts
         for face in self._faces:  # the loop runs a thousand times a tick on a large form
             ops = face.drawn
@@ -341,7 +342,7 @@ class FormView(QWidget):
             except Exception as e:  # no log: _fault logs it, once
                 self._fault(face.model, e, "drawing")
 
-    def _paint_texts(self, p: QPainter, texts: list[tuple[Face, tuple[TextSlot, int, int, str, Ink]]]) -> None:
+    def _paint_texts(self, p: QPainter, texts: list[tuple[Face, Text]]) -> None:
         """The value texts of `_paint_passes`, each as `TextSlot.paint` draws it."""
         clipped, pen = False, None
         for face, (slot, x, y, text, ink) in texts:

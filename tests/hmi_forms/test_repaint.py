@@ -378,7 +378,8 @@ def test_texts_drawn_in_a_pass_of_their_own_are_the_texts_drawn_element_by_eleme
     wide = {**LEVEL, "Name": "Wide", "AppMax": 65535, "PhyMax": 10000}
     kinds = ("dial", "digital", "hbar", "semidial", "digital", "dial") * 2
     doc = [{**dial(f"A{i}", i % 6 * 64, f"0{0o4010 + 2 * i:o}", size=64, Device="Wide", Precision=1,
-                   Appearance=kind, Units="%", PhyHigh=9000), "y": i // 6 * 64} for i, kind in enumerate(kinds)]
+                   Appearance=kind, Units="%", PhyHigh=9000), "y": i // 6 * 64}
+           for i, kind in enumerate(kinds)]
     doc += [{"type": "DiscreteColorLabel", "Name": f"L{i}", "x": i * 64, "y": 128, "w": 64, "h": 64,
              "InAddr": f"0{0o2120 + i:o}", "TextFalse": "OFF", "TextTrue": "ON", "BackColorTrue": "#2e7d32"}
             for i in range(6)]
