@@ -21,7 +21,9 @@ every cache is bounded. `--workload demo` is the old one: 1,001 values of 0..100
 
 Ticks of the form and the yardstick alternate, so both see the same machine load. Prints per tick
 the mean, median, p95 and worst of the form, the yardstick beside it and the ratio of the medians,
-and the resident memory after warm-up and after all ticks (flat = no growth).
+the median thread CPU time of each and its ratio (on a loaded machine a tick's wall time is mostly
+waiting for a core, its CPU time is the work), and the resident memory after warm-up and after
+all ticks (flat = no growth).
 
 `--readings` refreshes as the workstation does, with the runtime's Readings of each scan: the
 words come from NREADs of one node (64 words each, link up), so every element's data quality is
@@ -296,6 +298,7 @@ def main() -> None:
     times = array("d", bytes(8 * ticks))
     models = array("d", bytes(8 * ticks))  # the refresh part: models, change detection, scheduling
     yard = array("d", bytes(8 * ticks))
+    cpu, y_cpu = array("d", bytes(8 * ticks)), array("d", bytes(8 * ticks))  # thread CPU time of each
     plots, polylines = array("d"), array("d")  # the redraws of the plots, of the yardstick's polylines
     redraws: list[int] = []  # the ticks that redrew the plots
     every = round(REDRAW_INTERVAL * 1000 / TICK_MS)
@@ -305,17 +308,19 @@ def main() -> None:
         drive(mem, n, tick, args.workload)
         snap = mem.snapshot(tick, tick * 0.1, 1.8e9 + tick * 0.1)
         readings = Readings(snap, qmap, links, qmap.evaluate(snap, links)) if args.readings else None
-        t0 = time.perf_counter()
+        c0, t0 = time.thread_time(), time.perf_counter()
         view.refresh(snap, readings)
         t1 = time.perf_counter()
         app.processEvents()
-        t2 = time.perf_counter()
+        t2, c1 = time.perf_counter(), time.thread_time()
         times[tick] = (t2 - t0) * 1000
         models[tick] = (t1 - t0) * 1000
-        t0 = time.perf_counter()
+        cpu[tick] = (c1 - c0) * 1000
+        c0, t0 = time.thread_time(), time.perf_counter()
         show_texts(plain, snap, args.workload)
         app.processEvents()
         yard[tick] = (time.perf_counter() - t0) * 1000
+        y_cpu[tick] = (time.thread_time() - c0) * 1000
         if lines and tick % every == 0:  # the plots, then their yardstick (in the plots' new window)
             t0 = time.perf_counter()
             view.redraw_trends(snap.wall)
@@ -345,6 +350,9 @@ def main() -> None:
     print(f"  yardstick, {len(plain)} QLabels with setText: "
           f"{y_mean:.2f} ms mean, {y_median:.2f} ms median, {y_p95:.2f} ms p95, {y_worst:.2f} ms worst; "
           f"form / yardstick (medians) {median / y_median:.2f}x (target <= 1.00x)")
+    f_cpu, f_y_cpu = statistics.median(cpu[warm:]), statistics.median(y_cpu[warm:])
+    print(f"  thread CPU time per tick (medians): form {f_cpu:.2f} ms, yardstick {f_y_cpu:.2f} ms, "
+          f"form / yardstick {f_cpu / f_y_cpu:.2f}x; load average {os.getloadavg()[0]:.1f}")
     if redraws:
         f_median, f_worst = statistics.median(plots), max(plots)
         y_median, y_worst = statistics.median(polylines), max(polylines)

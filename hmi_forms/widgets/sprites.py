@@ -237,18 +237,10 @@ class TextSlot:
     def paint(self, p: QPainter, text: str, ink: Ink, x: int = 0, y: int = 0) -> None:
         """`draw` of a text that `fits`, as one glyph run (the slot's own: refilled only with a
         new text, its places only with new advances)."""
-        width, places = self.glyphs.layout(text)
-        plan = self.plans.get((width, x, y)) or self._plan(width, x, y)
-        origin, cut = plan
-        if ink.back is not None and width <= self.span64:  # the flat colour under the text, opaque
-            p.fillRect(x + self.left, y + self.top, self.size.width(), self.size.height(), ink.back)
+        width, origin, cut = self.ready(text, x, y)
+        if ink.back is not None and width <= self.span64:
+            self.fill(p, ink, x, y)
         run = self.run
-        if text != self.text:
-            self.text = text
-            run.setGlyphIndexes(list(map(self.glyphs.indexes.__getitem__, text)))
-            if places is not self.places:
-                self.places = places
-                run.setPositions(places)
         p.setPen(ink.fore)
         if cut is None:  # (the usual case: nothing to cut)
             p.drawGlyphRun(origin, run)
@@ -261,6 +253,25 @@ class TextSlot:
             p.setClipRect(cut)
             p.drawGlyphRun(origin, run)
             p.setClipping(False)
+
+    def ready(self, text: str, x: int, y: int) -> tuple[int, QPointF, QRect | None]:
+        """The slot's run made to hold `text` (a text that `fits`); its width in 64ths, where the
+        run starts with the box moved by (x, y), and where it is cut (None: nowhere)."""
+        width, places = self.glyphs.layout(text)
+        origin, cut = self.plans.get((width, x, y)) or self._plan(width, x, y)
+        if text != self.text:
+            self.text = text
+            run = self.run
+            run.setGlyphIndexes(list(map(self.glyphs.indexes.__getitem__, text)))
+            if places is not self.places:
+                self.places = places
+                run.setPositions(places)
+        return width, origin, cut
+
+    def fill(self, p: QPainter, ink: Ink, x: int, y: int) -> None:
+        """The flat colour under a text (`ink.back`, opaque) that lies inside the area (what a new
+        text alone repaints), drawn before the text."""
+        p.fillRect(x + self.left, y + self.top, self.size.width(), self.size.height(), ink.back)
 
     def _plan(self, width: int, x: int, y: int) -> tuple[QPointF, QRect | None]:
         """Where a text of `width` 64ths starts with the box moved by (x, y), and where it is cut

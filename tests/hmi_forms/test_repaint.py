@@ -370,6 +370,48 @@ def test_a_composed_form_is_pixel_for_pixel_the_form_drawn_with_a_painter(qtbot,
     assert view.errors == []
 
 
+def test_texts_drawn_in_a_pass_of_their_own_are_the_texts_drawn_element_by_element(qtbot, tmp_path) -> None:
+    """A form whose elements do not overlap draws the value texts after every element, each
+    setting its clip in turn (`FormView._paint_passes`): the same pixels as element by element,
+    with words over their whole range in 64 px tiles (texts wider than their boxes, cut as drawText
+    cuts them, and wider than their elements), lamps, and a stale element drawn with a painter."""
+    wide = {**LEVEL, "Name": "Wide", "AppMax": 65535, "PhyMax": 10000}
+    kinds = ("dial", "digital", "hbar", "semidial", "digital", "dial") * 2
+    doc = [{**dial(f"A{i}", i % 6 * 64, f"0{0o4010 + 2 * i:o}", size=64, Device="Wide", Precision=1,
+                   Appearance=kind, Units="%", PhyHigh=9000), "y": i // 6 * 64}
+           for i, kind in enumerate(kinds)]
+    doc += [{"type": "DiscreteColorLabel", "Name": f"L{i}", "x": i * 64, "y": 128, "w": 64, "h": 64,
+             "InAddr": f"0{0o2120 + i:o}", "TextFalse": "OFF", "TextTrue": "ON", "BackColorTrue": "#2e7d32"}
+            for i in range(6)]
+    path = tmp_path / "t.hmi"
+    path.write_text(json.dumps({"form": {"title": "t", "width": 400, "height": 200}, "devices": [wide],
+                                "elements": doc}), encoding="utf-8")
+    view = FormView(load_form(path), NullTarget())
+    view.show()
+    qtbot.addWidget(view)
+    assert view._apart
+    for scan in range(4):
+        words = {0o4010 + 2 * i: (scan * 40503 + i * 9973) & 0xFFFF for i in range(12)}
+        view.refresh(snap(scan=scan, words=words, bits={0o2120 + i: (scan + i) % 2 for i in range(6)}))
+        if scan == 3:
+            view.painted[4].model.stale = True  # drawn with a painter, among the others
+            view.painted[4].sync()
+        passes = view.grab().toImage()
+        view._apart = False
+        assert view.grab().toImage() == passes, scan
+        view._apart = True
+    assert any(cut is not None for w in view.painted[:12] for _, cut in w._value.plans.values())
+    assert view.errors == []
+
+
+def test_elements_that_overlap_are_drawn_element_by_element(qtbot, tmp_path) -> None:
+    apart = form_of(tmp_path, [dial("A", 0, "04010"), dial("B", 140, "04012")])  # touching
+    over = form_of(tmp_path, [dial("A", 0, "04010"), dial("B", 100, "04012")])
+    qtbot.addWidget(apart)
+    qtbot.addWidget(over)
+    assert apart._apart and not over._apart
+
+
 def test_an_element_with_no_value_yet_or_a_stale_one_is_drawn_with_a_painter(qtbot, tmp_path) -> None:
     view = gallery(tmp_path)
     qtbot.addWidget(view)
