@@ -5,10 +5,9 @@ Every OPC UA server the station starts first fills the standard address space of
 the tests start dozens of them. One fill per process, made outside any server before the first
 test that may start one, is kept untouched, and each server gets a copy with nodes, attribute
 records and reference lists of its own, as a fresh fill would give it, each node copied when the
-server first reaches it (`_Nodes`). The attribute values
-themselves are shared: a server never changes a stored value in place (a write stores a new
-DataValue), except that a caller may append to an array it read (`Server.register_namespace`
-does), so array values are copied too.
+server first reaches it (`_Nodes`). The attribute values themselves are shared: a server never
+changes a stored value in place (a write stores a new DataValue), except that a caller may append
+to an array it read (`Server.register_namespace` does), so array values are copied too.
 """
 
 from __future__ import annotations
