@@ -5,6 +5,7 @@ builds every attribute of every node afresh: about 0.1 s per condition, minutes 
 thousands of alarms. Here each standard type's instance declarations are read once per process
 (`template`); the first condition of each shape is added through AddNodes, and every other one of
 that shape is a copy of its nodes (`clone`), which shares the attribute values that never change.
+The station's files (files.py) are FileType objects added the same way (`add_instance`).
 """
 
 from __future__ import annotations
@@ -102,18 +103,25 @@ async def add(server: Server, ids: list[ua.NodeId], declared: list[Declared], fo
     name = ua.QualifiedName(root.Identifier.removeprefix("Alarms."), root.NamespaceIndex)
     attributes = ua.ObjectAttributes(DisplayName=ua.LocalizedText(name.Name), EventNotifier=0,
                                      Description=ua.LocalizedText(description))
-    items = [ua.AddNodesItem(ParentNodeId=folder, ReferenceTypeId=ua.NodeId(_O.Organizes),
-                             RequestedNewNodeId=root, BrowseName=name, NodeClass=ua.NodeClass.Object,
-                             NodeAttributes=attributes, TypeDefinition=ua.NodeId(type_id))]
+    item = ua.AddNodesItem(ParentNodeId=folder, ReferenceTypeId=ua.NodeId(_O.Organizes),
+                           RequestedNewNodeId=root, BrowseName=name, NodeClass=ua.NodeClass.Object,
+                           NodeAttributes=attributes, TypeDefinition=ua.NodeId(type_id))
+    await add_instance(server, item, ids, declared)
+
+
+async def add_instance(server: Server, root: ua.AddNodesItem, ids: list[ua.NodeId],
+                       declared: list[Declared]) -> None:
+    """An instance's nodes through AddNodes: `root` (at `ids[0]`), then `declared` at `ids[1:]`, each
+    below the node its path names."""
+    items = [root]
     for d, nodeid in zip(declared, ids[1:]):
         item = copy.copy(d.item)
         item.RequestedNewNodeId = nodeid
-        item.ParentNodeId = ua.NodeId(".".join((root.Identifier, *d.path[:-1])), root.NamespaceIndex)
+        item.ParentNodeId = ua.NodeId(".".join((ids[0].Identifier, *d.path[:-1])), ids[0].NamespaceIndex)
         items.append(item)
     for item, result in zip(items, await server.iserver.isession.add_nodes(items)):
         if not result.StatusCode.is_good():
-            raise RuntimeError(f"condition node {item.RequestedNewNodeId.to_string()} not added: "
-                               f"{result.StatusCode}")
+            raise RuntimeError(f"node {item.RequestedNewNodeId.to_string()} not added: {result.StatusCode}")
 
 
 def clone(aspace: Any, first: list[ua.NodeId], ids: list[ua.NodeId], description: str) -> None:
