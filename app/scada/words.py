@@ -5,16 +5,18 @@ OPC UA, MQTT and every console; so they are built in the station's language from
 catalogue, never translated after. Alarm identities (LEVEL.HH) and journal kinds are keys, not
 prose, and stay as they are. The log stays English (ENGLISH), for whoever supports the station.
 A sentence made of parts (a pair's record naming the cause of a takeover) takes its parts as
-`Phrase`s, said in the sentence's language. netplc cannot import this catalogue: its exchange's
-words are its own (netplc/exchange.py LINK_WORDS), in English, and said here in Russian."""
+`Phrase`s, said in the sentence's language. netplc cannot import this catalogue: its records
+(the exchange's links, the operator's writes and forces, the engine's faults) are its own
+(netplc/words.py WORDS), in English, and said here in Russian; the runtime hands the engine and the
+exchange this catalogue to say them."""
 
 from __future__ import annotations
 
 import os
-from collections.abc import Mapping
+from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass, field
 
-from netplc.exchange import LINK_WORDS
+from netplc.words import WORDS as NETPLC_WORDS
 
 TEXTS: dict[str, dict[str, str]] = {
     "en": {
@@ -52,7 +54,6 @@ TEXTS: dict[str, dict[str, str]] = {
         "station stopped": "station stopped",
         "node answers": "simulated node {node} answers again",
         "node silent": "simulated node {node} stopped answering",
-        **LINK_WORDS,
         # a hot-standby pair's records (app/station/pair.py) and the causes they name
         "role starting": "starting", "role primary": "primary", "role standby": "standby",
         "pair role": "pair {letter}: {old} -> {new}: {cause}",
@@ -100,6 +101,130 @@ TEXTS: dict[str, dict[str, str]] = {
         "link is up": "up", "link is down": "DOWN",
         "user added": "user {user} added as {role}", "user removed": "user {user} removed",
         "password changed": "password of {user} changed",
+        **NETPLC_WORDS,
+        # the station's problems and its servers' starts (app/station/runtime.py, app/publish/station.py)
+        "modbus not started": "Modbus server not started: {path}: modbus_server.port: cannot listen on "
+                              "{host}:{port}: {error}",
+        "modbus not yet": "Modbus server not started yet: {path}: modbus_server.port: {fault}; retrying "
+                          "every {every:g} s",
+        "force not restored": "retained force not restored: {problem}",
+        "scan failed": "scan failed: {error}",
+        "opcua not started": "OPC UA server not started: {path}: opcua.endpoint: {error}",
+        "opcua started": "OPC UA server at {endpoint} ({security}), {tags} tags",
+        "opcua secure": "Basic256Sha256 Sign&Encrypt, trusted clients", "opcua open": "no security, loopback",
+        "mqtt started": "MQTT Sparkplug B publisher to {broker} as {node}, {tags} metrics, devices {devices}",
+        "mqtt primary": "MQTT Sparkplug B publisher to {broker} as {node}, {tags} metrics, devices "
+                        "{devices}, primary host {host}",
+        "no devices": "none",
+        "logged in": "logged in as {role}", "logged out": "logged out", "logged out idle": "logged out: idle",
+        "logged out switched": "logged out: user switched",
+        "joining": "the station is joining its pair",
+        "pair starting": "the station is starting as one of a pair: it takes commands once it is the primary",
+        "pair standby": "this station ({letter}) is the standby: the primary is {primary}",
+        "nothing to hand over": "no standby on the pair link to hand over to",
+        "pair link down": "pair link to {partner} down",
+        # the command layer (app/authority/layer.py): its records, refusals and answers
+        "refused": "refused {what}: {why}", "refused more": "refused {what}: {why} ({n} more refused like "
+                                                              "it in the minute before)",
+        # the policy's actions (app/authority/policy.py Action), as a refusal names them
+        "action write": "write", "action acknowledge": "acknowledge", "action shelve": "shelve",
+        "action unshelve": "unshelve", "action comment": "comment", "action silence": "silence",
+        "action out of service": "out of service", "action force": "force", "action unforce": "unforce",
+        "action run": "run", "action stop": "stop", "action step": "step", "action quit": "quit",
+        "action users": "users", "action trust": "trust", "action IntoStandBy": "IntoStandBy",
+        "role viewer": "viewer", "role operator": "operator", "role engineer": "engineer",
+        "role admin": "admin",
+        "denied source": "needs the {role} role; clients with no user act as {has}",
+        "denied nobody": "nobody is logged in ({role} needed)",
+        "denied gone": "{user} is no longer a user ({role} needed)",
+        "denied role": "needs the {role} role; {user} is {has}",
+        "no tag": "no tag {name!r}", "no number": "{value!r} is not a number",
+        "not 0 or 1": "{value!r} is not 0 or 1", "outside": "{value!r} is outside {lo} .. {hi}",
+        "not applied": "{what}: not applied (see the journal)",
+        "journal full": "the archive cannot take the record (disk full or too slow): not done",
+        "busy": "the station is busy (its queue of outside actions is full): not done, try again",
+        "no alarm system": "the station has no alarm system",
+        "no alarm": "no alarm {alarm!r}", "shelve nobody": "{alarm}: shelving needs the operator's name",
+        "shelve no reason": "{alarm}: shelving needs a reason",
+        "shelve no duration": "{alarm}: shelving needs a duration of more than 0 s",
+        "comment nobody": "{alarm}: a comment needs the operator's name",
+        "comment empty": "{alarm}: the comment is empty",
+        "silenced": "alarm sound silenced", "NetPlc started": "NetPlc started",
+        "NetPlc stopped": "NetPlc stopped",
+        "not started": "the station is not started", "running": "NetPlc is running: stop it to step one scan",
+        "stepped": "step one scan (scan {scan})",
+        "not a pair": "the station is not one of a hot-standby pair ([redundancy])",
+        "handing over": "IntoStandBy: the primary role goes to the partner",
+        "station quit": "station quit",
+        # the publishers' records (app/publish/mqtt.py, opcua.py, seats.py)
+        "mqtt bad bdseq": "MQTT: {file}: not a bdSeq ({error}); starting again at 0",
+        "mqtt bdseq not kept": "MQTT: {file}: bdSeq not kept ({error})",
+        "mqtt refused": "MQTT broker {peer} refused the connection: {reason}",
+        "mqtt connected": "MQTT connected to {peer} as {node} (bdSeq {bdseq}){lost}{waiting}",
+        "mqtt dropped": ", {n} NDATA/DDATA dropped so far",
+        "mqtt awaiting": "; NBIRTH once primary host {host} is online",
+        "mqtt lost": "MQTT connection to {peer} lost ({reason}); reconnecting with back-off, NDATA buffered "
+                     "meanwhile",
+        "mqtt bad state": "MQTT: STATE of primary host {host} ignored: {error}",
+        "mqtt old state": "MQTT: STATE of primary host {host} ignored: its timestamp {stamp} is older than "
+                          "{last} (a session of the host's before)",
+        "mqtt host online": "MQTT: primary host {host} is online",
+        "mqtt rebirth": "MQTT rebirth requested by NCMD via {peer}",
+        "mqtt leads": "MQTT: this station leads its pair: connecting as {node} (bdSeq {bdseq})",
+        "mqtt follows": "MQTT: this station is the standby of its pair: NDEATH, session ended (bdSeq "
+                        "{bdseq}); "
+                        "the primary publishes",
+        "mqtt host offline": "MQTT: primary host {host} is offline: NDEATH, session ended; a new one once it "
+                             "is "
+                             "online again, NDATA buffered meanwhile",
+        "opcua note": "OPC UA: {note}",
+        "opcua untrusted": "OPC UA: client certificate refused, not trusted: {subject} (thumbprint {thumb}), "
+                           "kept in {kept}; `python main.py opcua trust {folder} {thumb}` trusts it",
+        "opcua connected": "OPC UA: {who} connected ({n} of at most {most} sessions)",
+        "opcua disconnected": "OPC UA: {who} disconnected ({n} left)",
+        # the archive's own records (registrar/)
+        "waiter failed": "archive commit waiter failed: {error}",
+        "queue full": "archive queue full: {lost} record(s) lost (the disk did not keep up; queue size "
+                      "{size})",
+        "writing resumed": "archive writing resumed after {seconds:.0f} s; no records were lost",
+        "listener removed": "archive commit listener failed and was removed: {error}",
+        "malformed": "archive refused {n} malformed record(s), the first: {first:.300}",
+        "write failed kept": "archive write failed: {error}; records are kept in memory and retried",
+        "retain crash": "retentive memory restored from the save written at the crash, {file}{why}",
+        "retain restored": "retentive memory restored from the {used} save {file}{why}",
+        "retain lost after": "retentive memory restored from the {used} save {file}{why}: writes "
+                             "acknowledged "
+                             "after {when} may be lost",
+        "retain why": " ({problems})", "retain zeroes": "retentive memory starts from zeroes ({problems})",
+        "retain zeroes lost": "retentive memory starts from zeroes ({problems}): every write acknowledged "
+                              "before "
+                              "may be lost",
+        "save current": "current", "save previous": "previous",
+        "current save problem": "current save {problem}", "previous save problem": "previous save {problem}",
+        "save missing": "is missing", "save unreadable": "cannot be read: {error}",
+        "save truncated": "is truncated",
+        "save version": "is not a retentive memory save of this version",
+        "save damaged": "is damaged (length or checksum wrong)",
+        "save counters": "has unreadable timer and counter values: {error}",
+        "retain not renamed": "retentive memory: {tmp} could not become {file}: {error}",
+        "retain not saved": "retentive memory could not be saved: {error}; writes are answered all the same "
+                            "and "
+                            "come back older after a crash until it is saved again",
+        "retain saved again": "retentive memory is being saved again",
+        "retain waiter failed": "retentive save waiter failed: {error}",
+        "states not restored": "alarm states not restored from {file}: {error}; every alarm starts normal "
+                               "(the "
+                               "file is kept as {damaged})",
+        "states restored": "alarm states restored from {file}: {n} alarm(s)",
+        "states not saved": "alarm states could not be saved: {error}; kept in memory and retried",
+        "states saved again": "alarm states are being saved again",
+        "plant lags": "forwarding to the plant archive lags by {lag:.0f} s ({why}); records are kept in the "
+                      "local "
+                      "archive and sent when it answers",
+        "plant slow": "PostgreSQL does not keep up",
+        "plant caught up": "forwarding to the plant archive caught up after a lag of up to {lag:.0f} s; no "
+                           "records "
+                           "were lost",
     },
     "ru": {
         "HH": "верхний аварийный", "H": "верхний предупредительный", "L": "нижний предупредительный",
@@ -136,9 +261,6 @@ TEXTS: dict[str, dict[str, str]] = {
         "station stopped": "станция остановлена",
         "node answers": "имитируемый узел {node} снова отвечает",
         "node silent": "имитируемый узел {node} перестал отвечать",
-        "link up": "узел {node} ({endpoint}): связь есть",
-        "link down": "узел {node} ({endpoint}): связи нет",
-        "link down because": "узел {node} ({endpoint}): связи нет: {error}",
         "role starting": "запуск", "role primary": "основная", "role standby": "резервная",
         "pair role": "пара, станция {letter}: {old} -> {new}: {cause}",
         "pair stays": "пара, станция {letter}: остаётся в роли «{role}» ({cause}): решает арбитр: {error}",
@@ -188,6 +310,152 @@ TEXTS: dict[str, dict[str, str]] = {
         "user added": "пользователь {user} добавлен, роль {role}",
         "user removed": "пользователь {user} удалён",
         "password changed": "пароль пользователя {user} изменён",
+        # netplc/words.py
+        "link up": "узел {node} ({endpoint}): связь есть",
+        "link down": "узел {node} ({endpoint}): связи нет",
+        "link down because": "узел {node} ({endpoint}): связи нет: {error}",
+        "write": "запись {where}: {old} -> {new}",
+        "write change": "запись {where}: {change} (код {old} -> {new} по адресу {addr})",
+        "bits": "{addr}:{n} бит",
+        "not io bits": "биты {addr}+{n} — не биты ввода-вывода",
+        "write refused": "запись отвергнута: {error}",
+        "write failed": "запись из очереди не выполнена: {error}",
+        "emergency stop by": "NetPlc остановлен, код 11: бит аварийного останова 03770 записал {user}",
+        "watchdog": "сторожевой таймер: скан не дошёл до конца (бесконечный цикл переходов)",
+        "listener failed": "обработчик скана {name} отказал (остальные работают): {error}",
+        "FON failed": "FON {name} в строке {line}: {error}",
+        "force": "фиксация {where}: {was} -> {value}{how}",
+        "forced value": "зафиксировано {value}",
+        "bumpless": " (безударно)",
+        "raw value": "{value} (код {raw})",
+        "unforce": "снятие фиксации {where} (было зафиксировано {value})",
+        "unforce all": "снятие фиксации {where} (было зафиксировано {value}; снять все)",
+        "force kind": "вид фиксации {kind!r} не один из {kinds}",
+        "cannot force": "нельзя зафиксировать {kind} {addr}: {error}",
+        "does not fit": "{value} не помещается в {kind} (0..{most})",
+        "force NaN": "нельзя зафиксировать {name} в значении NaN",
+        "modbus not started": "сервер Modbus не запущен: {path}: modbus_server.port: нельзя слушать "
+                              "{host}:{port}: {error}",
+        "modbus not yet": "сервер Modbus ещё не запущен: {path}: modbus_server.port: {fault}; новая попытка "
+                          "каждые {every:g} с",
+        "force not restored": "сохранённая фиксация не восстановлена: {problem}",
+        "scan failed": "скан отказал: {error}",
+        "opcua not started": "сервер OPC UA не запущен: {path}: opcua.endpoint: {error}",
+        "opcua started": "сервер OPC UA на {endpoint} ({security}), тегов: {tags}",
+        "opcua secure": "Basic256Sha256 Sign&Encrypt, доверенные клиенты",
+        "opcua open": "без защиты, только этот компьютер",
+        "mqtt started": "публикация MQTT Sparkplug B на {broker} как {node}, метрик: {tags}, устройства: "
+                        "{devices}",
+        "mqtt primary": "публикация MQTT Sparkplug B на {broker} как {node}, метрик: {tags}, устройства: "
+                        "{devices}, главный хост {host}",
+        "no devices": "нет",
+        "logged in": "вход, роль «{role}»", "logged out": "выход", "logged out idle": "выход: бездействие",
+        "logged out switched": "выход: сменился пользователь",
+        "joining": "станция входит в пару",
+        "pair starting": "станция запускается как одна из пары: команды принимает, когда станет основной",
+        "pair standby": "эта станция ({letter}) — резервная: основная — {primary}",
+        "nothing to hand over": "в связи пары нет резервной станции, которой передать управление",
+        "pair link down": "связи пары с {partner} нет",
+        "refused": "отказ: {what}: {why}",
+        "refused more": "отказ: {what}: {why} (и ещё таких отказов за минуту до того: {n})",
+        "action write": "запись", "action acknowledge": "квитирование", "action shelve": "откладывание",
+        "action unshelve": "возврат из отложенных", "action comment": "комментарий",
+        "action silence": "отключение звука", "action out of service": "вывод из работы",
+        "action force": "фиксация", "action unforce": "снятие фиксации", "action run": "пуск",
+        "action stop": "останов", "action step": "один скан", "action quit": "выход из станции",
+        "action users": "пользователи", "action trust": "доверие сертификату",
+        "action IntoStandBy": "IntoStandBy",
+        "role viewer": "наблюдатель", "role operator": "оператор", "role engineer": "инженер",
+        "role admin": "администратор",
+        "denied source": "нужна роль «{role}»; клиенты без пользователя действуют как «{has}»",
+        "denied nobody": "никто не вошёл (нужна роль «{role}»)",
+        "denied gone": "{user} больше не пользователь (нужна роль «{role}»)",
+        "denied role": "нужна роль «{role}»; {user} — {has}",
+        "no tag": "нет тега {name!r}", "no number": "{value!r} — не число",
+        "not 0 or 1": "{value!r} — не 0 и не 1", "outside": "{value!r} вне диапазона {lo} .. {hi}",
+        "not applied": "{what}: не выполнено (см. журнал)",
+        "journal full": "архив не может принять запись (диск полон или слишком медленный): не выполнено",
+        "busy": "станция занята (её очередь внешних действий полна): не выполнено, повторите",
+        "no alarm system": "у станции нет системы аварий",
+        "no alarm": "нет аварии {alarm!r}", "shelve nobody": "{alarm}: для откладывания нужно имя оператора",
+        "shelve no reason": "{alarm}: для откладывания нужна причина",
+        "shelve no duration": "{alarm}: для откладывания нужен срок больше 0 с",
+        "comment nobody": "{alarm}: для комментария нужно имя оператора",
+        "comment empty": "{alarm}: комментарий пуст",
+        "silenced": "звук аварий отключён", "NetPlc started": "NetPlc запущен",
+        "NetPlc stopped": "NetPlc остановлен",
+        "not started": "станция не запущена",
+        "running": "NetPlc работает: остановите его, чтобы выполнить один скан",
+        "stepped": "выполнен один скан (скан {scan})",
+        "not a pair": "станция не входит в пару горячего резерва ([redundancy])",
+        "handing over": "IntoStandBy: роль основной переходит к партнёру",
+        "station quit": "выход из станции",
+        "mqtt bad bdseq": "MQTT: {file}: не bdSeq ({error}); счёт начинается снова с 0",
+        "mqtt bdseq not kept": "MQTT: {file}: bdSeq не сохранён ({error})",
+        "mqtt refused": "брокер MQTT {peer} отказал в соединении: {reason}",
+        "mqtt connected": "MQTT: соединение с {peer} как {node} (bdSeq {bdseq}){lost}{waiting}",
+        "mqtt dropped": ", отброшено NDATA/DDATA: {n}",
+        "mqtt awaiting": "; NBIRTH, когда главный хост {host} будет в сети",
+        "mqtt lost": "MQTT: соединение с {peer} потеряно ({reason}); повторные попытки с нарастающей паузой, "
+                     "NDATA пока копятся",
+        "mqtt bad state": "MQTT: STATE главного хоста {host} не принят: {error}",
+        "mqtt old state": "MQTT: STATE главного хоста {host} не принят: его метка времени {stamp} старше "
+                          "{last} (из прежнего сеанса хоста)",
+        "mqtt host online": "MQTT: главный хост {host} в сети",
+        "mqtt rebirth": "MQTT: повторное рождение (rebirth) по NCMD через {peer}",
+        "mqtt leads": "MQTT: эта станция ведёт пару: соединение как {node} (bdSeq {bdseq})",
+        "mqtt follows": "MQTT: эта станция — резервная в паре: NDEATH, сеанс окончен (bdSeq {bdseq}); "
+                        "публикует основная",
+        "mqtt host offline": "MQTT: главный хост {host} не в сети: NDEATH, сеанс окончен; новый — когда он "
+                             "вернётся, NDATA пока копятся",
+        "opcua note": "OPC UA: {note}",
+        "opcua untrusted": "OPC UA: сертификат клиента отвергнут, ему нет доверия: {subject} (отпечаток "
+                           "{thumb}), "
+                           "сохранён в {kept}; `python main.py opcua trust {folder} {thumb}` даёт ему "
+                           "доверие",
+        "opcua connected": "OPC UA: подключился {who} (сеансов {n} из не более чем {most})",
+        "opcua disconnected": "OPC UA: отключился {who} (осталось {n})",
+        "waiter failed": "ожидающий записи в архив отказал: {error}",
+        "queue full": "очередь архива полна: потеряно записей: {lost} (диск не успевал; размер очереди "
+                      "{size})",
+        "writing resumed": "запись в архив возобновилась через {seconds:.0f} с; записи не потеряны",
+        "listener removed": "обработчик записи в архив отказал и удалён: {error}",
+        "malformed": "архив отверг неправильных записей: {n}, первая: {first:.300}",
+        "write failed kept": "запись в архив не удалась: {error}; записи хранятся в памяти, запись "
+                             "повторяется",
+        "retain crash": "сохраняемая память восстановлена из сохранения, записанного при сбое, {file}{why}",
+        "retain restored": "сохраняемая память восстановлена из {used} сохранения {file}{why}",
+        "retain lost after": "сохраняемая память восстановлена из {used} сохранения {file}{why}: записи, "
+                             "подтверждённые после {when}, могут быть потеряны",
+        "retain why": " ({problems})", "retain zeroes": "сохраняемая память начинается с нулей ({problems})",
+        "retain zeroes lost": "сохраняемая память начинается с нулей ({problems}): все подтверждённые ранее "
+                              "записи могут быть потеряны",
+        "save current": "текущего", "save previous": "предыдущего",
+        "current save problem": "текущее сохранение {problem}",
+        "previous save problem": "предыдущее сохранение {problem}",
+        "save missing": "отсутствует", "save unreadable": "не читается: {error}",
+        "save truncated": "обрезано",
+        "save version": "не сохранение памяти этой версии",
+        "save damaged": "повреждено (неверны длина или контрольная сумма)",
+        "save counters": "содержит нечитаемые значения таймеров и счётчиков: {error}",
+        "retain not renamed": "сохраняемая память: {tmp} не удалось сделать {file}: {error}",
+        "retain not saved": "сохраняемую память не удалось сохранить: {error}; на записи всё равно "
+                            "отвечается, "
+                            "после сбоя они вернутся более старыми, пока сохранение не удастся",
+        "retain saved again": "сохраняемая память снова сохраняется",
+        "retain waiter failed": "ожидающий сохранения памяти отказал: {error}",
+        "states not restored": "состояния аварий не восстановлены из {file}: {error}; все аварии начинают в "
+                               "норме (файл сохранён как {damaged})",
+        "states restored": "состояния аварий восстановлены из {file}: аварий {n}",
+        "states not saved": "состояния аварий не удалось сохранить: {error}; они хранятся в памяти, запись "
+                            "повторяется",
+        "states saved again": "состояния аварий снова сохраняются",
+        "plant lags": "передача в архив предприятия отстаёт на {lag:.0f} с ({why}); записи хранятся в "
+                      "местном "
+                      "архиве и будут отправлены, когда он ответит",
+        "plant slow": "PostgreSQL не успевает",
+        "plant caught up": "передача в архив предприятия догнала после отставания до {lag:.0f} с; записи не "
+                           "потеряны",
     },
 }
 
@@ -214,6 +482,14 @@ def phrase(name: str, /, **values: object) -> Phrase:
 
 
 @dataclass(frozen=True)
+class Phrases:
+    """Parts said one after the other, joined by `sep` (a restore's problems, one per file)."""
+
+    parts: Sequence[Phrase]
+    sep: str = "; "
+
+
+@dataclass(frozen=True)
 class Words:
     """The catalogue of one language: `words("limit", label=..., ...)` is its text, filled in."""
 
@@ -224,6 +500,8 @@ class Words:
 
     def say(self, value: object) -> object:
         """A value as it goes into a sentence: a phrase said in this language, the rest as it is."""
+        if isinstance(value, Phrases):
+            return value.sep.join(str(self.say(part)) for part in value.parts)
         return self(value.name, **value.values) if isinstance(value, Phrase) else value
 
     @property
@@ -241,3 +519,4 @@ def words(language: str = "") -> Words:
 
 
 ENGLISH = Words("en")  # of the log, read by whoever supports the station
+Journal = Callable[..., None]  # `journal(name, **values)`: a 'system' record of the catalogue (Runtime.say)

@@ -24,7 +24,7 @@ from cryptography.x509.oid import ExtendedKeyUsageOID
 
 from app.publish.pki import thumbprint
 from tests.app.conftest import REPO
-from tests.app.publish.conftest import demo_with, free_port, tag_node
+from tests.app.publish.conftest import STATION_URI, demo_with, free_port, tag_node
 
 
 class Secure:
@@ -34,7 +34,8 @@ class Secure:
         self.port = free_port()
         self.runtime = demo_with(folder, f'[opcua]\nenabled = true\n'
                                          f'endpoint = "opc.tcp://0.0.0.0:{self.port}/netplc/"\n'
-                                         'writable = ["TEMP_SP"]\ncertificate_names = ["scada.plant"]\n')
+                                         'writable = ["TEMP_SP"]\ncertificate_names = ["scada.plant"]\n',
+                                 language="en")
         self.records: list = []
         self.runtime.subscribe(self.records.append)
         self.url = f"opc.tcp://127.0.0.1:{self.port}/netplc/"
@@ -116,7 +117,7 @@ def test_the_key_is_private_and_the_certificate_names_the_host(secure: Secure) -
     names = cert.extensions.get_extension_for_class(x509.SubjectAlternativeName).value
     dns = set(names.get_values_for_type(x509.DNSName))
     assert {socket.gethostname(), socket.getfqdn(), "scada.plant"} <= dns and "0.0.0.0" not in dns
-    assert names.get_values_for_type(x509.UniformResourceIdentifier) == ["urn:netplc:station:Demo station"]
+    assert names.get_values_for_type(x509.UniformResourceIdentifier) == [STATION_URI]
 
 
 def test_an_untrusted_client_is_refused_kept_journaled_once_and_trusted_by_the_command(
