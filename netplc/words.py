@@ -25,6 +25,22 @@ WORDS = {
     "watchdog": "watchdog: the scan did not reach its end (endless jump loop)",
     "listener failed": "engine listener {name} failed (the others go on): {error}",
     "FON failed": "FON {name} at line {line}: {error}",
+    # the Modbus server's own (netplc/modbus/)
+    "peer refused": "Modbus server refused a connection from {peer}: {n} connections from {host} are open "
+                    "(max_per_peer)",
+    "server full": "Modbus server refused a connection from {peer}: {n} connections are open "
+                   "(max_connections)",
+    "not modbus tcp": "Modbus server closed the connection of {peer}: not Modbus TCP (protocol {proto}, "
+                      "length {length})",
+    "idle half": "Modbus server closed the connection of {peer}: half a frame received for {idle:g} s "
+                 "(idle_timeout)",
+    "idle nothing": "Modbus server closed the connection of {peer}: nothing received for {idle:g} s "
+                    "(idle_timeout)",
+    "more like it": "{text} (and {n} more like it in the last minute)",
+    "rtu cannot open": "Modbus RTU on {port} cannot be opened: {error}",
+    "rtu failed": "Modbus RTU on {port} failed: {error}",
+    "rtu retrying": "{fault}; retrying every {every:g} s",
+    "rtu works": "Modbus RTU on {port} works again",
     # forces (netplc/forcing.py, app/scada/forcing.py)
     "force": "force {where}: {was} -> {value}{how}",
     "forced value": "forced {value}",

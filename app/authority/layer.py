@@ -191,7 +191,7 @@ class Commands:
             if len(self._refused) > 4096:  # bounded: forget the oldest causes
                 for old in sorted(self._refused, key=lambda k: self._refused[k][0])[:1024]:
                     del self._refused[old]
-        said = self.say(f"action {action.value}") if isinstance(action, Action) else action
+        said = self.say(f"action {action}") if self.say.knows(f"action {action}") else action
         what = f"{said} {target}".strip()
         self.sink.put(Record(self.wallclock(), "operator", source=who.name,
                              text=self.say("refused more" if more else "refused", what=what, why=text,

@@ -50,7 +50,7 @@ class Seats:
             full = len(self._seats) >= self.limit
         if full:
             self.commands.refuse(who, "open a session", "", Reason.BUSY,
-                                 f"[opcua] max_consoles = {self.limit} sessions are open already")
+                                 self.commands.say("sessions full", n=self.limit))
             raise ServiceError(ua.StatusCodes.BadTooManySessions)
 
     def take(self, session: object, who: Who) -> None:

@@ -132,6 +132,11 @@ TEXTS: dict[str, dict[str, str]] = {
         "action out of service": "out of service", "action force": "force", "action unforce": "unforce",
         "action run": "run", "action stop": "stop", "action step": "step", "action quit": "quit",
         "action users": "users", "action trust": "trust", "action IntoStandBy": "IntoStandBy",
+        "action log in": "log in", "action open a session": "open a session",
+        "login waits": "{n} failed logins from {host}: refused for {wait:.0f} s more",
+        "login wrong": "wrong user name or password",
+        "login wrong wait": "wrong user name or password; the next attempts wait {wait:g} s",
+        "sessions full": "[opcua] max_consoles = {n} sessions are open already",
         "role viewer": "viewer", "role operator": "operator", "role engineer": "engineer",
         "role admin": "admin",
         "denied source": "needs the {role} role; clients with no user act as {has}",
@@ -156,6 +161,20 @@ TEXTS: dict[str, dict[str, str]] = {
         "not a pair": "the station is not one of a hot-standby pair ([redundancy])",
         "handing over": "IntoStandBy: the primary role goes to the partner",
         "station quit": "station quit",
+        # station.toml's reader (app/station/config.py): its fixed wording; keys, files and values as
+        # they are
+        "cfg no file": "{file}: no station file here", "cfg not toml": "{file}: not valid TOML: {error}",
+        "cfg toml digits": "{file}: not valid TOML: a number of more than {n} digits",
+        "cfg toml deep": "{file}: not valid TOML: arrays or tables nested too deeply",
+        "cfg missing": "missing", "cfg too large": "a {n}-digit number is too large",
+        "cfg expected": "expected {kind}, got {value!r}", "cfg or": " or ",
+        "kind bool": "true or false", "kind int": "an integer", "kind float": "a number",
+        "kind str": "a string", "kind list": "a list", "kind dict": "a table",
+        "cfg outside": "{value} is outside {lo}-{hi}", "cfg empty path": "empty path",
+        "cfg nul": "a path cannot hold a NUL character",
+        "cfg outside folder": "{path} is outside the station folder {base} (allow_outside = true permits it)",
+        "cfg unknown": "unknown setting", "cfg not a file": "{path} is not a file",
+        "cfg not one of": "{value!r} is not one of {names}",
         # the publishers' records (app/publish/mqtt.py, opcua.py, seats.py)
         "mqtt bad bdseq": "MQTT: {file}: not a bdSeq ({error}); starting again at 0",
         "mqtt bdseq not kept": "MQTT: {file}: bdSeq not kept ({error})",
@@ -324,6 +343,19 @@ TEXTS: dict[str, dict[str, str]] = {
         "watchdog": "сторожевой таймер: скан не дошёл до конца (бесконечный цикл переходов)",
         "listener failed": "обработчик скана {name} отказал (остальные работают): {error}",
         "FON failed": "FON {name} в строке {line}: {error}",
+        "peer refused": "сервер Modbus отказал в соединении {peer}: открыто соединений: {n}, с {host} "
+                        "(max_per_peer)",
+        "server full": "сервер Modbus отказал в соединении {peer}: открыто соединений: {n} (max_connections)",
+        "not modbus tcp": "сервер Modbus закрыл соединение {peer}: это не Modbus TCP (протокол {proto}, "
+                          "длина {length})",
+        "idle half": "сервер Modbus закрыл соединение {peer}: полкадра за {idle:g} с (idle_timeout)",
+        "idle nothing": "сервер Modbus закрыл соединение {peer}: ничего не получено за {idle:g} с "
+                        "(idle_timeout)",
+        "more like it": "{text} (и ещё таких за последнюю минуту: {n})",
+        "rtu cannot open": "Modbus RTU на {port}: порт не открывается: {error}",
+        "rtu failed": "Modbus RTU на {port}: отказ: {error}",
+        "rtu retrying": "{fault}; новая попытка каждые {every:g} с",
+        "rtu works": "Modbus RTU на {port} снова работает",
         "force": "фиксация {where}: {was} -> {value}{how}",
         "forced value": "зафиксировано {value}",
         "bumpless": " (безударно)",
@@ -365,6 +397,11 @@ TEXTS: dict[str, dict[str, str]] = {
         "action stop": "останов", "action step": "один скан", "action quit": "выход из станции",
         "action users": "пользователи", "action trust": "доверие сертификату",
         "action IntoStandBy": "IntoStandBy",
+        "action log in": "вход", "action open a session": "открытие сеанса",
+        "login waits": "неудачных входов: {n}, с {host}; вход закрыт ещё на {wait:.0f} с",
+        "login wrong": "неверное имя пользователя или пароль",
+        "login wrong wait": "неверное имя пользователя или пароль; следующие попытки ждут {wait:g} с",
+        "sessions full": "[opcua] max_consoles = {n}: столько сеансов уже открыто",
         "role viewer": "наблюдатель", "role operator": "оператор", "role engineer": "инженер",
         "role admin": "администратор",
         "denied source": "нужна роль «{role}»; клиенты без пользователя действуют как «{has}»",
@@ -390,6 +427,18 @@ TEXTS: dict[str, dict[str, str]] = {
         "not a pair": "станция не входит в пару горячего резерва ([redundancy])",
         "handing over": "IntoStandBy: роль основной переходит к партнёру",
         "station quit": "выход из станции",
+        "cfg no file": "{file}: здесь нет файла станции", "cfg not toml": "{file}: не TOML: {error}",
+        "cfg toml digits": "{file}: не TOML: число длиннее {n} цифр",
+        "cfg toml deep": "{file}: не TOML: массивы или таблицы вложены слишком глубоко",
+        "cfg missing": "отсутствует", "cfg too large": "число из {n} цифр слишком велико",
+        "cfg expected": "ожидается {kind}, а задано {value!r}", "cfg or": " или ",
+        "kind bool": "true или false", "kind int": "целое число", "kind float": "число", "kind str": "строка",
+        "kind list": "список", "kind dict": "таблица",
+        "cfg outside": "{value} вне диапазона {lo}-{hi}", "cfg empty path": "пустой путь",
+        "cfg nul": "путь не может содержать символ NUL",
+        "cfg outside folder": "{path} вне папки станции {base} (allow_outside = true это разрешает)",
+        "cfg unknown": "неизвестный параметр", "cfg not a file": "{path} — не файл",
+        "cfg not one of": "{value!r} — не одно из: {names}",
         "mqtt bad bdseq": "MQTT: {file}: не bdSeq ({error}); счёт начинается снова с 0",
         "mqtt bdseq not kept": "MQTT: {file}: bdSeq не сохранён ({error})",
         "mqtt refused": "брокер MQTT {peer} отказал в соединении: {reason}",
@@ -497,6 +546,9 @@ class Words:
 
     def __call__(self, name: str, /, **values: object) -> str:
         return TEXTS[self.language][name].format(**{k: self.say(v) for k, v in values.items()})
+
+    def knows(self, name: str) -> bool:
+        return name in TEXTS[self.language]
 
     def say(self, value: object) -> object:
         """A value as it goes into a sentence: a phrase said in this language, the rest as it is."""

@@ -368,7 +368,7 @@ class Runtime:
                                   server.max_per_peer)
             modbus = ModbusServer(ModbusCommands(self.commands, server.writable), host=server.host,
                                   port=server.port, unit=server.unit, serial=server.serial,
-                                  limits=limits, sink=self)
+                                  limits=limits, sink=self, words=self.words)
             try:
                 modbus.start(retry=True)
                 self.modbus = modbus
