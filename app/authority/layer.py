@@ -204,9 +204,9 @@ class Commands:
         if why is None:
             return None
         # the journal names the action and target once: "refused write Пуск: needs the operator role"
-        return self.refuse(who, action, target, Reason.DENIED, self._denied(why), why)
+        return self.refuse(who, action, target, Reason.DENIED, self.refusal_text(why), why)
 
-    def _denied(self, why: Refusal) -> str:
+    def refusal_text(self, why: Refusal) -> str:
         """The refusal for the role in the station's language, without its action (the record's)."""
         say = self.say
 

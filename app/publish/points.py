@@ -113,10 +113,11 @@ class PointWriter:
         commands = self.commands
         if not self.writable(tag.name):
             return commands.refuse(who, Action.WRITE, tag.name, Reason.NOT_WRITABLE,
-                                   f"not among the points {self.section} writable names")
+                                   commands.say("not writable point", section=self.section))
         if mismatch:
             if (why := commands.denial(who, Action.WRITE)) is not None:  # the role first, as the layer
-                return commands.refuse(who, Action.WRITE, tag.name, Reason.DENIED, str(why), why)
+                return commands.refuse(who, Action.WRITE, tag.name, Reason.DENIED, commands.refusal_text(why),
+                                       why)
             return commands.refuse(who, Action.WRITE, tag.name, Reason.TYPE_MISMATCH, mismatch)
         if tag.name in commands.tags:
             return commands.write_tag(who, tag.name, value)

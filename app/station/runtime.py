@@ -262,11 +262,6 @@ class Runtime:
         if observer in self._observers:
             self._observers.remove(observer)
 
-    def system(self, text: str, level: int = logging.INFO) -> None:
-        """A 'system' record, and the same words in the log (at `level`: WARNING for a fault)."""
-        logger.log(level, "%s", text)
-        self.put(Record(self.wallclock(), "system", source="station", text=text))
-
     def say(self, name: str, level: int = logging.INFO, **values: object) -> None:
         """A 'system' record of the catalogue (app/scada/words.py: `name` and its `values`) in the
         station's `Language`, and the same in English in the log (at `level`), which is read by

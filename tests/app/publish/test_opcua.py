@@ -160,7 +160,8 @@ def test_a_taken_port_is_a_problem_and_the_station_runs_on(tmp_path: Path) -> No
         taken.bind(("127.0.0.1", 0))
         taken.listen()
         url = f"opc.tcp://127.0.0.1:{taken.getsockname()[1]}/netplc/"
-        runtime = demo_with(tmp_path / "station", f'[opcua]\nenabled = true\nendpoint = "{url}"\n')
+        runtime = demo_with(tmp_path / "station", f'[opcua]\nenabled = true\nendpoint = "{url}"\n',
+                            language="en")
         try:
             status = runtime.status()
             assert status.running and runtime.publishers == []
