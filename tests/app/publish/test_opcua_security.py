@@ -117,7 +117,9 @@ def test_the_key_is_private_and_the_certificate_names_the_host(secure: Secure) -
     names = cert.extensions.get_extension_for_class(x509.SubjectAlternativeName).value
     dns = set(names.get_values_for_type(x509.DNSName))
     assert {socket.gethostname(), socket.getfqdn(), "scada.plant"} <= dns and "0.0.0.0" not in dns
-    assert names.get_values_for_type(x509.UniformResourceIdentifier) == [STATION_URI]
+    # the demo's Russian name percent-encoded (RFC 3987 3.1): a certificate's URI is ASCII
+    encoded = "urn:netplc:station:%D0%94%D0%B5%D0%BC%D0%BE-%D1%81%D1%82%D0%B0%D0%BD%D1%86%D0%B8%D1%8F"
+    assert names.get_values_for_type(x509.UniformResourceIdentifier) == [STATION_URI] == [encoded]
 
 
 def test_an_untrusted_client_is_refused_kept_journaled_once_and_trusted_by_the_command(
