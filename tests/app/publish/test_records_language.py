@@ -2,41 +2,24 @@
 its alarms (tests/app/scada/test_words.py) and its pair's records (tests/app/pair/test_language.py):
 the writes, the forces, the refusals and the answers a person reads, the registrar's own records, the
 start records of OPC UA and MQTT, a login; none of the catalogue's English words is left. Without a
-`Language`, under the C locale, the same records stay English (the other tests read them so)."""
+`Language`, under the C locale, the same records stay English: the tests of the commands and the
+protocols read them so, on an English copy of the demo (`copy_demo(..., "en")`)."""
 
 from __future__ import annotations
 
 import re
 from pathlib import Path
 
-import pytest
-
 from app.authority import Reason, Source, Who
 from app.scada.words import phrase
 from app.station.runtime import Runtime
 from netplc.records import Record
-from tests.app.conftest import copy_demo
 from tests.app.publish.conftest import Mosquitto, demo_with, free_port, mqtt_section
 from tests.app.scada.test_words import english_words
 from tests.netplc.test_exchange import wait_until
 
 ENGINEER = Who("engineer", Source.CONSOLE)
 VIEWER = Who("viewer", Source.CONSOLE)
-
-
-def said(language: str, folder: Path, extra: str = "") -> tuple[list[str], list[str]]:
-    """The demo in `language` ("" without the key) with `extra` settings: its 'system' and
-    'operator' records after a write, forces, refusals and a login, and the answers of the refusals."""
-    records: list[Record] = []
-    toml = copy_demo(folder) / "station.toml"
-    toml.write_text(toml.read_text(encoding="utf-8").replace('Language = "ru"', f'Language = "{language}"'),
-                    encoding="utf-8")
-    station = demo_with(folder, extra, records)
-    try:
-        answers = act(station)
-    finally:
-        station.stop()
-    return [r.text for r in records if r.kind in ("system", "operator") and r.text], answers
 
 
 def act(station: Runtime) -> list[str]:
@@ -63,16 +46,17 @@ def act(station: Runtime) -> list[str]:
     return [a.text for a in refused]
 
 
-@pytest.fixture
-def ru(tmp_path_factory: pytest.TempPathFactory, broker: Mosquitto) -> tuple[list[str], list[str]]:
+def test_a_russian_station_journals_its_commands_and_its_own_records_in_russian(tmp_path: Path,
+                                                                              broker: Mosquitto) -> None:
     url = f"opc.tcp://127.0.0.1:{free_port()}/netplc/"
-    return said("ru", tmp_path_factory.mktemp("ru") / "station",
-                f'[opcua]\nenabled = true\nendpoint = "{url}"\n\n{mqtt_section(broker)}')
-
-
-def test_a_russian_station_journals_its_commands_and_its_own_records_in_russian(
-        ru: tuple[list[str], list[str]]) -> None:
-    texts, answers = ru
+    records: list[Record] = []
+    opcua = f'[opcua]\nenabled = true\nendpoint = "{url}"\n'
+    station = demo_with(tmp_path / "station", f"{opcua}\n{mqtt_section(broker)}", records)  # the demo's ru
+    try:
+        answers = act(station)
+    finally:
+        station.stop()
+    texts = [r.text for r in records if r.kind in ("system", "operator") and r.text]
     write = r"запись Уставка температуры TEMP_SP: [-\d.]+ -> 100\.0 °C \(код \d+ -> 3071 по адресу \d+\)"
     assert any(re.fullmatch(write, t) for t in texts), texts
     assert "запись Пуск (02000): 0 -> 1" in texts, texts
@@ -96,12 +80,3 @@ def test_a_russian_station_journals_its_commands_and_its_own_records_in_russian(
     left = {w for t in prose for w in re.findall(r"[A-Za-z]{2,}", t)} & english_words()
     assert not left, f"English words in a Russian station's records: {sorted(left)}: {texts}"
 
-
-def test_a_station_without_language_journals_in_english(tmp_path: Path,
-                                                        monkeypatch: pytest.MonkeyPatch) -> None:
-    monkeypatch.setenv("LC_ALL", "C.UTF-8")
-    texts, answers = said("", tmp_path / "station")
-    assert "write Пуск (02000): 0 -> 1" in texts and "unforce TEMP_SP (was forced 90.0 °C)" in texts
-    assert "refused write TEMP_SP: needs the operator role; viewer is viewer" in texts, texts
-    assert answers[1:3] == ["1000 is outside -50.0 °C .. 150.0 °C", "no tag 'NO_SUCH'"]
-    assert "logged in as engineer" in texts and "station stopped" in texts
