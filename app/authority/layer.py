@@ -498,7 +498,8 @@ class Commands:
         try:
             text = change()
         except UserError as e:
-            return self.refuse(who, Action.USERS, target, Reason.INVALID, str(e))
+            return self.refuse(who, Action.USERS, target, Reason.INVALID,
+                               self.say(e.name, **e.values) if e.name else str(e))
         self._put(who, text)
         return self._answer_after_commit()
 

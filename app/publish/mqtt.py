@@ -319,7 +319,7 @@ class SparkplugPublisher:
         device = self.layout.by_id.get(name)
         if device is None:
             self._refused(self.commands.refuse(who, Action.WRITE, name, Reason.UNKNOWN,
-                                               f"no such device of {self.topics.node}"))
+                                               self.commands.say("no device", node=self.topics.node)))
             return
         self._command(message.payload, device, who)
 
@@ -330,7 +330,7 @@ class SparkplugPublisher:
             payload = spb.Payload.FromString(data)
         except Exception as e:  # no log: bad input, answered by the journaled refusal below
             self._refused(self.commands.refuse(who, Action.WRITE, "", Reason.INVALID,
-                                               f"not a Sparkplug B payload ({type(e).__name__})"))
+                                               self.commands.say("not sparkplug", error=type(e).__name__)))
             return
         layout = self.layout
         for metric in payload.metrics:
@@ -349,11 +349,11 @@ class SparkplugPublisher:
                                            spb.mismatch(metric, kind))
             elif device is not None and (link := layout.link_name(device, name, alias)):
                 ticket = self.commands.refuse(who, Action.WRITE, link, Reason.NOT_WRITABLE,
-                                              "a link metric, read-only")
+                                              self.commands.say("link metric"))
             else:
                 of = f"device {device.id}" if device is not None else self.topics.node
                 ticket = self.commands.refuse(who, Action.WRITE, label, Reason.UNKNOWN,
-                                              f"no such metric of {of}")
+                                              self.commands.say("no metric", node=of))
             self._refused(ticket)
 
     def _refused(self, ticket: Ticket) -> None:

@@ -646,8 +646,7 @@ class OpcUaServer:
         def create_session(name: str, user: User | None = None, external: bool = False) -> Any:
             if external and self.secure and not _SECURE_CHANNEL.get():
                 self.commands.refuse(Who("", Source.OPCUA, _peer(name)), "open a session", "",
-                                     Reason.DENIED, f"security None at {self.endpoint} is for discovery "
-                                     "only (GetEndpoints): sessions need Basic256Sha256 Sign&Encrypt")
+                                     Reason.DENIED, self.commands.say("session none", endpoint=self.endpoint))
                 raise ServiceError(ua.StatusCodes.BadSecurityPolicyRejected)
             session = create(name, user=user or User(role=UserRole.Anonymous), external=external)
             if not external:
@@ -760,13 +759,12 @@ class OpcUaServer:
             target = wv.NodeId.to_string()
             if wv.NodeId in self.server.iserver.aspace:
                 return commands.refuse(who, Action.WRITE, target, Reason.NOT_WRITABLE,
-                                       "only tags are written over OPC UA")
-            return commands.refuse(who, Action.WRITE, target, Reason.UNKNOWN, "no such node")
+                                       commands.say("only tags"))
+            return commands.refuse(who, Action.WRITE, target, Reason.UNKNOWN, commands.say("no node"))
         tag, kind = self.tags[i], self.kinds[i]
         if wv.AttributeId != ua.AttributeIds.Value:
             return commands.refuse(who, Action.WRITE, tag.name, Reason.NOT_WRITABLE,
-                                   f"only the value of a tag is written, not its "
-                                   f"{ua.AttributeIds(wv.AttributeId).name}")
+                                   commands.say("only value", attribute=ua.AttributeIds(wv.AttributeId).name))
         variant = wv.Value.Value if wv.Value is not None else None
         value = variant.Value if variant is not None else None
         mismatch = ""

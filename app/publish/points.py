@@ -125,10 +125,10 @@ class PointWriter:
         lo, hi = tag.limits
         if not isinstance(value, int):
             return commands.refuse(who, Action.WRITE, tag.name, Reason.TYPE_MISMATCH,
-                                   f"{value!r} is not whole")
+                                   commands.say("not whole", value=value))
         if not lo <= value <= hi:
             return commands.refuse(who, Action.WRITE, tag.name, Reason.OUT_OF_RANGE,
-                                   f"{value} is outside {lo:g} .. {hi:g}")
+                                   commands.say("outside g", value=value, lo=lo, hi=hi))
         if tag.type is TagType.BIT:
             return commands.write_bit(who, tag.address, 1 if value else 0, label=tag.name)
         return commands.write_word(who, tag.address, value, label=tag.name)
