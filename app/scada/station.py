@@ -58,7 +58,7 @@ class StationAlarms:
         hot-standby pair, why it has no standby now ("" while it has), for PAIR.NO_STANDBY; `horn`:
         the HMI bit set while an alarm sounds (station.toml `alarm_horn`); `language`: the station's
         `Language`, of every alarm text."""
-        self.table = load_tags(tags, symbols) if tags is not None else TagTable()
+        self.table = load_tags(tags, symbols, words(language)) if tags is not None else TagTable()
         self.quality_map = QualityMap(program, self.table.tags)
         self.sink = sink
         self.series = SeriesQuality(program, regdata or {})

@@ -92,8 +92,10 @@ def test_check_reports_exactly_what_a_start_refuses(tmp_path: Path) -> None:
     assert check_station(st).problems == refused.value.problems
 
 
-def test_tags_csv_problems_are_reported_by_check(tmp_path: Path) -> None:
-    st = copy_demo(tmp_path / "tags")
+@pytest.mark.parametrize("language", ["en", "ru"])
+def test_tags_csv_problems_are_reported_by_check(tmp_path: Path, language: str) -> None:
+    """In the station's language, naming the file, the line, the tag and its values as they are."""
+    st = copy_demo(tmp_path / "tags", language)
     plant(st / "tags.csv", "LEVEL,LEVEL,word,%,0,4095,0,100,1,Уровень,95,90,",
           "LEVEL,LEVEL,word,%,0,4095,0,100,1,Уровень,85,90,")
     plant(st / "tags.csv", "TEMP,TEMP,word,°C,0,1000,", "TEMP,TEMP,word,°C,7,7,")
@@ -103,9 +105,18 @@ def test_tags_csv_problems_are_reported_by_check(tmp_path: Path) -> None:
     tags = st / "tags.csv"
     lines = tags.read_text(encoding="utf-8").splitlines()
     level = next(i for i, line in enumerate(lines, 1) if line.startswith("LEVEL,"))
-    assert f"{tags}:{level}: LEVEL: HH 85 is below H 90" in r.stdout
-    assert f"{tags}:{level + 1}: TEMP: app_min = app_max = 7" in r.stdout
-    assert f"{tags}:{level + 3}: TRIGGER: address '010000' cannot hold an I/O bit or a data bit" in r.stdout
+    said = {
+        "en": [f"{tags}:{level}: LEVEL: HH 85 is below H 90: the limits must keep the order",
+               f"{tags}:{level + 1}: TEMP: app_min = app_max = 7: the conversion is undefined",
+               f"{tags}:{level + 3}: TRIGGER: address '010000' cannot hold an I/O bit or a data bit"],
+        "ru": [f"{tags}:{level}: LEVEL: HH 85 ниже H 90: пределы должны идти в порядке",
+               f"{tags}:{level + 1}: TEMP: app_min = app_max = 7: преобразование не определено",
+               f"{tags}:{level + 3}: TRIGGER: address '010000' не может вместить бит ввода-вывода"],
+    }[language]
+    for line in said:
+        assert line in r.stdout, r.stdout
+    if language != "en":
+        return
     plant(st / "station.toml", 'Tags = "tags.csv"', 'Tags = "no_tags.csv"')
     r = run_check(st)
     assert f"{st / 'station.toml'}: Tags: file {st / 'no_tags.csv'} does not exist" in r.stdout
