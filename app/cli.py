@@ -266,7 +266,7 @@ def _password() -> str:
 
     first = getpass.getpass("password: ")
     if getpass.getpass("again: ") != first:
-        raise UserError("the two passwords differ")
+        raise UserError("passwords differ")
     return first
 
 

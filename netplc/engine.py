@@ -49,6 +49,7 @@ from netplc.program import Program
 from netplc.records import NullSink, Record, RecordSink
 from netplc.rtc import Rtc
 from netplc.timers import held, make_ctr, make_tim, update_generators
+from netplc.words import Say, english
 
 WRITE_BUDGET = 256  # outside writes applied per scan: a few ms at most, whatever clients send
 WRITE_QUEUE = 4096  # outside writes waiting; the next one is refused (Modbus exception 6)
@@ -118,6 +119,7 @@ class Engine:
         self.clock = clock
         self.wallclock = wallclock
         self.sink: RecordSink = sink or NullSink()
+        self.words: Say = english  # the station's words for its records (netplc/words.py)
         self.exchange = exchange
         self.tick = tick
         self.compiled = compiled
@@ -216,7 +218,8 @@ class Engine:
         name = spec.mnemonic if spec else fon.f
         if index not in self._faulted:
             logger.error("FON %s at line %d failed (FErr1 set)", name, fon.line, exc_info=e)
-        self._fault_once(index, f"FON {name} at line {fon.line}: {type(e).__name__}: {e}")
+        self._fault_once(index, self.words("FON failed", name=name, line=fon.line,
+                                           error=f"{type(e).__name__}: {e}"))
 
     def _make_fon(self, index: int) -> Callable[[int], None]:
         """Bit C = RES; while RES is 1 the function runs every scan (level semantics).
@@ -325,10 +328,10 @@ class Engine:
         def apply(mem: Memory) -> None:
             bits = mem.bits
             if addr < 0 or addr + len(values) > IO_BITS:
-                raise ValueError(f"bits {fmt_octal(addr)}+{len(values)} are not I/O bits")
+                raise ValueError(self.words("not io bits", addr=fmt_octal(addr), n=len(values)))
             old = "".join("1" if b else "0" for b in bits[addr : addr + len(values)])
             bits[addr : addr + len(values)] = [1 if v else 0 for v in values]
-            self._journal(user, f"{fmt_octal(addr)}:{len(values)} bits", old, new, addr)
+            self._journal(user, self.words("bits", addr=fmt_octal(addr), n=len(values)), old, new, addr)
 
         return apply
 
@@ -344,8 +347,9 @@ class Engine:
                 self._journal(user, fmt_octal(addr), old, new, addr, label)
             else:
                 self.sink.put(Record(self.wall_time(), "operator", source=user, number=addr, value=float(new),
-                                     text=f"write {label or fmt_octal(addr)}: {describe(old, new)} "
-                                          f"(raw {old} -> {new} at {fmt_octal(addr)})"))
+                                     text=self.words("write change", where=label or fmt_octal(addr),
+                                                     change=describe(old, new), old=old, new=new,
+                                                     addr=fmt_octal(addr))))
 
         return apply
 
@@ -389,7 +393,7 @@ class Engine:
             where = f"{label} ({where})"
         self.sink.put(
             Record(self.wall_time(), "operator", source=user, number=addr, value=value,
-                   text=f"write {where}: {old} -> {new}")
+                   text=self.words("write", where=where, old=old, new=new))
         )
 
     # --- run control ---------------------------------------------------------------------------
@@ -441,8 +445,7 @@ class Engine:
             self.stop(11)
             if self._stop_by:
                 self.sink.put(Record(self.wall_time(), "system", source=self._stop_by, number=EMERGENCY_STOP,
-                                     text=f"NetPlc stopped, code 11: emergency-stop bit 03770 "
-                                          f"written by {self._stop_by}"))
+                                     text=self.words("emergency stop by", user=self._stop_by)))
         self._stop_by = ""
         if self.state is RunState.RUNNING or self._stepping:
             outcome = self._run()
@@ -451,7 +454,7 @@ class Engine:
             elif outcome == "watchdog":
                 self.stop(0)
                 self.sink.put(Record(self.wall_time(), "system", source="netplc",
-                                     text="watchdog: the scan did not reach its end (endless jump loop)"))
+                                     text=self.words("watchdog")))
             if bits[EMERGENCY_STOP]:
                 self.stop(11)
             self.rtc.watch(mem)
@@ -499,7 +502,7 @@ class Engine:
             logger.error("engine listener %s failed at scan %d", name, self.scan_counter, exc_info=e)
             self.listener_faults[name] = text
             self.sink.put(Record(self.wall_time(), "system", source="netplc",
-                                 text=f"engine listener {name} failed (the others go on): {text}"))
+                                 text=self.words("listener failed", name=name, error=text)))
 
     def step(self) -> Snapshot:
         """Step one scan: with NetPlc stopped or halted, run exactly one scan with the program, one
@@ -527,11 +530,12 @@ class Engine:
         try:
             fn(mem)
         except ValueError as e:  # a queued write to an address that does not exist
-            self.sink.put(Record(self.wall_time(), "system", source="netplc", text=f"write refused: {e}"))
+            self.sink.put(Record(self.wall_time(), "system", source="netplc",
+                                 text=self.words("write refused", error=e)))
             return False
         except Exception as e:  # a faulty producer must not cost the scan or the writes after it
             logger.exception("queued write failed")
-            text = f"queued write failed: {type(e).__name__}: {e}"
+            text = self.words("write failed", error=f"{type(e).__name__}: {e}")
             self.sink.put(Record(self.wall_time(), "system", source="netplc", text=text))
             return False
         finally:

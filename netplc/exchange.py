@@ -60,23 +60,13 @@ from netplc.modbus import (
 from netplc.program import Diagnostic, Program
 from netplc.records import NullSink, Record, RecordSink
 from netplc.tcp_exchange import TcpHub, TcpNode
+from netplc.words import Say, english
 
 if TYPE_CHECKING:
     from netplc.engine import Engine
     from netplc.program import Instr
 
 NODE, NREAD, NWRITE = 300, 301, 302
-# the exchange's records (English; the station says them in its Language, app/scada/words.py)
-LINK_WORDS = {
-    "link up": "node {node} ({endpoint}): link up",
-    "link down": "node {node} ({endpoint}): link down",
-    "link down because": "node {node} ({endpoint}): link down: {error}",
-}
-Say = Callable[..., str]  # `say(name, **values)`: a record's text
-
-
-def english(name: str, /, **values: object) -> str:
-    return LINK_WORDS[name].format(**values)
 
 logger = logging.getLogger(__name__)
 
@@ -360,7 +350,7 @@ class Exchange:
             raise ValueError(f"node {cfg.node}: {key}: {text}")
         self.configs: dict[int, NodeConfig] = {cfg.node: cfg for cfg in nodes}
         self.sink: RecordSink = sink or NullSink()
-        self.words: Say = english  # the station's words for its records (app/scada/words.py)
+        self.words: Say = english  # the station's words for its records (netplc/words.py)
         self.engine: Engine | None = None
         self.stats: dict[int, NodeStats] = {
             n: NodeStats(n, str(cfg.parsed)) for n, cfg in self.configs.items()

@@ -28,6 +28,7 @@ from typing import Literal, Protocol
 from netplc.address import HMI_DATA_BIT_BASE, IO_BITS, check_operand, fmt_octal, parse_hmi_bit, parse_octal
 from netplc.memory import Memory, MemoryView
 from netplc.records import Record, RecordSink
+from netplc.words import Say, english
 
 Kind = Literal["bit", "byte", "word"]
 KINDS: tuple[Kind, ...] = ("bit", "byte", "word")
@@ -37,7 +38,14 @@ SOURCE = "force"  # journal text prefix, so the viewer filters forcing with one 
 
 
 class ForceError(ValueError):
-    """A force that names no memory, or a value that does not fit."""
+    """A force that names no memory, or a value that does not fit: English as an exception, in
+    parts (`name`, `values` of netplc/words.py) for the station's command layer to say it in its
+    language."""
+
+    def __init__(self, name: str, /, **values: object) -> None:
+        super().__init__(english(name, **values))
+        self.name = name
+        self.values = values
 
 
 @dataclass(frozen=True, slots=True)
@@ -88,26 +96,27 @@ class Force:
 def check_target(kind: str, addr: int) -> None:
     """ForceError unless `kind` at `addr` names memory a force can pin."""
     if kind not in KINDS:
-        raise ForceError(f"force kind {kind!r} is not one of {', '.join(KINDS)}")
+        raise ForceError("force kind", kind=kind, kinds=", ".join(KINDS))
     try:
         if kind == "bit":
             parse_hmi_bit(addr)
         else:
             check_operand(addr, _SIZE[kind])
     except ValueError as e:
-        raise ForceError(f"cannot force {kind} {fmt_octal(addr)}: {e}") from None
+        raise ForceError("cannot force", kind=kind, addr=fmt_octal(addr), error=e) from None
 
 
 def check_value(kind: Kind, value: int) -> int:
     if not 0 <= value <= _MASK[kind]:
-        raise ForceError(f"{value} does not fit a {kind} (0..{_MASK[kind]})")
+        raise ForceError("does not fit", value=value, kind=kind, most=_MASK[kind])
     return value
 
 
 class ForceHost(Protocol):
-    """What the forces need of the engine: its queue, its sink and its wall clock."""
+    """What the forces need of the engine: its queue, its sink, its words and its wall clock."""
 
     sink: RecordSink
+    words: Say
 
     def post(self, fn: Callable[[Memory], None]) -> None: ...
 
@@ -161,9 +170,10 @@ class Forces:
             new = Force(kind, addr, current if value is None else value, user)
             self.listing = (*(f for f in self.listing if f.key != new.key), new)
             new.apply(mem)
-            was = f"forced {old.value}" if old else str(current)
-            how = " (bumpless)" if value is None else ""
-            self.journal(user, new, f"force {new.where}: {was} -> {new.value}{how}")
+            say = self.host.words
+            was = say("forced value", value=old.value) if old else str(current)
+            how = say("bumpless") if value is None else ""
+            self.journal(user, new, say("force", where=new.where, was=was, value=new.value, how=how))
 
         return apply
 
@@ -174,7 +184,7 @@ class Forces:
             old = self.forced(kind, addr)
             if old is not None:
                 self.listing = tuple(f for f in self.listing if f.key != old.key)
-                self.journal(user, old, f"unforce {old.where} (was forced {old.value})")
+                self.journal(user, old, self.host.words("unforce", where=old.where, value=old.value))
 
         return apply
 
@@ -184,7 +194,7 @@ class Forces:
         def apply(_mem: Memory) -> None:
             released, self.listing = self.listing, ()
             for old in released:
-                self.journal(user, old, f"unforce {old.where} (was forced {old.value}; unforce all)")
+                self.journal(user, old, self.host.words("unforce all", where=old.where, value=old.value))
 
         return apply
 
@@ -227,7 +237,7 @@ def load_forces(path: Path) -> tuple[list[Force], list[str]]:
             kind, addr, value = row["kind"], parse_octal(str(row["addr"])), row["value"]
             check_target(kind, addr)
             if not isinstance(value, int):
-                raise ForceError(f"value {value!r} is not an integer")
+                raise ValueError(f"value {value!r} is not an integer")
             forces.append(Force(kind, addr, check_value(kind, value), str(row.get("user", ""))))
         except KeyError as e:
             problems.append(f"{path}: force [{i}]: missing {e}")

@@ -25,6 +25,7 @@ from collections.abc import Callable
 from pathlib import Path
 from typing import Any
 
+from app.scada.words import ENGLISH, Words, words
 from netplc.records import NullSink, Record, RecordSink
 
 logger = logging.getLogger(__name__)
@@ -35,8 +36,9 @@ FLUSH_EVERY = 0.1  # seconds the writer waits for more changes before it writes
 
 class AlarmStateFile:
     def __init__(self, path: str | Path, sink: RecordSink | None = None,
-                 wallclock: Callable[[], float] = time.time) -> None:
+                 wallclock: Callable[[], float] = time.time, say: Words | None = None) -> None:
         self.path = Path(path)
+        self.say = say or words()  # its records in the station's language (app/scada/words.py)
         self.sink = sink or NullSink()
         self.wallclock = wallclock
         self.saves = 0  # transactions committed
@@ -62,13 +64,12 @@ class AlarmStateFile:
             damaged = self.path.with_name(self.path.name + ".damaged")
             with contextlib.suppress(OSError):  # nothing to move aside
                 os.replace(self.path, damaged)
-            text = (f"alarm states not restored from {self.path.name}: {e}; every alarm starts "
-                    f"normal (the file is kept as {damaged.name})")
-            logger.warning("%s", text)
-            self._journal(text)
+            said = {"file": self.path.name, "error": e, "damaged": damaged.name}
+            logger.warning("%s", ENGLISH("states not restored", **said))
+            self._journal("states not restored", **said)
             return {}
         if states:
-            self._journal(f"alarm states restored from {self.path.name}: {len(states)} alarm(s)")
+            self._journal("states restored", file=self.path.name, n=len(states))
         return states
 
     def _open(self) -> sqlite3.Connection:
@@ -120,14 +121,14 @@ class AlarmStateFile:
                 if not self.last_error:
                     logger.warning("alarm states could not be saved to %s: %s; kept in memory and retried",
                                    self.path, e)
-                    self._journal(f"alarm states could not be saved: {e}; kept in memory and retried")
+                    self._journal("states not saved", error=e)
                 self.last_error = str(e)
                 return
             self.saves += 1
             self.rows += len(pending)
             if self.last_error:
                 self.last_error = ""
-                self._journal("alarm states are being saved again")
+                self._journal("states saved again")
 
     def start(self) -> None:
         self._stop.clear()
@@ -153,5 +154,5 @@ class AlarmStateFile:
             self._wake.clear()
             self.flush()
 
-    def _journal(self, text: str) -> None:
-        self.sink.put(Record(self.wallclock(), "system", source=SOURCE, text=text))
+    def _journal(self, name: str, /, **values: object) -> None:
+        self.sink.put(Record(self.wallclock(), "system", source=SOURCE, text=self.say(name, **values)))

@@ -39,6 +39,7 @@ from collections.abc import Callable
 from dataclasses import dataclass
 from pathlib import Path
 
+from app.scada.words import ENGLISH, Phrase, Phrases, Words, phrase, words
 from netplc.address import DATA_SIZE, IO_BITS, RETAIN_BITS
 from netplc.engine import Engine
 from netplc.memory import Snapshot
@@ -56,7 +57,14 @@ logger = logging.getLogger(__name__)
 
 
 class SaveError(ValueError):
-    """A save file that cannot be used (missing, truncated, damaged, another format)."""
+    """A save file that cannot be used (missing, truncated, damaged, another format): English as
+    an exception, in parts (the catalogue's `name` and `values`, app/scada/words.py) for the
+    journal's language."""
+
+    def __init__(self, name: str, /, **values: object) -> None:
+        super().__init__(ENGLISH(name, **values))
+        self.name = name
+        self.values = values
 
 
 @dataclass(frozen=True)
@@ -81,8 +89,10 @@ class _Taken:
 
 
 class Retainer:
-    def __init__(self, path: str | Path, engine: Engine, sink: RecordSink | None = None) -> None:
+    def __init__(self, path: str | Path, engine: Engine, sink: RecordSink | None = None,
+                 say: Words | None = None) -> None:
         self.path = Path(path)
+        self.say = say or words()  # its records in the station's language (app/scada/words.py)
         _, (_, self._tmp), (_, self.previous) = save_files(self.path)
         self.engine = engine
         self.sink = sink if sink is not None else engine.sink
@@ -111,34 +121,35 @@ class Retainer:
         in its place) leaves the newest save, complete and fsynced, as the temporary file: it is used,
         and becomes the current save.
         """
-        problems: list[str] = []
+        problems: list[Phrase] = []  # "current save is missing"...
         for used, path in save_files(self.path):
             try:
                 saved = read_save(path)
             except SaveError as e:
                 if used != "written":  # it is there only when a crash came while a save was written
-                    problems.append(f"{used} save {e}")
+                    problems.append(phrase(f"{used} save problem", problem=phrase(e.name, **e.values)))
                 continue
             self._apply(saved)
-            why = f" ({'; '.join(problems)})" if problems else ""
+            why = phrase("retain why", problems=Phrases(problems)) if problems else ""
             if used == "written":  # a crash between a save's two renames: the newest save, complete
-                self._journal(f"retentive memory restored from the save written at the crash, "
-                              f"{path.name}{why}")
+                self._journal("retain crash", file=path.name, why=why)
                 self._promote()
                 return "current"
             self._current_good = used == "current"
-            text = f"retentive memory restored from the {used} save {path.name}{why}"
+            said = {"used": phrase(f"save {used}"), "file": path.name, "why": why}
             if used == "previous":
-                text += f": writes acknowledged after {_when(saved.wall)} may be lost"
-                logger.warning("%s", text)
-            self._journal(text)
+                said["when"] = _when(saved.wall)
+                logger.warning("%s", ENGLISH("retain lost after", **said))
+                self._journal("retain lost after", **said)
+            else:
+                self._journal("retain restored", **said)
             return used
         self._apply(Saved(bytes(len(RETAIN_BITS)), bytes(DATA_SIZE), {}, {}, 0.0))
-        text = f"retentive memory starts from zeroes ({'; '.join(problems)})"
-        if any(not p.endswith("is missing") for p in problems):
-            text += ": every write acknowledged before may be lost"
-            logger.warning("%s", text)
-        self._journal(text)
+        name = "retain zeroes"
+        if any(p.values["problem"].name != "save missing" for p in problems):  # type: ignore[attr-defined]
+            name = "retain zeroes lost"
+            logger.warning("%s", ENGLISH(name, problems=Phrases(problems)))
+        self._journal(name, problems=Phrases(problems))
         return "zeroes"
 
     def _promote(self) -> None:
@@ -148,7 +159,7 @@ class Retainer:
             _fsync_dir(self.path.parent)
         except OSError as e:  # the next save tries again; until then the file is used as it is
             logger.warning("retentive save %s not renamed to %s: %s", self._tmp, self.path, e)
-            self._journal(f"retentive memory: {self._tmp.name} could not become {self.path.name}: {e}")
+            self._journal("retain not renamed", tmp=self._tmp.name, file=self.path.name, error=e)
         else:
             self._current_good = True
 
@@ -161,8 +172,8 @@ class Retainer:
         # Publish at once, so that a save before the first scan keeps what was restored.
         engine.snapshot = mem.snapshot(engine.scan_counter, engine.now, engine.wall_time(), engine.state_text)
 
-    def _journal(self, text: str) -> None:
-        self.sink.put(Record(self.engine.wall_time(), "system", source=SOURCE, text=text))
+    def _journal(self, name: str, /, **values: object) -> None:
+        self.sink.put(Record(self.engine.wall_time(), "system", source=SOURCE, text=self.say(name, **values)))
 
     # --- save ----------------------------------------------------------------------------------
 
@@ -236,19 +247,18 @@ class Retainer:
         except OSError as e:
             if not self.last_error:  # said once; the health strip shows it while it lasts
                 logger.warning("retentive memory could not be saved to %s: %s", self.path, e)
-                self._journal(f"retentive memory could not be saved: {e}; writes are answered all the "
-                              "same and come back older after a crash until it is saved again")
+                self._journal("retain not saved", error=e)
             self.last_error = str(e)
         else:
             if self.last_error:
                 self.last_error = ""
-                self._journal("retentive memory is being saved again")
+                self._journal("retain saved again")
         for callback in taken.waiters:
             try:
                 callback()
             except Exception as e:  # one waiter's bug must not leave the others unanswered
                 logger.exception("a writer waiting for the retentive save failed")
-                self._journal(f"retentive save waiter failed: {e!r}")
+                self._journal("retain waiter failed", error=repr(e))
 
     # --- background ----------------------------------------------------------------------------
 
@@ -324,21 +334,21 @@ def read_save(path: Path) -> Saved:
     try:
         blob = path.read_bytes()
     except FileNotFoundError:
-        raise SaveError("is missing") from None
+        raise SaveError("save missing") from None
     except OSError as e:
-        raise SaveError(f"cannot be read: {e.strerror}") from None
+        raise SaveError("save unreadable", error=e.strerror) from None
     return parse_save(blob)
 
 
 def parse_save(blob: bytes) -> Saved:
     if len(blob) < HEADER.size:
-        raise SaveError("is truncated")
+        raise SaveError("save truncated")
     magic, version, crc, length = HEADER.unpack_from(blob)
     if magic != MAGIC or version != VERSION:
-        raise SaveError("is not a retentive memory save of this version")
+        raise SaveError("save version")
     payload = blob[HEADER.size:]
     if len(payload) != length or zlib.crc32(payload) != crc:
-        raise SaveError("is damaged (length or checksum wrong)")
+        raise SaveError("save damaged")
     nbits = len(RETAIN_BITS)
     try:
         meta = json.loads(payload[nbits + DATA_SIZE:])
@@ -348,7 +358,7 @@ def parse_save(blob: bytes) -> Saved:
         if any(not 0 <= c < IO_BITS for c in (*tim, *ctr)):
             raise ValueError("a timer or counter address outside the I/O bits")
     except (ValueError, KeyError, TypeError, AttributeError) as e:
-        raise SaveError(f"has unreadable timer and counter values: {e}") from None
+        raise SaveError("save counters", error=e) from None
     return Saved(payload[:nbits], payload[nbits:nbits + DATA_SIZE], tim, ctr, wall)
 
 

@@ -25,6 +25,7 @@ from dataclasses import dataclass
 from pathlib import Path
 
 from app.scada.table import TagTable
+from app.scada.words import Words, words
 from netplc.records import Record
 from netplc.textfile import kind
 from registrar.catalog import Catalog
@@ -152,8 +153,10 @@ class Store:
         on_commit: Callable[[int], None] | None = None,
         tags: TagTable | None = None,
         station: str = "",
+        say: Words | None = None,
     ) -> None:
         self.path = Path(path)
+        self.say = say or words()  # its own records in the station's language (app/scada/words.py)
         self.station = station  # its name, kept in `meta` so the file says whose it is
         self.catalog = catalog or Catalog()
         self.tags = tags or TagTable()  # copied in, like the catalog, so the file explains its data
@@ -352,7 +355,7 @@ class Store:
             except Exception as e:  # a waiter's bug must not stop the archive
                 logger.exception("archive commit waiter failed")
                 self._queue.append(Record(self.wallclock(), "system", source=SOURCE,
-                                          text=f"archive commit waiter failed: {e!r}"))
+                                          text=self.say("waiter failed", error=repr(e))))
 
     def _take(self) -> list[Record]:
         queue = self._queue
@@ -372,8 +375,7 @@ class Store:
             lost = dropped - self._reported_drops
             self._reported_drops = dropped
             batch.append(Record(self.wallclock(), "system", source=SOURCE,
-                                text=f"archive queue full: {lost} record(s) lost "
-                                     f"(the disk did not keep up; queue size {self.queue_size})"))
+                                text=self.say("queue full", lost=lost, size=self.queue_size)))
         return batch
 
     def _write(self, batch: list[Record]) -> bool:
@@ -399,8 +401,7 @@ class Store:
             self._failing_since = None
             logger.warning("archive writing resumed after %.0f s; no records were lost", seconds)
             self._queue.appendleft(Record(self.wallclock(), "system", source=SOURCE,
-                                          text=f"archive writing resumed after {seconds:.0f} s; "
-                                               "no records were lost"))
+                                          text=self.say("writing resumed", seconds=seconds)))
             self._wake.set()
         if self.on_commit is not None:
             try:
@@ -409,7 +410,7 @@ class Store:
                 logger.exception("archive commit listener failed and was removed")
                 self.on_commit = None
                 self._queue.append(Record(self.wallclock(), "system", source=SOURCE,
-                                          text=f"archive commit listener failed and was removed: {e!r}"))
+                                          text=self.say("listener removed", error=repr(e))))
         return True
 
     def _insert(self, con: sqlite3.Connection, batch: list[Record]) -> None:
@@ -432,8 +433,7 @@ class Store:
             bad = [r for r in batch if not _well_formed(r)]
             logger.error("archive refused %d malformed record(s), the first: %.300r", len(bad), bad[0])
             good.append(Record(self.wallclock(), "system", source=SOURCE,
-                               text=f"archive refused {len(bad)} malformed record(s), "
-                                    f"the first: {bad[0]!r:.300}"))
+                               text=self.say("malformed", n=len(bad), first=repr(bad[0]))))
         return good
 
     def _failed(self, con: sqlite3.Connection, error: Exception, batch: list[Record]) -> None:
@@ -445,7 +445,7 @@ class Store:
             logger.warning("%s; records are kept in memory and retried", text)
             self._failing_since = self.wallclock()
             batch.append(Record(self.wallclock(), "system", source=SOURCE,
-                                text=f"{text}; records are kept in memory and retried"))
+                                text=self.say("write failed kept", error=error)))
 
     def _rows_by_table(self, batch: list[Record]) -> dict[str, list[Row]]:
         """Rows for each day table, built in C loops where it counts (a batch is mostly one day)."""

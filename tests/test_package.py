@@ -23,7 +23,7 @@ import zipfile
 from pathlib import Path
 
 from app import __version__
-from tests.app.conftest import stop_once_up
+from tests.app.conftest import DEMO_NAME, stop_once_up
 
 REPO = Path(__file__).resolve().parents[1]
 SOURCES = ("pyproject.toml", "README.md", "app", "netplc", "registrar", "hmi_forms")
@@ -113,7 +113,7 @@ def test_the_wheel_installs_netplc_station_with_the_demo_and_the_translations(tm
     assert f"норма: станция {demo / 'station.toml'}" in r.stdout  # the demo's Language is ru
     assert station.returncode == 0, err
     lines = out.splitlines()
-    assert lines[0].startswith("station Demo station started"), out
+    assert lines[0].startswith(f"station {DEMO_NAME} started"), out
     assert "nodes 1/1 up" in out and "SIGTERM: stopping" in out
     assert lines[-1].startswith("station stopped after")
     assert (demo / "archive" / "journal.sqlite").is_file()  # the installed demo runs where it is

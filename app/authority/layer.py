@@ -8,7 +8,8 @@ A command carries who (`Who`: the user, or the peer where the protocol has none)
 - queues the action to the engine thread through the engine's bounded queue of outside actions
   (`Engine.command`), so the scan period holds whatever clients send and memory has one writer;
 - journals it once, as the effect's own record naming who and from where (the write, the force,
-  the alarm transition), in one wording for every entry point;
+  the alarm transition), in one wording for every entry point, in the station's language
+  (app/scada/words.py: its records and the sentences of its answers);
 - answers (`Ticket`, a future of `Answer`) only when the action was applied and its record is
   committed to the archive, or at once with the reason it was refused, which each protocol maps to
   its own code (`Reason`: a Modbus exception, an OPC UA StatusCode, an NCMD refusal, the console's
@@ -33,9 +34,11 @@ from typing import TYPE_CHECKING
 
 from app.authority.policy import POLICY, ROLE_OF_SOURCE, ROLES, Action, Refusal, Source, needs, rank
 from app.authority.users import UserError
+from app.scada.alarms import UnknownAlarm
 from app.scada.forcing import forcing_tag, unforcing_tag
 from app.scada.station import STOPPED_BY_COMMAND
 from app.scada.tag import Tag, TagType
+from app.scada.words import Words, phrase, words
 from netplc.address import EMERGENCY_STOP, IO_BITS, fmt_octal
 from netplc.engine import BUSY, JOURNAL_FULL, Engine, RunState
 from netplc.forcing import ForceError, Kind
@@ -116,8 +119,10 @@ class Commands:
                  wallclock: Callable[[], float] = time.time,
                  monotonic: Callable[[], float] = time.monotonic,
                  standby: Callable[[], str | None] = lambda: None,
-                 hand_over: Callable[[str], str | None] | None = None) -> None:
+                 hand_over: Callable[[str], str | None] | None = None,
+                 say: Words | None = None) -> None:
         self.engine = engine
+        self.say = say or words()  # the station's language: its records and refusals
         self.standby = standby  # why this station of a pair takes no commands now (names the primary)
         self.hand_over = hand_over  # IntoStandBy by a user: None when done, else why not; None: no pair
         self.sink = sink
@@ -186,10 +191,11 @@ class Commands:
             if len(self._refused) > 4096:  # bounded: forget the oldest causes
                 for old in sorted(self._refused, key=lambda k: self._refused[k][0])[:1024]:
                     del self._refused[old]
-        what = f"{action} {target}".strip()
-        tail = f" ({more} more refused like it in the minute before)" if more else ""
+        said = self.say(f"action {action}") if self.say.knows(f"action {action}") else action
+        what = f"{said} {target}".strip()
         self.sink.put(Record(self.wallclock(), "operator", source=who.name,
-                             text=f"refused {what}: {text}{tail}"))
+                             text=self.say("refused more" if more else "refused", what=what, why=text,
+                                           n=more)))
 
     def _check(self, who: Who, action: Action, target: str, at_least: str | None = None,
                what: str | None = None) -> Ticket | None:
@@ -198,7 +204,22 @@ class Commands:
         if why is None:
             return None
         # the journal names the action and target once: "refused write Пуск: needs the operator role"
-        return self.refuse(who, action, target, Reason.DENIED, str(why).removeprefix(f"{why.action}: "), why)
+        return self.refuse(who, action, target, Reason.DENIED, self.refusal_text(why), why)
+
+    def refusal_text(self, why: Refusal) -> str:
+        """The refusal for the role in the station's language, without its action (the record's)."""
+        say = self.say
+
+        def role(name: str) -> object:
+            return phrase(f"role {name}") if name in ROLES else name
+
+        if not why.user and why.user_role:
+            return say("denied source", role=role(why.role), has=role(why.user_role))
+        if not why.user:
+            return say("denied nobody", role=role(why.role))
+        if not why.user_role:
+            return say("denied gone", user=why.user, role=role(why.role))
+        return say("denied role", role=role(why.role), user=why.user, has=role(why.user_role))
 
     def _queue(self, who: Who, action: Action, target: str,
                apply: Callable[[Memory], None]) -> Ticket:
@@ -208,15 +229,13 @@ class Commands:
         ticket: Ticket = Future()
 
         def done(ok: bool) -> None:
-            ticket.set_result(APPLIED if ok else Answer(
-                Reason.FAILED, f"{action.value} {target}: not applied (see the journal)"))
+            what = f"{self.say(f'action {action.value}')} {target}"
+            ticket.set_result(APPLIED if ok else Answer(Reason.FAILED, self.say("not applied", what=what)))
 
         if not self.engine.command(apply, who.name, done):
             busy = self.engine.refusal() or BUSY
             reason = Reason.JOURNAL_FULL if busy == JOURNAL_FULL else Reason.BUSY
-            text = ("the archive cannot take the record (disk full or too slow): not done"
-                    if reason is Reason.JOURNAL_FULL else
-                    "the station is busy (its queue of outside actions is full): not done, try again")
+            text = self.say("journal full" if reason is Reason.JOURNAL_FULL else "busy")
             return self.refuse(who, action, target, reason, text)
         return ticket
 
@@ -233,22 +252,22 @@ class Commands:
         physical range, journaled with the tag's name and unit."""
         tag = self.tags.get(name)
         if tag is None:
-            return self.refuse(who, Action.WRITE, name, Reason.UNKNOWN, f"no tag {name!r}")
+            return self.refuse(who, Action.WRITE, name, Reason.UNKNOWN, self.say("no tag", name=name))
         if (denied := self._check(who, Action.WRITE, name)) is not None:
             return denied
         if isinstance(value, str) or value is None or not isinstance(value, (bool, int, float)):
             return self.refuse(who, Action.WRITE, name, Reason.TYPE_MISMATCH,
-                               f"{value!r} is not a number")
+                               self.say("no number", value=value))
         phy = float(value)
         if tag.type is TagType.BIT:
             if phy not in (0.0, 1.0):
                 return self.refuse(who, Action.WRITE, name, Reason.OUT_OF_RANGE,
-                                   f"{value!r} is not 0 or 1")
+                                   self.say("not 0 or 1", value=value))
         else:
             lo, hi = write_range(tag)
             if not math.isfinite(phy) or not lo <= phy <= hi:
                 return self.refuse(who, Action.WRITE, name, Reason.OUT_OF_RANGE,
-                                   f"{value!r} is outside {tag.format(lo)} .. {tag.format(hi)}")
+                                   self.say("outside", value=value, lo=tag.format(lo), hi=tag.format(hi)))
         raw = tag.to_raw(phy)
         label = f"{tag.description} {name}".strip() if tag.description else name
         engine = self.engine
@@ -305,14 +324,14 @@ class Commands:
         """An alarm action: the alarm's transition record (naming the user) is its journal."""
         alarms = self.alarms
         if alarms is None:
-            return self.refuse(who, action, alarm_id, Reason.NOT_RUNNING, "the station has no alarm system")
+            return self.refuse(who, action, alarm_id, Reason.NOT_RUNNING, self.say("no alarm system"))
         if (denied := self._check(who, action, alarm_id)) is not None:
             return denied
         try:
             if check is not None:
                 check(alarms)
         except ValueError as e:  # AlarmError: unknown alarm, shelving without reason or duration
-            reason = Reason.UNKNOWN if "no alarm" in str(e) else Reason.INVALID
+            reason = Reason.UNKNOWN if isinstance(e, UnknownAlarm) else Reason.INVALID
             return self.refuse(who, action, alarm_id, reason, str(e))
         run = act(alarms)
         return self._queue(who, action, alarm_id, lambda _mem: alarms.run_now(run))
@@ -358,7 +377,7 @@ class Commands:
         def apply(_mem: Memory) -> None:
             if alarms is not None:
                 alarms.silence(self.wall())  # the consoles' sound and the horn bit
-            self._put(who, "alarm sound silenced")
+            self._put(who, self.say("silenced"))
 
         return self._queue(who, Action.SILENCE, "", apply)
 
@@ -371,7 +390,7 @@ class Commands:
         try:
             apply = build()
         except ForceError as e:
-            return self.refuse(who, action, target, Reason.INVALID, str(e))
+            return self.refuse(who, action, target, Reason.INVALID, self.say(e.name, **e.values))
         return self._queue(who, action, target, apply)
 
     def force(self, who: Who, kind: Kind, addr: int, value: int | None = None) -> Ticket:
@@ -382,12 +401,12 @@ class Commands:
     def force_tag(self, who: Who, name: str, phy: float | None = None) -> Ticket:
         tag = self.tags.get(name)
         if tag is None:
-            return self.refuse(who, Action.FORCE, name, Reason.UNKNOWN, f"no tag {name!r}")
+            return self.refuse(who, Action.FORCE, name, Reason.UNKNOWN, self.say("no tag", name=name))
         if phy is not None and tag.type is not TagType.BIT:
             lo, hi = write_range(tag)
             if not (math.isfinite(phy) and lo <= phy <= hi):
                 return self.refuse(who, Action.FORCE, name, Reason.OUT_OF_RANGE,
-                                   f"{phy!r} is outside {tag.format(lo)} .. {tag.format(hi)}")
+                                   self.say("outside", value=phy, lo=tag.format(lo), hi=tag.format(hi)))
         forces = self.engine.forces
         return self._force(who, Action.FORCE, name, lambda: forcing_tag(forces, tag, phy, user=who.name))
 
@@ -399,7 +418,7 @@ class Commands:
     def unforce_tag(self, who: Who, name: str) -> Ticket:
         tag = self.tags.get(name)
         if tag is None:
-            return self.refuse(who, Action.UNFORCE, name, Reason.UNKNOWN, f"no tag {name!r}")
+            return self.refuse(who, Action.UNFORCE, name, Reason.UNKNOWN, self.say("no tag", name=name))
         forces = self.engine.forces
         return self._force(who, Action.UNFORCE, name, lambda: unforcing_tag(forces, tag, user=who.name))
 
@@ -416,7 +435,7 @@ class Commands:
 
         def apply(_mem: Memory) -> None:
             engine.start()
-            self._put(who, "NetPlc started")
+            self._put(who, self.say("NetPlc started"))
 
         return self._queue(who, Action.RUN, "NetPlc", apply)
 
@@ -426,7 +445,7 @@ class Commands:
         engine = self.engine
 
         def apply(_mem: Memory) -> None:
-            self._put(who, STOPPED_BY_COMMAND)  # first: NETPLC.STOPPED names who
+            self._put(who, self.say(STOPPED_BY_COMMAND))  # first: NETPLC.STOPPED names who
             engine.stop()
 
         return self._queue(who, Action.STOP, "NetPlc", apply)
@@ -438,15 +457,14 @@ class Commands:
             return denied
         engine = self.engine
         if lock is None:
-            return self.refuse(who, Action.STEP, "NetPlc", Reason.NOT_RUNNING, "the station is not started")
+            return self.refuse(who, Action.STEP, "NetPlc", Reason.NOT_RUNNING, self.say("not started"))
         if (standby := self.standby()) is not None:
             return self.refuse(who, Action.STEP, "NetPlc", Reason.STANDBY, standby)
         with lock:
             if engine.state is RunState.RUNNING:
-                return self.refuse(who, Action.STEP, "NetPlc", Reason.INVALID,
-                                   "NetPlc is running: stop it to step one scan")
+                return self.refuse(who, Action.STEP, "NetPlc", Reason.INVALID, self.say("running"))
             engine.step()
-            self._put(who, f"step one scan (scan {engine.scan_counter})", number=engine.scan_counter)
+            self._put(who, self.say("stepped", scan=engine.scan_counter), number=engine.scan_counter)
         ticket: Ticket = Future()
         ticket.set_result(APPLIED)
         return ticket
@@ -461,11 +479,10 @@ class Commands:
         if (standby := self.standby()) is not None:
             return self.refuse(who, Action.INTO_STANDBY, "station", Reason.STANDBY, standby)
         if self.hand_over is None:
-            return self.refuse(who, Action.INTO_STANDBY, "station", Reason.INVALID,
-                               "the station is not one of a hot-standby pair ([redundancy])")
+            return self.refuse(who, Action.INTO_STANDBY, "station", Reason.INVALID, self.say("not a pair"))
         if (why := self.hand_over(who.name)) is not None:
             return self.refuse(who, Action.INTO_STANDBY, "station", Reason.INVALID, why)
-        self._put(who, "IntoStandBy: the primary role goes to the partner")
+        self._put(who, self.say("handing over"))
         return self._answer_after_commit()
 
     # --- user administration ---------------------------------------------------------------------
@@ -481,7 +498,8 @@ class Commands:
         try:
             text = change()
         except UserError as e:
-            return self.refuse(who, Action.USERS, target, Reason.INVALID, str(e))
+            return self.refuse(who, Action.USERS, target, Reason.INVALID,
+                               self.say(e.name, **e.values) if e.name else str(e))
         self._put(who, text)
         return self._answer_after_commit()
 
@@ -501,7 +519,7 @@ class Commands:
         able to stop a station whose disk is full (its last records are flushed at the stop)."""
         if (denied := self._check(who, Action.QUIT, "station")) is not None:
             return denied
-        self._put(who, "station quit")
+        self._put(who, self.say("station quit"))
         ticket: Ticket = Future()
         ticket.set_result(APPLIED)
         return ticket

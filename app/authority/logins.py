@@ -63,7 +63,7 @@ class Logins:
         wait = self.backoff(failures) - (now - last)
         if wait > 0:
             self.commands.refuse(who, LOG_IN, "", Reason.BUSY,
-                                 f"{failures} failed logins from {host}: refused for {wait:.0f} s more")
+                                 self.commands.say("login waits", n=failures, host=host, wait=wait))
             return None
         try:
             user = self.users().verify(name, password)
@@ -80,6 +80,7 @@ class Logins:
             if len(self._failed) > HOSTS:
                 for old in sorted(self._failed, key=lambda h: self._failed[h][1])[:HOSTS // 4]:
                     del self._failed[old]
-        tail = f"; the next attempts wait {self.backoff(failures):g} s" if failures >= self.free else ""
-        self.commands.refuse(who, LOG_IN, "", Reason.DENIED, f"wrong user name or password{tail}")
+        why = self.commands.say("login wrong wait", wait=self.backoff(failures)) if failures >= self.free \
+            else self.commands.say("login wrong")
+        self.commands.refuse(who, LOG_IN, "", Reason.DENIED, why)
         return None

@@ -91,7 +91,8 @@ def needs(action: Action, at_least: str | None = None) -> str:
 @dataclass(frozen=True)
 class Refusal:
     """Why a command is refused for its role, in parts, so the console can say it in its own
-    language (app/gui/words.py); `str()` is the English sentence the journal and the tests read."""
+    language (app/gui/words.py) and the command layer in the station's (its journal and answers);
+    `str()` is the English sentence."""
 
     action: str
     role: str  # the role the action needs

@@ -20,11 +20,12 @@ import json
 import os
 import secrets
 import time
-from collections.abc import Callable
+from collections.abc import Callable, Mapping
 from dataclasses import asdict, dataclass
 from pathlib import Path
 
 from app.authority.policy import ROLES, VIEWER, rank
+from app.scada.words import ENGLISH
 from netplc.problems import Problems
 from netplc.textfile import TextFileError, read_text
 
@@ -34,7 +35,16 @@ __all__ = ["Refused", "Session", "User", "UserError", "Users", "UsersFileError",
 
 
 class UserError(ValueError):
-    """A users-file command that cannot be done, in words for whoever typed it."""
+    """A users-file command that cannot be done, in words for whoever typed it: English as an
+    exception, in parts (`name`, `values` of app/scada/words.py; "" for a file's problems) for the
+    command layer to say it in the station's language."""
+
+    name = ""
+    values: Mapping[str, object] = {}
+
+    def __init__(self, name: str, /, **values: object) -> None:
+        super().__init__(ENGLISH(name, **values))
+        self.name, self.values = name, values
 
 
 class UsersFileError(UserError, Problems):
@@ -84,22 +94,22 @@ class Users:
     def add(self, name: str, role: str, password: str) -> User:
         name = name.strip()
         if not name:
-            raise UserError("a user needs a name")
+            raise UserError("user no name")
         if name in self.users:
-            raise UserError(f"user {name!r} exists already (passwd changes the password)")
+            raise UserError("user exists", name=name)
         user = self.users[name] = new_user(name, _role(role), _password(password))
         self.save()
         return user
 
     def remove(self, name: str) -> None:
         if self.users.pop(name, None) is None:
-            raise UserError(f"no user {name!r}")
+            raise UserError("no user", name=name)
         self.save()
 
     def passwd(self, name: str, password: str) -> None:
         user = self.users.get(name)
         if user is None:
-            raise UserError(f"no user {name!r}")
+            raise UserError("no user", name=name)
         self.users[name] = new_user(name, user.role, _password(password))
         self.save()
 
@@ -129,13 +139,13 @@ def _stand_in() -> User:
 
 def _role(role: str) -> str:
     if role not in ROLES:
-        raise UserError(f"role {role!r} is not one of {', '.join(ROLES)}")
+        raise UserError("no such role", role=role, roles=", ".join(ROLES))
     return role
 
 
 def _password(password: str) -> str:
     if not password:
-        raise UserError("the password is empty")
+        raise UserError("empty password")
     return password
 
 

@@ -59,6 +59,7 @@ from app.gui.zoom import ACTUAL, FIT_WIDTH, FIT_WINDOW, ZoomArea
 from app.scada.alarms import AlarmRow
 from app.scada.readings import Readings
 from app.scada.trends import TrendBook
+from app.scada.words import phrase
 from app.station.config import load_station
 from app.station.runtime import Runtime
 from hmi_forms.elements.analog import AnalogOutput
@@ -359,7 +360,7 @@ class MainWindow(QMainWindow):
         self._running = status.state == "running"
         self.header.tick()
         if (idle := self.session.idle_expired()) is not None:
-            self.runtime.operator(idle.name, "logged out: idle")
+            self.runtime.operator(idle.name, "logged out idle")
             self._user_changed()
         else:
             self._show_rights()
@@ -425,8 +426,8 @@ class MainWindow(QMainWindow):
         before = self.session.user
         user = self.session.login(name, password)
         if before is not None and before is not user:
-            self.runtime.operator(before.name, "logged out: user switched")
-        self.runtime.operator(user.name, f"logged in as {user.role}")
+            self.runtime.operator(before.name, "logged out switched")
+        self.runtime.operator(user.name, "logged in", role=phrase(f"role {user.role}"))
         self._user_changed()
 
     def manage_users(self) -> UsersDialog | None:

@@ -43,7 +43,7 @@ from concurrent.futures import Future
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Any, Literal
-from urllib.parse import urlsplit
+from urllib.parse import unquote, urlsplit
 
 from asyncua import Client, ua
 from asyncua.crypto.security_policies import SecurityPolicyBasic256Sha256
@@ -53,7 +53,7 @@ from cryptography.x509.oid import ExtendedKeyUsageOID
 
 from app.authority import APPLIED, Action, Answer, Reason, Ticket
 from app.publish.methods import METHODS
-from app.publish.opcua import ANSWERS, is_loopback, variant_type
+from app.publish.opcua import ANSWERS, application_uri, is_loopback, variant_type
 from app.publish.pki import _general_names, _private_folder, _write, subject, thumbprint
 from app.scada.tag import Tag
 from netplc.address import parse_octal
@@ -306,7 +306,7 @@ class StationClient:
 
     def where(self) -> str:
         """The station logged in to, with its letter when it is one of a pair ("pair B")."""
-        letter = self.server.removeprefix(f"{STATION_URI}{self.station}:") if self.station else ""
+        letter = self.server.removeprefix(f"{application_uri(self.station)}:") if self.station else ""
         name = self.station or self.url
         return f"{name} {letter}" if letter and letter != self.server else name
 
@@ -389,7 +389,7 @@ class StationClient:
             station = ours[-1] if ours else None
             if station is None:
                 raise LoginError(f"{self.url} is not a NetPlc station (no {STATION_URI}... namespace)")
-            self._ns, self.station = station[0], station[1].removeprefix(STATION_URI)
+            self._ns, self.station = station[0], unquote(station[1].removeprefix(STATION_URI))
             self.server = spaces[1] if len(spaces) > 1 else ""
             self._client = client
             await self._ask_rights()

@@ -157,15 +157,14 @@ class StationMethods:
         alarm = args[0]
         if not isinstance(alarm, str):
             return commands.refuse(who, method.action, str(alarm), Reason.INVALID,
-                                   "an alarm's identity is a String")
+                                   commands.say("alarm id string"))
         if method.name == "Acknowledge":
             return commands.acknowledge(who, alarm)
         if method.name == "Unshelve":
             return commands.unshelve(who, alarm)
         reason, seconds = args[1], args[2]
         if not isinstance(reason, str) or not isinstance(seconds, (int, float)) or isinstance(seconds, bool):
-            return commands.refuse(who, method.action, alarm, Reason.INVALID,
-                                   "Shelve takes a String reason and a number of seconds")
+            return commands.refuse(who, method.action, alarm, Reason.INVALID, commands.say("shelve args"))
         return commands.shelve(who, alarm, reason, float(seconds))
 
     def _write(self, who: Who, method: Method, args: list[object]) -> Ticket:
@@ -185,14 +184,16 @@ class StationMethods:
     def _tag(self, who: Who, method: Method, args: list[object]) -> Ticket:
         commands, name = self.commands, args[0]
         if not isinstance(name, str):
-            return commands.refuse(who, method.action, str(name), Reason.INVALID, "a tag's name is a String")
+            return commands.refuse(who, method.action, str(name), Reason.INVALID,
+                                   commands.say("tag name string"))
         if method.name == "UnforceTag":
             return commands.unforce_tag(who, name)
         value = args[1]
         if method.name == "WriteTag":  # the layer checks the value's type and the tag's range
             return commands.write_tag(who, name, value)
         if value is not None and (not isinstance(value, (int, float)) or isinstance(value, bool)):
-            return commands.refuse(who, method.action, name, Reason.INVALID, f"{value!r} is not a number")
+            return commands.refuse(who, method.action, name, Reason.INVALID,
+                                   commands.say("no number", value=value))
         return commands.force_tag(who, name, None if value is None else float(value))
 
 

@@ -60,6 +60,7 @@ from app.publish.points import PointReader, PointWriter, Reading, Writable
 from app.scada.quality import QualityMap
 from app.scada.readings import Readings
 from app.scada.tag import Tag
+from app.scada.words import Journal, phrase
 from app.station.config import MqttSettings
 
 if TYPE_CHECKING:
@@ -88,7 +89,7 @@ class MqttStatus:
 
 class SparkplugPublisher:
     def __init__(self, settings: MqttSettings, station: str, *, tags: Sequence[Tag], commands: Commands,
-                 watch: Watch, journal: Callable[[str], None], bdseq_file: Path | None = None,
+                 watch: Watch, journal: Journal, bdseq_file: Path | None = None,
                  quality_map: QualityMap | None = None, exchange: Exchange | None = None,
                  leads: Callable[[], bool] = lambda: True) -> None:
         """`bdseq_file` keeps the bdSeq of the last connection across restarts (Sparkplug 3.0:
@@ -226,7 +227,7 @@ class SparkplugPublisher:
             if not 0 <= value <= 255:
                 raise ValueError(f"{value} is not 0..255")
         except (OSError, ValueError) as e:
-            self.journal(f"MQTT: {self.bdseq_file}: not a bdSeq ({e}); starting again at 0")
+            self.journal("mqtt bad bdseq", file=self.bdseq_file, error=e)
             return -1
         return value
 
@@ -238,7 +239,7 @@ class SparkplugPublisher:
             tmp.write_text(f"{self.bdseq}\n", encoding="utf-8")
             os.replace(tmp, self.bdseq_file)
         except OSError as e:  # the station runs on; a host may then see a bdSeq again after a restart
-            self.journal(f"MQTT: {self.bdseq_file}: bdSeq not kept ({e})")
+            self.journal("mqtt bdseq not kept", file=self.bdseq_file, error=e)
 
     def _death(self) -> bytes:
         payload = spb.Payload(timestamp=_ms(time.time()))
@@ -258,7 +259,7 @@ class SparkplugPublisher:
 
     def _on_connect(self, client: mqtt.Client, userdata: object, flags: Any, reason: Any, props: Any) -> None:
         if reason.is_failure:
-            self.journal(f"MQTT broker {self.peer} refused the connection: {reason}")
+            self.journal("mqtt refused", peer=self.peer, reason=reason)
             return
         topics = [(self.topics.ncmd, 1), (self.topics.dcmd, 1)]
         if self.primary:
@@ -271,10 +272,9 @@ class SparkplugPublisher:
         self._birth_due = True
         self._wake.set()
         dropped = self.status.dropped
-        lost = f", {dropped} NDATA/DDATA dropped so far" if dropped else ""
-        waiting = f"; NBIRTH once primary host {self.primary} is online" if self.primary else ""
-        self.journal(f"MQTT connected to {self.peer} as {self.topics.node} (bdSeq {self.bdseq})"
-                     f"{lost}{waiting}")
+        self.journal("mqtt connected", peer=self.peer, node=self.topics.node, bdseq=self.bdseq,
+                     lost=phrase("mqtt dropped", n=dropped) if dropped else "",
+                     waiting=phrase("mqtt awaiting", host=self.primary) if self.primary else "")
 
     def _on_disconnect(self, client: mqtt.Client, userdata: object, flags: Any, reason: Any,
                        props: Any) -> None:
@@ -285,29 +285,27 @@ class SparkplugPublisher:
             self.bdseq = (self.bdseq + 1) % 256  # the next session's NDEATH, before paho reconnects
             self._set_will()
         if was and not (self._stopping or self._leaving):
-            self.journal(f"MQTT connection to {self.peer} lost ({reason}); reconnecting with back-off, "
-                         "NDATA buffered meanwhile")
+            self.journal("mqtt lost", peer=self.peer, reason=reason)
 
     def _on_state(self, client: mqtt.Client, userdata: object, message: mqtt.MQTTMessage) -> None:
         """The primary host's STATE (spec 3.0): taken unless older than the last one seen."""
         try:
             state = spb.parse_state(message.payload)
         except ValueError as e:
-            problem = f"MQTT: STATE of primary host {self.primary} ignored: {e}"
+            problem = f"{self.primary}: {e}"
             if problem != self._state_problem:  # a retained one comes again at every connection
                 self._state_problem = problem
-                self.journal(problem)
+                self.journal("mqtt bad state", host=self.primary, error=e)
             return
         last = self._host_time
         if last is not None and state.timestamp < last:
-            self.journal(f"MQTT: STATE of primary host {self.primary} ignored: its timestamp "
-                         f"{state.timestamp} is older than {last} (a session of the host's before)")
+            self.journal("mqtt old state", host=self.primary, stamp=state.timestamp, last=last)
             return
         self._host_time = state.timestamp
         was, self._host_online = self._host_online, state.online
         self.status.host_online = state.online
         if state.online and not was:
-            self.journal(f"MQTT: primary host {self.primary} is online")
+            self.journal("mqtt host online", host=self.primary)
         elif not state.online:
             self._leave_due = True
         self._wake.set()
@@ -321,7 +319,7 @@ class SparkplugPublisher:
         device = self.layout.by_id.get(name)
         if device is None:
             self._refused(self.commands.refuse(who, Action.WRITE, name, Reason.UNKNOWN,
-                                               f"no such device of {self.topics.node}"))
+                                               self.commands.say("no device", node=self.topics.node)))
             return
         self._command(message.payload, device, who)
 
@@ -332,7 +330,7 @@ class SparkplugPublisher:
             payload = spb.Payload.FromString(data)
         except Exception as e:  # no log: bad input, answered by the journaled refusal below
             self._refused(self.commands.refuse(who, Action.WRITE, "", Reason.INVALID,
-                                               f"not a Sparkplug B payload ({type(e).__name__})"))
+                                               self.commands.say("not sparkplug", error=type(e).__name__)))
             return
         layout = self.layout
         for metric in payload.metrics:
@@ -341,7 +339,7 @@ class SparkplugPublisher:
                 if spb.get_value(metric):
                     self._birth_due = True
                     self._wake.set()
-                    self.journal(f"MQTT rebirth requested by NCMD via {self.peer}")
+                    self.journal("mqtt rebirth", peer=self.peer)
                 continue
             i = layout.point(device, name, alias)
             label = name or (self.tags[alias - 1].name if 0 < alias <= len(self.tags) else f"alias {alias}")
@@ -351,11 +349,11 @@ class SparkplugPublisher:
                                            spb.mismatch(metric, kind))
             elif device is not None and (link := layout.link_name(device, name, alias)):
                 ticket = self.commands.refuse(who, Action.WRITE, link, Reason.NOT_WRITABLE,
-                                              "a link metric, read-only")
+                                              self.commands.say("link metric"))
             else:
                 of = f"device {device.id}" if device is not None else self.topics.node
                 ticket = self.commands.refuse(who, Action.WRITE, label, Reason.UNKNOWN,
-                                              f"no such metric of {of}")
+                                              self.commands.say("no metric", node=of))
             self._refused(ticket)
 
     def _refused(self, ticket: Ticket) -> None:
@@ -400,13 +398,11 @@ class SparkplugPublisher:
         follow; True while it publishes."""
         leads = self.leads()
         if leads and not self._online:
-            self.journal(f"MQTT: this station leads its pair: connecting as {self.topics.node} "
-                         f"(bdSeq {self.bdseq})")
+            self.journal("mqtt leads", node=self.topics.node, bdseq=self.bdseq)
             self._buffer.clear()  # what a standby saw was the primary's to publish
             self._go_online()
         elif not leads and self._online:
-            self.journal(f"MQTT: this station is the standby of its pair: NDEATH, session ended "
-                         f"(bdSeq {self.bdseq}); the primary publishes")
+            self.journal("mqtt follows", bdseq=self.bdseq)
             self._go_offline()
         return leads
 
@@ -418,8 +414,7 @@ class SparkplugPublisher:
             return
         self._session = False
         self._leaving = True
-        self.journal(f"MQTT: primary host {self.primary} is offline: NDEATH, session ended; "
-                     "a new one once it is online again, NDATA buffered meanwhile")
+        self.journal("mqtt host offline", host=self.primary)
         self._publish_death()
         self.client.disconnect()
         self.client.loop_stop()  # its thread ends with a deliberate disconnect: a new one connects

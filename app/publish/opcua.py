@@ -50,7 +50,7 @@ from dataclasses import dataclass
 from datetime import UTC, datetime
 from pathlib import Path
 from typing import Any
-from urllib.parse import urlsplit
+from urllib.parse import quote, urlsplit
 
 import numpy as np
 from asyncua import Node, Server, ua
@@ -85,6 +85,7 @@ from app.publish.ua_types import (
 from app.scada.alarms import Alarm
 from app.scada.readings import Readings
 from app.scada.tag import Tag
+from app.scada.words import Journal
 from app.station.config import OpcUaSettings
 from netplc.address import DATA_SIZE, IO_BITS, fmt_octal
 from netplc.forcing import Force
@@ -109,6 +110,15 @@ MEMORY_DATA = ("NetPlc's data memory, its 8 banks of 2 KB in turn: byte k*2048 +
                "k*010000 + 04000 + i (04000..07777, 014000..017777, ... 074000..077777)")
 FORCES = ('what is forced, as JSON: [{"kind": "bit", "address": "02120", "value": 1, "user": "..."}] '
           "(kind bit, byte or word; address in octal); force > program > live")
+
+
+def application_uri(station: str, letter: str = "") -> str:
+    """A station's ApplicationUri, and without `letter` its namespace's URI: `urn:netplc:station:` and
+    its name, with its letter for one of a pair; its non-ASCII characters (a Russian name) are
+    percent-encoded as UTF-8, as RFC 3987 section 3.1 maps an IRI to a URI, since the certificate
+    holds the ApplicationUri as an IA5String and the server's is the certificate's (Part 4 7.2)."""
+    uri = f"urn:netplc:station:{station}:{letter}" if letter else f"urn:netplc:station:{station}"
+    return "".join(c if c.isascii() else quote(c, safe="") for c in uri)
 
 
 def is_loopback(endpoint: str) -> bool:
@@ -221,7 +231,7 @@ class OpcUaServer:
 
     def __init__(self, *, settings: OpcUaSettings, station: str, folder: Path, tags: Sequence[Tag],
                  commands: Commands, watch: Watch, engine: Any, exchange: Any, alarms: Sequence[Alarm] = (),
-                 journal: Callable[[str], None] = lambda _text: None,
+                 journal: Journal = lambda _name, **_values: None,
                  step_lock: StepLock = lambda: None, archived: Archived | None = None,
                  language: str = "", pair_letter: str = "",
                  service_level: Callable[[], int] = lambda: HEALTHY,
@@ -336,8 +346,8 @@ class OpcUaServer:
         server.application_type = ua.ApplicationType.Server
         await server.set_build_info(build.product_uri, build.manufacturer, build.product, build.version,
                                     build.build_number, build.build_date)
-        uri = f"urn:netplc:station:{self.station}"  # the namespace's: one for both stations of a pair
-        application = f"{uri}:{self.pair_letter}" if self.pair_letter else uri
+        uri = application_uri(self.station)  # the namespace's: one for both stations of a pair
+        application = application_uri(self.station, self.pair_letter)
         await server.set_application_uri(application)
         if self.secure:
             await self._secure(server, application)
@@ -406,7 +416,7 @@ class OpcUaServer:
         names = host_names(urlsplit(self.endpoint).hostname or "", self.settings.certificate_names)
         own = await asyncio.to_thread(station_certificate, self.folder, uri, names, self.station)
         for note in own.notes:
-            self.journal(f"OPC UA: {note}")
+            self.journal("opcua note", note=note)
         await server.load_certificate(str(own.cert))
         await server.load_private_key(str(own.key))
         server.set_security_policy([ua.SecurityPolicyType.Basic256Sha256_SignAndEncrypt])
@@ -429,9 +439,8 @@ class OpcUaServer:
             kept = None
         if kept is not None:
             thumb = thumbprint(der)
-            self.journal(f"OPC UA: client certificate refused, not trusted: {subject(der)} (thumbprint "
-                         f"{thumb}), kept in {kept.parent}; `python main.py opcua trust {self.folder} "
-                         f"{thumb}` trusts it")
+            self.journal("opcua untrusted", subject=subject(der), thumb=thumb, kept=kept.parent,
+                         folder=self.folder)
         return False
 
     async def _build(self, server: Server, uri: str) -> None:
@@ -637,8 +646,7 @@ class OpcUaServer:
         def create_session(name: str, user: User | None = None, external: bool = False) -> Any:
             if external and self.secure and not _SECURE_CHANNEL.get():
                 self.commands.refuse(Who("", Source.OPCUA, _peer(name)), "open a session", "",
-                                     Reason.DENIED, f"security None at {self.endpoint} is for discovery "
-                                     "only (GetEndpoints): sessions need Basic256Sha256 Sign&Encrypt")
+                                     Reason.DENIED, self.commands.say("session none", endpoint=self.endpoint))
                 raise ServiceError(ua.StatusCodes.BadSecurityPolicyRejected)
             session = create(name, user=user or User(role=UserRole.Anonymous), external=external)
             if not external:
@@ -751,13 +759,12 @@ class OpcUaServer:
             target = wv.NodeId.to_string()
             if wv.NodeId in self.server.iserver.aspace:
                 return commands.refuse(who, Action.WRITE, target, Reason.NOT_WRITABLE,
-                                       "only tags are written over OPC UA")
-            return commands.refuse(who, Action.WRITE, target, Reason.UNKNOWN, "no such node")
+                                       commands.say("only tags"))
+            return commands.refuse(who, Action.WRITE, target, Reason.UNKNOWN, commands.say("no node"))
         tag, kind = self.tags[i], self.kinds[i]
         if wv.AttributeId != ua.AttributeIds.Value:
             return commands.refuse(who, Action.WRITE, tag.name, Reason.NOT_WRITABLE,
-                                   f"only the value of a tag is written, not its "
-                                   f"{ua.AttributeIds(wv.AttributeId).name}")
+                                   commands.say("only value", attribute=ua.AttributeIds(wv.AttributeId).name))
         variant = wv.Value.Value if wv.Value is not None else None
         value = variant.Value if variant is not None else None
         mismatch = ""

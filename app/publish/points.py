@@ -113,10 +113,11 @@ class PointWriter:
         commands = self.commands
         if not self.writable(tag.name):
             return commands.refuse(who, Action.WRITE, tag.name, Reason.NOT_WRITABLE,
-                                   f"not among the points {self.section} writable names")
+                                   commands.say("not writable point", section=self.section))
         if mismatch:
             if (why := commands.denial(who, Action.WRITE)) is not None:  # the role first, as the layer
-                return commands.refuse(who, Action.WRITE, tag.name, Reason.DENIED, str(why), why)
+                return commands.refuse(who, Action.WRITE, tag.name, Reason.DENIED, commands.refusal_text(why),
+                                       why)
             return commands.refuse(who, Action.WRITE, tag.name, Reason.TYPE_MISMATCH, mismatch)
         if tag.name in commands.tags:
             return commands.write_tag(who, tag.name, value)
@@ -124,10 +125,10 @@ class PointWriter:
         lo, hi = tag.limits
         if not isinstance(value, int):
             return commands.refuse(who, Action.WRITE, tag.name, Reason.TYPE_MISMATCH,
-                                   f"{value!r} is not whole")
+                                   commands.say("not whole", value=value))
         if not lo <= value <= hi:
             return commands.refuse(who, Action.WRITE, tag.name, Reason.OUT_OF_RANGE,
-                                   f"{value} is outside {lo:g} .. {hi:g}")
+                                   commands.say("outside g", value=value, lo=lo, hi=hi))
         if tag.type is TagType.BIT:
             return commands.write_bit(who, tag.address, 1 if value else 0, label=tag.name)
         return commands.write_word(who, tag.address, value, label=tag.name)

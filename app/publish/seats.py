@@ -18,6 +18,7 @@ from asyncua import ua
 from asyncua.common.utils import ServiceError
 
 from app.authority import Commands, Reason, Who
+from app.scada.words import Journal
 from hmi_forms.elements import formats
 
 
@@ -34,7 +35,7 @@ class Seat:
 class Seats:
     """Sessions by id; taken and left on the server's loop, read from any thread."""
 
-    def __init__(self, limit: int, commands: Commands, journal: Callable[[str], None],
+    def __init__(self, limit: int, commands: Commands, journal: Journal,
                  wallclock: Callable[[], float] = time.time) -> None:
         self.limit = limit
         self.commands = commands
@@ -49,7 +50,7 @@ class Seats:
             full = len(self._seats) >= self.limit
         if full:
             self.commands.refuse(who, "open a session", "", Reason.BUSY,
-                                 f"[opcua] max_consoles = {self.limit} sessions are open already")
+                                 self.commands.say("sessions full", n=self.limit))
             raise ServiceError(ua.StatusCodes.BadTooManySessions)
 
     def take(self, session: object, who: Who) -> None:
@@ -59,14 +60,14 @@ class Seats:
                 return  # activated again (a new user token on the same session): kept as it was
             self._seats[session] = seat
             count = len(self._seats)
-        self.journal(f"OPC UA: {who.name} connected ({count} of at most {self.limit} sessions)")
+        self.journal("opcua connected", who=who.name, n=count, most=self.limit)
 
     def leave(self, session: object) -> None:
         with self._lock:
             seat = self._seats.pop(session, None)
             count = len(self._seats)
         if seat is not None:
-            self.journal(f"OPC UA: {seat.user or 'anonymous'}@{seat.peer} disconnected ({count} left)")
+            self.journal("opcua disconnected", who=f"{seat.user or 'anonymous'}@{seat.peer}", n=count)
 
     def sessions(self) -> set[object]:
         with self._lock:

@@ -10,6 +10,7 @@ from typing import TYPE_CHECKING, Any, Protocol
 from app.authority import Source
 from app.publish.points import published_tags
 from app.scada.series import nstore_keys
+from app.scada.words import phrase
 
 if TYPE_CHECKING:
     from app.station.runtime import Runtime
@@ -39,7 +40,7 @@ def start_publishers(runtime: Runtime) -> list[Publisher]:
         archived = Archived(st.Archive, nstore_keys(runtime.program))
         server = OpcUaServer(settings=st.opcua, station=st.name, folder=st.folder, tags=tags,
                              commands=runtime.commands, watch=runtime.watch, engine=runtime.engine,
-                             exchange=runtime.exchange, alarms=alarms, journal=runtime.system,
+                             exchange=runtime.exchange, alarms=alarms, journal=runtime.say,
                              step_lock=lambda: runtime.scan_thread.lock if runtime.scan_thread else None,
                              archived=archived, language=st.Language,
                              pair_letter=st.redundancy.letter if st.redundancy is not None else "",
@@ -47,28 +48,26 @@ def start_publishers(runtime: Runtime) -> list[Publisher]:
         try:
             server.start()
         except (OSError, RuntimeError) as e:
-            runtime.problem(f"OPC UA server not started: {st.path}: opcua.endpoint: {e}")
+            runtime.problem("opcua not started", path=st.path, error=e)
         else:
             runtime.subscribe(server.on_record)
             runtime.alarms.adopted.append(server.on_adopted)
             started.append(_Unsubscribing(server, runtime))
-            security = "Basic256Sha256 Sign&Encrypt, trusted clients" if server.secure else \
-                "no security, loopback"
-            runtime.system(f"OPC UA server at {st.opcua.endpoint} ({security}), {len(tags)} tags")
+            runtime.say("opcua started", endpoint=st.opcua.endpoint, tags=len(tags),
+                        security=phrase("opcua secure" if server.secure else "opcua open"))
     if st.mqtt.enabled:
         from app.publish.mqtt import SparkplugPublisher
 
         runtime.commands.grant(Source.MQTT, st.mqtt.role)
         publisher = SparkplugPublisher(st.mqtt, st.name, tags=tags, commands=runtime.commands,
-                                       watch=runtime.watch, journal=runtime.system,
+                                       watch=runtime.watch, journal=runtime.say,
                                        bdseq_file=st.folder / BDSEQ_FILE, exchange=runtime.exchange,
                                        quality_map=runtime.alarms.quality_map, leads=runtime.leads)
         publisher.start()
         started.append(publisher)
-        devices = ", ".join(d.id for d in publisher.layout.devices) or "none"
-        primary = f", primary host {st.mqtt.primary_host}" if st.mqtt.primary_host else ""
-        runtime.system(f"MQTT Sparkplug B publisher to {st.mqtt.broker} as {publisher.topics.node}, "
-                       f"{len(tags)} metrics, devices {devices}{primary}")
+        devices = ", ".join(d.id for d in publisher.layout.devices) or phrase("no devices")
+        runtime.say("mqtt primary" if st.mqtt.primary_host else "mqtt started", broker=st.mqtt.broker,
+                    node=publisher.topics.node, tags=len(tags), devices=devices, host=st.mqtt.primary_host)
     return started
 
 

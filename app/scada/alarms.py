@@ -96,7 +96,12 @@ class Source(StrEnum):
 
 
 class AlarmError(ValueError):
-    """An operator action that cannot be done (unknown alarm, shelving without a reason...)."""
+    """An operator action that cannot be done (unknown alarm, shelving without a reason...), said
+    in the alarm system's language."""
+
+
+class UnknownAlarm(AlarmError):
+    """No alarm by that identity."""
 
 
 class CatalogMessage(Protocol):
@@ -544,7 +549,7 @@ class AlarmSystem:
     def _index(self, alarm_id: str) -> int:
         i = self.by_id.get(alarm_id)
         if i is None:
-            raise AlarmError(f"no alarm {alarm_id!r}")
+            raise UnknownAlarm(self.say("no alarm", alarm=alarm_id))
         return i
 
     def _act(self, action: Callable[[list[Transition]], None]) -> list[Transition]:
@@ -607,11 +612,11 @@ class AlarmSystem:
         duration (what `shelve` checks, for callers that hand the shelving to another thread)."""
         i = self._index(alarm_id)
         if not user.strip():
-            raise AlarmError(f"{alarm_id}: shelving needs the operator's name")
+            raise AlarmError(self.say("shelve nobody", alarm=alarm_id))
         if not reason.strip():
-            raise AlarmError(f"{alarm_id}: shelving needs a reason")
+            raise AlarmError(self.say("shelve no reason", alarm=alarm_id))
         if not (math.isfinite(duration) and duration > 0):
-            raise AlarmError(f"{alarm_id}: shelving needs a duration of more than 0 s")
+            raise AlarmError(self.say("shelve no duration", alarm=alarm_id))
         return i
 
     def unshelve(self, alarm_id: str, user: str, now: float | None = None) -> list[Transition]:
@@ -638,9 +643,9 @@ class AlarmSystem:
         """AlarmError unless the alarm exists and the comment names its operator and says something."""
         i = self._index(alarm_id)
         if not user.strip():
-            raise AlarmError(f"{alarm_id}: a comment needs the operator's name")
+            raise AlarmError(self.say("comment nobody", alarm=alarm_id))
         if not text.strip():
-            raise AlarmError(f"{alarm_id}: the comment is empty")
+            raise AlarmError(self.say("comment empty", alarm=alarm_id))
         return i
 
     def set_out_of_service(self, alarm_id: str, user: str, out_of_service: bool = True,

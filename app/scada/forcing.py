@@ -47,7 +47,7 @@ def forcing_tag(forces: Forces, tag: Tag, phy: float | None = None, *,
     """Force every word of `tag` (or its bit) as one command to the physical value `phy`, or
     bumpless to what it holds when applied; journaled with the tag's name and unit."""
     if phy is not None and phy != phy:
-        raise ForceError(f"cannot force {tag.name} to NaN")
+        raise ForceError("force NaN", name=tag.name)
 
     def apply(mem: Memory) -> None:
         keys = tag_keys(tag)
@@ -60,10 +60,13 @@ def forcing_tag(forces: Forces, tag: Tag, phy: float | None = None, *,
         for f in new:
             f.apply(mem)
         value = tag.value(mem)
-        was = f"forced {old:.{tag.decimals}f}" if was_forced else f"{old:.{tag.decimals}f}"
-        how = " (bumpless)" if phy is None else ""
+        say = forces.host.words
+        before = f"{old:.{tag.decimals}f}"
+        was = say("forced value", value=before) if was_forced else before
+        how = say("bumpless") if phy is None else ""
         raw = str(new[0].value) if tag.type is TagType.BIT else " ".join(f"{f.value:04X}h" for f in new)
-        _journal(forces, user, tag, value, f"force {tag.name}: {was} -> {tag.format(value)} (raw {raw}){how}")
+        _journal(forces, user, tag, value, say("force", where=tag.name, was=was, how=how,
+                                                value=say("raw value", value=tag.format(value), raw=raw)))
 
     return apply
 
@@ -76,7 +79,8 @@ def unforcing_tag(forces: Forces, tag: Tag, *, user: str) -> Callable[[Memory], 
         if any(forces.forced(*k) for k in keys):
             forces.listing = tuple(f for f in forces.listing if f.key not in keys)
             value = tag.value(mem)
-            _journal(forces, user, tag, value, f"unforce {tag.name} (was forced {tag.format(value)})")
+            _journal(forces, user, tag, value,
+                     forces.host.words("unforce", where=tag.name, value=tag.format(value)))
 
     return apply
 

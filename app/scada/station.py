@@ -58,11 +58,11 @@ class StationAlarms:
         hot-standby pair, why it has no standby now ("" while it has), for PAIR.NO_STANDBY; `horn`:
         the HMI bit set while an alarm sounds (station.toml `alarm_horn`); `language`: the station's
         `Language`, of every alarm text."""
-        self.table = load_tags(tags, symbols) if tags is not None else TagTable()
+        self.table = load_tags(tags, symbols, words(language)) if tags is not None else TagTable()
         self.quality_map = QualityMap(program, self.table.tags)
         self.sink = sink
         self.series = SeriesQuality(program, regdata or {})
-        self.state = AlarmStateFile(state_file, sink)
+        self.state = AlarmStateFile(state_file, sink, say=words(language))
         self.system = AlarmSystem(self.table, messages, sink=sink, saved=self.state.load(),
                                   on_change=self._changed, station=True, pair=no_standby is not None,
                                   language=language)
@@ -101,7 +101,7 @@ class StationAlarms:
         """The runtime's record observer: collects the NMSG numbers of the scan being run."""
         if record.kind == "message" and record.number is not None:
             self._messages.append(record.number)
-        elif record.kind == "operator" and record.text == STOPPED_BY_COMMAND:
+        elif record.kind == "operator" and record.text == self.system.say(STOPPED_BY_COMMAND):
             self._stopped_by = record.source or ""
 
     def on_scan(self, snapshot: Snapshot) -> None:
@@ -242,7 +242,7 @@ class StationAlarms:
 
 
 
-STOPPED_BY_COMMAND = "NetPlc stopped"  # the command layer's record of a Stop, naming who
+STOPPED_BY_COMMAND = "NetPlc stopped"  # the catalogue's name of the command layer's Stop record, naming who
 
 
 def stop_reason(state: str, by: str = "", say: Words | None = None) -> str:

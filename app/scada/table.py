@@ -16,6 +16,7 @@ from dataclasses import dataclass, field
 from pathlib import Path
 
 from app.scada.tag import BYTE_ORDERS, NETPLC_ORDER, WIDE, Scaling, Tag, TagType, check_address
+from app.scada.words import Words, phrase, words
 from netplc.address import AddressError, parse_hmi_bit, parse_octal
 from netplc.problems import Problems
 from netplc.textfile import TextFileError, csv_rows, read_text
@@ -78,16 +79,20 @@ class TagTable:
         return self.by_name.get(name)
 
 
-def load_tags(path: str | Path, symbols: dict[str, int] | None = None) -> TagTable:
-    """The tags of a file; TagError lists every problem."""
-    table, problems = read_tags(path, symbols)
+def load_tags(path: str | Path, symbols: dict[str, int] | None = None, say: Words | None = None) -> TagTable:
+    """The tags of a file; TagError lists every problem (in the language of `say`)."""
+    table, problems = read_tags(path, symbols, say)
     if problems:
         raise TagError(problems)
     return table
 
 
-def read_tags(path: str | Path, symbols: dict[str, int] | None = None) -> tuple[TagTable, list[str]]:
-    """The good lines' tags and every problem (for `check`, which reports and goes on)."""
+def read_tags(path: str | Path, symbols: dict[str, int] | None = None,
+              say: Words | None = None) -> tuple[TagTable, list[str]]:
+    """The good lines' tags and every problem (for `check`, which reports and goes on), its fixed
+    wording in the language of `say` (the station's; the system locale's without it), each
+    naming the file, the line, the tag, the column and the value as they are."""
+    say = say or words()
     path = Path(path)
     fname = str(path)
     try:
@@ -107,31 +112,32 @@ def read_tags(path: str | Path, symbols: dict[str, int] | None = None) -> tuple[
     columns = [c.strip().lower() for c in header]
     missing = [c for c in REQUIRED if c not in columns]
     if missing:
-        problems.append(f"{fname}:{line}: the header must name the columns {', '.join(REQUIRED)} "
-                        f"(missing: {', '.join(missing)}); known columns: {', '.join(COLUMNS)}")
+        problems.append(f"{fname}:{line}: " + say("tags header", required=", ".join(REQUIRED),
+                                                  missing=", ".join(missing), known=", ".join(COLUMNS)))
         return TagTable(source=fname), problems
     for c in columns:
         if c not in COLUMNS:
-            problems.append(f"{fname}:{line}: unknown column {c!r} (known: {', '.join(COLUMNS)})")
+            problems.append(f"{fname}:{line}: " + say("tags unknown column", column=c,
+                                                      known=", ".join(COLUMNS)))
         elif columns.count(c) > 1:
-            problems.append(f"{fname}:{line}: column {c!r} appears twice")
+            problems.append(f"{fname}:{line}: " + say("tags column twice", column=c))
     tags: list[Tag] = []
     alarms: dict[str, TagAlarms] = {}
     first_line: dict[str, int] = {}
     for lineno, row in rows[1:]:
         if len(row) > len(columns) and any(v.strip() for v in row[len(columns):]):
-            problems.append(f"{fname}:{lineno}: {len(row)} fields, but the header names {len(columns)}")
+            problems.append(f"{fname}:{lineno}: " + say("tags fields", n=len(row), header=len(columns)))
             continue
         cells = {c: (row[i].strip() if i < len(row) else "") for i, c in enumerate(columns)}
-        parser = _Row(f"{fname}:{lineno}", cells, symbols or {})
+        parser = _Row(f"{fname}:{lineno}", cells, symbols or {}, say)
         result = parser.parse()
         problems += parser.problems
         if result is None:
             continue
         tag, tag_alarms = result
         if tag.name in first_line:
-            problems.append(f"{fname}:{lineno}: {tag.name}: the name is already used on line "
-                            f"{first_line[tag.name]}")
+            problems.append(f"{fname}:{lineno}: {tag.name}: "
+                            + say("tags name used", line=first_line[tag.name]))
             continue
         first_line[tag.name] = lineno
         tags.append(tag)
@@ -143,15 +149,18 @@ def read_tags(path: str | Path, symbols: dict[str, int] | None = None) -> tuple[
 class _Row:
     """One line: typed cells, and the problems found in it."""
 
-    def __init__(self, where: str, cells: dict[str, str], symbols: dict[str, int]) -> None:
+    def __init__(self, where: str, cells: dict[str, str], symbols: dict[str, int], say: Words) -> None:
         self.where = where
+        self.say = say
         self.cells = cells
         self.symbols = symbols
         self.name = cells.get("name", "")
         self.problems: list[str] = []
 
-    def bad(self, problem: str) -> None:
-        self.problems.append(f"{self.where}: {self.name or '(no name)'}: {problem}")
+    def bad(self, name: str, /, **values: object) -> None:
+        """A problem of the catalogue (`name`, `values`) in the reader's language."""
+        who = self.name or self.say("tag no name given")
+        self.problems.append(f"{self.where}: {who}: {self.say(name, **values)}")
 
     def number(self, key: str, default: float | None = None) -> float | None:
         text = self.cells.get(key, "")
@@ -160,19 +169,19 @@ class _Row:
         try:
             value = float(text.replace(",", "."))
         except ValueError:
-            self.bad(f"{key} {text!r} is not a number")
+            self.bad("tag not number", key=key, text=text)
             return default
         if not math.isfinite(value):
-            self.bad(f"{key} {text!r} is not a finite number")
+            self.bad("tag not finite", key=key, text=text)
             return default
         return value
 
-    def whole(self, key: str, default: int | None, lo: int, hi: int, meaning: str = "") -> int | None:
+    def whole(self, key: str, default: int | None, lo: int, hi: int, meaning: object = "") -> int | None:
         value = self.number(key)
         if value is None:
             return default
         if value != int(value) or not lo <= value <= hi:
-            self.bad(f"{key} {self.cells[key]!r} is not a whole number {lo}-{hi}{meaning}")
+            self.bad("tag not whole", key=key, text=self.cells[key], lo=lo, hi=hi, meaning=meaning)
             return default
         return int(value)
 
@@ -181,42 +190,42 @@ class _Row:
         if not text:
             return default
         if text not in _YES:
-            self.bad(f"{key} {self.cells[key]!r} is not yes/no (or 1/0, true/false)")
+            self.bad("tag not yes no", key=key, text=self.cells[key])
             return default
         return _YES[text]
 
     def address(self, kind: TagType | None) -> int | None:
         text = self.cells["address"]
         if not text:
-            self.bad("address is missing")
+            self.bad("tag no address")
             return None
         try:
             addr = self.symbols[text] if text in self.symbols else parse_octal(text)
         except ValueError:
-            self.bad(f"address {text!r} is neither an octal address nor a symbol")
+            self.bad("tag bad address", text=text)
             return None
         if kind is not None:
             try:
                 check_address(addr, kind)
             except AddressError as e:
-                what = "an I/O bit or a data bit (byte*8+bit)" if kind is TagType.BIT else f"a {kind} value"
-                self.bad(f"address {text!r} cannot hold {what}: {e}")
+                what = phrase("tag bit kind") if kind is TagType.BIT else phrase("tag value kind", kind=kind)
+                self.bad("tag cannot hold", text=text, what=what, error=e)
                 return None
         return addr
 
     def parse(self) -> tuple[Tag, TagAlarms] | None:
         ok = True
         if not self.name:
-            self.bad("name is missing")
+            self.bad("tag no name")
             ok = False
         elif not _NAME.fullmatch(self.name):
-            self.bad(f"{self.name!r} is not a valid tag name (a letter, then letters, digits or _)")
+            self.bad("tag bad name", name=self.name)
             ok = False
         type_text = self.cells["type"].strip().lower()
         type_text = ALIASES.get(type_text, type_text)
         kind = TagType(type_text) if type_text in TYPES else None
         if kind is None:
-            self.bad(f"type {self.cells['type']!r} is not one of {', '.join(TagType)}")
+            self.bad("tag bad type", text=self.cells["type"], types=", ".join(TagType))
             ok = False
         addr = self.address(kind)
         scaling = self.scaling(kind)
@@ -240,11 +249,10 @@ class _Row:
             return NETPLC_ORDER
         order = ORDER_LETTERS.get(text.upper(), text)
         if order not in BYTE_ORDERS:
-            self.bad(f"byte_order {text!r} is not one of {', '.join(BYTE_ORDERS)} "
-                     f"(or {', '.join(ORDER_LETTERS)})")
+            self.bad("tag bad order", text=text, orders=", ".join(BYTE_ORDERS),
+                     letters=", ".join(ORDER_LETTERS))
         elif kind is not None and kind not in WIDE:
-            self.bad(f"byte_order is for int32 and float32 tags; a {kind} tag is read as NetPlc memory "
-                     "holds it")
+            self.bad("tag order narrow", kind=kind)
         return order if order in BYTE_ORDERS else NETPLC_ORDER
 
     def scaling(self, kind: TagType | None) -> Scaling | None:
@@ -255,18 +263,17 @@ class _Row:
             return None
         if len(given) < 4:
             missing = [k for k in keys if k not in given]
-            self.bad(f"give all of app_min, app_max, phy_min, phy_max or none "
-                     f"(missing: {', '.join(missing)})")
+            self.bad("tag scaling partial", missing=", ".join(missing))
             return None
         app_min, app_max, phy_min, phy_max = values
         if kind is TagType.BIT:
-            self.bad("a bit tag has no conversion (app_min..phy_max must be empty)")
+            self.bad("tag bit scaling")
             return None
         if app_min == app_max:
-            self.bad(f"app_min = app_max = {app_min:g}: the conversion is undefined")
+            self.bad("tag app undefined", value=app_min)
             return None
         if phy_min == phy_max:
-            self.bad(f"phy_min = phy_max = {phy_min:g}: the conversion is undefined")
+            self.bad("tag phy undefined", value=phy_min)
             return None
         return Scaling(app_min, app_max, phy_min, phy_max)  # type: ignore[arg-type]
 
@@ -275,22 +282,21 @@ class _Row:
         deadband = self.number("deadband", 0.0)
         delay = self.number("delay", 0.0) or 0.0  # both ways, unless on_delay / off_delay say otherwise
         if delay < 0:
-            self.bad(f"delay {delay:g} is negative")
+            self.bad("tag negative", key="delay", value=delay)
             delay = 0.0
         on_delay = self.number("on_delay", delay)
         off_delay = self.number("off_delay", delay)
-        when = self.whole("alarm_when", None, 0, 1, " (the bit value that is the alarm)")
-        priority = self.whole("priority", DEFAULT_PRIORITY, 1, 4, " (1 critical, 2 high, 3 medium, 4 low)")
+        when = self.whole("alarm_when", None, 0, 1, phrase("tag when meaning"))
+        priority = self.whole("priority", DEFAULT_PRIORITY, 1, 4, phrase("tag priority meaning"))
         latching = self.flag("latching", False)
         suppress = self.suppress_bit()
         for key, value in (("deadband", deadband), ("on_delay", on_delay), ("off_delay", off_delay)):
             if value is not None and value < 0:
-                self.bad(f"{key} {value:g} is negative")
+                self.bad("tag negative", key=key, value=value)
         given = [(k, v) for k, v in limits.items() if v is not None]
         for (k1, v1), (k2, v2) in itertools.pairwise(given):
             if v2 < v1:
-                self.bad(f"{k2.upper()} {v2:g} is below {k1.upper()} {v1:g}: the limits must keep "
-                         "the order LL <= L <= H <= HH")
+                self.bad("tag limits order", upper=k2.upper(), value=v2, lower=k1.upper(), below=v1)
         process = bool(given) or when is not None
         quality = self.flag("quality_alarm", process)
         if self.problems:
@@ -307,7 +313,7 @@ class _Row:
             addr = self.symbols[text] if text in self.symbols else parse_octal(text)
             return parse_hmi_bit(addr).hmi
         except (ValueError, AddressError) as e:
-            self.bad(f"suppress_by {text!r} is not a bit address or a bit's symbol: {e}")
+            self.bad("tag bad suppress", text=text, error=e)
             return None
 
     def fits(self, tag: Tag, alarms: TagAlarms) -> None:
@@ -315,11 +321,11 @@ class _Row:
         the tag can never reach."""
         if tag.type is TagType.BIT:
             if alarms.limits():
-                self.bad("a bit tag cannot have limit alarms (HH/H/L/LL); give alarm_when 0 or 1")
+                self.bad("tag bit limits")
             return
         if alarms.alarm_when is not None:
-            self.bad(f"alarm_when needs a bit tag; {tag.type} takes limit alarms (HH/H/L/LL)")
+            self.bad("tag when needs bit", type=tag.type)
         lo, hi = tag.phy_limits
         for key, value in alarms.limits():
             if not lo <= value <= hi:
-                self.bad(f"{key} {value:g} is outside what a {tag.type} tag can take here ({lo:g}..{hi:g})")
+                self.bad("tag limit outside", key=key, value=value, type=tag.type, lo=lo, hi=hi)

@@ -16,6 +16,7 @@ from typing import Any
 
 from app.authority.policy import OPERATOR, ROLES
 from app.scada.tag import TagType
+from app.scada.words import Words, words
 from netplc.address import fmt_octal, is_data_byte, is_io_bit, parse_hmi_bit, parse_octal
 from netplc.exchange import NODE_DEFAULTS, NodeConfig, shared_problems
 from netplc.modbus import Endpoint, default_stopbits, line_problems
@@ -357,12 +358,22 @@ def station_file(path: str | Path) -> Path:
     return p / STATION_FILE if p.is_dir() else p
 
 
+class Found(list[str]):
+    """The problems of one station.toml, and the words its readers say them in: the file's
+    `Language` (app/scada/words.py), read before anything else is; each names its key as it is."""
+
+    def __init__(self, say: Words) -> None:
+        super().__init__()
+        self.say = say
+
+
 class _Reader:
     """Typed access to one TOML table that records problems instead of raising at the first."""
 
-    def __init__(self, problems: list[str], fname: str, table: dict[str, Any], section: str = "",
+    def __init__(self, problems: Found, fname: str, table: dict[str, Any], section: str = "",
                  prefix: str | None = None, allow_outside: bool = False) -> None:
         self.problems = problems
+        self.say = problems.say
         self.fname = fname
         self.table = table
         self.keys = KEYS[section]
@@ -382,19 +393,16 @@ class _Reader:
         self.known.add(key)
         if key not in self.table:
             if required:
-                self.bad(key, "missing")
+                self.bad(key, self.say("cfg missing"))
             return default
         value = self.table[key]
         if kind is float and isinstance(value, int) and not isinstance(value, bool):
             if abs(value) > 1e300:  # float() would overflow
-                self.bad(key, f"a {len(str(abs(value)))}-digit number is too large")
+                self.bad(key, self.say("cfg too large", n=len(str(abs(value)))))
                 return default
             return float(value)
-        if isinstance(value, bool) and kind is not bool:
-            self.bad(key, f"expected {_kind_name(kind)}, got {value!r}")
-            return default
-        if not isinstance(value, kind):
-            self.bad(key, f"expected {_kind_name(kind)}, got {value!r}")
+        if (isinstance(value, bool) and kind is not bool) or not isinstance(value, kind):
+            self.bad(key, self.say("cfg expected", kind=_kind_name(kind, self.say), value=value))
             return default
         return value
 
@@ -405,7 +413,7 @@ class _Reader:
         value = self.get(key, default, required, kind=int)
         lo, hi = declared.bounds or (value, value)
         if value is not None and not lo <= value <= hi:
-            self.bad(key, f"{value} is outside {lo}-{hi}")
+            self.bad(key, self.say("cfg outside", value=value, lo=lo, hi=hi))
             return default
         return value
 
@@ -414,10 +422,10 @@ class _Reader:
         if value is None:
             return None
         if not value.strip():
-            self.bad(key, "empty path")
+            self.bad(key, self.say("cfg empty path"))
             return None
         if "\0" in value:
-            self.bad(key, "a path cannot hold a NUL character")
+            self.bad(key, self.say("cfg nul"))
             return None
         try:
             path = resolve(base / value)
@@ -425,21 +433,20 @@ class _Reader:
             self.bad(key, f"{e.source}: {e.problem}")
             return None
         if not self.allow_outside and not path.is_relative_to(base):
-            self.bad(key, f"{path} is outside the station folder {base} (allow_outside = true permits it)")
+            self.bad(key, self.say("cfg outside folder", path=path, base=base))
             return None
         return path
 
     def finish(self) -> None:
         for key in self.table:
             if key not in self.known:
-                self.bad(key, "unknown setting")
+                self.bad(key, self.say("cfg unknown"))
 
 
-def _kind_name(kind: type | tuple[type, ...]) -> str:
-    names = {bool: "true or false", int: "an integer", float: "a number", str: "a string",
-             list: "a list", dict: "a table"}
+def _kind_name(kind: type | tuple[type, ...], say: Words) -> str:
     kinds = kind if isinstance(kind, tuple) else (kind,)
-    return " or ".join(names.get(k, k.__name__) for k in kinds)
+    return say("cfg or").join(say(f"kind {k.__name__}") if say.knows(f"kind {k.__name__}") else k.__name__
+                             for k in kinds)
 
 
 def load_station(path: str | Path) -> Station:
@@ -473,19 +480,21 @@ def read_station(path: str | Path) -> tuple[Station | None, list[str]]:
     in the returned station; None instead of a station when the file is not TOML at all."""
     file = station_file(path)
     fname = str(file)
+    say = words()  # the file's language is not known until it is read
     if not (file.exists() or file.is_symlink()):  # a link that leads nowhere is named by read_text
-        return None, [f"{fname}: no station file here"]
+        return None, [say("cfg no file", file=fname)]
     try:
         data = tomllib.loads(read_text(file, "the station file"))
     except TextFileError as e:
         return None, [str(e)]
     except tomllib.TOMLDecodeError as e:
-        return None, [f"{fname}: not valid TOML: {e}"]
+        return None, [say("cfg not toml", file=fname, error=e)]
     except ValueError:  # from int(), which tomllib calls without saying where
-        return None, [f"{fname}: not valid TOML: a number of more than {sys.get_int_max_str_digits()} digits"]
+        return None, [say("cfg toml digits", file=fname, n=sys.get_int_max_str_digits())]
     except RecursionError:
-        return None, [f"{fname}: not valid TOML: arrays or tables nested too deeply"]
-    problems: list[str] = []
+        return None, [say("cfg toml deep", file=fname)]
+    said = data.get("Language")
+    problems = Found(words(said if said in LANGUAGES else ""))
     base = file.parent.resolve()
     top = _Reader(problems, fname, data)
     top.allow_outside = bool(top.get("allow_outside"))
@@ -507,7 +516,7 @@ def read_station(path: str | Path) -> tuple[Station | None, list[str]]:
     alarm_sounds = (top.path("alarm_sound_p1", base), top.path("alarm_sound_p2", base))
     for key, sound in zip(("alarm_sound_p1", "alarm_sound_p2"), alarm_sounds, strict=True):
         if sound is not None and not sound.is_file():
-            top.bad(key, f"{sound} is not a file")
+            top.bad(key, top.say("cfg not a file", path=sound))
     alarm_horn = _horn_bit(top)
     server = _modbus_server(problems, fname, top.get("modbus_server"))
     nodes = _nodes(problems, fname, top.get("nodes"))
@@ -515,7 +524,7 @@ def read_station(path: str | Path) -> tuple[Station | None, list[str]]:
     operator = _operator(problems, fname, top.get("operator"))
     language = top.get("Language")
     if language and language not in LANGUAGES:
-        top.bad("Language", f"{language!r} is not one of {', '.join(LANGUAGES)}")
+        top.bad("Language", top.say("cfg not one of", value=language, names=", ".join(LANGUAGES)))
         language = ""
     opcua = _opcua(problems, fname, top.get("opcua"))
     mqtt = _mqtt(problems, fname, top.get("mqtt"), base, top.allow_outside)
@@ -600,18 +609,18 @@ def _role(r: _Reader) -> str:
     """`role`: what the clients of a protocol without users may do (viewer: read-only)."""
     role = r.get("role")
     if role not in ROLES:
-        r.bad("role", f"{role!r} is not one of {', '.join(ROLES)}")
+        r.bad("role", r.say("cfg not one of", value=role, names=", ".join(ROLES)))
         return OPERATOR
     return role
 
 
-def _modbus_server(problems: list[str], fname: str, table: dict[str, Any]) -> ModbusServerSettings:
+def _modbus_server(problems: Found, fname: str, table: dict[str, Any]) -> ModbusServerSettings:
     r = _Reader(problems, fname, table, "modbus_server")
     d = ModbusServerSettings()
     enabled = r.get("enabled")
     transport = r.get("transport")
     if transport not in TRANSPORTS:
-        r.bad("transport", f"{transport!r} is not one of {', '.join(TRANSPORTS)}")
+        r.bad("transport", r.say("cfg not one of", value=transport, names=", ".join(TRANSPORTS)))
         transport = "tcp"
     rtu = transport == "rtu"
     for key in _SERVER_KEYS["tcp" if rtu else "rtu"]:
@@ -685,7 +694,7 @@ def _ranges(r: _Reader, ranges: list[Any]) -> tuple[tuple[int, int], ...]:
     return tuple(out)
 
 
-def _array_tables(problems: list[str], fname: str, items: list[Any], key: str) -> list[tuple[int, _Reader]]:
+def _array_tables(problems: Found, fname: str, items: list[Any], key: str) -> list[tuple[int, _Reader]]:
     """A reader for each table of an array of tables ([[nodes]], [[simulators]]); an item that is
     not a table is a problem naming its index."""
     readers = []
@@ -697,7 +706,7 @@ def _array_tables(problems: list[str], fname: str, items: list[Any], key: str) -
     return readers
 
 
-def _nodes(problems: list[str], fname: str, items: list[Any]) -> list[NodeConfig]:
+def _nodes(problems: Found, fname: str, items: list[Any]) -> list[NodeConfig]:
     """The [[nodes]] tables as NodeConfig, with every problem named by its key: this reads the
     TOML types, the model checks the values (netplc/exchange.py `node_problems`), so a node
     station.toml accepts is one the exchange runs."""
@@ -733,7 +742,7 @@ def _seconds(r: _Reader, key: str) -> float:
     return value
 
 
-def _simulators(problems: list[str], fname: str, items: list[Any], base: Path,
+def _simulators(problems: Found, fname: str, items: list[Any], base: Path,
                 allow_outside: bool) -> list[SimulatorSettings]:
     sims: list[SimulatorSettings] = []
     for _i, r in _array_tables(problems, fname, items, "simulators"):
@@ -763,7 +772,7 @@ def _horn_bit(top: _Reader) -> int | None:
         return None
 
 
-def _operator(problems: list[str], fname: str, table: dict[str, Any]) -> OperatorSettings:
+def _operator(problems: Found, fname: str, table: dict[str, Any]) -> OperatorSettings:
     r = _Reader(problems, fname, table, "operator")
     if "users" in table:
         r.known.add("users")
@@ -845,7 +854,7 @@ def _host_names(r: _Reader, key: str) -> tuple[str, ...]:
     return tuple(names)
 
 
-def _opcua(problems: list[str], fname: str, table: dict[str, Any]) -> OpcUaSettings:
+def _opcua(problems: Found, fname: str, table: dict[str, Any]) -> OpcUaSettings:
     r = _Reader(problems, fname, table, "opcua")
     d = OpcUaSettings()
     enabled = r.get("enabled")
@@ -860,7 +869,7 @@ def _opcua(problems: list[str], fname: str, table: dict[str, Any]) -> OpcUaSetti
     return OpcUaSettings(enabled, endpoint, writable, certificate_names, max_consoles)
 
 
-def _mqtt(problems: list[str], fname: str, table: dict[str, Any], base: Path,
+def _mqtt(problems: Found, fname: str, table: dict[str, Any], base: Path,
           allow_outside: bool) -> MqttSettings:
     r = _Reader(problems, fname, table, "mqtt", allow_outside=allow_outside)
     d = MqttSettings()
@@ -896,7 +905,7 @@ def _mqtt(problems: list[str], fname: str, table: dict[str, Any], base: Path,
                         writable, buffer, primary, role)
 
 
-def _redundancy(problems: list[str], fname: str, table: dict[str, Any] | None,
+def _redundancy(problems: Found, fname: str, table: dict[str, Any] | None,
                 sync: int) -> RedundancySettings | None:
     """[redundancy], or None when the station has none. failover_after counts NetSyncTime ticks
     and is bounded so that a takeover comes within about a second (FAILOVER_MAX_MS)."""

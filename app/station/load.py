@@ -20,7 +20,7 @@ from typing import TYPE_CHECKING
 from app.authority.policy import VIEWER
 from app.authority.users import USERS_FILE, Users, UsersFileError
 from app.scada.table import TagTable, read_tags
-from app.scada.words import Phrase, phrase
+from app.scada.words import Phrase, phrase, words
 from app.station.config import Station
 from app.station.extras import station_problems
 from netplc.exchange import check_program_nodes
@@ -73,7 +73,7 @@ def load(station: Station, parse_cache: Path | None = None) -> Loaded:
         except CatalogError as e:
             out.problems += e.problems
     if station.Tags is not None:
-        out.tags, problems = read_tags(station.Tags, out.symbols)
+        out.tags, problems = read_tags(station.Tags, out.symbols, words(station.Language))
         out.problems += problems
         out.notes.append(phrase("note tags", file=station.Tags.name, n=len(out.tags.tags),
                                 alarms=len(out.tags.alarms)))

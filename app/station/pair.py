@@ -260,8 +260,8 @@ class Pair:
         if self.role is Role.PRIMARY:
             return None
         if self.role is Role.STARTING:
-            return "the station is starting as one of a pair: it takes commands once it is the primary"
-        return f"this station ({self.settings.letter}) is the standby: the primary is {self.partner_name}"
+            return self.runtime.words("pair starting")
+        return self.runtime.words("pair standby", letter=self.settings.letter, primary=self.partner_name)
 
     def _may_lead(self, cause: Phrase, patience: float = 0.0) -> bool:
         """Without an arbiter, always; with one, once this station holds its lease (`patience`:

@@ -161,6 +161,7 @@ class Runtime:
     def __init__(self, station: Station, *, wallclock: Callable[[], float] = time.time) -> None:
         self.station = station
         self.wallclock = wallclock
+        self.words = words(station.Language)  # what its records say (app/scada/words.py)
         loaded = load(station, parse_cache=station.Archive.parent / PARSE_CACHE)
         if loaded.problems:
             raise StartError(loaded.problems)
@@ -270,18 +271,12 @@ class Runtime:
         if observer in self._observers:
             self._observers.remove(observer)
 
-    def system(self, text: str, level: int = logging.INFO) -> None:
-        """A 'system' record, and the same words in the log (at `level`: WARNING for a fault)."""
-        logger.log(level, "%s", text)
-        self.put(Record(self.wallclock(), "system", source="station", text=text))
-
     def say(self, name: str, level: int = logging.INFO, **values: object) -> None:
         """A 'system' record of the catalogue (app/scada/words.py: `name` and its `values`) in the
         station's `Language`, and the same in English in the log (at `level`), which is read by
         whoever supports the station, not only by its operators."""
         logger.log(level, "%s", ENGLISH(name, **values))
-        self.put(Record(self.wallclock(), "system", source="station",
-                        text=words(self.station.Language)(name, **values)))
+        self.put(Record(self.wallclock(), "system", source="station", text=self.words(name, **values)))
 
     # --- start and stop ------------------------------------------------------------------------
 
@@ -298,7 +293,7 @@ class Runtime:
             raise StartError([f"{st.path}: cannot lock the station folder: {self._folder_lock.path}: "
                               f"{e.strerror or e}"]) from None
         store = Store(st.Archive, catalog=self.catalog, keep_days=st.keep_days, wallclock=self.wallclock,
-                      tags=self.tags, station=st.name)
+                      tags=self.tags, station=st.name, say=self.words)
         try:
             store.start()
         except (OSError, sqlite3.Error) as e:
@@ -309,7 +304,7 @@ class Runtime:
             from registrar.plant.forward import Forwarder  # psycopg only where a plant archive is named
 
             self.forwarder = Forwarder(st.Archive, st.plant_archive, st.name, keep_days=st.plant_keep_days,
-                                       sink=self.put, wallclock=self.wallclock,
+                                       sink=self.put, wallclock=self.wallclock, say=self.words,
                                        letter=st.redundancy.letter if st.redundancy is not None else "")
             self.forwarder.start()  # never fails: PostgreSQL away is a lag, not a start error
         started = False
@@ -329,12 +324,13 @@ class Runtime:
         self.say("starting", path=st.path)
         self.engine = Engine(self.program, sink=self, tick=st.tick, wallclock=self.wallclock,
                              code_cache=st.Archive.parent / CODE_CACHE)
+        self.engine.words = self.words
         self.started_clock = self.engine.now  # engine-clock time of the start (DateTime elements)
         for problem in self.form_problems:
             self.say("form not loaded", problem=problem)
         if not st.NetPlcLoad:
             self.engine.stop()
-        self.retainer = Retainer(st.Retain, self.engine, self)
+        self.retainer = Retainer(st.Retain, self.engine, self, say=self.words)
         self.restored = self.retainer.restore()
         self._restore_forces()
         regdata: dict[str, tuple[tuple[int, int], ...]] = {}
@@ -356,7 +352,7 @@ class Runtime:
             self.simulators.append(simulator)
             self._fill_endpoint(sim.node, f"tcp://{sim.host}:{simulator.port}")
         self.exchange = Exchange(self.nodes, self)
-        self.exchange.words = words(st.Language)
+        self.exchange.words = self.words
         self.exchange.attach(self.engine)
         self.exchange.start()
         self.alarms = StationAlarms(st.Tags, self.program, list(self.catalog), self,
@@ -367,7 +363,8 @@ class Runtime:
         self.alarms.attach(self.engine, self.exchange)
         self.commands = Commands(self.engine, self, role_of=self.role_of, tags=self.alarms.table.tags,
                                  alarms=self.alarms, wallclock=self.wallclock, standby=self._standby,
-                                 hand_over=self._hand_over if st.redundancy is not None else None)
+                                 hand_over=self._hand_over if st.redundancy is not None else None,
+                                 say=self.words)
         server = st.modbus_server
         if server.enabled:
             self.commands.grant(Source.MODBUS, server.role)
@@ -375,17 +372,15 @@ class Runtime:
                                   server.max_per_peer)
             modbus = ModbusServer(ModbusCommands(self.commands, server.writable), host=server.host,
                                   port=server.port, unit=server.unit, serial=server.serial,
-                                  limits=limits, sink=self)
+                                  limits=limits, sink=self, words=self.words)
             try:
                 modbus.start(retry=True)
                 self.modbus = modbus
             except OSError as e:  # the station runs on without it; the operator sees why
-                self.problem(f"Modbus server not started: {st.path}: modbus_server.port: cannot listen on "
-                              f"{server.host}:{server.port}: {_reason(e)}")
+                self.problem("modbus not started", path=st.path, host=server.host, port=server.port,
+                             error=_reason(e))
             if modbus.fault:  # a serial port not there yet, or not ours to open: tried again
-                self.system(f"Modbus server not started yet: {st.path}: "
-                            f"modbus_server.port: {modbus.fault}; retrying every {REOPEN:g} s",
-                            logging.WARNING)
+                self.say("modbus not yet", logging.WARNING, path=st.path, fault=modbus.fault, every=REOPEN)
         self.publishers = start_publishers(self)
         self.say("program loaded", source=self.program.source, instrs=len(self.program.instrs),
                     words=self.program.words)
@@ -435,20 +430,20 @@ class Runtime:
         status = pair.status()
         if pair.refused:
             return pair.refused
-        return "" if status.link else f"pair link to {status.partner} down"
+        return "" if status.link else self.words("pair link down", partner=status.partner)
 
     def _standby(self) -> str | None:
         """Why the command layer refuses a write or command now: this station is not the primary."""
         pair = self.pair
         if pair is None:
-            return None if self.station.redundancy is None else "the station is joining its pair"
+            return None if self.station.redundancy is None else self.words("joining")
         return pair.refusal()
 
     def _hand_over(self, user: str) -> str | None:
         """IntoStandBy by `user`, for the command layer: None once asked for, else why not."""
         pair = self.pair
-        if pair is None or not pair.into_standby(words(self.station.Language)("into standby", user=user)):
-            return "no standby on the pair link to hand over to"
+        if pair is None or not pair.into_standby(self.words("into standby", user=user)):
+            return self.words("nothing to hand over")
         return None
 
     def _restore_forces(self) -> None:
@@ -459,7 +454,7 @@ class Runtime:
             return
         forces, problems = load_forces(st.forces_file)
         for problem in problems:
-            self.problem(f"retained force not restored: {problem}")
+            self.problem("force not restored", problem=problem)
         self.engine.forces.restore(forces, user="station (RetainForces)")
         if forces:
             self.say("forces restored", n=len(forces), file=st.forces_file)
@@ -519,23 +514,25 @@ class Runtime:
                       for n in self.nodes]
 
     def _scan_error(self, error: BaseException) -> None:
-        self.problem(f"scan failed: {error!r}")
+        self.problem("scan failed", error=repr(error))
 
-    def problem(self, text: str) -> None:
+    def problem(self, name: str, /, **values: object) -> None:
         """What an operator must see, said once (a server that did not start, a scan that failed):
-        the health strip (`RuntimeStatus.problems`) for as long as the station runs, a 'system'
-        record and a warning in the log."""
+        the health strip (`RuntimeStatus.problems`) for as long as the station runs and a 'system'
+        record, in the station's language (the catalogue's `name` and `values`), and a warning in
+        the log."""
+        text = self.words(name, **values)
         with self._lock:
             if text in self._problems:
                 return
             self._problems.append(text)
-        self.system(text, logging.WARNING)
+        self.say(name, logging.WARNING, **values)
 
     def stop(self) -> None:
         """Stop everything in the reverse order of start; safe to call twice or after a failed start.
         The primary of a pair hands over to its standby first."""
         if self.pair is not None:
-            self.pair.into_standby(words(self.station.Language)("primary stopping"), wait=1.0)
+            self.pair.into_standby(self.words("primary stopping"), wait=1.0)
             self.pair.stop()
             self.pair = None
         if self.scan_thread is not None:
@@ -637,10 +634,11 @@ class Runtime:
         assert self.commands is not None, "the station is not started"
         return self.commands.stop(Who(user, Source.CONSOLE))
 
-    def operator(self, user: str, text: str) -> None:
+    def operator(self, user: str, name: str, /, **values: object) -> None:
         """What a user did at the workstation that is not a command (log in and out): an 'operator'
-        record naming the user, as the commands' records do."""
-        self.put(Record(self.wallclock(), "operator", source=user or "nobody", text=text))
+        record naming the user, as the commands' records do, in the station's language."""
+        self.put(Record(self.wallclock(), "operator", source=user or "nobody",
+                        text=self.words(name, **values)))
 
     # --- status --------------------------------------------------------------------------------
 

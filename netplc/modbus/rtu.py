@@ -30,6 +30,7 @@ import serial
 
 from netplc.modbus.endpoint import Endpoint
 from netplc.modbus.pdu import ServeHandler, answer
+from netplc.words import Say, english
 
 if TYPE_CHECKING:
     from pymodbus.pdu import DecodePDU
@@ -159,8 +160,9 @@ class RtuServer:
 
     def __init__(self, handler: ServeHandler, unit: int | None, line: SerialLine | None, name: str,
                  reopen: Callable[[], SerialLine] | None = None,
-                 note: Callable[[str], None] | None = None) -> None:
+                 note: Callable[[str], None] | None = None, words: Say = english) -> None:
         self.handler = handler
+        self.words = words  # the station's words for its records (netplc/words.py)
         self.unit = unit
         self.line = line
         self.name = name  # the port, for journal records and thread names
@@ -218,8 +220,8 @@ class RtuServer:
 
     def _failed(self, error: OSError) -> None:
         """The port failed: say so once, then try it again every REOPEN seconds until it works."""
-        self.fault = f"Modbus RTU on {self.name} failed: {error}"
-        self.note(f"{self.fault}; retrying every {REOPEN:g} s")
+        self.fault = self.words("rtu failed", port=self.name, error=error)
+        self.note(self.words("rtu retrying", fault=self.fault, every=REOPEN))
         self._reopen()
 
     def _reopen(self) -> None:
@@ -233,7 +235,7 @@ class RtuServer:
                 continue
             break
         if not self._stop.is_set():
-            self.note(f"Modbus RTU on {self.name} works again")
+            self.note(self.words("rtu works", port=self.name))
             self.fault = ""
 
     def frame(self, frame: bytes) -> bytes | None:

@@ -32,6 +32,7 @@ from netplc.modbus.pdu import ILLEGAL_ADDRESS, Done, ServeHandler
 from netplc.modbus.rtu import RtuServer, SerialLine, open_line
 from netplc.modbus.tcp_server import ServerLimits, TcpServer
 from netplc.records import Record, RecordSink
+from netplc.words import Say, english
 
 logger = logging.getLogger(__name__)
 
@@ -95,15 +96,16 @@ class ModbusServer:
     def __init__(self, handler: ServeHandler, host: str = "127.0.0.1", port: int = 0,
                  unit: int | None = None, serial: Endpoint | None = None,
                  limits: ServerLimits | None = None, loop: LoopThread | None = None,
-                 sink: RecordSink | None = None) -> None:
+                 sink: RecordSink | None = None, words: Say = english) -> None:
         self.handler = handler
+        self.words = words  # the station's words for its records (netplc/words.py)
         self.host = host
         self.requested_port = port
         self.unit = unit
         self.serial = serial
         self.sink = sink
         self.rtu: RtuServer | None = None
-        self._server = TcpServer(handler, unit, limits, self.journal)
+        self._server = TcpServer(handler, unit, limits, self.journal, words)
         self._own_thread = loop is None
         self._thread = loop or LoopThread(f"modbus-server-{host}:{port}")
 
@@ -138,9 +140,9 @@ class ModbusServer:
                 if not retry:
                     raise
                 why = os.strerror(e.errno) if e.errno else str(e)  # pyserial repeats the port in its text
-                fault = f"Modbus RTU on {serial.device} cannot be opened: {why}"
+                fault = self.words("rtu cannot open", port=serial.device, error=why)
             self.rtu = RtuServer(self.handler, self.unit, line, serial.device,
-                                 reopen=lambda: open_line(serial), note=self.journal)
+                                 reopen=lambda: open_line(serial), note=self.journal, words=self.words)
             self.rtu.start(fault)
             return
         if self._own_thread:

@@ -32,6 +32,7 @@ from netplc.modbus.pdu import (
     ServeHandler,
     answer,
 )
+from netplc.words import Say, english
 
 logger = logging.getLogger(__name__)
 
@@ -55,8 +56,9 @@ class Throttle:
     the cause's next line."""
 
     def __init__(self, emit: Callable[[str], None], period: float = 60.0,
-                 clock: Callable[[], float] = time.monotonic) -> None:
+                 clock: Callable[[], float] = time.monotonic, words: Say = english) -> None:
         self.emit = emit
+        self.words = words
         self.period = period
         self.clock = clock
         self._last: dict[str, float] = {}
@@ -70,7 +72,7 @@ class Throttle:
             return
         self._last[cause] = now
         held = self._held.pop(cause, 0)
-        self.emit(f"{text} (and {held} more like it in the last minute)" if held else text)
+        self.emit(self.words("more like it", text=text, n=held) if held else text)
 
 
 class _Connection(asyncio.Protocol):
@@ -107,13 +109,12 @@ class _Connection(asyncio.Protocol):
         limits, peers = server.limits, server.peers
         if peers.get(host, 0) >= limits.max_per_peer:
             transport.close()
-            server.note("peer", f"Modbus server refused a connection from {self.peer}: "
-                                f"{limits.max_per_peer} connections from {host} are open (max_per_peer)")
+            server.note("peer", server.words("peer refused", peer=self.peer, n=limits.max_per_peer,
+                                             host=host))
             return
         if len(server.connections) >= limits.max_connections:
             transport.close()
-            server.note("connections", f"Modbus server refused a connection from {self.peer}: "
-                                       f"{limits.max_connections} connections are open (max_connections)")
+            server.note("connections", server.words("server full", peer=self.peer, n=limits.max_connections))
             return
         self.transport = transport
         self.host = host
@@ -165,8 +166,8 @@ class _Connection(asyncio.Protocol):
         while end - pos >= 8 and n < TURN and not self.blocked and self.held_bytes < self.high:
             tid, proto, length, unit = MBAP.unpack_from(buf, pos)
             if proto != 0 or not 2 <= length <= 254:
-                server.note("frames", f"Modbus server closed the connection of {self.peer}: "
-                                      f"not Modbus TCP (protocol {proto}, length {length})")
+                server.note("frames", server.words("not modbus tcp", peer=self.peer, proto=proto,
+                                                   length=length))
                 transport.close()
                 self.transport = None
                 return
@@ -259,11 +260,12 @@ class TcpServer:
     closed, loop errors), at most one line per cause per minute."""
 
     def __init__(self, handler: ServeHandler, unit: int | None, limits: ServerLimits | None = None,
-                 note: Callable[[str], None] | None = None) -> None:
+                 note: Callable[[str], None] | None = None, words: Say = english) -> None:
         self.handler = handler
         self.unit = unit
         self.limits = limits or ServerLimits()
-        self.note = Throttle(note or logger.warning)
+        self.words = words  # the station's words for its records (netplc/words.py)
+        self.note = Throttle(note or logger.warning, words=words)
         self.connections: set[_Connection] = set()
         self.peers: dict[str, int] = {}  # open connections by the peer's address
         self._server: asyncio.Server | None = None
@@ -305,9 +307,8 @@ class TcpServer:
         now, idle = self.loop_time(), self.limits.idle_timeout
         for conn in list(self.connections):
             if now - conn.last > idle and conn.transport is not None:
-                what = "half a frame" if conn.buf else "nothing"
-                self.note("idle", f"Modbus server closed the connection of {conn.peer}: {what} "
-                                  f"received for {idle:g} s (idle_timeout)")
+                self.note("idle", self.words("idle half" if conn.buf else "idle nothing", peer=conn.peer,
+                                             idle=idle))
                 conn.transport.abort()
         self._schedule_sweep()
 

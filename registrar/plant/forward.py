@@ -32,6 +32,7 @@ from urllib.parse import quote
 
 import psycopg
 
+from app.scada.words import Words, phrase, words
 from netplc.records import Record
 from registrar.plant import schema as plant
 from registrar.reading import ArchiveError
@@ -69,9 +70,12 @@ class Forwarder:
         batch: int = BATCH,
         lag_alarm: float = LAG_ALARM,
         letter: str = "",
+        say: Words | None = None,
     ) -> None:
-        """`letter`: this station's in a hot-standby pair ("A", "B"), "" for a station alone."""
+        """`letter`: this station's in a hot-standby pair ("A", "B"), "" for a station alone;
+        `say`: the station's words for its records (app/scada/words.py)."""
         self.local = Path(local)
+        self.say = say or words()
         self.url = url
         self.station = station
         self.keep_days = keep_days
@@ -183,18 +187,15 @@ class Forwarder:
         self._max_lag = max(self._max_lag, self._lag)
         if self._lag > self.lag_alarm and not self._alarmed:
             self._alarmed = True
-            why = self._error or "PostgreSQL does not keep up"
-            self._tell(f"forwarding to the plant archive lags by {self._lag:.0f} s ({why}); records "
-                       "are kept in the local archive and sent when it answers")
+            self._tell("plant lags", lag=self._lag, why=self._error or phrase("plant slow"))
         elif self._alarmed and self._backlog == 0:
             self._alarmed = False
-            self._tell(f"forwarding to the plant archive caught up after a lag of up to "
-                       f"{self._max_lag:.0f} s; no records were lost")
+            self._tell("plant caught up", lag=self._max_lag)
             self._max_lag = 0.0
 
-    def _tell(self, text: str) -> None:
+    def _tell(self, name: str, /, **values: object) -> None:
         if self.sink is not None:
-            self.sink(Record(self.wallclock(), "system", source=SOURCE, text=text))
+            self.sink(Record(self.wallclock(), "system", source=SOURCE, text=self.say(name, **values)))
 
     # --- the two ends --------------------------------------------------------------------------
 

@@ -13,6 +13,8 @@ from collections.abc import Callable
 from dataclasses import dataclass
 from pathlib import Path
 
+from tests.app.conftest import DEMO_NAME
+
 
 @dataclass(frozen=True)
 class Broken:
@@ -38,7 +40,7 @@ def append_line(path: Path, text: str) -> int:
 
 
 def allow_outside(st: Path) -> None:
-    replace(st / "station.toml", 'name = "Demo station"', 'name = "Demo station"\nallow_outside = true')
+    replace(st / "station.toml", f'name = "{DEMO_NAME}"', f'name = "{DEMO_NAME}"\nallow_outside = true')
 
 
 def link(path: Path, target: str | Path) -> None:
@@ -187,7 +189,7 @@ def _retain_folder(st: Path) -> str:
 
 
 def _forces_dev_zero(st: Path) -> str:
-    replace(st / "station.toml", 'name = "Demo station"', 'name = "Demo station"\nRetainForces = true')
+    replace(st / "station.toml", f'name = "{DEMO_NAME}"', f'name = "{DEMO_NAME}"\nRetainForces = true')
     forces = st / "archive" / "retain.forces.json"
     forces.parent.mkdir()
     link(forces, "/dev/zero")

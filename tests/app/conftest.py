@@ -15,12 +15,20 @@ from app.station.config import DEMO_STATION
 
 REPO = Path(__file__).resolve().parents[2]
 DEMO = DEMO_STATION
+DEMO_NAME = "Демо-станция"  # the demo's `name` in its station.toml
 
 
-def copy_demo(dest: Path) -> Path:
-    """The demo station copied to `dest`, its archive there too, its Modbus server on a free port."""
+def copy_demo(dest: Path, language: str | None = None) -> Path:
+    """The demo station copied to `dest`, its archive there too, its Modbus server on a free port;
+    in `language` when given ("" follows the locale: English under the tests' C locale), else in
+    the demo's (ru). The tests of a protocol or a command that read its records word for word take
+    an English copy; the demo's Russian is tested where the language is the point."""
     copy_station(dest)
-    assert "\nport = 0\n" in (dest / "station.toml").read_text(encoding="utf-8")
+    toml = dest / "station.toml"
+    text = toml.read_text(encoding="utf-8")
+    assert "\nport = 0\n" in text and '\nLanguage = "ru"' in text
+    if language is not None:
+        toml.write_text(text.replace('\nLanguage = "ru"', f'\nLanguage = "{language}"'), encoding="utf-8")
     return dest
 
 

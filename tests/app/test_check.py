@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import json
+import re
 import subprocess
 import sys
 from pathlib import Path
@@ -59,8 +60,8 @@ def test_every_planted_error_is_found(tmp_path: Path) -> None:
     node_lines = (st / "node0.stl").read_text(encoding="utf-8").splitlines()
     ctr = node_lines.index("CTR TB N:999") + 1
     expected = [
-        f"{st / 'station.toml'}: NetSyncTime: expected an integer",
-        f"{st / 'station.toml'}: Colour: unknown setting",
+        f"{st / 'station.toml'}: NetSyncTime: ожидается целое число, а задано 'fast'",  # the demo's ru
+        f"{st / 'station.toml'}: Colour: неизвестный параметр",
         f"{st / 'station.toml'}: nodes[0].endpoint: endpoint 'tcp://plc:99999'",
         f"{st / 'netplc.stl'}:{tnx}:1: unknown instruction 'TNX'",
         f"{st / 'netplc.stl'}:{nosuch}:",
@@ -91,8 +92,10 @@ def test_check_reports_exactly_what_a_start_refuses(tmp_path: Path) -> None:
     assert check_station(st).problems == refused.value.problems
 
 
-def test_tags_csv_problems_are_reported_by_check(tmp_path: Path) -> None:
-    st = copy_demo(tmp_path / "tags")
+@pytest.mark.parametrize("language", ["en", "ru"])
+def test_tags_csv_problems_are_reported_by_check(tmp_path: Path, language: str) -> None:
+    """In the station's language, naming the file, the line, the tag and its values as they are."""
+    st = copy_demo(tmp_path / "tags", language)
     plant(st / "tags.csv", "LEVEL,LEVEL,word,%,0,4095,0,100,1,Уровень,95,90,",
           "LEVEL,LEVEL,word,%,0,4095,0,100,1,Уровень,85,90,")
     plant(st / "tags.csv", "TEMP,TEMP,word,°C,0,1000,", "TEMP,TEMP,word,°C,7,7,")
@@ -102,9 +105,18 @@ def test_tags_csv_problems_are_reported_by_check(tmp_path: Path) -> None:
     tags = st / "tags.csv"
     lines = tags.read_text(encoding="utf-8").splitlines()
     level = next(i for i, line in enumerate(lines, 1) if line.startswith("LEVEL,"))
-    assert f"{tags}:{level}: LEVEL: HH 85 is below H 90" in r.stdout
-    assert f"{tags}:{level + 1}: TEMP: app_min = app_max = 7" in r.stdout
-    assert f"{tags}:{level + 3}: TRIGGER: address '010000' cannot hold an I/O bit or a data bit" in r.stdout
+    said = {
+        "en": [f"{tags}:{level}: LEVEL: HH 85 is below H 90: the limits must keep the order",
+               f"{tags}:{level + 1}: TEMP: app_min = app_max = 7: the conversion is undefined",
+               f"{tags}:{level + 3}: TRIGGER: address '010000' cannot hold an I/O bit or a data bit"],
+        "ru": [f"{tags}:{level}: LEVEL: HH 85 ниже H 90: пределы должны идти в порядке",
+               f"{tags}:{level + 1}: TEMP: app_min = app_max = 7: преобразование не определено",
+               f"{tags}:{level + 3}: TRIGGER: address '010000' не может вместить бит ввода-вывода"],
+    }[language]
+    for line in said:
+        assert line in r.stdout, r.stdout
+    if language != "en":
+        return
     plant(st / "station.toml", 'Tags = "tags.csv"', 'Tags = "no_tags.csv"')
     r = run_check(st)
     assert f"{st / 'station.toml'}: Tags: file {st / 'no_tags.csv'} does not exist" in r.stdout
@@ -120,6 +132,40 @@ def test_a_horn_bit_the_program_writes_is_a_problem(tmp_path: Path) -> None:
     problems = check_station(station).problems
     assert any("alarm_horn: бит 02200 пишет программа (строка " in p and "может только читать" in p
                for p in problems), problems
+
+
+@pytest.mark.parametrize("language", ["ru", "en"])
+def test_station_toml_problems_are_said_in_the_station_language(tmp_path: Path, language: str) -> None:
+    """station.toml's reader says its problems in the file's `Language` (app/scada/words.py), each
+    naming the file, the key and the value as they are; a Russian one leaves no English word of
+    the catalogue."""
+    from app.station.check import check_station
+    from tests.app.scada.test_words import english_words
+
+    st = copy_demo(tmp_path / "st", language)
+    plant(st / "station.toml", "NetSyncTime = 100", 'NetSyncTime = "fast"\nColour = "red"\nkeep_days = -5')
+    plant(st / "station.toml", "keep_days = 30 ", "")
+    plant(st / "station.toml", 'Messages = "messages.csv"', 'Messages = ""')
+    plant(st / "station.toml", 'Retain = "archive/retain.bin"', 'Retain = "../../elsewhere.bin"')
+    plant(st / "station.toml", "[modbus_server]", '[modbus_server]\ntransport = "ascii"')
+    toml = st / "station.toml"
+    problems = [p.removeprefix(f"{toml}: ") for p in check_station(st).problems if p.startswith(f"{toml}: ")]
+    said = {
+        "ru": ["NetSyncTime: ожидается целое число, а задано 'fast'", "Colour: неизвестный параметр",
+               "keep_days: -5 вне диапазона 0-", "Messages: пустой путь", "Retain: ",
+               "modbus_server.transport: 'ascii' — не одно из: tcp, rtu"],
+        "en": ["NetSyncTime: expected an integer, got 'fast'", "Colour: unknown setting",
+               "keep_days: -5 is outside 0-", "Messages: empty path", "Retain: ",
+               "modbus_server.transport: 'ascii' is not one of tcp, rtu"],
+    }[language]
+    for line in said:
+        assert any(p.startswith(line) for p in problems), f"{line!r} not in {problems}"
+    outside = "вне папки станции" if language == "ru" else "is outside the station folder"
+    assert any(p.startswith("Retain: ") and outside in p for p in problems), problems
+    if language == "ru":
+        prose = (re.sub(r"\S*[/.:]\S*|'[^']*'|\b[A-Za-z_]+ = \w+", "", p) for p in problems)
+        left = {w for p in prose for w in re.findall(r"[A-Za-z]{2,}", p)} & english_words()
+        assert not left, f"English words in a Russian station.toml's problems: {sorted(left)}: {problems}"
 
 
 @pytest.mark.parametrize("language", ["ru", "en"])

@@ -21,6 +21,7 @@ from app.station.runtime import Runtime
 from hmi_forms.elements import formats
 from netplc.address import fmt_octal
 from registrar.query import Archive
+from tests.app.conftest import copy_demo
 
 LEVEL = 0o4010
 START_BIT = 0o40042
@@ -29,7 +30,9 @@ BROKEN = ('{"form": {"title": "broken", "width": 100, "height": 100}, "elements"
 
 
 @pytest.fixture
-def console(qtbot, demo_copy: Path) -> Iterator[MainWindow]:
+def console(qtbot, tmp_path: Path) -> Iterator[MainWindow]:
+    """The demo's console in English: its tests read the journal word for word."""
+    demo_copy = copy_demo(tmp_path / "station", "en")
     (demo_copy / "forms" / "99_broken.hmi").write_text(BROKEN, encoding="utf-8")
     runtime = Runtime(load_station(demo_copy))
     runtime.start()
@@ -334,7 +337,8 @@ def test_the_console_speaks_russian_and_the_forms_keep_their_texts(qtbot, russia
 
 def test_refusals_roles_and_alarms_speak_russian_too(qtbot, russian, demo_copy: Path) -> None:
     """What the Qt-free models say in English (users.py refusals, roles, alarm priorities and
-    states, qualities) the console shows in its language; the journal keeps the English."""
+    states, qualities) the console shows in its language; the journal is in the station's (the
+    demo's Russian)."""
     import dataclasses
 
     from app.gui.alarms import AlarmBanner
@@ -354,8 +358,8 @@ def test_refusals_roles_and_alarms_speak_russian_too(qtbot, russian, demo_copy: 
         assert window.status.currentMessage() == "Отказано: Пуск: нужна роль «оператор»; viewer — наблюдатель"
         assert "нужна роль «оператор»" in window.alarms.ack.toolTip()
         assert "Выход: нужна роль «инженер»" in window.act_quit.toolTip()
-        runtime.stop()  # the journal keeps the English
-        assert ("viewer", "refused write Пуск: needs the operator role; viewer is viewer") in [
+        runtime.stop()  # the journal speaks the station's language
+        assert ("viewer", "отказ: запись Пуск: нужна роль «оператор»; viewer — наблюдатель") in [
             (s, t.split(" (")[0]) for s, t in operator_rows(runtime)]
         summary = window.summary
         heads = [summary.model.headerData(i, Qt.Orientation.Horizontal, Qt.ItemDataRole.DisplayRole)

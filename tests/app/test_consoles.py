@@ -164,7 +164,7 @@ def test_an_acknowledge_shows_on_the_other_console_and_in_the_journal_a_viewer_i
     lines = station.runtime.status().consoles
     assert any(line.startswith("operator@127.0.0.1:") for line in lines)
     assert any(line.startswith("viewer@127.0.0.1:") for line in lines)
-    assert any("OPC UA: opcua:viewer@127.0.0.1:" in (r.text or "") and "connected" in (r.text or "")
+    assert any("OPC UA: подключился opcua:viewer@127.0.0.1:" in (r.text or "")
                for r in station.records)
 
 

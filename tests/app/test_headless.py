@@ -9,7 +9,7 @@ import subprocess
 import sys
 from pathlib import Path
 
-from tests.app.conftest import REPO, stop_once_up
+from tests.app.conftest import DEMO_NAME, REPO, stop_once_up
 
 
 def day_table() -> str:
@@ -59,7 +59,7 @@ def test_headless_run_for_a_duration(headless_archive: tuple[Path, str]) -> None
     archive, out = headless_archive
     check_archive(archive)
     lines = out.splitlines()
-    assert lines[0].startswith("station Demo station started")
+    assert lines[0].startswith(f"station {DEMO_NAME} started")
     status = [line for line in lines if line.startswith("NetPlc running")]
     assert status and "nodes 1/1 up" in status[-1] and "records" in status[-1]
     assert re.fullmatch(r"station stopped after \d+ scans, \d+ records written", lines[-1]), lines[-1]

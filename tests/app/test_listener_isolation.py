@@ -12,13 +12,13 @@ from pathlib import Path
 from asyncua import Client, ua
 
 from app.gui.bridge import RuntimeBridge
-from tests.app.publish.conftest import demo_with, free_port
+from tests.app.publish.conftest import STATION_URI, demo_with, free_port
 
 
 def test_a_listener_that_raises_stops_neither_quality_nor_the_hmi_nor_opc_ua(qtbot, tmp_path: Path,
                                                                             caplog) -> None:
     url = f"opc.tcp://127.0.0.1:{free_port()}/netplc/"
-    runtime = demo_with(tmp_path / "station", f'[opcua]\nenabled = true\nendpoint = "{url}"\n')
+    runtime = demo_with(tmp_path / "station", f'[opcua]\nenabled = true\nendpoint = "{url}"\n', language="en")
     try:
         engine = runtime.engine
         assert engine is not None
@@ -37,7 +37,7 @@ def test_a_listener_that_raises_stops_neither_quality_nor_the_hmi_nor_opc_ua(qtb
 
         async def opcua_scans() -> list[int]:
             async with Client(url, timeout=30) as client:
-                ns = await client.get_namespace_index("urn:netplc:station:Demo station")
+                ns = await client.get_namespace_index(STATION_URI)
                 scan = client.get_node(ua.NodeId("NetPlc.Tick", ns))
                 seen = [await scan.read_value()]
                 deadline = time.monotonic() + 10

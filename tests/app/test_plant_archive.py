@@ -36,7 +36,7 @@ def test_a_station_forwards_its_archive_to_the_plant_archive(tmp_path: Path, pg_
     runtime = Runtime(station)
     runtime.start()
     try:
-        runtime.system("hello plant")
+        runtime.put(Record(runtime.wallclock(), "system", source="station", text="hello plant"))
         assert runtime.forwarder is not None
         wait_for(lambda: runtime.forwarder.stats.forwarded >= 2)
         assert not any("plant archive" in p for p in runtime.status().problems)

@@ -7,6 +7,8 @@ from __future__ import annotations
 import time
 from pathlib import Path
 
+import pytest
+
 from app.authority import Reason, Source, Who
 from app.station.config import load_station
 from app.station.runtime import Runtime
@@ -14,6 +16,7 @@ from netplc.engine import RunState
 from netplc.forcing import Force, load_forces
 from netplc.modbus import LeanTcpClient, LoopThread, parse_endpoint
 from netplc.records import Record
+from tests.app.conftest import copy_demo
 
 LEVEL, SETPOINT, LEVEL_OK = 0o4010, 0o4030, 0o2131
 
@@ -36,8 +39,14 @@ def after_scans(runtime: Runtime, n: int = 3) -> None:
     wait_for(runtime, lambda s: s.scan >= target)
 
 
-def test_exchange_and_modbus_writes_lose_to_forces_and_the_status_counts_them(demo_copy: Path) -> None:
-    runtime = Runtime(load_station(demo_copy))
+@pytest.fixture
+def english(tmp_path: Path) -> Path:
+    """The demo in English: these tests read the forces' records word for word."""
+    return copy_demo(tmp_path / "station", "en")
+
+
+def test_exchange_and_modbus_writes_lose_to_forces_and_the_status_counts_them(english: Path) -> None:
+    runtime = Runtime(load_station(english))
     records: list[Record] = []
     runtime.subscribe(records.append)
     runtime.start()
@@ -103,8 +112,8 @@ def test_forces_are_not_retained_by_default_and_are_with_retain_forces(demo_copy
     assert (demo_copy / "archive" / "retain.forces.json").is_file()
 
 
-def test_step_one_scan_runs_the_stopped_program_once(demo_copy: Path) -> None:
-    runtime = Runtime(load_station(demo_copy))
+def test_step_one_scan_runs_the_stopped_program_once(english: Path) -> None:
+    runtime = Runtime(load_station(english))
     records: list[Record] = []
     runtime.subscribe(records.append)
     runtime.start()

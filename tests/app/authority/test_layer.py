@@ -184,7 +184,7 @@ def test_user_administration_needs_the_admin_and_is_answered_after_the_commit():
     def taken() -> str:
         from app.authority.users import UserError
 
-        raise UserError("user 'ivan' exists already")
+        raise UserError("user exists", name="ivan")
 
     answer = layer.manage_users(Who("anna", Source.CONSOLE), "ivan", taken).result(0)
     assert answer.reason is Reason.INVALID and "exists already" in answer.text

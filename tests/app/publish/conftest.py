@@ -18,9 +18,10 @@ import paho.mqtt.client as mqtt
 import pytest
 
 from app.publish import sparkplug as spb
+from app.publish.opcua import application_uri
 from app.station.config import load_station
 from app.station.runtime import Runtime
-from tests.app.conftest import copy_demo
+from tests.app.conftest import DEMO_NAME, copy_demo
 from tests.netplc.test_exchange import wait_until
 
 
@@ -30,10 +31,10 @@ def free_port() -> int:
         return s.getsockname()[1]
 
 
-def demo_with(folder: Path, extra: str, records: list | None = None) -> Runtime:
-    """The demo station copied to `folder` (unless there already) with `extra` TOML appended,
-    started headless; its records from the start in `records`."""
-    station = folder if (folder / "station.toml").exists() else copy_demo(folder)
+def demo_with(folder: Path, extra: str, records: list | None = None, language: str | None = None) -> Runtime:
+    """The demo station copied to `folder` (unless there already; in `language` when given, see
+    `copy_demo`) with `extra` TOML appended, started headless; its records from the start in `records`."""
+    station = folder if (folder / "station.toml").exists() else copy_demo(folder, language)
     toml = station / "station.toml"
     toml.write_text(toml.read_text(encoding="utf-8") + "\n" + extra, encoding="utf-8")
     runtime = Runtime(load_station(station))
@@ -223,7 +224,7 @@ class Host:
         self.client.loop_stop()
 
 
-STATION_URI = "urn:netplc:station:Demo station"
+STATION_URI = application_uri(DEMO_NAME)  # the demo's namespace: its Russian name percent-encoded
 
 
 def opcua_client(url: str, user: str | None = None, password: str = "") -> object:

@@ -30,7 +30,7 @@ def host(broker: Mosquitto) -> Iterator[Host]:
 
 @pytest.fixture
 def station(tmp_path: Path, broker: Mosquitto, host: Host) -> Iterator[Runtime]:
-    runtime = demo_with(tmp_path / "station", mqtt_section(broker))
+    runtime = demo_with(tmp_path / "station", mqtt_section(broker), language="en")
     yield runtime
     runtime.stop()
 
@@ -145,7 +145,7 @@ def test_bdseq_goes_on_across_restarts_of_the_station(tmp_path: Path, broker: Mo
     from app.publish.station import BDSEQ_FILE
     from app.station.config import load_station
 
-    station = copy_demo(tmp_path / "station")
+    station = copy_demo(tmp_path / "station", "en")
     toml = station / "station.toml"
     toml.write_text(toml.read_text(encoding="utf-8") + "\n" + mqtt_section(broker), encoding="utf-8")
     records: list = []

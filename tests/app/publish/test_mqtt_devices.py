@@ -26,7 +26,7 @@ def host(broker: Mosquitto) -> Iterator[Host]:
 def started(folder: Path, broker: Mosquitto, extra: str = "",
             writable: str = "TEMP_SP") -> tuple[Runtime, list]:
     records: list = []
-    return demo_with(folder, mqtt_section(broker, extra, "Devices", writable), records), records
+    return demo_with(folder, mqtt_section(broker, extra, "Devices", writable), records, "en"), records
 
 
 def test_a_node_that_stops_answering_dies_and_is_born_again(tmp_path: Path, broker: Mosquitto,

@@ -16,7 +16,7 @@ def waiting(folder: Path, broker: Mosquitto, host_id: str,
             group: str) -> tuple[Runtime, SparkplugPublisher, list]:
     """A demo station with `primary_host = host_id`, connected to the broker; its records."""
     records: list = []
-    runtime = demo_with(folder, mqtt_section(broker, f'primary_host = "{host_id}"\n', group), records)
+    runtime = demo_with(folder, mqtt_section(broker, f'primary_host = "{host_id}"\n', group), records, "en")
     publisher = next(p for p in runtime.publishers if isinstance(p, SparkplugPublisher))
     wait_until(lambda: publisher.status.connected, 5)
     return runtime, publisher, records

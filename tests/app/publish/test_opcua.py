@@ -14,7 +14,8 @@ from asyncua import Client, ua
 
 from app.publish.opcua import is_loopback
 from app.station.runtime import Runtime
-from tests.app.publish.conftest import demo_with, free_port, opcua_client, tag_node
+from tests.app.conftest import DEMO_NAME
+from tests.app.publish.conftest import STATION_URI, demo_with, free_port, opcua_client, tag_node
 
 
 @pytest.fixture
@@ -31,7 +32,7 @@ def run(coro: object) -> object:
 
 
 async def _tag(client: Client, name: str) -> object:
-    ns = await client.get_namespace_index("urn:netplc:station:Demo station")
+    ns = await client.get_namespace_index(STATION_URI)
     return client.get_node(ua.NodeId(f"Tags.{name}", ns))
 
 
@@ -49,8 +50,8 @@ def test_browse_read_units_and_quality(station: tuple[Runtime, str]) -> None:
         async with Client(url, timeout=30) as client:
             root = client.nodes.objects
             names = [(await n.read_browse_name()).Name for n in await root.get_children()]
-            assert "Demo station" in names
-            ns = await client.get_namespace_index("urn:netplc:station:Demo station")
+            assert DEMO_NAME in names
+            ns = await client.get_namespace_index(STATION_URI)
             tags = client.get_node(ua.NodeId("Tags", ns))
             tag_names = {(await n.read_browse_name()).Name for n in await tags.get_children()}
             assert {"LEVEL", "TEMP", "TEMP_SP", "TRIGGER"} <= tag_names
@@ -89,7 +90,7 @@ def test_subscription_sees_changes_within_two_ticks(station: tuple[Runtime, str]
     async def go() -> None:
         async with Client(url, timeout=30) as client:
             tick = client.get_node(ua.NodeId("NetPlc.Tick", await client.get_namespace_index(
-                "urn:netplc:station:Demo station")))
+                STATION_URI)))
             sub = await client.create_subscription(50, Handler())
             await sub.subscribe_data_change(tick)
             await asyncio.sleep(1.0)
@@ -112,9 +113,9 @@ def test_quality_goes_bad_when_the_node_is_killed(station: tuple[Runtime, str]) 
 
     async def go() -> None:
         async with Client(url, timeout=30) as client:
-            ns = await client.get_namespace_index("urn:netplc:station:Demo station")
+            ns = await client.get_namespace_index(STATION_URI)
             sub = await client.create_subscription(50, Handler())
-            await sub.subscribe_events(client.get_node(ua.NodeId("Demo station", ns)),
+            await sub.subscribe_events(client.get_node(ua.NodeId(DEMO_NAME, ns)),
                                        ua.ObjectIds.AlarmConditionType)
             level = await _tag(client, "LEVEL")
             deadline = time.monotonic() + 5
@@ -146,7 +147,7 @@ def test_asyncua_command_line_tools(station: tuple[Runtime, str]) -> None:
     ls = subprocess.run([str(bindir / "uals"), "-u", url, "-n", "i=85", "-l", "0"],
                         capture_output=True, text=True, timeout=60)
     assert ls.returncode == 0, ls.stderr
-    assert "Demo station" in ls.stdout
+    assert DEMO_NAME in ls.stdout
     read = subprocess.run([str(bindir / "uaread"), "-u", url, "-n", "ns=1;s=NetPlc.State"],
                           capture_output=True, text=True, timeout=60)
     assert read.returncode == 0, read.stderr
@@ -159,7 +160,8 @@ def test_a_taken_port_is_a_problem_and_the_station_runs_on(tmp_path: Path) -> No
         taken.bind(("127.0.0.1", 0))
         taken.listen()
         url = f"opc.tcp://127.0.0.1:{taken.getsockname()[1]}/netplc/"
-        runtime = demo_with(tmp_path / "station", f'[opcua]\nenabled = true\nendpoint = "{url}"\n')
+        runtime = demo_with(tmp_path / "station", f'[opcua]\nenabled = true\nendpoint = "{url}"\n',
+                            language="en")
         try:
             status = runtime.status()
             assert status.running and runtime.publishers == []

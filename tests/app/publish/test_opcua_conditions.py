@@ -16,7 +16,7 @@ from app.authority import Source, Who
 from app.scada.alarms import State
 from app.station.runtime import Runtime
 from netplc.records import Record
-from tests.app.conftest import copy_demo
+from tests.app.conftest import DEMO_NAME, copy_demo
 from tests.app.publish.conftest import STATION_URI, demo_with, free_port, opcua_client
 
 BITS = {"ALM_EVENTS": 0o2600, "ALM_ACK": 0o2601, "ALM_STATION": 0o2602, "ALM_REFRESH": 0o2603,
@@ -119,7 +119,7 @@ def test_events_arrive_at_the_server_object_and_the_station_with_the_a_and_c_fie
     async def go() -> tuple[Any, Any, int]:
         async with Client(url, timeout=30) as client:
             at_server, _, _ = await subscribe(client)
-            at_station, _, _ = await subscribe(client, ua.NodeId("Demo station", await ns(client)))
+            at_station, _, _ = await subscribe(client, ua.NodeId(DEMO_NAME, await ns(client)))
             alarm_on(runtime, "ALM_EVENTS")
             event = await at_server.last(alarm_id, ActiveState__Id=True)
             same = await at_station.last(alarm_id, ActiveState__Id=True)
@@ -177,7 +177,7 @@ def test_the_conditions_are_instances_of_the_standard_types_with_stable_node_ids
                    "shelve": ua.NodeId("Alarms.LEVEL.H.ShelvingState.TimedShelve", idx), "state": "normal",
                    "input": ua.NodeId("Tags.LEVEL", idx),
                    "has condition": [ua.NodeId(f"Alarms.LEVEL.{key}", idx) for key in ("HH", "H", "BAD")],
-                   "notifies": [ua.NodeId("Demo station", idx)], "normal": False}
+                   "notifies": [ua.NodeId(DEMO_NAME, idx)], "normal": False}
 
 
 def test_an_operator_acknowledges_and_shelves_a_viewer_is_refused_and_the_summary_agrees(
@@ -239,8 +239,8 @@ def test_an_operator_acknowledges_and_shelves_a_viewer_is_refused_and_the_summar
     assert shelving == "TimedShelved" and 55_000 < left <= 60_000
     refused = [r.text for r in records if r.kind == "operator" and r.source.startswith("opcua:viewer@")]
     assert sorted(refused) == [  # once per cause: the two acknowledgements are one record
-        f"refused acknowledge {alarm_id}: needs the operator role; viewer is viewer",
-        f"refused shelve {alarm_id}: needs the operator role; viewer is viewer"]
+        f"отказ: квитирование {alarm_id}: нужна роль «оператор»; viewer — наблюдатель",
+        f"отказ: откладывание {alarm_id}: нужна роль «оператор»; viewer — наблюдатель"]
     acts = [r.text for r in records if r.kind == "alarm" and r.source == alarm_id]
     assert all("оператор opcua:operator@127.0.0.1:" in t for t in acts[1:])  # the demo speaks Russian
     assert ["квитирована: seen" in t for t in acts[1:]] == [True, False, False, False]
@@ -255,7 +255,7 @@ def test_an_alarm_acknowledged_at_the_station_updates_its_condition(station: Sta
     async def go() -> tuple[Any, bool, str]:
         async with Client(url, timeout=30) as client:
             idx = await ns(client)
-            events, _, _ = await subscribe(client, ua.NodeId("Demo station", idx))
+            events, _, _ = await subscribe(client, ua.NodeId(DEMO_NAME, idx))
             alarm_on(runtime, "ALM_STATION")
             await events.last(alarm_id, ActiveState__Id=True)
             ticket = runtime.commands.acknowledge(Who("operator", Source.CONSOLE), alarm_id)
@@ -287,7 +287,7 @@ def test_condition_refresh_sends_the_retained_conditions_between_refresh_start_a
             alarm_on(runtime, "ALM_REFRESH")
             out["first"] = await live.last(alarm_id, ActiveState__Id=True)
             events, sub, at_server = await subscribe(client)
-            demo = client.get_node(ua.NodeId("Demo station", await ns(client)))
+            demo = client.get_node(ua.NodeId(DEMO_NAME, await ns(client)))
             at_station = await sub.subscribe_events(demo, _O.AlarmConditionType)
             out["items"] = at_server, at_station
             sid = ua.Variant(sub.subscription_id, ua.VariantType.UInt32)

@@ -26,7 +26,7 @@ from netplc.records import Record
 from registrar.query import Archive
 from registrar.reading import SeriesKey
 from registrar.store import Store
-from tests.app.conftest import copy_demo
+from tests.app.conftest import DEMO_NAME, copy_demo
 from tests.app.publish.conftest import STATION_URI, demo_with, free_port
 
 N = 250  # LEVEL values archived, 0.2 s apart, in the minute before T
@@ -206,7 +206,7 @@ def test_the_journal_as_events_of_the_station_and_the_server(station: tuple[Runt
                                         NumValuesPerNode=10, Filter=evfilter)
             pages: list[list[object]] = []
             sizes: list[int] = []
-            for node in (client.get_node(ua.NodeId("Demo station", ns)), client.nodes.server):
+            for node in (client.get_node(ua.NodeId(DEMO_NAME, ns)), client.nodes.server):
                 events: list[object] = []
                 point = None
                 while True:
@@ -223,7 +223,7 @@ def test_the_journal_as_events_of_the_station_and_the_server(station: tuple[Runt
                     if point is None:
                         break
                 pages.append(events)
-            system = await client.get_node(ua.NodeId("Demo station", ns)).read_event_history(
+            system = await client.get_node(ua.NodeId(DEMO_NAME, ns)).read_event_history(
                 utc((t - 61) * 1000), utc(t * 1000), evtypes=ua.ObjectIds.SystemEventType)
             level = client.get_node(ua.NodeId("Tags.LEVEL", ns))
             asked.NumValuesPerNode = 0
@@ -242,7 +242,7 @@ def test_the_journal_as_events_of_the_station_and_the_server(station: tuple[Runt
     assert [e["Message"] for e in server_events] == [e["Message"] for e in station_events]
     # the source is the station (an alarm's: its condition's), wherever its history is read
     assert {e["SourceNode"] for e in station_events + server_events} == {
-        ua.NodeId("Demo station", 1), ua.NodeId("Tags.LEVEL", 1)}
+        ua.NodeId(DEMO_NAME, 1), ua.NodeId("Tags.LEVEL", 1)}
     assert len({e["EventId"] for e in station_events}) == len(station_events)  # each once
     message, alarm, operator, record = station_events[:4]
     assert message["Message"].Text == "Уровень выше 90 %" and message["SourceName"] == "MSG3"
@@ -297,7 +297,7 @@ def test_the_journal_filtered_by_a_like_of_its_message_and_a_severity(
                 params = ua.HistoryReadParameters(
                     HistoryReadDetails=asked, TimestampsToReturn=ua.TimestampsToReturn.Both,
                     ReleaseContinuationPoints=False,
-                    NodesToRead=[ua.HistoryReadValueId(NodeId=ua.NodeId("Demo station", ns))])
+                    NodesToRead=[ua.HistoryReadValueId(NodeId=ua.NodeId(DEMO_NAME, ns))])
                 result = (await client.uaclient.history_read(params))[0]
                 result.StatusCode.check()
                 texts.append([e.EventFields[0].Value.Text for e in result.HistoryData.Events])
@@ -337,7 +337,7 @@ def test_what_is_not_archived_says_so(station: tuple[Runtime, str, float]) -> No
                 (await trigger.read_attribute(ua.AttributeIds.Historizing)).Value.Value
             out["user access"] = (await level.read_attribute(ua.AttributeIds.UserAccessLevel)).Value.Value, \
                 (await trigger.read_attribute(ua.AttributeIds.UserAccessLevel)).Value.Value
-            out["notifier"] = await client.get_node(ua.NodeId("Demo station", ns)).read_event_notifier()
+            out["notifier"] = await client.get_node(ua.NodeId(DEMO_NAME, ns)).read_event_notifier()
             out["capabilities"] = [await client.get_node(n).read_value() for n in (
                 ua.ObjectIds.HistoryServerCapabilities_AccessHistoryDataCapability,
                 ua.ObjectIds.HistoryServerCapabilities_AccessHistoryEventsCapability,

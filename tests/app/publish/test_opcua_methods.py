@@ -16,6 +16,7 @@ from app.scada.alarms import STOPPED_ID, State
 from app.scada.forcing import tag_keys
 from app.station.runtime import Runtime
 from netplc.address import DATA_SIZE, IO_BITS, data_index
+from tests.app.conftest import DEMO_NAME
 from tests.app.publish.conftest import STATION_URI, demo_with, free_port, opcua_client
 
 BIT = 0o2120  # the demo's PUMP command bit
@@ -24,7 +25,7 @@ BIT = 0o2120  # the demo's PUMP command bit
 @pytest.fixture
 def station(tmp_path: Path) -> Iterator[tuple[Runtime, str, list]]:
     url = f"opc.tcp://127.0.0.1:{free_port()}/netplc/"
-    runtime = demo_with(tmp_path / "station", f'[opcua]\nenabled = true\nendpoint = "{url}"\n')
+    runtime = demo_with(tmp_path / "station", f'[opcua]\nenabled = true\nendpoint = "{url}"\n', language="en")
     records: list = []
     runtime.subscribe(records.append)
     yield runtime, url, records
@@ -33,7 +34,7 @@ def station(tmp_path: Path) -> Iterator[tuple[Runtime, str, list]]:
 
 async def call(client: object, name: str, *args: ua.Variant) -> int:
     ns = await client.get_namespace_index(STATION_URI)
-    station = client.get_node(ua.NodeId("Demo station", ns))
+    station = client.get_node(ua.NodeId(DEMO_NAME, ns))
     try:
         await station.call_method(f"{ns}:{name}", *args)
     except ua.UaStatusCodeError as e:

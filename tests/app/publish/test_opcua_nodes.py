@@ -16,7 +16,7 @@ from asyncua import Client, Node, ua
 
 from app.publish.ua_types import eu_information, unit_id
 from app.station.runtime import Runtime
-from tests.app.conftest import DEMO
+from tests.app.conftest import DEMO, DEMO_NAME
 from tests.app.publish.conftest import STATION_URI, demo_with, free_port
 
 PERCENT, CELSIUS = 20529, 4408652  # UnitId of P1 and CEL (OPC UA Part 8 5.6.3)
@@ -113,11 +113,11 @@ def test_every_node_of_the_station_has_a_string_nodeid_and_a_plain_browse_name(
                         bad.append(f"{child.nodeid.to_string()} {name.to_string()}")
                     await walk(child)
 
-            await walk(client.get_node(ua.NodeId("Demo station", ns)))
+            await walk(client.get_node(ua.NodeId(DEMO_NAME, ns)))
             objects = client.nodes.objects
-            priority = await objects.get_child([f"{ns}:Demo station", f"{ns}:Alarms", f"{ns}:LEVEL.H",
+            priority = await objects.get_child([f"{ns}:{DEMO_NAME}", f"{ns}:Alarms", f"{ns}:LEVEL.H",
                                                 f"{ns}:Priority"])
-            eu_range = await objects.get_child([f"{ns}:Demo station", f"{ns}:Tags", f"{ns}:LEVEL",
+            eu_range = await objects.get_child([f"{ns}:{DEMO_NAME}", f"{ns}:Tags", f"{ns}:LEVEL",
                                                 "0:EURange"])
         return bad, priority.nodeid, eu_range.nodeid
 
@@ -158,7 +158,7 @@ def test_build_info_and_application_name_name_netplc_station(station: tuple[Runt
     version = importlib.metadata.version("netplc-station")
     assert (info.ProductName, info.SoftwareVersion, info.BuildNumber) == ("NetPlc Station", version, version)
     assert info.ProductUri == "urn:netplc:station" and info.ManufacturerName and info.BuildDate
-    assert [s.ApplicationName.Text for s in servers] == ["NetPlc Station Demo station"]
+    assert [s.ApplicationName.Text for s in servers] == [f"NetPlc Station {DEMO_NAME}"]
     assert servers[0].ProductUri == "urn:netplc:station"
     assert servers[0].ApplicationType == ua.ApplicationType.Server
 

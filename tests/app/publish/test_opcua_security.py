@@ -24,7 +24,7 @@ from cryptography.x509.oid import ExtendedKeyUsageOID
 
 from app.publish.pki import thumbprint
 from tests.app.conftest import REPO
-from tests.app.publish.conftest import demo_with, free_port, tag_node
+from tests.app.publish.conftest import STATION_URI, demo_with, free_port, tag_node
 
 
 class Secure:
@@ -34,7 +34,8 @@ class Secure:
         self.port = free_port()
         self.runtime = demo_with(folder, f'[opcua]\nenabled = true\n'
                                          f'endpoint = "opc.tcp://0.0.0.0:{self.port}/netplc/"\n'
-                                         'writable = ["TEMP_SP"]\ncertificate_names = ["scada.plant"]\n')
+                                         'writable = ["TEMP_SP"]\ncertificate_names = ["scada.plant"]\n',
+                                 language="en")
         self.records: list = []
         self.runtime.subscribe(self.records.append)
         self.url = f"opc.tcp://127.0.0.1:{self.port}/netplc/"
@@ -116,7 +117,9 @@ def test_the_key_is_private_and_the_certificate_names_the_host(secure: Secure) -
     names = cert.extensions.get_extension_for_class(x509.SubjectAlternativeName).value
     dns = set(names.get_values_for_type(x509.DNSName))
     assert {socket.gethostname(), socket.getfqdn(), "scada.plant"} <= dns and "0.0.0.0" not in dns
-    assert names.get_values_for_type(x509.UniformResourceIdentifier) == ["urn:netplc:station:Demo station"]
+    # the demo's Russian name percent-encoded (RFC 3987 3.1): a certificate's URI is ASCII
+    encoded = "urn:netplc:station:%D0%94%D0%B5%D0%BC%D0%BE-%D1%81%D1%82%D0%B0%D0%BD%D1%86%D0%B8%D1%8F"
+    assert names.get_values_for_type(x509.UniformResourceIdentifier) == [STATION_URI] == [encoded]
 
 
 def test_an_untrusted_client_is_refused_kept_journaled_once_and_trusted_by_the_command(

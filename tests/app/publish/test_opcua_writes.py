@@ -24,7 +24,8 @@ READ, WRITE, HISTORY = 1, 2, 4  # AccessLevel bits CurrentRead, CurrentWrite, Hi
 def station(tmp_path: Path) -> Iterator[tuple[Runtime, str, list]]:
     url = f"opc.tcp://127.0.0.1:{free_port()}/netplc/"
     runtime = demo_with(tmp_path / "station",
-                        f'[opcua]\nenabled = true\nendpoint = "{url}"\nwritable = ["TEMP_SP", "TRIGGER"]\n')
+                        f'[opcua]\nenabled = true\nendpoint = "{url}"\nwritable = ["TEMP_SP", "TRIGGER"]\n',
+                        language="en")
     records: list = []
     runtime.subscribe(records.append)
     yield runtime, url, records
