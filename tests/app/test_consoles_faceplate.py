@@ -103,7 +103,7 @@ def test_the_consoles_faceplate_sets_forces_and_unforces_as_the_user_at_the_stat
     plate.entry.setText("50")
     plate.set_value()
     qtbot.waitUntil(lambda: engine.snapshot.get_word(SETPOINT) == round(100 / 200 * 4095), timeout=WAIT)
-    written = [r for r in st.records if r.kind == "operator" and (r.text or "").startswith("write ")
+    written = [r for r in st.records if r.kind == "operator" and (r.text or "").startswith("запись ")
                and "TEMP_SP" in (r.text or "")]
     assert written and (written[-1].source or "").startswith("opcua:operator@")
     assert "-> 50.0 °C" in (written[-1].text or "")
@@ -122,7 +122,7 @@ def test_the_consoles_faceplate_sets_forces_and_unforces_as_the_user_at_the_stat
     assert asked.asked[-1].startswith("Force: Force TEMP_SP to 20.0 °C?")
     qtbot.waitUntil(lambda: plate.forced.text().startswith("F forced by opcua:engineer@")
                     and plate.value.text() == "20.0 °C", timeout=WAIT)
-    forced = [r for r in st.records if r.kind == "operator" and (r.text or "").startswith("force TEMP_SP")]
+    forced = [r for r in st.records if r.kind == "operator" and (r.text or "").startswith("фиксация TEMP_SP")]
     assert forced and (forced[-1].source or "").startswith("opcua:engineer@")
     plate.unforce_value()
     qtbot.waitUntil(lambda: plate.forced.text() == "", timeout=WAIT)
