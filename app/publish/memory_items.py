@@ -29,6 +29,35 @@ logger = logging.getLogger(__name__)
 GAP = 32  # bytes between two operands below which they are watched as one range: an item costs more
 PUBLISH_MIN_MS = 20.0  # the shortest publishing interval asked (half the station's tick otherwise)
 Span = tuple[int, int]  # first and last index, both included (a NumericRange's)
+Apply = Callable[[ua.DataValue], None]  # what a monitored item's value is given to
+RETIRED_KEPT = 1024  # client handles of deleted items whose late notifications are expected
+
+
+class _Retired(logging.Filter):
+    """A publish the station sent before it deleted an item may still reach the client after
+    (Part 4 5.12.6: the queued notifications are not recalled), and asyncua warns of a
+    notification for an unknown handle at each form switched. For a handle this process's
+    consoles deleted that is expected, not a fault, and a warning for it would bury the real
+    ones in the console's log: such warnings are dropped, any other kept."""
+
+    UNKNOWN = "Received a notification for unknown handle: %s"
+
+    def __init__(self) -> None:
+        super().__init__()
+        self.handles: dict[int, None] = {}  # insertion-ordered: the oldest go first
+
+    def retire(self, handles: Iterable[int]) -> None:
+        for handle in handles:
+            self.handles[handle] = None
+        for handle in list(self.handles)[: max(0, len(self.handles) - RETIRED_KEPT)]:
+            del self.handles[handle]
+
+    def filter(self, record: logging.LogRecord) -> bool:
+        return not (record.msg == self.UNKNOWN and record.args and record.args[0] in self.handles)
+
+
+_retired = _Retired()
+logging.getLogger("asyncua.common.subscription").addFilter(_retired)
 
 
 def merge(spans: Iterable[Span], gap: int = GAP) -> tuple[Span, ...]:
@@ -111,7 +140,8 @@ class MemoryItems:
         self.client: Client | None = None  # the session the subscription is of
         self.on_batch: Callable[[], None] = lambda: None
         self._subscription: object = None
-        self._items: dict[tuple[str, Span], int] = {}  # (Bits or Data, part) -> monitored item id
+        self._items: dict[tuple[str, Span], tuple[int, int]] = {}  # (Bits or Data, part) ->
+        # (monitored item id, client handle)
         self._apply: dict[int, Callable[[ua.DataValue], None]] = {}  # by client handle
         self._handle = 0
         self._pending = False
@@ -142,19 +172,22 @@ class MemoryItems:
         assert client is not None and subscription is not None, "open() first"
         want = {("Bits", s) for s in wanted.bits} | {("Data", s) for s in wanted.data}
         new = sorted(want - self._items.keys())
-        gone = [self._items[k] for k in self._items.keys() - want]
+        gone = self._items.keys() - want
         if not new and not gone:
             return False
         targets = {"Bits": self.bits, "Data": self.data}
         parts = [(self.node(f"NetPlc.Memory.{name}"), _text(span)) for name, span in new]
         for dv, (name, span) in zip(await self._read(parts), new):
             self._part(targets[name], span[0], dv)
-        ids = await self._watch(subscription, [(node, text, self._setter(targets[name], span[0]))
-                                               for (node, text), (name, span) in zip(parts, new)])
-        self._items.update(zip(new, ids))
+        made = await self._watch(subscription, [(node, text, self._setter(targets[name], span[0]))
+                                                for (node, text), (name, span) in zip(parts, new)])
+        self._items.update(zip(new, made))
         if gone:
-            await subscription.unsubscribe(gone)  # type: ignore[attr-defined]
-            self._items = {k: v for k, v in self._items.items() if v not in gone}
+            items = [self._items.pop(k) for k in gone]
+            _retired.retire(handle for _, handle in items)
+            await subscription.unsubscribe([mid for mid, _ in items])  # type: ignore[attr-defined]
+            for _, handle in items:
+                del self._apply[handle]
         self.covered = wanted
         self.on_batch()
         return True
@@ -194,7 +227,8 @@ class MemoryItems:
         return await self.client.uaclient.read(params)
 
     async def _watch(self, subscription: object,
-                     items: list[tuple[ua.NodeId, str, Callable[[ua.DataValue], None]]]) -> list[int]:
+                     items: list[tuple[ua.NodeId, str, Apply]]) -> list[tuple[int, int]]:
+        """Each item's (monitored item id, client handle)."""
         requests = []
         for node, text, apply in items:
             self._handle += 1
@@ -208,7 +242,7 @@ class MemoryItems:
         for result in made:
             if isinstance(result, ua.StatusCode):
                 raise ua.UaStatusCodeError(result.value)  # the station's memory is not what it was
-        return [int(m) for m in made]
+        return [(int(m), r.RequestedParameters.ClientHandle) for m, r in zip(made, requests)]
 
     def _setter(self, target: bytearray, first: int) -> Callable[[ua.DataValue], None]:
         return lambda dv: self._part(target, first, dv)

@@ -3,7 +3,11 @@ memory variables (indexes of NetPlc.Memory.Bits and NetPlc.Memory.Data, both end
 
 from __future__ import annotations
 
-from app.publish.memory_items import WHOLE, Ranges, merge, ranges_of
+import logging
+
+import pytest
+
+from app.publish.memory_items import RETIRED_KEPT, WHOLE, Ranges, _retired, merge, ranges_of
 from hmi_forms.elements.analog import AnalogBase
 from hmi_forms.elements.reads import operands
 from netplc.address import BitRef, parse_octal
@@ -33,3 +37,15 @@ def test_a_forms_operands_are_all_it_reads_gates_included() -> None:
     gauge = AnalogBase(InAddr=parse_octal("04010"), QualityAddr=BitRef(parse_octal("02131")),
                        SyncType=BitRef(parse_octal("02151")))
     assert operands([gauge]) == [(0o2131, 0), (0o2151, 0), (0o4010, 2)]
+
+
+def test_a_late_notification_for_an_item_given_up_is_not_a_warning_and_any_other_is(
+        caplog: pytest.LogCaptureFixture) -> None:
+    log = logging.getLogger("asyncua.common.subscription")
+    _retired.retire([900_001])
+    with caplog.at_level(logging.WARNING, logger="asyncua.common.subscription"):
+        log.warning("Received a notification for unknown handle: %s", 900_001)
+        log.warning("Received a notification for unknown handle: %s", 900_002)
+    assert [r.getMessage() for r in caplog.records] == ["Received a notification for unknown handle: 900002"]
+    _retired.retire(range(1_000_000, 1_000_000 + RETIRED_KEPT))  # bounded: the oldest forgotten
+    assert 900_001 not in _retired.handles and len(_retired.handles) == RETIRED_KEPT
