@@ -104,7 +104,7 @@ class Reactor:
         def call() -> None:
             try:
                 future.set_result(fn())
-            except Exception as e:  # handed to the caller, who raises it
+            except Exception as e:  # no log: handed to the caller, who raises it
                 future.set_exception(e)
 
         self.call(call)
