@@ -12,6 +12,7 @@ from __future__ import annotations
 import errno
 import functools
 import logging
+import os
 import socket
 import time
 from collections import deque
@@ -47,6 +48,7 @@ class ServerLimits:
     max_per_peer: int = 4  # connections from one address (within max_connections); the next is closed
 
 
+ACCEPT_RETRY = 1.0  # s without accepting after accept() ran out of descriptors or memory
 TURN = 128  # requests a connection is answered in a row before every other connection's turn
 
 
@@ -322,6 +324,7 @@ class TcpServer:
         self.peers: dict[str, int] = {}  # open connections by the peer's address
         self.reactor: Reactor = None  # type: ignore[assignment]  # set by listen
         self._sock: socket.socket | None = None
+        self._accepting = False  # the listening socket is registered with the reactor
         self._sweep: Timer | None = None
         self._finished: deque[tuple[_Connection, list[Any], bytes]] = deque()
         self._wake = False
@@ -329,12 +332,14 @@ class TcpServer:
         self.port = 0
 
     def bind(self, host: str, port: int) -> None:
-        """Any thread: OSError if the address cannot be bound."""
-        family = socket.AF_INET6 if ":" in host else socket.AF_INET
+        """Any thread: OSError if the address cannot be bound (a name: its first address)."""
+        family, _, _, _, address = socket.getaddrinfo(host or None, port, type=socket.SOCK_STREAM,
+                                                      flags=socket.AI_PASSIVE)[0]
         sock = socket.socket(family, socket.SOCK_STREAM)
         try:
-            sock.setsockopt(socket.SOL_SOCKET, socket.SO_REUSEADDR, 1)
-            sock.bind((host, port))
+            if os.name == "posix":  # as asyncio: a restart binds at once; on Windows it would share the port
+                sock.setsockopt(socket.SOL_SOCKET, socket.SO_REUSEADDR, 1)
+            sock.bind(address)
             sock.listen(128)
             sock.setblocking(False)
         except OSError:
@@ -348,6 +353,7 @@ class TcpServer:
         assert self._sock is not None
         self.reactor = reactor
         reactor.selector.register(self._sock, READ, self)
+        self._accepting = True
         self._schedule_sweep()
 
     def ready(self, events: int) -> None:
@@ -362,6 +368,7 @@ class TcpServer:
             except OSError as e:  # out of file descriptors, ...: one line per cause a minute
                 self.note(f"accept {e.errno}", f"Modbus server: accept() failed: {e}")
                 if e.errno in (errno.EMFILE, errno.ENFILE, errno.ENOBUFS, errno.ENOMEM):
+                    self._pause_accepting()  # as asyncio does: not a busy loop until one is free
                     return
                 continue
             peer = f"{address[0]}:{address[1]}"
@@ -382,6 +389,19 @@ class TcpServer:
             self.connections.add(conn)
             peers[host] = peers.get(host, 0) + 1
             self.reactor.selector.register(sock, READ, conn)
+
+    def _pause_accepting(self) -> None:
+        """Accept nothing for ACCEPT_RETRY seconds: the listening socket stays readable meanwhile."""
+        sock, selector = self._sock, self.reactor.selector
+        selector.unregister(sock)
+        self._accepting = False
+
+        def resume() -> None:
+            if self._sock is sock:  # else closed meanwhile
+                selector.register(sock, READ, self)
+                self._accepting = True
+
+        self.reactor.later(ACCEPT_RETRY, resume)
 
     def lost(self, conn: _Connection) -> None:
         if conn in self.connections:
@@ -427,8 +447,9 @@ class TcpServer:
             self._sweep.cancel()
         sock, self._sock = self._sock, None
         if sock is not None:
-            if self.reactor is not None:
+            if self._accepting:
                 self.reactor.selector.unregister(sock)
+                self._accepting = False
             sock.close()
         for conn in list(self.connections):
             conn.abort()
