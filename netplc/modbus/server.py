@@ -146,7 +146,13 @@ class ModbusServer:
         self._server.bind(self.host, self.requested_port)
         if self._own_thread:
             self._thread.start()
-        self._thread.run(lambda: self._server.listen(self._thread))
+        try:
+            self._thread.run(lambda: self._server.listen(self._thread))
+        except Exception:
+            self._server.close()
+            if self._own_thread:
+                self._thread.stop()
+            raise
 
     def stop(self) -> None:
         if self.rtu is not None:
