@@ -1,11 +1,11 @@
 """Block reads per second, data age and NetPlc CPU use of the exchange, for K = 1 ... 256 nodes.
 
-K simulated CPU-165 nodes (an engine + a Modbus TCP server each, all served by one event-loop
-thread and scanned by one thread, each every 100 ms, spread over the tick) run in a separate
-process; this process runs NetPlc: an engine on its scan thread whose program, for every node,
-selects it with NODE and NREADs 64 bytes (32 registers) of its data memory on every scan, and
-the exchange (its Modbus TCP thread: one epoll selector over the nodes' non-blocking sockets, a
-request in flight on every node at once). Runs per K:
+K simulated CPU-165 nodes (an engine + a Modbus TCP server each, all served by one selector
+thread, netplc/modbus/reactor.py, and scanned by one thread, each every 100 ms, spread over the
+tick) run in a separate process; this process runs NetPlc: an engine on its scan thread whose
+program, for every node, selects it with NODE and NREADs 64 bytes (32 registers) of its data
+memory on every scan, and the exchange (its Modbus TCP thread: one epoll selector over the nodes'
+non-blocking sockets, a request in flight on every node at once). Runs per K:
 
 - tick 100 ms (the default NetSyncTime): every node must be fully refreshed on every tick, i.e.
   K x 10 block reads per second with the data 1 scan old (age = scans from the NREAD that
@@ -84,13 +84,13 @@ def serve(k: int) -> None:
     import threading
 
     from netplc.engine import Engine
-    from netplc.modbus import LoopThread, ModbusServer
+    from netplc.modbus import ModbusServer, Reactor
     from netplc.simulator import EngineMemory
 
-    loop = LoopThread("nodes")
-    loop.start()
+    reactor = Reactor("nodes")
+    reactor.start()
     engines = [Engine(parse(NODE_PROGRAM, "node.stl"), tick=0.1) for _ in range(k)]
-    servers = [ModbusServer(EngineMemory(e), loop=loop) for e in engines]
+    servers = [ModbusServer(EngineMemory(e), reactor=reactor) for e in engines]
     for s in servers:
         s.start()
     stop = threading.Event()
@@ -107,7 +107,7 @@ def serve(k: int) -> None:
     stop.set()
     for s in servers:
         s.stop()
-    loop.stop()
+    reactor.stop()
 
 
 def cpu_seconds(pid: int) -> float:

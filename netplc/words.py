@@ -36,6 +36,7 @@ WORDS = {
                  "(idle_timeout)",
     "idle nothing": "Modbus server closed the connection of {peer}: nothing received for {idle:g} s "
                     "(idle_timeout)",
+    "accept failed": "Modbus server: accept() failed: {error}",
     "more like it": "{text} (and {n} more like it in the last minute)",
     "rtu cannot open": "Modbus RTU on {port} cannot be opened: {error}",
     "rtu failed": "Modbus RTU on {port} failed: {error}",

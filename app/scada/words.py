@@ -405,6 +405,7 @@ TEXTS: dict[str, dict[str, str]] = {
         "idle half": "сервер Modbus закрыл соединение {peer}: полкадра за {idle:g} с (idle_timeout)",
         "idle nothing": "сервер Modbus закрыл соединение {peer}: ничего не получено за {idle:g} с "
                         "(idle_timeout)",
+        "accept failed": "сервер Modbus: accept() не удался: {error}",
         "more like it": "{text} (и ещё таких за последнюю минуту: {n})",
         "rtu cannot open": "Modbus RTU на {port}: порт не открывается: {error}",
         "rtu failed": "Modbus RTU на {port}: отказ: {error}",

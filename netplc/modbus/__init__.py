@@ -41,6 +41,7 @@ from netplc.modbus.pdu import (
     ServeHandler,
     exception_text,
 )
+from netplc.modbus.reactor import Reactor
 from netplc.modbus.rtu import REOPEN
 from netplc.modbus.server import ALL_MEMORY, MemoryServed, ModbusServer
 from netplc.modbus.tcp_server import ServerLimits
@@ -74,6 +75,7 @@ __all__ = [
     "MemoryWrite",
     "ModbusClient",
     "ModbusServer",
+    "Reactor",
     "ServeHandler",
     "ServerLimits",
     "Table",

@@ -1,4 +1,4 @@
-"""The event-loop thread the exchange and the Modbus servers run on."""
+"""The event-loop thread of the asyncio clients: serial lines and pymodbus in the exchange, the monitors."""
 
 from __future__ import annotations
 
@@ -11,7 +11,7 @@ T = TypeVar("T")
 
 
 class LoopThread:
-    """An asyncio event loop on a thread of its own: the exchange and the server run there, so
+    """An asyncio event loop on a thread of its own: the clients run there, so
     neither the scan thread nor the GUI thread ever waits on a socket."""
 
     def __init__(self, name: str) -> None:

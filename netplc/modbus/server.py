@@ -19,7 +19,6 @@ from typing import Protocol
 from netplc.address import fmt_octal
 from netplc.memory import Snapshot
 from netplc.modbus.endpoint import Endpoint
-from netplc.modbus.loop import LoopThread
 from netplc.modbus.map import (
     MemoryWrite,
     Table,
@@ -29,6 +28,7 @@ from netplc.modbus.map import (
     register_slice,
 )
 from netplc.modbus.pdu import ILLEGAL_ADDRESS, Done, ServeHandler
+from netplc.modbus.reactor import Reactor
 from netplc.modbus.rtu import RtuServer, SerialLine, open_line
 from netplc.modbus.tcp_server import ServerLimits, TcpServer
 from netplc.records import Record, RecordSink
@@ -87,15 +87,15 @@ class ModbusServer:
     `handler` is what is served (`ServeHandler`: usually a `MemoryServed`).
     `unit` None answers every unit id; otherwise other unit ids get exception 0x0B.
     `limits` bounds what clients may hold (connections, per peer, idle time, requests in flight).
-    `loop`: an event-loop thread to listen on, shared with other servers (many simulated nodes in
-    one process); by default the server has a thread of its own.
+    `reactor`: the thread to answer on, shared with other servers (many simulated nodes in one
+    process); by default the server has a thread of its own.
     `sink` takes the server's own 'system' records (refused connections, a serial port fault);
     without one they go to the log.
     """
 
     def __init__(self, handler: ServeHandler, host: str = "127.0.0.1", port: int = 0,
                  unit: int | None = None, serial: Endpoint | None = None,
-                 limits: ServerLimits | None = None, loop: LoopThread | None = None,
+                 limits: ServerLimits | None = None, reactor: Reactor | None = None,
                  sink: RecordSink | None = None, words: Say = english) -> None:
         self.handler = handler
         self.words = words  # the station's words for its records (netplc/words.py)
@@ -106,8 +106,8 @@ class ModbusServer:
         self.sink = sink
         self.rtu: RtuServer | None = None
         self._server = TcpServer(handler, unit, limits, self.journal, words)
-        self._own_thread = loop is None
-        self._thread = loop or LoopThread(f"modbus-server-{host}:{port}")
+        self._own_thread = reactor is None
+        self._thread = reactor or Reactor(f"modbus-server-{host}:{port}")
 
     @property
     def port(self) -> int:
@@ -145,11 +145,13 @@ class ModbusServer:
                                  reopen=lambda: open_line(serial), note=self.journal, words=self.words)
             self.rtu.start(fault)
             return
+        self._server.bind(self.host, self.requested_port)
         if self._own_thread:
             self._thread.start()
         try:
-            self._thread.run(self._server.listen(self.host, self.requested_port))
+            self._thread.run(lambda: self._server.listen(self._thread))
         except Exception:
+            self._server.close()
             if self._own_thread:
                 self._thread.stop()
             raise
@@ -158,7 +160,9 @@ class ModbusServer:
         if self.rtu is not None:
             self.rtu.stop()
             self.rtu = None
-        if self._thread.loop is not None:
-            self._thread.run(self._server.close())
+        if self._thread.running:
+            self._thread.run(self._server.close)
+        else:
+            self._server.close()
         if self._own_thread:
             self._thread.stop()
