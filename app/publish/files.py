@@ -56,17 +56,19 @@ def station_parts(station: Station) -> dict[str, Path]:
     return {part: path for part, path in paths.items() if path is not None}
 
 
-def _inside(path: Path, folder: Path) -> str | None:
+def _inside(path: Path, root: Path) -> str | None:
+    """`path` relative to `root` (resolved already: the scan looks at every file each second)."""
     try:
-        return path.resolve().relative_to(folder.resolve()).as_posix()
+        return path.resolve().relative_to(root).as_posix()
     except ValueError:
         return None
 
 
 def manifest_of(station: Station, files: dict[str, Served]) -> str:
     """The manifest's JSON: the station, its language and tick, its parts and its files' hashes."""
+    root = station.folder.resolve()
     parts = {part: rel for part, path in station_parts(station).items()
-             if (rel := _inside(path, station.folder)) is not None}
+             if (rel := _inside(path, root)) is not None}
     return json.dumps({"station": station.name, "language": station.Language, "tick_ms": station.NetSyncTime,
                        "parts": parts, "files": {rel: f.sha256 for rel, f in sorted(files.items())}},
                       ensure_ascii=False, sort_keys=True)
@@ -74,7 +76,7 @@ def manifest_of(station: Station, files: dict[str, Served]) -> str:
 
 def scan(station: Station, before: dict[str, Served]) -> dict[str, Served]:
     """The files to serve now (off the server's loop: it reads the disk)."""
-    folder = station.folder
+    folder = station.folder.resolve()
     found: list[Path] = []
     for part, path in station_parts(station).items():
         if _inside(path, folder) is None:
