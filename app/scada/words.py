@@ -13,10 +13,13 @@ exchange this catalogue to say them."""
 from __future__ import annotations
 
 import os
-from collections.abc import Callable, Mapping, Sequence
-from dataclasses import dataclass, field
+from collections.abc import Callable, Sequence
+from dataclasses import dataclass
 
 from netplc.words import WORDS as NETPLC_WORDS
+from netplc.words import Phrase as Phrase
+from netplc.words import WordedError
+from netplc.words import phrase as phrase
 
 TEXTS: dict[str, dict[str, str]] = {
     "en": {
@@ -420,6 +423,62 @@ TEXTS: dict[str, dict[str, str]] = {
         "cannot force": "нельзя зафиксировать {kind} {addr}: {error}",
         "does not fit": "{value} не помещается в {kind} (0..{most})",
         "force NaN": "нельзя зафиксировать {name} в значении NaN",
+        "addr not octal": "{text!r} — не восьмеричное число",
+        "addr not data": "{addr} — не адрес памяти данных",
+        "addr past io": "{addr}: операнд из байтов ({n}) выходит за бит 03777",
+        "addr not valid": "{addr} — недопустимый адрес",
+        "addr past bank": "{addr}: операнд из байтов ({n}) выходит за конец своего банка",
+        "addr not bit": "{addr} — ни бит ввода-вывода, ни бит данных (байт*8+бит)",
+        "addr not io bit": "{addr} — не бит ввода-вывода",
+        "addr not hmi bit": "{addr} — не адрес бита ЧМИ",
+        "addr bit past": "бит {k} от {addr} выходит за бит 03777",
+        "addr not bytes": "{first}..{last} — не целое число байтов",
+        "addr mixes": "{first}..{last} смешивает биты ввода-вывода и память данных",
+        "addr missing": "нет операнда",
+        "addr no memory": "{addr} не называет памяти: ни бит ввода-вывода (00000-03777), ни байт данных "
+                          "(k*010000 + 04000-07777), ни бит данных (байт*8 + бит)",
+        "addr too long": "адрес длиной {n} знаков не называет памяти",
+        "sym no address": "у символа {name!r} нет адреса",
+        "sym bad name": "{name!r} — недопустимое имя символа",
+        "sym twice": "символ {name!r} определён дважды",
+        "stl too big": "программе нужно слов: {words}; память программ вмещает {most}",
+        "stl symbol not octal": "символ {name!r}: {value!r} — не восьмеричный адрес $",
+        "stl label twice": "метка {label!r} определена дважды",
+        "stl expected": "ожидается инструкция",
+        "stl unknown": "неизвестная инструкция {op!r}{hint}",
+        "stl label hint": " (после метки нужно двоеточие: '{name}:')",
+        "stl cannot read": "не удаётся прочесть параметр в {text!r}",
+        "stl no value": "{key}: нет значения",
+        "stl no more": "{op} больше параметров не принимает (лишний {token!r})",
+        "stl no such param": "у {op} нет параметра {key}:",
+        "stl takes none": "{op} не принимает параметров",
+        "stl given twice": "параметр {key}: задан дважды",
+        "stl not octal address": "{key}: {token!r} — не восьмеричный адрес",
+        "stl offset long": "{key}: смещение бита от {name!r} длиннее {n} цифр",
+        "stl unknown symbol": "{key}: неизвестный символ {token!r}",
+        "stl operand": "{key}: {error}",
+        "stl needs c": "{op} нужен C: (адрес бита)",
+        "stl not io bit": "C: {addr} — не бит ввода-вывода (00000-03777)",
+        "stl coil past": "C: {op} занимает биты {first}-{last}, за битом ввода-вывода 03777",
+        "stl const not address": "{key}: здесь нужна константа, а не адрес {token!r}",
+        "stl not bcd": "{key}: {token!r} — не двоично-десятичная константа (до 4 десятичных цифр)",
+        "stl not octal const": "{key}: {token!r} — не восьмеричное число",
+        "stl not decimal": "{key}: {token!r} — не десятичное число",
+        "stl outside": "{key}: {token} вне {bounds}",
+        "stl needs label": "{op} нужна метка",
+        "stl not program address": "L: {token!r} — не восьмеричный адрес программы",
+        "stl not start": "L: адрес программы {token} — не начало инструкции",
+        "stl undefined label": "L: метка {token!r} не определена",
+        "stl needs preset": "{op} нужен N: (уставка 0-255)",
+        "stl fon needs n": "FON нужен N: (номер или мнемоника функции)",
+        "stl not function number": "N: {token!r} — не номер функции",
+        "stl no function": "N: функции {number} нет",
+        "stl unknown function": "N: неизвестная функция {token!r}",
+        "stl fon no more": "FON {name} больше параметров не принимает (лишний {token!r})",
+        "stl takes no key": "{name} не принимает параметра {key}:",
+        "stl needs key": "{name} нужен {key}: ({kind})",
+        "stl kind M": "адрес", "stl kind O": "восьмеричная константа", "stl kind D": "десятичная константа",
+        "stl kind B": "двоично-десятичная константа",
         "modbus not started": "сервер Modbus не запущен: {path}: modbus_server.port: нельзя слушать "
                               "{host}:{port}: {error}",
         "modbus not yet": "сервер Modbus ещё не запущен: {path}: modbus_server.port: {fault}; новая попытка "
@@ -619,18 +678,6 @@ def system_language() -> str:
 
 
 @dataclass(frozen=True)
-class Phrase:
-    """A part of a sentence, said in the sentence's language when the sentence is said."""
-
-    name: str
-    values: Mapping[str, object] = field(default_factory=dict)
-
-
-def phrase(name: str, /, **values: object) -> Phrase:
-    return Phrase(name, values)
-
-
-@dataclass(frozen=True)
 class Phrases:
     """Parts said one after the other, joined by `sep` (a restore's problems, one per file)."""
 
@@ -654,6 +701,8 @@ class Words:
         """A value as it goes into a sentence: a phrase said in this language, the rest as it is."""
         if isinstance(value, Phrases):
             return value.sep.join(str(self.say(part)) for part in value.parts)
+        if isinstance(value, WordedError):  # an address's problem, a reader's (netplc/words.py)
+            value = value.phrase
         return self(value.name, **value.values) if isinstance(value, Phrase) else value
 
     @property

@@ -181,7 +181,7 @@ def test_each_bad_input_is_named_by_check_and_by_the_start(tmp_path: Path, case:
     from app.station.runtime import Runtime
     from netplc.problems import Problems
 
-    st = copy_demo(tmp_path / "st")
+    st = copy_demo(tmp_path / "st", "en")  # the cases name their problems in English (test_check: ru)
     expected = case.plant(st)
     report = check_station(st)
     assert any(p.startswith(expected) for p in report.problems), (expected, report.problems)

@@ -63,7 +63,7 @@ def test_every_planted_error_is_found(tmp_path: Path) -> None:
         f"{st / 'station.toml'}: NetSyncTime: ожидается целое число, а задано 'fast'",  # the demo's ru
         f"{st / 'station.toml'}: Colour: неизвестный параметр",
         f"{st / 'station.toml'}: nodes[0].endpoint: endpoint 'tcp://plc:99999'",
-        f"{st / 'netplc.stl'}:{tnx}:1: unknown instruction 'TNX'",
+        f"{st / 'netplc.stl'}:{tnx}:1: неизвестная инструкция 'TNX'",
         f"{st / 'netplc.stl'}:{nosuch}:",
         f"{st / 'netplc.stl'}:{node7}:1: NODE S:7: node 7 is not configured",  # found past other errors
         f"{st / 'symbols.csv'}:",
@@ -140,7 +140,6 @@ def test_station_toml_problems_are_said_in_the_station_language(tmp_path: Path, 
     naming the file, the key and the value as they are; a Russian one leaves no English word of
     the catalogue."""
     from app.station.check import check_station
-    from tests.app.scada.test_words import english_words
 
     st = copy_demo(tmp_path / "st", language)
     plant(st / "station.toml", "NetSyncTime = 100", 'NetSyncTime = "fast"\nColour = "red"\nkeep_days = -5')
@@ -163,9 +162,54 @@ def test_station_toml_problems_are_said_in_the_station_language(tmp_path: Path, 
     outside = "вне папки станции" if language == "ru" else "is outside the station folder"
     assert any(p.startswith("Retain: ") and outside in p for p in problems), problems
     if language == "ru":
-        prose = (re.sub(r"\S*[/.:]\S*|'[^']*'|\b[A-Za-z_]+ = \w+", "", p) for p in problems)
-        left = {w for p in prose for w in re.findall(r"[A-Za-z]{2,}", p)} & english_words()
-        assert not left, f"English words in a Russian station.toml's problems: {sorted(left)}: {problems}"
+        russian_leaves_no_english(problems)
+
+
+def russian_leaves_no_english(problems: list[str]) -> None:
+    """No English word of the catalogue in Russian problems, past file names, quoted values and
+    names as they are."""
+    from tests.app.scada.test_words import english_words
+
+    prose = (re.sub(r"\S*[/.:]\S*|'[^']*'|\b[A-Za-z_]+ = \w+", "", p) for p in problems)
+    left = {w for p in prose for w in re.findall(r"[A-Za-z]{2,}", p)} & english_words()
+    assert not left, f"English words in Russian problems: {sorted(left)}: {problems}"
+
+
+@pytest.mark.parametrize("language", ["ru", "en"])
+def test_program_and_symbols_problems_are_said_in_the_station_language(tmp_path: Path, language: str) -> None:
+    """The program reader's diagnostics (instruction, operand, address, jump, a function's
+    parameters) and symbols.csv's, naming file, line, column and the text as it is."""
+    from app.station.check import check_station
+
+    st = copy_demo(tmp_path / "st", language)
+    stl = st / "netplc.stl"
+    program = stl.read_text(encoding="utf-8").splitlines()
+    stl.write_text("\n".join(program + ["TNX ON", "FON C:$02500 N:MOV S:$10000 D:$04000", "JMP NOWHERE",
+                                        "FON C:$02504 N:MOV S:$04000", "TIM $02510 N:999"]) + "\n",
+                   encoding="utf-8")
+    plant(st / "symbols.csv", "PUMP,02120", "PUMP,02190")
+    n = len(program)
+    symbol = next(i for i, line in enumerate((st / "symbols.csv").read_text(encoding="utf-8").splitlines(), 1)
+                  if line.startswith("PUMP,"))
+    problems = check_station(st).problems
+    said = {
+        "ru": [f"{stl}:{n + 1}:1: неизвестная инструкция 'TNX'",
+               f"{stl}:{n + 2}:22: S: 010000 — недопустимый адрес",
+               f"{stl}:{n + 3}:5: L: метка 'NOWHERE' не определена",
+               f"{stl}:{n + 4}:1: MOV нужен D: (адрес)",
+               f"{stl}:{n + 5}:14: N: 999 вне 0-255",
+               f"{st / 'symbols.csv'}:{symbol}:6: '02190' — не восьмеричное число"],
+        "en": [f"{stl}:{n + 1}:1: unknown instruction 'TNX'",
+               f"{stl}:{n + 2}:22: S: 010000 is not a valid address",
+               f"{stl}:{n + 3}:5: L: undefined label 'NOWHERE'",
+               f"{stl}:{n + 4}:1: MOV needs D: (an address)",
+               f"{stl}:{n + 5}:14: N: 999 is outside 0-255",
+               f"{st / 'symbols.csv'}:{symbol}:6: '02190' is not an octal number"],
+    }[language]
+    for line in said:
+        assert line in problems, f"{line!r} not in {problems}"
+    if language == "ru":
+        russian_leaves_no_english([p for p in problems if p.startswith((str(stl), str(st / "symbols.csv")))])
 
 
 @pytest.mark.parametrize("language", ["ru", "en"])
