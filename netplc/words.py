@@ -131,12 +131,17 @@ def phrase(name: str, /, **values: object) -> Phrase:
 
 
 class WordedError(ValueError):
-    """An error whose text is a `Phrase`: English as `str()`, said in a station's language by a
-    host that reports it (`said`)."""
+    """An error whose text is a `Phrase`: English as `str()` (`in_english`, this catalogue's; a
+    subclass of app names its own), said in a station's language by a host that reports it."""
+
+    in_english: Say
 
     def __init__(self, name: str, /, **values: object) -> None:
         self.phrase = Phrase(name, values)
-        super().__init__(english(name, **values))
+        super().__init__(name)
+
+    def __str__(self) -> str:
+        return str(said(type(self).in_english, self.phrase))
 
 
 def said(say: Say, value: object) -> object:
@@ -148,3 +153,6 @@ def said(say: Say, value: object) -> object:
 
 def english(name: str, /, **values: object) -> str:
     return WORDS[name].format(**{k: said(english, v) for k, v in values.items()})
+
+
+WordedError.in_english = english

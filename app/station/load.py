@@ -96,7 +96,7 @@ def load_station_forms(station: Station, symbols: dict[str, int],
     from hmi_forms.form import load_forms  # the form code loads only for a station that has forms
 
     return load_forms(station.HMIload, symbols, station=station.folder, allow_outside=station.allow_outside,
-                      tags=tags)
+                      tags=tags, say=words(station.Language))
 
 
 def _symbols(path: Path | None, out: Loaded, say: Words) -> dict[str, int]:
