@@ -151,8 +151,14 @@ def said(say: Say, value: object) -> object:
     return say(value.name, **value.values) if isinstance(value, Phrase) else value
 
 
-def english(name: str, /, **values: object) -> str:
-    return WORDS[name].format(**{k: said(english, v) for k, v in values.items()})
+def speaker(table: Mapping[str, str]) -> Say:
+    """The English `Say` of a catalogue (this one; registrar/words.py's)."""
+    def say(name: str, /, **values: object) -> str:
+        return table[name].format(**{k: said(say, v) for k, v in values.items()})
+    return say
+
+
+english = speaker(WORDS)
 
 
 WordedError.in_english = english

@@ -20,6 +20,7 @@ from netplc.words import WORDS as NETPLC_WORDS
 from netplc.words import Phrase as Phrase
 from netplc.words import WordedError
 from netplc.words import phrase as phrase
+from registrar.words import WORDS as REGISTRAR_WORDS
 
 TEXTS: dict[str, dict[str, str]] = {
     "en": {
@@ -108,7 +109,16 @@ TEXTS: dict[str, dict[str, str]] = {
         "no user": "no user {name!r}", "no such role": "role {role!r} is not one of {roles}",
         "empty password": "the password is empty", "passwords differ": "the two passwords differ",
         "password changed": "password of {user} changed",
+        # users.json's reader (app/authority/users.py): keys, names and roles as they are
+        "users user": "{file}: user {name!r}", "users twice": "listed twice",
+        "users not object": "expected an object with name, role, salt and hash",
+        "users missing": "{keys} missing (each a text)",
+        "users not hex": "salt and hash must be hexadecimal (set the password again: `main.py users passwd`)",
+        "users bad json": "not a users file: bad JSON at line {line}, column {col}: {error}",
+        "users not json": "not a users file: {kind}",
+        "users no list": 'not a users file: expected {{"users": [...]}}, as `main.py users` writes it',
         **NETPLC_WORDS,
+        **REGISTRAR_WORDS,
         # the station's problems and its servers' starts (app/station/runtime.py, app/publish/station.py)
         "modbus not started": "Modbus server not started: {path}: modbus_server.port: cannot listen on "
                               "{host}:{port}: {error}",
@@ -615,6 +625,20 @@ TEXTS: dict[str, dict[str, str]] = {
         "not a pair": "станция не входит в пару горячего резерва ([redundancy])",
         "handing over": "IntoStandBy: роль основной переходит к партнёру",
         "station quit": "выход из станции",
+        "users user": "{file}: пользователь {name!r}", "users twice": "указан дважды",
+        "users not object": "ожидается объект с name, role, salt и hash",
+        "users missing": "нет {keys} (каждый — текст)",
+        "users not hex": "salt и hash должны быть шестнадцатеричными (задайте пароль снова: `main.py users "
+                         "passwd`)",
+        "users bad json": "не файл пользователей: ошибка JSON в строке {line}, столбце {col}: {error}",
+        "users not json": "не файл пользователей: {kind}",
+        "users no list": 'не файл пользователей: ожидается {{"users": [...]}}, как пишет `main.py users`',
+        "msg fields": "ожидается number,group,type,text, а полей {n}",
+        "msg type": "type {kind} — не один из: 0 info, 1 warning, 2 alarm, 3 critical",
+        "msg no text": "у сообщения {number} нет текста",
+        "msg not whole": "{name} {text} — не целое неотрицательное число",
+        "msg past": "{name} {value} больше {most}, наибольшего, что вмещает архив",
+        "msg defined": "сообщение {number} уже определено в строке {line}",
         "form as is": "{error}",
         "form expected text": "ожидается текст, а задано {value}",
         "form expected bool": "ожидается true или false, а задано {value}",

@@ -72,7 +72,7 @@ def load(station: Station, parse_cache: Path | None = None) -> Loaded:
             out.catalog = Catalog.load(station.Messages)
             out.notes.append(phrase("note messages", file=station.Messages.name, n=len(out.catalog)))
         except CatalogError as e:
-            out.problems += e.problems
+            out.problems += e.said(say)
     if station.Tags is not None:
         out.tags, problems = read_tags(station.Tags, out.symbols, say)
         out.problems += problems
@@ -120,7 +120,7 @@ def _users(station: Station, out: Loaded) -> None:
         out.problems.append(str(e))
         return
     except UsersFileError as e:
-        out.problems += e.problems
+        out.problems += e.said(words(station.Language))
         return
     name = station.operator.default_user
     user = users.get(name)

@@ -178,8 +178,8 @@ def russian_leaves_no_english(problems: list[str]) -> None:
 @pytest.mark.parametrize("language", ["ru", "en"])
 def test_readers_problems_are_said_in_the_station_language(tmp_path: Path, language: str) -> None:
     """The program reader's diagnostics (instruction, operand, address, jump, a function's
-    parameters), symbols.csv's and the forms', naming file, line, column, element, property and
-    the text as it is."""
+    parameters), symbols.csv's, the forms', messages.csv's and users.json's, naming file, line,
+    column, element, property, user and the text as it is."""
     from app.station.check import check_station
 
     st = copy_demo(tmp_path / "st", language)
@@ -196,7 +196,12 @@ def test_readers_problems_are_said_in_the_station_language(tmp_path: Path, langu
         {"type": "NoSuchElement", "Name": "Alien", "x": 0, "y": 0, "w": 10, "h": 10},
         {"type": "AnalogBase", "Name": "Gauge", "x": 0, "y": 0, "w": 10, "h": 10, "InAddr": "04000",
          "AppMin": 0, "AppMax": 0, "PhyMin": 0, "PhyMax": 100}]}), encoding="utf-8")
+    plant(st / "messages.csv", "3,1,2,", "3,1,alarm,")
+    users = [{"name": "ivanov", "role": "boss", "salt": "00", "hash": "00"}, {"name": "petrov"}]
+    (st / "users.json").write_text(json.dumps({"users": users}), encoding="utf-8")
     n = len(program)
+    messages = (st / "messages.csv").read_text(encoding="utf-8").splitlines()
+    message = next(i for i, line in enumerate(messages, 1) if line.startswith("3,1,alarm,"))
     symbol = next(i for i, line in enumerate((st / "symbols.csv").read_text(encoding="utf-8").splitlines(), 1)
                   if line.startswith("PUMP,"))
     problems = check_station(st).problems
@@ -210,7 +215,10 @@ def test_readers_problems_are_said_in_the_station_language(tmp_path: Path, langu
                f"{form}: form: Font: размер шрифта 1 вне диапазона 4..200",
                f'{form}: элемент "Broken": InAddr: 010000 — ни бит ввода-вывода, ни бит данных (байт*8+бит)',
                f"{form}: элемент \"Alien\": type: неизвестный тип элемента 'NoSuchElement' (типы: ",
-               f'{form}: элемент "Gauge": AppMax: равно AppMin (0): преобразование не определено'],
+               f'{form}: элемент "Gauge": AppMax: равно AppMin (0): преобразование не определено',
+               f"{st / 'messages.csv'}:{message}: type 'alarm' — не целое неотрицательное число",
+               f"{st / 'users.json'}: пользователь 'ivanov': роль 'boss' — не одна из: ",
+               f"{st / 'users.json'}: пользователь 'petrov': нет role, salt, hash (каждый — текст)"],
         "en": [f"{stl}:{n + 1}:1: unknown instruction 'TNX'",
                f"{stl}:{n + 2}:22: S: 010000 is not a valid address",
                f"{stl}:{n + 3}:5: L: undefined label 'NOWHERE'",
@@ -220,7 +228,10 @@ def test_readers_problems_are_said_in_the_station_language(tmp_path: Path, langu
                f"{form}: form: Font: font size 1 is out of range 4..200",
                f'{form}: element "Broken": InAddr: 010000 is neither an I/O bit nor a data bit (byte*8+bit)',
                f"{form}: element \"Alien\": type: unknown element type 'NoSuchElement' (types: ",
-               f'{form}: element "Gauge": AppMax: equals AppMin (0): the conversion is undefined'],
+               f'{form}: element "Gauge": AppMax: equals AppMin (0): the conversion is undefined',
+               f"{st / 'messages.csv'}:{message}: type 'alarm' is not a non-negative whole number",
+               f"{st / 'users.json'}: user 'ivanov': role 'boss' is not one of ",
+               f"{st / 'users.json'}: user 'petrov': role, salt, hash missing (each a text)"],
     }[language]
     for line in said:
         assert any(p.startswith(line) for p in problems), f"{line!r} not in {problems}"
