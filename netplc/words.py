@@ -113,6 +113,31 @@ WORDS = {
     "stl needs key": "{name} needs {key}: ({kind})",
     "stl kind M": "an address", "stl kind O": "an octal constant", "stl kind D": "a decimal constant",
     "stl kind B": "a BCD constant",
+    # a node's settings (netplc/exchange.py node_problems, netplc/modbus/endpoint.py): values as they are
+    "ep forms": "expected tcp://host:port, rtu:///dev/ttyX?baudrate=19200&parity=E or rtu://COM3?baudrate=...",
+    "ep wrong": "endpoint {text!r}: {error} ({forms})",
+    "ep no host": "endpoint {text!r}: no host ({forms})",
+    "ep tcp path": "endpoint {text!r}: a tcp endpoint has no path or options ({forms})",
+    "ep bad host": "endpoint {text!r}: {host!r} is not a valid host name",
+    "ep no device": "endpoint {text!r}: the serial device must follow rtu:// ({forms})",
+    "ep parity": "endpoint {text!r}: parity {value!r} is not N, E or O",
+    "ep not positive": "endpoint {text!r}: {key} {value!r} is not a positive number",
+    "ep option": "endpoint {text!r}: unknown option {key!r} (baudrate, parity, bytesize, stopbits)",
+    "ep line": "endpoint {text!r}: {problem}",
+    "ep scheme": "endpoint {text!r}: unknown scheme {scheme!r} ({forms})",
+    "line not one of": "{key} {value!r} is not one of {allowed}",
+    "node outside": "{node} is outside {lo}-{hi}",
+    "node unit": "unit {unit} is not {lo}-{hi} on {scheme}{why}",
+    "node unit why": " (0 is broadcast, which never answers; 248-255 are reserved)",
+    "node not one of": "{value!r} is not one of {names}",
+    "node count outside": "{value} is outside {least:g}-{most:g}",
+    "node seconds outside": "{value:g} s is outside {least:g}-{most:g} s",
+    "node name": "{name!r} may not hold '/', '+', '#', control characters or outer spaces (it names the "
+                 "node in topics and paths)",
+    "node backoff": "{backoff:g} s is more than backoff_max {most:g} s",
+    "node twice": "node {node} is configured twice",
+    "node title used": "{title!r} already names node {node}",
+    "node shared line": "{endpoint} and node {node}'s {first} share {device} with different line settings",
 }
 Say = Callable[..., str]  # `say(name, **values)`: a record's text
 

@@ -178,8 +178,8 @@ def russian_leaves_no_english(problems: list[str]) -> None:
 @pytest.mark.parametrize("language", ["ru", "en"])
 def test_readers_problems_are_said_in_the_station_language(tmp_path: Path, language: str) -> None:
     """The program reader's diagnostics (instruction, operand, address, jump, a function's
-    parameters), symbols.csv's, the forms', messages.csv's and users.json's, naming file, line,
-    column, element, property, user and the text as it is."""
+    parameters), symbols.csv's, the forms', messages.csv's, users.json's and a node's settings',
+    naming file, line, column, element, property, user, key and the text as it is."""
     from app.station.check import check_station
 
     st = copy_demo(tmp_path / "st", language)
@@ -197,6 +197,9 @@ def test_readers_problems_are_said_in_the_station_language(tmp_path: Path, langu
         {"type": "AnalogBase", "Name": "Gauge", "x": 0, "y": 0, "w": 10, "h": 10, "InAddr": "04000",
          "AppMin": 0, "AppMax": 0, "PhyMin": 0, "PhyMax": 100}]}), encoding="utf-8")
     plant(st / "messages.csv", "3,1,2,", "3,1,alarm,")
+    plant(st / "station.toml", "timeout = 0.5",
+          'timeout = 0.5\nendpoint = "rtu:///dev/ttyS9?parity=X"\nname = "a/b"')
+    toml = st / "station.toml"
     users = [{"name": "ivanov", "role": "boss", "salt": "00", "hash": "00"}, {"name": "petrov"}]
     (st / "users.json").write_text(json.dumps({"users": users}), encoding="utf-8")
     n = len(program)
@@ -218,7 +221,10 @@ def test_readers_problems_are_said_in_the_station_language(tmp_path: Path, langu
                f'{form}: элемент "Gauge": AppMax: равно AppMin (0): преобразование не определено',
                f"{st / 'messages.csv'}:{message}: type 'alarm' — не целое неотрицательное число",
                f"{st / 'users.json'}: пользователь 'ivanov': роль 'boss' — не одна из: ",
-               f"{st / 'users.json'}: пользователь 'petrov': нет role, salt, hash (каждый — текст)"],
+               f"{st / 'users.json'}: пользователь 'petrov': нет role, salt, hash (каждый — текст)",
+               f"{toml}: nodes[0].endpoint: endpoint 'rtu:///dev/ttyS9?parity=X': "
+               "parity 'X' — не N, E и не O",
+               f"{toml}: nodes[0].name: 'a/b' не может содержать '/', '+', '#'"],
         "en": [f"{stl}:{n + 1}:1: unknown instruction 'TNX'",
                f"{stl}:{n + 2}:22: S: 010000 is not a valid address",
                f"{stl}:{n + 3}:5: L: undefined label 'NOWHERE'",
@@ -231,7 +237,10 @@ def test_readers_problems_are_said_in_the_station_language(tmp_path: Path, langu
                f'{form}: element "Gauge": AppMax: equals AppMin (0): the conversion is undefined',
                f"{st / 'messages.csv'}:{message}: type 'alarm' is not a non-negative whole number",
                f"{st / 'users.json'}: user 'ivanov': role 'boss' is not one of ",
-               f"{st / 'users.json'}: user 'petrov': role, salt, hash missing (each a text)"],
+               f"{st / 'users.json'}: user 'petrov': role, salt, hash missing (each a text)",
+               f"{toml}: nodes[0].endpoint: endpoint 'rtu:///dev/ttyS9?parity=X': "
+               "parity 'X' is not N, E or O",
+               f"{toml}: nodes[0].name: 'a/b' may not hold '/', '+', '#'"],
     }[language]
     for line in said:
         assert any(p.startswith(line) for p in problems), f"{line!r} not in {problems}"
