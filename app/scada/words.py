@@ -111,6 +111,9 @@ TEXTS: dict[str, dict[str, str]] = {
         "password changed": "password of {user} changed",
         # users.json's reader (app/authority/users.py): keys, names and roles as they are
         "users user": "{file}: user {name!r}", "users twice": "listed twice",
+        "users no default": "no user {name!r} in {path} (`main.py users add {name} --role viewer` adds one)",
+        "users default role": "{name!r} is of role {role}: the default user acts for whoever is at the "
+                              "workstation without logging in, so it must be a viewer",
         "users not object": "expected an object with name, role, salt and hash",
         "users missing": "{keys} missing (each a text)",
         "users not hex": "salt and hash must be hexadecimal (set the password again: `main.py users passwd`)",
@@ -651,6 +654,10 @@ TEXTS: dict[str, dict[str, str]] = {
         "handing over": "IntoStandBy: роль основной переходит к партнёру",
         "station quit": "выход из станции",
         "users user": "{file}: пользователь {name!r}", "users twice": "указан дважды",
+        "users no default": "нет пользователя {name!r} в {path} (`main.py users add {name} --role viewer` "
+                            "добавит его)",
+        "users default role": "{name!r} с ролью {role}: пользователь по умолчанию действует за того, кто "
+                              "сидит за рабочим местом, не войдя, поэтому он должен быть наблюдателем",
         "users not object": "ожидается объект с name, role, salt и hash",
         "users missing": "нет {keys} (каждый — текст)",
         "users not hex": "salt и hash должны быть шестнадцатеричными (задайте пароль снова: `main.py users "

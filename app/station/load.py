@@ -125,12 +125,11 @@ def _users(station: Station, out: Loaded) -> None:
     name = station.operator.default_user
     user = users.get(name)
     key = f"{station.path}: operator.default_user"
+    say = words(station.Language)
     if name and user is None:
-        out.problems.append(f"{key}: no user {name!r} in {path} (`main.py users add {name} --role viewer` "
-                            "adds one)")
+        out.problems.append(f"{key}: " + say("users no default", name=name, path=path))
     elif user is not None and user.role != VIEWER:
-        out.problems.append(f"{key}: {name!r} is of role {user.role}: the default user acts for whoever "
-                            "is at the workstation without logging in, so it must be a viewer")
+        out.problems.append(f"{key}: " + say("users default role", name=name, role=user.role))
     elif users.users:
         out.notes.append(phrase("note users", file=USERS_FILE, n=len(users.users)) if not name else
                          phrase("note users default", file=USERS_FILE, n=len(users.users), name=name))
