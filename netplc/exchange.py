@@ -556,15 +556,15 @@ def check_program_nodes(program: Program, nodes: list[NodeConfig]) -> list[Diagn
     NetPlc memory.
     """
     configs = {c.node: c for c in nodes}
-    have = ", ".join(str(n) for n in sorted(configs)) or "none"
+    have: object = ", ".join(str(n) for n in sorted(configs)) or phrase("stl no nodes")
     out: list[Diagnostic] = []
 
-    def err(ins: Instr, text: str) -> None:
-        out.append(Diagnostic(program.source, ins.line, 1, text))
+    def err(ins: Instr, name: str, /, **values: object) -> None:
+        out.append(Diagnostic(program.source, ins.line, 1, phrase(name, **values)))
 
     for ins in program.instrs:
         if ins.op == "FON" and ins.n == NODE and ins.s not in configs:
-            err(ins, f"NODE S:{ins.s}: node {ins.s} is not configured (configured nodes: {have})")
+            err(ins, "stl node not configured", node=ins.s, have=have)
     for fn, ins, node in _fon_nodes(program):
         name = "NREAD" if fn == NREAD else "NWRITE"
         remote, local = (ins.s, ins.d) if fn == NREAD else (ins.d, ins.s)
@@ -572,20 +572,19 @@ def check_program_nodes(program: Program, nodes: list[NodeConfig]) -> list[Diagn
         try:
             check_operand(local, length)
         except AddressError as e:
-            err(ins, f"{name}: local block of {length} bytes: {e}")
+            err(ins, "stl local block", name=name, length=length, error=e)
         if node is None:
             continue
         cfg = configs.get(node)
         if cfg is None:
             if not any(i.op == "FON" and i.n == NODE for i in program.instrs):
-                err(ins, f"{name} with no NODE in the program talks to node 0, which is not configured "
-                         f"(configured nodes: {have})")
+                err(ins, "stl no node", name=name, have=have)
             continue  # otherwise its NODE is reported above
         try:
             block = locate(cfg.profile, cfg.table, remote, length)
         except MapError as e:
-            err(ins, f"{name}: node {node}: {e}")
+            err(ins, "stl node map", name=name, node=node, error=e)
             continue
         if fn == NWRITE and block.table not in WRITABLE_TABLES:
-            err(ins, f"NWRITE: node {node}: table {block.table} is read-only")
+            err(ins, "stl read only", node=node, table=block.table)
     return out

@@ -113,6 +113,14 @@ WORDS = {
     "stl needs key": "{name} needs {key}: ({kind})",
     "stl kind M": "an address", "stl kind O": "an octal constant", "stl kind D": "a decimal constant",
     "stl kind B": "a BCD constant",
+    # the program's network instructions against the nodes (netplc/exchange.py check_program_nodes)
+    "stl node not configured": "NODE S:{node}: node {node} is not configured (configured nodes: {have})",
+    "stl no nodes": "none",
+    "stl local block": "{name}: local block of {length} bytes: {error}",
+    "stl no node": "{name} with no NODE in the program talks to node 0, which is not configured (configured "
+                   "nodes: {have})",
+    "stl node map": "{name}: node {node}: {error}",
+    "stl read only": "NWRITE: node {node}: table {table} is read-only",
     # a node's settings (netplc/exchange.py node_problems, netplc/modbus/endpoint.py): values as they are
     "ep forms": "expected tcp://host:port, rtu:///dev/ttyX?baudrate=19200&parity=E or rtu://COM3?baudrate=...",
     "ep wrong": "endpoint {text!r}: {error} ({forms})",

@@ -581,6 +581,13 @@ TEXTS: dict[str, dict[str, str]] = {
         "stl needs key": "{name} нужен {key}: ({kind})",
         "stl kind M": "адрес", "stl kind O": "восьмеричная константа", "stl kind D": "десятичная константа",
         "stl kind B": "двоично-десятичная константа",
+        "stl node not configured": "NODE S:{node}: узел {node} не задан (заданные узлы: {have})",
+        "stl no nodes": "нет",
+        "stl local block": "{name}: местный блок из байтов ({length}): {error}",
+        "stl no node": "{name} без NODE в программе обращается к узлу 0, а он не задан (заданные узлы: "
+                       "{have})",
+        "stl node map": "{name}: узел {node}: {error}",
+        "stl read only": "NWRITE: узел {node}: таблица {table} только для чтения",
         "modbus not started": "сервер Modbus не запущен: {path}: modbus_server.port: нельзя слушать "
                               "{host}:{port}: {error}",
         "modbus not yet": "сервер Modbus ещё не запущен: {path}: modbus_server.port: {fault}; новая попытка "

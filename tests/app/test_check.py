@@ -65,7 +65,7 @@ def test_every_planted_error_is_found(tmp_path: Path) -> None:
         f"{st / 'station.toml'}: nodes[0].endpoint: endpoint 'tcp://plc:99999'",
         f"{st / 'netplc.stl'}:{tnx}:1: неизвестная инструкция 'TNX'",
         f"{st / 'netplc.stl'}:{nosuch}:",
-        f"{st / 'netplc.stl'}:{node7}:1: NODE S:7: node 7 is not configured",  # found past other errors
+        f"{st / 'netplc.stl'}:{node7}:1: NODE S:7: узел 7 не задан",  # found past other errors
         f"{st / 'symbols.csv'}:",
         f"{st / 'node0.stl'}:{ctr}:",
         "messages.csv:",
