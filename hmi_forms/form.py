@@ -22,6 +22,7 @@ from pathlib import Path
 from typing import Any
 
 from app.scada.table import TagTable
+from app.scada.words import Phrase, Words, phrase, words
 from hmi_forms.elements import ELEMENT_TYPES, Element
 from hmi_forms.elements import props as p
 from hmi_forms.elements.analog import Scaled, scaling_problems
@@ -90,9 +91,9 @@ FORM_PROPS: dict[str, p.Parser] = {
 DEVICE_PROPS = ("Name", "AppMin", "AppMax", "PhyMin", "PhyMax")
 
 
-def _unknown(name: str, known: list[str]) -> str:
+def _unknown(name: str, known: list[str]) -> Phrase:
     close = difflib.get_close_matches(name, known, n=1)
-    return f'unknown property; did you mean "{close[0]}"?' if close else "unknown property"
+    return phrase("form unknown close", close=close[0]) if close else phrase("form unknown property")
 
 
 def parse_form(path: Path, parse_int: Callable[[str], Any] = p.json_int) -> Any:
@@ -116,21 +117,23 @@ def parse_form(path: Path, parse_int: Callable[[str], Any] = p.json_int) -> Any:
 
 class _Loader:
     def __init__(self, path: Path, symbols: dict[str, int], station: Path | None,
-                 allow_outside: bool, tags: TagTable | None = None) -> None:
+                 allow_outside: bool, tags: TagTable | None = None, say: Words | None = None) -> None:
         self.path = path
+        self.say = say or words()  # the station's Language (the system locale's without a station)
         self.problems: list[str] = []
         self.warnings: list[str] = []
         self.fatal = 0  # problems that stop the form from opening (the others only lose a picture)
         self.ctx = p.Context(symbols, path.parent, roots=(station,) if station else (),
                              allow_outside=allow_outside, tags=tags or TagTable())
 
-    def problem(self, where: str, prop: str | None, text: str, fatal: bool = True) -> None:
+    def problem(self, where: str, prop: str | None, text: object, fatal: bool = True) -> None:
+        """`text`: a phrase of app/scada/words.py (or a PropError carrying one), said here."""
         head = f"{self.path}: {where}: {prop}" if prop else f"{self.path}: {where}"
-        self.problems.append(f"{head}: {text}")
+        self.problems.append(f"{head}: {self.say.say(text)}")
         self.fatal += fatal
 
-    def warn(self, where: str, prop: str, text: str) -> None:
-        self.warnings.append(f"{self.path}: {where}: {prop}: {text}")
+    def warn(self, where: str, prop: str, text: object) -> None:
+        self.warnings.append(f"{self.path}: {where}: {prop}: {self.say.say(text)}")
 
     def load(self) -> Form:
         """The form of the file. A station's form is read only from inside the station folder,
@@ -148,16 +151,17 @@ class _Loader:
         if not isinstance(doc, dict):
             raise FormError([f"{self.path}: the form must be a JSON object with form, devices, elements"])
         for key in sorted(set(doc) - {"form", "devices", "images", "elements"}):
-            self.problem("file", key, "unknown section (form, devices, images, elements)")
+            self.problem(self.say("form where file"), key, phrase("form unknown section"))
         form = self.form_settings(doc.get("form"))
         form.devices = self.ctx.devices = self.devices(doc.get("devices", []))
         form.images = self.ctx.images = self.images(doc.get("images", []))
         form.elements = self.elements(doc.get("elements"))
         for el in form.elements:
             if el.x + el.w > form.width or el.y + el.h > form.height:
-                self.problem(f'element "{el.Name}"', "w" if el.x + el.w > form.width else "h",
-                             f"the element ({el.x},{el.y} {el.w}x{el.h}) extends past the form "
-                             f"({form.width}x{form.height})")
+                self.problem(self.say("form where element", name=el.Name),
+                             "w" if el.x + el.w > form.width else "h",
+                             phrase("form past", x=el.x, y=el.y, w=el.w, h=el.h, width=form.width,
+                                    height=form.height))
         if self.fatal:
             raise FormError(self.problems)
         form.problems = self.problems
@@ -167,7 +171,7 @@ class _Loader:
     def form_settings(self, raw: Any) -> Form:
         form = Form(self.path, self.path.stem, 800, 600)
         if not isinstance(raw, dict):
-            self.problem("form", None, 'missing or not an object {"title": ..., "width": ..., "height": ...}')
+            self.problem("form", None, phrase("form no settings"))
             return form
         for key, value in raw.items():
             parser = FORM_PROPS.get(key)
@@ -177,22 +181,23 @@ class _Loader:
             try:
                 setattr(form, key, parser(value, self.ctx))
             except p.PropError as e:
-                self.problem("form", key, str(e), fatal=not isinstance(e, p.Outside))
+                self.problem("form", key, e, fatal=not isinstance(e, p.Outside))
         for key in ("width", "height"):
             if key not in raw:
-                self.problem("form", key, "missing required property")
+                self.problem("form", key, phrase("form missing"))
         return form
 
     def devices(self, raw: Any) -> dict[str, p.Scaling]:
         out: dict[str, p.Scaling] = {}
         if not isinstance(raw, list):
-            self.problem("devices", None, "must be a list of {Name, AppMin, AppMax, PhyMin, PhyMax}")
+            self.problem("devices", None, phrase("form devices list"))
             return out
         for i, dev in enumerate(raw):
             named = isinstance(dev, dict) and isinstance(dev.get("Name"), str)
-            where = f'device "{dev["Name"]}"' if named else f"device #{i + 1}"
+            where = (self.say("form where device", name=dev["Name"]) if named
+                     else self.say("form where device n", n=i + 1))
             if not isinstance(dev, dict):
-                self.problem(where, None, "must be an object {Name, AppMin, AppMax, PhyMin, PhyMax}")
+                self.problem(where, None, phrase("form device object"))
                 continue
             values: dict[str, Any] = {}
             for key, value in dev.items():
@@ -202,10 +207,10 @@ class _Loader:
                 try:
                     values[key] = (p.text if key == "Name" else p.number)(value, self.ctx)
                 except p.PropError as e:
-                    self.problem(where, key, str(e))
+                    self.problem(where, key, e)
             missing = [k for k in DEVICE_PROPS if k not in dev]
             for key in missing:
-                self.problem(where, key, "missing required property")
+                self.problem(where, key, phrase("form missing"))
             if len(values) < len(DEVICE_PROPS):
                 continue
             name = values.pop("Name")
@@ -213,39 +218,40 @@ class _Loader:
             for key, text in bad:
                 self.problem(where, key, text)
             if name in out:
-                self.problem(where, "Name", "duplicate device name")
+                self.problem(where, "Name", phrase("form duplicate device"))
             elif not bad:
                 out[name] = p.Scaling(**values)
         return out
 
     def images(self, raw: Any) -> list[Path | None]:
         if not isinstance(raw, list):
-            self.problem("images", None, "must be a list of image files")
+            self.problem("images", None, phrase("form images list"))
             return []
         out: list[Path | None] = []
         for i, name in enumerate(raw):
             try:
                 out.append(p.image_file(name, self.ctx))
             except p.PropError as e:
-                self.problem(f"image #{i}", None, str(e), fatal=not isinstance(e, p.Outside))
+                self.problem(self.say("form where image", n=i), None, e, fatal=not isinstance(e, p.Outside))
                 out.append(None)  # keeps the indices of later images
         return out
 
     def elements(self, raw: Any) -> list[Element]:
         if not isinstance(raw, list):
-            self.problem("elements", None, "missing or not a list of elements")
+            self.problem("elements", None, phrase("form elements list"))
             return []
         out: list[Element] = []
         names: set[str] = set()
         for i, el in enumerate(raw):
             name = el.get("Name") if isinstance(el, dict) else None
-            where = f'element "{name}"' if isinstance(name, str) else f"element #{i + 1}"
+            where = (self.say("form where element", name=name) if isinstance(name, str)
+                     else self.say("form where element n", n=i + 1))
             if not isinstance(el, dict):
-                self.problem(where, None, "must be an object with type, Name, x, y, w, h")
+                self.problem(where, None, phrase("form element object"))
                 continue
             if isinstance(name, str):
                 if name in names:
-                    self.problem(where, "Name", "duplicate element name")
+                    self.problem(where, "Name", phrase("form duplicate element"))
                 names.add(name)
             element = self.element(where, el)
             if element is not None:
@@ -256,10 +262,11 @@ class _Loader:
         kind = raw.get("type")
         cls = ELEMENT_TYPES.get(kind) if isinstance(kind, str) else None
         if cls is None:
-            hint = f"; did you mean \"{m[0]}\"?" if isinstance(kind, str) and (
+            hint = phrase("form did you mean", close=m[0]) if isinstance(kind, str) and (
                 m := difflib.get_close_matches(kind, list(ELEMENT_TYPES), n=1)) else ""
-            text = "missing" if kind is None else f"unknown element type {kind!r}{hint}"
-            self.problem(where, "type", f"{text} (types: {', '.join(ELEMENT_TYPES)})")
+            text = (phrase("form type missing") if kind is None
+                    else phrase("form unknown type", kind=kind, hint=hint))
+            self.problem(where, "type", phrase("form types", text=text, types=", ".join(ELEMENT_TYPES)))
             return None
         schema = {f.name: f for f in fields(cls) if "parser" in f.metadata}
         aliases = {f.metadata["alias"]: f.name for f in schema.values() if f.metadata["alias"]}
@@ -275,16 +282,16 @@ class _Loader:
                 self.problem(where, key, _unknown(key, list(schema)))
                 continue
             if target in seen:
-                self.problem(where, key, f"given twice (as {seen[target]} and {key})")
+                self.problem(where, key, phrase("form given twice", first=seen[target], key=key))
                 continue
             seen[target] = key
             try:
                 values[target] = f.metadata["parser"](value, self.ctx)
             except p.PropError as e:
-                self.problem(where, key, str(e), fatal=not isinstance(e, p.Outside))
+                self.problem(where, key, e, fatal=not isinstance(e, p.Outside))
         for f in schema.values():
             if f.metadata["required"] and f.name not in raw and f.metadata["alias"] not in raw:
-                self.problem(where, f.name, "missing required property")
+                self.problem(where, f.name, phrase("form missing"))
         if self.fatal > before:
             return None
         element = cls(**values)
@@ -299,22 +306,23 @@ class _Loader:
 
 
 def load_form(path: str | Path, symbols: dict[str, int] | None = None, *, station: Path | None = None,
-              allow_outside: bool = False, tags: TagTable | None = None) -> Form:
-    """Load one form; FormError lists every problem of the file. Files it names must be in its
-    folder or in the `station` folder unless `allow_outside`; one that is not is left out and
-    named in `Form.problems`. Addresses may name the station's `tags`."""
-    return _Loader(Path(path), symbols or {}, station, allow_outside, tags).load()
+              allow_outside: bool = False, tags: TagTable | None = None, say: Words | None = None) -> Form:
+    """Load one form; FormError lists every problem of the file (in the language of `say`). Files
+    it names must be in its folder or in the `station` folder unless `allow_outside`; one that is
+    not is left out and named in `Form.problems`. Addresses may name the station's `tags`."""
+    return _Loader(Path(path), symbols or {}, station, allow_outside, tags, say).load()
 
 
 def load_forms(folder: str | Path, symbols: dict[str, int] | None = None, *, station: Path | None = None,
-               allow_outside: bool = False, tags: TagTable | None = None) -> tuple[list[Form], list[str]]:
+               allow_outside: bool = False, tags: TagTable | None = None,
+               say: Words | None = None) -> tuple[list[Form], list[str]]:
     """Load every `*.hmi` of a folder (sorted by name): the forms that open, and every problem
     (those of the forms that do not open, and the files left out of those that do)."""
     forms: list[Form] = []
     problems: list[str] = []
     for path in sorted(Path(folder).glob("*.hmi")):
         try:
-            form = load_form(path, symbols, station=station, allow_outside=allow_outside, tags=tags)
+            form = load_form(path, symbols, station=station, allow_outside=allow_outside, tags=tags, say=say)
         except FormError as e:
             problems.extend(e.problems)
         else:

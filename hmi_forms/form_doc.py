@@ -103,7 +103,8 @@ class Reader:
 
     def _where(self, raw: dict[str, Any]) -> str:
         name = raw.get("Name")
-        return f'element "{name}"' if isinstance(name, str) else "element"
+        say = self.loader.say  # the loader's words, so that its problems are found by their place
+        return say("form where element", name=name) if isinstance(name, str) else say("form where an element")
 
     def _props(self, raw: dict[str, Any], found: list[str]) -> list[tuple[str, str]]:
         """The loader's problems of one element as (property, problem)."""

@@ -9,6 +9,8 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 
+from netplc.words import WordedError
+
 IO_BITS = 0o4000  # bits 00000-03777 (00000-01777 external, 02000-03777 internal)
 BANKS = 8
 BANK_SIZE = 0o4000  # 2 KB per bank
@@ -33,19 +35,19 @@ PRESENCE_LIST = 0o77740  # 077740-077777: 00 absent, FF present, byte i = node i
 PRESENCE_NODES = 32
 
 
-class AddressError(ValueError):
-    """An address that names no memory of a CPU-165."""
+class AddressError(WordedError):
+    """An address that names no memory of a CPU-165 (its text a phrase of netplc/words.py)."""
 
 
 def parse_octal(text: str) -> int:
-    """Parse `04000`, `$04000` or `4000` as octal; raise ValueError naming the text."""
+    """Parse `04000`, `$04000` or `4000` as octal; raise a ValueError (WordedError) naming the text."""
     t = text.strip()
     if t.startswith("$"):
         t = t[1:]
     if t.lower().startswith("0o"):
         t = t[2:]
     if not t or any(ch not in "01234567" for ch in t):
-        raise ValueError(f"{text!r} is not an octal number")
+        raise WordedError("addr not octal", text=text)
     return int(t, 8)
 
 
@@ -65,7 +67,7 @@ def is_data_byte(addr: int) -> bool:
 def data_index(addr: int) -> int:
     """Index of a data byte in the flat 16 KB data array; AddressError for gaps."""
     if not is_data_byte(addr):
-        raise AddressError(f"{fmt_octal(addr)} is not a data memory address")
+        raise AddressError("addr not data", addr=fmt_octal(addr))
     return (addr >> 12) * BANK_SIZE + (addr & 0o3777)
 
 
@@ -78,13 +80,13 @@ def check_operand(addr: int, nbytes: int) -> None:
     """Validate an operand of `nbytes` bytes at `addr` (below 04000: 8*nbytes I/O bits)."""
     if 0 <= addr < IO_BITS:
         if addr + 8 * nbytes > IO_BITS:
-            raise AddressError(f"{fmt_octal(addr)}: {nbytes}-byte operand runs past bit 03777")
+            raise AddressError("addr past io", addr=fmt_octal(addr), n=nbytes)
         return
     if not is_data_byte(addr):
-        raise AddressError(f"{fmt_octal(addr)} is not a valid address")
+        raise AddressError("addr not valid", addr=fmt_octal(addr))
     last = addr + nbytes - 1
     if not is_data_byte(last) or (last >> 12) != (addr >> 12):
-        raise AddressError(f"{fmt_octal(addr)}: {nbytes}-byte operand runs past the end of its bank")
+        raise AddressError("addr past bank", addr=fmt_octal(addr), n=nbytes)
 
 
 def is_valid_operand(addr: int, nbytes: int) -> bool:
@@ -124,4 +126,4 @@ def parse_hmi_bit(value: int | str) -> BitRef:
         return BitRef(addr)
     if addr >= HMI_DATA_BIT_BASE and is_data_byte(addr >> 3):
         return BitRef(addr)
-    raise AddressError(f"{fmt_octal(addr)} is neither an I/O bit nor a data bit (byte*8+bit)")
+    raise AddressError("addr not bit", addr=fmt_octal(addr))

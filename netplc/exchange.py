@@ -60,7 +60,7 @@ from netplc.modbus import (
 from netplc.program import Diagnostic, Program
 from netplc.records import NullSink, Record, RecordSink
 from netplc.tcp_exchange import TcpHub, TcpNode
-from netplc.words import Say, english
+from netplc.words import Phrase, Say, WordedError, english, phrase, said
 
 if TYPE_CHECKING:
     from netplc.engine import Engine
@@ -77,16 +77,16 @@ UNITS = {"tcp": (0, 255), "rtu": (1, 247)}  # Modbus unit id per scheme (docs/ar
 LIMITS: dict[str, tuple[float, float]] = {"timeout": (0.01, 60.0), "retries": (0, 10),
                                           "backoff": (0.01, 600.0), "backoff_max": (0.01, 3600.0)}
 NAME_RESERVED = "/+#"  # a node's name is a level of MQTT topics (Sparkplug device id) and of paths
-Problem = tuple[str, str]  # (setting, what is wrong with it)
+Problem = tuple[str, Phrase]  # (setting, what is wrong with it: a phrase of netplc/words.py)
 
 
-def unit_problem(scheme: str, unit: int) -> str | None:
+def unit_problem(scheme: str, unit: int) -> Phrase | None:
     """Why `unit` cannot address a device over `scheme` (tcp or rtu), or None."""
     lo, hi = UNITS[scheme]
     if lo <= unit <= hi:
         return None
-    why = "" if scheme == "tcp" else " (0 is broadcast, which never answers; 248-255 are reserved)"
-    return f"unit {unit} is not {lo}-{hi} on {scheme}{why}"
+    why = "" if scheme == "tcp" else phrase("node unit why")
+    return phrase("node unit", unit=unit, lo=lo, hi=hi, scheme=scheme, why=why)
 
 
 def node_problems(settings: Mapping[str, Any]) -> tuple[Endpoint | None, list[Problem]]:
@@ -97,32 +97,31 @@ def node_problems(settings: Mapping[str, Any]) -> tuple[Endpoint | None, list[Pr
     node = settings["node"]
     lo, hi = NODE_NUMBERS
     if not isinstance(node, int) or isinstance(node, bool) or not lo <= node <= hi:
-        found.append(("node", f"{node} is outside {lo}-{hi}"))
+        found.append(("node", phrase("node outside", node=node, lo=lo, hi=hi)))
     endpoint = None
     if settings["endpoint"]:
         try:
             endpoint = parse_endpoint(settings["endpoint"])
-        except ValueError as e:
-            found.append(("endpoint", str(e)))
+        except WordedError as e:
+            found.append(("endpoint", e.phrase))
     if problem := unit_problem(endpoint.scheme if endpoint else "tcp", settings["unit"]):
         found.append(("unit", problem))
     for key, names in (("profile", PROFILES), ("table", TABLES)):
         if settings[key] not in names:
-            found.append((key, f"{settings[key]!r} is not one of {', '.join(names)}"))
+            found.append((key, phrase("node not one of", value=settings[key], names=", ".join(names))))
     for key, (least, most) in LIMITS.items():
         value = settings[key]
         if not least <= value <= most:
             if key == "retries":  # a count, perhaps of 400 digits: not a float
-                found.append((key, f"{value} is outside {least:g}-{most:g}"))
+                found.append((key, phrase("node count outside", value=value, least=least, most=most)))
             else:
-                found.append((key, f"{value:g} s is outside {least:g}-{most:g} s"))
+                found.append((key, phrase("node seconds outside", value=value, least=least, most=most)))
     name = settings["name"]
     if any(c in name for c in NAME_RESERVED) or not name.isprintable() or name != name.strip():
-        found.append(("name", f"{name!r} may not hold '/', '+', '#', control characters or outer "
-                              "spaces (it names the node in topics and paths)"))
+        found.append(("name", phrase("node name", name=name)))
     backoff, backoff_max = settings["backoff"], settings["backoff_max"]
     if not any(key.startswith("backoff") for key, _ in found) and backoff > backoff_max:
-        found.append(("backoff", f"{backoff:g} s is more than backoff_max {backoff_max:g} s"))
+        found.append(("backoff", phrase("node backoff", backoff=backoff, most=backoff_max)))
     return endpoint, found
 
 
@@ -176,7 +175,8 @@ NODE_DEFAULTS: dict[str, Any] = {"endpoint": "", **{f.name: f.default for f in f
 def _named(problem: Problem) -> str:
     """A problem as a sentence: its text, after its setting unless the text names it already
     (`unit 256 is not 0-255 on tcp`, `endpoint 'x': ...`)."""
-    key, text = problem
+    key, phrase = problem
+    text = str(said(english, phrase))
     return text if text.startswith(f"{key} ") else f"{key} {text}"
 
 
@@ -190,16 +190,16 @@ def shared_problems(nodes: Iterable[NodeConfig]) -> list[tuple[NodeConfig, Probl
     lines: dict[str, NodeConfig] = {}  # serial device -> the first node on it
     for cfg in nodes:
         if cfg.node in numbers:
-            found.append((cfg, ("node", f"node {cfg.node} is configured twice")))
+            found.append((cfg, ("node", phrase("node twice", node=cfg.node))))
         elif titles.setdefault(cfg.title, cfg.node) != cfg.node:
-            found.append((cfg, ("name", f"{cfg.title!r} already names node {titles[cfg.title]}")))
+            found.append((cfg, ("name", phrase("node title used", title=cfg.title, node=titles[cfg.title]))))
         numbers.add(cfg.node)
         ep = cfg.parsed
         if ep is not None and ep.scheme == "rtu":
             first = lines.setdefault(ep.device, cfg)
             if first.parsed != ep:
-                found.append((cfg, ("endpoint", f"{ep} and node {first.node}'s {first.parsed} share "
-                                                f"{ep.device} with different line settings")))
+                found.append((cfg, ("endpoint", phrase("node shared line", endpoint=str(ep), node=first.node,
+                                                       first=str(first.parsed), device=ep.device))))
     return found
 
 
@@ -347,7 +347,7 @@ class Exchange:
             if cfg.parsed is None:
                 raise ValueError(f"node {cfg.node}: no endpoint")
         for cfg, (key, text) in shared_problems(nodes):
-            raise ValueError(f"node {cfg.node}: {key}: {text}")
+            raise ValueError(f"node {cfg.node}: {key}: {said(english, text)}")
         self.configs: dict[int, NodeConfig] = {cfg.node: cfg for cfg in nodes}
         self.sink: RecordSink = sink or NullSink()
         self.words: Say = english  # the station's words for its records (netplc/words.py)
@@ -556,15 +556,15 @@ def check_program_nodes(program: Program, nodes: list[NodeConfig]) -> list[Diagn
     NetPlc memory.
     """
     configs = {c.node: c for c in nodes}
-    have = ", ".join(str(n) for n in sorted(configs)) or "none"
+    have: object = ", ".join(str(n) for n in sorted(configs)) or phrase("stl no nodes")
     out: list[Diagnostic] = []
 
-    def err(ins: Instr, text: str) -> None:
-        out.append(Diagnostic(program.source, ins.line, 1, text))
+    def err(ins: Instr, name: str, /, **values: object) -> None:
+        out.append(Diagnostic(program.source, ins.line, 1, phrase(name, **values)))
 
     for ins in program.instrs:
         if ins.op == "FON" and ins.n == NODE and ins.s not in configs:
-            err(ins, f"NODE S:{ins.s}: node {ins.s} is not configured (configured nodes: {have})")
+            err(ins, "stl node not configured", node=ins.s, have=have)
     for fn, ins, node in _fon_nodes(program):
         name = "NREAD" if fn == NREAD else "NWRITE"
         remote, local = (ins.s, ins.d) if fn == NREAD else (ins.d, ins.s)
@@ -572,20 +572,19 @@ def check_program_nodes(program: Program, nodes: list[NodeConfig]) -> list[Diagn
         try:
             check_operand(local, length)
         except AddressError as e:
-            err(ins, f"{name}: local block of {length} bytes: {e}")
+            err(ins, "stl local block", name=name, length=length, error=e)
         if node is None:
             continue
         cfg = configs.get(node)
         if cfg is None:
             if not any(i.op == "FON" and i.n == NODE for i in program.instrs):
-                err(ins, f"{name} with no NODE in the program talks to node 0, which is not configured "
-                         f"(configured nodes: {have})")
+                err(ins, "stl no node", name=name, have=have)
             continue  # otherwise its NODE is reported above
         try:
             block = locate(cfg.profile, cfg.table, remote, length)
         except MapError as e:
-            err(ins, f"{name}: node {node}: {e}")
+            err(ins, "stl node map", name=name, node=node, error=e)
             continue
         if fn == NWRITE and block.table not in WRITABLE_TABLES:
-            err(ins, f"NWRITE: node {node}: table {block.table} is read-only")
+            err(ins, "stl read only", node=node, table=block.table)
     return out

@@ -38,7 +38,7 @@ class MemoryView:
 
     def get_bit(self, addr: int) -> int:
         if not 0 <= addr < IO_BITS:
-            raise AddressError(f"{fmt_octal(addr)} is not an I/O bit")
+            raise AddressError("addr not io bit", addr=fmt_octal(addr))
         return 1 if self.bits[addr] else 0  # the compiled program may store True/False
 
     def read(self, addr: int, n: int) -> bytes:
@@ -78,7 +78,7 @@ class MemoryView:
         if hmi < IO_BITS:
             return 1 if self.bits[hmi] else 0
         if hmi < HMI_DATA_BIT_BASE:
-            raise AddressError(f"{fmt_octal(hmi)} is not an HMI bit address")
+            raise AddressError("addr not hmi bit", addr=fmt_octal(hmi))
         return (self.data[data_index(hmi >> 3)] >> (hmi & 7)) & 1
 
 
@@ -91,7 +91,7 @@ class Memory(MemoryView):
 
     def set_bit(self, addr: int, value: int) -> None:
         if not 0 <= addr < IO_BITS:
-            raise AddressError(f"{fmt_octal(addr)} is not an I/O bit")
+            raise AddressError("addr not io bit", addr=fmt_octal(addr))
         self.bits[addr] = 1 if value else 0
 
     def write(self, addr: int, payload: bytes | bytearray) -> None:
@@ -132,7 +132,7 @@ class Memory(MemoryView):
             self.bits[hmi] = 1 if value else 0
             return
         if hmi < HMI_DATA_BIT_BASE:
-            raise AddressError(f"{fmt_octal(hmi)} is not an HMI bit address")
+            raise AddressError("addr not hmi bit", addr=fmt_octal(hmi))
         i = data_index(hmi >> 3)
         mask = 1 << (hmi & 7)
         self.data[i] = (self.data[i] | mask) if value else (self.data[i] & ~mask & 0xFF)

@@ -22,6 +22,7 @@ from netplc.address import (
 from netplc.functions.registry import DEFINED_CODES, FunctionSpec, lookup
 from netplc.problems import Problems
 from netplc.textfile import MAX_DIGITS, TextFileError, csv_rows, read_text
+from netplc.words import Phrase, Say, WordedError, english, phrase, said
 
 PROGRAM_WORDS = 0o20000  # 8 K words of program memory
 
@@ -52,13 +53,19 @@ _COMMENT = re.compile(r"\s[;#]|;;|\s//")
 
 @dataclass(frozen=True, slots=True)
 class Diagnostic:
+    """A problem at a place: `message` a phrase of netplc/words.py (or a file's own problem, as
+    it is), said in English by str() and in a station's language by `said(say)`."""
+
     file: str
     line: int
     col: int
-    message: str
+    message: Phrase | str
+
+    def said(self, say: Say = english) -> str:
+        return f"{self.file}:{self.line}:{self.col}: {said(say, self.message)}"
 
     def __str__(self) -> str:
-        return f"{self.file}:{self.line}:{self.col}: {self.message}"
+        return self.said()
 
 
 class ProgramError(Problems):
@@ -122,17 +129,17 @@ def read_symbols(path: str | Path) -> tuple[dict[str, int], list[Diagnostic]]:
             continue
         name = row[0].strip()
         if len(row) < 2:
-            errors.append(Diagnostic(str(path), lineno, 1, f"symbol {name!r} has no address"))
+            errors.append(Diagnostic(str(path), lineno, 1, phrase("sym no address", name=name)))
             continue
         try:
             addr = _symbol_address(row[1])
-        except ValueError as e:
-            errors.append(Diagnostic(str(path), lineno, len(row[0]) + 2, str(e)))
+        except WordedError as e:
+            errors.append(Diagnostic(str(path), lineno, len(row[0]) + 2, e.phrase))
             continue
         if not re.fullmatch(_NAME, name):
-            errors.append(Diagnostic(str(path), lineno, 1, f"{name!r} is not a valid symbol name"))
+            errors.append(Diagnostic(str(path), lineno, 1, phrase("sym bad name", name=name)))
         elif name in symbols:
-            errors.append(Diagnostic(str(path), lineno, 1, f"symbol {name!r} defined twice"))
+            errors.append(Diagnostic(str(path), lineno, 1, phrase("sym twice", name=name)))
         else:
             symbols[name] = addr
     return symbols, errors
@@ -142,11 +149,10 @@ def _symbol_address(text: str) -> int:
     """A symbol's address: an I/O bit, a data byte, or a data bit the HMI way (byte*8 + bit). A
     symbol no program uses is checked too: an address naming no memory is a typo all the same."""
     if len(text.strip()) > MAX_DIGITS:
-        raise ValueError(f"an address of {len(text.strip())} characters names no memory")
+        raise WordedError("addr too long", n=len(text.strip()))
     addr = parse_octal(text)
     if not (is_data_byte(addr) or _is_hmi_bit(addr)):
-        raise AddressError(f"{fmt_octal(addr)} names no memory: neither an I/O bit (00000-03777), a "
-                           "data byte (k*010000 + 04000-07777) nor a data bit (byte*8 + bit)")
+        raise AddressError("addr no memory", addr=fmt_octal(addr))
     return addr
 
 
@@ -199,8 +205,9 @@ class _Parser:
         self.symbols = symbols
         self.errors: list[Diagnostic] = []
 
-    def err(self, line: int, col: int, msg: str) -> None:
-        self.errors.append(Diagnostic(self.source, line, col, msg))
+    def err(self, line: int, col: int, name: str, /, **values: object) -> None:
+        """A problem of the catalogue (netplc/words.py), said by whoever reports it."""
+        self.errors.append(Diagnostic(self.source, line, col, phrase(name, **values)))
 
     def run(self, text: str) -> Program:
         raws: list[_Raw] = []
@@ -219,7 +226,7 @@ class _Parser:
             if ins is not None:
                 instrs.append(ins)
         if words > PROGRAM_WORDS:
-            self.err(raws[-1].line, 1, f"program needs {words} words; program memory holds {PROGRAM_WORDS}")
+            self.err(raws[-1].line, 1, "stl too big", words=words, most=PROGRAM_WORDS)
         if self.errors:
             self.errors.sort(key=lambda d: (d.line, d.col))
             raise ProgramError(self.errors)
@@ -235,10 +242,10 @@ class _Parser:
             try:
                 addr = parse_octal(value)
             except ValueError:
-                self.err(lineno, m.start(2) + 1, f"symbol {name!r}: {value!r} is not a $octal address")
+                self.err(lineno, m.start(2) + 1, "stl symbol not octal", name=name, value=value)
                 return
             if name in self.symbols:
-                self.err(lineno, m.start(1) + 1, f"symbol {name!r} defined twice")
+                self.err(lineno, m.start(1) + 1, "sym twice", name=name)
             self.symbols[name] = addr
             return
         pos = 0
@@ -249,7 +256,7 @@ class _Parser:
         if m:
             label = m.group(1)
             if label in labels:
-                self.err(lineno, m.start(1) + 1, f"label {label!r} defined twice")
+                self.err(lineno, m.start(1) + 1, "stl label twice", label=label)
             else:
                 labels[label] = len(raws)
             pos = m.end()
@@ -257,15 +264,15 @@ class _Parser:
                 return  # a label alone on its line names the next instruction
         m = _MNEMONIC.match(line, pos)
         if not m:
-            self.err(lineno, pos + 1 + len(line[pos:]) - len(line[pos:].lstrip()), "expected an instruction")
+            self.err(lineno, pos + 1 + len(line[pos:]) - len(line[pos:].lstrip()), "stl expected")
             return
         op = m.group(1).upper()
         if op not in LOGIC:
-            hint = ""
+            hint: Phrase | str = ""
             after = _MNEMONIC.match(line, m.end())
             if after and after.group(1).upper() in LOGIC:
-                hint = f" (a label needs a colon: '{m.group(1)}:')"
-            self.err(lineno, m.start(1) + 1, f"unknown instruction {m.group(1)!r}{hint}")
+                hint = phrase("stl label hint", name=m.group(1))
+            self.err(lineno, m.start(1) + 1, "stl unknown", op=m.group(1), hint=hint)
             return
         keys = LOGIC[op][0]
         pos = m.end()
@@ -284,14 +291,14 @@ class _Parser:
                 continue
             pm = _PARAM.match(rest, i)
             if not pm or pm.end() == i:
-                self.err(lineno, pos + i + 1, f"cannot read parameter at {rest[i:].strip()!r}")
+                self.err(lineno, pos + i + 1, "stl cannot read", text=rest[i:].strip())
                 ok = False
                 break
             key = (pm.group(1) or "").upper()
             token = pm.group(2)
             col = pos + pm.start(2) + 1
             if not token:
-                self.err(lineno, pos + pm.start(1) + 1, f"{key}: has no value")
+                self.err(lineno, pos + pm.start(1) + 1, "stl no value", key=key)
                 ok = False
                 break
             if not key:
@@ -302,16 +309,15 @@ class _Parser:
                     i = pm.end()
                     continue
                 if not free:
-                    self.err(lineno, col, f"{op} takes no more parameters (extra {token!r})")
+                    self.err(lineno, col, "stl no more", op=op, token=token)
                     ok = False
                     break
                 key = free[0]
             if key not in keys:
-                problem = f"has no parameter {key}:" if keys else "takes no parameters"
-                self.err(lineno, col, f"{op} {problem}")
+                self.err(lineno, col, "stl no such param" if keys else "stl takes none", op=op, key=key)
                 ok = False
             elif key in params:
-                self.err(lineno, col, f"parameter {key}: given twice")
+                self.err(lineno, col, "stl given twice", key=key)
                 ok = False
             else:
                 params[key] = (token, col)
@@ -328,17 +334,17 @@ class _Parser:
             try:
                 return parse_octal(token)
             except ValueError:
-                self.err(raw.line, col, f"{key}: {token!r} is not an octal address")
+                self.err(raw.line, col, "stl not octal address", key=key, token=token)
                 return None
         if token in self.symbols:
             return self.symbols[token]
         m = _OFFSET.fullmatch(token)
         if m and m.group(1) in self.symbols:
             if len(m.group(2)) > MAX_DIGITS:
-                self.err(raw.line, col, f"{key}: bit offset of {m.group(1)!r} is over {MAX_DIGITS} digits")
+                self.err(raw.line, col, "stl offset long", key=key, name=m.group(1), n=MAX_DIGITS)
                 return None
             return self.symbols[m.group(1)] + int(m.group(2))
-        self.err(raw.line, col, f"{key}: unknown symbol {token!r}")
+        self.err(raw.line, col, "stl unknown symbol", key=key, token=token)
         return None
 
     def _address(self, raw: _Raw, key: str, nbytes: int = 1) -> int | None:
@@ -349,46 +355,47 @@ class _Parser:
         try:
             check_operand(addr, nbytes)
         except AddressError as e:
-            self.err(raw.line, raw.params[key][1], f"{key}: {e}")
+            self.err(raw.line, raw.params[key][1], "stl operand", key=key, error=e)
             return None
         return addr
 
     def _coil(self, raw: _Raw, nbits: int) -> int | None:
         """The C parameter: `nbits` consecutive I/O bits (a contact or a coil uses one)."""
         if "C" not in raw.params:
-            self.err(raw.line, raw.col, f"{raw.op} needs C: (a bit address)")
+            self.err(raw.line, raw.col, "stl needs c", op=raw.op)
             return None
         addr = self._resolve(raw, "C")
         if addr is None:
             return None
         col = raw.params["C"][1]
         if addr >= IO_BITS:
-            self.err(raw.line, col, f"C: {fmt_octal(addr)} is not an I/O bit (00000-03777)")
+            self.err(raw.line, col, "stl not io bit", addr=fmt_octal(addr))
             return None
         if addr + nbits > IO_BITS:
-            last = fmt_octal(addr + nbits - 1)
-            self.err(raw.line, col, f"C: {raw.op} uses bits {fmt_octal(addr)}-{last}, past I/O bit 03777")
+            self.err(raw.line, col, "stl coil past", op=raw.op, first=fmt_octal(addr),
+                     last=fmt_octal(addr + nbits - 1))
             return None
         return addr
 
     def _const(self, raw: _Raw, key: str, kind: str, lo: int = 0, hi: int = 0xFFFF) -> int | None:
         token, col = raw.params[key]
         if token.startswith("$") or token in self.symbols:
-            self.err(raw.line, col, f"{key}: a constant is needed here, not the address {token!r}")
+            self.err(raw.line, col, "stl const not address", key=key, token=token)
             return None
         if kind == "B":
             if not re.fullmatch(r"[0-9]{1,4}", token):
-                self.err(raw.line, col, f"{key}: {token!r} is not a BCD constant (up to 4 decimal digits)")
+                self.err(raw.line, col, "stl not bcd", key=key, token=token)
                 return None
             return int(token, 16)
         octal = kind == "O"
-        pattern, radix, name = (_OCTAL, 8, "an octal") if octal else (_DECIMAL, 10, "a decimal")
+        pattern, radix, name = (_OCTAL, 8, "stl not octal const") if octal else (
+            _DECIMAL, 10, "stl not decimal")
         if not pattern.fullmatch(token):
-            self.err(raw.line, col, f"{key}: {token!r} is not {name} number")
+            self.err(raw.line, col, name, key=key, token=token)
             return None
         if len(token) > MAX_DIGITS or not lo <= int(token, radix) <= hi:
             bounds = f"{lo:o}-{hi:o}" if octal else f"{lo}-{hi}"  # in the radix the constant is written in
-            self.err(raw.line, col, f"{key}: {token} is outside {bounds}")
+            self.err(raw.line, col, "stl outside", key=key, token=token, bounds=bounds)
             return None
         return int(token, radix)
 
@@ -407,29 +414,29 @@ class _Parser:
             return Instr(op, **common)
         if op in JUMPS:
             if "L" not in raw.params:
-                self.err(raw.line, raw.col, f"{op} needs a label")
+                self.err(raw.line, raw.col, "stl needs label", op=op)
                 return None
             token, col = raw.params["L"]
             if token[0] == "$" or token[0] in "0123456789":
                 try:
                     value = parse_octal(token)
                 except ValueError:
-                    self.err(raw.line, col, f"L: {token!r} is not an octal program address")
+                    self.err(raw.line, col, "stl not program address", token=token)
                     return None
                 if value == 0:
                     return Instr(op, target=None, **common)
                 if value not in by_addr:
-                    self.err(raw.line, col, f"L: program address {token} is not the start of an instruction")
+                    self.err(raw.line, col, "stl not start", token=token)
                     return None
                 return Instr(op, target=by_addr[value], **common)
             if token not in labels:
-                self.err(raw.line, col, f"L: undefined label {token!r}")
+                self.err(raw.line, col, "stl undefined label", token=token)
                 return None
             return Instr(op, target=labels[token], **common)
         if op in ("TIM", "CTR"):
             c = self._coil(raw, COIL_BITS[op])
             if "N" not in raw.params:
-                self.err(raw.line, raw.col, f"{op} needs N: (preset 0-255)")
+                self.err(raw.line, raw.col, "stl needs preset", op=op)
                 return None
             n = self._const(raw, "N", "D", 0, 255)
             if c is None or n is None:
@@ -440,23 +447,23 @@ class _Parser:
     def _build_fon(self, raw: _Raw, common: dict) -> Instr | None:
         c = self._coil(raw, COIL_BITS["FON"])
         if "N" not in raw.params:
-            self.err(raw.line, raw.col, "FON needs N: (function number or mnemonic)")
+            self.err(raw.line, raw.col, "stl fon needs n")
             return None
         token, col = raw.params["N"]
         spec: FunctionSpec | None = None
         if token[0] in "0123456789":
             if not _DECIMAL.fullmatch(token):
-                self.err(raw.line, col, f"N: {token!r} is not a function number")
+                self.err(raw.line, col, "stl not function number", token=token)
                 return None
             number = int(token) if len(token) <= MAX_DIGITS else -1
             if number not in DEFINED_CODES:
-                self.err(raw.line, col, f"N: function {number if number >= 0 else token} does not exist")
+                self.err(raw.line, col, "stl no function", number=number if number >= 0 else token)
                 return None
             spec = lookup(number)
         else:
             spec = lookup(token)
             if spec is None:
-                self.err(raw.line, col, f"N: unknown function {token!r}")
+                self.err(raw.line, col, "stl unknown function", token=token)
                 return None
             number = spec.number
         # positional operands fill the parameters this function takes, in S, D, R order
@@ -466,8 +473,7 @@ class _Parser:
             raw.params[key] = (token, col)
         if len(raw.extra) > len(free):
             token, col = raw.extra[len(free)]
-            self.err(raw.line, col, f"FON {spec.mnemonic if spec else number} takes no more parameters "
-                                    f"(extra {token!r})")
+            self.err(raw.line, col, "stl fon no more", name=spec.mnemonic if spec else number, token=token)
             return None
         values: dict[str, int | None] = {"S": None, "D": None, "R": None}
         ok = c is not None
@@ -475,11 +481,13 @@ class _Parser:
             for key, kind in spec.kinds().items():
                 if kind is None:
                     if key in raw.params:
-                        self.err(raw.line, raw.params[key][1], f"{spec.mnemonic} takes no {key}: parameter")
+                        self.err(raw.line, raw.params[key][1], "stl takes no key", name=spec.mnemonic,
+                                 key=key)
                         ok = False
                     continue
                 if key not in raw.params:
-                    self.err(raw.line, raw.col, f"{spec.mnemonic} needs {key}: ({_KIND_NAMES[kind]})")
+                    self.err(raw.line, raw.col, "stl needs key", name=spec.mnemonic, key=key,
+                             kind=phrase(f"stl kind {kind}"))
                     ok = False
                     continue
                 v = self._address(raw, key) if kind == "M" else self._const(raw, key, kind, *spec.bounds(key))
@@ -494,5 +502,3 @@ class _Parser:
             return None
         return Instr("FON", c=c, n=number, s=values["S"], d=values["D"], r=values["R"], **common)
 
-
-_KIND_NAMES = {"M": "an address", "O": "an octal constant", "D": "a decimal constant", "B": "a BCD constant"}

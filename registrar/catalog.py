@@ -10,8 +10,10 @@ from collections.abc import Iterator
 from dataclasses import dataclass
 from pathlib import Path
 
-from netplc.problems import Problems
+from netplc.problems import Problem, Problems
 from netplc.textfile import TextFileError, csv_rows, read_text, whole_number
+from netplc.words import phrase
+from registrar.words import RowError, english
 
 MESSAGE_TYPES = {0: "info", 1: "warning", 2: "alarm", 3: "critical"}  # docs/architecture.md section 8
 INT64_MAX = 2**63 - 1  # the archive's INTEGER columns hold a signed 64-bit value
@@ -40,7 +42,7 @@ class Catalog:
             text = read_text(path, "the message catalog")
         except TextFileError as e:
             raise CatalogError([str(e)]) from None
-        problems: list[str] = []
+        problems: list[str | Problem] = []
         messages: dict[int, Message] = {}
         lines: dict[int, int] = {}
         for lineno, row in csv_rows(text):
@@ -53,12 +55,12 @@ class Catalog:
                 continue  # a header line
             try:
                 message = _parse_row(row)
-            except ValueError as e:
-                problems.append(f"{path}:{lineno}: {e}")
+            except RowError as e:
+                problems.append(Problem(f"{path}:{lineno}", e.phrase, english))
                 continue
             if message.number in messages:
-                problems.append(f"{path}:{lineno}: message {message.number} is already defined "
-                                f"on line {lines[message.number]}")
+                problems.append(Problem(f"{path}:{lineno}", phrase("msg defined", number=message.number,
+                                                                   line=lines[message.number]), english))
                 continue
             messages[message.number] = message
             lines[message.number] = lineno
@@ -82,24 +84,24 @@ class Catalog:
 
 def _parse_row(row: list[str]) -> Message:
     if len(row) < 4:
-        raise ValueError(f"expected number,group,type,text but found {len(row)} field(s)")
+        raise RowError("msg fields", n=len(row))
     number = _integer(row[0], "number")
     grp = _integer(row[1], "group")
     kind = _integer(row[2], "type")
     if kind not in MESSAGE_TYPES:
-        raise ValueError(f"type {kind} is not one of 0 info, 1 warning, 2 alarm, 3 critical")
+        raise RowError("msg type", kind=kind)
     text = ",".join(row[3:]).strip()  # an unquoted comma in the text is still part of it
     if not text:
-        raise ValueError(f"message {number} has no text")
+        raise RowError("msg no text", number=number)
     return Message(number, grp, kind, text)
 
 
 def _integer(field: str, name: str) -> int:
     value = whole_number(field)
     if value is None:
-        raise ValueError(f"{name} {_show(field.strip())} is not a non-negative whole number")
+        raise RowError("msg not whole", name=name, text=_show(field.strip()))
     if value > INT64_MAX:
-        raise ValueError(f"{name} {value} is past {INT64_MAX}, the largest the archive holds")
+        raise RowError("msg past", name=name, value=value, most=INT64_MAX)
     return value
 
 

@@ -20,13 +20,13 @@ import json
 import os
 import secrets
 import time
-from collections.abc import Callable, Mapping
+from collections.abc import Callable, Mapping, Sequence
 from dataclasses import asdict, dataclass
 from pathlib import Path
 
 from app.authority.policy import ROLES, VIEWER, rank
-from app.scada.words import ENGLISH
-from netplc.problems import Problems
+from app.scada.words import ENGLISH, Phrase, phrase
+from netplc.problems import Problem, Problems
 from netplc.textfile import TextFileError, read_text
 
 USERS_FILE = "users.json"
@@ -51,7 +51,7 @@ class UsersFileError(UserError, Problems):
     """A users.json that cannot be used: every problem, each naming the file (`check` lists them,
     a start refuses with them); a UserError too, for whoever manages users."""
 
-    def __init__(self, problems: list[str]) -> None:
+    def __init__(self, problems: Sequence[str | Problem]) -> None:
         Problems.__init__(self, problems)
 
 
@@ -157,24 +157,25 @@ def _read(path: Path) -> dict[str, User]:
     except TextFileError as e:
         raise UsersFileError([str(e)]) from None
     except json.JSONDecodeError as e:
-        raise UsersFileError([f"{path}: not a users file: bad JSON at line {e.lineno}, column {e.colno}: "
-                              f"{e.msg}"]) from None
+        raise UsersFileError([Problem(str(path), phrase("users bad json", line=e.lineno, col=e.colno,
+                                                        error=e.msg), ENGLISH)]) from None
     except (ValueError, RecursionError) as e:  # int() past 4300 digits; nesting past the stack
-        raise UsersFileError([f"{path}: not a users file: {type(e).__name__}"]) from None
+        raise UsersFileError([Problem(str(path), phrase("users not json", kind=type(e).__name__),
+                                      ENGLISH)]) from None
     items = doc.get("users") if isinstance(doc, dict) else None
     if not isinstance(items, list):
-        raise UsersFileError([f'{path}: not a users file: expected {{"users": [...]}}, as `main.py users` '
-                              "writes it"])
+        raise UsersFileError([Problem(str(path), phrase("users no list"), ENGLISH)])
     users: dict[str, User] = {}
-    problems: list[str] = []
+    problems: list[Problem] = []
     for i, item in enumerate(items):
         user, problem = _user(item)
         name = item.get("name") if isinstance(item, dict) else None
-        where = f"{path}: user {name!r}" if isinstance(name, str) and name else f"{path}: users[{i}]"
+        where = (phrase("users user", file=path, name=name) if isinstance(name, str) and name
+                 else f"{path}: users[{i}]")
         if problem:
-            problems.append(f"{where}: {problem}")
+            problems.append(Problem(where, problem, ENGLISH))
         elif user is not None and user.name in users:
-            problems.append(f"{where}: listed twice")
+            problems.append(Problem(where, phrase("users twice"), ENGLISH))
         elif user is not None:
             users[user.name] = user
     if problems:
@@ -182,20 +183,20 @@ def _read(path: Path) -> dict[str, User]:
     return users
 
 
-def _user(item: object) -> tuple[User | None, str]:
+def _user(item: object) -> tuple[User | None, Phrase | None]:
     """One entry of the users file, or what is wrong with it."""
     if not isinstance(item, dict):
-        return None, "expected an object with name, role, salt and hash"
+        return None, phrase("users not object")
     missing = [k for k in ("name", "role", "salt", "hash") if not isinstance(item.get(k), str) or not item[k]]
     if missing:
-        return None, f"{', '.join(missing)} missing (each a text)"
+        return None, phrase("users missing", keys=", ".join(missing))
     if item["role"] not in ROLES:
-        return None, f"role {item['role']!r} is not one of {', '.join(ROLES)}"
+        return None, phrase("no such role", role=item["role"], roles=", ".join(ROLES))
     try:
         bytes.fromhex(item["salt"]), bytes.fromhex(item["hash"])
     except ValueError:
-        return None, "salt and hash must be hexadecimal (set the password again: `main.py users passwd`)"
-    return User(item["name"], item["role"], item["salt"], item["hash"]), ""
+        return None, phrase("users not hex")
+    return User(item["name"], item["role"], item["salt"], item["hash"]), None
 
 
 class Session:

@@ -13,10 +13,14 @@ exchange this catalogue to say them."""
 from __future__ import annotations
 
 import os
-from collections.abc import Callable, Mapping, Sequence
-from dataclasses import dataclass, field
+from collections.abc import Callable, Sequence
+from dataclasses import dataclass
 
 from netplc.words import WORDS as NETPLC_WORDS
+from netplc.words import Phrase as Phrase
+from netplc.words import WordedError
+from netplc.words import phrase as phrase
+from registrar.words import WORDS as REGISTRAR_WORDS
 
 TEXTS: dict[str, dict[str, str]] = {
     "en": {
@@ -105,7 +109,19 @@ TEXTS: dict[str, dict[str, str]] = {
         "no user": "no user {name!r}", "no such role": "role {role!r} is not one of {roles}",
         "empty password": "the password is empty", "passwords differ": "the two passwords differ",
         "password changed": "password of {user} changed",
+        # users.json's reader (app/authority/users.py): keys, names and roles as they are
+        "users user": "{file}: user {name!r}", "users twice": "listed twice",
+        "users no default": "no user {name!r} in {path} (`main.py users add {name} --role viewer` adds one)",
+        "users default role": "{name!r} is of role {role}: the default user acts for whoever is at the "
+                              "workstation without logging in, so it must be a viewer",
+        "users not object": "expected an object with name, role, salt and hash",
+        "users missing": "{keys} missing (each a text)",
+        "users not hex": "salt and hash must be hexadecimal (set the password again: `main.py users passwd`)",
+        "users bad json": "not a users file: bad JSON at line {line}, column {col}: {error}",
+        "users not json": "not a users file: {kind}",
+        "users no list": 'not a users file: expected {{"users": [...]}}, as `main.py users` writes it',
         **NETPLC_WORDS,
+        **REGISTRAR_WORDS,
         # the station's problems and its servers' starts (app/station/runtime.py, app/publish/station.py)
         "modbus not started": "Modbus server not started: {path}: modbus_server.port: cannot listen on "
                               "{host}:{port}: {error}",
@@ -225,6 +241,70 @@ TEXTS: dict[str, dict[str, str]] = {
         "tag bit limits": "a bit tag cannot have limit alarms (HH/H/L/LL); give alarm_when 0 or 1",
         "tag when needs bit": "alarm_when needs a bit tag; {type} takes limit alarms (HH/H/L/LL)",
         "tag limit outside": "{key} {value:g} is outside what a {type} tag can take here ({lo:g}..{hi:g})",
+        # a form's reader (hmi_forms/form.py, elements/): properties, names and values as they are
+        "form as is": "{error}",
+        "form expected text": "expected text, got {value}",
+        "form expected bool": "expected true or false, got {value}",
+        "form out of range": "{value} is out of range {lo}..{hi}",
+        "form expected integer": "expected an integer from {lo} to {hi}, got {value}",
+        "form expected number": "expected a number, got {value}",
+        "form not one of": "{value} is not one of {options}",
+        "form address text": 'addresses are octal text such as "02000" or a symbol, got {value}',
+        "form tag type": 'tag "{tag}" is of type {type}; this property takes {kinds}',
+        "form no tag": 'tag "{tag}" is of type {type}; this property takes no tag',
+        "form bit number": 'bit number after "{name}." must be 0-7, got "{bit}"',
+        "form unknown tag": 'unknown tag or symbol "{name}"',
+        "form unknown symbol": 'unknown symbol "{name}"',
+        "form not address": '"{value}" is not an octal address or a symbol',
+        "form expected colour": 'expected a colour such as "#1a2b3c", got {value}',
+        "form not colour": '"{value}" is not a colour (#RRGGBB, #AARRGGBB or {names})',
+        "form expected font": 'expected {{"Family": ..., "Size": ..., "Bold": ...}}, got {value}',
+        "form font field": "unknown font field {fields} (Family, Size, Bold, Italic)",
+        "form font size": "font size {size:g} is out of range 4..200",
+        "form image nul": "image file {name} has a NUL character",
+        "form image problem": 'image file "{name}": {problem}',
+        "form image outside": 'image file "{name}" is outside the station folder {roots} (shown without it; '
+                              "allow_outside = true in station.toml allows it)",
+        "form image missing": 'image file "{name}" not found in {folder}',
+        "form and": "{first} and {then}", "form digits": "a {n}-digit number",
+        "form where element": 'element "{name}"', "form where element n": "element #{n}",
+        "form where an element": "element", "form where device": 'device "{name}"',
+        "form where device n": "device #{n}", "form where image": "image #{n}", "form where file": "file",
+        "form image why": 'image file "{name}" {why}',
+        "form expected index": "expected an image index (-1 for none), got {value}",
+        "form index range": "image index {value} is out of range: the form has {n} images (-1 = none)",
+        "form unknown close": 'unknown property; did you mean "{close}"?',
+        "form unknown property": "unknown property",
+        "form unknown section": "unknown section (form, devices, images, elements)",
+        "form past": "the element ({x},{y} {w}x{h}) extends past the form ({width}x{height})",
+        "form no settings": 'missing or not an object {{"title": ..., "width": ..., "height": ...}}',
+        "form missing": "missing required property",
+        "form devices list": "must be a list of {{Name, AppMin, AppMax, PhyMin, PhyMax}}",
+        "form device object": "must be an object {{Name, AppMin, AppMax, PhyMin, PhyMax}}",
+        "form duplicate device": "duplicate device name",
+        "form images list": "must be a list of image files",
+        "form elements list": "missing or not a list of elements",
+        "form element object": "must be an object with type, Name, x, y, w, h",
+        "form duplicate element": "duplicate element name",
+        "form did you mean": '; did you mean "{close}"?',
+        "form type missing": "missing",
+        "form unknown type": "unknown element type {kind!r}{hint}",
+        "form types": "{text} (types: {types})",
+        "form given twice": "given twice (as {first} and {key})",
+        "form device or ranges": "give either Device or AppMin/AppMax/PhyMin/PhyMax, not both",
+        "form no devices": "the form has no devices",
+        "form unknown device": 'unknown device "{device}" ({known})',
+        "form no conversion": "missing: name a tag as the address (its conversion is taken), or give a "
+                              "Device or AppMin, AppMax, PhyMin and PhyMax",
+        "form range missing": "missing (needed with the other range properties)",
+        "form equals": "equals {key} ({value:g}): the conversion is undefined",
+        "form above": "{high:g} must be above PhyLow {low:g}",
+        "form negative": "must not be negative",
+        "form contradicts": "{own} contradicts tag {tag}'s {truth}: word {word:g} shows {here} here, {there} "
+                            "(remove the element's own conversion to take the tag's)",
+        "form unit contradicts": '"{units}" contradicts tag {tag}\'s unit "{unit}"',
+        "form image before": "{last} is before ImageFirst {first}",
+        "form phase": "phase {phase} must be less than the period {period}",
         # the publishers' records (app/publish/mqtt.py, opcua.py, seats.py)
         "mqtt bad bdseq": "MQTT: {file}: not a bdSeq ({error}); starting again at 0",
         "mqtt bdseq not kept": "MQTT: {file}: bdSeq not kept ({error})",
@@ -421,6 +501,94 @@ TEXTS: dict[str, dict[str, str]] = {
         "cannot force": "нельзя зафиксировать {kind} {addr}: {error}",
         "does not fit": "{value} не помещается в {kind} (0..{most})",
         "force NaN": "нельзя зафиксировать {name} в значении NaN",
+        "ep forms": "ожидается tcp://host:port, rtu:///dev/ttyX?baudrate=19200&parity=E или "
+                    "rtu://COM3?baudrate=...",
+        "ep wrong": "endpoint {text!r}: {error} ({forms})",
+        "ep no host": "endpoint {text!r}: нет хоста ({forms})",
+        "ep tcp path": "endpoint {text!r}: у endpoint tcp не бывает пути и параметров ({forms})",
+        "ep bad host": "endpoint {text!r}: {host!r} — недопустимое имя хоста",
+        "ep no device": "endpoint {text!r}: после rtu:// должно идти последовательное устройство ({forms})",
+        "ep parity": "endpoint {text!r}: parity {value!r} — не N, E и не O",
+        "ep not positive": "endpoint {text!r}: {key} {value!r} — не положительное число",
+        "ep option": "endpoint {text!r}: неизвестный параметр {key!r} (baudrate, parity, bytesize, stopbits)",
+        "ep line": "endpoint {text!r}: {problem}",
+        "ep scheme": "endpoint {text!r}: неизвестная схема {scheme!r} ({forms})",
+        "line not one of": "{key} {value!r} — не одно из: {allowed}",
+        "node outside": "{node} вне диапазона {lo}-{hi}",
+        "node unit": "unit {unit} — не {lo}-{hi} для {scheme}{why}",
+        "node unit why": " (0 — широковещательный, на него не отвечают; 248-255 зарезервированы)",
+        "node not one of": "{value!r} — не одно из: {names}",
+        "node count outside": "{value} вне диапазона {least:g}-{most:g}",
+        "node seconds outside": "{value:g} с вне диапазона {least:g}-{most:g} с",
+        "node name": "{name!r} не может содержать '/', '+', '#', управляющие знаки и пробелы по краям "
+                     "(это имя узла в топиках и путях)",
+        "node backoff": "{backoff:g} с больше backoff_max {most:g} с",
+        "node twice": "узел {node} задан дважды",
+        "node title used": "{title!r} уже называет узел {node}",
+        "node shared line": "{endpoint} и узел {node} с {first} делят {device} с разными настройками линии",
+        "addr not octal": "{text!r} — не восьмеричное число",
+        "addr not data": "{addr} — не адрес памяти данных",
+        "addr past io": "{addr}: операнд из байтов ({n}) выходит за бит 03777",
+        "addr not valid": "{addr} — недопустимый адрес",
+        "addr past bank": "{addr}: операнд из байтов ({n}) выходит за конец своего банка",
+        "addr not bit": "{addr} — ни бит ввода-вывода, ни бит данных (байт*8+бит)",
+        "addr not io bit": "{addr} — не бит ввода-вывода",
+        "addr not hmi bit": "{addr} — не адрес бита ЧМИ",
+        "addr bit past": "бит {k} от {addr} выходит за бит 03777",
+        "addr not bytes": "{first}..{last} — не целое число байтов",
+        "addr mixes": "{first}..{last} смешивает биты ввода-вывода и память данных",
+        "addr missing": "нет операнда",
+        "addr no memory": "{addr} не называет памяти: ни бит ввода-вывода (00000-03777), ни байт данных "
+                          "(k*010000 + 04000-07777), ни бит данных (байт*8 + бит)",
+        "addr too long": "адрес длиной {n} знаков не называет памяти",
+        "sym no address": "у символа {name!r} нет адреса",
+        "sym bad name": "{name!r} — недопустимое имя символа",
+        "sym twice": "символ {name!r} определён дважды",
+        "stl too big": "программе нужно слов: {words}; память программ вмещает {most}",
+        "stl symbol not octal": "символ {name!r}: {value!r} — не восьмеричный адрес $",
+        "stl label twice": "метка {label!r} определена дважды",
+        "stl expected": "ожидается инструкция",
+        "stl unknown": "неизвестная инструкция {op!r}{hint}",
+        "stl label hint": " (после метки нужно двоеточие: '{name}:')",
+        "stl cannot read": "не удаётся прочесть параметр в {text!r}",
+        "stl no value": "{key}: нет значения",
+        "stl no more": "{op} больше параметров не принимает (лишний {token!r})",
+        "stl no such param": "у {op} нет параметра {key}:",
+        "stl takes none": "{op} не принимает параметров",
+        "stl given twice": "параметр {key}: задан дважды",
+        "stl not octal address": "{key}: {token!r} — не восьмеричный адрес",
+        "stl offset long": "{key}: смещение бита от {name!r} длиннее {n} цифр",
+        "stl unknown symbol": "{key}: неизвестный символ {token!r}",
+        "stl operand": "{key}: {error}",
+        "stl needs c": "{op} нужен C: (адрес бита)",
+        "stl not io bit": "C: {addr} — не бит ввода-вывода (00000-03777)",
+        "stl coil past": "C: {op} занимает биты {first}-{last}, за битом ввода-вывода 03777",
+        "stl const not address": "{key}: здесь нужна константа, а не адрес {token!r}",
+        "stl not bcd": "{key}: {token!r} — не двоично-десятичная константа (до 4 десятичных цифр)",
+        "stl not octal const": "{key}: {token!r} — не восьмеричное число",
+        "stl not decimal": "{key}: {token!r} — не десятичное число",
+        "stl outside": "{key}: {token} вне {bounds}",
+        "stl needs label": "{op} нужна метка",
+        "stl not program address": "L: {token!r} — не восьмеричный адрес программы",
+        "stl not start": "L: адрес программы {token} — не начало инструкции",
+        "stl undefined label": "L: метка {token!r} не определена",
+        "stl needs preset": "{op} нужен N: (уставка 0-255)",
+        "stl fon needs n": "FON нужен N: (номер или мнемоника функции)",
+        "stl not function number": "N: {token!r} — не номер функции",
+        "stl no function": "N: функции {number} нет",
+        "stl unknown function": "N: неизвестная функция {token!r}",
+        "stl fon no more": "FON {name} больше параметров не принимает (лишний {token!r})",
+        "stl takes no key": "{name} не принимает параметра {key}:",
+        "stl needs key": "{name} нужен {key}: ({kind})",
+        "stl kind M": "адрес", "stl kind O": "восьмеричная константа", "stl kind D": "десятичная константа",
+        "stl kind B": "двоично-десятичная константа",
+        "stl node not configured": "NODE S:{node}: узел {node} не задан (заданные узлы: {have})",
+        "stl no nodes": "нет",
+        "stl local block": "{name}: местный блок из байтов ({length}): {error}",
+        "stl no node": "{name} без NODE в программе обращается к узлу 0, а он не задан (заданные узлы: "
+                       "{have})",
+        "stl node map": "{name}: узел {node}: {error}",
+        "stl read only": "NWRITE: узел {node}: таблица {table} только для чтения",
         "modbus not started": "сервер Modbus не запущен: {path}: modbus_server.port: нельзя слушать "
                               "{host}:{port}: {error}",
         "modbus not yet": "сервер Modbus ещё не запущен: {path}: modbus_server.port: {fault}; новая попытка "
@@ -493,6 +661,89 @@ TEXTS: dict[str, dict[str, str]] = {
         "not a pair": "станция не входит в пару горячего резерва ([redundancy])",
         "handing over": "IntoStandBy: роль основной переходит к партнёру",
         "station quit": "выход из станции",
+        "users user": "{file}: пользователь {name!r}", "users twice": "указан дважды",
+        "users no default": "нет пользователя {name!r} в {path} (`main.py users add {name} --role viewer` "
+                            "добавит его)",
+        "users default role": "{name!r} с ролью {role}: пользователь по умолчанию действует за того, кто "
+                              "сидит за рабочим местом, не войдя, поэтому он должен быть наблюдателем",
+        "users not object": "ожидается объект с name, role, salt и hash",
+        "users missing": "нет {keys} (каждый — текст)",
+        "users not hex": "salt и hash должны быть шестнадцатеричными (задайте пароль снова: `main.py users "
+                         "passwd`)",
+        "users bad json": "не файл пользователей: ошибка JSON в строке {line}, столбце {col}: {error}",
+        "users not json": "не файл пользователей: {kind}",
+        "users no list": 'не файл пользователей: ожидается {{"users": [...]}}, как пишет `main.py users`',
+        "msg fields": "ожидается number,group,type,text, а полей {n}",
+        "msg type": "type {kind} — не один из: 0 info, 1 warning, 2 alarm, 3 critical",
+        "msg no text": "у сообщения {number} нет текста",
+        "msg not whole": "{name} {text} — не целое неотрицательное число",
+        "msg past": "{name} {value} больше {most}, наибольшего, что вмещает архив",
+        "msg defined": "сообщение {number} уже определено в строке {line}",
+        "form as is": "{error}",
+        "form expected text": "ожидается текст, а задано {value}",
+        "form expected bool": "ожидается true или false, а задано {value}",
+        "form out of range": "{value} вне диапазона {lo}..{hi}",
+        "form expected integer": "ожидается целое число от {lo} до {hi}, а задано {value}",
+        "form expected number": "ожидается число, а задано {value}",
+        "form not one of": "{value} — не одно из: {options}",
+        "form address text": 'адрес — восьмеричный текст вида "02000" или символ, а задано {value}',
+        "form tag type": 'тег "{tag}" типа {type}; это свойство принимает {kinds}',
+        "form no tag": 'тег "{tag}" типа {type}; это свойство тегов не принимает',
+        "form bit number": 'номер бита после "{name}." должен быть 0-7, а задано "{bit}"',
+        "form unknown tag": 'неизвестный тег или символ "{name}"',
+        "form unknown symbol": 'неизвестный символ "{name}"',
+        "form not address": '"{value}" — не восьмеричный адрес и не символ',
+        "form expected colour": 'ожидается цвет вида "#1a2b3c", а задано {value}',
+        "form not colour": '"{value}" — не цвет (#RRGGBB, #AARRGGBB или {names})',
+        "form expected font": 'ожидается {{"Family": ..., "Size": ..., "Bold": ...}}, а задано {value}',
+        "form font field": "неизвестное поле шрифта {fields} (Family, Size, Bold, Italic)",
+        "form font size": "размер шрифта {size:g} вне диапазона 4..200",
+        "form image nul": "в имени файла картинки {name} есть знак NUL",
+        "form image problem": 'файл картинки "{name}": {problem}',
+        "form image outside": 'файл картинки "{name}" вне папки станции {roots} (показано без него; '
+                              "allow_outside = true в station.toml разрешает)",
+        "form image missing": 'файл картинки "{name}" не найден в {folder}',
+        "form and": "{first} и {then}", "form digits": "число из {n} цифр",
+        "form where element": 'элемент "{name}"', "form where element n": "элемент #{n}",
+        "form where an element": "элемент", "form where device": 'устройство "{name}"',
+        "form where device n": "устройство #{n}", "form where image": "картинка #{n}",
+        "form where file": "файл",
+        "form image why": 'файл картинки "{name}" {why}',
+        "form expected index": "ожидается номер картинки (-1 — без картинки), а задано {value}",
+        "form index range": "номер картинки {value} вне диапазона: в форме картинок {n} (-1 — без картинки)",
+        "form unknown close": 'неизвестное свойство; может быть, "{close}"?',
+        "form unknown property": "неизвестное свойство",
+        "form unknown section": "неизвестный раздел (form, devices, images, elements)",
+        "form past": "элемент ({x},{y} {w}x{h}) выходит за форму ({width}x{height})",
+        "form no settings": 'нет или не объект {{"title": ..., "width": ..., "height": ...}}',
+        "form missing": "нет обязательного свойства",
+        "form devices list": "должен быть списком {{Name, AppMin, AppMax, PhyMin, PhyMax}}",
+        "form device object": "должен быть объектом {{Name, AppMin, AppMax, PhyMin, PhyMax}}",
+        "form duplicate device": "имя устройства повторяется",
+        "form images list": "должен быть списком файлов картинок",
+        "form elements list": "нет или не список элементов",
+        "form element object": "должен быть объектом с type, Name, x, y, w, h",
+        "form duplicate element": "имя элемента повторяется",
+        "form did you mean": '; может быть, "{close}"?',
+        "form type missing": "нет",
+        "form unknown type": "неизвестный тип элемента {kind!r}{hint}",
+        "form types": "{text} (типы: {types})",
+        "form given twice": "задано дважды (как {first} и {key})",
+        "form device or ranges": "задайте либо Device, либо AppMin/AppMax/PhyMin/PhyMax, но не то и другое",
+        "form no devices": "в форме нет устройств",
+        "form unknown device": 'неизвестное устройство "{device}" ({known})',
+        "form no conversion": "нет: назовите адресом тег (его преобразование будет взято) или задайте Device "
+                              "либо AppMin, AppMax, PhyMin и PhyMax",
+        "form range missing": "нет (нужно вместе с другими свойствами диапазона)",
+        "form equals": "равно {key} ({value:g}): преобразование не определено",
+        "form above": "{high:g} должно быть больше PhyLow {low:g}",
+        "form negative": "не должно быть отрицательным",
+        "form contradicts": "{own} противоречит тегу {tag} с {truth}: слово {word:g} здесь показывает "
+                            "{here}, у тега {there} (уберите собственное преобразование элемента, чтобы "
+                            "взять тега)",
+        "form unit contradicts": '"{units}" противоречит тегу {tag} с единицей "{unit}"',
+        "form image before": "{last} раньше ImageFirst {first}",
+        "form phase": "фаза {phase} должна быть меньше периода {period}",
         "tags header": "заголовок должен назвать столбцы {required} (нет: {missing}); известные столбцы: "
                        "{known}",
         "tags unknown column": "неизвестный столбец {column!r} (известные: {known})",
@@ -620,18 +871,6 @@ def system_language() -> str:
 
 
 @dataclass(frozen=True)
-class Phrase:
-    """A part of a sentence, said in the sentence's language when the sentence is said."""
-
-    name: str
-    values: Mapping[str, object] = field(default_factory=dict)
-
-
-def phrase(name: str, /, **values: object) -> Phrase:
-    return Phrase(name, values)
-
-
-@dataclass(frozen=True)
 class Phrases:
     """Parts said one after the other, joined by `sep` (a restore's problems, one per file)."""
 
@@ -655,6 +894,8 @@ class Words:
         """A value as it goes into a sentence: a phrase said in this language, the rest as it is."""
         if isinstance(value, Phrases):
             return value.sep.join(str(self.say(part)) for part in value.parts)
+        if isinstance(value, WordedError):  # an address's problem, a reader's (netplc/words.py)
+            value = value.phrase
         return self(value.name, **value.values) if isinstance(value, Phrase) else value
 
     @property

@@ -381,8 +381,9 @@ class _Reader:
         self.allow_outside = allow_outside  # may paths leave the station folder?
         self.known: set[str] = set()
 
-    def bad(self, key: str, problem: str) -> None:
-        self.problems.append(f"{self.fname}: {self.prefix}{key}: {problem}")
+    def bad(self, key: str, problem: object) -> None:
+        """`problem`: text, or a phrase of the catalogue (a node's own checks, netplc/words.py)."""
+        self.problems.append(f"{self.fname}: {self.prefix}{key}: {self.say.say(problem)}")
 
     def get(self, key: str, default: Any = _DECLARED, required: bool = False,
             kind: type | tuple[type, ...] | None = None) -> Any:

@@ -20,7 +20,7 @@ from typing import TYPE_CHECKING
 from app.authority.policy import VIEWER
 from app.authority.users import USERS_FILE, Users, UsersFileError
 from app.scada.table import TagTable, read_tags
-from app.scada.words import Phrase, phrase, words
+from app.scada.words import Phrase, Words, phrase, words
 from app.station.config import Station
 from app.station.extras import station_problems
 from netplc.exchange import check_program_nodes
@@ -52,16 +52,17 @@ def load(station: Station, parse_cache: Path | None = None) -> Loaded:
     """What the station reads; with `parse_cache` (a start's, not `check`'s: check writes nothing),
     the parsed programs are kept in that folder for the next start (netplc/parsecache.py)."""
     out = Loaded()
-    out.symbols = _symbols(station.Symbols, out)
+    say = words(station.Language)
+    out.symbols = _symbols(station.Symbols, out, say)
     cache = ParseCache(parse_cache) if parse_cache is not None else None
-    program = _program(station, out, cache)
+    program = _program(station, out, cache, say)
     if program is not None:
-        out.problems += [str(d) for d in check_program_nodes(program, station.nodes)]
+        out.problems += [d.said(say) for d in check_program_nodes(program, station.nodes)]
     for sim in station.simulators:
         try:
             p = _parse(sim.program, load_symbols(sim.symbols) if sim.symbols else {}, cache)
         except ProgramError as e:
-            out.problems += e.problems
+            out.problems += [d.said(say) for d in e.errors]
             continue
         out.node_programs.append(p)
         out.notes.append(phrase("note simulator", node=sim.node, program=sim.program.name,
@@ -71,9 +72,9 @@ def load(station: Station, parse_cache: Path | None = None) -> Loaded:
             out.catalog = Catalog.load(station.Messages)
             out.notes.append(phrase("note messages", file=station.Messages.name, n=len(out.catalog)))
         except CatalogError as e:
-            out.problems += e.problems
+            out.problems += e.said(say)
     if station.Tags is not None:
-        out.tags, problems = read_tags(station.Tags, out.symbols, words(station.Language))
+        out.tags, problems = read_tags(station.Tags, out.symbols, say)
         out.problems += problems
         out.notes.append(phrase("note tags", file=station.Tags.name, n=len(out.tags.tags),
                                 alarms=len(out.tags.alarms)))
@@ -95,15 +96,15 @@ def load_station_forms(station: Station, symbols: dict[str, int],
     from hmi_forms.form import load_forms  # the form code loads only for a station that has forms
 
     return load_forms(station.HMIload, symbols, station=station.folder, allow_outside=station.allow_outside,
-                      tags=tags)
+                      tags=tags, say=words(station.Language))
 
 
-def _symbols(path: Path | None, out: Loaded) -> dict[str, int]:
+def _symbols(path: Path | None, out: Loaded, say: Words) -> dict[str, int]:
     """The symbols; with errors, those of the good lines, so the program is checked against them."""
     if path is None:
         return {}
     symbols, errors = read_symbols(path)
-    out.problems += [str(d) for d in errors]
+    out.problems += [d.said(say) for d in errors]
     return symbols
 
 
@@ -119,17 +120,16 @@ def _users(station: Station, out: Loaded) -> None:
         out.problems.append(str(e))
         return
     except UsersFileError as e:
-        out.problems += e.problems
+        out.problems += e.said(words(station.Language))
         return
     name = station.operator.default_user
     user = users.get(name)
     key = f"{station.path}: operator.default_user"
+    say = words(station.Language)
     if name and user is None:
-        out.problems.append(f"{key}: no user {name!r} in {path} (`main.py users add {name} --role viewer` "
-                            "adds one)")
+        out.problems.append(f"{key}: " + say("users no default", name=name, path=path))
     elif user is not None and user.role != VIEWER:
-        out.problems.append(f"{key}: {name!r} is of role {user.role}: the default user acts for whoever "
-                            "is at the workstation without logging in, so it must be a viewer")
+        out.problems.append(f"{key}: " + say("users default role", name=name, role=user.role))
     elif users.users:
         out.notes.append(phrase("note users", file=USERS_FILE, n=len(users.users)) if not name else
                          phrase("note users default", file=USERS_FILE, n=len(users.users), name=name))
@@ -148,7 +148,7 @@ def _parse(path: Path, symbols: dict[str, int], cache: ParseCache | None) -> Pro
     return parse_file(path, symbols) if cache is None else parse_file_cached(path, symbols, cache)
 
 
-def _program(station: Station, out: Loaded, cache: ParseCache | None) -> Program | None:
+def _program(station: Station, out: Loaded, cache: ParseCache | None, say: Words) -> Program | None:
     """The program (none when NetPlcLoad is false); with errors, the program without its bad lines
     (line numbers kept) for the checks that need a whole program, and `out.program` stays empty."""
     path = station.NetPlcProgram
@@ -157,7 +157,7 @@ def _program(station: Station, out: Loaded, cache: ParseCache | None) -> Program
     try:
         program = _parse(path, out.symbols, cache)
     except ProgramError as e:
-        out.problems += e.problems
+        out.problems += [d.said(say) for d in e.errors]
         return _recovered(path, out.symbols, {d.line for d in e.errors})
     out.program = program
     out.notes.append(phrase("note program", file=path.name, instrs=len(program.instrs), words=program.words))

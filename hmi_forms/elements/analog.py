@@ -31,6 +31,7 @@ from typing import Any, NamedTuple
 
 from app.scada.table import TagTable
 from app.scada.tag import Tag
+from app.scada.words import Phrase, phrase
 from hmi_forms.elements import props as p
 from hmi_forms.elements.base import Element, Reader, Writer, word_reader
 from hmi_forms.elements.sentence import Sentence
@@ -107,14 +108,14 @@ class Scaled(Element):
                 self.PhyHigh = alarms.h
         return tag
 
-    def disagreements(self, raw: Mapping[str, Any], tags: TagTable) -> list[tuple[str, str]]:
+    def disagreements(self, raw: Mapping[str, Any], tags: TagTable) -> list[tuple[str, Phrase]]:
         """Where the form's own conversion or unit (`raw`, checked) contradicts the tag the element
         is bound to: the tag is the station's truth (alarms, journal, OPC UA read it), so an element
         scaling otherwise shows a wrong number with the right unit. Warnings: the form still opens."""
         tag = tags.by_name.get(self.tag)
         if tag is None:
             return []
-        out: list[tuple[str, str]] = []
+        out: list[tuple[str, Phrase]] = []
         lo, hi = tag.limits
         truth = tag.scaling or p.Scaling(lo, hi, lo, hi)
         own = self.scaling
@@ -125,31 +126,30 @@ class Scaled(Element):
                 (k for k in ("AppMin", "AppMax", "PhyMin", "PhyMax") if getattr(own, k) != getattr(truth, k)),
                 "AppMin")
             word = truth.AppMax
-            out.append((key, f"{_ranges(own)} contradicts tag {tag.name}'s {_ranges(truth)}: word "
-                             f"{word:g} shows {self.format(own.to_phy(word))} here, "
-                             f"{self.format(truth.to_phy(word))} {tag.unit}".rstrip()
-                             + " (remove the element's own conversion to take the tag's)"))
+            out.append((key, phrase("form contradicts", own=_ranges(own), tag=tag.name, truth=_ranges(truth),
+                                    word=word, here=self.format(own.to_phy(word)),
+                                    there=f"{self.format(truth.to_phy(word))} {tag.unit}".rstrip())))
         if "Units" in raw and tag.unit and self.Units != tag.unit:
-            out.append(("Units", f'"{self.Units}" contradicts tag {tag.name}\'s unit "{tag.unit}"'))
+            out.append(("Units", phrase("form unit contradicts", units=self.Units, tag=tag.name,
+                                        unit=tag.unit)))
         return out
 
-    def check(self, ctx: p.Context) -> list[tuple[str, str]]:
+    def check(self, ctx: p.Context) -> list[tuple[str, Phrase]]:
         inline = {k: getattr(self, k) for k in ("AppMin", "AppMax", "PhyMin", "PhyMax")}
         given = [k for k, v in inline.items() if v is not None]
         if self.Device is not None:
             if given:
-                return [(given[0], "give either Device or AppMin/AppMax/PhyMin/PhyMax, not both")]
+                return [(given[0], phrase("form device or ranges"))]
             if self.Device not in ctx.devices:
-                known = ", ".join(sorted(ctx.devices)) or "the form has no devices"
-                return [("Device", f'unknown device "{self.Device}" ({known})')]
+                known = ", ".join(sorted(ctx.devices)) or phrase("form no devices")
+                return [("Device", phrase("form unknown device", device=self.Device, known=known))]
             self.scaling = ctx.devices[self.Device]
             return []
         missing = [k for k, v in inline.items() if v is None]
         if len(missing) == 4:
-            return [("Device", "missing: name a tag as the address (its conversion is taken), or give a "
-                                "Device or AppMin, AppMax, PhyMin and PhyMax")]
+            return [("Device", phrase("form no conversion"))]
         if missing:
-            return [(k, "missing (needed with the other range properties)") for k in missing]
+            return [(k, phrase("form range missing")) for k in missing]
         problems = scaling_problems(inline)
         if not problems:
             self.scaling = p.Scaling(**inline)
@@ -180,13 +180,13 @@ def _ranges(sc: p.Scaling) -> str:
     return f"{sc.AppMin:g}..{sc.AppMax:g} -> {sc.PhyMin:g}..{sc.PhyMax:g}"
 
 
-def scaling_problems(ranges: dict[str, Any]) -> list[tuple[str, str]]:
+def scaling_problems(ranges: dict[str, Any]) -> list[tuple[str, Phrase]]:
     """Ranges that would divide by zero; shared by elements and the form's Devices table."""
     problems = []
     if ranges["AppMax"] == ranges["AppMin"]:
-        problems.append(("AppMax", f"equals AppMin ({ranges['AppMin']:g}): the conversion is undefined"))
+        problems.append(("AppMax", phrase("form equals", key="AppMin", value=ranges["AppMin"])))
     if ranges["PhyMax"] == ranges["PhyMin"]:
-        problems.append(("PhyMax", f"equals PhyMin ({ranges['PhyMin']:g}): the conversion is undefined"))
+        problems.append(("PhyMax", phrase("form equals", key="PhyMin", value=ranges["PhyMin"])))
     return problems
 
 
@@ -216,12 +216,12 @@ class AnalogBase(Scaled):
     trend: Trend | None = field(default=None, init=False, repr=False)
     last_scan: int = field(default=-1, init=False)
 
-    def check(self, ctx: p.Context) -> list[tuple[str, str]]:
+    def check(self, ctx: p.Context) -> list[tuple[str, Phrase]]:
         problems = super().check(ctx)
         if self.PhyLow is not None and self.PhyHigh is not None and self.PhyLow >= self.PhyHigh:
-            problems.append(("PhyHigh", f"{self.PhyHigh:g} must be above PhyLow {self.PhyLow:g}"))
+            problems.append(("PhyHigh", phrase("form above", high=self.PhyHigh, low=self.PhyLow)))
         if self.Hysteresis < 0:
-            problems.append(("Hysteresis", "must not be negative"))
+            problems.append(("Hysteresis", phrase("form negative")))
         key = (self.scaling, self.Precision, self.PhyLow, self.PhyHigh, self.Hysteresis)
         self.remembered = SHOWN.setdefault(key, {})  # shared once the conversion is known
         return problems

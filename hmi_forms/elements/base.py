@@ -26,6 +26,7 @@ from app.authority.policy import ROLES
 from app.scada.quality import Quality
 from app.scada.table import TagTable
 from app.scada.tag import Tag
+from app.scada.words import Phrase
 from hmi_forms.elements import props as p
 from hmi_forms.elements.target import Effects, Target
 from netplc.address import IO_BITS, BitRef, data_index
@@ -108,7 +109,7 @@ class Element:
             return self.Name
         return self.described or self.tag
 
-    def check(self, ctx: p.Context) -> list[tuple[str, str]]:
+    def check(self, ctx: p.Context) -> list[tuple[str, Phrase]]:
         """Problems between properties, as (property, problem); resolves references to the context."""
         return []
 

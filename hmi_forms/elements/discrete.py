@@ -15,6 +15,7 @@ import logging
 from dataclasses import dataclass, field
 from functools import cached_property
 
+from app.scada.words import Phrase, phrase
 from hmi_forms.elements import props as p
 from hmi_forms.elements.base import Element, Reader, Writer, bit_reader
 from netplc.address import BitRef
@@ -169,9 +170,9 @@ class DiscreteAnimation(DiscreteControlledEnable):
     frame: int = field(default=0, init=False)
     ticks: int = field(default=0, init=False)
 
-    def check(self, ctx: p.Context) -> list[tuple[str, str]]:
+    def check(self, ctx: p.Context) -> list[tuple[str, Phrase]]:
         if self.ImageLast < self.ImageFirst:
-            return [("ImageLast", f"{self.ImageLast} is before ImageFirst {self.ImageFirst}")]
+            return [("ImageLast", phrase("form image before", last=self.ImageLast, first=self.ImageFirst))]
         return []
 
     @property

@@ -17,14 +17,19 @@ from typing import Any
 
 from app.scada.table import TagTable
 from app.scada.tag import Scaling, TagType  # the one conversion, shared with tags, journal and viewer
+from app.scada.words import ENGLISH, Phrase, phrase
 from netplc.address import AddressError, BitRef, check_operand, parse_hmi_bit, parse_octal
 from netplc.textfile import MAX_DIGITS, MISSING, TextFileError, file_problem, resolve
+from netplc.words import WordedError
 
 Color = tuple[int, int, int, int]  # r, g, b, alpha
 
 
-class PropError(ValueError):
-    """A property value the loader refuses; the message is the `problem` part of the report."""
+class PropError(WordedError):
+    """A property value the loader refuses: a phrase of app/scada/words.py, the `problem` part of
+    the report, said in the station's language by the loader."""
+
+    in_english = ENGLISH
 
 
 class Outside(PropError):
@@ -68,7 +73,11 @@ class LongNumber:
     text: str
 
     def __repr__(self) -> str:
-        return f"a {len(self.text.lstrip('-'))}-digit number"
+        return str(ENGLISH.say(self.said))
+
+    @property
+    def said(self) -> Phrase:
+        return phrase("form digits", n=len(self.text.lstrip("-")))
 
 
 def json_int(text: str) -> int | LongNumber:
@@ -86,24 +95,24 @@ def _show(value: Any) -> str:
 
 def text(value: Any, _ctx: Context) -> str:
     if not isinstance(value, str):
-        raise PropError(f"expected text, got {_show(value)}")
+        raise PropError("form expected text", value=_show(value))
     return value
 
 
 def boolean(value: Any, _ctx: Context) -> bool:
     if not isinstance(value, bool):
-        raise PropError(f"expected true or false, got {_show(value)}")
+        raise PropError("form expected bool", value=_show(value))
     return value
 
 
 def integer(lo: int, hi: int) -> Parser:
     def parse(value: Any, _ctx: Context) -> int:
         if isinstance(value, LongNumber):
-            raise PropError(f"{value!r} is out of range {lo}..{hi}")
+            raise PropError("form out of range", value=value.said, lo=lo, hi=hi)
         if isinstance(value, bool) or not isinstance(value, int):
-            raise PropError(f"expected an integer from {lo} to {hi}, got {_show(value)}")
+            raise PropError("form expected integer", lo=lo, hi=hi, value=_show(value))
         if not lo <= value <= hi:
-            raise PropError(f"{value} is out of range {lo}..{hi}")
+            raise PropError("form out of range", value=value, lo=lo, hi=hi)
         return value
 
     return parse
@@ -114,19 +123,19 @@ MAX_NUMBER = 1e15  # past this a scaled value loses its units digit in a float
 
 def number(value: Any, _ctx: Context) -> float:
     if isinstance(value, LongNumber):
-        raise PropError(f"{value!r} is out of range -1e15..1e15")
+        raise PropError("form out of range", value=value.said, lo="-1e15", hi="1e15")
     if isinstance(value, bool) or not isinstance(value, int | float) or (
             isinstance(value, float) and not math.isfinite(value)):
-        raise PropError(f"expected a number, got {_show(value)}")
+        raise PropError("form expected number", value=_show(value))
     if not -MAX_NUMBER <= value <= MAX_NUMBER:  # exact for ints too, which float() may not hold
-        raise PropError(f"{_show(value)} is out of range -1e15..1e15")
+        raise PropError("form out of range", value=_show(value), lo="-1e15", hi="1e15")
     return float(value)
 
 
 def choice(*options: str) -> Parser:
     def parse(value: Any, _ctx: Context) -> str:
         if value not in options:
-            raise PropError(f"{_show(value)} is not one of {', '.join(options)}")
+            raise PropError("form not one of", value=_show(value), options=", ".join(options))
         return value
 
     return parse
@@ -136,12 +145,12 @@ def _address(value: Any, ctx: Context, kinds: tuple[TagType, ...] = ()) -> int:
     """Octal text (`"02000"`), a tag of one of `kinds`, a symbol, or `symbol.k` (bit k of the byte
     a symbol names)."""
     if not isinstance(value, str):
-        raise PropError(f'addresses are octal text such as "02000" or a symbol, got {_show(value)}')
+        raise PropError("form address text", value=_show(value))
     tag = ctx.tags.get(value)
     if tag is not None:
         if tag.type not in kinds:
-            raise PropError(f'tag "{value}" is of type {tag.type}; this property takes '
-                            f'{" or ".join(kinds) or "no tag"}')
+            raise PropError("form tag type" if kinds else "form no tag", tag=value, type=tag.type,
+                            kinds=" | ".join(kinds))
         return tag.address
     name, _, bit = value.partition(".")
     if name in ctx.symbols:
@@ -149,14 +158,14 @@ def _address(value: Any, ctx: Context, kinds: tuple[TagType, ...] = ()) -> int:
         if not bit:
             return addr
         if bit not in tuple("01234567"):
-            raise PropError(f'bit number after "{name}." must be 0-7, got "{bit}"')
+            raise PropError("form bit number", name=name, bit=bit)
         return addr * 8 + int(bit)
     if re.fullmatch(r"[A-Za-z_]\w*(\.\d+)?", value):
-        raise PropError(f'unknown {"tag or symbol" if ctx.tags.tags else "symbol"} "{name}"')
+        raise PropError("form unknown tag" if ctx.tags.tags else "form unknown symbol", name=name)
     try:
         return parse_octal(value)
     except ValueError:
-        raise PropError(f'"{value}" is not an octal address or a symbol') from None
+        raise PropError("form not address", value=value) from None
 
 
 def bit(value: Any, ctx: Context) -> BitRef:
@@ -164,7 +173,7 @@ def bit(value: Any, ctx: Context) -> BitRef:
     try:
         return parse_hmi_bit(_address(value, ctx, (TagType.BIT,)))
     except AddressError as e:
-        raise PropError(str(e)) from None
+        raise PropError("form as is", error=e) from None
 
 
 def word(value: Any, ctx: Context) -> int:
@@ -173,7 +182,7 @@ def word(value: Any, ctx: Context) -> int:
     try:
         check_operand(addr, 2)
     except AddressError as e:
-        raise PropError(str(e)) from None
+        raise PropError("form as is", error=e) from None
     return addr
 
 
@@ -194,24 +203,24 @@ _NAMED_COLORS = {
 def color(value: Any, _ctx: Context) -> Color:
     """`#RRGGBB`, `#AARRGGBB` (as Qt and .NET write them) or one of a few names."""
     if not isinstance(value, str):
-        raise PropError(f'expected a colour such as "#1a2b3c", got {_show(value)}')
+        raise PropError("form expected colour", value=_show(value))
     v = _NAMED_COLORS.get(value.lower(), value)
     if re.fullmatch(r"#[0-9a-fA-F]{6}", v):
         return int(v[1:3], 16), int(v[3:5], 16), int(v[5:7], 16), 255
     if re.fullmatch(r"#[0-9a-fA-F]{8}", v):
         return int(v[3:5], 16), int(v[5:7], 16), int(v[7:9], 16), int(v[1:3], 16)
-    raise PropError(f'"{value}" is not a colour (#RRGGBB, #AARRGGBB or {", ".join(sorted(_NAMED_COLORS))})')
+    raise PropError("form not colour", value=value, names=", ".join(sorted(_NAMED_COLORS)))
 
 
 def font(value: Any, ctx: Context) -> Font:
     if not isinstance(value, dict):
-        raise PropError(f'expected {{"Family": ..., "Size": ..., "Bold": ...}}, got {_show(value)}')
+        raise PropError("form expected font", value=_show(value))
     unknown = sorted(set(value) - {"Family", "Size", "Bold", "Italic"})
     if unknown:
-        raise PropError(f"unknown font field {', '.join(unknown)} (Family, Size, Bold, Italic)")
+        raise PropError("form font field", fields=", ".join(unknown))
     size = number(value.get("Size", 10), ctx)
     if not 4 <= size <= 200:
-        raise PropError(f"font size {size:g} is out of range 4..200")
+        raise PropError("form font size", size=size)
     return Font(
         text(value.get("Family", Font.Family), ctx),
         size,
@@ -226,19 +235,21 @@ def image_file(value: Any, ctx: Context) -> Path:
     anywhere: a form must not make the workstation read /etc/passwd or another station's files."""
     name = text(value, ctx)
     if "\0" in name:
-        raise PropError(f"image file {_show(name)} has a NUL character")
+        raise PropError("form image nul", name=_show(name))
     try:
         path = resolve(ctx.folder / name)
     except TextFileError as e:
-        raise PropError(f'image file "{name}": {e.problem}') from None
+        raise PropError("form image problem", name=name, problem=e.problem) from None
     roots = (ctx.folder, *ctx.roots)
     if not ctx.allow_outside and not any(path.is_relative_to(root.resolve()) for root in roots):
-        raise Outside(f'image file "{name}" is outside the station folder {" and ".join(map(str, roots))} '
-                      "(shown without it; allow_outside = true in station.toml allows it)")
+        folders: object = str(roots[0])
+        for root in roots[1:]:
+            folders = phrase("form and", first=folders, then=str(root))
+        raise Outside("form image outside", name=name, roots=folders)
     if (why := file_problem(path)) == MISSING:
-        raise PropError(f'image file "{name}" not found in {ctx.folder}')
+        raise PropError("form image missing", name=name, folder=ctx.folder)
     if why is not None:
-        raise PropError(f'image file "{name}" {why}')
+        raise PropError("form image why", name=name, why=why)
     return path
 
 
@@ -246,9 +257,9 @@ def image_index(value: Any, ctx: Context) -> int:
     """An index into the form's "images" list; -1 = no image."""
     n = len(ctx.images)
     if isinstance(value, bool) or not isinstance(value, int):
-        raise PropError(f"expected an image index (-1 for none), got {_show(value)}")
+        raise PropError("form expected index", value=_show(value))
     if not -1 <= value < n:
-        raise PropError(f"image index {value} is out of range: the form has {n} images (-1 = none)")
+        raise PropError("form index range", value=value, n=n)
     return value
 
 

@@ -13,6 +13,7 @@ from __future__ import annotations
 
 from dataclasses import dataclass, field
 
+from app.scada.words import Phrase, phrase
 from hmi_forms.elements import props as p
 from hmi_forms.elements.base import Element
 from netplc.address import BitRef
@@ -38,9 +39,9 @@ class SyncGenerator(Element):
     enabled: bool = field(default=True, init=False)
     last_scan: int = field(default=-1, init=False)
 
-    def check(self, ctx: p.Context) -> list[tuple[str, str]]:
+    def check(self, ctx: p.Context) -> list[tuple[str, Phrase]]:
         pairs = (("Phase0", self.Period0, self.Phase0), ("Phase1", self.Period1, self.Phase1))
-        return [(name, f"phase {phase} must be less than the period {period}")
+        return [(name, phrase("form phase", phase=phase, period=period))
                 for name, period, phase in pairs if phase >= period]
 
     @property

@@ -180,7 +180,7 @@ def operand_bit(base: int, k: int) -> int:
     """Bit k of the bit string at operand `base`, as a `bit_get` address (bit k = bit k%8 of byte k//8)."""
     if base < IO_BITS:
         if base + k >= IO_BITS:
-            raise AddressError(f"bit {k} of {fmt_octal(base)} runs past bit 03777")
+            raise AddressError("addr bit past", k=k, addr=fmt_octal(base))
         return base + k
     check_operand(base + k // 8, 1)
     return (base + k // 8) * 8 + k % 8
@@ -201,10 +201,10 @@ def span(first: int | None, last: int | None) -> int:
     a, b = first or 0, last or 0
     if a < IO_BITS and b < IO_BITS:
         if (b - a) % 8:
-            raise AddressError(f"{fmt_octal(a)}..{fmt_octal(b)} is not a whole number of bytes")
+            raise AddressError("addr not bytes", first=fmt_octal(a), last=fmt_octal(b))
         return (b - a) // 8 + 1
     if (a < IO_BITS) != (b < IO_BITS):
-        raise AddressError(f"{fmt_octal(a)}..{fmt_octal(b)} mixes I/O bits and data memory")
+        raise AddressError("addr mixes", first=fmt_octal(a), last=fmt_octal(b))
     return b - a + 1
 
 
@@ -221,7 +221,7 @@ def valid_block(addr: int, n: int) -> bool:
 
 def _operand(addr: int | None, n: int) -> int:
     if addr is None:
-        raise AddressError("missing operand")
+        raise AddressError("addr missing")
     check_operand(addr, n)
     return addr
 

@@ -9,6 +9,8 @@ from urllib.parse import parse_qsl, urlsplit
 
 from serial import SerialBase
 
+from netplc.words import Phrase, WordedError, phrase
+
 PARITIES = ("N", "E", "O")
 BAUDRATES: tuple[int, ...] = SerialBase.BAUDRATES  # the standard rates every platform's port takes
 STOPBITS = (1, 2)
@@ -37,48 +39,48 @@ class Endpoint:
 
 
 def parse_endpoint(text: str) -> Endpoint:
-    """Parse an endpoint; ValueError says what is wrong with it and shows the expected form."""
-    forms = "expected tcp://host:port, rtu:///dev/ttyX?baudrate=19200&parity=E or rtu://COM3?baudrate=..."
+    """Parse an endpoint; a ValueError (WordedError, netplc/words.py) says what is wrong with it
+    and shows the expected form."""
+    forms = phrase("ep forms")
     try:
         url = urlsplit(text.strip())
         port = url.port
     except ValueError as e:
-        raise ValueError(f"endpoint {text!r}: {e} ({forms})") from None
+        raise WordedError("ep wrong", text=text, error=e, forms=forms) from None
     if url.scheme == "tcp":
         if not url.hostname:
-            raise ValueError(f"endpoint {text!r}: no host ({forms})")
+            raise WordedError("ep no host", text=text, forms=forms)
         if url.path not in ("", "/") or url.query:
-            raise ValueError(f"endpoint {text!r}: a tcp endpoint has no path or options ({forms})")
+            raise WordedError("ep tcp path", text=text, forms=forms)
         try:
             url.hostname.encode("idna")
         except UnicodeError:
-            raise ValueError(f"endpoint {text!r}: {url.hostname!r} is not a valid host name") from None
+            raise WordedError("ep bad host", text=text, host=url.hostname) from None
         return Endpoint("tcp", host=url.hostname, port=port if port is not None else 502)
     if url.scheme == "rtu":
         # rtu:///dev/ttyS0 names a device path; rtu://COM3 a Windows port (the URL's "host")
         device = url.path if not url.netloc else url.netloc if not url.path else ""
         if not device:
-            raise ValueError(f"endpoint {text!r}: the serial device must follow rtu:// ({forms})")
+            raise WordedError("ep no device", text=text, forms=forms)
         options: dict[str, Any] = {}
         for key, value in parse_qsl(url.query, keep_blank_values=True):
             if key == "parity":
                 if value.upper() not in PARITIES:
-                    raise ValueError(f"endpoint {text!r}: parity {value!r} is not N, E or O")
+                    raise WordedError("ep parity", text=text, value=value)
                 options[key] = value.upper()
             elif key in ("baudrate", "bytesize", "stopbits"):
                 if not value.isdigit() or int(value) <= 0:
-                    raise ValueError(f"endpoint {text!r}: {key} {value!r} is not a positive number")
+                    raise WordedError("ep not positive", text=text, key=key, value=value)
                 options[key] = int(value)
             else:
-                raise ValueError(f"endpoint {text!r}: unknown option {key!r} "
-                                 "(baudrate, parity, bytesize, stopbits)")
+                raise WordedError("ep option", text=text, key=key)
         if "parity" in options:  # else the defaults, even parity and 1 stop bit, keep the rule
             options.setdefault("stopbits", default_stopbits(options["parity"]))
         endpoint = Endpoint("rtu", device=device, **options)
         if problems := line_problems(endpoint):
-            raise ValueError(f"endpoint {text!r}: {problems[0][1]}")
+            raise WordedError("ep line", text=text, problem=problems[0][1])
         return endpoint
-    raise ValueError(f"endpoint {text!r}: unknown scheme {url.scheme!r} ({forms})")
+    raise WordedError("ep scheme", text=text, scheme=url.scheme, forms=forms)
 
 
 def default_stopbits(parity: str) -> int:
@@ -86,10 +88,10 @@ def default_stopbits(parity: str) -> int:
     return 2 if parity == "N" else 1
 
 
-def line_problems(endpoint: Endpoint) -> list[tuple[str, str]]:
+def line_problems(endpoint: Endpoint) -> list[tuple[str, Phrase]]:
     """(setting, problem) for each serial line setting of an rtu endpoint that a port cannot take:
     a typo in a rate would otherwise open the port at a speed nobody on the line talks."""
     checks = (("baudrate", endpoint.baudrate, BAUDRATES), ("parity", endpoint.parity, PARITIES),
               ("stopbits", endpoint.stopbits, STOPBITS), ("bytesize", endpoint.bytesize, BYTESIZES))
-    return [(key, f"{key} {value!r} is not one of {', '.join(map(str, allowed))}")
+    return [(key, phrase("line not one of", key=key, value=value, allowed=", ".join(map(str, allowed))))
             for key, value, allowed in checks if value not in allowed]

@@ -1,5 +1,6 @@
 """Broken station files end as named problems (`file:line: ...`), never as tracebacks, hangs or
-an OOM: `check` exits 1 listing them, a start exits 2, and the forms that are fine still open."""
+an OOM: `check` exits 1 listing them, a start exits 2, and the forms that are fine still open.
+The stations here are English, as the cases name their problems (test_check.py tries ru)."""
 
 from __future__ import annotations
 
@@ -58,7 +59,7 @@ def bad_forms(folder: Path) -> dict[str, str]:
 
 
 def test_check_lists_every_bad_file_and_exits_1(tmp_path: Path) -> None:
-    st = copy_demo(tmp_path / "st")
+    st = copy_demo(tmp_path / "st", "en")
     program_line = append_line(st / "netplc.stl", b"; bad " + NOT_CP1251)
     symbols_line = append_line(st / "symbols.csv", b"LONG,02000," + b"x" * 140_000)
     big_line = append_line(st / "messages.csv", f"{2**63},1,0,too big for the archive".encode())
@@ -78,7 +79,7 @@ def test_check_lists_every_bad_file_and_exits_1(tmp_path: Path) -> None:
 def test_a_station_written_in_cp1251_checks_clean(tmp_path: Path) -> None:
     from app.scada.table import load_tags
 
-    st = copy_demo(tmp_path / "st")
+    st = copy_demo(tmp_path / "st", "en")
     for name in ("netplc.stl", "symbols.csv", "messages.csv", "tags.csv"):
         path = st / name
         path.write_bytes(path.read_text(encoding="utf-8").encode("cp1251"))
@@ -90,7 +91,7 @@ def test_a_station_written_in_cp1251_checks_clean(tmp_path: Path) -> None:
 
 
 def test_a_start_with_an_unreadable_symbols_file_exits_2_naming_it(tmp_path: Path) -> None:
-    st = copy_demo(tmp_path / "st")
+    st = copy_demo(tmp_path / "st", "en")
     line = append_line(st / "symbols.csv", b"BAD" + NOT_CP1251 + b",02000")
     r = main("--no-gui", st, "--duration", "1")
     assert r.returncode == 2, r.stdout + r.stderr
@@ -99,7 +100,7 @@ def test_a_start_with_an_unreadable_symbols_file_exits_2_naming_it(tmp_path: Pat
 
 
 def test_a_start_with_a_message_number_past_int64_exits_2_naming_the_line(tmp_path: Path) -> None:
-    st = copy_demo(tmp_path / "st")
+    st = copy_demo(tmp_path / "st", "en")
     line = append_line(st / "messages.csv", f"{2**64},1,0,too big".encode())
     r = main("--no-gui", st, "--duration", "1")
     assert r.returncode == 2, r.stdout + r.stderr
@@ -156,7 +157,7 @@ def test_the_workstation_opens_the_demo_forms_beside_the_broken_ones(tmp_path: P
     from app.station.config import load_station
     from app.station.runtime import Runtime
 
-    st = copy_demo(tmp_path / "st")
+    st = copy_demo(tmp_path / "st", "en")
     expected = bad_forms(st / "forms")
     runtime = Runtime(load_station(st))
     runtime.start()
@@ -181,7 +182,7 @@ def test_each_bad_input_is_named_by_check_and_by_the_start(tmp_path: Path, case:
     from app.station.runtime import Runtime
     from netplc.problems import Problems
 
-    st = copy_demo(tmp_path / "st")
+    st = copy_demo(tmp_path / "st", "en")
     expected = case.plant(st)
     report = check_station(st)
     assert any(p.startswith(expected) for p in report.problems), (expected, report.problems)
@@ -200,7 +201,7 @@ def test_each_bad_input_is_named_by_check_and_by_the_start(tmp_path: Path, case:
 
 
 def test_check_exits_1_naming_a_default_user_who_is_no_viewer_and_a_broken_users_file(tmp_path: Path) -> None:
-    st = copy_demo(tmp_path / "st")
+    st = copy_demo(tmp_path / "st", "en")
     replace(st / "station.toml", 'default_user = "viewer"', 'default_user = "operator"')
     r = main("check", st)
     assert r.returncode == 1 and "Traceback" not in r.stderr
@@ -215,7 +216,7 @@ def test_check_exits_1_naming_a_default_user_who_is_no_viewer_and_a_broken_users
 def test_a_station_without_users_may_have_no_default_user(tmp_path: Path) -> None:
     from app.station.check import check_station
 
-    st = copy_demo(tmp_path / "st")
+    st = copy_demo(tmp_path / "st", "en")
     (st / "users.json").unlink()
     assert check_station(st).problems == [
         f"{st / 'station.toml'}: operator.default_user: no user 'viewer' in {st / 'users.json'} "

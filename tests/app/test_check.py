@@ -63,14 +63,14 @@ def test_every_planted_error_is_found(tmp_path: Path) -> None:
         f"{st / 'station.toml'}: NetSyncTime: ожидается целое число, а задано 'fast'",  # the demo's ru
         f"{st / 'station.toml'}: Colour: неизвестный параметр",
         f"{st / 'station.toml'}: nodes[0].endpoint: endpoint 'tcp://plc:99999'",
-        f"{st / 'netplc.stl'}:{tnx}:1: unknown instruction 'TNX'",
+        f"{st / 'netplc.stl'}:{tnx}:1: неизвестная инструкция 'TNX'",
         f"{st / 'netplc.stl'}:{nosuch}:",
-        f"{st / 'netplc.stl'}:{node7}:1: NODE S:7: node 7 is not configured",  # found past other errors
+        f"{st / 'netplc.stl'}:{node7}:1: NODE S:7: узел 7 не задан",  # found past other errors
         f"{st / 'symbols.csv'}:",
         f"{st / 'node0.stl'}:{ctr}:",
         "messages.csv:",
-        'zz_broken.hmi: element "Broken": InAddr',
-        'zz_broken.hmi: element "Alien"',
+        'zz_broken.hmi: элемент "Broken": InAddr',
+        'zz_broken.hmi: элемент "Alien"',
     ]
     for e in expected:
         assert e in out, f"{e!r} not in:\n{out}"
@@ -140,7 +140,6 @@ def test_station_toml_problems_are_said_in_the_station_language(tmp_path: Path, 
     naming the file, the key and the value as they are; a Russian one leaves no English word of
     the catalogue."""
     from app.station.check import check_station
-    from tests.app.scada.test_words import english_words
 
     st = copy_demo(tmp_path / "st", language)
     plant(st / "station.toml", "NetSyncTime = 100", 'NetSyncTime = "fast"\nColour = "red"\nkeep_days = -5')
@@ -163,9 +162,90 @@ def test_station_toml_problems_are_said_in_the_station_language(tmp_path: Path, 
     outside = "вне папки станции" if language == "ru" else "is outside the station folder"
     assert any(p.startswith("Retain: ") and outside in p for p in problems), problems
     if language == "ru":
-        prose = (re.sub(r"\S*[/.:]\S*|'[^']*'|\b[A-Za-z_]+ = \w+", "", p) for p in problems)
-        left = {w for p in prose for w in re.findall(r"[A-Za-z]{2,}", p)} & english_words()
-        assert not left, f"English words in a Russian station.toml's problems: {sorted(left)}: {problems}"
+        russian_leaves_no_english(problems)
+
+
+def russian_leaves_no_english(problems: list[str]) -> None:
+    """No English word of the catalogue in Russian problems, past file names, quoted values and
+    names as they are."""
+    from tests.app.scada.test_words import english_words
+
+    prose = (re.sub(r"\S*[/.:]\S*|'[^']*'|\b[A-Za-z_]+ = \w+", "", p) for p in problems)
+    left = {w for p in prose for w in re.findall(r"[A-Za-z]{2,}", p)} & english_words()
+    assert not left, f"English words in Russian problems: {sorted(left)}: {problems}"
+
+
+@pytest.mark.parametrize("language", ["ru", "en"])
+def test_readers_problems_are_said_in_the_station_language(tmp_path: Path, language: str) -> None:
+    """The program reader's diagnostics (instruction, operand, address, jump, a function's
+    parameters), symbols.csv's, the forms', messages.csv's, users.json's and a node's settings',
+    naming file, line, column, element, property, user, key and the text as it is."""
+    from app.station.check import check_station
+
+    st = copy_demo(tmp_path / "st", language)
+    stl = st / "netplc.stl"
+    program = stl.read_text(encoding="utf-8").splitlines()
+    stl.write_text("\n".join([*program, "TNX ON", "FON C:$02500 N:MOV S:$10000 D:$04000", "JMP NOWHERE",
+                              "FON C:$02504 N:MOV S:$04000", "TIM $02510 N:999"]) + "\n",
+                   encoding="utf-8")
+    plant(st / "symbols.csv", "PUMP,02120", "PUMP,02190")
+    form = st / "forms" / "zz_broken.hmi"
+    form.write_text(json.dumps({"form": {"title": "t", "width": 100, "height": 100, "Font": {"Size": 1}},
+                                "elements": [
+        {"type": "DiscreteBase", "Name": "Broken", "x": 0, "y": 0, "w": 10, "h": 10, "InAddr": "010000"},
+        {"type": "NoSuchElement", "Name": "Alien", "x": 0, "y": 0, "w": 10, "h": 10},
+        {"type": "AnalogBase", "Name": "Gauge", "x": 0, "y": 0, "w": 10, "h": 10, "InAddr": "04000",
+         "AppMin": 0, "AppMax": 0, "PhyMin": 0, "PhyMax": 100}]}), encoding="utf-8")
+    plant(st / "messages.csv", "3,1,2,", "3,1,alarm,")
+    plant(st / "station.toml", "timeout = 0.5",
+          'timeout = 0.5\nendpoint = "rtu:///dev/ttyS9?parity=X"\nname = "a/b"')
+    toml = st / "station.toml"
+    users = [{"name": "ivanov", "role": "boss", "salt": "00", "hash": "00"}, {"name": "petrov"}]
+    (st / "users.json").write_text(json.dumps({"users": users}), encoding="utf-8")
+    n = len(program)
+    messages = (st / "messages.csv").read_text(encoding="utf-8").splitlines()
+    message = next(i for i, line in enumerate(messages, 1) if line.startswith("3,1,alarm,"))
+    symbol = next(i for i, line in enumerate((st / "symbols.csv").read_text(encoding="utf-8").splitlines(), 1)
+                  if line.startswith("PUMP,"))
+    problems = check_station(st).problems
+    said = {
+        "ru": [f"{stl}:{n + 1}:1: неизвестная инструкция 'TNX'",
+               f"{stl}:{n + 2}:22: S: 010000 — недопустимый адрес",
+               f"{stl}:{n + 3}:5: L: метка 'NOWHERE' не определена",
+               f"{stl}:{n + 4}:1: MOV нужен D: (адрес)",
+               f"{stl}:{n + 5}:14: N: 999 вне 0-255",
+               f"{st / 'symbols.csv'}:{symbol}:6: '02190' — не восьмеричное число",
+               f"{form}: form: Font: размер шрифта 1 вне диапазона 4..200",
+               f'{form}: элемент "Broken": InAddr: 010000 — ни бит ввода-вывода, ни бит данных (байт*8+бит)',
+               f"{form}: элемент \"Alien\": type: неизвестный тип элемента 'NoSuchElement' (типы: ",
+               f'{form}: элемент "Gauge": AppMax: равно AppMin (0): преобразование не определено',
+               f"{st / 'messages.csv'}:{message}: type 'alarm' — не целое неотрицательное число",
+               f"{st / 'users.json'}: пользователь 'ivanov': роль 'boss' — не одна из: ",
+               f"{st / 'users.json'}: пользователь 'petrov': нет role, salt, hash (каждый — текст)",
+               f"{toml}: nodes[0].endpoint: endpoint 'rtu:///dev/ttyS9?parity=X': "
+               "parity 'X' — не N, E и не O",
+               f"{toml}: nodes[0].name: 'a/b' не может содержать '/', '+', '#'"],
+        "en": [f"{stl}:{n + 1}:1: unknown instruction 'TNX'",
+               f"{stl}:{n + 2}:22: S: 010000 is not a valid address",
+               f"{stl}:{n + 3}:5: L: undefined label 'NOWHERE'",
+               f"{stl}:{n + 4}:1: MOV needs D: (an address)",
+               f"{stl}:{n + 5}:14: N: 999 is outside 0-255",
+               f"{st / 'symbols.csv'}:{symbol}:6: '02190' is not an octal number",
+               f"{form}: form: Font: font size 1 is out of range 4..200",
+               f'{form}: element "Broken": InAddr: 010000 is neither an I/O bit nor a data bit (byte*8+bit)',
+               f"{form}: element \"Alien\": type: unknown element type 'NoSuchElement' (types: ",
+               f'{form}: element "Gauge": AppMax: equals AppMin (0): the conversion is undefined',
+               f"{st / 'messages.csv'}:{message}: type 'alarm' is not a non-negative whole number",
+               f"{st / 'users.json'}: user 'ivanov': role 'boss' is not one of ",
+               f"{st / 'users.json'}: user 'petrov': role, salt, hash missing (each a text)",
+               f"{toml}: nodes[0].endpoint: endpoint 'rtu:///dev/ttyS9?parity=X': "
+               "parity 'X' is not N, E or O",
+               f"{toml}: nodes[0].name: 'a/b' may not hold '/', '+', '#'"],
+    }[language]
+    for line in said:
+        assert any(p.startswith(line) for p in problems), f"{line!r} not in {problems}"
+    if language == "ru":
+        russian_leaves_no_english(problems)
 
 
 @pytest.mark.parametrize("language", ["ru", "en"])

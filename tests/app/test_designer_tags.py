@@ -99,9 +99,10 @@ def test_check_and_the_problems_pane_warn_of_a_contradicting_conversion(
                        text=True, timeout=60)
     assert r.returncode == 0, r.stdout + r.stderr  # a warning: the station still opens the form
     warned = [line for line in r.stdout.splitlines() if line.startswith("предупреждение:")]  # the demo is ru
-    assert any("02_analog.hmi" in line and "AppMax: 0..4095 -> 0..100 contradicts tag TEMP's "
-               "0..1000 -> -50..150: word 1000 shows 24.4 here, 150.0 °C" in line for line in warned), warned
-    assert any('Units: "K" contradicts tag TEMP\'s unit "°C"' in line for line in warned), warned
+    assert any("02_analog.hmi" in line and "AppMax: 0..4095 -> 0..100 противоречит тегу TEMP с "
+               "0..1000 -> -50..150: слово 1000 здесь показывает 24.4, у тега 150.0 °C" in line
+               for line in warned), warned
+    assert any('Units: "K" противоречит тегу TEMP с единицей "°C"' in line for line in warned), warned
     w: DesignerWindow = make_window(qtbot, form)
     assert w.problems.recheck() == []
     assert len(w.problems.warnings) == 2
