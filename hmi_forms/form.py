@@ -100,7 +100,7 @@ def parse_form(path: Path, parse_int: Callable[[str], Any] = p.json_int) -> Any:
     """The JSON of a form file; FormError naming the file and the place for anything else (not
     text, not JSON, nested too deeply, with the default `parse_int` never a number too long)."""
     try:
-        raw = read_text(path, "the form")
+        raw = read_text(path, "read form")
     except TextFileError as e:
         raise FormError([str(e)]) from None
     try:

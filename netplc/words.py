@@ -146,6 +146,23 @@ WORDS = {
     "node backoff": "{backoff:g} s is more than backoff_max {most:g} s",
     "node twice": "node {node} is configured twice",
     "node title used": "{title!r} already names node {node}",
+    # a station's text file that cannot be read (netplc/textfile.py): what the system says as it is
+    "read file": "the file", "read program": "program", "read symbols": "symbols", "read tags": "the tags",
+    "read messages": "the message catalog", "read users": "the users file",
+    "read station": "the station file",
+    "read form": "the form",
+    "file cannot read": "cannot read {what}: {error}",
+    "file not a file": "cannot read {what}: it is {kind}, not a file",
+    "file too large": "cannot read {what}: larger than {mb} MB, the most a station file may hold",
+    "file not text": "neither UTF-8 nor {fallback} text (byte 0x{byte:02X})",
+    "file link loop": "a loop of symbolic links",
+    "file outside": "{real} is outside the station folder {root} (allow_outside = true permits it)",
+    "kind file": "a file", "kind folder": "a folder", "kind fifo": "a FIFO (named pipe)",
+    "kind char": "a character device", "kind block": "a block device", "kind socket": "a socket",
+    "kind special": "a special file",
+    "csv field long": "a field is longer than {n} characters",
+    "csv error": "{error}",
+    "csv runs on": "a quoted field runs on to line {line}: a row is one line (a closing quote missing?)",
     "node shared line": "{endpoint} and node {node}'s {first} share {device} with different line settings",
 }
 Say = Callable[..., str]  # `say(name, **values)`: a record's text

@@ -153,9 +153,9 @@ def _read(path: Path) -> dict[str, User]:
     """The users of a users file; UsersFileError names every problem (read as every station file
     is: a regular file, with a size limit)."""
     try:
-        doc = json.loads(read_text(path, "the users file"))
+        doc = json.loads(read_text(path, "read users"))
     except TextFileError as e:
-        raise UsersFileError([str(e)]) from None
+        raise UsersFileError([e]) from None
     except json.JSONDecodeError as e:
         raise UsersFileError([Problem(str(path), phrase("users bad json", line=e.lineno, col=e.colno,
                                                         error=e.msg), ENGLISH)]) from None
