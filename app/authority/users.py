@@ -25,7 +25,7 @@ from dataclasses import asdict, dataclass
 from pathlib import Path
 
 from app.authority.policy import ROLES, VIEWER, rank
-from app.scada.words import ENGLISH, Phrase, phrase
+from app.scada.words import ENGLISH, Phrase, json_error, phrase
 from netplc.problems import Problem, Problems
 from netplc.textfile import TextFileError, read_text
 
@@ -158,7 +158,7 @@ def _read(path: Path) -> dict[str, User]:
         raise UsersFileError([e]) from None
     except json.JSONDecodeError as e:
         raise UsersFileError([Problem(str(path), phrase("users bad json", line=e.lineno, col=e.colno,
-                                                        error=e.msg), ENGLISH)]) from None
+                                                        error=json_error(e.msg)), ENGLISH)]) from None
     except (ValueError, RecursionError) as e:  # int() past 4300 digits; nesting past the stack
         raise UsersFileError([Problem(str(path), phrase("users not json", kind=type(e).__name__),
                                       ENGLISH)]) from None

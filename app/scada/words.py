@@ -243,6 +243,18 @@ TEXTS: dict[str, dict[str, str]] = {
         "tag limit outside": "{key} {value:g} is outside what a {type} tag can take here ({lo:g}..{hi:g})",
         # a form's reader (hmi_forms/form.py, elements/): properties, names and values as they are
         "form as is": "{error}",
+        "form bad json": "bad JSON: {error}",
+        "form too deep": "bad JSON: arrays or objects nested too deeply (here past {n} levels)",
+        "form not object": "the form must be a JSON object with form, devices, elements",
+        "form elements not list": "elements: must be a list of element objects",
+        "form settings not object": 'form: must be an object {{"title": ..., "width": ..., "height": ...}}',
+        # what the json module says of a file that is not JSON (json_error)
+        "json value": "Expecting value", "json comma": "Expecting ',' delimiter",
+        "json colon": "Expecting ':' delimiter",
+        "json name": "Expecting property name enclosed in double quotes",
+        "json extra": "Extra data", "json string": "Unterminated string starting at",
+        "json control": "Invalid control character at", "json escape": "Invalid \\escape",
+        "json unicode": "Invalid \\uXXXX escape",
         "form expected text": "expected text, got {value}",
         "form expected bool": "expected true or false, got {value}",
         "form out of range": "{value} is out of range {lo}..{hi}",
@@ -696,6 +708,19 @@ TEXTS: dict[str, dict[str, str]] = {
         "msg past": "{name} {value} больше {most}, наибольшего, что вмещает архив",
         "msg defined": "сообщение {number} уже определено в строке {line}",
         "form as is": "{error}",
+        "form bad json": "ошибка JSON: {error}",
+        "form too deep": "ошибка JSON: массивы или объекты вложены слишком глубоко (здесь глубже {n} "
+                         "уровней)",
+        "form not object": "форма должна быть объектом JSON с form, devices, elements",
+        "form elements not list": "elements: должен быть списком объектов элементов",
+        "form settings not object": 'form: должен быть объектом {{"title": ..., "width": ..., '
+                                    '"height": ...}}',
+        "json value": "ожидается значение", "json comma": "ожидается разделитель ','",
+        "json colon": "ожидается разделитель ':'", "json name": "ожидается имя свойства в двойных кавычках",
+        "json extra": "лишние данные после конца", "json string": "строка не закрыта",
+        "json control": "недопустимый управляющий символ",
+        "json escape": "недопустимая последовательность с \\",
+        "json unicode": "недопустимая последовательность \\uXXXX",
         "form expected text": "ожидается текст, а задано {value}",
         "form expected bool": "ожидается true или false, а задано {value}",
         "form out of range": "{value} вне диапазона {lo}..{hi}",
@@ -875,6 +900,20 @@ TEXTS: dict[str, dict[str, str]] = {
                            "потеряны",
     },
 }
+
+
+JSON_ERRORS = {"Expecting value": "json value", "Expecting ',' delimiter": "json comma",
+               "Expecting ':' delimiter": "json colon",
+               "Expecting property name enclosed in double quotes": "json name", "Extra data": "json extra",
+               "Unterminated string starting at": "json string",
+               "Invalid control character at": "json control",
+               "Invalid \\escape": "json escape", "Invalid \\uXXXX escape": "json unicode"}
+
+
+def json_error(msg: str) -> Phrase | str:
+    """What the json module says of a file that is not JSON (`JSONDecodeError.msg`), as a phrase
+    of this catalogue; a message it does not know as it is."""
+    return phrase(JSON_ERRORS[msg]) if msg in JSON_ERRORS else msg
 
 
 def system_language() -> str:
