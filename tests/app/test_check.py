@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import csv
 import json
 import re
 import subprocess
@@ -179,6 +180,7 @@ def russian_leaves_no_english(problems: list[str]) -> None:
 def test_readers_problems_are_said_in_the_station_language(tmp_path: Path, language: str) -> None:
     """The program reader's diagnostics (instruction, operand, address, jump, a function's
     parameters), symbols.csv's, the forms', messages.csv's, users.json's and a node's settings',
+    a file that is not text, a CSV line the csv module refuses and a form that is not JSON,
     naming file, line, column, element, property, user, key and the text as it is."""
     from app.station.check import check_station
 
@@ -200,6 +202,12 @@ def test_readers_problems_are_said_in_the_station_language(tmp_path: Path, langu
     plant(st / "station.toml", "timeout = 0.5",
           'timeout = 0.5\nendpoint = "rtu:///dev/ttyS9?parity=X"\nname = "a/b"')
     toml = st / "station.toml"
+    (st / "node0.stl").write_bytes(b"NOP\n\x98\n")  # neither UTF-8 nor cp1251
+    tags = st / "tags.csv"
+    tags.write_text(tags.read_text(encoding="utf-8") + '"' + "x" * (csv.field_size_limit() + 1) + '"\n',
+                    encoding="utf-8")
+    tag_line = len(tags.read_text(encoding="utf-8").splitlines())
+    (st / "forms" / "zz_text.hmi").write_text('{"form": {"title": "t",}}', encoding="utf-8")
     users = [{"name": "ivanov", "role": "boss", "salt": "00", "hash": "00"}, {"name": "petrov"}]
     (st / "users.json").write_text(json.dumps({"users": users}), encoding="utf-8")
     n = len(program)
@@ -224,7 +232,11 @@ def test_readers_problems_are_said_in_the_station_language(tmp_path: Path, langu
                f"{st / 'users.json'}: пользователь 'petrov': нет role, salt, hash (каждый — текст)",
                f"{toml}: nodes[0].endpoint: endpoint 'rtu:///dev/ttyS9?parity=X': "
                "parity 'X' — не N, E и не O",
-               f"{toml}: nodes[0].name: 'a/b' не может содержать '/', '+', '#'"],
+               f"{toml}: nodes[0].name: 'a/b' не может содержать '/', '+', '#'",
+               f"{st / 'node0.stl'}:2:0: ни UTF-8, ни cp1251 (байт 0x98)",
+               f"{tags}:{tag_line}: поле длиннее {csv.field_size_limit()} символов",
+               f"{st / 'forms' / 'zz_text.hmi'}:1:24: ошибка JSON: ожидается имя свойства в двойных "
+               "кавычках"],
         "en": [f"{stl}:{n + 1}:1: unknown instruction 'TNX'",
                f"{stl}:{n + 2}:22: S: 010000 is not a valid address",
                f"{stl}:{n + 3}:5: L: undefined label 'NOWHERE'",
@@ -240,7 +252,11 @@ def test_readers_problems_are_said_in_the_station_language(tmp_path: Path, langu
                f"{st / 'users.json'}: user 'petrov': role, salt, hash missing (each a text)",
                f"{toml}: nodes[0].endpoint: endpoint 'rtu:///dev/ttyS9?parity=X': "
                "parity 'X' is not N, E or O",
-               f"{toml}: nodes[0].name: 'a/b' may not hold '/', '+', '#'"],
+               f"{toml}: nodes[0].name: 'a/b' may not hold '/', '+', '#'",
+               f"{st / 'node0.stl'}:2:0: neither UTF-8 nor cp1251 text (byte 0x98)",
+               f"{tags}:{tag_line}: a field is longer than {csv.field_size_limit()} characters",
+               f"{st / 'forms' / 'zz_text.hmi'}:1:24: bad JSON: Expecting property name enclosed in double "
+               "quotes"],
     }[language]
     for line in said:
         assert any(p.startswith(line) for p in problems), f"{line!r} not in {problems}"
