@@ -122,6 +122,11 @@ WORDS = {
                    "nodes: {have})",
     "stl node map": "{name}: node {node}: {error}",
     "stl read only": "NWRITE: node {node}: table {table} is read-only",
+    "map no bytes": "block length {length}: at least 1 byte is needed",
+    "map remote": "remote {error}",
+    "map table": "table {table!r} is not one of {tables}",
+    "map past": "{table} {remote}+{count} runs past Modbus address 65535",
+    "map profile": "profile {profile!r} is not one of {profiles}",
     # a node's settings (netplc/exchange.py node_problems, netplc/modbus/endpoint.py): values as they are
     "ep forms": "expected tcp://host:port, rtu:///dev/ttyX?baudrate=19200&parity=E or rtu://COM3?baudrate=...",
     "ep wrong": "endpoint {text!r}: {error} ({forms})",

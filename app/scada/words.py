@@ -616,6 +616,11 @@ TEXTS: dict[str, dict[str, str]] = {
         "stl no node": "{name} без NODE в программе обращается к узлу 0, а он не задан (заданные узлы: "
                        "{have})",
         "stl node map": "{name}: узел {node}: {error}",
+        "map no bytes": "длина блока {length}: нужен хотя бы 1 байт",
+        "map remote": "удалённый адрес: {error}",
+        "map table": "таблица {table!r} — не одна из: {tables}",
+        "map past": "{table} {remote}+{count} выходит за адрес Modbus 65535",
+        "map profile": "профиль {profile!r} — не один из: {profiles}",
         "stl read only": "NWRITE: узел {node}: таблица {table} только для чтения",
         "modbus not started": "сервер Modbus не запущен: {path}: modbus_server.port: нельзя слушать "
                               "{host}:{port}: {error}",

@@ -188,7 +188,8 @@ def test_readers_problems_are_said_in_the_station_language(tmp_path: Path, langu
     stl = st / "netplc.stl"
     program = stl.read_text(encoding="utf-8").splitlines()
     stl.write_text("\n".join([*program, "TNX ON", "FON C:$02500 N:MOV S:$10000 D:$04000", "JMP NOWHERE",
-                              "FON C:$02504 N:MOV S:$04000", "TIM $02510 N:999"]) + "\n",
+                              "FON C:$02504 N:MOV S:$04000", "TIM $02510 N:999",
+                              "FON C:$02520 N:NREAD S:10000 D:$04100 R:2"]) + "\n",
                    encoding="utf-8")
     plant(st / "symbols.csv", "PUMP,02120", "PUMP,02190")
     form = st / "forms" / "zz_broken.hmi"
@@ -222,6 +223,7 @@ def test_readers_problems_are_said_in_the_station_language(tmp_path: Path, langu
                f"{stl}:{n + 3}:5: L: метка 'NOWHERE' не определена",
                f"{stl}:{n + 4}:1: MOV нужен D: (адрес)",
                f"{stl}:{n + 5}:14: N: 999 вне 0-255",
+               f"{stl}:{n + 6}:1: NREAD: узел 0: удалённый адрес: 010000 — недопустимый адрес",
                f"{st / 'symbols.csv'}:{symbol}:6: '02190' — не восьмеричное число",
                f"{form}: form: Font: размер шрифта 1 вне диапазона 4..200",
                f'{form}: элемент "Broken": InAddr: 010000 — ни бит ввода-вывода, ни бит данных (байт*8+бит)',
@@ -242,6 +244,7 @@ def test_readers_problems_are_said_in_the_station_language(tmp_path: Path, langu
                f"{stl}:{n + 3}:5: L: undefined label 'NOWHERE'",
                f"{stl}:{n + 4}:1: MOV needs D: (an address)",
                f"{stl}:{n + 5}:14: N: 999 is outside 0-255",
+               f"{stl}:{n + 6}:1: NREAD: node 0: remote 010000 is not a valid address",
                f"{st / 'symbols.csv'}:{symbol}:6: '02190' is not an octal number",
                f"{form}: form: Font: font size 1 is out of range 4..200",
                f'{form}: element "Broken": InAddr: 010000 is neither an I/O bit nor a data bit (byte*8+bit)',
