@@ -22,11 +22,11 @@ from pathlib import Path
 from typing import Any
 
 from app.scada.table import TagTable
-from app.scada.words import Phrase, Words, phrase, words
+from app.scada.words import ENGLISH, Phrase, Words, json_error, phrase, words
 from hmi_forms.elements import ELEMENT_TYPES, Element
 from hmi_forms.elements import props as p
 from hmi_forms.elements.analog import Scaled, scaling_problems
-from netplc.problems import Problems
+from netplc.problems import Problem, Problems
 from netplc.textfile import TextFileError, confine, read_text
 
 FORM_BACK = (0xDD, 0xE1, 0xE6, 255)
@@ -98,21 +98,28 @@ def _unknown(name: str, known: list[str]) -> Phrase:
 
 def parse_form(path: Path, parse_int: Callable[[str], Any] = p.json_int) -> Any:
     """The JSON of a form file; FormError naming the file and the place for anything else (not
-    text, not JSON, nested too deeply, with the default `parse_int` never a number too long)."""
+    text, not JSON, nested too deeply, with the default `parse_int` never a number too long), its
+    problem a phrase its reporter says in the station's language (`FormError.said`)."""
     try:
-        raw = read_text(path, "the form")
+        raw = read_text(path, "read form")
     except TextFileError as e:
-        raise FormError([str(e)]) from None
+        raise FormError([e]) from None
     try:
         return json.loads(raw, parse_int=parse_int)
     except json.JSONDecodeError as e:
-        raise FormError([f"{path}:{e.lineno}:{e.colno}: bad JSON: {e.msg}"]) from None
+        where, text = f"{path}:{e.lineno}:{e.colno}", phrase("form bad json", error=json_error(e.msg))
+        raise not_a_form(where, text) from None
     except RecursionError:
         line, col = _too_deep(raw)
-        raise FormError([f"{path}:{line}:{col}: bad JSON: arrays or objects nested too deeply "
-                         f"(here past {MAX_NESTING} levels)"]) from None
+        raise not_a_form(f"{path}:{line}:{col}", phrase("form too deep", n=MAX_NESTING)) from None
     except ValueError as e:  # a `parse_int` that refuses a number (int: past 4300 digits)
-        raise FormError([f"{path}: bad JSON: {e}"]) from None
+        raise not_a_form(str(path), phrase("form bad json", error=e)) from None
+
+
+def not_a_form(where: str, text: Phrase) -> FormError:
+    """A form file that is no form at all: the place as it is, the problem a phrase (English in
+    `problems`, said in a station's language by `said`)."""
+    return FormError([Problem(where, text, ENGLISH)])
 
 
 class _Loader:
@@ -143,13 +150,17 @@ class _Loader:
             try:
                 confine(self.path, self.ctx.roots[0])
             except TextFileError as e:
-                raise FormError([str(e)]) from None
-        return self.build(parse_form(self.path))
+                raise FormError([e.said(self.say)]) from None
+        try:
+            doc = parse_form(self.path)
+        except FormError as e:
+            raise FormError(e.said(self.say)) from None
+        return self.build(doc)
 
     def build(self, doc: Any) -> Form:
         """The form of a parsed document (the designer checks its unsaved document through this)."""
         if not isinstance(doc, dict):
-            raise FormError([f"{self.path}: the form must be a JSON object with form, devices, elements"])
+            raise FormError([f"{self.path}: {self.say('form not object')}"])
         for key in sorted(set(doc) - {"form", "devices", "images", "elements"}):
             self.problem(self.say("form where file"), key, phrase("form unknown section"))
         form = self.form_settings(doc.get("form"))

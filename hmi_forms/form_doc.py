@@ -17,9 +17,10 @@ from pathlib import Path
 from typing import Any
 
 from app.scada.table import TagTable
+from app.scada.words import phrase, words
 from hmi_forms.elements import ELEMENT_TYPES, Element
 from hmi_forms.elements import props as p
-from hmi_forms.form import FormError, _Loader, parse_form
+from hmi_forms.form import FormError, _Loader, not_a_form, parse_form
 from hmi_forms.form_writer import dump_form, save_form
 
 # What a required property stands in with while it is missing or bad, for drawing only.
@@ -34,6 +35,7 @@ class FormDoc:
     station: Path | None = None  # the station folder: images may come from it as well as the form's
     allow_outside: bool = False  # the station lets paths leave its folder
     tags: TagTable = field(default_factory=TagTable)  # the station's: their conversion, unit, limits
+    language: str = ""  # the station's Language, its problems are said in ("": the system locale's)
 
     @property
     def settings(self) -> dict[str, Any]:
@@ -58,13 +60,18 @@ def read_doc(path: str | Path) -> FormDoc:
     path = Path(path)
     data = parse_form(path, parse_int=int)  # plain ints: the writer saves what it read
     if not isinstance(data, dict):
-        raise FormError([f"{path}: the form must be a JSON object with form, devices, elements"])
+        raise not_a_form(str(path), phrase("form not object"))
     elements = data.get("elements", [])
     if not isinstance(elements, list) or not all(isinstance(e, dict) for e in elements):
-        raise FormError([f"{path}: elements: must be a list of element objects"])
+        raise not_a_form(str(path), phrase("form elements not list"))
     if not isinstance(data.get("form", {}), dict):
-        raise FormError([f'{path}: form: must be an object {{"title": ..., "width": ..., "height": ...}}'])
+        raise not_a_form(str(path), phrase("form settings not object"))
     return FormDoc(path, data)
+
+
+def _loader(doc: FormDoc, symbols: dict[str, int]) -> _Loader:
+    """The loader of the document's station, saying its problems in the station's language."""
+    return _Loader(doc.path, symbols, doc.station, doc.allow_outside, doc.tags, words(doc.language))
 
 
 def problems(doc: FormDoc, symbols: dict[str, int]) -> list[str]:
@@ -75,7 +82,7 @@ def problems(doc: FormDoc, symbols: dict[str, int]) -> list[str]:
 def checked(doc: FormDoc, symbols: dict[str, int]) -> tuple[list[str], list[str]]:
     """What `check` would report for this document if it were saved now: its problems, and its
     warnings (an element whose conversion or unit contradicts its tag's)."""
-    loader = _Loader(doc.path, symbols, doc.station, doc.allow_outside, doc.tags)
+    loader = _loader(doc, symbols)
     try:
         loader.build(json.loads(json.dumps(doc.data)))
     except FormError as e:
@@ -90,7 +97,7 @@ class Reader:
     def __init__(self, doc: FormDoc, symbols: dict[str, int]) -> None:
         self.path = doc.path
         self.symbols = symbols
-        self.loader = _Loader(doc.path, symbols, doc.station, doc.allow_outside, doc.tags)
+        self.loader = _loader(doc, symbols)
         self.loader.ctx.devices = self.loader.devices(doc.data.get("devices", []))
         self.loader.ctx.images = self.loader.images(doc.data.get("images", []))
         self.ctx = self.loader.ctx

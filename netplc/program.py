@@ -116,11 +116,11 @@ def read_symbols(path: str | Path) -> tuple[dict[str, int], list[Diagnostic]]:
     errors: list[Diagnostic] = []
     symbols: dict[str, int] = {}
     try:
-        text = read_text(path, "symbols")
+        text = read_text(path, "read symbols")
     except TextFileError as e:
-        return {}, [Diagnostic(str(path), e.line, 0, e.problem)]
+        return {}, [Diagnostic(str(path), e.line, 0, e.phrase)]
     for lineno, row in csv_rows(text):
-        if isinstance(row, str):
+        if isinstance(row, Phrase):
             errors.append(Diagnostic(str(path), lineno, 1, row))
             continue
         if not row or not row[0].strip() or row[0].lstrip().startswith(("#", ";")):
@@ -172,9 +172,9 @@ def parse_file(path: str | Path, symbols: dict[str, int] | None = None) -> Progr
 def read_program_text(path: Path) -> str:
     """The program file's text; a file that cannot be read is a ProgramError naming it."""
     try:
-        return read_text(path, "program")
+        return read_text(path, "read program")
     except TextFileError as e:
-        raise ProgramError([Diagnostic(str(path), e.line, 0, e.problem)]) from None
+        raise ProgramError([Diagnostic(str(path), e.line, 0, e.phrase)]) from None
 
 
 def load_program(path: str | Path, symbols_path: str | Path | None = None) -> Program:

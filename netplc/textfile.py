@@ -11,6 +11,10 @@ A station folder is input like any other: only a regular file of at most MAX_BYT
 name that is a link to /dev/zero, a FIFO, a device or a folder is a named problem instead of a
 read that never ends or fills the memory, and a loop of symbolic links is named too (Python 3.11's
 `Path.resolve` raises RuntimeError for one).
+
+Its problems are phrases of netplc/words.py (`TextFileError.phrase`, a CSV line's problem), said in
+the station's language by whoever reports them with a station; what the system says inside one
+(an OS error, the csv module's own message) stays as it is.
 """
 
 from __future__ import annotations
@@ -20,6 +24,8 @@ import os
 import stat
 from collections.abc import Iterator
 from pathlib import Path
+
+from netplc.words import Phrase, Say, WordedError, english, phrase, said
 
 FALLBACK = "cp1251"
 # The largest station text file read: the demo's largest is 20 KB, a full 8 K-word program with
@@ -32,13 +38,24 @@ _OPEN = os.O_RDONLY | getattr(os, "O_NONBLOCK", 0) | getattr(os, "O_BINARY", 0) 
 MAX_DIGITS = 100
 
 
-class TextFileError(ValueError):
+class TextFileError(WordedError):
     """A text file that cannot be read or decoded: `file:line: problem` (`file: problem` when the
-    problem is the whole file's, line 0)."""
+    problem is the whole file's, line 0), the problem a phrase (`phrase`; `problem` its English)."""
 
-    def __init__(self, source: str, line: int, problem: str) -> None:
-        self.source, self.line, self.problem = source, line, problem
-        super().__init__(f"{source}:{line}: {problem}" if line else f"{source}: {problem}")
+    def __init__(self, source: str, line: int, name: str, /, **values: object) -> None:
+        super().__init__(name, **values)
+        self.source, self.line = source, line
+
+    @property
+    def problem(self) -> str:
+        return str(said(english, self.phrase))
+
+    def said(self, say: Say) -> str:
+        text = said(say, self.phrase)
+        return f"{self.source}:{self.line}: {text}" if self.line else f"{self.source}: {text}"
+
+    def __str__(self) -> str:
+        return self.said(english)
 
 
 def decode(data: bytes, source: str) -> str:
@@ -51,47 +68,52 @@ def decode(data: bytes, source: str) -> str:
             return data.decode(FALLBACK)
         except UnicodeDecodeError as e:
             line = data.count(b"\n", 0, e.start) + 1
-            raise TextFileError(source, line, f"neither UTF-8 nor {FALLBACK} text "
-                                              f"(byte 0x{data[e.start]:02X})") from None
+            raise TextFileError(source, line, "file not text", fallback=FALLBACK,
+                                byte=data[e.start]) from None
 
 
-def read_text(path: str | Path, what: str = "the file", limit: int = MAX_BYTES) -> str:
-    """The text of `path` (see `decode`); TextFileError names the file and what it is."""
+def read_text(path: str | Path, what: str = "read file", limit: int = MAX_BYTES) -> str:
+    """The text of `path` (see `decode`); TextFileError names the file and what it is (`what`, a
+    phrase of netplc/words.py: "read program", "read tags"...)."""
     return decode(read_bytes(path, what, limit), str(path))
 
 
-def read_bytes(path: str | Path, what: str = "the file", limit: int = MAX_BYTES) -> bytes:
+def read_bytes(path: str | Path, what: str = "read file", limit: int = MAX_BYTES) -> bytes:
     """The bytes of the regular file `path`, at most `limit` of them; TextFileError names the file
     and why it is not read (not a file, too large, a loop of links, no permission)."""
-    source = str(path)
+    source, named = str(path), phrase(what)
     try:
         fd = os.open(path, _OPEN)
     except OSError as e:
-        raise TextFileError(source, 0, f"cannot read {what}: {e.strerror or e}") from None
+        raise TextFileError(source, 0, "file cannot read", what=named, error=e.strerror or e) from None
     try:
         info = os.fstat(fd)
         if not stat.S_ISREG(info.st_mode):
-            raise TextFileError(source, 0, f"cannot read {what}: it is {kind(info.st_mode)}, not a file")
+            raise TextFileError(source, 0, "file not a file", what=named, kind=phrase(_kind(info.st_mode)))
         with open(fd, "rb", closefd=False) as f:
             data = f.read(limit + 1) if info.st_size <= limit else b""
     except OSError as e:
-        raise TextFileError(source, 0, f"cannot read {what}: {e.strerror or e}") from None
+        raise TextFileError(source, 0, "file cannot read", what=named, error=e.strerror or e) from None
     finally:
         os.close(fd)
     if info.st_size > limit or len(data) > limit:
-        raise TextFileError(source, 0, f"cannot read {what}: larger than {limit // 1024 // 1024} MB, "
-                                       "the most a station file may hold")
+        raise TextFileError(source, 0, "file too large", what=named, mb=limit // 1024 // 1024)
     return data
 
 
 def kind(mode: int) -> str:
     """What a file system entry of `mode` is, for a problem saying it is not what was expected."""
-    for test, what in ((stat.S_ISREG, "a file"), (stat.S_ISDIR, "a folder"),
-                       (stat.S_ISFIFO, "a FIFO (named pipe)"), (stat.S_ISCHR, "a character device"),
-                       (stat.S_ISBLK, "a block device"), (stat.S_ISSOCK, "a socket")):
+    return english(_kind(mode))
+
+
+def _kind(mode: int) -> str:
+    """The phrase of netplc/words.py naming what a file system entry of `mode` is."""
+    for test, what in ((stat.S_ISREG, "kind file"), (stat.S_ISDIR, "kind folder"),
+                       (stat.S_ISFIFO, "kind fifo"), (stat.S_ISCHR, "kind char"),
+                       (stat.S_ISBLK, "kind block"), (stat.S_ISSOCK, "kind socket")):
         if test(mode):
             return what
-    return "a special file"
+    return "kind special"
 
 
 def file_problem(path: Path, folder: bool = False) -> str | None:
@@ -113,7 +135,7 @@ def resolve(path: Path) -> Path:
     try:
         return path.resolve()
     except (OSError, RuntimeError):  # Python 3.11 raises RuntimeError("Symlink loop ...")
-        raise TextFileError(str(path), 0, "a loop of symbolic links") from None
+        raise TextFileError(str(path), 0, "file link loop") from None
 
 
 def confine(path: Path, folder: Path) -> Path:
@@ -121,12 +143,11 @@ def confine(path: Path, folder: Path) -> Path:
     (a station reads its own files only, unless its station.toml says allow_outside)."""
     real, root = resolve(path), resolve(folder)
     if not real.is_relative_to(root):
-        raise TextFileError(str(path), 0, f"{real} is outside the station folder {root} "
-                                          "(allow_outside = true permits it)")
+        raise TextFileError(str(path), 0, "file outside", real=real, root=root)
     return real
 
 
-def csv_rows(text: str) -> Iterator[tuple[int, list[str] | str]]:
+def csv_rows(text: str) -> Iterator[tuple[int, list[str] | Phrase]]:
     """(line number, row) of CSV text, or (line number, problem) for a line the csv module refuses.
 
     A row is one line: a quoted field that runs on over the next lines (a closing quote missing,
@@ -142,14 +163,11 @@ def csv_rows(text: str) -> Iterator[tuple[int, list[str] | str]]:
         except StopIteration:
             return
         except csv.Error as e:
-            problem = str(e)
-            if "field larger than field limit" in problem:
-                problem = f"a field is longer than {csv.field_size_limit()} characters"
-            yield start, problem
+            yield start, (phrase("csv field long", n=csv.field_size_limit())
+                          if "field larger than field limit" in str(e) else phrase("csv error", error=e))
         else:
             if reader.line_num > start:
-                yield start, (f"a quoted field runs on to line {reader.line_num}: a row is one line "
-                              "(a closing quote missing?)")
+                yield start, phrase("csv runs on", line=reader.line_num)
             else:
                 yield start, row
         start = reader.line_num + 1

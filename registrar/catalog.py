@@ -12,7 +12,7 @@ from pathlib import Path
 
 from netplc.problems import Problem, Problems
 from netplc.textfile import TextFileError, csv_rows, read_text, whole_number
-from netplc.words import phrase
+from netplc.words import Phrase, phrase
 from registrar.words import RowError, english
 
 MESSAGE_TYPES = {0: "info", 1: "warning", 2: "alarm", 3: "critical"}  # docs/architecture.md section 8
@@ -39,15 +39,15 @@ class Catalog:
     def load(cls, path: str | Path) -> Catalog:
         path = Path(path)
         try:
-            text = read_text(path, "the message catalog")
+            text = read_text(path, "read messages")
         except TextFileError as e:
-            raise CatalogError([str(e)]) from None
+            raise CatalogError([e]) from None
         problems: list[str | Problem] = []
         messages: dict[int, Message] = {}
         lines: dict[int, int] = {}
         for lineno, row in csv_rows(text):
-            if isinstance(row, str):
-                problems.append(f"{path}:{lineno}: {row}")
+            if isinstance(row, Phrase):
+                problems.append(Problem(f"{path}:{lineno}", row))
                 continue
             if not row or not "".join(row).strip() or row[0].lstrip().startswith(("#", ";")):
                 continue

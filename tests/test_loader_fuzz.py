@@ -338,7 +338,7 @@ def test_main_check_and_the_headless_start_print_named_problems_not_tracebacks(t
                                                                        "form is /dev/zero"))
     runs = []
     for case, args in ((loop, ["check"]), (zero, ["--no-gui", "--duration", "0.5", "--status-every", "0.2"])):
-        station = copy_demo(tmp_path / args[0].strip("-"))
+        station = copy_demo(tmp_path / args[0].strip("-"), "en")  # the cases' problems are English
         expected = case.plant(station)
         runs.append((expected, subprocess.Popen([sys.executable, "main.py", args[0], str(station), *args[1:]],
                                                 cwd=REPO, stdout=subprocess.PIPE, stderr=subprocess.PIPE,

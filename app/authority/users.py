@@ -25,7 +25,7 @@ from dataclasses import asdict, dataclass
 from pathlib import Path
 
 from app.authority.policy import ROLES, VIEWER, rank
-from app.scada.words import ENGLISH, Phrase, phrase
+from app.scada.words import ENGLISH, Phrase, json_error, phrase
 from netplc.problems import Problem, Problems
 from netplc.textfile import TextFileError, read_text
 
@@ -153,12 +153,12 @@ def _read(path: Path) -> dict[str, User]:
     """The users of a users file; UsersFileError names every problem (read as every station file
     is: a regular file, with a size limit)."""
     try:
-        doc = json.loads(read_text(path, "the users file"))
+        doc = json.loads(read_text(path, "read users"))
     except TextFileError as e:
-        raise UsersFileError([str(e)]) from None
+        raise UsersFileError([e]) from None
     except json.JSONDecodeError as e:
         raise UsersFileError([Problem(str(path), phrase("users bad json", line=e.lineno, col=e.colno,
-                                                        error=e.msg), ENGLISH)]) from None
+                                                        error=json_error(e.msg)), ENGLISH)]) from None
     except (ValueError, RecursionError) as e:  # int() past 4300 digits; nesting past the stack
         raise UsersFileError([Problem(str(path), phrase("users not json", kind=type(e).__name__),
                                       ENGLISH)]) from None

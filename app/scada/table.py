@@ -16,7 +16,7 @@ from dataclasses import dataclass, field
 from pathlib import Path
 
 from app.scada.tag import BYTE_ORDERS, NETPLC_ORDER, WIDE, Scaling, Tag, TagType, check_address
-from app.scada.words import Words, phrase, words
+from app.scada.words import Phrase, Words, phrase, words
 from netplc.address import AddressError, parse_hmi_bit, parse_octal
 from netplc.problems import Problems
 from netplc.textfile import TextFileError, csv_rows, read_text
@@ -96,14 +96,14 @@ def read_tags(path: str | Path, symbols: dict[str, int] | None = None,
     path = Path(path)
     fname = str(path)
     try:
-        text = read_text(path, "the tags")
+        text = read_text(path, "read tags")
     except TextFileError as e:
-        return TagTable(source=fname), [f"{fname}:{e.line}: {e.problem}"]
+        return TagTable(source=fname), [f"{fname}:{e.line}: {say.say(e)}"]
     problems: list[str] = []
     rows: list[tuple[int, list[str]]] = []
     for n, row in csv_rows(text):
-        if isinstance(row, str):
-            problems.append(f"{fname}:{n}: {row}")
+        if isinstance(row, Phrase):
+            problems.append(f"{fname}:{n}: {say.say(row)}")
         elif row and "".join(row).strip() and not row[0].lstrip().startswith(("#", ";")):
             rows.append((n, row))
     if not rows:

@@ -243,6 +243,18 @@ TEXTS: dict[str, dict[str, str]] = {
         "tag limit outside": "{key} {value:g} is outside what a {type} tag can take here ({lo:g}..{hi:g})",
         # a form's reader (hmi_forms/form.py, elements/): properties, names and values as they are
         "form as is": "{error}",
+        "form bad json": "bad JSON: {error}",
+        "form too deep": "bad JSON: arrays or objects nested too deeply (here past {n} levels)",
+        "form not object": "the form must be a JSON object with form, devices, elements",
+        "form elements not list": "elements: must be a list of element objects",
+        "form settings not object": 'form: must be an object {{"title": ..., "width": ..., "height": ...}}',
+        # what the json module says of a file that is not JSON (json_error)
+        "json value": "Expecting value", "json comma": "Expecting ',' delimiter",
+        "json colon": "Expecting ':' delimiter",
+        "json name": "Expecting property name enclosed in double quotes",
+        "json extra": "Extra data", "json string": "Unterminated string starting at",
+        "json control": "Invalid control character at", "json escape": "Invalid \\escape",
+        "json unicode": "Invalid \\uXXXX escape",
         "form expected text": "expected text, got {value}",
         "form expected bool": "expected true or false, got {value}",
         "form out of range": "{value} is out of range {lo}..{hi}",
@@ -526,6 +538,22 @@ TEXTS: dict[str, dict[str, str]] = {
         "node twice": "узел {node} задан дважды",
         "node title used": "{title!r} уже называет узел {node}",
         "node shared line": "{endpoint} и узел {node} с {first} делят {device} с разными настройками линии",
+        "read file": "файл", "read program": "программу", "read symbols": "символы", "read tags": "теги",
+        "read messages": "каталог сообщений", "read users": "файл пользователей",
+        "read station": "файл станции", "read form": "форму",
+        "file cannot read": "не удаётся прочитать {what}: {error}",
+        "file not a file": "не удаётся прочитать {what}: это {kind}, а не файл",
+        "file too large": "не удаётся прочитать {what}: больше {mb} МБ, предела файла станции",
+        "file not text": "ни UTF-8, ни {fallback} (байт 0x{byte:02X})",
+        "file link loop": "символические ссылки образуют петлю",
+        "file outside": "{real} — вне папки станции {root} (allow_outside = true разрешает)",
+        "kind file": "файл", "kind folder": "папка", "kind fifo": "FIFO (именованный канал)",
+        "kind char": "символьное устройство", "kind block": "блочное устройство", "kind socket": "сокет",
+        "kind special": "особый файл",
+        "csv field long": "поле длиннее {n} символов",
+        "csv error": "{error}",
+        "csv runs on": "поле в кавычках продолжается до строки {line}: строка таблицы — одна строка "
+                       "(нет закрывающей кавычки?)",
         "addr not octal": "{text!r} — не восьмеричное число",
         "addr not data": "{addr} — не адрес памяти данных",
         "addr past io": "{addr}: операнд из байтов ({n}) выходит за бит 03777",
@@ -588,6 +616,11 @@ TEXTS: dict[str, dict[str, str]] = {
         "stl no node": "{name} без NODE в программе обращается к узлу 0, а он не задан (заданные узлы: "
                        "{have})",
         "stl node map": "{name}: узел {node}: {error}",
+        "map no bytes": "длина блока {length}: нужен хотя бы 1 байт",
+        "map remote": "удалённый адрес: {error}",
+        "map table": "таблица {table!r} — не одна из: {tables}",
+        "map past": "{table} {remote}+{count} выходит за адрес Modbus 65535",
+        "map profile": "профиль {profile!r} — не один из: {profiles}",
         "stl read only": "NWRITE: узел {node}: таблица {table} только для чтения",
         "modbus not started": "сервер Modbus не запущен: {path}: modbus_server.port: нельзя слушать "
                               "{host}:{port}: {error}",
@@ -680,6 +713,19 @@ TEXTS: dict[str, dict[str, str]] = {
         "msg past": "{name} {value} больше {most}, наибольшего, что вмещает архив",
         "msg defined": "сообщение {number} уже определено в строке {line}",
         "form as is": "{error}",
+        "form bad json": "ошибка JSON: {error}",
+        "form too deep": "ошибка JSON: массивы или объекты вложены слишком глубоко (здесь глубже {n} "
+                         "уровней)",
+        "form not object": "форма должна быть объектом JSON с form, devices, elements",
+        "form elements not list": "elements: должен быть списком объектов элементов",
+        "form settings not object": 'form: должен быть объектом {{"title": ..., "width": ..., '
+                                    '"height": ...}}',
+        "json value": "ожидается значение", "json comma": "ожидается разделитель ','",
+        "json colon": "ожидается разделитель ':'", "json name": "ожидается имя свойства в двойных кавычках",
+        "json extra": "лишние данные после конца", "json string": "строка не закрыта",
+        "json control": "недопустимый управляющий символ",
+        "json escape": "недопустимая последовательность с \\",
+        "json unicode": "недопустимая последовательность \\uXXXX",
         "form expected text": "ожидается текст, а задано {value}",
         "form expected bool": "ожидается true или false, а задано {value}",
         "form out of range": "{value} вне диапазона {lo}..{hi}",
@@ -859,6 +905,20 @@ TEXTS: dict[str, dict[str, str]] = {
                            "потеряны",
     },
 }
+
+
+JSON_ERRORS = {"Expecting value": "json value", "Expecting ',' delimiter": "json comma",
+               "Expecting ':' delimiter": "json colon",
+               "Expecting property name enclosed in double quotes": "json name", "Extra data": "json extra",
+               "Unterminated string starting at": "json string",
+               "Invalid control character at": "json control",
+               "Invalid \\escape": "json escape", "Invalid \\uXXXX escape": "json unicode"}
+
+
+def json_error(msg: str) -> Phrase | str:
+    """What the json module says of a file that is not JSON (`JSONDecodeError.msg`), as a phrase
+    of this catalogue; a message it does not know as it is."""
+    return phrase(JSON_ERRORS[msg]) if msg in JSON_ERRORS else msg
 
 
 def system_language() -> str:

@@ -431,7 +431,7 @@ class _Reader:
         try:
             path = resolve(base / value)
         except TextFileError as e:
-            self.bad(key, f"{e.source}: {e.problem}")
+            self.bad(key, e.said(self.say))
             return None
         if not self.allow_outside and not path.is_relative_to(base):
             self.bad(key, self.say("cfg outside folder", path=path, base=base))
@@ -485,9 +485,9 @@ def read_station(path: str | Path) -> tuple[Station | None, list[str]]:
     if not (file.exists() or file.is_symlink()):  # a link that leads nowhere is named by read_text
         return None, [say("cfg no file", file=fname)]
     try:
-        data = tomllib.loads(read_text(file, "the station file"))
+        data = tomllib.loads(read_text(file, "read station"))
     except TextFileError as e:
-        return None, [str(e)]
+        return None, [e.said(say)]
     except tomllib.TOMLDecodeError as e:
         return None, [say("cfg not toml", file=fname, error=e)]
     except ValueError:  # from int(), which tomllib calls without saying where

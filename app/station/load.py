@@ -117,7 +117,7 @@ def _users(station: Station, out: Loaded) -> None:
             confine(path, station.folder)
         users = Users(station.folder)
     except TextFileError as e:
-        out.problems.append(str(e))
+        out.problems.append(e.said(words(station.Language)))
         return
     except UsersFileError as e:
         out.problems += e.said(words(station.Language))

@@ -239,7 +239,7 @@ def image_file(value: Any, ctx: Context) -> Path:
     try:
         path = resolve(ctx.folder / name)
     except TextFileError as e:
-        raise PropError("form image problem", name=name, problem=e.problem) from None
+        raise PropError("form image problem", name=name, problem=e.phrase) from None
     roots = (ctx.folder, *ctx.roots)
     if not ctx.allow_outside and not any(path.is_relative_to(root.resolve()) for root in roots):
         folders: object = str(roots[0])

@@ -18,6 +18,7 @@ from typing import Literal
 
 from netplc.address import BANK_SIZE, IO_BITS, MAX_ADDRESS, AddressError, check_operand, fmt_octal
 from netplc.memory import MemoryView
+from netplc.words import WordedError
 
 Table = Literal["coils", "discrete", "holding", "input"]
 TABLES: tuple[Table, ...] = ("coils", "discrete", "holding", "input")
@@ -35,6 +36,11 @@ ADDRESS_SPACE = 0x10000
 
 class MapError(ValueError):
     """An address the map does not cover: Modbus exception 2 on a server, a failed request on a client."""
+
+
+class BlockError(WordedError, MapError):
+    """A block of NREAD/NWRITE a node's map cannot hold (`locate`): a phrase of netplc/words.py, said
+    in the station's language where the program is checked against the nodes."""
 
 
 # --- packing -------------------------------------------------------------------------------------
@@ -212,24 +218,24 @@ class Block:
 def locate(profile: str, table: str, remote: int, length: int) -> Block:
     """Map `length` bytes at `remote` (NREAD S / NWRITE D) of a node; MapError names the problem."""
     if length < 1:
-        raise MapError(f"block length {length}: at least 1 byte is needed")
+        raise BlockError("map no bytes", length=length)
     if profile == "cpu165":
         try:
             check_operand(remote, length)
         except AddressError as e:
-            raise MapError(f"remote {e}") from None
+            raise BlockError("map remote", error=e) from None
         if remote < IO_BITS:
             return Block("coils", remote, 8 * length, 0, length)
         first, end = remote >> 1, (remote + length + 1) >> 1
         return Block("holding", first, end - first, remote & 1, length)
     if profile == "modbus":
         if table not in TABLES:
-            raise MapError(f"table {table!r} is not one of {', '.join(TABLES)}")
+            raise BlockError("map table", table=table, tables=", ".join(TABLES))
         count = 8 * length if table in BIT_TABLES else (length + 1) // 2
         if remote < 0 or remote + count > ADDRESS_SPACE:
-            raise MapError(f"{table} {remote}+{count} runs past Modbus address 65535")
+            raise BlockError("map past", table=table, remote=remote, count=count)
         return Block(table, remote, count, 0, length)  # type: ignore[arg-type]
-    raise MapError(f"profile {profile!r} is not one of {', '.join(PROFILES)}")
+    raise BlockError("map profile", profile=profile, profiles=", ".join(PROFILES))
 
 
 def describe(profile: str, remote: int) -> str:

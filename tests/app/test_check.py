@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import csv
 import json
 import re
 import subprocess
@@ -179,6 +180,7 @@ def russian_leaves_no_english(problems: list[str]) -> None:
 def test_readers_problems_are_said_in_the_station_language(tmp_path: Path, language: str) -> None:
     """The program reader's diagnostics (instruction, operand, address, jump, a function's
     parameters), symbols.csv's, the forms', messages.csv's, users.json's and a node's settings',
+    a file that is not text, a CSV line the csv module refuses and a form that is not JSON,
     naming file, line, column, element, property, user, key and the text as it is."""
     from app.station.check import check_station
 
@@ -186,7 +188,8 @@ def test_readers_problems_are_said_in_the_station_language(tmp_path: Path, langu
     stl = st / "netplc.stl"
     program = stl.read_text(encoding="utf-8").splitlines()
     stl.write_text("\n".join([*program, "TNX ON", "FON C:$02500 N:MOV S:$10000 D:$04000", "JMP NOWHERE",
-                              "FON C:$02504 N:MOV S:$04000", "TIM $02510 N:999"]) + "\n",
+                              "FON C:$02504 N:MOV S:$04000", "TIM $02510 N:999",
+                              "FON C:$02520 N:NREAD S:10000 D:$04100 R:2"]) + "\n",
                    encoding="utf-8")
     plant(st / "symbols.csv", "PUMP,02120", "PUMP,02190")
     form = st / "forms" / "zz_broken.hmi"
@@ -200,6 +203,12 @@ def test_readers_problems_are_said_in_the_station_language(tmp_path: Path, langu
     plant(st / "station.toml", "timeout = 0.5",
           'timeout = 0.5\nendpoint = "rtu:///dev/ttyS9?parity=X"\nname = "a/b"')
     toml = st / "station.toml"
+    (st / "node0.stl").write_bytes(b"NOP\n\x98\n")  # neither UTF-8 nor cp1251
+    tags = st / "tags.csv"
+    tags.write_text(tags.read_text(encoding="utf-8") + '"' + "x" * (csv.field_size_limit() + 1) + '"\n',
+                    encoding="utf-8")
+    tag_line = len(tags.read_text(encoding="utf-8").splitlines())
+    (st / "forms" / "zz_text.hmi").write_text('{"form": {"title": "t",}}', encoding="utf-8")
     users = [{"name": "ivanov", "role": "boss", "salt": "00", "hash": "00"}, {"name": "petrov"}]
     (st / "users.json").write_text(json.dumps({"users": users}), encoding="utf-8")
     n = len(program)
@@ -214,6 +223,7 @@ def test_readers_problems_are_said_in_the_station_language(tmp_path: Path, langu
                f"{stl}:{n + 3}:5: L: метка 'NOWHERE' не определена",
                f"{stl}:{n + 4}:1: MOV нужен D: (адрес)",
                f"{stl}:{n + 5}:14: N: 999 вне 0-255",
+               f"{stl}:{n + 6}:1: NREAD: узел 0: удалённый адрес: 010000 — недопустимый адрес",
                f"{st / 'symbols.csv'}:{symbol}:6: '02190' — не восьмеричное число",
                f"{form}: form: Font: размер шрифта 1 вне диапазона 4..200",
                f'{form}: элемент "Broken": InAddr: 010000 — ни бит ввода-вывода, ни бит данных (байт*8+бит)',
@@ -224,12 +234,17 @@ def test_readers_problems_are_said_in_the_station_language(tmp_path: Path, langu
                f"{st / 'users.json'}: пользователь 'petrov': нет role, salt, hash (каждый — текст)",
                f"{toml}: nodes[0].endpoint: endpoint 'rtu:///dev/ttyS9?parity=X': "
                "parity 'X' — не N, E и не O",
-               f"{toml}: nodes[0].name: 'a/b' не может содержать '/', '+', '#'"],
+               f"{toml}: nodes[0].name: 'a/b' не может содержать '/', '+', '#'",
+               f"{st / 'node0.stl'}:2:0: ни UTF-8, ни cp1251 (байт 0x98)",
+               f"{tags}:{tag_line}: поле длиннее {csv.field_size_limit()} символов",
+               f"{st / 'forms' / 'zz_text.hmi'}:1:24: ошибка JSON: ожидается имя свойства в двойных "
+               "кавычках"],
         "en": [f"{stl}:{n + 1}:1: unknown instruction 'TNX'",
                f"{stl}:{n + 2}:22: S: 010000 is not a valid address",
                f"{stl}:{n + 3}:5: L: undefined label 'NOWHERE'",
                f"{stl}:{n + 4}:1: MOV needs D: (an address)",
                f"{stl}:{n + 5}:14: N: 999 is outside 0-255",
+               f"{stl}:{n + 6}:1: NREAD: node 0: remote 010000 is not a valid address",
                f"{st / 'symbols.csv'}:{symbol}:6: '02190' is not an octal number",
                f"{form}: form: Font: font size 1 is out of range 4..200",
                f'{form}: element "Broken": InAddr: 010000 is neither an I/O bit nor a data bit (byte*8+bit)',
@@ -240,7 +255,11 @@ def test_readers_problems_are_said_in_the_station_language(tmp_path: Path, langu
                f"{st / 'users.json'}: user 'petrov': role, salt, hash missing (each a text)",
                f"{toml}: nodes[0].endpoint: endpoint 'rtu:///dev/ttyS9?parity=X': "
                "parity 'X' is not N, E or O",
-               f"{toml}: nodes[0].name: 'a/b' may not hold '/', '+', '#'"],
+               f"{toml}: nodes[0].name: 'a/b' may not hold '/', '+', '#'",
+               f"{st / 'node0.stl'}:2:0: neither UTF-8 nor cp1251 text (byte 0x98)",
+               f"{tags}:{tag_line}: a field is longer than {csv.field_size_limit()} characters",
+               f"{st / 'forms' / 'zz_text.hmi'}:1:24: bad JSON: Expecting property name enclosed in double "
+               "quotes"],
     }[language]
     for line in said:
         assert any(p.startswith(line) for p in problems), f"{line!r} not in {problems}"

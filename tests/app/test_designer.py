@@ -27,7 +27,7 @@ from hmi_forms.form import load_form
 from hmi_forms.form_doc import read_doc
 from netplc.program import load_symbols, parse
 from netplc.simulator import Simulator
-from tests.app.conftest import DEMO
+from tests.app.conftest import DEMO, copy_demo
 
 
 def make_window(qtbot: QtBot, target: Path) -> DesignerWindow:
@@ -37,6 +37,13 @@ def make_window(qtbot: QtBot, target: Path) -> DesignerWindow:
     window.warn = window.warned.append  # type: ignore[attr-defined,method-assign]
     qtbot.addWidget(window)
     return window
+
+
+@pytest.fixture
+def demo_copy(tmp_path: Path) -> Path:
+    """An English copy of the demo: these tests read the designer's problems word for word, which it
+    says in the station's Language (the demo's Russian: test_problems_pane_speaks_the_station_language)."""
+    return copy_demo(tmp_path / "station", "en")
 
 
 @pytest.fixture
@@ -312,6 +319,31 @@ def test_problems_pane_lists_what_check_reports_and_goes_to_the_element(window: 
     found = window.problems.recheck()
     assert any('element "Время": w: the element (745,245 400x100) extends past the form' in t for t in found)
     assert window.design.items[id(named(window, "Время"))].flagged
+
+
+@pytest.mark.parametrize("language", ["ru", "en"])
+def test_problems_pane_speaks_the_station_language(qtbot: QtBot, tmp_path: Path, language: str) -> None:
+    """The pane says a form's problems as `check` does, in the Language of the station whose form it
+    edits, naming element and property as they are; a click goes to the element in either."""
+    from app.station.check import check_station
+
+    station = copy_demo(tmp_path / "st", language)
+    w = make_window(qtbot, station / "forms" / "01_trigger.hmi")
+    w.design.add("DiscreteBase")
+    raw = w.design.doc.elements[-1]
+    found = w.problems.recheck()
+    said = {"ru": 'элемент "DiscreteBase": InAddr: нет обязательного свойства',
+            "en": 'element "DiscreteBase": InAddr: missing required property'}[language]
+    assert [t.split(": ", 1)[1] for t in found] == [said]
+    w.problems.go_to(w.problems.item(0))
+    assert w.design.selected() == [raw]
+    assert w.save() is True
+    assert any(p.endswith(said) for p in check_station(station).problems)  # what check says of the saved form
+    (station / "forms" / "zz.hmi").write_text("{", encoding="utf-8")
+    assert w.open_path(station / "forms" / "zz.hmi") is False
+    assert w.warned == [f"{station / 'forms' / 'zz.hmi'}:1:2: " + {
+        "ru": "ошибка JSON: ожидается имя свойства в двойных кавычках",
+        "en": "bad JSON: Expecting property name enclosed in double quotes"}[language]]
 
 
 def test_save_with_problems_asks_first(window: DesignerWindow) -> None:

@@ -107,7 +107,7 @@ def test_check_and_the_problems_pane_warn_of_a_contradicting_conversion(
     assert w.problems.recheck() == []
     assert len(w.problems.warnings) == 2
     texts = [w.problems.item(i).text() for i in range(w.problems.count())]
-    assert all(t.startswith("warning: element") for t in texts), texts
+    assert all(t.startswith('warning: элемент "') for t in texts), texts  # check's words
     flagged = [i.raw.get("Name") for i in w.design.items.values() if i.flagged]
     assert len(flagged) == 1
     assert "warning" in w.problems_label.text()

@@ -10,11 +10,12 @@ from pathlib import Path
 import pytest
 
 from netplc.textfile import MAX_BYTES, TextFileError, confine, csv_rows, file_problem, read_text, resolve
+from netplc.words import english, phrase
 
 
 def problem(path: Path, **kw: int) -> str:
     with pytest.raises(TextFileError) as e:
-        read_text(path, "the program", **kw)
+        read_text(path, "read form", **kw)
     assert e.value.source == str(path)
     return str(e.value)
 
@@ -25,17 +26,17 @@ def test_only_a_regular_file_is_read(tmp_path: Path) -> None:
     os.symlink("/dev/zero", tmp_path / "zero")
     os.symlink("loop", tmp_path / "loop")
     os.symlink("nowhere", tmp_path / "dangling")
-    assert problem(tmp_path / "folder") == (f"{tmp_path / 'folder'}: cannot read the program: it is a "
+    assert problem(tmp_path / "folder") == (f"{tmp_path / 'folder'}: cannot read the form: it is a "
                                             "folder, not a file")
-    assert problem(tmp_path / "zero") == (f"{tmp_path / 'zero'}: cannot read the program: it is a character "
+    assert problem(tmp_path / "zero") == (f"{tmp_path / 'zero'}: cannot read the form: it is a character "
                                           "device, not a file")
-    assert problem(tmp_path / "loop").endswith("cannot read the program: Too many levels of symbolic links")
-    assert problem(tmp_path / "dangling").endswith("cannot read the program: No such file or directory")
+    assert problem(tmp_path / "loop").endswith("cannot read the form: Too many levels of symbolic links")
+    assert problem(tmp_path / "dangling").endswith("cannot read the form: No such file or directory")
     fifo: list[str] = []
     reader = threading.Thread(target=lambda: fifo.append(problem(tmp_path / "fifo")), daemon=True)
     reader.start()
     reader.join(5)  # opening a FIFO no one writes to blocks, unless opened non-blocking
-    assert fifo == [f"{tmp_path / 'fifo'}: cannot read the program: it is a FIFO (named pipe), not a file"]
+    assert fifo == [f"{tmp_path / 'fifo'}: cannot read the form: it is a FIFO (named pipe), not a file"]
     assert file_problem(tmp_path / "fifo") == "is a FIFO (named pipe), not a file"
     assert file_problem(tmp_path / "folder", folder=True) is None
     assert file_problem(tmp_path / "nothing") == "does not exist"
@@ -45,7 +46,7 @@ def test_a_file_past_the_limit_is_not_read(tmp_path: Path) -> None:
     path = tmp_path / "big.stl"
     path.write_bytes(b"NOP\n" * 100)
     assert read_text(path, limit=400) == "NOP\n" * 100
-    assert problem(path, limit=399) == (f"{path}: cannot read the program: larger than 0 MB, the most a "
+    assert problem(path, limit=399) == (f"{path}: cannot read the form: larger than 0 MB, the most a "
                                         "station file may hold")
     with path.open("r+b") as f:
         f.truncate(MAX_BYTES + 1)  # sparse
@@ -71,5 +72,7 @@ def test_links_are_followed_and_a_loop_or_an_escape_is_named(tmp_path: Path) -> 
 def test_a_csv_row_is_one_line() -> None:
     assert list(csv_rows('A,1\n"B\nC",2\nD,3\n')) == [
         (1, ["A", "1"]),
-        (2, "a quoted field runs on to line 3: a row is one line (a closing quote missing?)"),
+        (2, phrase("csv runs on", line=3)),
         (4, ["D", "3"])]
+    assert english("csv runs on", line=3) == ("a quoted field runs on to line 3: a row is one line "
+                                              "(a closing quote missing?)")

@@ -14,8 +14,12 @@ from PySide6.QtCore import Qt, QTimer
 from PySide6.QtWidgets import QListWidget, QListWidgetItem, QStyle, QWidget
 
 from app.gui.designer.design import Design
+from app.scada.words import TEXTS
 
-ELEMENT = re.compile(r': element (?:"(?P<name>.*?)"|#(?P<index>\d+)): ')
+# `element "Name"` or `element #3` in every language a problem may be said in (the station's)
+_ELEMENT_WORD = "|".join(sorted({re.escape(t["form where element n"].split(" #")[0])
+                                 for t in TEXTS.values()}))
+ELEMENT = re.compile(rf': (?:{_ELEMENT_WORD}) (?:"(?P<name>.*?)"|#(?P<index>\d+)): ')
 DELAY_MS = 250
 
 

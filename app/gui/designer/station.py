@@ -26,6 +26,12 @@ class Context:
     tags: TagTable = field(default_factory=TagTable)  # the good rows of the station's tags.csv
 
     @property
+    def language(self) -> str:
+        """The station's Language: the form's problems are said in it, as `check` says them, and
+        the designer's own words follow it ("": the system locale's, a form without a station)."""
+        return self.station.Language if self.station is not None else ""
+
+    @property
     def forms(self) -> list[Path]:
         folder = self.station.HMIload if self.station is not None else None
         return sorted(folder.glob("*.hmi")) if folder is not None else []

@@ -31,6 +31,7 @@ from app.gui.designer.problems import ProblemsPane
 from app.gui.designer.properties import PropertyPanel
 from app.gui.designer.station import Context, open_target
 from app.gui.designer.tag_browser import TagBrowser
+from app.scada.words import words
 from hmi_forms.elements import ELEMENT_TYPES
 from hmi_forms.form import FormError
 from hmi_forms.form_doc import FormDoc, new_doc, read_doc
@@ -93,6 +94,7 @@ class DesignerWindow(QMainWindow):
         station = self.context.station
         if station is not None:
             doc.station, doc.allow_outside = station.folder, station.allow_outside
+        doc.language = self.context.language
         doc.tags = self.context.tags
         archive = station.Archive if station is not None and station.Archive.is_file() else None
         return Design(doc, self.context.names, archive, self)
@@ -344,7 +346,7 @@ class DesignerWindow(QMainWindow):
         try:
             doc = read_doc(path)
         except FormError as e:
-            self.warn("\n".join(e.problems))
+            self.warn("\n".join(e.said(words(self.context.language))))
             return False
         self.set_document(doc)
         return True
@@ -418,11 +420,11 @@ def run_designer(target: str, screenshot: str | None = None) -> int:
     from app.gui.application import application
 
     app = application()
-    i18n.install(app, context.station.Language if context.station is not None else "")
+    i18n.install(app, context.language)
     try:
         window = DesignerWindow(context)
     except FormError as e:
-        print("\n".join(e.problems), file=sys.stderr)
+        print("\n".join(e.said(words(context.language))), file=sys.stderr)
         return 2
     window.show()
     window.canvas.home()
