@@ -110,7 +110,8 @@ def test_the_consoles_faceplate_sets_forces_and_unforces_as_the_user_at_the_stat
     qtbot.waitUntil(lambda: plate.value.text() == "50.0 °C", timeout=WAIT)  # shown back from the station
     plate.entry.setText("900")  # outside PhyMin..PhyMax: the station refuses it
     plate.set_value()
-    qtbot.waitUntil(lambda: "BadOutOfRange" in plate.message.text(), timeout=WAIT)
+    # Bad_OutOfRange carries no text: the console says it as the station's layer does, with the range
+    qtbot.waitUntil(lambda: "900.0 вне диапазона -50.0 °C .. 150.0 °C" in plate.message.text(), timeout=WAIT)
     assert not plate.force.isEnabled()
 
     engineer = attach(st, "engineer")

@@ -34,7 +34,7 @@ from PySide6.QtWidgets import (
     QWidget,
 )
 
-from app.authority import Action, Answer, Refusal, Source, Ticket, Who
+from app.authority import Action, Answer, Reason, Refusal, Source, Ticket, Who, write_range
 from app.gui import i18n, words
 from app.gui.alarm_summary import AlarmSummary
 from app.gui.application import application
@@ -63,7 +63,7 @@ from app.publish.console import ConsoleClient, StationCommands
 from app.publish.memory_items import NOTHING, WHOLE, Ranges, ranges_of
 from app.scada.alarms import AlarmRow, alarm_defs
 from app.scada.readings import Readings
-from app.scada.tag import Tag
+from app.scada.tag import Tag, TagType
 from app.scada.trends import TrendBook
 from app.scada.words import words as words_of
 from hmi_forms.elements.base import Writer
@@ -98,10 +98,10 @@ class RemoteTarget(CommandTarget):
         return self.client.denial(action, None, what)
 
     def write_tag(self, who: Who, tag: Tag, value: float) -> Ticket:
-        return self._tag(Action.WRITE, tag, "WriteTag", float(value))
+        return self._ranged(tag, value, self._tag(Action.WRITE, tag, "WriteTag", float(value)))
 
     def force_tag(self, who: Who, tag: Tag, phy: float | None) -> Ticket:
-        return self._tag(Action.FORCE, tag, "ForceTag", phy)
+        return self._ranged(tag, phy, self._tag(Action.FORCE, tag, "ForceTag", phy))
 
     def unforce_tag(self, who: Who, tag: Tag) -> Ticket:
         return self._tag(Action.UNFORCE, tag, "UnforceTag")
@@ -110,6 +110,23 @@ class RemoteTarget(CommandTarget):
         """The station's method of a tag's command (a Null value: none given)."""
         client = self.client
         return client.said(client.call(method, tag.name, *args), action, tag.name)
+
+    def _ranged(self, tag: Tag, value: float | None, sent: Ticket) -> Ticket:
+        """A value the station refused as out of the tag's range (Bad_OutOfRange, which carries
+        no text) is said as the station's layer says it, with the range: the station decided,
+        the console only words its answer."""
+        ticket: Ticket = Ticket()
+
+        def done(answer: Ticket) -> None:
+            said: Answer = answer.result()
+            if said.reason is Reason.OUT_OF_RANGE and tag.type is not TagType.BIT:
+                lo, hi = write_range(tag)
+                say = words_of(str(self.client.files.manifest.get("language", "")))
+                said = Answer(said.reason, say("outside", value=value, lo=tag.format(lo), hi=tag.format(hi)))
+            ticket.set_result(said)
+
+        sent.add_done_callback(done)
+        return ticket
 
 
 class SharedSession(OpcUaSource):
