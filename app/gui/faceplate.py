@@ -27,6 +27,7 @@ import math
 import time
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass
+from functools import partial
 from pathlib import Path
 
 import numpy as np
@@ -135,6 +136,8 @@ class Faceplate(QDialog):
         self.setObjectName("faceplate")
         self.tag = tag
         self.console = console
+        self.released = False  # closed, or deleted with its window: answers to come are not its own
+        self.destroyed.connect(partial(setattr, self, "released", True))
         self.defs = [d for d in console.defs if d.tag == tag.name]
         self.setWindowTitle(self.tr("Faceplate: {0}").format(tag.name))
         self.readings: Readings | None = None
@@ -313,6 +316,8 @@ class Faceplate(QDialog):
 
     def _follow(self, what: str, ticket: Ticket, then: Callable[[Answer], None] | None = None) -> Ticket:
         def said(answer: Answer) -> None:
+            if self.released:  # closed before the answer came (its widgets are gone with it): the
+                return  # window's status bar says the answer, as it does every answer followed
             self.message.setText("" if answer.ok else words.answer(what, answer))
             if then is not None:
                 then(answer)
@@ -387,6 +392,7 @@ class Faceplate(QDialog):
 
     def _release(self) -> None:
         """Closed (or done with Escape): its reads stop, and so does the watch of its tag."""
+        self.released = True
         self.loader.close()
         self.console.watch(self.watching, None)
 
