@@ -104,6 +104,7 @@ ANSWERS = {Reason.APPLIED: _S.Good, Reason.DENIED: _S.BadUserAccessDenied,  # by
            Reason.FAILED: _S.BadInternalError, Reason.STANDBY: _S.BadInvalidState}
 HEALTHY = 255  # ServiceLevel of a station alone (Part 4 6.6.2.4.2: 200-255 healthy)
 YIELD_EVERY = 500  # variable writes between two turns of the event loop
+_UNWRITTEN = object()  # no value written yet (see _write_changed)
 READABLE_WITHIN = 2.0  # s at most an applied write waits for its value to be readable here
 MEMORY_BITS = "NetPlc's I/O bits 00000-03777, one byte each (0 or 1): byte n is bit n"
 MEMORY_DATA = ("NetPlc's data memory, its 8 banks of 2 KB in turn: byte k*2048 + i is address "
@@ -274,6 +275,7 @@ class OpcUaServer:
         self._published = -1  # the scan whose values the address space holds
         self._events = 0  # the journal's events since the start (Station.JournalEvents)
         self._events_shown = 0
+        self._written: dict[ua.NodeId, object] = {}  # what _write_changed wrote last, by node
         self._waiting: list[tuple[int, asyncio.Future[None]]] = []  # writes waiting to be readable
         self._loop: asyncio.AbstractEventLoop | None = None
         self._ready = threading.Event()
@@ -592,7 +594,7 @@ class OpcUaServer:
             await write(self.nodeids[i], value_attr, dv)
         self.status.updates += len(changed)
         await self._publish_memory(readings.snapshot, when, now)  # before the tick that says which scan
-        await self.plc_state.write_value(reading.state)
+        await self._write_changed(self.plc_state, reading.state)
         await self.plc_scan_ms.write_value(float(self.engine.stats.last_ms))
         await write(self.plc_tick.nodeid, value_attr,  # the scan's time: a console's latency counts from it
                     ua.DataValue(ua.Variant(reading.scan, ua.VariantType.UInt64), SourceTimestamp=when,
@@ -608,7 +610,16 @@ class OpcUaServer:
                                ("Writes", ua.Variant(stats.writes, ua.VariantType.UInt64)),
                                ("Errors", ua.Variant(stats.errors, ua.VariantType.UInt64)),
                                ("LastError", stats.last_error)):
-                await vars_[key].write_value(value)
+                await self._write_changed(vars_[key], value)
+
+    async def _write_changed(self, node: Node, value: object) -> None:
+        """`value` written to `node` only when it is not the one written last: a variable that
+        rarely changes (the PLC's state, a node's link) written at every scan costs each
+        console's monitored item a sampling and a comparison per scan, and moves its source
+        timestamp though the value did not change."""
+        if self._written.get(node.nodeid, _UNWRITTEN) != value:
+            self._written[node.nodeid] = value
+            await node.write_value(value)
 
     def _readable(self, scan: int) -> None:
         """The address space holds the values of `scan`: answer the writes that waited for them."""
