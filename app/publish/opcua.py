@@ -274,7 +274,6 @@ class OpcUaServer:
         self._unwatch: Callable[[], None] | None = None
         self._published = -1  # the scan whose values the address space holds
         self._events = 0  # the journal's events since the start (Station.JournalEvents)
-        self._events_shown = 0
         self._written: dict[ua.NodeId, object] = {}  # what _write_changed wrote last, by node
         self._waiting: list[tuple[int, asyncio.Future[None]]] = []  # writes waiting to be readable
         self._loop: asyncio.AbstractEventLoop | None = None
@@ -599,9 +598,7 @@ class OpcUaServer:
         await write(self.plc_tick.nodeid, value_attr,  # the scan's time: a console's latency counts from it
                     ua.DataValue(ua.Variant(reading.scan, ua.VariantType.UInt64), SourceTimestamp=when,
                                  ServerTimestamp=now))
-        if self._events != self._events_shown:
-            self._events_shown = self._events
-            await self.journal_events.write_value(ua.Variant(self._events_shown, ua.VariantType.UInt64))
+        await self._write_changed(self.journal_events, ua.Variant(self._events, ua.VariantType.UInt64))
         for n, stats in (self.exchange.stats.items() if self.exchange is not None else ()):
             vars_ = self.node_vars.get(n)
             if vars_ is None:
