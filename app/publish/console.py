@@ -189,14 +189,19 @@ class ConsoleClient(StationClient):
         """Which of the station's tags `tags` it keeps the history of (their Historizing)."""
         return self._submit(self._historizing(tags))
 
-    def said(self, sent: Ticket, action: Action, what: str, at_least: str | None = None) -> Ticket:
-        """The station's answer, a refusal for the role in its parts (the role it needs, the user's)."""
+    def said(self, sent: Ticket, action: Action, what: str, at_least: str | None = None,
+             out_of_range: Callable[[], str] | None = None) -> Ticket:
+        """The station's answer, a refusal for the role in its parts (the role it needs, the user's);
+        a refusal for the range in `out_of_range()`'s words, where the caller knows the range (the
+        StatusCode carries no text)."""
         ticket: Ticket = Ticket()
 
         def done(answer: Ticket) -> None:
             a: Answer = answer.result()
             if a.reason is Reason.DENIED:
                 a = Answer(a.reason, a.text, Refusal(what, needs(action, at_least), self.user, self.role))
+            elif a.reason is Reason.OUT_OF_RANGE and out_of_range is not None:
+                a = Answer(a.reason, out_of_range())
             ticket.set_result(a)
 
         sent.add_done_callback(done)

@@ -34,7 +34,7 @@ from PySide6.QtWidgets import (
     QWidget,
 )
 
-from app.authority import Action, Answer, Reason, Refusal, Source, Ticket, Who, write_range
+from app.authority import Action, Answer, Refusal, Source, Ticket, Who, write_range
 from app.gui import i18n, words
 from app.gui.alarm_summary import AlarmSummary
 from app.gui.application import application
@@ -98,35 +98,28 @@ class RemoteTarget(CommandTarget):
         return self.client.denial(action, None, what)
 
     def write_tag(self, who: Who, tag: Tag, value: float) -> Ticket:
-        return self._ranged(tag, value, self._tag(Action.WRITE, tag, "WriteTag", float(value)))
+        return self._tag(Action.WRITE, tag, "WriteTag", float(value))
 
     def force_tag(self, who: Who, tag: Tag, phy: float | None) -> Ticket:
-        return self._ranged(tag, phy, self._tag(Action.FORCE, tag, "ForceTag", phy))
+        return self._tag(Action.FORCE, tag, "ForceTag", phy)
 
     def unforce_tag(self, who: Who, tag: Tag) -> Ticket:
         return self._tag(Action.UNFORCE, tag, "UnforceTag")
 
-    def _tag(self, action: Action, tag: Tag, method: str, *args: object) -> Ticket:
-        """The station's method of a tag's command (a Null value: none given)."""
+    def _tag(self, action: Action, tag: Tag, method: str, value: float | None = None) -> Ticket:
+        """The station's method of a tag's command (a Null value: none given). A value refused as
+        out of the tag's range is said as the station's layer says it, with the range: the
+        station decided, the console only words its answer."""
         client = self.client
-        return client.said(client.call(method, tag.name, *args), action, tag.name)
 
-    def _ranged(self, tag: Tag, value: float | None, sent: Ticket) -> Ticket:
-        """A value the station refused as out of the tag's range (Bad_OutOfRange, which carries
-        no text) is said as the station's layer says it, with the range: the station decided,
-        the console only words its answer."""
-        ticket: Ticket = Ticket()
+        def outside() -> str:
+            lo, hi = write_range(tag)
+            say = words_of(str(client.files.manifest.get("language", "")))
+            return say("outside", value=value, lo=tag.format(lo), hi=tag.format(hi))
 
-        def done(answer: Ticket) -> None:
-            said: Answer = answer.result()
-            if said.reason is Reason.OUT_OF_RANGE and tag.type is not TagType.BIT:
-                lo, hi = write_range(tag)
-                say = words_of(str(self.client.files.manifest.get("language", "")))
-                said = Answer(said.reason, say("outside", value=value, lo=tag.format(lo), hi=tag.format(hi)))
-            ticket.set_result(said)
-
-        sent.add_done_callback(done)
-        return ticket
+        args = () if action is Action.UNFORCE else (value,)
+        return client.said(client.call(method, tag.name, *args), action, tag.name,
+                           out_of_range=None if tag.type is TagType.BIT else outside)
 
 
 class SharedSession(OpcUaSource):
