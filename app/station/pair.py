@@ -10,7 +10,9 @@ One TCP link between the two, always dialled by B to A (one dialler: two station
 together never cross two connections); once both said hello the roles decide who sends. The
 roles at a hello: a primary stays primary and the other follows; two primaries (a link healed
 after both acted): the one that led more scans; none (both starting): A. A station that hears
-no partner within its start window (failover_after ticks and two more, 0.5 s at least) leads.
+no partner within its start window (failover_after ticks and two more, 0.5 s at least) leads;
+one whose partner has connected but not yet said hello (a loaded PC) waits for that hello, as
+long as a link waits for any frame, rather than lead beside it.
 
 The standby takes over when the primary's frames have stopped for failover_after ticks: the
 newest mirrored state is put into its engine and the program runs on from it in the next scan
@@ -165,6 +167,7 @@ class Pair:
         self._handed = threading.Event()  # the handover was sent (or the link ended)
         self._stopping = threading.Event()
         self._decided = threading.Event()
+        self._greeting = 0  # links connected whose hellos have not yet crossed
         self._server: socket.socket | None = None
         self._threads: list[threading.Thread] = []
         self.port = 0  # the port this station's link listens on
@@ -220,6 +223,10 @@ class Pair:
         self._spawn(self._watch, "pair watch")
         window = max(self.failover + 2 * self.tick, START_WINDOW)
         if not self._decided.wait(window):
+            with self._changed:  # a partner connected is a partner: its hello decides, or its silence
+                self._changed.wait_for(lambda: self._decided.is_set() or not self._greeting,
+                                       self.failover + 1.0)
+        if not self._decided.is_set():
             self._become(Role.PRIMARY, phrase("no partner", ms=window * 1000))
 
     def _spawn(self, target: Callable[[], None], name: str) -> None:
@@ -391,10 +398,13 @@ class Pair:
 
     def _serve(self, conn: socket.socket) -> None:
         """One link, from hello to its end (a status query answered and closed, or the pair's)."""
-        paired = False
+        paired = greeting = False
         try:
             # longer than failover_after: the watch takes over first and tells the partner (TAKEN)
             conn.settimeout(self.failover + 1.0)
+            with self._changed:
+                self._greeting += 1
+                greeting = True
             send_frame(conn, HELLO, json.dumps(self._hello()).encode())
             kind, payload = read_frame(conn)
             hello = json.loads(payload) if kind == HELLO else None
@@ -416,6 +426,7 @@ class Pair:
                          phrase("partner is", letter=hello["letter"], role=said_role(Role(hello["role"]))))
             self.refused = ""
             paired = True
+            greeting = self._greeted()
             self._run_link(conn)
         except (OSError, LinkError, ValueError) as e:
             if paired and not self._stopping.is_set() and conn is not self._told:  # told: journaled
@@ -425,6 +436,8 @@ class Pair:
             elif not self._stopping.is_set():
                 logger.info("pair link ended: %s", e)
         finally:
+            if greeting:
+                self._greeted()
             with self._changed:
                 if self._link is conn:
                     self._link = None
@@ -436,6 +449,13 @@ class Pair:
             conn.close()
             if alone:
                 self._mirrored(None)  # no standby to wait for: the primary's own commit stands
+
+    def _greeted(self) -> bool:
+        """A link's hellos have crossed, or it ended before: a starting station waits no more for it."""
+        with self._changed:
+            self._greeting -= 1
+            self._changed.notify_all()
+        return False
 
     def _hello(self) -> dict[str, object]:
         return {"letter": self.settings.letter, "role": self.role.value, "led": self.led_scans,

@@ -73,6 +73,14 @@ def wait_for(condition: Callable[[], object], timeout: float = 15.0, what: str =
         time.sleep(0.01)
 
 
+def wait_paired(primary: Station, standby: Station) -> None:
+    """Both ends of the link up and the roles decided: a station that started beside a loaded
+    partner may first lead alone (its start window is 0.5 s) and follow once the hellos cross."""
+    wait_for(lambda: primary.role == "primary" and standby.role == "standby"
+             and primary.rt.pair is not None and primary.rt.pair.status().link
+             and standby.rt.pair is not None and standby.rt.pair.status().link, what="the pair linked")
+
+
 class Station:
     """One station of the pair: its folder, the runtime while it runs, and its journal."""
 

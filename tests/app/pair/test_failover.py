@@ -12,7 +12,7 @@ from app.cli import run_redundancy
 from app.station.pair import HSB_NUM_PLC, HSB_STATUS_BYTE, HSB_SWITCH
 from netplc.modbus import BUSY
 from netplc.simulator import Simulator
-from tests.app.pair.conftest import OPERATOR, Station, modbus_write, wait_for
+from tests.app.pair.conftest import OPERATOR, Station, modbus_write, wait_for, wait_paired
 
 NODE_WORD = 0o4100  # where the primary's NWRITE puts the operator's word 04000 on the node
 TIMER, COUNTER = 0o3000, 0o3010
@@ -77,6 +77,7 @@ def test_into_standby_switches_over_and_back_with_nothing_lost(
     a, b = pair
     a.start()
     b.start()
+    wait_paired(a, b)
     assert a.write(0o4000, 1).ok
     assert a.rt.commands is not None
     assert a.rt.commands.into_standby(OPERATOR).result(3).reason is Reason.DENIED  # engineer's

@@ -13,7 +13,7 @@ import pytest
 from app.authority import Source, Who
 from app.cli import run_redundancy
 from netplc.simulator import Simulator
-from tests.app.pair.conftest import Station, make_pair, wait_for
+from tests.app.pair.conftest import Station, make_pair, wait_for, wait_paired
 from tests.app.scada.test_words import english_words
 
 ENGINEER = Who("", Source.STATION)
@@ -31,6 +31,7 @@ def test_a_russian_pair_journals_its_link_and_takeovers_in_russian(
     try:
         a.start()
         b.start()
+        wait_paired(a, b)
         assert a.rt.commands is not None and a.rt.commands.into_standby(ENGINEER).result(3).ok
         wait_for(lambda: b.role == "primary" and a.role == "standby", what="switchover")
         wait_for(lambda: any("передано партнёром" in t for t in records(b)), what="the takeover journaled")

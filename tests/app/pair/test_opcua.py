@@ -14,7 +14,7 @@ from asyncua import Client, ua
 from app.authority.users import Users
 from app.publish.client import StationClient
 from netplc.simulator import Simulator
-from tests.app.pair.conftest import make_pair, serve_opcua, wait_for
+from tests.app.pair.conftest import make_pair, serve_opcua, wait_for, wait_paired
 
 
 async def redundancy(client: Client) -> dict[str, Any]:
@@ -51,6 +51,7 @@ def test_clients_are_told_the_primary_and_a_monitor_follows_it(tmp_path: Path, n
         client.discover().result(10)
         client.open("eng1", "eng1").result(20)
         wait_for(lambda: client.snapshot is not None, what="the monitor reads A")
+        wait_paired(a, b)
         assert a.rt.pair is not None and a.rt.pair.into_standby("IntoStandBy by test", wait=2)
         wait_for(lambda: client.url == b_url and client.switches == 1, what="the monitor on B")
         wait_for(lambda: client.service_level == 255, what="B's ServiceLevel the primary's")
