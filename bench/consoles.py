@@ -10,7 +10,11 @@ process's CPU is its own rusage (utime + stime, every thread) over the phase's w
 one core: the station's from /proc, a console's by itself. Latency is from the scan (its wall
 time, NetPlc.Tick's source timestamp) to the paint of the console's form that shows it (the
 paint after the newest readings; a scan that changed nothing on the form paints nothing), over
-every console and paint of a phase. The local workstation's cost on the same form is measured as
+every console and paint of a phase. The first console's cost is measured in rounds that alternate
+the station alone and the station with one console (a new console process each round, its start
+and login outside the phase), each round's difference its cost: a load that drifts over the run
+falls on both halves of a round alike. The 8 consoles' phase is compared with the median of the
+phases alone. The local workstation's cost on the same form is measured as
 bench/workstation.py does: this process with a headless runtime alone, then with the window
 shown on it; the window's share is the difference.
 
@@ -20,7 +24,7 @@ the demo whose program shifts banks 1-4 by a word at every scan behind a counter
 changes at every tick by 256 raw. One console shows it; then the local workstation shows it; each
 is quoted with its scan -> paint latency and the share of scans its form painted.
 
-    QT_QPA_PLATFORM=offscreen python bench/consoles.py [--seconds 15] [--consoles 8]
+    QT_QPA_PLATFORM=offscreen python bench/consoles.py [--seconds 10] [--rounds 4] [--consoles 8]
 """
 
 from __future__ import annotations
@@ -316,7 +320,8 @@ def ms(values: list[float]) -> str:
 
 def main(argv: list[str] | None = None) -> int:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    ap.add_argument("--seconds", type=float, default=15.0, help="length of each measured phase (default 15)")
+    ap.add_argument("--seconds", type=float, default=10.0, help="length of each measured phase (default 10)")
+    ap.add_argument("--rounds", type=int, default=4, help="rounds of no console and one console (default 4)")
     ap.add_argument("--consoles", type=int, default=CONSOLES, help=f"consoles of the last phase ({CONSOLES})")
     ap.add_argument("--console", help=argparse.SUPPRESS)  # a console process of the bench
     ap.add_argument("--folder", help=argparse.SUPPRESS)
@@ -332,13 +337,19 @@ def main(argv: list[str] | None = None) -> int:
         consoles: list[Console] = []
         try:
             time.sleep(3.0)  # the station settles
-            idle, _ = station_cpu(proc.pid, seconds, [])
-            consoles.append(Console(url, folder / "config", ANALOG))
-            consoles[0].ready()
-            one, (first,) = station_cpu(proc.pid, seconds, consoles)
-            for _ in range(args.consoles - 1):
+            idles, ones, firsts = [], [], []
+            for _ in range(args.rounds):
+                idles.append(station_cpu(proc.pid, seconds, [])[0])
                 consoles.append(Console(url, folder / "config", ANALOG))
-            for c in consoles[1:]:
+                consoles[0].ready()
+                one, (first,) = station_cpu(proc.pid, seconds, consoles)
+                ones.append(one)
+                firsts.append(first)
+                consoles.pop().stop()
+                time.sleep(1.0)  # the station ends the session
+            for _ in range(args.consoles):
+                consoles.append(Console(url, folder / "config", ANALOG))
+            for c in consoles:
                 c.ready()
             many, results = station_cpu(proc.pid, seconds, consoles)
         finally:
@@ -365,13 +376,20 @@ def main(argv: list[str] | None = None) -> int:
     share = with_window - alone
     latencies = [x for r in results for x in r.latency]
     cpus = [r.cpu for r in results]
+    idle = statistics.median(idles)
+    costs = [one - alone for one, alone in zip(ones, idles, strict=True)]
+    first = firsts[-1]
     print(f"load average {load[0]:.2f} {load[1]:.2f} {load[2]:.2f} (1, 5, 15 min); phases of {seconds:g} s")
-    print(f"station CPU, % of one core: {idle:.2f} with no console, {one:.2f} with 1 (+{one - idle:.2f}), "
+    print(f"station CPU, % of one core: {idle:.2f} with no console (median of {len(idles)}); "
+          f"the first console +{statistics.median(costs):.2f} median, +{max(costs):.2f} worst "
+          f"of {len(costs)} rounds "
+          f"({', '.join(f'{alone:.2f} -> {one:.2f}' for alone, one in zip(idles, ones, strict=True))}); "
           f"{many:.2f} with {len(results)} (+{(many - idle) / len(results):.2f} per console)")
-    print(f"latency scan -> console paint: 1 console {ms(first.latency)}; {len(results)} consoles, "
-          f"{len(latencies)} paints: {ms(latencies)} (tick 100 ms)")
-    worst = max(*cpus, first.cpu)
-    print(f"console CPU on the analog form ({first.watched} parts of the memory watched): {first.cpu:.2f} % "
+    print(f"latency scan -> console paint: 1 console {ms([x for f in firsts for x in f.latency])}; "
+          f"{len(results)} consoles, {len(latencies)} paints: {ms(latencies)} (tick 100 ms)")
+    worst = max(*cpus, *(f.cpu for f in firsts))
+    print(f"console CPU on the analog form ({first.watched} parts of the memory watched): "
+          f"{statistics.median(f.cpu for f in firsts):.2f} % "
           f"of one core alone; with {len(results)}: median {statistics.median(cpus):.2f}, worst "
           f"{max(cpus):.2f}; the local workstation's window on the same form adds {share:.2f} % "
           f"({with_window:.2f} with, {alone:.2f} runtime alone): worst "

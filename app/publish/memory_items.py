@@ -27,7 +27,7 @@ from netplc.address import DATA_SIZE, IO_BITS, data_index
 logger = logging.getLogger(__name__)
 
 GAP = 32  # bytes between two operands below which they are watched as one range: an item costs more
-PUBLISH_MIN_MS = 20.0  # the shortest publishing interval asked (half the station's tick otherwise)
+PUBLISH_MIN_MS = 20.0  # the shortest publishing interval asked (the station's tick otherwise)
 Span = tuple[int, int]  # first and last index, both included (a NumericRange's)
 Apply = Callable[[ua.DataValue], None]  # what a monitored item's value is given to
 RETIRED_KEPT = 1024  # client handles of deleted items whose late notifications are expected
@@ -147,10 +147,11 @@ class MemoryItems:
         self._pending = False
 
     async def open(self, client: Client, tick_ms: float) -> None:
-        """A subscription in `client`'s session, publishing at half the station's tick, with the
-        scan's variables; no part of the memory yet (`follow`)."""
+        """A subscription in `client`'s session, publishing at the station's tick (the station ends
+        each cycle right after a scan: app/publish/aligned.py), with the scan's variables; no part
+        of the memory yet (`follow`)."""
         self.client, self._items, self._apply, self.covered = client, {}, {}, NOTHING
-        period = max(PUBLISH_MIN_MS, tick_ms / 2)
+        period = max(PUBLISH_MIN_MS, tick_ms)
         self._subscription = await client.create_subscription(period, self)
         scalars: list[tuple[ua.NodeId, Callable[[ua.DataValue], None]]] = [
             (self.node("NetPlc.Tick"), self._tick), (self.node("NetPlc.State"), self._state),

@@ -62,6 +62,7 @@ from asyncua.crypto.security_policies import SecurityPolicyBasic256Sha256, Secur
 from app.authority import Action, Commands, Reason, Source, Ticket, Who
 from app.authority.logins import Logins
 from app.authority.users import UserError, Users
+from app.publish.aligned import ScanClock
 from app.publish.conditions import Conditions
 from app.publish.feed import LatestReadings, Watch
 from app.publish.files import StationFiles
@@ -281,6 +282,7 @@ class OpcUaServer:
         self._thread: threading.Thread | None = None
         self._stop: asyncio.Event | None = None
         self._tick: asyncio.Event | None = None
+        self._scans = ScanClock(self.engine.tick)  # on the loop: its subscriptions' cycles end at the scans
 
     # --- life cycle (any thread) ---------------------------------------------------------------
 
@@ -379,6 +381,7 @@ class OpcUaServer:
                 if item is not None:
                     await self._publish(item)
                     self._readable(item.snapshot.scan)
+                    self._scans.published()
                 await self._serve_level()
                 self.status.skipped = self.feed.skipped
         finally:
@@ -687,7 +690,9 @@ class OpcUaServer:
             async def create_subscription(params: ua.CreateSubscriptionParameters, callback: Any,
                                           request_callback: Any = None) -> ua.CreateSubscriptionResult:
                 result = await subscribe(params, callback, request_callback)
-                ranged(session.subscription_service.subscriptions[result.SubscriptionId])
+                subscription = session.subscription_service.subscriptions[result.SubscriptionId]
+                ranged(subscription)
+                self._scans.align(subscription)
                 return result
 
             service, close, subscribe = session.call, session.close_session, session.create_subscription
@@ -695,7 +700,7 @@ class OpcUaServer:
             session.close_session = close_session
             session.write = write
             session.call = call
-            session.create_subscription = create_subscription  # monitored items honour IndexRange
+            session.create_subscription = create_subscription  # IndexRange honoured, cycles at the scans
             return session
 
         iserver.create_session = create_session
