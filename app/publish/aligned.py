@@ -7,7 +7,9 @@ ended empty half the time.
 
 A cycle still lasts the revised publishing interval on average (Part 4 5.13.1): it ends at the
 first scan published at or after half a tick before it is due, or half a tick after it is due when
-no scan came (a stopped station still sends its keep-alives on time). A client that asks the
+no scan came (a stopped station still sends its keep-alives on time); the next is due an interval
+after the scan that ended it, or after its own time. A cycle shorter than the tick waits at most
+half its interval for a scan, so the keep-alives a client counts on come on time. A client that asks the
 tick is sent each scan's changes once, as soon as they exist; one that asks a second is sent
 a second's changes, at the scan nearest to each second.
 """
@@ -54,14 +56,20 @@ class ScanClock:
 
     async def _cycles(self, subscription: InternalSubscription) -> None:
         period = max(0.0, subscription.data.RevisedPublishingInterval / 1000.0)
-        half = self.tick / 2
+        half = min(self.tick, period) / 2  # a cycle shorter than the tick keeps its own time
         try:
             await subscription.publish_results()  # the first cycle at once, as asyncua's loop
+            due = time.monotonic() + period
             while not subscription._closing:
-                due = time.monotonic() + period
-                while await self._scan(due + half) and time.monotonic() < due - half:
-                    pass
+                scanned = False
+                while await self._scan(due + half):
+                    if time.monotonic() >= due - half:
+                        scanned = True
+                        break
+                now = time.monotonic()
                 await subscription.publish_results()
+                # from the scan that ended it, else on its own time (a late loop catches up once)
+                due = now + period if scanned else max(due + period, now)
         except Exception:
             logger.exception("OPC UA: the publishing cycles of subscription %s ended",
                              subscription.data.SubscriptionId)

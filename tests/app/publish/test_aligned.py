@@ -77,6 +77,21 @@ def test_a_cycle_of_the_tick_ends_at_each_scan_and_stops_with_its_subscription()
     asyncio.run(run())
 
 
+def test_a_cycle_shorter_than_the_tick_keeps_its_own_time_between_scans() -> None:
+    """A client's 100 ms beside a 1 s tick: its cycles (keep-alives) do not wait for the scans."""
+    async def run() -> None:
+        clock, cycles = ScanClock(1.0), []
+        sub = await _subscription(100.0, cycles)
+        clock.align(sub)
+        try:
+            await asyncio.sleep(0.65)
+            assert len(cycles) >= 4, cycles  # about 6; waiting for scans it would be 1 or 2
+        finally:
+            await sub.stop()
+
+    asyncio.run(run())
+
+
 def test_a_subscription_without_cycles_is_left_as_it_is() -> None:
     async def run() -> None:
         sub = await _subscription(0.0, [])
