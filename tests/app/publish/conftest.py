@@ -22,6 +22,7 @@ from app.publish.opcua import application_uri
 from app.station.config import load_station
 from app.station.runtime import Runtime
 from tests.app.conftest import DEMO_NAME, copy_demo
+from tests.cheap_users import cheap_demo_users
 from tests.netplc.test_exchange import wait_until
 
 
@@ -33,8 +34,10 @@ def free_port() -> int:
 
 def demo_with(folder: Path, extra: str, records: list | None = None, language: str | None = None) -> Runtime:
     """The demo station copied to `folder` (unless there already; in `language` when given, see
-    `copy_demo`) with `extra` TOML appended, started headless; its records from the start in `records`."""
+    `copy_demo`; its users at the tests' cheap cost) with `extra` TOML appended, started headless;
+    its records from the start in `records`."""
     station = folder if (folder / "station.toml").exists() else copy_demo(folder, language)
+    cheap_demo_users(station)
     toml = station / "station.toml"
     toml.write_text(toml.read_text(encoding="utf-8") + "\n" + extra, encoding="utf-8")
     runtime = Runtime(load_station(station))
