@@ -18,13 +18,23 @@ from tests.app.conftest import DEMO_NAME
 from tests.app.publish.conftest import STATION_URI, demo_with, free_port, opcua_client, tag_node
 
 
-@pytest.fixture
-def station(tmp_path: Path) -> Iterator[tuple[Runtime, str]]:
+def _station(folder: Path) -> Iterator[tuple[Runtime, str]]:
     url = f"opc.tcp://127.0.0.1:{free_port()}/netplc/"
-    runtime = demo_with(tmp_path / "station",
-                        f'[opcua]\nenabled = true\nendpoint = "{url}"\nwritable = ["TEMP_*"]\n')
+    runtime = demo_with(folder, f'[opcua]\nenabled = true\nendpoint = "{url}"\nwritable = ["TEMP_*"]\n')
     yield runtime, url
     runtime.stop()
+
+
+@pytest.fixture(scope="module")
+def station(tmp_path_factory: pytest.TempPathFactory) -> Iterator[tuple[Runtime, str]]:
+    """One station for the module's tests that only read it."""
+    yield from _station(tmp_path_factory.mktemp("opcua") / "station")
+
+
+@pytest.fixture
+def own_station(tmp_path: Path) -> Iterator[tuple[Runtime, str]]:
+    """A station of the test's own, whose node it may kill."""
+    yield from _station(tmp_path / "station")
 
 
 def run(coro: object) -> object:
@@ -102,9 +112,9 @@ def test_subscription_sees_changes_within_two_ticks(station: tuple[Runtime, str]
     assert all(engine - int(val) <= 2 for engine, val in received[1:])
 
 
-def test_quality_goes_bad_when_the_node_is_killed(station: tuple[Runtime, str]) -> None:
+def test_quality_goes_bad_when_the_node_is_killed(own_station: tuple[Runtime, str]) -> None:
     """... and TRIGGER's quality alarm comes: its condition's state and an event on the station."""
-    runtime, url = station
+    runtime, url = own_station
     events: list = []
 
     class Handler:
