@@ -6,6 +6,7 @@ from __future__ import annotations
 
 import asyncio
 import json
+import time
 from collections.abc import Iterator
 from pathlib import Path
 
@@ -132,12 +133,15 @@ def test_memory_and_forces_are_read_only_variables_of_the_station(station: tuple
             assert await call(client, "Force", ua.Variant("word", ua.VariantType.String),
                               ua.Variant("04010", ua.VariantType.String),
                               ua.Variant(310, ua.VariantType.Int32)) == ua.StatusCodes.Good
-            await asyncio.sleep(0.5)  # a few scans published
             plc = client.get_node(ua.NodeId("NetPlc", ns))
             memory = await plc.get_child(ua.QualifiedName("Memory", ns))
             bits = await memory.get_child(ua.QualifiedName("Bits", ns))
             data = client.get_node(ua.NodeId("NetPlc.Memory.Data", ns))
             forces = client.get_node(ua.NodeId("NetPlc.Forces", ns))
+            deadline = time.monotonic() + 10
+            while json.loads(await forces.read_value()) == []:  # until a scan with the force is published
+                assert time.monotonic() < deadline
+                await asyncio.sleep(0.02)
             out = {"bits id": bits.nodeid, "names": [await n.read_browse_name()
                                                      for n in (memory, bits, data, forces)],
                    "bits": await bits.read_value(), "data": await data.read_value(),
