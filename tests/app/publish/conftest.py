@@ -159,6 +159,8 @@ class Host:
         client = mqtt.Client(mqtt.CallbackAPIVersion.VERSION2, client_id=f"host-{group}-{id(self)}")
         client.on_connect = self._connected
         client.on_message = self._message
+        subscribed = threading.Event()
+        client.on_subscribe = lambda *_: subscribed.set()  # the broker's SUBACK
         self.since_ms = int(time.time() * 1000)
         if primary:
             offline = json.dumps({"online": False, "timestamp": self.since_ms}).encode()
@@ -167,8 +169,7 @@ class Host:
         client.connect("127.0.0.1", broker.port)
         client.loop_start()
         self.client = client
-        wait_until(client.is_connected, 5)
-        time.sleep(0.2)  # the subscription is in place
+        wait_until(subscribed.is_set, 10)  # connected, and the subscription in place
 
     def _connected(self, client: Any, *_: object) -> None:
         client.subscribe(f"spBv1.0/{self.group}/#", qos=1)
