@@ -2,8 +2,9 @@
 
 Roles are ordered, each allowing what the one before allows: viewer (looks), operator (writes and
 acknowledges), engineer (runs and stops NetPlc, forces), admin (manages users). Users live in
-`users.json` in the station folder (docs/architecture.md section 10), each with a random salt and
-an scrypt hash of the password, never the password itself; the file is written whole (a temporary
+`users.json` in the station folder (docs/architecture.md section 10), each with a random salt, an
+scrypt hash of the password (never the password itself) and the scrypt cost it was made with, so
+that a dearer default later leaves the older hashes valid; the file is written whole (a temporary
 file replaced atomically) and readable by its owner only.
 
 Qt-free. The session says who is at the workstation (logged in, the default viewer, idle logout);
@@ -21,7 +22,7 @@ import os
 import secrets
 import time
 from collections.abc import Callable, Mapping, Sequence
-from dataclasses import asdict, dataclass
+from dataclasses import dataclass
 from pathlib import Path
 
 from app.authority.policy import ROLES, VIEWER, rank
@@ -30,7 +31,7 @@ from netplc.problems import Problem, Problems
 from netplc.textfile import TextFileError, read_text
 
 USERS_FILE = "users.json"
-SCRYPT = {"n": 2**14, "r": 8, "p": 1}  # RFC 7914's interactive-login cost: ~50 ms per check
+MAXMEM = 2**27  # bytes scrypt may take for one hash: room for n = 2**17 at r = 8, 8 times the default
 __all__ = ["Refused", "Session", "User", "UserError", "Users", "UsersFileError", "rank"]
 
 
@@ -59,8 +60,32 @@ class Refused(Exception):
     """A login that failed; the text says why."""
 
 
-def _digest(password: str, salt: bytes) -> str:
-    return hashlib.scrypt(password.encode("utf-8"), salt=salt, dklen=32, **SCRYPT).hex()
+@dataclass(frozen=True)
+class Scrypt:
+    """The cost of one user's hash (RFC 7914), kept beside it as modular-crypt formats keep theirs:
+    a station may raise the default without invalidating the hashes made before."""
+
+    n: int = 2**14
+    r: int = 8
+    p: int = 1
+
+    @property
+    def work(self) -> int:
+        return self.n * self.r * self.p
+
+    def usable(self) -> bool:
+        """Integers, n a power of two of at least 2 and below 2**(16·r), r and p at least 1, within
+        MAXMEM as OpenSSL counts it: what hashlib.scrypt takes."""
+        return (all(type(v) is int for v in (self.n, self.r, self.p)) and self.n >= 2
+                and not self.n & (self.n - 1) and self.r >= 1 and self.p >= 1
+                and 128 * self.r * (self.n + self.p + 2) <= MAXMEM and self.n < 1 << (16 * self.r))
+
+    def digest(self, password: str, salt: bytes) -> str:
+        return hashlib.scrypt(password.encode("utf-8"), salt=salt, n=self.n, r=self.r, p=self.p,
+                              maxmem=MAXMEM, dklen=32).hex()
+
+
+SCRYPT = Scrypt()  # RFC 7914's interactive-login cost, ~50 ms per check: what `add` and `passwd` write
 
 
 @dataclass(frozen=True)
@@ -69,14 +94,20 @@ class User:
     role: str
     salt: str  # hex
     hash: str  # hex scrypt of the password with the salt
+    scrypt: Scrypt = SCRYPT  # the cost the hash was made with (a file without it: the default)
 
     def check(self, password: str) -> bool:
-        return hmac.compare_digest(self.hash, _digest(password, bytes.fromhex(self.salt)))
+        return hmac.compare_digest(self.hash, self.scrypt.digest(password, bytes.fromhex(self.salt)))
+
+    def saved(self) -> dict[str, object]:
+        """The user as users.json holds it."""
+        return {"name": self.name, "role": self.role, "salt": self.salt, "hash": self.hash,
+                "scrypt": {"n": self.scrypt.n, "r": self.scrypt.r, "p": self.scrypt.p}}
 
 
-def new_user(name: str, role: str, password: str) -> User:
+def new_user(name: str, role: str, password: str, scrypt: Scrypt = SCRYPT) -> User:
     salt = secrets.token_bytes(16)
-    return User(name, role, salt.hex(), _digest(password, salt))
+    return User(name, role, salt.hex(), scrypt.digest(password, salt), scrypt)
 
 
 class Users:
@@ -91,13 +122,15 @@ class Users:
     def get(self, name: str) -> User | None:
         return self.users.get(name)
 
-    def add(self, name: str, role: str, password: str) -> User:
+    def add(self, name: str, role: str, password: str, scrypt: Scrypt = SCRYPT) -> User:
+        """A new user, hashed at `scrypt`'s cost (the default everywhere but in tests, whose users
+        guard nothing and whose hashes are a tenth of the suite's time at the default)."""
         name = name.strip()
         if not name:
             raise UserError("user no name")
         if name in self.users:
             raise UserError("user exists", name=name)
-        user = self.users[name] = new_user(name, _role(role), _password(password))
+        user = self.users[name] = new_user(name, _role(role), _password(password), scrypt)
         self.save()
         return user
 
@@ -110,31 +143,38 @@ class Users:
         user = self.users.get(name)
         if user is None:
             raise UserError("no user", name=name)
-        self.users[name] = new_user(name, user.role, _password(password))
+        self.users[name] = new_user(name, user.role, _password(password))  # at today's default cost
         self.save()
 
     def verify(self, name: str, password: str) -> User | None:
         """The user if the password is theirs. An unknown name costs the same scrypt as a wrong
-        password (checked against a stand-in), so the time of a refusal does not tell a client
-        which names exist."""
+        password (checked against a stand-in at `dearest`), so the time of a refusal does not tell
+        a client which names exist."""
         user = self.users.get(name)
         if user is None:
-            _stand_in().check(password)
+            _stand_in(self.dearest).check(password)
             return None
         return user if user.check(password) else None
+
+    @property
+    def dearest(self) -> Scrypt:
+        """The cost of an unknown name's refusal: the dearest among the users (the default in a
+        file without users). A user whose hash is cheaper than another's (made before the default
+        was raised) is told apart by time until `passwd` hashes it again at the default."""
+        return max((u.scrypt for u in self.users.values()), key=lambda s: s.work, default=SCRYPT)
 
     def save(self) -> None:
         tmp = self.path.with_suffix(".tmp")
         fd = os.open(tmp, os.O_WRONLY | os.O_CREAT | os.O_TRUNC, 0o600)
         with os.fdopen(fd, "w", encoding="utf-8") as f:
-            json.dump({"users": [asdict(u) for u in self.users.values()]}, f, indent=1)
+            json.dump({"users": [u.saved() for u in self.users.values()]}, f, indent=1)
         os.replace(tmp, self.path)
 
 
 @functools.cache
-def _stand_in() -> User:
-    """A user no name leads to, whose check costs what a real user's does."""
-    return new_user("", VIEWER, secrets.token_hex(16))
+def _stand_in(scrypt: Scrypt) -> User:
+    """A user no name leads to, whose check costs what a real user's at `scrypt` does."""
+    return new_user("", VIEWER, secrets.token_hex(16), scrypt)
 
 
 def _role(role: str) -> str:
@@ -196,7 +236,12 @@ def _user(item: object) -> tuple[User | None, Phrase | None]:
         bytes.fromhex(item["salt"]), bytes.fromhex(item["hash"])
     except ValueError:
         return None, phrase("users not hex")
-    return User(item["name"], item["role"], item["salt"], item["hash"]), None
+    cost = item.get("scrypt", {"n": SCRYPT.n, "r": SCRYPT.r, "p": SCRYPT.p})
+    keys = {"n", "r", "p"}
+    scrypt = Scrypt(cost["n"], cost["r"], cost["p"]) if isinstance(cost, dict) and set(cost) == keys else None
+    if scrypt is None or not scrypt.usable():
+        return None, phrase("users bad scrypt", mib=MAXMEM >> 20)
+    return User(item["name"], item["role"], item["salt"], item["hash"], scrypt), None
 
 
 class Session:

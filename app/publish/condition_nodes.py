@@ -5,7 +5,8 @@ builds every attribute of every node afresh: about 0.1 s per condition, minutes 
 thousands of alarms. Here each standard type's instance declarations are read once per process
 (`template`); the first condition of each shape is added through AddNodes, and every other one of
 that shape is a copy of its nodes (`clone`), which shares the attribute values that never change.
-The station's files (files.py) are FileType objects added the same way (`add_instance`).
+The station's files (files.py) are FileType objects added the same way (`add_instance`, then
+`clone`).
 """
 
 from __future__ import annotations
@@ -124,14 +125,17 @@ async def add_instance(server: Server, root: ua.AddNodesItem, ids: list[ua.NodeI
             raise RuntimeError(f"node {item.RequestedNewNodeId.to_string()} not added: {result.StatusCode}")
 
 
-def clone(aspace: Any, first: list[ua.NodeId], ids: list[ua.NodeId], description: str) -> None:
-    """A condition's nodes (`ids`, its root first) as copies of `first`'s, a condition of the same
-    shape added by `add`. The copies share the attribute values that never change: only a node's
-    Value is ever written, by the station (clients' writes are the station's commands, which refuse
-    every node but a tag's value)."""
+def clone(aspace: Any, first: list[ua.NodeId], ids: list[ua.NodeId], description: str | None,
+          name: str | None = None) -> None:
+    """An instance's nodes (`ids`, its root first) as copies of `first`'s, an instance of the same
+    shape added by `add` or `add_instance`, named `name` (a condition: its NodeId's last part after
+    "Alarms."), described by `description` (None: as `first`). The copies share the attribute
+    values that never change: only a node's Value is ever written, by the station (clients' writes
+    are the station's commands, which refuse every node but a tag's value)."""
     remap = dict(zip(first, ids))
     root = ids[0]
-    name = ua.QualifiedName(root.Identifier.removeprefix("Alarms."), root.NamespaceIndex)
+    name = ua.QualifiedName(root.Identifier.removeprefix("Alarms.") if name is None else name,
+                            root.NamespaceIndex)
     text = ua.LocalizedText(name.Name)
     value_id, node_id = ua.AttributeIds.Value, ua.AttributeIds.NodeId
     for old, new in zip(first, ids):
@@ -147,10 +151,12 @@ def clone(aspace: Any, first: list[ua.NodeId], ids: list[ua.NodeId], description
                            for ref in original.references]
         aspace[new] = node
     node = aspace[root]
-    for attribute, value in ((ua.AttributeIds.BrowseName, ua.Variant(name, _V.QualifiedName)),
-                             (ua.AttributeIds.DisplayName, ua.Variant(text, _V.LocalizedText)),
-                             (ua.AttributeIds.Description, ua.Variant(ua.LocalizedText(description),
-                                                                      _V.LocalizedText))):
+    named = [(ua.AttributeIds.BrowseName, ua.Variant(name, _V.QualifiedName)),
+             (ua.AttributeIds.DisplayName, ua.Variant(text, _V.LocalizedText))]
+    if description is not None:
+        named.append((ua.AttributeIds.Description,
+                      ua.Variant(ua.LocalizedText(description), _V.LocalizedText)))
+    for attribute, value in named:
         node.attributes[attribute] = AttributeValue(ua.DataValue(value))
     up = next(r for r in node.references if not r.IsForward and r.ReferenceTypeId == ua.NodeId(_O.Organizes))
     typedef = next(r.NodeId for r in node.references if r.ReferenceTypeId == ua.NodeId(_O.HasTypeDefinition))

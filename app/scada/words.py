@@ -117,6 +117,8 @@ TEXTS: dict[str, dict[str, str]] = {
         "users not object": "expected an object with name, role, salt and hash",
         "users missing": "{keys} missing (each a text)",
         "users not hex": "salt and hash must be hexadecimal (set the password again: `main.py users passwd`)",
+        "users bad scrypt": 'scrypt must be {{"n": a power of two from 2, "r": 1 or more, "p": 1 or more}}, '
+                            "at most {mib} MiB (set the password again: `main.py users passwd`)",
         "users bad json": "not a users file: bad JSON at line {line}, column {col}: {error}",
         "users not json": "not a users file: {kind}",
         "users no list": 'not a users file: expected {{"users": [...]}}, as `main.py users` writes it',
@@ -703,6 +705,9 @@ TEXTS: dict[str, dict[str, str]] = {
         "users missing": "нет {keys} (каждый — текст)",
         "users not hex": "salt и hash должны быть шестнадцатеричными (задайте пароль снова: `main.py users "
                          "passwd`)",
+        "users bad scrypt": 'scrypt должен быть {{"n": степень двойки от 2, "r": 1 и больше, '
+                            '"p": 1 и больше}}, не больше {mib} МиБ '
+                            "(задайте пароль снова: `main.py users passwd`)",
         "users bad json": "не файл пользователей: ошибка JSON в строке {line}, столбце {col}: {error}",
         "users not json": "не файл пользователей: {kind}",
         "users no list": 'не файл пользователей: ожидается {{"users": [...]}}, как пишет `main.py users`',

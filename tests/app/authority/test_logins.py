@@ -7,17 +7,20 @@ import statistics
 import time
 from pathlib import Path
 
+import pytest
+
 from app.authority import Commands, Source
 from app.authority.logins import Logins
-from app.authority.users import Users
+from app.authority.users import SCRYPT, Scrypt, Users
 from netplc.engine import Engine, FakeClock
 from netplc.program import parse
 from netplc.records import ListSink
+from tests.cheap_users import CHEAP
 
 
 def rig(folder: Path) -> tuple[Logins, ListSink, list[float]]:
     users = Users(folder)
-    users.add("olga", "operator", "s3cret")
+    users.add("olga", "operator", "s3cret", CHEAP)
     sink, mono = ListSink(), [0.0]
     engine = Engine(parse("JMP 0\n"), clock=FakeClock(), sink=sink)
     layer = Commands(engine, sink, role_of=lambda name: users.get(name) and users.get(name).role,
@@ -62,9 +65,14 @@ def test_failures_are_journaled_once_per_user_and_host_per_minute(tmp_path: Path
     assert "more refused like it" in sink.records[-1].text
 
 
-def test_an_unknown_name_takes_the_time_of_a_wrong_password(tmp_path: Path) -> None:
+@pytest.mark.parametrize("scrypt", [Scrypt(n=2**12), Scrypt(n=2**11)], ids=["n4096", "n2048"])
+def test_an_unknown_name_takes_the_time_of_a_wrong_password(tmp_path: Path, scrypt: Scrypt) -> None:
+    """At two costs kept in the file, one twice the other: the stand-in an unknown name is checked
+    against follows the file's users (a stand-in of one fixed cost fails the other by 50 % or more;
+    the default's own 50 ms are the same scrypt, four times longer)."""
     users = Users(tmp_path)
-    users.add("olga", "operator", "s3cret")
+    users.add("olga", "operator", "s3cret", scrypt)
+    users = Users(tmp_path)
 
     def cost(name: str) -> float:
         """The thread's CPU time of one check: the work done, not the shared machine's wait."""
@@ -73,8 +81,8 @@ def test_an_unknown_name_takes_the_time_of_a_wrong_password(tmp_path: Path) -> N
         return time.thread_time() - t0
 
     cost("nobody")  # warm up: the stand-in is made once
-    pairs = [(cost("nobody"), cost("olga")) for _ in range(15)]  # interleaved, so drift hits both
+    pairs = [(cost("nobody"), cost("olga")) for _ in range(7)]  # interleaved, so drift hits both
     unknown = statistics.median(p[0] for p in pairs)
     wrong = statistics.median(p[1] for p in pairs)
-    assert wrong > 0.005  # scrypt ran
+    assert wrong > 0.002 * scrypt.work / SCRYPT.work  # scrypt ran, at that cost (~50 ms at the default's)
     assert abs(unknown - wrong) < 0.25 * wrong, (unknown, wrong)

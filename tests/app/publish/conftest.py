@@ -22,6 +22,7 @@ from app.publish.opcua import application_uri
 from app.station.config import load_station
 from app.station.runtime import Runtime
 from tests.app.conftest import DEMO_NAME, copy_demo
+from tests.cheap_users import cheap_demo_users
 from tests.netplc.test_exchange import wait_until
 
 
@@ -33,8 +34,10 @@ def free_port() -> int:
 
 def demo_with(folder: Path, extra: str, records: list | None = None, language: str | None = None) -> Runtime:
     """The demo station copied to `folder` (unless there already; in `language` when given, see
-    `copy_demo`) with `extra` TOML appended, started headless; its records from the start in `records`."""
+    `copy_demo`; its users at the tests' cheap cost) with `extra` TOML appended, started headless;
+    its records from the start in `records`."""
     station = folder if (folder / "station.toml").exists() else copy_demo(folder, language)
+    cheap_demo_users(station)
     toml = station / "station.toml"
     toml.write_text(toml.read_text(encoding="utf-8") + "\n" + extra, encoding="utf-8")
     runtime = Runtime(load_station(station))
@@ -156,6 +159,8 @@ class Host:
         client = mqtt.Client(mqtt.CallbackAPIVersion.VERSION2, client_id=f"host-{group}-{id(self)}")
         client.on_connect = self._connected
         client.on_message = self._message
+        subscribed = threading.Event()
+        client.on_subscribe = lambda *_: subscribed.set()  # the broker's SUBACK
         self.since_ms = int(time.time() * 1000)
         if primary:
             offline = json.dumps({"online": False, "timestamp": self.since_ms}).encode()
@@ -164,8 +169,7 @@ class Host:
         client.connect("127.0.0.1", broker.port)
         client.loop_start()
         self.client = client
-        wait_until(client.is_connected, 5)
-        time.sleep(0.2)  # the subscription is in place
+        wait_until(subscribed.is_set, 10)  # connected, and the subscription in place
 
     def _connected(self, client: Any, *_: object) -> None:
         client.subscribe(f"spBv1.0/{self.group}/#", qos=1)

@@ -6,6 +6,7 @@ from __future__ import annotations
 
 import asyncio
 import json
+import time
 from collections.abc import Iterator
 from pathlib import Path
 
@@ -22,14 +23,26 @@ from tests.app.publish.conftest import STATION_URI, demo_with, free_port, opcua_
 BIT = 0o2120  # the demo's PUMP command bit
 
 
-@pytest.fixture
-def station(tmp_path: Path) -> Iterator[tuple[Runtime, str, list]]:
+def _station(folder: Path) -> Iterator[tuple[Runtime, str, list]]:
     url = f"opc.tcp://127.0.0.1:{free_port()}/netplc/"
-    runtime = demo_with(tmp_path / "station", f'[opcua]\nenabled = true\nendpoint = "{url}"\n', language="en")
+    runtime = demo_with(folder, f'[opcua]\nenabled = true\nendpoint = "{url}"\n', language="en")
     records: list = []
     runtime.subscribe(records.append)
     yield runtime, url, records
     runtime.stop()
+
+
+@pytest.fixture
+def station(tmp_path: Path) -> Iterator[tuple[Runtime, str, list]]:
+    """A station of the test's own, which it may stop, force and alarm."""
+    yield from _station(tmp_path / "station")
+
+
+@pytest.fixture(scope="module")
+def untouched(tmp_path_factory: pytest.TempPathFactory) -> Iterator[tuple[Runtime, str, list]]:
+    """One station for the tests whose every command is refused or only reads: NetPlc runs on,
+    nothing forced."""
+    yield from _station(tmp_path_factory.mktemp("methods") / "station")
 
 
 async def call(client: object, name: str, *args: ua.Variant) -> int:
@@ -82,8 +95,8 @@ def test_an_engineer_stops_steps_forces_and_runs_each_answered_once_applied(
 
 
 def test_an_operator_may_not_force_or_stop_and_bad_arguments_are_named(
-        station: tuple[Runtime, str, list]) -> None:
-    runtime, url, records = station
+        untouched: tuple[Runtime, str, list]) -> None:
+    runtime, url, records = untouched
 
     async def go() -> list[int]:
         async with opcua_client(url, "operator", "operator") as client:
@@ -103,8 +116,8 @@ def test_an_operator_may_not_force_or_stop_and_bad_arguments_are_named(
     assert any("'nibble' is not one of bit, byte, word" in t for t in refused)
 
 
-def test_user_executable_follows_the_sessions_role(station: tuple[Runtime, str, list]) -> None:
-    _, url, _ = station
+def test_user_executable_follows_the_sessions_role(untouched: tuple[Runtime, str, list]) -> None:
+    _, url, _ = untouched
 
     async def executable(user: str, password: str) -> dict[str, bool]:
         async with opcua_client(url, user, password) as client:
@@ -132,12 +145,15 @@ def test_memory_and_forces_are_read_only_variables_of_the_station(station: tuple
             assert await call(client, "Force", ua.Variant("word", ua.VariantType.String),
                               ua.Variant("04010", ua.VariantType.String),
                               ua.Variant(310, ua.VariantType.Int32)) == ua.StatusCodes.Good
-            await asyncio.sleep(0.5)  # a few scans published
             plc = client.get_node(ua.NodeId("NetPlc", ns))
             memory = await plc.get_child(ua.QualifiedName("Memory", ns))
             bits = await memory.get_child(ua.QualifiedName("Bits", ns))
             data = client.get_node(ua.NodeId("NetPlc.Memory.Data", ns))
             forces = client.get_node(ua.NodeId("NetPlc.Forces", ns))
+            deadline = time.monotonic() + 10
+            while json.loads(await forces.read_value()) == []:  # until a scan with the force is published
+                assert time.monotonic() < deadline
+                await asyncio.sleep(0.02)
             out = {"bits id": bits.nodeid, "names": [await n.read_browse_name()
                                                      for n in (memory, bits, data, forces)],
                    "bits": await bits.read_value(), "data": await data.read_value(),

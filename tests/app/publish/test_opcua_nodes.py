@@ -8,8 +8,9 @@ from __future__ import annotations
 import asyncio
 import csv
 import importlib.metadata
+import json
 import time
-from collections.abc import Iterator
+from collections.abc import Callable, Iterator
 
 import pytest
 from asyncua import Client, Node, ua
@@ -104,16 +105,36 @@ def test_every_node_of_the_station_has_a_string_nodeid_and_a_plain_browse_name(
         async with Client(url, timeout=30) as client:
             ns = await client.get_namespace_index(STATION_URI)
 
-            async def walk(node: Node) -> None:
-                for child in await node.get_children():
-                    if child.nodeid.NamespaceIndex != ns:
-                        continue  # a reference to a standard node (a type, a modelling rule)
-                    name = await child.read_browse_name()
-                    if child.nodeid.NodeIdType != ua.NodeIdType.String or ":" in name.Name[:3]:
-                        bad.append(f"{child.nodeid.to_string()} {name.to_string()}")
-                    await walk(child)
+            async def children(nodes: list[ua.NodeId]) -> list[ua.NodeId]:
+                """The hierarchical children of `nodes`, one Browse request for all (as get_children
+                asks for one node): a level of the tree per round trip, not a node per round trip."""
+                params = ua.BrowseParameters()
+                params.View = ua.ViewDescription()
+                params.RequestedMaxReferencesPerNode = 0
+                params.NodesToBrowse = [ua.BrowseDescription(
+                    NodeId=n, BrowseDirection=ua.BrowseDirection.Forward,
+                    ReferenceTypeId=ua.NodeId(ua.ObjectIds.HierarchicalReferences), IncludeSubtypes=True,
+                    NodeClassMask=0, ResultMask=ua.BrowseResultMask.All) for n in nodes]
+                found = []
+                for result in await client.uaclient.browse(params):
+                    result.StatusCode.check()
+                    assert not result.ContinuationPoint  # every reference in one answer
+                    found += [r.NodeId for r in result.References]
+                return found
 
-            await walk(client.get_node(ua.NodeId(DEMO_NAME, ns)))
+            level, seen = [ua.NodeId(DEMO_NAME, ns)], set()
+            while level:
+                # a reference to a standard node (a type, a modelling rule) is not the station's
+                level = [n for n in await children(level) if n.NamespaceIndex == ns and n not in seen]
+                if not level:
+                    break
+                seen.update(level)
+                for nodeid, read in zip(level, await client.uaclient.read_attributes(
+                        level, ua.AttributeIds.BrowseName), strict=True):
+                    name = read.Value.Value
+                    if nodeid.NodeIdType != ua.NodeIdType.String or ":" in name.Name[:3]:
+                        bad.append(f"{nodeid.to_string()} {name.to_string()}")
+            assert len(seen) > 500  # the tags, alarms, programs and memory, each walked (985 in the demo)
             objects = client.nodes.objects
             priority = await objects.get_child([f"{ns}:{DEMO_NAME}", f"{ns}:Alarms", f"{ns}:LEVEL.H",
                                                 f"{ns}:Priority"])
@@ -243,3 +264,47 @@ def test_a_monitored_item_with_an_index_range_reports_that_part_when_it_changes(
     assert made[3] == ua.StatusCode(ua.StatusCodes.BadIndexRangeInvalid)
     assert all(len(v) == 2 for v in seen[1]) and len(seen[1]) < len(seen[3])
     assert seen[2] == [bytes(100)]  # once, at creation: nothing changed there since
+
+
+def test_the_station_files_are_file_type_objects_each_read_as_written(station: tuple[Runtime, str]) -> None:
+    """The first file is added through AddNodes, the others are copies of its nodes (files.py):
+    each is a FileType object of its own name, size and content, Open and Read as Part 5 C.2 has
+    them, also a file added while the station runs. Last in the module: it adds forms."""
+    from asyncua.client.ua_file import UaFile
+
+    runtime, url = station
+    folder = runtime.station.folder
+
+    async def served(client: Client, ns: int) -> dict[str, str]:
+        return json.loads(await client.get_node(ua.NodeId("Files.Manifest", ns)).read_value())["files"]
+
+    async def check(client: Client, ns: int, rel: str) -> None:
+        node = client.get_node(ua.NodeId(f"Files.{rel}", ns))
+        assert (await node.read_browse_name()).Name == rel
+        assert (await node.read_display_name()).Text == rel
+        assert (await node.read_type_definition()) == ua.NodeId(ua.ObjectIds.FileType)
+        assert await (await node.get_child("0:Size")).read_value() == (folder / rel).stat().st_size
+        async with UaFile(node, "r") as f:
+            assert await f.read() == (folder / rel).read_bytes()
+
+    async def until(client: Client, ns: int, what: Callable[[dict[str, str]], bool]) -> dict[str, str]:
+        deadline = time.monotonic() + 20
+        while not what(files := await served(client, ns)):
+            assert time.monotonic() < deadline, files
+            await asyncio.sleep(0.05)
+        return files
+
+    async def go() -> None:
+        async with Client(url, timeout=30) as client:
+            ns = await client.get_namespace_index(STATION_URI)
+            files = await served(client, ns)
+            assert {"netplc.stl", "symbols.csv", "tags.csv", "messages.csv"} < set(files)
+            assert any(rel.startswith("forms/") for rel in files)
+            for rel in files:
+                await check(client, ns, rel)
+            for n in (1, 2):
+                (folder / "forms" / f"new{n}.hmi").write_text(f"; form {n}\n", encoding="utf-8")
+                await until(client, ns, lambda f, n=n: f"forms/new{n}.hmi" in f)
+                await check(client, ns, f"forms/new{n}.hmi")
+
+    run(go())
