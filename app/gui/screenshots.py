@@ -2,7 +2,8 @@
 
 The workstation's tabs, a tag's faceplate (over the analog form), the run-time trend of LEVEL
 and TEMP and the designer are taken at 1366x768 and 1920x1080, in English
-(`workstation-02-analog.png`, `designer-02-analog-1920x1080.png`) and in Russian (`...-ru.png`).
+(`workstation-02-analog.png`, `designer-02-analog-1920x1080.png`) and in Russian (`...-ru.png`);
+`--language en` or `--language ru` takes only those (the viewer's two are taken with English).
 
 The demo station runs for real (a copy in a temporary folder, the embedded node over TCP, its own
 archive) while a short script plays the operator: Пуск pressed a few times, a setpoint entered,
@@ -60,12 +61,13 @@ def main(argv: list[str] | None = None) -> int:
                                  description="Render the workstation and the viewer on the demo station.")
     ap.add_argument("out", type=Path, help="folder for the PNGs (docs/screenshots)")
     ap.add_argument("--seconds", type=float, default=RUN_SECONDS, help="how long the station runs first")
+    ap.add_argument("--language", action="append", choices=LANGUAGES,
+                    help="only the pictures in this language (again for more; the viewer's are in en)")
     args = ap.parse_args(argv)
-
+    languages = [lang for lang in LANGUAGES if lang in (args.language or LANGUAGES)]
 
     from app.gui import i18n
     from app.gui.application import application
-    from app.gui.viewer import ViewerWindow
     from app.station.runtime import Runtime
 
     app = application()
@@ -76,7 +78,7 @@ def main(argv: list[str] | None = None) -> int:
         runtime = Runtime(load_station(copy_station(Path(tmp) / "station")))
         runtime.start()
         try:
-            for n, language in enumerate(LANGUAGES):
+            for n, language in enumerate(languages):
                 i18n.install(app, language)  # the window's texts are translated as it is made
                 suffix = "" if language == "en" else "-ru"
                 written += _workstation(runtime, args.out, wait,
@@ -85,24 +87,36 @@ def main(argv: list[str] | None = None) -> int:
             i18n.install(app, "en")
         finally:
             runtime.stop()
-        viewer = ViewerWindow(runtime.station.Archive)
+        if "en" in languages:
+            written += _viewer(runtime.station.Archive, args.out, wait)
+    for path in written:
+        print(path)
+    return 0
+
+
+def _viewer(archive: Path, out: Path, wait: Callable[[float], None]) -> list[Path]:
+    """The offline viewer on the archive the run left: a page of records, and three series."""
+    from app.gui.viewer import ViewerWindow
+
+    written: list[Path] = []
+    viewer = ViewerWindow(archive)
+    try:
         viewer.resize(*SIZE)
         viewer.show()
         _until(wait, lambda: viewer.paging is None)  # the page is read in a thread
-        path = args.out / "viewer-records.png"
+        path = out / "viewer-records.png"
         viewer.grab().save(str(path))
         written.append(path)
         for row in range(min(3, viewer.series_list.count())):
             viewer.check_series(row)
         viewer.tabs.setCurrentIndex(1)
         _until(wait, lambda: not viewer.loading)  # the series are read in a thread
-        path = args.out / "viewer-series.png"
+        path = out / "viewer-series.png"
         viewer.grab().save(str(path))
         written.append(path)
+    finally:
         viewer.close()
-    for path in written:
-        print(path)
-    return 0
+    return written
 
 
 def _workstation(runtime: Runtime, out: Path, wait: Callable[[float], None], seconds: float,
