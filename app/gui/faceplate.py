@@ -247,10 +247,12 @@ class Faceplate(QDialog):
         self.finished.connect(self._release)
         self.loader = SeriesLoader(TREND_POINTS, self)
         self.loader.answered.connect(self._history)
+        self.loader.failed.connect(self._answered)  # logged by the loader; the trend shows the live part
+        self.asked: set[int] = set()  # the hour's reads not yet answered (`loading`)
         if available(console.archive):
             now, key = dt.datetime.now(), SeriesKey("data", None, None, fmt_octal(tag.address))
             for day in sorted({(now - dt.timedelta(hours=1)).date(), now.date()}):
-                self.loader.request(console.archive, day, key)
+                self.asked.add(self.loader.request(console.archive, day, key))
 
     # --- showing ---------------------------------------------------------------------------------
 
@@ -292,7 +294,15 @@ class Faceplate(QDialog):
         self._plot()
         self.show_rights()
 
-    def _history(self, _token: int, series: Series) -> None:
+    def loading(self) -> bool:
+        """Whether the hour of history is still being read (the screenshots wait for it)."""
+        return bool(self.asked)
+
+    def _answered(self, token: int, *_: object) -> None:
+        self.asked.discard(token)
+
+    def _history(self, token: int, series: Series) -> None:
+        self._answered(token)
         _key, ts, raw = series
         values = raw if self.tag.scaling is None else self.tag.scaling.to_phy(raw)
         order = np.argsort(np.concatenate([self.times, ts]), kind="stable")

@@ -2,7 +2,8 @@
 
 The workstation's tabs, a tag's faceplate (over the analog form), the run-time trend of LEVEL
 and TEMP and the designer are taken at 1366x768 and 1920x1080, in English
-(`workstation-02-analog.png`, `designer-02-analog-1920x1080.png`) and in Russian (`...-ru.png`).
+(`workstation-02-analog.png`, `designer-02-analog-1920x1080.png`) and in Russian (`...-ru.png`);
+`--language en` or `--language ru` takes only those (the viewer's two are taken with English).
 
 The demo station runs for real (a copy in a temporary folder, the embedded node over TCP, its own
 archive) while a short script plays the operator: Пуск pressed a few times, a setpoint entered,
@@ -19,6 +20,7 @@ import sys
 import tempfile
 import time
 from collections.abc import Callable
+from functools import partial
 from pathlib import Path
 from typing import TYPE_CHECKING
 
@@ -27,6 +29,7 @@ from app.station.config import DEMO_STATION, load_station
 if TYPE_CHECKING:
     from PySide6.QtCore import QCoreApplication
 
+    from app.gui.designer.window import DesignerWindow
     from app.gui.main_window import MainWindow
     from app.station.runtime import Runtime
 
@@ -58,51 +61,62 @@ def main(argv: list[str] | None = None) -> int:
                                  description="Render the workstation and the viewer on the demo station.")
     ap.add_argument("out", type=Path, help="folder for the PNGs (docs/screenshots)")
     ap.add_argument("--seconds", type=float, default=RUN_SECONDS, help="how long the station runs first")
+    ap.add_argument("--language", action="append", choices=LANGUAGES,
+                    help="only the pictures in this language (again for more; the viewer's are in en)")
     args = ap.parse_args(argv)
-
+    languages = [lang for lang in LANGUAGES if lang in (args.language or LANGUAGES)]
 
     from app.gui import i18n
     from app.gui.application import application
-    from app.gui.viewer import ViewerWindow
     from app.station.runtime import Runtime
 
     app = application()
+    wait = partial(_pump_events, app)
     args.out.mkdir(parents=True, exist_ok=True)
     written: list[Path] = []
     with tempfile.TemporaryDirectory() as tmp:
         runtime = Runtime(load_station(copy_station(Path(tmp) / "station")))
         runtime.start()
         try:
-            for n, language in enumerate(LANGUAGES):
+            for n, language in enumerate(languages):
                 i18n.install(app, language)  # the window's texts are translated as it is made
                 suffix = "" if language == "en" else "-ru"
-                written += _workstation(runtime, args.out, lambda s: _pump_events(app, s),
+                written += _workstation(runtime, args.out, wait,
                                         args.seconds if n == 0 else 0.0, suffix)
-                written += _designer(runtime, args.out, lambda s: _pump_events(app, s), suffix)
+                written += _designer(runtime, args.out, wait, suffix)
             i18n.install(app, "en")
         finally:
             runtime.stop()
-        viewer = ViewerWindow(runtime.station.Archive)
+        if "en" in languages:
+            written += _viewer(runtime.station.Archive, args.out, wait)
+    for path in written:
+        print(path)
+    return 0
+
+
+def _viewer(archive: Path, out: Path, wait: Callable[[float], None]) -> list[Path]:
+    """The offline viewer on the archive the run left: a page of records, and three series."""
+    from app.gui.viewer import ViewerWindow
+
+    written: list[Path] = []
+    viewer = ViewerWindow(archive)
+    try:
         viewer.resize(*SIZE)
         viewer.show()
-        _pump_events(app, 0.3)
-        path = args.out / "viewer-records.png"
+        _until(wait, lambda: viewer.paging is None)  # the page is read in a thread
+        path = out / "viewer-records.png"
         viewer.grab().save(str(path))
         written.append(path)
         for row in range(min(3, viewer.series_list.count())):
             viewer.check_series(row)
         viewer.tabs.setCurrentIndex(1)
-        deadline = time.monotonic() + 30
-        while viewer.loading and time.monotonic() < deadline:  # the series are read in a thread
-            _pump_events(app, 0.05)
-        _pump_events(app, 0.5)
-        path = args.out / "viewer-series.png"
+        _until(wait, lambda: not viewer.loading)  # the series are read in a thread
+        path = out / "viewer-series.png"
         viewer.grab().save(str(path))
         written.append(path)
+    finally:
         viewer.close()
-    for path in written:
-        print(path)
-    return 0
+    return written
 
 
 def _workstation(runtime: Runtime, out: Path, wait: Callable[[float], None], seconds: float,
@@ -117,13 +131,16 @@ def _workstation(runtime: Runtime, out: Path, wait: Callable[[float], None], sec
     window.show()
     written: list[Path] = []
     try:
-        _play_operator(runtime, wait, seconds)
+        if seconds > 0:  # once: the next language's window shows the same plant
+            _play_operator(runtime, wait, seconds)
+        window.journal.refresh()  # its newest records, without waiting for the dock's timer
+        _until(wait, lambda: window.faceplates.last is not None and bool(window.journal.summary.text()))
         for size in WINDOW_SIZES:
             window.resize(*size)
             suffix = ("" if size == WINDOW_SIZES[0] else f"-{size[0]}x{size[1]}") + language
             for i, view in enumerate(window.views):
                 window.tabs.setCurrentIndex(i)
-                wait(0.3)
+                wait(0.0)  # laid out; the view shows the last scan already (every tab follows them)
                 view.flush()
                 path = out / f"workstation-{slug(view.form.path.stem)}{suffix}.png"
                 window.grab().save(str(path))
@@ -131,7 +148,7 @@ def _workstation(runtime: Runtime, out: Path, wait: Callable[[float], None], sec
             analog = next(i for i, v in enumerate(window.views) if v.form.path.stem == "02_analog")
             window.tabs.setCurrentIndex(analog)
             plate = window.faceplates.show_tag(next(t for t in runtime.alarms.table.tags if t.name == "TEMP"))
-            wait(0.5)  # its hour of history is read in a thread
+            _until(wait, lambda plate=plate: not plate.loading())  # its hour of history is read in a thread
             picture = window.grab()
             p = QPainter(picture)
             try:  # the dialog where a window manager would put it: over the middle of the window
@@ -155,13 +172,14 @@ def _trend(window: MainWindow, path: Path, size: tuple[int, int], wait: Callable
     trend.resize(*size)
     for name in ("LEVEL", "TEMP"):
         trend.add_pen(name)
-    deadline = time.monotonic() + 30
-    while (trend.loading() or not all(p.live_t for p in trend.pens.values())) and time.monotonic() < deadline:
-        wait(0.05)  # the archive is read in a thread, the live values come with the scans
+    # the archive is read in a thread, the live values come with the scans
+    _until(wait, lambda: not trend.loading() and all(p.live_t for p in trend.pens.values()))
     now = time.time()
     trend.set_range(now - 60, now)
     trend.set_cursors(now - 25, now - 2)
-    wait(0.6)
+    # the minute is read again at its own detail once the zoom has settled (DETAIL_MS), then drawn
+    _until(wait, lambda: not trend.settled.isActive() and not trend.loading())
+    trend.redraw()
     trend.grab().save(str(path))
     trend.close()
     return path
@@ -172,6 +190,7 @@ def _designer(runtime: Runtime, out: Path, wait: Callable[[float], None], langua
     live, a gauge selected."""
     from app.gui.designer.station import open_target
     from app.gui.designer.window import DesignerWindow
+    from hmi_forms.elements.journal import MessageJournal
 
     window = DesignerWindow(open_target(runtime.station.path.parent / "forms" / "02_analog.hmi"))
     window.resize(*WINDOW_SIZES[0])
@@ -180,11 +199,18 @@ def _designer(runtime: Runtime, out: Path, wait: Callable[[float], None], langua
     try:
         window.design.select([e for e in window.design.doc.elements if e.get("Name") == "Уровень"])
         window.start_preview("127.0.0.1", runtime.modbus.port if runtime.modbus is not None else None)
-        wait(2.0)
+        # the memory is read over Modbus in a thread, a journal element's page in another, and the
+        # journal is drawn again at its next refresh (RefreshTicks snapshots) with the page read
+        polled = _snapshots(window)
+        journals = [i for i in window.design.items.values() if isinstance(i.model, MessageJournal)]
+        _until(wait, lambda: polled() > 0 and all(i.widget is not None and i.widget.status.text()
+                                                  for i in journals))
+        shown = polled()
+        _until(wait, lambda: all(polled() > shown + i.model.RefreshTicks for i in journals))
         for size in WINDOW_SIZES:
             window.resize(*size)
             window.canvas.home()
-            wait(0.3)
+            wait(0.0)
             window.problems.recheck()
             suffix = ("" if size == WINDOW_SIZES[0] else f"-{size[0]}x{size[1]}") + language
             path = out / f"designer-02-analog{suffix}.png"
@@ -194,6 +220,19 @@ def _designer(runtime: Runtime, out: Path, wait: Callable[[float], None], langua
     finally:
         window.close()
     return written
+
+
+def _snapshots(window: DesignerWindow) -> Callable[[], int]:
+    """How many snapshots of the preview the canvas has shown since this was called (asked often
+    enough to see each: the preview polls every 0.2 s)."""
+    seen = [window.design.snapshot]
+
+    def count() -> int:
+        if window.design.snapshot is not seen[-1]:
+            seen.append(window.design.snapshot)
+        return len(seen) - 1
+
+    return count
 
 
 def _play_operator(runtime: Runtime, wait: Callable[[float], None], seconds: float) -> None:
@@ -215,11 +254,21 @@ def _play_operator(runtime: Runtime, wait: Callable[[float], None], seconds: flo
         wait(1.2)
 
 
+def _until(wait: Callable[[float], None], done: Callable[[], bool], seconds: float = 30.0) -> None:
+    """Events handled until `done()` (a read in a thread answered), for at most `seconds`: no
+    picture waits longer than what it shows needs."""
+    deadline = time.monotonic() + seconds
+    while not done() and time.monotonic() < deadline:
+        wait(0.02)
+
+
 def _pump_events(app: QCoreApplication, seconds: float) -> None:
+    """The events of `seconds` handled; of none: those posted so far (a resize's layout)."""
     end = time.monotonic() + seconds
+    app.processEvents()
     while time.monotonic() < end:
-        app.processEvents()
         time.sleep(0.01)
+        app.processEvents()
 
 
 if __name__ == "__main__":

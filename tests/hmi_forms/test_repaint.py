@@ -5,6 +5,7 @@ of `draw` after Qt has processed the paint; the pictures are really rendered wit
 
 from __future__ import annotations
 
+import itertools
 import json
 from pathlib import Path
 
@@ -249,15 +250,19 @@ def test_the_picture_caches_stay_bounded_whatever_the_values(qtbot, tmp_path) ->
     view.show()
     qtbot.addWidget(view)
 
-    def feed(first: int, count: int) -> int:
-        for k in range(first, first + count):
-            hw = k * 40503 & 0xFFFF
-            view.refresh(snap(scan=k, words={0o4010: hw, 0o4012: hw ^ 0x5555, 0o4014: hw ^ 0xAAAA}))
+    scans = itertools.count(1)
+
+    def feed(words: list[int]) -> int:
+        for hw in words:
+            view.refresh(snap(scan=next(scans), words={0o4010: hw, 0o4012: hw ^ 0x5555, 0o4014: hw ^ 0xAAAA}))
             settle()
         return SPRITES.bytes  # what the pictures hold (entries and remembered words: counted below)
 
-    warm = feed(1, 1500)
-    assert feed(1501, 1500) <= warm * 1.05  # the next 1,500 values are drawn from what the first cached
+    # the whole range in even steps: every pixel a needle can move to (a dial's needle has 266)
+    warm = feed([round(j * 0xFFFF / 511) for j in range(512)])
+    # then 700 words spread as a plant's are: 1,212 distinct values in all, past MAX_ENTRIES, drawn
+    # from the needles the sweep cached
+    assert feed([k * 40503 & 0xFFFF for k in range(1, 701)]) <= warm * 1.05
     for widget in view.painted:
         model = widget.model
         assert len(model.remembered) <= MAX_SHOWN
