@@ -2,7 +2,7 @@
 
 `python main.py --no-gui STATION` spends most of its start importing (a second of CPU); a test that
 starts a station twenty times spends it twenty times. Here a child process (`Forks`) imports
-`app.cli` and the runtime once and then forks on request; each fork runs `app.cli.main` with the
+`app.cli`, the runtime and what a station's start imports lazily once and then forks on request; each fork runs `app.cli.main` with the
 arguments given, exactly as `main.py` does, and ends with its exit code. The test signals the fork
 by its PID like any process and asks the forking process, its parent, for its exit code (`Forked`,
 a small Popen).
@@ -109,9 +109,16 @@ def _wait(pid: int, timeout: float) -> int | None:
 
 
 def serve() -> None:
-    # what every fork would import first: the command line and the runtime
+    # what every fork would import first: the command line, the runtime, and what a start imports
+    # lazily (numpy for the quality of the tags, netplc/lazy.py: 0.6 s of a fork's start otherwise;
+    # the service manager's notifier) and what the first bytes through a socket need (idna)
+    import encodings.idna  # noqa: F401
+
+    import numpy  # noqa: F401
+
     import app.cli
-    import app.station.runtime  # noqa: F401
+    import app.station.runtime
+    import app.station.service  # noqa: F401
 
     for line in sys.stdin:
         request = json.loads(line)
