@@ -2,10 +2,10 @@
 
 `python main.py --no-gui STATION` spends most of its start importing (a second of CPU); a test that
 starts a station twenty times spends it twenty times. Here a child process (`Forks`) imports
-`app.cli`, the runtime and what a station's start imports lazily once and then forks on request; each fork runs `app.cli.main` with the
-arguments given, exactly as `main.py` does, and ends with its exit code. The test signals the fork
-by its PID like any process and asks the forking process, its parent, for its exit code (`Forked`,
-a small Popen).
+`app.cli`, the runtime and what a station's start imports lazily, once, and then forks on request;
+each fork runs `app.cli.main` with the arguments given, exactly as `main.py` does, and ends with its
+exit code. The test signals the fork by its PID like any process and asks the forking process, its
+parent, for its exit code (`Forked`, a small Popen).
 
     python -m tests.app.station_fork    (requests on stdin, one JSON array a line)
 """
