@@ -38,8 +38,10 @@ def test_counting_continues_after_a_clean_stop(tmp_path: Path) -> None:
     station = load_station(counting_station(tmp_path))
     first = Runtime(station)
     first.start()
-    time.sleep(0.6)
-    first.stop()
+    try:
+        assert wait_for(lambda: counter(first) > 5)
+    finally:
+        first.stop()
     saved = counter(first)
     assert saved > 5
     second = Runtime(station)
@@ -47,8 +49,7 @@ def test_counting_continues_after_a_clean_stop(tmp_path: Path) -> None:
     try:
         assert second.restored == "current"
         assert saved <= counter(second) <= saved + 10
-        time.sleep(0.2)
-        assert counter(second) > saved
+        assert wait_for(lambda: counter(second) > saved)
     finally:
         second.stop()
 
@@ -146,7 +147,12 @@ def test_a_start_left_pressed_is_no_new_press_after_a_restart(tmp_path: Path) ->
     not one more at every restart."""
     from tests.app.conftest import copy_demo
 
-    station = load_station(copy_demo(tmp_path / "station"))
+    folder = copy_demo(tmp_path / "station")
+    toml = folder / "station.toml"  # a scan every 20 ms, not 100: the 15 scans of each run sooner
+    toml.write_text(toml.read_text(encoding="utf-8").replace("\nNetSyncTime = 100 ", "\nNetSyncTime = 20 "),
+                    encoding="utf-8")
+    station = load_station(folder)
+    assert station.NetSyncTime == 20
     start_bit = 0o40042
     for run in range(2):
         runtime = Runtime(station)
