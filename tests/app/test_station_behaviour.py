@@ -8,8 +8,6 @@ import itertools
 import signal
 import socket
 import sqlite3
-import subprocess
-import sys
 import threading
 import time
 from collections.abc import Iterator
@@ -20,7 +18,7 @@ import pytest
 from app.station.config import load_station
 from app.station.runtime import Runtime
 from netplc.memory import Snapshot
-from tests.app.conftest import REPO
+from tests.app.station_fork import Forks
 
 SELECT, OUT, ENABLE, TIMER_OUT = 0o2000, 0o2001, 0o2002, 0o2003  # 03_sync.hmi
 PUMP, TEMP = 0o2120, 0o4012
@@ -168,7 +166,8 @@ def free_port() -> int:
         return s.getsockname()[1]
 
 
-def test_no_gui_process_pulses_and_journals_what_a_modbus_client_switches(demo_copy: Path) -> None:
+def test_no_gui_process_pulses_and_journals_what_a_modbus_client_switches(
+        demo_copy: Path, station_forks: Forks) -> None:
     from pymodbus.client import ModbusTcpClient
 
     port = free_port()
@@ -177,8 +176,8 @@ def test_no_gui_process_pulses_and_journals_what_a_modbus_client_switches(demo_c
     text = toml.read_text(encoding="utf-8").replace(server + "0", server + str(port))
     toml.write_text(text, encoding="utf-8")
     assert f"port = {port}" in toml.read_text(encoding="utf-8")
-    proc = subprocess.Popen([sys.executable, "main.py", "--no-gui", str(demo_copy)],
-                            cwd=REPO, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+    # `main.py --no-gui` as a process of its own (a fork of the worker's, tests/app/station_fork.py)
+    proc = station_forks.start(["--no-gui", str(demo_copy)], demo_copy / "stderr.txt")
     try:
         client = ModbusTcpClient("127.0.0.1", port=port)
         poll(client.connect)
@@ -190,11 +189,11 @@ def test_no_gui_process_pulses_and_journals_what_a_modbus_client_switches(demo_c
             time.sleep(0.01)
         client.close()
         proc.send_signal(signal.SIGTERM)  # a stop as the service manager's: everything is flushed
-        _, err = proc.communicate(timeout=30)
+        assert proc.wait(30) == 0, proc.errors()
     finally:
         if proc.poll() is None:
             proc.kill()
-    assert proc.returncode == 0, err
+            proc.wait(10)
     assert outputs == {False, True}  # the generator pulses without a window
     con = sqlite3.connect(f"file:{demo_copy / 'archive' / 'journal.sqlite'}?mode=ro", uri=True)
     try:
