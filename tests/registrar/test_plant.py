@@ -53,15 +53,15 @@ def test_two_stations_write_at_once(tmp_path, pg_url):
     for name in ("north", "south"):
         store = Store(tmp_path / name / "journal.sqlite", flush_interval=0.01)
         store.start()
-        forwarder = Forwarder(store.path, pg_url, name, interval=0.01, batch=500)
+        forwarder = Forwarder(store.path, pg_url, name, interval=0.01, batch=250)  # 12 batches each
         forwarder.start()
         stations[name] = (store, forwarder)
 
     def produce(name: str) -> None:
         store = stations[name][0]
-        for i in range(6_000):
+        for i in range(3_000):
             store.put(Record(T0 + i / 10, "data", 1, 1, "04010", value=float(i)))
-            if i % 1000 == 0:
+            if i % 500 == 0:
                 store.put(Record(T0 + i / 10, "message", 1, 2, number=7, text=f"{name} alarm"))
                 time.sleep(0.01)
 
@@ -74,18 +74,18 @@ def test_two_stations_write_at_once(tmp_path, pg_url):
         store.close()
         wait_for(lambda f=forwarder, s=store: f.stats.backlog == 0 and f.stats.forwarded == s.committed)
         forwarder.close()
-        assert central(pg_url, name) == (6_006, 6_006)
+        assert central(pg_url, name) == (3_006, 3_006)
     with Archive(pg_url) as plant:
         assert plant.stations() == ["north", "south"]
         assert plant.days() == [DAY]
-        assert plant.count(DAY) == 12_012
+        assert plant.count(DAY) == 6_012
         alarms = plant.records(DAY, Filter(kinds={"message"}), limit=100, newest_first=False)
         assert [(r.station, r.text) for r in alarms[:2]] == [("north", "north alarm"),
                                                              ("south", "south alarm")]
         assert plant.count(DAY, Filter(stations={"south"}, kinds={"message"})) == 6
         assert len(plant.series_keys(DAY)) == 2
         ts, values = plant.series(DAY, grp=1, type=1, source="04010", station="north", points=100_000)
-        assert len(ts) == 6_000 and values[-1] == 5999.0
+        assert len(ts) == 3_000 and values[-1] == 2999.0
 
 
 def test_forwarding_survives_a_server_restart(tmp_path, pg_cluster, pg_url):
