@@ -5,13 +5,14 @@ from __future__ import annotations
 import signal
 import subprocess
 import time
-from collections.abc import Callable
+from collections.abc import Callable, Iterator
 from pathlib import Path
 
 import pytest
 
 from app.gui.screenshots import copy_station
 from app.station.config import DEMO_STATION
+from tests.app.station_fork import Forks
 
 REPO = Path(__file__).resolve().parents[2]
 DEMO = DEMO_STATION
@@ -69,6 +70,16 @@ def write_station(folder: Path, toml: str, files: dict[str, str] | None = None) 
         (folder / name).parent.mkdir(parents=True, exist_ok=True)
         (folder / name).write_text(text, encoding="utf-8")
     return folder
+
+
+@pytest.fixture(scope="session")
+def station_forks(tmp_path_factory: pytest.TempPathFactory) -> Iterator[Forks]:
+    """The worker's forking process (tests/app/station_fork.py): a test that needs a station as a
+    process of its own (signals, exit codes, SIGKILL) starts it as a fork of this one, which has
+    imported the station once, instead of a `python main.py` that imports it again."""
+    forks = Forks(tmp_path_factory.mktemp("forks") / "stderr.txt")
+    yield forks
+    forks.close()
 
 
 @pytest.fixture

@@ -2,10 +2,10 @@
 
 `python main.py --no-gui STATION` spends most of its start importing (a second of CPU); a test that
 starts a station twenty times spends it twenty times. Here a child process (`Forks`) imports
-`app.cli` and the runtime once and then forks on request; each fork runs `app.cli.main` with the
-arguments given, exactly as `main.py` does, and ends with its exit code. The test signals the fork
-by its PID like any process and asks the forking process, its parent, for its exit code (`Forked`,
-a small Popen).
+`app.cli`, the runtime and what a station's start imports lazily, once, and then forks on request;
+each fork runs `app.cli.main` with the arguments given, exactly as `main.py` does, and ends with its
+exit code. The test signals the fork by its PID like any process and asks the forking process, its
+parent, for its exit code (`Forked`, a small Popen).
 
     python -m tests.app.station_fork    (requests on stdin, one JSON array a line)
 """
@@ -18,6 +18,8 @@ import select
 import signal
 import subprocess
 import sys
+import time
+from collections.abc import Callable
 from pathlib import Path
 
 REPO = Path(__file__).resolve().parents[2]
@@ -40,11 +42,13 @@ class Forks:
             raise RuntimeError(f"the forking process ended (exit code {self.proc.wait(10)})")
         return json.loads(answer)
 
-    def start(self, args: list[str], stderr: Path) -> Forked:
-        """`python main.py ARGS` with its stderr appended to `stderr` and its stdout dropped."""
-        pid = self.ask("start", args, str(stderr))
+    def start(self, args: list[str], stderr: Path, stdout: Path | None = None,
+              env: dict[str, str] | None = None) -> Forked:
+        """`python main.py ARGS` with its stderr appended to `stderr`, its stdout to `stdout` (or
+        dropped), and `env` added to its environment."""
+        pid = self.ask("start", args, str(stderr), str(stdout or os.devnull), env or {})
         assert isinstance(pid, int)
-        return Forked(self, pid)
+        return Forked(self, pid, stderr, stdout)
 
     def close(self) -> None:
         assert self.proc.stdin is not None
@@ -55,9 +59,29 @@ class Forks:
 class Forked:
     """One forked station, like a `subprocess.Popen` of it."""
 
-    def __init__(self, forks: Forks, pid: int) -> None:
+    def __init__(self, forks: Forks, pid: int, stderr: Path, stdout: Path | None) -> None:
         self.forks, self.pid = forks, pid
+        self.stderr, self.stdout = stderr, stdout
         self.returncode: int | None = None
+
+    def output(self) -> str:
+        """What it printed so far (its prints are flushed line by line)."""
+        assert self.stdout is not None
+        return self.stdout.read_text(encoding="utf-8") if self.stdout.exists() else ""
+
+    def errors(self) -> str:
+        return self.stderr.read_text(encoding="utf-8", errors="replace") if self.stderr.exists() else ""
+
+    def until(self, said: Callable[[str], bool], timeout: float = 30.0) -> str:
+        """Its output once `said(output)` holds, polled every 20 ms; AssertionError if it ends or
+        `timeout` s pass first."""
+        deadline = time.monotonic() + timeout
+        while not said(out := self.output()):
+            if self.poll() is not None or time.monotonic() > deadline:
+                raise AssertionError(f"station {self.pid} (exit code {self.returncode}) said:\n"
+                                     f"{out}{self.errors()}")
+            time.sleep(0.02)
+        return out
 
     def send_signal(self, sig: int) -> None:
         if self.returncode is None:
@@ -80,19 +104,20 @@ class Forked:
         return self.returncode
 
 
-def _fork(args: list[str], stderr: str) -> int:
+def _fork(args: list[str], stderr: str, stdout: str, env: dict[str, str]) -> int:
     from app.cli import main
 
     sys.stdout.flush()
     pid = os.fork()
     if pid:
         return pid
-    err = os.open(stderr, os.O_WRONLY | os.O_APPEND | os.O_CREAT, 0o644)
+    os.environ.update(env)
     null = os.open(os.devnull, os.O_RDWR)
     os.dup2(null, 0)
-    os.dup2(null, 1)
-    os.dup2(err, 2)
-    os.close(err)
+    for fd, path in ((1, stdout), (2, stderr)):
+        out = os.open(path, os.O_WRONLY | os.O_APPEND | os.O_CREAT, 0o644)
+        os.dup2(out, fd)
+        os.close(out)
     os.close(null)
     sys.exit(main(args))  # and the interpreter ends as main.py's does
 
@@ -109,14 +134,22 @@ def _wait(pid: int, timeout: float) -> int | None:
 
 
 def serve() -> None:
-    # what every fork would import first: the command line and the runtime
+    # what every fork would import first: the command line, the runtime, and what a start imports
+    # lazily (numpy for the quality of the tags, netplc/lazy.py: 0.6 s of a fork's start otherwise;
+    # the service manager's notifier) and what the first bytes through a socket need (idna)
+    import encodings.idna  # noqa: F401
+
+    import numpy  # noqa: F401
+
     import app.cli
-    import app.station.runtime  # noqa: F401
+    import app.station.runtime
+    import app.station.service  # noqa: F401
+    import hmi_forms.behaviour  # noqa: F401  (the forms of a station that has them)
 
     for line in sys.stdin:
         request = json.loads(line)
         if request[0] == "start":
-            answer: object = _fork(request[1], request[2])
+            answer: object = _fork(*request[1:])
         else:
             answer = _wait(request[1], request[2])
         print(json.dumps(answer), flush=True)

@@ -27,7 +27,7 @@ from tests.app.conftest import write_station
 
 PROGRAM = "TNA $03760\nCTR C:$03000 N:255\nJMP 0\n"
 RATE = 1000  # records a second while the backup runs
-PREFILL = 20_000  # records in the journal before it: pages for many steps
+PREFILL = 10_000  # records in the journal before it: pages for many steps (of 2 pages)
 
 
 def station_folder(folder: Path) -> Path:
@@ -107,7 +107,7 @@ def test_a_backup_while_the_journal_is_written_holds_every_record_committed_befo
         before = rows(st.Archive)
         assert running.store is not None
         batches = running.store.stats.batches
-        report = backup(st.folder, tmp_path / "backup", pages=4, pause=0.002)
+        report = backup(st.folder, tmp_path / "backup", pages=2, pause=0.002)
         during = running.store.stats.batches - batches
     finally:
         writer.stop.set()

@@ -1,15 +1,18 @@
-"""`python main.py --no-gui`: the whole station in a subprocess, over real TCP into a real archive."""
+"""`python main.py --no-gui`: the whole station in a process of its own, over real TCP into a real archive."""
 
 from __future__ import annotations
 
 import datetime as dt
 import re
+import signal
 import sqlite3
-import subprocess
-import sys
 from pathlib import Path
 
-from tests.app.conftest import DEMO_NAME, REPO, stop_once_up
+import pytest
+
+from app.cli import main as cli
+from tests.app.conftest import DEMO_NAME
+from tests.app.station_fork import Forks
 
 
 def day_table() -> str:
@@ -71,28 +74,35 @@ def test_a_start_raises_no_quality_alarm_before_the_first_answer(headless_archiv
     assert not [r for r in alarms if r[3].endswith(".BAD")], alarms
 
 
-def test_sigterm_mid_run_exits_0_with_everything_flushed(demo_copy: Path) -> None:
-    proc = subprocess.Popen([sys.executable, "main.py", "--no-gui", str(demo_copy), "--status-every", "0.5"],
-                            cwd=REPO, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+def test_sigterm_mid_run_exits_0_with_everything_flushed(demo_copy: Path, station_forks: Forks) -> None:
+    """The station as a process of its own (a fork of the worker's, tests/app/station_fork.py),
+    stopped with SIGTERM as systemd does."""
     archive = demo_copy / "archive" / "journal.sqlite"
-    out, err = stop_once_up(proc, until=lambda: level_rose(archive))  # NSTOREs, once a second
-    assert proc.returncode == 0, err
-    assert "SIGTERM: stopping" in out
-    check_archive(demo_copy / "archive" / "journal.sqlite")
+    station = station_forks.start(["--no-gui", str(demo_copy), "--status-every", "0.5"],
+                                  demo_copy / "stderr.txt", demo_copy / "stdout.txt")
+    try:  # up, and NSTOREs (once a second) in the archive
+        station.until(lambda out: "nodes 1/1 up" in out and level_rose(archive))
+        station.send_signal(signal.SIGTERM)
+        assert station.wait(60) == 0, station.errors()
+    finally:
+        if station.poll() is None:
+            station.kill()
+            station.wait(10)
+    assert "SIGTERM: stopping" in station.output()
+    check_archive(archive)
 
 
-def test_bad_station_exits_2_naming_the_problem(tmp_path: Path) -> None:
+def test_bad_station_exits_2_naming_the_problem(tmp_path: Path, station_forks: Forks) -> None:
     (tmp_path / "station.toml").write_text('NetPlcProgram = "p.stl"\n', encoding="utf-8")
     (tmp_path / "p.stl").write_text("TNA $09000\nJMP 0\n", encoding="utf-8")
-    r = subprocess.run([sys.executable, "main.py", "--no-gui", str(tmp_path), "--duration", "1"],
-                       cwd=REPO, capture_output=True, text=True, timeout=30)
-    assert r.returncode == 2
-    assert f"{tmp_path / 'p.stl'}:1:5:" in r.stderr
+    station = station_forks.start(["--no-gui", str(tmp_path), "--duration", "1"], tmp_path / "stderr.txt")
+    assert station.wait(30) == 2
+    assert f"{tmp_path / 'p.stl'}:1:5:" in station.errors()
 
 
-def test_help_everywhere() -> None:
+def test_help_everywhere(capsys: pytest.CaptureFixture[str]) -> None:
     for args in ([], ["view"], ["check"], ["simulate"]):
-        r = subprocess.run([sys.executable, "main.py", *args, "--help"], cwd=REPO, capture_output=True,
-                           text=True, timeout=30)
-        assert r.returncode == 0, (args, r.stderr)
-        assert "usage:" in r.stdout
+        with pytest.raises(SystemExit) as end:  # `main.py ARGS --help`: what main.py exits with
+            cli([*args, "--help"])
+        assert end.value.code == 0, (args, capsys.readouterr().err)
+        assert "usage:" in capsys.readouterr().out

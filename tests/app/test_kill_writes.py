@@ -21,7 +21,6 @@ import sqlite3
 import struct
 import threading
 import time
-from collections.abc import Iterator
 from pathlib import Path
 
 import pytest
@@ -159,15 +158,9 @@ def system_texts(archive: Path) -> list[str]:
         con.close()
 
 
-@pytest.fixture
-def forks(tmp_path: Path) -> Iterator[Forks]:
-    forks = Forks(tmp_path / "forks-stderr.txt")
-    yield forks
-    forks.close()
-
-
 @pytest.mark.timeout(60 + 6 * KILLS)
-def test_no_acknowledged_write_is_lost_to_sigkill(tmp_path: Path, forks: Forks) -> None:
+def test_no_acknowledged_write_is_lost_to_sigkill(tmp_path: Path, station_forks: Forks) -> None:
+    forks = station_forks
     port = free_port()
     folder = station(tmp_path / "station", port)
     seed = random.randrange(1 << 30)

@@ -6,8 +6,6 @@ from __future__ import annotations
 
 import re
 import signal
-import subprocess
-import sys
 import threading
 import time
 from pathlib import Path
@@ -16,7 +14,8 @@ from app.station.config import load_station
 from app.station.runtime import Runtime
 from netplc.memory import Memory
 from registrar.retain import read_save
-from tests.app.conftest import REPO, write_station
+from tests.app.conftest import write_station
+from tests.app.station_fork import Forks
 from tests.app.test_runtime_errors import wait_for
 
 COUNTER = 0o4000
@@ -38,8 +37,10 @@ def test_counting_continues_after_a_clean_stop(tmp_path: Path) -> None:
     station = load_station(counting_station(tmp_path))
     first = Runtime(station)
     first.start()
-    time.sleep(0.6)
-    first.stop()
+    try:
+        assert wait_for(lambda: counter(first) > 5)
+    finally:
+        first.stop()
     saved = counter(first)
     assert saved > 5
     second = Runtime(station)
@@ -47,29 +48,28 @@ def test_counting_continues_after_a_clean_stop(tmp_path: Path) -> None:
     try:
         assert second.restored == "current"
         assert saved <= counter(second) <= saved + 10
-        time.sleep(0.2)
-        assert counter(second) > saved
+        assert wait_for(lambda: counter(second) > saved)
     finally:
         second.stop()
 
 
-def test_counting_continues_after_sigkill(tmp_path: Path) -> None:
+def test_counting_continues_after_sigkill(tmp_path: Path, station_forks: Forks) -> None:
     folder = counting_station(tmp_path)
-    proc = subprocess.Popen([sys.executable, "main.py", "--no-gui", str(folder), "--status-every", "0.3"],
-                            cwd=REPO, stdout=subprocess.PIPE, text=True)
-    scans = 0
+    # `main.py --no-gui` as a process of its own (a fork of the worker's, tests/app/station_fork.py)
+    proc = station_forks.start(["--no-gui", str(folder), "--status-every", "0.3"], tmp_path / "stderr.txt",
+                               tmp_path / "stdout.txt")
+
+    def scanned(out: str) -> int:
+        return max(map(int, re.findall(r"(\d+) scans\)", out)), default=0)
+
     try:
-        assert proc.stdout is not None
-        deadline = time.monotonic() + 20
-        while scans < 100 and time.monotonic() < deadline:
-            m = re.search(r"(\d+) scans\)", proc.stdout.readline())
-            if m:
-                scans = int(m.group(1))
+        scans = scanned(proc.until(lambda out: scanned(out) >= 100, timeout=20))
         proc.send_signal(signal.SIGKILL)
         proc.wait(10)
     finally:
         if proc.poll() is None:
             proc.kill()
+            proc.wait(10)
     assert scans >= 100
     runtime = Runtime(load_station(folder))
     runtime.start()
@@ -146,7 +146,12 @@ def test_a_start_left_pressed_is_no_new_press_after_a_restart(tmp_path: Path) ->
     not one more at every restart."""
     from tests.app.conftest import copy_demo
 
-    station = load_station(copy_demo(tmp_path / "station"))
+    folder = copy_demo(tmp_path / "station")
+    toml = folder / "station.toml"  # a scan every 20 ms, not 100: the 15 scans of each run sooner
+    toml.write_text(toml.read_text(encoding="utf-8").replace("\nNetSyncTime = 100 ", "\nNetSyncTime = 20 "),
+                    encoding="utf-8")
+    station = load_station(folder)
+    assert station.NetSyncTime == 20
     start_bit = 0o40042
     for run in range(2):
         runtime = Runtime(station)

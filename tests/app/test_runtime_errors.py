@@ -5,21 +5,20 @@ from __future__ import annotations
 import asyncio
 import socket
 import sqlite3
-import subprocess
-import sys
 import threading
 import time
 from pathlib import Path
 
 import pytest
 
+from app.cli import main as cli
 from app.station.check import check_station
 from app.station.config import load_station
 from app.station.runtime import Runtime, StartError, unresolved_hosts
 from netplc.modbus import DeviceError, LeanTcpClient, parse_endpoint
 from netplc.program import parse
 from netplc.simulator import Simulator
-from tests.app.conftest import REPO, write_station
+from tests.app.conftest import write_station
 
 SIMULATED = """
 NetPlcLoad = false
@@ -46,9 +45,12 @@ backoff_max = 0.1
 """
 
 
-def headless(station: Path) -> subprocess.CompletedProcess[str]:
-    return subprocess.run([sys.executable, "main.py", "--no-gui", str(station), "--duration", "0.5"],
-                          cwd=REPO, capture_output=True, text=True, timeout=60)
+def headless(station: Path, capsys: pytest.CaptureFixture[str]) -> tuple[int, str]:
+    """`main.py --no-gui STATION --duration 0.5` run in this process (tests/app/test_headless.py runs
+    it as a process of its own): its exit code and stderr."""
+    capsys.readouterr()
+    code = cli(["--no-gui", str(station), "--duration", "0.5"])
+    return code, capsys.readouterr().err
 
 
 def system_texts(archive: Path) -> list[str]:
@@ -171,21 +173,21 @@ def wait_for(condition, seconds: float = 15.0) -> bool:
     return True
 
 
-def test_a_missing_program_file_exits_2_naming_the_key(tmp_path: Path) -> None:
+def test_a_missing_program_file_exits_2_naming_the_key(tmp_path: Path, capsys) -> None:
     write_station(tmp_path, 'NetPlcProgram = "gone.stl"\n')
-    r = headless(tmp_path)
-    assert r.returncode == 2 and "Traceback" not in r.stderr
-    assert r.stderr.strip() == (f"{tmp_path / 'station.toml'}: NetPlcProgram: file {tmp_path / 'gone.stl'} "
-                                "does not exist")
+    code, err = headless(tmp_path, capsys)
+    assert code == 2 and "Traceback" not in err
+    assert err.strip() == (f"{tmp_path / 'station.toml'}: NetPlcProgram: file {tmp_path / 'gone.stl'} "
+                           "does not exist")
 
 
-def test_headless_with_a_simulator_port_in_use_exits_2_naming_the_key(tmp_path: Path) -> None:
+def test_headless_with_a_simulator_port_in_use_exits_2_naming_the_key(tmp_path: Path, capsys) -> None:
     with socket.create_server(("127.0.0.1", 0)) as taken:
         port = taken.getsockname()[1]
         write_station(tmp_path, SIMULATED.format(port=port), {"node.stl": "JMP 0\n"})
-        r = headless(tmp_path)
-    assert r.returncode == 2 and "Traceback" not in r.stderr
-    assert f"simulators[0].port: cannot listen on 127.0.0.1:{port}" in r.stderr
+        code, err = headless(tmp_path, capsys)
+    assert code == 2 and "Traceback" not in err
+    assert f"simulators[0].port: cannot listen on 127.0.0.1:{port}" in err
 
 
 def test_the_modbus_server_port_in_use_is_a_problem_shown_not_a_stop(tmp_path: Path) -> None:

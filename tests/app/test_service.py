@@ -23,6 +23,7 @@ from app.station.notify import Notifier
 from app.station.runtime import Runtime, StartError
 from app.station.service import Service
 from tests.app.conftest import REPO, write_station
+from tests.app.station_fork import Forks
 
 WATCHDOG_USEC = 200_000  # a ping every 0.1 s; the station scans every 20 ms
 PROGRAM = "TNA $03760\nCTR C:$03000 N:255\nJMP 0\n"
@@ -128,29 +129,29 @@ def test_ready_after_the_first_scan_pings_while_scanning_none_while_hung(tmp_pat
     assert pings(stopping[-1:]) == []
 
 
-def test_main_no_gui_tells_systemd_ready_watchdog_and_stopping(tmp_path: Path) -> None:
-    """The real headless station: NOTIFY_SOCKET a path, the log on stderr at --log-level INFO (the
-    service unit's), SIGTERM as systemd stops it."""
+def test_main_no_gui_tells_systemd_ready_watchdog_and_stopping(tmp_path: Path, station_forks: Forks) -> None:
+    """The real headless station (`main.py --no-gui` as a process of its own: a fork of the
+    worker's, tests/app/station_fork.py): NOTIFY_SOCKET a path, the log on stderr at --log-level
+    INFO (the service unit's), SIGTERM as systemd stops it."""
     manager = Manager(str(tmp_path / "notify"))
     station = tiny_station(tmp_path / "station")
-    env = {**os.environ, "NOTIFY_SOCKET": manager.address, "WATCHDOG_USEC": str(WATCHDOG_USEC)}
-    proc = subprocess.Popen([sys.executable, "main.py", "--no-gui", str(station), "--log-level", "INFO",
-                             "--status-every", "60"], cwd=REPO, env=env, stdout=subprocess.PIPE,
-                            stderr=subprocess.PIPE, text=True)
+    env = {"NOTIFY_SOCKET": manager.address, "WATCHDOG_USEC": str(WATCHDOG_USEC)}
+    proc = station_forks.start(["--no-gui", str(station), "--log-level", "INFO", "--status-every", "60"],
+                               tmp_path / "stderr.txt", tmp_path / "stdout.txt", env)
     try:
         manager.until("READY=1", timeout=30)
         manager.until("WATCHDOG=1", timeout=2)
         manager.until("WATCHDOG=1", timeout=2)
         proc.send_signal(signal.SIGTERM)
         manager.until("STOPPING=1", timeout=10)
-        out, err = proc.communicate(timeout=30)
+        assert proc.wait(30) == 0, proc.errors()
     finally:
         if proc.poll() is None:
             proc.kill()
+            proc.wait(10)
         manager.close()
-    assert proc.returncode == 0, err
-    assert "SIGTERM: stopping" in out
-    assert "INFO MainThread app.station.runtime: station started" in err  # the journal gets the log
+    assert "SIGTERM: stopping" in proc.output()
+    assert "INFO MainThread app.station.runtime: station started" in proc.errors()  # the journal gets the log
 
 
 def test_without_a_service_manager_nothing_is_sent() -> None:

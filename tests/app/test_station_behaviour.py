@@ -8,8 +8,6 @@ import itertools
 import signal
 import socket
 import sqlite3
-import subprocess
-import sys
 import threading
 import time
 from collections.abc import Iterator
@@ -20,7 +18,7 @@ import pytest
 from app.station.config import load_station
 from app.station.runtime import Runtime
 from netplc.memory import Snapshot
-from tests.app.conftest import REPO
+from tests.app.station_fork import Forks
 
 SELECT, OUT, ENABLE, TIMER_OUT = 0o2000, 0o2001, 0o2002, 0o2003  # 03_sync.hmi
 PUMP, TEMP = 0o2120, 0o4012
@@ -73,9 +71,20 @@ def messages(runtime: Runtime) -> list[tuple[str, str]]:
         con.close()
 
 
+def scanning_every(folder: Path, ms: int) -> Path:
+    """The demo copy scanning every `ms`, not 100 ms: the pulses are counted in scans, and the
+    node (its own tick, 100 ms) still holds the temperature over 120 °C for about a second."""
+    toml = folder / "station.toml"
+    text = toml.read_text(encoding="utf-8")
+    assert "\nNetSyncTime = 100 " in text
+    toml.write_text(text.replace("\nNetSyncTime = 100 ", f"\nNetSyncTime = {ms} "), encoding="utf-8")
+    return folder
+
+
 @pytest.fixture
-def runtime(demo_copy: Path) -> Iterator[Runtime]:
-    rt = Runtime(load_station(demo_copy))
+def runtime(request: pytest.FixtureRequest, demo_copy: Path) -> Iterator[Runtime]:
+    """The demo running, scanning every `request.param` ms (indirect parametrization) or 20 ms."""
+    rt = Runtime(load_station(scanning_every(demo_copy, getattr(request, "param", 20))))
     rt.start()
     try:
         yield rt
@@ -84,16 +93,19 @@ def runtime(demo_copy: Path) -> Iterator[Runtime]:
 
 
 def drive(runtime: Runtime, scans: Scans, wait) -> None:
-    """The operator switches the pump and the timer on; the plant's temperature jumps over 120 °C."""
+    """The operator switches the pump and the timer on; the plant's temperature jumps over 120 °C;
+    returns once both messages were journaled and 30 scans ran."""
     engine = runtime.engine
     assert engine is not None
+    said: list[tuple[str | None, str | None]] = []
+    runtime.subscribe(lambda r: said.append((r.source, r.text)) if r.kind == "message" else None)
     wait(lambda: runtime.status().nodes_up == 1)
     engine.write_bit(ENABLE, 1, user="test")
     engine.write_bit(PUMP, 1, user="test")
     # raw 1000 = 150 °C: the node pulls it back 1/32 a scan, so it stays over 120 °C for ~1 s
     runtime.simulators[0].engine.write_word(TEMP, 1000)
     start = scans.count()
-    wait(lambda: scans.count() > start + 30)
+    wait(lambda: scans.count() > start + 30 and PUMP_ON in said and TEMP_HIGH in said)
 
 
 def poll(condition, timeout: float = 15.0) -> None:
@@ -122,6 +134,7 @@ def test_headless_runtime_pulses_every_scan_and_journals_the_forms_records(runti
     assert any(t.startswith(loaded) for t in system)
 
 
+@pytest.mark.parametrize("runtime", [50], indirect=True)  # the window draws every scan it keeps up with
 def test_the_workstation_changes_nothing_even_when_its_window_lags(qtbot, runtime: Runtime) -> None:
     from app.gui.main_window import MainWindow
 
@@ -137,7 +150,7 @@ def test_the_workstation_changes_nothing_even_when_its_window_lags(qtbot, runtim
 
     drive(runtime, scans, wait)
     before = scans.count()
-    time.sleep(1.5)  # the GUI thread is busy: the bridge drops every snapshot meanwhile
+    time.sleep(0.75)  # the GUI thread is busy: the bridge drops every snapshot meanwhile (15 scans)
     assert scans.count() >= before + 10
     wait(lambda: scans.count() > before + 25)
     assert check_every_scan(scans) > 10
@@ -153,7 +166,8 @@ def free_port() -> int:
         return s.getsockname()[1]
 
 
-def test_no_gui_process_pulses_and_journals_what_a_modbus_client_switches(demo_copy: Path) -> None:
+def test_no_gui_process_pulses_and_journals_what_a_modbus_client_switches(
+        demo_copy: Path, station_forks: Forks) -> None:
     from pymodbus.client import ModbusTcpClient
 
     port = free_port()
@@ -162,8 +176,8 @@ def test_no_gui_process_pulses_and_journals_what_a_modbus_client_switches(demo_c
     text = toml.read_text(encoding="utf-8").replace(server + "0", server + str(port))
     toml.write_text(text, encoding="utf-8")
     assert f"port = {port}" in toml.read_text(encoding="utf-8")
-    proc = subprocess.Popen([sys.executable, "main.py", "--no-gui", str(demo_copy)],
-                            cwd=REPO, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+    # `main.py --no-gui` as a process of its own (a fork of the worker's, tests/app/station_fork.py)
+    proc = station_forks.start(["--no-gui", str(demo_copy)], demo_copy / "stderr.txt")
     try:
         client = ModbusTcpClient("127.0.0.1", port=port)
         poll(client.connect)
@@ -175,11 +189,11 @@ def test_no_gui_process_pulses_and_journals_what_a_modbus_client_switches(demo_c
             time.sleep(0.01)
         client.close()
         proc.send_signal(signal.SIGTERM)  # a stop as the service manager's: everything is flushed
-        _, err = proc.communicate(timeout=30)
+        assert proc.wait(30) == 0, proc.errors()
     finally:
         if proc.poll() is None:
             proc.kill()
-    assert proc.returncode == 0, err
+            proc.wait(10)
     assert outputs == {False, True}  # the generator pulses without a window
     con = sqlite3.connect(f"file:{demo_copy / 'archive' / 'journal.sqlite'}?mode=ro", uri=True)
     try:

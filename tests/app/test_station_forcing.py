@@ -21,7 +21,7 @@ from tests.app.conftest import copy_demo
 LEVEL, SETPOINT, LEVEL_OK = 0o4010, 0o4030, 0o2131
 
 
-def wait_for(runtime: Runtime, what, scans: int = 600) -> None:
+def wait_for(runtime: Runtime, what, scans: int = 1500) -> None:
     """Let the station scan until `what(snapshot)` holds (at most `scans` scans)."""
     engine = runtime.engine
     assert engine is not None
@@ -39,10 +39,25 @@ def after_scans(runtime: Runtime, n: int = 3) -> None:
     wait_for(runtime, lambda s: s.scan >= target)
 
 
+def scanning_every_20_ms(folder: Path) -> Path:
+    """The demo scanning every 20 ms, not 100: the tests wait for scans, the exchange and the node
+    keep their own times."""
+    toml = folder / "station.toml"
+    text = toml.read_text(encoding="utf-8")
+    assert "\nNetSyncTime = 100 " in text
+    toml.write_text(text.replace("\nNetSyncTime = 100 ", "\nNetSyncTime = 20 "), encoding="utf-8")
+    return folder
+
+
 @pytest.fixture
 def english(tmp_path: Path) -> Path:
     """The demo in English: these tests read the forces' records word for word."""
-    return copy_demo(tmp_path / "station", "en")
+    return scanning_every_20_ms(copy_demo(tmp_path / "station", "en"))
+
+
+@pytest.fixture
+def demo_copy(demo_copy: Path) -> Path:
+    return scanning_every_20_ms(demo_copy)
 
 
 def test_exchange_and_modbus_writes_lose_to_forces_and_the_status_counts_them(english: Path) -> None:
@@ -131,7 +146,7 @@ def test_step_one_scan_runs_the_stopped_program_once(english: Path) -> None:
         assert commands.step(engineer, thread.lock).result(0).ok
         assert engine.state is RunState.STOPPED and engine.scan_counter >= before + 1
         seconds = engine.snapshot.get_word(0o4100)
-        after_scans(runtime, 12)  # the stopped scans that follow do not run the program
+        after_scans(runtime, 60)  # 1.2 s of stopped scans that follow do not run the program
         assert engine.snapshot.get_word(0o4100) == seconds
     finally:
         runtime.stop()

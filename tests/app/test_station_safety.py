@@ -3,16 +3,15 @@ Modbus clients cannot write the special bits 03700-03777 unless station.toml nam
 
 from __future__ import annotations
 
-import subprocess
-import sys
 from pathlib import Path
 
 import pytest
 
+from app.cli import main as cli
 from app.station.config import DEFAULT_WRITABLE, ConfigError, load_station, read_station
 from app.station.runtime import Runtime
 from netplc.records import Record
-from tests.app.conftest import REPO, write_station
+from tests.app.conftest import write_station
 
 PROGRAM = {"p.stl": "TNA $03760\nYON $02000\n", "s.csv": "X,02001,\n"}
 
@@ -46,7 +45,7 @@ def test_paths_outside_the_station_folder_are_refused_unless_allowed(tmp_path: P
     ("Archive", "node.stl", "simulators[0].program"),
 ])
 def test_retain_or_archive_on_a_station_input_is_refused_by_check_and_start(
-        tmp_path: Path, key: str, value: str, what: str) -> None:
+        tmp_path: Path, key: str, value: str, what: str, capsys: pytest.CaptureFixture[str]) -> None:
     (tmp_path / "forms").mkdir()
     toml = (f'NetPlcProgram = "p.stl"\nSymbols = "s.csv"\nHMIload = "forms"\n{key} = "{value}"\n'
             '[modbus_server]\nenabled = false\n[[simulators]]\nnode = 0\nprogram = "node.stl"\n')
@@ -54,9 +53,8 @@ def test_retain_or_archive_on_a_station_input_is_refused_by_check_and_start(
     path = (tmp_path / value).resolve()
     expected = f"{key}: {path} is a station input ({what}): writing there would overwrite it"
     assert problems(tmp_path) == [expected]
-    r = subprocess.run([sys.executable, "main.py", "check", str(tmp_path)], cwd=REPO, capture_output=True,
-                       text=True, timeout=60)
-    assert r.returncode == 1 and f"{tmp_path / 'station.toml'}: {expected}" in r.stdout
+    assert cli(["check", str(tmp_path)]) == 1  # `main.py check`, its exit code
+    assert f"{tmp_path / 'station.toml'}: {expected}" in capsys.readouterr().out
     before = (tmp_path / value).read_bytes() if (tmp_path / value).exists() else None
     with pytest.raises(ConfigError):
         Runtime(load_station(tmp_path))

@@ -4,6 +4,7 @@ restart and a SIGKILL of the station, retention, the lag alarm, `archive migrate
 from __future__ import annotations
 
 import datetime as dt
+import os
 import re
 import signal
 import sqlite3
@@ -52,15 +53,15 @@ def test_two_stations_write_at_once(tmp_path, pg_url):
     for name in ("north", "south"):
         store = Store(tmp_path / name / "journal.sqlite", flush_interval=0.01)
         store.start()
-        forwarder = Forwarder(store.path, pg_url, name, interval=0.01, batch=500)
+        forwarder = Forwarder(store.path, pg_url, name, interval=0.01, batch=250)  # 12 batches each
         forwarder.start()
         stations[name] = (store, forwarder)
 
     def produce(name: str) -> None:
         store = stations[name][0]
-        for i in range(6_000):
+        for i in range(3_000):
             store.put(Record(T0 + i / 10, "data", 1, 1, "04010", value=float(i)))
-            if i % 1000 == 0:
+            if i % 500 == 0:
                 store.put(Record(T0 + i / 10, "message", 1, 2, number=7, text=f"{name} alarm"))
                 time.sleep(0.01)
 
@@ -73,22 +74,24 @@ def test_two_stations_write_at_once(tmp_path, pg_url):
         store.close()
         wait_for(lambda f=forwarder, s=store: f.stats.backlog == 0 and f.stats.forwarded == s.committed)
         forwarder.close()
-        assert central(pg_url, name) == (6_006, 6_006)
+        assert central(pg_url, name) == (3_006, 3_006)
     with Archive(pg_url) as plant:
         assert plant.stations() == ["north", "south"]
         assert plant.days() == [DAY]
-        assert plant.count(DAY) == 12_012
+        assert plant.count(DAY) == 6_012
         alarms = plant.records(DAY, Filter(kinds={"message"}), limit=100, newest_first=False)
         assert [(r.station, r.text) for r in alarms[:2]] == [("north", "north alarm"),
                                                              ("south", "south alarm")]
         assert plant.count(DAY, Filter(stations={"south"}, kinds={"message"})) == 6
         assert len(plant.series_keys(DAY)) == 2
         ts, values = plant.series(DAY, grp=1, type=1, source="04010", station="north", points=100_000)
-        assert len(ts) == 6_000 and values[-1] == 5999.0
+        assert len(ts) == 3_000 and values[-1] == 2999.0
 
 
-def test_forwarding_survives_a_server_restart(tmp_path, own_pg_cluster):
-    url = own_pg_cluster.url
+def test_forwarding_survives_a_server_restart(tmp_path, pg_cluster, pg_url):
+    """The session's cluster is stopped and started again (on its port, with its other databases):
+    no cluster of the test's own to make (an initdb) and to throw away."""
+    url = pg_url
     store = Store(tmp_path / "journal.sqlite", flush_interval=0.01)
     store.start()
     forwarder = Forwarder(store.path, url, "st", interval=0.01, batch=200)
@@ -97,32 +100,47 @@ def test_forwarding_survives_a_server_restart(tmp_path, own_pg_cluster):
         for i in range(1000):
             store.put(Record(T0 + i, "data", 1, 1, "04010", value=float(i)))
         wait_for(lambda: forwarder.stats.forwarded == 1000)
-        own_pg_cluster.stop()
+        pg_cluster.stop()
         for i in range(1000, 3000):
             store.put(Record(T0 + i, "data", 1, 1, "04010", value=float(i)))
         wait_for(lambda: store.committed == 3000)
         wait_for(lambda: forwarder.stats.last_error != "" and not forwarder.stats.connected
                  and forwarder.stats.backlog == 2000)
-        own_pg_cluster.start()
+        pg_cluster.start()
         wait_for(lambda: forwarder.stats.backlog == 0, timeout=30)
     finally:
         store.close()
         forwarder.close()
+        if pg_cluster.process is None:  # the next tests have their server back whatever failed here
+            pg_cluster.start()
     assert central(url, "st") == (3000, 3000) and local_count(store.path) == 3000
 
 
 def test_a_sigkilled_station_loses_and_doubles_nothing(tmp_path, pg_url):
     db = tmp_path / "journal.sqlite"
-    for round_ in range(3):
-        child = spawn("plant_child.py", str(db), pg_url)
-        assert child.stdout is not None
-        start = central(pg_url, "killed")[0]
-        for line in child.stdout:  # forwarding is under way: kill it somewhere in a batch
-            if int(line) > 2_000 + 500 * round_:
-                break
-        child.send_signal(signal.SIGKILL)
-        child.communicate(timeout=10)
-        assert central(pg_url, "killed")[0] > start
+    stations = spawn("plant_child.py", str(db), pg_url)  # forks each station run (plant_child.py)
+    assert stations.stdin is not None and stations.stdout is not None
+    try:
+        for round_ in range(3):
+            start = central(pg_url, "killed")[0]
+            stations.stdin.write("start\n")
+            stations.stdin.flush()
+            pid = None
+            for line in stations.stdout:  # forwarding is under way: kill it somewhere in a batch
+                word = line.split()[0]
+                if word == "pid":
+                    pid = int(line.split()[1])
+                elif pid is not None and int(word) > 2_000 + 500 * round_:  # (the killed run's last
+                    break  # lines come before the pid of the next)
+            assert pid is not None
+            os.kill(pid, signal.SIGKILL)
+            wait_for(lambda start=start: central(pg_url, "killed")[0] > start)
+        stations.communicate(timeout=20)  # its stdin closed: it reaps the last station and ends
+        assert stations.returncode == 0
+    finally:
+        if stations.poll() is None:
+            stations.kill()
+            stations.communicate(timeout=10)
     # The station starts again: its forwarder sends the rest from the committed position.
     assert Forwarder(db, pg_url, "killed").forward_all() >= 0
     total, distinct = central(pg_url, "killed")
