@@ -7,9 +7,10 @@ workers (about 10 s, most of it pip). The venv sees the test venv's site-package
 file, so pip resolves the wheel's dependencies against what is installed there and installs our
 wheel alone (no download of PySide6 and the rest); pip leaves the test venv untouched (what it
 finds there is "outside environment"). The venv's own interpreter runs that pip (found through the
-same .pth), as `pip --python` would after starting a first pip only to start it there. The wheel is built by the PEP 517 backend pyproject.toml
-names, called as pip calls it, in this venv (with the test extra's setuptools) rather than in an
-isolated build environment pip would first install: the same wheel, in a quarter of the time.
+same .pth), as `pip --python` would after starting a first pip only to start it there. The wheel
+is built by the PEP 517 backend pyproject.toml names, called as pip calls it, in this venv (with
+the test extra's setuptools) rather than in an isolated build environment pip would first install:
+the same wheel, in a quarter of the time.
 """
 
 from __future__ import annotations
