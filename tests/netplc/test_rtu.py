@@ -33,13 +33,17 @@ REPO = Path(__file__).resolve().parents[2]
 
 
 class PtyLine:
-    """The master side of a pty as a serial line: `read` returns at a 5 ms silence."""
+    """The master side of a pty as a serial line: `read` returns at a 5 ms silence, or b"" after
+    `idle` seconds of silence (a serial port's read timeout), each counted in `silences`."""
 
-    def __init__(self, fd: int) -> None:
+    def __init__(self, fd: int, idle: float = 0.1) -> None:
         self.fd = fd
+        self.idle = idle
+        self.silences = 0
 
     def read(self, size: int) -> bytes:
-        if not select.select([self.fd], [], [], 0.1)[0]:
+        if not select.select([self.fd], [], [], self.idle)[0]:
+            self.silences += 1
             return b""
         data = os.read(self.fd, size)
         while len(data) < size and select.select([self.fd], [], [], 0.005)[0]:
