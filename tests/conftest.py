@@ -10,8 +10,16 @@ import sys
 from pathlib import Path
 
 import pytest
+from hypothesis import HealthCheck, settings
 
 os.environ.setdefault("QT_QPA_PLATFORM", "offscreen")
+
+# --- hypothesis -----------------------------------------------------------------------------------
+# No example has a deadline and none is "too slow": on a loaded machine (CI runs more workers than
+# cores) an example's time says nothing about the code, and either check would fail a test that
+# holds. Each property sets its own number of examples, for its own space.
+settings.register_profile("suite", deadline=None, suppress_health_check=[HealthCheck.too_slow])
+settings.load_profile("suite")
 
 # Bytecode caches (__pycache__, ignored by git) are written even where PYTHONDONTWRITEBYTECODE is set,
 # as container images often do: without them each xdist worker compiles and assertion-rewrites every

@@ -22,8 +22,8 @@ import subprocess
 import sys
 from pathlib import Path
 
-REPO = Path(__file__).resolve().parents[1]
-PACKAGES = ("netplc", "registrar", "hmi_forms", "app")
+from tests.project_sources import REPO, sources, tree
+
 QT = ("PySide6", "shiboken6", "pyqtgraph")
 HEADLESS = ("netplc", "registrar", "hmi_forms.elements", "hmi_forms.form", "hmi_forms.behaviour",
             "app.station", "app.scada", "app.authority")
@@ -37,7 +37,7 @@ def module_name(path: Path) -> str:
 @functools.cache
 def modules() -> dict[str, Path]:
     """Every module of the project by name (read once per session: the tests only look)."""
-    found = {module_name(p): p for pkg in PACKAGES for p in (REPO / pkg).rglob("*.py")}
+    found = {module_name(p): p for p in sources()}
     found["main"] = REPO / "main.py"
     return found
 
@@ -48,30 +48,30 @@ def _type_checking(node: ast.If) -> bool:
         isinstance(test, ast.Attribute) and test.attr == "TYPE_CHECKING")
 
 
-@functools.cache
-def tree(path: Path) -> ast.Module:
-    return ast.parse(path.read_text(encoding="utf-8"))
+def _statements(node: ast.AST) -> list[ast.AST]:
+    """The statements (and except/match clauses) directly inside `node`: an import is a statement,
+    and an expression holds none, so only these are looked into."""
+    return [child for field in ("body", "orelse", "finalbody", "handlers", "cases")
+            for child in getattr(node, field, ())]
 
 
 def imports(path: Path, known: frozenset[str]) -> set[str]:
     """Every module `path` imports when it runs: project modules by name, others by top package."""
     out: set[str] = set()
-
-    def visit(node: ast.AST) -> None:
+    todo = _statements(tree(path))
+    while todo:
+        node = todo.pop()
         if isinstance(node, ast.If) and _type_checking(node):
-            for child in node.orelse:
-                visit(child)
-            return
-        if isinstance(node, ast.Import):
+            todo += node.orelse
+        elif isinstance(node, ast.Import):
             out.update(alias.name for alias in node.names)
-        elif isinstance(node, ast.ImportFrom) and node.module and not node.level:
-            for alias in node.names:
-                sub = f"{node.module}.{alias.name}"
-                out.add(sub if sub in known else node.module)
-        for child in ast.iter_child_nodes(node):
-            visit(child)
-
-    visit(tree(path))
+        elif isinstance(node, ast.ImportFrom):
+            if node.module and not node.level:
+                for alias in node.names:
+                    sub = f"{node.module}.{alias.name}"
+                    out.add(sub if sub in known else node.module)
+        else:
+            todo += _statements(node)
     return out
 
 
@@ -103,13 +103,25 @@ def test_headless_parts_import_no_qt_even_indirectly() -> None:
     assert bad == []
 
 
-def test_headless_parts_run_without_qt_loaded() -> None:
+@functools.cache
+def loaded_by_imports() -> tuple[str, str]:
+    """One fresh interpreter for both import checks (its start is most of their cost): the Qt
+    modules loaded once the headless parts are imported, then the psycopg modules loaded once the
+    CLI, the configuration and the plant archive's URL are imported too (what a station does before
+    it names a plant archive)."""
     code = ("import sys, app.station.check, app.station.runtime, hmi_forms.behaviour, netplc.simulator\n"
             "import registrar.query\n"
-            f"print(sorted(m for m in sys.modules if m.split('.')[0] in {QT!r}))")
+            f"print(sorted(m for m in sys.modules if m.split('.')[0] in {QT!r}))\n"
+            "import app.cli, app.station.config, registrar.plant.url\n"
+            "print(sorted(m for m in sys.modules if m.split('.')[0] == 'psycopg'))")
     r = subprocess.run([sys.executable, "-c", code], cwd=REPO, capture_output=True, text=True, timeout=60)
     assert r.returncode == 0, r.stderr
-    assert r.stdout.strip() == "[]"
+    qt, psycopg = r.stdout.splitlines()
+    return qt, psycopg
+
+
+def test_headless_parts_run_without_qt_loaded() -> None:
+    assert loaded_by_imports()[0] == "[]"
 
 
 def test_only_the_modbus_subpackage_imports_pymodbus() -> None:
@@ -145,12 +157,7 @@ def test_only_the_plant_archive_imports_psycopg() -> None:
 
 
 def test_psycopg_is_not_loaded_until_a_plant_archive_is_named() -> None:
-    code = ("import sys, app.station.check, app.cli, app.station.config, app.station.runtime\n"
-            "import registrar.query, registrar.plant.url\n"
-            "print(sorted(m for m in sys.modules if m.split('.')[0] == 'psycopg'))")
-    r = subprocess.run([sys.executable, "-c", code], cwd=REPO, capture_output=True, text=True, timeout=60)
-    assert r.returncode == 0, r.stderr
-    assert r.stdout.strip() == "[]"
+    assert loaded_by_imports()[1] == "[]"
 
 
 def test_hmi_forms_names_no_roles_of_its_own() -> None:

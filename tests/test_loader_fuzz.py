@@ -164,6 +164,12 @@ JSON_LEAVES = st.one_of(
                      "MiddleCenter"]))
 JSON_VALUES = st.recursive(JSON_LEAVES, lambda inner: st.one_of(
     st.lists(inner, max_size=3), st.dictionaries(st.text(max_size=6), inner, max_size=3)), max_leaves=8)
+# a property's value: a leaf, or a list or object of leaves, lists and objects (what a property
+# holds, a list of states or points, is at most that deep); whole documents take JSON_VALUES
+KEYS = st.text(max_size=6)
+FLAT = st.one_of(st.lists(JSON_LEAVES, max_size=3), st.dictionaries(KEYS, JSON_LEAVES, max_size=3))
+PROPERTY_VALUES = st.one_of(JSON_LEAVES, st.lists(st.one_of(JSON_LEAVES, FLAT), max_size=3),
+                            st.dictionaries(KEYS, st.one_of(JSON_LEAVES, FLAT), max_size=3))
 PROPERTY_NAMES = sorted({f for cls in ELEMENT_TYPES.values() for f in cls.__dataclass_fields__} |
                         {"type", "Address", "Image", "Device"})
 
@@ -174,7 +180,7 @@ FORM_KEYS = st.lists(st.sampled_from(["title", "width", "height", "BackColor", "
                                       "Nope"]), max_size=8)
 ELEMENT_TYPE, ELEMENT_NAME = st.sampled_from([*ELEMENT_TYPES, "Nope"]), st.text(max_size=4)
 DEVICES = st.lists(st.fixed_dictionaries({}, optional={
-    k: JSON_VALUES for k in ("Name", "AppMin", "AppMax", "PhyMin", "PhyMax")}), max_size=2)
+    k: PROPERTY_VALUES for k in ("Name", "AppMin", "AppMax", "PhyMin", "PhyMax")}), max_size=2)
 IMAGES = st.lists(JSON_LEAVES, max_size=3)
 
 
@@ -182,7 +188,7 @@ IMAGES = st.lists(JSON_LEAVES, max_size=3)
 def form_documents(draw: st.DrawFn) -> Any:
     def props(names: st.SearchStrategy[list[str]]) -> dict[str, Any]:
         keys = draw(names)
-        return {k: draw(JSON_VALUES) for k in keys}
+        return {k: draw(PROPERTY_VALUES) for k in keys}
 
     elements = []
     for _ in range(draw(st.integers(0, 3))):

@@ -6,9 +6,11 @@ One test, so that the wheel is built and installed once however the suite is spr
 workers (about 10 s, most of it pip). The venv sees the test venv's site-packages through a .pth
 file, so pip resolves the wheel's dependencies against what is installed there and installs our
 wheel alone (no download of PySide6 and the rest); pip leaves the test venv untouched (what it
-finds there is "outside environment"). The wheel is built by the PEP 517 backend pyproject.toml
-names, called as pip calls it, in this venv (with the test extra's setuptools) rather than in an
-isolated build environment pip would first install: the same wheel, in a quarter of the time.
+finds there is "outside environment"). The venv's own interpreter runs that pip (found through the
+same .pth), as `pip --python` would after starting a first pip only to start it there. The wheel
+is built by the PEP 517 backend pyproject.toml names, called as pip calls it, in this venv (with
+the test extra's setuptools) rather than in an isolated build environment pip would first install:
+the same wheel, in a quarter of the time.
 """
 
 from __future__ import annotations
@@ -31,8 +33,8 @@ DERIVED = shutil.ignore_patterns("__pycache__", "*.pyc", "archive", "log", "stat
                                  "*.egg-info")
 
 
-def pip(*args: str, timeout: float = 300) -> None:
-    r = subprocess.run([sys.executable, "-m", "pip", "--disable-pip-version-check", *args],
+def pip(venv: Path, *args: str, timeout: float = 300) -> None:
+    r = subprocess.run([str(venv / "bin" / "python"), "-m", "pip", "--disable-pip-version-check", *args],
                        capture_output=True, text=True, timeout=timeout)
     assert r.returncode == 0, r.stdout + r.stderr
 
@@ -90,7 +92,7 @@ def test_the_wheel_installs_netplc_station_with_the_demo_and_the_translations(tm
     assert not [n for n in names if "/archive/" in n or "/log/" in n or n.endswith("station.lock")]
 
     venv = fresh_venv(tmp_path)
-    pip("--python", str(venv / "bin" / "python"), "install", "-q", str(wheel))  # its dependencies resolved
+    pip(venv, "install", "-q", str(wheel))  # its dependencies resolved
     command = str(venv / "bin" / "netplc-station")
 
     r = run(venv, command, "--version")

@@ -1,29 +1,42 @@
 """Broken station files end as named problems (`file:line: ...`), never as tracebacks, hangs or
 an OOM: `check` exits 1 listing them, a start exits 2, and the forms that are fine still open.
-The stations here are English, as the cases name their problems (test_check.py tries ru)."""
+The stations here are English, as the cases name their problems (test_check.py tries ru). Two
+commands run as real processes (a check that exits 1, a start that exits 2); the others run in this
+process (`app.cli.main` and `netplc.cli.main`, what main.py and `python -m netplc` call,
+tests/commands.py)."""
 
 from __future__ import annotations
 
 import json
 import subprocess
 import sys
+from collections.abc import Callable
 from pathlib import Path
 
 import pytest
 
+import netplc.cli
+from app import cli
 from app.station.config import read_station
 from app.station.runtime import StartError
 from hmi_forms.form import load_forms
 from registrar.catalog import Catalog
 from tests.app.broken_stations import CASES, Broken, replace
 from tests.app.conftest import REPO, copy_demo
+from tests.commands import run_in_process
 
 NOT_CP1251 = b"\x98"  # a byte that is neither UTF-8 (alone) nor defined in cp1251
 
 
-def main(*args: object) -> subprocess.CompletedProcess[str]:
+def main_process(*args: object) -> subprocess.CompletedProcess[str]:
     return subprocess.run([sys.executable, "main.py", *map(str, args)], cwd=REPO, capture_output=True,
                           text=True, timeout=60)
+
+
+@pytest.fixture
+def main(capsys: pytest.CaptureFixture[str]) -> Callable[..., subprocess.CompletedProcess[str]]:
+    """`python main.py ARGS`, in this process."""
+    return lambda *args: run_in_process(cli.main, args, capsys)
 
 
 def append_line(path: Path, data: bytes) -> int:
@@ -64,7 +77,7 @@ def test_check_lists_every_bad_file_and_exits_1(tmp_path: Path) -> None:
     symbols_line = append_line(st / "symbols.csv", b"LONG,02000," + b"x" * 140_000)
     big_line = append_line(st / "messages.csv", f"{2**63},1,0,too big for the archive".encode())
     expected_forms = bad_forms(st / "forms")
-    r = main("check", st)
+    r = main_process("check", st)
     assert r.returncode == 1, r.stdout + r.stderr
     assert "Traceback" not in r.stderr
     out = r.stdout.splitlines()
@@ -76,7 +89,7 @@ def test_check_lists_every_bad_file_and_exits_1(tmp_path: Path) -> None:
         assert any(line.startswith(start) for line in out), (start, out)
 
 
-def test_a_station_written_in_cp1251_checks_clean(tmp_path: Path) -> None:
+def test_a_station_written_in_cp1251_checks_clean(tmp_path: Path, main) -> None:
     from app.scada.table import load_tags
 
     st = copy_demo(tmp_path / "st", "en")
@@ -93,13 +106,13 @@ def test_a_station_written_in_cp1251_checks_clean(tmp_path: Path) -> None:
 def test_a_start_with_an_unreadable_symbols_file_exits_2_naming_it(tmp_path: Path) -> None:
     st = copy_demo(tmp_path / "st", "en")
     line = append_line(st / "symbols.csv", b"BAD" + NOT_CP1251 + b",02000")
-    r = main("--no-gui", st, "--duration", "1")
+    r = main_process("--no-gui", st, "--duration", "1")
     assert r.returncode == 2, r.stdout + r.stderr
     assert "Traceback" not in r.stderr
     assert f"{st / 'symbols.csv'}:{line}:0: neither UTF-8 nor cp1251 text (byte 0x98)" in r.stderr
 
 
-def test_a_start_with_a_message_number_past_int64_exits_2_naming_the_line(tmp_path: Path) -> None:
+def test_a_start_with_a_message_number_past_int64_exits_2_naming_the_line(tmp_path: Path, main) -> None:
     st = copy_demo(tmp_path / "st", "en")
     line = append_line(st / "messages.csv", f"{2**64},1,0,too big".encode())
     r = main("--no-gui", st, "--duration", "1")
@@ -125,19 +138,19 @@ def test_a_station_file_in_cp1251_reads(tmp_path: Path) -> None:
     assert problems == [] and station is not None and station.name == "Насосная"
 
 
-def test_netplc_run_names_an_unreadable_program_or_symbols_file(tmp_path: Path) -> None:
+def test_netplc_run_names_an_unreadable_program_or_symbols_file(tmp_path: Path,
+                                                                capsys: pytest.CaptureFixture[str]) -> None:
     program = tmp_path / "p.stl"
     program.write_bytes(b"TNA $02000 ; \xcf\xf3\xf1\xea\nYON $02001\n")  # a cp1251 comment: fine
     symbols = tmp_path / "s.csv"
     symbols.write_bytes(b"A,02000\nB" + NOT_CP1251 + b",02001\n")
-    run = [sys.executable, "-m", "netplc", "run", str(program), "--set", "02000=1", "--print", "02001"]
-    r = subprocess.run(run, cwd=REPO, capture_output=True, text=True, timeout=30)
+    run = ["run", str(program), "--set", "02000=1", "--print", "02001"]
+    r = run_in_process(netplc.cli.main, run, capsys)
     assert r.returncode == 0 and r.stdout == "02001 = 1\n", r.stderr
-    r = subprocess.run([*run, "--symbols", str(symbols)], cwd=REPO, capture_output=True, text=True,
-                       timeout=30)
+    r = run_in_process(netplc.cli.main, [*run, "--symbols", str(symbols)], capsys)
     assert r.returncode == 2 and r.stderr == f"{symbols}:2:0: neither UTF-8 nor cp1251 text (byte 0x98)\n"
     program.write_bytes(b"TNA $02000\n" + NOT_CP1251 + b"\n")
-    r = subprocess.run(run, cwd=REPO, capture_output=True, text=True, timeout=30)
+    r = run_in_process(netplc.cli.main, run, capsys)
     assert r.returncode == 2 and r.stderr == f"{program}:2:0: neither UTF-8 nor cp1251 text (byte 0x98)\n"
 
 
@@ -200,7 +213,8 @@ def test_each_bad_input_is_named_by_check_and_by_the_start(tmp_path: Path, case:
     assert refused.value.problems == [p for p in report.problems if p.startswith(expected)]  # the same words
 
 
-def test_check_exits_1_naming_a_default_user_who_is_no_viewer_and_a_broken_users_file(tmp_path: Path) -> None:
+def test_check_exits_1_naming_a_default_user_who_is_no_viewer_and_a_broken_users_file(tmp_path: Path,
+                                                                                     main) -> None:
     st = copy_demo(tmp_path / "st", "en")
     replace(st / "station.toml", 'default_user = "viewer"', 'default_user = "operator"')
     r = main("check", st)

@@ -1,4 +1,6 @@
-"""`python main.py check`: every error planted in a broken copy of the demo station is reported."""
+"""`python main.py check`: every error planted in a broken copy of the demo station is reported. The
+demo's check is a real `python main.py check`; the broken copies are checked in this process
+(`app.cli.main`, what main.py runs, tests/commands.py)."""
 
 from __future__ import annotations
 
@@ -7,20 +9,25 @@ import json
 import re
 import subprocess
 import sys
+from collections.abc import Callable
 from pathlib import Path
 
 import pytest
 
+from app.cli import main
 from tests.app.conftest import DEMO, REPO, copy_demo
+from tests.commands import run_in_process
 
 
-def run_check(station: Path) -> subprocess.CompletedProcess[str]:
-    return subprocess.run([sys.executable, "main.py", "check", str(station)], cwd=REPO, capture_output=True,
-                          text=True, timeout=60)
+@pytest.fixture
+def run_check(capsys: pytest.CaptureFixture[str]) -> Callable[[Path], subprocess.CompletedProcess[str]]:
+    """`python main.py check STATION`, in this process."""
+    return lambda station: run_in_process(main, ["check", station], capsys)
 
 
 def test_the_demo_station_is_clean() -> None:
-    r = run_check(DEMO)
+    r = subprocess.run([sys.executable, "main.py", "check", str(DEMO)], cwd=REPO, capture_output=True,
+                       text=True, timeout=60)
     assert r.returncode == 0, r.stdout + r.stderr
     assert "норма: программа netplc.stl: инструкций" in r.stdout  # the demo's Language is ru
 
@@ -31,7 +38,7 @@ def plant(path: Path, old: str, new: str) -> None:
     path.write_text(text.replace(old, new, 1), encoding="utf-8")
 
 
-def test_every_planted_error_is_found(tmp_path: Path) -> None:
+def test_every_planted_error_is_found(tmp_path: Path, run_check) -> None:
     st = copy_demo(tmp_path / "broken")
     plant(st / "station.toml", "NetSyncTime = 100", 'NetSyncTime = "fast"\nColour = "red"')
     plant(st / "station.toml", "timeout = 0.5", 'timeout = 0.5\nendpoint = "tcp://plc:99999"')
@@ -94,7 +101,7 @@ def test_check_reports_exactly_what_a_start_refuses(tmp_path: Path) -> None:
 
 
 @pytest.mark.parametrize("language", ["en", "ru"])
-def test_tags_csv_problems_are_reported_by_check(tmp_path: Path, language: str) -> None:
+def test_tags_csv_problems_are_reported_by_check(tmp_path: Path, language: str, run_check) -> None:
     """In the station's language, naming the file, the line, the tag and its values as they are."""
     st = copy_demo(tmp_path / "tags", language)
     plant(st / "tags.csv", "LEVEL,LEVEL,word,%,0,4095,0,100,1,Уровень,95,90,",
@@ -268,8 +275,8 @@ def test_readers_problems_are_said_in_the_station_language(tmp_path: Path, langu
 
 
 @pytest.mark.parametrize("language", ["ru", "en"])
-def test_check_says_its_own_words_in_the_station_language_naming_file_and_line(tmp_path: Path,
-                                                                             language: str) -> None:
+def test_check_says_its_own_words_in_the_station_language_naming_file_and_line(tmp_path: Path, language: str,
+                                                                             run_check) -> None:
     """The summary, what was found good and check's own problems in the station's `Language`, each
     problem still naming its file, key and line."""
     st = copy_demo(tmp_path / "st")

@@ -1,4 +1,6 @@
-"""`python -m netplc run` through a real subprocess: output format, options and exit status 2."""
+"""`python -m netplc run`: output format, options and exit status 2. The command runs in this process
+(`netplc.cli.main`, what `python -m netplc` calls, tests/commands.py); the malformed program's run is
+a real subprocess, for the status and the streams of the process itself."""
 
 from __future__ import annotations
 
@@ -8,12 +10,25 @@ from pathlib import Path
 
 import pytest
 
+from netplc.cli import main
+from tests.commands import run_in_process
+
 COUNTER = "TNA TTC\nCTR TA N:2\nTNA TA[2]\nYON $02000\n"
 
 
-def netplc(*args: str | Path, cwd: Path) -> subprocess.CompletedProcess:
+def netplc_process(*args: str | Path, cwd: Path) -> subprocess.CompletedProcess:
     return subprocess.run([sys.executable, "-m", "netplc", *map(str, args)], cwd=cwd,
                           capture_output=True, text=True, timeout=60)
+
+
+@pytest.fixture
+def netplc(capsys: pytest.CaptureFixture[str], monkeypatch: pytest.MonkeyPatch):
+    """`python -m netplc ARGS` run in `cwd`, in this process."""
+    def run(*args: str | Path, cwd: Path) -> subprocess.CompletedProcess:
+        monkeypatch.chdir(cwd)
+        return run_in_process(main, args, capsys)
+
+    return run
 
 
 @pytest.fixture
@@ -26,7 +41,7 @@ def prog(tmp_path):
     return write
 
 
-def test_bits_words_and_bytes_are_printed(prog, tmp_path):
+def test_bits_words_and_bytes_are_printed(prog, tmp_path, netplc):
     p = prog("TNA $00000\nYON $02005\nTFA $00000\nYON $02006\n")
     r = netplc("run", p, "--set", "00000=1", "--set", "04000=0x9876", "--set", "04002=0o17",
                "--print", "02005", "--print", "02006", "--print", "04000", "--print", "04000:4",
@@ -37,7 +52,7 @@ def test_bits_words_and_bytes_are_printed(prog, tmp_path):
     assert r.stderr == ""
 
 
-def test_scans_dt_and_timed_sets_drive_a_timer(prog, tmp_path):
+def test_scans_dt_and_timed_sets_drive_a_timer(prog, tmp_path, netplc):
     p = prog("TNA $00000\nTIM $03000 N:5\n")
     base = ["run", p, "--at", "1:00000=1", "--print", "03001"]
     # scan 1 starts the timer; 5 ticks of 0.1 s later (scan 6) it is done
@@ -48,7 +63,7 @@ def test_scans_dt_and_timed_sets_drive_a_timer(prog, tmp_path):
     assert off.stdout == "03001 = 0\n"
 
 
-def test_symbols_file(prog, tmp_path):
+def test_symbols_file(prog, tmp_path, netplc):
     sym = tmp_path / "symbols.csv"
     sym.write_text("name,address,comment\nTTC,02042,input\nTA,02003,counter\n", encoding="utf-8")
     p = prog(COUNTER)
@@ -59,14 +74,14 @@ def test_symbols_file(prog, tmp_path):
     assert r.stdout == "02005 = 1\n02000 = 1\n"  # two rising edges reach N:2
 
 
-def test_halt_state_is_reported_on_stderr(prog, tmp_path):
+def test_halt_state_is_reported_on_stderr(prog, tmp_path, netplc):
     r = netplc("run", prog("HLT\n"), cwd=tmp_path)
     assert r.returncode == 0 and "state: halted" in r.stderr
 
 
 def test_malformed_program_goes_to_stderr_with_status_2(prog, tmp_path):
     p = prog("TNA $02042\nTIM $03000 N:300\nFOO\n")
-    r = netplc("run", p, cwd=tmp_path)
+    r = netplc_process("run", p, cwd=tmp_path)
     assert r.returncode == 2 and r.stdout == ""
     expected = [f"{p}:2:14: N: 300 is outside 0-255", f"{p}:3:1: unknown instruction 'FOO'"]
     assert r.stderr.splitlines() == expected
@@ -85,12 +100,12 @@ def test_malformed_program_goes_to_stderr_with_status_2(prog, tmp_path):
     (["--scans", "-1"], "expected a number of scans"),
     (["--symbols", "missing.csv"], "cannot read symbols"),
 ])
-def test_bad_options_go_to_stderr_with_status_2(prog, tmp_path, args, message):
+def test_bad_options_go_to_stderr_with_status_2(prog, tmp_path, args, message, netplc):
     r = netplc("run", prog("NOP\n"), *args, cwd=tmp_path)
     assert r.returncode == 2 and r.stdout == ""
     assert message in r.stderr
 
 
-def test_missing_program_file(tmp_path):
+def test_missing_program_file(tmp_path, netplc):
     r = netplc("run", tmp_path / "none.stl", cwd=tmp_path)
     assert r.returncode == 2 and "cannot read program" in r.stderr

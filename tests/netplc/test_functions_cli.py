@@ -1,15 +1,17 @@
 """The function tutorial of the manual is true: each `$ python -m netplc run ...`
-line in its console blocks is run as a subprocess from the repository root, and its output must be
-the one shown (a command shown twice runs once)."""
+line in its console blocks is run from the repository root, and its output must be the one shown
+(a command shown twice runs once). The command runs in this process (`netplc.cli.main`, what
+`python -m netplc` calls; tests/netplc/test_cli.py runs the module as a process too)."""
 
 from __future__ import annotations
 
 import shlex
-import subprocess
-import sys
 from pathlib import Path
 
 import pytest
+
+from netplc.cli import main
+from tests.commands import run_in_process
 
 ROOT = Path(__file__).resolve().parents[2]
 PROMPT = "$ python -m netplc run "
@@ -44,8 +46,12 @@ def test_the_tutorial_covers_the_required_examples(name: str) -> None:
 
 
 @pytest.mark.parametrize(("command", "expected"), COMMANDS, ids=[c for c, _ in COMMANDS])
-def test_tutorial_command_prints_what_the_tutorial_shows(command: str, expected: list[str]) -> None:
-    argv = [sys.executable, *shlex.split(command)[1:]]
-    done = subprocess.run(argv, cwd=ROOT, capture_output=True, text=True, timeout=60)
+def test_tutorial_command_prints_what_the_tutorial_shows(command: str, expected: list[str],
+                                                         capsys: pytest.CaptureFixture[str],
+                                                         monkeypatch: pytest.MonkeyPatch) -> None:
+    python, dash_m, module, *args = shlex.split(command)
+    assert (python, dash_m, module) == ("python", "-m", "netplc")
+    monkeypatch.chdir(ROOT)
+    done = run_in_process(main, args, capsys)
     assert (done.stdout + done.stderr).splitlines() == expected
     assert done.returncode == (2 if "bad.stl" in command else 0)

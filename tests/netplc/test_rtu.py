@@ -26,6 +26,7 @@ from netplc.modbus.rtu import RtuServer, crc16, request_length, take_frames
 from netplc.program import parse
 from netplc.scheduler import ScanThread
 from netplc.simulator import EngineMemory
+from tests.commands import run_in_process
 from tests.netplc.test_exchange import Station, wait_until
 
 UNIT = 5
@@ -33,13 +34,17 @@ REPO = Path(__file__).resolve().parents[2]
 
 
 class PtyLine:
-    """The master side of a pty as a serial line: `read` returns at a 5 ms silence."""
+    """The master side of a pty as a serial line: `read` returns at a 5 ms silence, or b"" after
+    `idle` seconds of silence (a serial port's read timeout), each counted in `silences`."""
 
-    def __init__(self, fd: int) -> None:
+    def __init__(self, fd: int, idle: float = 0.1) -> None:
         self.fd = fd
+        self.idle = idle
+        self.silences = 0
 
     def read(self, size: int) -> bytes:
-        if not select.select([self.fd], [], [], 0.1)[0]:
+        if not select.select([self.fd], [], [], self.idle)[0]:
+            self.silences += 1
             return b""
         data = os.read(self.fd, size)
         while len(data) < size and select.select([self.fd], [], [], 0.005)[0]:
@@ -190,8 +195,10 @@ class Master:
         return reply
 
 
-@pytest.fixture
-def simulated(tmp_path: Path) -> Iterator[tuple[Master, subprocess.Popen[str]]]:
+@pytest.fixture(scope="module")
+def simulated(tmp_path_factory: pytest.TempPathFactory) -> Iterator[tuple[Master, subprocess.Popen[str]]]:
+    """One `main.py simulate` process for the module's tests: each writes the words it then reads."""
+    tmp_path = tmp_path_factory.mktemp("simulated")
     (tmp_path / "node.stl").write_text(NODE)
     master, slave = os.openpty()
     serial = f"rtu://{os.ttyname(slave)}?baudrate=19200&parity=E"
@@ -329,13 +336,17 @@ def test_a_serial_port_failure_is_journaled_and_retried() -> None:
                     os.close(f)
 
 
-def test_simulate_with_a_serial_port_that_cannot_be_opened(tmp_path: Path) -> None:
+def test_simulate_with_a_serial_port_that_cannot_be_opened(tmp_path: Path,
+                                                          capsys: pytest.CaptureFixture[str]) -> None:
+    """The port that cannot be opened as a real process (its exit status); the refused endpoint in
+    this process (tests/commands.py)."""
+    from app.cli import main
+
     (tmp_path / "node.stl").write_text(NODE)
     r = subprocess.run([sys.executable, "main.py", "simulate", str(tmp_path / "node.stl"),
                         "--serial", "rtu:///dev/no-such-tty"], cwd=REPO, capture_output=True, text=True,
                        timeout=60)
     assert r.returncode == 1 and "Traceback" not in r.stderr
     assert r.stderr.startswith("simulate: cannot open /dev/no-such-tty: ")
-    r = subprocess.run([sys.executable, "main.py", "simulate", str(tmp_path / "node.stl"),
-                        "--serial", "tcp://h:502"], cwd=REPO, capture_output=True, text=True, timeout=60)
+    r = run_in_process(main, ["simulate", tmp_path / "node.stl", "--serial", "tcp://h:502"], capsys)
     assert r.returncode == 2 and "expected an rtu:// endpoint" in r.stderr
