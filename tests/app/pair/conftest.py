@@ -8,6 +8,7 @@ import struct
 import threading
 import time
 from collections.abc import Callable, Iterator
+from concurrent.futures import ThreadPoolExecutor
 from dataclasses import replace
 from pathlib import Path
 
@@ -79,6 +80,24 @@ def wait_paired(primary: Station, standby: Station) -> None:
     wait_for(lambda: primary.role == "primary" and standby.role == "standby"
              and primary.rt.pair is not None and primary.rt.pair.status().link
              and standby.rt.pair is not None and standby.rt.pair.status().link, what="the pair linked")
+
+
+def start_pair(a: Station, b: Station) -> None:
+    """A started, and B as soon as A's pair link listens: their hellos cross at once and A leads,
+    as when both start together, instead of A waiting out its start window (0.5 s) alone first.
+    B dials a link that listens, so it never leads alone beside a loaded A: a starting station
+    whose partner has connected waits for its hello."""
+    def listening() -> int:
+        return sum(t.name == "pair accept" for t in threading.enumerate())
+
+    before = listening()
+    with ThreadPoolExecutor(1, thread_name_prefix="start A") as pool:
+        started = pool.submit(a.start)
+        wait_for(lambda: started.done() or listening() > before, what="A's pair link listening")
+        try:
+            b.start()
+        finally:
+            started.result()
 
 
 class Station:

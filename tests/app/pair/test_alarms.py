@@ -17,7 +17,7 @@ from app.authority.users import Users
 from app.scada.alarms import NO_STANDBY_ID, Alarm, State
 from app.scada.horn import Horn
 from netplc.simulator import Simulator
-from tests.app.pair.conftest import Station, make_pair, serve_opcua, wait_for
+from tests.app.pair.conftest import Station, make_pair, serve_opcua, start_pair, wait_for
 from tests.app.publish.conftest import opcua_client
 from tests.app.publish.test_opcua_conditions import call, eid, subscribe, text, until
 
@@ -58,8 +58,7 @@ def raise_alarm(station: Station, alarm_id: str) -> None:
 def test_acknowledged_on_the_primary_acknowledged_on_the_new_primary(
         alarm_pair: tuple[Station, Station]) -> None:
     a, b = alarm_pair
-    a.start()
-    b.start()
+    start_pair(a, b)
     for alarm_id in BITS:
         raise_alarm(a, alarm_id)
     assert a.rt.commands is not None
@@ -133,8 +132,7 @@ def test_the_conditions_show_the_adopted_states_and_take_the_acknowledgement_aft
         return before, after, acked
 
     try:
-        a.start()
-        b.start()
+        start_pair(a, b)
         raise_alarm(a, TRIP)
         wait_for(lambda: alarm(b, TRIP).state is State.UNACK, what="B holds A's alarm")
         before, after, acked = asyncio.run(on_b())
@@ -160,8 +158,7 @@ def test_the_standby_s_horn_bit_is_the_primary_s_and_a_silence_holds_after_a_tak
     for st in (a, b):
         Users(st.folder).add("ivan", "operator", "ivan-secret")
     try:
-        a.start()
-        b.start()
+        start_pair(a, b)
         raise_alarm(a, TRIP)  # priority 2: it sounds
         wait_for(lambda: alarm(b, TRIP).state is State.UNACK, what="B holds A's alarm")
         wait_for(lambda: a.bit(horn) == 1 and b.bit(horn) == 1, what="the horn bit on both")

@@ -17,7 +17,7 @@ from app.scada.alarms import State
 from app.scada.readings import Readings
 from app.station.config import Station as StationSettings
 from netplc.simulator import Simulator
-from tests.app.pair.conftest import TICK_MS, make_pair, serve_opcua, wait_for
+from tests.app.pair.conftest import TICK_MS, make_pair, serve_opcua, start_pair, wait_for
 from tests.app.pair.test_alarms import TAGS, raise_alarm
 from tests.app.test_consoles import WAIT, qualities, shown
 
@@ -45,8 +45,7 @@ def test_a_console_follows_the_primary_through_a_switchover_and_a_kill(
     client = ConsoleClient(a_url, partner=b_url, folder=tmp_path / "config", period=0.05)
     window: ConsoleWindow | None = None
     try:
-        a.start()
-        b.start()
+        start_pair(a, b)
         wait_for(lambda: b.role == "standby", what="B the standby")
         raise_alarm(a, "TRIP.ALARM")
         client.discover().result(20)

@@ -14,7 +14,7 @@ from asyncua import Client, ua
 from app.authority.users import Users
 from app.publish.client import StationClient
 from netplc.simulator import Simulator
-from tests.app.pair.conftest import make_pair, serve_opcua, wait_for, wait_paired
+from tests.app.pair.conftest import make_pair, serve_opcua, start_pair, wait_for, wait_paired
 
 
 async def redundancy(client: Client) -> dict[str, Any]:
@@ -45,8 +45,7 @@ def test_clients_are_told_the_primary_and_a_monitor_follows_it(tmp_path: Path, n
 
     client = StationClient(a_url, partner=b_url, folder=tmp_path / "config", period=0.05)
     try:
-        a.start()
-        b.start()
+        start_pair(a, b)
         asyncio.run(told())
         client.discover().result(10)
         client.open("eng1", "eng1").result(20)
