@@ -15,6 +15,7 @@ from pathlib import Path
 import pytest
 
 from app.authority import Source, Who
+from app.authority.users import USERS_FILE, Users
 from app.station.config import Station as StationSettings
 from app.station.config import load_station
 from app.station.runtime import Runtime
@@ -158,6 +159,25 @@ class Station:
 
     def texts(self) -> list[str]:
         return [r.text for r in self.journal if r.text]
+
+
+_users: dict[tuple[tuple[str, str, str], ...], bytes] = {}
+
+
+def give_users(stations: tuple[Station, ...], *users: tuple[str, str, str]) -> None:
+    """`users` (name, role, password) in each station's users.json, as `users add` writes it and
+    an engineer copies it to the partner: hashed once per process (scrypt, 70 ms a user) and the
+    file copied, the owner's alone as Users leaves it."""
+    if users not in _users:
+        made = Users(stations[0].folder)
+        for name, role, password in users:
+            made.add(name, role, password)
+        _users[users] = made.path.read_bytes()
+    for station in stations:
+        path = station.folder / USERS_FILE
+        if not path.exists():
+            path.touch(mode=0o600)
+            path.write_bytes(_users[users])
 
 
 def serve_opcua(station: Station) -> str:

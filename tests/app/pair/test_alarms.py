@@ -13,11 +13,10 @@ import pytest
 from asyncua import Client, ua
 
 from app.authority import Source, Who
-from app.authority.users import Users
 from app.scada.alarms import NO_STANDBY_ID, Alarm, State
 from app.scada.horn import Horn
 from netplc.simulator import Simulator
-from tests.app.pair.conftest import Station, make_pair, serve_opcua, start_pair, wait_for
+from tests.app.pair.conftest import Station, give_users, make_pair, serve_opcua, start_pair, wait_for
 from tests.app.publish.conftest import opcua_client
 from tests.app.publish.test_opcua_conditions import call, eid, subscribe, text, until
 
@@ -36,10 +35,7 @@ OLGA = Who("olga", Source.CONSOLE, "test")  # an engineer: out of service is her
 @pytest.fixture
 def alarm_pair(tmp_path: Path, node: Simulator) -> Iterator[tuple[Station, Station]]:
     a, b = make_pair(tmp_path, node, top='Tags = "tags.csv"\n', files={"tags.csv": TAGS})
-    for st in (a, b):
-        users = Users(st.folder)
-        users.add("ivan", "operator", "ivan-secret")
-        users.add("olga", "engineer", "olga-secret")
+    give_users((a, b), ("ivan", "operator", "ivan-secret"), ("olga", "engineer", "olga-secret"))
     yield a, b
     for st in (b, a):
         st.stop()
@@ -155,8 +151,7 @@ def test_the_standby_s_horn_bit_is_the_primary_s_and_a_silence_holds_after_a_tak
     horn = 0o3600
     a, b = make_pair(tmp_path, node, top=f'Tags = "tags.csv"\nalarm_horn = "0{horn:o}"\n',
                      files={"tags.csv": TAGS})
-    for st in (a, b):
-        Users(st.folder).add("ivan", "operator", "ivan-secret")
+    give_users((a, b), ("ivan", "operator", "ivan-secret"))
     try:
         start_pair(a, b)
         raise_alarm(a, TRIP)  # priority 2: it sounds
