@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import contextlib
+import random
 import socket
 import struct
 import threading
@@ -60,10 +61,21 @@ arbiter = "{arbiter}"
 OPERATOR = Who("", Source.MODBUS, "test")
 
 
+EPHEMERAL = Path("/proc/sys/net/ipv4/ip_local_port_range")
+
+
 def free_port() -> int:
-    with socket.socket() as s:
-        s.bind(("127.0.0.1", 0))
-        return s.getsockname()[1]
+    """A port free now, for a station to bind later: below the range the OS hands to the local
+    ends of connections (a port of that range, free now, may be any connection's end by then:
+    "Address already in use" on a busy test run)."""
+    low = int(EPHEMERAL.read_text().split()[0]) if EPHEMERAL.exists() else 32768
+    while True:
+        with socket.socket() as s:
+            try:
+                s.bind(("127.0.0.1", random.randrange(10_000, low)))
+            except OSError:
+                continue  # a station of another test, or a service, listens there
+            return s.getsockname()[1]
 
 
 def wait_for(condition: Callable[[], object], timeout: float = 15.0, what: str = "") -> None:
