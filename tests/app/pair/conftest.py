@@ -106,7 +106,7 @@ def start_pair(a: Station, b: Station) -> None:
     before = listening()
     with ThreadPoolExecutor(1, thread_name_prefix="start A") as pool:
         started = pool.submit(a.start)
-        wait_for(lambda: started.done() or listening() > before, what="A's pair link listening")
+        wait_for(lambda: started.done() or listening() > before, timeout=60, what="A's pair link listening")
         try:
             b.start()
         finally:
