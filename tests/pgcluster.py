@@ -3,9 +3,12 @@ a data folder under /tmp, a free port on 127.0.0.1, the postmaster our own child
 PID). initdb refuses to run as root, so as root the cluster belongs to the `postgres` user the
 package creates; the reason a cluster cannot be had is what the tests are skipped with.
 
-A cluster's data folder is a copy of one initdb kept under /tmp (`_template`): initdb is 4 s of
+A cluster's data folder is a copy of one initdb kept beside it (`_template`): initdb is 4 s of
 wall time and 1.5 s of CPU, a copy a tenth of that, and each test process (an xdist worker, a
-bench) starts a cluster of its own; the copy is what initdb would have written anew.
+bench) starts a cluster of its own; the copy is what initdb would have written anew. A test
+cluster (no fsync: its data is thrown away) lives in /dev/shm where that has room: every
+CREATE DATABASE writes 15 MB (the template's blocks and their WAL), which a disk's file system
+costs as much system CPU again as the server's own, and its removal unlinks thousands of files.
 """
 
 from __future__ import annotations
@@ -31,17 +34,29 @@ def _bin(name: str) -> str | None:
     return found[0] if found else shutil.which(name)
 
 
-def _template(initdb: str, user: str | None) -> Path:
+SHM = Path("/dev/shm")
+SHM_ROOM = 2 << 30  # bytes free for a test cluster in /dev/shm (a container's may have 64 MB)
+
+
+def _base(durable: bool) -> Path:
+    """Where a cluster's folder goes: /dev/shm for a test cluster if it has room, else /tmp (a
+    durable one, a benchmark's, is on a disk as a plant archive's is)."""
+    if not durable and SHM.is_dir() and os.access(SHM, os.W_OK) and shutil.disk_usage(SHM).free > SHM_ROOM:
+        return SHM
+    return Path(tempfile.gettempdir())
+
+
+def _template(initdb: str, user: str | None, base: Path) -> Path:
     """The data folder of one initdb of this PostgreSQL's binaries for `user`, made by the first
     process that needs it (the others wait on its lock) and kept for the next runs; named by the
     binary's path and time, so that an upgraded package makes a new one."""
     stamp = int(os.stat(initdb).st_mtime)
     version = initdb.replace("/", "_").strip("_")
-    kept = Path(tempfile.gettempdir()) / f"netplc-pg-template-{user or os.geteuid()}-{version}-{stamp}"
+    kept = base / f"netplc-pg-template-{user or os.geteuid()}-{version}-{stamp}"
     with open(f"{kept}.lock", "w") as lock:
         fcntl.flock(lock, fcntl.LOCK_EX)
         if not (kept / "PG_VERSION").exists():
-            making = Path(tempfile.mkdtemp(prefix="netplc-pg-initdb-"))
+            making = Path(tempfile.mkdtemp(prefix="netplc-pg-initdb-", dir=base))
             if user:
                 shutil.chown(making, user)
             done = subprocess.run([initdb, "-D", str(making / "data"), "-U", "postgres", "--auth=trust",
@@ -77,12 +92,13 @@ class PgCluster:
             except KeyError:
                 raise RuntimeError("running as root and there is no 'postgres' user for initdb") from None
             self.user = "postgres"
-        self.folder = Path(tempfile.mkdtemp(prefix="netplc-pg-"))
+        base = _base(durable)
+        self.folder = Path(tempfile.mkdtemp(prefix="netplc-pg-", dir=base))
         if self.user:
             shutil.chown(self.folder, self.user)
         self.data = self.folder / "data"
         try:
-            template = _template(initdb, self.user)
+            template = _template(initdb, self.user, base)
         except RuntimeError:
             shutil.rmtree(self.folder, ignore_errors=True)
             raise
