@@ -430,9 +430,11 @@ class Pair:
             self._run_link(conn)
         except (OSError, LinkError, ValueError) as e:
             if paired and not self._stopping.is_set() and conn is not self._told:  # told: journaled
+                # a reset or a broken pipe is the partner's close met by a write (an ACK, a frame)
+                closed = isinstance(e, (LinkClosed, BrokenPipeError, ConnectionResetError))
                 self.runtime.say("pair link lost", logging.WARNING, letter=self.settings.letter,
                                  role=said_role(self.role), error=phrase("link closed")
-                                 if isinstance(e, LinkClosed) else e or type(e).__name__)
+                                 if closed else e or type(e).__name__)
             elif not self._stopping.is_set():
                 logger.info("pair link ended: %s", e)
         finally:

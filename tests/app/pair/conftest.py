@@ -3,17 +3,20 @@
 from __future__ import annotations
 
 import contextlib
+import random
 import socket
 import struct
 import threading
 import time
 from collections.abc import Callable, Iterator
+from concurrent.futures import ThreadPoolExecutor
 from dataclasses import replace
 from pathlib import Path
 
 import pytest
 
 from app.authority import Source, Who
+from app.authority.users import USERS_FILE, Users
 from app.station.config import Station as StationSettings
 from app.station.config import load_station
 from app.station.runtime import Runtime
@@ -58,10 +61,21 @@ arbiter = "{arbiter}"
 OPERATOR = Who("", Source.MODBUS, "test")
 
 
+EPHEMERAL = Path("/proc/sys/net/ipv4/ip_local_port_range")
+
+
 def free_port() -> int:
-    with socket.socket() as s:
-        s.bind(("127.0.0.1", 0))
-        return s.getsockname()[1]
+    """A port free now, for a station to bind later: below the range the OS hands to the local
+    ends of connections (a port of that range, free now, may be any connection's end by then:
+    "Address already in use" on a busy test run)."""
+    low = int(EPHEMERAL.read_text().split()[0]) if EPHEMERAL.exists() else 32768
+    while True:
+        with socket.socket() as s:
+            try:
+                s.bind(("127.0.0.1", random.randrange(10_000, low)))
+            except OSError:
+                continue  # a station of another test, or a service, listens there
+            return s.getsockname()[1]
 
 
 def wait_for(condition: Callable[[], object], timeout: float = 15.0, what: str = "") -> None:
@@ -79,6 +93,24 @@ def wait_paired(primary: Station, standby: Station) -> None:
     wait_for(lambda: primary.role == "primary" and standby.role == "standby"
              and primary.rt.pair is not None and primary.rt.pair.status().link
              and standby.rt.pair is not None and standby.rt.pair.status().link, what="the pair linked")
+
+
+def start_pair(a: Station, b: Station) -> None:
+    """A started, and B as soon as A's pair link listens: their hellos cross at once and A leads,
+    as when both start together, instead of A waiting out its start window (0.5 s) alone first.
+    B dials a link that listens, so it never leads alone beside a loaded A: a starting station
+    whose partner has connected waits for its hello."""
+    def listening() -> int:
+        return sum(t.name == "pair accept" for t in threading.enumerate())
+
+    before = listening()
+    with ThreadPoolExecutor(1, thread_name_prefix="start A") as pool:
+        started = pool.submit(a.start)
+        wait_for(lambda: started.done() or listening() > before, timeout=60, what="A's pair link listening")
+        try:
+            b.start()
+        finally:
+            started.result()
 
 
 class Station:
@@ -139,6 +171,25 @@ class Station:
 
     def texts(self) -> list[str]:
         return [r.text for r in self.journal if r.text]
+
+
+_users: dict[tuple[tuple[str, str, str], ...], bytes] = {}
+
+
+def give_users(stations: tuple[Station, ...], *users: tuple[str, str, str]) -> None:
+    """`users` (name, role, password) in each station's users.json, as `users add` writes it and
+    an engineer copies it to the partner: hashed once per process (scrypt, 70 ms a user) and the
+    file copied, the owner's alone as Users leaves it."""
+    if users not in _users:
+        made = Users(stations[0].folder)
+        for name, role, password in users:
+            made.add(name, role, password)
+        _users[users] = made.path.read_bytes()
+    for station in stations:
+        path = station.folder / USERS_FILE
+        if not path.exists():
+            path.touch(mode=0o600)
+            path.write_bytes(_users[users])
 
 
 def serve_opcua(station: Station) -> str:

@@ -13,11 +13,10 @@ import pytest
 from asyncua import Client, ua
 
 from app.authority import Source, Who
-from app.authority.users import Users
 from app.scada.alarms import NO_STANDBY_ID, Alarm, State
 from app.scada.horn import Horn
 from netplc.simulator import Simulator
-from tests.app.pair.conftest import Station, make_pair, serve_opcua, wait_for
+from tests.app.pair.conftest import Station, give_users, make_pair, serve_opcua, start_pair, wait_for
 from tests.app.publish.conftest import opcua_client
 from tests.app.publish.test_opcua_conditions import call, eid, subscribe, text, until
 
@@ -36,10 +35,7 @@ OLGA = Who("olga", Source.CONSOLE, "test")  # an engineer: out of service is her
 @pytest.fixture
 def alarm_pair(tmp_path: Path, node: Simulator) -> Iterator[tuple[Station, Station]]:
     a, b = make_pair(tmp_path, node, top='Tags = "tags.csv"\n', files={"tags.csv": TAGS})
-    for st in (a, b):
-        users = Users(st.folder)
-        users.add("ivan", "operator", "ivan-secret")
-        users.add("olga", "engineer", "olga-secret")
+    give_users((a, b), ("ivan", "operator", "ivan-secret"), ("olga", "engineer", "olga-secret"))
     yield a, b
     for st in (b, a):
         st.stop()
@@ -58,8 +54,7 @@ def raise_alarm(station: Station, alarm_id: str) -> None:
 def test_acknowledged_on_the_primary_acknowledged_on_the_new_primary(
         alarm_pair: tuple[Station, Station]) -> None:
     a, b = alarm_pair
-    a.start()
-    b.start()
+    start_pair(a, b)
     for alarm_id in BITS:
         raise_alarm(a, alarm_id)
     assert a.rt.commands is not None
@@ -133,8 +128,7 @@ def test_the_conditions_show_the_adopted_states_and_take_the_acknowledgement_aft
         return before, after, acked
 
     try:
-        a.start()
-        b.start()
+        start_pair(a, b)
         raise_alarm(a, TRIP)
         wait_for(lambda: alarm(b, TRIP).state is State.UNACK, what="B holds A's alarm")
         before, after, acked = asyncio.run(on_b())
@@ -157,11 +151,9 @@ def test_the_standby_s_horn_bit_is_the_primary_s_and_a_silence_holds_after_a_tak
     horn = 0o3600
     a, b = make_pair(tmp_path, node, top=f'Tags = "tags.csv"\nalarm_horn = "0{horn:o}"\n',
                      files={"tags.csv": TAGS})
-    for st in (a, b):
-        Users(st.folder).add("ivan", "operator", "ivan-secret")
+    give_users((a, b), ("ivan", "operator", "ivan-secret"))
     try:
-        a.start()
-        b.start()
+        start_pair(a, b)
         raise_alarm(a, TRIP)  # priority 2: it sounds
         wait_for(lambda: alarm(b, TRIP).state is State.UNACK, what="B holds A's alarm")
         wait_for(lambda: a.bit(horn) == 1 and b.bit(horn) == 1, what="the horn bit on both")

@@ -12,18 +12,15 @@ from pathlib import Path
 from app.station.config import load_station
 from netplc.simulator import Simulator
 from registrar.plant.lease import LEASE_CLIENT_GIVES_UP, LEASE_SERVER_DROP, Lease
-from tests.app.pair.conftest import OPERATOR, Proxy, Station, make_pair, wait_for
+from tests.app.pair.conftest import OPERATOR, Proxy, Station, make_pair, start_pair, wait_for
 
 
 def cut_pair(tmp_path: Path, node: Simulator, proxy: Proxy, arbiter: str) -> tuple[Station, Station]:
     a, b = make_pair(tmp_path, node, arbiter, b_dials=proxy.port)
     proxy.target = load_station(a.folder).redundancy.listen_address[1]  # type: ignore[union-attr]
-    a.start()
-    b.start()
+    start_pair(a, b)
     assert (a.role, b.role) == ("primary", "standby")
     proxy.cut()
-    assert b.rt.pair is not None
-    time.sleep(2 * b.rt.pair.failover)  # twice failover_after: a standby that may lead has led by now
     return a, b
 
 
@@ -31,6 +28,8 @@ def test_with_the_arbiter_exactly_one_primary_when_the_link_is_cut(
         tmp_path: Path, node: Simulator, proxy: Proxy, pg_url: str) -> None:
     a, b = cut_pair(tmp_path, node, proxy, pg_url)
     try:
+        assert b.rt.pair is not None
+        time.sleep(2 * b.rt.pair.failover)  # twice failover_after: a standby that may lead has led by now
         wait_for(lambda: any("the arbiter decides" in t for t in b.texts()), what="B asked the arbiter")
         assert (a.role, b.role) == ("primary", "standby")
         assert any("link to the partner lost (primary)" in t for t in a.texts())
@@ -64,8 +63,7 @@ def test_a_primary_that_loses_the_arbiter_and_its_partner_steps_down(
     a.adjust = lambda st: replace(st, redundancy=replace(st.redundancy, arbiter=via_proxy))  # type: ignore[arg-type]
     proxy.target = load_station(a.folder).redundancy.listen_address[1]  # type: ignore[union-attr]
     try:
-        a.start()
-        b.start()
+        start_pair(a, b)
         assert (a.role, b.role) == ("primary", "standby")
         to_arbiter.cut()
         proxy.cut()

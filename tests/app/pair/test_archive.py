@@ -20,7 +20,7 @@ from app.station.pair import query
 from netplc.simulator import Simulator
 from registrar.plant.schema import PAIR_ID_BASE
 from registrar.schema import DAY_GLOB
-from tests.app.pair.conftest import OPERATOR, TICK_MS, Proxy, Station, make_pair, wait_for
+from tests.app.pair.conftest import OPERATOR, TICK_MS, Proxy, Station, make_pair, start_pair, wait_for
 from tests.app.pair.test_alarms import BITS, TAGS, alarm
 
 TRIP = "TRIP.ALARM"
@@ -48,8 +48,7 @@ def test_the_pair_forwards_to_one_plant_archive_nothing_lost_nothing_doubled(
     a, b = make_pair(tmp_path, node, top=f'Archive = "{pg_url}"\nTags = "tags.csv"\n',
                      files={"tags.csv": TAGS})
     try:
-        a.start()
-        b.start()
+        start_pair(a, b)
         assert a.rt.engine is not None and a.rt.engine.write_bit(BITS[TRIP], 1, user="test")
         wait_for(lambda: alarm(b, TRIP).state is State.UNACK, what="the alarm on both")
         assert a.write(0o4000, 1111).ok
@@ -95,8 +94,7 @@ def held_transition(tmp_path: Path, node: Simulator, proxy: Proxy, top: str = ""
                      files={"tags.csv": DELAYED})
     proxy.target = load_station(a.folder).redundancy.listen_address[1]  # type: ignore[union-attr]
     b.adjust = lambda st: replace(st, redundancy=replace(st.redundancy, failover_after=PATIENT))
-    a.start()
-    b.start()
+    start_pair(a, b)
     assert a.rt.engine is not None and a.rt.engine.write_bit(BITS[TRIP], 1, user="test")
     wait_for(lambda: b.rt.engine is not None and b.rt.engine.snapshot.get_bit(BITS[TRIP]), what="bit on B")
     proxy.hold()
@@ -162,8 +160,7 @@ def test_a_status_query_answers_no_write_that_waits_for_the_standby(
     proxy.target = load_station(a.folder).redundancy.listen_address[1]  # type: ignore[union-attr]
     b.adjust = lambda st: replace(st, redundancy=replace(st.redundancy, failover_after=PATIENT))
     try:
-        a.start()
-        b.start()
+        start_pair(a, b)
         proxy.hold()  # A's frames lost on their way: B acknowledges nothing more
         assert a.rt.commands is not None and a.rt.pair is not None
         ticket = a.rt.commands.write_word(OPERATOR, 0o4000, 99)
@@ -192,8 +189,7 @@ def whole_pair(tmp_path: Path, node: Simulator, pg_url: str,
                      top=f'Archive = "{pg_url}"\nTags = "tags.csv"\n', files={"tags.csv": TAGS})
     if proxy is not None:
         proxy.target = load_station(a.folder).redundancy.listen_address[1]  # type: ignore[union-attr]
-    a.start()
-    b.start()
+    start_pair(a, b)
     wait_for(lambda: a.rt.pair is not None and a.rt.pair.status().link, what="the pair whole")
     return a, b
 

@@ -9,7 +9,6 @@ import json
 from dataclasses import replace
 from pathlib import Path
 
-from app.authority.users import Users
 from app.gui.console.source import StationSource
 from app.gui.console.window import ConsoleWindow
 from app.publish.console import ConsoleClient
@@ -17,7 +16,7 @@ from app.scada.alarms import State
 from app.scada.readings import Readings
 from app.station.config import Station as StationSettings
 from netplc.simulator import Simulator
-from tests.app.pair.conftest import TICK_MS, make_pair, serve_opcua, wait_for
+from tests.app.pair.conftest import TICK_MS, give_users, make_pair, serve_opcua, start_pair, wait_for
 from tests.app.pair.test_alarms import TAGS, raise_alarm
 from tests.app.test_consoles import WAIT, qualities, shown
 
@@ -40,13 +39,11 @@ def test_a_console_follows_the_primary_through_a_switchover_and_a_kill(
     for st in (a, b):  # a GUI and two endpoints in this process: the pair's silence judged less tightly
         served = st.adjust
         st.adjust = lambda settings, served=served: slower_failover(served(settings))
-    for st in (a, b):
-        Users(st.folder).add("operator", "operator", "operator")
+    give_users((a, b), ("operator", "operator", "operator"))
     client = ConsoleClient(a_url, partner=b_url, folder=tmp_path / "config", period=0.05)
     window: ConsoleWindow | None = None
     try:
-        a.start()
-        b.start()
+        start_pair(a, b)
         wait_for(lambda: b.role == "standby", what="B the standby")
         raise_alarm(a, "TRIP.ALARM")
         client.discover().result(20)

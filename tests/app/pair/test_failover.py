@@ -12,7 +12,7 @@ from app.cli import run_redundancy
 from app.station.pair import HSB_NUM_PLC, HSB_STATUS_BYTE, HSB_SWITCH
 from netplc.modbus import BUSY
 from netplc.simulator import Simulator
-from tests.app.pair.conftest import OPERATOR, Station, modbus_write, wait_for, wait_paired
+from tests.app.pair.conftest import OPERATOR, Station, modbus_write, start_pair, wait_for, wait_paired
 
 NODE_WORD = 0o4100  # where the primary's NWRITE puts the operator's word 04000 on the node
 TIMER, COUNTER = 0o3000, 0o3010
@@ -31,8 +31,7 @@ def node_word(node: Simulator) -> int:
 def test_the_standby_mirrors_and_refuses_writes_naming_the_primary(
         pair: tuple[Station, Station], node: Simulator) -> None:
     a, b = pair
-    a.start()
-    b.start()
+    start_pair(a, b)
     assert (a.role, b.role) == ("primary", "standby")
     assert a.write(0o4000, 1234).ok
     wait_for(lambda: node_word(node) == 1234, what="the primary writes the node")
@@ -49,8 +48,7 @@ def test_the_standby_mirrors_and_refuses_writes_naming_the_primary(
 def test_kill_the_primary_the_standby_takes_over_and_the_old_one_comes_back_as_standby(
         pair: tuple[Station, Station], node: Simulator) -> None:
     a, b = pair
-    a.start()
-    b.start()
+    start_pair(a, b)
     assert a.write(0o4000, 1111).ok
     assert a.rt.engine is not None and b.rt.engine is not None
     wait_for(lambda: b.word(0o4000) == 1111 and b.rt.engine.tim_ticks[TIMER] > 2, what="mirrored")
@@ -75,8 +73,7 @@ def test_kill_the_primary_the_standby_takes_over_and_the_old_one_comes_back_as_s
 def test_into_standby_switches_over_and_back_with_nothing_lost(
         pair: tuple[Station, Station], node: Simulator) -> None:
     a, b = pair
-    a.start()
-    b.start()
+    start_pair(a, b)
     wait_paired(a, b)
     assert a.write(0o4000, 1).ok
     assert a.rt.commands is not None
@@ -99,8 +96,7 @@ def test_into_standby_switches_over_and_back_with_nothing_lost(
 def test_the_hsb_status_words_and_redundancy_status(pair: tuple[Station, Station], node: Simulator,
                                                     capsys: pytest.CaptureFixture[str]) -> None:
     a, b = pair
-    a.start()
-    b.start()
+    start_pair(a, b)
     wait_for(lambda: (byte(a, HSB_NUM_PLC), byte(a, HSB_STATUS_BYTE)) == (1, 5)
              and (byte(b, HSB_NUM_PLC), byte(b, HSB_STATUS_BYTE)) == (0, 4), what="HSBNumPLC, HSBStatus")
     assert b.rt.pair is not None

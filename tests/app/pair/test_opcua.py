@@ -11,10 +11,9 @@ from typing import Any
 
 from asyncua import Client, ua
 
-from app.authority.users import Users
 from app.publish.client import StationClient
 from netplc.simulator import Simulator
-from tests.app.pair.conftest import make_pair, serve_opcua, wait_for, wait_paired
+from tests.app.pair.conftest import give_users, make_pair, serve_opcua, start_pair, wait_for, wait_paired
 
 
 async def redundancy(client: Client) -> dict[str, Any]:
@@ -30,8 +29,7 @@ async def redundancy(client: Client) -> dict[str, Any]:
 def test_clients_are_told_the_primary_and_a_monitor_follows_it(tmp_path: Path, node: Simulator) -> None:
     a, b = make_pair(tmp_path, node)
     a_url, b_url = serve_opcua(a), serve_opcua(b)
-    for st in (a, b):
-        Users(st.folder).add("eng1", "engineer", "eng1")
+    give_users((a, b), ("eng1", "engineer", "eng1"))
 
     async def told() -> None:
         async with Client(a_url) as on_a, Client(b_url) as on_b:
@@ -45,8 +43,7 @@ def test_clients_are_told_the_primary_and_a_monitor_follows_it(tmp_path: Path, n
 
     client = StationClient(a_url, partner=b_url, folder=tmp_path / "config", period=0.05)
     try:
-        a.start()
-        b.start()
+        start_pair(a, b)
         asyncio.run(told())
         client.discover().result(10)
         client.open("eng1", "eng1").result(20)

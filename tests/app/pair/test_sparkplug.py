@@ -8,7 +8,7 @@ from __future__ import annotations
 from pathlib import Path
 
 from netplc.simulator import Simulator
-from tests.app.pair.conftest import make_pair, wait_for
+from tests.app.pair.conftest import make_pair, start_pair, wait_for
 from tests.app.publish.conftest import Host, Mosquitto, metric
 from tests.app.publish.conftest import mosquitto as mosquitto  # the fixture, a broker of the test's
 
@@ -23,8 +23,7 @@ def test_one_edge_node_for_the_pair(tmp_path: Path, node: Simulator, mosquitto: 
     host = Host(mosquitto, group="Pair", edge="Boiler")
     a, b = make_pair(tmp_path, node, top=MQTT.format(url=mosquitto.url))
     try:
-        a.start()
-        b.start()
+        start_pair(a, b)
         first = bdseq(host.wait("NBIRTH"))
         assert b.rt.pair is not None and b.role == "standby"
         wait_for(lambda: b.rt.pair is not None and b.rt.pair.mirror.complete, timeout=10,
