@@ -4,7 +4,9 @@ a real station over a loopback Modbus port: it watches, and is read-only (Modbus
 
 from __future__ import annotations
 
+import functools
 import socket
+import tempfile
 import time
 from pathlib import Path
 
@@ -14,7 +16,7 @@ from PySide6.QtWidgets import QApplication, QMenu
 
 from app.authority import Source as Seat
 from app.authority import Who
-from app.authority.users import Users
+from app.authority.users import USERS_FILE, Users
 from app.gui.monitor.listing import Listing, fmt_value, parse_value, parse_watch
 from app.gui.monitor.source import READ_ONLY, LocalSource, RemoteSource
 from app.gui.monitor.view import ON, ProgramMonitor, parse_force
@@ -44,14 +46,21 @@ end: NOP
 SYMBOLS = "name,address,comment\nPUMP,02000,pump\nLEVEL,04000,level\n"
 
 
+@functools.cache
+def users_json() -> str:
+    """users.json of eng1 engineer, olga operator and vera viewer (each password the name), made
+    once per process: each user is an scrypt hash, the same in every station of the tests."""
+    with tempfile.TemporaryDirectory() as folder:
+        users = Users(Path(folder))
+        for name, role in (("eng1", "engineer"), ("olga", "operator"), ("vera", "viewer")):
+            users.add(name, role, name)
+        return users.path.read_text(encoding="utf-8")
+
+
 def station(folder: Path, port: int = 0) -> Path:
     toml = (f'NetPlcProgram = "p.stl"\nSymbols = "s.csv"\nNetSyncTime = 20\n'
             f'[modbus_server]\nport = {port}\nwritable = [["00000", "02177"], ["04000", "04777"]]\n')
-    write_station(folder, toml, {"p.stl": PROGRAM, "s.csv": SYMBOLS})
-    users = Users(folder)
-    for name, role in (("eng1", "engineer"), ("olga", "operator"), ("vera", "viewer")):
-        users.add(name, role, name)
-    return folder
+    return write_station(folder, toml, {"p.stl": PROGRAM, "s.csv": SYMBOLS, USERS_FILE: users_json()})
 
 
 @pytest.fixture
@@ -399,19 +408,14 @@ def test_station_menu_opens_the_program_view_and_the_status_bar_counts_forces(qt
     assert not opened[0].isVisible()
 
 
-def test_main_monitor_command_refuses_a_bad_target_with_a_message() -> None:
-    import os
-    import subprocess
-    import sys
+def test_main_monitor_command_refuses_a_bad_target_with_a_message(qtbot, capsys) -> None:
+    """`main.py monitor nowhere`, as the command's own function in this process."""
+    from app.cli import main
 
-    from tests.app.conftest import REPO
-
-    env = {**os.environ, "QT_QPA_PLATFORM": "offscreen"}
-    r = subprocess.run([sys.executable, "main.py", "monitor", "nowhere"], cwd=REPO, capture_output=True,
-                       text=True, timeout=60, env=env)
-    assert r.returncode == 2
-    assert "nowhere: neither an opc.tcp:// URL, a station folder nor HOST:PORT" in r.stderr
-    assert "Traceback" not in r.stderr
+    assert main(["monitor", "nowhere"]) == 2
+    err = capsys.readouterr().err
+    assert "nowhere: neither an opc.tcp:// URL, a station folder nor HOST:PORT" in err
+    assert "Traceback" not in err
 
 
 def test_the_watch_table_forces_a_tag_in_physical_units(qtbot, tmp_path: Path) -> None:
