@@ -128,7 +128,8 @@ Attach = Callable[[Station, str], ConsoleWindow]
 
 def reset(window: ConsoleWindow) -> None:
     """What a test left on a console that the next one could mistake for its own: the message said,
-    the answers given for the operator, the windows and faceplates opened, the form shown."""
+    the answers given for the operator, the windows and faceplates opened, the form shown; hidden
+    (nothing painted) until a test attaches it again."""
     window.status.clearMessage()
     vars(window).pop("ask", None)
     if window.faceplates is not None:
@@ -138,6 +139,7 @@ def reset(window: ConsoleWindow) -> None:
     window.programs.clear()
     window.windows.clear()
     window.tabs.setCurrentIndex(0)
+    window.hide()
 
 
 @pytest.fixture
@@ -158,7 +160,7 @@ def attach(qtbot) -> Iterator[Attach]:
                 client.close()
                 raise
             window = station.consoles[user] = ConsoleWindow(StationSource(client))
-            window.show()
+        window.show()
         used.append(window)
         qtbot.waitUntil(lambda: bool(window.views) and window.views[0].form is not None, timeout=WAIT)
         return window
