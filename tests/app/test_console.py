@@ -23,6 +23,7 @@ from netplc.address import fmt_octal
 from netplc.records import Record
 from registrar.query import Archive
 from tests.app.conftest import copy_demo
+from tests.cheap_users import cheap_demo_users
 
 LEVEL = 0o4010
 START_BIT = 0o40042
@@ -32,8 +33,10 @@ BROKEN = ('{"form": {"title": "broken", "width": 100, "height": 100}, "elements"
 
 @pytest.fixture
 def console(qtbot, tmp_path: Path) -> Iterator[MainWindow]:
-    """The demo's console in English: its tests read the journal word for word."""
+    """The demo's console in English: its tests read the journal word for word; its users at the
+    tests' cheap scrypt cost (tests/cheap_users.py)."""
     demo_copy = copy_demo(tmp_path / "station", "en")
+    cheap_demo_users(demo_copy)
     (demo_copy / "forms" / "99_broken.hmi").write_text(BROKEN, encoding="utf-8")
     runtime = Runtime(load_station(demo_copy))
     runtime.start()

@@ -4,9 +4,7 @@ a real station over a loopback Modbus port: it watches, and is read-only (Modbus
 
 from __future__ import annotations
 
-import functools
 import socket
-import tempfile
 import time
 from pathlib import Path
 
@@ -16,7 +14,7 @@ from PySide6.QtWidgets import QApplication, QMenu
 
 from app.authority import Source as Seat
 from app.authority import Who
-from app.authority.users import USERS_FILE, Users
+from app.authority.users import Users
 from app.gui.monitor.listing import Listing, fmt_value, parse_value, parse_watch
 from app.gui.monitor.source import READ_ONLY, LocalSource, RemoteSource
 from app.gui.monitor.view import ON, ProgramMonitor, parse_force
@@ -28,6 +26,7 @@ from netplc.problems import Problems
 from netplc.program import parse
 from netplc.records import Record
 from tests.app.conftest import write_station
+from tests.cheap_users import CHEAP, cheap_demo_users
 
 PROGRAM = """; the monitor's test program
 TNA $00000
@@ -46,21 +45,16 @@ end: NOP
 SYMBOLS = "name,address,comment\nPUMP,02000,pump\nLEVEL,04000,level\n"
 
 
-@functools.cache
-def users_json() -> str:
-    """users.json of eng1 engineer, olga operator and vera viewer (each password the name), made
-    once per process: each user is an scrypt hash, the same in every station of the tests."""
-    with tempfile.TemporaryDirectory() as folder:
-        users = Users(Path(folder))
-        for name, role in (("eng1", "engineer"), ("olga", "operator"), ("vera", "viewer")):
-            users.add(name, role, name)
-        return users.path.read_text(encoding="utf-8")
-
-
 def station(folder: Path, port: int = 0) -> Path:
+    """Users eng1 engineer, olga operator and vera viewer (each password the name), at the tests'
+    cheap scrypt cost (tests/cheap_users.py)."""
     toml = (f'NetPlcProgram = "p.stl"\nSymbols = "s.csv"\nNetSyncTime = 20\n'
             f'[modbus_server]\nport = {port}\nwritable = [["00000", "02177"], ["04000", "04777"]]\n')
-    return write_station(folder, toml, {"p.stl": PROGRAM, "s.csv": SYMBOLS, USERS_FILE: users_json()})
+    write_station(folder, toml, {"p.stl": PROGRAM, "s.csv": SYMBOLS})
+    users = Users(folder)
+    for name, role in (("eng1", "engineer"), ("olga", "operator"), ("vera", "viewer")):
+        users.add(name, role, name, CHEAP)
+    return folder
 
 
 @pytest.fixture
@@ -380,6 +374,7 @@ def test_station_menu_opens_the_program_view_and_the_status_bar_counts_forces(qt
     from app.gui.main_window import MainWindow
     from app.gui.monitor.window import ProgramWindow
 
+    cheap_demo_users(demo_copy)
     runtime = Runtime(load_station(demo_copy))
     runtime.start()
     window = MainWindow(runtime)
