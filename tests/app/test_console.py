@@ -20,8 +20,10 @@ from app.station.config import load_station
 from app.station.runtime import Runtime
 from hmi_forms.elements import formats
 from netplc.address import fmt_octal
+from netplc.records import Record
 from registrar.query import Archive
 from tests.app.conftest import copy_demo
+from tests.cheap_users import cheap_demo_users
 
 LEVEL = 0o4010
 START_BIT = 0o40042
@@ -31,8 +33,10 @@ BROKEN = ('{"form": {"title": "broken", "width": 100, "height": 100}, "elements"
 
 @pytest.fixture
 def console(qtbot, tmp_path: Path) -> Iterator[MainWindow]:
-    """The demo's console in English: its tests read the journal word for word."""
+    """The demo's console in English: its tests read the journal word for word; its users at the
+    tests' cheap scrypt cost (tests/cheap_users.py)."""
     demo_copy = copy_demo(tmp_path / "station", "en")
+    cheap_demo_users(demo_copy)
     (demo_copy / "forms" / "99_broken.hmi").write_text(BROKEN, encoding="utf-8")
     runtime = Runtime(load_station(demo_copy))
     runtime.start()
@@ -72,6 +76,15 @@ def test_the_forms_stay_put_when_an_alarm_comes(qtbot, console: MainWindow) -> N
     console.alarms.acknowledge_all()
     qtbot.wait(50)
     assert console.tabs.mapTo(console, console.tabs.rect().topLeft()) == top
+
+
+def scans_later(qtbot, runtime: Runtime, scans: int = 2) -> None:
+    """Back once the engine has run `scans` more scans: a command queued before is applied at the
+    start of the next scan, so whatever was sent by then shows in the snapshot now."""
+    engine = runtime.engine
+    assert engine is not None
+    start = engine.scan_counter
+    qtbot.waitUntil(lambda: engine.scan_counter >= start + scans, timeout=5000)
 
 
 def element(window: MainWindow, name: str):
@@ -117,7 +130,7 @@ def test_the_demo_opens_as_its_viewer_who_may_not_act(qtbot, console: MainWindow
     ok, why = setpoint.submit("50")
     assert not ok and why == "Уставка температуры: needs the operator role; viewer is viewer"
     assert not console.alarms.ack.isEnabled() and "needs the operator role" in console.alarms.ack.toolTip()
-    qtbot.wait(300)
+    scans_later(qtbot, console.runtime)
     assert engine.snapshot.get_hmi_bit(START_BIT) == 0
 
 
@@ -137,7 +150,7 @@ def test_run_stop_and_quit_need_the_engineer_and_ask(qtbot, console: MainWindow)
     assert console.stop_program() is None and console.request_quit() is None  # answered no
     assert console.isVisible()
     assert [q.split(":")[0] for q in no.asked] == ["Stop NetPlc", "Quit"]
-    qtbot.wait(300)
+    scans_later(qtbot, runtime)
     assert runtime.status().state == "running"  # both answered no
     console.ask = Answers(True)
     console.stop_program()
@@ -174,7 +187,7 @@ def test_an_element_asks_when_the_form_says_confirm_and_checks_its_role(qtbot, c
     console.ask = no = Answers(False)
     assert model.click() is False
     assert no.asked == ["Confirm: Пуск \u2192 Пуск (1)?"]  # the state in the element's words
-    qtbot.wait(300)
+    scans_later(qtbot, console.runtime)
     assert engine.snapshot.get_hmi_bit(START_BIT) == 0
     console.ask = Answers(True)
     qtbot.mouseClick(button, Qt.MouseButton.LeftButton)
@@ -281,11 +294,14 @@ def level_samples(archive: Path) -> int:
 
 def test_a_trend_starts_with_the_archives_history(qtbot, demo_copy: Path) -> None:
     first = Runtime(load_station(demo_copy))
+    stored: list[Record] = []  # the level's samples as the station archives them
+    first.subscribe(lambda r: stored.append(r) if r.kind == "data" and r.source == fmt_octal(LEVEL) else None)
     first.start()
     try:
-        qtbot.waitUntil(lambda: level_samples(first.station.Archive) > 1, timeout=15_000)
+        qtbot.waitUntil(lambda: len(stored) > 1, timeout=15_000)
     finally:
-        first.stop()
+        first.stop()  # the archive written to the last record
+    assert level_samples(first.station.Archive) > 1
     runtime = Runtime(load_station(demo_copy))
     runtime.start()
     window = MainWindow(runtime)

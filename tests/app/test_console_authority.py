@@ -16,7 +16,7 @@ from app.gui.monitor.view import ProgramMonitor
 from app.scada.alarms import STOPPED_ID, State
 from app.station.runtime import Runtime
 from tests.app import test_console
-from tests.app.test_console import Answers, element, operator_rows
+from tests.app.test_console import Answers, element, operator_rows, scans_later
 
 console = test_console.console  # the fixture: the demo station's console, started, viewer on duty
 START_BIT = 0o40042
@@ -66,7 +66,7 @@ def test_a_viewer_is_refused_everything_once_per_cause_and_sees_it_greyed(qtbot,
                                                "viewer is viewer")
     assert monitor.message.text() == "Refused: force 02120: needs the engineer role; viewer is viewer"
     assert console.ask.asked == []  # nothing refused is asked first
-    qtbot.wait(300)
+    scans_later(qtbot, runtime)
     assert runtime.engine is not None and runtime.engine.snapshot.get_hmi_bit(START_BIT) == 0
     assert runtime.status().forced == 0 and runtime.status().state == "running"
     runtime.stop()
@@ -100,7 +100,7 @@ def test_an_operator_acknowledges_and_writes_but_does_not_force(qtbot, console: 
     assert greyed(monitor.unforce_button, "engineer")
     monitor.force("bit", FORCED_BIT, 1)
     assert monitor.message.text() == "Refused: force 02120: needs the engineer role; operator is operator"
-    qtbot.wait(300)
+    scans_later(qtbot, runtime)
     assert runtime.status().forced == 0
     runtime.stop()
     rows = operator_rows(runtime)

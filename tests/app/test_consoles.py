@@ -6,6 +6,7 @@ console does is the station's command as its user; what it shows is the station'
 from __future__ import annotations
 
 import datetime as dt
+import gc
 import json
 import math
 import subprocess
@@ -47,18 +48,27 @@ ANALOG = 1  # the demo's analog form (02_analog.hmi), the second tab
 
 class Station:
     """The demo station serving OPC UA on loopback (users viewer, operator, engineer: their password
-    their name), restartable on the same port."""
+    their name), restartable on the same port; the consoles attached to it, one per user."""
 
     def __init__(self, folder: Path) -> None:
         self.port = free_port()
         self.url = f"opc.tcp://127.0.0.1:{self.port}/netplc/"
         self.folder = folder / "st"
         self.records: list[Record] = []
+        self.consoles: dict[str, ConsoleWindow] = {}
         self.runtime = demo_with(self.folder, f'[opcua]\nenabled = true\nendpoint = "{self.url}"\n',
                                  self.records)
 
     def stop(self) -> None:
         self.runtime.stop()
+
+    def close_consoles(self) -> None:
+        """Log the consoles out and close them, on the GUI thread (app/gui/application.py)."""
+        for window in self.consoles.values():
+            window.close()
+            window.deleteLater()
+        self.consoles.clear()
+        gc.collect()
 
     def restart(self) -> None:
         self.runtime = Runtime(load_station(self.folder))
@@ -68,48 +78,98 @@ class Station:
 
 @contextmanager
 def serving(folder: Path) -> Iterator[Station]:
-    """The station of `folder` (the demo copied to `folder/st`, unless there already) while in it."""
+    """The station of `folder` (the demo copied to `folder/st`, unless there already) while in it;
+    its consoles closed at the end."""
     st = Station(folder)
     try:
         yield st
     finally:
+        st.close_consoles()
         st.stop()
 
 
 @pytest.fixture(scope="module")
-def station(tmp_path_factory: pytest.TempPathFactory) -> Iterator[Station]:
-    with serving(tmp_path_factory.mktemp("consoles")) as st:
-        yield st
+def served(tmp_path_factory: pytest.TempPathFactory) -> Iterator[tuple[Station, list[float]]]:
+    """The module's station, its archive holding LEVEL's NSTORE series of the minute before it
+    started: raw words 0, 40, 80, ... (0 %, ~1 %, ~2 % ...), one a gap; and in that minute two
+    messages, an alarm ("Насос 2 остановлен", type 2) and an info one (type 0), and an operator's
+    record. The other tests look at neither."""
+    folder = tmp_path_factory.mktemp("consoles")
+    station = copy_demo(folder / "st")
+    t = time.time()
+    store = Store(station / "archive" / "journal.sqlite")
+    store.start()
+    times = [t - 60 + 0.5 * k for k in range(100)]
+    journal = {10: Record(times[10], "message", grp=1, type=2, number=901, text="Насос 2 остановлен"),
+               20: Record(times[20], "message", grp=1, type=0, number=902, text="Насос 2 в работе"),
+               30: Record(times[30], "operator", source="olga@10.0.0.21", text="write Уставка: 1 -> 2")}
+    for k, ts in enumerate(times):  # in time order, as a station writes
+        store.put(Record(ts, "data", grp=1, type=1, source="04010", value=None if k == 50 else 40 * k,
+                         text="comm-fail" if k == 50 else None))
+        if k in journal:
+            store.put(journal[k])
+    store.close()
+    with serving(folder) as st:
+        yield st, times
+
+
+@pytest.fixture(scope="module")
+def station(served: tuple[Station, list[float]]) -> Station:
+    return served[0]
+
+
+@pytest.fixture(scope="module")
+def archived(served: tuple[Station, list[float]]) -> tuple[Station, list[float]]:
+    return served
 
 
 Attach = Callable[[Station, str], ConsoleWindow]
 
 
+def reset(window: ConsoleWindow) -> None:
+    """What a test left on a console that the next one could mistake for its own: the message said,
+    the answers given for the operator, the windows and faceplates opened, the form shown; hidden
+    (nothing painted) until a test attaches it again."""
+    window.status.clearMessage()
+    vars(window).pop("ask", None)
+    if window.faceplates is not None:
+        window.faceplates.close()
+    for opened in (*window.programs, *window.windows):
+        opened.close()
+    window.programs.clear()
+    window.windows.clear()
+    window.tabs.setCurrentIndex(0)
+    window.hide()
+
+
 @pytest.fixture
-def attach(qtbot, tmp_path: Path) -> Iterator[Attach]:
-    """Consoles logged in as users of a station, each with its own config folder; closed after."""
-    windows: list[ConsoleWindow] = []
+def attach(qtbot) -> Iterator[Attach]:
+    """Consoles logged in as users of a station, each with its own config folder: one per user,
+    logged in by the first test that asks for it and kept for the module's others (a login is a
+    session, its subscriptions and the station's files read), each test leaving it `reset`."""
+    used: list[ConsoleWindow] = []
 
     def open_(station: Station, user: str) -> ConsoleWindow:
-        client = ConsoleClient(station.url, folder=tmp_path / user, period=0.05)
-        try:
-            client.discover().result(20)
-            client.open(user, user).result(30)
-        except Exception:
-            client.close()
-            raise
-        window = ConsoleWindow(StationSource(client))
-        windows.append(window)
+        window = station.consoles.get(user)
+        if window is None:
+            client = ConsoleClient(station.url, folder=station.folder.parent / "consoles" / user, period=0.05)
+            try:
+                client.discover().result(20)
+                client.open(user, user).result(30)
+            except Exception:
+                client.close()
+                raise
+            window = station.consoles[user] = ConsoleWindow(StationSource(client))
         window.show()
+        used.append(window)
         qtbot.waitUntil(lambda: bool(window.views) and window.views[0].form is not None, timeout=WAIT)
         return window
 
     try:
         yield open_
     finally:
-        for window in windows:
-            window.close()
-            window.deleteLater()
+        for window in used:
+            reset(window)
 
 
 def qualities(window: ConsoleWindow, views: list[FormView] | None = None) -> set[str]:
@@ -124,10 +184,16 @@ def shown(window: ConsoleWindow) -> dict[str, State]:
     return {r.id: r.state for r in window.source.client.alarms if r.state is not State.NORMAL}
 
 
-def readings_of(window: ConsoleWindow) -> list[Readings]:
+@contextmanager
+def readings_of(window: ConsoleWindow) -> Iterator[list[Readings]]:
+    """The readings the console takes while in it."""
     seen: list[Readings] = []
-    window.source.readings.connect(seen.append)
-    return seen
+    slot = seen.append
+    window.source.readings.connect(slot)
+    try:
+        yield seen
+    finally:
+        window.source.readings.disconnect(slot)
 
 
 def test_an_acknowledge_shows_on_the_other_console_and_in_the_journal_a_viewer_is_refused_by_role(
@@ -172,12 +238,12 @@ def test_a_setpoint_written_on_one_console_shows_on_the_other(
         qtbot, station: Station, attach: Attach) -> None:
     writer, watcher = attach(station, "operator"), attach(station, "viewer")
     watcher.tabs.setCurrentIndex(ANALOG)  # the form that shows the setpoint: the console watches it
-    seen = readings_of(watcher)
     address = station.runtime.symbols["SETPOINT"]
     raw = 1234 if station.runtime.readings().tag("TEMP_SP").raw != 1234 else 2345
-    assert writer.target.write_word(address, raw, user="operator", label="Уставка") is None  # sent
-    qtbot.waitUntil(lambda: bool(seen) and seen[-1].tag("TEMP_SP").raw == raw and
-                    watcher.source.covered.covers(watcher.reads[ANALOG]), timeout=WAIT)
+    with readings_of(watcher) as seen:
+        assert writer.target.write_word(address, raw, user="operator", label="Уставка") is None  # sent
+        qtbot.waitUntil(lambda: bool(seen) and seen[-1].tag("TEMP_SP").raw == raw and
+                        watcher.source.covered.covers(watcher.reads[ANALOG]), timeout=WAIT)
     written = [r for r in station.records if r.kind == "operator" and "TEMP_SP" in (r.text or "")]
     assert written and (written[-1].source or "").startswith("opcua:operator@")
     watcher.target.write_word(address, 7, user="viewer", label="Уставка")  # refused by the station
@@ -190,9 +256,12 @@ def test_a_setpoint_written_on_one_console_shows_on_the_other(
     program.close()
     assert writer.client.error == "" and writer.client.snapshot is not None  # its session goes on
     element = next(m for v in writer.views for m in v.form.elements if isinstance(m, Writer))
-    element.Confirm = True  # a command that cannot be taken back: the console asks first
+    confirm, element.Confirm = element.Confirm, True  # a command that cannot be taken back: asked first
     writer.ask = lambda title, text: False
-    assert element.refused("Уставка = 100") == "cancelled"
+    try:
+        assert element.refused("Уставка = 100") == "cancelled"
+    finally:
+        element.Confirm = confirm
 
 
 def watched(station: Station, window: ConsoleWindow) -> Ranges:
@@ -295,53 +364,10 @@ def test_a_silence_the_station_took_stops_the_consoles_sound_at_once(
         node.write_word(0o4010, 0)
 
 
-def test_a_console_shows_the_station_unreachable_and_reconnects_by_itself(
-        qtbot, station: Station, attach: Attach) -> None:
-    """Last of the module: it stops the station, and leaves it restarted."""
-    console = attach(station, "operator")
-    qtbot.waitUntil(lambda: qualities(console) == {""}, timeout=WAIT)
-    station.stop()
-    qtbot.waitUntil(lambda: qualities(console) == {Quality.UNREACHABLE.word}, timeout=WAIT)
-    assert console.health.isVisible() and "station unreachable" in console.health.problems[0]
-    station.restart()
-    shown_view = console.views[console.tabs.currentIndex()]  # refreshed while shown; others once shown
-    qtbot.waitUntil(lambda: qualities(console, [shown_view]) == {""} and not console.client.error,
-                    timeout=WAIT)
-    assert not console.health.isVisible()
-    console.tabs.setCurrentIndex(ANALOG)
-    qtbot.waitUntil(lambda: qualities(console, [console.views[ANALOG]]) == {""}, timeout=WAIT)
-    qtbot.waitUntil(lambda: shown(console) == {r.id: r.state for r in station.runtime.alarms.summary},
-                    timeout=WAIT)  # the station's alarms as they are now
-
-
 def test_the_console_command_wants_an_opc_tcp_url() -> None:
     run = subprocess.run([sys.executable, str(REPO / "main.py"), "console", "http://10.0.0.10/"],
                          capture_output=True, text=True, timeout=60, cwd=REPO)
     assert run.returncode == 2 and run.stderr == "http://10.0.0.10/: not an opc.tcp:// URL\n"
-
-
-@pytest.fixture(scope="module")
-def archived(tmp_path_factory: pytest.TempPathFactory) -> Iterator[tuple[Station, list[float]]]:
-    """A station whose archive holds LEVEL's NSTORE series of the minute before it started: raw
-    words 0, 40, 80, ... (0 %, ~1 %, ~2 % ...), one a gap; and in that minute two messages, an
-    alarm ("Насос 2 остановлен", type 2) and an info one (type 0), and an operator's record."""
-    folder = tmp_path_factory.mktemp("archived")
-    station = copy_demo(folder / "st")
-    t = time.time()
-    store = Store(station / "archive" / "journal.sqlite")
-    store.start()
-    times = [t - 60 + 0.5 * k for k in range(100)]
-    journal = {10: Record(times[10], "message", grp=1, type=2, number=901, text="Насос 2 остановлен"),
-               20: Record(times[20], "message", grp=1, type=0, number=902, text="Насос 2 в работе"),
-               30: Record(times[30], "operator", source="olga@10.0.0.21", text="write Уставка: 1 -> 2")}
-    for k, ts in enumerate(times):  # in time order, as a station writes
-        store.put(Record(ts, "data", grp=1, type=1, source="04010", value=None if k == 50 else 40 * k,
-                         text="comm-fail" if k == 50 else None))
-        if k in journal:
-            store.put(journal[k])
-    store.close()
-    with serving(folder) as st:
-        yield st, times
 
 
 def test_a_consoles_trend_shows_the_stations_archived_values_of_a_stored_tag(
@@ -412,8 +438,13 @@ def test_the_consoles_viewer_queries_the_stations_journal_and_series(
         qtbot.waitUntil(lambda: viewer.paging is None, timeout=WAIT)
         return [r.text or "" for r in viewer.model.rows]
 
+    def between(first: float, last: float) -> None:
+        for edit, ts in ((viewer.since, first), (viewer.until, last)):
+            edit.setTime(QTime.fromString(dt.datetime.fromtimestamp(ts).strftime("%H:%M:%S"), "HH:mm:ss"))
+
     assert {"Насос 2 остановлен", "Насос 2 в работе", "write Уставка: 1 -> 2"} <= set(texts())
     assert not viewer.group.isEnabled()  # a message's group is not in its event
+    between(times[0] - 1, times[-1] + 1)  # the archived minute: the station's own records came after it
     viewer.text.setText("НАСОС")  # contains, in the spellings the local archive tries: by the station
     viewer.apply_filter()
     assert texts() == ["Насос 2 остановлен", "Насос 2 в работе"]
@@ -426,13 +457,11 @@ def test_the_consoles_viewer_queries_the_stations_journal_and_series(
     viewer.apply_filter()
     assert texts() == ["write Уставка: 1 -> 2"]
     viewer.kind.setCurrentText("all")
-    for edit, k in ((viewer.since, 15), (viewer.until, 40)):
-        edit.setTime(QTime.fromString(dt.datetime.fromtimestamp(times[k]).strftime("%H:%M:%S"), "HH:mm:ss"))
+    between(times[15], times[40])
     viewer.apply_filter()
     assert "Насос 2 остановлен" not in texts() and "Насос 2 в работе" in texts()
     assert viewer.export_csv(tmp_path / "journal.csv") == len(texts())
-    viewer.since.setTime(QTime(0, 0))
-    viewer.until.setTime(viewer.until.maximumTime())
+    between(times[0] - 1, times[-1] + 1)
     labels = [viewer.series_list.item(i).text() for i in range(viewer.series_list.count())]
     level = next(i for i, label in enumerate(labels) if label.startswith("LEVEL"))
     assert labels[level] == "LEVEL Уровень, % (04010)"
@@ -441,3 +470,22 @@ def test_the_consoles_viewer_queries_the_stations_journal_and_series(
     xs, ys = next(iter(viewer.curves.values())).getData()
     assert len(xs) >= 100 and np.nanmax(ys) == pytest.approx(40 * 99 * 100 / 4095, abs=0.01)
     assert np.isnan(ys).any()  # the gap
+
+
+def test_a_console_shows_the_station_unreachable_and_reconnects_by_itself(
+        qtbot, station: Station, attach: Attach) -> None:
+    """Last of the module: it stops the station, and leaves it restarted."""
+    console = attach(station, "operator")
+    qtbot.waitUntil(lambda: qualities(console) == {""}, timeout=WAIT)
+    station.stop()
+    qtbot.waitUntil(lambda: qualities(console) == {Quality.UNREACHABLE.word}, timeout=WAIT)
+    assert console.health.isVisible() and "station unreachable" in console.health.problems[0]
+    station.restart()
+    shown_view = console.views[console.tabs.currentIndex()]  # refreshed while shown; others once shown
+    qtbot.waitUntil(lambda: qualities(console, [shown_view]) == {""} and not console.client.error,
+                    timeout=WAIT)
+    assert not console.health.isVisible()
+    console.tabs.setCurrentIndex(ANALOG)
+    qtbot.waitUntil(lambda: qualities(console, [console.views[ANALOG]]) == {""}, timeout=WAIT)
+    qtbot.waitUntil(lambda: shown(console) == {r.id: r.state for r in station.runtime.alarms.summary},
+                    timeout=WAIT)  # the station's alarms as they are now

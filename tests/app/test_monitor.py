@@ -26,6 +26,7 @@ from netplc.problems import Problems
 from netplc.program import parse
 from netplc.records import Record
 from tests.app.conftest import write_station
+from tests.cheap_users import CHEAP, cheap_demo_users
 
 PROGRAM = """; the monitor's test program
 TNA $00000
@@ -45,12 +46,14 @@ SYMBOLS = "name,address,comment\nPUMP,02000,pump\nLEVEL,04000,level\n"
 
 
 def station(folder: Path, port: int = 0) -> Path:
+    """Users eng1 engineer, olga operator and vera viewer (each password the name), at the tests'
+    cheap scrypt cost (tests/cheap_users.py)."""
     toml = (f'NetPlcProgram = "p.stl"\nSymbols = "s.csv"\nNetSyncTime = 20\n'
             f'[modbus_server]\nport = {port}\nwritable = [["00000", "02177"], ["04000", "04777"]]\n')
     write_station(folder, toml, {"p.stl": PROGRAM, "s.csv": SYMBOLS})
     users = Users(folder)
     for name, role in (("eng1", "engineer"), ("olga", "operator"), ("vera", "viewer")):
-        users.add(name, role, name)
+        users.add(name, role, name, CHEAP)
     return folder
 
 
@@ -371,6 +374,7 @@ def test_station_menu_opens_the_program_view_and_the_status_bar_counts_forces(qt
     from app.gui.main_window import MainWindow
     from app.gui.monitor.window import ProgramWindow
 
+    cheap_demo_users(demo_copy)
     runtime = Runtime(load_station(demo_copy))
     runtime.start()
     window = MainWindow(runtime)
@@ -399,19 +403,14 @@ def test_station_menu_opens_the_program_view_and_the_status_bar_counts_forces(qt
     assert not opened[0].isVisible()
 
 
-def test_main_monitor_command_refuses_a_bad_target_with_a_message() -> None:
-    import os
-    import subprocess
-    import sys
+def test_main_monitor_command_refuses_a_bad_target_with_a_message(qtbot, capsys) -> None:
+    """`main.py monitor nowhere`, as the command's own function in this process."""
+    from app.cli import main
 
-    from tests.app.conftest import REPO
-
-    env = {**os.environ, "QT_QPA_PLATFORM": "offscreen"}
-    r = subprocess.run([sys.executable, "main.py", "monitor", "nowhere"], cwd=REPO, capture_output=True,
-                       text=True, timeout=60, env=env)
-    assert r.returncode == 2
-    assert "nowhere: neither an opc.tcp:// URL, a station folder nor HOST:PORT" in r.stderr
-    assert "Traceback" not in r.stderr
+    assert main(["monitor", "nowhere"]) == 2
+    err = capsys.readouterr().err
+    assert "nowhere: neither an opc.tcp:// URL, a station folder nor HOST:PORT" in err
+    assert "Traceback" not in err
 
 
 def test_the_watch_table_forces_a_tag_in_physical_units(qtbot, tmp_path: Path) -> None:

@@ -7,9 +7,8 @@ refused by the station, journaled there once a minute naming the user."""
 
 from __future__ import annotations
 
-import os
+import io
 import stat
-import subprocess
 import sys
 from collections.abc import Iterator
 from pathlib import Path
@@ -20,6 +19,7 @@ from PySide6.QtWidgets import QDialog, QMenu
 
 from app.authority import Source as Seat
 from app.authority import Who
+from app.cli import main
 from app.gui.monitor.login import LoginDialog
 from app.gui.monitor.source import RAW_WRITE, OpcUaSource
 from app.gui.monitor.view import ProgramMonitor
@@ -29,7 +29,6 @@ from app.publish.pki import TrustList, thumbprint
 from app.station.config import load_station
 from app.station.runtime import Runtime
 from netplc.records import Record
-from tests.app.conftest import REPO
 from tests.app.publish.conftest import free_port
 from tests.app.test_monitor import station
 
@@ -70,17 +69,38 @@ class Station:
         return [r.text or "" for r in self.records
                 if r.kind == "operator" and (r.source or "").startswith(f"opcua:{who}@127.0.0.1:")]
 
-    def stop(self) -> None:
+    def close_clients(self) -> None:
         for client in self.clients:
             client.close()
+        self.clients.clear()
+
+    def stop(self) -> None:
+        self.close_clients()
         self.runtime.stop()
 
 
+@pytest.fixture(scope="module")
+def served(tmp_path_factory: pytest.TempPathFactory) -> Iterator[Station]:
+    """One station for the module's tests: each logs in as a user of its own (the journal's records
+    are told apart by user), and what one changes that another looks at is put back after it."""
+    st = Station(tmp_path_factory.mktemp("monitor") / "st")
+    try:
+        yield st
+    finally:
+        st.stop()
+
+
 @pytest.fixture
-def remote(tmp_path: Path) -> Iterator[Station]:
-    st = Station(tmp_path / "st")
-    yield st
-    st.stop()
+def remote(served: Station) -> Iterator[Station]:
+    """The module's station for one test; after it, its clients logged out, no force left and
+    NetPlc running."""
+    yield served
+    served.close_clients()
+    commands, engineer = served.runtime.commands, Who("eng1", Seat.CONSOLE)
+    assert commands is not None
+    assert commands.unforce_all(engineer).result(10).ok
+    if served.runtime.status().state != "running":
+        assert served.runtime.run_program("eng1").result(10).ok
 
 
 def monitor_of(qtbot, remote: Station, user: str, tmp_path: Path) -> ProgramMonitor:
@@ -213,21 +233,27 @@ def test_the_login_dialog_says_a_refusal_and_logs_in(qtbot, remote: Station, tmp
     assert client._loop.loop is None  # closing the window logged out and stopped the client
 
 
-def test_main_monitor_opcua_refuses_a_wrong_password_with_a_message(remote: Station, tmp_path: Path) -> None:
-    env = {**os.environ, "QT_QPA_PLATFORM": "offscreen", "XDG_CONFIG_HOME": str(tmp_path / "config")}
+def test_main_monitor_opcua_refuses_a_wrong_password_with_a_message(
+        qtbot, remote: Station, tmp_path: Path, monkeypatch: pytest.MonkeyPatch,
+        capsys: pytest.CaptureFixture[str]) -> None:
+    """`main.py monitor URL --user NAME`, its password the first line of stdin (not a terminal):
+    run in this process, as the command's own function (tests/app/test_consoles.py runs `main.py
+    console` as a process, for its exit status)."""
+    monkeypatch.setenv("XDG_CONFIG_HOME", str(tmp_path / "config"))
 
-    def monitor(*args: str, password: str) -> subprocess.CompletedProcess[str]:
-        return subprocess.run([sys.executable, "main.py", "monitor", *args], input=password + "\n", cwd=REPO,
-                              capture_output=True, text=True, timeout=120, env=env)
+    def monitor(*args: str, password: str) -> tuple[int, str]:
+        monkeypatch.setattr(sys, "stdin", io.StringIO(password + "\n"))
+        code = main(["monitor", *args])
+        return code, capsys.readouterr().err
 
-    r = monitor(remote.url, "--user", "eng1", password="wrong")
-    assert r.returncode == 2 and "refused the login of 'eng1'" in r.stderr
-    assert "Traceback" not in r.stderr
+    code, err = monitor(remote.url, "--user", "eng1", password="wrong")
+    assert code == 2 and "refused the login of 'eng1'" in err
+    assert "Traceback" not in err
     dead = f"opc.tcp://127.0.0.1:{free_port()}/netplc/"
-    r = monitor(dead, "--user", "eng1", "--program", "nowhere.stl", password="eng1")
-    assert r.returncode == 2 and "nowhere.stl: neither a program file nor a station folder" in r.stderr
-    r = monitor(dead, "--user", "eng1", password="eng1")
-    assert r.returncode == 2 and f"{dead}: no answer" in r.stderr and "Traceback" not in r.stderr
+    code, err = monitor(dead, "--user", "eng1", "--program", "nowhere.stl", password="eng1")
+    assert code == 2 and "nowhere.stl: neither a program file nor a station folder" in err
+    code, err = monitor(dead, "--user", "eng1", password="eng1")
+    assert code == 2 and f"{dead}: no answer" in err and "Traceback" not in err
 
 
 def test_off_loopback_the_monitor_trusts_the_station_once_and_an_admin_trusts_the_monitor(
@@ -282,6 +308,7 @@ def test_off_loopback_the_monitor_trusts_the_station_once_and_an_admin_trusts_th
 
 
 def test_a_lost_link_is_said_and_the_monitor_logs_in_again(qtbot, remote: Station, tmp_path: Path) -> None:
+    """Last of the module: it stops the station, and leaves it restarted."""
     monitor = monitor_of(qtbot, remote, "eng1", tmp_path)
     client = remote.clients[-1]
     wait(qtbot, lambda: monitor.state.text().startswith("eng1 at st: NetPlc running"))
