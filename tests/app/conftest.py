@@ -13,6 +13,7 @@ import pytest
 from app.gui.screenshots import copy_station
 from app.station.config import DEMO_STATION
 from tests.app.station_fork import Forks
+from tests.cheap_users import cheap_demo_users
 
 REPO = Path(__file__).resolve().parents[2]
 DEMO = DEMO_STATION
@@ -23,8 +24,10 @@ def copy_demo(dest: Path, language: str | None = None) -> Path:
     """The demo station copied to `dest`, its archive there too, its Modbus server on a free port;
     in `language` when given ("" follows the locale: English under the tests' C locale), else in
     the demo's (ru). The tests of a protocol or a command that read its records word for word take
-    an English copy; the demo's Russian is tested where the language is the point."""
+    an English copy; the demo's Russian is tested where the language is the point. Its users
+    are hashed at the tests' cheap cost (tests/cheap_users.py), their passwords the demo's."""
     copy_station(dest)
+    cheap_demo_users(dest)
     toml = dest / "station.toml"
     text = toml.read_text(encoding="utf-8")
     assert "\nport = 0\n" in text and '\nLanguage = "ru"' in text
