@@ -18,7 +18,8 @@ logged in: what a console reads once at its start (the journal's first page, its
 history) is not what it costs the station from then on. The 8 consoles' phase is compared
 with the median of the phases alone. The local workstation's cost on the same form is measured
 as bench/workstation.py does: this process with a headless runtime alone, then with the window
-shown on it; the window's share is the difference.
+shown on it, in as many rounds as the consoles' (a new window each round); the window's share is
+the median of the rounds' differences.
 
 The 3,000-element form is bench/hmi.py's (two dials, two lamps, a readout and a bar per six
 elements, its words moved to banks 1-3 and its lamps to data bits of bank 4), added to a copy of
@@ -284,32 +285,37 @@ def station_cpu(pid: int, seconds: float, consoles: list[Console]) -> tuple[floa
     return station, [c.result() for c in consoles]
 
 
-def local(app: QApplication, folder: Path, form: int, seconds: float) -> tuple[float, float, Latency]:
+def local(app: QApplication, folder: Path, form: int, seconds: float, rounds: int = 1
+          ) -> tuple[list[float], list[float], Latency]:
     """The local workstation on `form`: this process's CPU with its runtime alone and with the
-    window shown on it (% of one core), and the latency of its form."""
+    window shown on it (% of one core), in `rounds` that alternate the two (a new window each
+    round, made and shown before its phase), and the latency of its form in the last round."""
     from app.gui.main_window import MainWindow
     from app.station.config import load_station
     from app.station.runtime import Runtime
 
     runtime = Runtime(load_station(folder))
     runtime.start()
+    alone, shown = [], []
     try:
         pump(app, 3.0)
-        c0, w0 = own_cpu(), time.monotonic()
-        pump(app, seconds)
-        alone = 100 * (own_cpu() - c0) / (time.monotonic() - w0)
-        window = MainWindow(runtime)
-        window.resize(*SIZE)
-        window.show()
-        window.tabs.setCurrentIndex(form)
-        probe = Latency(window.tabs.widget(form), window.bridge.readings)
-        pump(app, 2.0)
-        c0, w0 = own_cpu(), time.monotonic()
-        probe.recording = True
-        pump(app, seconds)
-        probe.recording = False
-        shown = 100 * (own_cpu() - c0) / (time.monotonic() - w0)
-        window.close()
+        for _ in range(rounds):
+            c0, w0 = own_cpu(), time.monotonic()
+            pump(app, seconds)
+            alone.append(100 * (own_cpu() - c0) / (time.monotonic() - w0))
+            window = MainWindow(runtime)
+            window.resize(*SIZE)
+            window.show()
+            window.tabs.setCurrentIndex(form)
+            probe = Latency(window.tabs.widget(form), window.bridge.readings)
+            pump(app, 2.0)
+            c0, w0 = own_cpu(), time.monotonic()
+            probe.recording = True
+            pump(app, seconds)
+            probe.recording = False
+            shown.append(100 * (own_cpu() - c0) / (time.monotonic() - w0))
+            window.close()
+            pump(app, 1.0)
     finally:
         runtime.stop()
     return alone, shown, probe
@@ -362,7 +368,7 @@ def main(argv: list[str] | None = None) -> int:
                 c.stop()
             proc.terminate()
             proc.wait(30)
-        alone, with_window, _ = local(app, copy_station(folder / "local"), ANALOG, seconds)
+        alones, with_windows, _ = local(app, copy_station(folder / "local"), ANALOG, seconds, args.rounds)
         big = big_station(folder / "big")
         proc, url = start_station(big)
         try:
@@ -377,9 +383,10 @@ def main(argv: list[str] | None = None) -> int:
             proc.wait(30)
         toml = folder / "big" / "station.toml"  # the local workstation's own, without OPC UA
         toml.write_text(toml.read_text(encoding="utf-8").split("\n[opcua]")[0], encoding="utf-8")
-        _, big_local_cpu, big_local = local(app, big, BIG, seconds)
+        _, (big_local_cpu,), big_local = local(app, big, BIG, seconds)
     load = os.getloadavg()
-    share = with_window - alone
+    shares = [shown - alone for alone, shown in zip(alones, with_windows, strict=True)]
+    share, alone, with_window = (statistics.median(v) for v in (shares, alones, with_windows))
     latencies = [x for r in results for x in r.latency]
     cpus = [r.cpu for r in results]
     idle = statistics.median(idles)
@@ -398,7 +405,8 @@ def main(argv: list[str] | None = None) -> int:
           f"{statistics.median(f.cpu for f in firsts):.2f} % "
           f"of one core alone; with {len(results)}: median {statistics.median(cpus):.2f}, worst "
           f"{max(cpus):.2f}; the local workstation's window on the same form adds {share:.2f} % "
-          f"({with_window:.2f} with, {alone:.2f} runtime alone): worst "
+          f"({with_window:.2f} with, {alone:.2f} runtime alone, medians of "
+          f"{', '.join(f'+{v:.2f}' for v in shares)}): worst "
           f"{worst / share if share > 0 else float('inf'):.2f}x")
     print(f"{BIG_ELEMENTS}-element form, every word changing each tick: 1 console {ms(big_result.latency)}, "
           f"{big_result.painted} of {max(1, big_result.scans)} scans painted, {big_result.cpu:.1f} % of one "
