@@ -22,7 +22,7 @@ import os
 import secrets
 import time
 from collections.abc import Callable, Mapping, Sequence
-from dataclasses import dataclass
+from dataclasses import asdict, dataclass
 from pathlib import Path
 
 from app.authority.policy import ROLES, VIEWER, rank
@@ -102,7 +102,7 @@ class User:
     def saved(self) -> dict[str, object]:
         """The user as users.json holds it."""
         return {"name": self.name, "role": self.role, "salt": self.salt, "hash": self.hash,
-                "scrypt": {"n": self.scrypt.n, "r": self.scrypt.r, "p": self.scrypt.p}}
+                "scrypt": asdict(self.scrypt)}
 
 
 def new_user(name: str, role: str, password: str, scrypt: Scrypt = SCRYPT) -> User:
@@ -236,9 +236,11 @@ def _user(item: object) -> tuple[User | None, Phrase | None]:
         bytes.fromhex(item["salt"]), bytes.fromhex(item["hash"])
     except ValueError:
         return None, phrase("users not hex")
-    cost = item.get("scrypt", {"n": SCRYPT.n, "r": SCRYPT.r, "p": SCRYPT.p})
-    keys = {"n", "r", "p"}
-    scrypt = Scrypt(cost["n"], cost["r"], cost["p"]) if isinstance(cost, dict) and set(cost) == keys else None
+    cost = item.get("scrypt")
+    if "scrypt" not in item:
+        scrypt: Scrypt | None = SCRYPT
+    else:
+        scrypt = Scrypt(**cost) if isinstance(cost, dict) and set(cost) == {"n", "r", "p"} else None
     if scrypt is None or not scrypt.usable():
         return None, phrase("users bad scrypt", mib=MAXMEM >> 20)
     return User(item["name"], item["role"], item["salt"], item["hash"], scrypt), None

@@ -9,9 +9,9 @@ A cycle still lasts the revised publishing interval on average (Part 4 5.13.1): 
 first scan published at or after half a tick before it is due, or half a tick after it is due when
 no scan came (a stopped station still sends its keep-alives on time); the next is due an interval
 after the scan that ended it, or after its own time. A cycle shorter than the tick waits at most
-half its interval for a scan, so the keep-alives a client counts on come on time. A client that asks the
-tick is sent each scan's changes once, as soon as they exist; one that asks a second is sent
-a second's changes, at the scan nearest to each second.
+half its interval for a scan, so the keep-alives a client counts on come on time. A client that
+asks the tick is sent each scan's changes once, as soon as they exist; one that asks a second is
+sent a second's changes, at the scan nearest to each second.
 """
 
 from __future__ import annotations

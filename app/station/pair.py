@@ -426,7 +426,8 @@ class Pair:
                          phrase("partner is", letter=hello["letter"], role=said_role(Role(hello["role"]))))
             self.refused = ""
             paired = True
-            greeting = self._greeted()
+            self._greeted()
+            greeting = False
             self._run_link(conn)
         except (OSError, LinkError, ValueError) as e:
             if paired and not self._stopping.is_set() and conn is not self._told:  # told: journaled
@@ -452,12 +453,11 @@ class Pair:
             if alone:
                 self._mirrored(None)  # no standby to wait for: the primary's own commit stands
 
-    def _greeted(self) -> bool:
+    def _greeted(self) -> None:
         """A link's hellos have crossed, or it ended before: a starting station waits no more for it."""
         with self._changed:
             self._greeting -= 1
             self._changed.notify_all()
-        return False
 
     def _hello(self) -> dict[str, object]:
         return {"letter": self.settings.letter, "role": self.role.value, "led": self.led_scans,

@@ -19,6 +19,7 @@ from netplc.modbus import DeviceError, LeanTcpClient, parse_endpoint
 from netplc.program import parse
 from netplc.simulator import Simulator
 from tests.app.conftest import write_station
+from tests.commands import run_in_process
 
 SIMULATED = """
 NetPlcLoad = false
@@ -48,9 +49,8 @@ backoff_max = 0.1
 def headless(station: Path, capsys: pytest.CaptureFixture[str]) -> tuple[int, str]:
     """`main.py --no-gui STATION --duration 0.5` run in this process (tests/app/test_headless.py runs
     it as a process of its own): its exit code and stderr."""
-    capsys.readouterr()
-    code = cli(["--no-gui", str(station), "--duration", "0.5"])
-    return code, capsys.readouterr().err
+    done = run_in_process(cli, ["--no-gui", station, "--duration", "0.5"], capsys)
+    return done.returncode, done.stderr
 
 
 def system_texts(archive: Path) -> list[str]:
