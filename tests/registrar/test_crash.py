@@ -50,13 +50,14 @@ def test_sigkill_during_writes_keeps_every_committed_record(tmp_path):
     db = tmp_path / "journal.sqlite"
     child = spawn("writer_child.py", str(db))
     try:
-        lines = read_until(child, lambda line: int(line[0]) >= 30_000)
+        # past its first commits (one every 20 ms), while it writes on: where 30,000 killed it too
+        lines = read_until(child, lambda line: int(line[0]) >= 5_000)
         lines += kill(child)
     finally:
         if child.poll() is None:
             child.kill()
     committed = int(lines[-1][0])
-    assert committed >= 30_000
+    assert committed >= 5_000
     con = sqlite3.connect(db)
     assert con.execute("PRAGMA integrity_check").fetchone() == ("ok",)
     tables = [n for (n,) in con.execute(
@@ -115,7 +116,7 @@ def test_sigkill_while_alarm_states_are_saved_leaves_one_whole_round(tmp_path):
     path = tmp_path / "alarms.sqlite"
     child = spawn("alarm_state_child.py", str(path))
     try:
-        lines = read_until(child, lambda line: int(line[0]) >= 50)
+        lines = read_until(child, lambda line: int(line[0]) >= 10)  # saving without pause: killed in one
         lines += kill(child)
     finally:
         if child.poll() is None:
