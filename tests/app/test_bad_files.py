@@ -1,9 +1,9 @@
 """Broken station files end as named problems (`file:line: ...`), never as tracebacks, hangs or
 an OOM: `check` exits 1 listing them, a start exits 2, and the forms that are fine still open.
-The stations here are English, as the cases name their problems (test_check.py tries ru). Two
-commands run as real processes (a check that exits 1, a start that exits 2); the others run in this
-process (`app.cli.main` and `netplc.cli.main`, what main.py and `python -m netplc` call,
-tests/commands.py)."""
+The stations here are English, as the cases name their problems (test_check.py tries ru). The check
+that exits 1 runs as a real process; the other commands run in this process (`app.cli.main` and
+`netplc.cli.main`, what main.py and `python -m netplc` call, tests/commands.py): a start that exits
+2 as a process of its own is tests/app/test_headless.py's."""
 
 from __future__ import annotations
 
@@ -103,10 +103,10 @@ def test_a_station_written_in_cp1251_checks_clean(tmp_path: Path, main) -> None:
     assert tag is not None and (tag.description, tag.unit) == ("Температура", "°C")
 
 
-def test_a_start_with_an_unreadable_symbols_file_exits_2_naming_it(tmp_path: Path) -> None:
+def test_a_start_with_an_unreadable_symbols_file_exits_2_naming_it(tmp_path: Path, main) -> None:
     st = copy_demo(tmp_path / "st", "en")
     line = append_line(st / "symbols.csv", b"BAD" + NOT_CP1251 + b",02000")
-    r = main_process("--no-gui", st, "--duration", "1")
+    r = main("--no-gui", st, "--duration", "1")
     assert r.returncode == 2, r.stdout + r.stderr
     assert "Traceback" not in r.stderr
     assert f"{st / 'symbols.csv'}:{line}:0: neither UTF-8 nor cp1251 text (byte 0x98)" in r.stderr
