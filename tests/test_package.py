@@ -1,6 +1,6 @@
 """The package as a user installs it: the wheel built from the source, installed with pip into a
 fresh venv, gives the command `netplc-station`, which finds the demo station and the compiled
-translations inside the package, checks the demo and runs it headless until SIGTERM.
+translations inside the package, runs the demo headless until SIGTERM and checks it meanwhile.
 
 One test, so that the wheel is built and installed once however the suite is spread over
 workers. The venv sees the test venv's site-packages through a .pth file, so pip resolves the
@@ -16,9 +16,10 @@ What is not what the test proves is left out (about 2 s of CPU): the machine's p
 (its indexes and constraints), pip's check of every other installed package's requirements, and
 pip's compiling of every module of the wheel, most of which a headless station never imports (the
 installed command compiles what it imports on its first run and writes it to the venv, as it
-would for a user). `--version` prints the version the wheel's metadata holds: that is checked in
-the venv, and what the option prints in this process; the console script itself runs the check
-and the station.
+would for a user). The console script runs the station; the venv's python, in one process, says
+where the code finds the demo and the translations, the version the wheel's metadata holds (what
+`--version` prints is checked in this process) and checks the demo as `netplc-station check` does
+(`app.cli.main`, what the console script calls).
 """
 
 from __future__ import annotations
@@ -115,27 +116,28 @@ def test_the_wheel_installs_netplc_station_with_the_demo_and_the_translations(
     pip(venv, "install", "-q", "--no-index", "--no-compile", "--no-warn-conflicts", str(wheel))  # its
     command = str(venv / "bin" / "netplc-station")  # dependencies resolved against what is installed
 
-    r = run(venv, str(venv / "bin" / "python"), "-c",
-            "from importlib.metadata import version; from app.station.config import DEMO_STATION\n"
-            "from app.gui.i18n import compiled\n"
-            "print(version('netplc-station')); print(DEMO_STATION); print(compiled('ru'))")
-    assert r.returncode == 0, r.stderr
-    installed, demo, qm = (Path(line) for line in r.stdout.split("\n")[:3])
-    assert str(installed) == __version__ and demo == site / "app" / "station" / "demo"
-    assert qm == site / "app" / "gui" / "i18n" / "console_ru.qm"
-
     station = subprocess.Popen([command, "--no-gui", "--status-every", "0.5"],  # the demo: no folder given
                                cwd=venv, env=installed_env(venv), stdout=subprocess.PIPE,
                                stderr=subprocess.PIPE, text=True)
     try:
-        r = run(venv, command, "check", str(demo))  # while the demo starts
+        assert station.stdout is not None
+        first = station.stdout.readline()  # started: what it imports compiled, for the next to read
+        r = run(venv, str(venv / "bin" / "python"), "-c",  # while the demo runs
+                "import sys\nfrom importlib.metadata import version\nfrom app.cli import main\n"
+                "from app.station.config import DEMO_STATION\nfrom app.gui.i18n import compiled\n"
+                "print(version('netplc-station')); print(DEMO_STATION); print(compiled('ru'), flush=True)\n"
+                "sys.exit(main(['check', str(DEMO_STATION)]))")
     finally:
         out, err = stop_once_up(station)
-    assert r.returncode == 0, r.stdout + r.stderr
+    out = first + out
+    installed, demo, qm = (Path(line) for line in r.stdout.split("\n")[:3])
+    assert str(installed) == __version__ and demo == site / "app" / "station" / "demo", r.stdout + r.stderr
+    assert qm == site / "app" / "gui" / "i18n" / "console_ru.qm"
+    assert r.returncode == 0, r.stdout + r.stderr  # the demo checks clean
     assert f"норма: станция {demo / 'station.toml'}" in r.stdout  # the demo's Language is ru
     assert station.returncode == 0, err
     lines = out.splitlines()
-    assert lines[0].startswith(f"station {DEMO_NAME} started"), out
+    assert lines[0] == f"station {DEMO_NAME} started: {demo / 'station.toml'}", out
     assert "nodes 1/1 up" in out and "SIGTERM: stopping" in out
     assert lines[-1].startswith("station stopped after")
     assert (demo / "archive" / "journal.sqlite").is_file()  # the installed demo runs where it is
