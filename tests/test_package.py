@@ -12,7 +12,7 @@ the PEP 517 backend pyproject.toml names, called as pip calls it, in this venv (
 extra's setuptools) rather than in an isolated build environment pip would first install: the
 same wheel, in a quarter of the time.
 
-What is not what the test proves is left out (about 2 s of CPU): the machine's pip configuration
+What is not what the test proves is left out (about 1.5 s of CPU): the machine's pip configuration
 (its indexes and constraints), pip's check of every other installed package's requirements, and
 pip's compiling of every module of the wheel, most of which a headless station never imports (the
 installed command compiles what it imports on its first run and writes it to the venv, as it
