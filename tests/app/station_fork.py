@@ -43,10 +43,11 @@ class Forks:
         return json.loads(answer)
 
     def start(self, args: list[str], stderr: Path, stdout: Path | None = None,
-              env: dict[str, str] | None = None) -> Forked:
+              env: dict[str, str] | None = None, stdin: Path | None = None) -> Forked:
         """`python main.py ARGS` with its stderr appended to `stderr`, its stdout to `stdout` (or
-        dropped), and `env` added to its environment."""
-        pid = self.ask("start", args, str(stderr), str(stdout or os.devnull), env or {})
+        dropped), `env` added to its environment, and its stdin read from `stdin` (or empty)."""
+        pid = self.ask("start", args, str(stderr), str(stdout or os.devnull), env or {},
+                       str(stdin or os.devnull))
         assert isinstance(pid, int)
         return Forked(self, pid, stderr, stdout)
 
@@ -104,7 +105,7 @@ class Forked:
         return self.returncode
 
 
-def _fork(args: list[str], stderr: str, stdout: str, env: dict[str, str]) -> int:
+def _fork(args: list[str], stderr: str, stdout: str, env: dict[str, str], stdin: str) -> int:
     from app.cli import main
 
     sys.stdout.flush()
@@ -112,13 +113,14 @@ def _fork(args: list[str], stderr: str, stdout: str, env: dict[str, str]) -> int
     if pid:
         return pid
     os.environ.update(env)
-    null = os.open(os.devnull, os.O_RDWR)
-    os.dup2(null, 0)
+    given = os.open(stdin, os.O_RDONLY)
+    os.dup2(given, 0)
+    os.close(given)
+    sys.stdin = open(0, encoding="utf-8", closefd=False)  # noqa: SIM115  (not the requests' buffer)
     for fd, path in ((1, stdout), (2, stderr)):
         out = os.open(path, os.O_WRONLY | os.O_APPEND | os.O_CREAT, 0o644)
         os.dup2(out, fd)
         os.close(out)
-    os.close(null)
     sys.exit(main(args))  # and the interpreter ends as main.py's does
 
 

@@ -1,15 +1,15 @@
 """Broken station files end as named problems (`file:line: ...`), never as tracebacks, hangs or
 an OOM: `check` exits 1 listing them, a start exits 2, and the forms that are fine still open.
-The stations here are English, as the cases name their problems (test_check.py tries ru). Two
-commands run as real processes (a check that exits 1, a start that exits 2); the others run in this
-process (`app.cli.main` and `netplc.cli.main`, what main.py and `python -m netplc` call,
-tests/commands.py)."""
+The stations here are English, as the cases name their problems (test_check.py tries ru). The check
+that exits 1 runs as a process of its own (a fork of the worker's, as tests/app/station_fork.py
+starts `main.py`); the other commands run in this process (`app.cli.main` and `netplc.cli.main`,
+what main.py and `python -m netplc` call, tests/commands.py): a start that exits 2 as a process of
+its own is tests/app/test_headless.py's."""
 
 from __future__ import annotations
 
 import json
 import subprocess
-import sys
 from collections.abc import Callable
 from pathlib import Path
 
@@ -22,15 +22,11 @@ from app.station.runtime import StartError
 from hmi_forms.form import load_forms
 from registrar.catalog import Catalog
 from tests.app.broken_stations import CASES, Broken, replace
-from tests.app.conftest import REPO, copy_demo
+from tests.app.conftest import copy_demo
+from tests.app.station_fork import Forks
 from tests.commands import run_in_process
 
 NOT_CP1251 = b"\x98"  # a byte that is neither UTF-8 (alone) nor defined in cp1251
-
-
-def main_process(*args: object) -> subprocess.CompletedProcess[str]:
-    return subprocess.run([sys.executable, "main.py", *map(str, args)], cwd=REPO, capture_output=True,
-                          text=True, timeout=60)
 
 
 @pytest.fixture
@@ -71,16 +67,16 @@ def bad_forms(folder: Path) -> dict[str, str]:
     }
 
 
-def test_check_lists_every_bad_file_and_exits_1(tmp_path: Path) -> None:
+def test_check_lists_every_bad_file_and_exits_1(tmp_path: Path, station_forks: Forks) -> None:
     st = copy_demo(tmp_path / "st", "en")
     program_line = append_line(st / "netplc.stl", b"; bad " + NOT_CP1251)
     symbols_line = append_line(st / "symbols.csv", b"LONG,02000," + b"x" * 140_000)
     big_line = append_line(st / "messages.csv", f"{2**63},1,0,too big for the archive".encode())
     expected_forms = bad_forms(st / "forms")
-    r = main_process("check", st)
-    assert r.returncode == 1, r.stdout + r.stderr
-    assert "Traceback" not in r.stderr
-    out = r.stdout.splitlines()
+    check = station_forks.start(["check", str(st)], tmp_path / "stderr.txt", tmp_path / "stdout.txt")
+    assert check.wait(60) == 1, check.output() + check.errors()
+    assert "Traceback" not in check.errors()
+    out = check.output().splitlines()
     assert f"{st / 'netplc.stl'}:{program_line}:0: neither UTF-8 nor cp1251 text (byte 0x98)" in out
     assert f"{st / 'symbols.csv'}:{symbols_line}:1: a field is longer than 131072 characters" in out
     assert (f"{st / 'messages.csv'}:{big_line}: number {2**63} is past {2**63 - 1}, the largest the archive "
@@ -103,10 +99,10 @@ def test_a_station_written_in_cp1251_checks_clean(tmp_path: Path, main) -> None:
     assert tag is not None and (tag.description, tag.unit) == ("Температура", "°C")
 
 
-def test_a_start_with_an_unreadable_symbols_file_exits_2_naming_it(tmp_path: Path) -> None:
+def test_a_start_with_an_unreadable_symbols_file_exits_2_naming_it(tmp_path: Path, main) -> None:
     st = copy_demo(tmp_path / "st", "en")
     line = append_line(st / "symbols.csv", b"BAD" + NOT_CP1251 + b",02000")
-    r = main_process("--no-gui", st, "--duration", "1")
+    r = main("--no-gui", st, "--duration", "1")
     assert r.returncode == 2, r.stdout + r.stderr
     assert "Traceback" not in r.stderr
     assert f"{st / 'symbols.csv'}:{line}:0: neither UTF-8 nor cp1251 text (byte 0x98)" in r.stderr

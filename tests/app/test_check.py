@@ -1,6 +1,7 @@
 """`python main.py check`: every error planted in a broken copy of the demo station is reported. The
-demo's check is a real `python main.py check`; the broken copies are checked in this process
-(`app.cli.main`, what main.py runs, tests/commands.py)."""
+checks run in this process (`app.cli.main`, what main.py runs, tests/commands.py): the demo's check
+as a process of its own is tests/test_package.py's (the installed command, exit code 0), a check
+that exits 1 tests/app/test_bad_files.py's."""
 
 from __future__ import annotations
 
@@ -8,14 +9,13 @@ import csv
 import json
 import re
 import subprocess
-import sys
 from collections.abc import Callable
 from pathlib import Path
 
 import pytest
 
 from app.cli import main
-from tests.app.conftest import DEMO, REPO, copy_demo
+from tests.app.conftest import DEMO, copy_demo
 from tests.commands import run_in_process
 
 
@@ -25,9 +25,8 @@ def run_check(capsys: pytest.CaptureFixture[str]) -> Callable[[Path], subprocess
     return lambda station: run_in_process(main, ["check", station], capsys)
 
 
-def test_the_demo_station_is_clean() -> None:
-    r = subprocess.run([sys.executable, "main.py", "check", str(DEMO)], cwd=REPO, capture_output=True,
-                       text=True, timeout=60)
+def test_the_demo_station_is_clean(run_check) -> None:
+    r = run_check(DEMO)
     assert r.returncode == 0, r.stdout + r.stderr
     assert "норма: программа netplc.stl: инструкций" in r.stdout  # the demo's Language is ru
 

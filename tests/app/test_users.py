@@ -5,8 +5,6 @@ from __future__ import annotations
 
 import io
 import json
-import subprocess
-import sys
 from pathlib import Path
 
 import pytest
@@ -18,9 +16,8 @@ from app.station.config import DEMO_STATION
 from netplc.engine import Engine
 from netplc.program import parse
 from netplc.records import ListSink
+from tests.app.station_fork import Forks
 from tests.cheap_users import CHEAP
-
-REPO = Path(__file__).resolve().parents[2]
 
 
 def test_a_user_is_kept_as_a_salted_hash_never_the_password(tmp_path: Path) -> None:
@@ -160,14 +157,15 @@ def test_a_cost_scrypt_cannot_use_is_named(tmp_path: Path, cost: object) -> None
 
 
 def test_the_users_command(tmp_path: Path, monkeypatch: pytest.MonkeyPatch,
-                           capsys: pytest.CaptureFixture[str]) -> None:
-    """The process once (its exit code, the default cost written), the command's function for the
-    rest (its exit code is main.py's)."""
+                           capsys: pytest.CaptureFixture[str], station_forks: Forks) -> None:
+    """The process once (its exit code, the default cost written; a fork of the worker's, as
+    tests/app/station_fork.py starts `main.py`), the command's function for the rest (its exit
+    code is main.py's)."""
     (tmp_path / "station.toml").write_text('NetPlcLoad = false\n', encoding="utf-8")
-    added = subprocess.run([sys.executable, "main.py", "users", "--station", str(tmp_path), "add", "ivan",
-                            "--role", "engineer"], input="pw\n", cwd=REPO, capture_output=True, text=True,
-                           timeout=60)
-    assert added.returncode == 0, added.stderr
+    (tmp_path / "password.txt").write_text("pw\n", encoding="utf-8")
+    added = station_forks.start(["users", "--station", str(tmp_path), "add", "ivan", "--role", "engineer"],
+                                tmp_path / "stderr.txt", stdin=tmp_path / "password.txt")
+    assert added.wait(60) == 0, added.errors()
     assert json.loads((tmp_path / "users.json").read_text(encoding="utf-8"))["users"][0]["scrypt"] == {
         "n": 2**14, "r": 8, "p": 1}  # RFC 7914's interactive cost, whatever the tests use
 

@@ -338,15 +338,14 @@ def test_a_serial_port_failure_is_journaled_and_retried() -> None:
 
 def test_simulate_with_a_serial_port_that_cannot_be_opened(tmp_path: Path,
                                                           capsys: pytest.CaptureFixture[str]) -> None:
-    """The port that cannot be opened as a real process (its exit status); the refused endpoint in
-    this process (tests/commands.py)."""
+    """In this process (tests/commands.py): `simulate` as a process of its own is the `simulated`
+    fixture's."""
     from app.cli import main
 
     (tmp_path / "node.stl").write_text(NODE)
-    r = subprocess.run([sys.executable, "main.py", "simulate", str(tmp_path / "node.stl"),
-                        "--serial", "rtu:///dev/no-such-tty"], cwd=REPO, capture_output=True, text=True,
-                       timeout=60)
+    node = tmp_path / "node.stl"
+    r = run_in_process(main, ["simulate", node, "--serial", "rtu:///dev/no-such-tty"], capsys)
     assert r.returncode == 1 and "Traceback" not in r.stderr
     assert r.stderr.startswith("simulate: cannot open /dev/no-such-tty: ")
-    r = run_in_process(main, ["simulate", tmp_path / "node.stl", "--serial", "tcp://h:502"], capsys)
+    r = run_in_process(main, ["simulate", node, "--serial", "tcp://h:502"], capsys)
     assert r.returncode == 2 and "expected an rtu:// endpoint" in r.stderr

@@ -16,7 +16,7 @@ from registrar.store import Store
 def station(path: str, url: str) -> None:
     store = Store(path, flush_interval=0.01, queue_size=10_000_000)
     store.start()
-    forwarder = Forwarder(path, url, "killed", interval=0.01, batch=3_000)
+    forwarder = Forwarder(path, url, "killed", interval=0.01, batch=600)
     forwarder.start()
     i = 0
     while True:
