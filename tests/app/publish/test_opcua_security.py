@@ -18,7 +18,11 @@ from pathlib import Path
 import pytest
 from asyncua import Client, ua
 from asyncua.crypto import uacrypto
-from asyncua.crypto.cert_gen import setup_self_signed_certificate
+from asyncua.crypto.cert_gen import (
+    dump_private_key_as_pem,
+    generate_private_key,
+    setup_self_signed_certificate,
+)
 from asyncua.crypto.security_policies import SecurityPolicyBasic256Sha256
 from cryptography import x509
 from cryptography.x509.oid import ExtendedKeyUsageOID
@@ -28,6 +32,8 @@ from app.publish.pki import thumbprint
 from app.publish.trust import main as trust
 from tests.app.conftest import REPO
 from tests.app.publish.conftest import STATION_URI, demo_with, free_port, tag_node
+
+CLIENT_KEY: list[object] = []  # made once
 
 
 class Secure:
@@ -47,7 +53,12 @@ class Secure:
         self.keys: dict[bytes, object] = {}  # the client keys loaded, by their PEM
 
     def client_certificate(self, name: str) -> tuple[Path, Path]:
+        """A certificate of the test's own, as asyncua's `setup_self_signed_certificate` makes it,
+        on the file's one client key (a new RSA key is a random 0.1-0.5 s of CPU)."""
         key, cert = self.folder.parent / f"{name}-key.pem", self.folder.parent / f"{name}-cert.der"
+        if not CLIENT_KEY:
+            CLIENT_KEY.append(generate_private_key())
+        key.write_bytes(dump_private_key_as_pem(CLIENT_KEY[0]))
         asyncio.run(setup_self_signed_certificate(key, cert, f"urn:test:{name}", "localhost",
                                                   [ExtendedKeyUsageOID.CLIENT_AUTH], {"commonName": name}))
         return cert, key
