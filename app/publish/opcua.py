@@ -424,7 +424,7 @@ class OpcUaServer:
         for note in own.notes:
             self.journal("opcua note", note=note)
         await server.load_certificate(str(own.cert))
-        await server.load_private_key(str(own.key))
+        server.iserver.private_key = own.private_key  # what `load_private_key` would load and check again
         server.set_security_policy([ua.SecurityPolicyType.Basic256Sha256_SignAndEncrypt])
         tokens: list[type] = [ua.UserNameIdentityToken]
         if not self.users.any():

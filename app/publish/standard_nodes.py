@@ -131,14 +131,22 @@ def _write(path: Path, nodes: dict[ua.NodeId, NodeData]) -> None:
 
 
 def _read(path: Path) -> dict[ua.NodeId, bytes] | None:
+    """The file's nodes, still pickled; None where there is none to be read (then one is made)."""
     if not path.exists():
         return None
     if not _private(path):
         logger.warning("%s: not read (others may write it); the OPC UA server fills the standard "
                        "address space itself", path)
         return None
-    return {ua.NodeId(ident, ns, ua.NodeIdType(kind)): blob
-            for ident, ns, kind, blob in marshal.loads(path.read_bytes())}
+    try:
+        blobs = {ua.NodeId(ident, ns, ua.NodeIdType(kind)): blob
+                 for ident, ns, kind, blob in marshal.loads(path.read_bytes())}
+        first = pickle.loads(next(iter(blobs.values())))  # unpickles as the others will
+        assert isinstance(first, NodeData), type(first)
+    except Exception:  # damaged, or of another build of asyncua under the same version
+        logger.exception("%s: not a cache of the standard address space: made again", path)
+        return None
+    return blobs
 
 
 def _load(folder: Path) -> _Kept:

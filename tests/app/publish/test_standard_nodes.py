@@ -112,3 +112,16 @@ def test_a_start_that_cannot_write_the_cache_fills_and_says_so(
         kept = standard_nodes._load(folder)
     assert list(kept) == list(some_nodes)
     assert "the standard address space is not cached: each start fills it" in caplog.text
+
+
+def test_a_damaged_cache_is_made_again(
+        tmp_path: Path, some_nodes: dict[ua.NodeId, NodeData], caplog: pytest.LogCaptureFixture) -> None:
+    """A cache file cut short (a full disk) or of another build of asyncua is not a server's
+    address space: the start says so, fills and writes it again."""
+    path = standard_nodes.cache_file(tmp_path)
+    path.write_bytes(b"\xdb\x05not marshal")
+    with caplog.at_level(logging.ERROR, standard_nodes.__name__):
+        again = standard_nodes._load(tmp_path)
+    assert not again._blobs and list(again) == list(some_nodes)
+    assert f"{path}: not a cache of the standard address space: made again" in caplog.text
+    assert list(standard_nodes._load(tmp_path)._blobs) == list(some_nodes)
