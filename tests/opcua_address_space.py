@@ -12,6 +12,10 @@ from pathlib import Path
 from app.publish import standard_nodes
 
 FOLDER = Path(__file__).resolve().parents[1] / ".pytest_cache" / "netplc"  # ignored by git
+# from the import on (tests/app/publish/conftest.py imports this module at collection, which
+# every worker makes of the whole suite): a station a test starts as a process before this
+# process's first server takes the run's cache too, and none writes to the user's home
+os.environ.setdefault(standard_nodes.CACHE_ENV, str(FOLDER))
 _loaded = False
 
 
@@ -21,7 +25,6 @@ def fill_once() -> bool:
     global _loaded
     if _loaded:
         return False
-    os.environ.setdefault(standard_nodes.CACHE_ENV, str(FOLDER))
     standard_nodes.kept()
     _loaded = True
     return True
