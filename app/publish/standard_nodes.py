@@ -126,7 +126,9 @@ def _write(path: Path, nodes: dict[ua.NodeId, NodeData]) -> None:
                         pickle.dumps(node, pickle.HIGHEST_PROTOCOL)))
     path.parent.mkdir(mode=0o700, parents=True, exist_ok=True)
     part = path.with_name(f"{path.name}.{os.getpid()}.part")
-    part.write_bytes(marshal.dumps(records))  # private: the folder is
+    fd = os.open(part, os.O_WRONLY | os.O_CREAT | os.O_TRUNC, 0o600)  # the user's alone, whatever the umask
+    with os.fdopen(fd, "wb") as f:
+        f.write(marshal.dumps(records))
     os.replace(part, path)  # whole or not at all
 
 
@@ -154,6 +156,7 @@ def _load(folder: Path) -> _Kept:
     blobs = _read(path)
     if blobs is not None:
         return _Kept(blobs, {})
+    nodes = None
     try:
         folder.mkdir(mode=0o700, parents=True, exist_ok=True)
         with _exclusive(path.with_name(f"{path.name}.lock")):  # one fill of the processes starting at once
@@ -162,11 +165,10 @@ def _load(folder: Path) -> _Kept:
                 return _Kept(blobs, {})
             nodes = fill()
             _write(path, nodes)
-            logger.info("OPC UA standard address space cached in %s for the next starts", path)
-            return _Kept({}, nodes)
+        logger.info("OPC UA standard address space cached in %s for the next starts", path)
     except OSError:
         logger.exception("%s: the standard address space is not cached: each start fills it", path)
-        return _Kept({}, fill())
+    return _Kept({}, fill() if nodes is None else nodes)
 
 
 _kept: dict[Path, _Kept] = {}

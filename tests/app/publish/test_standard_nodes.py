@@ -72,14 +72,16 @@ def some_nodes(monkeypatch: pytest.MonkeyPatch) -> dict[ua.NodeId, NodeData]:
 def test_the_first_start_writes_the_cache_and_the_next_reads_it(
         tmp_path: Path, some_nodes: dict[ua.NodeId, NodeData], monkeypatch: pytest.MonkeyPatch) -> None:
     """A start that finds no cache fills as asyncua does and writes what it filled, whole (a file
-    replaced, never half written: no part left), in a folder of the user's alone; the next start
-    reads the nodes back from it. $NETPLC_CACHE_DIR names the folder."""
+    replaced, never half written: no part left), the user's alone whatever the umask, in a folder
+    of the user's alone; the next start reads the nodes back from it. $NETPLC_CACHE_DIR names the
+    folder."""
     folder = tmp_path / "cache"
     monkeypatch.setenv(standard_nodes.CACHE_ENV, str(folder))
     assert standard_nodes.cache_folder() == folder
     first = standard_nodes._load(folder)
     assert not first._blobs and list(first) == list(some_nodes)
     assert folder.stat().st_mode & 0o777 == 0o700
+    assert standard_nodes.cache_file(folder).stat().st_mode & 0o777 == 0o600
     made = [p.name for p in folder.iterdir() if p.suffix != ".lock"]
     assert made == [standard_nodes.cache_file(folder).name]
     monkeypatch.setattr(standard_nodes, "fill", lambda: pytest.fail("filled again"))
