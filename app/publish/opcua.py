@@ -62,6 +62,7 @@ from asyncua.crypto.security_policies import SecurityPolicyBasic256Sha256, Secur
 from app.authority import Action, Commands, Reason, Source, Ticket, Who
 from app.authority.logins import Logins
 from app.authority.users import UserError, Users
+from app.publish import standard_nodes
 from app.publish.aligned import ScanClock
 from app.publish.conditions import Conditions
 from app.publish.feed import LatestReadings, Watch
@@ -341,6 +342,7 @@ class OpcUaServer:
         self._loop = asyncio.get_running_loop()
         self._stop, self._tick = asyncio.Event(), asyncio.Event()
         server = Server(user_manager=self.users)
+        standard_nodes.install(server)  # from the cache: asyncua's own fill is 3 s of CPU
         await server.init()
         server.set_endpoint(self.endpoint)
         build = build_info()
@@ -422,7 +424,7 @@ class OpcUaServer:
         for note in own.notes:
             self.journal("opcua note", note=note)
         await server.load_certificate(str(own.cert))
-        await server.load_private_key(str(own.key))
+        server.iserver.private_key = own.private_key  # what `load_private_key` would load and check again
         server.set_security_policy([ua.SecurityPolicyType.Basic256Sha256_SignAndEncrypt])
         tokens: list[type] = [ua.UserNameIdentityToken]
         if not self.users.any():

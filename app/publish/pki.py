@@ -118,6 +118,7 @@ class Own:
     cert: Path
     key: Path
     notes: list[str] = field(default_factory=list)
+    private_key: rsa.RSAPrivateKey | None = None  # the key as loaded or made here (loading checks it: 60 ms)
 
 
 def station_certificate(folder: Path, uri: str, names: list[str], station: str,
@@ -155,6 +156,7 @@ def station_certificate(folder: Path, uri: str, names: list[str], station: str,
         _write(own.cert, cert.public_bytes(serialization.Encoding.DER), 0o644)
         own.notes.append(f"certificate made ({why}) naming {', '.join(names)}; thumbprint "
                          f"{thumbprint(own.cert.read_bytes())}")
+    own.private_key = key
     return own
 
 

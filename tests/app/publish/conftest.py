@@ -24,6 +24,7 @@ from app.station.runtime import Runtime
 from tests.app.conftest import DEMO_NAME, copy_demo
 from tests.cheap_users import cheap_demo_users
 from tests.netplc.test_exchange import wait_until
+from tests.opcua_address_space import FOLDER as _CACHE  # noqa: F401  the run's OPC UA cache from now on
 
 
 def free_port() -> int:

@@ -17,7 +17,12 @@ from pathlib import Path
 
 import pytest
 from asyncua import Client, ua
-from asyncua.crypto.cert_gen import setup_self_signed_certificate
+from asyncua.crypto import uacrypto
+from asyncua.crypto.cert_gen import (
+    dump_private_key_as_pem,
+    generate_private_key,
+    setup_self_signed_certificate,
+)
 from asyncua.crypto.security_policies import SecurityPolicyBasic256Sha256
 from cryptography import x509
 from cryptography.x509.oid import ExtendedKeyUsageOID
@@ -27,6 +32,8 @@ from app.publish.pki import thumbprint
 from app.publish.trust import main as trust
 from tests.app.conftest import REPO
 from tests.app.publish.conftest import STATION_URI, demo_with, free_port, tag_node
+
+CLIENT_KEY: list[object] = []  # made once
 
 
 class Secure:
@@ -43,18 +50,33 @@ class Secure:
         self.url = f"opc.tcp://127.0.0.1:{self.port}/netplc/"
         self.folder = folder
         self.own = folder / "pki" / "own"
+        self.keys: dict[bytes, object] = {}  # the client keys loaded, by their PEM
 
     def client_certificate(self, name: str) -> tuple[Path, Path]:
+        """A certificate of the test's own, as asyncua's `setup_self_signed_certificate` makes it,
+        on the file's one client key (a new RSA key is a random 0.1-0.5 s of CPU)."""
         key, cert = self.folder.parent / f"{name}-key.pem", self.folder.parent / f"{name}-cert.der"
+        if not CLIENT_KEY:
+            CLIENT_KEY.append(generate_private_key())
+        key.write_bytes(dump_private_key_as_pem(CLIENT_KEY[0]))
         asyncio.run(setup_self_signed_certificate(key, cert, f"urn:test:{name}", "localhost",
                                                   [ExtendedKeyUsageOID.CLIENT_AUTH], {"commonName": name}))
         return cert, key
 
     async def client(self, cert: Path, key: Path, user: str | None = None, password: str = "") -> Client:
+        """A client of certificate `cert` over Basic256Sha256 Sign&Encrypt, as asyncua's
+        `Client.set_security` makes it, but with the key loaded once: asyncua loads it at
+        every client, and loading a key checks it (80 ms of CPU, a third of this file's)."""
         client = Client(self.url, timeout=30)
         client.application_uri = f"urn:test:{cert.stem.removesuffix('-cert')}"
-        await client.set_security(SecurityPolicyBasic256Sha256, str(cert), str(key),
-                                  server_certificate=str(self.own / "cert.der"))
+        pem = key.read_bytes()
+        if pem not in self.keys:
+            self.keys[pem] = await uacrypto.load_private_key(pem, extension="pem")
+        station = await uacrypto.load_certificate(str(self.own / "cert.der"))
+        client.security_policy = SecurityPolicyBasic256Sha256(
+            station, await uacrypto.load_certificate(str(cert)), self.keys[pem],
+            ua.MessageSecurityMode.SignAndEncrypt)
+        client.uaclient.set_security(client.security_policy)
         if user is not None:
             client.set_user(user)
             client.set_password(password)
