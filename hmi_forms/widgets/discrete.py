@@ -10,7 +10,7 @@ from __future__ import annotations
 from collections.abc import Hashable
 
 from PySide6.QtCore import QCoreApplication, QRectF, Qt
-from PySide6.QtGui import QColor, QLinearGradient, QMouseEvent, QPainter, QPen, QPixmap
+from PySide6.QtGui import QColor, QLinearGradient, QMouseEvent, QPainter, QPen
 from PySide6.QtWidgets import QWidget
 
 from hmi_forms.elements.bank import BitBank
@@ -31,7 +31,7 @@ class DiscreteFace(Face):
     def __init__(self, widget: ElementWidget) -> None:
         super().__init__(widget)
         self.pressed = False  # the operator holds the mouse button on it
-        self.by_state: dict[tuple[int | None, bool], QPixmap] = {}
+        self.by_state: dict[tuple[int | None, bool], list[Op]] = {}  # the composition of each
         self.simple = False
 
     def load(self) -> None:
@@ -40,13 +40,14 @@ class DiscreteFace(Face):
         self.simple = type(self.model) in (DiscreteBase, DiscreteColorLabel)
 
     def put(self, shown: int) -> bool:
-        """`Face.put` in one step: the layer by the bit and the press (a plain element is simple)."""
+        """`Face.put` in one step: the composition by the bit and the press (a plain element is
+        simple), the same list while its layer is: an unchanged one is told by identity."""
         if not self.fresh:
             self.load()
         if self.style_of(self.attrs) != self.style:
             return super().put(shown)
-        drawn = [(PIX, (self.x, self.y, self._layer()))]
-        if drawn == self.drawn:
+        drawn = self._composed()
+        if drawn is self.drawn:
             return False
         self.drawn = drawn
         if self.marked:
@@ -59,14 +60,14 @@ class DiscreteFace(Face):
         m = self.model
         if m.stale or self.restyled():
             return None
-        return [(PIX, (self.x, self.y, self._layer()))]
+        return self._composed()
 
-    def _layer(self) -> QPixmap:
+    def _composed(self) -> list[Op]:
         state = (self.model.value, self.pressed)
-        layer = self.by_state.get(state)
-        if layer is None:
-            layer = self.by_state[state] = self.widget.layer()
-        return layer
+        drawn = self.by_state.get(state)
+        if drawn is None:
+            drawn = self.by_state[state] = [(PIX, (self.x, self.y, self.widget.layer()))]
+        return drawn
 
 
 class DiscreteWidget(ElementWidget):
