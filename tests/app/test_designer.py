@@ -11,8 +11,8 @@ import socket
 from pathlib import Path
 
 import pytest
-from PySide6.QtCore import QPoint, QPointF, Qt
-from PySide6.QtGui import QDropEvent, QImage, QMouseEvent
+from PySide6.QtCore import QPoint, QPointF, QRectF, Qt
+from PySide6.QtGui import QDropEvent, QImage, QMouseEvent, QPainter
 from PySide6.QtWidgets import QApplication, QWidget
 from pytestqt.qtbot import QtBot
 
@@ -606,3 +606,30 @@ def test_another_element_of_the_same_type_fills_the_same_editors_and_looks_as_if
     assert panel.editors == editors
     fresh.show_selection()  # of the same design: the element selected now
     assert editor_states(panel) == editor_states(fresh)
+
+
+def test_a_journal_on_the_canvas_is_drawn_again_when_its_page_is_read(qtbot: QtBot, demo_copy: Path) -> None:
+    """The canvas shows a picture of each element's widget; a journal's page is read in a thread
+    after the first picture was taken, and the canvas shows the page once it is read."""
+    from hmi_forms.elements.journal import MessageJournal
+    from tests.app.held_archive import archive_with
+
+    archive_with(demo_copy / "archive" / "journal.sqlite", ["первая запись", "вторая запись"])
+    w = make_window(qtbot, demo_copy / "forms" / "02_analog.hmi")
+    item = next(i for i in w.design.items.values() if isinstance(i.model, MessageJournal))
+    w.show()
+    qtbot.waitExposed(w)
+    qtbot.waitUntil(lambda: item.widget is not None and item.widget.table.rowCount() == 2, timeout=10_000)
+    widget = item.widget
+
+    def drawn_as_shown() -> bool:  # the element's area of the canvas, as the widget shows itself
+        shown = widget.grab().toImage().convertToFormat(QImage.Format.Format_RGB32)
+        drawn = QImage(shown.size(), QImage.Format.Format_RGB32)
+        painter = QPainter(drawn)
+        try:
+            w.design.scene.render(painter, QRectF(drawn.rect()), item.mapToScene(item.rect()).boundingRect())
+        finally:
+            painter.end()
+        return drawn == shown
+
+    qtbot.waitUntil(drawn_as_shown, timeout=10_000)
