@@ -23,7 +23,7 @@ from importlib import metadata
 from typing import TYPE_CHECKING
 
 from PySide6.QtCore import QCoreApplication, QEvent, QObject, QSize, Qt, QTimer
-from PySide6.QtGui import QAction, QCloseEvent, QKeySequence
+from PySide6.QtGui import QAction, QCloseEvent, QGuiApplication, QKeySequence
 from PySide6.QtWidgets import (
     QApplication,
     QDockWidget,
@@ -565,7 +565,13 @@ def station_frame(window: QMainWindow, title: str) -> Frame:
 
 class _Activity(QObject):
     """Any key, click or wheel in the application keeps the user logged in: the idle logout
-    counts from the last one."""
+    counts from the last one.
+
+    The application's windows are watched (QWindow: a key, click or wheel reaches the window before
+    its widgets), not the application: a filter on the application is called in Python for every
+    event of every widget (paints, timers, layouts), a tenth of a busy workstation's time. A window
+    is watched from the moment one of them takes the focus, as a new window does when shown and a
+    click does in any other."""
 
     INPUT = (QEvent.Type.KeyPress, QEvent.Type.MouseButtonPress, QEvent.Type.Wheel)
 
@@ -573,8 +579,13 @@ class _Activity(QObject):
         super().__init__(parent)
         self.session = session
         self.app = QApplication.instance()
-        if self.app is not None:
-            self.app.installEventFilter(self)
+        if isinstance(self.app, QGuiApplication):
+            self.app.focusWindowChanged.connect(self._watch)
+            self._watch()
+
+    def _watch(self, *_: object) -> None:
+        for window in QGuiApplication.topLevelWindows():
+            window.installEventFilter(self)  # once: installing again only moves it to the front
 
     def eventFilter(self, watched: QObject, event: QEvent) -> bool:
         if event.type() in self.INPUT:
@@ -582,9 +593,11 @@ class _Activity(QObject):
         return False
 
     def stop(self) -> None:
-        if self.app is not None:
-            self.app.removeEventFilter(self)
-            self.app = None
+        if isinstance(self.app, QGuiApplication):
+            self.app.focusWindowChanged.disconnect(self._watch)
+            for window in QGuiApplication.topLevelWindows():
+                window.removeEventFilter(self)
+        self.app = None
 
 
 def version() -> str:

@@ -199,14 +199,12 @@ def _designer(runtime: Runtime, out: Path, wait: Callable[[float], None], langua
     try:
         window.design.select([e for e in window.design.doc.elements if e.get("Name") == "Уровень"])
         window.start_preview("127.0.0.1", runtime.modbus.port if runtime.modbus is not None else None)
-        # the memory is read over Modbus in a thread, a journal element's page in another, and the
-        # journal is drawn again at its next refresh (RefreshTicks snapshots) with the page read
+        # the memory is read over Modbus in a thread, a journal element's page in another (the
+        # canvas draws the journal again when its page arrives)
         polled = _snapshots(window)
         journals = [i for i in window.design.items.values() if isinstance(i.model, MessageJournal)]
         _until(wait, lambda: polled() > 0 and all(i.widget is not None and i.widget.status.text()
                                                   for i in journals))
-        shown = polled()
-        _until(wait, lambda: all(polled() > shown + i.model.RefreshTicks for i in journals))
         for size in WINDOW_SIZES:
             window.resize(*size)
             window.canvas.home()

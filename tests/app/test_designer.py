@@ -11,15 +11,16 @@ import socket
 from pathlib import Path
 
 import pytest
-from PySide6.QtCore import QPoint, QPointF, Qt
-from PySide6.QtGui import QDropEvent, QImage, QMouseEvent
-from PySide6.QtWidgets import QApplication
+from PySide6.QtCore import QPoint, QPointF, QRectF, Qt
+from PySide6.QtGui import QDropEvent, QImage, QMouseEvent, QPainter
+from PySide6.QtWidgets import QApplication, QWidget
 from pytestqt.qtbot import QtBot
 
 from app.cli import main
 from app.gui.designer.canvas import ELEMENT_MIME
 from app.gui.designer.commands import MISSING
 from app.gui.designer.editors import BoolEditor, ColorEditor, ComboEditor, FontEditor, LineEditor
+from app.gui.designer.properties import PropertyPanel
 from app.gui.designer.station import open_target
 from app.gui.designer.window import DesignerWindow
 from hmi_forms.elements import ELEMENT_TYPES
@@ -541,3 +542,94 @@ def test_a_failed_save_says_why_and_keeps_the_form(window: DesignerWindow, tmp_p
     assert window.save(tmp_path / "no" / "such" / "folder" / "f.hmi") is False
     assert "The form was not saved" in window.warned[0]  # type: ignore[attr-defined]
     assert window.design.doc.path == path and not window.design.undo.isClean()
+
+
+def editor_states(panel: PropertyPanel) -> list[tuple[object, ...]]:
+    """What each editor of the panel shows, the entries of its lists too (not in a picture)."""
+    states: list[tuple[object, ...]] = [(panel.title.text(),)]
+    for key, e in panel.editors.items():
+        refusal = (e.reason.isVisibleTo(e), e.reason.text())
+        if isinstance(e, LineEditor):  # ColorEditor too
+            shown = (e.line.text(), e.line.placeholderText(), e.line.styleSheet())
+        elif isinstance(e, ComboEditor):
+            shown = ([e.combo.itemText(i) for i in range(e.combo.count())], e.combo.currentIndex())
+        elif isinstance(e, BoolEditor):
+            shown = (e.box.checkState(),)
+        else:
+            assert isinstance(e, FontEditor)
+            shown = (e.button.text(),)
+        states.append((key, type(e).__name__, *shown, *refusal))
+    return states
+
+
+def picture(widget: QWidget) -> QImage:
+    """The widget as drawn on a white page (a docked panel and a window have other backgrounds)."""
+    image = QImage(widget.size(), QImage.Format.Format_RGB32)
+    image.fill(Qt.GlobalColor.white)
+    widget.render(image)
+    return image
+
+
+def test_another_element_of_the_same_type_fills_the_same_editors_and_looks_as_if_new(
+        window: DesignerWindow, qtbot: QtBot) -> None:
+    """A click on an element of the type shown already refills its editors instead of making them
+    again (most of a click's time): what it shows, a refusal of the last element's cleared and the
+    panel scrolled back to the top, is what a panel made afresh for the element shows."""
+    window.show()
+    qtbot.waitExposed(window)
+    panel = window.properties
+    select(window, "Связь с узлом 0")
+    editors = dict(panel.editors)
+    addr = panel.editors["InAddr"]
+    assert isinstance(addr, LineEditor)
+    addr.line.setText("NO_SUCH")
+    addr.line.editingFinished.emit()
+    assert addr.reason.isVisibleTo(addr)
+    panel.scroll.verticalScrollBar().setValue(panel.scroll.verticalScrollBar().maximum())
+    select(window, "Выход триггера")  # DiscreteColorLabel as well
+    assert panel.editors == editors  # the same editor objects
+    assert not addr.reason.isVisibleTo(addr) and addr.line.text() == "040005"
+    QApplication.processEvents()  # laid out: the window's docks, a refusal's line gone, the title
+    fresh = PropertyPanel(window.design, panel.names)
+    qtbot.addWidget(fresh)
+    fresh.show_selection()
+    fresh.resize(panel.size())
+    fresh.show()
+    qtbot.waitExposed(fresh)
+    QApplication.processEvents()
+    assert [id(e) for e in fresh.editors.values()] != [id(e) for e in editors.values()]
+    assert editor_states(panel) == editor_states(fresh)
+    assert picture(panel) == picture(fresh)
+    select(window, "Пуск")  # another type: other editors; back to the first type: its own again
+    assert "TextFalse" in panel.editors and panel.editors["InAddr"] is not addr
+    select(window, "Связь с узлом 0")
+    assert panel.editors == editors
+    fresh.show_selection()  # of the same design: the element selected now
+    assert editor_states(panel) == editor_states(fresh)
+
+
+def test_a_journal_on_the_canvas_is_drawn_again_when_its_page_is_read(qtbot: QtBot, demo_copy: Path) -> None:
+    """The canvas shows a picture of each element's widget; a journal's page is read in a thread
+    after the first picture was taken, and the canvas shows the page once it is read."""
+    from hmi_forms.elements.journal import MessageJournal
+    from tests.app.held_archive import archive_with
+
+    archive_with(demo_copy / "archive" / "journal.sqlite", ["первая запись", "вторая запись"])
+    w = make_window(qtbot, demo_copy / "forms" / "02_analog.hmi")
+    item = next(i for i in w.design.items.values() if isinstance(i.model, MessageJournal))
+    w.show()
+    qtbot.waitExposed(w)
+    qtbot.waitUntil(lambda: item.widget is not None and item.widget.table.rowCount() == 2, timeout=10_000)
+    widget = item.widget
+
+    def drawn_as_shown() -> bool:  # the element's area of the canvas, as the widget shows itself
+        shown = widget.grab().toImage().convertToFormat(QImage.Format.Format_RGB32)
+        drawn = QImage(shown.size(), QImage.Format.Format_RGB32)
+        painter = QPainter(drawn)
+        try:
+            w.design.scene.render(painter, QRectF(drawn.rect()), item.mapToScene(item.rect()).boundingRect())
+        finally:
+            painter.end()
+        return drawn == shown
+
+    qtbot.waitUntil(drawn_as_shown, timeout=10_000)

@@ -4,21 +4,21 @@ the element fitting a tag, and `check` and the problems pane warn of a contradic
 from __future__ import annotations
 
 import json
-import subprocess
-import sys
 from pathlib import Path
 
+import pytest
 from PySide6.QtCore import QMimeData, QPointF, Qt
 from PySide6.QtGui import QDropEvent
 from pytestqt.qtbot import QtBot
 
+from app.cli import main
 from app.gui.designer.canvas import TAG_MIME
 from app.gui.designer.window import DesignerWindow
 from netplc.address import data_index
 from netplc.memory import Snapshot
 from tests.app.test_designer import make_window
+from tests.commands import run_in_process
 
-REPO = Path(__file__).resolve().parents[2]
 TEMP_ADDR = 0o4012  # symbols.csv: TEMP, raw 0..1000 for -50..150 °C
 
 
@@ -92,11 +92,10 @@ def contradict(form: Path) -> None:
 
 
 def test_check_and_the_problems_pane_warn_of_a_contradicting_conversion(
-        qtbot: QtBot, demo_copy: Path) -> None:
+        qtbot: QtBot, demo_copy: Path, capsys: pytest.CaptureFixture[str]) -> None:
     form = demo_copy / "forms" / "02_analog.hmi"
     contradict(form)
-    r = subprocess.run([sys.executable, "main.py", "check", str(demo_copy)], cwd=REPO, capture_output=True,
-                       text=True, timeout=60)
+    r = run_in_process(main, ["check", demo_copy], capsys)  # test_check.py runs `main.py check` itself
     assert r.returncode == 0, r.stdout + r.stderr  # a warning: the station still opens the form
     warned = [line for line in r.stdout.splitlines() if line.startswith("предупреждение:")]  # the demo is ru
     assert any("02_analog.hmi" in line and "AppMax: 0..4095 -> 0..100 противоречит тегу TEMP с "

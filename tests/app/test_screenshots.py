@@ -37,5 +37,5 @@ def check_pictures(folder: Path, language: str, others: list[str]) -> None:
 
 
 def test_screenshots_of_every_form_and_the_viewer_in_english(qtbot, tmp_path: Path) -> None:
-    assert main([str(tmp_path), "--seconds", "1.5", "--language", "en"]) == 0
+    assert main([str(tmp_path), "--seconds", "0.5", "--language", "en"]) == 0
     check_pictures(tmp_path, "", ["viewer-records.png", "viewer-series.png"])

@@ -185,3 +185,39 @@ def test_elements_mark_a_dead_node_and_a_stopped_netplc_and_link_labels_follow_t
     runtime.simulator_answers(0, False)  # NetPlc is stopped, its copy of the link frozen at 1...
     qtbot.waitUntil(lambda: link.value == 0, timeout=10_000)  # ...the label follows the link itself
     assert "нет связи" in link.text and not link.stale
+
+
+def test_a_key_click_or_wheel_in_any_window_of_the_workstation_keeps_the_user_logged_in(
+        qtbot, workstation: MainWindow) -> None:
+    """Input as the window system gives it (to a window, then to its widget), in the main window and
+    in a window opened from it; with none, the idle user is logged out."""
+    from PySide6.QtCore import QPoint, QPointF
+    from PySide6.QtGui import QWheelEvent
+    from PySide6.QtTest import QTest
+    from PySide6.QtWidgets import QApplication
+
+    now = [0.0]
+    session = workstation.session
+    session.clock = lambda: now[0]
+    session.idle = 900
+    workstation.login("operator", "operator")
+    qtbot.waitExposed(workstation)
+    trends = workstation.open_trends()
+    qtbot.waitExposed(trends)
+
+    def idle_then(act) -> str:
+        now[0] += 800
+        act()
+        now[0] += 200  # 1000 s after the login, 200 s after the input
+        workstation.refresh_status()
+        return workstation.user
+
+    main = workstation.windowHandle()
+    assert idle_then(lambda: QTest.keyClick(main, Qt.Key.Key_Shift)) == "operator"
+    assert idle_then(lambda: QTest.mouseClick(trends.windowHandle(), Qt.MouseButton.LeftButton,
+                                              Qt.KeyboardModifier.NoModifier, QPoint(5, 5))) == "operator"
+    wheel = QWheelEvent(QPointF(5, 5), QPointF(main.mapToGlobal(QPoint(5, 5))), QPoint(), QPoint(0, -120),
+                        Qt.MouseButton.NoButton, Qt.KeyboardModifier.NoModifier, Qt.ScrollPhase.NoScrollPhase,
+                        False)
+    assert idle_then(lambda: QApplication.sendEvent(main, wheel)) == "operator"
+    assert idle_then(lambda: None) == "viewer"  # 1000 s without input

@@ -124,10 +124,18 @@ class Design(QObject):
         return [raw for raw in self.doc.elements if id(raw) in chosen]
 
     def select(self, raws: list[dict[str, Any]]) -> None:
-        self.scene.clearSelection()
-        for raw in raws:
-            if id(raw) in self.items:
-                self.items[id(raw)].setSelected(True)
+        """Select `raws`, said once (the scene says each item's change: as many panels shown)."""
+        before = [id(r) for r in self.selected()]
+        self.blockSignals(True)
+        try:
+            self.scene.clearSelection()
+            for raw in raws:
+                if id(raw) in self.items:
+                    self.items[id(raw)].setSelected(True)
+        finally:
+            self.blockSignals(False)
+        if [id(r) for r in self.selected()] != before:
+            self.selection_changed.emit()
 
     # --- changing it (called by the commands) ---------------------------------------------------
 

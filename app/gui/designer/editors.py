@@ -95,29 +95,45 @@ class Editor(QWidget):
     def __init__(self, check: Check, parent: QWidget | None = None) -> None:
         super().__init__(parent)
         self.check = check
-        self.reason = QLabel()
-        self.reason.setObjectName("refusal")
-        self.reason.setWordWrap(True)
-        self.reason.setStyleSheet("color: #b71c1c;")
-        self.reason.hide()
+        self._reason: QLabel | None = None
         self.row = QHBoxLayout()
         self.row.setContentsMargins(0, 0, 0, 0)
-        box = QVBoxLayout(self)
-        box.setContentsMargins(0, 0, 0, 0)
-        box.setSpacing(1)
-        box.addLayout(self.row)
-        box.addWidget(self.reason)
+        self.column = QVBoxLayout(self)
+        self.column.setContentsMargins(0, 0, 0, 0)
+        self.column.setSpacing(1)
+        self.column.addLayout(self.row)
+
+    @property
+    def reason(self) -> QLabel:
+        """The line under the editor saying why a value was refused, made the first time one is: a
+        panel has dozens of editors, and most are never refused (hidden, it takes no room)."""
+        if self._reason is None:
+            self._reason = QLabel()
+            self._reason.setObjectName("refusal")
+            self._reason.setWordWrap(True)
+            self._reason.setStyleSheet("color: #b71c1c;")
+            self._reason.hide()
+            self.column.addWidget(self._reason)
+        return self._reason
 
     def set_value(self, value: Any, mixed: bool = False) -> None:
         raise NotImplementedError
 
     def refuse(self, reason: str | None) -> None:
         """Show why the last value was refused (None: clear the mark)."""
-        self.reason.setText(reason or "")
-        self.reason.setVisible(bool(reason))
+        if reason or self._reason is not None:
+            self.reason.setText(reason or "")
+            self.reason.setVisible(bool(reason))
 
     def submit(self, value: Any) -> None:
         self.edited.emit(value)
+
+
+def _restyle(widget: QWidget, sheet: str) -> None:
+    """Set a widget's style sheet unless it has it already: setting one, even the same or an empty
+    one, polishes the widget again, and a panel's refresh sets each of its editors'."""
+    if widget.styleSheet() != sheet:
+        widget.setStyleSheet(sheet)
 
 
 class LineEditor(Editor):
@@ -142,12 +158,12 @@ class LineEditor(Editor):
         self._shown = "" if mixed else shown(value)
         self.line.setText(self._shown)
         self.line.setPlaceholderText("(several values)" if mixed else "")
-        self.line.setStyleSheet("")
+        _restyle(self.line, "")
         self.refuse(None)
 
     def _typed(self, text: str) -> None:
         reason = self.check(from_text(self.kind, text))
-        self.line.setStyleSheet(REFUSED_STYLE if reason else "")
+        _restyle(self.line, REFUSED_STYLE if reason else "")
         self.refuse(reason)
 
     def _finished(self) -> None:
@@ -192,6 +208,7 @@ class ComboEditor(Editor):
         self.combo.addItem(self.tr("(default)"), MISSING)
         for label, value in options:
             self.combo.addItem(label, value)
+        self.options = self.combo.count()  # those after them are values set_value added
         self.row.addWidget(self.combo)
         self.combo.activated.connect(lambda i: self.submit(self.combo.itemData(i)))
         if editable:
@@ -204,6 +221,8 @@ class ComboEditor(Editor):
         self.submit(value)
 
     def set_value(self, value: Any, mixed: bool = False) -> None:
+        while self.combo.count() > self.options:  # another element's value, not one to offer
+            self.combo.removeItem(self.combo.count() - 1)
         i = -1 if mixed else next((k for k in range(self.combo.count())
                                    if self.combo.itemData(k) == value), -1)
         if i < 0 and not mixed and value is not MISSING:
@@ -228,9 +247,9 @@ class ColorEditor(LineEditor):
         super().set_value(value, mixed)
         try:
             r, g, b, a = p.color(value, None)  # type: ignore[arg-type]
-            self.pick.setStyleSheet(f"background: rgba({r},{g},{b},{a});")
+            _restyle(self.pick, f"background: rgba({r},{g},{b},{a});")
         except p.PropError:
-            self.pick.setStyleSheet("")
+            _restyle(self.pick, "")
 
     def _dialog(self) -> None:
         color = QColorDialog.getColor(QColor(self.line.text() or "#ffffff"), self, self.tr("Colour"),

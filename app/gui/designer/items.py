@@ -24,6 +24,7 @@ from hmi_forms.elements import Element
 from hmi_forms.elements.analog import AnalogBase, Scaled
 from hmi_forms.widgets import theme
 from hmi_forms.widgets.base import ElementWidget, SelfPainted
+from hmi_forms.widgets.journal import JournalWidget
 from netplc.memory import Snapshot
 
 if TYPE_CHECKING:
@@ -134,6 +135,12 @@ class ElementItem(QGraphicsItem):
             self._pixmap = None
             self.update()
 
+    def _read_again(self, *_: object) -> None:
+        """A journal's page arrived: the canvas shows a picture of the widget taken before, which
+        the widget's own repaint does not reach; drawn again with the rows."""
+        self._pixmap = None
+        self.update()
+
     def _placeholder(self, p: QPainter, r: QRectF) -> None:
         """An element no widget can draw (an unknown type): its type and name on a hatched box."""
         p.fillRect(r, QBrush(QColor(211, 47, 47, 60), Qt.BrushStyle.BDiagPattern))
@@ -171,6 +178,8 @@ class ElementItem(QGraphicsItem):
             self.show_snapshot(self.design.snapshot)
         if self.widget is None and self.model is not None:
             self.widget = self.design.widget_for(self.model)
+            if isinstance(self.widget, JournalWidget):  # its page is read in a thread, after this
+                self.widget.worker.answered.connect(self._read_again)
         widget = self.widget
         p.save()
         try:

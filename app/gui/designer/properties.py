@@ -13,6 +13,7 @@ import copy
 from dataclasses import fields, replace
 from typing import Any
 
+from PySide6.QtGui import QShowEvent
 from PySide6.QtWidgets import QFormLayout, QLabel, QScrollArea, QVBoxLayout, QWidget
 
 from app.gui.designer.commands import MISSING
@@ -71,8 +72,13 @@ class PropertyPanel(QWidget):
         self.design = design
         self.names = names
         self.targets: list[dict[str, Any]] = []
-        self.editors: dict[str, Editor] = {}
+        self._editors: dict[str, Editor] = {}
         self._key: tuple[object, ...] | None = None
+        self._stale = False  # the selection changed while the panel was not seen: shown when it is
+        # the editors made for a kind of selection, kept to be filled again when another selection
+        # of the same kind (type and properties) is shown: building them is most of a click's time
+        self._panels: dict[tuple[object, ...], tuple[QWidget, dict[str, Editor]]] = {}
+        self._offered: tuple[str, str] | None = None
         self.title = QLabel()
         self.title.setWordWrap(True)
         self.title.setStyleSheet("font-weight: bold; padding: 4px;")
@@ -86,15 +92,23 @@ class PropertyPanel(QWidget):
     def set_design(self, design: Design) -> None:
         self.design = design
         self._key = None
+        self._forget_panels()  # another form: its own pictures and devices to offer
         self.show_selection()
 
     @property
     def form_mode(self) -> bool:
         return not self.targets or self.targets[0] is self.design.doc.settings
 
+    @property
+    def editors(self) -> dict[str, Editor]:
+        """The editors of the selection's properties (made now if the panel was not seen yet)."""
+        self._catch_up()
+        return self._editors
+
     def show_selection(self) -> None:
-        """Rebuild the editors when the selection (or what the editors offer) changed; otherwise
-        only refresh their values."""
+        """Show the editors of another selection (or of what the editors offer changing) from the
+        top, now if the panel is seen, else when it is (a window not shown yet, a closed dock); for
+        the same selection only refresh their values."""
         raws = self.design.selected()
         offered = (str(self.design.doc.data.get("images")), str(self.design.doc.data.get("devices")))
         key = (*(id(r) for r in raws), *(str(r.get("type")) for r in raws), *offered)
@@ -102,10 +116,55 @@ class PropertyPanel(QWidget):
             self.refresh()
             return
         self._key = key
+        if offered != self._offered:  # the image and device pickers offer other entries now
+            self._forget_panels()
+            self._offered = offered
         self.targets = raws or [self.design.doc.settings]
-        self._build(raws)
+        self._stale = True
+        if self.isVisible():
+            self._catch_up()
+        else:
+            self.refresh()  # the title
 
-    def _build(self, raws: list[dict[str, Any]]) -> None:
+    def showEvent(self, event: QShowEvent) -> None:
+        self._catch_up()
+        super().showEvent(event)
+
+    def _catch_up(self) -> None:
+        if not self._stale:
+            return
+        self._stale = False
+        self._show([] if self.form_mode else self.targets)
+        self.scroll.verticalScrollBar().setValue(0)
+
+    def _forget_panels(self) -> None:
+        shown = self.scroll.takeWidget()  # the scroll area would delete it when given the next
+        if shown is not None:
+            shown.setParent(self)
+            shown.hide()
+        for body, _ in self._panels.values():
+            body.deleteLater()
+        self._panels.clear()
+
+    def _show(self, raws: list[dict[str, Any]]) -> None:
+        """The editors of the selection's kind: those made for an earlier selection of the same type
+        and properties when there are (each editor's set_value leaves it as a new one), else new."""
+        keys, parsers = self._offer(raws)
+        kind = (str(raws[0].get("type")) if raws else None, *keys)
+        if kind not in self._panels:
+            self._panels[kind] = self._build(keys, parsers)
+        body, self._editors = self._panels[kind]
+        if self.scroll.widget() is not body:
+            shown = self.scroll.takeWidget()
+            if shown is not None:
+                shown.setParent(self)  # kept, hidden, for the next selection of its kind
+                shown.hide()
+            self.scroll.setWidget(body)
+            body.show()
+        self.refresh()
+
+    def _offer(self, raws: list[dict[str, Any]]) -> tuple[list[str], dict[str, Any]]:
+        """The properties to edit for `raws` (the form's when empty), and their parsers."""
         if raws:
             keys = shown_keys(raws[0])
             for raw in raws[1:]:
@@ -117,19 +176,21 @@ class PropertyPanel(QWidget):
         else:
             keys = [*FORM_PROPS, *FORM_SECTIONS]
             parsers = dict(FORM_PROPS)
+        return keys, parsers
+
+    def _build(self, keys: list[str], parsers: dict[str, Any]) -> tuple[QWidget, dict[str, Editor]]:
         body = QWidget()
         form = QFormLayout(body)
         form.setFieldGrowthPolicy(QFormLayout.FieldGrowthPolicy.AllNonFixedFieldsGrow)
-        self.editors = {}
+        editors: dict[str, Editor] = {}
         for k in keys:
             editor = self._editor(k, parsers.get(k))
             editor.edited.connect(lambda value, k=k: self.commit(k, value))
-            self.editors[k] = editor
+            editors[k] = editor
             label = QLabel(k)
             label.setToolTip(f"{k}: {kind_of(parsers[k]) if k in parsers else 'JSON'}")
             form.addRow(label, editor)
-        self.scroll.setWidget(body)
-        self.refresh()
+        return body, editors
 
     def _editor(self, key: str, parser: Any) -> Editor:
         def check(value: Any, key: str = key) -> str | None:
@@ -164,7 +225,9 @@ class PropertyPanel(QWidget):
         one = f'{t[0].get("type")} "{t[0].get("Name")}"'
         self.title.setText(self.tr("Form {0}").format(self.design.doc.path.name) if self.form_mode else
                            one if len(t) == 1 else self.tr("{0} elements").format(len(t)))
-        for key, editor in self.editors.items():
+        if self._stale:
+            return  # the editors are made and filled when the panel is seen
+        for key, editor in self._editors.items():
             values = [self._source(t, key).get(key, MISSING) for t in self.targets]
             mixed = any(v != values[0] for v in values[1:])
             editor.set_value(values[0], mixed)

@@ -2,10 +2,11 @@
 
 from __future__ import annotations
 
+from functools import lru_cache
 from typing import TYPE_CHECKING, Any
 
 from PySide6.QtCore import QPointF, QRectF
-from PySide6.QtGui import QColor, QPainter
+from PySide6.QtGui import QColor, QPainter, QPolygonF
 from PySide6.QtWidgets import QGraphicsScene
 
 from hmi_forms.elements import props as p
@@ -47,9 +48,17 @@ class FormScene(QGraphicsScene):
             painter.setPen(GRID_DOT)
             visible = rect.intersected(form)
             g = d.grid
-            x0 = int(visible.left()) // g * g
-            y0 = int(visible.top()) // g * g
-            points = [QPointF(x, y) for x in range(x0, int(visible.right()) + 1, g)
-                      for y in range(y0, int(visible.bottom()) + 1, g)]
-            if len(points) < MAX_DOTS:
-                painter.drawPoints(points)
+            dots = _dots(int(visible.left()) // g * g, int(visible.top()) // g * g, int(visible.right()),
+                         int(visible.bottom()), g)
+            if dots is not None:
+                painter.drawPoints(dots)
+
+
+@lru_cache(maxsize=16)
+def _dots(x0: int, y0: int, right: int, bottom: int, g: int) -> QPolygonF | None:
+    """The grid's dots in a rectangle (None: too many to draw), kept for the next repaint of the same
+    area (an element's at each preview snapshot, the whole canvas when scrolled back): making
+    thousands of points in Python was most of a repaint's time."""
+    if ((right - x0) // g + 1) * ((bottom - y0) // g + 1) >= MAX_DOTS:
+        return None
+    return QPolygonF([QPointF(x, y) for x in range(x0, right + 1, g) for y in range(y0, bottom + 1, g)])
