@@ -4,13 +4,15 @@ fits a 1366x768 screen whatever the forms hold."""
 from __future__ import annotations
 
 import datetime as dt
+import gc
 import math
 import sqlite3
-from collections.abc import Iterator
+import threading
+from collections.abc import Callable, Iterator
 from pathlib import Path
 
 import pytest
-from PySide6.QtCore import QPoint, Qt
+from PySide6.QtCore import QEvent, QPoint, Qt
 from PySide6.QtWidgets import QPlainTextEdit
 
 from app import __version__
@@ -20,10 +22,8 @@ from app.station.config import load_station
 from app.station.runtime import Runtime
 from hmi_forms.elements import formats
 from netplc.address import fmt_octal
-from netplc.records import Record
 from registrar.query import Archive
 from tests.app.conftest import copy_demo
-from tests.cheap_users import cheap_demo_users
 
 LEVEL = 0o4010
 START_BIT = 0o40042
@@ -31,24 +31,70 @@ BROKEN = ('{"form": {"title": "broken", "width": 100, "height": 100}, "elements"
           '"Name": "' + "a_very_long_element_name_" * 40 + '", "x": "not a number"}]}')
 
 
-@pytest.fixture
-def console(qtbot, tmp_path: Path) -> Iterator[MainWindow]:
-    """The demo's console in English: its tests read the journal word for word; its users at the
-    tests' cheap scrypt cost (tests/cheap_users.py)."""
-    demo_copy = copy_demo(tmp_path / "station", "en")
-    cheap_demo_users(demo_copy)
+def open_console(folder: Path) -> MainWindow:
+    """The demo's console in English, started: its tests read the journal word for word; its users
+    at the tests' cheap scrypt cost (tests/cheap_users.py); a broken form among its forms."""
+    demo_copy = copy_demo(folder, "en")
     (demo_copy / "forms" / "99_broken.hmi").write_text(BROKEN, encoding="utf-8")
     runtime = Runtime(load_station(demo_copy))
     runtime.start()
     window = MainWindow(runtime)
-    qtbot.addWidget(window)
     window.resize(1366, 768)
     window.show()
+    return window
+
+
+def reset(window: MainWindow, idle: tuple[float, Callable[[], float]]) -> None:
+    """What a test left on the module's console that the next one could mistake for its own: the
+    user on duty, the answers given for the operator, the session's clock, the faceplates and
+    windows opened, the message said, the form shown."""
+    vars(window).pop("ask", None)
+    window.session.idle, window.session.clock = idle
+    window.log_out()
+    window.faceplates.close()
+    for opened in window.viewers:
+        opened.close()
+    window.viewers.clear()
+    window.programs.clear()
+    window.status.clearMessage()
+    window.tabs.setCurrentIndex(0)
+
+
+@pytest.fixture(scope="module")
+def shared_console(qapp, tmp_path_factory: pytest.TempPathFactory) -> Iterator[MainWindow]:
+    """One console for the module's tests that leave the station running, its users as they were
+    and put back what they change (`reset` after each): a console and its station cost more to
+    build than most of these tests take."""
+    window = open_console(tmp_path_factory.mktemp("console") / "station")
     try:
         yield window
     finally:
         window.close()
-        runtime.stop()
+        window.runtime.stop()
+        window.deleteLater()
+        qapp.sendPostedEvents(None, QEvent.Type.DeferredDelete.value)
+        del window
+        gc.collect()  # on the GUI thread (app/gui/application.py)
+
+
+@pytest.fixture
+def console(shared_console: MainWindow) -> Iterator[MainWindow]:
+    """The module's console (`shared_console`), the default viewer on duty, and reset after the test."""
+    idle = shared_console.session.idle, shared_console.session.clock
+    yield shared_console
+    reset(shared_console, idle)
+
+
+@pytest.fixture
+def own_console(qtbot, tmp_path: Path) -> Iterator[MainWindow]:
+    """A console of the test's own, for a test that stops its station, quits it or changes its users."""
+    window = open_console(tmp_path / "station")
+    qtbot.addWidget(window)
+    try:
+        yield window
+    finally:
+        window.close()
+        window.runtime.stop()
 
 
 def test_a_broken_form_does_not_widen_the_window(qtbot, console: MainWindow) -> None:
@@ -104,6 +150,14 @@ def operator_rows(runtime: Runtime) -> list[tuple[str, str]]:
         con.close()
 
 
+def committed(qtbot, runtime: Runtime) -> None:
+    """Back once every record journaled so far is in the archive's file (the writer commits it at
+    once for the barrier), for a test that reads the journal while its station runs on."""
+    done = threading.Event()
+    runtime.after_commit(done.set)
+    qtbot.waitUntil(done.is_set, timeout=10_000)
+
+
 class Answers:
     """The operator's answers to the confirmations, and the questions asked."""
 
@@ -134,7 +188,8 @@ def test_the_demo_opens_as_its_viewer_who_may_not_act(qtbot, console: MainWindow
     assert engine.snapshot.get_hmi_bit(START_BIT) == 0
 
 
-def test_run_stop_and_quit_need_the_engineer_and_ask(qtbot, console: MainWindow) -> None:
+def test_run_stop_and_quit_need_the_engineer_and_ask(qtbot, own_console: MainWindow) -> None:
+    console = own_console
     runtime = console.runtime
     console.ask = no = Answers(False)
     console.login("operator", "operator")
@@ -178,7 +233,9 @@ def test_ctrl_q_and_f5_no_longer_act_at_once(console: MainWindow) -> None:
     assert console.isVisible()
 
 
-def test_an_element_asks_when_the_form_says_confirm_and_checks_its_role(qtbot, console: MainWindow) -> None:
+def test_an_element_asks_when_the_form_says_confirm_and_checks_its_role(
+        qtbot, own_console: MainWindow) -> None:
+    console = own_console
     engine = console.runtime.engine
     model, button = element(console, "Пуск")
     qtbot.waitUntil(lambda: model.value == 0, timeout=5000)
@@ -211,7 +268,7 @@ def test_an_idle_user_is_logged_out_and_it_is_journaled(qtbot, console: MainWind
     now[0] += 901
     console.refresh_status()
     assert console.user == "viewer" and "Log in" in console.header.login.text()
-    console.runtime.stop()
+    committed(qtbot, console.runtime)
     assert operator_rows(console.runtime)[-1] == ("operator", "logged out: idle")
 
 
@@ -230,6 +287,7 @@ def test_every_demo_form_fits_a_1366x768_window(qtbot, console: MainWindow) -> N
     console.tabs.setCurrentIndex(0)
     area.set_mode(ACTUAL)
     assert area.factor == 1.0 and area.cut_off()  # 760 px of form above the journal: it needs the zoom
+    area.set_mode(FIT_WINDOW)  # as it was
 
 
 def test_the_zoom_is_remembered_per_form(qtbot, console: MainWindow) -> None:
@@ -246,6 +304,8 @@ def test_the_zoom_is_remembered_per_form(qtbot, console: MainWindow) -> None:
         assert again.zooms[2].mode == FIT_WINDOW  # the default
     finally:
         again.close()
+        first.set_mode(FIT_WINDOW)  # as they were
+        second.set_mode(FIT_WINDOW)
 
 
 def test_the_trends_of_a_form_share_one_time_axis(qtbot, console: MainWindow) -> None:
@@ -292,18 +352,11 @@ def level_samples(archive: Path) -> int:
         reader.close()
 
 
-def test_a_trend_starts_with_the_archives_history(qtbot, demo_copy: Path) -> None:
-    first = Runtime(load_station(demo_copy))
-    stored: list[Record] = []  # the level's samples as the station archives them
-    first.subscribe(lambda r: stored.append(r) if r.kind == "data" and r.source == fmt_octal(LEVEL) else None)
-    first.start()
-    try:
-        qtbot.waitUntil(lambda: len(stored) > 1, timeout=15_000)
-    finally:
-        first.stop()  # the archive written to the last record
-    assert level_samples(first.station.Archive) > 1
-    runtime = Runtime(load_station(demo_copy))
-    runtime.start()
+def test_a_trend_starts_with_the_archives_history(qtbot, console: MainWindow) -> None:
+    """A window opened on a station whose archive holds the level's samples (the module's, run a
+    while: NSTORE once a second) starts its trend with them."""
+    runtime = console.runtime
+    qtbot.waitUntil(lambda: level_samples(runtime.station.Archive) > 1, timeout=15_000)  # committed
     window = MainWindow(runtime)
     qtbot.addWidget(window)
     try:
@@ -314,7 +367,6 @@ def test_a_trend_starts_with_the_archives_history(qtbot, demo_copy: Path) -> Non
         assert values and all(0 <= v <= 100 for v in values)  # raw NSTORE words, scaled to %
     finally:
         window.close()
-        runtime.stop()
 
 
 def test_about_names_the_version(console: MainWindow) -> None:
@@ -411,7 +463,8 @@ def test_the_language_comes_from_station_toml(demo_copy: Path) -> None:
     assert load_station(demo_copy).Language == "en"
 
 
-def test_only_an_admin_manages_users_and_it_is_journaled(qtbot, console: MainWindow) -> None:
+def test_only_an_admin_manages_users_and_it_is_journaled(qtbot, own_console: MainWindow) -> None:
+    console = own_console
     from app.authority.users import Users
 
     for name in ("operator", "engineer"):
