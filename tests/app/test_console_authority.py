@@ -18,7 +18,11 @@ from app.station.runtime import Runtime
 from tests.app import test_console
 from tests.app.test_console import Answers, element, operator_rows, scans_later
 
-console = test_console.console  # the fixture: the demo station's console, started, viewer on duty
+# the fixtures: the demo station's console, started, viewer on duty: the module's (`console`, reset
+# after each test) or, for a test that reads the whole journal of its station, one of its own
+console, shared_console = test_console.console, test_console.shared_console
+own_console = test_console.own_console
+
 START_BIT = 0o40042
 FORCED_BIT = 0o2120
 
@@ -38,7 +42,9 @@ def greyed(control, role: str) -> bool:
     return not control.isEnabled() and f"needs the {role} role" in control.toolTip()
 
 
-def test_a_viewer_is_refused_everything_once_per_cause_and_sees_it_greyed(qtbot, console: MainWindow) -> None:
+def test_a_viewer_is_refused_everything_once_per_cause_and_sees_it_greyed(
+        qtbot, own_console: MainWindow) -> None:
+    console = own_console
     runtime, summary = console.runtime, console.summary
     assert console.user == "viewer"
     for control in (summary.ack, summary.ack_all, summary.shelve, summary.unshelve, console.alarms.ack,
@@ -76,7 +82,8 @@ def test_a_viewer_is_refused_everything_once_per_cause_and_sees_it_greyed(qtbot,
         ("viewer", "refused stop NetPlc"): 1, ("program view:viewer", "refused force bit 02120"): 1}
 
 
-def test_an_operator_acknowledges_and_writes_but_does_not_force(qtbot, console: MainWindow) -> None:
+def test_an_operator_acknowledges_and_writes_but_does_not_force(qtbot, own_console: MainWindow) -> None:
+    console = own_console
     runtime, summary = console.runtime, console.summary
     console.login("operator", "operator")
     runtime.stop_program("engineer")  # the station's own alarm: NetPlc is not running
@@ -109,7 +116,8 @@ def test_an_operator_acknowledges_and_writes_but_does_not_force(qtbot, console: 
     assert refusals(runtime) == {("program view:operator", "refused force bit 02120"): 1}
 
 
-def test_an_engineer_forces_and_stops(qtbot, console: MainWindow) -> None:
+def test_an_engineer_forces_and_stops(qtbot, own_console: MainWindow) -> None:
+    console = own_console
     runtime = console.runtime
     console.login("engineer", "engineer")
     monitor = program_view(console)

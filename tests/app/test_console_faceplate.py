@@ -8,7 +8,7 @@ from PySide6.QtCore import Qt
 
 from app.gui.faceplate import Faceplate
 from app.gui.main_window import MainWindow
-from tests.app.test_console import Answers, console, element  # noqa: F401 - the console fixture
+from tests.app.test_console import Answers, console, element, shared_console  # noqa: F401 - fixtures
 
 SETPOINT = 0o4030
 
@@ -16,8 +16,8 @@ SETPOINT = 0o4030
 def open_plate(qtbot, window: MainWindow, name: str) -> Faceplate:
     _, widget = element(window, name)
     qtbot.mouseDClick(widget, Qt.MouseButton.LeftButton)
-    plate = window.findChild(Faceplate)
-    assert plate is not None and plate.isVisible()
+    plate = window.faceplates.open[window.faceplates.bound[widget].name]
+    assert isinstance(plate, Faceplate) and plate.isVisible()
     return plate
 
 

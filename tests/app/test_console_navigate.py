@@ -8,7 +8,7 @@ from PySide6.QtCore import Qt
 
 from app.gui.main_window import MainWindow
 from app.gui.navigate import Highlight
-from tests.app.test_console import LEVEL, console  # noqa: F401 - the console fixture
+from tests.app.test_console import LEVEL, console, shared_console  # noqa: F401 - the console fixtures
 
 
 def test_a_double_clicked_alarm_shows_its_element_and_the_tab_is_marked(qtbot, console: MainWindow) -> None:  # noqa: F811
