@@ -5,12 +5,13 @@ from __future__ import annotations
 
 import csv
 import datetime as dt
+import gc
 import time
 from collections.abc import Iterator
 from pathlib import Path
 
 import pytest
-from PySide6.QtCore import Qt
+from PySide6.QtCore import QEvent, Qt
 
 from app.gui.main_window import MainWindow
 from app.gui.trend_window import TrendWindow
@@ -19,6 +20,7 @@ from app.station.config import load_station
 from app.station.runtime import Runtime
 from netplc.records import Record
 from registrar.store import Store
+from tests.app.conftest import copy_demo
 
 WAIT = 15_000
 
@@ -34,20 +36,37 @@ def archived(path: Path, t0: float) -> None:
     store.close()
 
 
-@pytest.fixture
-def station(qtbot, demo_copy: Path) -> Iterator[tuple[MainWindow, float]]:
+@pytest.fixture(scope="module")
+def trended(qapp, tmp_path_factory: pytest.TempPathFactory) -> Iterator[tuple[MainWindow, float]]:
+    """The demo's console, its archive holding the `archived` samples from two hours ago: one for
+    the module's tests that open trends on it (`station` closes them after each)."""
+    demo_copy = copy_demo(tmp_path_factory.mktemp("trends") / "station")
     t0 = float(int(time.time()) - 7200)  # two hours ago, whole seconds (the archive keeps ms)
     archived(demo_copy / "archive" / "journal.sqlite", t0)
     runtime = Runtime(load_station(demo_copy))
     runtime.start()
     window = MainWindow(runtime)
-    qtbot.addWidget(window)
     window.resize(1366, 768)
     try:
         yield window, t0
     finally:
         window.close()
         runtime.stop()
+        window.deleteLater()
+        qapp.sendPostedEvents(None, QEvent.Type.DeferredDelete.value)
+        del window
+        gc.collect()  # on the GUI thread (app/gui/application.py)
+
+
+@pytest.fixture
+def station(trended: tuple[MainWindow, float]) -> Iterator[tuple[MainWindow, float]]:
+    """The module's console for one test: its trend windows closed after it, the viewer on duty."""
+    yield trended
+    window = trended[0]
+    for opened in window.viewers:
+        opened.close()
+    window.viewers.clear()
+    window.log_out()
 
 
 def test_two_tags_picked_give_pens_cursors_and_statistics_of_the_archive(
