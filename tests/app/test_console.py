@@ -60,6 +60,17 @@ def reset(window: MainWindow, idle: tuple[float, Callable[[], float]]) -> None:
     window.tabs.setCurrentIndex(0)
 
 
+def close_shared(qapp, window: MainWindow) -> None:
+    """A module's console closed, its station stopped, and the window freed on the GUI thread
+    (app/gui/application.py) before the next module starts."""
+    window.close()
+    window.runtime.stop()
+    window.deleteLater()
+    qapp.sendPostedEvents(None, QEvent.Type.DeferredDelete.value)
+    del window
+    gc.collect()
+
+
 @pytest.fixture(scope="module")
 def shared_console(qapp, tmp_path_factory: pytest.TempPathFactory) -> Iterator[MainWindow]:
     """One console for the module's tests that leave the station running, its users as they were
@@ -69,12 +80,25 @@ def shared_console(qapp, tmp_path_factory: pytest.TempPathFactory) -> Iterator[M
     try:
         yield window
     finally:
-        window.close()
-        window.runtime.stop()
-        window.deleteLater()
-        qapp.sendPostedEvents(None, QEvent.Type.DeferredDelete.value)
-        del window
-        gc.collect()  # on the GUI thread (app/gui/application.py)
+        close_shared(qapp, window)
+
+
+@pytest.fixture(scope="module")
+def russian_console(qapp, tmp_path_factory: pytest.TempPathFactory) -> Iterator[MainWindow]:
+    """The demo's console in the demo's Russian (its station's language, installed as `main.py`
+    does before the window is made), for the module's tests of the language; each test installs
+    the translation again for itself (the `russian` fixture)."""
+    from app.gui import i18n
+
+    demo_copy = copy_demo(tmp_path_factory.mktemp("russian") / "station")
+    assert i18n.install(qapp, load_station(demo_copy).Language) == "ru"
+    runtime = Runtime(load_station(demo_copy))
+    runtime.start()
+    window = MainWindow(runtime)
+    try:
+        yield window
+    finally:
+        close_shared(qapp, window)
 
 
 @pytest.fixture
@@ -233,27 +257,29 @@ def test_ctrl_q_and_f5_no_longer_act_at_once(console: MainWindow) -> None:
     assert console.isVisible()
 
 
-def test_an_element_asks_when_the_form_says_confirm_and_checks_its_role(
-        qtbot, own_console: MainWindow) -> None:
-    console = own_console
+def test_an_element_asks_when_the_form_says_confirm_and_checks_its_role(qtbot, console: MainWindow) -> None:
     engine = console.runtime.engine
     model, button = element(console, "Пуск")
     qtbot.waitUntil(lambda: model.value == 0, timeout=5000)
     console.login("operator", "operator")
-    model.Confirm = True
-    console.ask = no = Answers(False)
-    assert model.click() is False
-    assert no.asked == ["Confirm: Пуск \u2192 Пуск (1)?"]  # the state in the element's words
-    scans_later(qtbot, console.runtime)
-    assert engine.snapshot.get_hmi_bit(START_BIT) == 0
-    console.ask = Answers(True)
-    qtbot.mouseClick(button, Qt.MouseButton.LeftButton)
-    qtbot.waitUntil(lambda: engine.snapshot.get_hmi_bit(START_BIT) == 1, timeout=3000)
-    model.Role = "engineer"
-    qtbot.waitUntil(lambda: model.value == 1, timeout=3000)
-    assert model.click() is False
-    assert "Пуск: needs the engineer role; operator is operator" in console.status.currentMessage()
-    console.runtime.stop()
+    confirm, role = model.Confirm, model.Role
+    try:
+        model.Confirm = True
+        console.ask = no = Answers(False)
+        assert model.click() is False
+        assert no.asked == ["Confirm: Пуск \u2192 Пуск (1)?"]  # the state in the element's words
+        scans_later(qtbot, console.runtime)
+        assert engine.snapshot.get_hmi_bit(START_BIT) == 0
+        console.ask = Answers(True)
+        qtbot.mouseClick(button, Qt.MouseButton.LeftButton)
+        qtbot.waitUntil(lambda: engine.snapshot.get_hmi_bit(START_BIT) == 1, timeout=3000)
+        model.Role = "engineer"
+        qtbot.waitUntil(lambda: model.value == 1, timeout=3000)
+        assert model.click() is False
+        assert "Пуск: needs the engineer role; operator is operator" in console.status.currentMessage()
+    finally:
+        model.Confirm, model.Role = confirm, role
+    committed(qtbot, console.runtime)
     writes = [t for s, t in operator_rows(console.runtime) if s == "operator" and "Пуск" in t]
     assert writes == ["write Пуск (040042): 0 -> 1",
                       "refused write Пуск: needs the engineer role; operator is operator"]
@@ -373,37 +399,31 @@ def test_about_names_the_version(console: MainWindow) -> None:
     assert f"NetPlc Station {__version__}" in console.about_text()
 
 
-def test_the_console_speaks_russian_and_the_forms_keep_their_texts(qtbot, russian, demo_copy: Path) -> None:
+def test_the_console_speaks_russian_and_the_forms_keep_their_texts(
+        qtbot, russian, russian_console: MainWindow) -> None:
     from app.gui import i18n
 
     assert i18n.compiled("ru") is not None  # the .ts in the repository compiles with PySide6's lrelease
-    runtime = Runtime(load_station(demo_copy))
-    runtime.start()
-    window = MainWindow(runtime)
-    qtbot.addWidget(window)
-    try:
-        menus = [a.text() for a in window.menuBar().actions()]
-        assert menus == ["&Станция", "&Вид", "&Справка"]
-        assert window.act_run.text() == "&Запустить NetPlc…" and window.act_quit.text() == "В&ыход…"
-        heads = [window.journal.model.headerData(i, Qt.Orientation.Horizontal) for i in range(3)]
-        assert heads == ["Время", "Вид", "Группа"]
-        assert window.alarms.ack.text() == "Квитировать"
-        assert window.header.quiet.text() == "Нет неквитированных аварий"
-        window.refresh_status()
-        assert window.status.state.text() == "NetPlc: работает"
-        assert window.journal.windowTitle() == "Журнал — сегодня"
-        titles = [v.form.title for v in window.views]
-        assert [window.tabs.tabText(i) for i in range(3)] == titles  # as the engineer wrote them
-        assert "Пуск" in [m.Name for v in window.views for m in v.form.elements]
-        import datetime as dt
+    window = russian_console
+    menus = [a.text() for a in window.menuBar().actions()]
+    assert menus == ["&Станция", "&Вид", "&Справка"]
+    assert window.act_run.text() == "&Запустить NetPlc…" and window.act_quit.text() == "В&ыход…"
+    heads = [window.journal.model.headerData(i, Qt.Orientation.Horizontal) for i in range(3)]
+    assert heads == ["Время", "Вид", "Группа"]
+    assert window.alarms.ack.text() == "Квитировать"
+    assert window.header.quiet.text() == "Нет неквитированных аварий"
+    window.refresh_status()
+    assert window.status.state.text() == "NetPlc: работает"
+    assert window.journal.windowTitle() == "Журнал — сегодня"
+    titles = [v.form.title for v in window.views]
+    assert [window.tabs.tabText(i) for i in range(3)] == titles  # as the engineer wrote them
+    assert "Пуск" in [m.Name for v in window.views for m in v.form.elements]
+    import datetime as dt
 
-        assert window.header.clock.text().startswith(f"{dt.date.today():%d.%m.%Y}")
-    finally:
-        window.close()
-        runtime.stop()
+    assert window.header.clock.text().startswith(f"{dt.date.today():%d.%m.%Y}")
 
 
-def test_refusals_roles_and_alarms_speak_russian_too(qtbot, russian, demo_copy: Path) -> None:
+def test_refusals_roles_and_alarms_speak_russian_too(qtbot, russian, russian_console: MainWindow) -> None:
     """What the Qt-free models say in English (users.py refusals, roles, alarm priorities and
     states, qualities) the console shows in its language; the journal is in the station's (the
     demo's Russian)."""
@@ -414,45 +434,40 @@ def test_refusals_roles_and_alarms_speak_russian_too(qtbot, russian, demo_copy: 
     from app.scada.alarms import AlarmRow, State
     from hmi_forms.widgets.base import quality_tip
 
-    runtime = Runtime(load_station(demo_copy))
-    runtime.start()
-    window = MainWindow(runtime)
-    qtbot.addWidget(window)
-    try:
-        assert window.header.user.text() == "viewer\nнаблюдатель"
-        model, button = element(window, "Пуск")
-        qtbot.waitUntil(lambda: model.value is not None, timeout=5000)
-        qtbot.mouseClick(button, Qt.MouseButton.LeftButton)
-        assert window.status.currentMessage() == "Отказано: Пуск: нужна роль «оператор»; viewer — наблюдатель"
-        assert "нужна роль «оператор»" in window.alarms.ack.toolTip()
-        assert "Выход: нужна роль «инженер»" in window.act_quit.toolTip()
-        runtime.stop()  # the journal speaks the station's language
-        assert ("viewer", "отказ: запись Пуск: нужна роль «оператор»; viewer — наблюдатель") in [
-            (s, t.split(" (")[0]) for s, t in operator_rows(runtime)]
-        summary = window.summary
-        heads = [summary.model.headerData(i, Qt.Orientation.Horizontal, Qt.ItemDataRole.DisplayRole)
-                 for i in range(6)]
-        assert heads == ["Приоритет", "Время", "Авария", "Состояние", "Значение при изменении", "Текст"]
-        assert summary.counts[1].text().startswith("P1 критическая: ")
-        assert summary.shelve.text() == "Отложить…" and window.summary_dock.windowTitle().startswith("Аварии")
-        shown = (State.UNACK, State.ACKED, State.RTNUN, State.SHELVED, State.SUPPRESSED, State.OUT_OF_SERVICE)
-        rows = [AlarmRow(f"A{s}", 2, s, 1.0, 1.0, None, "текст") for s in shown]
-        summary.model.set_rows(rows)
-        display = Qt.ItemDataRole.DisplayRole
-        states = [summary.model.data(summary.model.index(i, 3), display) for i in range(6)]
-        assert states == ["активна, не квитирована", "активна, квитирована", "вернулась, не квитирована",
-                          "отложена", "подавлена", "выведена из работы"]
-        assert summary.model.data(summary.model.index(0, 0), Qt.ItemDataRole.DisplayRole) == "2 высокая"
-        banner = AlarmBanner()
-        qtbot.addWidget(banner)
-        banner.show_alarms(rows[:1])
-        assert "P2 ВЫСОКАЯ" in banner.text.text() and "активна, не квитирована" in banner.text.text()
-        assert quality_tip("comm-fail").startswith("? нет связи")
-        stopped = dataclasses.replace(runtime.status(), state="stopped")
-        assert "NetPlc: остановлен" in station_problems(stopped)
-    finally:
-        window.close()
-        runtime.stop()
+    window = russian_console
+    runtime = window.runtime
+    window.refresh_status()  # the rights said again in the translation installed for this test
+    assert window.header.user.text() == "viewer\nнаблюдатель"
+    model, button = element(window, "Пуск")
+    qtbot.waitUntil(lambda: model.value is not None, timeout=5000)
+    qtbot.mouseClick(button, Qt.MouseButton.LeftButton)
+    assert window.status.currentMessage() == "Отказано: Пуск: нужна роль «оператор»; viewer — наблюдатель"
+    assert "нужна роль «оператор»" in window.alarms.ack.toolTip()
+    assert "Выход: нужна роль «инженер»" in window.act_quit.toolTip()
+    committed(qtbot, runtime)  # the journal speaks the station's language
+    assert ("viewer", "отказ: запись Пуск: нужна роль «оператор»; viewer — наблюдатель") in [
+        (s, t.split(" (")[0]) for s, t in operator_rows(runtime)]
+    summary = window.summary
+    heads = [summary.model.headerData(i, Qt.Orientation.Horizontal, Qt.ItemDataRole.DisplayRole)
+             for i in range(6)]
+    assert heads == ["Приоритет", "Время", "Авария", "Состояние", "Значение при изменении", "Текст"]
+    assert summary.counts[1].text().startswith("P1 критическая: ")
+    assert summary.shelve.text() == "Отложить…" and window.summary_dock.windowTitle().startswith("Аварии")
+    shown = (State.UNACK, State.ACKED, State.RTNUN, State.SHELVED, State.SUPPRESSED, State.OUT_OF_SERVICE)
+    rows = [AlarmRow(f"A{s}", 2, s, 1.0, 1.0, None, "текст") for s in shown]
+    summary.model.set_rows(rows)
+    display = Qt.ItemDataRole.DisplayRole
+    states = [summary.model.data(summary.model.index(i, 3), display) for i in range(6)]
+    assert states == ["активна, не квитирована", "активна, квитирована", "вернулась, не квитирована",
+                      "отложена", "подавлена", "выведена из работы"]
+    assert summary.model.data(summary.model.index(0, 0), Qt.ItemDataRole.DisplayRole) == "2 высокая"
+    banner = AlarmBanner()
+    qtbot.addWidget(banner)
+    banner.show_alarms(rows[:1])
+    assert "P2 ВЫСОКАЯ" in banner.text.text() and "активна, не квитирована" in banner.text.text()
+    assert quality_tip("comm-fail").startswith("? нет связи")
+    stopped = dataclasses.replace(runtime.status(), state="stopped")
+    assert "NetPlc: остановлен" in station_problems(stopped)
 
 
 def test_the_language_comes_from_station_toml(demo_copy: Path) -> None:

@@ -5,13 +5,12 @@ from __future__ import annotations
 
 import csv
 import datetime as dt
-import gc
 import time
 from collections.abc import Iterator
 from pathlib import Path
 
 import pytest
-from PySide6.QtCore import QEvent, Qt
+from PySide6.QtCore import Qt
 
 from app.gui.main_window import MainWindow
 from app.gui.trend_window import TrendWindow
@@ -21,6 +20,7 @@ from app.station.runtime import Runtime
 from netplc.records import Record
 from registrar.store import Store
 from tests.app.conftest import copy_demo
+from tests.app.test_console import close_shared
 
 WAIT = 15_000
 
@@ -50,12 +50,7 @@ def trended(qapp, tmp_path_factory: pytest.TempPathFactory) -> Iterator[tuple[Ma
     try:
         yield window, t0
     finally:
-        window.close()
-        runtime.stop()
-        window.deleteLater()
-        qapp.sendPostedEvents(None, QEvent.Type.DeferredDelete.value)
-        del window
-        gc.collect()  # on the GUI thread (app/gui/application.py)
+        close_shared(qapp, window)
 
 
 @pytest.fixture
