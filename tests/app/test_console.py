@@ -31,11 +31,20 @@ BROKEN = ('{"form": {"title": "broken", "width": 100, "height": 100}, "elements"
           '"Name": "' + "a_very_long_element_name_" * 40 + '", "x": "not a number"}]}')
 
 
+LEVEL_TAG = "LEVEL,LEVEL,word,%,0,4095,0,100,1,Уровень,95,90,,,2,2,1,"  # the demo's: on after 2 s
+
+
 def open_console(folder: Path) -> MainWindow:
     """The demo's console in English, started: its tests read the journal word for word; its users
-    at the tests' cheap scrypt cost (tests/cheap_users.py); a broken form among its forms."""
+    at the tests' cheap scrypt cost (tests/cheap_users.py); a broken form among its forms; LEVEL's
+    alarms on 0.2 s after the limit rather than the demo's 2 s (no test of it is about the delay:
+    tests/app/scada/ are)."""
     demo_copy = copy_demo(folder, "en")
     (demo_copy / "forms" / "99_broken.hmi").write_text(BROKEN, encoding="utf-8")
+    tags = demo_copy / "tags.csv"
+    text = tags.read_text(encoding="utf-8")
+    assert LEVEL_TAG in text
+    tags.write_text(text.replace(LEVEL_TAG, LEVEL_TAG.replace(",2,2,1,", ",2,0.2,1,")), encoding="utf-8")
     runtime = Runtime(load_station(demo_copy))
     runtime.start()
     window = MainWindow(runtime)
