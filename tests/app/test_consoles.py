@@ -549,6 +549,7 @@ def test_the_consoles_faceplate_sets_forces_and_unforces_as_the_user_at_the_stat
     qtbot.waitUntil(lambda: "needs the operator role; viewer is viewer" in plate.message.text(), timeout=WAIT)
     assert engine.snapshot.get_word(SETPOINT) != round(100 / 200 * 4095)
 
+    reset(viewer)  # done with: hidden, it no longer paints its forms and faceplate at each scan
     operator = attach(st, "operator")
     plate = open_plate(qtbot, operator, "Уставка температуры")
     qtbot.waitUntil(lambda: plate.set.isEnabled(), timeout=WAIT)
@@ -566,6 +567,7 @@ def test_the_consoles_faceplate_sets_forces_and_unforces_as_the_user_at_the_stat
     qtbot.waitUntil(lambda: "900.0 вне диапазона -50.0 °C .. 150.0 °C" in plate.message.text(), timeout=WAIT)
     assert not plate.force.isEnabled()
 
+    reset(operator)
     engineer = attach(st, "engineer")
     plate = open_plate(qtbot, engineer, "Уставка температуры")
     qtbot.waitUntil(lambda: plate.force.isEnabled(), timeout=WAIT)
