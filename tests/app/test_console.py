@@ -487,35 +487,41 @@ def test_the_language_comes_from_station_toml(demo_copy: Path) -> None:
     assert load_station(demo_copy).Language == "en"
 
 
-def test_only_an_admin_manages_users_and_it_is_journaled(qtbot, own_console: MainWindow) -> None:
-    console = own_console
+def test_only_an_admin_manages_users_and_it_is_journaled(qtbot, console: MainWindow) -> None:
     from app.authority.users import Users
 
-    for name in ("operator", "engineer"):
-        console.login(name, name)
-        assert console.manage_users() is None
-        assert f"Users: needs the admin role; {name} is {name}" in console.status.currentMessage()
-    console.login("admin", "admin")
-    dialog = console.manage_users()
-    assert dialog is not None and dialog.table.rowCount() == 4
-    assert dialog.add_user("ivan", "operator", "pw") and dialog.table.rowCount() == 5
-    assert not dialog.add_user("ivan", "viewer", "x")
-    assert dialog.message.text() == ("Add user ivan: user 'ivan' exists already (passwd changes the "
-                                     "password)")
-    assert dialog.set_password("ivan", "new") and dialog.remove_user("viewer")
-    console.log_out()  # the dialog left open: its changes are the commands of whoever is on duty, now
-    assert not dialog.remove_user("ivan")  # the default viewer, just removed
-    assert dialog.message.text() == "Remove user ivan: viewer is no longer a user (admin needed)"
-    dialog.close()
-    folder = console.runtime.station.folder
-    assert Users(folder).verify("ivan", "new").role == "operator" and Users(folder).get("viewer") is None
-    console.runtime.stop()
-    rows = [(s, t) for s, t in operator_rows(console.runtime) if s == "admin"]
-    assert rows[-5:] == [("admin", "user ivan added as operator"),
-                         ("admin", "refused users ivan: user 'ivan' exists already (passwd changes the "
-                                   "password)"),
-                         ("admin", "password of ivan changed"), ("admin", "user viewer removed"),
-                         ("admin", "logged out")]
+    users = console.session.users  # the station's users.json, which the dialog changes
+    before = dict(users.users)
+    try:
+        for name in ("operator", "engineer"):
+            console.login(name, name)
+            assert console.manage_users() is None
+            assert f"Users: needs the admin role; {name} is {name}" in console.status.currentMessage()
+        console.login("admin", "admin")
+        dialog = console.manage_users()
+        assert dialog is not None and dialog.table.rowCount() == 4
+        assert dialog.add_user("ivan", "operator", "pw") and dialog.table.rowCount() == 5
+        assert not dialog.add_user("ivan", "viewer", "x")
+        assert dialog.message.text() == ("Add user ivan: user 'ivan' exists already (passwd changes the "
+                                         "password)")
+        assert dialog.set_password("ivan", "new") and dialog.remove_user("viewer")
+        console.log_out()  # the dialog left open: its changes are the commands of whoever is on duty, now
+        assert not dialog.remove_user("ivan")  # the default viewer, just removed
+        assert dialog.message.text() == "Remove user ivan: viewer is no longer a user (admin needed)"
+        dialog.close()
+        folder = console.runtime.station.folder
+        assert Users(folder).verify("ivan", "new").role == "operator" and Users(folder).get("viewer") is None
+        committed(qtbot, console.runtime)
+        rows = [(s, t) for s, t in operator_rows(console.runtime) if s == "admin"]
+        assert rows[-5:] == [("admin", "user ivan added as operator"),
+                             ("admin", "refused users ivan: user 'ivan' exists already (passwd changes the "
+                                       "password)"),
+                             ("admin", "password of ivan changed"), ("admin", "user viewer removed"),
+                             ("admin", "logged out")]
+    finally:  # the module's users as they were
+        users.users.clear()
+        users.users.update(before)
+        users.save()
 
 
 def test_the_header_says_while_forces_are_active_and_the_element_shows_f(qtbot, console: MainWindow) -> None:
