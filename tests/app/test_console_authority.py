@@ -16,9 +16,12 @@ from app.gui.monitor.view import ProgramMonitor
 from app.scada.alarms import STOPPED_ID, State
 from app.station.runtime import Runtime
 from tests.app import test_console
-from tests.app.test_console import Answers, element, operator_rows, scans_later
+from tests.app.test_console import Answers, committed, element, operator_rows, scans_later
 
-console = test_console.console  # the fixture: the demo station's console, started, viewer on duty
+# the fixtures: the demo station's console, started, viewer on duty: the module's, reset after each
+# test; each test reads the journal's records from its own start (`journaled`)
+console, shared_console = test_console.console, test_console.shared_console
+
 START_BIT = 0o40042
 FORCED_BIT = 0o2120
 
@@ -28,9 +31,17 @@ def program_view(window: MainWindow) -> ProgramMonitor:
     return window.viewers[-1].monitor  # type: ignore[attr-defined]
 
 
-def refusals(runtime: Runtime) -> Counter[tuple[str, str]]:
-    """The refusal records of the journal, by who and what was refused."""
-    return Counter((source, text.split(":")[0]) for source, text in operator_rows(runtime)
+def journaled(qtbot, runtime: Runtime) -> int:
+    """How many operator records the archive holds once all journaled so far is committed: where
+    a test's own records begin."""
+    committed(qtbot, runtime)
+    return len(operator_rows(runtime))
+
+
+def refusals(runtime: Runtime, since: int) -> Counter[tuple[str, str]]:
+    """The refusal records of the journal from its `since`th operator record, by who and what was
+    refused."""
+    return Counter((source, text.split(":")[0]) for source, text in operator_rows(runtime)[since:]
                    if text.startswith("refused "))
 
 
@@ -39,7 +50,9 @@ def greyed(control, role: str) -> bool:
 
 
 def test_a_viewer_is_refused_everything_once_per_cause_and_sees_it_greyed(qtbot, console: MainWindow) -> None:
+    """First of the module: no refusal of the minute before it."""
     runtime, summary = console.runtime, console.summary
+    since = journaled(qtbot, runtime)
     assert console.user == "viewer"
     for control in (summary.ack, summary.ack_all, summary.shelve, summary.unshelve, console.alarms.ack,
                     console.alarms.ack_all):
@@ -69,8 +82,8 @@ def test_a_viewer_is_refused_everything_once_per_cause_and_sees_it_greyed(qtbot,
     scans_later(qtbot, runtime)
     assert runtime.engine is not None and runtime.engine.snapshot.get_hmi_bit(START_BIT) == 0
     assert runtime.status().forced == 0 and runtime.status().state == "running"
-    runtime.stop()
-    assert refusals(runtime) == {
+    committed(qtbot, runtime)
+    assert refusals(runtime, since) == {
         ("viewer", "refused acknowledge all"): 1, ("viewer", "refused shelve NETPLC.STOPPED"): 1,
         ("viewer", "refused write Пуск"): 1,  # and the setpoint: the same cause, counted into it
         ("viewer", "refused stop NetPlc"): 1, ("program view:viewer", "refused force bit 02120"): 1}
@@ -78,6 +91,7 @@ def test_a_viewer_is_refused_everything_once_per_cause_and_sees_it_greyed(qtbot,
 
 def test_an_operator_acknowledges_and_writes_but_does_not_force(qtbot, console: MainWindow) -> None:
     runtime, summary = console.runtime, console.summary
+    since = journaled(qtbot, runtime)
     console.login("operator", "operator")
     runtime.stop_program("engineer")  # the station's own alarm: NetPlc is not running
     qtbot.waitUntil(lambda: any(r.id == STOPPED_ID for r in summary.unacknowledged()), timeout=5000)
@@ -102,15 +116,16 @@ def test_an_operator_acknowledges_and_writes_but_does_not_force(qtbot, console: 
     assert monitor.message.text() == "Refused: force 02120: needs the engineer role; operator is operator"
     scans_later(qtbot, runtime)
     assert runtime.status().forced == 0
-    runtime.stop()
-    rows = operator_rows(runtime)
+    committed(qtbot, runtime)
+    rows = operator_rows(runtime)[since:]
     assert ("operator", "write Пуск (040042): 0 -> 1") in rows
     assert any(s == "operator" and t.startswith("write Уставка температуры TEMP_SP:") for s, t in rows)
-    assert refusals(runtime) == {("program view:operator", "refused force bit 02120"): 1}
+    assert refusals(runtime, since) == {("program view:operator", "refused force bit 02120"): 1}
 
 
 def test_an_engineer_forces_and_stops(qtbot, console: MainWindow) -> None:
     runtime = console.runtime
+    since = journaled(qtbot, runtime)
     console.login("engineer", "engineer")
     monitor = program_view(console)
     assert monitor.unforce_button.isEnabled() and monitor.unforce_button.toolTip() == ""
@@ -122,11 +137,12 @@ def test_an_engineer_forces_and_stops(qtbot, console: MainWindow) -> None:
     qtbot.waitUntil(lambda: runtime.status().state != "running", timeout=3000)
     monitor.unforce_all()
     qtbot.waitUntil(lambda: runtime.status().forced == 0, timeout=3000)
-    runtime.stop()
-    rows = operator_rows(runtime)
+    committed(qtbot, runtime)
+    rows = operator_rows(runtime)[since:]
     assert ("program view:engineer", "force 02120: 0 -> 1") in rows
     assert ("engineer", "NetPlc stopped") in rows
-    assert not refusals(runtime)
+    assert not refusals(runtime, since)
+    assert runtime.run_program("engineer").result(5).ok  # running again, as the module's others find it
 
 
 def test_the_tooltips_follow_a_logout_and_an_idle_logout(qtbot, console: MainWindow) -> None:

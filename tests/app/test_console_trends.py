@@ -19,35 +19,53 @@ from app.station.config import load_station
 from app.station.runtime import Runtime
 from netplc.records import Record
 from registrar.store import Store
+from tests.app.conftest import copy_demo
+from tests.app.test_console import close_shared
 
 WAIT = 15_000
 
 
 def archived(path: Path, t0: float) -> None:
     """LEVEL (0..4095 raw = 0..100 %) at 0, 10, ... 90 % and TEMP (0..1000 raw = -50..150 °C) at
-    0, 20, ... 180 raw = -50..-14 °C, a sample a minute from t0."""
+    0, 20, ... 180 raw = -50..-14 °C, a sample a minute from t0; and an hour of TEMP_SP (0..4095
+    raw = -50..150 °C) every half second from t0, raw 0, 1, 2 ... (7200 samples, more than a day's
+    read keeps)."""
     store = Store(path, wallclock=lambda: t0)
-    for i in range(10):
-        store.put(Record(t0 + 60 * i, "data", 1, 1, "04010", value=i * 409.5))
-        store.put(Record(t0 + 60 * i, "data", 1, 1, "04012", value=i * 20.0))
+    for i in range(7200):
+        if i % 120 == 0 and i < 1200:
+            store.put(Record(t0 + 60 * (i // 120), "data", 1, 1, "04010", value=i // 120 * 409.5))
+            store.put(Record(t0 + 60 * (i // 120), "data", 1, 1, "04012", value=i // 120 * 20.0))
+        store.put(Record(t0 + 0.5 * i, "data", 1, 5, "04030", value=float(i % 4096)))
     store.start()
     store.close()
 
 
-@pytest.fixture
-def station(qtbot, demo_copy: Path) -> Iterator[tuple[MainWindow, float]]:
+@pytest.fixture(scope="module")
+def trended(qapp, tmp_path_factory: pytest.TempPathFactory) -> Iterator[tuple[MainWindow, float]]:
+    """The demo's console, its archive holding the `archived` samples from two hours ago: one for
+    the module's tests that open trends on it (`station` closes them after each)."""
+    demo_copy = copy_demo(tmp_path_factory.mktemp("trends") / "station")
     t0 = float(int(time.time()) - 7200)  # two hours ago, whole seconds (the archive keeps ms)
     archived(demo_copy / "archive" / "journal.sqlite", t0)
     runtime = Runtime(load_station(demo_copy))
     runtime.start()
     window = MainWindow(runtime)
-    qtbot.addWidget(window)
     window.resize(1366, 768)
     try:
         yield window, t0
     finally:
-        window.close()
-        runtime.stop()
+        close_shared(qapp, window)
+
+
+@pytest.fixture
+def station(trended: tuple[MainWindow, float]) -> Iterator[tuple[MainWindow, float]]:
+    """The module's console for one test: its trend windows closed after it, the viewer on duty."""
+    yield trended
+    window = trended[0]
+    for opened in window.viewers:
+        opened.close()
+    window.viewers.clear()
+    window.log_out()
 
 
 def test_two_tags_picked_give_pens_cursors_and_statistics_of_the_archive(
@@ -119,35 +137,22 @@ def test_a_saved_trend_reopens_with_its_pens_for_the_same_user_only(qtbot, stati
     assert "Печь" in other.message.text()
 
 
-def test_a_range_zoomed_into_is_read_at_its_own_detail(qtbot, demo_copy: Path) -> None:
-    """A day of LEVEL every half second (7200 samples, more than a day's read keeps): zoomed into
-    20 s, every sample of them is drawn, not the day's bucket extremes."""
-    t0 = float(int(time.time()) - 7200)
-    store = Store(demo_copy / "archive" / "journal.sqlite", wallclock=lambda: t0)
-    for i in range(7200):
-        store.put(Record(t0 + 0.5 * i, "data", 1, 1, "04010", value=float(i % 4096)))
-    store.start()
-    store.close()
-    runtime = Runtime(load_station(demo_copy))
-    runtime.start()
-    window = MainWindow(runtime)
-    qtbot.addWidget(window)
-    try:
-        trend = window.open_trends()
-        trend.add_pen("LEVEL")
-        a, b = t0 + 600 - 0.25, t0 + 620 - 0.25  # 600 s .. 619.5 s: samples 1200 .. 1239
-        trend.set_range(a, b)
+def test_a_range_zoomed_into_is_read_at_its_own_detail(qtbot, station) -> None:
+    """A day of TEMP_SP every half second (the archive's hour of it, more than a day's read keeps):
+    zoomed into 20 s, every sample of them is drawn, not the day's bucket extremes."""
+    window, t0 = station
+    trend = window.open_trends()
+    trend.add_pen("TEMP_SP")
+    a, b = t0 + 600 - 0.25, t0 + 620 - 0.25  # 600 s .. 619.5 s: samples 1200 .. 1239
+    trend.set_range(a, b)
 
-        def inside() -> int:
-            ts, _ = trend.pens["LEVEL"].samples()
-            return int(((ts >= a) & (ts < b)).sum())
+    def inside() -> int:
+        ts, _ = trend.pens["TEMP_SP"].samples()
+        return int(((ts >= a) & (ts < b)).sum())
 
-        qtbot.waitUntil(lambda: trend.pens["LEVEL"].detail is not None and not trend.loading(), timeout=WAIT)
-        assert inside() == 40
-        trend.dirty = True
-        trend.redraw()
-        assert trend.cell("LEVEL", "Min") == f"{1200 / 4095 * 100:.1f}"
-        assert trend.cell("LEVEL", "Max") == f"{1239 / 4095 * 100:.1f}"
-    finally:
-        window.close()
-        runtime.stop()
+    qtbot.waitUntil(lambda: trend.pens["TEMP_SP"].detail is not None and not trend.loading(), timeout=WAIT)
+    assert inside() == 40
+    trend.dirty = True
+    trend.redraw()
+    assert trend.cell("TEMP_SP", "Min") == f"{1200 / 4095 * 200 - 50:.1f}"
+    assert trend.cell("TEMP_SP", "Max") == f"{1239 / 4095 * 200 - 50:.1f}"
