@@ -208,3 +208,15 @@ def test_the_unit_does_not_restart_a_station_whose_configuration_was_refused(tmp
     folder = write_station(tmp_path / "station", 'NetPlcProgram = "missing.stl"\nNetSyncTime = 20\n', {})
     status = run_headless(str(folder), 1, 60)
     assert keys["Restart"] == "on-failure" and keys["RestartPreventExitStatus"] == str(status) == "2"
+
+
+def test_the_unit_gives_the_station_a_private_cache_folder_it_may_write() -> None:
+    """The unit's hardening leaves the service user no home and a read-only OS: the OPC UA server's
+    standard address space (app/publish/standard_nodes.py) is kept in the folder systemd makes for
+    the unit, private to its user, which is what the station reads a cache file from."""
+    from app.publish.standard_nodes import CACHE_ENV
+
+    unit = (REPO / "resources/systemd/netplc-station.service").read_text(encoding="utf-8")
+    keys = dict(line.split("=", 1) for line in unit.splitlines() if "=" in line and not line.startswith("#"))
+    assert keys["Environment"] == f"{CACHE_ENV}=/var/cache/{keys['CacheDirectory']}"
+    assert keys["CacheDirectoryMode"] == "0700" and keys["ProtectHome"] == "yes"
