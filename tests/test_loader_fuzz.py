@@ -38,6 +38,7 @@ from netplc.program import LOGIC, ProgramError, load_program, load_symbols
 from registrar.catalog import Catalog, CatalogError
 from tests.app.broken_stations import CASES
 from tests.app.conftest import REPO, copy_demo
+from tests.unicode_text import any_text
 
 FUZZ = settings(max_examples=200, deadline=None, derandomize=True,
                 suppress_health_check=[HealthCheck.too_slow, HealthCheck.data_too_large])
@@ -50,7 +51,7 @@ WORDS = st.one_of(
     st.sampled_from(["", " ", "\t", ",", ";", ":", "=", "$", "[", "]", ".", "#", "//", '"', "\\", "\x00",
                      "\ufeff", "²", "Пуск", "\r", "\n"]),
     NUMBER_TEXT,
-    st.text(max_size=8),
+    any_text(max_size=8),
 )
 
 
@@ -136,7 +137,7 @@ TOML_VALUES = st.one_of(
                                   '[{node = 0, endpoint = "tcp://127.0.0.1:1"}]',
                                   '[{node = 300, endpoint = "x"}]', '[{node = 0, program = "p.stl"}]',
                                   "[" * 2000 + "]" * 2000, '"Пуск"']),
-    st.text(max_size=10).map(json.dumps),
+    any_text(max_size=10).map(json.dumps),
 )
 TOML_TEXT = st.lists(st.tuples(TOML_KEYS, TOML_VALUES).map(lambda kv: f"{kv[0]} = {kv[1]}"),
                      max_size=8).map("\n".join)
@@ -159,14 +160,14 @@ def test_station_loads_or_names_its_errors(folder: Path, text: str, how: str, ra
 # --- .hmi forms --------------------------------------------------------------------------------
 
 JSON_LEAVES = st.one_of(
-    st.none(), st.booleans(), st.integers(-(2**70), 2**70), st.floats(allow_nan=True), st.text(max_size=10),
+    st.none(), st.booleans(), st.integers(-(2**70), 2**70), st.floats(allow_nan=True), any_text(max_size=10),
     st.sampled_from(["02000", "04010", "A", "A.3", "#ff0000", "x.png", "/etc/passwd", "../../x.png",
                      "MiddleCenter"]))
 JSON_VALUES = st.recursive(JSON_LEAVES, lambda inner: st.one_of(
-    st.lists(inner, max_size=3), st.dictionaries(st.text(max_size=6), inner, max_size=3)), max_leaves=8)
+    st.lists(inner, max_size=3), st.dictionaries(any_text(max_size=6), inner, max_size=3)), max_leaves=8)
 # a property's value: a leaf, or a list or object of leaves, lists and objects (what a property
 # holds, a list of states or points, is at most that deep); whole documents take JSON_VALUES
-KEYS = st.text(max_size=6)
+KEYS = any_text(max_size=6)
 FLAT = st.one_of(st.lists(JSON_LEAVES, max_size=3), st.dictionaries(KEYS, JSON_LEAVES, max_size=3))
 PROPERTY_VALUES = st.one_of(JSON_LEAVES, st.lists(st.one_of(JSON_LEAVES, FLAT), max_size=3),
                             st.dictionaries(KEYS, st.one_of(JSON_LEAVES, FLAT), max_size=3))
@@ -178,7 +179,7 @@ PROPERTY_NAMES = sorted({f for cls in ELEMENT_TYPES.values() for f in cls.__data
 ELEMENT_KEYS = st.lists(st.sampled_from(PROPERTY_NAMES), max_size=8)
 FORM_KEYS = st.lists(st.sampled_from(["title", "width", "height", "BackColor", "Font", "BackgroundImage",
                                       "Nope"]), max_size=8)
-ELEMENT_TYPE, ELEMENT_NAME = st.sampled_from([*ELEMENT_TYPES, "Nope"]), st.text(max_size=4)
+ELEMENT_TYPE, ELEMENT_NAME = st.sampled_from([*ELEMENT_TYPES, "Nope"]), any_text(max_size=4)
 DEVICES = st.lists(st.fixed_dictionaries({}, optional={
     k: PROPERTY_VALUES for k in ("Name", "AppMin", "AppMax", "PhyMin", "PhyMax")}), max_size=2)
 IMAGES = st.lists(JSON_LEAVES, max_size=3)
@@ -239,7 +240,7 @@ def test_tags_load_or_name_their_errors(folder: Path, text: str, how: str, raw: 
 
 
 USER_ENTRIES = st.one_of(JSON_VALUES, st.fixed_dictionaries({}, optional={
-    "name": st.one_of(st.text(max_size=5), JSON_LEAVES),
+    "name": st.one_of(any_text(max_size=5), JSON_LEAVES),
     "role": st.one_of(st.sampled_from(ROLES), JSON_LEAVES),
     "salt": st.one_of(st.just("00ff"), JSON_LEAVES),
     "hash": st.one_of(st.just("abcd"), JSON_LEAVES)}))

@@ -9,6 +9,7 @@ from hypothesis import strategies as st
 
 from netplc.functions.registry import BY_NAME, REGISTRY, FunctionSpec
 from netplc.program import PROGRAM_WORDS, ProgramError, load_symbols, parse, parse_file, read_symbols
+from tests.unicode_text import any_text
 
 
 def errors(text: str, **kw) -> list[str]:
@@ -233,7 +234,7 @@ LINE_PIECES = [
 
 
 @settings(max_examples=400, deadline=None)
-@given(st.lists(st.sampled_from(LINE_PIECES), max_size=30).map("".join), st.text(max_size=40))
+@given(st.lists(st.sampled_from(LINE_PIECES), max_size=30).map("".join), any_text(max_size=40))
 def test_arbitrary_text_gives_a_program_or_a_program_error(pieces, text):
     for candidate in (pieces, text, pieces + text):
         try:
