@@ -5,8 +5,8 @@ mixed with arbitrary text, numbers past every limit, deep nesting and bytes that
 that the examples reach the checks behind the syntax. Example counts are bounded: a few seconds each.
 
 Then whole station folders: copies of the demo with files damaged at random (seeded) through
-`check` and the start, in process, and the command line on the worst of the broken stations of
-tests/app/broken_stations.py (whose words tests/app/test_bad_files.py checks, in process): 0
+`check` and the start, and the command line on the worst of the broken stations of
+tests/app/broken_stations.py (whose words tests/app/test_bad_files.py checks), all in process: 0
 tracebacks, and every problem names a file of the folder.
 """
 
@@ -15,8 +15,6 @@ from __future__ import annotations
 import json
 import os
 import random
-import subprocess
-import sys
 from collections.abc import Callable
 from pathlib import Path
 from typing import Any
@@ -25,6 +23,7 @@ import pytest
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
+from app import cli
 from app.authority.policy import ROLES
 from app.authority.users import USERS_FILE, Users, UsersFileError
 from app.scada.table import read_tags
@@ -37,7 +36,8 @@ from netplc.problems import Problems
 from netplc.program import LOGIC, ProgramError, load_program, load_symbols
 from registrar.catalog import Catalog, CatalogError
 from tests.app.broken_stations import CASES
-from tests.app.conftest import REPO, copy_demo
+from tests.app.conftest import copy_demo
+from tests.commands import run_in_process
 from tests.unicode_text import any_text
 
 FUZZ = settings(max_examples=200, deadline=None, derandomize=True,
@@ -338,21 +338,22 @@ def test_damaged_demo_stations_end_in_named_problems_or_run(tmp_path: Path) -> N
             raise
 
 
-def test_main_check_and_the_headless_start_print_named_problems_not_tracebacks(tmp_path: Path) -> None:
+def test_main_check_and_the_headless_start_print_named_problems_not_tracebacks(
+        tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
     """The command line on the two cases that ended in tracebacks (RuntimeError for a program that is
-    a link to itself, MemoryError for a form that is a link to /dev/zero), side by side."""
+    a link to itself, MemoryError for a form that is a link to /dev/zero), in this process
+    (tests/commands.py; an exception would end the test, and the log's tracebacks are in stderr):
+    tests/app/test_bad_files.py runs `check` and a start as processes of their own."""
     loop, zero = (next(c for c in CASES if c.name == name) for name in ("program links to itself",
                                                                        "form is /dev/zero"))
-    runs = []
-    for case, args in ((loop, ["check"]), (zero, ["--no-gui", "--duration", "0.5", "--status-every", "0.2"])):
-        station = copy_demo(tmp_path / args[0].strip("-"), "en")  # the cases' problems are English
-        expected = case.plant(station)
-        runs.append((expected, subprocess.Popen([sys.executable, "main.py", args[0], str(station), *args[1:]],
-                                                cwd=REPO, stdout=subprocess.PIPE, stderr=subprocess.PIPE,
-                                                text=True)))
-    (expected, check), (shown, start) = runs
-    out, err = check.communicate(timeout=60)
-    assert check.returncode == 1 and "Traceback" not in err and out.startswith(expected), out + err
-    out, err = start.communicate(timeout=60)
-    assert start.returncode == 0 and "Traceback" not in err, err  # the station runs without the form
-    assert f"form problem: {shown}" in out, out
+    station = copy_demo(tmp_path / "check", "en")  # the cases' problems are English
+    expected = loop.plant(station)
+    check = run_in_process(cli.main, ["check", station], capsys)
+    assert check.returncode == 1 and "Traceback" not in check.stderr, check.stdout + check.stderr
+    assert check.stdout.startswith(expected), check.stdout
+    station = copy_demo(tmp_path / "start", "en")
+    shown = zero.plant(station)
+    start = run_in_process(cli.main, ["--no-gui", station, "--duration", "0.5", "--status-every", "0.2"],
+                           capsys)
+    assert start.returncode == 0 and "Traceback" not in start.stderr, start.stderr  # runs without the form
+    assert f"form problem: {shown}" in start.stdout, start.stdout
