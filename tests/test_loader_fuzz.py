@@ -23,7 +23,7 @@ from pathlib import Path
 from typing import Any
 
 import pytest
-from hypothesis import HealthCheck, given, settings
+from hypothesis import HealthCheck, example, given, settings
 from hypothesis import strategies as st
 
 from app import cli
@@ -101,11 +101,18 @@ ENCODINGS = st.sampled_from(["utf-8", "bom", "cp1251"])
 RAW = st.binary(max_size=300)
 
 
-def file_bytes(*texts: st.SearchStrategy[str]) -> st.SearchStrategy[bytes]:
-    """What a file holds: a text of one of `texts` in one of ENCODINGS, or any bytes, each alike.
-    Only what is written is drawn: a text and bytes drawn for every example, one thrown away, were
-    half of the draws."""
-    return st.one_of(*(st.tuples(text, ENCODINGS).map(lambda t: encoded(*t)) for text in texts), RAW)
+RAW_OR_TEXT = st.booleans()
+
+
+def file_bytes(text: st.SearchStrategy[str]) -> st.SearchStrategy[bytes]:
+    """What a file holds: any bytes or, as often, a text of `text` in one of ENCODINGS. Only what is
+    written is drawn: a text and bytes drawn for every example, one thrown away, were half of the
+    draws."""
+    def draw_file(draw: st.DrawFn) -> bytes:
+        if draw(RAW_OR_TEXT):
+            return draw(RAW)
+        return encoded(draw(text), draw(ENCODINGS))
+    return st.composite(draw_file)()
 
 
 def loaded(path: Path, load: Callable[[Path], Any], error: type[Exception],
@@ -129,6 +136,7 @@ PROGRAM_LINES = rows([*PROGRAM_WORDS, *PUNCTUATION], MADE_WORDS, Fraction(1, 2),
 
 @FUZZ
 @given(data=file_bytes(PROGRAM_LINES), symbols=st.booleans())
+@example(data=b"0.1 TNA $02000 ; a line number, a comment\n", symbols=False)  # reached now and then
 def test_program_loads_or_names_its_errors(folder: Path, data: bytes, symbols: bool) -> None:
     path = folder / "p.stl"
     path.write_bytes(data)
@@ -149,6 +157,7 @@ CSV_TEXT = rows([*PUNCTUATION, *CSV_WORDS], st.one_of(MADE_WORDS, LONG_FIELDS), 
 
 @FUZZ
 @given(data=file_bytes(CSV_TEXT), messages=st.booleans())
+@example(data=b"1,1,9,a message of no type\n", messages=True)  # reached now and then
 def test_symbols_and_messages_load_or_name_their_errors(folder: Path, data: bytes, messages: bool) -> None:
     path = folder / ("messages.csv" if messages else "symbols.csv")
     path.write_bytes(data)
@@ -179,6 +188,9 @@ TOML_TEXT = st.lists(st.tuples(TOML_KEYS, TOML_VALUES).map(lambda kv: f"{kv[0]} 
 
 @FUZZ
 @given(data=file_bytes(TOML_TEXT))
+# a path out of the folder and writable ranges that parse: 200 examples reach them only now and then
+@example(data=b'NetPlcProgram = "../x"\n'
+              b'modbus_server.writable = [["02000", "02177"], ["04000", "02000"], "x"]')
 def test_station_loads_or_names_its_errors(folder: Path, data: bytes) -> None:
     station = folder / "station"
     station.mkdir(exist_ok=True)
@@ -239,20 +251,26 @@ def form_documents(draw: st.DrawFn) -> Any:
     return doc
 
 
-# a form's text: a document of form_documents or, half the time, any JSON (drawn only then); as is,
-# nested too deeply, or with a number of 5000 digits
+# a form's text: a document of form_documents or, half the time, any JSON (drawn only then); written
+# as is, nested too deeply, with a number of 5000 digits, or any bytes instead
 FORM_TEXT = st.one_of(form_documents(), JSON_VALUES).map(lambda doc: json.dumps(doc, ensure_ascii=False))
-TOO_DEEP = "[" * 50_000 + "]" * 50_000
-DEEP_FORM = FORM_TEXT.map(lambda text: '{"elements": ' + TOO_DEEP + ', "form": ' + text + "}")
-LONG_NUMBER_FORM = FORM_TEXT.map(lambda text: text.replace("0", "1" * 5000, 1))
+FORM_MODES = st.sampled_from(["json", "raw", "deep", "digits"])
+# an element that loads, past the form's edge: the examples build one only now and then (1 in 200)
+BUILT = json.dumps({"form": {"width": 100, "height": 100}, "elements": [
+    {"type": "StaticText", "Name": "t", "x": 0, "y": 0, "w": 200, "h": 10, "Text": "x"}]})
 
 
 @FUZZ
-@given(data=file_bytes(FORM_TEXT, DEEP_FORM, LONG_NUMBER_FORM))
-def test_form_loads_or_names_its_errors(folder: Path, data: bytes) -> None:
+@given(text=FORM_TEXT, how=ENCODINGS, raw=RAW, mode=FORM_MODES)
+@example(text=BUILT, how="utf-8", raw=b"", mode="json")
+def test_form_loads_or_names_its_errors(folder: Path, text: str, how: str, raw: bytes, mode: str) -> None:
     path = folder / "f.hmi"
     (folder / "x.png").write_bytes(b"not really a picture")
-    path.write_bytes(data)
+    if mode == "deep":
+        text = '{"elements": ' + "[" * 50_000 + "]" * 50_000 + ', "form": ' + text + "}"
+    elif mode == "digits":
+        text = text.replace("0", "1" * 5000, 1)
+    path.write_bytes(raw if mode == "raw" else encoded(text, how))
     form = loaded(path, lambda p: load_form(p, {"A": 0o2000}), FormError, lambda e: e.problems)
     assert form is None or all(p.startswith(str(path)) for p in form.problems)
 
@@ -287,6 +305,7 @@ USER_DOCS = st.one_of(JSON_VALUES, st.fixed_dictionaries({"users": st.lists(USER
 
 @FUZZ
 @given(data=st.one_of(USER_DOCS.map(lambda doc: json.dumps(doc).encode()), RAW))
+@example(data=b"\xff\xfe\x98")  # not text at all: 200 examples reach it only now and then
 def test_users_load_or_name_their_errors(folder: Path, data: bytes) -> None:
     path = folder / USERS_FILE
     path.write_bytes(data)
