@@ -13,8 +13,11 @@ size and with tiny chunks, so that chunk boundaries fall everywhere.
 
 from __future__ import annotations
 
+import bisect
 import itertools
+import math
 import tempfile
+from fractions import Fraction
 from unittest import mock
 
 from hypothesis import HealthCheck, given, settings
@@ -51,10 +54,26 @@ CONSTANTS = {"D": st.integers(0, 65535).map(str), "O": st.integers(0, 0o177777).
 # the strategies drawn from, made once: hypothesis validates each new one (more time than the draws)
 COUNTS = {kind: st.one_of(st.integers(0, 5).map(str), constant) for kind, constant in CONSTANTS.items()}
 SPECS, OPERAND = st.sampled_from(FUNCTIONS), st.sampled_from(OPERANDS)
-JUMPS = st.sampled_from(["JMY", "JMN", "JMP"])
-# a scan's input bits drawn as one word: one draw, not 16 (the draws were half the test's time)
-SCAN_INPUTS = st.integers(0, 2 ** len(INPUTS) - 1).map(lambda w: [w >> k & 1 for k in range(len(INPUTS))])
-LENGTH, SHAPE, SHALLOW_SHAPE = st.integers(0, 8), st.integers(0, 10), st.integers(0, 6)
+
+
+def scan_inputs(fewest: int, most: int) -> st.SearchStrategy[list[list[int]]]:
+    """`fewest` to `most` scans' input bits, a 16-bit word a scan, drawn as one string of bytes (an
+    odd last byte left over): one draw, not 16 a scan (the draws were half the test's time)."""
+    def bits(data: bytes) -> list[list[int]]:
+        words = [int.from_bytes(data[at:at + 2], "little") for at in range(0, len(data) - 1, 2)]
+        return [[w >> k & 1 for k in range(len(INPUTS))] for w in words]
+    return st.binary(min_size=2 * fewest, max_size=2 * most).map(bits)
+
+
+def scan_times(values: list[float], scans: int) -> st.SearchStrategy[list[float]]:
+    """`scans` times each one of `values`, drawn as one integer, the times its digits in base
+    len(values)."""
+    n = len(values)
+    return st.integers(0, n ** scans - 1).map(lambda i: [values[i // n ** k % n] for k in range(scans)])
+
+
+LENGTH_MAX = 8
+LENGTH = st.integers(0, LENGTH_MAX)
 FON_NUMBER, FON_SPEC = st.integers(0, 7), st.integers(0, 4)
 
 
@@ -74,22 +93,56 @@ def _fon(draw) -> str:
     return f"FON C:$0{c:o} N:{spec.mnemonic} " + " ".join(params)
 
 
-# An instruction is two draws: its kind, then one of the kind's instructions, each operation with
-# each of its operands in one list (the same instructions as often as an operation and an operand
-# drawn apart, in one draw fewer). The kinds' weights: 6 contacts, 3 coils, 1 each of the others.
-CONTACT = st.sampled_from([f"{op} $0{a:o}" for op in ("TNA", "TFA", "TNO", "TFO", "TNE", "TFE")
-                           for a in READ])
-COIL = st.sampled_from([f"{op} $0{a:o}" for op in ("YON", "SON", "SOF") for a in WRITE])
-TIM = st.sampled_from([f"TIM $0{t:o} N:{n}" for t in TIMERS for n in range(5)])
-CTR = st.sampled_from([f"CTR $0{c:o} N:{n}" for c in COUNTERS for n in range(4)])
-FON = st.composite(_fon)()
-JMP0 = st.sampled_from(["JMP 0"] + ["NOP"] * 5)  # keep scans long enough
-HLT = st.sampled_from(["HLT"] + ["NOP"] * 7)
-KINDS = st.sampled_from([CONTACT] * 6 + [COIL] * 3 + [TIM, CTR, FON, st.just("NOP"), JMP0, HLT])
+# A body's steps are one draw: three bytes a step, read as a number below 2**24 that picks the step
+# (its shape and, for an instruction, the instruction with its operands) at its weight in one table
+# of every step (a FON's operands are drawn after). Hypothesis draws bytes uniformly, and not
+# integers past 256 (it favours the small), so not one integer. The weights: of 11 shapes, 5 an
+# instruction, 1 SKP before an instruction, 1 SKP before what follows, 2 a forward jump (JMY, JMN or
+# JMP), 2 a loop; below depth 3, the first three shapes alone. An instruction's kind: 6 contacts, 3
+# coils, 1 each of the others; each kind's instructions alike. Drawn as three a step (shape, kind,
+# instruction), as they once were, the same programs cost three times the generation.
+CONTACT_LINES = [f"{op} $0{a:o}" for op in ("TNA", "TFA", "TNO", "TFO", "TNE", "TFE") for a in READ]
+COIL_LINES = [f"{op} $0{a:o}" for op in ("YON", "SON", "SOF") for a in WRITE]
+TIM_LINES = [f"TIM $0{t:o} N:{n}" for t in TIMERS for n in range(5)]
+CTR_LINES = [f"CTR $0{c:o} N:{n}" for c in COUNTERS for n in range(4)]
+JMP0_LINES = ["JMP 0"] + ["NOP"] * 5  # keep scans long enough
+HLT_LINES = ["HLT"] + ["NOP"] * 7
+FON = "FON"  # an instruction whose operands are drawn next (`_fon`)
+KINDS = ((6, CONTACT_LINES), (3, COIL_LINES), (1, TIM_LINES), (1, CTR_LINES), (1, ["NOP"]), (1, JMP0_LINES),
+         (1, HLT_LINES), (1, [FON]))
+INSTRUCTIONS = [(Fraction(weight, 15 * len(kind)), line) for weight, kind in KINDS for line in kind]
 
 
-def instruction(draw) -> str:
-    return draw(draw(KINDS))
+class Steps:
+    """The steps a body draws from, each (SKP before it?, an instruction, "jump" with its opcode, or
+    "loop"), and the draw of `n` of them at their weights."""
+
+    def __init__(self, nested: bool) -> None:
+        shape = Fraction(1, 11 if nested else 7)
+        steps = [(5 * shape * p, (False, line)) for p, line in INSTRUCTIONS]
+        steps += [(shape * p, (True, line)) for p, line in INSTRUCTIONS]
+        steps.append((shape, (True, None)))
+        if nested:
+            steps += [(2 * shape / 3, (False, ("jump", op))) for op in ("JMY", "JMN", "JMP")]
+            steps.append((2 * shape, (False, ("loop",))))
+        assert sum(p for p, _ in steps) == 1
+        self.scale = math.lcm(*(p.denominator for p, _ in steps))
+        assert min(p for p, _ in steps) * 2**24 >= 100  # each step's share of the numbers off by under 1 %
+        self.steps = [step for _, step in steps]
+        self.ends = list(itertools.accumulate(int(p * self.scale) for p, _ in steps))
+        self.bytes = [st.binary(min_size=3 * n, max_size=3 * n) for n in range(LENGTH_MAX + 1)]
+
+    def picks(self, draw, n: int) -> list[tuple]:
+        data = draw(self.bytes[n])
+        return [self.steps[bisect.bisect_right(self.ends, int.from_bytes(data[at:at + 3]) * self.scale >> 24)]
+                for at in range(0, len(data), 3)]
+
+
+NESTED, SHALLOW = Steps(nested=True), Steps(nested=False)
+
+
+def instruction(draw, line: str) -> str:
+    return _fon(draw) if line is FON else line
 
 
 class _Labels:
@@ -102,18 +155,16 @@ class _Labels:
 
 def body(draw, labels: _Labels, depth: int) -> list[str]:
     lines: list[str] = []
-    for _ in range(draw(LENGTH)):
-        shape = draw(SHAPE if depth < 3 else SHALLOW_SHAPE)
-        if shape <= 4:
-            lines.append(instruction(draw))
-        elif shape <= 6:  # SKP before an instruction, or before what follows (jump, label, end)
+    for skp, step in (NESTED if depth < 3 else SHALLOW).picks(draw, draw(LENGTH)):
+        if skp:  # SKP before an instruction, or before what follows (jump, label, end)
             lines.append("SKP")
-            if shape == 5:
-                lines.append(instruction(draw))
-        elif shape <= 8:  # a forward jump over a nested body (the label may land mid-chain)
+        if isinstance(step, str):
+            lines.append(instruction(draw, step))
+        elif step is None:
+            pass
+        elif step[0] == "jump":  # a forward jump over a nested body (the label may land mid-chain)
             label = labels.new()
-            op = draw(JUMPS)
-            lines.append(f"{op} {label}")
+            lines.append(f"{step[1]} {label}")
             lines += body(draw, labels, depth + 1)
             lines.append(f"{label}:")
         else:  # a backward loop: the body runs twice, then the loop bit is cleared
@@ -176,8 +227,8 @@ def run_both(text: str, inputs: list[list[int]], dts: list[float], data: bytes =
 @settings(max_examples=300, deadline=None, suppress_health_check=[HealthCheck.too_slow])
 @given(
     programs(),
-    st.lists(SCAN_INPUTS, min_size=4, max_size=6),
-    st.lists(st.sampled_from([0.01, 0.05, 0.1, 0.35, 1.0]), min_size=6, max_size=6),
+    scan_inputs(4, 6),
+    scan_times([0.01, 0.05, 0.1, 0.35, 1.0], 6),
     st.binary(min_size=len(INITIAL), max_size=len(INITIAL)),
 )
 def test_random_programs_leave_identical_state(text, inputs, dts, data):
@@ -195,8 +246,8 @@ FORCEABLE = st.one_of(
 @settings(max_examples=100, deadline=None, suppress_health_check=[HealthCheck.too_slow])
 @given(
     programs(),
-    st.lists(SCAN_INPUTS, min_size=4, max_size=5),
-    st.lists(st.sampled_from([0.05, 0.1, 0.35]), min_size=5, max_size=5),
+    scan_inputs(4, 5),
+    scan_times([0.05, 0.1, 0.35], 5),
     st.binary(min_size=len(INITIAL), max_size=len(INITIAL)),
     st.lists(FORCEABLE, min_size=1, max_size=4).map(tuple),
 )
