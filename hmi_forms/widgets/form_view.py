@@ -25,7 +25,7 @@ from pathlib import Path
 
 import numpy as np
 from PySide6.QtCore import QRect, QRectF, QSize, Qt
-from PySide6.QtGui import QColor, QPainter, QPaintEvent, QRegion, QTransform
+from PySide6.QtGui import QColor, QPainter, QPaintEvent, QPixmap, QRegion, QTransform
 from PySide6.QtWidgets import QWidget
 
 from app.scada.quality import Quality
@@ -46,7 +46,7 @@ from hmi_forms.widgets.base import ElementWidget, Face, Images, Op, SelfPainted,
 from hmi_forms.widgets.discrete import DiscreteWidget
 from hmi_forms.widgets.gauges import GaugeWidget
 from hmi_forms.widgets.journal import JournalWidget
-from hmi_forms.widgets.sprites import Ink, TextSlot, draw_text
+from hmi_forms.widgets.sprites import Ink, TextSlot, blank, draw_text
 from hmi_forms.widgets.static import DateTimeWidget, StaticPictureWidget, StaticTextWidget, SyncWidget
 from hmi_forms.widgets.tank import TankWidget
 from hmi_forms.widgets.trend import REDRAW_INTERVAL, TrendWidget
@@ -125,6 +125,8 @@ class FormView(QWidget):
         self._slots = {w.face: (w, QTransform.fromTranslate(w.x(), w.y()), QRectF(w.rect()))
                        for w in self.painted}
         self._apart = _apart(self._places)  # the texts can be drawn in a pass of their own
+        self._ground: QPixmap | None = None  # the backdrop (`_backdrop`), made at the first paint
+        self._tiles: list[QPixmap | None] = []  # the layer at each painted element's place in it
         self.live = True  # the trends follow the clock; paused, the operator pans and zooms them
         self.history_wanted: Callable[[TrendWidget, float, float], None] | None = None
         self._next_flush = clock()
@@ -273,41 +275,101 @@ class FormView(QWidget):
     def paintEvent(self, event: QPaintEvent) -> None:
         """The background, and every QPainter-drawn element in the repainted region, with one
         painter: a composed element (`Face.compose`) costs a C++ call per part; the
-        others are drawn with the painter moved and clipped to them."""
+        others are drawn with the painter moved and clipped to them. Elements apart are drawn
+        over the backdrop (`_backdrop`), overlapping ones each from its layer up."""
+        region = event.region()
+        backdrop = self._backdrop() if self._apart else None
         p = QPainter(self)
         try:  # a painter left active after an error would crash Qt
-            region = event.region()
+            if backdrop is not None:
+                self._paint_over(p, region, backdrop)
+                return
             bare = region.intersected(self._bare)  # the background under an opaque element is not seen
             if not bare.isEmpty():
                 p.setClipRegion(bare)
                 p.fillRect(bare.boundingRect(), self._back)
-                if self.form.BackgroundImage is not None:
-                    draw_pixmap(p, self.images.get(self.form.BackgroundImage), QRectF(self.rect()), "Stretch")
+                self._paint_ground(p)
                 p.setClipping(False)
             p.setRenderHint(QPainter.RenderHint.Antialiasing)
-            if region.rectCount() == 1 and event.rect().contains(self._extent):  # no test per element
-                if self._apart:
-                    self._paint_passes(p)
-                    return
-                for face in self._faces:  # the loop runs a thousand times a tick on a large form
-                    ops = face.drawn
-                    if ops is None:
-                        self._paint_one(p, face)
-                        continue
-                    try:
-                        for method, args in ops:
-                            method(p, *args)
-                    except Exception as e:  # no log: _fault logs it, once
-                        self._fault(face.model, e, "drawing")
-                return
+            whole = region.rectCount() == 1 and event.rect().contains(self._extent)  # no test per element
             for face, geometry in zip(self._faces, self._places):
-                if region.intersects(geometry):
+                if whole or region.intersects(geometry):
                     self._paint_one(p, face)
         finally:
             p.end()
 
-    def _paint_passes(self, p: QPainter) -> None:
-        """Every painted element, in three passes: each element up to its value's text, then
+    def _paint_ground(self, p: QPainter) -> None:
+        """The form's background picture, where the painter is clipped to."""
+        if self.form.BackgroundImage is not None:
+            draw_pixmap(p, self.images.get(self.form.BackgroundImage), QRectF(self.rect()), "Stretch")
+
+    def _backdrop(self) -> QPixmap | None:
+        """The form as it looks under the elements' dynamic parts: its background, and the layer
+        of each composed element at its place (`_tiles`), made at the first paint; a tile is
+        composed anew only when its element's layer is another (a lamp's state, a restyle, a
+        stale mark). A whole repaint then costs one copy of the form, not one per element (each
+        a call into Qt that streams its pixels through memory). None at a fractional device
+        pixel ratio, where a part of the form copied might not land on whole pixels."""
+        dpr = self.devicePixelRatioF()
+        if dpr != int(dpr):
+            return None
+        backdrop = self._ground
+        if backdrop is None or backdrop.devicePixelRatio() != dpr:
+            backdrop = self._ground = blank(self.size(), dpr, self._back)
+            self._tiles = [None] * len(self._faces)
+            if self.form.BackgroundImage is not None:
+                p = QPainter(backdrop)
+                try:
+                    self._paint_ground(p)
+                finally:
+                    p.end()
+        tiles, p = self._tiles, None
+        try:
+            for i, face in enumerate(self._faces):  # the loop runs a thousand times a tick on a large form
+                ops = face.drawn
+                layer = None if ops is None else ops[0][1][2]  # the first part: the layer (`Face`)
+                if layer is not tiles[i]:
+                    if p is None:
+                        p = QPainter(backdrop)
+                    self._compose_tile(p, self._places[i], layer)  # type: ignore[arg-type]
+                    tiles[i] = layer
+        finally:
+            if p is not None:
+                p.end()
+        return backdrop
+
+    def _compose_tile(self, p: QPainter, place: QRect, layer: QPixmap | None) -> None:
+        """The backdrop at one element's place: its layer, over the background where that shows
+        through (None: the background alone; the element is drawn with a painter)."""
+        if layer is None or layer.hasAlphaChannel():
+            p.fillRect(place, self._back)
+            if self.form.BackgroundImage is not None:
+                p.setClipRect(place)
+                self._paint_ground(p)
+                p.setClipping(False)
+        if layer is not None:
+            p.drawPixmap(place.x(), place.y(), layer)
+
+    def _paint_over(self, p: QPainter, region: QRegion, backdrop: QPixmap) -> None:
+        """The repainted region of the backdrop in one copy, then the elements in it past their
+        layers, which the backdrop holds."""
+        rect = region.boundingRect()
+        several = region.rectCount() > 1
+        if several:  # the copy stays inside the region: the elements outside it are not redrawn
+            p.setClipRegion(region)
+        dpr = backdrop.devicePixelRatio()
+        p.drawPixmap(rect.topLeft(), backdrop, QRect(rect.topLeft() * dpr, rect.size() * dpr))
+        if several:
+            p.setClipping(False)
+        p.setRenderHint(QPainter.RenderHint.Antialiasing)
+        if several or not rect.contains(self._extent):  # no test per element on a whole repaint
+            faces = [f for f, g in zip(self._faces, self._places) if region.intersects(g)]
+        else:
+            faces = self._faces
+        self._paint_passes(p, faces)
+
+    def _paint_passes(self, p: QPainter, faces: list[Face]) -> None:
+        """The elements over the backdrop, in three passes: each element up to its value's text, then
         the texts, then what lies over them (a dial's needle). Drawn element by element, a text cut
         at its box or its element's sides needs a clip turned on before it and off after it, and
         that costs Qt more than its glyphs; in a pass of their own each text sets its clip in
@@ -317,14 +379,14 @@ class FormView(QWidget):
         this is pixel for pixel the order element by element."""
         texts: list[tuple[Face, Text]] = []
         over: list[tuple[Face, Op]] = []  # drawn after the texts
-        for face in self._faces:  # the loop runs a thousand times a tick on a large form
+        for face in faces:  # the loop runs a thousand times a tick on a large form
             ops = face.drawn
             if ops is None:
                 self._paint_one(p, face)
                 continue
             try:
                 later = False
-                for op in ops:
+                for op in ops[1:]:  # past the layer
                     method, args = op
                     if later:
                         over.append((face, op))
