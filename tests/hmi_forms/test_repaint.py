@@ -392,7 +392,9 @@ def test_texts_drawn_in_a_pass_of_their_own_are_the_texts_drawn_element_by_eleme
         view._apart = False
         assert view.grab().toImage() == passes, scan
         view._apart = True
-    assert any(cut is not None for w in view.painted[:12] for _, cut in w._value.plans.values())
+    plans = [plan for w in view.painted[:12] for plan in w._value.plans.values()]
+    assert any(boxed for _, _, boxed in plans)  # under the one clip of the boxes
+    assert any(cut is not None and not boxed for _, cut, boxed in plans)  # each under its own
     assert view.errors == []
 
 
