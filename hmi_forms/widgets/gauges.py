@@ -506,8 +506,8 @@ class GaugeFace(Face):
     (`_ops`) on every path; a plant's words over their whole range rarely recur, so nothing is
     kept per word: composing one costs less than looking it up did."""
 
-    __slots__ = ("bar", "contained", "inks", "kind", "needles", "painted", "part", "slot", "tall",
-                 "text_op", "travel", "units")
+    __slots__ = ("alone", "bar", "contained", "inks", "kind", "needles", "painted", "part", "slot", "tall",
+                 "text_op", "travel", "units", "zones")
 
     bank = WordBank
 
@@ -519,6 +519,8 @@ class GaugeFace(Face):
         assert widget._value is not None
         kind = self.kind = widget.model.Appearance
         self.slot = widget._value
+        self.alone = self.slot.glyphs.alone  # the characters drawn from glyphs (`TextSlot.fits`)
+        self.zones: dict[str | None, tuple[Op, Ink, QColor]] = {}  # `_zone`, by zone
         self.inks, self.units = (BARE, widget._units) if kind == "hbar" else (BOXED, "")
         self.needles, self.travel, self.contained = widget._needles, widget._travel, widget._contained
         self.bar, self.tall = widget._bar, widget._digital[0].height() > 30
@@ -578,17 +580,17 @@ class GaugeFace(Face):
         large gauge, past its area: repainted with its whole element; a needle too large)."""
         text = (shown.text or "---") + self.units
         slot = self.slot
-        if not slot.fits(text) or (self.part is not None and not slot.inside(text)):
+        if not (self.alone.issuperset(text) or slot.fits(text)) or (
+                self.part is not None and not slot.inside(text)):  # (a gauge's slot cuts at its sides)
             return None
-        zone, kind, x, y = shown.zone, self.kind, self.x, self.y
-        layer = self.layers.get(zone)  # (not `or`: the truth of a QPixmap is a call into Qt)
-        base = (PIX, (x, y, self.widget.layer() if layer is None else layer))
-        value = self.text_op = (draw_text, (slot, x, y, text, self.inks[zone]))
+        zone, x, y = shown.zone, self.x, self.y
+        base, ink, fill = self.zones.get(zone) or self._zone(zone)
+        value = self.text_op = (draw_text, (slot, x, y, text, ink))
+        kind = self.kind
         if shown.hw is None or kind == "digital":
             return [base, value]
         if kind == "hbar":
             left, top, height, travel = self.bar
-            fill = theme.ZONE_COLORS.get(zone or "") or theme.ACCENT
             return [base, (FILL, (x + left, y + top, round(travel * shown.fraction), height, fill)), value]
         needles = self.needles
         if needles is None:
@@ -596,6 +598,14 @@ class GaugeFace(Face):
         pointer = round(shown.fraction * self.travel)
         nx, ny, needle = needles.get(pointer) or self.widget._needle_sprite(pointer)
         return [base, value, (PIX, (x + nx, y + ny, needle))]
+
+    def _zone(self, zone: str | None) -> tuple[Op, Ink, QColor]:
+        """What a zone draws with: its layer's copy, the value's ink and a bar's fill colour."""
+        layer = self.layers.get(zone)  # (not `or`: the truth of a QPixmap is a call into Qt)
+        base = (PIX, (self.x, self.y, self.widget.layer() if layer is None else layer))
+        fill = theme.ZONE_COLORS.get(zone or "") or theme.ACCENT
+        made = self.zones[zone] = (base, self.inks[zone], fill)
+        return made
 
 
 GaugeWidget.face_class = GaugeFace

@@ -99,6 +99,8 @@ class Glyphs:
         self.alone: set[str] = set()  # characters whose advance is the same beside every other here
         self.kerned: set[str] = set()  # kerned, or not in the font itself (drawText takes another font)
         self.layouts: dict[tuple[int, ...], tuple[int, list[QPointF]]] = {}  # `layout`
+        self.steps: set[int] = set()  # the advances of the characters known, in 64ths
+        self.lengths: dict[int, tuple[int, list[QPointF]]] = {}  # `layout` by length, while one step
 
     def learn(self, text: str) -> bool:
         """Whether `text` can be drawn as a glyph run: each character a glyph of the font itself
@@ -116,7 +118,8 @@ class Glyphs:
                 self.kerned.add(c)
                 return False
             self.indexes[c] = found[0]
-            self.advances64[c] = round(own * 64)
+            self.advances64[c] = step = round(own * 64)
+            self.steps.add(step)
             self.alone.add(c)
         return True
 
@@ -127,7 +130,13 @@ class Glyphs:
     def layout(self, text: str) -> tuple[int, list[QPointF]]:
         """The width of `text` and its glyphs' places from its start, in 64ths of a pixel as Qt
         lays a line out: advanced by each glyph's advance, itself whole 64ths. Kept by the
-        advances (the digits of a value share theirs), so a few layouts serve every value."""
+        advances (the digits of a value share theirs), so a few layouts serve every value; in a
+        font whose characters known all advance alike (a monospaced one), by the length alone."""
+        alike = len(self.steps) == 1
+        if alike:
+            found = self.lengths.get(len(text))
+            if found is not None:
+                return found
         key = tuple(map(self.advances64.__getitem__, text))
         found = self.layouts.get(key)
         if found is None:
@@ -138,6 +147,8 @@ class Glyphs:
             if len(self.layouts) >= MAX_RUNS:
                 self.layouts.clear()
             found = self.layouts[key] = (at, places)
+        if alike:  # (as many lengths as a value's text has: a few)
+            self.lengths[len(text)] = found
         return found
 
 
