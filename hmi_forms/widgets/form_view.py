@@ -386,6 +386,8 @@ class FormView(QWidget):
             if ops is None:
                 self._paint_one(p, face)
                 continue
+            if len(ops) == 1:  # its layer alone (a lamp): the backdrop holds it
+                continue
             try:
                 later = False
                 for op in ops[1:]:  # past the layer

@@ -212,7 +212,7 @@ class TextSlot:
             self.anchor, self.pull = box.left(), 0.0
         self.row, self.fy = divmod(int(self.base * 64), 64)  # the baseline in pixels and 64ths
         self.span64, self.box64 = self.span * 64, box.width() * 64
-        self.plans: dict[tuple[int, int, int], Plan] = {}  # `_plan`
+        self.plans: dict[int, Plan] = {}  # `_plan`, by width and place in one int (no tuple per text)
         self.run = QGlyphRun()  # the text shown last, laid out
         self.run.setRawFont(glyphs.raw)
         self.text, self.places = "", glyphs.layout("")[1]
@@ -273,7 +273,7 @@ class TextSlot:
         run starts with the box moved by (x, y), where it is cut (None: nowhere), and whether
         that cut is the box alone (`Plan`)."""
         width, places = self.glyphs.layout(text)
-        origin, cut, boxed = self.plans.get((width, x, y)) or self._plan(width, x, y)
+        origin, cut, boxed = self.plans.get((width << 40) + (x << 20) + y) or self._plan(width, x, y)
         if text != self.text:
             self.text = text
             run = self.run
@@ -311,7 +311,7 @@ class TextSlot:
         boxed = cut is not None and clip is self.cut and holds(self.sides)  # type: ignore[arg-type]
         if len(self.plans) >= MAX_PLANS:
             self.plans.clear()
-        plan = self.plans[(width, x, y)] = (QPointF(at / 64, gy + self.fy / 64), cut, boxed)
+        plan = self.plans[(width << 40) + (x << 20) + y] = (QPointF(at / 64, gy + self.fy / 64), cut, boxed)
         return plan
 
 
