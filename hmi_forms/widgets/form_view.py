@@ -42,7 +42,7 @@ from hmi_forms.elements.sync import SyncGenerator
 from hmi_forms.elements.target import Target
 from hmi_forms.form import Form
 from hmi_forms.widgets.analog_output import AnalogOutputWidget
-from hmi_forms.widgets.base import ElementWidget, Face, Images, Op, SelfPainted, draw_pixmap
+from hmi_forms.widgets.base import PIX, ElementWidget, Face, Images, Op, SelfPainted, draw_pixmap
 from hmi_forms.widgets.discrete import DiscreteWidget
 from hmi_forms.widgets.gauges import GaugeWidget
 from hmi_forms.widgets.journal import JournalWidget
@@ -333,7 +333,10 @@ class FormView(QWidget):
                 if layer is not tiles[i]:
                     if p is None:
                         p = QPainter(backdrop)
-                    self._compose_tile(p, self._places[i], layer)  # type: ignore[arg-type]
+                    if layer is None or layer.hasAlphaChannel():  # type: ignore[union-attr]
+                        self._compose_tile(p, self._places[i], layer)  # type: ignore[arg-type]
+                    else:  # an opaque layer covers its tile: its composition's own copy
+                        PIX(p, *ops[0][1])  # type: ignore[index]
                     tiles[i] = layer
         finally:
             if p is not None:
@@ -341,14 +344,13 @@ class FormView(QWidget):
         return backdrop
 
     def _compose_tile(self, p: QPainter, place: QRect, layer: QPixmap | None) -> None:
-        """The backdrop at one element's place: its layer, over the background where that shows
-        through (None: the background alone; the element is drawn with a painter)."""
-        if layer is None or layer.hasAlphaChannel():
-            p.fillRect(place, self._back)
-            if self.form.BackgroundImage is not None:
-                p.setClipRect(place)
-                self._paint_ground(p)
-                p.setClipping(False)
+        """The backdrop at one element's place: a layer that is not opaque over the background
+        (None: the background alone; the element is drawn with a painter)."""
+        p.fillRect(place, self._back)
+        if self.form.BackgroundImage is not None:
+            p.setClipRect(place)
+            self._paint_ground(p)
+            p.setClipping(False)
         if layer is not None:
             p.drawPixmap(place.x(), place.y(), layer)
 
