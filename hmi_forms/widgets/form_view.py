@@ -278,7 +278,8 @@ class FormView(QWidget):
         """The background, and every QPainter-drawn element in the repainted region, with one
         painter: a composed element (`Face.compose`) costs a C++ call per part; the
         others are drawn with the painter moved and clipped to them. Elements apart are drawn
-        over the backdrop (`_backdrop`), overlapping ones each from its layer up."""
+        over the backdrop (`_backdrop`; without one, over their layers drawn first), overlapping
+        ones each from its layer up."""
         region = event.region()
         backdrop = self._backdrop() if self._apart else None
         p = QPainter(self)
@@ -294,9 +295,17 @@ class FormView(QWidget):
                 p.setClipping(False)
             p.setRenderHint(QPainter.RenderHint.Antialiasing)
             whole = region.rectCount() == 1 and event.rect().contains(self._extent)  # no test per element
-            for face, geometry in zip(self._faces, self._places):
-                if whole or region.intersects(geometry):
-                    self._paint_one(p, face)
+            faces = self._faces if whole else [
+                f for f, g in zip(self._faces, self._places) if region.intersects(g)]
+            if self._apart:  # at a fractional device pixel ratio: the layers, then the passes
+                for face in faces:
+                    ops = face.drawn
+                    if ops is not None:
+                        PIX(p, *ops[0][1])
+                self._paint_passes(p, faces)
+                return
+            for face in faces:
+                self._paint_one(p, face)
         finally:
             p.end()
 
