@@ -524,3 +524,23 @@ def test_repaints_over_the_backdrop_show_the_form_drawn_element_by_element(qtbot
         assert screen.convertToFormat(whole.format()) == whole, scan
     assert big.face.part is not None  # a text alone repainted its box (scan 2)
     assert view._ground is not None and view.errors == []
+
+
+def test_layouts_kept_by_length_while_every_character_known_advances_alike(qtbot) -> None:
+    """A monospaced font's texts are laid out by their length alone (`Glyphs.layout`); once a
+    character of another advance is known, by the advances again: the places are Qt's either way."""
+    from hmi_forms.widgets.sprites import Glyphs
+
+    glyphs = Glyphs(theme.sized_font(12))  # proportional, its digits all of one advance
+    assert glyphs.learn("0123456789") and len(glyphs.steps) == 1
+
+    def places(text: str) -> list[float]:
+        return [point.x() for point in glyphs.layout(text)[1]]
+
+    digits = places("1234")
+    assert glyphs.lengths[4][1] == glyphs.layout("9876")[1]  # by length: the same places
+    assert glyphs.learn("1.5") and len(glyphs.steps) == 2  # a point narrower than a digit
+    assert places("1.55") != places("1234") == digits
+    step = glyphs.advances64["1"] / 64
+    assert digits == [k * step for k in range(4)]
+    assert places("1.55")[2] == (glyphs.advances64["1"] + glyphs.advances64["."]) / 64
