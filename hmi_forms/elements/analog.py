@@ -26,6 +26,7 @@ import math
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, field
 from functools import cached_property
+from itertools import repeat
 from operator import attrgetter
 from typing import Any, NamedTuple
 
@@ -337,6 +338,9 @@ class Settler:
         self.high = np.array([math.inf if m.PhyHigh is None else m.PhyHigh for m in models])
         self.zoned = np.array([m.PhyLow is not None or m.PhyHigh is not None for m in models])
         self.specs = [f".{m.Precision}f" for m in models]
+        # one precision for all (the usual form): their texts made by one % of a joined format
+        precisions = {m.Precision for m in models}
+        self.percent = f"%.{precisions.pop()}f" if len(precisions) == 1 else None
 
     def __call__(self, positions: list[int], words: list[int]) -> list[Shown]:
         """What each of the models at `positions` shows of its new word, each model settled."""
@@ -354,9 +358,9 @@ class Settler:
             zone = np.where(phy < self.low[at], 1, np.where(phy > self.high[at], 2, 0))
             zone[~self.zoned[at]] = 3
             phys = phy.tolist()
-            specs = self.specs
-            texts = list(map(format, phys, [specs[i] for i in at.tolist()]))
-            made = map(Shown, hw, phys, texts, map(ZONES.__getitem__, zone.tolist()), fraction.tolist())
+            zones = map(ZONES.__getitem__, zone.tolist())
+            parts = zip(hw, phys, self._texts(phys, at), zones, fraction.tolist())
+            made = map(tuple.__new__, repeat(Shown), parts)  # as `_make` makes them, with no Python call
             for k, new in zip(missed, made):
                 i = positions[k]
                 table = remembered[i]
@@ -369,6 +373,14 @@ class Settler:
             model.shown = s
             model.stale = False
         return shown
+
+    def _texts(self, phys: list[float], at: np.ndarray) -> list[str]:
+        """The values' texts, as `format` makes each ("%.1f" is `format(v, ".1f")`, and a text
+        holds no separator)."""
+        if self.percent is not None:
+            return ("\x1f".join([self.percent] * len(phys)) % tuple(phys)).split("\x1f")
+        specs = self.specs
+        return list(map(format, phys, [specs[i] for i in at.tolist()]))
 
 
 @dataclass(eq=False)

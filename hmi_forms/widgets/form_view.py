@@ -24,8 +24,8 @@ from collections.abc import Callable
 from pathlib import Path
 
 import numpy as np
-from PySide6.QtCore import QRect, QRectF, QSize, Qt
-from PySide6.QtGui import QColor, QPainter, QPaintEvent, QRegion, QTransform
+from PySide6.QtCore import QPointF, QRect, QRectF, QSize, Qt
+from PySide6.QtGui import QColor, QGlyphRun, QPainter, QPaintEvent, QPixmap, QRegion, QTransform
 from PySide6.QtWidgets import QWidget
 
 from app.scada.quality import Quality
@@ -42,11 +42,11 @@ from hmi_forms.elements.sync import SyncGenerator
 from hmi_forms.elements.target import Target
 from hmi_forms.form import Form
 from hmi_forms.widgets.analog_output import AnalogOutputWidget
-from hmi_forms.widgets.base import ElementWidget, Face, Images, Op, SelfPainted, draw_pixmap
+from hmi_forms.widgets.base import PIX, ElementWidget, Face, Images, Op, SelfPainted, draw_pixmap
 from hmi_forms.widgets.discrete import DiscreteWidget
 from hmi_forms.widgets.gauges import GaugeWidget
 from hmi_forms.widgets.journal import JournalWidget
-from hmi_forms.widgets.sprites import Ink, TextSlot, draw_text
+from hmi_forms.widgets.sprites import Ink, TextSlot, blank, draw_text
 from hmi_forms.widgets.static import DateTimeWidget, StaticPictureWidget, StaticTextWidget, SyncWidget
 from hmi_forms.widgets.tank import TankWidget
 from hmi_forms.widgets.trend import REDRAW_INTERVAL, TrendWidget
@@ -125,6 +125,10 @@ class FormView(QWidget):
         self._slots = {w.face: (w, QTransform.fromTranslate(w.x(), w.y()), QRectF(w.rect()))
                        for w in self.painted}
         self._apart = _apart(self._places)  # the texts can be drawn in a pass of their own
+        self._ground: QPixmap | None = None  # the backdrop (`_backdrop`), made at the first paint
+        self._tiles: list[QPixmap | None] = []  # the layer at each painted element's place in it
+        self._boxes: dict[Face, QRect] = {}  # the box of each text cut at its box (`_paint_boxed`)
+        self._box_clip: QRegion | None = None  # the region of them all (None: to be made again)
         self.live = True  # the trends follow the clock; paused, the operator pans and zooms them
         self.history_wanted: Callable[[TrendWidget, float, float], None] | None = None
         self._next_flush = clock()
@@ -273,41 +277,112 @@ class FormView(QWidget):
     def paintEvent(self, event: QPaintEvent) -> None:
         """The background, and every QPainter-drawn element in the repainted region, with one
         painter: a composed element (`Face.compose`) costs a C++ call per part; the
-        others are drawn with the painter moved and clipped to them."""
+        others are drawn with the painter moved and clipped to them. Elements apart are drawn
+        over the backdrop (`_backdrop`; without one, over their layers drawn first), overlapping
+        ones each from its layer up."""
+        region = event.region()
+        backdrop = self._backdrop() if self._apart else None
         p = QPainter(self)
         try:  # a painter left active after an error would crash Qt
-            region = event.region()
+            if backdrop is not None:
+                self._paint_over(p, region, backdrop)
+                return
             bare = region.intersected(self._bare)  # the background under an opaque element is not seen
             if not bare.isEmpty():
                 p.setClipRegion(bare)
                 p.fillRect(bare.boundingRect(), self._back)
-                if self.form.BackgroundImage is not None:
-                    draw_pixmap(p, self.images.get(self.form.BackgroundImage), QRectF(self.rect()), "Stretch")
+                self._paint_ground(p)
                 p.setClipping(False)
             p.setRenderHint(QPainter.RenderHint.Antialiasing)
-            if region.rectCount() == 1 and event.rect().contains(self._extent):  # no test per element
-                if self._apart:
-                    self._paint_passes(p)
-                    return
-                for face in self._faces:  # the loop runs a thousand times a tick on a large form
+            whole = region.rectCount() == 1 and event.rect().contains(self._extent)  # no test per element
+            faces = self._faces if whole else [
+                f for f, g in zip(self._faces, self._places) if region.intersects(g)]
+            if self._apart:  # at a fractional device pixel ratio: the layers, then the passes
+                for face in faces:
                     ops = face.drawn
-                    if ops is None:
-                        self._paint_one(p, face)
-                        continue
-                    try:
-                        for method, args in ops:
-                            method(p, *args)
-                    except Exception as e:  # no log: _fault logs it, once
-                        self._fault(face.model, e, "drawing")
+                    if ops is not None:
+                        PIX(p, *ops[0][1])
+                self._paint_passes(p, faces)
                 return
-            for face, geometry in zip(self._faces, self._places):
-                if region.intersects(geometry):
-                    self._paint_one(p, face)
+            for face in faces:
+                self._paint_one(p, face)
         finally:
             p.end()
 
-    def _paint_passes(self, p: QPainter) -> None:
-        """Every painted element, in three passes: each element up to its value's text, then
+    def _paint_ground(self, p: QPainter) -> None:
+        """The form's background picture, where the painter is clipped to."""
+        if self.form.BackgroundImage is not None:
+            draw_pixmap(p, self.images.get(self.form.BackgroundImage), QRectF(self.rect()), "Stretch")
+
+    def _backdrop(self) -> QPixmap | None:
+        """The form as it looks under the elements' dynamic parts: its background, and the layer
+        of each composed element at its place (`_tiles`), made at the first paint; a tile is
+        composed anew only when its element's layer is another (a lamp's state, a restyle, a
+        stale mark). A whole repaint then costs one copy of the form, not one per element (each
+        a call into Qt that streams its pixels through memory). None at a fractional device
+        pixel ratio, where a part of the form copied might not land on whole pixels."""
+        dpr = self.devicePixelRatioF()
+        if dpr != int(dpr):
+            return None
+        backdrop = self._ground
+        if backdrop is None or backdrop.devicePixelRatio() != dpr:
+            backdrop = self._ground = blank(self.size(), dpr, self._back)
+            self._tiles = [None] * len(self._faces)
+            if self.form.BackgroundImage is not None:
+                p = QPainter(backdrop)
+                try:
+                    self._paint_ground(p)
+                finally:
+                    p.end()
+        tiles, p = self._tiles, None
+        try:
+            for i, face in enumerate(self._faces):  # the loop runs a thousand times a tick on a large form
+                ops = face.drawn
+                layer = None if ops is None else ops[0][1][2]  # the first part: the layer (`Face`)
+                if layer is not tiles[i]:
+                    if p is None:
+                        p = QPainter(backdrop)
+                    if layer is None or layer.hasAlphaChannel():  # type: ignore[union-attr]
+                        self._compose_tile(p, self._places[i], layer)  # type: ignore[arg-type]
+                    else:  # an opaque layer covers its tile: its composition's own copy
+                        PIX(p, *ops[0][1])  # type: ignore[index]
+                    tiles[i] = layer
+        finally:
+            if p is not None:
+                p.end()
+        return backdrop
+
+    def _compose_tile(self, p: QPainter, place: QRect, layer: QPixmap | None) -> None:
+        """The backdrop at one element's place: a layer that is not opaque over the background
+        (None: the background alone; the element is drawn with a painter)."""
+        p.fillRect(place, self._back)
+        if self.form.BackgroundImage is not None:
+            p.setClipRect(place)
+            self._paint_ground(p)
+            p.setClipping(False)
+        if layer is not None:
+            p.drawPixmap(place.x(), place.y(), layer)
+
+    def _paint_over(self, p: QPainter, region: QRegion, backdrop: QPixmap) -> None:
+        """The repainted region of the backdrop in one copy, then the elements in it past their
+        layers, which the backdrop holds."""
+        rect = region.boundingRect()
+        several = region.rectCount() > 1
+        if several:  # the copy stays inside the region: the elements outside it are not redrawn
+            p.setClipRegion(region)
+        dpr = backdrop.devicePixelRatio()
+        p.drawPixmap(rect.topLeft(), backdrop, QRect(rect.topLeft() * dpr, rect.size() * dpr))
+        if several:
+            p.setClipping(False)
+        p.setRenderHint(QPainter.RenderHint.Antialiasing)
+        if several or not rect.contains(self._extent):  # no test per element on a whole repaint
+            faces = [f for f, g in zip(self._faces, self._places) if region.intersects(g)]
+        else:
+            faces = self._faces
+        self._paint_passes(p, faces)
+
+    def _paint_passes(self, p: QPainter, faces: list[Face]) -> None:
+        """The elements over the backdrop, in three passes: each element up to its value's text, then
         the texts, then what lies over them (a dial's needle). Drawn element by element, a text cut
         at its box or its element's sides needs a clip turned on before it and off after it, and
         that costs Qt more than its glyphs; in a pass of their own each text sets its clip in
@@ -317,14 +392,16 @@ class FormView(QWidget):
         this is pixel for pixel the order element by element."""
         texts: list[tuple[Face, Text]] = []
         over: list[tuple[Face, Op]] = []  # drawn after the texts
-        for face in self._faces:  # the loop runs a thousand times a tick on a large form
+        for face in faces:  # the loop runs a thousand times a tick on a large form
             ops = face.drawn
             if ops is None:
                 self._paint_one(p, face)
                 continue
+            if len(ops) == 1:  # its layer alone (a lamp): the backdrop holds it
+                continue
             try:
                 later = False
-                for op in ops:
+                for op in ops[1:]:  # past the layer
                     method, args = op
                     if later:
                         over.append((face, op))
@@ -343,16 +420,21 @@ class FormView(QWidget):
                 self._fault(face.model, e, "drawing")
 
     def _paint_texts(self, p: QPainter, texts: list[tuple[Face, Text]]) -> None:
-        """The value texts of `_paint_passes`, each as `TextSlot.paint` draws it."""
+        """The value texts of `_paint_passes`, each as `TextSlot.paint` draws it. A text cut at
+        its box alone, its ink inside its element (a `Plan` `boxed`), waits for the last pass."""
         clipped, pen = False, None
+        boxed: list[tuple[Face, QPointF, QGlyphRun, Ink, QRect]] = []
         for face, (slot, x, y, text, ink) in texts:
             try:
-                width, origin, cut = slot.ready(text, x, y)
+                width, origin, cut, alone = slot.ready(text, x, y)
                 if ink.back is not None and width <= slot.span64:
                     if clipped:
                         p.setClipping(False)
                         clipped = False
                     slot.fill(p, ink, x, y)
+                if alone:
+                    boxed.append((face, origin, slot.run, ink, cut))  # type: ignore[arg-type]
+                    continue
                 if ink is not pen:
                     p.setPen(ink.fore)
                     pen = ink
@@ -367,6 +449,38 @@ class FormView(QWidget):
                 self._fault(face.model, e, "drawing")
         if clipped:
             p.setClipping(False)
+        if boxed:
+            self._paint_boxed(p, boxed)
+
+    def _paint_boxed(self, p: QPainter, boxed: list[tuple[Face, QPointF, QGlyphRun, Ink, QRect]]) -> None:
+        """Texts each cut at its box, all under one clip: the boxes of every text of the form
+        known to be cut at its box (`_boxes`, the region made again when one is new). Within a
+        text's element that region is its own box (the others lie in other elements, and its ink
+        does not leave its element), so each is cut as alone; one clip costs Qt less than a
+        clip switched per text, and the glyphs drawn under it half as much as under those."""
+        boxes = self._boxes
+        for face, _, _, _, cut in boxed:
+            known = boxes.get(face)
+            if known is None or known != cut:
+                boxes[face] = cut
+                self._box_clip = None
+        region = self._box_clip
+        if region is None:
+            region = self._box_clip = _union(list(boxes.values()))
+        p.save()  # (Qt 6.11 cuts cached glyphs at a clip of many rectangles set inside a save only)
+        try:
+            p.setClipRegion(region)
+            pen = None
+            for face, origin, run, ink, _ in boxed:
+                try:
+                    if ink is not pen:
+                        p.setPen(ink.fore)
+                        pen = ink
+                    p.drawGlyphRun(origin, run)
+                except Exception as e:  # no log: _fault logs it, once
+                    self._fault(face.model, e, "drawing")
+        finally:
+            p.restore()
 
     def _paint_one(self, p: QPainter, face: Face) -> None:
         """One element: from its composition, or with the painter moved and clipped to it."""
@@ -394,6 +508,17 @@ def _apart(places: list[QRect]) -> bool:
             return False
         covered += rect
     return True
+
+
+def _union(rects: list[QRect]) -> QRegion:
+    """The region the rectangles cover, joined by halves (one at a time costs time squared)."""
+    if len(rects) <= 8:
+        region = QRegion()
+        for rect in rects:
+            region += rect
+        return region
+    half = len(rects) // 2
+    return _union(rects[:half]) | _union(rects[half:])
 
 
 def _worst(sources: tuple[tuple[int, int], ...], readings: Readings,

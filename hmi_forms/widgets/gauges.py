@@ -68,10 +68,6 @@ BOXED = {None: Ink(theme.TEXT, WHITE), "normal": Ink(theme.TEXT, WHITE), "low": 
          "high": Ink(WHITE, theme.ALARM)}
 BARE = {None: Ink(theme.TEXT), "normal": Ink(theme.TEXT), "low": Ink(theme.WARN.darker(115)),
         "high": Ink(theme.ALARM.darker(115))}
-# what a gauge draws for what its model shows: that `Shown`, its text and ink, and the needle's
-# sprite or the bar fill's (width, colour) or None (`GaugeFace.entries`)
-Entry = tuple[Shown, tuple[str, Ink], object]
-MAX_ENTRIES = 1024  # entries kept per family of alike gauges: words recur in a demo, not in a plant
 
 
 class GaugeWidget(ElementWidget):
@@ -506,12 +502,12 @@ class GaugeFace(Face):
     large for sprites or one that pokes out of its element are drawn with a painter. Repainted
     only when something moved by a pixel or a text changed (a value that creeps below a pixel
     per tick costs no paint until it has moved one), in a large gauge only the text's box when
-    that is all that changed. What the model shows (its `Shown`) is drawn with parts looked up in
-    one step (`entries`), the same for every gauge drawn from the same sprites with the same
-    conversion."""
+    that is all that changed. What the model shows (its `Shown`) is composed by one function
+    (`_ops`) on every path; a plant's words over their whole range rarely recur, so nothing is
+    kept per word: composing one costs less than looking it up did."""
 
-    __slots__ = ("bar", "contained", "entries", "inks", "kind", "needles", "painted", "part",
-                 "slot", "tall", "text_op", "travel", "units")
+    __slots__ = ("alone", "bar", "contained", "inks", "kind", "needles", "painted", "part", "slot", "tall",
+                 "text_op", "travel", "units", "zones")
 
     bank = WordBank
 
@@ -521,9 +517,10 @@ class GaugeFace(Face):
         assert isinstance(widget, GaugeWidget)
         widget._layout()
         assert widget._value is not None
-        m = widget.model
-        kind = self.kind = m.Appearance
+        kind = self.kind = widget.model.Appearance
         self.slot = widget._value
+        self.alone = self.slot.glyphs.alone  # the characters drawn from glyphs (`TextSlot.fits`)
+        self.zones: dict[str | None, tuple[Op, Ink, QColor]] = {}  # `_zone`, by zone
         self.inks, self.units = (BARE, widget._units) if kind == "hbar" else (BOXED, "")
         self.needles, self.travel, self.contained = widget._needles, widget._travel, widget._contained
         self.bar, self.tall = widget._bar, widget._digital[0].height() > 30
@@ -531,11 +528,6 @@ class GaugeFace(Face):
         self.part = None if part is None else part.translated(self.rect.topLeft()).intersected(self.rect)
         self.painted: tuple[object, ...] | None = None  # what a painter drew last (`GaugeWidget.shown`)
         self.text_op: Op | None = None
-        family = ("entries", kind, id(self.slot.glyphs), self.slot.span, id(self.needles), self.travel,
-                  self.bar, self.units,
-                  self.part is None, id(m.remembered))
-        # emptied with the sprites; none for a dial that pokes out of its element (a painter draws it)
-        self.entries: dict[int | None, Entry] = SPRITES.family(family) if self.contained else {}
 
     def sync(self) -> None:
         if not self.fresh:
@@ -558,17 +550,16 @@ class GaugeFace(Face):
         self.show(self.part if text_only and self.part is not None else self.rect)
 
     def put(self, shown: Shown) -> bool:
-        """`Face.put`, with the composition of what the model shows looked up in one step."""
+        """`Face.put`: the composition of what the model shows, in one step."""
         if not self.fresh:
             self.load()
         if not self.contained or self.style_of(self.attrs) != self.style:
             self.sync()
             return False
-        entry = self._entry(shown)  # a word not shown lately: its parts, then drawn as one that was
-        if entry is None:
+        drawn = self._ops(shown)
+        if drawn is None:  # a painter draws it
             self.sync()
             return False
-        drawn = self._ops(shown.zone, entry[1], entry[2])
         if drawn == self.drawn:
             return False
         self.drawn, self.painted = drawn, None
@@ -581,60 +572,40 @@ class GaugeFace(Face):
         marked = m.maximum is not None and (self.kind != "digital" or self.tall)  # drawn by a painter
         if m.stale or not self.contained or marked or self.restyled():
             return None
-        shown = m.shown
-        entry = self._entry(shown)
-        return None if entry is None else self._ops(shown.zone, entry[1], entry[2])
+        return self._ops(m.shown)
 
-    def _entry(self, shown: Shown) -> Entry | None:
-        """What `shown` is drawn with, from `entries` or made now; None where a painter must draw."""
-        entries = self.entries
-        entry = entries.get(shown.hw)
-        if entry is None or entry[0] is not shown:
-            parts = self._parts(shown)
-            if parts is None:
-                return None
-            if len(entries) >= MAX_ENTRIES:  # bounded: a plant's words over their range do not recur
-                entries.clear()
-            entry = entries[shown.hw] = (shown, *parts)
-        return entry
-
-    def _parts(self, shown: Shown) -> tuple[tuple[str, Ink], object] | None:
-        """The value's text and ink, and the needle's sprite or the bar's fill (width, colour);
-        None where a painter must draw."""
-        zone = shown.zone
+    def _ops(self, shown: Shown) -> list[Op] | None:
+        """The composition of `shown` at the element's place: its zone's layer, the text, the
+        needle or the fill; None where a painter must draw (a text past the glyphs or, in a
+        large gauge, past its area: repainted with its whole element; a needle too large)."""
         text = (shown.text or "---") + self.units
         slot = self.slot
-        # past its area, a text is repainted with its whole element, not with the area alone
-        if not slot.fits(text) or (self.part is not None and not slot.inside(text)):
+        if not (self.alone.issuperset(text) or slot.fits(text)) or (
+                self.part is not None and not slot.inside(text)):  # (a gauge's slot cuts at its sides)
             return None
-        value = (text, self.inks[zone])
+        zone, x, y = shown.zone, self.x, self.y
+        base, ink, fill = self.zones.get(zone) or self._zone(zone)
+        value = self.text_op = (draw_text, (slot, x, y, text, ink))
         kind = self.kind
         if shown.hw is None or kind == "digital":
-            return value, None
+            return [base, value]
         if kind == "hbar":
-            fill = theme.ZONE_COLORS.get(zone or "") or theme.ACCENT
-            return value, (round(self.bar[3] * shown.fraction), fill)
-        if self.needles is None:
+            left, top, height, travel = self.bar
+            return [base, (FILL, (x + left, y + top, round(travel * shown.fraction), height, fill)), value]
+        needles = self.needles
+        if needles is None:
             return None
         pointer = round(shown.fraction * self.travel)
-        return value, self.needles.get(pointer) or self.widget._needle_sprite(pointer)
+        nx, ny, needle = needles.get(pointer) or self.widget._needle_sprite(pointer)
+        return [base, value, (PIX, (x + nx, y + ny, needle))]
 
-    def _ops(self, zone: str | None, text: tuple[str, Ink], extra: object) -> list[Op]:
-        """The composition at the element's place: its zone's layer, the text, the needle or fill."""
-        x, y = self.x, self.y
+    def _zone(self, zone: str | None) -> tuple[Op, Ink, QColor]:
+        """What a zone draws with: its layer's copy, the value's ink and a bar's fill colour."""
         layer = self.layers.get(zone)  # (not `or`: the truth of a QPixmap is a call into Qt)
-        drawn: list[Op] = [(PIX, (x, y, self.widget.layer() if layer is None else layer))]
-        value = self.text_op = (draw_text, (self.slot, x, y, *text))
-        if extra is None:
-            drawn.append(value)
-        elif self.kind == "hbar":
-            left, top, height, _ = self.bar
-            width, fill = extra  # type: ignore[misc]
-            drawn += (FILL, (x + left, y + top, width, height, fill)), value
-        else:
-            nx, ny, needle = extra  # type: ignore[misc]
-            drawn += value, (PIX, (x + nx, y + ny, needle))
-        return drawn
+        base = (PIX, (self.x, self.y, self.widget.layer() if layer is None else layer))
+        fill = theme.ZONE_COLORS.get(zone or "") or theme.ACCENT
+        made = self.zones[zone] = (base, self.inks[zone], fill)
+        return made
 
 
 GaugeWidget.face_class = GaugeFace

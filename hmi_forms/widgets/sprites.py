@@ -21,6 +21,9 @@ BUDGET = 64 * 2**20  # bytes of cached pixmaps in all
 
 
 Sprite = tuple[int, int, QPixmap]  # where a pixmap's top-left corner goes, and the pixmap
+# where a text's run starts, where it is cut (None: nowhere), and whether that cut is its box alone
+# with its ink inside its element's sides (`boxed`: a form may cut it with others, `FormView`)
+Plan = tuple[QPointF, QRect | None, bool]
 
 
 class SpriteCache:
@@ -96,6 +99,8 @@ class Glyphs:
         self.alone: set[str] = set()  # characters whose advance is the same beside every other here
         self.kerned: set[str] = set()  # kerned, or not in the font itself (drawText takes another font)
         self.layouts: dict[tuple[int, ...], tuple[int, list[QPointF]]] = {}  # `layout`
+        self.steps: set[int] = set()  # the advances of the characters known, in 64ths
+        self.lengths: dict[int, tuple[int, list[QPointF]]] = {}  # `layout` by length, while one step
 
     def learn(self, text: str) -> bool:
         """Whether `text` can be drawn as a glyph run: each character a glyph of the font itself
@@ -113,7 +118,8 @@ class Glyphs:
                 self.kerned.add(c)
                 return False
             self.indexes[c] = found[0]
-            self.advances64[c] = round(own * 64)
+            self.advances64[c] = step = round(own * 64)
+            self.steps.add(step)
             self.alone.add(c)
         return True
 
@@ -124,7 +130,13 @@ class Glyphs:
     def layout(self, text: str) -> tuple[int, list[QPointF]]:
         """The width of `text` and its glyphs' places from its start, in 64ths of a pixel as Qt
         lays a line out: advanced by each glyph's advance, itself whole 64ths. Kept by the
-        advances (the digits of a value share theirs), so a few layouts serve every value."""
+        advances (the digits of a value share theirs), so a few layouts serve every value; in a
+        font whose characters known all advance alike (a monospaced one), by the length alone."""
+        alike = len(self.steps) == 1
+        if alike:
+            found = self.lengths.get(len(text))
+            if found is not None:
+                return found
         key = tuple(map(self.advances64.__getitem__, text))
         found = self.layouts.get(key)
         if found is None:
@@ -135,6 +147,8 @@ class Glyphs:
             if len(self.layouts) >= MAX_RUNS:
                 self.layouts.clear()
             found = self.layouts[key] = (at, places)
+        if alike:  # (as many lengths as a value's text has: a few)
+            self.lengths[len(text)] = found
         return found
 
 
@@ -198,7 +212,7 @@ class TextSlot:
             self.anchor, self.pull = box.left(), 0.0
         self.row, self.fy = divmod(int(self.base * 64), 64)  # the baseline in pixels and 64ths
         self.span64, self.box64 = self.span * 64, box.width() * 64
-        self.plans: dict[tuple[int, int, int], tuple[QPointF, QRect | None]] = {}  # `_plan`
+        self.plans: dict[int, Plan] = {}  # `_plan`, by width and place in one int (no tuple per text)
         self.run = QGlyphRun()  # the text shown last, laid out
         self.run.setRawFont(glyphs.raw)
         self.text, self.places = "", glyphs.layout("")[1]
@@ -237,7 +251,7 @@ class TextSlot:
     def paint(self, p: QPainter, text: str, ink: Ink, x: int = 0, y: int = 0) -> None:
         """`draw` of a text that `fits`, as one glyph run (the slot's own: refilled only with a
         new text, its places only with new advances)."""
-        width, origin, cut = self.ready(text, x, y)
+        width, origin, cut, _ = self.ready(text, x, y)
         if ink.back is not None and width <= self.span64:
             self.fill(p, ink, x, y)
         run = self.run
@@ -254,11 +268,12 @@ class TextSlot:
             p.drawGlyphRun(origin, run)
             p.setClipping(False)
 
-    def ready(self, text: str, x: int, y: int) -> tuple[int, QPointF, QRect | None]:
+    def ready(self, text: str, x: int, y: int) -> tuple[int, QPointF, QRect | None, bool]:
         """The slot's run made to hold `text` (a text that `fits`); its width in 64ths, where the
-        run starts with the box moved by (x, y), and where it is cut (None: nowhere)."""
+        run starts with the box moved by (x, y), where it is cut (None: nowhere), and whether
+        that cut is the box alone (`Plan`)."""
         width, places = self.glyphs.layout(text)
-        origin, cut = self.plans.get((width, x, y)) or self._plan(width, x, y)
+        origin, cut, boxed = self.plans.get((width << 40) + (x << 20) + y) or self._plan(width, x, y)
         if text != self.text:
             self.text = text
             run = self.run
@@ -266,14 +281,14 @@ class TextSlot:
             if places is not self.places:
                 self.places = places
                 run.setPositions(places)
-        return width, origin, cut
+        return width, origin, cut, boxed
 
     def fill(self, p: QPainter, ink: Ink, x: int, y: int) -> None:
         """The flat colour under a text (`ink.back`, opaque) that lies inside the area (what a new
         text alone repaints), drawn before the text."""
         p.fillRect(x + self.left, y + self.top, self.size.width(), self.size.height(), ink.back)
 
-    def _plan(self, width: int, x: int, y: int) -> tuple[QPointF, QRect | None]:
+    def _plan(self, width: int, x: int, y: int) -> Plan:
         """Where a text of `width` 64ths starts with the box moved by (x, y), and where it is cut
         (None: nowhere). Its start is made whole 64ths once, as Qt makes it (QFixed::fromReal);
         where its glyphs may reach past the element's sides or past the box drawText clips a too
@@ -282,15 +297,21 @@ class TextSlot:
         glyphs = self.glyphs
         at = int(self._left(width / 64) * 64) + (x << 6)
         gy = self.row + y
+        left, right = (at >> 6) - PAD, (at + width >> 6) + PAD + 2  # what its ink may reach
+        top, bottom = gy - PAD - glyphs.ascent, gy + glyphs.below
+
+        def holds(clip: tuple[int, ...]) -> bool:
+            return (clip[0] + x <= left and right <= clip[2] + x and
+                    clip[1] + y <= top and bottom <= clip[3] + y)
+
         clip = self.cut if width > self.box64 or self.tall else self.sides
         cut = None
-        if clip is not None and not (
-                clip[0] + x <= (at >> 6) - PAD and (at + width >> 6) + PAD + 2 <= clip[2] + x and
-                clip[1] + y <= gy - PAD - glyphs.ascent and gy + glyphs.below <= clip[3] + y):
+        if clip is not None and not holds(clip):
             cut = QRect(clip[0] + x, clip[1] + y, clip[2] - clip[0], clip[3] - clip[1])
+        boxed = cut is not None and clip is self.cut and holds(self.sides)  # type: ignore[arg-type]
         if len(self.plans) >= MAX_PLANS:
             self.plans.clear()
-        plan = self.plans[(width, x, y)] = (QPointF(at / 64, gy + self.fy / 64), cut)
+        plan = self.plans[(width << 40) + (x << 20) + y] = (QPointF(at / 64, gy + self.fy / 64), cut, boxed)
         return plan
 
 
