@@ -22,7 +22,7 @@ run: $(STAMP) $(QM)
 	$(PY) main.py
 
 test: $(STAMP) $(QM)
-	QT_QPA_PLATFORM=offscreen $(PY) -m pytest -q -n 4
+	QT_QPA_PLATFORM=offscreen $(PY) -m pytest -q -n 5
 	$(PY) -m ruff check .
 
 lint: $(STAMP)
