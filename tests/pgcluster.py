@@ -122,6 +122,9 @@ class PgCluster:
         self.process = subprocess.Popen(
             [self.postgres, "-D", str(self.data), "-p", str(self.port), "-c", "listen_addresses=127.0.0.1",
              "-c", f"unix_socket_directories={self.folder}", "-c", "max_connections=50",
+             # its dynamic shared memory in its data folder, removed with it: POSIX segments in
+             # /dev/shm outlive a cluster stopped by SIGQUIT
+             "-c", "dynamic_shared_memory_type=mmap",
              *([] if self.durable else ["-c", "fsync=off", "-c", "synchronous_commit=off",
                                         "-c", "full_page_writes=off"])],
             user=self.user, stdout=subprocess.DEVNULL, stderr=open(self.folder / "log", "ab"))  # noqa: SIM115
