@@ -27,18 +27,13 @@ import pytest
 
 from tests.app.conftest import write_station
 from tests.app.station_fork import Forked, Forks
+from tests.ports import free_port
 
 pytestmark = pytest.mark.skipif(not hasattr(signal, "SIGKILL"), reason="needs POSIX signals")
 
 KILLS = int(os.environ.get("KILL_TEST_KILLS", "20"))
 REGISTERS = (1024, 1025, 1031, 1100)  # holding registers: the words at 04000, 04002, 04016, 04230
 PROGRAM = "TNA $03760\nCTR C:$03000 N:255\nJMP 0\n"  # a counter: retentive state beside the writes
-
-
-def free_port() -> int:
-    with socket.socket() as s:
-        s.bind(("127.0.0.1", 0))
-        return s.getsockname()[1]
 
 
 def station(folder: Path, port: int) -> Path:

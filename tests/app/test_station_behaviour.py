@@ -6,7 +6,6 @@ from __future__ import annotations
 import datetime as dt
 import itertools
 import signal
-import socket
 import sqlite3
 import threading
 import time
@@ -19,6 +18,7 @@ from app.station.config import load_station
 from app.station.runtime import Runtime
 from netplc.memory import Snapshot
 from tests.app.station_fork import Forks
+from tests.ports import free_port
 
 SELECT, OUT, ENABLE, TIMER_OUT = 0o2000, 0o2001, 0o2002, 0o2003  # 03_sync.hmi
 PUMP, TEMP = 0o2120, 0o4012
@@ -158,12 +158,6 @@ def test_the_workstation_changes_nothing_even_when_its_window_lags(qtbot, runtim
     runtime.stop()
     found = messages(runtime)
     assert found.count(PUMP_ON) == 1 and found.count(TEMP_HIGH) == 1  # the views journal nothing
-
-
-def free_port() -> int:
-    with socket.socket() as s:
-        s.bind(("127.0.0.1", 0))
-        return s.getsockname()[1]
 
 
 def test_no_gui_process_pulses_and_journals_what_a_modbus_client_switches(

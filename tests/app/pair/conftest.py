@@ -3,7 +3,6 @@
 from __future__ import annotations
 
 import contextlib
-import random
 import socket
 import struct
 import threading
@@ -24,6 +23,7 @@ from netplc.program import parse
 from netplc.records import Record
 from netplc.simulator import Simulator
 from tests.app.conftest import write_station
+from tests.ports import free_port
 
 TICK_MS = 40
 # the node's link, the operator's word 04000 written to the node's 04100 every scan, a 10 s timer
@@ -59,23 +59,6 @@ partner = "127.0.0.1:{partner}"
 arbiter = "{arbiter}"
 """
 OPERATOR = Who("", Source.MODBUS, "test")
-
-
-EPHEMERAL = Path("/proc/sys/net/ipv4/ip_local_port_range")
-
-
-def free_port() -> int:
-    """A port free now, for a station to bind later: below the range the OS hands to the local
-    ends of connections (a port of that range, free now, may be any connection's end by then:
-    "Address already in use" on a busy test run)."""
-    low = int(EPHEMERAL.read_text().split()[0]) if EPHEMERAL.exists() else 32768
-    while True:
-        with socket.socket() as s:
-            try:
-                s.bind(("127.0.0.1", random.randrange(10_000, low)))
-            except OSError:
-                continue  # a station of another test, or a service, listens there
-            return s.getsockname()[1]
 
 
 def wait_for(condition: Callable[[], object], timeout: float = 15.0, what: str = "") -> None:

@@ -25,12 +25,7 @@ from tests.app.conftest import DEMO_NAME, copy_demo
 from tests.cheap_users import cheap_demo_users
 from tests.netplc.test_exchange import wait_until
 from tests.opcua_address_space import FOLDER as _CACHE  # noqa: F401  the run's OPC UA cache from now on
-
-
-def free_port() -> int:
-    with socket.socket() as s:
-        s.bind(("127.0.0.1", 0))
-        return s.getsockname()[1]
+from tests.ports import free_port
 
 
 def demo_with(folder: Path, extra: str, records: list | None = None, language: str | None = None) -> Runtime:
