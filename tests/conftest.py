@@ -32,8 +32,8 @@ _databases = itertools.count(1)
 
 # --- assertion rewriting, once before the workers start -------------------------------------------
 # A fresh clone has no bytecode cache: each xdist worker then rewrites the asserts of every test file
-# as it collects (pytest's rewriting walks each assert's tree: 8-9 s of CPU a worker, 36 s of the
-# suite's with 4 workers, each worker doing the same). The controller does it once, split over the
+# as it collects (pytest's rewriting walks each assert's tree: 8-9 s of CPU a worker, 45 s of the
+# suite's with 5 workers, each worker doing the same). The controller does it once, split over the
 # cores, before the workers start: they find the rewritten files in __pycache__, as a second run
 # does, and so do the project's modules, compiled here as well. So with hypothesis's constants of
 # each local module (its plugin gathers them at each worker's collection, 1.6 s a worker without
