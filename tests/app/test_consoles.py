@@ -146,12 +146,7 @@ def reset(window: ConsoleWindow) -> None:
     (nothing painted) until a test attaches it again."""
     window.status.clearMessage()
     vars(window).pop("ask", None)
-    if window.faceplates is not None:
-        window.faceplates.close()
-    for opened in (*window.programs, *window.windows):
-        opened.close()
-    window.programs.clear()
-    window.windows.clear()
+    window.close_opened()
     window.tabs.setCurrentIndex(0)
     window.hide()
 

@@ -364,12 +364,19 @@ class ConsoleWindow(QMainWindow):
         if not answer.ok:
             self.status.showMessage(self.tr("Refused: ") + words.answer(what, answer), REFUSAL_MS)
 
-    def closeEvent(self, event: QCloseEvent) -> None:
-        self._timer.stop()
+    def close_opened(self) -> None:
+        """The faceplates, Program views, trend windows and viewers opened from here closed: as the
+        console closes, and when a test hands its console to the next test."""
         if self.faceplates is not None:
             self.faceplates.close()
         for window in (*self.programs, *self.windows):
             window.close()
+        self.programs.clear()
+        self.windows.clear()
+
+    def closeEvent(self, event: QCloseEvent) -> None:
+        self._timer.stop()
+        self.close_opened()
         self.summary.stop()
         self.journal.close_archive()
         if self.history is not None:
