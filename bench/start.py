@@ -2,12 +2,14 @@
 
 Each run is a fresh `python` process doing what `python main.py --no-gui STATION` does (import,
 read station.toml, load messages and program, start the archive, Modbus server and scan thread)
-and stopping at the first finished scan. Runs alternate between a cold start (no compiled or parsed
+and stopping at the first finished scan (once the compiled code runs the scans: a cold start scans
+with the interpreter while a child process compiles, netplc/compile_behind.py, and the row says when
+the compiled code took over). Runs alternate between a cold start (no compiled or parsed
 program kept beside the archive) and a warm one (those of the previous start), interleaved with the
 yardsticks: `python -c pass` (the interpreter alone) and a process that imports exactly the
 modules the station's start loaded, in the order it loaded them, and does nothing else. That is
 fair: it is the least any start of this station can cost, so start / imports says what the
-station adds to its imports (issue 28: warm start <= 1.3x), and a module the configuration does
+station adds to its imports (issue 28: start <= 1.3x), and a module the configuration does
 not use (Qt, pymodbus, the form code) would count against neither. Each row: median and worst.
 Target (issue 16): first scan <= 0.5 s after the process starts.
 
@@ -55,6 +57,8 @@ t["started"] = time.time()
 while runtime.engine.stats.count < 1:
     time.sleep(0.0002)
 t["first_scan"] = time.time()
+runtime.engine.compiled_ready.wait(60)
+t["compiled"] = time.time()
 runtime.stop()
 print(json.dumps(t))
 print(json.dumps(list(sys.modules)))
@@ -168,13 +172,16 @@ def main() -> None:
                   f"interpreter up {p['main']:.0f}, imports {p['imported'] - p['main']:.0f}, "
                   f"station + messages + program (parse) {p['loaded'] - p['imported']:.0f}, "
                   f"archive + engine (compile) + server "
-                  f"{p['started'] - p['loaded']:.0f}, first scan {p['first_scan'] - p['started']:.0f} ms")
+                  f"{p['started'] - p['loaded']:.0f}, first scan {p['first_scan'] - p['started']:.0f} ms; "
+                  f"scans on compiled code from {p['compiled']:.0f} ms")
         print(f"  in process: {phases_in_process(station)}")
-        worst = max(s / i for s, i in zip(rows["warm"], rows["imports"], strict=True))
+        worst = {kind: max(s / i for s, i in zip(rows[kind], rows["imports"], strict=True))
+                 for kind in ("cold", "warm")}
         fast = max(statistics.median(rows["cold"]), statistics.median(rows["warm"])) <= 500
-        print(f"target warm start <= 1.3x the imports in every run: {'met' if worst <= 1.3 else 'NOT met'} "
-              f"(worst {worst:.2f}x); first scan <= 500 ms (median, cold and warm): "
-              f"{'met' if fast else 'NOT met'}")
+        verdicts = "; ".join(f"{kind} {'met' if w <= 1.3 else 'NOT met'} (worst {w:.2f}x)"
+                             for kind, w in worst.items())
+        print(f"target start <= 1.3x the imports in every run: {verdicts}; first scan <= 500 ms (median, "
+              f"cold and warm): {'met' if fast else 'NOT met'}")
 
 
 if __name__ == "__main__":

@@ -18,6 +18,7 @@ import functools
 import re
 from collections.abc import Callable
 from pathlib import Path
+from types import CodeType
 
 from netplc import backend, timers
 from netplc.backend import Backend, Outcome, ScanHost
@@ -307,17 +308,27 @@ def program_key(program: Program, inline: dict[int, list[str]]) -> bytes:
                      instrs, repr(sorted(inline.items())))
 
 
+def compile_code(program: Program, inline: dict[int, list[str]]) -> CodeType:
+    """The code object of `program` with these in-line FONs (the same wherever it is compiled)."""
+    return compile(generate_source(program, inline), f"<compiled {program.source}>", "exec")
+
+
 def compile_program(program: Program, engine: ScanHost, cache: CodeCache | None = None) -> Backend:
     """One scan of `program` on `engine`: returns None at the end, "halt" or "watchdog". With a
     `cache`, the code object is taken from it when it holds this program's, else stored there."""
-    instrs = program.instrs
     inline, steps = fon_code(engine)
     key = program_key(program, inline) if cache is not None else b""
     code = cache.load(key) if cache is not None else None
     if code is None:
-        code = compile(generate_source(program, inline), f"<compiled {program.source}>", "exec")
+        code = compile_code(program, inline)
         if cache is not None:
             cache.store(key, code)
+    return backend_of(code, program, engine, steps)
+
+
+def backend_of(code: CodeType, program: Program, engine: ScanHost, steps: dict[int, Callable]) -> Backend:
+    """One scan of `program` on `engine` by its compiled `code`, with the FON `steps` of `fon_code`."""
+    instrs = program.instrs
     namespace: dict = {}
     exec(code, namespace)
     data = engine.mem.data

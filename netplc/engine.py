@@ -18,7 +18,9 @@ the plain reference kept beside it.
 
 from __future__ import annotations
 
+import functools
 import logging
+import threading
 import time
 import traceback
 from collections import deque
@@ -39,6 +41,7 @@ from netplc.address import (
 )
 from netplc.backend import Backend
 from netplc.codecache import CodeCache
+from netplc.compile_behind import compile_program_behind
 from netplc.compiler import compile_program
 from netplc.forcing import Forces
 from netplc.functions._util import Step, bind, fail
@@ -158,6 +161,11 @@ class Engine:
         # primary's, put by the pair link (app/station/pair.py); it never runs the program
         self.follower = False
         self.snapshot: Snapshot = self._publish()
+        # the backend is swapped under this lock: a compiled program that a child process made
+        # (netplc/compile_behind.py) replaces the interpreter between two scans; compiled_ready is
+        # set once the scans run compiled code
+        self._swap = threading.Lock()
+        self.compiled_ready = threading.Event()
         self.load(program)
 
     # --- program -------------------------------------------------------------------------------
@@ -178,8 +186,26 @@ class Engine:
                 fon = Fon(ins.c or 0, ins.n or 0, ins.s, ins.d, ins.r, index, ins.line)
                 self.fons[index] = (fon, lookup(fon.f))
                 self._calls[index] = self._make_fon(index)
-        self._run: Backend = (compile_program(program, self, self.code_cache) if self.compiled
-                              else Interpreter(program, self).run)
+        with self._swap:
+            run: Backend | None = None
+            if self.compiled and self.code_cache is None:
+                run = compile_program(program, self)
+            elif self.compiled:  # None while a child process compiles it: the interpreter until then
+                run = compile_program_behind(program, self, self.code_cache,
+                                             functools.partial(self._take_compiled, program))
+            self._run = run or Interpreter(program, self).run
+            if run is None:
+                self.compiled_ready.clear()
+            else:
+                self.compiled_ready.set()
+
+    def _take_compiled(self, program: Program, run: Backend) -> None:
+        """The compiled program a child process made (netplc/compile_behind.py): it runs from the
+        next scan on, unless another program was loaded meanwhile."""
+        with self._swap:
+            if self.program is program:
+                self._run = run
+                self.compiled_ready.set()
 
     # --- what the program calls ----------------------------------------------------------------
 

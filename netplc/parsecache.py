@@ -18,6 +18,7 @@ import functools
 import hashlib
 import logging
 import marshal
+import operator
 import os
 import tempfile
 from pathlib import Path
@@ -32,7 +33,7 @@ PREFIX = "parsed-"
 SUFFIX = ".bin"
 MAX_FILES = 16
 MAX_BYTES = 64 << 20
-_FIELDS = ("op", "c", "n", "s", "d", "r", "target", "addr", "line", "text")
+_ROW = operator.attrgetter("op", "c", "n", "s", "d", "r", "target", "addr", "line", "text")  # Instr's fields
 
 
 @functools.cache
@@ -92,7 +93,7 @@ class ParseCache:
     def store(self, key: bytes, program: Program) -> None:
         """Write `program` under `key` (atomically), then drop the least recently used files beyond
         the bounds; a folder that cannot be written is left alone."""
-        rows = [tuple(getattr(i, f) for f in _FIELDS) for i in program.instrs]
+        rows = [_ROW(i) for i in program.instrs]
         payload = marshal.dumps((program.symbols, program.words, rows))
         path = self._path(key)
         tmp: Path | None = None
