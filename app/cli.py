@@ -427,6 +427,7 @@ def _open_runtime(station: str):  # -> Runtime | None (typed lazily: the runtime
 def run_headless(station: str, duration: float | None, every: float) -> int:
     """The station without a window; under systemd (`Type=notify`) it also tells the service
     manager that it is ready, that its scan goes on, and that it stops (app/station/service.py)."""
+    from app.station import heap
     from app.station.notify import Notifier
     from app.station.runtime import StartError
     from app.station.service import Service
@@ -451,6 +452,7 @@ def run_headless(station: str, duration: float | None, every: float) -> int:
                 print(problem, file=sys.stderr)
             return 2
         print(f"station {runtime.station.name} started: {runtime.station.path}", flush=True)
+        heap.settle()  # what the start built lives until the stop: no collection walks it again
         service = Service(runtime, notifier, every)
         service.start()
         started = time.monotonic()

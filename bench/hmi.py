@@ -71,6 +71,7 @@ from PySide6.QtWidgets import QApplication, QLabel, QWidget
 
 from app.scada.quality import LinkView, QualityMap
 from app.scada.readings import Readings
+from app.station import heap
 from hmi_forms.elements.target import NullTarget
 from hmi_forms.form import load_form
 from hmi_forms.widgets import theme
@@ -294,6 +295,7 @@ def main() -> None:
     mem = Memory()
     qmap, links = station(n), LinkView(links={0: True})
     app.processEvents()
+    heap.settle()  # as the workstation does once its window is shown (app/station/heap.py)
     # allocated up front, so that the measurement itself does not grow the memory it measures
     times = array("d", bytes(8 * ticks))
     models = array("d", bytes(8 * ticks))  # the refresh part: models, change detection, scheduling

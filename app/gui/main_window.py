@@ -60,6 +60,7 @@ from app.scada.alarms import AlarmRow
 from app.scada.readings import Readings
 from app.scada.trends import TrendBook
 from app.scada.words import phrase
+from app.station import heap
 from app.station.config import load_station
 from app.station.runtime import Runtime
 from hmi_forms.elements.analog import AnalogOutput
@@ -648,6 +649,7 @@ def run_workstation(station_path: str, fullscreen: bool = False) -> int:
     if window.placement.docks_collapsed() is None and screen is not None \
             and screen.size().height() < SMALL_SCREEN:
         window.dock_strip.set_collapsed(True)  # the first start on a small screen: the picture first
+    heap.settle()  # the runtime, the forms and their widgets live until the stop: no collection walks them
     _quit_on_signals(app)
     try:
         return app.exec()
