@@ -28,7 +28,7 @@ from typing import Literal, Protocol
 from netplc.address import HMI_DATA_BIT_BASE, IO_BITS, check_operand, fmt_octal, parse_hmi_bit, parse_octal
 from netplc.memory import Memory, MemoryView
 from netplc.records import Record, RecordSink
-from netplc.words import Say, english
+from netplc.words import Say, english, phrase
 
 Kind = Literal["bit", "byte", "word"]
 KINDS: tuple[Kind, ...] = ("bit", "byte", "word")
@@ -93,17 +93,29 @@ class Force:
             mem.set_word(self.addr, self.value)
 
 
-def check_target(kind: str, addr: int) -> None:
-    """ForceError unless `kind` at `addr` names memory a force can pin."""
+def given(addr: object) -> str:
+    """An address as a caller handed it: octal as the documents print it if it is one, else as it
+    came (a protocol's or a form's text, a float...), so a refusal names what was asked for."""
+    if isinstance(addr, int) and not isinstance(addr, bool) and addr >= 0:
+        return fmt_octal(addr)
+    return repr(addr)
+
+
+def check_target(kind: object, addr: object) -> None:
+    """ForceError unless `kind` at `addr` names memory a force can pin. Anything is checked, not
+    only what the types promise: a protocol or a form that hands octal text, a float or None gets a
+    ForceError naming the kind and the address as given, like a bad integer address does."""
     if kind not in KINDS:
         raise ForceError("force kind", kind=kind, kinds=", ".join(KINDS))
+    if not isinstance(addr, int) or isinstance(addr, bool) or addr < 0:
+        raise ForceError("cannot force", kind=kind, addr=given(addr), error=phrase("addr not int"))
     try:
         if kind == "bit":
             parse_hmi_bit(addr)
         else:
             check_operand(addr, _SIZE[kind])
     except ValueError as e:
-        raise ForceError("cannot force", kind=kind, addr=fmt_octal(addr), error=e) from None
+        raise ForceError("cannot force", kind=kind, addr=given(addr), error=e) from None
 
 
 def check_value(kind: Kind, value: int) -> int:
@@ -178,7 +190,9 @@ class Forces:
         return apply
 
     def unforcing(self, kind: Kind, addr: int, *, user: str) -> Callable[[Memory], None]:
-        """Release one force: the memory keeps the value and live writers take over again."""
+        """Release one force: the memory keeps the value and live writers take over again.
+        ForceError at once for a target no force could have pinned."""
+        check_target(kind, addr)
 
         def apply(_mem: Memory) -> None:
             old = self.forced(kind, addr)

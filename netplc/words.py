@@ -62,6 +62,7 @@ WORDS = {
     "addr past io": "{addr}: {n}-byte operand runs past bit 03777",
     "addr not valid": "{addr} is not a valid address",
     "addr past bank": "{addr}: {n}-byte operand runs past the end of its bank",
+    "addr not int": "not an address (an integer from 0)",
     "addr not bit": "{addr} is neither an I/O bit nor a data bit (byte*8+bit)",
     "addr not io bit": "{addr} is not an I/O bit",
     "addr not hmi bit": "{addr} is not an HMI bit address",

@@ -41,7 +41,7 @@ from app.scada.tag import Tag, TagType
 from app.scada.words import Words, phrase, words
 from netplc.address import EMERGENCY_STOP, IO_BITS, fmt_octal
 from netplc.engine import BUSY, JOURNAL_FULL, Engine, RunState
-from netplc.forcing import ForceError, Kind
+from netplc.forcing import ForceError, Kind, given
 from netplc.memory import Memory
 from netplc.records import Record, RecordSink
 
@@ -395,7 +395,7 @@ class Commands:
 
     def force(self, who: Who, kind: Kind, addr: int, value: int | None = None) -> Ticket:
         forces = self.engine.forces
-        return self._force(who, Action.FORCE, f"{kind} {fmt_octal(addr)}",
+        return self._force(who, Action.FORCE, f"{kind} {given(addr)}",
                            lambda: forces.forcing(kind, addr, value, user=who.name))
 
     def force_tag(self, who: Who, name: str, phy: float | None = None) -> Ticket:
@@ -412,7 +412,7 @@ class Commands:
 
     def unforce(self, who: Who, kind: Kind, addr: int) -> Ticket:
         forces = self.engine.forces
-        return self._force(who, Action.UNFORCE, f"{kind} {fmt_octal(addr)}",
+        return self._force(who, Action.UNFORCE, f"{kind} {given(addr)}",
                            lambda: forces.unforcing(kind, addr, user=who.name))
 
     def unforce_tag(self, who: Who, name: str) -> Ticket:

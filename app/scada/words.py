@@ -561,6 +561,7 @@ TEXTS: dict[str, dict[str, str]] = {
         "addr past io": "{addr}: операнд из байтов ({n}) выходит за бит 03777",
         "addr not valid": "{addr} — недопустимый адрес",
         "addr past bank": "{addr}: операнд из байтов ({n}) выходит за конец своего банка",
+        "addr not int": "не адрес (целое число от 0)",
         "addr not bit": "{addr} — ни бит ввода-вывода, ни бит данных (байт*8+бит)",
         "addr not io bit": "{addr} — не бит ввода-вывода",
         "addr not hmi bit": "{addr} — не адрес бита ЧМИ",

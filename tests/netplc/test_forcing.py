@@ -3,6 +3,7 @@
 
 from __future__ import annotations
 
+import re
 from pathlib import Path
 
 import pytest
@@ -156,6 +157,21 @@ def test_bad_forces_are_refused_at_once_naming_the_address() -> None:
         eng.forces.force("byte", 0o4000, 256, user="x")
     with pytest.raises(ForceError, match="kind 'dword'"):
         eng.forces.force("dword", 0o4000, 1, user="x")  # type: ignore[arg-type]
+
+
+@pytest.mark.parametrize(("addr", "named"), [("04000", "'04000'"), (0o4000 * 1.0, "2048.0"), (None, "None"),
+                                             (True, "True"), (-8, "-8"), (b"\x08", "b'\\x08'")])
+@pytest.mark.parametrize("kind", ["bit", "byte", "word"])
+def test_an_address_that_is_no_integer_is_a_force_error_naming_it_as_given(kind, addr, named) -> None:
+    """A protocol or a form may hand octal text or a float: refused like a bad address, never a
+    ValueError of the octal formatting; octal text is not taken for an address either."""
+    eng, _, _ = engine()
+    for command in (lambda: eng.forces.force(kind, addr, 1, user="x"),
+                    lambda: eng.forces.unforce(kind, addr, user="x")):
+        with pytest.raises(ForceError, match=f"cannot force {kind} {re.escape(named)}") as caught:
+            command()
+        assert caught.value.values["kind"] == kind and caught.value.values["addr"] == named
+    assert eng.forces.count == 0
 
 
 def test_with_no_force_the_scan_is_unchanged() -> None:

@@ -143,6 +143,17 @@ def test_forcing_needs_the_engineer_and_is_journaled_with_who():
     assert too_hot.reason is Reason.OUT_OF_RANGE
 
 
+def test_a_force_of_an_address_that_is_no_integer_is_refused_as_invalid_naming_it():
+    """A caller's octal text reaches the layer as it was typed: refused, journaled, never raised."""
+    layer, engine, *_ = rig()
+    who = Who("egor", Source.OPCUA, "10.0.0.5:5000")
+    for ticket in (layer.force(who, "word", "04010", 5), layer.unforce(who, "bit", "02000")):  # type: ignore[arg-type]
+        answer = ticket.result(0)
+        assert answer.reason is Reason.INVALID
+        assert "'04010'" in answer.text or "'02000'" in answer.text
+    assert engine.forces.count == 0 and engine.writes_waiting == 0
+
+
 def test_run_and_stop_need_the_engineer():
     layer, engine, sink, clock, _ = rig()
     assert layer.stop(Who("olga", Source.CONSOLE)).result(0).reason is Reason.DENIED
