@@ -42,6 +42,7 @@ CACHE_ENV = "NETPLC_CACHE_DIR"  # the cache folder instead of the user's (a read
 FORMAT = 1  # of the file: bumped when what it holds changes
 
 if os.name == "nt":  # not run by the suite (Linux); here so that a station starts on Windows too
+    import _winapi
     import msvcrt
 
     @contextlib.contextmanager
@@ -55,6 +56,16 @@ if os.name == "nt":  # not run by the suite (Linux); here so that a station star
 
     def _private(path: Path) -> bool:
         return True  # the user's own profile: NTFS rights, not mode bits, keep others out
+
+    def _running(pid: int) -> bool:
+        try:
+            handle = _winapi.OpenProcess(0x1000, False, pid)  # PROCESS_QUERY_LIMITED_INFORMATION
+        except OSError as e:
+            return e.winerror != 87  # ERROR_INVALID_PARAMETER: no such process (5, denied: it runs)
+        try:
+            return _winapi.GetExitCodeProcess(handle) == _winapi.STILL_ACTIVE
+        finally:
+            _winapi.CloseHandle(handle)
 else:
     import fcntl
 
@@ -70,6 +81,15 @@ else:
     def _private(path: Path) -> bool:
         info = path.stat()
         return info.st_uid == os.getuid() and not info.st_mode & 0o022
+
+    def _running(pid: int) -> bool:
+        try:
+            os.kill(pid, 0)  # no signal sent: asks whether the process exists
+        except ProcessLookupError:
+            return False
+        except PermissionError:  # another user's process
+            return True
+        return True
 
 
 def cache_folder() -> Path:
@@ -127,9 +147,30 @@ def _write(path: Path, nodes: dict[ua.NodeId, NodeData]) -> None:
     path.parent.mkdir(mode=0o700, parents=True, exist_ok=True)
     part = path.with_name(f"{path.name}.{os.getpid()}.part")
     fd = os.open(part, os.O_WRONLY | os.O_CREAT | os.O_TRUNC, 0o600)  # the user's alone, whatever the umask
-    with os.fdopen(fd, "wb") as f:
-        f.write(marshal.dumps(records))
-    os.replace(part, path)  # whole or not at all
+    try:
+        with os.fdopen(fd, "wb") as f:
+            f.write(marshal.dumps(records))
+        os.replace(part, path)  # whole or not at all
+    finally:
+        part.unlink(missing_ok=True)  # a write that failed (a full disk) leaves no part; a kill does
+
+
+def _sweep(folder: Path) -> None:
+    """Remove the parts of cache files whose writer no longer runs (killed, crashed, the power cut
+    while it wrote: 11-18 MB each, never read, else left forever), logging each. The part of a
+    running process stays: two stations of a host may write at once, each the file of its own
+    asyncua under its own lock, and only a part's pid tells whether its writer is still at it."""
+    for part in folder.glob("opcua-standard-*.part"):
+        pid = part.name.rsplit(".", 2)[-2]
+        if not pid.isdigit() or _running(int(pid)):
+            continue
+        try:
+            part.unlink(missing_ok=True)  # missing: a start of another asyncua swept it first
+        except OSError:
+            logger.exception("%s: cannot remove this part of a cache file its process left", part)
+            continue
+        logger.info("%s removed: the part of a cache file left by process %s, which no longer runs",
+                    part, pid)
 
 
 def _read(path: Path) -> dict[ua.NodeId, bytes] | None:
@@ -163,6 +204,7 @@ def _load(folder: Path) -> _Kept:
             blobs = _read(path)
             if blobs is not None:
                 return _Kept(blobs, {})
+            _sweep(folder)
             nodes = fill()
             _write(path, nodes)
         logger.info("OPC UA standard address space cached in %s for the next starts", path)
