@@ -501,8 +501,8 @@ class MainWindow(QMainWindow):
             event.ignore()
             return
         self._activity.stop()
-        self.placement.save(self)
         self.placement.put_docks_collapsed(self.dock_strip.collapsed)
+        self.placement.save(self)  # written now, with the zoom choices kept since the last write
         for view in self.views:  # the guards refer back to the window: no cycle left for the GC
             for model in view.form.elements:
                 if isinstance(model, Writer):

@@ -40,8 +40,10 @@ class Placement:
         return str(self.settings.value(f"{self.group}/zoom/{form.name}", FIT_WINDOW))
 
     def put_zoom(self, form: Path, choice: str) -> None:
-        self.settings.setValue(f"{self.group}/zoom/{form.name}", choice)
-        self.settings.sync()
+        """Kept when it changes, written when QSettings writes (soon after, or at `save`): a form
+        view says its zoom at every resize, the same choice each time but the operator's."""
+        if choice != self.zoom(form):
+            self.settings.setValue(f"{self.group}/zoom/{form.name}", choice)
 
     def docks_collapsed(self) -> bool | None:
         """Whether the docks were left collapsed on this screen size; None: never chosen here."""
@@ -49,8 +51,8 @@ class Placement:
         return None if value is None else str(value).lower() == "true"
 
     def put_docks_collapsed(self, collapsed: bool) -> None:
-        self.settings.setValue(f"{self.group}/docks_collapsed", collapsed)
-        self.settings.sync()
+        if collapsed != self.docks_collapsed():
+            self.settings.setValue(f"{self.group}/docks_collapsed", collapsed)
 
     def restore(self, window: QMainWindow) -> bool:
         """The geometry and docks kept for this screen size; False at the first start on it."""
@@ -63,6 +65,7 @@ class Placement:
         return True
 
     def save(self, window: QMainWindow) -> None:
+        """The window's geometry and docks, and whatever else was kept, on disk now (at its close)."""
         self.settings.setValue(f"{self.group}/geometry", window.saveGeometry())
         self.settings.setValue(f"{self.group}/state", window.saveState())
         self.settings.sync()

@@ -3,12 +3,13 @@ the operator mode; the zoom of a form chosen on one screen size does not follow 
 
 from __future__ import annotations
 
+import configparser
 from pathlib import Path
 
-from PySide6.QtCore import QSize, Qt
+from PySide6.QtCore import QCoreApplication, QSize, Qt
 from PySide6.QtWidgets import QDockWidget, QLabel, QMainWindow
 
-from app.gui.placement import Placement, primary_size
+from app.gui.placement import Placement, primary_size, screen_key
 from app.gui.zoom import FIT_WIDTH, FIT_WINDOW
 from app.station.config import load_station
 from tests.app.conftest import write_station
@@ -50,6 +51,51 @@ def test_the_zoom_is_kept_per_screen_size(tmp_path: Path) -> None:
     Placement(ini, DESK).put_zoom(form, FIT_WIDTH)
     assert Placement(ini, DESK).zoom(form) == FIT_WIDTH
     assert Placement(ini, PANEL).zoom(form) == FIT_WINDOW
+
+
+def on_disk(ini: Path, group: str) -> dict[str, str]:
+    """What the ini file holds for a screen size, read from the disk: a QSettings of this process
+    would answer from the cache it shares with the window's."""
+    kept = configparser.ConfigParser(interpolation=None)
+    kept.optionxform = str  # type: ignore[assignment,method-assign]
+    kept.read(ini, encoding="utf-8")
+    return dict(kept[group]) if kept.has_section(group) else {}
+
+
+def test_a_resize_writes_nothing_and_the_last_zoom_chosen_is_on_disk_after_the_close(
+        qtbot, demo_copy: Path) -> None:
+    """A form view says its zoom at every resize: the ini file is written when the choice changes
+    (by QSettings, at its own time), not per resize event; a choice made just before the window
+    closes is on disk after the close."""
+    from app.gui.main_window import MainWindow
+    from app.station.runtime import Runtime
+
+    runtime = Runtime(load_station(demo_copy))
+    runtime.start()
+    window = MainWindow(runtime)
+    ini, group = runtime.station.Archive.parent / "workstation.ini", screen_key(primary_size())
+    try:
+        qtbot.addWidget(window)
+        window.resize(1366, 768)
+        window.show()
+        analog = next(a for a in window.zooms if a.form_view.form.path.stem == "02_analog")
+        key = f"zoom\\{analog.form_view.form.path.name}"
+        window.tabs.setCurrentWidget(analog)
+        analog.set_mode(FIT_WIDTH)
+        qtbot.waitUntil(lambda: ini.exists() and on_disk(ini, group).get(key) == FIT_WIDTH, timeout=10_000)
+        written = ini.stat().st_mtime_ns
+        for width in (1100, 1300, 1150, 1366):
+            was = analog.viewport().width()
+            window.resize(width, 768)
+            qtbot.waitUntil(lambda w=was: analog.viewport().width() != w, timeout=5000)
+            QCoreApplication.processEvents()  # where QSettings would write what changed
+        assert ini.stat().st_mtime_ns == written, "the ini file was written at a resize"
+        analog.zoom_by(1)
+        window.close()
+        assert on_disk(ini, group)[key] == analog.choice != FIT_WIDTH
+    finally:
+        window.close()
+        runtime.stop()
 
 
 def test_the_operator_mode_is_a_station_toml_key(tmp_path: Path) -> None:
