@@ -14,6 +14,13 @@ logged (with its traceback unless it is one the view expects) and answered, for 
 
 The thread's state is a plain object apart from the QObject, so that a view destroyed by its
 parent still stops its thread (`destroyed`) and no answer is emitted on a deleted object.
+
+Closing (a window that closes) drops the queued jobs and waits for the one under way at most
+`CLOSE_WAIT_S`: a day of a 10 Hz series is read in about half a second, but a station's archive
+read from a console waits up to a minute for a station that does not answer, and a plant archive
+up to its connect timeout, which the GUI thread must not wait for. A job still running then ends
+on its own, its answer dropped; what it opened is closed (`on_close`) on the worker thread once
+it has ended, never under it.
 """
 
 from __future__ import annotations
@@ -21,13 +28,14 @@ from __future__ import annotations
 import logging
 import threading
 from collections.abc import Callable, Hashable
-from concurrent.futures import Future, ThreadPoolExecutor
+from concurrent.futures import Future, ThreadPoolExecutor, wait
 
 from PySide6.QtCore import QObject, Signal
 
 logger = logging.getLogger(__name__)
 
 Job = Callable[[], object]
+CLOSE_WAIT_S = 1.0  # how long a close waits for the job under way (the window's GUI thread waits)
 
 
 class Worker(QObject):
@@ -56,7 +64,8 @@ class Worker(QObject):
         return self._thread.closed
 
     def close(self) -> None:
-        """Drop the queued jobs and wait for the one under way (a second call does nothing)."""
+        """Drop the queued jobs and wait for the one under way, at most CLOSE_WAIT_S (a second call
+        does nothing)."""
         self._thread.close()
 
 
@@ -75,6 +84,7 @@ class _Thread:
         self.closed = False
         self.newest: dict[Hashable, int] = {}
         self.queued: dict[Hashable, Future] = {}
+        self.pending: set[Future] = set()  # every job not yet ended, to drop the queued ones at close
         self.said: str | None = None  # the expected failure logged last, until a job succeeds
 
     def submit(self, token: int, job: Job, topic: Hashable | None) -> None:
@@ -87,6 +97,8 @@ class _Thread:
                 if older is not None:
                     older.cancel()  # only if it has not started; its answer is dropped otherwise
             future = self.pool.submit(self.run, token, job, topic)
+            self.pending.add(future)
+            future.add_done_callback(self.pending.discard)
             if topic is not None:
                 self.queued[topic] = future
 
@@ -120,6 +132,22 @@ class _Thread:
             if self.closed:
                 return
             self.closed = True
-        self.pool.shutdown(wait=True, cancel_futures=True)
-        if self.on_close is not None:
+            for future in self.pending.copy():
+                future.cancel()  # the queued ones; the one under way runs on, its answer dropped
+        running = wait([f for f in self.pending.copy() if not f.cancelled()], CLOSE_WAIT_S).not_done
+        if running:  # one at most: the pool has one thread
+            logger.warning("%s: closed while a job has run for more than %g s: it ends on its own "
+                           "(its answer dropped, then what it opened closed)", self.name, CLOSE_WAIT_S)
+            running.pop().add_done_callback(lambda _job: self.closing())  # on the worker thread
+            self.pool.shutdown(wait=False)
+            return
+        self.pool.shutdown(wait=True)  # nothing runs: the thread ends at once
+        self.closing()
+
+    def closing(self) -> None:
+        if self.on_close is None:
+            return
+        try:
             self.on_close()
+        except Exception:  # after a job that outlived the close, nobody is there to be told
+            logger.exception("%s: closing what the jobs opened failed", self.name)

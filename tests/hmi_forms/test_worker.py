@@ -9,8 +9,9 @@ import threading
 
 import pytest
 import shiboken6
-from PySide6.QtCore import QObject
+from PySide6.QtCore import QCoreApplication, QObject
 
+from hmi_forms.widgets import worker as worker_module
 from hmi_forms.widgets.worker import Worker
 
 WAIT = 10_000
@@ -88,3 +89,36 @@ def test_the_thread_stops_with_its_owner_and_closes_what_it_opened(qtbot) -> Non
     for t in threads:
         t.join(5)
         assert not t.is_alive()
+
+
+def test_a_close_waits_for_the_job_under_way_a_bounded_time_and_the_job_ends_on_its_own(
+        qtbot, caplog, monkeypatch) -> None:
+    """A window that closes during a read that does not end (a station's archive read from a
+    console whose station does not answer: up to a minute) waits at most CLOSE_WAIT_S, never for the
+    read: the read ends on its own, its answer dropped, the queued jobs never run, and what the
+    jobs opened is closed on the worker thread after the read, not under it."""
+    monkeypatch.setattr(worker_module, "CLOSE_WAIT_S", 0.05)
+    worker = Worker("slow", (), on_close=lambda: closed_after.append(release.is_set()))
+    reading, release, closed_after, ran, answers = threading.Event(), threading.Event(), [], [], []
+    worker.answered.connect(lambda _token, result: answers.append(result))
+
+    def read() -> str:
+        reading.set()
+        release.wait(WAIT / 1000)  # the station that does not answer
+        return "rows"
+
+    worker.submit(read)
+    worker.submit(lambda: ran.append("queued"))
+    assert reading.wait(WAIT / 1000)
+    with caplog.at_level(logging.WARNING, logger="hmi_forms.widgets.worker"):
+        worker.close()
+    assert not release.is_set() and not closed_after, "the close waited for the read"
+    assert "slow: closed while a job has run for more than 0.05 s" in caplog.text
+    threads = [t for t in threading.enumerate() if t.name.startswith("slow")]
+    release.set()
+    for t in threads:
+        t.join(WAIT / 1000)
+        assert not t.is_alive()
+    assert closed_after == [True] and not ran
+    QCoreApplication.processEvents()  # where an answer would arrive
+    assert answers == []
