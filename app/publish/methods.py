@@ -142,7 +142,7 @@ class StationMethods:
         try:
             if kind not in KINDS:
                 raise ValueError(f"{kind!r} is not one of {', '.join(KINDS)}")
-            addr = parse_octal(str(address))
+            addr = _octal(address)
             value = args[2] if method.name == "Force" else None
             if value is not None and (not isinstance(value, int) or isinstance(value, bool)):
                 raise ValueError(f"{value!r} is not a whole number")
@@ -170,7 +170,7 @@ class StationMethods:
     def _write(self, who: Who, method: Method, args: list[object]) -> Ticket:
         address, value, label, role = args
         try:
-            addr = parse_octal(str(address))
+            addr = _octal(address)
             top = 1 if method.name == "WriteBit" else 0xFFFF
             if not isinstance(value, int) or isinstance(value, bool) or not 0 <= value <= top:
                 raise ValueError(f"{value!r} is not a whole number 0..{top}")
@@ -195,6 +195,14 @@ class StationMethods:
             return commands.refuse(who, method.action, name, Reason.INVALID,
                                    commands.say("no number", value=value))
         return commands.force_tag(who, name, None if value is None else float(value))
+
+
+def _octal(address: object) -> int:
+    """An Address argument, octal text (its DataType is String): a number a client sends instead
+    is refused, not read as octal digits (an Int32 1000 would be bit 01000)."""
+    if not isinstance(address, str):
+        raise ValueError(f"{address!r} is not an address: octal text, as 04010")
+    return parse_octal(address)
 
 
 def arguments(request: ua.CallMethodRequest, count: int) -> tuple[list[Any], ua.CallMethodResult]:
