@@ -7,7 +7,7 @@ traceback, so the parser collects diagnostics and raises one ProgramError at the
 from __future__ import annotations
 
 import re
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, fields
 from pathlib import Path
 
 from netplc.address import (
@@ -36,6 +36,7 @@ LOGIC = {
 }
 CONTACTS = frozenset({"TNA", "TFA", "TNO", "TFO", "TNE", "TFE"})
 JUMPS = frozenset({"JMY", "JMN", "JMP"})
+ONE_BIT = CONTACTS | {"SON", "SOF", "YON"}  # one I/O bit at C
 # bits used by a coil-like instruction at C: C..C+n-1 must be I/O bits
 COIL_BITS = {"SON": 1, "SOF": 1, "YON": 1, "TIM": 2, "CTR": 3, "FON": 4}
 
@@ -53,9 +54,11 @@ _COMMENT = re.compile(r"\s[;#]|;;|\s//")
 # after it, a mnemonic, parameters `K:token` or `token` (ASCII letters, digits, `$_.[]-`) separated
 # by spaces or tabs, and a comment after a space or a tab, if any. Every other line (a symbol, a
 # label alone, `;` between parameters, other white space, other characters) is read the general way.
+# Groups: label, mnemonic, the first parameter's key and token (most lines have one), the others.
 _PLAIN = re.compile(
     r"[ \t]*(?:[0-9]+\.[0-9]+[ \t]+)?(?:([A-Za-z_]\w*)[ \t]*:[ \t]+)?([A-Za-z]+)"
-    r"((?:[ \t]+(?:[A-Za-z]:)?[\w$.\[\]-]+)*)(?:[ \t]+(?:[;#]|//).*|[ \t]*)",
+    r"(?:[ \t]+(?:([A-Za-z]):)?([\w$.\[\]-]+)((?:[ \t]+(?:[A-Za-z]:)?[\w$.\[\]-]+)*))?"
+    r"(?:[ \t]+(?:[;#]|//).*|[ \t]*)",
     re.ASCII,
 )
 _PLAIN_PARAM = re.compile(r"(?:([A-Za-z]):)?([\w$.\[\]-]+)", re.ASCII)
@@ -87,8 +90,15 @@ class ProgramError(Problems):
         super().__init__([str(e) for e in errors])
 
 
-@dataclass(frozen=True, slots=True)
+@dataclass(frozen=True, slots=True, init=False)
 class Instr:
+    """One instruction of a program, as parsed.
+
+    `__init__` is written out: the one a frozen dataclass generates sets each field through
+    `object.__setattr__`, 3.5 us an instruction here, a fifth of a program's parse and most of a
+    parse-cache load; the slots' own setters (`_INSTR_SLOTS`) do the same in half the time.
+    tests/netplc/test_parse_plain.py holds its parameters to the fields."""
+
     op: str
     c: int | None = None
     n: int | None = None  # TIM/CTR preset, FON function number
@@ -99,6 +109,24 @@ class Instr:
     addr: int = 0  # word address in program memory
     line: int = 0
     text: str = ""
+
+    def __init__(self, op: str, c: int | None = None, n: int | None = None, s: int | None = None,
+                 d: int | None = None, r: int | None = None, target: int | None = None, addr: int = 0,
+                 line: int = 0, text: str = "") -> None:
+        set_op, set_c, set_n, set_s, set_d, set_r, set_target, set_addr, set_line, set_text = _INSTR_SLOTS
+        set_op(self, op)
+        set_c(self, c)
+        set_n(self, n)
+        set_s(self, s)
+        set_d(self, d)
+        set_r(self, r)
+        set_target(self, target)
+        set_addr(self, addr)
+        set_line(self, line)
+        set_text(self, text)
+
+
+_INSTR_SLOTS = tuple(getattr(Instr, f.name).__set__ for f in fields(Instr))
 
 
 @dataclass
@@ -194,7 +222,7 @@ def load_program(path: str | Path, symbols_path: str | Path | None = None) -> Pr
     return parse_file(path, symbols)
 
 
-@dataclass
+@dataclass(slots=True)
 class _Raw:
     line: int
     col: int
@@ -227,8 +255,13 @@ class _Parser:
     def run(self, text: str) -> Program:
         raws: list[_Raw] = []
         labels: dict[str, int] = {}  # label -> instruction index
+        plain = self._plain if self.fast else None
         for lineno, line in enumerate(text.splitlines(), start=1):
-            self._scan_line(lineno, line, raws, labels)
+            stripped = line.strip()
+            if not stripped or stripped.startswith((";", "#", "//")):
+                continue
+            if plain is None or not plain(lineno, line, stripped, raws, labels):
+                self._general(lineno, line, stripped, raws, labels)
         instrs: list[Instr] = []
         words = 0
         addr_of: list[int] = []
@@ -236,8 +269,9 @@ class _Parser:
             addr_of.append(words)
             words += LOGIC[raw.op][1]
         by_addr = {a: i for i, a in enumerate(addr_of)}
-        for index, raw in enumerate(raws):
-            ins = self._build(raw, index, addr_of[index], labels, by_addr)
+        build = self._build
+        for raw, addr in zip(raws, addr_of):
+            ins = build(raw, addr, labels, by_addr)
             if ins is not None:
                 instrs.append(ins)
         if words > PROGRAM_WORDS:
@@ -246,13 +280,6 @@ class _Parser:
             self.errors.sort(key=lambda d: (d.line, d.col))
             raise ProgramError(self.errors)
         return Program(instrs, self.symbols, self.source, words)
-
-    def _scan_line(self, lineno: int, line: str, raws: list[_Raw], labels: dict[str, int]) -> None:
-        stripped = line.strip()
-        if not stripped or stripped.startswith((";", "#", "//")):
-            return
-        if not (self.fast and self._plain(lineno, line, stripped, raws, labels)):
-            self._general(lineno, line, stripped, raws, labels)
 
     def _plain(self, lineno: int, line: str, text: str, raws: list[_Raw], labels: dict[str, int]) -> bool:
         """Read a plain line (`_PLAIN`) in one match; False, having done nothing, for any other line.
@@ -264,14 +291,16 @@ class _Parser:
         m = _PLAIN.fullmatch(line)
         if m is None:
             return False
-        op = m.group(2).upper()
+        label, mnemonic, key, token, more = m.groups()
+        op = mnemonic.upper()
         if op not in LOGIC:
             return False
-        if m.group(1):
-            self._label(lineno, m.start(1) + 1, m.group(1), labels, len(raws))
-        tokens = [((key or "").upper(), token, p.start(2) + 1)
-                  for p in _PLAIN_PARAM.finditer(line, m.start(3), m.end(3))
-                  for key, token in (p.groups(),)]
+        if label:
+            self._label(lineno, m.start(1) + 1, label, labels, len(raws))
+        tokens = [] if token is None else [(key.upper() if key else "", token, m.start(4) + 1)]
+        if more:
+            tokens += [((p[1] or "").upper(), p[2], p.start(2) + 1)
+                       for p in _PLAIN_PARAM.finditer(line, m.start(5), m.end(5))]
         self._instruction(lineno, m.start(2) + 1, op, tokens, None, text, raws)
         return True
 
@@ -358,14 +387,15 @@ class _Parser:
         for key, token, tcol in tokens:
             if not key:
                 # a positional parameter: the first one the instruction takes that is not given yet
-                free = [k for k in keys if k not in params]
-                if op == "FON" and free and free[0] in "SDR":
-                    extra.append((token, tcol))  # which of S, D, R depends on the function
-                    continue
-                if not free:
+                for key in keys:
+                    if key not in params:
+                        break
+                else:
                     self.err(lineno, tcol, "stl no more", op=op, token=token)
                     return
-                key = free[0]
+                if op == "FON" and key in ("S", "D", "R"):
+                    extra.append((token, tcol))  # which of S, D, R depends on the function
+                    continue
             if key not in keys:
                 self.err(lineno, tcol, "stl no such param" if keys else "stl takes none", op=op, key=key)
                 ok = False
@@ -385,7 +415,7 @@ class _Parser:
     def _resolve(self, raw: _Raw, key: str) -> int | None:
         """An address parameter: `$octal`, bare octal digits, a symbol, or `symbol[k]` (k bits on)."""
         token, col = raw.params[key]
-        if token[0] == "$" or token[0] in "0123456789":
+        if token[0] in "$0123456789":
             try:
                 return parse_octal(token)
             except ValueError:
@@ -455,39 +485,36 @@ class _Parser:
         return int(token, radix)
 
     def _build(
-        self, raw: _Raw, index: int, addr: int, labels: dict[str, int], by_addr: dict[int, int]
+        self, raw: _Raw, addr: int, labels: dict[str, int], by_addr: dict[int, int]
     ) -> Instr | None:
         op = raw.op
-        common = {"addr": addr, "line": raw.line, "text": raw.text}
-        if op in CONTACTS:
+        if op in ONE_BIT:
             c = self._coil(raw, 1)
-            return None if c is None else Instr(op, c=c, **common)
-        if op in ("SON", "SOF", "YON"):
-            c = self._coil(raw, 1)
-            return None if c is None else Instr(op, c=c, **common)
+            # positional: the fields in their order (op, c, n, s, d, r, target, addr, line, text)
+            return None if c is None else Instr(op, c, None, None, None, None, None, addr, raw.line, raw.text)
         if op in ("NOP", "SKP", "HLT"):
-            return Instr(op, **common)
+            return Instr(op, addr=addr, line=raw.line, text=raw.text)
         if op in JUMPS:
             if "L" not in raw.params:
                 self.err(raw.line, raw.col, "stl needs label", op=op)
                 return None
             token, col = raw.params["L"]
-            if token[0] == "$" or token[0] in "0123456789":
+            if token[0] in "$0123456789":
                 try:
                     value = parse_octal(token)
                 except ValueError:
                     self.err(raw.line, col, "stl not program address", token=token)
                     return None
                 if value == 0:
-                    return Instr(op, target=None, **common)
+                    return Instr(op, target=None, addr=addr, line=raw.line, text=raw.text)
                 if value not in by_addr:
                     self.err(raw.line, col, "stl not start", token=token)
                     return None
-                return Instr(op, target=by_addr[value], **common)
+                return Instr(op, target=by_addr[value], addr=addr, line=raw.line, text=raw.text)
             if token not in labels:
                 self.err(raw.line, col, "stl undefined label", token=token)
                 return None
-            return Instr(op, target=labels[token], **common)
+            return Instr(op, target=labels[token], addr=addr, line=raw.line, text=raw.text)
         if op in ("TIM", "CTR"):
             c = self._coil(raw, COIL_BITS[op])
             if "N" not in raw.params:
@@ -496,10 +523,10 @@ class _Parser:
             n = self._const(raw, "N", "D", 0, 255)
             if c is None or n is None:
                 return None
-            return Instr(op, c=c, n=n, **common)
-        return self._build_fon(raw, common)
+            return Instr(op, c=c, n=n, addr=addr, line=raw.line, text=raw.text)
+        return self._build_fon(raw, addr)
 
-    def _build_fon(self, raw: _Raw, common: dict) -> Instr | None:
+    def _build_fon(self, raw: _Raw, addr: int) -> Instr | None:
         c = self._coil(raw, COIL_BITS["FON"])
         if "N" not in raw.params:
             self.err(raw.line, raw.col, "stl fon needs n")
@@ -555,5 +582,6 @@ class _Parser:
                     ok = ok and values[key] is not None
         if not ok:
             return None
-        return Instr("FON", c=c, n=number, s=values["S"], d=values["D"], r=values["R"], **common)
+        return Instr("FON", c=c, n=number, s=values["S"], d=values["D"], r=values["R"], addr=addr,
+                     line=raw.line, text=raw.text)
 

@@ -4,10 +4,14 @@ plain lines take the one-match path or every line is read part by part (`parse(.
 
 from __future__ import annotations
 
+import dataclasses
+import inspect
+
+import pytest
 from hypothesis import example, given, settings
 from hypothesis import strategies as st
 
-from netplc.program import _PLAIN, LOGIC, Program, ProgramError, parse
+from netplc.program import _PLAIN, LOGIC, Instr, Program, ProgramError, parse
 
 SYMBOLS = {"TA": 0o2003, "ON": 0o3760, "W": 0o5000, "X": 0o4000}
 
@@ -108,3 +112,16 @@ def test_plain_lines_take_the_one_match():
         assert _PLAIN.fullmatch(line), line
     for line in ["TA = $02003", "L1:", "TNA $03000;N:5", "TNA C: $03000", "TNA\u00a0$03000", "TNA $03000;;c"]:
         assert not _PLAIN.fullmatch(line), line
+
+
+def test_instr_init_takes_the_fields():
+    """Instr's written-out __init__ (netplc/program.py says why) takes every field, in order, with
+    its default, and the instruction stays frozen."""
+    params = list(inspect.signature(Instr).parameters.values())
+    assert [(p.name, p.default) for p in params] == [
+        (f.name, inspect.Parameter.empty if f.default is dataclasses.MISSING else f.default)
+        for f in dataclasses.fields(Instr)]
+    ins = Instr("FON", 1, 2, 3, 4, 5, 6, 7, 8, "t")
+    assert [getattr(ins, f.name) for f in dataclasses.fields(Instr)] == ["FON", 1, 2, 3, 4, 5, 6, 7, 8, "t"]
+    with pytest.raises(dataclasses.FrozenInstanceError):
+        ins.c = 0  # type: ignore[misc]
