@@ -287,9 +287,10 @@ class _Parser:
         """Read a plain line (`_PLAIN`) in one match; False, having done nothing, for any other line.
 
         A station's cold start parses its whole program, and nearly every line of one is plain: one
-        match instead of a regex per part and per parameter makes that about 3x faster. What it
-        reads goes on as the general reading's would (`_label`, `_instruction`), so a construct has
-        one meaning; a mnemonic that is no instruction is left to `_general`, which says why."""
+        match instead of a regex per part and per parameter reads the 8 K-word program of
+        bench/scan.py in less than half the time. What it reads goes on as the general reading's
+        would (`_label`, `_instruction`), so a construct has one meaning; a mnemonic that is no
+        instruction is left to `_general`, which says why."""
         m = _PLAIN.fullmatch(line)
         if m is None:
             return False
