@@ -8,7 +8,7 @@ import dataclasses
 import inspect
 
 import pytest
-from hypothesis import example, given, settings
+from hypothesis import HealthCheck, example, given, settings
 from hypothesis import strategies as st
 
 from netplc.program import _PLAIN, LOGIC, Instr, Program, ProgramError, parse
@@ -95,7 +95,8 @@ def outcome(text: str, fast: bool) -> Program | list[tuple[str, int, int, str]]:
         return [(d.file, d.line, d.col, str(d)) for d in e.errors]
 
 
-@settings(max_examples=300, deadline=None, derandomize=True)
+# the CI machine is loaded: generating may be slow there, which says nothing of the parser
+@settings(max_examples=300, deadline=None, derandomize=True, suppress_health_check=[HealthCheck.too_slow])
 @given(PROGRAMS)
 @example(NEAR_MISSES)
 @example("TNA $03000\nFON C:$03600 N:MOV S:$05000 D:$05002\nFON C:$03604 N:ADD $05000 $05002 $05004\nJMP 0")
