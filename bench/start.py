@@ -115,7 +115,7 @@ def phases_in_process(station: Path) -> str:
     inline, _ = compiler.fon_code(engine)
     source = compiler.generate_source(program, inline)
     cache = station / "phases-cache"
-    Engine(program, clock=FakeClock(), code_cache=cache)
+    assert Engine(program, clock=FakeClock(), code_cache=cache).compiled_ready.wait(60)  # a child compiles it
     parsed = ParseCache(station / "phases-parsed")
     parse_file_cached(station / "program.stl", {}, parsed)
     figures = {

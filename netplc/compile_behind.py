@@ -10,8 +10,9 @@ takes the code between two scans (`compile_program_behind`). A child that fails
 or hangs is logged and the code is compiled in the station's process instead, as before. Programs
 below BEHIND_MIN compile in place: a child would cost more than their compile.
 
-The child is this module run as `python -m netplc.compile_behind`: the program's instructions and
-in-line functions come on its stdin and the code object goes back on its stdout, both marshalled.
+The child is this module run as `python -m netplc.compile_behind`, at a lower priority (NICE): the
+program's instructions and in-line functions come on its stdin and the code object goes back on
+its stdout, both marshalled.
 """
 
 from __future__ import annotations
@@ -36,6 +37,7 @@ logger = logging.getLogger(__name__)
 BEHIND_MIN = 2000  # instructions: about 70 ms of compile, twice what a child's start costs
 TIMEOUT = 120.0  # seconds a child may take before it is killed and the station compiles itself
 PYTHON = sys.executable  # the child's interpreter: the station's own
+NICE = 10  # the child's niceness added: on a busy machine it takes the CPU the station leaves
 
 
 def compile_program_behind(program: Program, engine: ScanHost, cache: CodeCache,
@@ -107,6 +109,7 @@ def child_code(payload: bytes, source: str) -> CodeType | None:
 
 
 def main() -> None:
+    os.nice(NICE)  # the station's own threads first: they start, scan and answer meanwhile
     source, rows, inline = marshal.loads(sys.stdin.buffer.read())
     program = Program([Instr(*row) for row in rows], source=source)
     sys.stdout.buffer.write(marshal.dumps(compile_code(program, inline)))
