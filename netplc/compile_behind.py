@@ -6,13 +6,13 @@ or stall the scans from a thread. When a start finds no compiled code (archive/c
 program of BEHIND_MIN instructions or more, the engine scans with the reference interpreter (the same
 memory, timers, counters and functions: the equivalence tests hold the two backends to identical
 results) while a child Python generates and compiles the code from the instructions; the engine
-takes the code between two scans (`compile_program_behind`). A child that fails
-or hangs is logged and the code is compiled in the station's process instead, as before. Programs
-below BEHIND_MIN compile in place: a child would cost more than their compile.
+takes the code between two scans (`compile_program_behind`). The child starts after the first
+scan and runs at a lower priority (NICE): the start and the scans go first on a busy machine. A
+child that fails or hangs is logged and the code is compiled in the station's process instead, as
+before. Programs below BEHIND_MIN compile in place: a child would cost more than their compile.
 
-The child is this module run as `python -m netplc.compile_behind`, at a lower priority (NICE): the
-program's instructions and in-line functions come on its stdin and the code object goes back on
-its stdout, both marshalled.
+The child is this module run as `python -m netplc.compile_behind`: the program's instructions and
+in-line functions come on its stdin and the code object goes back on its stdout, both marshalled.
 """
 
 from __future__ import annotations
@@ -38,14 +38,16 @@ BEHIND_MIN = 2000  # instructions: about 70 ms of compile, twice what a child's 
 TIMEOUT = 120.0  # seconds a child may take before it is killed and the station compiles itself
 PYTHON = sys.executable  # the child's interpreter: the station's own
 NICE = 10  # the child's niceness added: on a busy machine it takes the CPU the station leaves
+AFTER_S = 5.0  # the longest the child waits for the first scan (an engine that never scans, a standby)
 
 
 def compile_program_behind(program: Program, engine: ScanHost, cache: CodeCache,
-                           ready: Callable[[Backend], None]) -> Backend | None:
+                           ready: Callable[[Backend], None], after: threading.Event) -> Backend | None:
     """`compile_program` with `cache` (netplc/compiler.py), except that a program of BEHIND_MIN
-    instructions or more that the cache lacks is compiled by a child process: None is returned at
-    once (the caller scans with the interpreter) and `ready(backend)` is called from a thread when
-    the code is there and kept in the cache."""
+    instructions or more that the cache lacks is compiled by a child process, started once `after`
+    is set (the engine's first scan) or AFTER_S have passed: None is returned at once (the caller
+    scans with the interpreter) and `ready(backend)` is called from a thread when the code is there
+    and kept in the cache."""
     if len(program.instrs) < BEHIND_MIN:
         return compile_program(program, engine, cache)
     inline, steps = fon_code(engine)
@@ -63,18 +65,24 @@ def compile_program_behind(program: Program, engine: ScanHost, cache: CodeCache,
         except Exception:
             logger.exception("%s not compiled: the interpreter goes on running its scans", program.source)
 
-    start(program, inline, done)
+    start(program, inline, done, after)
     return None
 
 
-def start(program: Program, inline: dict[int, list[str]], done: Callable[[CodeType | None], None]) -> None:
-    """Compile `program` in a child process; `done(code)` from a thread when it is there, `done(None)`
-    (after logging why) when the child failed. The thread is not a daemon: a station that stops
-    meanwhile still gets its code into the cache for the next start."""
+def start(program: Program, inline: dict[int, list[str]], done: Callable[[CodeType | None], None],
+          after: threading.Event) -> None:
+    """Compile `program` in a child process once `after` is set (or AFTER_S have passed); `done(code)`
+    from a thread when it is there, `done(None)` (after logging why) when the child failed. The
+    thread is not a daemon: a station that stops meanwhile still gets its code into the cache for
+    the next start."""
     rows = [(i.op, i.c, i.n, i.s, i.d, i.r, i.target) for i in program.instrs]
     payload = marshal.dumps((program.source, rows, inline))
-    threading.Thread(target=lambda: done(child_code(payload, program.source)), name="netplc-compile",
-                     daemon=False).start()
+
+    def compile_after() -> None:
+        after.wait(AFTER_S)
+        done(child_code(payload, program.source))
+
+    threading.Thread(target=compile_after, name="netplc-compile", daemon=False).start()
 
 
 def child_code(payload: bytes, source: str) -> CodeType | None:

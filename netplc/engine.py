@@ -166,6 +166,7 @@ class Engine:
         # set once the scans run compiled code
         self._swap = threading.Lock()
         self.compiled_ready = threading.Event()
+        self.scanned = threading.Event()  # set by the first scan that ran the program or could have
         self.load(program)
 
     # --- program -------------------------------------------------------------------------------
@@ -192,7 +193,7 @@ class Engine:
                 run = compile_program(program, self)
             elif self.compiled:  # None while a child process compiles it: the interpreter until then
                 run = compile_program_behind(program, self, self.code_cache,
-                                             functools.partial(self._take_compiled, program))
+                                             functools.partial(self._take_compiled, program), self.scanned)
             self._run = run or Interpreter(program, self).run
             if run is None:
                 self.compiled_ready.clear()
@@ -486,6 +487,8 @@ class Engine:
             self.rtc.watch(mem)
         if forces.listing:  # force hook 2: over what the program wrote, before the snapshot
             forces.apply(mem)
+        if self.scan_counter == 0:
+            self.scanned.set()
         self.scan_counter += 1
         self.snapshot = self._publish()
         self.stats.add((time.perf_counter() - t0) * 1000.0, self.tick * 1000.0)

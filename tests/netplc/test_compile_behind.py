@@ -88,9 +88,10 @@ def test_a_failing_child_costs_only_the_compile(tmp_path: Path, monkeypatch: pyt
     caplog.set_level(logging.ERROR, logger="netplc.compile_behind")
     program = parse(TEXT, source="p.stl")
     behind = engine(program, code_cache=tmp_path)
+    reference = engine(program, compiled=False)
+    scan(behind, reference)  # the child starts after the first scan
     assert behind.compiled_ready.wait(60)
     assert "the child process compiling p.stl failed (exit code 1)" in caplog.text
-    reference = engine(program, compiled=False)
     for _ in range(20):
         scan(behind, reference)
     assert state(behind) == state(reference)
@@ -103,8 +104,9 @@ def test_a_program_loaded_meanwhile_is_not_replaced_by_the_older_ones_code(tmp_p
     eng = engine(first, code_cache=tmp_path)
     eng.load(second)
     assert eng.compiled_ready.is_set()
-    wait_for_compilers()  # the first program's child is done and its code offered
     reference = engine(second, compiled=False)
+    scan(eng, reference)  # the first scan: the first program's child starts
+    wait_for_compilers()  # the first program's child is done and its code offered
     for _ in range(3):
         scan(eng, reference)
     assert state(eng) == state(reference)
