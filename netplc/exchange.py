@@ -533,18 +533,19 @@ class Exchange:
         self.engine.post(apply)
 
 
-def _fon_nodes(program: Program) -> Iterable[tuple[int, Instr, int | None]]:
-    """(function, instruction, node it talks to): the nearest NODE above it in the text; node 0
-    when the program has no NODE; None above the first NODE (the last NODE of the previous scan)."""
-    has_node = any(i.op == "FON" and i.n == NODE for i in program.instrs)
-    current: int | None = None if has_node else 0
-    for ins in program.instrs:
-        if ins.op != "FON":
-            continue
+def _fon_nodes(program: Program) -> list[tuple[int, int, Instr, int | None]]:
+    """(index, function, instruction, node it talks to) of each NREAD and NWRITE: the nearest NODE
+    above it in the text; node 0 when the program has no NODE; None above the first NODE (the last
+    NODE of the previous scan). Over the FONs alone: a plant program is mostly contacts and coils."""
+    fons = [(k, ins) for k, ins in enumerate(program.instrs) if ins.op == "FON"]
+    current: int | None = None if any(ins.n == NODE for _, ins in fons) else 0
+    out = []
+    for k, ins in fons:
         if ins.n == NODE:
             current = ins.s
         elif ins.n in (NREAD, NWRITE):
-            yield ins.n, ins, current
+            out.append((k, ins.n, ins, current))
+    return out
 
 
 def check_program_nodes(program: Program, nodes: list[NodeConfig]) -> list[Diagnostic]:
@@ -565,7 +566,7 @@ def check_program_nodes(program: Program, nodes: list[NodeConfig]) -> list[Diagn
     for ins in program.instrs:
         if ins.op == "FON" and ins.n == NODE and ins.s not in configs:
             err(ins, "stl node not configured", node=ins.s, have=have)
-    for fn, ins, node in _fon_nodes(program):
+    for _, fn, ins, node in _fon_nodes(program):
         name = "NREAD" if fn == NREAD else "NWRITE"
         remote, local = (ins.s, ins.d) if fn == NREAD else (ins.d, ins.s)
         length = ins.r or 0

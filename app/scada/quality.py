@@ -114,28 +114,31 @@ class Feed:
     line: int = 0  # of the program text, for messages
 
 
-def _exchanges(program: Program) -> list[tuple[int, Instr, int]]:
-    """Every NREAD and NWRITE with the node it talks to. One above the first NODE talks to the
-    node of the last NODE in the text (the one selected when the previous scan ended)."""
+Exchanges = list[tuple[int, int, Instr, int]]  # (index, NREAD or NWRITE, instruction, node)
+
+
+def _exchanges(program: Program) -> Exchanges:
+    """(index, function, instruction, node) of every NREAD and NWRITE. One above the first NODE
+    talks to the node of the last NODE in the text (the one selected when the previous scan ended)."""
     nodes = [i.s for i in program.instrs if i.op == "FON" and i.n == NODE]
     wrap = nodes[-1] if nodes else 0
-    return [(fn, ins, wrap if node is None else node) for fn, ins, node in _fon_nodes(program)]
+    return [(k, fn, ins, wrap if node is None else node) for k, fn, ins, node in _fon_nodes(program)]
 
 
-def nread_feeds(program: Program) -> list[Feed]:
+def nread_feeds(program: Program, exchanges: Exchanges | None = None) -> list[Feed]:
     """Every NREAD of the program with the node it talks to and the bytes it fills."""
-    index = {id(ins): k for k, ins in enumerate(program.instrs)}
     feeds = []
-    for fn, ins, node in _exchanges(program):
+    for k, fn, ins, node in _exchanges(program) if exchanges is None else exchanges:
         if fn == NREAD:
             first, last = span(ins.d or 0, ins.r or 0)
-            feeds.append(Feed(index[id(ins)], node, ins.c or 0, first, last, ins.line))
+            feeds.append(Feed(k, node, ins.c or 0, first, last, ins.line))
     return feeds
 
 
-def link_outputs(program: Program) -> dict[int, int]:
+def link_outputs(program: Program, exchanges: Exchanges | None = None) -> dict[int, int]:
     """The link output bit (C+1) of every NREAD and NWRITE -> the node whose link it copies."""
-    return {(ins.c or 0) + 1: node for fn, ins, node in _exchanges(program) if fn in (NREAD, NWRITE)}
+    found = _exchanges(program) if exchanges is None else exchanges
+    return {(ins.c or 0) + 1: node for _, fn, ins, node in found if fn in (NREAD, NWRITE)}
 
 
 @dataclass(frozen=True)
@@ -185,8 +188,9 @@ class QualityMap:
     """Which NREADs fill each tag, worked out once at load time; per scan, every tag's quality."""
 
     def __init__(self, program: Program, tags: Sequence[Tag]) -> None:
-        self.feeds = nread_feeds(program)
-        self.link_bits = link_outputs(program)
+        exchanges = _exchanges(program)  # once: a plant program has thousands of instructions
+        self.feeds = nread_feeds(program, exchanges)
+        self.link_bits = link_outputs(program, exchanges)
         self.tags = list(tags)
         self._tags = Operands(self.feeds, [t.footprint() for t in self.tags])
         self._pos = {t.name: i for i, t in enumerate(self.tags)}
