@@ -38,7 +38,7 @@ PRESENCE_NODES = 32
 # Octal text: `$` and `0o` prefixes optional, then octal digits only (int(t, 8) alone would also take
 # `_`, a sign, white space and other scripts' digits). One match instead of a test per character:
 # a program's parse reads thousands of addresses.
-_OCTAL_TEXT = re.compile(r"\$?(?:0[oO])?([0-7]+)")
+OCTAL_TEXT = re.compile(r"\$?(?:0[oO])?([0-7]+)")
 
 
 class AddressError(WordedError):
@@ -47,7 +47,7 @@ class AddressError(WordedError):
 
 def parse_octal(text: str) -> int:
     """Parse `04000`, `$04000` or `4000` as octal; raise a ValueError (WordedError) naming the text."""
-    m = _OCTAL_TEXT.fullmatch(text.strip())
+    m = OCTAL_TEXT.fullmatch(text.strip())
     if m is None:
         raise WordedError("addr not octal", text=text)
     return int(m.group(1), 8)

@@ -13,6 +13,7 @@ from pathlib import Path
 
 from netplc.address import (
     IO_BITS,
+    OCTAL_TEXT,
     AddressError,
     check_operand,
     fmt_octal,
@@ -255,7 +256,7 @@ class _Parser:
         self.errors.append(Diagnostic(self.source, line, col, phrase(name, **values)))
 
     def run(self, text: str) -> Program:
-        raws: list[_Raw] = []
+        raws: list[_Raw | tuple[str, int, int, str]] = []  # a tuple: (op, C, line, text), see `_plain`
         labels: dict[str, int] = {}  # label -> instruction index
         plain = self._plain if self.fast else None
         for lineno, line in enumerate(text.splitlines(), start=1):
@@ -269,21 +270,27 @@ class _Parser:
         addr_of: list[int] = []
         for raw in raws:
             addr_of.append(words)
-            words += LOGIC[raw.op][1]
+            words += 1 if type(raw) is tuple else LOGIC[raw.op][1]
         by_addr = {a: i for i, a in enumerate(addr_of)}
         build = self._build
         for raw, addr in zip(raws, addr_of):
+            if type(raw) is tuple:  # a contact or coil read whole (`_plain`)
+                op, c, line, text = raw
+                instrs.append(Instr(op, c, None, None, None, None, None, addr, line, text))
+                continue
             ins = build(raw, addr, labels, by_addr)
             if ins is not None:
                 instrs.append(ins)
         if words > PROGRAM_WORDS:
-            self.err(raws[-1].line, 1, "stl too big", words=words, most=PROGRAM_WORDS)
+            last = raws[-1]
+            self.err(last[2] if type(last) is tuple else last.line, 1, "stl too big", words=words,
+                     most=PROGRAM_WORDS)
         if self.errors:
             self.errors.sort(key=lambda d: (d.line, d.col))
             raise ProgramError(self.errors)
         return Program(instrs, self.symbols, self.source, words)
 
-    def _plain(self, lineno: int, line: str, text: str, raws: list[_Raw], labels: dict[str, int]) -> bool:
+    def _plain(self, lineno: int, line: str, text: str, raws: list, labels: dict[str, int]) -> bool:
         """Read a plain line (`_PLAIN`) in one match; False, having done nothing, for any other line.
 
         A station's cold start parses its whole program, and nearly every line of one is plain: one
@@ -306,7 +313,13 @@ class _Parser:
             keys = LOGIC[op][0]
             name = key.upper() if key else keys[0] if keys else ""
             if name in keys:
-                raws.append(_Raw(lineno, m.start(2) + 1, op, {name: (token, m.start(4) + 1)}, text))
+                bit = OCTAL_TEXT.fullmatch(token) if op in ONE_BIT else None
+                if bit is not None and (c := int(bit.group(1), 8)) < IO_BITS:
+                    # a contact or a coil at an I/O bit given in octal, most of a program: what
+                    # `_build` would make of it, without a _Raw and the look-ups on the way there
+                    raws.append((op, c, lineno, text))
+                else:
+                    raws.append(_Raw(lineno, m.start(2) + 1, op, {name: (token, m.start(4) + 1)}, text))
                 return True
         tokens = [] if token is None else [(key.upper() if key else "", token, m.start(4) + 1)]
         if more:
