@@ -11,6 +11,7 @@ from asyncua import ua
 from asyncua.server.address_space import NodeData
 
 from app.publish import standard_nodes
+from tests.collection_paused import collection_paused  # noqa: F401  a fixture
 from tests.opcua_address_space import fill_once
 
 
@@ -24,6 +25,7 @@ def same_node(ours: NodeData, plain: NodeData) -> None:
     assert ours.references == plain.references, ours.nodeid
 
 
+@pytest.mark.usefixtures("collection_paused")
 def test_a_server_gets_from_the_cache_every_node_attribute_and_reference_of_a_plain_fill() -> None:
     """The run's cache file (made by the first start that found none), read as a later start reads
     it, gives a server the nodes of asyncua's plain fill: the same NodeIds, and for each the same
