@@ -176,33 +176,21 @@ def test_symbols_and_messages_load_or_name_their_errors(folder: Path, data: byte
 
 # --- station.toml ------------------------------------------------------------------------------
 
-TOML_KEYS = [
+TOML_KEYS = st.sampled_from([
     "name", "NetPlcLoad", "NetPlcProgram", "Symbols", "HMIload", "NetSyncTime", "Archive", "Messages",
     "keep_days", "Retain", "modbus_server.port", "modbus_server.writable", "modbus_server.host",
     "modbus_server.unit", "modbus_server.enabled", "nodes", "simulators", "operator.users", "unknown",
-]
+])
 TOML_WORDS = st.sampled_from(["true", "1e999", "nan", "-inf", "1.5", '""', '"p.stl"', '"/etc"', '"../x"',
                               '"a\\u0000b"', '[["02000", "02177"]]', '[["9", "1"]]', "[]", "{}",
                               '[{node = 0, endpoint = "tcp://127.0.0.1:1"}]',
                               '[{node = 300, endpoint = "x"}]', '[{node = 0, program = "p.stl"}]',
                               "[" * 2000 + "]" * 2000, '"Пуск"'])
-# a number, a word of TOML or a string, a third each
-TOML_VALUES = (*NUMBER_TEXTS, *[TOML_WORDS] * len(NUMBER_TEXTS),
-               *[any_text(max_size=10).map(json.dumps)] * len(NUMBER_TEXTS))
-TOML_PICKS = st.binary(max_size=16)
-
-
-@st.composite
-def toml_text(draw: st.DrawFn) -> str:
-    """Up to 8 lines `key = value`: two bytes a line pick its key and the kind of its value, then the
-    value is drawn (a list of tuples of a key and a `one_of` took six draws a line, this two)."""
-    picks = draw(TOML_PICKS)
-    return "\n".join(f"{TOML_KEYS[picks[at] * len(TOML_KEYS) // 256]} = "
-                     f"{draw(TOML_VALUES[picks[at + 1] * len(TOML_VALUES) // 256])}"
-                     for at in range(0, len(picks) - 1, 2))
-
-
-TOML_TEXT = toml_text()
+# a number, a word of TOML or a string, a third each (in one one_of, one draw fewer than in two)
+TOML_VALUES = st.one_of(*NUMBER_TEXTS, *[TOML_WORDS] * len(NUMBER_TEXTS),
+                        *[any_text(max_size=10).map(json.dumps)] * len(NUMBER_TEXTS))
+TOML_TEXT = st.lists(st.tuples(TOML_KEYS, TOML_VALUES).map(lambda kv: f"{kv[0]} = {kv[1]}"),
+                     max_size=8).map("\n".join)
 
 
 @FUZZ
@@ -238,8 +226,9 @@ PROPERTY_NAMES = sorted({f for cls in ELEMENT_TYPES.values() for f in cls.__data
 
 
 # the strategies drawn from, made once: hypothesis validates each new one (more time than the draws)
-FORM_NAMES = ["title", "width", "height", "BackColor", "Font", "BackgroundImage", "Nope"]
-NAME_PICKS = st.binary(max_size=8)  # up to 8 names, a byte each (a list of sampled_from: two draws each)
+ELEMENT_KEYS = st.lists(st.sampled_from(PROPERTY_NAMES), max_size=8)
+FORM_KEYS = st.lists(st.sampled_from(["title", "width", "height", "BackColor", "Font", "BackgroundImage",
+                                      "Nope"]), max_size=8)
 ELEMENT_TYPE, ELEMENT_NAME = st.sampled_from([*ELEMENT_TYPES, "Nope"]), any_text(max_size=4)
 DEVICES = st.lists(st.fixed_dictionaries({}, optional={
     k: PROPERTY_VALUES for k in ("Name", "AppMin", "AppMax", "PhyMin", "PhyMax")}), max_size=2)
@@ -249,17 +238,17 @@ ELEMENT_COUNT = st.integers(0, 3)
 
 @st.composite
 def form_documents(draw: st.DrawFn) -> Any:
-    def props(names: list[str]) -> dict[str, Any]:
-        keys = [names[b * len(names) // 256] for b in draw(NAME_PICKS)]
+    def props(names: st.SearchStrategy[list[str]]) -> dict[str, Any]:
+        keys = draw(names)
         return {k: draw(PROPERTY_VALUES) for k in keys}
 
     elements = []
     for _ in range(draw(ELEMENT_COUNT)):
         el = {"type": draw(ELEMENT_TYPE), "Name": draw(ELEMENT_NAME), "x": 0, "y": 0, "w": 10, "h": 10}
-        el.update(props(PROPERTY_NAMES))
+        el.update(props(ELEMENT_KEYS))
         elements.append(el)
     doc: dict[str, Any] = {
-        "form": {"width": 100, "height": 100, **props(FORM_NAMES)},
+        "form": {"width": 100, "height": 100, **props(FORM_KEYS)},
         "devices": draw(DEVICES),
         "images": draw(IMAGES),
         "elements": elements,

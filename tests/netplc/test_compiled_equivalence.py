@@ -242,16 +242,18 @@ FORCEABLE = {"bit": ([*INPUTS, *COILS, *TIMERS, *COUNTERS, 0o3773], 2),
              "byte": ([*DATA, 0o2010], 256)}
 
 
-def force(data: bytes) -> tuple[str, int, int]:
-    """A force (kind, address, value) of four bytes: the kind (a third each), the address of its
-    kind, and a value of its kind (bit, word or byte) from the last two: one draw, not four (a
-    one_of of tuples of sampled_from and integers)."""
-    kind = ("bit", "word", "byte")[data[0] * 3 // 256]
+def force(drawn: tuple[bytes, int]) -> tuple[str, int, int]:
+    """A force (kind, address, value): two bytes pick the kind (a third each) and an address of its
+    kind, an integer (hypothesis favours 0, 65535 and the like) its value of that kind (bit, word or
+    byte). Three draws, not five (a one_of of tuples of just, sampled_from and integers)."""
+    (kind_byte, address_byte), value = drawn
+    kind = ("bit", "word", "byte")[kind_byte * 3 // 256]
     addresses, values = FORCEABLE[kind]
-    return kind, addresses[data[1] * len(addresses) // 256], int.from_bytes(data[2:], "little") % values
+    return kind, addresses[address_byte * len(addresses) // 256], value % values
 
 
-FORCES = st.lists(st.binary(min_size=4, max_size=4).map(force), min_size=1, max_size=4).map(tuple)
+FORCES = st.lists(st.tuples(st.binary(min_size=2, max_size=2), st.integers(0, 65535)).map(force),
+                  min_size=1, max_size=4).map(tuple)
 
 
 @settings(max_examples=100, deadline=None, suppress_health_check=[HealthCheck.too_slow])
