@@ -427,7 +427,7 @@ def test_main_check_and_the_headless_start_print_named_problems_not_tracebacks(
     assert check.stdout.startswith(expected), check.stdout
     station = copy_demo(tmp_path / "start", "en")
     shown = zero.plant(station)
-    start = run_in_process(cli.main, ["--no-gui", station, "--duration", "0.2", "--status-every", "0.1"],
+    start = run_in_process(cli.main, ["--no-gui", station, "--duration", "0.5", "--status-every", "0.2"],
                            capsys)
     assert start.returncode == 0 and "Traceback" not in start.stderr, start.stderr  # runs without the form
     assert f"form problem: {shown}" in start.stdout, start.stdout
