@@ -52,33 +52,35 @@ NUMBER_TEXTS = (st.integers(-3, 70000).map(str), st.integers(-(2**70), 2**70).ma
                 st.integers(1, 6000).map(lambda n: "9" * n))
 PUNCTUATION = ["", " ", "\t", ",", ";", ":", "=", "$", "[", "]", ".", "#", "//", '"', "\\", "\x00", "\ufeff",
                "²", "Пуск", "\r", "\n"]
-# a number or any text, alike: one one_of of the four kinds of numbers and four times the text is
-# one draw fewer than a one_of of two one_ofs
-MADE_WORDS = st.one_of(*NUMBER_TEXTS, *[any_text(max_size=8)] * len(NUMBER_TEXTS))
+# a number or any text, alike: the four kinds of numbers and four times the text, one picked by
+# `rows` for a field
+MADE_WORDS = (*NUMBER_TEXTS, *[any_text(max_size=8)] * len(NUMBER_TEXTS))
 
 
 @functools.cache
-def exactly(n: int, strategy: st.SearchStrategy[Any] | None = None) -> st.SearchStrategy[Any]:
-    """`n` bytes, or a list of `n` values of `strategy`: made once (hypothesis validates each new one)."""
-    if strategy is None:
-        return st.binary(min_size=n, max_size=n)
-    return st.lists(strategy, min_size=n, max_size=n)
+def exactly(n: int) -> st.SearchStrategy[bytes]:
+    """`n` bytes: made once (hypothesis validates each new strategy)."""
+    return st.binary(min_size=n, max_size=n)
 
 
-def rows(fixed: list[str], made: st.SearchStrategy[str], made_share: Fraction, most_rows: int,
+def rows(fixed: list[str], made: tuple[st.SearchStrategy[str], ...], made_share: Fraction, most_rows: int,
          most_fields: int, sep: str) -> st.SearchStrategy[list[str]]:
-    """Up to `most_rows` rows of up to `most_fields` fields joined by `sep`; a field is a value of `made`
-    at `made_share`, else one of `fixed`. Drawn as a byte a row (its number of fields), a byte a field
-    (which), then the made values as one list: a list of lists of `one_of`s took three draws a field
-    and more, for the same texts (the draws were the tests' time)."""
+    """Up to `most_rows` rows of up to `most_fields` fields joined by `sep`; a field is a value of one
+    of `made` (each alike) at `made_share`, else one of `fixed`. Drawn as a byte a row (its number of
+    fields), a byte a field (which, and of which of `made`), then each made value: a list of lists of
+    `one_of`s took three draws a field and more, a list of `one_of`s of the made values two draws
+    and two choices a value more than this, for the same texts (the draws were the tests' time)."""
     cut = round(256 * made_share)
     counts = st.binary(max_size=most_rows)
 
+    def field(draw: st.DrawFn, b: int) -> str:
+        if b < cut:
+            return draw(made[b * len(made) // cut])
+        return fixed[(b - cut) * len(fixed) // (256 - cut)]
+
     def draw_rows(draw: st.DrawFn) -> list[str]:
         sizes = [b % (most_fields + 1) for b in draw(counts)]
-        picks = draw(exactly(sum(sizes)))
-        values = iter(draw(exactly(sum(b < cut for b in picks), made)))
-        fields = [next(values) if b < cut else fixed[(b - cut) * len(fixed) // (256 - cut)] for b in picks]
+        fields = [field(draw, b) for b in draw(exactly(sum(sizes)))]
         ends = list(itertools.accumulate(sizes))
         return [sep.join(fields[end - size:end]) for size, end in zip(sizes, ends)]
     return st.composite(draw_rows)()
@@ -86,7 +88,13 @@ def rows(fixed: list[str], made: st.SearchStrategy[str], made_share: Fraction, m
 
 @pytest.fixture(scope="module")
 def folder(tmp_path_factory: pytest.TempPathFactory) -> Path:
-    return tmp_path_factory.mktemp("fuzz")
+    """The files the examples read beside the one they write: written once (no example changes them)."""
+    folder = tmp_path_factory.mktemp("fuzz")
+    (folder / "ok_symbols.csv").write_text("A,02000\nW,04000\n", encoding="utf-8")
+    (folder / "x.png").write_bytes(b"not really a picture")
+    (folder / "station").mkdir()
+    (folder / "station" / "p.stl").write_text("JMP 0\n", encoding="utf-8")
+    return folder
 
 
 def encoded(text: str, how: str) -> bytes:
@@ -141,7 +149,6 @@ def test_program_loads_or_names_its_errors(folder: Path, data: bytes, symbols: b
     path = folder / "p.stl"
     path.write_bytes(data)
     sym = folder / "ok_symbols.csv"
-    sym.write_text("A,02000\nW,04000\n", encoding="utf-8")
     loaded(path, lambda p: load_program(p, sym if symbols else None), ProgramError,
            lambda e: [str(d) for d in e.errors])
 
@@ -151,7 +158,7 @@ def test_program_loads_or_names_its_errors(folder: Path, data: bytes, symbols: b
 CSV_WORDS = ["name", "A", "$02000", "04000", "8", "0", "1", "3", "text"]
 LONG_FIELDS = st.integers(0, 200_000).map(lambda n: "x" * n if n > 131_000 else "x")
 # a field: punctuation, CSV words, a number, any text or a field past the line's limit, a fifth each
-CSV_TEXT = rows([*PUNCTUATION, *CSV_WORDS], st.one_of(MADE_WORDS, LONG_FIELDS), Fraction(3, 5), 8, 5,
+CSV_TEXT = rows([*PUNCTUATION, *CSV_WORDS], (*MADE_WORDS, LONG_FIELDS), Fraction(3, 5), 8, 5,
                 ",").map("\n".join)
 
 
@@ -193,8 +200,6 @@ TOML_TEXT = st.lists(st.tuples(TOML_KEYS, TOML_VALUES).map(lambda kv: f"{kv[0]} 
               b'modbus_server.writable = [["02000", "02177"], ["04000", "02000"], "x"]')
 def test_station_loads_or_names_its_errors(folder: Path, data: bytes) -> None:
     station = folder / "station"
-    station.mkdir(exist_ok=True)
-    (station / "p.stl").write_text("JMP 0\n", encoding="utf-8")
     path = station / "station.toml"
     path.write_bytes(data)
     _, problems = read_station(station)
@@ -255,22 +260,34 @@ def form_documents(draw: st.DrawFn) -> Any:
 # as is, nested too deeply, with a number of 5000 digits, or any bytes instead
 FORM_TEXT = st.one_of(form_documents(), JSON_VALUES).map(lambda doc: json.dumps(doc, ensure_ascii=False))
 FORM_MODES = st.sampled_from(["json", "raw", "deep", "digits"])
+
+
+@st.composite
+def form_files(draw: st.DrawFn) -> bytes:
+    """What a form's file holds, in one of FORM_MODES: only what is written is drawn (a text, its
+    encoding and bytes drawn for every example, two thrown away, were a third of the draws)."""
+    mode = draw(FORM_MODES)
+    if mode == "raw":
+        return draw(RAW)
+    text = draw(FORM_TEXT)
+    if mode == "deep":
+        text = '{"elements": ' + "[" * 50_000 + "]" * 50_000 + ', "form": ' + text + "}"
+    elif mode == "digits":
+        text = text.replace("0", "1" * 5000, 1)
+    return encoded(text, draw(ENCODINGS))
+
+
 # an element that loads, past the form's edge: the examples build one only now and then (1 in 200)
 BUILT = json.dumps({"form": {"width": 100, "height": 100}, "elements": [
     {"type": "StaticText", "Name": "t", "x": 0, "y": 0, "w": 200, "h": 10, "Text": "x"}]})
 
 
 @FUZZ
-@given(text=FORM_TEXT, how=ENCODINGS, raw=RAW, mode=FORM_MODES)
-@example(text=BUILT, how="utf-8", raw=b"", mode="json")
-def test_form_loads_or_names_its_errors(folder: Path, text: str, how: str, raw: bytes, mode: str) -> None:
+@given(data=form_files())
+@example(data=BUILT.encode())
+def test_form_loads_or_names_its_errors(folder: Path, data: bytes) -> None:
     path = folder / "f.hmi"
-    (folder / "x.png").write_bytes(b"not really a picture")
-    if mode == "deep":
-        text = '{"elements": ' + "[" * 50_000 + "]" * 50_000 + ', "form": ' + text + "}"
-    elif mode == "digits":
-        text = text.replace("0", "1" * 5000, 1)
-    path.write_bytes(raw if mode == "raw" else encoded(text, how))
+    path.write_bytes(data)
     form = loaded(path, lambda p: load_form(p, {"A": 0o2000}), FormError, lambda e: e.problems)
     assert form is None or all(p.startswith(str(path)) for p in form.problems)
 
@@ -281,7 +298,7 @@ TAG_WORDS = ["name", "address", "type", "unit", "h", "hh", "ll", "word", "bit", 
              "040005", "A", "yes", "1e309", "nan", "-0", "Уровень", "°C"]
 # a field: as in the CSV files, or a word of tags.csv: a sixth each
 TAG_HEADER = "name,address,type,unit,app_min,app_max,phy_min,phy_max,h,hh,alarm_when"
-TAG_TEXT = rows([*PUNCTUATION, *CSV_WORDS, *TAG_WORDS], st.one_of(MADE_WORDS, LONG_FIELDS), Fraction(1, 2),
+TAG_TEXT = rows([*PUNCTUATION, *CSV_WORDS, *TAG_WORDS], (*MADE_WORDS, LONG_FIELDS), Fraction(1, 2),
                 8, 8, ",").map(lambda lines: "\n".join([TAG_HEADER, *lines]))
 
 

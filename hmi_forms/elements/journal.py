@@ -20,13 +20,13 @@ KINDS = ("message", "alarm", "operator", "system", "data")
 EVENT_KINDS = ("message", "alarm", "operator", "system")
 
 
+_KIND = p.choice(*KINDS)
+
+
 def kinds(value: Any, ctx: p.Context) -> tuple[str, ...]:
     if not isinstance(value, list) or not value:
-        raise p.PropError(f"expected a list of record kinds from {', '.join(KINDS)}")
-    for v in value:
-        if v not in KINDS:
-            raise p.PropError(f"{v!r} is not a record kind ({', '.join(KINDS)})")
-    return tuple(value)
+        raise p.PropError("form record kinds", options=", ".join(KINDS))
+    return tuple(_KIND(v, ctx) for v in value)
 
 
 def optional_int(lo: int, hi: int) -> p.Parser:

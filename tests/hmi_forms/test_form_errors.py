@@ -54,6 +54,17 @@ def test_bad_property_values(tmp_path, change: dict[str, Any], expected: str) ->
     assert len(found) == 1 and found[0].startswith('element "Пуск": ' + expected), found
 
 
+@pytest.mark.parametrize(("kinds", "expected"), [
+    (None, "expected a list of record kinds from message, alarm, operator, system, data"),
+    (["alarm", "log"], '"log" is not one of message, alarm, operator, system, data'),
+])
+def test_a_journal_names_bad_record_kinds(tmp_path, kinds: Any, expected: str) -> None:
+    """Found by tests/test_loader_fuzz.py: the loader ended in a KeyError (a phrase of no words)."""
+    journal = {"type": "MessageJournal", "Name": "j", "x": 10, "y": 10, "w": 100, "h": 40, "Kinds": kinds}
+    found = problems(tmp_path, [journal])
+    assert len(found) == 1 and found[0].startswith(f'element "j": Kinds: {expected}'), found
+
+
 def test_missing_required_properties_and_duplicate_names(tmp_path) -> None:
     found = problems(tmp_path, [
         {"type": "DiscreteBase", "Name": "A", "x": 0, "y": 0, "w": 10, "h": 10},
