@@ -75,12 +75,11 @@ def start(program: Program, inline: dict[int, list[str]], done: Callable[[CodeTy
     from a thread when it is there, `done(None)` (after logging why) when the child failed. The
     thread is not a daemon: a station that stops meanwhile still gets its code into the cache for
     the next start."""
-    rows = [(i.op, i.c, i.n, i.s, i.d, i.r, i.target) for i in program.instrs]
-    payload = marshal.dumps((program.source, rows, inline))
 
     def compile_after() -> None:
         after.wait(AFTER_S)
-        done(child_code(payload, program.source))
+        rows = [(i.op, i.c, i.n, i.s, i.d, i.r, i.target) for i in program.instrs]
+        done(child_code(marshal.dumps((program.source, rows, inline)), program.source))
 
     threading.Thread(target=compile_after, name="netplc-compile", daemon=False).start()
 

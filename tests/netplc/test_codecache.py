@@ -90,3 +90,16 @@ def test_a_cache_folder_that_cannot_be_written_only_costs_the_compile(tmp_path: 
     reference = run(Engine(parse(TEXT), clock=FakeClock(), wallclock=lambda: 0.0, compiled=False))
     assert run(engine(TEXT, blocked / "cache")) == reference
     assert CodeCache(blocked / "cache").load(b"\0" * 32) is None
+
+
+def test_the_key_is_the_same_for_a_parsed_program_and_one_from_the_parse_cache(tmp_path: Path) -> None:
+    from netplc.parsecache import ParseCache, parse_file_cached
+
+    (tmp_path / "p.stl").write_text(TEXT, encoding="utf-8")
+    cache = ParseCache(tmp_path / "parsed")
+    parsed = parse_file_cached(tmp_path / "p.stl", {}, cache)
+    loaded = parse_file_cached(tmp_path / "p.stl", {}, cache)  # unmarshalled: shares equal objects
+    assert parsed is not loaded and parsed.instrs == loaded.instrs
+    eng = Engine(parsed, clock=FakeClock())
+    inline, _ = compiler.fon_code(eng)
+    assert compiler.program_key(parsed, inline) == compiler.program_key(loaded, inline)
