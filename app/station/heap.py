@@ -9,8 +9,9 @@ median (bench/hmi.py); with OPC UA's 400,000 objects a headless station's collec
 gc.freeze() puts them in the permanent generation, which no collection walks; whatever is made
 afterwards is collected as before, and what the start built is still freed by its reference counts
 when it goes. What is lost: a reference cycle among those objects that dies before the process ends
-stays in memory (a simulated node restarted from the demo's menu leaves its old one's cycles), so
-this is done once per process, after the start of the station it runs.
+stays in memory (a simulated node restarted from the demo's menu leaves its old one's cycles, a
+remote console a form the station changed), so this is done once per process: after the start of
+the station it runs, or once a remote console shows its station's forms.
 """
 
 from __future__ import annotations

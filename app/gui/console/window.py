@@ -66,6 +66,7 @@ from app.scada.readings import Readings
 from app.scada.tag import Tag, TagType
 from app.scada.trends import TrendBook
 from app.scada.words import words as words_of
+from app.station import heap
 from hmi_forms.elements.base import Writer
 from hmi_forms.elements.reads import operands
 from hmi_forms.elements.target import CommandTarget
@@ -412,5 +413,6 @@ def run_console(url: str, user: str | None = None, partner: str = "") -> int:
     if window is None:
         return 1
     window.show()
+    heap.settle()  # the client, the forms and their widgets live until the console ends
     _quit_on_signals(app)  # Ctrl+C or SIGTERM log out of the station before the console ends
     return app.exec()
