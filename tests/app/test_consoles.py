@@ -357,6 +357,7 @@ def test_a_silence_the_station_took_stops_the_consoles_sound_at_once(
     console = attach(station, "operator")
     summary, horn = console.summary, console.source.station_alarms.horn
     node = station.runtime.simulators[0].engine
+    node.stop()  # its program moves the level 10 a scan (a triangle wave): held, no transition comes later
     node.write_word(0o4010, 3950)  # LEVEL 96 %: LEVEL.HH, priority 2, sounds until silenced
     try:
         qtbot.waitUntil(lambda: horn.sounding, timeout=WAIT)
@@ -371,6 +372,7 @@ def test_a_silence_the_station_took_stops_the_consoles_sound_at_once(
         assert not summary.annunciator.sounding and not horn.sounding
     finally:
         node.write_word(0o4010, 0)
+        node.start()
 
 
 def test_the_console_command_wants_an_opc_tcp_url() -> None:
