@@ -30,7 +30,7 @@ from types import CodeType
 
 from netplc.backend import Backend, ScanHost
 from netplc.codecache import CodeCache
-from netplc.compiler import backend_of, compile_code, compile_program, fon_code, program_key
+from netplc.compiler import backend_of, code_rows, compile_code, compile_program, fon_code, program_key
 from netplc.program import Instr, Program
 
 logger = logging.getLogger(__name__)
@@ -78,8 +78,7 @@ def start(program: Program, inline: dict[int, list[str]], done: Callable[[CodeTy
 
     def compile_after() -> None:
         after.wait(AFTER_S)
-        rows = [(i.op, i.c, i.n, i.s, i.d, i.r, i.target) for i in program.instrs]
-        done(child_code(marshal.dumps((program.source, rows, inline)), program.source))
+        done(child_code(marshal.dumps((program.source, code_rows(program), inline)), program.source))
 
     threading.Thread(target=compile_after, name="netplc-compile", daemon=False).start()
 

@@ -302,11 +302,17 @@ def _compiler_version() -> bytes:
     return cache_key(Path(__file__).read_bytes(), Path(timers.__file__ or "").read_bytes())
 
 
+def code_rows(program: Program) -> list[tuple]:
+    """The fields of each instruction that `generate_source` reads (op, c, n, s, d, r, target): what
+    the cache key covers and what a child process compiles from (netplc/compile_behind.py)."""
+    return [(i.op, i.c, i.n, i.s, i.d, i.r, i.target) for i in program.instrs]
+
+
 def program_key(program: Program, inline: dict[int, list[str]]) -> bytes:
     """The cache key of the code `generate_source` makes from `program` with these in-line FONs."""
     # marshal's version 2 writes no back-references, so equal instructions give equal bytes however
     # they were made (a repr of them cost 13 ms a start for the 8 K-word program, this 3)
-    instrs = marshal.dumps([(i.op, i.c, i.n, i.s, i.d, i.r, i.target) for i in program.instrs], 2)
+    instrs = marshal.dumps(code_rows(program), 2)
     return cache_key(_compiler_version(), f"{_CHUNK_CONSTS},{_MAX_DEPTH},{_MAX_TERMS}", program.source,
                      instrs, repr(sorted(inline.items())))
 
